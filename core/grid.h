@@ -1,0 +1,48 @@
+/*
+ * grid.h - placement of a light propagation volume in the world.
+ *
+ * Cells are cubes of side cell_size. A grid over bounds [min, max] with dims
+ * cells per axis uses cell_size = max_i (max_i - min_i) / max(dims_i - 1, 1),
+ * so every axis keeps at least half a cell of margin on each side, and is
+ * centred on the bounds. Degenerate (zero or non-finite) extents give
+ * cell_size 1. Cell (i, j, k) spans origin + [i, i+1) * cell_size, its centre
+ * is at origin + (i + 0.5) * cell_size. The geometry volume (GV) has
+ * dims + 1 points per axis, point (i, j, k) at origin + (i, j, k) * cell_size:
+ * on the LPV's cell corners (the paper's half-cell shift).
+ */
+#ifndef LPV_GRID_H
+#define LPV_GRID_H
+
+#include <stddef.h>
+
+typedef struct lpv_grid {
+    int dims[3];
+    float origin[3];  /* world position of the lower corner, m */
+    float cell_size;  /* m */
+} lpv_grid;
+
+/* Places a grid of dims cells over [bmin, bmax]. Returns 0, or -1 when a
+ * dimension is outside 1..LPV_MAX_GRID_DIM. */
+int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], lpv_grid *out);
+
+size_t lpv_grid_cell_count(const lpv_grid *g);
+size_t lpv_grid_gv_count(const lpv_grid *g); /* (dims+1) product */
+
+static inline size_t lpv_grid_index(const lpv_grid *g, int x, int y, int z)
+{
+    return (size_t)x + (size_t)g->dims[0] * ((size_t)y + (size_t)g->dims[1] * (size_t)z);
+}
+
+static inline size_t lpv_grid_gv_index(const lpv_grid *g, int x, int y, int z)
+{
+    return (size_t)x + (size_t)(g->dims[0] + 1) * ((size_t)y + (size_t)(g->dims[1] + 1) * (size_t)z);
+}
+
+/* Cell containing p (floor). Returns 1 if inside the grid, 0 otherwise
+ * (including non-finite p). */
+int lpv_grid_cell_of(const lpv_grid *g, const float p[3], int cell[3]);
+
+/* Nearest GV point to p (round). Returns 1 if inside 0..dims, 0 otherwise. */
+int lpv_grid_gv_point_of(const lpv_grid *g, const float p[3], int point[3]);
+
+#endif /* LPV_GRID_H */

@@ -1,0 +1,60 @@
+/*
+ * oracle.h - the plain-C reference implementation of the LPV pipeline.
+ *
+ * Straightforward loops, no GL, sharing only shaders/lpv_shared.h with the
+ * shaders. The tests feed the same VPLs and surfels (read back from the GPU)
+ * to both and compare grids. docs/propagation.md states the algorithm; every
+ * function here follows it literally so the GLSL can be checked against it.
+ */
+#ifndef LPV_ORACLE_H
+#define LPV_ORACLE_H
+
+#include <stddef.h>
+#include "lpv_shared.h"
+#include "grid.h"
+
+typedef struct LpvCell lpv_cell;
+typedef struct LpvVpl lpv_vpl;
+typedef struct LpvSurfel lpv_surfel;
+
+/* Adds each valid VPL (position.w != 0, finite, unit-able normal) to the cell
+ * containing position + 0.5 * cell_size * normal, as lobe(normal) * flux / pi
+ * per channel, in array order. VPLs landing outside the grid are dropped.
+ * Returns the number injected. */
+size_t lpv_oracle_inject_vpls(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells);
+
+/* Adds each valid surfel (area > 0, finite, unit-able normal) to its nearest
+ * GV point as (area / cell_size^2) * lobe(normal). gv has lpv_grid_gv_count
+ * entries. Returns the number injected. */
+size_t lpv_oracle_inject_surfels(const lpv_grid *g, const lpv_surfel *surfels, size_t n, vec4 *gv);
+
+/* Merges one buffer's GV into the total: per GV point, the total keeps the
+ * coefficient vector with the larger DC term, so a surface seen by two buffers
+ * is not counted twice. */
+void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, vec4 *dst);
+
+/* Per cell and direction (order +x -x +y -y +z -z, the direction light
+ * travels), the transmittance 1 - clamp(B(-d), 0, 1) of the face through which
+ * light from the neighbour at cell - d enters, with B the GV averaged over the
+ * face's four corners. t has 6 * cell_count floats. */
+void lpv_oracle_transmittance(const lpv_grid *g, const vec4 *gv, float *t);
+
+/* One propagation step, flux-limited (docs/propagation.md): in -> out (out is
+ * overwritten). t NULL means no occlusion. */
+void lpv_oracle_propagate_step(const lpv_grid *g, const lpv_cell *in, const float *t, lpv_cell *out);
+
+/* The whole propagation: acc = injected + sum over iterations of each step's
+ * output; occlusion (t non-NULL) is skipped on the first step. Allocates its
+ * own ping-pong buffers. Returns 0, or -1 on allocation failure. */
+int lpv_oracle_propagate(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
+                         lpv_cell *acc);
+
+/* Irradiance (W/m^2, rgb) at p for a surface with unit normal n:
+ * max(0, dot(c(p), lobe(-n)) / cell_size^2) with c trilinearly interpolated
+ * between cell centres, clamped at the grid's edge. */
+void lpv_oracle_irradiance(const lpv_grid *g, const lpv_cell *acc, const float p[3], const float n[3], float rgb[3]);
+
+/* Total flux (W) of a grid per channel: sum of c0 * sqrt(4 pi). */
+void lpv_oracle_total_flux(const lpv_grid *g, const lpv_cell *cells, double flux[3]);
+
+#endif /* LPV_ORACLE_H */

@@ -1,0 +1,119 @@
+/*
+ * scene.h - the scene model every part of lpvd works on.
+ *
+ * A scene is flattened at load time: every mesh primitive instanced by a node
+ * becomes a draw over world-space vertices, so the GPU passes and the C oracle
+ * never walk a hierarchy. Units: metres; light intensities are radiometric
+ * (W/sr for point and spot lights, W/m^2 for directional lights) and emission
+ * is radiance in W/(m^2 sr). Loaders convert from glTF's photometric units
+ * (candela, lux, nits) with 683 lm/W; see docs/units.md.
+ */
+#ifndef LPV_SCENE_H
+#define LPV_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define LPV_NAME_MAX 64
+#define LPV_LUMENS_PER_WATT 683.0f /* photometric -> radiometric, docs/units.md */
+
+typedef enum lpv_light_type {
+    LPV_LIGHT_DIRECTIONAL = 0,
+    LPV_LIGHT_POINT = 1,
+    LPV_LIGHT_SPOT = 2,
+} lpv_light_type;
+
+typedef struct lpv_light {
+    lpv_light_type type;
+    char name[LPV_NAME_MAX];
+    float color[3];     /* linear RGB factor, multiplies intensity */
+    float intensity;    /* W/sr (point, spot) or W/m^2 (directional) */
+    float range;        /* m; 0 = unlimited (glTF's smooth window when > 0) */
+    float inner_cone;   /* rad, spot only */
+    float outer_cone;   /* rad, spot only */
+    float position[3];  /* world, m (unused for directional) */
+    float direction[3]; /* world, unit: the direction the light travels */
+} lpv_light;
+
+typedef struct lpv_camera {
+    char name[LPV_NAME_MAX];
+    int orthographic;   /* 0 perspective, 1 orthographic */
+    float yfov;         /* rad, perspective */
+    float aspect;       /* 0 = use the image's aspect */
+    float znear, zfar;  /* m; zfar 0 = infinite */
+    float xmag, ymag;   /* orthographic half extents, m */
+    float eye[3];       /* world position */
+    float forward[3];   /* unit view direction (glTF camera -Z) */
+    float up[3];        /* unit up (glTF camera +Y) */
+} lpv_camera;
+
+typedef struct lpv_texture {
+    int width, height;
+    uint8_t *rgba8; /* width*height*4 bytes, sRGB-encoded base colour */
+} lpv_texture;
+
+typedef struct lpv_material {
+    char name[LPV_NAME_MAX];
+    float base_color[4];    /* linear RGBA factor */
+    int base_color_texture; /* index into textures, -1 = none */
+    float emission[3];      /* radiance, W/(m^2 sr) (factor x strength / 683) */
+    float metallic;
+    float roughness;
+    int double_sided;
+} lpv_material;
+
+typedef struct lpv_vertex {
+    float position[3]; /* world, m */
+    float normal[3];   /* world, unit (zero if the file had a degenerate one) */
+    float uv[2];
+} lpv_vertex;
+
+/* A run of triangles (3 indices each) sharing one material. */
+typedef struct lpv_draw {
+    uint32_t first_index;
+    uint32_t index_count;
+    int material; /* index into materials */
+} lpv_draw;
+
+typedef struct lpv_scene {
+    lpv_vertex *vertices;
+    uint32_t vertex_count;
+    uint32_t *indices;
+    uint32_t index_count;
+    lpv_draw *draws;
+    uint32_t draw_count;
+    lpv_material *materials;
+    uint32_t material_count;
+    lpv_texture *textures;
+    uint32_t texture_count;
+    lpv_light *lights;
+    uint32_t light_count;
+    lpv_camera *cameras;
+    uint32_t camera_count;
+    float bounds_min[3], bounds_max[3]; /* of all vertices */
+    int default_light_added;            /* 1 when lpv_scene_ensure_light added one */
+    char source[256];                   /* file path, or "built-in:cornell-box" */
+} lpv_scene;
+
+/* Frees everything the scene owns and zeroes it. Safe on a zeroed scene. */
+void lpv_scene_free(lpv_scene *scene);
+
+/* Recomputes bounds_min/max from the vertices. */
+void lpv_scene_compute_bounds(lpv_scene *scene);
+
+/* Number of materials with non-zero emission that some draw uses. */
+uint32_t lpv_scene_emissive_draw_count(const lpv_scene *scene);
+
+/* If the scene has no punctual light and no emissive surface, adds the
+ * documented default light (docs/units.md: a point light 10% below the top of
+ * the bounds, centred, giving 1 W/m^2 straight below it at the bounds' floor)
+ * and sets default_light_added. Returns 0, or -1 on allocation failure. */
+int lpv_scene_ensure_light(lpv_scene *scene);
+
+/* The built-in scene: the Cornell box (McGuire & Cardenas 2011 data, public
+ * domain) with its emissive ceiling quad, a spot light under the ceiling and a
+ * camera, in the same units as ../shared/scenes/cornell-box.glb after loading.
+ * Returns 0, or -1 on allocation failure. */
+int lpv_scene_builtin_cornell(lpv_scene *scene);
+
+#endif /* LPV_SCENE_H */

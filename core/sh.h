@@ -1,0 +1,23 @@
+/*
+ * sh.h - two-band real spherical harmonics (4 coefficients), the basis and
+ * lobe conventions of shaders/lpv_shared.h. Plain C, no GL.
+ */
+#ifndef LPV_SH_H
+#define LPV_SH_H
+
+/* Basis functions at unit direction d: out = (C0, C1 d.y, C1 d.z, C1 d.x). */
+void lpv_sh_basis(const float d[3], float out[4]);
+
+/* Coefficients of the clamped cosine max(0, <n, w>) around unit n. */
+void lpv_sh_cosine_lobe(const float n[3], float out[4]);
+
+/* Evaluates coefficients c at unit direction d. */
+float lpv_sh_eval(const float c[4], const float d[3]);
+
+/* Integral over the sphere of the function with coefficients c: c0 sqrt(4 pi). */
+float lpv_sh_integral(const float c[4]);
+
+/* Integral over the sphere of the product of two functions: dot(a, b). */
+float lpv_sh_dot(const float a[4], const float b[4]);
+
+#endif /* LPV_SH_H */

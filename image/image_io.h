@@ -1,0 +1,36 @@
+/*
+ * image_io.h - reading and writing image files through OpenImageIO.
+ *
+ * Pixels are tightly packed rows, top row first. 8-bit data is written as is
+ * (the caller has already encoded sRGB); float data is linear and is written
+ * as 32-bit float (EXR). The format follows the file extension.
+ */
+#ifndef LPV_IMAGE_IO_H
+#define LPV_IMAGE_IO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* channels 1..4. Returns 0, or -1 with a message naming the file in err. */
+int lpv_image_write_u8(const char *path, int width, int height, int channels, const uint8_t *pixels,
+                       char *err, size_t err_size);
+int lpv_image_write_f32(const char *path, int width, int height, int channels, const float *pixels,
+                        char *err, size_t err_size);
+
+/* Reads any format OpenImageIO knows as float, converting to `channels`
+ * channels (missing ones 0, alpha 1). *pixels is malloc'd; free() it. */
+int lpv_image_read_f32(const char *path, int channels, int *width, int *height, float **pixels,
+                       char *err, size_t err_size);
+
+/* 1 if the path's extension is one lpv writes as float (".exr"), else 0. */
+int lpv_image_is_float_format(const char *path);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LPV_IMAGE_IO_H */

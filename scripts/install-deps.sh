@@ -1,0 +1,37 @@
+#!/bin/sh
+# Installs every Debian 12 package lpvd needs to build, run, test and benchmark.
+# Run as root, or as a user with sudo. Safe to run repeatedly.
+set -eu
+
+PACKAGES="
+  build-essential cmake pkg-config clang libclang-rt-14-dev
+  libegl-dev libgl-dev mesa-common-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
+  libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev
+  libopenimageio-dev
+  libcglm-dev libuv1-dev libzstd-dev libjansson-dev libembree-dev
+  libcmocka-dev
+  python3 gnuplot-nox
+"
+
+if [ "$(id -u)" -eq 0 ]; then
+  SUDO=""
+elif command -v sudo >/dev/null 2>&1; then
+  SUDO="sudo"
+else
+  echo "install-deps: run as root or install sudo" >&2
+  exit 1
+fi
+
+missing=""
+for p in $PACKAGES; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+
+if [ -n "$missing" ]; then
+  echo "install-deps: installing:$missing"
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -q
+  # shellcheck disable=SC2086
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends $missing
+else
+  echo "install-deps: all packages present"
+fi

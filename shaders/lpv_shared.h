@@ -1,0 +1,115 @@
+/*
+ * lpv_shared.h - the one header of constants and memory layouts shared by the
+ * C code (core/, gpu/) and every GLSL shader (gpu/shader.c pastes it after the
+ * #version line and a "#define LPV_GLSL 1").
+ *
+ * Keep to the subset both languages accept: #define with float literals that
+ * carry an 'f' suffix, and structs whose members are vec4 (a 16-byte aligned
+ * float[4] in C through cglm, a vec4 in GLSL std430/std140). Everything here is
+ * a fact the two sides must agree on; change it in one place only.
+ *
+ * Units (see docs/units.md): positions in metres, flux in W, intensity in W/sr,
+ * irradiance in W/m^2, radiance in W/(m^2 sr).
+ */
+#ifndef LPV_SHARED_H
+#define LPV_SHARED_H
+
+#ifndef LPV_GLSL
+#include <cglm/types.h>
+#endif
+
+/* ---- Spherical harmonics: 2 bands, 4 coefficients per colour channel ------
+ * Coefficient order in a vec4: (Y00, Y1-1, Y10, Y11) = (1, y, z, x) shape.
+ * The basis is the real SH *without* the Condon-Shortley phase:
+ *   Y00 = C0, Y1-1 = C1*y, Y10 = C1*z, Y11 = C1*x.
+ * Used identically in C and GLSL, so the sign choice cannot drift. */
+#define LPV_SH_C0 0.28209479177387814f /* 1 / (2 sqrt(pi)) */
+#define LPV_SH_C1 0.48860251190291992f /* sqrt(3 / (4 pi)) */
+
+/* SH projection of the clamped cosine max(0, <n, w>) around a unit n:
+ * (LOBE0, LOBE1*n.y, LOBE1*n.z, LOBE1*n.x); it integrates to pi over the sphere. */
+#define LPV_SH_LOBE0 0.88622692545275801f /* sqrt(pi) / 2 */
+#define LPV_SH_LOBE1 1.02332670794648849f /* sqrt(pi / 3) */
+
+#define LPV_PI 3.14159265358979324f
+
+/* ---- Propagation (cascaded-LPV paper section 3.3, see docs/propagation.md) ---
+ * Source cell at the origin, destination at +d, cell size 1. The shared face
+ * subtends 2 pi / 3 sr; rays through it leave the destination through its far
+ * face and its four side faces.
+ *   far face:  4 asin(1/10)                = 0.4006696846 sr
+ *   side face: (2 pi / 3 - far) / 4         = 0.4234313544 sr
+ * (lpv-notes.md prints 0.4234413544 for the side face; that value breaks the
+ * 30 faces' partition of the sphere by 4e-5 sr per step. tests/test_sh.c
+ * integrates both faces numerically.) */
+#define LPV_FACE_SOLID_ANGLE_FAR  0.40066968464623920f
+#define LPV_FACE_SOLID_ANGLE_SIDE 0.42343135443673900f
+
+/* One propagation step from a source cell with coefficients c (one channel) to
+ * its neighbour along axis k with sign s is the sparse 4x4 matrix
+ *   out0 = A c0 + s B ck,   outk = s E c0 + F ck,   outj = G cj (j != k)
+ * obtained by summing, over the five faces f of the destination,
+ *   (solid_angle_f / pi) * lobe(n_f) * Y(w_f)^T
+ * with w_f the direction from the source centre to the centre of face f.
+ * A is exactly 1/6: the six neighbours share the source's total flux.
+ * tests/test_propagation.c rebuilds the matrices from the face table. */
+#define LPV_PROP_A 0.16666666666666666f
+#define LPV_PROP_B 0.26402916857008096f
+#define LPV_PROP_E 0.03681679577750147f
+#define LPV_PROP_F 0.06376856085851985f
+#define LPV_PROP_G 0.06027651555929470f
+
+/* ---- Memory layouts (std430 SSBOs) -----------------------------------------
+ * A light propagation volume is an array of LpvCell, x fastest:
+ * index = x + dims.x * (y + dims.y * z). Each vec4 holds the 4 SH coefficients
+ * of one colour channel of radiant intensity (W/sr). */
+struct LpvCell {
+    vec4 r;
+    vec4 g;
+    vec4 b;
+};
+
+/* A virtual point light: a small diffuse reflector or emitter whose radiant
+ * intensity is I(w) = (flux / pi) max(0, <n, w>), so that its integral is flux. */
+struct LpvVpl {
+    vec4 position; /* xyz world position (m); w = 1 for a valid VPL, 0 = skip */
+    vec4 normal;   /* xyz unit normal; w unused */
+    vec4 flux;     /* rgb flux (W); a unused */
+};
+
+/* A surfel for the geometry volume: an oriented patch that blocks light. */
+struct LpvSurfel {
+    vec4 position; /* xyz world position (m); w = area (m^2), 0 = skip */
+    vec4 normal;   /* xyz unit normal; w unused */
+};
+
+/* Placement of a grid, as a uniform block (std140). */
+struct LpvGridParams {
+    vec4 origin_cell; /* xyz world position of the grid's lower corner (m); w = cell size (m) */
+    vec4 dims;        /* xyz number of cells per axis (integers stored as float); w = cell count */
+};
+
+/* Six propagation directions, in this order everywhere (C and GLSL):
+ * +x, -x, +y, -y, +z, -z. Per-cell transmittances are stored the same way. */
+#define LPV_DIR_COUNT 6
+
+/* ---- Binding points -------------------------------------------------------- */
+#define LPV_UBO_GRID      0
+#define LPV_UBO_VIEW      1
+#define LPV_UBO_LIGHT     2
+
+#define LPV_SSBO_LPV_IN   0
+#define LPV_SSBO_LPV_OUT  1
+#define LPV_SSBO_LPV_ACC  2
+#define LPV_SSBO_TRANSMIT 3
+#define LPV_SSBO_GV       4
+#define LPV_SSBO_VPLS     5
+#define LPV_SSBO_SURFELS  6
+
+/* ---- Limits ---------------------------------------------------------------- */
+#define LPV_MAX_GRID_DIM     256  /* cells per axis */
+#define LPV_MAX_ITERATIONS   4096
+#define LPV_MAX_RSM_SIZE     2048
+#define LPV_FP16_MAX         65504.0f
+
+#endif /* LPV_SHARED_H */

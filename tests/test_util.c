@@ -1,0 +1,53 @@
+/* test_util.c - see test_util.h. */
+#define _DEFAULT_SOURCE /* mkdtemp */
+#include "test_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+const char *lpvt_shared_dir(void)
+{
+    const char *d = getenv("LPVD_SHARED_DIR");
+    struct stat st;
+    if (!d || stat(d, &st) != 0 || !S_ISDIR(st.st_mode))
+        return NULL;
+    return d;
+}
+
+const char *lpvt_source_dir(void)
+{
+    const char *d = getenv("LPVD_SOURCE_DIR");
+    return d ? d : ".";
+}
+
+const char *lpvt_tmpdir(void)
+{
+    static char path[256];
+    if (!path[0]) {
+        const char *base = getenv("TMPDIR");
+        snprintf(path, sizeof path, "%s/lpvd-test-XXXXXX", base ? base : "/tmp");
+        if (!mkdtemp(path)) {
+            perror("mkdtemp");
+            abort();
+        }
+    }
+    return path;
+}
+
+const char *lpvt_write_file(const char *dir, const char *name, const void *data, size_t size)
+{
+    static char slots[8][512];
+    static int next;
+    char *p = slots[next++ & 7];
+    snprintf(p, 512, "%s/%s", dir, name);
+    FILE *f = fopen(p, "wb");
+    if (!f || (size && fwrite(data, 1, size, f) != size)) {
+        perror(p);
+        abort();
+    }
+    fclose(f);
+    return p;
+}

@@ -1,0 +1,22 @@
+/* test_util.h - small helpers shared by the tests (paths, temp folders). */
+#ifndef LPV_TEST_UTIL_H
+#define LPV_TEST_UTIL_H
+
+#include <stddef.h>
+
+/* ../shared next to the checkout (LPVD_SHARED_DIR), or NULL when absent:
+ * tests that use it skip cleanly without it. */
+const char *lpvt_shared_dir(void);
+
+/* The source tree (LPVD_SOURCE_DIR). */
+const char *lpvt_source_dir(void);
+
+/* A fresh temporary folder for this test process (removed by the OS's tmp
+ * cleaning, not by the test). Never NULL; aborts on failure. */
+const char *lpvt_tmpdir(void);
+
+/* Writes size bytes to dir/name and returns the full path in a static buffer
+ * rotated over 8 slots. Aborts on failure. */
+const char *lpvt_write_file(const char *dir, const char *name, const void *data, size_t size);
+
+#endif
