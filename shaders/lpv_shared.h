@@ -16,6 +16,10 @@
 
 #ifndef LPV_GLSL
 #include <cglm/types.h>
+/* A struct type used as a member: GLSL names it bare, C with "struct". */
+#define LPV_STRUCT(name) struct name
+#else
+#define LPV_STRUCT(name) name
 #endif
 
 /* ---- Spherical harmonics: 2 bands, 4 coefficients per colour channel ------
@@ -93,6 +97,49 @@ struct LpvGridParams {
  * +x, -x, +y, -y, +z, -z. Per-cell transmittances are stored the same way. */
 #define LPV_DIR_COUNT 6
 
+/* ---- Lights and their shadow-map faces (uniform block, std140) ------------
+ * Every light renders a reflective shadow map (RSM) into one or more layers
+ * of 2D array textures: 1 for directional and spot lights, 6 (cube faces)
+ * for point lights and for spots wider than LPV_SPOT_MAX_SINGLE_FACE. */
+#define LPV_MAX_LIGHTS 16
+#define LPV_MAX_FACES 48
+#define LPV_SPOT_MAX_SINGLE_FACE 1.3962634f /* 80 deg half angle */
+
+#define LPV_LIGHT_TYPE_DIRECTIONAL 0
+#define LPV_LIGHT_TYPE_POINT 1
+#define LPV_LIGHT_TYPE_SPOT 2
+
+struct LpvLightGpu {
+    vec4 position_type;   /* xyz world position (m); w = LPV_LIGHT_TYPE_* */
+    vec4 direction_range; /* xyz unit travel direction; w = range (m), 0 = unlimited */
+    vec4 intensity;       /* rgb: W/sr (point, spot) or W/m^2 (directional); a unused */
+    vec4 cone_faces;      /* x cos(inner), y cos(outer), z first face, w face count */
+};
+
+struct LpvFaceGpu {
+    mat4 view_proj;       /* world -> clip of this RSM / shadow-map face */
+    vec4 info;            /* x light index; y 1 perspective, 0 orthographic;
+                             z texel footprint: m^2 (ortho) or tan(fov/2) (persp);
+                             w RSM size in texels */
+    vec4 axis;            /* xyz unit view axis of the face; w unused */
+};
+
+struct LpvLightBlock {
+    vec4 counts;          /* x lights, y faces */
+    LPV_STRUCT(LpvLightGpu) lights[LPV_MAX_LIGHTS];
+    LPV_STRUCT(LpvFaceGpu) faces[LPV_MAX_FACES];
+};
+
+/* The camera, as a uniform block (std140). */
+struct LpvViewBlock {
+    mat4 view_proj;       /* world -> clip */
+    vec4 eye;             /* xyz world position; w 1 perspective, 0 orthographic */
+    vec4 forward;         /* xyz unit view direction; w tan(yfov/2) or ymag (ortho) */
+    vec4 viewport;        /* x width, y height (pixels); z aspect; w unused */
+    vec4 shading;         /* x indirect gain; y include direct (0/1); z include indirect (0/1);
+                             w include emission (0/1) */
+};
+
 /* ---- Binding points -------------------------------------------------------- */
 #define LPV_UBO_GRID      0
 #define LPV_UBO_VIEW      1
@@ -105,6 +152,14 @@ struct LpvGridParams {
 #define LPV_SSBO_GV       4
 #define LPV_SSBO_VPLS     5
 #define LPV_SSBO_SURFELS  6
+#define LPV_SSBO_GV_TOTAL 7
+#define LPV_SSBO_SIGMA_IN 8
+#define LPV_SSBO_SIGMA_OUT 9
+
+/* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
+#define LPV_PROP_WG_X 8
+#define LPV_PROP_WG_Y 8
+#define LPV_WG_2D 8
 
 /* ---- Limits ---------------------------------------------------------------- */
 #define LPV_MAX_GRID_DIM     256  /* cells per axis */

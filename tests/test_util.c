@@ -1,5 +1,4 @@
 /* test_util.c - see test_util.h. */
-#define _DEFAULT_SOURCE /* mkdtemp */
 #include "test_util.h"
 
 #include <stdio.h>

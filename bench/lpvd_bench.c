@@ -1,0 +1,151 @@
+/*
+ * lpvd_bench.c - per-stage GPU milliseconds of the engine (median over
+ * repeated ticks, after warm-up ticks that absorb shader compilation) and
+ * the propagation throughput in cell-steps per second.
+ *
+ *   lpvd-bench [--repeat N] [--warmup N] [--size WxH] [--backend NAME] [SCENE]
+ *
+ * Configurations: the issue's 32^3 / 8 iterations / RSM 256^2 and the same at
+ * 64^3. Prints a Markdown table; README.md records it with the machine.
+ * Not a test: nothing here asserts a time.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "context.h"
+#include "engine.h"
+#include "options.h"
+#include "scene_load.h"
+
+typedef struct config {
+    int grid, iterations, rsm;
+} config;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+int main(int argc, char **argv)
+{
+    int repeat = 15, warmup = 3;
+    const char *scene_path = NULL;
+    lpvd_options opt = {0};
+    char err[1024];
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
+            repeat = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--warmup") == 0 && i + 1 < argc) {
+            warmup = atoi(argv[++i]);
+        } else if (argv[i][0] == '-' && argv[i][1] == '-' && lpvd_option_takes_value(argv[i] + 2) > 0 &&
+                   i + 1 < argc) {
+            if (lpvd_option_parse(&opt, argv[i] + 2, argv[i + 1], err, sizeof err) < 0) {
+                fprintf(stderr, "lpvd-bench: %s\n", err);
+                return 2;
+            }
+            ++i;
+        } else if (argv[i][0] != '-') {
+            scene_path = argv[i];
+        } else {
+            fprintf(stderr, "usage: lpvd-bench [--repeat N] [--warmup N] [--size WxH] [--backend NAME] [SCENE]\n");
+            return 2;
+        }
+    }
+    if (repeat < 1 || repeat > 1000 || warmup < 0) {
+        fprintf(stderr, "lpvd-bench: --repeat 1..1000, --warmup >= 0\n");
+        return 2;
+    }
+
+    lpv_scene scene;
+    if (lpv_scene_load(scene_path, &scene, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-bench: %s\n", err);
+        return 1;
+    }
+    lpv_view view;
+    if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-bench: %s\n", err);
+        return 2;
+    }
+    lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt.backend}, err, sizeof err);
+    if (!ctx) {
+        fprintf(stderr, "lpvd-bench: %s\n", err);
+        return 1;
+    }
+    lpv_engine *e = lpv_engine_create(err, sizeof err);
+    if (!e) {
+        fprintf(stderr, "lpvd-bench: %s\n", err);
+        return 1;
+    }
+    float *rgba = malloc((size_t)view.width * view.height * 4 * sizeof(float));
+
+    printf("# lpvd-bench: %s, backend %s, GL_RENDERER %s, image %dx%d, median of %d ticks after %d warm-up\n\n",
+           scene.source, lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), view.width,
+           view.height, repeat, warmup);
+    const config configs[] = {{32, 8, 256}, {64, 8, 256}};
+    int rc = 0;
+    for (size_t c = 0; c < sizeof configs / sizeof configs[0] && rc == 0; ++c) {
+        lpv_settings s = opt.settings;
+        s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = configs[c].grid;
+        s.iterations = configs[c].iterations;
+        s.rsm_size = configs[c].rsm;
+        if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0 || lpv_engine_set_scene(e, &scene, err, sizeof err) ||
+            lpv_engine_set_view(e, &view, err, sizeof err) != 0) {
+            fprintf(stderr, "lpvd-bench: %s\n", err);
+            rc = 1;
+            break;
+        }
+        double samples[LPV_STAGE_MAX][1000];
+        double totals[1000];
+        char names[LPV_STAGE_MAX][32];
+        int stage_count = 0;
+        for (int r = 0; r < warmup + repeat; ++r) {
+            if (lpv_engine_tick(e, err, sizeof err) != 0 || lpv_engine_render(e, LPV_TERMS_FULL, rgba, err, sizeof err)) {
+                fprintf(stderr, "lpvd-bench: %s\n", err);
+                rc = 1;
+                break;
+            }
+            if (r < warmup)
+                continue;
+            const lpv_engine_stats *st = lpv_engine_last_stats(e);
+            stage_count = st->stage_count;
+            double total = 0.0;
+            for (int k = 0; k < st->stage_count; ++k) {
+                snprintf(names[k], sizeof names[k], "%s", st->stages[k].name);
+                samples[k][r - warmup] = st->stages[k].gpu_ms;
+                total += st->stages[k].gpu_ms;
+            }
+            totals[r - warmup] = total;
+        }
+        if (rc)
+            break;
+        const lpv_engine_stats *st = lpv_engine_last_stats(e);
+        printf("## %d^3 cells, %d iterations, RSM %d^2, occlusion %s\n\n", configs[c].grid, configs[c].iterations,
+               configs[c].rsm, st->occlusion ? "on" : "off");
+        printf("| stage | GPU ms (median) |\n|---|---:|\n");
+        double prop_ms = 0.0;
+        for (int k = 0; k < stage_count; ++k) {
+            double m = median(samples[k], repeat);
+            if (strcmp(names[k], "propagate") == 0)
+                prop_ms = m;
+            printf("| %s | %.2f |\n", names[k], m);
+        }
+        printf("| **total** | **%.2f** |\n\n", median(totals, repeat));
+        double cell_steps = (double)st->cells * configs[c].iterations;
+        printf("propagation: %.0f cell-steps in %.2f ms = **%.1f M cell-steps/s**\n\n", cell_steps, prop_ms,
+               prop_ms > 0.0 ? cell_steps / prop_ms / 1e3 : 0.0);
+        fflush(stdout);
+    }
+    free(rgba);
+    lpv_engine_destroy(e);
+    lpv_gl_context_destroy(ctx);
+    lpv_scene_free(&scene);
+    return rc;
+}

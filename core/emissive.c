@@ -1,0 +1,133 @@
+/* emissive.c - see emissive.h. */
+#include "emissive.h"
+
+#include <math.h>
+#include <string.h>
+
+static int material_emits(const lpv_scene *s, int m)
+{
+    if (m < 0 || (uint32_t)m >= s->material_count)
+        return 0;
+    const float *e = s->materials[m].emission;
+    return (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) && isfinite(e[0] + e[1] + e[2]);
+}
+
+/* Triangle t of draw d: corners, area and the unit normal of the emitting
+ * side (the winding's normal, flipped to agree with the file's vertex normals
+ * when they exist). Returns 0 for a degenerate triangle. */
+static int triangle(const lpv_scene *s, uint32_t first, const float *p[3], float n[3], double *area)
+{
+    const lpv_vertex *v[3];
+    for (int k = 0; k < 3; ++k) {
+        uint32_t idx = s->indices[first + (uint32_t)k];
+        if (idx >= s->vertex_count)
+            return 0;
+        v[k] = &s->vertices[idx];
+        p[k] = v[k]->position;
+    }
+    double e1[3], e2[3], c[3];
+    for (int i = 0; i < 3; ++i) {
+        e1[i] = (double)p[1][i] - p[0][i];
+        e2[i] = (double)p[2][i] - p[0][i];
+    }
+    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(len > 1e-12) || !isfinite(len))
+        return 0;
+    double vn = 0.0;
+    for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i)
+            vn += c[i] * v[k]->normal[i];
+    double sign = vn < 0.0 ? -1.0 : 1.0;
+    for (int i = 0; i < 3; ++i)
+        n[i] = (float)(sign * c[i] / len);
+    *area = 0.5 * len;
+    return 1;
+}
+
+static double emission_weight(const float e[3])
+{
+    return (double)e[0] + e[1] + e[2];
+}
+
+void lpv_emissive_total_flux(const lpv_scene *s, double flux[3])
+{
+    flux[0] = flux[1] = flux[2] = 0.0;
+    for (uint32_t d = 0; d < s->draw_count; ++d) {
+        const lpv_draw *dr = &s->draws[d];
+        if (!material_emits(s, dr->material))
+            continue;
+        const float *e = s->materials[dr->material].emission;
+        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
+            const float *p[3];
+            float n[3];
+            double area;
+            if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, p, n, &area))
+                continue;
+            for (int c = 0; c < 3; ++c)
+                flux[c] += M_PI * e[c] * area;
+        }
+    }
+}
+
+size_t lpv_emissive_sample(const lpv_scene *s, size_t target, lpv_vpl *out, size_t max)
+{
+    double total = 0.0;
+    for (uint32_t d = 0; d < s->draw_count; ++d) {
+        const lpv_draw *dr = &s->draws[d];
+        if (!material_emits(s, dr->material))
+            continue;
+        double w = emission_weight(s->materials[dr->material].emission);
+        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
+            const float *p[3];
+            float n[3];
+            double area;
+            if (dr->first_index + t + 3 <= s->index_count && triangle(s, dr->first_index + t, p, n, &area))
+                total += w * area;
+        }
+    }
+    if (!(total > 0.0) || target == 0)
+        return 0;
+
+    /* R2 low-discrepancy sequence (generalised golden ratio). */
+    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
+    size_t count = 0;
+    for (uint32_t d = 0; d < s->draw_count; ++d) {
+        const lpv_draw *dr = &s->draws[d];
+        if (!material_emits(s, dr->material))
+            continue;
+        const float *e = s->materials[dr->material].emission;
+        double w = emission_weight(e);
+        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
+            const float *p[3];
+            float n[3];
+            double area;
+            if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, p, n, &area))
+                continue;
+            size_t k_count = (size_t)floor((double)target * w * area / total + 0.5);
+            if (k_count == 0)
+                k_count = 1;
+            if (count + k_count > max)
+                k_count = max - count;
+            if (k_count == 0)
+                return count;
+            for (size_t k = 0; k < k_count; ++k) {
+                double u = fmod(0.5 + a1 * (double)(k + 1), 1.0);
+                double v = fmod(0.5 + a2 * (double)(k + 1), 1.0);
+                double r = sqrt(u);
+                double b0 = 1.0 - r, b1 = r * (1.0 - v), b2 = r * v;
+                lpv_vpl *o = &out[count++];
+                memset(o, 0, sizeof *o);
+                for (int i = 0; i < 3; ++i) {
+                    o->position[i] = (float)(b0 * p[0][i] + b1 * p[1][i] + b2 * p[2][i]);
+                    o->normal[i] = n[i];
+                    o->flux[i] = (float)(M_PI * e[i] * area / (double)k_count);
+                }
+                o->position[3] = 1.0f;
+            }
+        }
+    }
+    return count;
+}

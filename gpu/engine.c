@@ -1,0 +1,596 @@
+/*
+ * engine.c - the engine object: programs, scene upload, settings, the tick's
+ * order of passes, and read-backs. The passes themselves are in pass_*.c.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "emissive.h"
+#include "engine_internal.h"
+#include "shader.h"
+
+int lpv_engine_fail(char *err, size_t err_size, const char *fmt, ...)
+{
+    if (err && err_size) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, err_size, fmt, ap);
+        va_end(ap);
+    }
+    return -1;
+}
+
+GLuint lpv_engine_program(const char *first, const char *geom, const char *frag, const char *const *includes,
+                          char *err, size_t err_size)
+{
+    /* The includes use the shared header's types, so it goes first; its
+     * include guard makes the copy shader.c adds afterwards a no-op. */
+    const char *shared = lpv_shader_text("lpv_shared.h");
+    size_t len = strlen(shared) + 2;
+    for (const char *const *i = includes; i && *i; ++i) {
+        const char *t = lpv_shader_text(*i);
+        if (!t) {
+            lpv_engine_fail(err, err_size, "shader include %s is not embedded", *i);
+            return 0;
+        }
+        len += strlen(t) + 64;
+    }
+    char *prelude = malloc(len);
+    if (!prelude) {
+        lpv_engine_fail(err, err_size, "out of memory building %s", first);
+        return 0;
+    }
+    strcpy(prelude, shared);
+    strcat(prelude, "\n");
+    for (const char *const *i = includes; i && *i; ++i) {
+        strcat(prelude, lpv_shader_text(*i));
+        strcat(prelude, "\n");
+    }
+    GLuint p = frag ? lpv_program_graphics(first, geom, frag, prelude, err, err_size)
+                    : lpv_program_compute(first, prelude, err, err_size);
+    free(prelude);
+    return p;
+}
+
+static const char *const INC_GRID[] = {"grid.glsl", NULL};
+static const char *const INC_PROPAGATE[] = {"grid.glsl", "flux_limit.glsl", NULL};
+static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
+static const char *const INC_RSM[] = {"material.glsl", "lights.glsl", NULL};
+static const char *const INC_SHADE[] = {"grid.glsl", "lights.glsl", "lookup.glsl", NULL};
+
+lpv_engine *lpv_engine_create(char *err, size_t err_size)
+{
+    lpv_engine *e = calloc(1, sizeof *e);
+    if (!e) {
+        lpv_engine_fail(err, err_size, "out of memory");
+        return NULL;
+    }
+    struct {
+        GLuint *prog;
+        const char *a, *b;
+        const char *const *inc;
+    } progs[] = {
+        {&e->prog_rsm, "scene.vert", "rsm.frag", INC_RSM},
+        {&e->prog_vpl_extract, "vpl_extract.comp", NULL, NULL},
+        {&e->prog_inject_vpl, "inject_vpl.vert", "inject_vpl.frag", INC_GRID},
+        {&e->prog_inject_gv, "inject_gv.vert", "inject_gv.frag", INC_GRID},
+        {&e->prog_pack, "lpv_pack.comp", NULL, INC_PROPAGATE},
+        {&e->prog_gv_merge, "gv_merge.comp", NULL, INC_GRID},
+        {&e->prog_transmit, "transmit.comp", NULL, INC_GRID},
+        {&e->prog_propagate, "propagate.comp", NULL, INC_PROPAGATE},
+        {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
+        {&e->prog_camera_surfels, "camera_surfels.comp", NULL, NULL},
+        {&e->prog_shade, "fullscreen.vert", "shade.frag", INC_SHADE},
+    };
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
+        *progs[i].prog = lpv_engine_program(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
+        if (!*progs[i].prog) {
+            lpv_engine_destroy(e);
+            return NULL;
+        }
+    }
+    glGenVertexArrays(1, &e->empty_vao);
+    glGenBuffers(1, &e->grid_ubo);
+    glGenBuffers(1, &e->light_ubo);
+    glGenBuffers(1, &e->view_ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, e->light_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvLightBlock), NULL, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvViewBlock), NULL, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, e->grid_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
+    lpv_timer_init(&e->timer);
+    lpv_settings_resolve(&e->settings);
+    return e;
+}
+
+static void delete_buffer(GLuint *b)
+{
+    if (*b)
+        glDeleteBuffers(1, b);
+    *b = 0;
+}
+
+static void delete_texture(GLuint *t)
+{
+    if (*t)
+        glDeleteTextures(1, t);
+    *t = 0;
+}
+
+static void delete_framebuffer(GLuint *f)
+{
+    if (*f)
+        glDeleteFramebuffers(1, f);
+    *f = 0;
+}
+
+static void free_scene(lpv_engine *e)
+{
+    if (e->vao)
+        glDeleteVertexArrays(1, &e->vao);
+    e->vao = 0;
+    delete_buffer(&e->vbo);
+    delete_buffer(&e->ibo);
+    delete_buffer(&e->emissive_vpls);
+    if (e->texture_count)
+        glDeleteTextures((GLsizei)e->texture_count, e->textures);
+    free(e->textures);
+    free(e->draws);
+    free(e->materials);
+    e->textures = NULL;
+    e->draws = NULL;
+    e->materials = NULL;
+    e->texture_count = e->draw_count = e->material_count = 0;
+    e->light_count = 0;
+    e->emissive_vpl_count = 0;
+    e->has_scene = 0;
+}
+
+static void free_rsm(lpv_engine *e)
+{
+    delete_texture(&e->rsm_position);
+    delete_texture(&e->rsm_normal);
+    delete_texture(&e->rsm_flux);
+    delete_texture(&e->rsm_depth);
+    delete_framebuffer(&e->rsm_fbo);
+    delete_buffer(&e->vpls);
+    delete_buffer(&e->surfels);
+    e->rsm_alloc_size = e->rsm_alloc_faces = 0;
+}
+
+static void free_grids(lpv_engine *e)
+{
+    lpv_atlas_destroy(&e->lpv_atlas);
+    lpv_atlas_destroy(&e->gv_atlas);
+    delete_buffer(&e->lpv_injected);
+    delete_buffer(&e->lpv_ping);
+    delete_buffer(&e->lpv_pong);
+    delete_buffer(&e->lpv_acc);
+    delete_buffer(&e->gv_total);
+    delete_buffer(&e->transmit);
+    delete_buffer(&e->sigma[0]);
+    delete_buffer(&e->sigma[1]);
+    GLuint *views[] = {&e->tbo_injected, &e->tbo_ping, &e->tbo_pong, &e->tbo_sigma[0], &e->tbo_sigma[1]};
+    for (size_t i = 0; i < sizeof views / sizeof views[0]; ++i)
+        delete_texture(views[i]);
+    e->grid_alloc_cells = 0;
+    e->ticked = 0;
+}
+
+static void free_camera(lpv_engine *e)
+{
+    for (int i = 0; i < 4; ++i)
+        delete_texture(&e->gbuf_tex[i]);
+    delete_texture(&e->gbuf_depth);
+    delete_texture(&e->frame_tex);
+    delete_framebuffer(&e->gbuf_fbo);
+    delete_framebuffer(&e->frame_fbo);
+    delete_buffer(&e->camera_surfels);
+    e->gbuf_w = e->gbuf_h = 0;
+}
+
+void lpv_engine_destroy(lpv_engine *e)
+{
+    if (!e)
+        return;
+    free_scene(e);
+    free_rsm(e);
+    free_grids(e);
+    free_camera(e);
+    GLuint *progs[] = {&e->prog_rsm, &e->prog_vpl_extract, &e->prog_inject_vpl, &e->prog_inject_gv,
+                       &e->prog_pack, &e->prog_gv_merge, &e->prog_transmit, &e->prog_propagate,
+                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade};
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
+        if (*progs[i])
+            glDeleteProgram(*progs[i]);
+    if (e->empty_vao)
+        glDeleteVertexArrays(1, &e->empty_vao);
+    delete_buffer(&e->grid_ubo);
+    delete_buffer(&e->light_ubo);
+    delete_buffer(&e->view_ubo);
+    lpv_timer_destroy(&e->timer);
+    free(e);
+}
+
+static GLuint new_ssbo(size_t bytes)
+{
+    GLuint b;
+    glGenBuffers(1, &b);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(bytes ? bytes : 16), NULL, GL_DYNAMIC_COPY);
+    return b;
+}
+
+/* An RGBA32F buffer texture over buffer b. */
+static GLuint buffer_view(GLuint b)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_BUFFER, t);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, b);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
+    return t;
+}
+
+/* (Re)places the grid from the settings and the scene, and sizes its buffers. */
+static int place_grid(lpv_engine *e, char *err, size_t err_size)
+{
+    const lpv_settings *s = &e->settings;
+    int given = 0;
+    for (int i = 0; i < 3; ++i)
+        given |= s->bounds_min[i] != 0.0f || s->bounds_max[i] != 0.0f;
+    const float *bmin = given ? s->bounds_min : e->scene_min;
+    const float *bmax = given ? s->bounds_max : e->scene_max;
+    lpv_grid g;
+    if (lpv_grid_place(s->grid_dims, bmin, bmax, &g) != 0)
+        return lpv_engine_fail(err, err_size, "grid %dx%dx%d cannot be placed", s->grid_dims[0], s->grid_dims[1],
+                               s->grid_dims[2]);
+    int same_dims = e->grid_alloc_cells && memcmp(g.dims, e->grid.dims, sizeof g.dims) == 0;
+    e->grid = g;
+    struct LpvGridParams params = {
+        .origin_cell = {g.origin[0], g.origin[1], g.origin[2], g.cell_size},
+        .dims = {(float)g.dims[0], (float)g.dims[1], (float)g.dims[2], (float)lpv_grid_cell_count(&g)},
+    };
+    glBindBuffer(GL_UNIFORM_BUFFER, e->grid_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
+    if (same_dims)
+        return 0;
+
+    free_grids(e);
+    size_t cells = lpv_grid_cell_count(&g), gv = lpv_grid_gv_count(&g);
+    int gv_dims[3] = {g.dims[0] + 1, g.dims[1] + 1, g.dims[2] + 1};
+    if (lpv_atlas_create(&e->lpv_atlas, g.dims, 3, err, err_size) != 0 ||
+        lpv_atlas_create(&e->gv_atlas, gv_dims, 1, err, err_size) != 0)
+        return -1;
+    e->lpv_injected = new_ssbo(cells * sizeof(lpv_cell));
+    e->lpv_ping = new_ssbo(cells * sizeof(lpv_cell));
+    e->lpv_pong = new_ssbo(cells * sizeof(lpv_cell));
+    e->lpv_acc = new_ssbo(cells * sizeof(lpv_cell));
+    e->gv_total = new_ssbo(gv * 4 * sizeof(float));
+    e->transmit = new_ssbo(cells * LPV_DIR_COUNT * sizeof(float));
+    e->sigma[0] = new_ssbo(cells * 4 * sizeof(float));
+    e->sigma[1] = new_ssbo(cells * 4 * sizeof(float));
+    e->tbo_injected = buffer_view(e->lpv_injected);
+    e->tbo_ping = buffer_view(e->lpv_ping);
+    e->tbo_pong = buffer_view(e->lpv_pong);
+    e->tbo_sigma[0] = buffer_view(e->sigma[0]);
+    e->tbo_sigma[1] = buffer_view(e->sigma[1]);
+    e->grid_alloc_cells = cells;
+    if (glGetError() != GL_NO_ERROR)
+        return lpv_engine_fail(err, err_size, "could not allocate a %dx%dx%d grid", g.dims[0], g.dims[1], g.dims[2]);
+    return 0;
+}
+
+int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *err, size_t err_size)
+{
+    lpv_settings s = *settings;
+    lpv_settings_resolve(&s);
+    if (lpv_settings_validate(&s, err, err_size) != 0)
+        return -1;
+    e->settings = s;
+    e->ticked = 0;
+    if (e->has_scene)
+        return place_grid(e, err, err_size);
+    return 0;
+}
+
+static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
+{
+    if (!scene->texture_count)
+        return 0;
+    e->textures = calloc(scene->texture_count, sizeof(GLuint));
+    if (!e->textures)
+        return lpv_engine_fail(err, err_size, "out of memory for textures");
+    e->texture_count = scene->texture_count;
+    glGenTextures((GLsizei)scene->texture_count, e->textures);
+    for (uint32_t i = 0; i < scene->texture_count; ++i) {
+        const lpv_texture *t = &scene->textures[i];
+        glBindTexture(GL_TEXTURE_2D, e->textures[i]);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        if (t->rgba8 && t->width > 0 && t->height > 0)
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                         t->rgba8);
+        else {
+            const uint8_t white[4] = {255, 255, 255, 255};
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, white);
+        }
+        glGenerateMipmap(GL_TEXTURE_2D);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    }
+    return 0;
+}
+
+int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
+{
+    free_scene(e);
+    e->ticked = 0;
+    e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
+    e->materials = calloc(scene->material_count ? scene->material_count : 1, sizeof *e->materials);
+    if (!e->draws || !e->materials)
+        return lpv_engine_fail(err, err_size, "out of memory for the scene");
+    for (uint32_t i = 0; i < scene->draw_count; ++i) {
+        const lpv_draw *d = &scene->draws[i];
+        if ((uint64_t)d->first_index + d->index_count > scene->index_count)
+            return lpv_engine_fail(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
+        e->draws[e->draw_count++] = (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material};
+    }
+    for (uint32_t i = 0; i < scene->material_count; ++i) {
+        const lpv_material *m = &scene->materials[i];
+        lpv_gpu_material *g = &e->materials[i];
+        memcpy(g->base_color, m->base_color, sizeof g->base_color);
+        memcpy(g->emission, m->emission, sizeof g->emission);
+        g->texture = (m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < scene->texture_count)
+                         ? m->base_color_texture
+                         : -1;
+    }
+    e->material_count = scene->material_count;
+    if (upload_textures(e, scene, err, err_size) != 0)
+        return -1;
+
+    glGenVertexArrays(1, &e->vao);
+    glBindVertexArray(e->vao);
+    glGenBuffers(1, &e->vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(scene->vertex_count * sizeof(lpv_vertex)), scene->vertices,
+                 GL_STATIC_DRAW);
+    glGenBuffers(1, &e->ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(scene->index_count * sizeof(uint32_t)), scene->indices,
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, position));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, normal));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, uv));
+    glBindVertexArray(0);
+
+    e->light_count = 0;
+    for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
+        e->lights[e->light_count++] = scene->lights[i];
+    memcpy(e->scene_min, scene->bounds_min, sizeof e->scene_min);
+    memcpy(e->scene_max, scene->bounds_max, sizeof e->scene_max);
+
+    size_t target = (size_t)e->settings.emissive_vpls;
+    lpv_vpl *vpls = target ? calloc(target * 2 + 1024, sizeof *vpls) : NULL;
+    size_t n = vpls ? lpv_emissive_sample(scene, target, vpls, target * 2 + 1024) : 0;
+    e->emissive_vpls = new_ssbo(n * sizeof(lpv_vpl));
+    if (n)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof(lpv_vpl)), vpls);
+    e->emissive_vpl_count = n;
+    free(vpls);
+
+    if (glGetError() != GL_NO_ERROR)
+        return lpv_engine_fail(err, err_size, "%s: GL error while uploading the scene", scene->source);
+    e->has_scene = 1;
+    return place_grid(e, err, err_size);
+}
+
+int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t err_size)
+{
+    if (!view) {
+        e->has_view = 0;
+        return 0;
+    }
+    if (view->width < 1 || view->height < 1 || view->width > 16384 || view->height > 16384)
+        return lpv_engine_fail(err, err_size, "image size %dx%d outside 1..16384", view->width, view->height);
+    e->view = *view;
+    e->has_view = 1;
+    return 0;
+}
+
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog)
+{
+    GLint loc_color = glGetUniformLocation(prog, "u_base_color");
+    GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
+    GLint loc_emission = glGetUniformLocation(prog, "u_emission");
+    glBindVertexArray(e->vao);
+    for (uint32_t i = 0; i < e->draw_count; ++i) {
+        const lpv_gpu_draw *d = &e->draws[i];
+        static const lpv_gpu_material fallback = {{1, 1, 1, 1}, {0, 0, 0}, -1};
+        const lpv_gpu_material *m =
+            (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
+        glUniform4fv(loc_color, 1, m->base_color);
+        glUniform3fv(loc_emission, 1, m->emission);
+        glUniform1i(loc_has_tex, m->texture >= 0);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m->texture >= 0 ? e->textures[m->texture] : 0);
+        if (d->index_count)
+            glDrawElements(GL_TRIANGLES, (GLsizei)d->index_count, GL_UNSIGNED_INT,
+                           (void *)(uintptr_t)(d->first_index * sizeof(uint32_t)));
+        lpv_timer_count(&e->timer, 1);
+    }
+    glBindVertexArray(0);
+}
+
+static void record_stats(lpv_engine *e)
+{
+    lpv_engine_stats *s = &e->stats;
+    memset(s, 0, sizeof *s);
+    lpv_timer_collect(&e->timer);
+    int n = e->timer.stage_count;
+    for (int i = 0; i < n && i < LPV_STAGE_MAX; ++i) {
+        const lpv_timer_stage *st = &e->timer.stages[i];
+        snprintf(s->stages[i].name, sizeof s->stages[i].name, "%s", st->name);
+        s->stages[i].gpu_ms = st->gpu_ms;
+        s->stages[i].cpu_ms = st->cpu_ms;
+        s->stages[i].calls = st->count;
+        s->stage_count = i + 1;
+    }
+    s->lights = (unsigned)e->light_block.counts[0];
+    s->rsm_faces = (unsigned)e->face_count;
+    s->rsm_size = (unsigned)e->settings.rsm_size;
+    s->vpls_rsm = e->rsm_texels;
+    s->vpls_emissive = e->emissive_vpl_count;
+    s->surfels_rsm = e->settings.occlusion == LPV_SWITCH_ON ? e->rsm_texels : 0;
+    s->surfels_camera = (e->settings.occlusion == LPV_SWITCH_ON && e->has_view) ? (size_t)e->gbuf_w * e->gbuf_h : 0;
+    s->cells = lpv_grid_cell_count(&e->grid);
+    s->iterations = e->settings.iterations;
+    s->cell_steps = (double)s->cells * e->settings.iterations;
+    s->occlusion = e->settings.occlusion == LPV_SWITCH_ON;
+}
+
+int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
+{
+    if (!e->has_scene)
+        return lpv_engine_fail(err, err_size, "no scene loaded");
+    if (lpv_pass_rsm_prepare(e, err, err_size) != 0)
+        return -1;
+    lpv_pass_rsm_run(e);
+    lpv_pass_inject_run(e);
+    if (e->has_view)
+        lpv_pass_gbuffer_run(e);
+    if (e->settings.occlusion == LPV_SWITCH_ON)
+        lpv_pass_gv_run(e);
+    lpv_pass_propagate_run(e);
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR)
+        return lpv_engine_fail(err, err_size, "GL error 0x%04x during the tick", gl_err);
+    e->ticked = 1;
+    record_stats(e);
+    return 0;
+}
+
+int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *err, size_t err_size)
+{
+    if (!e->ticked)
+        return lpv_engine_fail(err, err_size, "render before a tick");
+    if (!e->has_view)
+        return lpv_engine_fail(err, err_size, "render needs a view (camera)");
+    lpv_pass_shade_run(e, terms);
+    const int w = e->gbuf_w, h = e->gbuf_h;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame_fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    /* GL rows run bottom-up; files and callers want the top row first. */
+    size_t row = (size_t)w * 4;
+    for (int y = 0; y < h / 2; ++y) {
+        float *a = rgba + (size_t)y * row, *b = rgba + (size_t)(h - 1 - y) * row;
+        for (size_t i = 0; i < row; ++i) {
+            float t = a[i];
+            a[i] = b[i];
+            b[i] = t;
+        }
+    }
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR)
+        return lpv_engine_fail(err, err_size, "GL error 0x%04x during rendering", gl_err);
+    /* Append the shading stage to the tick's stats. */
+    lpv_timer_collect(&e->timer);
+    lpv_engine_stats *s = &e->stats;
+    for (int i = 0; i < e->timer.stage_count && s->stage_count < LPV_STAGE_MAX; ++i) {
+        const lpv_timer_stage *st = &e->timer.stages[i];
+        int k = s->stage_count++;
+        snprintf(s->stages[k].name, sizeof s->stages[k].name, "%s", st->name);
+        s->stages[k].gpu_ms = st->gpu_ms;
+        s->stages[k].cpu_ms = st->cpu_ms;
+        s->stages[k].calls = st->count;
+    }
+    return 0;
+}
+
+const lpv_grid *lpv_engine_grid(const lpv_engine *e) { return &e->grid; }
+const lpv_settings *lpv_engine_settings(const lpv_engine *e) { return &e->settings; }
+const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e) { return &e->stats; }
+
+static size_t read_buffer(GLuint buf, size_t elem_size, size_t available, void *out, size_t max)
+{
+    size_t n = available < max ? available : max;
+    if (!buf || !n)
+        return 0;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * elem_size), out);
+    return n;
+}
+
+size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max)
+{
+    if (!e->ticked)
+        return 0;
+    GLuint b = e->lpv_acc;
+    if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && e->settings.iterations == 0))
+        b = e->lpv_injected;
+    else if (which == LPV_GRID_LAST_STEP)
+        b = (e->settings.iterations & 1) ? e->lpv_ping : e->lpv_pong;
+    return read_buffer(b, sizeof(lpv_cell), lpv_grid_cell_count(&e->grid), out, max);
+}
+
+size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max)
+{
+    if (!e->ticked || e->settings.occlusion != LPV_SWITCH_ON)
+        return 0;
+    return read_buffer(e->gv_total, sizeof(vec4), lpv_grid_gv_count(&e->grid), out, max);
+}
+
+size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats)
+{
+    if (!e->ticked || e->settings.occlusion != LPV_SWITCH_ON)
+        return 0;
+    return read_buffer(e->transmit, sizeof(float), lpv_grid_cell_count(&e->grid) * LPV_DIR_COUNT, out, max_floats);
+}
+
+size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
+{
+    if (!e->ticked)
+        return 0;
+    size_t n = read_buffer(e->vpls, sizeof(lpv_vpl), e->rsm_texels, out, max);
+    if (n < max)
+        n += read_buffer(e->emissive_vpls, sizeof(lpv_vpl), e->emissive_vpl_count, out + n, max - n);
+    return n;
+}
+
+size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
+{
+    return (size_t)e->light_block.counts[0] + (e->has_view ? 1 : 0);
+}
+
+size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max)
+{
+    if (!e->ticked || e->settings.occlusion != LPV_SWITCH_ON)
+        return 0;
+    size_t lights = (size_t)e->light_block.counts[0];
+    if (buffer < lights) {
+        const struct LpvLightGpu *l = &e->light_block.lights[buffer];
+        size_t per_face = (size_t)e->rsm_size * (size_t)e->rsm_size;
+        size_t first = (size_t)l->cone_faces[2] * per_face, count = (size_t)l->cone_faces[3] * per_face;
+        size_t n = count < max ? count : max;
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
+        glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, (GLintptr)(first * sizeof(lpv_surfel)),
+                           (GLsizeiptr)(n * sizeof(lpv_surfel)), out);
+        return n;
+    }
+    if (buffer == lights && e->has_view)
+        return read_buffer(e->camera_surfels, sizeof(lpv_surfel), (size_t)e->gbuf_w * e->gbuf_h, out, max);
+    return 0;
+}

@@ -1,0 +1,95 @@
+/*
+ * engine.h - the GPU light propagation volume engine.
+ *
+ * One engine per GL context. Give it a scene and settings, optionally a view
+ * (camera), then each tick runs, in order:
+ *   RSMs (one per light face) -> VPL and surfel extraction -> VPL injection
+ *   (+ emissive-surface VPLs) -> geometry volume (one per RSM light and the
+ *   camera, max-merged) -> transmittances -> propagation -> accumulation,
+ * and lpv_engine_render shades the camera's view with direct light (shadow
+ * maps) and the LPV's irradiance. Every stage is timed with GL timer queries.
+ *
+ * All functions need the engine's GL context current on the calling thread.
+ */
+#ifndef LPV_ENGINE_H
+#define LPV_ENGINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "grid.h"
+#include "oracle.h"
+#include "scene.h"
+#include "settings.h"
+#include "view.h"
+
+typedef struct lpv_engine lpv_engine;
+
+typedef enum lpv_frame_terms {
+    LPV_TERMS_FULL = 0,          /* direct + gain * LPV + emission */
+    LPV_TERMS_INDIRECT_ONLY = 1, /* gain * LPV only (albedo / pi * E_lpv) */
+    LPV_TERMS_DIRECT_ONLY = 2,   /* direct + emission */
+} lpv_frame_terms;
+
+#define LPV_STAGE_MAX 16
+
+/* What the last tick and render did: GPU milliseconds per stage (timer
+ * queries), dispatches and draws per stage, and counts. */
+typedef struct lpv_engine_stats {
+    int stage_count;
+    struct {
+        char name[32];
+        double gpu_ms;
+        double cpu_ms;
+        unsigned calls; /* dispatches + draws */
+    } stages[LPV_STAGE_MAX];
+    unsigned lights, rsm_faces, rsm_size;
+    size_t vpls_rsm, vpls_emissive, vpls_injected_capacity;
+    size_t surfels_rsm, surfels_camera;
+    size_t cells;
+    int iterations;
+    double cell_steps;
+    int occlusion;
+} lpv_engine_stats;
+
+lpv_engine *lpv_engine_create(char *err, size_t err_size);
+void lpv_engine_destroy(lpv_engine *e);
+
+/* Uploads the scene (geometry, materials, textures, lights) and samples its
+ * emissive surfaces into VPLs. The scene may be freed afterwards. The grid is
+ * re-placed from the settings and the scene's bounds. */
+int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
+
+/* Copies, resolves and validates settings (zero fields get defaults). */
+int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *err, size_t err_size);
+
+/* Sets the camera (NULL: none; the GV then uses only the RSMs). */
+int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t err_size);
+
+/* Runs one tick: RSMs through propagation. */
+int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size);
+
+/* Shades the view after a tick into rgba (width*height*4 floats, linear
+ * radiance W/(m^2 sr), top row first, alpha 1 where geometry was hit). */
+int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *err, size_t err_size);
+
+const lpv_grid *lpv_engine_grid(const lpv_engine *e);
+const lpv_settings *lpv_engine_settings(const lpv_engine *e);
+const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e);
+
+/* Read-backs for tests and the daemon. Each returns the element count written
+ * (at most max), or 0 if nothing exists yet. */
+typedef enum lpv_grid_which {
+    LPV_GRID_INJECTED = 0,
+    LPV_GRID_ACCUMULATED = 1,
+    LPV_GRID_LAST_STEP = 2, /* the output of the last propagation step */
+} lpv_grid_which;
+size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max);
+size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max);
+size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);
+size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);  /* RSM VPLs then emissive */
+/* Surfels of one GV buffer: 0..light_count-1 = each light's RSM, light_count = the camera. */
+size_t lpv_engine_gv_buffer_count(const lpv_engine *e);
+size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max);
+
+#endif /* LPV_ENGINE_H */

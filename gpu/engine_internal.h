@@ -1,0 +1,120 @@
+/*
+ * engine_internal.h - the engine's GL objects, shared by engine.c and the
+ * pass files (pass_*.c). Not part of the public API.
+ */
+#ifndef LPV_ENGINE_INTERNAL_H
+#define LPV_ENGINE_INTERNAL_H
+
+#include "engine.h"
+#include "gl.h"
+#include "lpv_shared.h"
+#include "timer.h"
+
+typedef struct lpv_gpu_material {
+    float base_color[4];
+    float emission[3];
+    int texture; /* index into lpv_engine.textures, -1 none */
+} lpv_gpu_material;
+
+typedef struct lpv_gpu_draw {
+    uint32_t first_index, index_count;
+    int material;
+} lpv_gpu_draw;
+
+/* A 2D atlas of z slices that points are blended into (see grid.glsl). */
+typedef struct lpv_atlas {
+    int tiles_x, width, height;
+    int attachments;
+    GLuint tex[3];
+    GLuint fbo;
+} lpv_atlas;
+
+struct lpv_engine {
+    lpv_settings settings;
+    lpv_grid grid;
+    int has_scene;
+
+    /* programs */
+    GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
+        prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade;
+
+    /* scene */
+    GLuint vao, vbo, ibo, empty_vao;
+    lpv_gpu_draw *draws;
+    uint32_t draw_count;
+    lpv_gpu_material *materials;
+    uint32_t material_count;
+    GLuint *textures;
+    uint32_t texture_count;
+    lpv_light lights[LPV_MAX_LIGHTS];
+    uint32_t light_count;
+    float scene_min[3], scene_max[3];
+    GLuint emissive_vpls;
+    size_t emissive_vpl_count;
+
+    /* lights and RSMs */
+    struct LpvLightBlock light_block;
+    GLuint light_ubo;
+    int rsm_size, face_count, rsm_alloc_size, rsm_alloc_faces;
+    GLuint rsm_position, rsm_normal, rsm_flux, rsm_depth, rsm_fbo;
+    GLuint vpls, surfels; /* one per RSM texel */
+    size_t rsm_texels;    /* face_count * rsm_size^2 */
+
+    /* grids */
+    GLuint grid_ubo;
+    lpv_atlas lpv_atlas, gv_atlas;
+    GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit;
+    GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
+    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2]; /* buffer-texture views for reading */
+    size_t grid_alloc_cells;
+    int ticked;
+
+    /* camera */
+    int has_view;
+    lpv_view view;
+    GLuint view_ubo;
+    struct LpvViewBlock view_block;
+    int gbuf_w, gbuf_h;
+    GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
+    GLuint frame_tex, frame_fbo;
+
+    lpv_timer timer;
+    lpv_engine_stats stats;
+};
+
+/* Sets a message and returns -1 (for "return fail(...)"). */
+int lpv_engine_fail(char *err, size_t err_size, const char *fmt, ...);
+
+/* Builds a program whose sources get the named .glsl include files first
+ * (after lpv_shared.h). includes is a NULL-terminated list. */
+GLuint lpv_engine_program(const char *vert_or_comp, const char *geom, const char *frag, const char *const *includes,
+                          char *err, size_t err_size);
+
+/* Draws every scene draw with the bound program (material uniforms set). */
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog);
+
+/* Per-pass set-up and work; each _run records its own timer stage. */
+int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
+void lpv_pass_rsm_run(lpv_engine *e);
+void lpv_pass_inject_run(lpv_engine *e);
+void lpv_pass_gbuffer_run(lpv_engine *e);
+void lpv_pass_gv_run(lpv_engine *e);
+void lpv_pass_propagate_run(lpv_engine *e);
+void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
+
+/* Light faces (RSM views) for the scene's lights: fills e->light_block. */
+void lpv_light_faces_build(lpv_engine *e);
+
+/* Atlas helpers (pass_inject.c). */
+int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);
+void lpv_atlas_destroy(lpv_atlas *a);
+void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog);
+void lpv_atlas_splat(lpv_engine *e, GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count);
+void lpv_atlas_end(void);
+
+static inline GLuint lpv_div_up(size_t n, unsigned d)
+{
+    return (GLuint)((n + d - 1) / d);
+}
+
+#endif /* LPV_ENGINE_INTERNAL_H */

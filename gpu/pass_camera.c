@@ -1,0 +1,179 @@
+/*
+ * pass_camera.c - the camera's passes: the G-buffer (position/surfel area,
+ * normal, albedo, emission) with its pixels as GV surfels, and the final
+ * shading of direct light (through the RSM depth as shadow maps) plus the
+ * LPV's irradiance into a linear-radiance frame.
+ */
+#include <math.h>
+#include <string.h>
+
+#include <cglm/cglm.h>
+
+#include "engine_internal.h"
+
+static GLuint texture_2d(GLenum format, int w, int h)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+static void ensure_targets(lpv_engine *e)
+{
+    const int w = e->view.width, h = e->view.height;
+    if (e->gbuf_w == w && e->gbuf_h == h)
+        return;
+    if (e->gbuf_fbo) {
+        glDeleteTextures(4, e->gbuf_tex);
+        glDeleteTextures(1, &e->gbuf_depth);
+        glDeleteTextures(1, &e->frame_tex);
+        glDeleteFramebuffers(1, &e->gbuf_fbo);
+        glDeleteFramebuffers(1, &e->frame_fbo);
+        glDeleteBuffers(1, &e->camera_surfels);
+    }
+    static const GLenum formats[4] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F};
+    glGenFramebuffers(1, &e->gbuf_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
+    GLenum bufs[4];
+    for (int i = 0; i < 4; ++i) {
+        e->gbuf_tex[i] = texture_2d(formats[i], w, h);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf_tex[i], 0);
+        bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
+    }
+    e->gbuf_depth = texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf_depth, 0);
+    glDrawBuffers(4, bufs);
+
+    glGenFramebuffers(1, &e->frame_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->frame_fbo);
+    e->frame_tex = texture_2d(GL_RGBA32F, w, h);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->frame_tex, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    glGenBuffers(1, &e->camera_surfels);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->camera_surfels);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)w * h * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
+    e->gbuf_w = w;
+    e->gbuf_h = h;
+}
+
+/* The view block: matrices from the lpv_view, far plane from the bounds. */
+static void build_view_block(lpv_engine *e)
+{
+    const lpv_view *v = &e->view;
+    struct LpvViewBlock *b = &e->view_block;
+    memset(b, 0, sizeof *b);
+    vec3 eye = {v->eye[0], v->eye[1], v->eye[2]}, fwd = {v->forward[0], v->forward[1], v->forward[2]},
+         up = {v->up[0], v->up[1], v->up[2]}, centre;
+    glm_vec3_normalize(fwd);
+    glm_vec3_add(eye, fwd, centre);
+    vec3 ext;
+    glm_vec3_sub(e->scene_max, e->scene_min, ext);
+    float radius = 0.5f * glm_vec3_norm(ext);
+    if (!(radius > 1e-6f))
+        radius = 1.0f;
+    float far_z = v->zfar;
+    if (!(far_z > 0.0f)) {
+        vec3 mid;
+        glm_vec3_center(e->scene_min, e->scene_max, mid);
+        far_z = glm_vec3_distance(eye, mid) + 2.0f * radius;
+    }
+    float near_z = v->znear > 0.0f ? v->znear : 1e-3f * radius;
+    float aspect = (float)v->width / (float)v->height;
+    mat4 view, proj;
+    glm_lookat(eye, centre, up, view);
+    if (v->orthographic)
+        glm_ortho(-v->ymag * aspect, v->ymag * aspect, -v->ymag, v->ymag, near_z, far_z, proj);
+    else
+        glm_perspective(v->yfov, aspect, near_z, far_z, proj);
+    glm_mat4_mul(proj, view, b->view_proj);
+    glm_vec3_copy(eye, b->eye);
+    b->eye[3] = v->orthographic ? 0.0f : 1.0f;
+    glm_vec3_copy(fwd, b->forward);
+    b->forward[3] = v->orthographic ? v->ymag : tanf(0.5f * v->yfov);
+    b->viewport[0] = (float)v->width;
+    b->viewport[1] = (float)v->height;
+    b->viewport[2] = aspect;
+}
+
+void lpv_pass_gbuffer_run(lpv_engine *e)
+{
+    lpv_timer_begin(&e->timer, "gbuffer");
+    ensure_targets(e);
+    build_view_block(e);
+    const lpv_view *v = &e->view;
+    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
+    glViewport(0, 0, v->width, v->height);
+    static const float zero[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 4; ++i)
+        glClearBufferfv(GL_COLOR, i, zero);
+    glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    GLuint p = e->prog_gbuffer;
+    glUseProgram(p);
+    glUniformMatrix4fv(glGetUniformLocation(p, "u_view_proj"), 1, GL_FALSE, (const float *)e->view_block.view_proj);
+    glUniform3fv(glGetUniformLocation(p, "u_eye"), 1, e->view_block.eye);
+    glUniform3fv(glGetUniformLocation(p, "u_forward"), 1, e->view_block.forward);
+    float pixel = 2.0f * e->view_block.forward[3] / (float)v->height; /* tan-plane or metres per pixel */
+    glUniform1f(glGetUniformLocation(p, "u_pixel_solid_angle"), v->orthographic ? 0.0f : pixel * pixel);
+    glUniform1f(glGetUniformLocation(p, "u_pixel_area"), v->orthographic ? pixel * pixel : 0.0f);
+    lpv_engine_draw_scene(e, p);
+    glDisable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    glUseProgram(e->prog_camera_surfels);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[0]);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[1]);
+    glUniform2i(glGetUniformLocation(e->prog_camera_surfels, "u_size"), v->width, v->height);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->camera_surfels);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up((size_t)v->width, LPV_WG_2D), lpv_div_up((size_t)v->height, LPV_WG_2D), 1);
+    lpv_timer_count(&e->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    lpv_timer_end(&e->timer);
+}
+
+void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
+{
+    lpv_timer_begin(&e->timer, "shade");
+    struct LpvViewBlock *b = &e->view_block;
+    b->shading[0] = e->settings.indirect_gain;
+    b->shading[1] = terms != LPV_TERMS_INDIRECT_ONLY;
+    b->shading[2] = terms != LPV_TERMS_DIRECT_ONLY;
+    b->shading[3] = terms != LPV_TERMS_INDIRECT_ONLY;
+    glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
+
+    glBindFramebuffer(GL_FRAMEBUFFER, e->frame_fbo);
+    glViewport(0, 0, e->gbuf_w, e->gbuf_h);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(e->prog_shade);
+    for (int i = 0; i < 4; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
+    }
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->rsm_depth);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
+    glBindVertexArray(e->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    lpv_timer_count(&e->timer, 1);
+    glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    lpv_timer_end(&e->timer);
+}

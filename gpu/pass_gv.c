@@ -1,0 +1,57 @@
+/*
+ * pass_gv.c - the geometry volume for fuzzy occlusion. Each buffer that saw
+ * surfaces (each light's RSM faces, and the camera's G-buffer) splats its
+ * surfels into the GV atlas and is then max-merged into the total, so a
+ * surface seen by several buffers blocks once. Finally the per-cell, per-
+ * direction transmittances are computed once for the whole propagation.
+ */
+#include "engine_internal.h"
+
+static void merge(lpv_engine *e)
+{
+    glUseProgram(e->prog_gv_merge);
+    glUniform1i(glGetUniformLocation(e->prog_gv_merge, "u_tiles_x"), e->gv_atlas.tiles_x);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, e->gv_atlas.tex[0]);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_GV_TOTAL, e->gv_total);
+    glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0] + 1, LPV_WG_2D),
+                      lpv_div_up((size_t)e->grid.dims[1] + 1, LPV_WG_2D), (GLuint)e->grid.dims[2] + 1);
+    lpv_timer_count(&e->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void lpv_pass_gv_run(lpv_engine *e)
+{
+    lpv_timer_begin(&e->timer, "gv");
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->gv_total);
+    glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_RGBA32F, GL_RGBA, GL_FLOAT, NULL);
+
+    const size_t per_face = (size_t)e->rsm_size * (size_t)e->rsm_size;
+    const int lights = (int)e->light_block.counts[0];
+    for (int l = 0; l < lights; ++l) {
+        const struct LpvLightGpu *g = &e->light_block.lights[l];
+        lpv_atlas_begin(e, &e->gv_atlas, e->prog_inject_gv);
+        lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->surfels, (size_t)g->cone_faces[2] * per_face,
+                        (size_t)g->cone_faces[3] * per_face);
+        lpv_atlas_end();
+        merge(e);
+    }
+    if (e->has_view) {
+        lpv_atlas_begin(e, &e->gv_atlas, e->prog_inject_gv);
+        lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->camera_surfels, 0,
+                        (size_t)e->gbuf_w * (size_t)e->gbuf_h);
+        lpv_atlas_end();
+        merge(e);
+    }
+
+    glUseProgram(e->prog_transmit);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_GV_TOTAL, e->gv_total);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_TRANSMIT, e->transmit);
+    glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D),
+                      (GLuint)e->grid.dims[2]);
+    lpv_timer_count(&e->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    lpv_timer_end(&e->timer);
+}

@@ -1,0 +1,39 @@
+/*
+ * pass_propagate.c - the propagation iterations: ping-pong between two
+ * buffers, each step's output also added into the accumulated volume (which
+ * the injection pass initialised with the injected grid). Occlusion is
+ * skipped on the first step (the paper's rule against self-shadowing).
+ */
+#include "engine_internal.h"
+
+void lpv_pass_propagate_run(lpv_engine *e)
+{
+    lpv_timer_begin(&e->timer, "propagate");
+    glUseProgram(e->prog_propagate);
+    GLint loc_occ = glGetUniformLocation(e->prog_propagate, "u_occlusion");
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_TRANSMIT, e->transmit);
+    const int occlusion = e->settings.occlusion == LPV_SWITCH_ON;
+    GLuint in = e->lpv_injected;
+
+    for (int i = 0; i < e->settings.iterations; ++i) {
+        GLuint out = (i & 1) ? e->lpv_pong : e->lpv_ping;
+        /* Reads go through buffer textures over the same storage: on
+         * llvmpipe texel fetches gather far faster than SSBO loads. */
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_BUFFER, in == e->lpv_injected ? e->tbo_injected : in == e->lpv_ping ? e->tbo_ping : e->tbo_pong);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_BUFFER, e->tbo_sigma[i & 1]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_IN, e->sigma[i & 1]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[(i + 1) & 1]);
+        glUniform1i(loc_occ, occlusion && i > 0);
+        glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
+                          lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y), (GLuint)e->grid.dims[2]);
+        lpv_timer_count(&e->timer, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        in = out;
+    }
+    lpv_timer_end(&e->timer);
+}

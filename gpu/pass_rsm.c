@@ -1,0 +1,120 @@
+/*
+ * pass_rsm.c - reflective shadow maps: every light face renders the scene's
+ * position/area, normal and reflected flux into one layer of three 2D array
+ * textures (plus depth, which direct shading reuses as its shadow map); a
+ * compute pass then turns every texel into one VPL and one surfel.
+ */
+#include "engine_internal.h"
+
+static GLuint array_texture(GLenum format, int size, int layers)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, t);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, format, size, size, layers);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+}
+
+int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
+{
+    lpv_light_faces_build(e);
+    glBindBuffer(GL_UNIFORM_BUFFER, e->light_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof e->light_block, &e->light_block);
+
+    const int size = e->settings.rsm_size;
+    const int layers = e->face_count > 0 ? e->face_count : 1;
+    e->rsm_size = size;
+    e->rsm_texels = (size_t)e->face_count * (size_t)size * (size_t)size;
+    if (e->rsm_alloc_size == size && e->rsm_alloc_faces == layers)
+        return 0;
+
+    if (e->rsm_position) {
+        GLuint tex[] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_depth};
+        glDeleteTextures(4, tex);
+        glDeleteFramebuffers(1, &e->rsm_fbo);
+        glDeleteBuffers(1, &e->vpls);
+        glDeleteBuffers(1, &e->surfels);
+    }
+    e->rsm_position = array_texture(GL_RGBA32F, size, layers);
+    e->rsm_normal = array_texture(GL_RGBA32F, size, layers);
+    e->rsm_flux = array_texture(GL_RGBA32F, size, layers);
+    e->rsm_depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
+    /* The depth layers double as shadow maps: compare mode, 2x2 PCF. */
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->rsm_depth);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glGenFramebuffers(1, &e->rsm_fbo);
+
+    size_t texels = (size_t)layers * (size_t)size * (size_t)size;
+    glGenBuffers(1, &e->vpls);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_vpl)), NULL, GL_DYNAMIC_COPY);
+    glGenBuffers(1, &e->surfels);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
+    if (glGetError() != GL_NO_ERROR)
+        return lpv_engine_fail(err, err_size, "could not allocate %d RSM faces of %d^2 texels", layers, size);
+    e->rsm_alloc_size = size;
+    e->rsm_alloc_faces = layers;
+    return 0;
+}
+
+void lpv_pass_rsm_run(lpv_engine *e)
+{
+    const int size = e->rsm_size;
+    lpv_timer_begin(&e->timer, "rsm");
+    glBindFramebuffer(GL_FRAMEBUFFER, e->rsm_fbo);
+    static const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(3, bufs);
+    glViewport(0, 0, size, size);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glUseProgram(e->prog_rsm);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
+    GLint loc_vp = glGetUniformLocation(e->prog_rsm, "u_view_proj");
+    GLint loc_face = glGetUniformLocation(e->prog_rsm, "u_face");
+    for (int f = 0; f < e->face_count; ++f) {
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->rsm_position, 0, f);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, e->rsm_normal, 0, f);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, e->rsm_flux, 0, f);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->rsm_depth, 0, f);
+        static const float zero[4] = {0, 0, 0, 0};
+        for (int i = 0; i < 3; ++i)
+            glClearBufferfv(GL_COLOR, i, zero);
+        glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+        glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
+        glUniform1i(loc_face, f);
+        lpv_engine_draw_scene(e, e->prog_rsm);
+    }
+    glDisable(GL_DEPTH_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    lpv_timer_end(&e->timer);
+
+    lpv_timer_begin(&e->timer, "vpl_extract");
+    if (e->face_count > 0) {
+        glUseProgram(e->prog_vpl_extract);
+        GLuint tex[3] = {e->rsm_position, e->rsm_normal, e->rsm_flux};
+        for (int i = 0; i < 3; ++i) {
+            glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+            glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
+        }
+        glUniform1i(glGetUniformLocation(e->prog_vpl_extract, "u_size"), size);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->vpls);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->surfels);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+        glDispatchCompute(lpv_div_up((size_t)size, LPV_WG_2D), lpv_div_up((size_t)size, LPV_WG_2D),
+                          (GLuint)e->face_count);
+        lpv_timer_count(&e->timer, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    lpv_timer_end(&e->timer);
+}

@@ -1,0 +1,8 @@
+/* commands.h - the subcommands of the lpvd program; each takes its own
+ * argv (argv[0] is the subcommand's name) and returns the exit status. */
+#ifndef LPVD_COMMANDS_H
+#define LPVD_COMMANDS_H
+
+int lpvd_cmd_render(int argc, char **argv);
+
+#endif

@@ -1,0 +1,40 @@
+/*
+ * main.c - the lpvd program: a dispatcher over subcommands.
+ *   lpvd render ...   one frame of a scene to an image (offline, batch jobs)
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "commands.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lpvd <command> [args]\n"
+            "commands:\n"
+            "  render [SCENE] -o OUT.png|OUT.exr   render a glTF scene (default: built-in Cornell box)\n"
+            "  version                             print the version\n"
+            "Run 'lpvd <command> --help' for a command's flags.\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "render") == 0)
+        return lpvd_cmd_render(argc - 1, argv + 1);
+    if (strcmp(cmd, "version") == 0 || strcmp(cmd, "--version") == 0) {
+        printf("lpvd %s\n", LPVD_VERSION);
+        return 0;
+    }
+    if (strcmp(cmd, "help") == 0 || strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    fprintf(stderr, "lpvd: unknown command '%s'\n", cmd);
+    usage(stderr);
+    return 2;
+}

@@ -1,0 +1,38 @@
+// gbuffer.frag - the camera's view of the scene: position, normal facing the
+// camera, albedo and emission per pixel (also the camera's surfels for the
+// geometry volume).
+in vec3 v_position;
+in vec3 v_normal;
+in vec2 v_uv;
+
+uniform vec3 u_eye;
+uniform float u_pixel_solid_angle; // sr per pixel at the image centre (perspective), 0 = orthographic
+uniform float u_pixel_area;        // m^2 per pixel (orthographic)
+uniform vec3 u_forward;
+
+layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0 = covered
+layout(location = 1) out vec4 o_normal;   // xyz unit, facing the camera; w 1 = covered
+layout(location = 2) out vec4 o_albedo;   // rgb linear albedo
+layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr)
+
+void main()
+{
+    vec3 p = v_position;
+    vec3 to_eye = normalize(u_eye - p);
+    vec3 n = surface_normal(v_normal, p, to_eye);
+    float cos_s = max(dot(n, to_eye), 0.05);
+    float area;
+    if (u_pixel_solid_angle > 0.0) {
+        vec3 d = p - u_eye;
+        float dist2 = dot(d, d);
+        float cos_t = max(dot(normalize(d), u_forward), 1e-3);
+        // a pixel's solid angle falls as cos^3 away from the image centre
+        area = u_pixel_solid_angle * cos_t * cos_t * cos_t * dist2 / cos_s;
+    } else {
+        area = u_pixel_area / cos_s;
+    }
+    o_position = vec4(p, area);
+    o_normal = vec4(n, 1.0);
+    o_albedo = vec4(material_albedo(v_uv).rgb, 1.0);
+    o_emission = vec4(u_emission, 1.0);
+}

@@ -1,0 +1,35 @@
+// inject_vpl.vert - one point per VPL into the LPV atlas, at the cell holding
+// position + half a cell along the normal, carrying lobe(n) * flux / pi per
+// channel. Additive blending sums VPLs in array order: portable, no float
+// atomics, deterministic.
+layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Vpls { LpvVpl vpls[]; };
+
+uniform int u_first;
+uniform vec2 u_atlas_size;
+
+flat out vec4 v_r;
+flat out vec4 v_g;
+flat out vec4 v_b;
+
+void main()
+{
+    LpvVpl v = vpls[u_first + gl_VertexID];
+    gl_PointSize = 1.0;
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
+    v_r = v_g = v_b = vec4(0.0);
+
+    float len = length(v.normal.xyz);
+    if (v.position.w == 0.0 || !finite3(v.position.xyz) || !finite3(v.flux.rgb) || !(len > 1e-8) || isinf(len))
+        return;
+    vec3 n = v.normal.xyz / len;
+    ivec3 c = ivec3(floor((v.position.xyz + 0.5 * grid_cell_size() * n - grid_origin()) / grid_cell_size()));
+    if (!cell_inside(c))
+        return;
+
+    vec4 lobe = sh_lobe(n) / LPV_PI;
+    v_r = lobe * v.flux.r;
+    v_g = lobe * v.flux.g;
+    v_b = lobe * v.flux.b;
+    vec2 texel = vec2(atlas_texel(c, grid_dims().xy)) + 0.5;
+    gl_Position = vec4(texel / u_atlas_size * 2.0 - 1.0, 0.0, 1.0);
+}

@@ -1,0 +1,56 @@
+// lights.glsl - punctual lights (KHR_lights_punctual semantics, radiometric
+// units): the power each light delivers, shared by the RSMs and direct shading.
+layout(std140, binding = LPV_UBO_LIGHT) uniform LightUBO { LpvLightBlock L; };
+
+// glTF's recommended smooth cone falloff: (clamp((cos - cos_outer) / (cos_inner - cos_outer)))^2.
+float spot_factor(LpvLightGpu li, vec3 travel_dir)
+{
+    if (int(li.position_type.w) != LPV_LIGHT_TYPE_SPOT)
+        return 1.0;
+    float cd = dot(travel_dir, li.direction_range.xyz);
+    float scale = 1.0 / max(1e-3, li.cone_faces.x - li.cone_faces.y);
+    float t = clamp((cd - li.cone_faces.y) * scale, 0.0, 1.0);
+    return t * t;
+}
+
+// glTF's range window clamp(1 - (d / range)^4, 0, 1)^2 (the 1/d^2 is separate).
+float range_window(LpvLightGpu li, float dist)
+{
+    float r = li.direction_range.w;
+    if (!(r > 0.0))
+        return 1.0;
+    float q = dist / r;
+    float w = clamp(1.0 - q * q * q * q, 0.0, 1.0);
+    return w * w;
+}
+
+// Irradiance (W/m^2, rgb) on a surface perpendicular to the light at p, and
+// the unit direction from p towards the light.
+vec3 light_irradiance_normal(LpvLightGpu li, vec3 p, out vec3 to_light)
+{
+    if (int(li.position_type.w) == LPV_LIGHT_TYPE_DIRECTIONAL) {
+        to_light = -li.direction_range.xyz;
+        return li.intensity.rgb;
+    }
+    vec3 d = li.position_type.xyz - p;
+    float dist2 = max(dot(d, d), 1e-12);
+    float dist = sqrt(dist2);
+    to_light = d / dist;
+    return li.intensity.rgb * spot_factor(li, -to_light) * range_window(li, dist) / dist2;
+}
+
+// The face of light `li` whose shadow map covers p: the single face, or the
+// cube face of the major axis of p - light (faces ordered +x -x +y -y +z -z).
+int light_face_for(LpvLightGpu li, vec3 p)
+{
+    int first = int(li.cone_faces.z);
+    if (int(li.cone_faces.w) < 6)
+        return first;
+    vec3 d = p - li.position_type.xyz;
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z)
+        return first + (d.x >= 0.0 ? 0 : 1);
+    if (a.y >= a.z)
+        return first + (d.y >= 0.0 ? 2 : 3);
+    return first + (d.z >= 0.0 ? 4 : 5);
+}

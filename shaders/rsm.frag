@@ -1,0 +1,49 @@
+// rsm.frag - reflective shadow map: for every texel the light sees, the
+// surfel's position and area, its normal (facing the light) and the flux it
+// reflects (W), so each texel becomes one VPL and one blocking surfel.
+in vec3 v_position;
+in vec3 v_normal;
+in vec2 v_uv;
+
+uniform int u_face;
+
+layout(location = 0) out vec4 o_position; // xyz world (m); w surfel area (m^2)
+layout(location = 1) out vec4 o_normal;   // xyz unit normal facing the light; w 1 = covered
+layout(location = 2) out vec4 o_flux;     // rgb reflected flux (W)
+
+// Grazing surfels would get unbounded areas; their blocking saturates anyway.
+const float MIN_COS = 0.05;
+
+void main()
+{
+    LpvFaceGpu F = L.faces[u_face];
+    LpvLightGpu li = L.lights[int(F.info.x)];
+    vec3 p = v_position;
+
+    vec3 to_light;
+    vec3 e_perp = light_irradiance_normal(li, p, to_light);
+    vec3 n = surface_normal(v_normal, p, to_light);
+    float cos_s = max(dot(n, to_light), MIN_COS);
+
+    // Power arriving through this texel: irradiance x footprint for an
+    // orthographic face; I x solid angle for a perspective one (octree thesis
+    // 3.3: Omega = 4 cos^3(theta) tan^2(fov/2) / N^2). e_perp already holds
+    // I * falloff / d^2, so multiply back by d^2.
+    float texel_area_perp; // m^2, perpendicular to the light's rays
+    if (F.info.y == 0.0) {
+        texel_area_perp = F.info.z;
+    } else {
+        vec3 d = p - li.position_type.xyz;
+        float dist2 = dot(d, d);
+        float cos_t = max(dot(normalize(d), F.axis.xyz), 0.0);
+        float n_texels = F.info.w;
+        float omega = 4.0 * cos_t * cos_t * cos_t * F.info.z * F.info.z / (n_texels * n_texels);
+        texel_area_perp = omega * dist2;
+    }
+    vec3 power = e_perp * texel_area_perp;
+    vec3 albedo = material_albedo(v_uv).rgb;
+
+    o_position = vec4(p, texel_area_perp / cos_s);
+    o_normal = vec4(n, 1.0);
+    o_flux = vec4(albedo * power, 0.0);
+}

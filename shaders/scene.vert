@@ -1,0 +1,19 @@
+// scene.vert - world-space scene geometry (lpv_vertex) through one view-projection.
+// Used by the reflective shadow maps and the camera G-buffer.
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+
+uniform mat4 u_view_proj;
+
+out vec3 v_position;
+out vec3 v_normal;
+out vec2 v_uv;
+
+void main()
+{
+    v_position = a_position;
+    v_normal = a_normal;
+    v_uv = a_uv;
+    gl_Position = u_view_proj * vec4(a_position, 1.0);
+}

@@ -1,0 +1,29 @@
+// vpl_extract.comp - turns every RSM texel of every face into one VPL and one
+// surfel (position.w = 0 / area 0 where the texel saw nothing).
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+layout(binding = 0) uniform sampler2DArray u_rsm_position;
+layout(binding = 1) uniform sampler2DArray u_rsm_normal;
+layout(binding = 2) uniform sampler2DArray u_rsm_flux;
+
+layout(std430, binding = LPV_SSBO_VPLS) writeonly buffer Vpls { LpvVpl vpls[]; };
+layout(std430, binding = LPV_SSBO_SURFELS) writeonly buffer Surfels { LpvSurfel surfels[]; };
+
+uniform int u_size;
+
+void main()
+{
+    ivec3 t = ivec3(gl_GlobalInvocationID);
+    if (t.x >= u_size || t.y >= u_size)
+        return;
+    uint i = uint(t.x + u_size * (t.y + u_size * t.z));
+    vec4 p = texelFetch(u_rsm_position, t, 0);
+    vec4 n = texelFetch(u_rsm_normal, t, 0);
+    vec4 f = texelFetch(u_rsm_flux, t, 0);
+    bool covered = n.w > 0.5;
+    vpls[i].position = vec4(p.xyz, covered ? 1.0 : 0.0);
+    vpls[i].normal = vec4(n.xyz, 0.0);
+    vpls[i].flux = vec4(f.rgb, 0.0);
+    surfels[i].position = vec4(p.xyz, covered ? p.w : 0.0);
+    surfels[i].normal = vec4(n.xyz, 0.0);
+}

@@ -1,0 +1,200 @@
+/*
+ * test_gpu_oracle.c - the GPU pipeline against the plain-C oracle.
+ *
+ * The built-in Cornell box is ticked on the GPU (llvmpipe in CI); the VPLs
+ * and surfels the GPU produced are read back and fed to the oracle, and each
+ * grid the GPU built (injected LPV, geometry volume, transmittances,
+ * accumulated LPV) must match the oracle's within a stated tolerance:
+ * |gpu - oracle| <= 1e-4 * max|oracle| + 1e-5 * |oracle| per value.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "context.h"
+#include "engine.h"
+#include "oracle.h"
+#include "scene.h"
+
+typedef struct fixture {
+    lpv_gl_context *ctx;
+    lpv_engine *engine;
+    lpv_scene scene;
+} fixture;
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    char err[1024];
+    f->ctx = lpv_gl_context_create(&(lpv_gl_context_desc){0}, err, sizeof err);
+    if (!f->ctx) {
+        fprintf(stderr, "no GL context: %s\n", err);
+        return -1;
+    }
+    if (lpv_scene_builtin_cornell(&f->scene) != 0)
+        return -1;
+    f->engine = lpv_engine_create(err, sizeof err);
+    if (!f->engine) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    lpv_engine_destroy(f->engine);
+    lpv_gl_context_destroy(f->ctx);
+    lpv_scene_free(&f->scene);
+    free(f);
+    return 0;
+}
+
+static void tick(fixture *f, const lpv_settings *s, int with_view)
+{
+    char err[1024] = "";
+    assert_int_equal(lpv_engine_set_settings(f->engine, s, err, sizeof err), 0);
+    assert_int_equal(lpv_engine_set_scene(f->engine, &f->scene, err, sizeof err), 0);
+    lpv_view view;
+    lpv_view_from_camera(&f->scene.cameras[0], 48, 48, &view);
+    assert_int_equal(lpv_engine_set_view(f->engine, with_view ? &view : NULL, err, sizeof err), 0);
+    if (lpv_engine_tick(f->engine, err, sizeof err) != 0)
+        fail_msg("tick: %s", err);
+}
+
+/* Compares n floats; returns the worst error relative to the tolerance. */
+static void assert_close(const char *what, const float *gpu, const float *ref, size_t n)
+{
+    double max_ref = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        if (fabs(ref[i]) > max_ref)
+            max_ref = fabs(ref[i]);
+    assert_true(max_ref > 0.0); /* the comparison must be about something */
+    size_t worst = 0;
+    double worst_ratio = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        assert_true(isfinite(gpu[i]));
+        double tol = 1e-4 * max_ref + 1e-5 * fabs(ref[i]);
+        double ratio = fabs((double)gpu[i] - ref[i]) / tol;
+        if (ratio > worst_ratio) {
+            worst_ratio = ratio;
+            worst = i;
+        }
+    }
+    printf("%s: %zu values, max |ref| %.4g, worst error %.3g of tolerance (at %zu: gpu %.6g ref %.6g)\n", what, n,
+           max_ref, worst_ratio, worst, gpu[worst], ref[worst]);
+    if (worst_ratio > 1.0)
+        fail_msg("%s differs from the oracle at %zu: gpu %.9g oracle %.9g", what, worst, gpu[worst], ref[worst]);
+}
+
+static void test_injection_matches_oracle(void **state)
+{
+    fixture *f = *state;
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 4, .occlusion = LPV_SWITCH_OFF};
+    tick(f, &s, 0);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
+    size_t cells = lpv_grid_cell_count(g);
+    size_t vmax = 64 * 64 * 6 + 8192;
+    lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
+    size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
+    assert_true(nv > 64 * 64); /* the spot's RSM plus the emissive ceiling quad */
+    lpv_cell *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref);
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, gpu, cells), cells);
+    size_t injected = lpv_oracle_inject_vpls(g, vpls, nv, ref);
+    assert_true(injected > 1000);
+    assert_close("injected LPV", (const float *)gpu, (const float *)ref, cells * 12);
+    free(vpls);
+    free(gpu);
+    free(ref);
+}
+
+static void test_geometry_volume_matches_oracle(void **state)
+{
+    fixture *f = *state;
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 4, .occlusion = LPV_SWITCH_ON};
+    tick(f, &s, 1);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
+    size_t gv_n = lpv_grid_gv_count(g), cells = lpv_grid_cell_count(g);
+    vec4 *ref = calloc(gv_n, sizeof *ref), *tmp = calloc(gv_n, sizeof *tmp), *gpu = calloc(gv_n, sizeof *gpu);
+    size_t smax = 64 * 64 * 6 + 48 * 48;
+    lpv_surfel *surfels = calloc(smax, sizeof *surfels);
+    size_t buffers = lpv_engine_gv_buffer_count(f->engine);
+    assert_int_equal(buffers, 2); /* the spot light's RSM and the camera */
+    for (size_t b = 0; b < buffers; ++b) {
+        size_t n = lpv_engine_read_surfels(f->engine, b, surfels, smax);
+        assert_true(n > 0);
+        memset(tmp, 0, gv_n * sizeof *tmp);
+        assert_true(lpv_oracle_inject_surfels(g, surfels, n, tmp) > 100);
+        lpv_oracle_gv_merge(g, tmp, ref);
+    }
+    assert_int_equal(lpv_engine_read_gv(f->engine, gpu, gv_n), gv_n);
+    assert_close("geometry volume", (const float *)gpu, (const float *)ref, gv_n * 4);
+
+    /* Transmittances from the GPU's GV: only the arithmetic is compared. */
+    float *t_gpu = calloc(cells * 6, sizeof *t_gpu), *t_ref = calloc(cells * 6, sizeof *t_ref);
+    assert_int_equal(lpv_engine_read_transmittance(f->engine, t_gpu, cells * 6), cells * 6);
+    lpv_oracle_transmittance(g, (const vec4 *)gpu, t_ref);
+    size_t blocked = 0;
+    for (size_t i = 0; i < cells * 6; ++i) {
+        assert_true(t_gpu[i] >= 0.0f && t_gpu[i] <= 1.0f);
+        assert_true(fabsf(t_gpu[i] - t_ref[i]) <= 1e-5f);
+        blocked += t_ref[i] < 0.5f;
+    }
+    assert_true(blocked > 50); /* the box's walls do block */
+    free(ref);
+    free(tmp);
+    free(gpu);
+    free(surfels);
+    free(t_gpu);
+    free(t_ref);
+}
+
+static void check_propagation(fixture *f, lpv_switch occlusion, int iterations)
+{
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = iterations, .occlusion = occlusion};
+    tick(f, &s, 1);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
+    size_t cells = lpv_grid_cell_count(g);
+    lpv_cell *inj = calloc(cells, sizeof *inj), *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref);
+    float *t = NULL;
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, inj, cells), cells);
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_ACCUMULATED, gpu, cells), cells);
+    if (occlusion == LPV_SWITCH_ON) {
+        t = calloc(cells * 6, sizeof *t);
+        assert_int_equal(lpv_engine_read_transmittance(f->engine, t, cells * 6), cells * 6);
+    }
+    assert_int_equal(lpv_oracle_propagate(g, inj, t, iterations, ref), 0);
+    char what[64];
+    snprintf(what, sizeof what, "accumulated LPV (%d steps, occlusion %s)", iterations,
+             occlusion == LPV_SWITCH_ON ? "on" : "off");
+    assert_close(what, (const float *)gpu, (const float *)ref, cells * 12);
+    free(inj);
+    free(gpu);
+    free(ref);
+    free(t);
+}
+
+static void test_propagation_matches_oracle(void **state)
+{
+    check_propagation(*state, LPV_SWITCH_OFF, 8);
+    check_propagation(*state, LPV_SWITCH_ON, 8);
+    check_propagation(*state, LPV_SWITCH_ON, 1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_injection_matches_oracle),
+        cmocka_unit_test(test_geometry_volume_matches_oracle),
+        cmocka_unit_test(test_propagation_matches_oracle),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
