@@ -21,7 +21,8 @@ typedef struct lpv_grid {
     float cell_size;  /* m */
 } lpv_grid;
 
-/* Places a grid of dims cells over [bmin, bmax]. Returns 0, or -1 when a
+/* Places a grid of dims cells over [bmin, bmax]. Returns 0, or -1 when a bound
+ * is not finite or when a
  * dimension is outside 1..LPV_MAX_GRID_DIM. */
 int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], lpv_grid *out);
 

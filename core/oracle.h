@@ -49,9 +49,10 @@ void lpv_oracle_propagate_step(const lpv_grid *g, const lpv_cell *in, const floa
 int lpv_oracle_propagate(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
                          lpv_cell *acc);
 
-/* Irradiance (W/m^2, rgb) at p for a surface with unit normal n:
- * max(0, dot(c(p), lobe(-n)) / cell_size^2) with c trilinearly interpolated
- * between cell centres, clamped at the grid's edge. */
+/* Irradiance (W/m^2, rgb) at p for a surface with normal n (normalised here;
+ * a degenerate n or NaN p gives 0): max(0, dot(c(q), lobe(-n)) / cell_size^2)
+ * with q = p + 0.5 * cell_size * n (half a cell in front of the surface) and c
+ * trilinearly interpolated between cell centres, clamped at the grid's edge. */
 void lpv_oracle_irradiance(const lpv_grid *g, const lpv_cell *acc, const float p[3], const float n[3], float rgb[3]);
 
 /* Total flux (W) of a grid per channel: sum of c0 * sqrt(4 pi). */

@@ -60,6 +60,7 @@ static const char *const INC_PROPAGATE[] = {"grid.glsl", "flux_limit.glsl", NULL
 static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
 static const char *const INC_RSM[] = {"material.glsl", "lights.glsl", NULL};
 static const char *const INC_SHADE[] = {"grid.glsl", "lights.glsl", "lookup.glsl", NULL};
+static const char *const INC_LOOKUP[] = {"grid.glsl", "lookup.glsl", NULL};
 
 lpv_engine *lpv_engine_create(char *err, size_t err_size)
 {
@@ -84,6 +85,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, NULL},
         {&e->prog_shade, "fullscreen.vert", "shade.frag", INC_SHADE},
+        {&e->prog_query, "query.comp", NULL, INC_LOOKUP},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog = lpv_engine_program(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
@@ -201,9 +203,11 @@ void lpv_engine_destroy(lpv_engine *e)
     free_rsm(e);
     free_grids(e);
     free_camera(e);
+    delete_buffer(&e->query_in);
+    delete_buffer(&e->query_out);
     GLuint *progs[] = {&e->prog_rsm, &e->prog_vpl_extract, &e->prog_inject_vpl, &e->prog_inject_gv,
                        &e->prog_pack, &e->prog_gv_merge, &e->prog_transmit, &e->prog_propagate,
-                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade};
+                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade, &e->prog_query};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -515,6 +519,59 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         s->stages[k].cpu_ms = st->cpu_ms;
         s->stages[k].calls = st->count;
     }
+    return 0;
+}
+
+int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
+                          size_t err_size)
+{
+    if (!e->ticked)
+        return lpv_engine_fail(err, err_size, "irradiance query before a tick");
+    if (n == 0)
+        return 0;
+    if (n > (size_t)1 << 26)
+        return lpv_engine_fail(err, err_size, "%zu query points, at most %zu per call", n, (size_t)1 << 26);
+    float *in = malloc(n * 8 * sizeof(float));
+    float *out = malloc(n * 4 * sizeof(float));
+    if (!in || !out) {
+        free(in);
+        free(out);
+        return lpv_engine_fail(err, err_size, "out of memory for %zu query points", n);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            in[i * 8 + (size_t)k] = points[i * 3 + (size_t)k];
+            in[i * 8 + 4 + (size_t)k] = normals[i * 3 + (size_t)k];
+        }
+        in[i * 8 + 3] = in[i * 8 + 7] = 0.0f;
+    }
+    if (e->query_capacity < n) {
+        delete_buffer(&e->query_in);
+        delete_buffer(&e->query_out);
+        e->query_in = new_ssbo(n * 8 * sizeof(float));
+        e->query_out = new_ssbo(n * 4 * sizeof(float));
+        e->query_capacity = n;
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_in);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
+    glUseProgram(e->prog_query);
+    glUniform1i(glGetUniformLocation(e->prog_query, "u_count"), (GLint)n);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
+    glDispatchCompute(lpv_div_up(n, 64), 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_out);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 4 * sizeof(float)), out);
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+            rgb[i * 3 + (size_t)k] = out[i * 4 + (size_t)k];
+    free(in);
+    free(out);
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR)
+        return lpv_engine_fail(err, err_size, "GL error 0x%04x during the irradiance query", gl_err);
     return 0;
 }
 

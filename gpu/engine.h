@@ -73,6 +73,12 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size);
  * radiance W/(m^2 sr), top row first, alpha 1 where geometry was hit). */
 int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *err, size_t err_size);
 
+/* Irradiance (W/m^2, rgb) from the last tick's accumulated LPV at n points
+ * (xyz triples) for surfaces with the given normals (xyz triples), the lookup
+ * the shading uses. rgb receives 3n floats. */
+int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
+                          size_t err_size);
+
 const lpv_grid *lpv_engine_grid(const lpv_engine *e);
 const lpv_settings *lpv_engine_settings(const lpv_engine *e);
 const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e);

@@ -36,7 +36,7 @@ struct lpv_engine {
 
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
-        prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade;
+        prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -77,6 +77,9 @@ struct lpv_engine {
     int gbuf_w, gbuf_h;
     GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
+
+    GLuint query_in, query_out; /* irradiance queries */
+    size_t query_capacity;
 
     lpv_timer timer;
     lpv_engine_stats stats;

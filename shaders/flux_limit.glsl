@@ -5,6 +5,8 @@
 // never sends out more flux than the cell holds.
 float flux_limit(vec4 c)
 {
+    if (any(isnan(c)) || any(isinf(c)))
+        return 0.0;
     vec3 bc = LPV_PROP_B * c.yzw;
     float a = LPV_PROP_A * c.x;
     vec3 plus = max(vec3(a) + bc, 0.0);

@@ -1,14 +1,19 @@
 // lookup.glsl - irradiance from the accumulated LPV (core/oracle_lookup.c is
 // the reference): trilinear interpolation between cell centres, clamped at
-// the grid's edge, then E = max(0, c . lobe(-n) / cell^2) per channel: the
+// the grid's edge, at half a cell in front of the surface, then E = max(0, c . lobe(-n) / cell^2) per channel: the
 // stored intensity per cell cross-section read as radiance, integrated against
 // the cosine over the hemisphere the surface faces.
 layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer AccLookup { LpvCell lpv[]; };
 
-vec3 lpv_irradiance(vec3 p, vec3 n)
+vec3 lpv_irradiance(vec3 p, vec3 n_in)
 {
+    float len = length(n_in);
+    if (!(len > 1e-8) || isinf(len) || !finite3(p))
+        return vec3(0.0);
+    vec3 n = n_in / len;
     ivec3 dims = grid_dims();
-    vec3 q = (p - grid_origin()) / grid_cell_size();
+    // half a cell in front of the surface, mirroring the injection offset
+    vec3 q = (p + 0.5 * grid_cell_size() * n - grid_origin()) / grid_cell_size();
     q = clamp(q, vec3(0.5), vec3(dims) - 0.5) - 0.5;
     ivec3 c0 = min(ivec3(floor(q)), dims - 1);
     ivec3 c1 = min(c0 + 1, dims - 1);

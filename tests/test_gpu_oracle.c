@@ -189,12 +189,52 @@ static void test_propagation_matches_oracle(void **state)
     check_propagation(*state, LPV_SWITCH_ON, 1);
 }
 
+/* The lookup: GPU irradiance queries against lpv_oracle_irradiance on the
+ * GPU's own accumulated grid, at points inside, on the edge and outside the
+ * grid, with axis-aligned, oblique and degenerate normals. */
+static void test_lookup_matches_oracle(void **state)
+{
+    fixture *f = *state;
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 8};
+    tick(f, &s, 1);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
+    size_t cells = lpv_grid_cell_count(g);
+    lpv_cell *acc = calloc(cells, sizeof *acc);
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_ACCUMULATED, acc, cells), cells);
+    enum { N = 500 };
+    float p[N * 3], n[N * 3], gpu[N * 3], ref[N * 3];
+    unsigned seed = 12345;
+    for (int i = 0; i < N; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            seed = seed * 1664525u + 1013904223u;
+            float u = (float)(seed >> 8) / 16777216.0f;
+            p[i * 3 + k] = -1.3f + 3.6f * u; /* the box spans about -1..1 x 0..2 x -1..1 */
+            seed = seed * 1664525u + 1013904223u;
+            n[i * 3 + k] = (float)(seed >> 8) / 8388608.0f - 1.0f;
+        }
+        if (i % 7 == 0) { /* axis-aligned normals */
+            n[i * 3] = n[i * 3 + 2] = 0.0f;
+            n[i * 3 + 1] = (i % 14 == 0) ? 1.0f : -1.0f;
+        }
+        if (i == 3)
+            n[9] = n[10] = n[11] = 0.0f; /* degenerate normal: 0 */
+    }
+    char err[256];
+    assert_int_equal(lpv_engine_irradiance(f->engine, p, n, N, gpu, err, sizeof err), 0);
+    for (int i = 0; i < N; ++i)
+        lpv_oracle_irradiance(g, acc, &p[i * 3], &n[i * 3], &ref[i * 3]);
+    assert_true(gpu[9] == 0.0f && gpu[10] == 0.0f && gpu[11] == 0.0f);
+    assert_close("irradiance lookup", gpu, ref, N * 3);
+    free(acc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_injection_matches_oracle),
         cmocka_unit_test(test_geometry_volume_matches_oracle),
         cmocka_unit_test(test_propagation_matches_oracle),
+        cmocka_unit_test(test_lookup_matches_oracle),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1,0 +1,208 @@
+/*
+ * test_render.c - whole frames: the Cornell box's indirect light bleeds the
+ * walls' colours onto the floor; the shared glTF Cornell box renders like the
+ * built-in one; `lpvd render` writes PNG and EXR files and rejects bad input.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "commands.h"
+#include "context.h"
+#include "engine.h"
+#include "image_io.h"
+#include "scene.h"
+#include "scene_load.h"
+#include "test_util.h"
+
+enum { W = 96, H = 96 };
+
+static lpv_gl_context *ctx;
+static lpv_engine *engine;
+
+static int setup(void **state)
+{
+    (void)state;
+    char err[1024];
+    ctx = lpv_gl_context_create(&(lpv_gl_context_desc){0}, err, sizeof err);
+    if (!ctx) {
+        fprintf(stderr, "no GL context: %s\n", err);
+        return -1;
+    }
+    engine = lpv_engine_create(err, sizeof err);
+    return engine ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    lpv_engine_destroy(engine);
+    lpv_gl_context_destroy(ctx);
+    return 0;
+}
+
+static void render(const lpv_scene *scene, lpv_frame_terms terms, lpv_view *view, float *rgba)
+{
+    char err[1024] = "";
+    lpv_settings s = {0};
+    lpv_view_from_camera(&scene->cameras[0], W, H, view);
+    if (lpv_engine_set_settings(engine, &s, err, sizeof err) || lpv_engine_set_scene(engine, scene, err, sizeof err) ||
+        lpv_engine_set_view(engine, view, err, sizeof err) || lpv_engine_tick(engine, err, sizeof err) ||
+        lpv_engine_render(engine, terms, rgba, err, sizeof err))
+        fail_msg("%s", err);
+}
+
+/* Mean radiance over the 5x5 pixels around world point p. */
+static void patch(const lpv_view *v, const float *rgba, const float p[3], double out[3])
+{
+    float px, py;
+    assert_int_equal(lpv_view_project(v, p, &px, &py), 0);
+    int cx = (int)px, cy = (int)py, n = 0;
+    out[0] = out[1] = out[2] = 0.0;
+    for (int y = cy - 2; y <= cy + 2; ++y)
+        for (int x = cx - 2; x <= cx + 2; ++x) {
+            assert_true(x >= 0 && x < W && y >= 0 && y < H);
+            const float *q = &rgba[((size_t)y * W + (size_t)x) * 4];
+            assert_true(q[3] > 0.5f); /* geometry was hit */
+            for (int c = 0; c < 3; ++c)
+                out[c] += q[c];
+            ++n;
+        }
+    for (int c = 0; c < 3; ++c)
+        out[c] /= n;
+}
+
+static void test_cornell_colour_bleeding(void **state)
+{
+    (void)state;
+    lpv_scene scene;
+    assert_int_equal(lpv_scene_builtin_cornell(&scene), 0);
+    float *ind = calloc((size_t)W * H * 4, sizeof *ind), *dir = calloc((size_t)W * H * 4, sizeof *dir);
+    lpv_view view;
+    render(&scene, LPV_TERMS_INDIRECT_ONLY, &view, ind);
+    render(&scene, LPV_TERMS_DIRECT_ONLY, &view, dir);
+    const float near_red[3] = {-0.85f, 0.0f, 0.5f}, near_green[3] = {0.85f, 0.0f, 0.5f};
+    double ir[3], ig[3], dr[3], dg[3];
+    patch(&view, ind, near_red, ir);
+    patch(&view, ind, near_green, ig);
+    patch(&view, dir, near_red, dr);
+    patch(&view, dir, near_green, dg);
+    printf("indirect near red wall %.4g %.4g %.4g, near green wall %.4g %.4g %.4g\n", ir[0], ir[1], ir[2], ig[0], ig[1],
+           ig[2]);
+    assert_true(ir[0] > 0.0 && ig[1] > 0.0);
+    /* The criterion, literally. */
+    assert_true(ir[0] > ir[1]);
+    assert_true(ig[1] > ig[0]);
+    /* And relative to the (warm, white-ish) direct light at the same pixels,
+     * so the warm spot colour alone cannot pass it. */
+    assert_true(ir[0] / ir[1] > dr[0] / dr[1]);
+    assert_true(ig[1] / ig[0] > dg[1] / dg[0]);
+    free(ind);
+    free(dir);
+    lpv_scene_free(&scene);
+}
+
+static void test_shared_glb_matches_builtin(void **state)
+{
+    (void)state;
+    const char *shared = lpvt_shared_dir();
+    if (!shared) {
+        skip();
+        return;
+    }
+    char path[1024], err[1024];
+    snprintf(path, sizeof path, "%s/scenes/cornell-box.glb", shared);
+    lpv_scene glb, builtin;
+    if (lpv_scene_load(path, &glb, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    assert_int_equal(lpv_scene_builtin_cornell(&builtin), 0);
+    float *a = calloc((size_t)W * H * 4, sizeof *a), *b = calloc((size_t)W * H * 4, sizeof *b);
+    lpv_view va, vb;
+    render(&glb, LPV_TERMS_FULL, &va, a);
+    render(&builtin, LPV_TERMS_FULL, &vb, b);
+    double diff = 0.0, sum = 0.0;
+    for (size_t i = 0; i < (size_t)W * H * 4; i += 4)
+        for (int c = 0; c < 3; ++c) {
+            diff += fabs((double)a[i + (size_t)c] - b[i + (size_t)c]);
+            sum += b[i + (size_t)c];
+        }
+    printf("glb vs built-in: relative L1 difference %.4f\n", diff / sum);
+    assert_true(sum > 0.0);
+    assert_true(diff / sum < 0.03);
+    free(a);
+    free(b);
+    lpv_scene_free(&glb);
+    lpv_scene_free(&builtin);
+}
+
+static int run(int argc, const char **argv)
+{
+    return lpvd_cmd_render(argc, (char **)argv);
+}
+
+static void test_render_command_files(void **state)
+{
+    (void)state;
+    char png[512], exr[512], err[512];
+    snprintf(png, sizeof png, "%s/cb.png", lpvt_tmpdir());
+    snprintf(exr, sizeof exr, "%s/cb.exr", lpvt_tmpdir());
+    const char *a1[] = {"render", "-o", png, "--size", "64x48", "--grid", "16", "--iterations", "4"};
+    assert_int_equal(run(9, a1), 0);
+    const char *a2[] = {"render", "-o", exr, "--size", "64x48", "--grid", "16", "--indirect-only", "--stats"};
+    assert_int_equal(run(9, a2), 0);
+    int w, h;
+    float *px = NULL;
+    assert_int_equal(lpv_image_read_f32(png, 4, &w, &h, &px, err, sizeof err), 0);
+    assert_int_equal(w, 64);
+    assert_int_equal(h, 48);
+    double sum = 0.0;
+    for (int i = 0; i < w * h * 4; i += 4)
+        sum += px[i] + px[i + 1] + px[i + 2];
+    assert_true(sum > 0.0);
+    free(px);
+    assert_int_equal(lpv_image_read_f32(exr, 4, &w, &h, &px, err, sizeof err), 0);
+    float mx = 0.0f;
+    for (int i = 0; i < w * h * 4; ++i) {
+        assert_true(isfinite(px[i]));
+        if (i % 4 != 3 && px[i] > mx)
+            mx = px[i];
+    }
+    assert_true(mx > 0.0f); /* linear radiance, not tone-mapped */
+    free(px);
+}
+
+static void test_render_command_rejects_bad_input(void **state)
+{
+    (void)state;
+    const char *bad_flag[] = {"render", "--no-such-flag"};
+    assert_int_equal(run(2, bad_flag), 2);
+    const char *bad_grid[] = {"render", "--grid", "0"};
+    assert_int_equal(run(3, bad_grid), 2);
+    const char *bad_size[] = {"render", "--size", "12"};
+    assert_int_equal(run(3, bad_size), 2);
+    const char *missing[] = {"render", "/nonexistent/scene.glb"};
+    assert_int_equal(run(2, missing), 1);
+    const char *bad_camera[] = {"render", "--camera", "NoSuchCamera"};
+    assert_int_equal(run(3, bad_camera), 2);
+    char out[512];
+    snprintf(out, sizeof out, "%s/no/such/folder/x.png", lpvt_tmpdir());
+    const char *bad_out[] = {"render", "--size", "16x16", "--grid", "8", "-o", out};
+    assert_int_equal(run(7, bad_out), 1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cornell_colour_bleeding),
+        cmocka_unit_test(test_shared_glb_matches_builtin),
+        cmocka_unit_test(test_render_command_files),
+        cmocka_unit_test(test_render_command_rejects_bad_input),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
