@@ -1,0 +1,94 @@
+/*
+ * grid.c - placement of a light propagation volume (see grid.h).
+ */
+#include "grid.h"
+
+#include <math.h>
+
+#include "lpv_shared.h"
+
+/* Cell sizes outside this range are treated as degenerate (cell size 1):
+ * the oracle divides by cell_size^2, which must stay a normal, finite float. */
+#define LPV_MIN_CELL_SIZE 1e-18
+#define LPV_MAX_CELL_SIZE 1e18
+
+static int bounds_finite(const float bmin[3], const float bmax[3])
+{
+    for (int i = 0; i < 3; i++) {
+        if (!isfinite(bmin[i]) || !isfinite(bmax[i]))
+            return 0;
+    }
+    return 1;
+}
+
+/* max_i extent_i / max(dims_i - 1, 1): every axis keeps at least half a cell
+ * of margin on each side. Computed in double so that huge finite bounds do
+ * not overflow before the division. */
+static double cell_size_for(const int dims[3], const float bmin[3], const float bmax[3])
+{
+    double size = 0.0;
+    for (int i = 0; i < 3; i++) {
+        double extent = (double)bmax[i] - (double)bmin[i];
+        double steps = dims[i] > 1 ? (double)(dims[i] - 1) : 1.0;
+        double s = extent / steps;
+        if (s > size)
+            size = s;
+    }
+    if (!(size >= LPV_MIN_CELL_SIZE && size <= LPV_MAX_CELL_SIZE))
+        return 1.0;
+    return size;
+}
+
+int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], lpv_grid *out)
+{
+    for (int i = 0; i < 3; i++) {
+        if (dims[i] < 1 || dims[i] > LPV_MAX_GRID_DIM)
+            return -1;
+    }
+    if (!bounds_finite(bmin, bmax))
+        return -1;
+
+    double cs = cell_size_for(dims, bmin, bmax);
+    for (int i = 0; i < 3; i++) {
+        double centre = 0.5 * ((double)bmin[i] + (double)bmax[i]);
+        out->dims[i] = dims[i];
+        out->origin[i] = (float)(centre - 0.5 * dims[i] * cs);
+    }
+    out->cell_size = (float)cs;
+    return 0;
+}
+
+size_t lpv_grid_cell_count(const lpv_grid *g)
+{
+    return (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+}
+
+size_t lpv_grid_gv_count(const lpv_grid *g)
+{
+    return (size_t)(g->dims[0] + 1) * (size_t)(g->dims[1] + 1) * (size_t)(g->dims[2] + 1);
+}
+
+/* Both lookups work in float, like the shaders. The range test happens on the
+ * float value before the int conversion, so no position (huge, Inf, NaN) can
+ * make an out-of-range conversion or index. */
+int lpv_grid_cell_of(const lpv_grid *g, const float p[3], int cell[3])
+{
+    for (int i = 0; i < 3; i++) {
+        float f = floorf((p[i] - g->origin[i]) / g->cell_size);
+        if (!(f >= 0.0f && f < (float)g->dims[i]))
+            return 0;
+        cell[i] = (int)f;
+    }
+    return 1;
+}
+
+int lpv_grid_gv_point_of(const lpv_grid *g, const float p[3], int point[3])
+{
+    for (int i = 0; i < 3; i++) {
+        float f = floorf((p[i] - g->origin[i]) / g->cell_size + 0.5f);
+        if (!(f >= 0.0f && f <= (float)g->dims[i]))
+            return 0;
+        point[i] = (int)f;
+    }
+    return 1;
+}

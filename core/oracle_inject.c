@@ -1,0 +1,111 @@
+/*
+ * oracle_inject.c - reference VPL and surfel injection and GV merging
+ * (see oracle.h and docs/propagation.md). Literal loops in array order; the
+ * injection shaders are checked against these.
+ */
+#include <math.h>
+
+#include "oracle.h"
+#include "sh.h"
+
+/* A normal is usable when it is finite and longer than 1e-8; it is then
+ * normalised. The length is a float, as in the shaders: a normal so long that
+ * its length overflows (> ~1.8e19) is rejected like a non-finite one. */
+static int unit_normal(const float in[3], float out[3])
+{
+    if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
+        return 0;
+    float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
+    if (!(len > 1e-8f) || !isfinite(len))
+        return 0;
+    for (int i = 0; i < 3; i++)
+        out[i] = in[i] / len;
+    return 1;
+}
+
+static int finite3(const float v[3])
+{
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+static void add_scaled(float dst[4], const float src[4], float scale)
+{
+    for (int i = 0; i < 4; i++)
+        dst[i] += src[i] * scale;
+}
+
+/* One VPL: validated, moved half a cell along its normal (so it lights the
+ * cell in front of its surface, not its own), then added as lobe * flux / pi:
+ * the lobe integrates to pi, so the cell's intensity integrates to the flux. */
+static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
+{
+    float n[3], p[3];
+    int cell[3];
+    if (v->position[3] == 0.0f || !finite3(v->position) || !finite3(v->flux))
+        return 0;
+    if (!unit_normal(v->normal, n))
+        return 0;
+    for (int i = 0; i < 3; i++)
+        p[i] = v->position[i] + 0.5f * g->cell_size * n[i];
+    if (!lpv_grid_cell_of(g, p, cell))
+        return 0;
+
+    float lobe[4];
+    lpv_sh_cosine_lobe(n, lobe);
+    for (int i = 0; i < 4; i++)
+        lobe[i] /= LPV_PI;
+    lpv_cell *c = &cells[lpv_grid_index(g, cell[0], cell[1], cell[2])];
+    add_scaled(c->r, lobe, v->flux[0]);
+    add_scaled(c->g, lobe, v->flux[1]);
+    add_scaled(c->b, lobe, v->flux[2]);
+    return 1;
+}
+
+size_t lpv_oracle_inject_vpls(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
+{
+    size_t injected = 0;
+    for (size_t i = 0; i < n; i++)
+        injected += (size_t)inject_vpl(g, &vpls[i], cells);
+    return injected;
+}
+
+/* One surfel: blocking potential B(w) = area / cell_size^2 * max(0, <n, w>)
+ * (paper section 3.2) at the nearest GV point (the LPV cell corners). */
+static int inject_surfel(const lpv_grid *g, const lpv_surfel *s, vec4 *gv)
+{
+    float n[3];
+    int pt[3];
+    float area = s->position[3];
+    if (!(area > 0.0f) || !isfinite(area) || !finite3(s->position))
+        return 0;
+    if (!unit_normal(s->normal, n))
+        return 0;
+    if (!lpv_grid_gv_point_of(g, s->position, pt))
+        return 0;
+
+    float lobe[4];
+    lpv_sh_cosine_lobe(n, lobe);
+    add_scaled(gv[lpv_grid_gv_index(g, pt[0], pt[1], pt[2])], lobe, area / (g->cell_size * g->cell_size));
+    return 1;
+}
+
+size_t lpv_oracle_inject_surfels(const lpv_grid *g, const lpv_surfel *surfels, size_t n, vec4 *gv)
+{
+    size_t injected = 0;
+    for (size_t i = 0; i < n; i++)
+        injected += (size_t)inject_surfel(g, &surfels[i], gv);
+    return injected;
+}
+
+/* Per GV point keep the vector with the larger DC term (ties keep dst): a
+ * surface seen by the camera and by an RSM must block once, not twice. */
+void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, vec4 *dst)
+{
+    size_t count = lpv_grid_gv_count(g);
+    for (size_t i = 0; i < count; i++) {
+        if (src[i][0] > dst[i][0]) {
+            for (int k = 0; k < 4; k++)
+                dst[i][k] = src[i][k];
+        }
+    }
+}
