@@ -1,0 +1,136 @@
+/* scene.c - ownership and small queries of lpv_scene (see scene.h). Plain C11. */
+#include "scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void lpv_scene_free(lpv_scene *scene)
+{
+    if (!scene)
+        return;
+    if (scene->textures) {
+        for (uint32_t i = 0; i < scene->texture_count; i++)
+            free(scene->textures[i].rgba8);
+    }
+    free(scene->vertices);
+    free(scene->indices);
+    free(scene->draws);
+    free(scene->materials);
+    free(scene->textures);
+    free(scene->lights);
+    free(scene->cameras);
+    memset(scene, 0, sizeof *scene);
+}
+
+void lpv_scene_compute_bounds(lpv_scene *scene)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY};
+    float hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    int any = 0;
+
+    if (!scene)
+        return;
+    for (uint32_t i = 0; scene->vertices && i < scene->vertex_count; i++) {
+        const float *p = scene->vertices[i].position;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            if (p[k] < lo[k])
+                lo[k] = p[k];
+            if (p[k] > hi[k])
+                hi[k] = p[k];
+        }
+        any = 1;
+    }
+    for (int k = 0; k < 3; k++) {
+        scene->bounds_min[k] = any ? lo[k] : 0.0f;
+        scene->bounds_max[k] = any ? hi[k] : 0.0f;
+    }
+}
+
+static int material_emits(const lpv_material *m)
+{
+    /* NaN compares false, so a NaN emission does not count as a light. */
+    return m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f;
+}
+
+uint32_t lpv_scene_emissive_draw_count(const lpv_scene *scene)
+{
+    uint32_t count = 0;
+
+    if (!scene || !scene->materials || !scene->draws || scene->material_count == 0)
+        return 0;
+
+    unsigned char *used = calloc(scene->material_count, 1);
+    if (used) {
+        for (uint32_t d = 0; d < scene->draw_count; d++) {
+            const lpv_draw *dr = &scene->draws[d];
+            if (dr->index_count > 0 && dr->material >= 0 &&
+                (uint32_t)dr->material < scene->material_count)
+                used[dr->material] = 1;
+        }
+        for (uint32_t m = 0; m < scene->material_count; m++)
+            if (used[m] && material_emits(&scene->materials[m]))
+                count++;
+        free(used);
+        return count;
+    }
+
+    /* Out of memory for the flags: the slow quadratic scan needs none. */
+    for (uint32_t m = 0; m < scene->material_count; m++) {
+        if (!material_emits(&scene->materials[m]))
+            continue;
+        for (uint32_t d = 0; d < scene->draw_count; d++) {
+            if (scene->draws[d].material == (int)m && scene->draws[d].index_count > 0) {
+                count++;
+                break;
+            }
+        }
+    }
+    return count;
+}
+
+int lpv_scene_ensure_light(lpv_scene *scene)
+{
+    if (!scene)
+        return -1;
+    if (scene->light_count > 0 || lpv_scene_emissive_draw_count(scene) > 0)
+        return 0;
+
+    lpv_light *lights = realloc(scene->lights, ((size_t)scene->light_count + 1) * sizeof *lights);
+    if (!lights)
+        return -1;
+    scene->lights = lights;
+
+    const float *lo = scene->bounds_min, *hi = scene->bounds_max;
+    float height = hi[1] - lo[1];
+    if (!(height > 0.0f) || !isfinite(height))
+        height = 1.0f; /* a flat or empty scene: place the light 0.9 m up */
+    float cx = 0.5f * (lo[0] + hi[0]);
+    float cz = 0.5f * (lo[2] + hi[2]);
+    if (!isfinite(cx))
+        cx = 0.0f;
+    if (!isfinite(cz))
+        cz = 0.0f;
+    float base_y = isfinite(lo[1]) ? lo[1] : 0.0f;
+    float d = 0.9f * height; /* distance from the light down to the bounds' floor */
+
+    lpv_light *l = &lights[scene->light_count];
+    memset(l, 0, sizeof *l);
+    l->type = LPV_LIGHT_POINT;
+    strcpy(l->name, "default");
+    l->color[0] = l->color[1] = l->color[2] = 1.0f;
+    /* E = I / d^2 straight below: I = d^2 * 1 W/m^2 gives 1 W/m^2 at the floor. */
+    l->intensity = d * d * 1.0f;
+    l->range = 0.0f;
+    l->position[0] = cx;
+    l->position[1] = base_y + d;
+    l->position[2] = cz;
+    l->direction[0] = 0.0f;
+    l->direction[1] = -1.0f;
+    l->direction[2] = 0.0f;
+    scene->light_count++;
+    scene->default_light_added = 1;
+    return 0;
+}

@@ -1,0 +1,1317 @@
+/*
+ * test_gltf.c - the glTF loader (scene/gltf_load.h): hand-made .glb and .gltf
+ * files built here, every malformed or hostile case refused with a message
+ * naming the file and the problem, and ../shared/scenes/cornell-box.glb
+ * against the built-in Cornell box.
+ *
+ * JSON in this file is written with single quotes; J() turns them into
+ * double quotes.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+/* cmocka.h after the headers it needs */
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "gltf_load.h"
+#include "scene.h"
+#include "test_util.h"
+
+#define S45 0.70710678118654752f
+
+/* ---- helpers ------------------------------------------------------------- */
+
+/* printf into a rotating static buffer, then ' -> ". */
+static const char *J(const char *fmt, ...)
+{
+    static char slots[4][65536];
+    static int next;
+    char *p = slots[next++ & 3];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(p, sizeof slots[0], fmt, ap);
+    va_end(ap);
+    assert_true(n > 0 && (size_t)n < sizeof slots[0]);
+    for (char *c = p; *c; c++)
+        if (*c == '\'')
+            *c = '"';
+    return p;
+}
+
+typedef struct bin {
+    unsigned char b[4096];
+    size_t n;
+} bin;
+
+static void put(bin *b, const void *p, size_t n)
+{
+    assert_true(b->n + n <= sizeof b->b);
+    memcpy(b->b + b->n, p, n);
+    b->n += n;
+}
+static void put_f32(bin *b, float v) { put(b, &v, 4); }
+static void put_u16(bin *b, uint16_t v) { put(b, &v, 2); }
+static void put_u8(bin *b, uint8_t v) { put(b, &v, 1); }
+static void put_vec3(bin *b, float x, float y, float z)
+{
+    put_f32(b, x);
+    put_f32(b, y);
+    put_f32(b, z);
+}
+static void pad4(bin *b)
+{
+    while (b->n % 4)
+        put_u8(b, 0);
+}
+
+static void put_le32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v;
+    p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16);
+    p[3] = (unsigned char)(v >> 24);
+}
+
+/* Assembles a .glb from a JSON text and an optional BIN payload (malloc). */
+static unsigned char *glb_build(const char *json, const void *binp, size_t bin_len, size_t *out_len)
+{
+    size_t jl = strlen(json), jpad = (jl + 3) & ~(size_t)3;
+    size_t bpad = (bin_len + 3) & ~(size_t)3;
+    size_t total = 12 + 8 + jpad + (bin_len ? 8 + bpad : 0);
+    unsigned char *g = calloc(1, total);
+    assert_non_null(g);
+    memcpy(g, "glTF", 4);
+    put_le32(g + 4, 2);
+    put_le32(g + 8, (uint32_t)total);
+    put_le32(g + 12, (uint32_t)jpad);
+    memcpy(g + 16, "JSON", 4);
+    memcpy(g + 20, json, jl);
+    memset(g + 20 + jl, ' ', jpad - jl);
+    if (bin_len) {
+        unsigned char *c = g + 20 + jpad;
+        put_le32(c, (uint32_t)bpad);
+        memcpy(c + 4, "BIN\0", 4);
+        memcpy(c + 8, binp, bin_len);
+    }
+    *out_len = total;
+    return g;
+}
+
+/* Writes a file into dir and copies its path into out (PATH_MAX-sized). */
+static void write_file(char *out, const char *dir, const char *name, const void *data, size_t size)
+{
+    snprintf(out, 512, "%s", lpvt_write_file(dir, name, data, size));
+}
+
+static void write_glb(char *out, const char *name, const char *json, const bin *b)
+{
+    size_t len;
+    unsigned char *g = glb_build(json, b ? b->b : NULL, b ? b->n : 0, &len);
+    write_file(out, lpvt_tmpdir(), name, g, len);
+    free(g);
+}
+
+static int scene_is_zero(const lpv_scene *s)
+{
+    static const lpv_scene zero;
+    return memcmp(s, &zero, sizeof zero) == 0;
+}
+
+static void load_ok(const char *path, lpv_scene *s)
+{
+    char err[512] = "";
+    memset(s, 0x5a, sizeof *s);
+    int rc = lpv_gltf_load_file(path, s, err, sizeof err);
+    if (rc != 0)
+        fail_msg("loading %s failed: %s", path, err);
+    assert_string_equal(s->source, path);
+    assert_int_equal(s->default_light_added, 0);
+}
+
+/* Loading must fail, name the file, and say `word`; the scene stays zeroed. */
+static void expect_fail_path(const char *path, const char *word)
+{
+    lpv_scene s;
+    char err[768] = "";
+    memset(&s, 0x5a, sizeof s);
+    int rc = lpv_gltf_load_file(path, &s, err, sizeof err);
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    print_message("    %-28s -> %s\n", base, err);
+    if (rc != -1)
+        fail_msg("%s loaded but should have failed with '%s'", path, word);
+    if (!strstr(err, base))
+        fail_msg("error '%s' does not name the file '%s'", err, base);
+    if (!strstr(err, word))
+        fail_msg("error '%s' does not mention '%s'", err, word);
+    assert_true(scene_is_zero(&s));
+    lpv_scene_free(&s);
+}
+
+static void expect_fail_glb(const char *name, const char *json, const bin *b, const char *word)
+{
+    char path[512];
+    write_glb(path, name, json, b);
+    expect_fail_path(path, word);
+}
+
+static void assert_vec3(const float *v, float x, float y, float z, float tol)
+{
+    if (fabsf(v[0] - x) > tol || fabsf(v[1] - y) > tol || fabsf(v[2] - z) > tol)
+        fail_msg("(%g, %g, %g) != (%g, %g, %g) within %g", v[0], v[1], v[2], x, y, z, tol);
+}
+
+static void make_subdir(char *out, const char *name)
+{
+    snprintf(out, 512, "%s/%s", lpvt_tmpdir(), name);
+    if (mkdir(out, 0700) != 0) {
+        struct stat st;
+        assert_true(stat(out, &st) == 0 && S_ISDIR(st.st_mode));
+    }
+}
+
+/* The simplest valid scene: one non-indexed triangle, no material, no normals. */
+static const char *TRI_JSON =
+    "{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+    "'bufferViews':[{'buffer':0,'byteLength':36}],"
+    "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+    "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+    "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}],'scene':0}";
+
+static void tri_bin(bin *b)
+{
+    memset(b, 0, sizeof *b);
+    put_vec3(b, 0, 0, 0);
+    put_vec3(b, 1, 0, 0);
+    put_vec3(b, 0, 1, 0);
+}
+
+/* ---- (a) valid files ------------------------------------------------------ */
+
+static void test_one_triangle(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    char path[512];
+    write_glb(path, "one-triangle.glb", J("%s", TRI_JSON), &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.vertex_count, 3);
+    assert_int_equal(s.index_count, 3);
+    assert_int_equal(s.draw_count, 1);
+    assert_int_equal(s.draws[0].first_index, 0);
+    assert_int_equal(s.draws[0].index_count, 3);
+    /* no material: the default one, white with roughness 1 */
+    assert_int_equal(s.material_count, 1);
+    assert_int_equal(s.draws[0].material, 0);
+    assert_vec3(s.materials[0].base_color, 1, 1, 1, 0);
+    assert_true(s.materials[0].base_color[3] == 1.0f);
+    assert_true(s.materials[0].roughness == 1.0f);
+    assert_int_equal(s.materials[0].base_color_texture, -1);
+    assert_vec3(s.vertices[s.indices[1]].position, 1, 0, 0, 0);
+    assert_vec3(s.vertices[s.indices[2]].position, 0, 1, 0, 0);
+    /* no normals in the file: flat from the counter-clockwise winding */
+    for (int i = 0; i < 3; i++)
+        assert_vec3(s.vertices[i].normal, 0, 0, 1, 1e-6f);
+    assert_vec3(s.bounds_min, 0, 0, 0, 0);
+    assert_vec3(s.bounds_max, 1, 1, 0, 0);
+    assert_int_equal(s.light_count, 0);
+    assert_int_equal(s.camera_count, 0);
+    lpv_scene_free(&s);
+    assert_true(scene_is_zero(&s));
+}
+
+static void test_indexed_quad_ushort_ubyte_normalized_uv(void **state)
+{
+    (void)state;
+    bin b = {0};
+    const float quad[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    for (int i = 0; i < 4; i++)
+        put_vec3(&b, quad[i][0], quad[i][1], quad[i][2]); /* 0..48 */
+    for (int i = 0; i < 4; i++)
+        put_vec3(&b, 0, 0, 1); /* 48..96 */
+    const uint8_t uv[8] = {0, 0, 255, 0, 255, 255, 0, 128};
+    for (int i = 0; i < 8; i++)
+        put_u8(&b, uv[i]); /* 96..104 */
+    const uint16_t q[6] = {0, 1, 2, 0, 2, 3};
+    for (int i = 0; i < 6; i++)
+        put_u16(&b, q[i]); /* 104..116 */
+    for (int i = 0; i < 6; i++)
+        put_u8(&b, (uint8_t)q[i]); /* 116..122 */
+    pad4(&b);
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'buffers':[{'byteLength':%zu}],"
+        "'bufferViews':[{'buffer':0,'byteOffset':0,'byteLength':48},{'buffer':0,'byteOffset':48,'byteLength':48},"
+        "{'buffer':0,'byteOffset':96,'byteLength':8},{'buffer':0,'byteOffset':104,'byteLength':12},"
+        "{'buffer':0,'byteOffset':116,'byteLength':6}],"
+        "'accessors':[{'bufferView':0,'componentType':5126,'count':4,'type':'VEC3'},"
+        "{'bufferView':1,'componentType':5126,'count':4,'type':'VEC3'},"
+        "{'bufferView':2,'componentType':5121,'normalized':true,'count':4,'type':'VEC2'},"
+        "{'bufferView':3,'componentType':5123,'count':6,'type':'SCALAR'},"
+        "{'bufferView':4,'componentType':5121,'count':6,'type':'SCALAR'}],"
+        "'materials':[{'name':'paint','doubleSided':true,'pbrMetallicRoughness':{'baseColorFactor':[0.5,0.25,1,0.75],"
+        "'metallicFactor':0.3,'roughnessFactor':0.7}}],"
+        "'meshes':[{'primitives':[{'attributes':{'POSITION':0,'NORMAL':1,'TEXCOORD_0':2},'indices':3,'material':0},"
+        "{'attributes':{'POSITION':0,'NORMAL':1,'TEXCOORD_0':2},'indices':4}]}],"
+        "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}",
+        b.n);
+    char path[512];
+    write_glb(path, "indexed-quad.glb", json, &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.draw_count, 2);
+    assert_int_equal(s.index_count, 12);
+    assert_int_equal(s.vertex_count, 8); /* shared within each primitive */
+    assert_int_equal(s.draws[1].first_index, 6);
+    for (int i = 0; i < 6; i++) {
+        assert_int_equal(s.indices[i], q[i]);
+        assert_int_equal(s.indices[6 + i], 4 + q[i]);
+    }
+    for (uint32_t v = 0; v < 8; v++) {
+        assert_vec3(s.vertices[v].position, quad[v % 4][0], quad[v % 4][1], quad[v % 4][2], 0);
+        assert_vec3(s.vertices[v].normal, 0, 0, 1, 1e-6f);
+    }
+    assert_true(fabsf(s.vertices[2].uv[0] - 1.0f) < 1e-6f && fabsf(s.vertices[2].uv[1] - 1.0f) < 1e-6f);
+    assert_true(fabsf(s.vertices[3].uv[0]) < 1e-6f && fabsf(s.vertices[3].uv[1] - 128.0f / 255.0f) < 1e-6f);
+    /* material 0 from the file, then the default one for the second primitive */
+    assert_int_equal(s.material_count, 2);
+    assert_int_equal(s.draws[0].material, 0);
+    assert_int_equal(s.draws[1].material, 1);
+    assert_string_equal(s.materials[0].name, "paint");
+    assert_true(s.materials[0].base_color[0] == 0.5f && s.materials[0].base_color[1] == 0.25f &&
+                s.materials[0].base_color[2] == 1.0f && s.materials[0].base_color[3] == 0.75f);
+    assert_true(fabsf(s.materials[0].metallic - 0.3f) < 1e-6f && fabsf(s.materials[0].roughness - 0.7f) < 1e-6f);
+    assert_int_equal(s.materials[0].double_sided, 1);
+    assert_string_equal(s.materials[1].name, "default");
+    lpv_scene_free(&s);
+}
+
+static void test_node_hierarchy(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    /* 0: translation (1,2,3) with child 1 rotated +90 deg about z;
+     * 2: mirrored in x (negative determinant); 3: a matrix translating by 10 in x. */
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+        "'bufferViews':[{'buffer':0,'byteLength':36}],"
+        "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+        "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+        "'nodes':[{'translation':[1,2,3],'children':[1]},{'rotation':[0,0,%.9f,%.9f],'mesh':0},"
+        "{'scale':[-1,1,1],'mesh':0},{'matrix':[1,0,0,0, 0,1,0,0, 0,0,1,0, 10,0,0,1],'mesh':0}],"
+        "'scenes':[{'nodes':[0,2,3]}]}",
+        S45, S45);
+    char path[512];
+    write_glb(path, "hierarchy.glb", json, &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.draw_count, 3);
+    assert_int_equal(s.vertex_count, 9);
+    /* child: R_z(90) p + (1,2,3) */
+    assert_vec3(s.vertices[0].position, 1, 2, 3, 1e-6f);
+    assert_vec3(s.vertices[1].position, 1, 3, 3, 1e-6f);
+    assert_vec3(s.vertices[2].position, 0, 2, 3, 1e-6f);
+    assert_vec3(s.vertices[0].normal, 0, 0, 1, 1e-6f);
+    /* mirrored: the winding is flipped, so the flat normal still faces +z */
+    assert_vec3(s.vertices[3].position, 0, 0, 0, 1e-6f);
+    assert_vec3(s.vertices[4].position, 0, 1, 0, 1e-6f);
+    assert_vec3(s.vertices[5].position, -1, 0, 0, 1e-6f);
+    for (int i = 3; i < 6; i++)
+        assert_vec3(s.vertices[i].normal, 0, 0, 1, 1e-6f);
+    /* matrix */
+    assert_vec3(s.vertices[7].position, 11, 0, 0, 1e-6f);
+    assert_vec3(s.bounds_min, -1, 0, 0, 1e-6f);
+    assert_vec3(s.bounds_max, 11, 3, 3, 1e-6f);
+    lpv_scene_free(&s);
+}
+
+static void test_normals_transformed_and_degenerate(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    put_vec3(&b, 0, 0, 1);
+    put_vec3(&b, 0, 0, 0);         /* zero-length normal */
+    put_vec3(&b, NAN, 0, 0);       /* NaN normal */
+    /* a scale (2,1,1) leaves the normal (0,0,1) alone */
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'buffers':[{'byteLength':72}],"
+        "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':36}],"
+        "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'},"
+        "{'bufferView':1,'componentType':5126,'count':3,'type':'VEC3'}],"
+        "'meshes':[{'primitives':[{'attributes':{'POSITION':0,'NORMAL':1}}]}],"
+        "'nodes':[{'mesh':0,'scale':[2,1,1]}],'scenes':[{'nodes':[0]}]}");
+    char path[512];
+    write_glb(path, "normals.glb", json, &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.vertex_count, 3);
+    assert_vec3(s.vertices[0].normal, 0, 0, 1, 1e-6f);
+    assert_vec3(s.vertices[1].normal, 0, 0, 0, 0); /* kept, as zero */
+    assert_vec3(s.vertices[2].normal, 0, 0, 0, 0);
+    assert_vec3(s.vertices[1].position, 2, 0, 0, 0);
+    lpv_scene_free(&s);
+
+    /* inverse transpose under a non-uniform scale */
+    bin c;
+    tri_bin(&c);
+    for (int i = 0; i < 3; i++)
+        put_vec3(&c, S45, S45, 0);
+    json = J(
+        "{'asset':{'version':'2.0'},'buffers':[{'byteLength':72}],"
+        "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':36}],"
+        "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'},"
+        "{'bufferView':1,'componentType':5126,'count':3,'type':'VEC3'}],"
+        "'meshes':[{'primitives':[{'attributes':{'POSITION':0,'NORMAL':1}}]}],"
+        "'nodes':[{'mesh':0,'scale':[2,1,1]}],'scenes':[{'nodes':[0]}]}");
+    write_glb(path, "normals-scaled.glb", json, &c);
+    load_ok(path, &s);
+    /* n' ~ S^-1 n = (0.5, 1, 0) normalised */
+    float l = sqrtf(0.25f + 1.0f);
+    assert_vec3(s.vertices[0].normal, 0.5f / l, 1.0f / l, 0, 1e-6f);
+    lpv_scene_free(&s);
+}
+
+static void test_sparse_accessors(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b); /* 0..36 */
+    put_u16(&b, 1);
+    pad4(&b);                 /* 36..40: sparse indices of accessor 0 */
+    put_vec3(&b, 5, 5, 5);    /* 40..52: sparse values of accessor 0 */
+    put_u16(&b, 0);
+    put_u16(&b, 2);           /* 52..56: sparse indices of accessor 1 */
+    put_vec3(&b, 1, 0, 0);
+    put_vec3(&b, 0, 1, 0);    /* 56..80: sparse values of accessor 1 */
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'buffers':[{'byteLength':80}],"
+        "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':4},"
+        "{'buffer':0,'byteOffset':40,'byteLength':12},{'buffer':0,'byteOffset':52,'byteLength':4},"
+        "{'buffer':0,'byteOffset':56,'byteLength':24}],"
+        "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3',"
+        "'sparse':{'count':1,'indices':{'bufferView':1,'componentType':5123},'values':{'bufferView':2}}},"
+        "{'componentType':5126,'count':3,'type':'VEC3',"
+        "'sparse':{'count':2,'indices':{'bufferView':3,'componentType':5123},'values':{'bufferView':4}}}],"
+        "'meshes':[{'primitives':[{'attributes':{'POSITION':0}},{'attributes':{'POSITION':1}}]}],"
+        "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    char path[512];
+    write_glb(path, "sparse.glb", json, &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.draw_count, 2);
+    assert_vec3(s.vertices[0].position, 0, 0, 0, 0);
+    assert_vec3(s.vertices[1].position, 5, 5, 5, 0); /* replaced */
+    assert_vec3(s.vertices[2].position, 0, 1, 0, 0);
+    /* no bufferView: zeros, then the sparse values */
+    assert_vec3(s.vertices[3].position, 1, 0, 0, 0);
+    assert_vec3(s.vertices[4].position, 0, 0, 0, 0);
+    assert_vec3(s.vertices[5].position, 0, 1, 0, 0);
+    lpv_scene_free(&s);
+}
+
+static void test_strip_fan_points_lines(void **state)
+{
+    (void)state;
+    bin b = {0};
+    /* a strip of 4 (offset 0) and a fan of 5 around its first vertex (offset 48) */
+    put_vec3(&b, 0, 0, 0);
+    put_vec3(&b, 1, 0, 0);
+    put_vec3(&b, 0, 1, 0);
+    put_vec3(&b, 1, 1, 0);
+    put_vec3(&b, 0, 0, 0);
+    put_vec3(&b, 1, 0, 0);
+    put_vec3(&b, 1, 1, 0);
+    put_vec3(&b, 0, 1, 0);
+    put_vec3(&b, -1, 1, 0);
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'buffers':[{'byteLength':108}],"
+        "'bufferViews':[{'buffer':0,'byteLength':108}],"
+        "'accessors':[{'bufferView':0,'componentType':5126,'count':4,'type':'VEC3'},"
+        "{'bufferView':0,'byteOffset':48,'componentType':5126,'count':5,'type':'VEC3'}],"
+        "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'mode':5},{'attributes':{'POSITION':1},'mode':6},"
+        "{'attributes':{'POSITION':1},'mode':0},{'attributes':{'POSITION':1},'mode':1},"
+        "{'attributes':{'POSITION':1},'mode':2},{'attributes':{'POSITION':1},'mode':3}]}],"
+        "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    char path[512];
+    write_glb(path, "strip-fan.glb", json, &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.draw_count, 2); /* points and lines give nothing */
+    assert_int_equal(s.draws[0].index_count, 6);
+    assert_int_equal(s.draws[1].index_count, 9);
+    assert_int_equal(s.index_count, 15);
+    /* strip triangle 1 is (v1, v3, v2) */
+    assert_vec3(s.vertices[s.indices[3]].position, 1, 0, 0, 0);
+    assert_vec3(s.vertices[s.indices[4]].position, 1, 1, 0, 0);
+    assert_vec3(s.vertices[s.indices[5]].position, 0, 1, 0, 0);
+    /* fan triangle 0 is (v1, v2, v0) */
+    assert_vec3(s.vertices[s.indices[6]].position, 1, 0, 0, 0);
+    assert_vec3(s.vertices[s.indices[7]].position, 1, 1, 0, 0);
+    assert_vec3(s.vertices[s.indices[8]].position, 0, 0, 0, 0);
+    /* every triangle of both faces +z (consistent winding) */
+    for (uint32_t i = 0; i < s.index_count; i++)
+        assert_vec3(s.vertices[s.indices[i]].normal, 0, 0, 1, 1e-6f);
+    lpv_scene_free(&s);
+}
+
+static void test_lights(void **state)
+{
+    (void)state;
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'extensionsUsed':['KHR_lights_punctual'],"
+        "'extensions':{'KHR_lights_punctual':{'lights':["
+        "{'type':'point','name':'bulb','intensity':683,'color':[1,0.5,0.25],'range':10},"
+        "{'type':'spot','intensity':1366,'spot':{'innerConeAngle':0.2,'outerConeAngle':0.5}},"
+        "{'type':'directional','intensity':2049},"
+        "{'type':'spot','spot':{}}]}},"
+        "'nodes':[{'translation':[1,2,3],'extensions':{'KHR_lights_punctual':{'light':0}}},"
+        "{'translation':[0,5,0],'extensions':{'KHR_lights_punctual':{'light':1}}},"
+        "{'rotation':[%.9f,0,0,%.9f],'extensions':{'KHR_lights_punctual':{'light':2}}},"
+        "{'rotation':[0,%.9f,0,%.9f],'extensions':{'KHR_lights_punctual':{'light':3}}}],"
+        "'scenes':[{'nodes':[0,1,2,3]}],'scene':0}",
+        -S45, S45, S45, S45);
+    char path[512];
+    write_glb(path, "lights.glb", json, NULL);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.light_count, 4);
+    assert_int_equal(s.vertex_count, 0);
+
+    const lpv_light *l = &s.lights[0];
+    assert_int_equal(l->type, LPV_LIGHT_POINT);
+    assert_string_equal(l->name, "bulb");
+    assert_true(fabsf(l->intensity - 1.0f) < 1e-6f); /* 683 cd -> 1 W/sr */
+    assert_vec3(l->color, 1, 0.5f, 0.25f, 0);
+    assert_true(l->range == 10.0f);
+    assert_vec3(l->position, 1, 2, 3, 1e-6f);
+
+    l = &s.lights[1];
+    assert_int_equal(l->type, LPV_LIGHT_SPOT);
+    assert_string_equal(l->name, "light1");
+    assert_true(fabsf(l->intensity - 2.0f) < 1e-6f);
+    assert_true(fabsf(l->inner_cone - 0.2f) < 1e-7f && fabsf(l->outer_cone - 0.5f) < 1e-7f);
+    assert_vec3(l->color, 1, 1, 1, 0);
+    assert_true(l->range == 0.0f);
+    assert_vec3(l->position, 0, 5, 0, 1e-6f);
+    assert_vec3(l->direction, 0, 0, -1, 1e-6f);
+
+    l = &s.lights[2];
+    assert_int_equal(l->type, LPV_LIGHT_DIRECTIONAL);
+    assert_true(fabsf(l->intensity - 3.0f) < 1e-6f); /* 2049 lx -> 3 W/m^2 */
+    assert_vec3(l->direction, 0, -1, 0, 1e-6f);      /* -90 deg about x */
+
+    l = &s.lights[3];
+    assert_int_equal(l->type, LPV_LIGHT_SPOT);
+    assert_true(fabsf(l->intensity - 1.0f / 683.0f) < 1e-9f); /* default 1 cd */
+    assert_true(l->inner_cone == 0.0f);
+    assert_true(fabsf(l->outer_cone - 0.78539816f) < 1e-6f);
+    assert_vec3(l->direction, -1, 0, 0, 1e-6f); /* +90 deg about y */
+    lpv_scene_free(&s);
+}
+
+static void test_cameras(void **state)
+{
+    (void)state;
+    const char *json = J(
+        "{'asset':{'version':'2.0'},"
+        "'cameras':[{'name':'cam','type':'perspective','perspective':{'yfov':0.8,'znear':0.05,'aspectRatio':1.5,"
+        "'zfar':100}},"
+        "{'type':'orthographic','orthographic':{'xmag':2,'ymag':3,'znear':0.1,'zfar':50}},"
+        "{'type':'perspective','perspective':{'yfov':1,'znear':0.1}}],"
+        "'nodes':[{'camera':0,'translation':[1,2,3],'rotation':[0,%.9f,0,%.9f]},{'camera':1},"
+        "{'children':[3],'rotation':[%.9f,0,0,%.9f]},{'camera':2}],"
+        "'scenes':[{'nodes':[0,1,2]}]}",
+        S45, S45, -S45, S45);
+    char path[512];
+    write_glb(path, "cameras.glb", json, NULL);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.camera_count, 3);
+    const lpv_camera *c = &s.cameras[0];
+    assert_string_equal(c->name, "cam");
+    assert_int_equal(c->orthographic, 0);
+    assert_true(fabsf(c->yfov - 0.8f) < 1e-7f && fabsf(c->aspect - 1.5f) < 1e-7f);
+    assert_true(fabsf(c->znear - 0.05f) < 1e-7f && c->zfar == 100.0f);
+    assert_vec3(c->eye, 1, 2, 3, 1e-6f);
+    assert_vec3(c->forward, -1, 0, 0, 1e-6f);
+    assert_vec3(c->up, 0, 1, 0, 1e-6f);
+    c = &s.cameras[1];
+    assert_string_equal(c->name, "camera1");
+    assert_int_equal(c->orthographic, 1);
+    assert_true(c->xmag == 2.0f && c->ymag == 3.0f && c->zfar == 50.0f);
+    assert_vec3(c->forward, 0, 0, -1, 0);
+    c = &s.cameras[2];
+    assert_true(c->aspect == 0.0f && c->zfar == 0.0f);
+    /* parent looks down (-90 deg about x): forward (0,-1,0), up (0,0,-1) */
+    assert_vec3(c->forward, 0, -1, 0, 1e-6f);
+    assert_vec3(c->up, 0, 0, -1, 1e-6f);
+    lpv_scene_free(&s);
+}
+
+static void test_emissive_strength(void **state)
+{
+    (void)state;
+    const char *json = J(
+        "{'asset':{'version':'2.0'},'extensionsUsed':['KHR_materials_emissive_strength'],"
+        "'materials':[{'name':'lamp','emissiveFactor':[1,0.5,0.25],"
+        "'extensions':{'KHR_materials_emissive_strength':{'emissiveStrength':4}}},"
+        "{'emissiveFactor':[1,1,1]},{}]}");
+    char path[512];
+    write_glb(path, "emissive.glb", json, NULL);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.material_count, 3);
+    assert_vec3(s.materials[0].emission, 4.0f / 683.0f, 2.0f / 683.0f, 1.0f / 683.0f, 1e-9f);
+    assert_vec3(s.materials[1].emission, 1.0f / 683.0f, 1.0f / 683.0f, 1.0f / 683.0f, 1e-9f);
+    assert_vec3(s.materials[2].emission, 0, 0, 0, 0);
+    assert_string_equal(s.materials[1].name, "material1");
+    /* defaults of a glTF material: metallic 1, roughness 1, single-sided */
+    assert_true(s.materials[2].metallic == 1.0f && s.materials[2].roughness == 1.0f);
+    assert_int_equal(s.materials[2].double_sided, 0);
+    lpv_scene_free(&s);
+}
+
+/* A 2x2 RGBA PNG: red, green / blue, white at alpha 128. */
+static const unsigned char png_2x2[] = {
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00, 0x00,
+    0x02, 0x00, 0x00, 0x00, 0x02, 0x08, 0x06, 0x00, 0x00, 0x00, 0x72, 0xb6, 0x0d, 0x24, 0x00, 0x00, 0x00, 0x13, 0x49,
+    0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0xf8, 0xcf, 0xc0, 0xf0, 0x1f, 0x0c, 0x81, 0x34, 0x08, 0x34, 0x00, 0x00, 0x49,
+    0x49, 0x09, 0x78, 0x28, 0xa0, 0xdb, 0x77, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+
+/* A PNG header claiming 20000 x 20000 texels (never decoded). */
+static const unsigned char png_huge[] = {
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00,
+    0x00, 0x4e, 0x20, 0x00, 0x00, 0x4e, 0x20, 0x08, 0x06, 0x00, 0x00, 0x00, 0xe3, 0x70, 0x46, 0x39, 0x00,
+    0x00, 0x00, 0x0b, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0x60, 0x80, 0x01, 0x00, 0x00, 0x0a, 0x00,
+    0x01, 0x7f, 0x80, 0x74, 0x5e, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+
+static const char *textured_json(size_t png_len, size_t image_offset)
+{
+    return J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':%zu}],"
+             "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':%zu,'byteLength':%zu}],"
+             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+             "'images':[{'bufferView':1,'mimeType':'image/png'}],'textures':[{'source':0}],"
+             "'materials':[{'pbrMetallicRoughness':{'baseColorTexture':{'index':0}}}],"
+             "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'material':0}]}],"
+             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}",
+             (size_t)((36 + png_len + 3) & ~3u), image_offset, png_len);
+}
+
+static void test_texture(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    put(&b, png_2x2, sizeof png_2x2);
+    pad4(&b);
+    char path[512];
+    write_glb(path, "textured.glb", textured_json(sizeof png_2x2, 36), &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.texture_count, 1);
+    assert_int_equal(s.materials[0].base_color_texture, 0);
+    assert_int_equal(s.textures[0].width, 2);
+    assert_int_equal(s.textures[0].height, 2);
+    static const uint8_t want[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+    assert_memory_equal(s.textures[0].rgba8, want, 16);
+    lpv_scene_free(&s);
+}
+
+static void test_gltf_external_bin_and_data_uri(void **state)
+{
+    (void)state;
+    char dir[512], path[512], sub[1024];
+    make_subdir(dir, "ext");
+    snprintf(sub, sizeof sub, "%s/bin", dir);
+    mkdir(sub, 0700);
+    bin b;
+    tri_bin(&b);
+    write_file(path, sub, "tri angle.bin", b.b, b.n);
+    const char *ext_text = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'bin/tri%%20angle.bin'}],"
+                             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                             "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, dir, "external.gltf", ext_text, strlen(ext_text));
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.vertex_count, 3);
+    assert_vec3(s.bounds_max, 1, 1, 0, 0);
+    lpv_scene_free(&s);
+
+    /* the same bytes as a data: URI (base64 of the 36 bytes) */
+    static const char b64tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    char b64[64] = "";
+    size_t o = 0;
+    for (size_t i = 0; i < b.n; i += 3) {
+        uint32_t v = (uint32_t)b.b[i] << 16 | (uint32_t)b.b[i + 1] << 8 | b.b[i + 2];
+        b64[o++] = b64tab[(v >> 18) & 63];
+        b64[o++] = b64tab[(v >> 12) & 63];
+        b64[o++] = b64tab[(v >> 6) & 63];
+        b64[o++] = b64tab[v & 63];
+    }
+    b64[o] = '\0';
+    const char *json = J("{'asset':{'version':'2.0'},"
+                         "'buffers':[{'byteLength':36,'uri':'data:application/octet-stream;base64,%s'}],"
+                         "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                         "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                         "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                         "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}",
+                         b64);
+    write_file(path, dir, "data-uri.gltf", json, strlen(json));
+    load_ok(path, &s);
+    assert_int_equal(s.vertex_count, 3);
+    assert_vec3(s.vertices[1].position, 1, 0, 0, 0);
+    lpv_scene_free(&s);
+
+    /* from memory: data: URIs work without a folder, external files do not */
+    char err[512];
+    assert_int_equal(lpv_gltf_load_memory(json, strlen(json), NULL, "mem-data", &s, err, sizeof err), 0);
+    assert_string_equal(s.source, "mem-data");
+    assert_int_equal(s.vertex_count, 3);
+    lpv_scene_free(&s);
+
+    const char *ext_json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'bin/tri%%20angle.bin'}],"
+                             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                             "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    memset(&s, 0x5a, sizeof s);
+    assert_int_equal(lpv_gltf_load_memory(ext_json, strlen(ext_json), NULL, "mem-ext", &s, err, sizeof err), -1);
+    print_message("    mem-ext -> %s\n", err);
+    assert_non_null(strstr(err, "mem-ext"));
+    assert_non_null(strstr(err, "refused"));
+    assert_true(scene_is_zero(&s));
+    assert_int_equal(lpv_gltf_load_memory(ext_json, strlen(ext_json), dir, "mem-dir", &s, err, sizeof err), 0);
+    assert_int_equal(s.vertex_count, 3);
+    lpv_scene_free(&s);
+
+    /* a glb from memory */
+    size_t len;
+    unsigned char *g = glb_build(J("%s", TRI_JSON), b.b, b.n, &len);
+    assert_int_equal(lpv_gltf_load_memory(g, len, NULL, "mem-glb", &s, err, sizeof err), 0);
+    assert_int_equal(s.index_count, 3);
+    lpv_scene_free(&s);
+    assert_int_equal(lpv_gltf_load_memory(g, len - 1, NULL, "mem-cut", &s, err, sizeof err), -1);
+    assert_non_null(strstr(err, "mem-cut"));
+    free(g);
+}
+
+/* ---- (b) malformed and hostile files ---------------------------------------- */
+
+static void test_truncated_glb(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    size_t len;
+    unsigned char *g = glb_build(J("%s", TRI_JSON), b.b, b.n, &len);
+    const size_t cuts[] = {0, 1, 3, 4, 8, 11, 12, 16, 19, 20, 40, len / 2, len - 44, len - 8, len - 1};
+    for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; i++) {
+        char name[64], path[512];
+        snprintf(name, sizeof name, "truncated-%zu.glb", cuts[i]);
+        write_file(path, lpvt_tmpdir(), name, g, cuts[i]);
+        expect_fail_path(path, "truncated");
+    }
+    free(g);
+}
+
+static void test_glb_header_lies(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    size_t len;
+    char path[512];
+    unsigned char *g = glb_build(J("%s", TRI_JSON), b.b, b.n, &len);
+
+    unsigned char *m = malloc(len);
+    assert_non_null(m);
+    memcpy(m, g, len);
+    memcpy(m, "glTX", 4);
+    write_file(path, lpvt_tmpdir(), "wrong-magic.glb", m, len);
+    expect_fail_path(path, "magic");
+
+    memcpy(m, g, len);
+    put_le32(m + 8, (uint32_t)len + 100);
+    write_file(path, lpvt_tmpdir(), "length-larger.glb", m, len);
+    expect_fail_path(path, "larger than the file");
+
+    memcpy(m, g, len);
+    put_le32(m + 8, (uint32_t)len - 8);
+    write_file(path, lpvt_tmpdir(), "length-smaller.glb", m, len);
+    expect_fail_path(path, "smaller");
+
+    memcpy(m, g, len);
+    put_le32(m + 12, (uint32_t)len);
+    write_file(path, lpvt_tmpdir(), "json-chunk-long.glb", m, len);
+    expect_fail_path(path, "out of range");
+
+    memcpy(m, g, len);
+    put_le32(m + 12, 0xfffffff0u);
+    write_file(path, lpvt_tmpdir(), "json-chunk-huge.glb", m, len);
+    expect_fail_path(path, "out of range");
+
+    /* BIN chunk longer than what is left */
+    memcpy(m, g, len);
+    size_t bin_hdr = 20 + ((strlen(J("%s", TRI_JSON)) + 3) & ~(size_t)3);
+    put_le32(m + bin_hdr, 400);
+    write_file(path, lpvt_tmpdir(), "bin-chunk-long.glb", m, len);
+    expect_fail_path(path, "out of range");
+
+    /* version 1 */
+    memcpy(m, g, len);
+    put_le32(m + 4, 1);
+    write_file(path, lpvt_tmpdir(), "version-1.glb", m, len);
+    expect_fail_path(path, "version");
+
+    /* binary junk, no magic at all */
+    memset(m, 0xee, len);
+    write_file(path, lpvt_tmpdir(), "junk.bin", m, len);
+    expect_fail_path(path, "magic");
+    free(m);
+    free(g);
+}
+
+static void test_invalid_json(void **state)
+{
+    (void)state;
+    expect_fail_glb("invalid-json.glb", "{'asset':{'version':'2.0'},'nodes':[{'mesh':0,}]", NULL, "invalid JSON");
+    char path[512];
+    const char *bad = "{\"asset\":{\"version\":\"2.0\"} trailing";
+    write_file(path, lpvt_tmpdir(), "invalid-json.gltf", bad, strlen(bad));
+    expect_fail_path(path, "invalid JSON");
+    const char *number = "{\"asset\":{\"version\":\"2.0\"},\"extras\":1e999}";
+    write_file(path, lpvt_tmpdir(), "number-overflow.gltf", number, strlen(number));
+    expect_fail_path(path, "invalid JSON");
+    /* not an object / no asset: tinygltf's own messages are passed on */
+    const char *noasset = "{\"nodes\":[]}";
+    write_file(path, lpvt_tmpdir(), "no-asset.gltf", noasset, strlen(noasset));
+    expect_fail_path(path, "asset");
+    /* hostile nesting */
+    static char deep[8192];
+    size_t n = (size_t)snprintf(deep, sizeof deep, "{\"asset\":{\"version\":\"2.0\"},\"extras\":");
+    for (int i = 0; i < 3000; i++)
+        deep[n++] = '[';
+    for (int i = 0; i < 3000; i++)
+        deep[n++] = ']';
+    deep[n++] = '}';
+    write_file(path, lpvt_tmpdir(), "deep-json.gltf", deep, n);
+    expect_fail_path(path, "nested");
+}
+
+static void test_ranges(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    /* accessor past the end of its bufferView */
+    expect_fail_glb("accessor-past-view.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':4,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range of bufferView");
+    expect_fail_glb("accessor-offset.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'byteOffset':4,'componentType':5126,'count':3,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range");
+    /* bufferView past the end of its buffer */
+    expect_fail_glb("view-past-buffer.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteOffset':12,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':2,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range of buffer");
+    /* buffer and accessor indices that do not exist */
+    expect_fail_glb("view-bad-buffer.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':3,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range");
+    expect_fail_glb("bad-accessor-index.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':7}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range");
+    /* byteStride of a view smaller than the element */
+    expect_fail_glb("small-stride.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36,'byteStride':8}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "byteStride");
+    /* sparse index outside the accessor */
+    bin c;
+    tri_bin(&c);
+    put_u16(&c, 9);
+    pad4(&c);
+    put_vec3(&c, 1, 1, 1);
+    expect_fail_glb("sparse-index.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':52}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':4},"
+                      "{'buffer':0,'byteOffset':40,'byteLength':12}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3',"
+                      "'sparse':{'count':1,'indices':{'bufferView':1,'componentType':5123},'values':{'bufferView':2}}}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &c, "out of range");
+}
+
+static void test_indices_and_values(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    put_u16(&b, 0);
+    put_u16(&b, 1);
+    put_u16(&b, 5);
+    pad4(&b);
+    expect_fail_glb("index-out-of-range.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':44}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':6}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'},"
+                      "{'bufferView':1,'componentType':5123,'count':3,'type':'SCALAR'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'indices':1}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range");
+    /* float indices are not allowed */
+    expect_fail_glb("float-indices.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':44}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':0,'byteLength':12}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'},"
+                      "{'bufferView':1,'componentType':5126,'count':3,'type':'SCALAR'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'indices':1}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "componentType");
+
+    const float bad[2] = {NAN, INFINITY};
+    const char *names[2] = {"nan-position.glb", "inf-position.glb"};
+    for (int i = 0; i < 2; i++) {
+        bin c;
+        tri_bin(&c);
+        memcpy(c.b + 16, &bad[i], 4); /* y of vertex 1 */
+        expect_fail_glb(names[i], J("%s", TRI_JSON), &c, "NaN");
+    }
+    /* finite in the file, infinite in the world */
+    expect_fail_glb("inf-world.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0,'scale':[1e300,1,1]}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "Inf");
+}
+
+static void test_missing_buffers(void **state)
+{
+    (void)state;
+    char path[512];
+    const char *json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'no-such-file.bin'}],"
+                         "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                         "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                         "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                         "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, lpvt_tmpdir(), "missing-buffer.gltf", json, strlen(json));
+    expect_fail_path(path, "not found");
+
+    json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+             "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, lpvt_tmpdir(), "buffer-without-uri.gltf", json, strlen(json));
+    expect_fail_path(path, "no data");
+    /* a .glb whose buffer has no BIN chunk to live in */
+    expect_fail_glb("glb-without-bin.glb", json, NULL, "BIN");
+    /* an external file of the wrong size */
+    bin b;
+    tri_bin(&b);
+    write_file(path, lpvt_tmpdir(), "short.bin", b.b, 24);
+    json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'short.bin'}],"
+             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+             "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, lpvt_tmpdir(), "short-buffer.gltf", json, strlen(json));
+    expect_fail_path(path, "size");
+    /* the file itself */
+    snprintf(path, sizeof path, "%s/does-not-exist.glb", lpvt_tmpdir());
+    expect_fail_path(path, "No such file");
+    expect_fail_path(lpvt_tmpdir(), "regular file");
+}
+
+/* An external URI that leaves the folder must be refused before reading:
+ * ../secret.bin holds a perfectly valid buffer, so only a refusal fails. */
+static void test_uri_escapes(void **state)
+{
+    (void)state;
+    char dir[512], path[512], secret[512], link[1024];
+    bin b;
+    tri_bin(&b);
+    write_file(secret, lpvt_tmpdir(), "secret.bin", b.b, b.n);
+    make_subdir(dir, "scene-dir");
+
+    const char *uris[] = {"../secret.bin", "%2e%2e/secret.bin", "sub/../../secret.bin", "/etc/passwd", secret};
+    const char *names[] = {"dotdot.gltf", "dotdot-encoded.gltf", "dotdot-deep.gltf", "absolute.gltf",
+                           "absolute-secret.gltf"};
+    for (int i = 0; i < 5; i++) {
+        const char *json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'%s'}],"
+                             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                             "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}",
+                             uris[i]);
+        write_file(path, dir, names[i], json, strlen(json));
+        expect_fail_path(path, "outside");
+        /* the same from a .glb */
+        char gname[64];
+        snprintf(gname, sizeof gname, "%s.glb", names[i]);
+        size_t len;
+        unsigned char *g = glb_build(json, NULL, 0, &len);
+        write_file(path, dir, gname, g, len);
+        free(g);
+        expect_fail_path(path, "outside");
+    }
+
+    /* a symbolic link inside the folder that points outside */
+    snprintf(link, sizeof link, "%s/link.bin", dir);
+    unlink(link);
+    assert_int_equal(symlink(secret, link), 0);
+    const char *json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'link.bin'}],"
+                         "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                         "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                         "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                         "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, dir, "symlink-out.gltf", json, strlen(json));
+    expect_fail_path(path, "outside");
+
+    /* a symbolic link that stays inside is fine */
+    write_file(path, dir, "inside.bin", b.b, b.n);
+    snprintf(link, sizeof link, "%s/link-in.bin", dir);
+    unlink(link);
+    assert_int_equal(symlink("inside.bin", link), 0);
+    json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'link-in.bin'}],"
+             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+             "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, dir, "symlink-in.gltf", json, strlen(json));
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_int_equal(s.vertex_count, 3);
+    lpv_scene_free(&s);
+
+    /* an image URI that leaves the folder is refused as well */
+    bin t;
+    tri_bin(&t);
+    json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+             "'images':[{'uri':'../secret.png'}],'textures':[{'source':0}],"
+             "'materials':[{'pbrMetallicRoughness':{'baseColorTexture':{'index':0}}}],"
+             "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'material':0}]}],"
+             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, lpvt_tmpdir(), "secret.png", png_2x2, sizeof png_2x2);
+    size_t len;
+    unsigned char *g = glb_build(json, t.b, t.n, &len);
+    write_file(path, dir, "image-outside.glb", g, len);
+    free(g);
+    expect_fail_path(path, "outside");
+}
+
+static void test_node_graphs(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    const char *head = "{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                       "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                       "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                       "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],";
+    expect_fail_glb("self-child.glb", J("%s'nodes':[{'mesh':0,'children':[0]}],'scenes':[{'nodes':[0]}]}", head), &b,
+                    "cycle");
+    expect_fail_glb("node-cycle.glb",
+                    J("%s'nodes':[{'children':[1]},{'children':[2]},{'mesh':0,'children':[1]}],"
+                      "'scenes':[{'nodes':[0]}]}",
+                      head),
+                    &b, "cycle");
+    /* a pure cycle with no root at all, and no scenes */
+    expect_fail_glb("rootless-cycle.glb", J("%s'nodes':[{'children':[1]},{'mesh':0,'children':[0]}]}", head), &b,
+                    "cycle");
+    expect_fail_glb("child-range.glb", J("%s'nodes':[{'children':[5]}],'scenes':[{'nodes':[0]}]}", head), &b,
+                    "out of range");
+    expect_fail_glb("scene-node-range.glb", J("%s'nodes':[{'mesh':0}],'scenes':[{'nodes':[3]}]}", head), &b,
+                    "out of range");
+    expect_fail_glb("scene-twice.glb", J("%s'nodes':[{'mesh':0}],'scenes':[{'nodes':[0,0]}]}", head), &b, "twice");
+    expect_fail_glb("default-scene-range.glb",
+                    J("%s'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}],'scene':4}", head), &b, "out of range");
+    expect_fail_glb("mesh-range.glb", J("%s'nodes':[{'mesh':9}],'scenes':[{'nodes':[0]}]}", head), &b,
+                    "out of range");
+    expect_fail_glb("light-range.glb",
+                    J("%s'nodes':[{'extensions':{'KHR_lights_punctual':{'light':0}}}],'scenes':[{'nodes':[0]}]}",
+                      head),
+                    &b, "out of range");
+    expect_fail_glb("bad-matrix.glb", J("%s'nodes':[{'mesh':0,'matrix':[1,0,0]}],'scenes':[{'nodes':[0]}]}", head),
+                    &b, "matrix");
+
+    /* 70 levels deep */
+    static char json[16384];
+    size_t n = (size_t)snprintf(json, sizeof json, "%s'nodes':[", head);
+    for (int i = 0; i < 70; i++)
+        n += (size_t)snprintf(json + n, sizeof json - n, "%s{'children':[%d]}", i ? "," : "", i + 1);
+    n += (size_t)snprintf(json + n, sizeof json - n, ",{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    expect_fail_glb("deep-nodes.glb", J("%s", json), &b, "deeper than 64");
+
+    /* exactly 64 levels is fine */
+    n = (size_t)snprintf(json, sizeof json, "%s'nodes':[", head);
+    for (int i = 0; i < 63; i++)
+        n += (size_t)snprintf(json + n, sizeof json - n, "%s{'children':[%d],'translation':[0,1,0]}", i ? "," : "",
+                              i + 1);
+    n += (size_t)snprintf(json + n, sizeof json - n, ",{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    char path[512];
+    write_glb(path, "nodes-64.glb", J("%s", json), &b);
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_vec3(s.bounds_min, 0, 63, 0, 1e-4f);
+    lpv_scene_free(&s);
+
+    /* no scenes: every root node is drawn */
+    write_glb(path, "no-scenes.glb", J("%s'nodes':[{'mesh':0},{'mesh':0,'translation':[0,0,1]}]}", head), &b);
+    load_ok(path, &s);
+    assert_int_equal(s.draw_count, 2);
+    lpv_scene_free(&s);
+}
+
+static void test_absurd_sizes(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    /* count 2^31 with a real bufferView and without one (zeros would need 24 GiB) */
+    expect_fail_glb("huge-count.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':2147483648,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "absurd");
+    expect_fail_glb("huge-count-noview.glb",
+                    J("{'asset':{'version':'2.0'},"
+                      "'accessors':[{'componentType':5126,'count':2147483648,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    NULL, "absurd");
+    /* within the element cap, count * stride still far past the view */
+    expect_fail_glb("big-stride.glb",
+                    J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                      "'bufferViews':[{'buffer':0,'byteLength':36,'byteStride':252}],"
+                      "'accessors':[{'bufferView':0,'componentType':5126,'count':40000000,'type':'VEC3'}],"
+                      "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                      "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}"),
+                    &b, "out of range");
+    /* a texture header claiming 20000 x 20000 */
+    bin t;
+    tri_bin(&t);
+    put(&t, png_huge, sizeof png_huge);
+    pad4(&t);
+    expect_fail_glb("huge-texture.glb", textured_json(sizeof png_huge, 36), &t, "texture limit");
+    /* the same as a JPEG start-of-frame */
+    static const unsigned char jpeg_huge[] = {0xff, 0xd8, 0xff, 0xe0, 0x00, 0x04, 0x00, 0x00, 0xff, 0xc0, 0x00,
+                                              0x11, 0x08, 0x4e, 0x20, 0x4e, 0x20, 0x03, 0x01, 0x22, 0x00, 0x02,
+                                              0x11, 0x01, 0x03, 0x11, 0x01, 0xff, 0xd9};
+    bin j;
+    tri_bin(&j);
+    put(&j, jpeg_huge, sizeof jpeg_huge);
+    pad4(&j);
+    expect_fail_glb("huge-jpeg.glb", textured_json(sizeof jpeg_huge, 36), &j, "texture limit");
+    /* an image whose bufferView lies outside its buffer */
+    bin u;
+    tri_bin(&u);
+    put(&u, png_2x2, sizeof png_2x2);
+    pad4(&u);
+    expect_fail_glb("image-view-range.glb", textured_json(sizeof png_2x2, 4000), &u, "out of range");
+    /* an extension lpvd cannot honour */
+    expect_fail_glb("draco.glb",
+                    J("{'asset':{'version':'2.0'},'extensionsUsed':['KHR_draco_mesh_compression'],"
+                      "'extensionsRequired':['KHR_draco_mesh_compression']}"),
+                    NULL, "unsupported extension");
+}
+
+/* ---- (c) the shared Cornell box against the built-in one -------------------- */
+
+static double tri_area(const lpv_scene *s, uint32_t t)
+{
+    const float *a = s->vertices[s->indices[3 * t]].position;
+    const float *b = s->vertices[s->indices[3 * t + 1]].position;
+    const float *c = s->vertices[s->indices[3 * t + 2]].position;
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = (double)b[k] - a[k];
+        e2[k] = (double)c[k] - a[k];
+    }
+    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    return 0.5 * sqrt(x * x + y * y + z * z);
+}
+
+static double area_of(const lpv_scene *s, const char *material)
+{
+    double sum = 0.0;
+    for (uint32_t d = 0; d < s->draw_count; d++) {
+        if (strcmp(s->materials[s->draws[d].material].name, material) != 0)
+            continue;
+        for (uint32_t t = 0; t < s->draws[d].index_count / 3; t++)
+            sum += tri_area(s, s->draws[d].first_index / 3 + t);
+    }
+    return sum;
+}
+
+static void test_cornell_glb_matches_builtin(void **state)
+{
+    (void)state;
+    const char *shared = lpvt_shared_dir();
+    if (!shared) {
+        print_message("    ../shared is absent: skipped\n");
+        skip();
+        return;
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/scenes/cornell-box.glb", shared);
+    lpv_scene g, b;
+    load_ok(path, &g);
+    assert_int_equal(lpv_scene_builtin_cornell(&b), 0);
+
+    assert_int_equal(g.index_count, 108); /* 36 triangles */
+    assert_int_equal(b.index_count, 108);
+    assert_int_equal(g.material_count, 8);
+    assert_int_equal(b.material_count, 8);
+    assert_int_equal(g.draw_count, 8);
+    assert_int_equal(g.light_count, 1);
+    assert_int_equal(g.camera_count, 1);
+    assert_int_equal(g.texture_count, 0);
+
+    for (int k = 0; k < 3; k++) {
+        assert_true(fabsf(g.bounds_min[k] - b.bounds_min[k]) < 1e-4f);
+        assert_true(fabsf(g.bounds_max[k] - b.bounds_max[k]) < 1e-4f);
+    }
+    for (uint32_t m = 0; m < b.material_count; m++) {
+        const char *name = b.materials[m].name;
+        double ag = area_of(&g, name), ab = area_of(&b, name);
+        print_message("    %-10s area glb %.6f built-in %.6f\n", name, ag, ab);
+        assert_true(ab > 0.0);
+        assert_true(fabs(ag - ab) < 1e-4);
+        /* the same material in both */
+        const lpv_material *mg = NULL;
+        for (uint32_t j = 0; j < g.material_count; j++)
+            if (strcmp(g.materials[j].name, name) == 0)
+                mg = &g.materials[j];
+        assert_non_null(mg);
+        assert_vec3(mg->base_color, b.materials[m].base_color[0], b.materials[m].base_color[1],
+                    b.materials[m].base_color[2], 1e-6f);
+        assert_vec3(mg->emission, b.materials[m].emission[0], b.materials[m].emission[1], b.materials[m].emission[2],
+                    1e-6f);
+        assert_true(fabsf(mg->roughness - b.materials[m].roughness) < 1e-6f);
+        assert_true(mg->metallic == b.materials[m].metallic);
+        assert_int_equal(mg->double_sided, b.materials[m].double_sided);
+    }
+
+    /* the lamp: (17, 12, 4) nits -> W/(m^2 sr) */
+    const lpv_material *lamp = NULL;
+    for (uint32_t j = 0; j < g.material_count; j++)
+        if (strcmp(g.materials[j].name, "light") == 0)
+            lamp = &g.materials[j];
+    assert_non_null(lamp);
+    assert_vec3(lamp->emission, 17.0f / 683.0f, 12.0f / 683.0f, 4.0f / 683.0f, 1e-6f);
+
+    const lpv_light *lg = &g.lights[0], *lb = &b.lights[0];
+    assert_int_equal(lg->type, LPV_LIGHT_SPOT);
+    assert_string_equal(lg->name, "CeilingSpot");
+    assert_string_equal(lb->name, lg->name);
+    assert_true(fabsf(lg->intensity - 2174.0565f / 683.0f) < 1e-5f);
+    assert_true(fabsf(lb->intensity - lg->intensity) < 1e-5f);
+    assert_vec3(lg->position, 0, 1.95f, 0, 1e-5f);
+    assert_vec3(lg->direction, 0, -1, 0, 1e-5f);
+    assert_vec3(lb->position, lg->position[0], lg->position[1], lg->position[2], 1e-5f);
+    assert_vec3(lb->direction, lg->direction[0], lg->direction[1], lg->direction[2], 1e-5f);
+    assert_vec3(lb->color, lg->color[0], lg->color[1], lg->color[2], 1e-6f);
+    assert_true(fabsf(lb->inner_cone - lg->inner_cone) < 1e-6f);
+    assert_true(fabsf(lb->outer_cone - lg->outer_cone) < 1e-6f);
+    assert_true(lg->range == 0.0f && lb->range == 0.0f);
+
+    const lpv_camera *cg = &g.cameras[0], *cb = &b.cameras[0];
+    assert_string_equal(cg->name, "Camera");
+    assert_string_equal(cb->name, cg->name);
+    assert_vec3(cg->eye, 0, 1, 3.9f, 1e-5f);
+    assert_vec3(cb->eye, cg->eye[0], cg->eye[1], cg->eye[2], 1e-5f);
+    assert_vec3(cb->forward, cg->forward[0], cg->forward[1], cg->forward[2], 1e-6f);
+    assert_vec3(cb->up, cg->up[0], cg->up[1], cg->up[2], 1e-6f);
+    assert_int_equal(cg->orthographic, 0);
+    assert_int_equal(cb->orthographic, 0);
+    assert_true(fabsf(cb->yfov - cg->yfov) < 1e-6f);
+    assert_true(cb->aspect == cg->aspect && cg->aspect == 1.0f);
+    assert_true(fabsf(cb->znear - cg->znear) < 1e-7f && cb->zfar == cg->zfar);
+
+    /* the glb's normals agree with the built-in orientation per material */
+    for (uint32_t d = 0; d < g.draw_count; d++) {
+        const char *name = g.materials[g.draws[d].material].name;
+        if (strcmp(name, "shortBox") == 0 || strcmp(name, "tallBox") == 0)
+            continue;
+        const float *ng = g.vertices[g.indices[g.draws[d].first_index]].normal;
+        for (uint32_t e = 0; e < b.draw_count; e++) {
+            if (strcmp(b.materials[b.draws[e].material].name, name) != 0)
+                continue;
+            const float *nb = b.vertices[b.indices[b.draws[e].first_index]].normal;
+            assert_true(ng[0] * nb[0] + ng[1] * nb[1] + ng[2] * nb[2] > 0.999f);
+        }
+    }
+    lpv_scene_free(&g);
+    lpv_scene_free(&b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_one_triangle),
+        cmocka_unit_test(test_indexed_quad_ushort_ubyte_normalized_uv),
+        cmocka_unit_test(test_node_hierarchy),
+        cmocka_unit_test(test_normals_transformed_and_degenerate),
+        cmocka_unit_test(test_sparse_accessors),
+        cmocka_unit_test(test_strip_fan_points_lines),
+        cmocka_unit_test(test_lights),
+        cmocka_unit_test(test_cameras),
+        cmocka_unit_test(test_emissive_strength),
+        cmocka_unit_test(test_texture),
+        cmocka_unit_test(test_gltf_external_bin_and_data_uri),
+        cmocka_unit_test(test_truncated_glb),
+        cmocka_unit_test(test_glb_header_lies),
+        cmocka_unit_test(test_invalid_json),
+        cmocka_unit_test(test_ranges),
+        cmocka_unit_test(test_indices_and_values),
+        cmocka_unit_test(test_missing_buffers),
+        cmocka_unit_test(test_uri_escapes),
+        cmocka_unit_test(test_node_graphs),
+        cmocka_unit_test(test_absurd_sizes),
+        cmocka_unit_test(test_cornell_glb_matches_builtin),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
