@@ -1,0 +1,1424 @@
+/*
+ * gl.h - the OpenGL 4.5 core function table of lpvd.
+ *
+ * Include this instead of any other GL header. It pulls in <GL/glcorearb.h>
+ * for types, enums and PFN... typedefs (never GL_GLEXT_PROTOTYPES: nothing
+ * links against libGL) and declares one function pointer per GL entry point,
+ *     extern PFNGLCLEARPROC lpv_gl_glClear;
+ * plus a macro that maps the standard name onto it,
+ *     #define glClear lpv_gl_glClear
+ * so the rest of the code calls GL by its usual names.
+ *
+ * Why our own table: the context (context.c) comes from EGL (pointers from
+ * eglGetProcAddress) or from OSMesa opened with dlopen (pointers from
+ * OSMesaGetProcAddress), and no loader library packaged by Debian covers
+ * OSMesa. lpv_gl_load() fills the table from whichever backend made the
+ * context current; context.c calls it, nobody else needs to.
+ *
+ * The table is every function of GL 1.0 to 4.5 core as listed in
+ * glcorearb.h (GL 4.6 is not required), grouped by version. All of them but
+ * the six in LPV_GL_OPTIONAL_FUNCTIONS are required: loading fails, naming
+ * the first missing function, if one is absent. The list was generated from
+ * glcorearb.h's GL_VERSION_x_y sections; to add a function, add it to a list
+ * *and* add its #define below (gl_loader.c assigns through the macro name, so
+ * a missing #define is a compile error, never a silent NULL).
+ *
+ * The table is process-wide. Pointers from EGL are valid for every EGL
+ * context; pointers from OSMesa for every OSMesa context; context.c reloads
+ * the table when a context of another backend is made current.
+ */
+#ifndef LPV_GL_H
+#define LPV_GL_H
+
+#include <stddef.h>
+#include <GL/glcorearb.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* X(PFN type, GL name) for every entry point of the table. */
+#define LPV_GL_FUNCTIONS(X) \
+    /* ---- GL 1.0 ---- */ \
+    X(PFNGLCULLFACEPROC, glCullFace) \
+    X(PFNGLFRONTFACEPROC, glFrontFace) \
+    X(PFNGLHINTPROC, glHint) \
+    X(PFNGLLINEWIDTHPROC, glLineWidth) \
+    X(PFNGLPOINTSIZEPROC, glPointSize) \
+    X(PFNGLPOLYGONMODEPROC, glPolygonMode) \
+    X(PFNGLSCISSORPROC, glScissor) \
+    X(PFNGLTEXPARAMETERFPROC, glTexParameterf) \
+    X(PFNGLTEXPARAMETERFVPROC, glTexParameterfv) \
+    X(PFNGLTEXPARAMETERIPROC, glTexParameteri) \
+    X(PFNGLTEXPARAMETERIVPROC, glTexParameteriv) \
+    X(PFNGLTEXIMAGE1DPROC, glTexImage1D) \
+    X(PFNGLTEXIMAGE2DPROC, glTexImage2D) \
+    X(PFNGLDRAWBUFFERPROC, glDrawBuffer) \
+    X(PFNGLCLEARPROC, glClear) \
+    X(PFNGLCLEARCOLORPROC, glClearColor) \
+    X(PFNGLCLEARSTENCILPROC, glClearStencil) \
+    X(PFNGLCLEARDEPTHPROC, glClearDepth) \
+    X(PFNGLSTENCILMASKPROC, glStencilMask) \
+    X(PFNGLCOLORMASKPROC, glColorMask) \
+    X(PFNGLDEPTHMASKPROC, glDepthMask) \
+    X(PFNGLDISABLEPROC, glDisable) \
+    X(PFNGLENABLEPROC, glEnable) \
+    X(PFNGLFINISHPROC, glFinish) \
+    X(PFNGLFLUSHPROC, glFlush) \
+    X(PFNGLBLENDFUNCPROC, glBlendFunc) \
+    X(PFNGLLOGICOPPROC, glLogicOp) \
+    X(PFNGLSTENCILFUNCPROC, glStencilFunc) \
+    X(PFNGLSTENCILOPPROC, glStencilOp) \
+    X(PFNGLDEPTHFUNCPROC, glDepthFunc) \
+    X(PFNGLPIXELSTOREFPROC, glPixelStoref) \
+    X(PFNGLPIXELSTOREIPROC, glPixelStorei) \
+    X(PFNGLREADBUFFERPROC, glReadBuffer) \
+    X(PFNGLREADPIXELSPROC, glReadPixels) \
+    X(PFNGLGETBOOLEANVPROC, glGetBooleanv) \
+    X(PFNGLGETDOUBLEVPROC, glGetDoublev) \
+    X(PFNGLGETERRORPROC, glGetError) \
+    X(PFNGLGETFLOATVPROC, glGetFloatv) \
+    X(PFNGLGETINTEGERVPROC, glGetIntegerv) \
+    X(PFNGLGETSTRINGPROC, glGetString) \
+    X(PFNGLGETTEXIMAGEPROC, glGetTexImage) \
+    X(PFNGLGETTEXPARAMETERFVPROC, glGetTexParameterfv) \
+    X(PFNGLGETTEXPARAMETERIVPROC, glGetTexParameteriv) \
+    X(PFNGLGETTEXLEVELPARAMETERFVPROC, glGetTexLevelParameterfv) \
+    X(PFNGLGETTEXLEVELPARAMETERIVPROC, glGetTexLevelParameteriv) \
+    X(PFNGLISENABLEDPROC, glIsEnabled) \
+    X(PFNGLDEPTHRANGEPROC, glDepthRange) \
+    X(PFNGLVIEWPORTPROC, glViewport) \
+    /* ---- GL 1.1 ---- */ \
+    X(PFNGLDRAWARRAYSPROC, glDrawArrays) \
+    X(PFNGLDRAWELEMENTSPROC, glDrawElements) \
+    X(PFNGLGETPOINTERVPROC, glGetPointerv) \
+    X(PFNGLPOLYGONOFFSETPROC, glPolygonOffset) \
+    X(PFNGLCOPYTEXIMAGE1DPROC, glCopyTexImage1D) \
+    X(PFNGLCOPYTEXIMAGE2DPROC, glCopyTexImage2D) \
+    X(PFNGLCOPYTEXSUBIMAGE1DPROC, glCopyTexSubImage1D) \
+    X(PFNGLCOPYTEXSUBIMAGE2DPROC, glCopyTexSubImage2D) \
+    X(PFNGLTEXSUBIMAGE1DPROC, glTexSubImage1D) \
+    X(PFNGLTEXSUBIMAGE2DPROC, glTexSubImage2D) \
+    X(PFNGLBINDTEXTUREPROC, glBindTexture) \
+    X(PFNGLDELETETEXTURESPROC, glDeleteTextures) \
+    X(PFNGLGENTEXTURESPROC, glGenTextures) \
+    X(PFNGLISTEXTUREPROC, glIsTexture) \
+    /* ---- GL 1.2 ---- */ \
+    X(PFNGLDRAWRANGEELEMENTSPROC, glDrawRangeElements) \
+    X(PFNGLTEXIMAGE3DPROC, glTexImage3D) \
+    X(PFNGLTEXSUBIMAGE3DPROC, glTexSubImage3D) \
+    X(PFNGLCOPYTEXSUBIMAGE3DPROC, glCopyTexSubImage3D) \
+    /* ---- GL 1.3 ---- */ \
+    X(PFNGLACTIVETEXTUREPROC, glActiveTexture) \
+    X(PFNGLSAMPLECOVERAGEPROC, glSampleCoverage) \
+    X(PFNGLCOMPRESSEDTEXIMAGE3DPROC, glCompressedTexImage3D) \
+    X(PFNGLCOMPRESSEDTEXIMAGE2DPROC, glCompressedTexImage2D) \
+    X(PFNGLCOMPRESSEDTEXIMAGE1DPROC, glCompressedTexImage1D) \
+    X(PFNGLCOMPRESSEDTEXSUBIMAGE3DPROC, glCompressedTexSubImage3D) \
+    X(PFNGLCOMPRESSEDTEXSUBIMAGE2DPROC, glCompressedTexSubImage2D) \
+    X(PFNGLCOMPRESSEDTEXSUBIMAGE1DPROC, glCompressedTexSubImage1D) \
+    X(PFNGLGETCOMPRESSEDTEXIMAGEPROC, glGetCompressedTexImage) \
+    /* ---- GL 1.4 ---- */ \
+    X(PFNGLBLENDFUNCSEPARATEPROC, glBlendFuncSeparate) \
+    X(PFNGLMULTIDRAWARRAYSPROC, glMultiDrawArrays) \
+    X(PFNGLMULTIDRAWELEMENTSPROC, glMultiDrawElements) \
+    X(PFNGLPOINTPARAMETERFPROC, glPointParameterf) \
+    X(PFNGLPOINTPARAMETERFVPROC, glPointParameterfv) \
+    X(PFNGLPOINTPARAMETERIPROC, glPointParameteri) \
+    X(PFNGLPOINTPARAMETERIVPROC, glPointParameteriv) \
+    X(PFNGLBLENDCOLORPROC, glBlendColor) \
+    X(PFNGLBLENDEQUATIONPROC, glBlendEquation) \
+    /* ---- GL 1.5 ---- */ \
+    X(PFNGLGENQUERIESPROC, glGenQueries) \
+    X(PFNGLDELETEQUERIESPROC, glDeleteQueries) \
+    X(PFNGLISQUERYPROC, glIsQuery) \
+    X(PFNGLBEGINQUERYPROC, glBeginQuery) \
+    X(PFNGLENDQUERYPROC, glEndQuery) \
+    X(PFNGLGETQUERYIVPROC, glGetQueryiv) \
+    X(PFNGLGETQUERYOBJECTIVPROC, glGetQueryObjectiv) \
+    X(PFNGLGETQUERYOBJECTUIVPROC, glGetQueryObjectuiv) \
+    X(PFNGLBINDBUFFERPROC, glBindBuffer) \
+    X(PFNGLDELETEBUFFERSPROC, glDeleteBuffers) \
+    X(PFNGLGENBUFFERSPROC, glGenBuffers) \
+    X(PFNGLISBUFFERPROC, glIsBuffer) \
+    X(PFNGLBUFFERDATAPROC, glBufferData) \
+    X(PFNGLBUFFERSUBDATAPROC, glBufferSubData) \
+    X(PFNGLGETBUFFERSUBDATAPROC, glGetBufferSubData) \
+    X(PFNGLMAPBUFFERPROC, glMapBuffer) \
+    X(PFNGLUNMAPBUFFERPROC, glUnmapBuffer) \
+    X(PFNGLGETBUFFERPARAMETERIVPROC, glGetBufferParameteriv) \
+    X(PFNGLGETBUFFERPOINTERVPROC, glGetBufferPointerv) \
+    /* ---- GL 2.0 ---- */ \
+    X(PFNGLBLENDEQUATIONSEPARATEPROC, glBlendEquationSeparate) \
+    X(PFNGLDRAWBUFFERSPROC, glDrawBuffers) \
+    X(PFNGLSTENCILOPSEPARATEPROC, glStencilOpSeparate) \
+    X(PFNGLSTENCILFUNCSEPARATEPROC, glStencilFuncSeparate) \
+    X(PFNGLSTENCILMASKSEPARATEPROC, glStencilMaskSeparate) \
+    X(PFNGLATTACHSHADERPROC, glAttachShader) \
+    X(PFNGLBINDATTRIBLOCATIONPROC, glBindAttribLocation) \
+    X(PFNGLCOMPILESHADERPROC, glCompileShader) \
+    X(PFNGLCREATEPROGRAMPROC, glCreateProgram) \
+    X(PFNGLCREATESHADERPROC, glCreateShader) \
+    X(PFNGLDELETEPROGRAMPROC, glDeleteProgram) \
+    X(PFNGLDELETESHADERPROC, glDeleteShader) \
+    X(PFNGLDETACHSHADERPROC, glDetachShader) \
+    X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, glDisableVertexAttribArray) \
+    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, glEnableVertexAttribArray) \
+    X(PFNGLGETACTIVEATTRIBPROC, glGetActiveAttrib) \
+    X(PFNGLGETACTIVEUNIFORMPROC, glGetActiveUniform) \
+    X(PFNGLGETATTACHEDSHADERSPROC, glGetAttachedShaders) \
+    X(PFNGLGETATTRIBLOCATIONPROC, glGetAttribLocation) \
+    X(PFNGLGETPROGRAMIVPROC, glGetProgramiv) \
+    X(PFNGLGETPROGRAMINFOLOGPROC, glGetProgramInfoLog) \
+    X(PFNGLGETSHADERIVPROC, glGetShaderiv) \
+    X(PFNGLGETSHADERINFOLOGPROC, glGetShaderInfoLog) \
+    X(PFNGLGETSHADERSOURCEPROC, glGetShaderSource) \
+    X(PFNGLGETUNIFORMLOCATIONPROC, glGetUniformLocation) \
+    X(PFNGLGETUNIFORMFVPROC, glGetUniformfv) \
+    X(PFNGLGETUNIFORMIVPROC, glGetUniformiv) \
+    X(PFNGLGETVERTEXATTRIBDVPROC, glGetVertexAttribdv) \
+    X(PFNGLGETVERTEXATTRIBFVPROC, glGetVertexAttribfv) \
+    X(PFNGLGETVERTEXATTRIBIVPROC, glGetVertexAttribiv) \
+    X(PFNGLGETVERTEXATTRIBPOINTERVPROC, glGetVertexAttribPointerv) \
+    X(PFNGLISPROGRAMPROC, glIsProgram) \
+    X(PFNGLISSHADERPROC, glIsShader) \
+    X(PFNGLLINKPROGRAMPROC, glLinkProgram) \
+    X(PFNGLSHADERSOURCEPROC, glShaderSource) \
+    X(PFNGLUSEPROGRAMPROC, glUseProgram) \
+    X(PFNGLUNIFORM1FPROC, glUniform1f) \
+    X(PFNGLUNIFORM2FPROC, glUniform2f) \
+    X(PFNGLUNIFORM3FPROC, glUniform3f) \
+    X(PFNGLUNIFORM4FPROC, glUniform4f) \
+    X(PFNGLUNIFORM1IPROC, glUniform1i) \
+    X(PFNGLUNIFORM2IPROC, glUniform2i) \
+    X(PFNGLUNIFORM3IPROC, glUniform3i) \
+    X(PFNGLUNIFORM4IPROC, glUniform4i) \
+    X(PFNGLUNIFORM1FVPROC, glUniform1fv) \
+    X(PFNGLUNIFORM2FVPROC, glUniform2fv) \
+    X(PFNGLUNIFORM3FVPROC, glUniform3fv) \
+    X(PFNGLUNIFORM4FVPROC, glUniform4fv) \
+    X(PFNGLUNIFORM1IVPROC, glUniform1iv) \
+    X(PFNGLUNIFORM2IVPROC, glUniform2iv) \
+    X(PFNGLUNIFORM3IVPROC, glUniform3iv) \
+    X(PFNGLUNIFORM4IVPROC, glUniform4iv) \
+    X(PFNGLUNIFORMMATRIX2FVPROC, glUniformMatrix2fv) \
+    X(PFNGLUNIFORMMATRIX3FVPROC, glUniformMatrix3fv) \
+    X(PFNGLUNIFORMMATRIX4FVPROC, glUniformMatrix4fv) \
+    X(PFNGLVALIDATEPROGRAMPROC, glValidateProgram) \
+    X(PFNGLVERTEXATTRIB1DPROC, glVertexAttrib1d) \
+    X(PFNGLVERTEXATTRIB1DVPROC, glVertexAttrib1dv) \
+    X(PFNGLVERTEXATTRIB1FPROC, glVertexAttrib1f) \
+    X(PFNGLVERTEXATTRIB1FVPROC, glVertexAttrib1fv) \
+    X(PFNGLVERTEXATTRIB1SPROC, glVertexAttrib1s) \
+    X(PFNGLVERTEXATTRIB1SVPROC, glVertexAttrib1sv) \
+    X(PFNGLVERTEXATTRIB2DPROC, glVertexAttrib2d) \
+    X(PFNGLVERTEXATTRIB2DVPROC, glVertexAttrib2dv) \
+    X(PFNGLVERTEXATTRIB2FPROC, glVertexAttrib2f) \
+    X(PFNGLVERTEXATTRIB2FVPROC, glVertexAttrib2fv) \
+    X(PFNGLVERTEXATTRIB2SPROC, glVertexAttrib2s) \
+    X(PFNGLVERTEXATTRIB2SVPROC, glVertexAttrib2sv) \
+    X(PFNGLVERTEXATTRIB3DPROC, glVertexAttrib3d) \
+    X(PFNGLVERTEXATTRIB3DVPROC, glVertexAttrib3dv) \
+    X(PFNGLVERTEXATTRIB3FPROC, glVertexAttrib3f) \
+    X(PFNGLVERTEXATTRIB3FVPROC, glVertexAttrib3fv) \
+    X(PFNGLVERTEXATTRIB3SPROC, glVertexAttrib3s) \
+    X(PFNGLVERTEXATTRIB3SVPROC, glVertexAttrib3sv) \
+    X(PFNGLVERTEXATTRIB4NBVPROC, glVertexAttrib4Nbv) \
+    X(PFNGLVERTEXATTRIB4NIVPROC, glVertexAttrib4Niv) \
+    X(PFNGLVERTEXATTRIB4NSVPROC, glVertexAttrib4Nsv) \
+    X(PFNGLVERTEXATTRIB4NUBPROC, glVertexAttrib4Nub) \
+    X(PFNGLVERTEXATTRIB4NUBVPROC, glVertexAttrib4Nubv) \
+    X(PFNGLVERTEXATTRIB4NUIVPROC, glVertexAttrib4Nuiv) \
+    X(PFNGLVERTEXATTRIB4NUSVPROC, glVertexAttrib4Nusv) \
+    X(PFNGLVERTEXATTRIB4BVPROC, glVertexAttrib4bv) \
+    X(PFNGLVERTEXATTRIB4DPROC, glVertexAttrib4d) \
+    X(PFNGLVERTEXATTRIB4DVPROC, glVertexAttrib4dv) \
+    X(PFNGLVERTEXATTRIB4FPROC, glVertexAttrib4f) \
+    X(PFNGLVERTEXATTRIB4FVPROC, glVertexAttrib4fv) \
+    X(PFNGLVERTEXATTRIB4IVPROC, glVertexAttrib4iv) \
+    X(PFNGLVERTEXATTRIB4SPROC, glVertexAttrib4s) \
+    X(PFNGLVERTEXATTRIB4SVPROC, glVertexAttrib4sv) \
+    X(PFNGLVERTEXATTRIB4UBVPROC, glVertexAttrib4ubv) \
+    X(PFNGLVERTEXATTRIB4UIVPROC, glVertexAttrib4uiv) \
+    X(PFNGLVERTEXATTRIB4USVPROC, glVertexAttrib4usv) \
+    X(PFNGLVERTEXATTRIBPOINTERPROC, glVertexAttribPointer) \
+    /* ---- GL 2.1 ---- */ \
+    X(PFNGLUNIFORMMATRIX2X3FVPROC, glUniformMatrix2x3fv) \
+    X(PFNGLUNIFORMMATRIX3X2FVPROC, glUniformMatrix3x2fv) \
+    X(PFNGLUNIFORMMATRIX2X4FVPROC, glUniformMatrix2x4fv) \
+    X(PFNGLUNIFORMMATRIX4X2FVPROC, glUniformMatrix4x2fv) \
+    X(PFNGLUNIFORMMATRIX3X4FVPROC, glUniformMatrix3x4fv) \
+    X(PFNGLUNIFORMMATRIX4X3FVPROC, glUniformMatrix4x3fv) \
+    /* ---- GL 3.0 ---- */ \
+    X(PFNGLCOLORMASKIPROC, glColorMaski) \
+    X(PFNGLGETBOOLEANI_VPROC, glGetBooleani_v) \
+    X(PFNGLGETINTEGERI_VPROC, glGetIntegeri_v) \
+    X(PFNGLENABLEIPROC, glEnablei) \
+    X(PFNGLDISABLEIPROC, glDisablei) \
+    X(PFNGLISENABLEDIPROC, glIsEnabledi) \
+    X(PFNGLBEGINTRANSFORMFEEDBACKPROC, glBeginTransformFeedback) \
+    X(PFNGLENDTRANSFORMFEEDBACKPROC, glEndTransformFeedback) \
+    X(PFNGLBINDBUFFERRANGEPROC, glBindBufferRange) \
+    X(PFNGLBINDBUFFERBASEPROC, glBindBufferBase) \
+    X(PFNGLTRANSFORMFEEDBACKVARYINGSPROC, glTransformFeedbackVaryings) \
+    X(PFNGLGETTRANSFORMFEEDBACKVARYINGPROC, glGetTransformFeedbackVarying) \
+    X(PFNGLCLAMPCOLORPROC, glClampColor) \
+    X(PFNGLBEGINCONDITIONALRENDERPROC, glBeginConditionalRender) \
+    X(PFNGLENDCONDITIONALRENDERPROC, glEndConditionalRender) \
+    X(PFNGLVERTEXATTRIBIPOINTERPROC, glVertexAttribIPointer) \
+    X(PFNGLGETVERTEXATTRIBIIVPROC, glGetVertexAttribIiv) \
+    X(PFNGLGETVERTEXATTRIBIUIVPROC, glGetVertexAttribIuiv) \
+    X(PFNGLVERTEXATTRIBI1IPROC, glVertexAttribI1i) \
+    X(PFNGLVERTEXATTRIBI2IPROC, glVertexAttribI2i) \
+    X(PFNGLVERTEXATTRIBI3IPROC, glVertexAttribI3i) \
+    X(PFNGLVERTEXATTRIBI4IPROC, glVertexAttribI4i) \
+    X(PFNGLVERTEXATTRIBI1UIPROC, glVertexAttribI1ui) \
+    X(PFNGLVERTEXATTRIBI2UIPROC, glVertexAttribI2ui) \
+    X(PFNGLVERTEXATTRIBI3UIPROC, glVertexAttribI3ui) \
+    X(PFNGLVERTEXATTRIBI4UIPROC, glVertexAttribI4ui) \
+    X(PFNGLVERTEXATTRIBI1IVPROC, glVertexAttribI1iv) \
+    X(PFNGLVERTEXATTRIBI2IVPROC, glVertexAttribI2iv) \
+    X(PFNGLVERTEXATTRIBI3IVPROC, glVertexAttribI3iv) \
+    X(PFNGLVERTEXATTRIBI4IVPROC, glVertexAttribI4iv) \
+    X(PFNGLVERTEXATTRIBI1UIVPROC, glVertexAttribI1uiv) \
+    X(PFNGLVERTEXATTRIBI2UIVPROC, glVertexAttribI2uiv) \
+    X(PFNGLVERTEXATTRIBI3UIVPROC, glVertexAttribI3uiv) \
+    X(PFNGLVERTEXATTRIBI4UIVPROC, glVertexAttribI4uiv) \
+    X(PFNGLVERTEXATTRIBI4BVPROC, glVertexAttribI4bv) \
+    X(PFNGLVERTEXATTRIBI4SVPROC, glVertexAttribI4sv) \
+    X(PFNGLVERTEXATTRIBI4UBVPROC, glVertexAttribI4ubv) \
+    X(PFNGLVERTEXATTRIBI4USVPROC, glVertexAttribI4usv) \
+    X(PFNGLGETUNIFORMUIVPROC, glGetUniformuiv) \
+    X(PFNGLBINDFRAGDATALOCATIONPROC, glBindFragDataLocation) \
+    X(PFNGLGETFRAGDATALOCATIONPROC, glGetFragDataLocation) \
+    X(PFNGLUNIFORM1UIPROC, glUniform1ui) \
+    X(PFNGLUNIFORM2UIPROC, glUniform2ui) \
+    X(PFNGLUNIFORM3UIPROC, glUniform3ui) \
+    X(PFNGLUNIFORM4UIPROC, glUniform4ui) \
+    X(PFNGLUNIFORM1UIVPROC, glUniform1uiv) \
+    X(PFNGLUNIFORM2UIVPROC, glUniform2uiv) \
+    X(PFNGLUNIFORM3UIVPROC, glUniform3uiv) \
+    X(PFNGLUNIFORM4UIVPROC, glUniform4uiv) \
+    X(PFNGLTEXPARAMETERIIVPROC, glTexParameterIiv) \
+    X(PFNGLTEXPARAMETERIUIVPROC, glTexParameterIuiv) \
+    X(PFNGLGETTEXPARAMETERIIVPROC, glGetTexParameterIiv) \
+    X(PFNGLGETTEXPARAMETERIUIVPROC, glGetTexParameterIuiv) \
+    X(PFNGLCLEARBUFFERIVPROC, glClearBufferiv) \
+    X(PFNGLCLEARBUFFERUIVPROC, glClearBufferuiv) \
+    X(PFNGLCLEARBUFFERFVPROC, glClearBufferfv) \
+    X(PFNGLCLEARBUFFERFIPROC, glClearBufferfi) \
+    X(PFNGLGETSTRINGIPROC, glGetStringi) \
+    X(PFNGLISRENDERBUFFERPROC, glIsRenderbuffer) \
+    X(PFNGLBINDRENDERBUFFERPROC, glBindRenderbuffer) \
+    X(PFNGLDELETERENDERBUFFERSPROC, glDeleteRenderbuffers) \
+    X(PFNGLGENRENDERBUFFERSPROC, glGenRenderbuffers) \
+    X(PFNGLRENDERBUFFERSTORAGEPROC, glRenderbufferStorage) \
+    X(PFNGLGETRENDERBUFFERPARAMETERIVPROC, glGetRenderbufferParameteriv) \
+    X(PFNGLISFRAMEBUFFERPROC, glIsFramebuffer) \
+    X(PFNGLBINDFRAMEBUFFERPROC, glBindFramebuffer) \
+    X(PFNGLDELETEFRAMEBUFFERSPROC, glDeleteFramebuffers) \
+    X(PFNGLGENFRAMEBUFFERSPROC, glGenFramebuffers) \
+    X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, glCheckFramebufferStatus) \
+    X(PFNGLFRAMEBUFFERTEXTURE1DPROC, glFramebufferTexture1D) \
+    X(PFNGLFRAMEBUFFERTEXTURE2DPROC, glFramebufferTexture2D) \
+    X(PFNGLFRAMEBUFFERTEXTURE3DPROC, glFramebufferTexture3D) \
+    X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, glFramebufferRenderbuffer) \
+    X(PFNGLGETFRAMEBUFFERATTACHMENTPARAMETERIVPROC, glGetFramebufferAttachmentParameteriv) \
+    X(PFNGLGENERATEMIPMAPPROC, glGenerateMipmap) \
+    X(PFNGLBLITFRAMEBUFFERPROC, glBlitFramebuffer) \
+    X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, glRenderbufferStorageMultisample) \
+    X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, glFramebufferTextureLayer) \
+    X(PFNGLMAPBUFFERRANGEPROC, glMapBufferRange) \
+    X(PFNGLFLUSHMAPPEDBUFFERRANGEPROC, glFlushMappedBufferRange) \
+    X(PFNGLBINDVERTEXARRAYPROC, glBindVertexArray) \
+    X(PFNGLDELETEVERTEXARRAYSPROC, glDeleteVertexArrays) \
+    X(PFNGLGENVERTEXARRAYSPROC, glGenVertexArrays) \
+    X(PFNGLISVERTEXARRAYPROC, glIsVertexArray) \
+    /* ---- GL 3.1 ---- */ \
+    X(PFNGLDRAWARRAYSINSTANCEDPROC, glDrawArraysInstanced) \
+    X(PFNGLDRAWELEMENTSINSTANCEDPROC, glDrawElementsInstanced) \
+    X(PFNGLTEXBUFFERPROC, glTexBuffer) \
+    X(PFNGLPRIMITIVERESTARTINDEXPROC, glPrimitiveRestartIndex) \
+    X(PFNGLCOPYBUFFERSUBDATAPROC, glCopyBufferSubData) \
+    X(PFNGLGETUNIFORMINDICESPROC, glGetUniformIndices) \
+    X(PFNGLGETACTIVEUNIFORMSIVPROC, glGetActiveUniformsiv) \
+    X(PFNGLGETACTIVEUNIFORMNAMEPROC, glGetActiveUniformName) \
+    X(PFNGLGETUNIFORMBLOCKINDEXPROC, glGetUniformBlockIndex) \
+    X(PFNGLGETACTIVEUNIFORMBLOCKIVPROC, glGetActiveUniformBlockiv) \
+    X(PFNGLGETACTIVEUNIFORMBLOCKNAMEPROC, glGetActiveUniformBlockName) \
+    X(PFNGLUNIFORMBLOCKBINDINGPROC, glUniformBlockBinding) \
+    /* ---- GL 3.2 ---- */ \
+    X(PFNGLDRAWELEMENTSBASEVERTEXPROC, glDrawElementsBaseVertex) \
+    X(PFNGLDRAWRANGEELEMENTSBASEVERTEXPROC, glDrawRangeElementsBaseVertex) \
+    X(PFNGLDRAWELEMENTSINSTANCEDBASEVERTEXPROC, glDrawElementsInstancedBaseVertex) \
+    X(PFNGLMULTIDRAWELEMENTSBASEVERTEXPROC, glMultiDrawElementsBaseVertex) \
+    X(PFNGLPROVOKINGVERTEXPROC, glProvokingVertex) \
+    X(PFNGLFENCESYNCPROC, glFenceSync) \
+    X(PFNGLISSYNCPROC, glIsSync) \
+    X(PFNGLDELETESYNCPROC, glDeleteSync) \
+    X(PFNGLCLIENTWAITSYNCPROC, glClientWaitSync) \
+    X(PFNGLWAITSYNCPROC, glWaitSync) \
+    X(PFNGLGETINTEGER64VPROC, glGetInteger64v) \
+    X(PFNGLGETSYNCIVPROC, glGetSynciv) \
+    X(PFNGLGETINTEGER64I_VPROC, glGetInteger64i_v) \
+    X(PFNGLGETBUFFERPARAMETERI64VPROC, glGetBufferParameteri64v) \
+    X(PFNGLFRAMEBUFFERTEXTUREPROC, glFramebufferTexture) \
+    X(PFNGLTEXIMAGE2DMULTISAMPLEPROC, glTexImage2DMultisample) \
+    X(PFNGLTEXIMAGE3DMULTISAMPLEPROC, glTexImage3DMultisample) \
+    X(PFNGLGETMULTISAMPLEFVPROC, glGetMultisamplefv) \
+    X(PFNGLSAMPLEMASKIPROC, glSampleMaski) \
+    /* ---- GL 3.3 ---- */ \
+    X(PFNGLBINDFRAGDATALOCATIONINDEXEDPROC, glBindFragDataLocationIndexed) \
+    X(PFNGLGETFRAGDATAINDEXPROC, glGetFragDataIndex) \
+    X(PFNGLGENSAMPLERSPROC, glGenSamplers) \
+    X(PFNGLDELETESAMPLERSPROC, glDeleteSamplers) \
+    X(PFNGLISSAMPLERPROC, glIsSampler) \
+    X(PFNGLBINDSAMPLERPROC, glBindSampler) \
+    X(PFNGLSAMPLERPARAMETERIPROC, glSamplerParameteri) \
+    X(PFNGLSAMPLERPARAMETERIVPROC, glSamplerParameteriv) \
+    X(PFNGLSAMPLERPARAMETERFPROC, glSamplerParameterf) \
+    X(PFNGLSAMPLERPARAMETERFVPROC, glSamplerParameterfv) \
+    X(PFNGLSAMPLERPARAMETERIIVPROC, glSamplerParameterIiv) \
+    X(PFNGLSAMPLERPARAMETERIUIVPROC, glSamplerParameterIuiv) \
+    X(PFNGLGETSAMPLERPARAMETERIVPROC, glGetSamplerParameteriv) \
+    X(PFNGLGETSAMPLERPARAMETERIIVPROC, glGetSamplerParameterIiv) \
+    X(PFNGLGETSAMPLERPARAMETERFVPROC, glGetSamplerParameterfv) \
+    X(PFNGLGETSAMPLERPARAMETERIUIVPROC, glGetSamplerParameterIuiv) \
+    X(PFNGLQUERYCOUNTERPROC, glQueryCounter) \
+    X(PFNGLGETQUERYOBJECTI64VPROC, glGetQueryObjecti64v) \
+    X(PFNGLGETQUERYOBJECTUI64VPROC, glGetQueryObjectui64v) \
+    X(PFNGLVERTEXATTRIBDIVISORPROC, glVertexAttribDivisor) \
+    X(PFNGLVERTEXATTRIBP1UIPROC, glVertexAttribP1ui) \
+    X(PFNGLVERTEXATTRIBP1UIVPROC, glVertexAttribP1uiv) \
+    X(PFNGLVERTEXATTRIBP2UIPROC, glVertexAttribP2ui) \
+    X(PFNGLVERTEXATTRIBP2UIVPROC, glVertexAttribP2uiv) \
+    X(PFNGLVERTEXATTRIBP3UIPROC, glVertexAttribP3ui) \
+    X(PFNGLVERTEXATTRIBP3UIVPROC, glVertexAttribP3uiv) \
+    X(PFNGLVERTEXATTRIBP4UIPROC, glVertexAttribP4ui) \
+    X(PFNGLVERTEXATTRIBP4UIVPROC, glVertexAttribP4uiv) \
+    /* ---- GL 4.0 ---- */ \
+    X(PFNGLMINSAMPLESHADINGPROC, glMinSampleShading) \
+    X(PFNGLBLENDEQUATIONIPROC, glBlendEquationi) \
+    X(PFNGLBLENDEQUATIONSEPARATEIPROC, glBlendEquationSeparatei) \
+    X(PFNGLBLENDFUNCIPROC, glBlendFunci) \
+    X(PFNGLBLENDFUNCSEPARATEIPROC, glBlendFuncSeparatei) \
+    X(PFNGLDRAWARRAYSINDIRECTPROC, glDrawArraysIndirect) \
+    X(PFNGLDRAWELEMENTSINDIRECTPROC, glDrawElementsIndirect) \
+    X(PFNGLUNIFORM1DPROC, glUniform1d) \
+    X(PFNGLUNIFORM2DPROC, glUniform2d) \
+    X(PFNGLUNIFORM3DPROC, glUniform3d) \
+    X(PFNGLUNIFORM4DPROC, glUniform4d) \
+    X(PFNGLUNIFORM1DVPROC, glUniform1dv) \
+    X(PFNGLUNIFORM2DVPROC, glUniform2dv) \
+    X(PFNGLUNIFORM3DVPROC, glUniform3dv) \
+    X(PFNGLUNIFORM4DVPROC, glUniform4dv) \
+    X(PFNGLUNIFORMMATRIX2DVPROC, glUniformMatrix2dv) \
+    X(PFNGLUNIFORMMATRIX3DVPROC, glUniformMatrix3dv) \
+    X(PFNGLUNIFORMMATRIX4DVPROC, glUniformMatrix4dv) \
+    X(PFNGLUNIFORMMATRIX2X3DVPROC, glUniformMatrix2x3dv) \
+    X(PFNGLUNIFORMMATRIX2X4DVPROC, glUniformMatrix2x4dv) \
+    X(PFNGLUNIFORMMATRIX3X2DVPROC, glUniformMatrix3x2dv) \
+    X(PFNGLUNIFORMMATRIX3X4DVPROC, glUniformMatrix3x4dv) \
+    X(PFNGLUNIFORMMATRIX4X2DVPROC, glUniformMatrix4x2dv) \
+    X(PFNGLUNIFORMMATRIX4X3DVPROC, glUniformMatrix4x3dv) \
+    X(PFNGLGETUNIFORMDVPROC, glGetUniformdv) \
+    X(PFNGLGETSUBROUTINEUNIFORMLOCATIONPROC, glGetSubroutineUniformLocation) \
+    X(PFNGLGETSUBROUTINEINDEXPROC, glGetSubroutineIndex) \
+    X(PFNGLGETACTIVESUBROUTINEUNIFORMIVPROC, glGetActiveSubroutineUniformiv) \
+    X(PFNGLGETACTIVESUBROUTINEUNIFORMNAMEPROC, glGetActiveSubroutineUniformName) \
+    X(PFNGLGETACTIVESUBROUTINENAMEPROC, glGetActiveSubroutineName) \
+    X(PFNGLUNIFORMSUBROUTINESUIVPROC, glUniformSubroutinesuiv) \
+    X(PFNGLGETUNIFORMSUBROUTINEUIVPROC, glGetUniformSubroutineuiv) \
+    X(PFNGLGETPROGRAMSTAGEIVPROC, glGetProgramStageiv) \
+    X(PFNGLPATCHPARAMETERIPROC, glPatchParameteri) \
+    X(PFNGLPATCHPARAMETERFVPROC, glPatchParameterfv) \
+    X(PFNGLBINDTRANSFORMFEEDBACKPROC, glBindTransformFeedback) \
+    X(PFNGLDELETETRANSFORMFEEDBACKSPROC, glDeleteTransformFeedbacks) \
+    X(PFNGLGENTRANSFORMFEEDBACKSPROC, glGenTransformFeedbacks) \
+    X(PFNGLISTRANSFORMFEEDBACKPROC, glIsTransformFeedback) \
+    X(PFNGLPAUSETRANSFORMFEEDBACKPROC, glPauseTransformFeedback) \
+    X(PFNGLRESUMETRANSFORMFEEDBACKPROC, glResumeTransformFeedback) \
+    X(PFNGLDRAWTRANSFORMFEEDBACKPROC, glDrawTransformFeedback) \
+    X(PFNGLDRAWTRANSFORMFEEDBACKSTREAMPROC, glDrawTransformFeedbackStream) \
+    X(PFNGLBEGINQUERYINDEXEDPROC, glBeginQueryIndexed) \
+    X(PFNGLENDQUERYINDEXEDPROC, glEndQueryIndexed) \
+    X(PFNGLGETQUERYINDEXEDIVPROC, glGetQueryIndexediv) \
+    /* ---- GL 4.1 ---- */ \
+    X(PFNGLRELEASESHADERCOMPILERPROC, glReleaseShaderCompiler) \
+    X(PFNGLSHADERBINARYPROC, glShaderBinary) \
+    X(PFNGLGETSHADERPRECISIONFORMATPROC, glGetShaderPrecisionFormat) \
+    X(PFNGLDEPTHRANGEFPROC, glDepthRangef) \
+    X(PFNGLCLEARDEPTHFPROC, glClearDepthf) \
+    X(PFNGLGETPROGRAMBINARYPROC, glGetProgramBinary) \
+    X(PFNGLPROGRAMBINARYPROC, glProgramBinary) \
+    X(PFNGLPROGRAMPARAMETERIPROC, glProgramParameteri) \
+    X(PFNGLUSEPROGRAMSTAGESPROC, glUseProgramStages) \
+    X(PFNGLACTIVESHADERPROGRAMPROC, glActiveShaderProgram) \
+    X(PFNGLCREATESHADERPROGRAMVPROC, glCreateShaderProgramv) \
+    X(PFNGLBINDPROGRAMPIPELINEPROC, glBindProgramPipeline) \
+    X(PFNGLDELETEPROGRAMPIPELINESPROC, glDeleteProgramPipelines) \
+    X(PFNGLGENPROGRAMPIPELINESPROC, glGenProgramPipelines) \
+    X(PFNGLISPROGRAMPIPELINEPROC, glIsProgramPipeline) \
+    X(PFNGLGETPROGRAMPIPELINEIVPROC, glGetProgramPipelineiv) \
+    X(PFNGLPROGRAMUNIFORM1IPROC, glProgramUniform1i) \
+    X(PFNGLPROGRAMUNIFORM1IVPROC, glProgramUniform1iv) \
+    X(PFNGLPROGRAMUNIFORM1FPROC, glProgramUniform1f) \
+    X(PFNGLPROGRAMUNIFORM1FVPROC, glProgramUniform1fv) \
+    X(PFNGLPROGRAMUNIFORM1DPROC, glProgramUniform1d) \
+    X(PFNGLPROGRAMUNIFORM1DVPROC, glProgramUniform1dv) \
+    X(PFNGLPROGRAMUNIFORM1UIPROC, glProgramUniform1ui) \
+    X(PFNGLPROGRAMUNIFORM1UIVPROC, glProgramUniform1uiv) \
+    X(PFNGLPROGRAMUNIFORM2IPROC, glProgramUniform2i) \
+    X(PFNGLPROGRAMUNIFORM2IVPROC, glProgramUniform2iv) \
+    X(PFNGLPROGRAMUNIFORM2FPROC, glProgramUniform2f) \
+    X(PFNGLPROGRAMUNIFORM2FVPROC, glProgramUniform2fv) \
+    X(PFNGLPROGRAMUNIFORM2DPROC, glProgramUniform2d) \
+    X(PFNGLPROGRAMUNIFORM2DVPROC, glProgramUniform2dv) \
+    X(PFNGLPROGRAMUNIFORM2UIPROC, glProgramUniform2ui) \
+    X(PFNGLPROGRAMUNIFORM2UIVPROC, glProgramUniform2uiv) \
+    X(PFNGLPROGRAMUNIFORM3IPROC, glProgramUniform3i) \
+    X(PFNGLPROGRAMUNIFORM3IVPROC, glProgramUniform3iv) \
+    X(PFNGLPROGRAMUNIFORM3FPROC, glProgramUniform3f) \
+    X(PFNGLPROGRAMUNIFORM3FVPROC, glProgramUniform3fv) \
+    X(PFNGLPROGRAMUNIFORM3DPROC, glProgramUniform3d) \
+    X(PFNGLPROGRAMUNIFORM3DVPROC, glProgramUniform3dv) \
+    X(PFNGLPROGRAMUNIFORM3UIPROC, glProgramUniform3ui) \
+    X(PFNGLPROGRAMUNIFORM3UIVPROC, glProgramUniform3uiv) \
+    X(PFNGLPROGRAMUNIFORM4IPROC, glProgramUniform4i) \
+    X(PFNGLPROGRAMUNIFORM4IVPROC, glProgramUniform4iv) \
+    X(PFNGLPROGRAMUNIFORM4FPROC, glProgramUniform4f) \
+    X(PFNGLPROGRAMUNIFORM4FVPROC, glProgramUniform4fv) \
+    X(PFNGLPROGRAMUNIFORM4DPROC, glProgramUniform4d) \
+    X(PFNGLPROGRAMUNIFORM4DVPROC, glProgramUniform4dv) \
+    X(PFNGLPROGRAMUNIFORM4UIPROC, glProgramUniform4ui) \
+    X(PFNGLPROGRAMUNIFORM4UIVPROC, glProgramUniform4uiv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX2FVPROC, glProgramUniformMatrix2fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX3FVPROC, glProgramUniformMatrix3fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX4FVPROC, glProgramUniformMatrix4fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX2DVPROC, glProgramUniformMatrix2dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX3DVPROC, glProgramUniformMatrix3dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX4DVPROC, glProgramUniformMatrix4dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX2X3FVPROC, glProgramUniformMatrix2x3fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX3X2FVPROC, glProgramUniformMatrix3x2fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX2X4FVPROC, glProgramUniformMatrix2x4fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX4X2FVPROC, glProgramUniformMatrix4x2fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX3X4FVPROC, glProgramUniformMatrix3x4fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX4X3FVPROC, glProgramUniformMatrix4x3fv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX2X3DVPROC, glProgramUniformMatrix2x3dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX3X2DVPROC, glProgramUniformMatrix3x2dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX2X4DVPROC, glProgramUniformMatrix2x4dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX4X2DVPROC, glProgramUniformMatrix4x2dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX3X4DVPROC, glProgramUniformMatrix3x4dv) \
+    X(PFNGLPROGRAMUNIFORMMATRIX4X3DVPROC, glProgramUniformMatrix4x3dv) \
+    X(PFNGLVALIDATEPROGRAMPIPELINEPROC, glValidateProgramPipeline) \
+    X(PFNGLGETPROGRAMPIPELINEINFOLOGPROC, glGetProgramPipelineInfoLog) \
+    X(PFNGLVERTEXATTRIBL1DPROC, glVertexAttribL1d) \
+    X(PFNGLVERTEXATTRIBL2DPROC, glVertexAttribL2d) \
+    X(PFNGLVERTEXATTRIBL3DPROC, glVertexAttribL3d) \
+    X(PFNGLVERTEXATTRIBL4DPROC, glVertexAttribL4d) \
+    X(PFNGLVERTEXATTRIBL1DVPROC, glVertexAttribL1dv) \
+    X(PFNGLVERTEXATTRIBL2DVPROC, glVertexAttribL2dv) \
+    X(PFNGLVERTEXATTRIBL3DVPROC, glVertexAttribL3dv) \
+    X(PFNGLVERTEXATTRIBL4DVPROC, glVertexAttribL4dv) \
+    X(PFNGLVERTEXATTRIBLPOINTERPROC, glVertexAttribLPointer) \
+    X(PFNGLGETVERTEXATTRIBLDVPROC, glGetVertexAttribLdv) \
+    X(PFNGLVIEWPORTARRAYVPROC, glViewportArrayv) \
+    X(PFNGLVIEWPORTINDEXEDFPROC, glViewportIndexedf) \
+    X(PFNGLVIEWPORTINDEXEDFVPROC, glViewportIndexedfv) \
+    X(PFNGLSCISSORARRAYVPROC, glScissorArrayv) \
+    X(PFNGLSCISSORINDEXEDPROC, glScissorIndexed) \
+    X(PFNGLSCISSORINDEXEDVPROC, glScissorIndexedv) \
+    X(PFNGLDEPTHRANGEARRAYVPROC, glDepthRangeArrayv) \
+    X(PFNGLDEPTHRANGEINDEXEDPROC, glDepthRangeIndexed) \
+    X(PFNGLGETFLOATI_VPROC, glGetFloati_v) \
+    X(PFNGLGETDOUBLEI_VPROC, glGetDoublei_v) \
+    /* ---- GL 4.2 ---- */ \
+    X(PFNGLDRAWARRAYSINSTANCEDBASEINSTANCEPROC, glDrawArraysInstancedBaseInstance) \
+    X(PFNGLDRAWELEMENTSINSTANCEDBASEINSTANCEPROC, glDrawElementsInstancedBaseInstance) \
+    X(PFNGLDRAWELEMENTSINSTANCEDBASEVERTEXBASEINSTANCEPROC, glDrawElementsInstancedBaseVertexBaseInstance) \
+    X(PFNGLGETINTERNALFORMATIVPROC, glGetInternalformativ) \
+    X(PFNGLGETACTIVEATOMICCOUNTERBUFFERIVPROC, glGetActiveAtomicCounterBufferiv) \
+    X(PFNGLBINDIMAGETEXTUREPROC, glBindImageTexture) \
+    X(PFNGLMEMORYBARRIERPROC, glMemoryBarrier) \
+    X(PFNGLTEXSTORAGE1DPROC, glTexStorage1D) \
+    X(PFNGLTEXSTORAGE2DPROC, glTexStorage2D) \
+    X(PFNGLTEXSTORAGE3DPROC, glTexStorage3D) \
+    X(PFNGLDRAWTRANSFORMFEEDBACKINSTANCEDPROC, glDrawTransformFeedbackInstanced) \
+    X(PFNGLDRAWTRANSFORMFEEDBACKSTREAMINSTANCEDPROC, glDrawTransformFeedbackStreamInstanced) \
+    /* ---- GL 4.3 ---- */ \
+    X(PFNGLCLEARBUFFERDATAPROC, glClearBufferData) \
+    X(PFNGLCLEARBUFFERSUBDATAPROC, glClearBufferSubData) \
+    X(PFNGLDISPATCHCOMPUTEPROC, glDispatchCompute) \
+    X(PFNGLDISPATCHCOMPUTEINDIRECTPROC, glDispatchComputeIndirect) \
+    X(PFNGLCOPYIMAGESUBDATAPROC, glCopyImageSubData) \
+    X(PFNGLFRAMEBUFFERPARAMETERIPROC, glFramebufferParameteri) \
+    X(PFNGLGETFRAMEBUFFERPARAMETERIVPROC, glGetFramebufferParameteriv) \
+    X(PFNGLGETINTERNALFORMATI64VPROC, glGetInternalformati64v) \
+    X(PFNGLINVALIDATETEXSUBIMAGEPROC, glInvalidateTexSubImage) \
+    X(PFNGLINVALIDATETEXIMAGEPROC, glInvalidateTexImage) \
+    X(PFNGLINVALIDATEBUFFERSUBDATAPROC, glInvalidateBufferSubData) \
+    X(PFNGLINVALIDATEBUFFERDATAPROC, glInvalidateBufferData) \
+    X(PFNGLINVALIDATEFRAMEBUFFERPROC, glInvalidateFramebuffer) \
+    X(PFNGLINVALIDATESUBFRAMEBUFFERPROC, glInvalidateSubFramebuffer) \
+    X(PFNGLMULTIDRAWARRAYSINDIRECTPROC, glMultiDrawArraysIndirect) \
+    X(PFNGLMULTIDRAWELEMENTSINDIRECTPROC, glMultiDrawElementsIndirect) \
+    X(PFNGLGETPROGRAMINTERFACEIVPROC, glGetProgramInterfaceiv) \
+    X(PFNGLGETPROGRAMRESOURCEINDEXPROC, glGetProgramResourceIndex) \
+    X(PFNGLGETPROGRAMRESOURCENAMEPROC, glGetProgramResourceName) \
+    X(PFNGLGETPROGRAMRESOURCEIVPROC, glGetProgramResourceiv) \
+    X(PFNGLGETPROGRAMRESOURCELOCATIONPROC, glGetProgramResourceLocation) \
+    X(PFNGLGETPROGRAMRESOURCELOCATIONINDEXPROC, glGetProgramResourceLocationIndex) \
+    X(PFNGLSHADERSTORAGEBLOCKBINDINGPROC, glShaderStorageBlockBinding) \
+    X(PFNGLTEXBUFFERRANGEPROC, glTexBufferRange) \
+    X(PFNGLTEXSTORAGE2DMULTISAMPLEPROC, glTexStorage2DMultisample) \
+    X(PFNGLTEXSTORAGE3DMULTISAMPLEPROC, glTexStorage3DMultisample) \
+    X(PFNGLTEXTUREVIEWPROC, glTextureView) \
+    X(PFNGLBINDVERTEXBUFFERPROC, glBindVertexBuffer) \
+    X(PFNGLVERTEXATTRIBFORMATPROC, glVertexAttribFormat) \
+    X(PFNGLVERTEXATTRIBIFORMATPROC, glVertexAttribIFormat) \
+    X(PFNGLVERTEXATTRIBLFORMATPROC, glVertexAttribLFormat) \
+    X(PFNGLVERTEXATTRIBBINDINGPROC, glVertexAttribBinding) \
+    X(PFNGLVERTEXBINDINGDIVISORPROC, glVertexBindingDivisor) \
+    X(PFNGLDEBUGMESSAGECONTROLPROC, glDebugMessageControl) \
+    X(PFNGLDEBUGMESSAGEINSERTPROC, glDebugMessageInsert) \
+    X(PFNGLDEBUGMESSAGECALLBACKPROC, glDebugMessageCallback) \
+    X(PFNGLGETDEBUGMESSAGELOGPROC, glGetDebugMessageLog) \
+    X(PFNGLPUSHDEBUGGROUPPROC, glPushDebugGroup) \
+    X(PFNGLPOPDEBUGGROUPPROC, glPopDebugGroup) \
+    X(PFNGLOBJECTLABELPROC, glObjectLabel) \
+    X(PFNGLGETOBJECTLABELPROC, glGetObjectLabel) \
+    X(PFNGLOBJECTPTRLABELPROC, glObjectPtrLabel) \
+    X(PFNGLGETOBJECTPTRLABELPROC, glGetObjectPtrLabel) \
+    /* ---- GL 4.4 ---- */ \
+    X(PFNGLBUFFERSTORAGEPROC, glBufferStorage) \
+    X(PFNGLCLEARTEXIMAGEPROC, glClearTexImage) \
+    X(PFNGLCLEARTEXSUBIMAGEPROC, glClearTexSubImage) \
+    X(PFNGLBINDBUFFERSBASEPROC, glBindBuffersBase) \
+    X(PFNGLBINDBUFFERSRANGEPROC, glBindBuffersRange) \
+    X(PFNGLBINDTEXTURESPROC, glBindTextures) \
+    X(PFNGLBINDSAMPLERSPROC, glBindSamplers) \
+    X(PFNGLBINDIMAGETEXTURESPROC, glBindImageTextures) \
+    X(PFNGLBINDVERTEXBUFFERSPROC, glBindVertexBuffers) \
+    /* ---- GL 4.5 ---- */ \
+    X(PFNGLCLIPCONTROLPROC, glClipControl) \
+    X(PFNGLCREATETRANSFORMFEEDBACKSPROC, glCreateTransformFeedbacks) \
+    X(PFNGLTRANSFORMFEEDBACKBUFFERBASEPROC, glTransformFeedbackBufferBase) \
+    X(PFNGLTRANSFORMFEEDBACKBUFFERRANGEPROC, glTransformFeedbackBufferRange) \
+    X(PFNGLGETTRANSFORMFEEDBACKIVPROC, glGetTransformFeedbackiv) \
+    X(PFNGLGETTRANSFORMFEEDBACKI_VPROC, glGetTransformFeedbacki_v) \
+    X(PFNGLGETTRANSFORMFEEDBACKI64_VPROC, glGetTransformFeedbacki64_v) \
+    X(PFNGLCREATEBUFFERSPROC, glCreateBuffers) \
+    X(PFNGLNAMEDBUFFERSTORAGEPROC, glNamedBufferStorage) \
+    X(PFNGLNAMEDBUFFERDATAPROC, glNamedBufferData) \
+    X(PFNGLNAMEDBUFFERSUBDATAPROC, glNamedBufferSubData) \
+    X(PFNGLCOPYNAMEDBUFFERSUBDATAPROC, glCopyNamedBufferSubData) \
+    X(PFNGLCLEARNAMEDBUFFERDATAPROC, glClearNamedBufferData) \
+    X(PFNGLCLEARNAMEDBUFFERSUBDATAPROC, glClearNamedBufferSubData) \
+    X(PFNGLMAPNAMEDBUFFERPROC, glMapNamedBuffer) \
+    X(PFNGLMAPNAMEDBUFFERRANGEPROC, glMapNamedBufferRange) \
+    X(PFNGLUNMAPNAMEDBUFFERPROC, glUnmapNamedBuffer) \
+    X(PFNGLFLUSHMAPPEDNAMEDBUFFERRANGEPROC, glFlushMappedNamedBufferRange) \
+    X(PFNGLGETNAMEDBUFFERPARAMETERIVPROC, glGetNamedBufferParameteriv) \
+    X(PFNGLGETNAMEDBUFFERPARAMETERI64VPROC, glGetNamedBufferParameteri64v) \
+    X(PFNGLGETNAMEDBUFFERPOINTERVPROC, glGetNamedBufferPointerv) \
+    X(PFNGLGETNAMEDBUFFERSUBDATAPROC, glGetNamedBufferSubData) \
+    X(PFNGLCREATEFRAMEBUFFERSPROC, glCreateFramebuffers) \
+    X(PFNGLNAMEDFRAMEBUFFERRENDERBUFFERPROC, glNamedFramebufferRenderbuffer) \
+    X(PFNGLNAMEDFRAMEBUFFERPARAMETERIPROC, glNamedFramebufferParameteri) \
+    X(PFNGLNAMEDFRAMEBUFFERTEXTUREPROC, glNamedFramebufferTexture) \
+    X(PFNGLNAMEDFRAMEBUFFERTEXTURELAYERPROC, glNamedFramebufferTextureLayer) \
+    X(PFNGLNAMEDFRAMEBUFFERDRAWBUFFERPROC, glNamedFramebufferDrawBuffer) \
+    X(PFNGLNAMEDFRAMEBUFFERDRAWBUFFERSPROC, glNamedFramebufferDrawBuffers) \
+    X(PFNGLNAMEDFRAMEBUFFERREADBUFFERPROC, glNamedFramebufferReadBuffer) \
+    X(PFNGLINVALIDATENAMEDFRAMEBUFFERDATAPROC, glInvalidateNamedFramebufferData) \
+    X(PFNGLINVALIDATENAMEDFRAMEBUFFERSUBDATAPROC, glInvalidateNamedFramebufferSubData) \
+    X(PFNGLCLEARNAMEDFRAMEBUFFERIVPROC, glClearNamedFramebufferiv) \
+    X(PFNGLCLEARNAMEDFRAMEBUFFERUIVPROC, glClearNamedFramebufferuiv) \
+    X(PFNGLCLEARNAMEDFRAMEBUFFERFVPROC, glClearNamedFramebufferfv) \
+    X(PFNGLCLEARNAMEDFRAMEBUFFERFIPROC, glClearNamedFramebufferfi) \
+    X(PFNGLBLITNAMEDFRAMEBUFFERPROC, glBlitNamedFramebuffer) \
+    X(PFNGLCHECKNAMEDFRAMEBUFFERSTATUSPROC, glCheckNamedFramebufferStatus) \
+    X(PFNGLGETNAMEDFRAMEBUFFERPARAMETERIVPROC, glGetNamedFramebufferParameteriv) \
+    X(PFNGLGETNAMEDFRAMEBUFFERATTACHMENTPARAMETERIVPROC, glGetNamedFramebufferAttachmentParameteriv) \
+    X(PFNGLCREATERENDERBUFFERSPROC, glCreateRenderbuffers) \
+    X(PFNGLNAMEDRENDERBUFFERSTORAGEPROC, glNamedRenderbufferStorage) \
+    X(PFNGLNAMEDRENDERBUFFERSTORAGEMULTISAMPLEPROC, glNamedRenderbufferStorageMultisample) \
+    X(PFNGLGETNAMEDRENDERBUFFERPARAMETERIVPROC, glGetNamedRenderbufferParameteriv) \
+    X(PFNGLCREATETEXTURESPROC, glCreateTextures) \
+    X(PFNGLTEXTUREBUFFERPROC, glTextureBuffer) \
+    X(PFNGLTEXTUREBUFFERRANGEPROC, glTextureBufferRange) \
+    X(PFNGLTEXTURESTORAGE1DPROC, glTextureStorage1D) \
+    X(PFNGLTEXTURESTORAGE2DPROC, glTextureStorage2D) \
+    X(PFNGLTEXTURESTORAGE3DPROC, glTextureStorage3D) \
+    X(PFNGLTEXTURESTORAGE2DMULTISAMPLEPROC, glTextureStorage2DMultisample) \
+    X(PFNGLTEXTURESTORAGE3DMULTISAMPLEPROC, glTextureStorage3DMultisample) \
+    X(PFNGLTEXTURESUBIMAGE1DPROC, glTextureSubImage1D) \
+    X(PFNGLTEXTURESUBIMAGE2DPROC, glTextureSubImage2D) \
+    X(PFNGLTEXTURESUBIMAGE3DPROC, glTextureSubImage3D) \
+    X(PFNGLCOMPRESSEDTEXTURESUBIMAGE1DPROC, glCompressedTextureSubImage1D) \
+    X(PFNGLCOMPRESSEDTEXTURESUBIMAGE2DPROC, glCompressedTextureSubImage2D) \
+    X(PFNGLCOMPRESSEDTEXTURESUBIMAGE3DPROC, glCompressedTextureSubImage3D) \
+    X(PFNGLCOPYTEXTURESUBIMAGE1DPROC, glCopyTextureSubImage1D) \
+    X(PFNGLCOPYTEXTURESUBIMAGE2DPROC, glCopyTextureSubImage2D) \
+    X(PFNGLCOPYTEXTURESUBIMAGE3DPROC, glCopyTextureSubImage3D) \
+    X(PFNGLTEXTUREPARAMETERFPROC, glTextureParameterf) \
+    X(PFNGLTEXTUREPARAMETERFVPROC, glTextureParameterfv) \
+    X(PFNGLTEXTUREPARAMETERIPROC, glTextureParameteri) \
+    X(PFNGLTEXTUREPARAMETERIIVPROC, glTextureParameterIiv) \
+    X(PFNGLTEXTUREPARAMETERIUIVPROC, glTextureParameterIuiv) \
+    X(PFNGLTEXTUREPARAMETERIVPROC, glTextureParameteriv) \
+    X(PFNGLGENERATETEXTUREMIPMAPPROC, glGenerateTextureMipmap) \
+    X(PFNGLBINDTEXTUREUNITPROC, glBindTextureUnit) \
+    X(PFNGLGETTEXTUREIMAGEPROC, glGetTextureImage) \
+    X(PFNGLGETCOMPRESSEDTEXTUREIMAGEPROC, glGetCompressedTextureImage) \
+    X(PFNGLGETTEXTURELEVELPARAMETERFVPROC, glGetTextureLevelParameterfv) \
+    X(PFNGLGETTEXTURELEVELPARAMETERIVPROC, glGetTextureLevelParameteriv) \
+    X(PFNGLGETTEXTUREPARAMETERFVPROC, glGetTextureParameterfv) \
+    X(PFNGLGETTEXTUREPARAMETERIIVPROC, glGetTextureParameterIiv) \
+    X(PFNGLGETTEXTUREPARAMETERIUIVPROC, glGetTextureParameterIuiv) \
+    X(PFNGLGETTEXTUREPARAMETERIVPROC, glGetTextureParameteriv) \
+    X(PFNGLCREATEVERTEXARRAYSPROC, glCreateVertexArrays) \
+    X(PFNGLDISABLEVERTEXARRAYATTRIBPROC, glDisableVertexArrayAttrib) \
+    X(PFNGLENABLEVERTEXARRAYATTRIBPROC, glEnableVertexArrayAttrib) \
+    X(PFNGLVERTEXARRAYELEMENTBUFFERPROC, glVertexArrayElementBuffer) \
+    X(PFNGLVERTEXARRAYVERTEXBUFFERPROC, glVertexArrayVertexBuffer) \
+    X(PFNGLVERTEXARRAYVERTEXBUFFERSPROC, glVertexArrayVertexBuffers) \
+    X(PFNGLVERTEXARRAYATTRIBBINDINGPROC, glVertexArrayAttribBinding) \
+    X(PFNGLVERTEXARRAYATTRIBFORMATPROC, glVertexArrayAttribFormat) \
+    X(PFNGLVERTEXARRAYATTRIBIFORMATPROC, glVertexArrayAttribIFormat) \
+    X(PFNGLVERTEXARRAYATTRIBLFORMATPROC, glVertexArrayAttribLFormat) \
+    X(PFNGLVERTEXARRAYBINDINGDIVISORPROC, glVertexArrayBindingDivisor) \
+    X(PFNGLGETVERTEXARRAYIVPROC, glGetVertexArrayiv) \
+    X(PFNGLGETVERTEXARRAYINDEXEDIVPROC, glGetVertexArrayIndexediv) \
+    X(PFNGLGETVERTEXARRAYINDEXED64IVPROC, glGetVertexArrayIndexed64iv) \
+    X(PFNGLCREATESAMPLERSPROC, glCreateSamplers) \
+    X(PFNGLCREATEPROGRAMPIPELINESPROC, glCreateProgramPipelines) \
+    X(PFNGLCREATEQUERIESPROC, glCreateQueries) \
+    X(PFNGLGETQUERYBUFFEROBJECTI64VPROC, glGetQueryBufferObjecti64v) \
+    X(PFNGLGETQUERYBUFFEROBJECTIVPROC, glGetQueryBufferObjectiv) \
+    X(PFNGLGETQUERYBUFFEROBJECTUI64VPROC, glGetQueryBufferObjectui64v) \
+    X(PFNGLGETQUERYBUFFEROBJECTUIVPROC, glGetQueryBufferObjectuiv) \
+    X(PFNGLMEMORYBARRIERBYREGIONPROC, glMemoryBarrierByRegion) \
+    X(PFNGLGETTEXTURESUBIMAGEPROC, glGetTextureSubImage) \
+    X(PFNGLGETCOMPRESSEDTEXTURESUBIMAGEPROC, glGetCompressedTextureSubImage) \
+    X(PFNGLGETGRAPHICSRESETSTATUSPROC, glGetGraphicsResetStatus) \
+    X(PFNGLREADNPIXELSPROC, glReadnPixels) \
+    X(PFNGLTEXTUREBARRIERPROC, glTextureBarrier) \
+    /* end of LPV_GL_FUNCTIONS */
+
+/* X(PFN type, GL name) for entry points that are loaded when present and left
+ * NULL otherwise: GL 4.5's KHR_robustness queries, which Mesa's OSMesa
+ * (22.3) does not export. Check for NULL before calling one. */
+#define LPV_GL_OPTIONAL_FUNCTIONS(X) \
+    X(PFNGLGETNCOMPRESSEDTEXIMAGEPROC, glGetnCompressedTexImage) \
+    X(PFNGLGETNTEXIMAGEPROC, glGetnTexImage) \
+    X(PFNGLGETNUNIFORMDVPROC, glGetnUniformdv) \
+    X(PFNGLGETNUNIFORMFVPROC, glGetnUniformfv) \
+    X(PFNGLGETNUNIFORMIVPROC, glGetnUniformiv) \
+    X(PFNGLGETNUNIFORMUIVPROC, glGetnUniformuiv) \
+    /* end of LPV_GL_OPTIONAL_FUNCTIONS */
+
+#define LPV_GL_DECLARE_(type, name) extern type lpv_gl_##name;
+LPV_GL_FUNCTIONS(LPV_GL_DECLARE_)
+LPV_GL_OPTIONAL_FUNCTIONS(LPV_GL_DECLARE_)
+#undef LPV_GL_DECLARE_
+
+/* Number of required entry points (LPV_GL_FUNCTIONS). */
+extern const size_t lpv_gl_function_count;
+
+/* Fills the table with get_proc(name) for every function. Returns 0, or -1
+ * with "missing GL function glXyz" (the first absent required one) in err;
+ * on failure the table is left cleared (all NULL). The pointers stay valid as
+ * long as the library they came from is loaded (context.c keeps libOSMesa
+ * mapped for the life of the process). */
+int lpv_gl_load(void *(*get_proc)(const char *name), char *err, size_t err_size);
+
+/* Clears the table (all NULL). */
+void lpv_gl_unload(void);
+
+/* Incremented by every lpv_gl_load and lpv_gl_unload: context.c reloads the
+ * table on make-current when it changed since the context loaded it. */
+unsigned lpv_gl_table_generation(void);
+
+/* Name of a GL error code ("GL_INVALID_OPERATION", ...), "GL_NO_ERROR" for 0,
+ * "unknown GL error" otherwise. */
+const char *lpv_gl_error_name(GLenum error);
+
+/* ---- Standard names -> table entries ------------------------------------- */
+/* GL 1.0 */
+#define glCullFace lpv_gl_glCullFace
+#define glFrontFace lpv_gl_glFrontFace
+#define glHint lpv_gl_glHint
+#define glLineWidth lpv_gl_glLineWidth
+#define glPointSize lpv_gl_glPointSize
+#define glPolygonMode lpv_gl_glPolygonMode
+#define glScissor lpv_gl_glScissor
+#define glTexParameterf lpv_gl_glTexParameterf
+#define glTexParameterfv lpv_gl_glTexParameterfv
+#define glTexParameteri lpv_gl_glTexParameteri
+#define glTexParameteriv lpv_gl_glTexParameteriv
+#define glTexImage1D lpv_gl_glTexImage1D
+#define glTexImage2D lpv_gl_glTexImage2D
+#define glDrawBuffer lpv_gl_glDrawBuffer
+#define glClear lpv_gl_glClear
+#define glClearColor lpv_gl_glClearColor
+#define glClearStencil lpv_gl_glClearStencil
+#define glClearDepth lpv_gl_glClearDepth
+#define glStencilMask lpv_gl_glStencilMask
+#define glColorMask lpv_gl_glColorMask
+#define glDepthMask lpv_gl_glDepthMask
+#define glDisable lpv_gl_glDisable
+#define glEnable lpv_gl_glEnable
+#define glFinish lpv_gl_glFinish
+#define glFlush lpv_gl_glFlush
+#define glBlendFunc lpv_gl_glBlendFunc
+#define glLogicOp lpv_gl_glLogicOp
+#define glStencilFunc lpv_gl_glStencilFunc
+#define glStencilOp lpv_gl_glStencilOp
+#define glDepthFunc lpv_gl_glDepthFunc
+#define glPixelStoref lpv_gl_glPixelStoref
+#define glPixelStorei lpv_gl_glPixelStorei
+#define glReadBuffer lpv_gl_glReadBuffer
+#define glReadPixels lpv_gl_glReadPixels
+#define glGetBooleanv lpv_gl_glGetBooleanv
+#define glGetDoublev lpv_gl_glGetDoublev
+#define glGetError lpv_gl_glGetError
+#define glGetFloatv lpv_gl_glGetFloatv
+#define glGetIntegerv lpv_gl_glGetIntegerv
+#define glGetString lpv_gl_glGetString
+#define glGetTexImage lpv_gl_glGetTexImage
+#define glGetTexParameterfv lpv_gl_glGetTexParameterfv
+#define glGetTexParameteriv lpv_gl_glGetTexParameteriv
+#define glGetTexLevelParameterfv lpv_gl_glGetTexLevelParameterfv
+#define glGetTexLevelParameteriv lpv_gl_glGetTexLevelParameteriv
+#define glIsEnabled lpv_gl_glIsEnabled
+#define glDepthRange lpv_gl_glDepthRange
+#define glViewport lpv_gl_glViewport
+/* GL 1.1 */
+#define glDrawArrays lpv_gl_glDrawArrays
+#define glDrawElements lpv_gl_glDrawElements
+#define glGetPointerv lpv_gl_glGetPointerv
+#define glPolygonOffset lpv_gl_glPolygonOffset
+#define glCopyTexImage1D lpv_gl_glCopyTexImage1D
+#define glCopyTexImage2D lpv_gl_glCopyTexImage2D
+#define glCopyTexSubImage1D lpv_gl_glCopyTexSubImage1D
+#define glCopyTexSubImage2D lpv_gl_glCopyTexSubImage2D
+#define glTexSubImage1D lpv_gl_glTexSubImage1D
+#define glTexSubImage2D lpv_gl_glTexSubImage2D
+#define glBindTexture lpv_gl_glBindTexture
+#define glDeleteTextures lpv_gl_glDeleteTextures
+#define glGenTextures lpv_gl_glGenTextures
+#define glIsTexture lpv_gl_glIsTexture
+/* GL 1.2 */
+#define glDrawRangeElements lpv_gl_glDrawRangeElements
+#define glTexImage3D lpv_gl_glTexImage3D
+#define glTexSubImage3D lpv_gl_glTexSubImage3D
+#define glCopyTexSubImage3D lpv_gl_glCopyTexSubImage3D
+/* GL 1.3 */
+#define glActiveTexture lpv_gl_glActiveTexture
+#define glSampleCoverage lpv_gl_glSampleCoverage
+#define glCompressedTexImage3D lpv_gl_glCompressedTexImage3D
+#define glCompressedTexImage2D lpv_gl_glCompressedTexImage2D
+#define glCompressedTexImage1D lpv_gl_glCompressedTexImage1D
+#define glCompressedTexSubImage3D lpv_gl_glCompressedTexSubImage3D
+#define glCompressedTexSubImage2D lpv_gl_glCompressedTexSubImage2D
+#define glCompressedTexSubImage1D lpv_gl_glCompressedTexSubImage1D
+#define glGetCompressedTexImage lpv_gl_glGetCompressedTexImage
+/* GL 1.4 */
+#define glBlendFuncSeparate lpv_gl_glBlendFuncSeparate
+#define glMultiDrawArrays lpv_gl_glMultiDrawArrays
+#define glMultiDrawElements lpv_gl_glMultiDrawElements
+#define glPointParameterf lpv_gl_glPointParameterf
+#define glPointParameterfv lpv_gl_glPointParameterfv
+#define glPointParameteri lpv_gl_glPointParameteri
+#define glPointParameteriv lpv_gl_glPointParameteriv
+#define glBlendColor lpv_gl_glBlendColor
+#define glBlendEquation lpv_gl_glBlendEquation
+/* GL 1.5 */
+#define glGenQueries lpv_gl_glGenQueries
+#define glDeleteQueries lpv_gl_glDeleteQueries
+#define glIsQuery lpv_gl_glIsQuery
+#define glBeginQuery lpv_gl_glBeginQuery
+#define glEndQuery lpv_gl_glEndQuery
+#define glGetQueryiv lpv_gl_glGetQueryiv
+#define glGetQueryObjectiv lpv_gl_glGetQueryObjectiv
+#define glGetQueryObjectuiv lpv_gl_glGetQueryObjectuiv
+#define glBindBuffer lpv_gl_glBindBuffer
+#define glDeleteBuffers lpv_gl_glDeleteBuffers
+#define glGenBuffers lpv_gl_glGenBuffers
+#define glIsBuffer lpv_gl_glIsBuffer
+#define glBufferData lpv_gl_glBufferData
+#define glBufferSubData lpv_gl_glBufferSubData
+#define glGetBufferSubData lpv_gl_glGetBufferSubData
+#define glMapBuffer lpv_gl_glMapBuffer
+#define glUnmapBuffer lpv_gl_glUnmapBuffer
+#define glGetBufferParameteriv lpv_gl_glGetBufferParameteriv
+#define glGetBufferPointerv lpv_gl_glGetBufferPointerv
+/* GL 2.0 */
+#define glBlendEquationSeparate lpv_gl_glBlendEquationSeparate
+#define glDrawBuffers lpv_gl_glDrawBuffers
+#define glStencilOpSeparate lpv_gl_glStencilOpSeparate
+#define glStencilFuncSeparate lpv_gl_glStencilFuncSeparate
+#define glStencilMaskSeparate lpv_gl_glStencilMaskSeparate
+#define glAttachShader lpv_gl_glAttachShader
+#define glBindAttribLocation lpv_gl_glBindAttribLocation
+#define glCompileShader lpv_gl_glCompileShader
+#define glCreateProgram lpv_gl_glCreateProgram
+#define glCreateShader lpv_gl_glCreateShader
+#define glDeleteProgram lpv_gl_glDeleteProgram
+#define glDeleteShader lpv_gl_glDeleteShader
+#define glDetachShader lpv_gl_glDetachShader
+#define glDisableVertexAttribArray lpv_gl_glDisableVertexAttribArray
+#define glEnableVertexAttribArray lpv_gl_glEnableVertexAttribArray
+#define glGetActiveAttrib lpv_gl_glGetActiveAttrib
+#define glGetActiveUniform lpv_gl_glGetActiveUniform
+#define glGetAttachedShaders lpv_gl_glGetAttachedShaders
+#define glGetAttribLocation lpv_gl_glGetAttribLocation
+#define glGetProgramiv lpv_gl_glGetProgramiv
+#define glGetProgramInfoLog lpv_gl_glGetProgramInfoLog
+#define glGetShaderiv lpv_gl_glGetShaderiv
+#define glGetShaderInfoLog lpv_gl_glGetShaderInfoLog
+#define glGetShaderSource lpv_gl_glGetShaderSource
+#define glGetUniformLocation lpv_gl_glGetUniformLocation
+#define glGetUniformfv lpv_gl_glGetUniformfv
+#define glGetUniformiv lpv_gl_glGetUniformiv
+#define glGetVertexAttribdv lpv_gl_glGetVertexAttribdv
+#define glGetVertexAttribfv lpv_gl_glGetVertexAttribfv
+#define glGetVertexAttribiv lpv_gl_glGetVertexAttribiv
+#define glGetVertexAttribPointerv lpv_gl_glGetVertexAttribPointerv
+#define glIsProgram lpv_gl_glIsProgram
+#define glIsShader lpv_gl_glIsShader
+#define glLinkProgram lpv_gl_glLinkProgram
+#define glShaderSource lpv_gl_glShaderSource
+#define glUseProgram lpv_gl_glUseProgram
+#define glUniform1f lpv_gl_glUniform1f
+#define glUniform2f lpv_gl_glUniform2f
+#define glUniform3f lpv_gl_glUniform3f
+#define glUniform4f lpv_gl_glUniform4f
+#define glUniform1i lpv_gl_glUniform1i
+#define glUniform2i lpv_gl_glUniform2i
+#define glUniform3i lpv_gl_glUniform3i
+#define glUniform4i lpv_gl_glUniform4i
+#define glUniform1fv lpv_gl_glUniform1fv
+#define glUniform2fv lpv_gl_glUniform2fv
+#define glUniform3fv lpv_gl_glUniform3fv
+#define glUniform4fv lpv_gl_glUniform4fv
+#define glUniform1iv lpv_gl_glUniform1iv
+#define glUniform2iv lpv_gl_glUniform2iv
+#define glUniform3iv lpv_gl_glUniform3iv
+#define glUniform4iv lpv_gl_glUniform4iv
+#define glUniformMatrix2fv lpv_gl_glUniformMatrix2fv
+#define glUniformMatrix3fv lpv_gl_glUniformMatrix3fv
+#define glUniformMatrix4fv lpv_gl_glUniformMatrix4fv
+#define glValidateProgram lpv_gl_glValidateProgram
+#define glVertexAttrib1d lpv_gl_glVertexAttrib1d
+#define glVertexAttrib1dv lpv_gl_glVertexAttrib1dv
+#define glVertexAttrib1f lpv_gl_glVertexAttrib1f
+#define glVertexAttrib1fv lpv_gl_glVertexAttrib1fv
+#define glVertexAttrib1s lpv_gl_glVertexAttrib1s
+#define glVertexAttrib1sv lpv_gl_glVertexAttrib1sv
+#define glVertexAttrib2d lpv_gl_glVertexAttrib2d
+#define glVertexAttrib2dv lpv_gl_glVertexAttrib2dv
+#define glVertexAttrib2f lpv_gl_glVertexAttrib2f
+#define glVertexAttrib2fv lpv_gl_glVertexAttrib2fv
+#define glVertexAttrib2s lpv_gl_glVertexAttrib2s
+#define glVertexAttrib2sv lpv_gl_glVertexAttrib2sv
+#define glVertexAttrib3d lpv_gl_glVertexAttrib3d
+#define glVertexAttrib3dv lpv_gl_glVertexAttrib3dv
+#define glVertexAttrib3f lpv_gl_glVertexAttrib3f
+#define glVertexAttrib3fv lpv_gl_glVertexAttrib3fv
+#define glVertexAttrib3s lpv_gl_glVertexAttrib3s
+#define glVertexAttrib3sv lpv_gl_glVertexAttrib3sv
+#define glVertexAttrib4Nbv lpv_gl_glVertexAttrib4Nbv
+#define glVertexAttrib4Niv lpv_gl_glVertexAttrib4Niv
+#define glVertexAttrib4Nsv lpv_gl_glVertexAttrib4Nsv
+#define glVertexAttrib4Nub lpv_gl_glVertexAttrib4Nub
+#define glVertexAttrib4Nubv lpv_gl_glVertexAttrib4Nubv
+#define glVertexAttrib4Nuiv lpv_gl_glVertexAttrib4Nuiv
+#define glVertexAttrib4Nusv lpv_gl_glVertexAttrib4Nusv
+#define glVertexAttrib4bv lpv_gl_glVertexAttrib4bv
+#define glVertexAttrib4d lpv_gl_glVertexAttrib4d
+#define glVertexAttrib4dv lpv_gl_glVertexAttrib4dv
+#define glVertexAttrib4f lpv_gl_glVertexAttrib4f
+#define glVertexAttrib4fv lpv_gl_glVertexAttrib4fv
+#define glVertexAttrib4iv lpv_gl_glVertexAttrib4iv
+#define glVertexAttrib4s lpv_gl_glVertexAttrib4s
+#define glVertexAttrib4sv lpv_gl_glVertexAttrib4sv
+#define glVertexAttrib4ubv lpv_gl_glVertexAttrib4ubv
+#define glVertexAttrib4uiv lpv_gl_glVertexAttrib4uiv
+#define glVertexAttrib4usv lpv_gl_glVertexAttrib4usv
+#define glVertexAttribPointer lpv_gl_glVertexAttribPointer
+/* GL 2.1 */
+#define glUniformMatrix2x3fv lpv_gl_glUniformMatrix2x3fv
+#define glUniformMatrix3x2fv lpv_gl_glUniformMatrix3x2fv
+#define glUniformMatrix2x4fv lpv_gl_glUniformMatrix2x4fv
+#define glUniformMatrix4x2fv lpv_gl_glUniformMatrix4x2fv
+#define glUniformMatrix3x4fv lpv_gl_glUniformMatrix3x4fv
+#define glUniformMatrix4x3fv lpv_gl_glUniformMatrix4x3fv
+/* GL 3.0 */
+#define glColorMaski lpv_gl_glColorMaski
+#define glGetBooleani_v lpv_gl_glGetBooleani_v
+#define glGetIntegeri_v lpv_gl_glGetIntegeri_v
+#define glEnablei lpv_gl_glEnablei
+#define glDisablei lpv_gl_glDisablei
+#define glIsEnabledi lpv_gl_glIsEnabledi
+#define glBeginTransformFeedback lpv_gl_glBeginTransformFeedback
+#define glEndTransformFeedback lpv_gl_glEndTransformFeedback
+#define glBindBufferRange lpv_gl_glBindBufferRange
+#define glBindBufferBase lpv_gl_glBindBufferBase
+#define glTransformFeedbackVaryings lpv_gl_glTransformFeedbackVaryings
+#define glGetTransformFeedbackVarying lpv_gl_glGetTransformFeedbackVarying
+#define glClampColor lpv_gl_glClampColor
+#define glBeginConditionalRender lpv_gl_glBeginConditionalRender
+#define glEndConditionalRender lpv_gl_glEndConditionalRender
+#define glVertexAttribIPointer lpv_gl_glVertexAttribIPointer
+#define glGetVertexAttribIiv lpv_gl_glGetVertexAttribIiv
+#define glGetVertexAttribIuiv lpv_gl_glGetVertexAttribIuiv
+#define glVertexAttribI1i lpv_gl_glVertexAttribI1i
+#define glVertexAttribI2i lpv_gl_glVertexAttribI2i
+#define glVertexAttribI3i lpv_gl_glVertexAttribI3i
+#define glVertexAttribI4i lpv_gl_glVertexAttribI4i
+#define glVertexAttribI1ui lpv_gl_glVertexAttribI1ui
+#define glVertexAttribI2ui lpv_gl_glVertexAttribI2ui
+#define glVertexAttribI3ui lpv_gl_glVertexAttribI3ui
+#define glVertexAttribI4ui lpv_gl_glVertexAttribI4ui
+#define glVertexAttribI1iv lpv_gl_glVertexAttribI1iv
+#define glVertexAttribI2iv lpv_gl_glVertexAttribI2iv
+#define glVertexAttribI3iv lpv_gl_glVertexAttribI3iv
+#define glVertexAttribI4iv lpv_gl_glVertexAttribI4iv
+#define glVertexAttribI1uiv lpv_gl_glVertexAttribI1uiv
+#define glVertexAttribI2uiv lpv_gl_glVertexAttribI2uiv
+#define glVertexAttribI3uiv lpv_gl_glVertexAttribI3uiv
+#define glVertexAttribI4uiv lpv_gl_glVertexAttribI4uiv
+#define glVertexAttribI4bv lpv_gl_glVertexAttribI4bv
+#define glVertexAttribI4sv lpv_gl_glVertexAttribI4sv
+#define glVertexAttribI4ubv lpv_gl_glVertexAttribI4ubv
+#define glVertexAttribI4usv lpv_gl_glVertexAttribI4usv
+#define glGetUniformuiv lpv_gl_glGetUniformuiv
+#define glBindFragDataLocation lpv_gl_glBindFragDataLocation
+#define glGetFragDataLocation lpv_gl_glGetFragDataLocation
+#define glUniform1ui lpv_gl_glUniform1ui
+#define glUniform2ui lpv_gl_glUniform2ui
+#define glUniform3ui lpv_gl_glUniform3ui
+#define glUniform4ui lpv_gl_glUniform4ui
+#define glUniform1uiv lpv_gl_glUniform1uiv
+#define glUniform2uiv lpv_gl_glUniform2uiv
+#define glUniform3uiv lpv_gl_glUniform3uiv
+#define glUniform4uiv lpv_gl_glUniform4uiv
+#define glTexParameterIiv lpv_gl_glTexParameterIiv
+#define glTexParameterIuiv lpv_gl_glTexParameterIuiv
+#define glGetTexParameterIiv lpv_gl_glGetTexParameterIiv
+#define glGetTexParameterIuiv lpv_gl_glGetTexParameterIuiv
+#define glClearBufferiv lpv_gl_glClearBufferiv
+#define glClearBufferuiv lpv_gl_glClearBufferuiv
+#define glClearBufferfv lpv_gl_glClearBufferfv
+#define glClearBufferfi lpv_gl_glClearBufferfi
+#define glGetStringi lpv_gl_glGetStringi
+#define glIsRenderbuffer lpv_gl_glIsRenderbuffer
+#define glBindRenderbuffer lpv_gl_glBindRenderbuffer
+#define glDeleteRenderbuffers lpv_gl_glDeleteRenderbuffers
+#define glGenRenderbuffers lpv_gl_glGenRenderbuffers
+#define glRenderbufferStorage lpv_gl_glRenderbufferStorage
+#define glGetRenderbufferParameteriv lpv_gl_glGetRenderbufferParameteriv
+#define glIsFramebuffer lpv_gl_glIsFramebuffer
+#define glBindFramebuffer lpv_gl_glBindFramebuffer
+#define glDeleteFramebuffers lpv_gl_glDeleteFramebuffers
+#define glGenFramebuffers lpv_gl_glGenFramebuffers
+#define glCheckFramebufferStatus lpv_gl_glCheckFramebufferStatus
+#define glFramebufferTexture1D lpv_gl_glFramebufferTexture1D
+#define glFramebufferTexture2D lpv_gl_glFramebufferTexture2D
+#define glFramebufferTexture3D lpv_gl_glFramebufferTexture3D
+#define glFramebufferRenderbuffer lpv_gl_glFramebufferRenderbuffer
+#define glGetFramebufferAttachmentParameteriv lpv_gl_glGetFramebufferAttachmentParameteriv
+#define glGenerateMipmap lpv_gl_glGenerateMipmap
+#define glBlitFramebuffer lpv_gl_glBlitFramebuffer
+#define glRenderbufferStorageMultisample lpv_gl_glRenderbufferStorageMultisample
+#define glFramebufferTextureLayer lpv_gl_glFramebufferTextureLayer
+#define glMapBufferRange lpv_gl_glMapBufferRange
+#define glFlushMappedBufferRange lpv_gl_glFlushMappedBufferRange
+#define glBindVertexArray lpv_gl_glBindVertexArray
+#define glDeleteVertexArrays lpv_gl_glDeleteVertexArrays
+#define glGenVertexArrays lpv_gl_glGenVertexArrays
+#define glIsVertexArray lpv_gl_glIsVertexArray
+/* GL 3.1 */
+#define glDrawArraysInstanced lpv_gl_glDrawArraysInstanced
+#define glDrawElementsInstanced lpv_gl_glDrawElementsInstanced
+#define glTexBuffer lpv_gl_glTexBuffer
+#define glPrimitiveRestartIndex lpv_gl_glPrimitiveRestartIndex
+#define glCopyBufferSubData lpv_gl_glCopyBufferSubData
+#define glGetUniformIndices lpv_gl_glGetUniformIndices
+#define glGetActiveUniformsiv lpv_gl_glGetActiveUniformsiv
+#define glGetActiveUniformName lpv_gl_glGetActiveUniformName
+#define glGetUniformBlockIndex lpv_gl_glGetUniformBlockIndex
+#define glGetActiveUniformBlockiv lpv_gl_glGetActiveUniformBlockiv
+#define glGetActiveUniformBlockName lpv_gl_glGetActiveUniformBlockName
+#define glUniformBlockBinding lpv_gl_glUniformBlockBinding
+/* GL 3.2 */
+#define glDrawElementsBaseVertex lpv_gl_glDrawElementsBaseVertex
+#define glDrawRangeElementsBaseVertex lpv_gl_glDrawRangeElementsBaseVertex
+#define glDrawElementsInstancedBaseVertex lpv_gl_glDrawElementsInstancedBaseVertex
+#define glMultiDrawElementsBaseVertex lpv_gl_glMultiDrawElementsBaseVertex
+#define glProvokingVertex lpv_gl_glProvokingVertex
+#define glFenceSync lpv_gl_glFenceSync
+#define glIsSync lpv_gl_glIsSync
+#define glDeleteSync lpv_gl_glDeleteSync
+#define glClientWaitSync lpv_gl_glClientWaitSync
+#define glWaitSync lpv_gl_glWaitSync
+#define glGetInteger64v lpv_gl_glGetInteger64v
+#define glGetSynciv lpv_gl_glGetSynciv
+#define glGetInteger64i_v lpv_gl_glGetInteger64i_v
+#define glGetBufferParameteri64v lpv_gl_glGetBufferParameteri64v
+#define glFramebufferTexture lpv_gl_glFramebufferTexture
+#define glTexImage2DMultisample lpv_gl_glTexImage2DMultisample
+#define glTexImage3DMultisample lpv_gl_glTexImage3DMultisample
+#define glGetMultisamplefv lpv_gl_glGetMultisamplefv
+#define glSampleMaski lpv_gl_glSampleMaski
+/* GL 3.3 */
+#define glBindFragDataLocationIndexed lpv_gl_glBindFragDataLocationIndexed
+#define glGetFragDataIndex lpv_gl_glGetFragDataIndex
+#define glGenSamplers lpv_gl_glGenSamplers
+#define glDeleteSamplers lpv_gl_glDeleteSamplers
+#define glIsSampler lpv_gl_glIsSampler
+#define glBindSampler lpv_gl_glBindSampler
+#define glSamplerParameteri lpv_gl_glSamplerParameteri
+#define glSamplerParameteriv lpv_gl_glSamplerParameteriv
+#define glSamplerParameterf lpv_gl_glSamplerParameterf
+#define glSamplerParameterfv lpv_gl_glSamplerParameterfv
+#define glSamplerParameterIiv lpv_gl_glSamplerParameterIiv
+#define glSamplerParameterIuiv lpv_gl_glSamplerParameterIuiv
+#define glGetSamplerParameteriv lpv_gl_glGetSamplerParameteriv
+#define glGetSamplerParameterIiv lpv_gl_glGetSamplerParameterIiv
+#define glGetSamplerParameterfv lpv_gl_glGetSamplerParameterfv
+#define glGetSamplerParameterIuiv lpv_gl_glGetSamplerParameterIuiv
+#define glQueryCounter lpv_gl_glQueryCounter
+#define glGetQueryObjecti64v lpv_gl_glGetQueryObjecti64v
+#define glGetQueryObjectui64v lpv_gl_glGetQueryObjectui64v
+#define glVertexAttribDivisor lpv_gl_glVertexAttribDivisor
+#define glVertexAttribP1ui lpv_gl_glVertexAttribP1ui
+#define glVertexAttribP1uiv lpv_gl_glVertexAttribP1uiv
+#define glVertexAttribP2ui lpv_gl_glVertexAttribP2ui
+#define glVertexAttribP2uiv lpv_gl_glVertexAttribP2uiv
+#define glVertexAttribP3ui lpv_gl_glVertexAttribP3ui
+#define glVertexAttribP3uiv lpv_gl_glVertexAttribP3uiv
+#define glVertexAttribP4ui lpv_gl_glVertexAttribP4ui
+#define glVertexAttribP4uiv lpv_gl_glVertexAttribP4uiv
+/* GL 4.0 */
+#define glMinSampleShading lpv_gl_glMinSampleShading
+#define glBlendEquationi lpv_gl_glBlendEquationi
+#define glBlendEquationSeparatei lpv_gl_glBlendEquationSeparatei
+#define glBlendFunci lpv_gl_glBlendFunci
+#define glBlendFuncSeparatei lpv_gl_glBlendFuncSeparatei
+#define glDrawArraysIndirect lpv_gl_glDrawArraysIndirect
+#define glDrawElementsIndirect lpv_gl_glDrawElementsIndirect
+#define glUniform1d lpv_gl_glUniform1d
+#define glUniform2d lpv_gl_glUniform2d
+#define glUniform3d lpv_gl_glUniform3d
+#define glUniform4d lpv_gl_glUniform4d
+#define glUniform1dv lpv_gl_glUniform1dv
+#define glUniform2dv lpv_gl_glUniform2dv
+#define glUniform3dv lpv_gl_glUniform3dv
+#define glUniform4dv lpv_gl_glUniform4dv
+#define glUniformMatrix2dv lpv_gl_glUniformMatrix2dv
+#define glUniformMatrix3dv lpv_gl_glUniformMatrix3dv
+#define glUniformMatrix4dv lpv_gl_glUniformMatrix4dv
+#define glUniformMatrix2x3dv lpv_gl_glUniformMatrix2x3dv
+#define glUniformMatrix2x4dv lpv_gl_glUniformMatrix2x4dv
+#define glUniformMatrix3x2dv lpv_gl_glUniformMatrix3x2dv
+#define glUniformMatrix3x4dv lpv_gl_glUniformMatrix3x4dv
+#define glUniformMatrix4x2dv lpv_gl_glUniformMatrix4x2dv
+#define glUniformMatrix4x3dv lpv_gl_glUniformMatrix4x3dv
+#define glGetUniformdv lpv_gl_glGetUniformdv
+#define glGetSubroutineUniformLocation lpv_gl_glGetSubroutineUniformLocation
+#define glGetSubroutineIndex lpv_gl_glGetSubroutineIndex
+#define glGetActiveSubroutineUniformiv lpv_gl_glGetActiveSubroutineUniformiv
+#define glGetActiveSubroutineUniformName lpv_gl_glGetActiveSubroutineUniformName
+#define glGetActiveSubroutineName lpv_gl_glGetActiveSubroutineName
+#define glUniformSubroutinesuiv lpv_gl_glUniformSubroutinesuiv
+#define glGetUniformSubroutineuiv lpv_gl_glGetUniformSubroutineuiv
+#define glGetProgramStageiv lpv_gl_glGetProgramStageiv
+#define glPatchParameteri lpv_gl_glPatchParameteri
+#define glPatchParameterfv lpv_gl_glPatchParameterfv
+#define glBindTransformFeedback lpv_gl_glBindTransformFeedback
+#define glDeleteTransformFeedbacks lpv_gl_glDeleteTransformFeedbacks
+#define glGenTransformFeedbacks lpv_gl_glGenTransformFeedbacks
+#define glIsTransformFeedback lpv_gl_glIsTransformFeedback
+#define glPauseTransformFeedback lpv_gl_glPauseTransformFeedback
+#define glResumeTransformFeedback lpv_gl_glResumeTransformFeedback
+#define glDrawTransformFeedback lpv_gl_glDrawTransformFeedback
+#define glDrawTransformFeedbackStream lpv_gl_glDrawTransformFeedbackStream
+#define glBeginQueryIndexed lpv_gl_glBeginQueryIndexed
+#define glEndQueryIndexed lpv_gl_glEndQueryIndexed
+#define glGetQueryIndexediv lpv_gl_glGetQueryIndexediv
+/* GL 4.1 */
+#define glReleaseShaderCompiler lpv_gl_glReleaseShaderCompiler
+#define glShaderBinary lpv_gl_glShaderBinary
+#define glGetShaderPrecisionFormat lpv_gl_glGetShaderPrecisionFormat
+#define glDepthRangef lpv_gl_glDepthRangef
+#define glClearDepthf lpv_gl_glClearDepthf
+#define glGetProgramBinary lpv_gl_glGetProgramBinary
+#define glProgramBinary lpv_gl_glProgramBinary
+#define glProgramParameteri lpv_gl_glProgramParameteri
+#define glUseProgramStages lpv_gl_glUseProgramStages
+#define glActiveShaderProgram lpv_gl_glActiveShaderProgram
+#define glCreateShaderProgramv lpv_gl_glCreateShaderProgramv
+#define glBindProgramPipeline lpv_gl_glBindProgramPipeline
+#define glDeleteProgramPipelines lpv_gl_glDeleteProgramPipelines
+#define glGenProgramPipelines lpv_gl_glGenProgramPipelines
+#define glIsProgramPipeline lpv_gl_glIsProgramPipeline
+#define glGetProgramPipelineiv lpv_gl_glGetProgramPipelineiv
+#define glProgramUniform1i lpv_gl_glProgramUniform1i
+#define glProgramUniform1iv lpv_gl_glProgramUniform1iv
+#define glProgramUniform1f lpv_gl_glProgramUniform1f
+#define glProgramUniform1fv lpv_gl_glProgramUniform1fv
+#define glProgramUniform1d lpv_gl_glProgramUniform1d
+#define glProgramUniform1dv lpv_gl_glProgramUniform1dv
+#define glProgramUniform1ui lpv_gl_glProgramUniform1ui
+#define glProgramUniform1uiv lpv_gl_glProgramUniform1uiv
+#define glProgramUniform2i lpv_gl_glProgramUniform2i
+#define glProgramUniform2iv lpv_gl_glProgramUniform2iv
+#define glProgramUniform2f lpv_gl_glProgramUniform2f
+#define glProgramUniform2fv lpv_gl_glProgramUniform2fv
+#define glProgramUniform2d lpv_gl_glProgramUniform2d
+#define glProgramUniform2dv lpv_gl_glProgramUniform2dv
+#define glProgramUniform2ui lpv_gl_glProgramUniform2ui
+#define glProgramUniform2uiv lpv_gl_glProgramUniform2uiv
+#define glProgramUniform3i lpv_gl_glProgramUniform3i
+#define glProgramUniform3iv lpv_gl_glProgramUniform3iv
+#define glProgramUniform3f lpv_gl_glProgramUniform3f
+#define glProgramUniform3fv lpv_gl_glProgramUniform3fv
+#define glProgramUniform3d lpv_gl_glProgramUniform3d
+#define glProgramUniform3dv lpv_gl_glProgramUniform3dv
+#define glProgramUniform3ui lpv_gl_glProgramUniform3ui
+#define glProgramUniform3uiv lpv_gl_glProgramUniform3uiv
+#define glProgramUniform4i lpv_gl_glProgramUniform4i
+#define glProgramUniform4iv lpv_gl_glProgramUniform4iv
+#define glProgramUniform4f lpv_gl_glProgramUniform4f
+#define glProgramUniform4fv lpv_gl_glProgramUniform4fv
+#define glProgramUniform4d lpv_gl_glProgramUniform4d
+#define glProgramUniform4dv lpv_gl_glProgramUniform4dv
+#define glProgramUniform4ui lpv_gl_glProgramUniform4ui
+#define glProgramUniform4uiv lpv_gl_glProgramUniform4uiv
+#define glProgramUniformMatrix2fv lpv_gl_glProgramUniformMatrix2fv
+#define glProgramUniformMatrix3fv lpv_gl_glProgramUniformMatrix3fv
+#define glProgramUniformMatrix4fv lpv_gl_glProgramUniformMatrix4fv
+#define glProgramUniformMatrix2dv lpv_gl_glProgramUniformMatrix2dv
+#define glProgramUniformMatrix3dv lpv_gl_glProgramUniformMatrix3dv
+#define glProgramUniformMatrix4dv lpv_gl_glProgramUniformMatrix4dv
+#define glProgramUniformMatrix2x3fv lpv_gl_glProgramUniformMatrix2x3fv
+#define glProgramUniformMatrix3x2fv lpv_gl_glProgramUniformMatrix3x2fv
+#define glProgramUniformMatrix2x4fv lpv_gl_glProgramUniformMatrix2x4fv
+#define glProgramUniformMatrix4x2fv lpv_gl_glProgramUniformMatrix4x2fv
+#define glProgramUniformMatrix3x4fv lpv_gl_glProgramUniformMatrix3x4fv
+#define glProgramUniformMatrix4x3fv lpv_gl_glProgramUniformMatrix4x3fv
+#define glProgramUniformMatrix2x3dv lpv_gl_glProgramUniformMatrix2x3dv
+#define glProgramUniformMatrix3x2dv lpv_gl_glProgramUniformMatrix3x2dv
+#define glProgramUniformMatrix2x4dv lpv_gl_glProgramUniformMatrix2x4dv
+#define glProgramUniformMatrix4x2dv lpv_gl_glProgramUniformMatrix4x2dv
+#define glProgramUniformMatrix3x4dv lpv_gl_glProgramUniformMatrix3x4dv
+#define glProgramUniformMatrix4x3dv lpv_gl_glProgramUniformMatrix4x3dv
+#define glValidateProgramPipeline lpv_gl_glValidateProgramPipeline
+#define glGetProgramPipelineInfoLog lpv_gl_glGetProgramPipelineInfoLog
+#define glVertexAttribL1d lpv_gl_glVertexAttribL1d
+#define glVertexAttribL2d lpv_gl_glVertexAttribL2d
+#define glVertexAttribL3d lpv_gl_glVertexAttribL3d
+#define glVertexAttribL4d lpv_gl_glVertexAttribL4d
+#define glVertexAttribL1dv lpv_gl_glVertexAttribL1dv
+#define glVertexAttribL2dv lpv_gl_glVertexAttribL2dv
+#define glVertexAttribL3dv lpv_gl_glVertexAttribL3dv
+#define glVertexAttribL4dv lpv_gl_glVertexAttribL4dv
+#define glVertexAttribLPointer lpv_gl_glVertexAttribLPointer
+#define glGetVertexAttribLdv lpv_gl_glGetVertexAttribLdv
+#define glViewportArrayv lpv_gl_glViewportArrayv
+#define glViewportIndexedf lpv_gl_glViewportIndexedf
+#define glViewportIndexedfv lpv_gl_glViewportIndexedfv
+#define glScissorArrayv lpv_gl_glScissorArrayv
+#define glScissorIndexed lpv_gl_glScissorIndexed
+#define glScissorIndexedv lpv_gl_glScissorIndexedv
+#define glDepthRangeArrayv lpv_gl_glDepthRangeArrayv
+#define glDepthRangeIndexed lpv_gl_glDepthRangeIndexed
+#define glGetFloati_v lpv_gl_glGetFloati_v
+#define glGetDoublei_v lpv_gl_glGetDoublei_v
+/* GL 4.2 */
+#define glDrawArraysInstancedBaseInstance lpv_gl_glDrawArraysInstancedBaseInstance
+#define glDrawElementsInstancedBaseInstance lpv_gl_glDrawElementsInstancedBaseInstance
+#define glDrawElementsInstancedBaseVertexBaseInstance lpv_gl_glDrawElementsInstancedBaseVertexBaseInstance
+#define glGetInternalformativ lpv_gl_glGetInternalformativ
+#define glGetActiveAtomicCounterBufferiv lpv_gl_glGetActiveAtomicCounterBufferiv
+#define glBindImageTexture lpv_gl_glBindImageTexture
+#define glMemoryBarrier lpv_gl_glMemoryBarrier
+#define glTexStorage1D lpv_gl_glTexStorage1D
+#define glTexStorage2D lpv_gl_glTexStorage2D
+#define glTexStorage3D lpv_gl_glTexStorage3D
+#define glDrawTransformFeedbackInstanced lpv_gl_glDrawTransformFeedbackInstanced
+#define glDrawTransformFeedbackStreamInstanced lpv_gl_glDrawTransformFeedbackStreamInstanced
+/* GL 4.3 */
+#define glClearBufferData lpv_gl_glClearBufferData
+#define glClearBufferSubData lpv_gl_glClearBufferSubData
+#define glDispatchCompute lpv_gl_glDispatchCompute
+#define glDispatchComputeIndirect lpv_gl_glDispatchComputeIndirect
+#define glCopyImageSubData lpv_gl_glCopyImageSubData
+#define glFramebufferParameteri lpv_gl_glFramebufferParameteri
+#define glGetFramebufferParameteriv lpv_gl_glGetFramebufferParameteriv
+#define glGetInternalformati64v lpv_gl_glGetInternalformati64v
+#define glInvalidateTexSubImage lpv_gl_glInvalidateTexSubImage
+#define glInvalidateTexImage lpv_gl_glInvalidateTexImage
+#define glInvalidateBufferSubData lpv_gl_glInvalidateBufferSubData
+#define glInvalidateBufferData lpv_gl_glInvalidateBufferData
+#define glInvalidateFramebuffer lpv_gl_glInvalidateFramebuffer
+#define glInvalidateSubFramebuffer lpv_gl_glInvalidateSubFramebuffer
+#define glMultiDrawArraysIndirect lpv_gl_glMultiDrawArraysIndirect
+#define glMultiDrawElementsIndirect lpv_gl_glMultiDrawElementsIndirect
+#define glGetProgramInterfaceiv lpv_gl_glGetProgramInterfaceiv
+#define glGetProgramResourceIndex lpv_gl_glGetProgramResourceIndex
+#define glGetProgramResourceName lpv_gl_glGetProgramResourceName
+#define glGetProgramResourceiv lpv_gl_glGetProgramResourceiv
+#define glGetProgramResourceLocation lpv_gl_glGetProgramResourceLocation
+#define glGetProgramResourceLocationIndex lpv_gl_glGetProgramResourceLocationIndex
+#define glShaderStorageBlockBinding lpv_gl_glShaderStorageBlockBinding
+#define glTexBufferRange lpv_gl_glTexBufferRange
+#define glTexStorage2DMultisample lpv_gl_glTexStorage2DMultisample
+#define glTexStorage3DMultisample lpv_gl_glTexStorage3DMultisample
+#define glTextureView lpv_gl_glTextureView
+#define glBindVertexBuffer lpv_gl_glBindVertexBuffer
+#define glVertexAttribFormat lpv_gl_glVertexAttribFormat
+#define glVertexAttribIFormat lpv_gl_glVertexAttribIFormat
+#define glVertexAttribLFormat lpv_gl_glVertexAttribLFormat
+#define glVertexAttribBinding lpv_gl_glVertexAttribBinding
+#define glVertexBindingDivisor lpv_gl_glVertexBindingDivisor
+#define glDebugMessageControl lpv_gl_glDebugMessageControl
+#define glDebugMessageInsert lpv_gl_glDebugMessageInsert
+#define glDebugMessageCallback lpv_gl_glDebugMessageCallback
+#define glGetDebugMessageLog lpv_gl_glGetDebugMessageLog
+#define glPushDebugGroup lpv_gl_glPushDebugGroup
+#define glPopDebugGroup lpv_gl_glPopDebugGroup
+#define glObjectLabel lpv_gl_glObjectLabel
+#define glGetObjectLabel lpv_gl_glGetObjectLabel
+#define glObjectPtrLabel lpv_gl_glObjectPtrLabel
+#define glGetObjectPtrLabel lpv_gl_glGetObjectPtrLabel
+/* GL 4.4 */
+#define glBufferStorage lpv_gl_glBufferStorage
+#define glClearTexImage lpv_gl_glClearTexImage
+#define glClearTexSubImage lpv_gl_glClearTexSubImage
+#define glBindBuffersBase lpv_gl_glBindBuffersBase
+#define glBindBuffersRange lpv_gl_glBindBuffersRange
+#define glBindTextures lpv_gl_glBindTextures
+#define glBindSamplers lpv_gl_glBindSamplers
+#define glBindImageTextures lpv_gl_glBindImageTextures
+#define glBindVertexBuffers lpv_gl_glBindVertexBuffers
+/* GL 4.5 */
+#define glClipControl lpv_gl_glClipControl
+#define glCreateTransformFeedbacks lpv_gl_glCreateTransformFeedbacks
+#define glTransformFeedbackBufferBase lpv_gl_glTransformFeedbackBufferBase
+#define glTransformFeedbackBufferRange lpv_gl_glTransformFeedbackBufferRange
+#define glGetTransformFeedbackiv lpv_gl_glGetTransformFeedbackiv
+#define glGetTransformFeedbacki_v lpv_gl_glGetTransformFeedbacki_v
+#define glGetTransformFeedbacki64_v lpv_gl_glGetTransformFeedbacki64_v
+#define glCreateBuffers lpv_gl_glCreateBuffers
+#define glNamedBufferStorage lpv_gl_glNamedBufferStorage
+#define glNamedBufferData lpv_gl_glNamedBufferData
+#define glNamedBufferSubData lpv_gl_glNamedBufferSubData
+#define glCopyNamedBufferSubData lpv_gl_glCopyNamedBufferSubData
+#define glClearNamedBufferData lpv_gl_glClearNamedBufferData
+#define glClearNamedBufferSubData lpv_gl_glClearNamedBufferSubData
+#define glMapNamedBuffer lpv_gl_glMapNamedBuffer
+#define glMapNamedBufferRange lpv_gl_glMapNamedBufferRange
+#define glUnmapNamedBuffer lpv_gl_glUnmapNamedBuffer
+#define glFlushMappedNamedBufferRange lpv_gl_glFlushMappedNamedBufferRange
+#define glGetNamedBufferParameteriv lpv_gl_glGetNamedBufferParameteriv
+#define glGetNamedBufferParameteri64v lpv_gl_glGetNamedBufferParameteri64v
+#define glGetNamedBufferPointerv lpv_gl_glGetNamedBufferPointerv
+#define glGetNamedBufferSubData lpv_gl_glGetNamedBufferSubData
+#define glCreateFramebuffers lpv_gl_glCreateFramebuffers
+#define glNamedFramebufferRenderbuffer lpv_gl_glNamedFramebufferRenderbuffer
+#define glNamedFramebufferParameteri lpv_gl_glNamedFramebufferParameteri
+#define glNamedFramebufferTexture lpv_gl_glNamedFramebufferTexture
+#define glNamedFramebufferTextureLayer lpv_gl_glNamedFramebufferTextureLayer
+#define glNamedFramebufferDrawBuffer lpv_gl_glNamedFramebufferDrawBuffer
+#define glNamedFramebufferDrawBuffers lpv_gl_glNamedFramebufferDrawBuffers
+#define glNamedFramebufferReadBuffer lpv_gl_glNamedFramebufferReadBuffer
+#define glInvalidateNamedFramebufferData lpv_gl_glInvalidateNamedFramebufferData
+#define glInvalidateNamedFramebufferSubData lpv_gl_glInvalidateNamedFramebufferSubData
+#define glClearNamedFramebufferiv lpv_gl_glClearNamedFramebufferiv
+#define glClearNamedFramebufferuiv lpv_gl_glClearNamedFramebufferuiv
+#define glClearNamedFramebufferfv lpv_gl_glClearNamedFramebufferfv
+#define glClearNamedFramebufferfi lpv_gl_glClearNamedFramebufferfi
+#define glBlitNamedFramebuffer lpv_gl_glBlitNamedFramebuffer
+#define glCheckNamedFramebufferStatus lpv_gl_glCheckNamedFramebufferStatus
+#define glGetNamedFramebufferParameteriv lpv_gl_glGetNamedFramebufferParameteriv
+#define glGetNamedFramebufferAttachmentParameteriv lpv_gl_glGetNamedFramebufferAttachmentParameteriv
+#define glCreateRenderbuffers lpv_gl_glCreateRenderbuffers
+#define glNamedRenderbufferStorage lpv_gl_glNamedRenderbufferStorage
+#define glNamedRenderbufferStorageMultisample lpv_gl_glNamedRenderbufferStorageMultisample
+#define glGetNamedRenderbufferParameteriv lpv_gl_glGetNamedRenderbufferParameteriv
+#define glCreateTextures lpv_gl_glCreateTextures
+#define glTextureBuffer lpv_gl_glTextureBuffer
+#define glTextureBufferRange lpv_gl_glTextureBufferRange
+#define glTextureStorage1D lpv_gl_glTextureStorage1D
+#define glTextureStorage2D lpv_gl_glTextureStorage2D
+#define glTextureStorage3D lpv_gl_glTextureStorage3D
+#define glTextureStorage2DMultisample lpv_gl_glTextureStorage2DMultisample
+#define glTextureStorage3DMultisample lpv_gl_glTextureStorage3DMultisample
+#define glTextureSubImage1D lpv_gl_glTextureSubImage1D
+#define glTextureSubImage2D lpv_gl_glTextureSubImage2D
+#define glTextureSubImage3D lpv_gl_glTextureSubImage3D
+#define glCompressedTextureSubImage1D lpv_gl_glCompressedTextureSubImage1D
+#define glCompressedTextureSubImage2D lpv_gl_glCompressedTextureSubImage2D
+#define glCompressedTextureSubImage3D lpv_gl_glCompressedTextureSubImage3D
+#define glCopyTextureSubImage1D lpv_gl_glCopyTextureSubImage1D
+#define glCopyTextureSubImage2D lpv_gl_glCopyTextureSubImage2D
+#define glCopyTextureSubImage3D lpv_gl_glCopyTextureSubImage3D
+#define glTextureParameterf lpv_gl_glTextureParameterf
+#define glTextureParameterfv lpv_gl_glTextureParameterfv
+#define glTextureParameteri lpv_gl_glTextureParameteri
+#define glTextureParameterIiv lpv_gl_glTextureParameterIiv
+#define glTextureParameterIuiv lpv_gl_glTextureParameterIuiv
+#define glTextureParameteriv lpv_gl_glTextureParameteriv
+#define glGenerateTextureMipmap lpv_gl_glGenerateTextureMipmap
+#define glBindTextureUnit lpv_gl_glBindTextureUnit
+#define glGetTextureImage lpv_gl_glGetTextureImage
+#define glGetCompressedTextureImage lpv_gl_glGetCompressedTextureImage
+#define glGetTextureLevelParameterfv lpv_gl_glGetTextureLevelParameterfv
+#define glGetTextureLevelParameteriv lpv_gl_glGetTextureLevelParameteriv
+#define glGetTextureParameterfv lpv_gl_glGetTextureParameterfv
+#define glGetTextureParameterIiv lpv_gl_glGetTextureParameterIiv
+#define glGetTextureParameterIuiv lpv_gl_glGetTextureParameterIuiv
+#define glGetTextureParameteriv lpv_gl_glGetTextureParameteriv
+#define glCreateVertexArrays lpv_gl_glCreateVertexArrays
+#define glDisableVertexArrayAttrib lpv_gl_glDisableVertexArrayAttrib
+#define glEnableVertexArrayAttrib lpv_gl_glEnableVertexArrayAttrib
+#define glVertexArrayElementBuffer lpv_gl_glVertexArrayElementBuffer
+#define glVertexArrayVertexBuffer lpv_gl_glVertexArrayVertexBuffer
+#define glVertexArrayVertexBuffers lpv_gl_glVertexArrayVertexBuffers
+#define glVertexArrayAttribBinding lpv_gl_glVertexArrayAttribBinding
+#define glVertexArrayAttribFormat lpv_gl_glVertexArrayAttribFormat
+#define glVertexArrayAttribIFormat lpv_gl_glVertexArrayAttribIFormat
+#define glVertexArrayAttribLFormat lpv_gl_glVertexArrayAttribLFormat
+#define glVertexArrayBindingDivisor lpv_gl_glVertexArrayBindingDivisor
+#define glGetVertexArrayiv lpv_gl_glGetVertexArrayiv
+#define glGetVertexArrayIndexediv lpv_gl_glGetVertexArrayIndexediv
+#define glGetVertexArrayIndexed64iv lpv_gl_glGetVertexArrayIndexed64iv
+#define glCreateSamplers lpv_gl_glCreateSamplers
+#define glCreateProgramPipelines lpv_gl_glCreateProgramPipelines
+#define glCreateQueries lpv_gl_glCreateQueries
+#define glGetQueryBufferObjecti64v lpv_gl_glGetQueryBufferObjecti64v
+#define glGetQueryBufferObjectiv lpv_gl_glGetQueryBufferObjectiv
+#define glGetQueryBufferObjectui64v lpv_gl_glGetQueryBufferObjectui64v
+#define glGetQueryBufferObjectuiv lpv_gl_glGetQueryBufferObjectuiv
+#define glMemoryBarrierByRegion lpv_gl_glMemoryBarrierByRegion
+#define glGetTextureSubImage lpv_gl_glGetTextureSubImage
+#define glGetCompressedTextureSubImage lpv_gl_glGetCompressedTextureSubImage
+#define glGetGraphicsResetStatus lpv_gl_glGetGraphicsResetStatus
+#define glGetnCompressedTexImage lpv_gl_glGetnCompressedTexImage
+#define glGetnTexImage lpv_gl_glGetnTexImage
+#define glGetnUniformdv lpv_gl_glGetnUniformdv
+#define glGetnUniformfv lpv_gl_glGetnUniformfv
+#define glGetnUniformiv lpv_gl_glGetnUniformiv
+#define glGetnUniformuiv lpv_gl_glGetnUniformuiv
+#define glReadnPixels lpv_gl_glReadnPixels
+#define glTextureBarrier lpv_gl_glTextureBarrier
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LPV_GL_H */
