@@ -579,16 +579,20 @@ static void test_irradiance_outside_grid(void **state)
     pipeline_run(&p, &g, v, 50, NULL, 0, 6);
     const float n[3] = {0.3f, -0.5f, 0.8f};
     /* Outside along each axis the lookup takes the value at the outermost
-     * cell centre (clamp to edge). */
+     * cell centre (clamp to edge). The lookup samples half a cell in front
+     * of the surface (q = p + n/2), so the reference points sit at
+     * centre - n/2 for the clamped axis. */
+    const float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const float off[3] = {0.5f * n[0] / len, 0.5f * n[1] / len, 0.5f * n[2] / len};
     const float far[] = {-1e6f, -3.0f, -0.2f, 100.0f, 1e30f, -INFINITY, INFINITY};
     float edge[3], got[3];
     for (size_t i = 0; i < sizeof far / sizeof far[0]; i++) {
-        float x = far[i], cx = far[i] < 0 ? 0.5f : 5.5f;
+        float x = far[i], cx = (far[i] < 0 ? 0.5f : 5.5f) - off[0];
         irradiance(&p, x, 2.2f, 1.7f, n[0], n[1], n[2], got);
         irradiance(&p, cx, 2.2f, 1.7f, n[0], n[1], n[2], edge);
         for (int c = 0; c < 3; c++)
             assert_true(got[c] == edge[c]);
-        float cz = far[i] < 0 ? 0.5f : 3.5f;
+        float cz = (far[i] < 0 ? 0.5f : 3.5f) - off[2];
         irradiance(&p, 3.3f, 1.1f, x, n[0], n[1], n[2], got);
         irradiance(&p, 3.3f, 1.1f, cz, n[0], n[1], n[2], edge);
         for (int c = 0; c < 3; c++)
@@ -597,7 +601,7 @@ static void test_irradiance_outside_grid(void **state)
     /* All three axes outside: the corner cell itself. */
     irradiance(&p, 50, 50, 50, n[0], n[1], n[2], got);
     float corner[3];
-    irradiance(&p, 5.5f, 4.5f, 3.5f, n[0], n[1], n[2], corner);
+    irradiance(&p, 5.5f - off[0], 4.5f - off[1], 3.5f - off[2], n[0], n[1], n[2], corner);
     for (int c = 0; c < 3; c++)
         assert_true(got[c] == corner[c]);
     /* A NaN position gives no light rather than NaN. */

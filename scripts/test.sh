@@ -1,0 +1,22 @@
+#!/bin/sh
+# Every test on a fresh Debian 12 machine: install, build, run the whole
+# suite (GL tests on Mesa's llvmpipe when there is no GPU), then build again
+# with AddressSanitizer + UndefinedBehaviorSanitizer and run the suite again.
+# Warnings are errors in both builds.
+set -eu
+cd "$(dirname "$0")/.."
+sh scripts/install-deps.sh
+jobs="$(nproc)"
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo
+cmake --build build -j "$jobs"
+ctest --test-dir build --output-on-failure -j "$jobs"
+
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DLPVD_SANITIZE=ON
+cmake --build build-asan -j "$jobs"
+# Mesa and LLVM keep some allocations for the life of the process; the
+# suppressions name only their libraries, never lpvd's code.
+ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:fast_unwind_on_malloc=0" \
+UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
+  ctest --test-dir build-asan --output-on-failure -j "$jobs"
