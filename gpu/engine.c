@@ -176,7 +176,8 @@ static void free_grids(lpv_engine *e)
     delete_buffer(&e->transmit);
     delete_buffer(&e->sigma[0]);
     delete_buffer(&e->sigma[1]);
-    GLuint *views[] = {&e->tbo_injected, &e->tbo_ping, &e->tbo_pong, &e->tbo_sigma[0], &e->tbo_sigma[1]};
+    GLuint *views[] = {&e->tbo_injected, &e->tbo_ping, &e->tbo_pong, &e->tbo_sigma[0], &e->tbo_sigma[1],
+                       &e->tbo_acc, &e->tbo_transmit};
     for (size_t i = 0; i < sizeof views / sizeof views[0]; ++i)
         delete_texture(views[i]);
     e->grid_alloc_cells = 0;
@@ -229,13 +230,13 @@ static GLuint new_ssbo(size_t bytes)
     return b;
 }
 
-/* An RGBA32F buffer texture over buffer b. */
-static GLuint buffer_view(GLuint b)
+/* A buffer texture of the given format over buffer b. */
+static GLuint buffer_view(GLuint b, GLenum format)
 {
     GLuint t;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_BUFFER, t);
-    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, b);
+    glTexBuffer(GL_TEXTURE_BUFFER, format, b);
     glBindTexture(GL_TEXTURE_BUFFER, 0);
     return t;
 }
@@ -278,11 +279,13 @@ static int place_grid(lpv_engine *e, char *err, size_t err_size)
     e->transmit = new_ssbo(cells * LPV_DIR_COUNT * sizeof(float));
     e->sigma[0] = new_ssbo(cells * 4 * sizeof(float));
     e->sigma[1] = new_ssbo(cells * 4 * sizeof(float));
-    e->tbo_injected = buffer_view(e->lpv_injected);
-    e->tbo_ping = buffer_view(e->lpv_ping);
-    e->tbo_pong = buffer_view(e->lpv_pong);
-    e->tbo_sigma[0] = buffer_view(e->sigma[0]);
-    e->tbo_sigma[1] = buffer_view(e->sigma[1]);
+    e->tbo_injected = buffer_view(e->lpv_injected, GL_RGBA32F);
+    e->tbo_ping = buffer_view(e->lpv_ping, GL_RGBA32F);
+    e->tbo_pong = buffer_view(e->lpv_pong, GL_RGBA32F);
+    e->tbo_sigma[0] = buffer_view(e->sigma[0], GL_RGBA32F);
+    e->tbo_sigma[1] = buffer_view(e->sigma[1], GL_RGBA32F);
+    e->tbo_acc = buffer_view(e->lpv_acc, GL_RGBA32F);
+    e->tbo_transmit = buffer_view(e->transmit, GL_R32F);
     e->grid_alloc_cells = cells;
     if (glGetError() != GL_NO_ERROR)
         return lpv_engine_fail(err, err_size, "could not allocate a %dx%dx%d grid", g.dims[0], g.dims[1], g.dims[2]);

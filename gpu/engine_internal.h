@@ -65,7 +65,7 @@ struct lpv_engine {
     lpv_atlas lpv_atlas, gv_atlas;
     GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit;
     GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
-    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2]; /* buffer-texture views for reading */
+    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit; /* buffer-texture views for reading */
     size_t grid_alloc_cells;
     int ticked;
 

@@ -52,6 +52,6 @@ void lpv_pass_gv_run(lpv_engine *e)
     glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D),
                       (GLuint)e->grid.dims[2]);
     lpv_timer_count(&e->timer, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     lpv_timer_end(&e->timer);
 }

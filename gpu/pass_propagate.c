@@ -13,27 +13,29 @@ void lpv_pass_propagate_run(lpv_engine *e)
     GLint loc_occ = glGetUniformLocation(e->prog_propagate, "u_occlusion");
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_TRANSMIT, e->transmit);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_ACC_IN);
+    glBindTexture(GL_TEXTURE_BUFFER, e->tbo_acc);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_TRANSMIT);
+    glBindTexture(GL_TEXTURE_BUFFER, e->tbo_transmit);
     const int occlusion = e->settings.occlusion == LPV_SWITCH_ON;
-    GLuint in = e->lpv_injected;
-
+    /* Step i reads (through buffer-texture views: on llvmpipe texel fetches
+     * gather far faster than SSBO loads) what step i - 1 wrote with SSBO
+     * stores: the injected grid first, then ping and pong in turn. */
+    GLuint in_view = e->tbo_injected;
     for (int i = 0; i < e->settings.iterations; ++i) {
         GLuint out = (i & 1) ? e->lpv_pong : e->lpv_ping;
-        /* Reads go through buffer textures over the same storage: on
-         * llvmpipe texel fetches gather far faster than SSBO loads. */
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_BUFFER, in == e->lpv_injected ? e->tbo_injected : in == e->lpv_ping ? e->tbo_ping : e->tbo_pong);
-        glActiveTexture(GL_TEXTURE1);
+        glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
+        glBindTexture(GL_TEXTURE_BUFFER, in_view);
+        glActiveTexture(GL_TEXTURE0 + LPV_TEX_SIGMA_IN);
         glBindTexture(GL_TEXTURE_BUFFER, e->tbo_sigma[i & 1]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_IN, e->sigma[i & 1]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[(i + 1) & 1]);
         glUniform1i(loc_occ, occlusion && i > 0);
         glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
                           lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y), (GLuint)e->grid.dims[2]);
         lpv_timer_count(&e->timer, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        in = out;
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        in_view = (i & 1) ? e->tbo_pong : e->tbo_ping;
     }
     lpv_timer_end(&e->timer);
 }

@@ -145,20 +145,23 @@ struct LpvViewBlock {
 #define LPV_UBO_VIEW      1
 #define LPV_UBO_LIGHT     2
 
-#define LPV_SSBO_LPV_IN   0
 #define LPV_SSBO_LPV_OUT  1
 #define LPV_SSBO_LPV_ACC  2
 #define LPV_SSBO_TRANSMIT 3
-#define LPV_SSBO_GV       4
 #define LPV_SSBO_VPLS     5
 #define LPV_SSBO_SURFELS  6
 #define LPV_SSBO_GV_TOTAL 7
-#define LPV_SSBO_SIGMA_IN 8
-#define LPV_SSBO_SIGMA_OUT 9
+#define LPV_SSBO_SIGMA_OUT 8
+
+/* Texture units of the propagation's inputs (RGBA32F buffer textures). */
+#define LPV_TEX_LPV_IN    0
+#define LPV_TEX_SIGMA_IN  1
+#define LPV_TEX_ACC_IN    2
+#define LPV_TEX_TRANSMIT  3
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
-#define LPV_PROP_WG_X 8
-#define LPV_PROP_WG_Y 8
+#define LPV_PROP_WG_X 32
+#define LPV_PROP_WG_Y 2
 #define LPV_WG_2D 8
 
 /* ---- Limits ---------------------------------------------------------------- */

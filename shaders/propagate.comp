@@ -6,11 +6,12 @@
 // transmittance. The step's output is also added to the accumulated volume.
 layout(local_size_x = LPV_PROP_WG_X, local_size_y = LPV_PROP_WG_Y, local_size_z = 1) in;
 
-layout(binding = 0) uniform samplerBuffer u_in;
+layout(binding = LPV_TEX_LPV_IN) uniform samplerBuffer u_in;       // LpvCell as 3 texels
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell cout[]; };
-layout(std430, binding = LPV_SSBO_LPV_ACC) buffer Acc { LpvCell acc[]; };
-layout(std430, binding = LPV_SSBO_TRANSMIT) readonly buffer Transmit { float transmit[]; };
-layout(binding = 1) uniform samplerBuffer u_sigma_in;
+layout(std430, binding = LPV_SSBO_LPV_ACC) writeonly buffer Acc { LpvCell acc[]; };
+layout(binding = LPV_TEX_ACC_IN) uniform samplerBuffer u_acc;           // LpvCell as 3 texels
+layout(binding = LPV_TEX_TRANSMIT) uniform samplerBuffer u_transmit;    // 6 per cell
+layout(binding = LPV_TEX_SIGMA_IN) uniform samplerBuffer u_sigma_in; // rgb flux limits
 layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 sigma_out[]; };
 
 uniform int u_occlusion; // 0 on the first step and when occlusion is off
@@ -44,7 +45,7 @@ void main()
         if (!cell_inside(src))
             continue;
         int slot = axis == 0 ? 3 : axis; // x lives in slot 3, y in 1, z in 2
-        float t = u_occlusion != 0 ? transmit[i * LPV_DIR_COUNT + dir] : 1.0;
+        float t = u_occlusion != 0 ? texelFetch(u_transmit, i * LPV_DIR_COUNT + dir).x : 1.0;
         int j = cell_index(src);
         LpvCell n;
         n.r = texelFetch(u_in, 3 * j);
@@ -59,9 +60,9 @@ void main()
     // The next step needs each source's flux limit; computing it here, once
     // per cell, saves recomputing it for each of the six destinations.
     sigma_out[i] = vec4(flux_limit(sum.r), flux_limit(sum.g), flux_limit(sum.b), 0.0);
-    LpvCell a = acc[i];
-    a.r += sum.r;
-    a.g += sum.g;
-    a.b += sum.b;
+    LpvCell a;
+    a.r = texelFetch(u_acc, 3 * i) + sum.r;
+    a.g = texelFetch(u_acc, 3 * i + 1) + sum.g;
+    a.b = texelFetch(u_acc, 3 * i + 2) + sum.b;
     acc[i] = a;
 }
