@@ -52,9 +52,12 @@ static double emission_weight(const float e[3])
     return (double)e[0] + e[1] + e[2];
 }
 
-void lpv_emissive_total_flux(const lpv_scene *s, double flux[3])
+/* Calls fn for every non-degenerate triangle of every emissive draw, in
+ * draw order. Returns 0, or the first non-zero value fn returned (stop). */
+typedef int (*triangle_fn)(void *ud, const float *p[3], const float n[3], double area, const float e[3]);
+
+static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *ud)
 {
-    flux[0] = flux[1] = flux[2] = 0.0;
     for (uint32_t d = 0; d < s->draw_count; ++d) {
         const lpv_draw *dr = &s->draws[d];
         if (!material_emits(s, dr->material))
@@ -66,68 +69,80 @@ void lpv_emissive_total_flux(const lpv_scene *s, double flux[3])
             double area;
             if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, p, n, &area))
                 continue;
-            for (int c = 0; c < 3; ++c)
-                flux[c] += M_PI * e[c] * area;
+            int rc = fn(ud, p, n, area, e);
+            if (rc)
+                return rc;
         }
     }
+    return 0;
+}
+
+static int add_flux(void *ud, const float *p[3], const float n[3], double area, const float e[3])
+{
+    (void)p;
+    (void)n;
+    double *flux = ud;
+    for (int c = 0; c < 3; ++c)
+        flux[c] += M_PI * e[c] * area;
+    return 0;
+}
+
+void lpv_emissive_total_flux(const lpv_scene *s, double flux[3])
+{
+    flux[0] = flux[1] = flux[2] = 0.0;
+    for_each_emissive_triangle(s, add_flux, flux);
+}
+
+static int add_weight(void *ud, const float *p[3], const float n[3], double area, const float e[3])
+{
+    (void)p;
+    (void)n;
+    *(double *)ud += emission_weight(e) * area;
+    return 0;
+}
+
+typedef struct sampler {
+    double total_weight;
+    size_t target, count, max;
+    lpv_vpl *out;
+} sampler;
+
+/* Places this triangle's share of the samples on the R2 low-discrepancy
+ * sequence (generalised golden ratio), warped uniformly onto the triangle. */
+static int sample_triangle(void *ud, const float *p[3], const float n[3], double area, const float e[3])
+{
+    sampler *sm = ud;
+    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
+    size_t k_count = (size_t)floor((double)sm->target * emission_weight(e) * area / sm->total_weight + 0.5);
+    if (k_count == 0)
+        k_count = 1;
+    if (sm->count + k_count > sm->max)
+        k_count = sm->max - sm->count;
+    if (k_count == 0)
+        return 1; /* out of room */
+    for (size_t k = 0; k < k_count; ++k) {
+        double u = fmod(0.5 + a1 * (double)(k + 1), 1.0);
+        double v = fmod(0.5 + a2 * (double)(k + 1), 1.0);
+        double r = sqrt(u);
+        double b0 = 1.0 - r, b1 = r * (1.0 - v), b2 = r * v;
+        lpv_vpl *o = &sm->out[sm->count++];
+        memset(o, 0, sizeof *o);
+        for (int i = 0; i < 3; ++i) {
+            o->position[i] = (float)(b0 * p[0][i] + b1 * p[1][i] + b2 * p[2][i]);
+            o->normal[i] = n[i];
+            o->flux[i] = (float)(M_PI * e[i] * area / (double)k_count);
+        }
+        o->position[3] = 1.0f;
+    }
+    return 0;
 }
 
 size_t lpv_emissive_sample(const lpv_scene *s, size_t target, lpv_vpl *out, size_t max)
 {
-    double total = 0.0;
-    for (uint32_t d = 0; d < s->draw_count; ++d) {
-        const lpv_draw *dr = &s->draws[d];
-        if (!material_emits(s, dr->material))
-            continue;
-        double w = emission_weight(s->materials[dr->material].emission);
-        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
-            const float *p[3];
-            float n[3];
-            double area;
-            if (dr->first_index + t + 3 <= s->index_count && triangle(s, dr->first_index + t, p, n, &area))
-                total += w * area;
-        }
-    }
-    if (!(total > 0.0) || target == 0)
+    sampler sm = {.target = target, .max = max, .out = out};
+    for_each_emissive_triangle(s, add_weight, &sm.total_weight);
+    if (!(sm.total_weight > 0.0) || target == 0)
         return 0;
-
-    /* R2 low-discrepancy sequence (generalised golden ratio). */
-    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
-    size_t count = 0;
-    for (uint32_t d = 0; d < s->draw_count; ++d) {
-        const lpv_draw *dr = &s->draws[d];
-        if (!material_emits(s, dr->material))
-            continue;
-        const float *e = s->materials[dr->material].emission;
-        double w = emission_weight(e);
-        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
-            const float *p[3];
-            float n[3];
-            double area;
-            if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, p, n, &area))
-                continue;
-            size_t k_count = (size_t)floor((double)target * w * area / total + 0.5);
-            if (k_count == 0)
-                k_count = 1;
-            if (count + k_count > max)
-                k_count = max - count;
-            if (k_count == 0)
-                return count;
-            for (size_t k = 0; k < k_count; ++k) {
-                double u = fmod(0.5 + a1 * (double)(k + 1), 1.0);
-                double v = fmod(0.5 + a2 * (double)(k + 1), 1.0);
-                double r = sqrt(u);
-                double b0 = 1.0 - r, b1 = r * (1.0 - v), b2 = r * v;
-                lpv_vpl *o = &out[count++];
-                memset(o, 0, sizeof *o);
-                for (int i = 0; i < 3; ++i) {
-                    o->position[i] = (float)(b0 * p[0][i] + b1 * p[1][i] + b2 * p[2][i]);
-                    o->normal[i] = n[i];
-                    o->flux[i] = (float)(M_PI * e[i] * area / (double)k_count);
-                }
-                o->position[3] = 1.0f;
-            }
-        }
-    }
-    return count;
+    for_each_emissive_triangle(s, sample_triangle, &sm);
+    return sm.count;
 }

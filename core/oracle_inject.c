@@ -8,21 +8,6 @@
 #include "oracle.h"
 #include "sh.h"
 
-/* A normal is usable when it is finite and longer than 1e-8; it is then
- * normalised. The length is a float, as in the shaders: a normal so long that
- * its length overflows (> ~1.8e19) is rejected like a non-finite one. */
-static int unit_normal(const float in[3], float out[3])
-{
-    if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
-        return 0;
-    float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
-    if (!(len > 1e-8f) || !isfinite(len))
-        return 0;
-    for (int i = 0; i < 3; i++)
-        out[i] = in[i] / len;
-    return 1;
-}
-
 static int finite3(const float v[3])
 {
     return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
@@ -43,7 +28,7 @@ static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
     int cell[3];
     if (v->position[3] == 0.0f || !finite3(v->position) || !finite3(v->flux))
         return 0;
-    if (!unit_normal(v->normal, n))
+    if (!lpv_unit_direction(v->normal, n))
         return 0;
     for (int i = 0; i < 3; i++)
         p[i] = v->position[i] + 0.5f * g->cell_size * n[i];
@@ -78,7 +63,7 @@ static int inject_surfel(const lpv_grid *g, const lpv_surfel *s, vec4 *gv)
     float area = s->position[3];
     if (!(area > 0.0f) || !isfinite(area) || !finite3(s->position))
         return 0;
-    if (!unit_normal(s->normal, n))
+    if (!lpv_unit_direction(s->normal, n))
         return 0;
     if (!lpv_grid_gv_point_of(g, s->position, pt))
         return 0;

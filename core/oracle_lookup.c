@@ -9,19 +9,6 @@
 #include "oracle.h"
 #include "sh.h"
 
-/* Same rule as injection: finite and longer than 1e-8, then normalised. */
-static int unit_normal(const float in[3], float out[3])
-{
-    if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
-        return 0;
-    float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
-    if (!(len > 1e-8f) || !isfinite(len))
-        return 0;
-    for (int i = 0; i < 3; i++)
-        out[i] = in[i] / len;
-    return 1;
-}
-
 /* Per axis: the two cells to blend and the weight of the upper one. The
  * position in cell units is clamped to [0.5, dims - 0.5] (the outermost cell
  * centres), so points outside the grid take the edge value. Returns 0 for a
@@ -78,7 +65,7 @@ void lpv_oracle_irradiance(const lpv_grid *g, const lpv_cell *acc, const float p
     int i0[3], i1[3];
     float f[3];
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
-    if (!unit_normal(n, un))
+    if (!lpv_unit_direction(n, un))
         return;
     /* Sample half a cell in front of the surface, the mirror of the
      * injection's half-cell offset: the cells behind a surface hold light

@@ -6,6 +6,8 @@
  */
 #include "sh.h"
 
+#include <math.h>
+
 #include "lpv_shared.h"
 
 /* sqrt(4 pi): the integral of the constant basis shape 1 / C0 over the sphere. */
@@ -48,4 +50,16 @@ float lpv_sh_integral(const float c[4])
 float lpv_sh_dot(const float a[4], const float b[4])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+}
+
+int lpv_unit_direction(const float in[3], float out[3])
+{
+    if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
+        return 0;
+    float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
+    if (!(len > 1e-8f) || !isfinite(len))
+        return 0;
+    for (int i = 0; i < 3; i++)
+        out[i] = in[i] / len;
+    return 1;
 }

@@ -20,4 +20,9 @@ float lpv_sh_integral(const float c[4]);
 /* Integral over the sphere of the product of two functions: dot(a, b). */
 float lpv_sh_dot(const float a[4], const float b[4]);
 
+/* A direction is usable when it is finite and longer than 1e-8 (length
+ * computed in float, as in the shaders, so one whose length overflows is
+ * rejected too); then out = in / |in| and 1 is returned, else 0. */
+int lpv_unit_direction(const float in[3], float out[3]);
+
 #endif /* LPV_SH_H */

@@ -22,6 +22,7 @@
  */
 #define _GNU_SOURCE 1 /* dl_iterate_phdr, RTLD_NOLOAD */
 #include "context.h"
+#include "error.h"
 #include "gl.h"
 
 #define EGL_NO_X11 1 /* never pull in Xlib through eglplatform.h */
@@ -97,15 +98,6 @@ static lpv_pfn_osmesa_get_proc g_osmesa_get_proc;
 static _Thread_local lpv_gl_context *t_current;
 
 /* ---- small helpers ---------------------------------------------------------- */
-static void set_msg(char *buf, size_t size, const char *fmt, ...)
-{
-    if (!buf || !size)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, size, fmt, ap);
-    va_end(ap);
-}
 
 /* Appends to a NUL-terminated buffer, truncating silently. */
 static void append_msg(char *buf, size_t size, const char *fmt, ...)
@@ -235,12 +227,12 @@ static int display_ref(EGLDisplay dpy, char *reason, size_t reason_size)
             free_slot = i;
     }
     if (free_slot < 0) {
-        set_msg(reason, reason_size, "too many EGL displays in this process");
+        lpv_error(reason, reason_size, "too many EGL displays in this process");
         goto out;
     }
     EGLint major = 0, minor = 0;
     if (!eglInitialize(dpy, &major, &minor)) {
-        set_msg(reason, reason_size, "eglInitialize failed (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "eglInitialize failed (%s)", egl_error_name(eglGetError()));
         goto out;
     }
     g_displays[free_slot].dpy = dpy;
@@ -350,7 +342,7 @@ static int finish_gl(lpv_gl_context *ctx, char *reason, size_t reason_size)
     ctx->table_gen = lpv_gl_table_generation();
     pthread_mutex_unlock(&g_lock);
     if (loaded != 0) {
-        set_msg(reason, reason_size, "GL function table: %s", e);
+        lpv_error(reason, reason_size, "GL function table: %s", e);
         return -1;
     }
 
@@ -364,12 +356,12 @@ static int finish_gl(lpv_gl_context *ctx, char *reason, size_t reason_size)
     if (major == 0 && version) /* GL_MAJOR_VERSION needs 3.0; fall back to the string */
         sscanf(version, "%d.%d", &major, &minor);
     if (major * 100 + minor < 405) {
-        set_msg(reason, reason_size, "OpenGL %d.%d (\"%s\", renderer \"%s\") is below the required 4.5 core",
+        lpv_error(reason, reason_size, "OpenGL %d.%d (\"%s\", renderer \"%s\") is below the required 4.5 core",
                 (int)major, (int)minor, ctx->version, ctx->renderer);
         return -1;
     }
     if (!ctx->renderer[0]) {
-        set_msg(reason, reason_size, "glGetString(GL_RENDERER) returned nothing");
+        lpv_error(reason, reason_size, "glGetString(GL_RENDERER) returned nothing");
         return -1;
     }
     if (ctx->debug)
@@ -412,7 +404,7 @@ static void egl_teardown(lpv_gl_context *ctx)
 static int egl_setup(lpv_gl_context *ctx, EGLDisplay dpy, char *reason, size_t reason_size)
 {
     if (dpy == EGL_NO_DISPLAY) {
-        set_msg(reason, reason_size, "eglGetPlatformDisplayEXT failed (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "eglGetPlatformDisplayEXT failed (%s)", egl_error_name(eglGetError()));
         return -1;
     }
     if (display_ref(dpy, reason, reason_size) != 0)
@@ -420,7 +412,7 @@ static int egl_setup(lpv_gl_context *ctx, EGLDisplay dpy, char *reason, size_t r
     ctx->egl_dpy = dpy;
 
     if (!eglBindAPI(EGL_OPENGL_API)) {
-        set_msg(reason, reason_size, "eglBindAPI(EGL_OPENGL_API) failed (%s): no desktop OpenGL",
+        lpv_error(reason, reason_size, "eglBindAPI(EGL_OPENGL_API) failed (%s): no desktop OpenGL",
                 egl_error_name(eglGetError()));
         goto fail;
     }
@@ -437,7 +429,7 @@ static int egl_setup(lpv_gl_context *ctx, EGLDisplay dpy, char *reason, size_t r
         };
         EGLint n = 0;
         if (!eglChooseConfig(dpy, config_attribs, &config, 1, &n) || n < 1) {
-            set_msg(reason, reason_size, "no pbuffer-capable OpenGL EGLConfig (%s)", egl_error_name(eglGetError()));
+            lpv_error(reason, reason_size, "no pbuffer-capable OpenGL EGLConfig (%s)", egl_error_name(eglGetError()));
             goto fail;
         }
     }
@@ -463,20 +455,20 @@ static int egl_setup(lpv_gl_context *ctx, EGLDisplay dpy, char *reason, size_t r
 
     ctx->egl_ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
     if (ctx->egl_ctx == EGL_NO_CONTEXT) {
-        set_msg(reason, reason_size, "eglCreateContext(OpenGL 4.5 core) failed (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "eglCreateContext(OpenGL 4.5 core) failed (%s)", egl_error_name(eglGetError()));
         goto fail;
     }
     if (!surfaceless) {
         static const EGLint pbuffer_attribs[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
         ctx->egl_surf = eglCreatePbufferSurface(dpy, config, pbuffer_attribs);
         if (ctx->egl_surf == EGL_NO_SURFACE) {
-            set_msg(reason, reason_size, "no EGL_KHR_surfaceless_context and eglCreatePbufferSurface failed (%s)",
+            lpv_error(reason, reason_size, "no EGL_KHR_surfaceless_context and eglCreatePbufferSurface failed (%s)",
                     egl_error_name(eglGetError()));
             goto fail;
         }
     }
     if (!eglMakeCurrent(dpy, ctx->egl_surf, ctx->egl_surf, ctx->egl_ctx)) {
-        set_msg(reason, reason_size, "eglMakeCurrent failed (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "eglMakeCurrent failed (%s)", egl_error_name(eglGetError()));
         goto fail;
     }
     if (finish_gl(ctx, reason, reason_size) != 0)
@@ -491,15 +483,15 @@ static int try_egl_device(lpv_gl_context *ctx, char *reason, size_t reason_size)
 {
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!client) {
-        set_msg(reason, reason_size, "EGL client extensions unavailable (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "EGL client extensions unavailable (%s)", egl_error_name(eglGetError()));
         return -1;
     }
     if (!has_token(client, "EGL_EXT_device_enumeration") && !has_token(client, "EGL_EXT_device_base")) {
-        set_msg(reason, reason_size, "EGL lacks EGL_EXT_device_enumeration");
+        lpv_error(reason, reason_size, "EGL lacks EGL_EXT_device_enumeration");
         return -1;
     }
     if (!has_token(client, "EGL_EXT_platform_device")) {
-        set_msg(reason, reason_size, "EGL lacks EGL_EXT_platform_device");
+        lpv_error(reason, reason_size, "EGL lacks EGL_EXT_platform_device");
         return -1;
     }
     PFNEGLQUERYDEVICESEXTPROC query_devices = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
@@ -508,7 +500,7 @@ static int try_egl_device(lpv_gl_context *ctx, char *reason, size_t reason_size)
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display =
         (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
     if (!query_devices || !query_device_string || !get_platform_display) {
-        set_msg(reason, reason_size, "EGL device functions unavailable");
+        lpv_error(reason, reason_size, "EGL device functions unavailable");
         return -1;
     }
 
@@ -516,7 +508,7 @@ static int try_egl_device(lpv_gl_context *ctx, char *reason, size_t reason_size)
     EGLDeviceEXT devices[MAX_DEVICES];
     EGLint count = 0;
     if (!query_devices(MAX_DEVICES, devices, &count)) {
-        set_msg(reason, reason_size, "eglQueryDevicesEXT failed (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "eglQueryDevicesEXT failed (%s)", egl_error_name(eglGetError()));
         return -1;
     }
     int software = 0;
@@ -538,10 +530,10 @@ static int try_egl_device(lpv_gl_context *ctx, char *reason, size_t reason_size)
                    file ? file : "no DRM file", why);
     }
     if (tried[0])
-        set_msg(reason, reason_size, "no usable hardware EGL device (%d found, %d software skipped; %s)", (int)count,
+        lpv_error(reason, reason_size, "no usable hardware EGL device (%d found, %d software skipped; %s)", (int)count,
                 software, tried);
     else
-        set_msg(reason, reason_size, "no hardware EGL device (%d found, %d software skipped)", (int)count, software);
+        lpv_error(reason, reason_size, "no hardware EGL device (%d found, %d software skipped)", (int)count, software);
     return -1;
 }
 
@@ -549,17 +541,17 @@ static int try_egl_surfaceless(lpv_gl_context *ctx, char *reason, size_t reason_
 {
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!client) {
-        set_msg(reason, reason_size, "EGL client extensions unavailable (%s)", egl_error_name(eglGetError()));
+        lpv_error(reason, reason_size, "EGL client extensions unavailable (%s)", egl_error_name(eglGetError()));
         return -1;
     }
     if (!has_token(client, "EGL_MESA_platform_surfaceless")) {
-        set_msg(reason, reason_size, "EGL lacks EGL_MESA_platform_surfaceless");
+        lpv_error(reason, reason_size, "EGL lacks EGL_MESA_platform_surfaceless");
         return -1;
     }
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display =
         (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
     if (!get_platform_display) {
-        set_msg(reason, reason_size, "eglGetPlatformDisplayEXT unavailable");
+        lpv_error(reason, reason_size, "eglGetPlatformDisplayEXT unavailable");
         return -1;
     }
     EGLDisplay dpy = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
@@ -592,7 +584,7 @@ static int try_osmesa(lpv_gl_context *ctx, char *reason, size_t reason_size)
     ctx->osmesa_lib = dlopen(LPV_OSMESA_LIBRARY, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
     if (!ctx->osmesa_lib) {
         const char *e = dlerror();
-        set_msg(reason, reason_size, "dlopen(%s) failed: %s", LPV_OSMESA_LIBRARY, e ? e : "unknown error");
+        lpv_error(reason, reason_size, "dlopen(%s) failed: %s", LPV_OSMESA_LIBRARY, e ? e : "unknown error");
         return -1;
     }
     lpv_pfn_osmesa_create_attribs create = (lpv_pfn_osmesa_create_attribs)dlsym(ctx->osmesa_lib,
@@ -602,7 +594,7 @@ static int try_osmesa(lpv_gl_context *ctx, char *reason, size_t reason_size)
     ctx->osmesa_get_current = (lpv_pfn_osmesa_get_current)dlsym(ctx->osmesa_lib, "OSMesaGetCurrentContext");
     lpv_pfn_osmesa_get_proc get_proc = (lpv_pfn_osmesa_get_proc)dlsym(ctx->osmesa_lib, "OSMesaGetProcAddress");
     if (!create || !ctx->osmesa_make_current || !ctx->osmesa_destroy || !ctx->osmesa_get_current || !get_proc) {
-        set_msg(reason, reason_size, "%s lacks OSMesaCreateContextAttribs/MakeCurrent/DestroyContext/"
+        lpv_error(reason, reason_size, "%s lacks OSMesaCreateContextAttribs/MakeCurrent/DestroyContext/"
                 "GetCurrentContext/GetProcAddress", LPV_OSMESA_LIBRARY);
         goto fail;
     }
@@ -622,11 +614,11 @@ static int try_osmesa(lpv_gl_context *ctx, char *reason, size_t reason_size)
     };
     ctx->osmesa_ctx = create(attribs, NULL);
     if (!ctx->osmesa_ctx) {
-        set_msg(reason, reason_size, "OSMesaCreateContextAttribs(OpenGL 4.5 core) failed");
+        lpv_error(reason, reason_size, "OSMesaCreateContextAttribs(OpenGL 4.5 core) failed");
         goto fail;
     }
     if (!ctx->osmesa_make_current(ctx->osmesa_ctx, &ctx->osmesa_pixel, GL_UNSIGNED_BYTE, 1, 1)) {
-        set_msg(reason, reason_size, "OSMesaMakeCurrent failed");
+        lpv_error(reason, reason_size, "OSMesaMakeCurrent failed");
         goto fail;
     }
     if (finish_gl(ctx, reason, reason_size) != 0)
@@ -645,24 +637,24 @@ static int try_backend(lpv_gl_context *ctx, lpv_backend b, char *reason, size_t 
     case LPV_BACKEND_EGL_DEVICE: return try_egl_device(ctx, reason, reason_size);
     case LPV_BACKEND_EGL_SURFACELESS: return try_egl_surfaceless(ctx, reason, reason_size);
     case LPV_BACKEND_OSMESA: return try_osmesa(ctx, reason, reason_size);
-    default: set_msg(reason, reason_size, "not a backend"); return -1;
+    default: lpv_error(reason, reason_size, "not a backend"); return -1;
     }
 }
 
 lpv_gl_context *lpv_gl_context_create(const lpv_gl_context_desc *desc, char *err, size_t err_size)
 {
-    set_msg(err, err_size, "%s", "");
+    lpv_error(err, err_size, "%s", "");
     lpv_backend wanted = desc ? desc->backend : LPV_BACKEND_AUTO;
     const char *origin = "";
     if ((int)wanted < 0 || (int)wanted >= LPV_BACKEND_COUNT) {
-        set_msg(err, err_size, "invalid backend %d in lpv_gl_context_desc", (int)wanted);
+        lpv_error(err, err_size, "invalid backend %d in lpv_gl_context_desc", (int)wanted);
         return NULL;
     }
     if (wanted == LPV_BACKEND_AUTO) {
         const char *env = getenv("LPVD_GL_BACKEND");
         if (env && env[0]) {
             if (lpv_backend_parse(env, &wanted) != 0) {
-                set_msg(err, err_size,
+                lpv_error(err, err_size,
                         "LPVD_GL_BACKEND=\"%s\" is not a backend (auto, egl-device, egl-surfaceless, osmesa)", env);
                 return NULL;
             }
@@ -672,7 +664,7 @@ lpv_gl_context *lpv_gl_context_create(const lpv_gl_context_desc *desc, char *err
 
     lpv_gl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx) {
-        set_msg(err, err_size, "out of memory");
+        lpv_error(err, err_size, "out of memory");
         return NULL;
     }
     ctx->debug = desc ? desc->debug : 0;
@@ -683,7 +675,7 @@ lpv_gl_context *lpv_gl_context_create(const lpv_gl_context_desc *desc, char *err
     static const lpv_backend order[] = {LPV_BACKEND_EGL_DEVICE, LPV_BACKEND_EGL_SURFACELESS, LPV_BACKEND_OSMESA};
     int ok = 0;
     if (wanted == LPV_BACKEND_AUTO) {
-        set_msg(err, err_size, "no OpenGL 4.5 core context:");
+        lpv_error(err, err_size, "no OpenGL 4.5 core context:");
         for (size_t i = 0; i < sizeof order / sizeof order[0] && !ok; i++) {
             char why[768] = "";
             if (try_backend(ctx, order[i], why, sizeof why) == 0)
@@ -696,7 +688,7 @@ lpv_gl_context *lpv_gl_context_create(const lpv_gl_context_desc *desc, char *err
         if (try_backend(ctx, wanted, why, sizeof why) == 0)
             ok = 1;
         else
-            set_msg(err, err_size, "no OpenGL 4.5 core context: %s%s: %s", lpv_backend_name(wanted), origin, why);
+            lpv_error(err, err_size, "no OpenGL 4.5 core context: %s%s: %s", lpv_backend_name(wanted), origin, why);
     }
     if (!ok) {
         free(ctx);
@@ -706,7 +698,7 @@ lpv_gl_context *lpv_gl_context_create(const lpv_gl_context_desc *desc, char *err
         pthread_mutex_unlock(&g_lock);
         return NULL;
     }
-    set_msg(err, err_size, "%s", "");
+    lpv_error(err, err_size, "%s", "");
     t_current = ctx;
     pthread_mutex_lock(&g_lock);
     g_live_contexts++;

@@ -9,19 +9,9 @@
 #include <string.h>
 
 #include "emissive.h"
+#include "error.h"
 #include "engine_internal.h"
 #include "shader.h"
-
-int lpv_engine_fail(char *err, size_t err_size, const char *fmt, ...)
-{
-    if (err && err_size) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, err_size, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
 
 GLuint lpv_engine_program(const char *first, const char *geom, const char *frag, const char *const *includes,
                           char *err, size_t err_size)
@@ -33,14 +23,14 @@ GLuint lpv_engine_program(const char *first, const char *geom, const char *frag,
     for (const char *const *i = includes; i && *i; ++i) {
         const char *t = lpv_shader_text(*i);
         if (!t) {
-            lpv_engine_fail(err, err_size, "shader include %s is not embedded", *i);
+            lpv_error(err, err_size, "shader include %s is not embedded", *i);
             return 0;
         }
         len += strlen(t) + 64;
     }
     char *prelude = malloc(len);
     if (!prelude) {
-        lpv_engine_fail(err, err_size, "out of memory building %s", first);
+        lpv_error(err, err_size, "out of memory building %s", first);
         return 0;
     }
     strcpy(prelude, shared);
@@ -66,7 +56,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
 {
     lpv_engine *e = calloc(1, sizeof *e);
     if (!e) {
-        lpv_engine_fail(err, err_size, "out of memory");
+        lpv_error(err, err_size, "out of memory");
         return NULL;
     }
     struct {
@@ -252,7 +242,7 @@ static int place_grid(lpv_engine *e, char *err, size_t err_size)
     const float *bmax = given ? s->bounds_max : e->scene_max;
     lpv_grid g;
     if (lpv_grid_place(s->grid_dims, bmin, bmax, &g) != 0)
-        return lpv_engine_fail(err, err_size, "grid %dx%dx%d cannot be placed", s->grid_dims[0], s->grid_dims[1],
+        return lpv_error(err, err_size, "grid %dx%dx%d cannot be placed", s->grid_dims[0], s->grid_dims[1],
                                s->grid_dims[2]);
     int same_dims = e->grid_alloc_cells && memcmp(g.dims, e->grid.dims, sizeof g.dims) == 0;
     e->grid = g;
@@ -288,7 +278,7 @@ static int place_grid(lpv_engine *e, char *err, size_t err_size)
     e->tbo_transmit = buffer_view(e->transmit, GL_R32F);
     e->grid_alloc_cells = cells;
     if (glGetError() != GL_NO_ERROR)
-        return lpv_engine_fail(err, err_size, "could not allocate a %dx%dx%d grid", g.dims[0], g.dims[1], g.dims[2]);
+        return lpv_error(err, err_size, "could not allocate a %dx%dx%d grid", g.dims[0], g.dims[1], g.dims[2]);
     return 0;
 }
 
@@ -311,7 +301,7 @@ static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, siz
         return 0;
     e->textures = calloc(scene->texture_count, sizeof(GLuint));
     if (!e->textures)
-        return lpv_engine_fail(err, err_size, "out of memory for textures");
+        return lpv_error(err, err_size, "out of memory for textures");
     e->texture_count = scene->texture_count;
     glGenTextures((GLsizei)scene->texture_count, e->textures);
     for (uint32_t i = 0; i < scene->texture_count; ++i) {
@@ -341,11 +331,11 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
     e->materials = calloc(scene->material_count ? scene->material_count : 1, sizeof *e->materials);
     if (!e->draws || !e->materials)
-        return lpv_engine_fail(err, err_size, "out of memory for the scene");
+        return lpv_error(err, err_size, "out of memory for the scene");
     for (uint32_t i = 0; i < scene->draw_count; ++i) {
         const lpv_draw *d = &scene->draws[i];
         if ((uint64_t)d->first_index + d->index_count > scene->index_count)
-            return lpv_engine_fail(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
+            return lpv_error(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
         e->draws[e->draw_count++] = (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material};
     }
     for (uint32_t i = 0; i < scene->material_count; ++i) {
@@ -395,7 +385,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     free(vpls);
 
     if (glGetError() != GL_NO_ERROR)
-        return lpv_engine_fail(err, err_size, "%s: GL error while uploading the scene", scene->source);
+        return lpv_error(err, err_size, "%s: GL error while uploading the scene", scene->source);
     e->has_scene = 1;
     return place_grid(e, err, err_size);
 }
@@ -407,7 +397,7 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
         return 0;
     }
     if (view->width < 1 || view->height < 1 || view->width > 16384 || view->height > 16384)
-        return lpv_engine_fail(err, err_size, "image size %dx%d outside 1..16384", view->width, view->height);
+        return lpv_error(err, err_size, "image size %dx%d outside 1..16384", view->width, view->height);
     e->view = *view;
     e->has_view = 1;
     return 0;
@@ -467,7 +457,7 @@ static void record_stats(lpv_engine *e)
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
 {
     if (!e->has_scene)
-        return lpv_engine_fail(err, err_size, "no scene loaded");
+        return lpv_error(err, err_size, "no scene loaded");
     if (lpv_pass_rsm_prepare(e, err, err_size) != 0)
         return -1;
     lpv_pass_rsm_run(e);
@@ -479,7 +469,7 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
     lpv_pass_propagate_run(e);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR)
-        return lpv_engine_fail(err, err_size, "GL error 0x%04x during the tick", gl_err);
+        return lpv_error(err, err_size, "GL error 0x%04x during the tick", gl_err);
     e->ticked = 1;
     record_stats(e);
     return 0;
@@ -488,9 +478,9 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
 int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *err, size_t err_size)
 {
     if (!e->ticked)
-        return lpv_engine_fail(err, err_size, "render before a tick");
+        return lpv_error(err, err_size, "render before a tick");
     if (!e->has_view)
-        return lpv_engine_fail(err, err_size, "render needs a view (camera)");
+        return lpv_error(err, err_size, "render needs a view (camera)");
     lpv_pass_shade_run(e, terms);
     const int w = e->gbuf_w, h = e->gbuf_h;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame_fbo);
@@ -510,7 +500,7 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     }
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR)
-        return lpv_engine_fail(err, err_size, "GL error 0x%04x during rendering", gl_err);
+        return lpv_error(err, err_size, "GL error 0x%04x during rendering", gl_err);
     /* Append the shading stage to the tick's stats. */
     lpv_timer_collect(&e->timer);
     lpv_engine_stats *s = &e->stats;
@@ -529,17 +519,17 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
                           size_t err_size)
 {
     if (!e->ticked)
-        return lpv_engine_fail(err, err_size, "irradiance query before a tick");
+        return lpv_error(err, err_size, "irradiance query before a tick");
     if (n == 0)
         return 0;
     if (n > (size_t)1 << 26)
-        return lpv_engine_fail(err, err_size, "%zu query points, at most %zu per call", n, (size_t)1 << 26);
+        return lpv_error(err, err_size, "%zu query points, at most %zu per call", n, (size_t)1 << 26);
     float *in = malloc(n * 8 * sizeof(float));
     float *out = malloc(n * 4 * sizeof(float));
     if (!in || !out) {
         free(in);
         free(out);
-        return lpv_engine_fail(err, err_size, "out of memory for %zu query points", n);
+        return lpv_error(err, err_size, "out of memory for %zu query points", n);
     }
     for (size_t i = 0; i < n; ++i) {
         for (int k = 0; k < 3; ++k) {
@@ -574,7 +564,7 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
     free(out);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR)
-        return lpv_engine_fail(err, err_size, "GL error 0x%04x during the irradiance query", gl_err);
+        return lpv_error(err, err_size, "GL error 0x%04x during the irradiance query", gl_err);
     return 0;
 }
 

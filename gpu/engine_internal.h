@@ -6,6 +6,7 @@
 #define LPV_ENGINE_INTERNAL_H
 
 #include "engine.h"
+#include "error.h"
 #include "gl.h"
 #include "lpv_shared.h"
 #include "timer.h"
@@ -84,9 +85,6 @@ struct lpv_engine {
     lpv_timer timer;
     lpv_engine_stats stats;
 };
-
-/* Sets a message and returns -1 (for "return fail(...)"). */
-int lpv_engine_fail(char *err, size_t err_size, const char *fmt, ...);
 
 /* Builds a program whose sources get the named .glsl include files first
  * (after lpv_shared.h). includes is a NULL-terminated list. */

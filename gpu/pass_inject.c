@@ -20,7 +20,7 @@ int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err
     GLint max_size = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
     if (a->width > max_size || a->height > max_size)
-        return lpv_engine_fail(err, err_size, "grid needs a %dx%d injection atlas, GL allows %d", a->width, a->height,
+        return lpv_error(err, err_size, "grid needs a %dx%d injection atlas, GL allows %d", a->width, a->height,
                                max_size);
     glGenTextures(attachments, a->tex);
     glGenFramebuffers(1, &a->fbo);
@@ -38,7 +38,7 @@ int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (status != GL_FRAMEBUFFER_COMPLETE)
-        return lpv_engine_fail(err, err_size, "injection atlas framebuffer incomplete (0x%04x)", status);
+        return lpv_error(err, err_size, "injection atlas framebuffer incomplete (0x%04x)", status);
     return 0;
 }
 

@@ -59,7 +59,7 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
     if (glGetError() != GL_NO_ERROR)
-        return lpv_engine_fail(err, err_size, "could not allocate %d RSM faces of %d^2 texels", layers, size);
+        return lpv_error(err, err_size, "could not allocate %d RSM faces of %d^2 texels", layers, size);
     e->rsm_alloc_size = size;
     e->rsm_alloc_faces = layers;
     return 0;

@@ -14,6 +14,7 @@
  * with source 0.
  */
 #include "shader.h"
+#include "error.h"
 
 #include "shader_sources.h"
 
@@ -24,15 +25,6 @@
 
 #define LPV_SHARED_HEADER "lpv_shared.h"
 
-static void set_msg(char *buf, size_t size, const char *fmt, ...)
-{
-    if (!buf || !size)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, size, fmt, ap);
-    va_end(ap);
-}
 
 const char *lpv_shader_text(const char *name)
 {
@@ -87,12 +79,12 @@ static GLuint compile_stage(GLenum stage, const char *name, const char *defines,
 {
     const char *text = lpv_shader_text(name);
     if (!text) {
-        set_msg(err, err_size, "%s: no such embedded shader (files of shaders/ are embedded at build time)", name);
+        lpv_error(err, err_size, "%s: no such embedded shader (files of shaders/ are embedded at build time)", name);
         return 0;
     }
     const char *shared = lpv_shader_text(LPV_SHARED_HEADER);
     if (!shared) {
-        set_msg(err, err_size, "%s: %s is not embedded", name, LPV_SHARED_HEADER);
+        lpv_error(err, err_size, "%s: %s is not embedded", name, LPV_SHARED_HEADER);
         return 0;
     }
     /* LPV_STAGE_* lets an include shared by several stages keep
@@ -112,7 +104,7 @@ static GLuint compile_stage(GLenum stage, const char *name, const char *defines,
     };
     GLuint sh = glCreateShader(stage);
     if (!sh) {
-        set_msg(err, err_size, "%s: glCreateShader(%s) failed (%s)", name, stage_name(stage),
+        lpv_error(err, err_size, "%s: glCreateShader(%s) failed (%s)", name, stage_name(stage),
                 lpv_gl_error_name(glGetError()));
         return 0;
     }
@@ -122,7 +114,7 @@ static GLuint compile_stage(GLenum stage, const char *name, const char *defines,
     glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
     if (!ok) {
         char *log = info_log(sh, 0);
-        set_msg(err, err_size,
+        lpv_error(err, err_size,
                 "%s: %s shader compile failed (source 2 = %s, source 1 = " LPV_SHARED_HEADER
                 ", source 0 = prelude/defines):\n%s",
                 name, stage_name(stage), name, log ? log : "(no log)");
@@ -139,7 +131,7 @@ static GLuint link_program(const GLuint *shaders, int count, const char *label, 
 {
     GLuint prog = glCreateProgram();
     if (!prog) {
-        set_msg(err, err_size, "%s: glCreateProgram failed (%s)", label, lpv_gl_error_name(glGetError()));
+        lpv_error(err, err_size, "%s: glCreateProgram failed (%s)", label, lpv_gl_error_name(glGetError()));
         for (int i = 0; i < count; i++)
             if (shaders[i])
                 glDeleteShader(shaders[i]);
@@ -159,7 +151,7 @@ static GLuint link_program(const GLuint *shaders, int count, const char *label, 
     glGetProgramiv(prog, GL_LINK_STATUS, &ok);
     if (!ok) {
         char *log = info_log(prog, 1);
-        set_msg(err, err_size, "%s: link failed:\n%s", label, log ? log : "(no log)");
+        lpv_error(err, err_size, "%s: link failed:\n%s", label, log ? log : "(no log)");
         free(log);
         glDeleteProgram(prog);
         return 0;
@@ -170,7 +162,7 @@ static GLuint link_program(const GLuint *shaders, int count, const char *label, 
 GLuint lpv_program_compute(const char *comp, const char *defines, char *err, size_t err_size)
 {
     if (!comp) {
-        set_msg(err, err_size, "lpv_program_compute: no compute shader named");
+        lpv_error(err, err_size, "lpv_program_compute: no compute shader named");
         return 0;
     }
     GLuint cs = compile_stage(GL_COMPUTE_SHADER, comp, defines, err, err_size);
@@ -186,7 +178,7 @@ GLuint lpv_program_graphics(const char *vert, const char *geom, const char *frag
                             char *err, size_t err_size)
 {
     if (!vert) {
-        set_msg(err, err_size, "lpv_program_graphics: no vertex shader named");
+        lpv_error(err, err_size, "lpv_program_graphics: no vertex shader named");
         return 0;
     }
     /* geom may be NULL; frag may be NULL for depth-only passes. */

@@ -21,6 +21,7 @@
 #include "engine.h"
 #include "oracle.h"
 #include "scene.h"
+#include "test_util.h"
 
 typedef struct fixture {
     lpv_gl_context *ctx;
@@ -31,28 +32,16 @@ typedef struct fixture {
 static int setup(void **state)
 {
     fixture *f = calloc(1, sizeof *f);
-    char err[1024];
-    f->ctx = lpv_gl_context_create(&(lpv_gl_context_desc){0}, err, sizeof err);
-    if (!f->ctx) {
-        fprintf(stderr, "no GL context: %s\n", err);
-        return -1;
-    }
-    if (lpv_scene_builtin_cornell(&f->scene) != 0)
-        return -1;
-    f->engine = lpv_engine_create(err, sizeof err);
-    if (!f->engine) {
-        fprintf(stderr, "%s\n", err);
-        return -1;
-    }
     *state = f;
-    return 0;
+    if (lpvt_gl_open(&f->ctx, &f->engine) != 0)
+        return -1;
+    return lpv_scene_builtin_cornell(&f->scene);
 }
 
 static int teardown(void **state)
 {
     fixture *f = *state;
-    lpv_engine_destroy(f->engine);
-    lpv_gl_context_destroy(f->ctx);
+    lpvt_gl_close(f->ctx, f->engine);
     lpv_scene_free(&f->scene);
     free(f);
     return 0;

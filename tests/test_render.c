@@ -29,21 +29,13 @@ static lpv_engine *engine;
 static int setup(void **state)
 {
     (void)state;
-    char err[1024];
-    ctx = lpv_gl_context_create(&(lpv_gl_context_desc){0}, err, sizeof err);
-    if (!ctx) {
-        fprintf(stderr, "no GL context: %s\n", err);
-        return -1;
-    }
-    engine = lpv_engine_create(err, sizeof err);
-    return engine ? 0 : -1;
+    return lpvt_gl_open(&ctx, &engine);
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    lpv_engine_destroy(engine);
-    lpv_gl_context_destroy(ctx);
+    lpvt_gl_close(ctx, engine);
     return 0;
 }
 

@@ -1,6 +1,9 @@
 /* test_util.c - see test_util.h. */
 #include "test_util.h"
 
+#include "context.h"
+#include "engine.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,4 +52,27 @@ const char *lpvt_write_file(const char *dir, const char *name, const void *data,
     }
     fclose(f);
     return p;
+}
+
+int lpvt_gl_open(lpv_gl_context **ctx, lpv_engine **engine)
+{
+    char err[1024];
+    *engine = NULL;
+    *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){0}, err, sizeof err);
+    if (!*ctx) {
+        fprintf(stderr, "no GL context: %s\n", err);
+        return -1;
+    }
+    *engine = lpv_engine_create(err, sizeof err);
+    if (!*engine) {
+        fprintf(stderr, "no engine: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+void lpvt_gl_close(lpv_gl_context *ctx, lpv_engine *engine)
+{
+    lpv_engine_destroy(engine);
+    lpv_gl_context_destroy(ctx);
 }

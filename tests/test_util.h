@@ -19,4 +19,11 @@ const char *lpvt_tmpdir(void);
  * rotated over 8 slots. Aborts on failure. */
 const char *lpvt_write_file(const char *dir, const char *name, const void *data, size_t size);
 
+/* For GL tests: a context (auto backend) and an engine on it. Returns 0, or
+ * -1 after printing why (cmocka then fails the group set-up). */
+struct lpv_gl_context;
+struct lpv_engine;
+int lpvt_gl_open(struct lpv_gl_context **ctx, struct lpv_engine **engine);
+void lpvt_gl_close(struct lpv_gl_context *ctx, struct lpv_engine *engine);
+
 #endif
