@@ -1,0 +1,558 @@
+/*
+ * volume_codec.c - binary16, raw volume packing, XOR deltas, zstd and the
+ * volume header (SPEC section 5). See volume_codec.h.
+ */
+#include "volume_codec.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <zstd.h>
+
+static void set_err(char *err, size_t err_n, const char *fmt, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void set_err(char *err, size_t err_n, const char *fmt, ...)
+{
+    va_list ap;
+    if (!err || err_n == 0)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(err, err_n, fmt, ap);
+    va_end(ap);
+}
+
+/* ---- binary16 ------------------------------------------------------------- */
+
+static uint32_t f32_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    return u;
+}
+
+static float bits_f32(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+
+uint16_t lpvp_f32_to_f16(float f)
+{
+    uint32_t x = f32_bits(f);
+    uint16_t sign = (uint16_t)((x >> 16) & 0x8000u);
+    uint32_t a = x & 0x7FFFFFFFu;
+
+    if (a > 0x7F800000u) /* NaN -> +0 (R5.4: NaN is never sent) */
+        return 0;
+    if (a >= 0x477FE000u) /* >= 65504 (and Inf): clamp, never Inf (R5.4) */
+        return (uint16_t)(sign | 0x7BFFu);
+    if (a >= 0x38800000u) { /* normal half: 2^-14 <= |f| < 65504 */
+        uint32_t h = (a >> 13) - ((uint32_t)(127 - 15) << 10);
+        uint32_t rem = a & 0x1FFFu;
+        if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
+            h++; /* cannot pass 0x7BFF: a < 65504 */
+        return (uint16_t)(sign | h);
+    }
+    if (a <= 0x33000000u) /* <= 2^-25: half of the smallest subnormal ties to 0 */
+        return sign;
+    {
+        /* Subnormal half: value / 2^-24 = m * 2^(e - 126), shift 14..24. */
+        uint32_t e = a >> 23;
+        uint32_t m = (a & 0x7FFFFFu) | 0x800000u;
+        uint32_t shift = 126u - e;
+        uint32_t r = m >> shift;
+        uint32_t rem = m & ((1u << shift) - 1u);
+        uint32_t half = 1u << (shift - 1u);
+        if (rem > half || (rem == half && (r & 1u)))
+            r++; /* may become 0x400, the smallest normal: still correct */
+        return (uint16_t)(sign | r);
+    }
+}
+
+float lpvp_f16_to_f32(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h & 0x8000u) << 16;
+    uint32_t e = (h >> 10) & 0x1Fu;
+    uint32_t m = h & 0x3FFu;
+    if (e == 0) {
+        uint32_t e32 = 113;
+        if (m == 0)
+            return bits_f32(sign);
+        while (!(m & 0x400u)) {
+            m <<= 1;
+            e32--;
+        }
+        m &= 0x3FFu;
+        return bits_f32(sign | (e32 << 23) | (m << 13));
+    }
+    if (e == 31) {
+        if (m == 0)
+            return bits_f32(sign | 0x7F800000u);
+        return bits_f32(sign | 0x7FC00000u | (m << 13));
+    }
+    return bits_f32(sign | ((e + 112u) << 23) | (m << 13));
+}
+
+/* ---- Names ---------------------------------------------------------------- */
+
+const char *lpvp_volume_format_name(lpvp_volume_format fmt)
+{
+    return fmt == LPVP_FMT_FP32 ? "fp32" : "fp16";
+}
+
+int lpvp_volume_format_parse(const char *s, lpvp_volume_format *out)
+{
+    if (s && strcmp(s, "fp16") == 0) {
+        *out = LPVP_FMT_FP16;
+        return 0;
+    }
+    if (s && strcmp(s, "fp32") == 0) {
+        *out = LPVP_FMT_FP32;
+        return 0;
+    }
+    return -1;
+}
+
+const char *lpvp_compression_name(lpvp_compression c)
+{
+    return c == LPVP_COMP_ZSTD ? "zstd" : "none";
+}
+
+int lpvp_compression_parse(const char *s, lpvp_compression *out)
+{
+    if (s && strcmp(s, "none") == 0) {
+        *out = LPVP_COMP_NONE;
+        return 0;
+    }
+    if (s && strcmp(s, "zstd") == 0) {
+        *out = LPVP_COMP_ZSTD;
+        return 0;
+    }
+    return -1;
+}
+
+/* ---- Raw volumes ---------------------------------------------------------- */
+
+size_t lpvp_volume_value_size(lpvp_volume_format fmt)
+{
+    return fmt == LPVP_FMT_FP32 ? 4 : 2;
+}
+
+size_t lpvp_volume_raw_size(size_t cells, lpvp_volume_format fmt)
+{
+    size_t per = LPVP_VALUES_PER_CELL * lpvp_volume_value_size(fmt);
+    if (cells > ((size_t)-1) / per)
+        return 0;
+    return cells * per;
+}
+
+void lpvp_volume_pack(const float *cells12, size_t cells, lpvp_volume_format fmt, uint8_t *out)
+{
+    size_t n = cells * LPVP_VALUES_PER_CELL;
+    if (fmt == LPVP_FMT_FP16) {
+        for (size_t i = 0; i < n; i++) {
+            uint16_t h = lpvp_f32_to_f16(cells12[i]);
+            out[2 * i] = (uint8_t)h;
+            out[2 * i + 1] = (uint8_t)(h >> 8);
+        }
+    } else {
+        for (size_t i = 0; i < n; i++) {
+            uint32_t u = f32_bits(cells12[i]);
+            if ((u & 0x7FFFFFFFu) > 0x7F800000u)
+                u = 0; /* NaN is never sent */
+            out[4 * i] = (uint8_t)u;
+            out[4 * i + 1] = (uint8_t)(u >> 8);
+            out[4 * i + 2] = (uint8_t)(u >> 16);
+            out[4 * i + 3] = (uint8_t)(u >> 24);
+        }
+    }
+}
+
+void lpvp_volume_unpack(const uint8_t *raw, size_t cells, lpvp_volume_format fmt, float *out)
+{
+    size_t n = cells * LPVP_VALUES_PER_CELL;
+    if (fmt == LPVP_FMT_FP16) {
+        for (size_t i = 0; i < n; i++)
+            out[i] = lpvp_f16_to_f32((uint16_t)(raw[2 * i] | (raw[2 * i + 1] << 8)));
+    } else {
+        for (size_t i = 0; i < n; i++) {
+            uint32_t u = (uint32_t)raw[4 * i] | ((uint32_t)raw[4 * i + 1] << 8) |
+                         ((uint32_t)raw[4 * i + 2] << 16) | ((uint32_t)raw[4 * i + 3] << 24);
+            out[i] = bits_f32(u);
+        }
+    }
+}
+
+/* ---- XOR ------------------------------------------------------------------ */
+
+void lpvp_xor(uint8_t *dst, const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i = 0;
+    /* Word at a time through memcpy (alias- and alignment-safe). */
+    for (; i + 8 <= n; i += 8) {
+        uint64_t x, y;
+        memcpy(&x, a + i, 8);
+        memcpy(&y, b + i, 8);
+        x ^= y;
+        memcpy(dst + i, &x, 8);
+    }
+    for (; i < n; i++)
+        dst[i] = (uint8_t)(a[i] ^ b[i]);
+}
+
+/* ---- zstd ----------------------------------------------------------------- */
+
+size_t lpvp_zstd_bound(size_t n)
+{
+    return ZSTD_compressBound(n);
+}
+
+size_t lpvp_zstd_compress_into(void *dst, size_t cap, const void *src, size_t n, int level,
+                               char *err, size_t err_n)
+{
+    size_t r;
+    if (level == 0)
+        level = LPVP_ZSTD_DEFAULT_LEVEL;
+    /* ZSTD_compress records the content size in the frame header. */
+    r = ZSTD_compress(dst, cap, n ? src : "", n, level);
+    if (ZSTD_isError(r)) {
+        set_err(err, err_n, "zstd compression failed: %s", ZSTD_getErrorName(r));
+        return 0;
+    }
+    return r;
+}
+
+int lpvp_zstd_compress(const void *src, size_t n, int level, uint8_t **out, size_t *out_len,
+                       char *err, size_t err_n)
+{
+    size_t cap = ZSTD_compressBound(n);
+    uint8_t *buf;
+    size_t r;
+    if (ZSTD_isError(cap) || cap == 0) {
+        set_err(err, err_n, "zstd: %zu bytes is too large to compress", n);
+        return -1;
+    }
+    buf = malloc(cap);
+    if (!buf) {
+        set_err(err, err_n, "zstd: out of memory (%zu bytes)", cap);
+        return -1;
+    }
+    r = lpvp_zstd_compress_into(buf, cap, src, n, level, err, err_n);
+    if (r == 0) {
+        free(buf);
+        return -1;
+    }
+    *out = buf;
+    *out_len = r;
+    return 0;
+}
+
+/* Checks that src is exactly one zstd frame with a recorded content size
+ * <= max; returns that size or (unsigned long long)-1 with err set. */
+static unsigned long long frame_content_size(const void *src, size_t n, size_t max, char *err,
+                                             size_t err_n)
+{
+    unsigned long long cs;
+    size_t fsize;
+    if (!src || n == 0) {
+        set_err(err, err_n, "zstd: empty input");
+        return (unsigned long long)-1;
+    }
+    cs = ZSTD_getFrameContentSize(src, n);
+    if (cs == ZSTD_CONTENTSIZE_ERROR) {
+        set_err(err, err_n, "zstd: not a zstd frame");
+        return (unsigned long long)-1;
+    }
+    if (cs == ZSTD_CONTENTSIZE_UNKNOWN) {
+        set_err(err, err_n, "zstd: frame content size is not recorded");
+        return (unsigned long long)-1;
+    }
+    if (cs > max) {
+        set_err(err, err_n, "zstd: content size %llu exceeds the maximum %zu", cs, max);
+        return (unsigned long long)-1;
+    }
+    fsize = ZSTD_findFrameCompressedSize(src, n);
+    if (ZSTD_isError(fsize)) {
+        set_err(err, err_n, "zstd: %s", ZSTD_getErrorName(fsize));
+        return (unsigned long long)-1;
+    }
+    if (fsize != n) {
+        set_err(err, err_n, "zstd: %zu bytes after the frame", n - fsize);
+        return (unsigned long long)-1;
+    }
+    return cs;
+}
+
+static int decompress_to(void *dst, size_t size, const void *src, size_t n, char *err,
+                         size_t err_n)
+{
+    size_t r = ZSTD_decompress(dst, size, src, n);
+    if (ZSTD_isError(r)) {
+        set_err(err, err_n, "zstd: %s", ZSTD_getErrorName(r));
+        return -1;
+    }
+    if (r != size) {
+        set_err(err, err_n, "zstd: frame gave %zu bytes, its header says %zu", r, size);
+        return -1;
+    }
+    return 0;
+}
+
+int lpvp_zstd_decompress(const void *src, size_t n, size_t max_out, uint8_t **out,
+                         size_t *out_len, char *err, size_t err_n)
+{
+    unsigned long long cs = frame_content_size(src, n, max_out, err, err_n);
+    uint8_t *buf;
+    if (cs == (unsigned long long)-1)
+        return -1;
+    buf = malloc(cs ? (size_t)cs : 1);
+    if (!buf) {
+        set_err(err, err_n, "zstd: out of memory (%llu bytes)", cs);
+        return -1;
+    }
+    if (decompress_to(buf, (size_t)cs, src, n, err, err_n) != 0) {
+        free(buf);
+        return -1;
+    }
+    *out = buf;
+    *out_len = (size_t)cs;
+    return 0;
+}
+
+int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expect, char *err,
+                               size_t err_n)
+{
+    unsigned long long cs = frame_content_size(src, n, expect, err, err_n);
+    if (cs == (unsigned long long)-1)
+        return -1;
+    if (cs != expect) {
+        set_err(err, err_n, "zstd: content size %llu, expected %zu", cs, expect);
+        return -1;
+    }
+    return decompress_to(dst, expect, src, n, err, err_n);
+}
+
+/* ---- Volume header -------------------------------------------------------- */
+
+static json_t *vec_json(const double *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < n; i++) {
+        if (json_array_append_new(a, json_real(isfinite(v[i]) ? v[i] : 0.0)) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
+{
+    json_t *o = json_object();
+    json_t *grid = json_object();
+    json_t *dims = json_array();
+    int bad = !o || !grid || !dims;
+    for (int i = 0; !bad && i < 3; i++)
+        bad |= json_array_append_new(dims, json_integer(vi->dims[i])) != 0;
+    if (!bad) {
+        bad |= json_object_set_new(grid, "dims", dims) != 0;
+        dims = NULL;
+        bad |= json_object_set_new(grid, "origin", vec_json(vi->origin, 3)) != 0;
+        bad |= json_object_set_new(grid, "cell_size",
+                                   json_real(isfinite(vi->cell_size) ? vi->cell_size : 0.0)) != 0;
+    }
+    if (!bad) {
+        bad |= json_object_set_new(o, "revision", json_integer(vi->revision)) != 0;
+        bad |= json_object_set_new(o, "tick", json_integer(vi->tick)) != 0;
+        bad |= json_object_set_new(o, "format",
+                                   json_string(lpvp_volume_format_name(vi->format))) != 0;
+        bad |= json_object_set_new(o, "compression",
+                                   json_string(lpvp_compression_name(vi->compression))) != 0;
+        bad |= json_object_set_new(o, "keyframe", json_boolean(vi->keyframe)) != 0;
+        if (!vi->keyframe)
+            bad |= json_object_set_new(o, "base_tick", json_integer(vi->base_tick)) != 0;
+        bad |= json_object_set_new(o, "grid", grid) != 0;
+        grid = NULL;
+        bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
+        bad |= json_object_set_new(o, "layout", json_string(LPVP_VOLUME_LAYOUT)) != 0;
+        bad |= json_object_set_new(o, "sh", json_string(LPVP_VOLUME_SH)) != 0;
+        bad |= json_object_set_new(o, "raw_length", json_integer((json_int_t)vi->raw_length)) != 0;
+    }
+    json_decref(dims);
+    json_decref(grid);
+    if (bad) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* Local getters (volume_codec does not depend on proto.c's). */
+static int need_int(const json_t *o, const char *key, long long min, long long *out, char *err,
+                    size_t err_n)
+{
+    json_t *v = json_object_get(o, key);
+    if (!json_is_integer(v)) {
+        set_err(err, err_n, "%s: expected an integer", key);
+        return -1;
+    }
+    if (json_integer_value(v) < min) {
+        set_err(err, err_n, "%s: %lld is less than %lld", key, (long long)json_integer_value(v),
+                min);
+        return -1;
+    }
+    *out = (long long)json_integer_value(v);
+    return 0;
+}
+
+int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    long long x;
+    json_t *v, *grid, *a;
+    size_t cells = 1;
+    memset(vi, 0, sizeof *vi);
+    vi->base_tick = -1;
+    if (!json_is_object(obj)) {
+        set_err(err, err_n, "volume header: not an object");
+        return -1;
+    }
+    if (need_int(obj, "revision", 0, &x, err, err_n))
+        return -1;
+    vi->revision = x;
+    if (need_int(obj, "tick", 0, &x, err, err_n))
+        return -1;
+    vi->tick = x;
+    if (lpvp_volume_format_parse(json_string_value(json_object_get(obj, "format")),
+                                 &vi->format) != 0) {
+        set_err(err, err_n, "format: expected \"fp16\" or \"fp32\"");
+        return -1;
+    }
+    if (lpvp_compression_parse(json_string_value(json_object_get(obj, "compression")),
+                               &vi->compression) != 0) {
+        set_err(err, err_n, "compression: expected \"zstd\" or \"none\"");
+        return -1;
+    }
+    v = json_object_get(obj, "keyframe");
+    if (!json_is_boolean(v)) {
+        set_err(err, err_n, "keyframe: expected true or false");
+        return -1;
+    }
+    vi->keyframe = json_is_true(v);
+    if (!vi->keyframe) {
+        if (need_int(obj, "base_tick", 0, &x, err, err_n))
+            return -1;
+        vi->base_tick = x;
+    }
+    grid = json_object_get(obj, "grid");
+    if (!json_is_object(grid)) {
+        set_err(err, err_n, "grid: expected an object");
+        return -1;
+    }
+    a = json_object_get(grid, "dims");
+    if (!json_is_array(a) || json_array_size(a) != 3) {
+        set_err(err, err_n, "grid.dims: expected an array of 3 integers");
+        return -1;
+    }
+    for (size_t i = 0; i < 3; i++) {
+        json_t *d = json_array_get(a, i);
+        if (!json_is_integer(d) || json_integer_value(d) < 1 ||
+            json_integer_value(d) > (1 << 20)) {
+            set_err(err, err_n, "grid.dims[%zu]: expected an integer in [1, 1048576]", i);
+            return -1;
+        }
+        vi->dims[i] = json_integer_value(d);
+        if (cells > ((size_t)-1) / (size_t)vi->dims[i]) {
+            set_err(err, err_n, "grid.dims: too many cells");
+            return -1;
+        }
+        cells *= (size_t)vi->dims[i];
+    }
+    a = json_object_get(grid, "origin");
+    if (!json_is_array(a) || json_array_size(a) != 3) {
+        set_err(err, err_n, "grid.origin: expected an array of 3 numbers");
+        return -1;
+    }
+    for (size_t i = 0; i < 3; i++) {
+        json_t *d = json_array_get(a, i);
+        if (!json_is_number(d)) {
+            set_err(err, err_n, "grid.origin[%zu]: expected a number", i);
+            return -1;
+        }
+        vi->origin[i] = json_number_value(d);
+    }
+    v = json_object_get(grid, "cell_size");
+    if (!json_is_number(v) || !(json_number_value(v) > 0.0) || !isfinite(json_number_value(v))) {
+        set_err(err, err_n, "grid.cell_size: expected a positive number");
+        return -1;
+    }
+    vi->cell_size = json_number_value(v);
+    if (need_int(obj, "raw_length", 0, &x, err, err_n))
+        return -1;
+    vi->raw_length = (uint64_t)x;
+    {
+        size_t expect = lpvp_volume_raw_size(cells, vi->format);
+        if (expect == 0 || (uint64_t)expect != vi->raw_length) {
+            set_err(err, err_n, "raw_length: %llu, but %zu cells of %s need %zu bytes", x, cells,
+                    lpvp_volume_format_name(vi->format), expect);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int lpvp_volume_decode(const lpvp_volume_info *vi, const void *attachment, size_t att_len,
+                       const uint8_t *base_raw, size_t base_len, uint8_t *raw_out, char *err,
+                       size_t err_n)
+{
+    size_t raw_len = (size_t)vi->raw_length;
+    if ((uint64_t)raw_len != vi->raw_length) {
+        set_err(err, err_n, "raw_length %llu does not fit in memory",
+                (unsigned long long)vi->raw_length);
+        return -1;
+    }
+    if (!vi->keyframe && (!base_raw || base_len != raw_len)) {
+        set_err(err, err_n, "delta against tick %lld without a base volume of %zu bytes",
+                (long long)vi->base_tick, raw_len);
+        return -1;
+    }
+    if (vi->compression == LPVP_COMP_ZSTD) {
+        if (!vi->keyframe && raw_out == base_raw) {
+            /* In place: decompress aside, then XOR into the base. */
+            uint8_t *tmp = malloc(raw_len ? raw_len : 1);
+            if (!tmp) {
+                set_err(err, err_n, "out of memory (%zu bytes)", raw_len);
+                return -1;
+            }
+            if (lpvp_zstd_decompress_exact(attachment, att_len, tmp, raw_len, err, err_n) != 0) {
+                free(tmp);
+                return -1;
+            }
+            lpvp_xor(raw_out, tmp, base_raw, raw_len);
+            free(tmp);
+            return 0;
+        }
+        if (lpvp_zstd_decompress_exact(attachment, att_len, raw_out, raw_len, err, err_n) != 0)
+            return -1;
+    } else {
+        if (att_len != raw_len) {
+            set_err(err, err_n, "attachment of %zu bytes, raw_length is %zu", att_len, raw_len);
+            return -1;
+        }
+        if (vi->keyframe) {
+            if (raw_len)
+                memmove(raw_out, attachment, raw_len);
+            return 0;
+        }
+        lpvp_xor(raw_out, attachment, base_raw, raw_len);
+        return 0;
+    }
+    if (!vi->keyframe)
+        lpvp_xor(raw_out, raw_out, base_raw, raw_len);
+    return 0;
+}

@@ -1,0 +1,152 @@
+/*
+ * volume_codec.h - payload helpers for the lpvd protocol: binary16
+ * conversion, raw volume packing (SPEC R5.1), XOR deltas (R5.3), zstd
+ * (R5.2, R6.1), and the volume header JSON (SPEC section 5). No I/O.
+ * Part of the lpv_protocol library (see proto.h).
+ */
+#ifndef LPVP_VOLUME_CODEC_H
+#define LPVP_VOLUME_CODEC_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <jansson.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- binary16 (R5.4) ------------------------------------------------------ */
+
+#define LPVP_HALF_MAX 65504.0f
+
+/* fp32 -> IEEE binary16 bits, round to nearest, ties to even, by bit
+ * manipulation (no _Float16). Finite values beyond the largest half (and
+ * +-Inf) clamp to +-65504 (0x7BFF / 0xFBFF), never Inf; NaN gives +0.
+ * Subnormal halves are produced correctly (gradual underflow); values below
+ * half the smallest subnormal round to a signed zero. */
+uint16_t lpvp_f32_to_f16(float f);
+
+/* binary16 bits -> fp32, exact for every half (subnormals, +-0, +-Inf, NaN
+ * payloads kept as quiet NaN). */
+float lpvp_f16_to_f32(uint16_t h);
+
+/* ---- Raw volumes (R5.1) --------------------------------------------------- */
+
+#define LPVP_VALUES_PER_CELL 12  /* r0 r1 r2 r3 g0 g1 g2 g3 b0 b1 b2 b3 */
+
+/* The SPEC strings of the volume header (section 5). */
+#define LPVP_VOLUME_UNITS "W/sr"
+#define LPVP_VOLUME_LAYOUT "cell-major, x fastest; per cell r0 r1 r2 r3 g0 g1 g2 g3 b0 b1 b2 b3"
+#define LPVP_VOLUME_SH "Y00, Y1-1 (y), Y10 (z), Y11 (x), no Condon-Shortley phase"
+
+typedef enum lpvp_volume_format {
+    LPVP_FMT_FP16 = 0,  /* "fp16": 2 bytes per value */
+    LPVP_FMT_FP32 = 1   /* "fp32": 4 bytes per value */
+} lpvp_volume_format;
+
+typedef enum lpvp_compression {
+    LPVP_COMP_NONE = 0, /* "none" */
+    LPVP_COMP_ZSTD = 1  /* "zstd" (R5.2) */
+} lpvp_compression;
+
+/* "fp16"/"fp32", "none"/"zstd"; parse returns 0 on success, -1 if unknown. */
+const char *lpvp_volume_format_name(lpvp_volume_format fmt);
+int lpvp_volume_format_parse(const char *s, lpvp_volume_format *out);
+const char *lpvp_compression_name(lpvp_compression c);
+int lpvp_compression_parse(const char *s, lpvp_compression *out);
+
+/* Bytes of one value (2 or 4). */
+size_t lpvp_volume_value_size(lpvp_volume_format fmt);
+
+/* cells x 12 x value size: the raw_length; 0 on size_t overflow. */
+size_t lpvp_volume_raw_size(size_t cells, lpvp_volume_format fmt);
+
+/* cells12: cells x 12 floats, in the engine's LpvCell memory order (r then g
+ * then b, each c0 y z x) which is the wire order (R5.1). out receives
+ * lpvp_volume_raw_size(cells, fmt) bytes, little-endian. fp16 converts with
+ * lpvp_f32_to_f16 (R5.4: clamped, NaN -> 0). fp32 sends NaN as 0 too and
+ * keeps every other value bit for bit (including +-Inf). */
+void lpvp_volume_pack(const float *cells12, size_t cells, lpvp_volume_format fmt, uint8_t *out);
+
+/* The inverse: raw (lpvp_volume_raw_size bytes) -> cells x 12 floats. */
+void lpvp_volume_unpack(const uint8_t *raw, size_t cells, lpvp_volume_format fmt, float *out);
+
+/* ---- XOR delta (R5.3) ----------------------------------------------------- */
+
+/* dst[i] = a[i] ^ b[i] for i < n. dst may be a or b (in place). The delta of
+ * volume V against base B is V ^ B; the client rebuilds V = delta ^ B. */
+void lpvp_xor(uint8_t *dst, const uint8_t *a, const uint8_t *b, size_t n);
+
+/* ---- zstd (R5.2, R6.1) ---------------------------------------------------- */
+
+#define LPVP_ZSTD_DEFAULT_LEVEL 1  /* latency over ratio */
+
+/* Worst-case compressed size of n bytes. */
+size_t lpvp_zstd_bound(size_t n);
+
+/* One zstd frame (content size recorded in the frame header, which
+ * lpvp_zstd_decompress requires) of src[0..n) at `level` (zstd's range; 0
+ * means LPVP_ZSTD_DEFAULT_LEVEL). Into a malloc'd buffer: returns 0 and
+ * sets *out / *out_len, or -1 (out of memory, zstd error) with err set. */
+int lpvp_zstd_compress(const void *src, size_t n, int level, uint8_t **out, size_t *out_len,
+                       char *err, size_t err_n);
+
+/* Same into dst[0..cap) (cap >= lpvp_zstd_bound(n) always suffices). Returns
+ * the compressed size, or 0 on error with err set. */
+size_t lpvp_zstd_compress_into(void *dst, size_t cap, const void *src, size_t n, int level,
+                               char *err, size_t err_n);
+
+/* Decompresses exactly one zstd frame occupying all of src[0..n). Refuses
+ * (returns -1 with err set, *out untouched): a frame whose content size is
+ * not recorded or exceeds max_out, garbage, a truncated frame, trailing
+ * bytes, a content size that does not match the data. On success returns 0
+ * with a malloc'd *out of *out_len bytes (never more than max_out; a
+ * 0-length result is a valid 1-byte allocation). */
+int lpvp_zstd_decompress(const void *src, size_t n, size_t max_out, uint8_t **out,
+                         size_t *out_len, char *err, size_t err_n);
+
+/* Same into dst, requiring the content size to be exactly `expect` bytes
+ * (e.g. the header's raw_length); returns 0 or -1 with err set. */
+int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expect, char *err,
+                               size_t err_n);
+
+/* ---- Volume header JSON (SPEC section 5) ---------------------------------- */
+
+typedef struct lpvp_volume_info {
+    int64_t revision;            /* R3.3 */
+    int64_t tick;
+    lpvp_volume_format format;
+    lpvp_compression compression;
+    int keyframe;                /* 1: raw is the volume; 0: XOR delta vs base_tick (R5.3) */
+    int64_t base_tick;           /* meaningful when keyframe == 0; -1 when absent */
+    int64_t dims[3];             /* cells per axis, each >= 1 */
+    double origin[3];            /* m, lower corner */
+    double cell_size;            /* m, > 0 */
+    uint64_t raw_length;         /* bytes of the raw volume = cells x 12 x value size */
+} lpvp_volume_info;
+
+/* Builds the header object (new reference; NULL if memory runs out) with
+ * every field of section 5 (base_tick only for deltas) plus the fixed
+ * "units", "layout" and "sh" strings. */
+json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
+
+/* Reads a header (client side). Checks types and ranges, that dims are
+ * >= 1 with a product that fits, and that raw_length == cells x 12 x value
+ * size. Returns 0, or -1 with "<field>: <what>" in err. */
+int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n);
+
+/* Client-side decoding of a VOLUME / GET_VOLUME attachment into the raw
+ * volume raw_out (vi->raw_length bytes): zstd-decompresses if
+ * vi->compression says so (exactly raw_length bytes, R5.2), then for a delta
+ * (keyframe 0) XORs with base_raw (the raw bytes of tick vi->base_tick, same
+ * length; R5.3). raw_out may equal base_raw (in-place update). Returns 0 or
+ * -1 with err set (sizes disagree, zstd refused, delta without base). */
+int lpvp_volume_decode(const lpvp_volume_info *vi, const void *attachment, size_t att_len,
+                       const uint8_t *base_raw, size_t base_len, uint8_t *raw_out, char *err,
+                       size_t err_n);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LPVP_VOLUME_CODEC_H */
