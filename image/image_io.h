@@ -26,6 +26,14 @@ int lpv_image_write_f32(const char *path, int width, int height, int channels, c
 int lpv_image_read_f32(const char *path, int channels, int *width, int *height, float **pixels,
                        char *err, size_t err_size);
 
+/* In-memory encoding (for the daemon's FRAME messages): ext is "png" (8-bit
+ * data) or "exr" (float data, written as 32-bit float). *out is malloc'd
+ * (*out_len bytes); free() it. Returns 0, or -1 with a message in err. */
+int lpv_image_encode_u8(const char *ext, int width, int height, int channels, const uint8_t *pixels,
+                        uint8_t **out, size_t *out_len, char *err, size_t err_size);
+int lpv_image_encode_f32(const char *ext, int width, int height, int channels, const float *pixels,
+                         uint8_t **out, size_t *out_len, char *err, size_t err_size);
+
 /* 1 if the path's extension is one lpv writes as float (".exr"), else 0. */
 int lpv_image_is_float_format(const char *path);
 

@@ -20,6 +20,7 @@
 //     carries OpenImageIO's message.
 #include "image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cctype>
@@ -239,4 +240,84 @@ extern "C" int lpv_image_is_float_format(const char *path)
     for (char &c : ext)
         c = (char)std::tolower((unsigned char)c);
     return ext == "exr" ? 1 : 0;
+}
+
+// ---- in-memory encoding (the daemon's FRAME payloads) ----------------------
+namespace {
+
+int encode_image(const char *ext, int width, int height, int channels, TypeDesc src_type, const void *pixels,
+                 uint8_t **out, size_t *out_len, char *err, size_t err_size)
+{
+    std::string name = std::string("frame.") + (ext ? ext : "");
+    if (!out || !out_len) {
+        set_err(err, err_size, name + ": no output buffer");
+        return -1;
+    }
+    *out = nullptr;
+    *out_len = 0;
+    if (!check_size(name.c_str(), width, height, channels, pixels, err, err_size))
+        return -1;
+    try {
+        OIIO::Filesystem::IOVecOutput vec;
+        auto img = ImageOutput::create(name, &vec);
+        if (!img || !img->supports("ioproxy")) {
+            set_err(err, err_size, name + ": no in-memory image writer for this type: " + one_line(OIIO::geterror()));
+            return -1;
+        }
+        const bool is_float = lpv_image_is_float_format(name.c_str()) != 0;
+        ImageSpec spec(width, height, channels, is_float ? TypeDesc::FLOAT : TypeDesc::UINT8);
+        spec.attribute("oiio:ColorSpace", is_float ? "Linear" : "sRGB");
+        if (!is_float)
+            spec.attribute("oiio:UnassociatedAlpha", 1);
+        if (channels == 2)
+            spec.alpha_channel = 1;
+        else if (channels == 4)
+            spec.alpha_channel = 3;
+        OIIO::Filesystem::IOProxy *proxy = &vec;
+        spec.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
+        if (!img->open(name, spec)) {
+            set_err(err, err_size, name + ": cannot encode: " + one_line(img->geterror()));
+            return -1;
+        }
+        if (!img->write_image(src_type, pixels)) {
+            std::string e = one_line(img->geterror());
+            img->close();
+            set_err(err, err_size, name + ": encoding failed: " + e);
+            return -1;
+        }
+        if (!img->close()) {
+            set_err(err, err_size, name + ": encoding failed: " + one_line(img->geterror()));
+            return -1;
+        }
+        const std::vector<unsigned char> &buf = vec.buffer();
+        uint8_t *p = static_cast<uint8_t *>(std::malloc(buf.size() ? buf.size() : 1));
+        if (!p) {
+            set_err(err, err_size, name + ": out of memory");
+            return -1;
+        }
+        if (!buf.empty())
+            std::memcpy(p, buf.data(), buf.size());
+        *out = p;
+        *out_len = buf.size();
+        return 0;
+    } catch (const std::exception &e) {
+        set_err(err, err_size, name + ": " + e.what());
+    } catch (...) {
+        set_err(err, err_size, name + ": unknown error while encoding");
+    }
+    return -1;
+}
+
+} // namespace
+
+extern "C" int lpv_image_encode_u8(const char *ext, int width, int height, int channels, const uint8_t *pixels,
+                                   uint8_t **out, size_t *out_len, char *err, size_t err_size)
+{
+    return encode_image(ext, width, height, channels, TypeDesc::UINT8, pixels, out, out_len, err, err_size);
+}
+
+extern "C" int lpv_image_encode_f32(const char *ext, int width, int height, int channels, const float *pixels,
+                                    uint8_t **out, size_t *out_len, char *err, size_t err_size)
+{
+    return encode_image(ext, width, height, channels, TypeDesc::FLOAT, pixels, out, out_len, err, err_size);
 }

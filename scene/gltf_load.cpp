@@ -148,6 +148,8 @@ struct Ctx {
     const tinygltf::Model *model = nullptr;
     uint64_t texels = 0;
     std::vector<std::string> warnings;
+    const lpv_gltf_node_override *overrides = nullptr; /* lpv_gltf_load_memory_ex */
+    size_t override_count = 0;
 
     void warn(const std::string &w)
     {
@@ -1524,6 +1526,31 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     if (!twarn.empty())
         ctx.warn("tinygltf: " + one_line(twarn));
 
+    for (size_t i = 0; i < ctx.override_count; ++i) {
+        const lpv_gltf_node_override &o = ctx.overrides[i];
+        if (o.node < 0 || size_t(o.node) >= model.nodes.size())
+            fail("node override %zu: node %d does not exist (the file has %zu nodes)", i, o.node,
+                 model.nodes.size());
+        tinygltf::Node &n = model.nodes[size_t(o.node)];
+        if (o.has_matrix) {
+            n.matrix.assign(o.matrix, o.matrix + 16);
+            n.translation.clear();
+            n.rotation.clear();
+            n.scale.clear();
+            continue;
+        }
+        if ((o.has_translation || o.has_rotation || o.has_scale) && !n.matrix.empty()) {
+            /* a node given as a matrix gets identity TRS parts it did not override */
+            n.matrix.clear();
+        }
+        if (o.has_translation)
+            n.translation.assign(o.translation, o.translation + 3);
+        if (o.has_rotation)
+            n.rotation.assign(o.rotation, o.rotation + 4);
+        if (o.has_scale)
+            n.scale.assign(o.scale, o.scale + 3);
+    }
+
     Builder b(model, ctx);
     b.build();
 
@@ -1661,6 +1688,13 @@ extern "C" int lpv_gltf_load_file(const char *path, lpv_scene *out, char *err, s
 extern "C" int lpv_gltf_load_memory(const void *data, size_t size, const char *base_dir, const char *label,
                                     lpv_scene *out, char *err, size_t err_size)
 {
+    return lpv_gltf_load_memory_ex(data, size, base_dir, label, nullptr, 0, out, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_memory_ex(const void *data, size_t size, const char *base_dir, const char *label,
+                                       const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out,
+                                       char *err, size_t err_size)
+{
     const char *name = label && label[0] ? label : "<memory>";
     if (err && err_size)
         err[0] = '\0';
@@ -1678,6 +1712,8 @@ extern "C" int lpv_gltf_load_memory(const void *data, size_t size, const char *b
     try {
         Ctx ctx;
         ctx.label = name;
+        ctx.overrides = nodes;
+        ctx.override_count = nodes ? node_count : 0;
         if (base_dir) {
             char *real = realpath(base_dir, nullptr);
             if (!real) {

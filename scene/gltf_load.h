@@ -35,6 +35,26 @@ int lpv_gltf_load_file(const char *path, lpv_scene *out, char *err, size_t err_s
 int lpv_gltf_load_memory(const void *data, size_t size, const char *base_dir, const char *label,
                          lpv_scene *out, char *err, size_t err_size);
 
+/* A node transform that replaces the file's (for the daemon's SCENE_UPDATE):
+ * either a column-major matrix, or any of translation / rotation (unit
+ * quaternion x y z w) / scale replacing those of the node's TRS. */
+typedef struct lpv_gltf_node_override {
+    int node;
+    int has_matrix, has_translation, has_rotation, has_scale;
+    float matrix[16];
+    float translation[3];
+    float rotation[4];
+    float scale[3];
+} lpv_gltf_node_override;
+
+/* lpv_gltf_load_memory with node transforms replaced before the scene is
+ * flattened; applied in order (a later override of the same node wins for
+ * the parts it gives). A node index out of range is refused like any other
+ * defect. */
+int lpv_gltf_load_memory_ex(const void *data, size_t size, const char *base_dir, const char *label,
+                            const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out, char *err,
+                            size_t err_size);
+
 #ifdef __cplusplus
 }
 #endif

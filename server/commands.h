@@ -4,5 +4,6 @@
 #define LPVD_COMMANDS_H
 
 int lpvd_cmd_render(int argc, char **argv);
+int lpvd_cmd_serve(int argc, char **argv); /* the daemon, serve.c */
 
 #endif

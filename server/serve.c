@@ -1,0 +1,536 @@
+/*
+ * serve.c - `lpvd serve`: the daemon's command line, start-up, signals and
+ * shutdown. The protocol is protocol/SPEC.md; the design is docs/server.md.
+ */
+#include "serve.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "options.h"
+#include "scene_load.h"
+
+uint64_t sv_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u;
+}
+
+uint64_t sv_hash_bytes(uint64_t h, const void *data, size_t n)
+{
+    const uint8_t *p = data;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lpvd serve [flags]\n"
+            "Runs the lpvd daemon: clients speak the wire protocol (protocol/SPEC.md) over a Unix socket\n"
+            "(default) or TCP, load scenes, set lights, cameras and settings, tick, and stream volumes\n"
+            "and frames. See docs/server.md.\n"
+            "Listening:\n"
+            "  --socket PATH           Unix socket (mode 0600; default $XDG_RUNTIME_DIR/lpvd.sock,\n"
+            "                          else /tmp/lpvd-$UID.sock); a stale socket file is replaced\n"
+            "  --listen HOST:PORT      also (or only, without --socket) listen on TCP; default host\n"
+            "                          127.0.0.1; a non-loopback host requires --token-file\n"
+            "  --token-file FILE       every client must present this token in HELLO\n"
+            "Scenes:\n"
+            "  --scene-root DIR        SCENE_LOAD paths resolve under DIR (none: paths are refused)\n"
+            "  --scene FILE.glb        the scene every session starts with (default: built-in Cornell box)\n"
+            "Limits:\n"
+            "  --max-clients N         connections at once (default 64)\n"
+            "  --max-message BYTES     json + attachment of one message (default 268435456)\n"
+            "  --max-body BYTES        json of one message (default 1048576)\n"
+            "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
+            "  --max-triangles N       per scene (default 10000000)\n"
+            "  --max-texture N         texels per texture side, and the largest rsm_size (default 8192)\n"
+            "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
+            "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
+            "  --idle-timeout S        a silent session is sent BYE and closed (default 300)\n"
+            "Default CONFIG of every session:\n"
+            "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
+            "%s",
+            LPVD_OPTIONS_HELP);
+}
+
+static int parse_u64(const char *v, uint64_t lo, uint64_t hi, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long x = strtoull(v, &end, 10);
+    if (!v[0] || v[0] == '-' || end == v || *end || errno || x < lo || x > hi)
+        return -1;
+    *out = x;
+    return 0;
+}
+
+static int parse_num(const char *v, double lo, double hi, double *out)
+{
+    char *end;
+    double x = strtod(v, &end);
+    if (end == v || *end || !(x >= lo && x <= hi))
+        return -1;
+    *out = x;
+    return 0;
+}
+
+static int read_token(const char *path, sv_config *cfg, char *err, size_t n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, n, "--token-file %s: %s", path, strerror(errno));
+        return -1;
+    }
+    size_t got = fread(cfg->token, 1, sizeof cfg->token - 1, f);
+    int more = fgetc(f) != EOF;
+    fclose(f);
+    if (more) {
+        snprintf(err, n, "--token-file %s: longer than %zu bytes", path, sizeof cfg->token - 1);
+        return -1;
+    }
+    cfg->token[got] = '\0';
+    if (strlen(cfg->token) != got) {
+        snprintf(err, n, "--token-file %s: contains a NUL byte", path);
+        return -1;
+    }
+    while (got && (cfg->token[got - 1] == '\n' || cfg->token[got - 1] == '\r' || cfg->token[got - 1] == ' ' ||
+                   cfg->token[got - 1] == '\t'))
+        cfg->token[--got] = '\0';
+    if (!got) {
+        snprintf(err, n, "--token-file %s: empty token", path);
+        return -1;
+    }
+    cfg->has_token = 1;
+    return 0;
+}
+
+/* Loads the default scene: --scene, or the built-in Cornell box. */
+static int load_default_scene(sv_server *s, char *err, size_t n)
+{
+    sv_scene *sc = calloc(1, sizeof *sc);
+    if (!sc) {
+        snprintf(err, n, "out of memory");
+        return -1;
+    }
+    if (!s->cfg.scene_file) {
+        if (lpv_scene_load(NULL, &sc->scene, err, n) != 0) {
+            free(sc);
+            return -1;
+        }
+        sc->hash = 0;
+    } else {
+        const char *path = s->cfg.scene_file;
+        char *real = realpath(path, NULL);
+        FILE *f = real ? fopen(real, "rb") : NULL;
+        if (!f) {
+            snprintf(err, n, "--scene %s: %s", path, strerror(errno));
+            free(real);
+            free(sc);
+            return -1;
+        }
+        size_t cap = 1 << 16, len = 0;
+        uint8_t *buf = malloc(cap);
+        for (;;) {
+            if (!buf)
+                break;
+            if (len == cap) {
+                uint8_t *nb = realloc(buf, cap * 2);
+                if (!nb) {
+                    free(buf);
+                    buf = NULL;
+                    break;
+                }
+                buf = nb;
+                cap *= 2;
+            }
+            size_t r = fread(buf + len, 1, cap - len, f);
+            if (r == 0)
+                break;
+            len += r;
+        }
+        fclose(f);
+        char *slash = real ? strrchr(real, '/') : NULL;
+        char *dir = NULL;
+        if (slash) {
+            dir = strndup(real, (size_t)(slash - real) + (slash == real));
+        }
+        if (!buf || !dir ||
+            lpv_gltf_load_memory_ex(buf, len, dir, path, NULL, 0, &sc->scene, err, n) != 0 ||
+            lpv_scene_ensure_light(&sc->scene) != 0) {
+            if (!buf || !dir)
+                snprintf(err, n, "--scene %s: out of memory", path);
+            lpv_scene_free(&sc->scene);
+            free(buf);
+            free(dir);
+            free(real);
+            free(sc);
+            return -1;
+        }
+        free(real);
+        sc->glb = buf;
+        sc->glb_size = len;
+        int external = 0; /* any "uri": the folder matters (as in serve_session.c) */
+        for (size_t i = 0; i + 5 <= len && !external; ++i)
+            external = buf[i] == '"' && memcmp(buf + i, "\"uri\"", 5) == 0;
+        if (!external) {
+            free(dir);
+            dir = NULL;
+        }
+        sc->base_dir = dir;
+        sc->hash = sv_hash_bytes(SV_HASH_INIT, buf, len);
+        if (dir)
+            sc->hash = sv_hash_bytes(sc->hash, dir, strlen(dir));
+        if (!sc->hash)
+            sc->hash = 1;
+        uint64_t tris = sc->scene.index_count / 3;
+        if (tris > s->cfg.max_triangles) {
+            snprintf(err, n, "--scene %s: %llu triangles, over --max-triangles %llu", path, (unsigned long long)tris,
+                     (unsigned long long)s->cfg.max_triangles);
+            lpv_scene_free(&sc->scene);
+            free(sc->glb);
+            free(sc->base_dir);
+            free(sc);
+            return -1;
+        }
+    }
+    sc->refs = 1;
+    sc->next = s->scenes;
+    s->scenes = sc;
+    s->builtin = sc;
+    return 0;
+}
+
+/* ---- timers, signals, shutdown ------------------------------------------- */
+static void idle_cb(uv_timer_t *t)
+{
+    sv_server *s = t->data;
+    uint64_t now = sv_now_ms();
+    uint64_t limit = (uint64_t)(s->cfg.idle_timeout * 1000.0);
+    for (sv_conn *c = s->conns; c; c = c->next) {
+        if (c->closing)
+            continue;
+        if (c->close_after_write) {
+            if (now > c->close_deadline_ms) /* it never read what we wrote */
+                sv_conn_close(c);
+            continue;
+        }
+        if (limit && now - c->last_rx_ms > limit && !c->busy) {
+            fprintf(stderr, "lpvd serve: client %llu (%s) idle for %g s: BYE\n", (unsigned long long)c->id, c->peer,
+                    s->cfg.idle_timeout);
+            sv_send(c, LPVP_BYE_REPLY, 0, json_object(), NULL, 0, SV_STREAM_NONE);
+            sv_conn_close_after_write(c);
+        }
+    }
+}
+
+static void close_all_cb(uv_timer_t *t)
+{
+    sv_server *s = t->data;
+    for (sv_conn *c = s->conns; c; c = c->next)
+        sv_conn_close(c);
+    uv_close((uv_handle_t *)t, NULL);
+}
+
+static void begin_shutdown(sv_server *s, int signum)
+{
+    if (s->stopping)
+        return;
+    s->stopping = 1;
+    fprintf(stderr, "lpvd serve: %s: finishing the tick in flight, saying BYE to %d client(s)\n",
+            signum == SIGINT ? "SIGINT" : "SIGTERM", s->conn_count);
+    sv_net_stop_listening(s);
+    uv_timer_stop(&s->idle_timer);
+    uv_close((uv_handle_t *)&s->idle_timer, NULL);
+    uv_close((uv_handle_t *)&s->sigterm, NULL);
+    uv_close((uv_handle_t *)&s->sigint, NULL);
+    for (sv_world *w = s->worlds; w; w = w->next)
+        if (w->timer_init)
+            uv_timer_stop(&w->timer);
+    /* every session leaves its world: destroy jobs go to the GL thread */
+    for (sv_conn *c = s->conns; c; c = c->next)
+        sv_world_detach(c);
+    sv_gl_stop(s); /* finishes the tick in flight and delivers its reply */
+    for (sv_conn *c = s->conns; c; c = c->next) {
+        if (c->closing)
+            continue;
+        sv_send(c, LPVP_BYE_REPLY, 0, json_object(), NULL, 0, SV_STREAM_NONE);
+        sv_conn_close_after_write(c);
+    }
+    uv_close((uv_handle_t *)&s->done_async, NULL);
+    /* clients that do not read get 2 s, then are closed */
+    if (uv_timer_init(s->loop, &s->stop_timer) == 0) {
+        s->stop_timer.data = s;
+        uv_timer_start(&s->stop_timer, close_all_cb, 2000, 0);
+        uv_unref((uv_handle_t *)&s->stop_timer);
+    }
+}
+
+static void signal_cb(uv_signal_t *h, int signum)
+{
+    begin_shutdown(h->data, signum);
+}
+
+static void default_socket_path(char *out, size_t n)
+{
+    const char *xdg = getenv("XDG_RUNTIME_DIR");
+    struct stat st;
+    if (xdg && xdg[0] == '/' && stat(xdg, &st) == 0 && S_ISDIR(st.st_mode))
+        snprintf(out, n, "%s/lpvd.sock", xdg);
+    else
+        snprintf(out, n, "/tmp/lpvd-%u.sock", (unsigned)getuid());
+}
+
+static void close_walk(uv_handle_t *h, void *arg)
+{
+    (void)arg;
+    if (!uv_is_closing(h))
+        uv_close(h, NULL);
+}
+
+static const char *const SERVE_VALUE_FLAGS[] = {
+    "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
+    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", NULL};
+
+int lpvd_cmd_serve(int argc, char **argv)
+{
+    static sv_server srv; /* one per process; its address is stable for the handles */
+    sv_server *s = &srv;
+    memset(s, 0, sizeof *s);
+    sv_config *cfg = &s->cfg;
+    cfg->max_body = LPVP_DEFAULT_MAX_BODY;
+    cfg->max_message = LPVP_DEFAULT_MAX_MESSAGE;
+    cfg->max_queue = 64u << 20;
+    cfg->max_clients = 64;
+    cfg->max_triangles = 10000000;
+    cfg->max_texture = 8192;
+    cfg->max_grid = 128;
+    cfg->max_tick_rate = 60.0;
+    cfg->idle_timeout = 300.0;
+    lpvd_options opt;
+    memset(&opt, 0, sizeof opt);
+    char err[2048] = "";
+    int have_socket = 0;
+    const char *token_file = NULL;
+
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage(stdout);
+            return 0;
+        }
+        if (a[0] != '-' || a[1] != '-') {
+            fprintf(stderr, "lpvd serve: unexpected argument %s (see lpvd serve --help)\n", a);
+            return 2;
+        }
+        const char *name = a + 2;
+        int known = 0;
+        for (int k = 0; SERVE_VALUE_FLAGS[k]; ++k)
+            if (strcmp(name, SERVE_VALUE_FLAGS[k]) == 0)
+                known = 1;
+        if (!known && lpvd_option_takes_value(name) < 0) {
+            fprintf(stderr, "lpvd serve: unknown flag %s (see lpvd serve --help)\n", a);
+            return 2;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "lpvd serve: %s needs a value\n", a);
+            return 2;
+        }
+        const char *v = argv[++i];
+        uint64_t u = 0;
+        double d = 0.0;
+        int bad = 0;
+        if (!known) {
+            if (!strcmp(name, "camera") || !strcmp(name, "eye") || !strcmp(name, "target") || !strcmp(name, "fov") ||
+                !strcmp(name, "size")) {
+                fprintf(stderr, "lpvd serve: %s is not used by the daemon (clients send CAMERA_SET)\n", a);
+                return 2;
+            }
+            if (lpvd_option_parse(&opt, name, v, err, sizeof err) < 0) {
+                fprintf(stderr, "lpvd serve: %s\n", err);
+                return 2;
+            }
+        } else if (!strcmp(name, "socket")) {
+            if (!v[0] || strlen(v) >= sizeof cfg->socket_path) {
+                fprintf(stderr, "lpvd serve: --socket: bad path\n");
+                return 2;
+            }
+            snprintf(cfg->socket_path, sizeof cfg->socket_path, "%s", v);
+            have_socket = 1;
+        } else if (!strcmp(name, "listen")) {
+            const char *colon = strrchr(v, ':');
+            char host[128];
+            if (!colon) {
+                snprintf(host, sizeof host, "127.0.0.1");
+                colon = v - 1;
+            } else {
+                size_t hl = (size_t)(colon - v);
+                if (hl >= sizeof host)
+                    hl = sizeof host - 1;
+                memcpy(host, v, hl);
+                host[hl] = '\0';
+                if (hl >= 2 && host[0] == '[' && host[hl - 1] == ']') {
+                    memmove(host, host + 1, hl - 2);
+                    host[hl - 2] = '\0';
+                }
+                if (!host[0])
+                    snprintf(host, sizeof host, "127.0.0.1");
+            }
+            if (parse_u64(colon + 1, 0, 65535, &u) != 0) {
+                fprintf(stderr, "lpvd serve: --listen %s: expected HOST:PORT or PORT (port 0..65535)\n", v);
+                return 2;
+            }
+            snprintf(cfg->listen_host, sizeof cfg->listen_host, "%s", host);
+            cfg->listen_port = (int)u;
+        } else if (!strcmp(name, "token-file")) {
+            token_file = v;
+        } else if (!strcmp(name, "scene-root")) {
+            char *real = realpath(v, NULL);
+            struct stat st;
+            if (!real || stat(real, &st) != 0 || !S_ISDIR(st.st_mode) || strlen(real) >= sizeof cfg->scene_root) {
+                fprintf(stderr, "lpvd serve: --scene-root %s: %s\n", v, real ? "not a folder" : strerror(errno));
+                free(real);
+                return 2;
+            }
+            snprintf(cfg->scene_root, sizeof cfg->scene_root, "%s", real);
+            free(real);
+        } else if (!strcmp(name, "scene")) {
+            cfg->scene_file = v;
+        } else if (!strcmp(name, "max-clients")) {
+            bad = parse_u64(v, 1, 100000, &u);
+            cfg->max_clients = (int)u;
+        } else if (!strcmp(name, "max-message")) {
+            bad = parse_u64(v, 64, (uint64_t)1 << 40, &u);
+            cfg->max_message = u;
+        } else if (!strcmp(name, "max-body")) {
+            bad = parse_u64(v, 64, UINT32_MAX, &u);
+            cfg->max_body = u;
+        } else if (!strcmp(name, "max-queue")) {
+            bad = parse_u64(v, 1024, (uint64_t)1 << 40, &u);
+            cfg->max_queue = u;
+        } else if (!strcmp(name, "max-triangles")) {
+            bad = parse_u64(v, 1, (uint64_t)1 << 40, &u);
+            cfg->max_triangles = u;
+        } else if (!strcmp(name, "max-texture")) {
+            bad = parse_u64(v, 16, 1 << 20, &u);
+            cfg->max_texture = (int)u;
+        } else if (!strcmp(name, "max-grid")) {
+            bad = parse_u64(v, 1, LPV_MAX_GRID_DIM, &u);
+            cfg->max_grid = (int)u;
+        } else if (!strcmp(name, "max-tick-rate")) {
+            bad = parse_num(v, 0.0, 10000.0, &d);
+            cfg->max_tick_rate = d;
+        } else if (!strcmp(name, "idle-timeout")) {
+            bad = parse_num(v, 0.0, 1e9, &d);
+            cfg->idle_timeout = d;
+        } else if (!strcmp(name, "tick-rate")) {
+            bad = parse_num(v, 0.0, 10000.0, &d);
+            cfg->tick_rate = d;
+        }
+        if (bad) {
+            fprintf(stderr, "lpvd serve: %s %s: bad value (see lpvd serve --help)\n", a, v);
+            return 2;
+        }
+    }
+    if (cfg->max_body > cfg->max_message)
+        cfg->max_body = cfg->max_message;
+    if (cfg->tick_rate > cfg->max_tick_rate) {
+        fprintf(stderr, "lpvd serve: --tick-rate %g is over --max-tick-rate %g\n", cfg->tick_rate,
+                cfg->max_tick_rate);
+        return 2;
+    }
+    for (int i = 0; i < 3; ++i)
+        if (opt.settings.grid_dims[i] > cfg->max_grid) {
+            fprintf(stderr, "lpvd serve: --grid is over --max-grid %d\n", cfg->max_grid);
+            return 2;
+        }
+    cfg->settings = opt.settings;
+    cfg->backend = opt.backend;
+    if (token_file && read_token(token_file, cfg, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd serve: %s\n", err);
+        return 2;
+    }
+    if (have_socket || !cfg->listen_host[0]) {
+        cfg->want_unix = 1;
+        if (!have_socket)
+            default_socket_path(cfg->socket_path, sizeof cfg->socket_path);
+    }
+    signal(SIGPIPE, SIG_IGN);
+
+    int rc = 1;
+    s->loop = malloc(sizeof *s->loop);
+    if (!s->loop || uv_loop_init(s->loop) != 0) {
+        fprintf(stderr, "lpvd serve: cannot start the event loop\n");
+        free(s->loop);
+        return 1;
+    }
+    pthread_mutex_init(&s->mu, NULL);
+    pthread_cond_init(&s->cv, NULL);
+    if (load_default_scene(s, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd serve: %s\n", err);
+        goto out;
+    }
+    if (sv_gl_start(s, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd serve: %s\n", err);
+        goto out;
+    }
+    if (sv_net_listen(s, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd serve: %s\n", err);
+        sv_net_stop_listening(s);
+        sv_gl_stop(s);
+        goto out;
+    }
+    uv_timer_init(s->loop, &s->idle_timer);
+    s->idle_timer.data = s;
+    uv_timer_start(&s->idle_timer, idle_cb, 1000, 1000);
+    uv_signal_init(s->loop, &s->sigterm);
+    uv_signal_init(s->loop, &s->sigint);
+    s->sigterm.data = s->sigint.data = s;
+    uv_signal_start(&s->sigterm, signal_cb, SIGTERM);
+    uv_signal_start(&s->sigint, signal_cb, SIGINT);
+
+    fprintf(stderr, "lpvd serve: lpvd %s, backend %s, GL_RENDERER %s\n", LPVD_VERSION, s->gl_backend,
+            s->gl_renderer);
+    fprintf(stderr, "lpvd serve: default scene %s (%u triangles)%s%s\n", s->builtin->scene.source,
+            s->builtin->scene.index_count / 3, cfg->scene_root[0] ? ", scene root " : "", cfg->scene_root);
+    if (cfg->want_unix)
+        fprintf(stderr, "lpvd serve: listening on unix:%s (connect: lpvctl --socket %s)\n", cfg->socket_path,
+                cfg->socket_path);
+    if (cfg->listen_host[0])
+        fprintf(stderr, "lpvd serve: listening on tcp:%s:%d%s\n", cfg->listen_host, cfg->listen_port,
+                cfg->has_token ? " (token required)" : "");
+    fflush(stderr);
+
+    uv_run(s->loop, UV_RUN_DEFAULT);
+    rc = 0;
+    fprintf(stderr, "lpvd serve: stopped (%llu ticks, %llu bytes sent)\n", (unsigned long long)s->ticks,
+            (unsigned long long)s->bytes_sent);
+out:
+    uv_walk(s->loop, close_walk, NULL);
+    uv_run(s->loop, UV_RUN_DEFAULT);
+    if (s->builtin)
+        sv_scene_unref(s, s->builtin);
+    while (s->scenes) { /* none should be left; free anyway */
+        sv_scene *sc = s->scenes;
+        sc->refs = 1;
+        sv_scene_unref(s, sc);
+    }
+    uv_loop_close(s->loop);
+    free(s->loop);
+    pthread_mutex_destroy(&s->mu);
+    pthread_cond_destroy(&s->cv);
+    return rc;
+}

@@ -1,0 +1,395 @@
+/*
+ * serve.h - the internals of `lpvd serve` (the daemon), shared by its files:
+ *
+ *   serve.c          the command: flags, start-up, signals, shutdown
+ *   serve_net.c      libuv listeners, connections, frame reading, bounded writes
+ *   serve_session.c  per-connection state, request dispatch, revisions, streams
+ *   serve_world.c    worlds (shared computations) and the GL thread
+ *   serve_encode.c   VOLUME / FRAME payloads (fp16, XOR delta, zstd, PNG, EXR)
+ *
+ * Threads: the libuv loop runs on the main thread and owns every structure
+ * here except the fields marked "GL thread". One GL thread owns the GL context
+ * and every lpv_engine; it takes sv_job's from a mutex-protected FIFO and
+ * hands them back through a second FIFO and a uv_async_t. Reference counts are
+ * only ever touched on the main thread. docs/server.md has the full picture.
+ */
+#ifndef LPVD_SERVE_H
+#define LPVD_SERVE_H
+
+#include <pthread.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <jansson.h>
+#include <uv.h>
+
+#include "context.h"
+#include "proto.h"
+#include "engine.h"
+#include "gltf_load.h"
+#include "scene.h"
+#include "settings.h"
+#include "view.h"
+
+#define SV_PROTOCOL_VERSION 1
+#define SV_HEADER_SIZE 24
+
+/* message types (SPEC section 4) */
+enum {
+    SV_HELLO = 0x0001,
+    SV_SCENE_LOAD = 0x0002,
+    SV_SCENE_UPDATE = 0x0003,
+    SV_LIGHT_SET = 0x0004,
+    SV_LIGHT_REMOVE = 0x0005,
+    SV_CAMERA_SET = 0x0006,
+    SV_CONFIG = 0x0007,
+    SV_TICK = 0x0008,
+    SV_SUBSCRIBE = 0x0009,
+    SV_UNSUBSCRIBE = 0x000A,
+    SV_GET_VOLUME = 0x000B,
+    SV_GET_FRAME = 0x000C,
+    SV_QUERY_IRRADIANCE = 0x000D,
+    SV_STATS = 0x000E,
+    SV_BYE = 0x000F,
+    SV_ACK = 0x0010,
+    SV_VOLUME = 0x0101,
+    SV_FRAME = 0x0102,
+    SV_REPLY = 0x8000,
+    SV_ERROR = 0xFFFF,
+};
+
+/* error codes (SPEC R3.4) */
+enum {
+    SV_E_BAD_MAGIC = 1,
+    SV_E_BAD_VERSION = 2,
+    SV_E_BAD_FRAME = 3,
+    SV_E_TOO_LARGE = 4,
+    SV_E_BAD_JSON = 5,
+    SV_E_UNKNOWN_TYPE = 6,
+    SV_E_BAD_FIELD = 7,
+    SV_E_UNAUTHORIZED = 8,
+    SV_E_HELLO_REQUIRED = 9,
+    SV_E_NOT_READY = 10,
+    SV_E_SCENE_INVALID = 11,
+    SV_E_PATH_REFUSED = 12,
+    SV_E_LIMIT = 13,
+    SV_E_INTERNAL = 14,
+    SV_E_SHUTTING_DOWN = 15,
+};
+
+typedef struct sv_server sv_server;
+typedef struct sv_conn sv_conn;
+typedef struct sv_world sv_world;
+typedef struct sv_job sv_job;
+
+/* ---- configuration ------------------------------------------------------ */
+typedef struct sv_config {
+    char socket_path[256];   /* "" = no Unix socket */
+    int want_unix;
+    char listen_host[128];   /* "" = no TCP */
+    int listen_port;
+    char token[512];         /* "" = none */
+    int has_token;
+    char scene_root[4096];   /* realpath, "" = none */
+    const char *scene_file;  /* --scene */
+    uint64_t max_body;       /* bytes of JSON, default 1 MiB */
+    uint64_t max_message;    /* json + attachment, default 256 MiB */
+    uint64_t max_queue;      /* bytes queued for writing per connection */
+    int max_clients;
+    uint64_t max_triangles;
+    int max_texture;
+    int max_grid;
+    double max_tick_rate;
+    double idle_timeout;     /* seconds */
+    lpv_backend backend;
+    lpv_settings settings;   /* default CONFIG */
+    double tick_rate;        /* default tick_rate_hz */
+} sv_config;
+
+/* ---- scenes: parsed glTF, shared by every session that loaded the same bytes */
+typedef struct sv_scene {
+    int refs;
+    uint64_t hash;          /* content hash (bytes + node overrides), 0 = built-in */
+    lpv_scene scene;        /* parsed, default light ensured */
+    uint8_t *glb;           /* the bytes (NULL for the built-in scene) */
+    size_t glb_size;
+    char *base_dir;         /* folder for external URIs (path loads), or NULL */
+    lpv_gltf_node_override *nodes; /* SCENE_UPDATE node transforms applied at load */
+    size_t node_count;
+    struct sv_scene *next;  /* server's list of live scenes */
+} sv_scene;
+
+/* An immutable snapshot of everything a world computes from. */
+typedef struct sv_inputs {
+    int refs;
+    sv_scene *scene;        /* ref */
+    lpv_material *materials;
+    uint32_t material_count;
+    lpv_light *lights;      /* name = the light's id */
+    uint32_t light_count;
+    lpv_settings settings;  /* as given (zero = default) */
+    double tick_rate;
+    lpv_view view;
+    uint8_t *key;           /* what identifies a world */
+    size_t key_len;
+    uint64_t key_hash;
+} sv_inputs;
+
+/* The product of one tick: immutable once handed to the main thread. */
+typedef struct sv_result {
+    int refs;
+    uint64_t tick;          /* world tick number, 1.. */
+    uint64_t gen;           /* world generation it was computed for */
+    lpv_grid grid;
+    float *cells;           /* cells * 12 floats */
+    size_t cell_count;
+    float *frames[3];       /* rgba float per lpv_frame_terms, NULL if not rendered */
+    int width, height;
+    lpv_engine_stats stats;
+    double tick_ms;         /* wall time of the tick on the GL thread */
+    /* main thread: keyframe attachments already encoded, [fp16][zstd] */
+    uint8_t *enc[2][2];
+    size_t enc_len[2][2];
+} sv_result;
+
+struct sv_world {
+    int refs;               /* sessions attached */
+    uint64_t id;
+    uint64_t gen;           /* bumped when the inputs change in place */
+    sv_inputs *inputs;      /* ref */
+    sv_result *latest;      /* ref, NULL before the first tick */
+    uv_timer_t timer;
+    int timer_init;
+    double timer_rate;
+    int periodic_pending;   /* a periodic tick job is queued or running */
+    int jobs;               /* jobs queued or running for this world */
+    int dying;              /* refs == 0, destroy job queued */
+    sv_server *srv;
+    sv_world *next;
+    /* GL thread only */
+    lpv_engine *engine;
+    uint64_t gl_applied_gen;
+    int gl_has_applied;
+    sv_inputs *gl_applied;  /* borrowed: only compared by content */
+    lpv_settings gl_settings;
+    lpv_view gl_view;
+    uint64_t gl_scene_sig;
+    uint64_t gl_ticks;
+    uint64_t gl_ticked_gen;
+    int gl_ticked;
+};
+
+/* ---- jobs for the GL thread -------------------------------------------- */
+typedef enum sv_job_kind {
+    SV_JOB_TICK = 1,
+    SV_JOB_RENDER,
+    SV_JOB_QUERY,
+    SV_JOB_DESTROY,
+    SV_JOB_QUIT,
+} sv_job_kind;
+
+struct sv_job {
+    sv_job_kind kind;
+    sv_world *world;
+    sv_inputs *inputs;      /* ref (world->inputs at submission) */
+    uint64_t gen;
+    sv_conn *conn;          /* ref, NULL for periodic ticks */
+    uint32_t request_id;
+    int periodic;
+    unsigned terms_mask;    /* tick: which frames to render (1 << terms) */
+    int terms;              /* render */
+    float *points;          /* query: 6n floats */
+    size_t count;
+    /* results */
+    int status;             /* 0 ok, else an SV_E_ code */
+    char err[512];
+    sv_result *result;      /* tick */
+    float *rgba;            /* render */
+    int width, height;
+    float *out;             /* query: 3n floats */
+    uint64_t tick;          /* render/query: the tick answered from */
+    sv_job *next;
+};
+
+/* ---- connections = sessions ------------------------------------------- */
+typedef struct sv_request {
+    uint16_t type;
+    uint32_t request_id;
+    char *json;             /* NUL-terminated */
+    size_t json_len;
+    uint8_t *att;
+    size_t att_len;
+    struct sv_request *next;
+} sv_request;
+
+typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */
+    uint64_t tick;
+    int dims[3];
+    int fp16;
+    uint8_t *raw;
+    size_t raw_len;
+} sv_sent;
+
+#define SV_SENT_KEEP 4
+
+typedef struct sv_sub {
+    int on;
+    int fp16;               /* volume: fp16 (default) or fp32 */
+    int zstd;               /* compression */
+    int delta;              /* volume only */
+    int fmt;                /* frame: 0 rgba8, 1 png, 2 exr */
+    int terms;              /* frame terms */
+    sv_sent sent[SV_SENT_KEEP];
+    sv_sent acked;          /* raw == NULL: none */
+} sv_sub;
+
+struct sv_wreq; /* one frame being written (serve_net.c) */
+
+enum { SV_STREAM_NONE = -1, SV_STREAM_VOLUME = 0, SV_STREAM_FRAME = 1 };
+
+struct sv_conn {
+    int refs;
+    uint64_t id;
+    sv_server *srv;
+    union {
+        uv_stream_t stream;
+        uv_pipe_t pipe;
+        uv_tcp_t tcp;
+    } h;
+    int closing, closed;
+    int close_after_write;  /* close when the write queue drains */
+    char peer[96];
+    /* reading */
+    lpvp_parser parser;
+    uint8_t rbuf[65536];
+    int reading;
+    uint64_t close_deadline_ms;
+    sv_request *pending_head, *pending_tail;
+    size_t pending_count, pending_bytes;
+    int busy;               /* a request is being processed asynchronously */
+    uint64_t last_rx_ms;
+    /* writing */
+    size_t wq_bytes;        /* bytes handed to uv_write, not yet completed */
+    size_t wq_count;
+    int stream_inflight[2];
+    struct sv_wreq *stream_pending[2]; /* newest unsent stream message */
+    uint64_t bytes_sent;
+    uint64_t stream_dropped;
+    /* session */
+    int hello;
+    uint64_t revision;
+    sv_scene *scene;        /* ref */
+    lpv_material *materials;
+    uint32_t material_count;
+    lpv_light *lights;
+    uint32_t light_count;
+    lpv_settings settings;
+    double tick_rate;
+    lpv_view view;
+    int view_explicit;      /* CAMERA_SET with eye/target was given */
+    int view_camera;        /* CAMERA_SET with a scene camera: index, else -1 */
+    int view_w, view_h;
+    sv_world *world;        /* ref */
+    uint64_t world_gen;
+    sv_sub subs[2];
+    sv_conn *next;
+};
+
+struct sv_server {
+    sv_config cfg;
+    uv_loop_t *loop;
+    uv_pipe_t unix_listener;
+    uv_tcp_t tcp_listener;
+    int unix_on, tcp_on;
+    uv_signal_t sigterm, sigint;
+    uv_timer_t idle_timer;
+    uv_timer_t stop_timer;
+    uv_async_t done_async;
+    int stopping;
+    sv_conn *conns;
+    int conn_count;
+    uint64_t next_conn_id;
+    sv_world *worlds;
+    int world_count;
+    uint64_t next_world_id;
+    sv_scene *scenes;
+    sv_scene *builtin;      /* the default scene */
+    /* GL thread */
+    pthread_t gl_thread;
+    int gl_started;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    sv_job *jobs_head, *jobs_tail;
+    size_t jobs_queued;
+    sv_job *done_head, *done_tail;
+    int gl_ready;           /* 1 ok, -1 failed */
+    char gl_err[1024];
+    char gl_backend[32];
+    char gl_renderer[256];
+    lpv_gl_context *gl_ctx;
+    /* counters */
+    uint64_t bytes_sent;
+    uint64_t ticks;
+    uint64_t requests;
+    int exit_code;
+};
+
+/* serve.c */
+uint64_t sv_now_ms(void);
+uint64_t sv_hash_bytes(uint64_t h, const void *data, size_t n);
+#define SV_HASH_INIT 1469598103934665603ull
+
+/* serve_net.c */
+int sv_net_listen(sv_server *s, char *err, size_t n);
+void sv_net_stop_listening(sv_server *s);
+/* Sends one frame. stream: SV_STREAM_* (a stream message replaces an unsent
+ * older one of its stream). Returns 0, or -1 when the connection was closed
+ * (over its write cap, or already closing). body is consumed (decref'd),
+ * att_owned is freed. */
+int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_t *att_owned, size_t att_len,
+            int stream); /* att_owned: malloc'd, freed by sv_send */
+int sv_send_error(sv_conn *c, uint32_t request_id, int code, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+void sv_conn_close(sv_conn *c);
+void sv_conn_close_after_write(sv_conn *c);
+void sv_conn_unref(sv_conn *c);
+void sv_net_resume_reading(sv_conn *c);
+const char *sv_error_name(int code);
+
+/* serve_session.c */
+void sv_session_init(sv_conn *c);
+void sv_session_free(sv_conn *c);        /* on close: detach, free state */
+void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
+void sv_session_job_done(sv_job *j);     /* a GL job of a request finished */
+void sv_session_stream(sv_conn *c, sv_result *r); /* after a tick of its world */
+
+/* serve_world.c */
+int sv_gl_start(sv_server *s, char *err, size_t n);
+void sv_gl_stop(sv_server *s);
+void sv_job_submit(sv_server *s, sv_job *j);
+sv_job *sv_job_new(sv_job_kind kind, sv_world *w);
+void sv_job_free(sv_job *j);
+sv_inputs *sv_inputs_build(sv_conn *c);
+void sv_inputs_unref(sv_inputs *in);
+void sv_world_attach(sv_conn *c, sv_inputs *in); /* consumes in */
+void sv_world_detach(sv_conn *c);
+void sv_world_unref(sv_world *w);
+void sv_result_unref(sv_result *r);
+sv_result *sv_result_ref(sv_result *r);
+void sv_scene_unref(sv_server *s, sv_scene *sc);
+sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
+unsigned sv_world_terms_mask(sv_world *w);
+void sv_world_update_timer(sv_world *w);
+size_t sv_jobs_queued(sv_server *s);
+
+/* serve_encode.c */
+/* Volume reply/stream body + attachment. ack: the subscriber (delta source and
+ * where the raw is remembered), or NULL. */
+int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
+                     uint8_t **att, size_t *att_len, char *err, size_t n);
+int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, uint64_t revision,
+                    uint64_t tick, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n);
+void sv_sub_clear(sv_sub *sub);
+void sv_sub_ack(sv_sub *sub, uint64_t tick);
+
+#endif

@@ -1,0 +1,223 @@
+/*
+ * serve_encode.c - the payloads of VOLUME / GET_VOLUME (SPEC section 5) and
+ * FRAME / GET_FRAME (section 6), through protocol/volume_codec.h: fp16/fp32
+ * packing, XOR deltas against the last volume a subscriber ACKed, zstd; and
+ * frames as tone-mapped rgba8, PNG or EXR (in-memory, image/image_io.h).
+ */
+#include "serve.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image_io.h"
+#include "tonemap.h"
+#include "volume_codec.h"
+
+void sv_sub_clear(sv_sub *sub)
+{
+    for (int i = 0; i < SV_SENT_KEEP; ++i) {
+        free(sub->sent[i].raw);
+        sub->sent[i].raw = NULL;
+    }
+    free(sub->acked.raw);
+    sub->acked.raw = NULL;
+}
+
+void sv_sub_ack(sv_sub *sub, uint64_t tick)
+{
+    for (int i = 0; i < SV_SENT_KEEP; ++i) {
+        if (sub->sent[i].raw && sub->sent[i].tick == tick) {
+            free(sub->acked.raw);
+            sub->acked = sub->sent[i];
+            sub->sent[i].raw = NULL;
+            /* older unacknowledged volumes can never become a base now */
+            for (int k = 0; k < SV_SENT_KEEP; ++k)
+                if (sub->sent[k].raw && sub->sent[k].tick < tick) {
+                    free(sub->sent[k].raw);
+                    sub->sent[k].raw = NULL;
+                }
+            return;
+        }
+    }
+}
+
+static void remember_sent(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, const uint8_t *raw, size_t len)
+{
+    int slot = 0;
+    for (int i = 0; i < SV_SENT_KEEP; ++i) {
+        if (!sub->sent[i].raw) {
+            slot = i;
+            break;
+        }
+        if (sub->sent[i].tick < sub->sent[slot].tick)
+            slot = i;
+    }
+    uint8_t *copy = malloc(len ? len : 1);
+    if (!copy)
+        return;
+    memcpy(copy, raw, len);
+    free(sub->sent[slot].raw);
+    sub->sent[slot].raw = copy;
+    sub->sent[slot].raw_len = len;
+    sub->sent[slot].tick = tick;
+    sub->sent[slot].fp16 = fp16;
+    memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
+}
+
+int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
+                     uint8_t **att, size_t *att_len, char *err, size_t n)
+{
+    lpvp_volume_format fmt = fp16 ? LPVP_FMT_FP16 : LPVP_FMT_FP32;
+    size_t raw_len = lpvp_volume_raw_size(r->cell_count, fmt);
+    uint8_t *raw = NULL;
+    int fast = r->enc[fp16 ? 1 : 0][zstd ? 1 : 0] && !(sub && sub->delta);
+    if (!fast) {
+        raw = malloc(raw_len ? raw_len : 1);
+        if (!raw) {
+            snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
+            return -1;
+        }
+        lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
+    }
+
+    lpvp_volume_info vi;
+    memset(&vi, 0, sizeof vi);
+    vi.revision = (int64_t)revision;
+    vi.tick = (int64_t)r->tick;
+    vi.format = fmt;
+    vi.compression = zstd ? LPVP_COMP_ZSTD : LPVP_COMP_NONE;
+    vi.keyframe = 1;
+    vi.base_tick = -1;
+    for (int i = 0; i < 3; ++i) {
+        vi.dims[i] = r->grid.dims[i];
+        vi.origin[i] = r->grid.origin[i];
+    }
+    vi.cell_size = r->grid.cell_size;
+    vi.raw_length = raw_len;
+
+    uint8_t *payload = raw; /* what gets compressed / sent */
+    uint8_t *delta = NULL;
+    if (sub && !fast) {
+        if (sub->delta && sub->acked.raw && sub->acked.fp16 == fp16 && sub->acked.raw_len == raw_len &&
+            memcmp(sub->acked.dims, r->grid.dims, sizeof sub->acked.dims) == 0 && sub->acked.tick < r->tick) {
+            delta = malloc(raw_len ? raw_len : 1);
+            if (delta) {
+                lpvp_xor(delta, raw, sub->acked.raw, raw_len);
+                payload = delta;
+                vi.keyframe = 0;
+                vi.base_tick = (int64_t)sub->acked.tick;
+            }
+        }
+        if (sub->delta)
+            remember_sent(sub, r->tick, r->grid.dims, fp16, raw, raw_len);
+    }
+
+    uint8_t **cache = &r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
+    size_t *cache_len = &r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0];
+    if (vi.keyframe && *cache) { /* another subscriber already had this keyframe encoded */
+        uint8_t *copy = malloc(*cache_len ? *cache_len : 1);
+        if (!copy) {
+            free(raw);
+            free(delta);
+            snprintf(err, n, "out of memory");
+            return -1;
+        }
+        memcpy(copy, *cache, *cache_len);
+        *att = copy;
+        *att_len = *cache_len;
+    } else if (zstd) {
+        uint8_t *z = NULL;
+        size_t zlen = 0;
+        if (lpvp_zstd_compress(payload, raw_len, 0, &z, &zlen, err, n) != 0) {
+            free(raw);
+            free(delta);
+            return -1;
+        }
+        *att = z;
+        *att_len = zlen;
+    } else if (payload == raw) {
+        *att = raw;
+        raw = NULL;
+        *att_len = raw_len;
+    } else {
+        *att = delta;
+        delta = NULL;
+        *att_len = raw_len;
+    }
+    free(raw);
+    free(delta);
+    if (vi.keyframe && !*cache && *att) {
+        *cache = malloc(*att_len ? *att_len : 1);
+        if (*cache) {
+            memcpy(*cache, *att, *att_len);
+            *cache_len = *att_len;
+        }
+    }
+    *body = lpvp_volume_header_build(&vi);
+    if (!*body) {
+        free(*att);
+        *att = NULL;
+        snprintf(err, n, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+static const char *const TERMS_NAMES[3] = {"full", "indirect", "direct"};
+static const char *const FMT_NAMES[3] = {"rgba8", "png", "exr"};
+
+int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, uint64_t revision, uint64_t tick,
+                    json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
+{
+    size_t px = (size_t)w * (size_t)h;
+    uint8_t *data = NULL;
+    size_t len = 0;
+    if (fmt == 2) {
+        if (lpv_image_encode_f32("exr", w, h, 4, rgba, &data, &len, err, n) != 0)
+            return -1;
+        zstd = 0;
+    } else {
+        uint8_t *rgba8 = malloc(px ? px * 4 : 1);
+        if (!rgba8) {
+            snprintf(err, n, "out of memory for a %dx%d frame", w, h);
+            return -1;
+        }
+        lpv_tonemap_rgba8(rgba, px, 1.0f, rgba8);
+        if (fmt == 1) {
+            int rc = lpv_image_encode_u8("png", w, h, 4, rgba8, &data, &len, err, n);
+            free(rgba8);
+            if (rc != 0)
+                return -1;
+            zstd = 0;
+        } else {
+            data = rgba8;
+            len = px * 4;
+        }
+    }
+    size_t raw_len = len;
+    if (zstd) {
+        uint8_t *z = NULL;
+        size_t zlen = 0;
+        if (lpvp_zstd_compress(data, len, 0, &z, &zlen, err, n) != 0) {
+            free(data);
+            return -1;
+        }
+        free(data);
+        data = z;
+        len = zlen;
+    }
+    *att = data;
+    *att_len = len;
+    *body = json_pack("{s:I, s:I, s:s, s:s, s:i, s:i, s:s, s:s, s:I}", "revision", (json_int_t)revision, "tick",
+                      (json_int_t)tick, "format", FMT_NAMES[fmt], "compression", zstd ? "zstd" : "none", "width", w,
+                      "height", h, "terms", TERMS_NAMES[terms], "units", fmt == 2 ? "W/(m^2 sr)" : "sRGB",
+                      "raw_length", (json_int_t)raw_len);
+    if (!*body) {
+        free(data);
+        *att = NULL;
+        snprintf(err, n, "out of memory");
+        return -1;
+    }
+    return 0;
+}

@@ -1,0 +1,538 @@
+/*
+ * serve_net.c - the network side of `lpvd serve`, all on the libuv loop:
+ * listeners (Unix socket, TCP), connections, frame reading through the
+ * protocol's incremental parser (protocol/proto.h), and bounded writes.
+ *
+ * Back-pressure: reading stops while a connection has too many requests
+ * waiting (SV_MAX_PENDING) and resumes when they drain; replies count
+ * against the connection's write cap (--max-queue, default 64 MiB plus one
+ * message) and a client over it is disconnected; stream messages (VOLUME,
+ * FRAME) keep at most one frame in flight and one unsent per stream, a newer
+ * one replacing the unsent older one (SPEC R5.5).
+ */
+#include "serve.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#define SV_MAX_PENDING 64
+#define SV_MAX_PENDING_BYTES (512u << 20)
+
+typedef struct sv_wreq {
+    uv_write_t req;
+    sv_conn *c;
+    uint8_t *head;
+    size_t head_len;
+    uint8_t *att;
+    size_t att_len;
+    int stream;
+} sv_wreq;
+
+const char *sv_error_name(int code)
+{
+    return lpvp_error_name(code);
+}
+
+static void wreq_free(sv_wreq *w)
+{
+    if (!w)
+        return;
+    free(w->head);
+    free(w->att);
+    free(w);
+}
+
+void sv_conn_unref(sv_conn *c)
+{
+    if (!c || --c->refs > 0)
+        return;
+    for (int i = 0; i < 2; ++i)
+        wreq_free(c->stream_pending[i]);
+    lpvp_parser_free(&c->parser);
+    free(c);
+}
+
+static void free_pending_requests(sv_conn *c)
+{
+    sv_request *r = c->pending_head;
+    while (r) {
+        sv_request *n = r->next;
+        free(r->json);
+        free(r->att);
+        free(r);
+        r = n;
+    }
+    c->pending_head = c->pending_tail = NULL;
+    c->pending_count = 0;
+    c->pending_bytes = 0;
+}
+
+static void on_closed(uv_handle_t *h)
+{
+    sv_conn *c = h->data;
+    sv_server *s = c->srv;
+    c->closed = 1;
+    for (sv_conn **p = &s->conns; *p; p = &(*p)->next)
+        if (*p == c) {
+            *p = c->next;
+            break;
+        }
+    s->conn_count--;
+    free_pending_requests(c);
+    sv_session_free(c);
+    sv_conn_unref(c);
+}
+
+void sv_conn_close(sv_conn *c)
+{
+    if (!c || c->closing)
+        return;
+    c->closing = 1;
+    if (c->reading) {
+        uv_read_stop(&c->h.stream);
+        c->reading = 0;
+    }
+    free_pending_requests(c);
+    uv_close((uv_handle_t *)&c->h.stream, on_closed);
+}
+
+void sv_conn_close_after_write(sv_conn *c)
+{
+    if (!c || c->closing)
+        return;
+    if (c->reading) {
+        uv_read_stop(&c->h.stream);
+        c->reading = 0;
+    }
+    free_pending_requests(c);
+    c->close_after_write = 1;
+    c->close_deadline_ms = sv_now_ms() + 5000;
+    if (c->wq_count == 0)
+        sv_conn_close(c);
+}
+
+static void write_start(sv_conn *c, sv_wreq *w);
+
+static void on_written(uv_write_t *req, int status)
+{
+    sv_wreq *w = (sv_wreq *)req;
+    sv_conn *c = w->c;
+    c->wq_bytes -= w->head_len + w->att_len;
+    c->wq_count--;
+    if (status == 0) {
+        c->bytes_sent += w->head_len + w->att_len;
+        c->srv->bytes_sent += w->head_len + w->att_len;
+    }
+    int stream = w->stream;
+    wreq_free(w);
+    if (stream != SV_STREAM_NONE) {
+        c->stream_inflight[stream] = 0;
+        if (!c->closing && !c->close_after_write && status == 0 && c->stream_pending[stream]) {
+            sv_wreq *next = c->stream_pending[stream];
+            c->stream_pending[stream] = NULL;
+            write_start(c, next);
+        }
+    }
+    if (status != 0 && status != UV_ECANCELED && !c->closing)
+        sv_conn_close(c);
+    else if (c->close_after_write && c->wq_count == 0)
+        sv_conn_close(c);
+    sv_conn_unref(c);
+}
+
+static void write_start(sv_conn *c, sv_wreq *w)
+{
+    uv_buf_t bufs[2];
+    unsigned nb = 0;
+    bufs[nb++] = uv_buf_init((char *)w->head, (unsigned)w->head_len);
+    if (w->att_len)
+        bufs[nb++] = uv_buf_init((char *)w->att, (unsigned)w->att_len);
+    w->c = c;
+    c->refs++;
+    c->wq_bytes += w->head_len + w->att_len;
+    c->wq_count++;
+    if (w->stream != SV_STREAM_NONE)
+        c->stream_inflight[w->stream] = 1;
+    int rc = uv_write(&w->req, &c->h.stream, bufs, nb, on_written);
+    if (rc != 0) {
+        c->wq_bytes -= w->head_len + w->att_len;
+        c->wq_count--;
+        if (w->stream != SV_STREAM_NONE)
+            c->stream_inflight[w->stream] = 0;
+        wreq_free(w);
+        sv_conn_close(c);
+        sv_conn_unref(c);
+    }
+}
+
+int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_t *att_owned, size_t att_len,
+            int stream)
+{
+    if (!c || c->closing || (c->close_after_write && type != LPVP_BYE_REPLY && type != LPVP_ERROR)) {
+        json_decref(body);
+        free(att_owned);
+        return -1;
+    }
+    sv_wreq *w = calloc(1, sizeof *w);
+    char *json = body ? json_dumps(body, JSON_COMPACT) : NULL;
+    json_decref(body);
+    if (!w || (body && !json)) {
+        free(w);
+        free(json);
+        free(att_owned);
+        sv_conn_close(c);
+        return -1;
+    }
+    w->head = lpvp_frame_build_head(type, request_id, json ? json : "{}", json ? strlen(json) : 2, att_len,
+                                    &w->head_len);
+    free(json);
+    w->att = att_owned;
+    w->att_len = att_len;
+    w->stream = stream;
+    if (!w->head) {
+        wreq_free(w);
+        sv_conn_close(c);
+        return -1;
+    }
+    if (stream != SV_STREAM_NONE) {
+        if (c->stream_inflight[stream]) { /* R5.5: newest replaces the unsent one */
+            if (c->stream_pending[stream])
+                c->stream_dropped++;
+            wreq_free(c->stream_pending[stream]);
+            c->stream_pending[stream] = w;
+            return 0;
+        }
+        write_start(c, w);
+        return c->closing ? -1 : 0;
+    }
+    size_t len = w->head_len + w->att_len;
+    if (c->wq_bytes > 0 && c->wq_bytes + len > c->srv->cfg.max_queue) {
+        fprintf(stderr, "lpvd serve: client %llu (%s) is not reading: %zu bytes queued, over the %llu-byte cap; "
+                        "disconnecting it\n",
+                (unsigned long long)c->id, c->peer, c->wq_bytes, (unsigned long long)c->srv->cfg.max_queue);
+        wreq_free(w);
+        sv_conn_close(c);
+        return -1;
+    }
+    write_start(c, w);
+    return c->closing ? -1 : 0;
+}
+
+int sv_send_error(sv_conn *c, uint32_t request_id, int code, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    json_t *b = lpvp_error_body(code, "%s", msg);
+    int rc = sv_send(c, LPVP_ERROR, request_id, b, NULL, 0, SV_STREAM_NONE);
+    if (lpvp_error_closes(code))
+        sv_conn_close_after_write(c);
+    return rc;
+}
+
+/* ---- reading ------------------------------------------------------------ */
+static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
+{
+    (void)suggested;
+    sv_conn *c = h->data;
+    *buf = uv_buf_init((char *)c->rbuf, sizeof c->rbuf);
+}
+
+static int enqueue_frame(sv_conn *c, const lpvp_frame *f)
+{
+    sv_request *r = calloc(1, sizeof *r);
+    if (!r)
+        return -1;
+    r->type = f->header.type;
+    r->request_id = f->header.request_id;
+    r->json_len = f->body_len;
+    r->json = malloc(f->body_len + 1);
+    r->att_len = f->attachment_len;
+    r->att = f->attachment_len ? malloc(f->attachment_len) : NULL;
+    if (!r->json || (f->attachment_len && !r->att)) {
+        free(r->json);
+        free(r->att);
+        free(r);
+        return -1;
+    }
+    memcpy(r->json, f->body, f->body_len);
+    r->json[f->body_len] = '\0';
+    if (f->attachment_len)
+        memcpy(r->att, f->attachment, f->attachment_len);
+    if (c->pending_tail)
+        c->pending_tail->next = r;
+    else
+        c->pending_head = r;
+    c->pending_tail = r;
+    c->pending_count++;
+    c->pending_bytes += r->json_len + r->att_len;
+    return 0;
+}
+
+static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
+{
+    sv_conn *c = st->data;
+    if (nread < 0) {
+        /* EOF or error: a frame cut mid-way has no effect (R2.6) */
+        sv_conn_close(c);
+        return;
+    }
+    if (nread == 0)
+        return;
+    c->last_rx_ms = sv_now_ms();
+    size_t off = 0, len = (size_t)nread;
+    c->refs++;
+    while (off < len && !c->closing && !c->close_after_write) {
+        size_t used = 0;
+        lpvp_frame f;
+        int stt = lpvp_parser_feed(&c->parser, buf->base + off, len - off, &used, &f);
+        off += used;
+        if (stt == LPVP_PARSE_FRAME) {
+            if (enqueue_frame(c, &f) != 0) {
+                sv_send_error(c, f.header.request_id, LPVP_E_INTERNAL, "out of memory for the request");
+                sv_conn_close_after_write(c);
+                break;
+            }
+        } else if (stt == LPVP_PARSE_ERROR) {
+            json_t *b = lpvp_error_body(c->parser.error_code, "%s", c->parser.error_message);
+            sv_send(c, LPVP_ERROR, c->parser.error_request_id, b, NULL, 0, SV_STREAM_NONE);
+            sv_conn_close_after_write(c);
+            break;
+        }
+    }
+    if (!c->closing && !c->close_after_write) {
+        if (c->pending_count >= SV_MAX_PENDING || c->pending_bytes >= SV_MAX_PENDING_BYTES) {
+            uv_read_stop(&c->h.stream);
+            c->reading = 0;
+        }
+        sv_session_pump(c);
+    }
+    sv_conn_unref(c);
+}
+
+void sv_net_resume_reading(sv_conn *c)
+{
+    if (c->closing || c->close_after_write || c->reading || c->srv->stopping)
+        return;
+    if (c->pending_count < SV_MAX_PENDING / 2 && c->pending_bytes < SV_MAX_PENDING_BYTES / 2) {
+        if (uv_read_start(&c->h.stream, on_alloc, on_read) == 0)
+            c->reading = 1;
+    }
+}
+
+/* ---- accepting ---------------------------------------------------------- */
+/* Connections that still count against --max-clients. Before refusing a
+ * newcomer, connections whose peer has already gone (EOF or reset waiting,
+ * not yet seen by the loop) are closed, so a slot freed by a client that just
+ * disconnected is reusable at once. */
+static int active_clients(sv_server *s, const sv_conn *except)
+{
+    int n = 0;
+    for (sv_conn *c = s->conns; c; c = c->next)
+        if (c != except && !c->closing && !c->close_after_write)
+            n++;
+    return n;
+}
+
+static void reap_gone(sv_server *s, const sv_conn *except)
+{
+    for (sv_conn *c = s->conns; c; c = c->next) {
+        if (c == except || c->closing)
+            continue;
+        uv_os_fd_t fd;
+        if (uv_fileno((uv_handle_t *)&c->h.stream, &fd) != 0)
+            continue;
+        char b;
+        ssize_t r = recv(fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
+        if (r == 0 || (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR))
+            sv_conn_close(c);
+    }
+}
+
+static void on_connection(uv_stream_t *server, int status)
+{
+    sv_server *s = server->data;
+    if (status < 0 || s->stopping)
+        return;
+    sv_conn *c = calloc(1, sizeof *c);
+    if (!c)
+        return;
+    c->refs = 1;
+    c->srv = s;
+    c->id = ++s->next_conn_id;
+    int is_tcp = server == (uv_stream_t *)&s->tcp_listener;
+    int rc = is_tcp ? uv_tcp_init(s->loop, &c->h.tcp) : uv_pipe_init(s->loop, &c->h.pipe, 0);
+    if (rc != 0) {
+        free(c);
+        return;
+    }
+    c->h.stream.data = c;
+    c->next = s->conns;
+    s->conns = c;
+    s->conn_count++;
+    lpvp_limits lim = {.max_body = (uint32_t)s->cfg.max_body, .max_message = s->cfg.max_message};
+    lpvp_parser_init(&c->parser, &lim);
+    if (uv_accept(server, &c->h.stream) != 0) {
+        sv_conn_close(c);
+        return;
+    }
+    if (is_tcp) {
+        struct sockaddr_storage ss;
+        int sl = sizeof ss;
+        char host[64] = "?";
+        if (uv_tcp_getpeername(&c->h.tcp, (struct sockaddr *)&ss, &sl) == 0) {
+            if (ss.ss_family == AF_INET6)
+                uv_ip6_name((struct sockaddr_in6 *)&ss, host, sizeof host);
+            else
+                uv_ip4_name((struct sockaddr_in *)&ss, host, sizeof host);
+        }
+        snprintf(c->peer, sizeof c->peer, "tcp %s", host);
+        uv_tcp_nodelay(&c->h.tcp, 1);
+    } else {
+        snprintf(c->peer, sizeof c->peer, "unix");
+    }
+    c->last_rx_ms = sv_now_ms();
+    sv_session_init(c);
+    if (active_clients(s, c) >= s->cfg.max_clients)
+        reap_gone(s, c);
+    if (active_clients(s, c) >= s->cfg.max_clients) {
+        sv_send_error(c, 0, LPVP_E_LIMIT, "too many clients: the server accepts at most %d (--max-clients)",
+                      s->cfg.max_clients);
+        sv_conn_close_after_write(c);
+        return;
+    }
+    if (uv_read_start(&c->h.stream, on_alloc, on_read) == 0)
+        c->reading = 1;
+    else
+        sv_conn_close(c);
+}
+
+/* ---- listeners ---------------------------------------------------------- */
+static int unix_socket_in_use(const char *path)
+{
+    int fd = socket(AF_UNIX, SOCK_STREAM, 0);
+    if (fd < 0)
+        return 0;
+    struct sockaddr_un sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sun_family = AF_UNIX;
+    snprintf(sa.sun_path, sizeof sa.sun_path, "%s", path);
+    int used = connect(fd, (struct sockaddr *)&sa, sizeof sa) == 0;
+    close(fd);
+    return used;
+}
+
+static int is_loopback(const struct sockaddr *sa)
+{
+    if (sa->sa_family == AF_INET) {
+        const uint8_t *b = (const uint8_t *)&((const struct sockaddr_in *)sa)->sin_addr;
+        return b[0] == 127;
+    }
+    if (sa->sa_family == AF_INET6) {
+        static const uint8_t lo[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
+        return memcmp(&((const struct sockaddr_in6 *)sa)->sin6_addr, lo, 16) == 0;
+    }
+    return 0;
+}
+
+int sv_net_listen(sv_server *s, char *err, size_t n)
+{
+    sv_config *cfg = &s->cfg;
+    if (cfg->want_unix) {
+        struct stat st;
+        if (strlen(cfg->socket_path) >= sizeof(((struct sockaddr_un *)0)->sun_path)) {
+            snprintf(err, n, "--socket %s: path too long for a Unix socket", cfg->socket_path);
+            return -1;
+        }
+        if (lstat(cfg->socket_path, &st) == 0) {
+            if (!S_ISSOCK(st.st_mode)) {
+                snprintf(err, n, "--socket %s: exists and is not a socket; refusing to replace it", cfg->socket_path);
+                return -1;
+            }
+            if (unix_socket_in_use(cfg->socket_path)) {
+                snprintf(err, n, "--socket %s: another server is listening there", cfg->socket_path);
+                return -1;
+            }
+            unlink(cfg->socket_path); /* stale */
+        }
+        if (uv_pipe_init(s->loop, &s->unix_listener, 0) != 0) {
+            snprintf(err, n, "uv_pipe_init failed");
+            return -1;
+        }
+        s->unix_listener.data = s;
+        s->unix_on = 1;
+        mode_t old = umask(0077); /* created 0600 (R1.1), no window */
+        int rc = uv_pipe_bind(&s->unix_listener, cfg->socket_path);
+        umask(old);
+        if (rc == 0)
+            chmod(cfg->socket_path, 0600);
+        if (rc == 0)
+            rc = uv_listen((uv_stream_t *)&s->unix_listener, 128, on_connection);
+        if (rc != 0) {
+            snprintf(err, n, "--socket %s: %s", cfg->socket_path, uv_strerror(rc));
+            return -1;
+        }
+    }
+    if (cfg->listen_host[0]) {
+        struct sockaddr_storage ss;
+        memset(&ss, 0, sizeof ss);
+        const char *host = cfg->listen_host;
+        if (strcmp(host, "localhost") == 0)
+            host = "127.0.0.1";
+        if (uv_ip4_addr(host, cfg->listen_port, (struct sockaddr_in *)&ss) != 0 &&
+            uv_ip6_addr(host, cfg->listen_port, (struct sockaddr_in6 *)&ss) != 0) {
+            snprintf(err, n, "--listen %s:%d: not a numeric IPv4/IPv6 address", cfg->listen_host, cfg->listen_port);
+            return -1;
+        }
+        if (!is_loopback((struct sockaddr *)&ss) && !cfg->has_token) {
+            snprintf(err, n,
+                     "--listen %s:%d is not a loopback address: a token is required (--token-file FILE), "
+                     "refusing to start",
+                     cfg->listen_host, cfg->listen_port);
+            return -1;
+        }
+        if (uv_tcp_init(s->loop, &s->tcp_listener) != 0) {
+            snprintf(err, n, "uv_tcp_init failed");
+            return -1;
+        }
+        s->tcp_listener.data = s;
+        s->tcp_on = 1;
+        int rc = uv_tcp_bind(&s->tcp_listener, (struct sockaddr *)&ss, 0);
+        if (rc == 0)
+            rc = uv_listen((uv_stream_t *)&s->tcp_listener, 128, on_connection);
+        if (rc != 0) {
+            snprintf(err, n, "--listen %s:%d: %s", cfg->listen_host, cfg->listen_port, uv_strerror(rc));
+            return -1;
+        }
+        if (cfg->listen_port == 0) { /* report the port the OS chose */
+            struct sockaddr_storage b;
+            int bl = sizeof b;
+            if (uv_tcp_getsockname(&s->tcp_listener, (struct sockaddr *)&b, &bl) == 0)
+                cfg->listen_port = ntohs(b.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&b)->sin6_port
+                                                                 : ((struct sockaddr_in *)&b)->sin_port);
+        }
+    }
+    return 0;
+}
+
+void sv_net_stop_listening(sv_server *s)
+{
+    if (s->unix_on) {
+        uv_close((uv_handle_t *)&s->unix_listener, NULL);
+        s->unix_on = 0;
+        unlink(s->cfg.socket_path);
+    }
+    if (s->tcp_on) {
+        uv_close((uv_handle_t *)&s->tcp_listener, NULL);
+        s->tcp_on = 0;
+    }
+}

@@ -1,0 +1,1426 @@
+/*
+ * serve_session.c - one session per connection (SPEC section 7): its state
+ * (scene, materials, lights, camera, config, revision, subscriptions), and
+ * the dispatch of its requests, strictly one at a time in arrival order
+ * (R3.2). Requests that need the GL thread (TICK, GET_FRAME,
+ * QUERY_IRRADIANCE) or a worker (SCENE_LOAD, SCENE_UPDATE of nodes) mark the
+ * session busy; its next request waits until the reply has been queued.
+ */
+#include "serve.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "gltf_load.h"
+#include "volume_codec.h"
+
+#define SV_MAX_LIGHTS 256
+#define SV_MAX_VIEW_SIDE 4096
+#define SV_DEFAULT_VIEW_SIDE 256
+
+static const char *const TERMS[] = {"full", "indirect", "direct"};
+static const char *const FRAME_FMTS[] = {"rgba8", "png", "exr"};
+static const char *const VOL_FMTS[] = {"fp16", "fp32"};
+static const char *const COMPS[] = {"zstd", "none"};
+static const char *const STREAMS[] = {"volume", "frame"};
+
+/* ERROR reply; closes the connection when the code does (R3.4), unless
+ * noclose (HELLO's BAD_VERSION, R4.1). */
+static void reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+static void reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    sv_send(c, LPVP_ERROR, rid, lpvp_error_body(code, "%s", msg), NULL, 0, SV_STREAM_NONE);
+    if (!noclose && lpvp_error_closes(code))
+        sv_conn_close_after_write(c);
+}
+
+static void reply(sv_conn *c, uint16_t type, uint32_t rid, json_t *body)
+{
+    sv_send(c, LPVP_REPLY(type), rid, body ? body : json_object(), NULL, 0, SV_STREAM_NONE);
+}
+
+static json_t *rev_body(sv_conn *c)
+{
+    return json_pack("{s:I}", "revision", (json_int_t)c->revision);
+}
+
+/* ---- session state ------------------------------------------------------ */
+static void name_lights(lpv_light *l, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; ++i) {
+        int dup = 0;
+        for (uint32_t k = 0; k < i; ++k)
+            if (strcmp(l[k].name, l[i].name) == 0)
+                dup = 1;
+        if (!l[i].name[0] || dup)
+            snprintf(l[i].name, sizeof l[i].name, "light%u", i);
+    }
+}
+
+static void default_view(sv_conn *c)
+{
+    const lpv_scene *sc = &c->scene->scene;
+    int w = c->view_w ? c->view_w : SV_DEFAULT_VIEW_SIDE, h = c->view_h ? c->view_h : SV_DEFAULT_VIEW_SIDE;
+    memset(&c->view, 0, sizeof c->view);
+    if (c->view_camera >= 0 && (uint32_t)c->view_camera < sc->camera_count)
+        lpv_view_from_camera(&sc->cameras[c->view_camera], w, h, &c->view);
+    else if (sc->camera_count)
+        lpv_view_from_camera(&sc->cameras[0], w, h, &c->view);
+    else
+        lpv_view_frame_bounds(sc, w, h, &c->view);
+}
+
+/* The scene's lights with clean names (their ids). NULL when it has none. */
+static lpv_light *named_lights(const lpv_scene *sc, int *fail)
+{
+    *fail = 0;
+    if (!sc->light_count)
+        return NULL;
+    lpv_light *l = calloc(sc->light_count, sizeof *l);
+    if (!l) {
+        *fail = 1;
+        return NULL;
+    }
+    memcpy(l, sc->lights, sizeof *l * sc->light_count);
+    for (uint32_t i = 0; i < sc->light_count; ++i) { /* zero the name padding: lights are keys */
+        char nm[LPV_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s", l[i].name);
+        memset(l[i].name, 0, sizeof l[i].name);
+        memcpy(l[i].name, nm, strlen(nm));
+    }
+    name_lights(l, sc->light_count);
+    return l;
+}
+
+/* Takes the scene (a reference) as the session's, with its materials and
+ * lights; resets the camera unless an explicit one was set. */
+static int session_set_scene(sv_conn *c, sv_scene *sc)
+{
+    lpv_material *m = NULL;
+    lpv_light *l = NULL;
+    if (sc->scene.material_count) {
+        m = malloc(sizeof *m * sc->scene.material_count);
+        if (!m)
+            return -1;
+        memcpy(m, sc->scene.materials, sizeof *m * sc->scene.material_count);
+    }
+    int lfail = 0;
+    l = named_lights(&sc->scene, &lfail);
+    if (lfail) {
+        free(m);
+        return -1;
+    }
+    if (c->scene)
+        sv_scene_unref(c->srv, c->scene);
+    c->scene = sc;
+    free(c->materials);
+    free(c->lights);
+    c->materials = m;
+    c->material_count = sc->scene.material_count;
+    c->lights = l;
+    c->light_count = sc->scene.light_count;
+    if (!c->view_explicit) {
+        if (c->view_camera >= 0 && (uint32_t)c->view_camera >= sc->scene.camera_count)
+            c->view_camera = -1;
+        default_view(c);
+    }
+    return 0;
+}
+
+static void session_changed(sv_conn *c)
+{
+    c->revision++;
+    sv_inputs *in = sv_inputs_build(c);
+    if (in)
+        sv_world_attach(c, in);
+}
+
+void sv_session_init(sv_conn *c)
+{
+    sv_server *s = c->srv;
+    c->view_camera = -1;
+    c->settings = s->cfg.settings;
+    c->tick_rate = s->cfg.tick_rate;
+    c->subs[0].fp16 = 1;
+    s->builtin->refs++;
+    if (session_set_scene(c, s->builtin) != 0) {
+        sv_conn_close(c);
+        return;
+    }
+    sv_inputs *in = sv_inputs_build(c);
+    if (in)
+        sv_world_attach(c, in);
+}
+
+void sv_session_free(sv_conn *c)
+{
+    sv_world_detach(c);
+    if (c->scene)
+        sv_scene_unref(c->srv, c->scene);
+    c->scene = NULL;
+    free(c->materials);
+    free(c->lights);
+    c->materials = NULL;
+    c->lights = NULL;
+    for (int i = 0; i < 2; ++i)
+        sv_sub_clear(&c->subs[i]);
+}
+
+/* ---- stats -------------------------------------------------------------- */
+static json_t *stats_stages(const lpv_engine_stats *st)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < st->stage_count; ++i)
+        json_array_append_new(a, json_pack("{s:s, s:f, s:f, s:i}", "name", st->stages[i].name, "gpu_ms",
+                                           st->stages[i].gpu_ms, "cpu_ms", st->stages[i].cpu_ms, "calls",
+                                           (int)st->stages[i].calls));
+    return a;
+}
+
+static json_t *tick_stats(const sv_result *r)
+{
+    const lpv_engine_stats *st = &r->stats;
+    double total = 0;
+    for (int i = 0; i < st->stage_count; ++i)
+        total += st->stages[i].gpu_ms;
+    return json_pack("{s:o, s:f, s:f, s:{s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b}, s:{s:[i,i,i], s:f, "
+                     "s:[f,f,f]}}",
+                     "stages", stats_stages(st), "total_gpu_ms", total, "tick_ms", r->tick_ms, "counts", "lights",
+                     (int)st->lights, "rsm_faces", (int)st->rsm_faces, "vpls_rsm", (json_int_t)st->vpls_rsm,
+                     "vpls_emissive", (json_int_t)st->vpls_emissive, "surfels_rsm", (json_int_t)st->surfels_rsm,
+                     "surfels_camera", (json_int_t)st->surfels_camera, "cells", (json_int_t)st->cells, "iterations",
+                     st->iterations, "cell_steps", st->cell_steps, "occlusion", st->occlusion != 0, "grid", "dims",
+                     r->grid.dims[0], r->grid.dims[1], r->grid.dims[2], "cell_size_m", (double)r->grid.cell_size,
+                     "origin_m", (double)r->grid.origin[0], (double)r->grid.origin[1], (double)r->grid.origin[2]);
+}
+
+static json_t *config_json(sv_conn *c)
+{
+    lpv_settings s = c->settings;
+    lpv_settings_resolve(&s);
+    json_t *bounds;
+    int auto_bounds = 1;
+    for (int i = 0; i < 3; ++i)
+        if (s.bounds_min[i] != 0.0f || s.bounds_max[i] != 0.0f)
+            auto_bounds = 0;
+    if (auto_bounds && c->world && c->world->latest && c->world->latest->gen == c->world_gen) {
+        const lpv_grid *g = &c->world->latest->grid;
+        bounds = json_pack("[f,f,f,f,f,f]", (double)g->origin[0], (double)g->origin[1], (double)g->origin[2],
+                           g->origin[0] + (double)g->cell_size * g->dims[0],
+                           g->origin[1] + (double)g->cell_size * g->dims[1],
+                           g->origin[2] + (double)g->cell_size * g->dims[2]);
+    } else if (auto_bounds) {
+        bounds = json_null(); /* the scene's, placed at the next tick */
+    } else {
+        bounds = json_pack("[f,f,f,f,f,f]", (double)s.bounds_min[0], (double)s.bounds_min[1], (double)s.bounds_min[2],
+                           (double)s.bounds_max[0], (double)s.bounds_max[1], (double)s.bounds_max[2]);
+    }
+    return json_pack("{s:[i,i,i], s:o, s:b, s:i, s:i, s:b, s:f, s:i, s:f}", "grid", s.grid_dims[0], s.grid_dims[1],
+                     s.grid_dims[2], "bounds", bounds, "bounds_auto", auto_bounds, "iterations", s.iterations,
+                     "rsm_size", s.rsm_size, "occlusion", s.occlusion != LPV_SWITCH_OFF, "indirect_gain",
+                     (double)s.indirect_gain, "emissive_vpls", s.emissive_vpls, "tick_rate_hz", c->tick_rate);
+}
+
+static json_t *scene_json(const lpv_scene *sc)
+{
+    return json_pack("{s:I, s:i, s:i, s:i, s:[f,f,f,f,f,f], s:s}", "triangles", (json_int_t)(sc->index_count / 3),
+                     "materials", (int)sc->material_count, "lights", (int)sc->light_count, "cameras",
+                     (int)sc->camera_count, "bounds", (double)sc->bounds_min[0], (double)sc->bounds_min[1],
+                     (double)sc->bounds_min[2], (double)sc->bounds_max[0], (double)sc->bounds_max[1],
+                     (double)sc->bounds_max[2], "source", sc->source);
+}
+
+/* ---- HELLO -------------------------------------------------------------- */
+static int token_equal(const char *a, size_t alen, const char *b, size_t blen)
+{
+    /* constant time in the secret's length: every byte of b is visited */
+    unsigned diff = (unsigned)(alen ^ blen);
+    for (size_t i = 0; i < blen; ++i) {
+        unsigned char x = i < alen ? (unsigned char)a[i] : 0;
+        diff |= x ^ (unsigned char)b[i];
+    }
+    return diff == 0;
+}
+
+static void do_hello(sv_conn *c, sv_request *r, json_t *j)
+{
+    sv_server *s = c->srv;
+    char err[256];
+    int64_t v = 0;
+    if (lpvp_get_int(j, "version", 1, INT32_MIN, INT32_MAX, &v, err, sizeof err) != LPVP_FIELD_OK) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (v != LPVP_VERSION) {
+        reply_err(c, r->request_id, LPVP_E_BAD_VERSION, 1, "HELLO version %lld is not spoken; this server speaks 1",
+                  (long long)v);
+        return;
+    }
+    const char *client = NULL, *token = NULL;
+    size_t tlen = 0;
+    if (lpvp_get_string(j, "client", 0, 256, &client, NULL, err, sizeof err) == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    int tst = lpvp_get_string(j, "token", 0, 4096, &token, &tlen, err, sizeof err);
+    if (s->cfg.has_token) {
+        if (tst != LPVP_FIELD_OK ||
+            !token_equal(token, tlen, s->cfg.token, strlen(s->cfg.token))) {
+            reply_err(c, r->request_id, LPVP_E_UNAUTHORIZED, 0, "%s",
+                      tst == LPVP_FIELD_OK ? "wrong token" : "this server requires a token in HELLO (\"token\")");
+            return;
+        }
+    } else if (tst == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    c->hello = 1;
+    char server[64];
+    snprintf(server, sizeof server, "lpvd %s", LPVD_VERSION);
+    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I}", "max_body", (json_int_t)s->cfg.max_body,
+                            "max_message", (json_int_t)s->cfg.max_message, "max_clients", s->cfg.max_clients,
+                            "max_triangles", (json_int_t)s->cfg.max_triangles, "max_texture", s->cfg.max_texture,
+                            "max_grid", s->cfg.max_grid, "max_tick_rate", s->cfg.max_tick_rate, "idle_timeout",
+                            s->cfg.idle_timeout, "max_queue", (json_int_t)s->cfg.max_queue);
+    json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
+                          (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
+                          "revision", (json_int_t)c->revision);
+    reply(c, LPVP_HELLO, r->request_id, b);
+}
+
+/* ---- SCENE_LOAD / SCENE_UPDATE (worker thread) --------------------------- */
+typedef struct load_work {
+    uv_work_t req;
+    sv_conn *c;
+    uint32_t request_id;
+    uint16_t type;
+    /* in */
+    char *path;            /* resolved real path, or NULL */
+    uint8_t *glb;          /* attachment or the session scene's bytes (owned copy) */
+    size_t glb_size;
+    char *base_dir;
+    lpv_gltf_node_override *nodes;
+    size_t node_count;
+    uint64_t base_hash;
+    /* out */
+    int status;
+    char err[1024];
+    sv_scene *scene;
+} load_work;
+
+static char *dir_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t n = slash ? (size_t)(slash - path) : 0;
+    char *d = malloc(n + 2);
+    if (!d)
+        return NULL;
+    if (n == 0) {
+        strcpy(d, slash ? "/" : ".");
+    } else {
+        memcpy(d, path, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+static int contains(const uint8_t *hay, size_t n, const char *needle)
+{
+    size_t k = strlen(needle);
+    for (size_t i = 0; i + k <= n; ++i)
+        if (hay[i] == (uint8_t)needle[0] && memcmp(hay + i, needle, k) == 0)
+            return 1;
+    return 0;
+}
+
+static void load_run(uv_work_t *req)
+{
+    load_work *w = req->data;
+    if (w->path) {
+        int fd = open(w->path, O_RDONLY | O_CLOEXEC);
+        struct stat st;
+        if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+            snprintf(w->err, sizeof w->err, "%s: %s", w->path, fd < 0 ? strerror(errno) : "not a regular file");
+            if (fd >= 0)
+                close(fd);
+            w->status = LPVP_E_SCENE_INVALID;
+            return;
+        }
+        w->glb_size = (size_t)st.st_size;
+        w->glb = malloc(w->glb_size ? w->glb_size : 1);
+        size_t got = 0;
+        while (w->glb && got < w->glb_size) {
+            ssize_t n = read(fd, w->glb + got, w->glb_size - got);
+            if (n < 0 && errno == EINTR)
+                continue;
+            if (n <= 0)
+                break;
+            got += (size_t)n;
+        }
+        close(fd);
+        if (!w->glb || got != w->glb_size) {
+            snprintf(w->err, sizeof w->err, "%s: cannot read", w->path);
+            w->status = LPVP_E_SCENE_INVALID;
+            return;
+        }
+        w->base_dir = dir_of(w->path);
+    }
+    sv_scene *sc = calloc(1, sizeof *sc);
+    if (!sc) {
+        w->status = LPVP_E_INTERNAL;
+        snprintf(w->err, sizeof w->err, "out of memory");
+        return;
+    }
+    const char *label = w->path ? w->path : "attachment";
+    int rc = lpv_gltf_load_memory_ex(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
+                                     w->err, sizeof w->err);
+    if (rc != 0) {
+        free(sc);
+        w->status = LPVP_E_SCENE_INVALID;
+        return;
+    }
+    if (lpv_scene_ensure_light(&sc->scene) != 0) {
+        lpv_scene_free(&sc->scene);
+        free(sc);
+        w->status = LPVP_E_INTERNAL;
+        snprintf(w->err, sizeof w->err, "out of memory adding the default light");
+        return;
+    }
+    if (w->base_dir && !contains(w->glb, w->glb_size, "\"uri\"")) {
+        /* self-contained: the folder plays no part, so a path load and an
+         * attachment of the same bytes are the same scene (and share worlds) */
+        free(w->base_dir);
+        w->base_dir = NULL;
+    }
+    uint64_t h = sv_hash_bytes(SV_HASH_INIT, w->glb, w->glb_size);
+    if (w->base_dir)
+        h = sv_hash_bytes(h, w->base_dir, strlen(w->base_dir));
+    if (w->node_count)
+        h = sv_hash_bytes(h, w->nodes, sizeof *w->nodes * w->node_count);
+    sc->hash = h ? h : 1;
+    sc->glb = w->glb;
+    sc->glb_size = w->glb_size;
+    sc->base_dir = w->base_dir;
+    sc->nodes = w->nodes;
+    sc->node_count = w->node_count;
+    w->glb = NULL;
+    w->base_dir = NULL;
+    w->nodes = NULL;
+    w->node_count = 0;
+    w->scene = sc;
+}
+
+static int scene_over_limits(sv_server *s, const lpv_scene *sc, char *err, size_t n)
+{
+    uint64_t tris = sc->index_count / 3;
+    if (tris > s->cfg.max_triangles) {
+        snprintf(err, n, "%s has %llu triangles, over the server's limit of %llu (--max-triangles)", sc->source,
+                 (unsigned long long)tris, (unsigned long long)s->cfg.max_triangles);
+        return 1;
+    }
+    for (uint32_t i = 0; i < sc->texture_count; ++i)
+        if (sc->textures[i].width > s->cfg.max_texture || sc->textures[i].height > s->cfg.max_texture) {
+            snprintf(err, n, "%s: texture %u is %dx%d, over the server's limit of %d texels per side (--max-texture)",
+                     sc->source, i, sc->textures[i].width, sc->textures[i].height, s->cfg.max_texture);
+            return 1;
+        }
+    return 0;
+}
+
+static void free_sv_scene_unlisted(sv_scene *sc)
+{
+    lpv_scene_free(&sc->scene);
+    free(sc->glb);
+    free(sc->base_dir);
+    free(sc->nodes);
+    free(sc);
+}
+
+static void load_done(uv_work_t *req, int status)
+{
+    load_work *w = req->data;
+    sv_conn *c = w->c;
+    sv_server *s = c->srv;
+    (void)status;
+    if (!c->closing && !c->close_after_write) {
+        char err[1024];
+        if (w->status == LPVP_E_SCENE_INVALID && w->type == LPVP_SCENE_UPDATE) {
+            /* the file loaded before: the new node transforms are at fault */
+            reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "nodes: %s", w->err);
+        } else if (w->status) {
+            reply_err(c, w->request_id, w->status, 0, "%s", w->err);
+        } else if (scene_over_limits(s, &w->scene->scene, err, sizeof err)) {
+            free_sv_scene_unlisted(w->scene);
+            w->scene = NULL;
+            reply_err(c, w->request_id, LPVP_E_LIMIT, 0, "%s", err);
+        } else {
+            sv_scene *sc = sv_scene_intern(s, w->scene);
+            w->scene = NULL;
+            /* SCENE_UPDATE of nodes keeps the session's material edits and lights */
+            lpv_material *keep_m = NULL;
+            lpv_light *keep_l = NULL, *old_file = NULL;
+            uint32_t keep_mn = 0, keep_ln = 0, old_n = 0;
+            int ofail = 0;
+            if (w->type == LPVP_SCENE_UPDATE) {
+                old_file = named_lights(&c->scene->scene, &ofail);
+                old_n = c->scene->scene.light_count;
+                keep_m = c->materials;
+                keep_mn = c->material_count;
+                keep_l = c->lights;
+                keep_ln = c->light_count;
+                c->materials = NULL;
+                c->lights = NULL;
+            }
+            if (session_set_scene(c, sc) != 0) {
+                sv_scene_unref(s, sc);
+                if (w->type == LPVP_SCENE_UPDATE) { /* the session keeps what it had */
+                    c->materials = keep_m;
+                    c->lights = keep_l;
+                }
+                reply_err(c, w->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            } else {
+                if (w->type == LPVP_SCENE_UPDATE) {
+                    if (keep_mn == c->material_count) {
+                        free(c->materials);
+                        c->materials = keep_m;
+                    } else {
+                        free(keep_m);
+                    }
+                    /* file lights the session did not edit follow their nodes */
+                    for (uint32_t i = 0; i < keep_ln && old_file && !ofail && c->lights; ++i)
+                        for (uint32_t k = 0; k < old_n && k < c->light_count; ++k)
+                            if (strcmp(keep_l[i].name, old_file[k].name) == 0 &&
+                                memcmp(&keep_l[i], &old_file[k], sizeof keep_l[i]) == 0 &&
+                                strcmp(c->lights[k].name, old_file[k].name) == 0) {
+                                keep_l[i] = c->lights[k];
+                                break;
+                            }
+                    free(c->lights);
+                    c->lights = keep_l;
+                    c->light_count = keep_ln;
+                } else {
+                    free(keep_m);
+                    free(keep_l);
+                }
+                session_changed(c);
+                json_t *b = rev_body(c);
+                if (w->type == LPVP_SCENE_LOAD)
+                    json_object_set_new(b, "scene", scene_json(&sc->scene));
+                reply(c, w->type, w->request_id, b);
+            }
+            free(old_file);
+        }
+    }
+    if (w->scene)
+        free_sv_scene_unlisted(w->scene);
+    free(w->path);
+    free(w->glb);
+    free(w->base_dir);
+    free(w->nodes);
+    c->busy = 0;
+    free(w);
+    sv_session_pump(c);
+    sv_conn_unref(c);
+}
+
+static int start_load(sv_conn *c, load_work *w)
+{
+    w->req.data = w;
+    w->c = c;
+    c->refs++;
+    c->busy = 1;
+    if (uv_queue_work(c->srv->loop, &w->req, load_run, load_done) != 0) {
+        c->busy = 0;
+        c->refs--;
+        return -1;
+    }
+    return 0;
+}
+
+/* R4.3: relative, no "..", resolved (symlinks too) inside the root. */
+static int resolve_scene_path(sv_server *s, const char *p, char **out, char *err, size_t n)
+{
+    if (!s->cfg.scene_root[0]) {
+        snprintf(err, n, "path %s: this server has no --scene-root; send the .glb as an attachment", p);
+        return -1;
+    }
+    if (!p[0] || p[0] == '/') {
+        snprintf(err, n, "path %s: absolute paths are refused; give a path relative to the scene root", p);
+        return -1;
+    }
+    const char *q = p;
+    while (*q) {
+        const char *e = strchr(q, '/');
+        size_t len = e ? (size_t)(e - q) : strlen(q);
+        if (len == 2 && q[0] == '.' && q[1] == '.') {
+            snprintf(err, n, "path %s: \"..\" components are refused", p);
+            return -1;
+        }
+        q += len;
+        if (*q == '/')
+            q++;
+    }
+    size_t need = strlen(s->cfg.scene_root) + strlen(p) + 2;
+    char *joined = malloc(need);
+    if (!joined) {
+        snprintf(err, n, "out of memory");
+        return -1;
+    }
+    snprintf(joined, need, "%s/%s", s->cfg.scene_root, p);
+    char *real = realpath(joined, NULL);
+    free(joined);
+    if (!real) {
+        snprintf(err, n, "path %s: %s under the scene root", p, strerror(errno));
+        return 1; /* not a refusal: the file does not exist */
+    }
+    size_t rl = strlen(s->cfg.scene_root);
+    if (strncmp(real, s->cfg.scene_root, rl) != 0 || (real[rl] != '/' && !(rl == 1 && s->cfg.scene_root[0] == '/'))) {
+        snprintf(err, n, "path %s: leaves the scene root (through a symbolic link)", p);
+        free(real);
+        return -1;
+    }
+    *out = real;
+    return 0;
+}
+
+static void do_scene_load(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[1024];
+    const char *path = NULL;
+    int pst = lpvp_get_string(j, "path", 0, 4096, &path, NULL, err, sizeof err);
+    if (pst == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    load_work *w = calloc(1, sizeof *w);
+    if (!w) {
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    w->request_id = r->request_id;
+    w->type = LPVP_SCENE_LOAD;
+    if (pst == LPVP_FIELD_OK) {
+        if (r->att_len) {
+            free(w);
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                      "path: give either \"path\" or a .glb attachment, not both");
+            return;
+        }
+        int rc = resolve_scene_path(c->srv, path, &w->path, err, sizeof err);
+        if (rc != 0) {
+            free(w);
+            reply_err(c, r->request_id, rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
+            return;
+        }
+    } else {
+        if (!r->att_len) {
+            free(w);
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                      "path: required (a path under --scene-root), or send the .glb as the attachment");
+            return;
+        }
+        w->glb = r->att; /* take the attachment */
+        w->glb_size = r->att_len;
+        r->att = NULL;
+        r->att_len = 0;
+    }
+    if (start_load(c, w) != 0) {
+        free(w->path);
+        free(w->glb);
+        free(w);
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene load");
+    }
+}
+
+static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    const json_t *nodes = NULL, *mats = NULL;
+    if (lpvp_get_array(j, "nodes", 0, 65536, &nodes, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_array(j, "materials", 0, 65536, &mats, err, sizeof err) == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    /* materials: validated into a copy, applied only if all are good */
+    lpv_material *m = NULL;
+    if (mats && json_array_size(mats)) {
+        m = malloc(sizeof *m * (c->material_count ? c->material_count : 1));
+        if (!m) {
+            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        if (c->material_count)
+            memcpy(m, c->materials, sizeof *m * c->material_count);
+        for (size_t i = 0; i < json_array_size(mats); ++i) {
+            const json_t *e = json_array_get(mats, i);
+            int64_t idx;
+            int bad = 0;
+            if (!json_is_object(e)) {
+                snprintf(err, sizeof err, "materials[%zu]: expected an object", i);
+                bad = 1;
+            } else if (lpvp_get_int(e, "material", 1, 0, (int64_t)c->material_count - 1, &idx, err, sizeof err) !=
+                       LPVP_FIELD_OK) {
+                if (c->material_count == 0)
+                    snprintf(err, sizeof err, "material: the scene has no materials");
+                bad = 1;
+            } else {
+                lpv_material *t = &m[idx];
+                if (lpvp_get_floats(e, "base_color", 0, 4, 0.0, 1.0, t->base_color, err, sizeof err) ==
+                        LPVP_FIELD_BAD ||
+                    lpvp_get_floats(e, "emission", 0, 3, 0.0, 1e30, t->emission, err, sizeof err) == LPVP_FIELD_BAD ||
+                    lpvp_get_float(e, "metallic", 0, 0.0, 1.0, &t->metallic, err, sizeof err) == LPVP_FIELD_BAD ||
+                    lpvp_get_float(e, "roughness", 0, 0.0, 1.0, &t->roughness, err, sizeof err) == LPVP_FIELD_BAD)
+                    bad = 1;
+            }
+            if (bad) {
+                if (strncmp(err, "materials[", 10) != 0)
+                    lpvp_err_prefix(err, sizeof err, "materials[%zu].", i);
+                free(m);
+                reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+                return;
+            }
+        }
+    }
+    /* nodes: parsed into overrides; the scene is rebuilt from its bytes */
+    lpv_gltf_node_override *ov = NULL;
+    size_t nov = 0;
+    if (nodes && json_array_size(nodes)) {
+        if (!c->scene->glb) {
+            free(m);
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                      "nodes: the built-in scene has no glTF nodes; SCENE_LOAD a .glb first");
+            return;
+        }
+        nov = json_array_size(nodes);
+        ov = calloc(nov, sizeof *ov);
+        if (!ov) {
+            free(m);
+            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        for (size_t i = 0; i < nov; ++i) {
+            const json_t *e = json_array_get(nodes, i);
+            lpv_gltf_node_override *o = &ov[i];
+            int64_t idx;
+            int st[4];
+            if (!json_is_object(e)) {
+                snprintf(err, sizeof err, "nodes[%zu]: expected an object", i);
+                goto bad_node;
+            }
+            if (lpvp_get_int(e, "node", 1, 0, INT32_MAX, &idx, err, sizeof err) != LPVP_FIELD_OK)
+                goto bad_node_prefix;
+            o->node = (int)idx;
+            if ((st[0] = lpvp_get_floats(e, "matrix", 0, 16, -1e30, 1e30, o->matrix, err, sizeof err)) ==
+                    LPVP_FIELD_BAD ||
+                (st[1] = lpvp_get_floats(e, "translation", 0, 3, -1e30, 1e30, o->translation, err, sizeof err)) ==
+                    LPVP_FIELD_BAD ||
+                (st[2] = lpvp_get_floats(e, "rotation", 0, 4, -1e30, 1e30, o->rotation, err, sizeof err)) ==
+                    LPVP_FIELD_BAD ||
+                (st[3] = lpvp_get_floats(e, "scale", 0, 3, -1e30, 1e30, o->scale, err, sizeof err)) ==
+                    LPVP_FIELD_BAD)
+                goto bad_node_prefix;
+            o->has_matrix = st[0] == LPVP_FIELD_OK;
+            o->has_translation = st[1] == LPVP_FIELD_OK;
+            o->has_rotation = st[2] == LPVP_FIELD_OK;
+            o->has_scale = st[3] == LPVP_FIELD_OK;
+            if (o->has_matrix && (o->has_translation || o->has_rotation || o->has_scale)) {
+                snprintf(err, sizeof err, "matrix: give either \"matrix\" or translation/rotation/scale");
+                goto bad_node_prefix;
+            }
+            continue;
+        bad_node_prefix:
+            lpvp_err_prefix(err, sizeof err, "nodes[%zu].", i);
+        bad_node:
+            free(ov);
+            free(m);
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+            return;
+        }
+    }
+    if (!ov) {
+        if (m) {
+            free(c->materials);
+            c->materials = m;
+        }
+        session_changed(c);
+        reply(c, LPVP_SCENE_UPDATE, r->request_id, rev_body(c));
+        return;
+    }
+    load_work *w = calloc(1, sizeof *w);
+    uint8_t *glb = malloc(c->scene->glb_size ? c->scene->glb_size : 1);
+    char *bd = c->scene->base_dir ? strdup(c->scene->base_dir) : NULL;
+    if (!w || !glb || (c->scene->base_dir && !bd)) {
+        free(w);
+        free(glb);
+        free(bd);
+        free(ov);
+        free(m);
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    memcpy(glb, c->scene->glb, c->scene->glb_size);
+    /* materials: apply now (the rebuilt scene keeps the session's material list) */
+    if (m) {
+        free(c->materials);
+        c->materials = m;
+    }
+    w->request_id = r->request_id;
+    w->type = LPVP_SCENE_UPDATE;
+    w->glb = glb;
+    w->glb_size = c->scene->glb_size;
+    w->base_dir = bd;
+    w->nodes = ov;
+    w->node_count = nov;
+    /* the overrides the scene already has come first (later ones win) */
+    if (c->scene->node_count) {
+        lpv_gltf_node_override *all = calloc(c->scene->node_count + nov, sizeof *all);
+        if (!all) {
+            free(w->glb);
+            free(w->base_dir);
+            free(w->nodes);
+            free(w);
+            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        memcpy(all, c->scene->nodes, sizeof *all * c->scene->node_count);
+        memcpy(all + c->scene->node_count, ov, sizeof *all * nov);
+        free(w->nodes);
+        w->nodes = all;
+        w->node_count = c->scene->node_count + nov;
+    }
+    if (start_load(c, w) != 0) {
+        free(w->glb);
+        free(w->base_dir);
+        free(w->nodes);
+        free(w);
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene rebuild");
+    }
+}
+
+/* ---- lights, camera, config ---------------------------------------------- */
+static void do_light_set(sv_conn *c, sv_request *r, json_t *j)
+{
+    static const char *const TYPES[] = {"directional", "point", "spot"}; /* = lpv_light_type */
+    char err[512];
+    const char *id = NULL;
+    size_t idlen = 0;
+    int type = 0;
+    lpv_light l;
+    memset(&l, 0, sizeof l);
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    l.direction[1] = -1.0f;
+    l.outer_cone = (float)(M_PI / 4.0);
+    if (lpvp_get_string(j, "id", 1, LPV_NAME_MAX - 1, &id, &idlen, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_enum(j, "type", 1, TYPES, 3, &type, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_floats(j, "color", 0, 3, 0.0, 1e30, l.color, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "intensity", 1, 0.0, 1e30, &l.intensity, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_floats(j, "position", 0, 3, -1e30, 1e30, l.position, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_floats(j, "direction", 0, 3, -1e30, 1e30, l.direction, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "range", 0, 0.0, 1e30, &l.range, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "inner_cone", 0, 0.0, M_PI / 2.0, &l.inner_cone, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "outer_cone", 0, 0.0, M_PI / 2.0, &l.outer_cone, err, sizeof err) == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (idlen == 0) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: must not be empty");
+        return;
+    }
+    float dl = sqrtf(l.direction[0] * l.direction[0] + l.direction[1] * l.direction[1] +
+                     l.direction[2] * l.direction[2]);
+    if (!(dl > 1e-12f) || !isfinite(dl)) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "direction: must be a non-zero vector");
+        return;
+    }
+    for (int i = 0; i < 3; ++i)
+        l.direction[i] /= dl;
+    if (type == LPV_LIGHT_SPOT && l.inner_cone > l.outer_cone) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "inner_cone: must not exceed outer_cone");
+        return;
+    }
+    if (type != LPV_LIGHT_SPOT)
+        l.inner_cone = l.outer_cone = 0.0f;
+    l.type = (lpv_light_type)type;
+    memcpy(l.name, id, idlen);
+    uint32_t i = 0;
+    while (i < c->light_count && strcmp(c->lights[i].name, l.name) != 0)
+        ++i;
+    if (i == c->light_count) {
+        if (c->light_count >= SV_MAX_LIGHTS) {
+            reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "a session has at most %d lights", SV_MAX_LIGHTS);
+            return;
+        }
+        lpv_light *nl = realloc(c->lights, sizeof *nl * (c->light_count + 1));
+        if (!nl) {
+            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        c->lights = nl;
+        c->light_count++;
+    }
+    c->lights[i] = l;
+    session_changed(c);
+    reply(c, LPVP_LIGHT_SET, r->request_id, rev_body(c));
+}
+
+static void do_light_remove(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    const char *id = NULL;
+    if (lpvp_get_string(j, "id", 1, 4096, &id, NULL, err, sizeof err) != LPVP_FIELD_OK) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    uint32_t i = 0;
+    while (i < c->light_count && strcmp(c->lights[i].name, id) != 0)
+        ++i;
+    if (i == c->light_count) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: no light \"%s\" in this session", id);
+        return;
+    }
+    memmove(&c->lights[i], &c->lights[i + 1], sizeof *c->lights * (c->light_count - i - 1));
+    c->light_count--;
+    session_changed(c);
+    reply(c, LPVP_LIGHT_REMOVE, r->request_id, rev_body(c));
+}
+
+static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int64_t w = c->view_w ? c->view_w : SV_DEFAULT_VIEW_SIDE, h = c->view_h ? c->view_h : SV_DEFAULT_VIEW_SIDE;
+    if (lpvp_get_int(j, "width", 0, 1, SV_MAX_VIEW_SIDE, &w, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_int(j, "height", 0, 1, SV_MAX_VIEW_SIDE, &h, err, sizeof err) == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    const json_t *cam = json_object_get(j, "camera");
+    const lpv_scene *sc = &c->scene->scene;
+    lpv_view v;
+    if (cam) {
+        char key[64];
+        if (json_is_integer(cam))
+            snprintf(key, sizeof key, "%lld", (long long)json_integer_value(cam));
+        else if (json_is_string(cam))
+            snprintf(key, sizeof key, "%s", json_string_value(cam));
+        else {
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: expected an index or a name");
+            return;
+        }
+        int idx = lpv_view_find_camera(sc, key);
+        if (idx < 0) {
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: the scene has %u camera(s) and none is \"%s\"",
+                      sc->camera_count, key);
+            return;
+        }
+        lpv_view_from_camera(&sc->cameras[idx], (int)w, (int)h, &v);
+        c->view_camera = idx;
+        c->view_explicit = 0;
+    } else {
+        float eye[3], target[3], up[3] = {0, 1, 0}, fov = 45.0f;
+        int has_up;
+        if (lpvp_get_floats(j, "eye", 1, 3, -1e30, 1e30, eye, err, sizeof err) != LPVP_FIELD_OK ||
+            lpvp_get_floats(j, "target", 1, 3, -1e30, 1e30, target, err, sizeof err) != LPVP_FIELD_OK ||
+            (has_up = lpvp_get_floats(j, "up", 0, 3, -1e30, 1e30, up, err, sizeof err)) == LPVP_FIELD_BAD ||
+            lpvp_get_float(j, "fov_deg", 0, 0.01, 179.0, &fov, err, sizeof err) == LPVP_FIELD_BAD) {
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+            return;
+        }
+        if (lpv_view_look_at(eye, target, fov * (float)(M_PI / 180.0), (int)w, (int)h, &v) != 0) {
+            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "target: must differ from eye");
+            return;
+        }
+        if (has_up == LPVP_FIELD_OK) { /* up, made orthogonal to forward */
+            float d = up[0] * v.forward[0] + up[1] * v.forward[1] + up[2] * v.forward[2];
+            float u[3] = {up[0] - d * v.forward[0], up[1] - d * v.forward[1], up[2] - d * v.forward[2]};
+            float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (!(ul > 1e-6f) || !isfinite(ul)) {
+                reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "up: must not be parallel to target - eye");
+                return;
+            }
+            for (int i = 0; i < 3; ++i)
+                v.up[i] = u[i] / ul;
+        }
+        c->view_explicit = 1;
+        c->view_camera = -1;
+    }
+    c->view_w = (int)w;
+    c->view_h = (int)h;
+    c->view = v;
+    session_changed(c);
+    reply(c, LPVP_CAMERA_SET, r->request_id, rev_body(c));
+}
+
+static void do_config(sv_conn *c, sv_request *r, json_t *j)
+{
+    sv_server *s = c->srv;
+    char err[512];
+    lpv_settings st = c->settings;
+    double rate = c->tick_rate;
+    int64_t grid[3], iv;
+    float bounds[6], gain;
+    int occl, gst;
+    double lim_rate = s->cfg.max_tick_rate;
+    const json_t *gj = json_object_get(j, "grid");
+    if (gj && json_is_integer(gj)) { /* a single N is accepted as NxNxN */
+        gst = lpvp_get_int(j, "grid", 1, 1, INT32_MAX, &grid[0], err, sizeof err);
+        grid[1] = grid[2] = grid[0];
+    } else {
+        gst = lpvp_get_ints(j, "grid", 0, 3, 1, INT32_MAX, grid, err, sizeof err);
+    }
+    if (gst == LPVP_FIELD_BAD)
+        goto bad;
+    if (gst == LPVP_FIELD_OK) {
+        for (int i = 0; i < 3; ++i)
+            if (grid[i] > s->cfg.max_grid) {
+                reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                          "grid: %lld cells on an axis is over the server's limit of %d (--max-grid)",
+                          (long long)grid[i], s->cfg.max_grid);
+                return;
+            }
+        for (int i = 0; i < 3; ++i)
+            st.grid_dims[i] = (int)grid[i];
+    }
+    int bst = lpvp_get_floats(j, "bounds", 0, 6, -1e30, 1e30, bounds, err, sizeof err);
+    if (bst == LPVP_FIELD_BAD)
+        goto bad;
+    if (bst == LPVP_FIELD_OK) {
+        if (!(bounds[3] > bounds[0] && bounds[4] > bounds[1] && bounds[5] > bounds[2])) {
+            snprintf(err, sizeof err, "bounds: expected [x0, y0, z0, x1, y1, z1] with max > min");
+            goto bad;
+        }
+        memcpy(st.bounds_min, bounds, sizeof st.bounds_min);
+        memcpy(st.bounds_max, bounds + 3, sizeof st.bounds_max);
+    }
+    int ist;
+    if ((ist = lpvp_get_int(j, "iterations", 0, 1, LPV_MAX_ITERATIONS, &iv, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK)
+        st.iterations = (int)iv;
+    if ((ist = lpvp_get_int(j, "rsm_size", 0, 16, LPV_MAX_RSM_SIZE, &iv, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK) {
+        if (iv > s->cfg.max_texture) {
+            reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                      "rsm_size: %lld is over the server's texture limit of %d (--max-texture)", (long long)iv,
+                      s->cfg.max_texture);
+            return;
+        }
+        st.rsm_size = (int)iv;
+    }
+    if ((ist = lpvp_get_bool(j, "occlusion", 0, &occl, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK)
+        st.occlusion = occl ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+    if ((ist = lpvp_get_float(j, "indirect_gain", 0, 1e-30, 1e30, &gain, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK)
+        st.indirect_gain = gain;
+    if ((ist = lpvp_get_int(j, "emissive_vpls", 0, 1, 1 << 20, &iv, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK)
+        st.emissive_vpls = (int)iv;
+    double rv;
+    if ((ist = lpvp_get_number(j, "tick_rate_hz", 0, 0.0, 1e9, &rv, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK) {
+        if (rv > lim_rate) {
+            reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                      "tick_rate_hz: %g is over the server's limit of %g Hz (--max-tick-rate)", rv, lim_rate);
+            return;
+        }
+        rate = rv;
+    }
+    lpv_settings chk = st;
+    lpv_settings_resolve(&chk);
+    if (lpv_settings_validate(&chk, err, sizeof err) != 0)
+        goto bad;
+    c->settings = st;
+    c->tick_rate = rate;
+    session_changed(c);
+    json_t *b = rev_body(c);
+    json_object_set_new(b, "config", config_json(c));
+    reply(c, LPVP_CONFIG, r->request_id, b);
+    return;
+bad:
+    reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+}
+
+/* ---- ticks, volumes, frames, queries -------------------------------------- */
+static int world_current(sv_conn *c)
+{
+    return c->world && c->world->latest && c->world->latest->gen == c->world_gen;
+}
+
+static void submit(sv_conn *c, sv_job *j)
+{
+    j->conn = c;
+    c->refs++;
+    c->busy = 1;
+    sv_job_submit(c->srv, j);
+}
+
+static void do_tick(sv_conn *c, sv_request *r)
+{
+    sv_job *j = c->world ? sv_job_new(SV_JOB_TICK, c->world) : NULL;
+    if (!j) {
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    j->request_id = r->request_id;
+    j->terms_mask = sv_world_terms_mask(c->world);
+    submit(c, j);
+}
+
+static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
+{
+    char err[512];
+    int stream = 0, fmt = -1, comp = -1, delta = 0, terms = 0;
+    if (lpvp_get_enum(j, "stream", 1, STREAMS, 2, &stream, err, sizeof err) != LPVP_FIELD_OK)
+        goto bad;
+    sv_sub *sub = &c->subs[stream];
+    if (!on) {
+        sub->on = 0;
+        sv_sub_clear(sub);
+        reply(c, LPVP_UNSUBSCRIBE, r->request_id, json_object());
+        return;
+    }
+    if (lpvp_get_enum(j, "format", 0, stream ? FRAME_FMTS : VOL_FMTS, stream ? 3 : 2, &fmt, err, sizeof err) ==
+            LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_bool(j, "delta", 0, &delta, err, sizeof err) == LPVP_FIELD_BAD ||
+        (stream && lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD))
+        goto bad;
+    if (stream && delta) {
+        snprintf(err, sizeof err, "delta: only the volume stream has deltas");
+        goto bad;
+    }
+    sv_sub_clear(sub);
+    sub->on = 1;
+    if (stream == SV_STREAM_VOLUME) {
+        sub->fp16 = fmt != 1;
+        sub->zstd = comp != 1; /* default zstd */
+        sub->delta = delta;
+    } else {
+        sub->fmt = fmt < 0 ? 1 : fmt; /* default png */
+        sub->zstd = comp == 0;        /* default none (rgba8 only) */
+        sub->terms = terms;
+    }
+    reply(c, LPVP_SUBSCRIBE, r->request_id, json_object());
+    return;
+bad:
+    reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+}
+
+static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int fmt = 0, comp = 0;
+    if (lpvp_get_enum(j, "format", 0, VOL_FMTS, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (!world_current(c)) {
+        reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+                  "no volume yet for this session's current scene, lights, camera and config: send TICK first");
+        return;
+    }
+    json_t *b = NULL;
+    uint8_t *att = NULL;
+    size_t alen = 0;
+    if (sv_encode_volume(c->world->latest, fmt == 0, comp == 0, NULL, c->revision, &b, &att, &alen, err,
+                         sizeof err) != 0) {
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
+        return;
+    }
+    sv_send(c, LPVP_REPLY(LPVP_GET_VOLUME), r->request_id, b, att, alen, SV_STREAM_NONE);
+}
+
+static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w, int h, int fmt, int zstd, int terms,
+                             uint64_t tick)
+{
+    char err[512];
+    json_t *b = NULL;
+    uint8_t *att = NULL;
+    size_t alen = 0;
+    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, c->revision, tick, &b, &att, &alen, err, sizeof err) != 0) {
+        reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
+        return;
+    }
+    sv_send(c, LPVP_REPLY(LPVP_GET_FRAME), rid, b, att, alen, SV_STREAM_NONE);
+}
+
+static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int fmt = 1, comp = 1, terms = 0;
+    if (lpvp_get_enum(j, "format", 0, FRAME_FMTS, 3, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (!world_current(c)) {
+        reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+                  "no tick yet for this session's current scene, lights, camera and config: send TICK first");
+        return;
+    }
+    const sv_result *res = c->world->latest;
+    if (res->frames[terms]) { /* rendered with the tick already */
+        send_frame_reply(c, r->request_id, res->frames[terms], res->width, res->height, fmt, comp == 0, terms,
+                         res->tick);
+        return;
+    }
+    sv_job *jb = sv_job_new(SV_JOB_RENDER, c->world);
+    if (!jb) {
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    jb->request_id = r->request_id;
+    jb->terms = terms;
+    jb->count = (size_t)fmt | ((size_t)(comp == 0) << 4); /* encoding choice, read back in job_done */
+    submit(c, jb);
+}
+
+static void do_query(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int64_t count = 0;
+    if (lpvp_get_int(j, "count", 1, 0, (int64_t)(c->srv->cfg.max_message / 24), &count, err, sizeof err) !=
+        LPVP_FIELD_OK) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (r->att_len != (size_t)count * 24) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                  "attachment: expected count x 24 = %lld bytes (px py pz nx ny nz float32 per point), got %zu",
+                  (long long)count * 24, r->att_len);
+        return;
+    }
+    if (!world_current(c)) {
+        reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+                  "no tick yet for this session's current scene, lights, camera and config: send TICK first");
+        return;
+    }
+    sv_job *jb = sv_job_new(SV_JOB_QUERY, c->world);
+    float *pts = malloc(count ? (size_t)count * 24 : 1);
+    if (!jb || !pts) {
+        free(pts);
+        sv_job_free(jb);
+        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    for (int64_t i = 0; i < count * 6; ++i) { /* little-endian float32 */
+        uint32_t u = lpvp_get_u32(r->att + i * 4);
+        float f;
+        memcpy(&f, &u, 4);
+        pts[i] = f;
+    }
+    jb->points = pts;
+    jb->count = (size_t)count;
+    jb->request_id = r->request_id;
+    submit(c, jb);
+}
+
+static void do_stats(sv_conn *c, sv_request *r)
+{
+    sv_server *s = c->srv;
+    json_t *stages = json_array(), *plan = json_object();
+    if (c->world && c->world->latest) {
+        const sv_result *res = c->world->latest;
+        json_decref(stages);
+        stages = stats_stages(&res->stats);
+        json_decref(plan);
+        plan = tick_stats(res);
+        json_object_set_new(plan, "tick", json_integer((json_int_t)res->tick));
+        json_object_set_new(plan, "current", json_boolean(res->gen == c->world_gen));
+    }
+    json_object_set_new(plan, "backend", json_string(s->gl_backend));
+    json_object_set_new(plan, "gl_renderer", json_string(s->gl_renderer));
+    json_object_set_new(plan, "config", config_json(c));
+    size_t pend = 0, wq = 0, drops = 0;
+    int sessions = 0;
+    for (sv_conn *o = s->conns; o; o = o->next) {
+        pend += o->pending_count;
+        wq += o->wq_bytes;
+        drops += o->stream_dropped;
+        if (o->hello)
+            sessions++;
+    }
+    int shared = 0;
+    if (c->world)
+        shared = c->world->refs;
+    json_t *b = json_pack(
+        "{s:o, s:o, s:i, s:i, s:i, s:{s:I, s:I, s:I, s:I, s:I, s:I}, s:I, s:I, s:I, s:I, s:i, s:I}", "stages", stages,
+        "plan", plan, "clients", s->conn_count, "sessions", sessions, "worlds", s->world_count, "queues", "gl_jobs",
+        (json_int_t)sv_jobs_queued(s), "requests_pending", (json_int_t)pend, "write_bytes", (json_int_t)wq,
+        "session_requests_pending", (json_int_t)c->pending_count, "session_write_bytes", (json_int_t)c->wq_bytes,
+        "stream_dropped", (json_int_t)drops, "bytes_sent", (json_int_t)s->bytes_sent, "session_bytes_sent",
+        (json_int_t)c->bytes_sent, "ticks", (json_int_t)s->ticks, "world_ticks",
+        (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
+        "revision", (json_int_t)c->revision);
+    reply(c, LPVP_STATS, r->request_id, b);
+}
+
+static void do_ack(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int stream = 0;
+    int64_t tick = 0;
+    if (lpvp_get_enum(j, "stream", 1, STREAMS, 1, &stream, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_int(j, "tick", 1, 0, INT64_MAX, &tick, err, sizeof err) != LPVP_FIELD_OK) {
+        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err); /* ACK has no reply, but a bad one is an error */
+        return;
+    }
+    sv_sub_ack(&c->subs[SV_STREAM_VOLUME], (uint64_t)tick);
+}
+
+/* ---- completions of GL jobs ---------------------------------------------- */
+void sv_session_job_done(sv_job *j)
+{
+    sv_conn *c = j->conn;
+    c->busy = 0;
+    if (c->closing || c->close_after_write)
+        return;
+    if (j->status) {
+        reply_err(c, j->request_id, j->status, 0, "%s", j->err);
+    } else if (j->kind == SV_JOB_TICK) {
+        json_t *b = rev_body(c);
+        json_object_set_new(b, "tick", json_integer((json_int_t)j->result->tick));
+        json_object_set_new(b, "stats", tick_stats(j->result));
+        reply(c, LPVP_TICK, j->request_id, b);
+    } else if (j->kind == SV_JOB_RENDER) {
+        send_frame_reply(c, j->request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
+                         j->terms, j->tick);
+    } else if (j->kind == SV_JOB_QUERY) {
+        uint8_t *att = malloc(j->count ? j->count * 12 : 1);
+        if (!att) {
+            reply_err(c, j->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        } else {
+            for (size_t i = 0; i < j->count * 3; ++i) {
+                uint32_t u;
+                memcpy(&u, &j->out[i], 4);
+                lpvp_put_u32(att + i * 4, u);
+            }
+            json_t *b = json_pack("{s:I, s:I, s:I}", "revision", (json_int_t)c->revision, "tick", (json_int_t)j->tick,
+                                  "count", (json_int_t)j->count);
+            sv_send(c, LPVP_REPLY(LPVP_QUERY_IRRADIANCE), j->request_id, b, att, j->count * 12, SV_STREAM_NONE);
+        }
+    }
+    sv_session_pump(c);
+}
+
+/* ---- streams ---------------------------------------------------------------- */
+void sv_session_stream(sv_conn *c, sv_result *r)
+{
+    if (!c->hello || c->close_after_write || c->world_gen != r->gen)
+        return;
+    char err[512];
+    sv_sub *vs = &c->subs[SV_STREAM_VOLUME];
+    if (vs->on) {
+        json_t *b = NULL;
+        uint8_t *att = NULL;
+        size_t alen = 0;
+        if (sv_encode_volume(r, vs->fp16, vs->zstd, vs, c->revision, &b, &att, &alen, err, sizeof err) == 0)
+            sv_send(c, LPVP_VOLUME, 0, b, att, alen, SV_STREAM_VOLUME);
+        else
+            fprintf(stderr, "lpvd serve: client %llu: volume: %s\n", (unsigned long long)c->id, err);
+    }
+    sv_sub *fs = &c->subs[SV_STREAM_FRAME];
+    if (fs->on && r->frames[fs->terms] && !c->closing) {
+        json_t *b = NULL;
+        uint8_t *att = NULL;
+        size_t alen = 0;
+        if (sv_encode_frame(r->frames[fs->terms], r->width, r->height, fs->fmt, fs->zstd, fs->terms, c->revision,
+                            r->tick, &b, &att, &alen, err, sizeof err) == 0)
+            sv_send(c, LPVP_FRAME, 0, b, att, alen, SV_STREAM_FRAME);
+        else
+            fprintf(stderr, "lpvd serve: client %llu: frame: %s\n", (unsigned long long)c->id, err);
+    }
+}
+
+/* ---- dispatch ---------------------------------------------------------------- */
+static void dispatch(sv_conn *c, sv_request *r)
+{
+    sv_server *s = c->srv;
+    s->requests++;
+    if (!lpvp_type_is_request(r->type)) {
+        reply_err(c, r->request_id, LPVP_E_UNKNOWN_TYPE, 0, "message type 0x%04x is not a request this server knows",
+                  r->type);
+        return;
+    }
+    char err[512];
+    json_t *j = lpvp_body_parse(r->json, r->json_len, err, sizeof err);
+    if (!j) {
+        reply_err(c, r->request_id, LPVP_E_BAD_JSON, 0, "%s", err);
+        return;
+    }
+    if (s->stopping) {
+        reply_err(c, r->request_id, LPVP_E_SHUTTING_DOWN, 0, "the server is stopping");
+    } else if (r->type == LPVP_HELLO) {
+        do_hello(c, r, j);
+    } else if (!c->hello) {
+        reply_err(c, r->request_id, LPVP_E_HELLO_REQUIRED, 0, "%s before HELLO: send HELLO first",
+                  lpvp_type_name(r->type));
+    } else {
+        switch (r->type) {
+        case LPVP_SCENE_LOAD: do_scene_load(c, r, j); break;
+        case LPVP_SCENE_UPDATE: do_scene_update(c, r, j); break;
+        case LPVP_LIGHT_SET: do_light_set(c, r, j); break;
+        case LPVP_LIGHT_REMOVE: do_light_remove(c, r, j); break;
+        case LPVP_CAMERA_SET: do_camera_set(c, r, j); break;
+        case LPVP_CONFIG: do_config(c, r, j); break;
+        case LPVP_TICK: do_tick(c, r); break;
+        case LPVP_SUBSCRIBE: do_subscribe(c, r, j, 1); break;
+        case LPVP_UNSUBSCRIBE: do_subscribe(c, r, j, 0); break;
+        case LPVP_GET_VOLUME: do_get_volume(c, r, j); break;
+        case LPVP_GET_FRAME: do_get_frame(c, r, j); break;
+        case LPVP_QUERY_IRRADIANCE: do_query(c, r, j); break;
+        case LPVP_STATS: do_stats(c, r); break;
+        case LPVP_BYE:
+            reply(c, LPVP_BYE, r->request_id, json_object());
+            sv_conn_close_after_write(c);
+            break;
+        case LPVP_ACK: do_ack(c, r, j); break;
+        default:
+            reply_err(c, r->request_id, LPVP_E_UNKNOWN_TYPE, 0, "message type 0x%04x is not handled", r->type);
+        }
+    }
+    json_decref(j);
+}
+
+void sv_session_pump(sv_conn *c)
+{
+    if (c->closed)
+        return;
+    c->refs++;
+    while (!c->busy && !c->closing && !c->close_after_write && c->pending_head) {
+        sv_request *r = c->pending_head;
+        c->pending_head = r->next;
+        if (!c->pending_head)
+            c->pending_tail = NULL;
+        c->pending_count--;
+        c->pending_bytes -= r->json_len + r->att_len;
+        dispatch(c, r);
+        free(r->json);
+        free(r->att);
+        free(r);
+    }
+    if (!c->closing)
+        sv_net_resume_reading(c);
+    sv_conn_unref(c);
+}

@@ -1,0 +1,741 @@
+/*
+ * serve_world.c - worlds and the GL thread of `lpvd serve`.
+ *
+ * A world is one computation: an lpv_engine with a scene, lights, materials,
+ * settings and a camera. Sessions whose inputs are byte-identical (the key
+ * built by sv_inputs_build) share a world; a world whose only session changes
+ * its inputs is updated in place (its generation bumps, and results of older
+ * generations are no longer answered from). The GL thread is the only thread
+ * that touches GL: it creates the context, owns every engine, and runs jobs
+ * (tick, render, query, destroy) one at a time in FIFO order; finished jobs go
+ * back to the loop through done_async.
+ */
+#include "serve.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ---- small helpers ------------------------------------------------------ */
+static double wall_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+sv_result *sv_result_ref(sv_result *r)
+{
+    if (r)
+        r->refs++;
+    return r;
+}
+
+static void result_free(sv_result *r)
+{
+    if (!r)
+        return;
+    free(r->cells);
+    for (int i = 0; i < 3; ++i)
+        free(r->frames[i]);
+    for (int i = 0; i < 4; ++i)
+        free(r->enc[i / 2][i % 2]);
+    free(r);
+}
+
+void sv_result_unref(sv_result *r)
+{
+    if (r && --r->refs <= 0)
+        result_free(r);
+}
+
+void sv_scene_unref(sv_server *s, sv_scene *sc)
+{
+    if (!sc || --sc->refs > 0)
+        return;
+    for (sv_scene **p = &s->scenes; *p; p = &(*p)->next)
+        if (*p == sc) {
+            *p = sc->next;
+            break;
+        }
+    if (s->builtin == sc)
+        s->builtin = NULL;
+    lpv_scene_free(&sc->scene);
+    free(sc->glb);
+    free(sc->base_dir);
+    free(sc->nodes);
+    free(sc);
+}
+
+sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc)
+{
+    for (sv_scene *o = s->scenes; o; o = o->next) {
+        if (o->hash == sc->hash && o->glb_size == sc->glb_size &&
+            (o->glb_size == 0 || (o->glb && sc->glb && memcmp(o->glb, sc->glb, o->glb_size) == 0)) &&
+            ((!o->base_dir && !sc->base_dir) || (o->base_dir && sc->base_dir && !strcmp(o->base_dir, sc->base_dir))) &&
+            o->node_count == sc->node_count &&
+            (!o->node_count || memcmp(o->nodes, sc->nodes, sizeof *o->nodes * o->node_count) == 0)) {
+            o->refs++;
+            sc->refs = 1;
+            sc->next = NULL;
+            /* sc was never listed: free it directly */
+            lpv_scene_free(&sc->scene);
+            free(sc->glb);
+            free(sc->base_dir);
+            free(sc->nodes);
+            free(sc);
+            return o;
+        }
+    }
+    sc->refs = 1;
+    sc->next = s->scenes;
+    s->scenes = sc;
+    return sc;
+}
+
+/* ---- inputs ------------------------------------------------------------- */
+void sv_inputs_unref(sv_inputs *in)
+{
+    if (!in || --in->refs > 0)
+        return;
+    free(in->materials);
+    free(in->lights);
+    free(in->key);
+    free(in);
+}
+
+static void key_put(uint8_t **k, size_t *len, size_t *cap, const void *d, size_t n)
+{
+    if (*len + n > *cap) {
+        size_t nc = (*cap ? *cap * 2 : 1024);
+        while (nc < *len + n)
+            nc *= 2;
+        uint8_t *p = realloc(*k, nc);
+        if (!p)
+            return;
+        *k = p;
+        *cap = nc;
+    }
+    memcpy(*k + *len, d, n);
+    *len += n;
+}
+
+sv_inputs *sv_inputs_build(sv_conn *c)
+{
+    sv_inputs *in = calloc(1, sizeof *in);
+    if (!in)
+        return NULL;
+    in->refs = 1;
+    in->scene = c->scene;
+    in->material_count = c->material_count;
+    in->light_count = c->light_count;
+    if (c->material_count) {
+        in->materials = malloc(sizeof(lpv_material) * c->material_count);
+        if (!in->materials)
+            goto fail;
+        memcpy(in->materials, c->materials, sizeof(lpv_material) * c->material_count);
+    }
+    if (c->light_count) {
+        in->lights = malloc(sizeof(lpv_light) * c->light_count);
+        if (!in->lights)
+            goto fail;
+        memcpy(in->lights, c->lights, sizeof(lpv_light) * c->light_count);
+    }
+    in->settings = c->settings;
+    in->tick_rate = c->tick_rate;
+    in->view = c->view;
+    size_t cap = 0;
+    uint64_t sh = c->scene ? c->scene->hash : 0;
+    uintptr_t sp = (uintptr_t)c->scene; /* interned: one object per content */
+    key_put(&in->key, &in->key_len, &cap, &sh, sizeof sh);
+    key_put(&in->key, &in->key_len, &cap, &sp, sizeof sp);
+    key_put(&in->key, &in->key_len, &cap, &in->material_count, sizeof in->material_count);
+    if (in->material_count)
+        key_put(&in->key, &in->key_len, &cap, in->materials, sizeof(lpv_material) * in->material_count);
+    key_put(&in->key, &in->key_len, &cap, &in->light_count, sizeof in->light_count);
+    if (in->light_count)
+        key_put(&in->key, &in->key_len, &cap, in->lights, sizeof(lpv_light) * in->light_count);
+    key_put(&in->key, &in->key_len, &cap, &in->settings, sizeof in->settings);
+    key_put(&in->key, &in->key_len, &cap, &in->tick_rate, sizeof in->tick_rate);
+    key_put(&in->key, &in->key_len, &cap, &in->view, sizeof in->view);
+    if (!in->key)
+        goto fail;
+    in->key_hash = sv_hash_bytes(SV_HASH_INIT, in->key, in->key_len);
+    if (in->scene)
+        in->scene->refs++;
+    return in;
+fail:
+    free(in->materials);
+    free(in->lights);
+    free(in->key);
+    free(in);
+    return NULL;
+}
+
+static void inputs_release(sv_server *s, sv_inputs *in)
+{
+    if (!in)
+        return;
+    if (in->refs == 1)
+        sv_scene_unref(s, in->scene);
+    sv_inputs_unref(in);
+}
+
+/* ---- jobs --------------------------------------------------------------- */
+sv_job *sv_job_new(sv_job_kind kind, sv_world *w)
+{
+    sv_job *j = calloc(1, sizeof *j);
+    if (!j)
+        return NULL;
+    j->kind = kind;
+    j->world = w;
+    if (w) {
+        j->inputs = w->inputs;
+        if (j->inputs)
+            j->inputs->refs++;
+        j->gen = w->gen;
+        w->jobs++;
+    }
+    return j;
+}
+
+void sv_job_free(sv_job *j)
+{
+    if (!j)
+        return;
+    if (j->world) {
+        j->world->jobs--;
+        inputs_release(j->world->srv, j->inputs);
+    }
+    if (j->conn)
+        sv_conn_unref(j->conn);
+    sv_result_unref(j->result);
+    free(j->points);
+    free(j->rgba);
+    free(j->out);
+    free(j);
+}
+
+void sv_job_submit(sv_server *s, sv_job *j)
+{
+    pthread_mutex_lock(&s->mu);
+    j->next = NULL;
+    if (s->jobs_tail)
+        s->jobs_tail->next = j;
+    else
+        s->jobs_head = j;
+    s->jobs_tail = j;
+    s->jobs_queued++;
+    pthread_cond_signal(&s->cv);
+    pthread_mutex_unlock(&s->mu);
+}
+
+size_t sv_jobs_queued(sv_server *s)
+{
+    pthread_mutex_lock(&s->mu);
+    size_t n = s->jobs_queued;
+    pthread_mutex_unlock(&s->mu);
+    return n;
+}
+
+/* ---- GL thread ---------------------------------------------------------- */
+static uint64_t scene_sig(const sv_inputs *in)
+{
+    uint64_t h = sv_hash_bytes(SV_HASH_INIT, &in->scene, sizeof in->scene);
+    if (in->material_count)
+        h = sv_hash_bytes(h, in->materials, sizeof(lpv_material) * in->material_count);
+    h = sv_hash_bytes(h, &in->material_count, sizeof in->material_count);
+    if (in->light_count)
+        h = sv_hash_bytes(h, in->lights, sizeof(lpv_light) * in->light_count);
+    h = sv_hash_bytes(h, &in->light_count, sizeof in->light_count);
+    return h;
+}
+
+/* Brings the world's engine to the job's inputs. */
+static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, size_t n)
+{
+    if (!w->engine) {
+        w->engine = lpv_engine_create(err, n);
+        if (!w->engine)
+            return -1;
+        w->gl_has_applied = 0;
+    }
+    if (w->gl_has_applied && w->gl_applied_gen == gen)
+        return 0;
+    uint64_t sig = scene_sig(in);
+    int settings_changed = !w->gl_has_applied || memcmp(&w->gl_settings, &in->settings, sizeof in->settings) != 0;
+    int scene_changed = !w->gl_has_applied || w->gl_scene_sig != sig;
+    int view_changed = !w->gl_has_applied || memcmp(&w->gl_view, &in->view, sizeof in->view) != 0;
+    w->gl_has_applied = 0;
+    if (settings_changed && lpv_engine_set_settings(w->engine, &in->settings, err, n) != 0)
+        return -1;
+    if (scene_changed || settings_changed) {
+        lpv_scene sc = in->scene->scene;
+        sc.materials = in->materials;
+        sc.material_count = in->material_count;
+        sc.lights = in->lights;
+        sc.light_count = in->light_count;
+        if (lpv_engine_set_scene(w->engine, &sc, err, n) != 0)
+            return -1;
+    }
+    if (view_changed && lpv_engine_set_view(w->engine, &in->view, err, n) != 0)
+        return -1;
+    w->gl_settings = in->settings;
+    w->gl_view = in->view;
+    w->gl_scene_sig = sig;
+    w->gl_applied_gen = gen;
+    w->gl_has_applied = 1;
+    w->gl_ticked = 0;
+    return 0;
+}
+
+static void gl_tick(sv_server *s, sv_job *j)
+{
+    (void)s;
+    sv_world *w = j->world;
+    double t0 = wall_ms();
+    if (gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err) != 0 ||
+        lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
+        j->status = SV_E_INTERNAL;
+        return;
+    }
+    w->gl_ticked = 1;
+    w->gl_ticked_gen = j->gen;
+    sv_result *r = calloc(1, sizeof *r);
+    if (!r) {
+        j->status = SV_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory");
+        return;
+    }
+    r->refs = 1;
+    r->gen = j->gen;
+    r->grid = *lpv_engine_grid(w->engine);
+    r->cell_count = lpv_grid_cell_count(&r->grid);
+    r->cells = malloc(r->cell_count * sizeof(lpv_cell));
+    if (!r->cells) {
+        j->status = SV_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory for %zu cells", r->cell_count);
+        result_free(r);
+        return;
+    }
+    size_t got = lpv_engine_read_grid(w->engine, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
+    if (got < r->cell_count)
+        memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
+    r->width = j->inputs->view.width;
+    r->height = j->inputs->view.height;
+    for (int t = 0; t < 3; ++t) {
+        if (!(j->terms_mask & (1u << t)))
+            continue;
+        size_t px = (size_t)r->width * (size_t)r->height;
+        r->frames[t] = malloc(px * 4 * sizeof(float));
+        if (!r->frames[t] || lpv_engine_render(w->engine, (lpv_frame_terms)t, r->frames[t], j->err, sizeof j->err)) {
+            free(r->frames[t]);
+            r->frames[t] = NULL;
+        }
+    }
+    r->stats = *lpv_engine_last_stats(w->engine);
+    r->tick = ++w->gl_ticks;
+    r->tick_ms = wall_ms() - t0;
+    j->result = r;
+}
+
+static int gl_ready_for(sv_world *w, sv_job *j)
+{
+    if (!w->engine || !w->gl_ticked || w->gl_ticked_gen != j->gen || w->gl_applied_gen != j->gen) {
+        j->status = SV_E_NOT_READY;
+        snprintf(j->err, sizeof j->err, "no tick since the last change of this session's scene, lights, camera or "
+                                        "config: send TICK first");
+        return 0;
+    }
+    return 1;
+}
+
+static void gl_render(sv_job *j)
+{
+    sv_world *w = j->world;
+    if (!gl_ready_for(w, j))
+        return;
+    j->width = j->inputs->view.width;
+    j->height = j->inputs->view.height;
+    j->rgba = malloc((size_t)j->width * (size_t)j->height * 4 * sizeof(float));
+    if (!j->rgba) {
+        j->status = SV_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory for a %dx%d frame", j->width, j->height);
+        return;
+    }
+    if (lpv_engine_render(w->engine, (lpv_frame_terms)j->terms, j->rgba, j->err, sizeof j->err) != 0)
+        j->status = SV_E_INTERNAL;
+    j->tick = w->gl_ticks;
+}
+
+static void gl_query(sv_job *j)
+{
+    sv_world *w = j->world;
+    if (!gl_ready_for(w, j))
+        return;
+    size_t n = j->count;
+    j->out = calloc(n ? n * 3 : 1, sizeof(float));
+    float *p = malloc((n ? n : 1) * 3 * sizeof(float)), *nr = malloc((n ? n : 1) * 3 * sizeof(float));
+    if (!j->out || !p || !nr) {
+        free(p);
+        free(nr);
+        j->status = SV_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory for %zu points", n);
+        return;
+    }
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            p[i * 3 + k] = j->points[i * 6 + k];
+            nr[i * 3 + k] = j->points[i * 6 + 3 + k];
+        }
+    if (n && lpv_engine_irradiance(w->engine, p, nr, n, j->out, j->err, sizeof j->err) != 0)
+        j->status = SV_E_INTERNAL;
+    for (size_t i = 0; i < n * 3; ++i)
+        if (!isfinite(j->out[i]))
+            j->out[i] = 0.0f;
+    free(p);
+    free(nr);
+    j->tick = w->gl_ticks;
+}
+
+static void *gl_main(void *arg)
+{
+    sv_server *s = arg;
+    lpv_gl_context_desc desc = {.backend = s->cfg.backend};
+    char err[1024] = "";
+    lpv_gl_context *ctx = lpv_gl_context_create(&desc, err, sizeof err);
+    pthread_mutex_lock(&s->mu);
+    if (!ctx) {
+        snprintf(s->gl_err, sizeof s->gl_err, "%s", err);
+        s->gl_ready = -1;
+        pthread_cond_broadcast(&s->cv);
+        pthread_mutex_unlock(&s->mu);
+        return NULL;
+    }
+    s->gl_ctx = ctx;
+    snprintf(s->gl_backend, sizeof s->gl_backend, "%s", lpv_backend_name(lpv_gl_context_backend(ctx)));
+    snprintf(s->gl_renderer, sizeof s->gl_renderer, "%s", lpv_gl_context_renderer(ctx));
+    s->gl_ready = 1;
+    pthread_cond_broadcast(&s->cv);
+    for (;;) {
+        while (!s->jobs_head)
+            pthread_cond_wait(&s->cv, &s->mu);
+        sv_job *j = s->jobs_head;
+        s->jobs_head = j->next;
+        if (!s->jobs_head)
+            s->jobs_tail = NULL;
+        s->jobs_queued--;
+        pthread_mutex_unlock(&s->mu);
+
+        int quit = 0;
+        switch (j->kind) {
+        case SV_JOB_TICK: gl_tick(s, j); break;
+        case SV_JOB_RENDER: gl_render(j); break;
+        case SV_JOB_QUERY: gl_query(j); break;
+        case SV_JOB_DESTROY:
+            lpv_engine_destroy(j->world->engine);
+            j->world->engine = NULL;
+            break;
+        case SV_JOB_QUIT: quit = 1; break;
+        }
+
+        pthread_mutex_lock(&s->mu);
+        if (quit) {
+            free(j);
+            break;
+        }
+        j->next = NULL;
+        if (s->done_tail)
+            s->done_tail->next = j;
+        else
+            s->done_head = j;
+        s->done_tail = j;
+        pthread_mutex_unlock(&s->mu);
+        uv_async_send(&s->done_async);
+        pthread_mutex_lock(&s->mu);
+    }
+    pthread_mutex_unlock(&s->mu);
+    lpv_gl_context_destroy(ctx);
+    return NULL;
+}
+
+/* ---- completions on the loop ------------------------------------------- */
+static void world_free(sv_world *w)
+{
+    if (w->timer_init) {
+        /* timer memory lives in the world: free it in the close callback */
+        return;
+    }
+    sv_result_unref(w->latest);
+    free(w);
+}
+
+static void timer_closed(uv_handle_t *h)
+{
+    sv_world *w = h->data;
+    w->timer_init = 0;
+    world_free(w);
+}
+
+static void tick_done(sv_server *s, sv_job *j)
+{
+    sv_world *w = j->world;
+    if (j->periodic)
+        w->periodic_pending = 0;
+    if (j->result) {
+        s->ticks++;
+        if (!w->latest || j->result->tick > w->latest->tick) {
+            sv_result_unref(w->latest);
+            w->latest = sv_result_ref(j->result);
+        }
+    } else if (j->periodic && j->status) {
+        fprintf(stderr, "lpvd serve: world %llu: tick failed: %s\n", (unsigned long long)w->id, j->err);
+    }
+    if (j->conn)
+        sv_session_job_done(j);
+    if (j->result && !w->dying)
+        for (sv_conn *c = s->conns; c; c = c->next)
+            if (c->world == w && !c->closing)
+                sv_session_stream(c, j->result);
+}
+
+static void done_cb(uv_async_t *a)
+{
+    sv_server *s = a->data;
+    for (;;) {
+        pthread_mutex_lock(&s->mu);
+        sv_job *j = s->done_head;
+        if (j) {
+            s->done_head = j->next;
+            if (!s->done_head)
+                s->done_tail = NULL;
+        }
+        pthread_mutex_unlock(&s->mu);
+        if (!j)
+            break;
+        switch (j->kind) {
+        case SV_JOB_TICK: tick_done(s, j); break;
+        case SV_JOB_RENDER:
+        case SV_JOB_QUERY:
+            if (j->conn)
+                sv_session_job_done(j);
+            break;
+        case SV_JOB_DESTROY: {
+            sv_world *w = j->world;
+            sv_job_free(j);
+            j = NULL;
+            inputs_release(s, w->inputs);
+            w->inputs = NULL;
+            if (w->timer_init)
+                uv_close((uv_handle_t *)&w->timer, timer_closed);
+            else
+                world_free(w);
+            break;
+        }
+        case SV_JOB_QUIT: break;
+        }
+        if (j)
+            sv_job_free(j);
+    }
+}
+
+int sv_gl_start(sv_server *s, char *err, size_t n)
+{
+    if (uv_async_init(s->loop, &s->done_async, done_cb) != 0) {
+        snprintf(err, n, "uv_async_init failed");
+        return -1;
+    }
+    s->done_async.data = s;
+    if (pthread_create(&s->gl_thread, NULL, gl_main, s) != 0) {
+        snprintf(err, n, "cannot start the GL thread");
+        return -1;
+    }
+    s->gl_started = 1;
+    pthread_mutex_lock(&s->mu);
+    while (s->gl_ready == 0)
+        pthread_cond_wait(&s->cv, &s->mu);
+    pthread_mutex_unlock(&s->mu);
+    if (s->gl_ready < 0) {
+        pthread_join(s->gl_thread, NULL);
+        s->gl_started = 0;
+        snprintf(err, n, "no OpenGL 4.5 context: %s", s->gl_err);
+        return -1;
+    }
+    return 0;
+}
+
+/* Drops the jobs not started yet (their requests get ERROR SHUTTING_DOWN),
+ * lets the running one finish, runs the engines' destroy jobs, stops the GL
+ * thread and runs every completion. The caller has detached every session
+ * from its world first, so every world has a destroy job queued. */
+void sv_gl_stop(sv_server *s)
+{
+    if (!s->gl_started)
+        return;
+    pthread_mutex_lock(&s->mu);
+    sv_job *dropped = s->jobs_head;
+    s->jobs_head = s->jobs_tail = NULL;
+    s->jobs_queued = 0;
+    pthread_mutex_unlock(&s->mu);
+    while (dropped) {
+        sv_job *next = dropped->next;
+        dropped->next = NULL;
+        if (dropped->kind == SV_JOB_DESTROY) {
+            sv_job_submit(s, dropped); /* engines must still be destroyed on the GL thread */
+        } else {
+            if (dropped->periodic && dropped->world)
+                dropped->world->periodic_pending = 0;
+            if (dropped->conn) {
+                dropped->status = SV_E_SHUTTING_DOWN;
+                snprintf(dropped->err, sizeof dropped->err, "the server is stopping");
+                sv_session_job_done(dropped);
+            }
+            sv_job_free(dropped);
+        }
+        dropped = next;
+    }
+    sv_job *q = calloc(1, sizeof *q);
+    if (q) {
+        q->kind = SV_JOB_QUIT;
+        sv_job_submit(s, q);
+        pthread_join(s->gl_thread, NULL);
+    }
+    s->gl_started = 0;
+    done_cb(&s->done_async);
+}
+
+/* ---- worlds ------------------------------------------------------------- */
+unsigned sv_world_terms_mask(sv_world *w)
+{
+    unsigned m = 0;
+    for (sv_conn *c = w->srv->conns; c; c = c->next)
+        if (c->world == w && c->subs[SV_STREAM_FRAME].on && c->world_gen == w->gen)
+            m |= 1u << c->subs[SV_STREAM_FRAME].terms;
+    return m;
+}
+
+static void world_timer_cb(uv_timer_t *t)
+{
+    sv_world *w = t->data;
+    sv_server *s = w->srv;
+    if (w->dying || s->stopping || w->periodic_pending)
+        return;
+    sv_job *j = sv_job_new(SV_JOB_TICK, w);
+    if (!j)
+        return;
+    j->periodic = 1;
+    j->terms_mask = sv_world_terms_mask(w);
+    w->periodic_pending = 1;
+    sv_job_submit(s, j);
+}
+
+void sv_world_update_timer(sv_world *w)
+{
+    double rate = w->inputs ? w->inputs->tick_rate : 0.0;
+    if (rate == w->timer_rate && w->timer_init)
+        return;
+    if (!w->timer_init) {
+        if (uv_timer_init(w->srv->loop, &w->timer) != 0)
+            return;
+        w->timer.data = w;
+        w->timer_init = 1;
+    }
+    w->timer_rate = rate;
+    uv_timer_stop(&w->timer);
+    if (rate > 0.0) {
+        uint64_t ms = (uint64_t)llround(1000.0 / rate);
+        if (ms < 1)
+            ms = 1;
+        uv_timer_start(&w->timer, world_timer_cb, ms, ms);
+    }
+}
+
+static sv_world *world_find(sv_server *s, const sv_inputs *in)
+{
+    for (sv_world *w = s->worlds; w; w = w->next)
+        if (!w->dying && w->inputs && w->inputs->key_hash == in->key_hash && w->inputs->key_len == in->key_len &&
+            memcmp(w->inputs->key, in->key, in->key_len) == 0)
+            return w;
+    return NULL;
+}
+
+void sv_world_unref(sv_world *w)
+{
+    if (!w || --w->refs > 0)
+        return;
+    sv_server *s = w->srv;
+    w->dying = 1;
+    for (sv_world **p = &s->worlds; *p; p = &(*p)->next)
+        if (*p == w) {
+            *p = w->next;
+            break;
+        }
+    s->world_count--;
+    if (w->timer_init)
+        uv_timer_stop(&w->timer);
+    sv_job *d = sv_job_new(SV_JOB_DESTROY, w);
+    if (d && s->gl_started) {
+        sv_job_submit(s, d);
+    } else {
+        sv_job_free(d);
+        inputs_release(s, w->inputs);
+        w->inputs = NULL;
+        if (w->timer_init)
+            uv_close((uv_handle_t *)&w->timer, timer_closed);
+        else
+            world_free(w);
+    }
+}
+
+void sv_world_detach(sv_conn *c)
+{
+    sv_world *w = c->world;
+    c->world = NULL;
+    sv_world_unref(w);
+}
+
+void sv_world_attach(sv_conn *c, sv_inputs *in)
+{
+    sv_server *s = c->srv;
+    sv_world *found = world_find(s, in);
+    if (found && found == c->world) {
+        inputs_release(s, in);
+        return;
+    }
+    if (found) {
+        found->refs++;
+        sv_world_detach(c);
+        c->world = found;
+        c->world_gen = found->gen;
+        inputs_release(s, in);
+        return;
+    }
+    if (c->world && c->world->refs == 1) { /* alone: update in place */
+        sv_world *w = c->world;
+        inputs_release(s, w->inputs);
+        w->inputs = in;
+        w->gen++;
+        c->world_gen = w->gen;
+        sv_world_update_timer(w);
+        return;
+    }
+    sv_world *w = calloc(1, sizeof *w);
+    if (!w) {
+        inputs_release(s, in);
+        return;
+    }
+    w->srv = s;
+    w->refs = 1;
+    w->id = ++s->next_world_id;
+    w->gen = 1;
+    w->inputs = in;
+    w->next = s->worlds;
+    s->worlds = w;
+    s->world_count++;
+    sv_world_detach(c);
+    c->world = w;
+    c->world_gen = w->gen;
+    sv_world_update_timer(w);
+}
