@@ -1,0 +1,242 @@
+/*
+ * lpvc.h - C client library for the lpvd daemon (wire protocol v1,
+ * protocol/SPEC.md). One connection = one session; blocking sockets (Unix
+ * socket path or HOST:PORT over TCP). Not thread-safe: use one lpvc per
+ * thread.
+ *
+ *   char err[256];
+ *   lpvc *c = lpvc_connect(NULL, NULL, err, sizeof err);   // default socket, HELLO
+ *   if (!c) { fprintf(stderr, "%s\n", err); return 1; }
+ *   if (lpvc_tick(c, NULL) != 0)
+ *       fprintf(stderr, "%s (%d): %s\n", lpvc_error_name(c), lpvc_error_code(c),
+ *               lpvc_error_message(c));
+ *   lpvc_volume v = {0};
+ *   lpvc_get_volume(c, NULL, &v);    // v.data: v.cells * 12 floats (W/sr)
+ *   lpvc_volume_free(&v);
+ *   lpvc_bye(c);
+ *   lpvc_close(c);
+ *
+ * Conventions:
+ *   - Every call returns 0 on success, -1 on failure; the failure is then in
+ *     lpvc_error_code/name/message: an ERROR reply's SPEC code (1..15) and
+ *     name (R3.4), or a client-side failure with a negative code
+ *     (LPVC_ERR_IO "IO", LPVC_ERR_PROTOCOL "PROTOCOL", LPVC_ERR_USAGE "USAGE",
+ *     LPVC_ERR_TIMEOUT "TIMEOUT", LPVC_ERR_CLOSED "CLOSED").
+ *   - The JSON body of the last reply is kept: lpvc_last_reply() (valid until
+ *     the next call on the connection) and lpvc_last_revision() (the
+ *     "revision" of the last reply that carried one, R3.3).
+ *   - Option structs are zero-initialised ({0}); a zero/NULL field means
+ *     "not sent, server default". NULL for a whole struct means all defaults.
+ *   - Stream messages (VOLUME, FRAME) arriving while a reply is awaited are
+ *     queued and returned by lpvc_next_stream_message() in order.
+ */
+#ifndef LPVC_H
+#define LPVC_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct lpvc lpvc;
+
+/* Client-side error codes (server errors are the SPEC's positive codes). */
+enum {
+    LPVC_ERR_IO = -1,        /* socket failure, connection closed */
+    LPVC_ERR_PROTOCOL = -2,  /* the server sent something the SPEC forbids */
+    LPVC_ERR_USAGE = -3,     /* bad arguments to this library */
+    LPVC_ERR_TIMEOUT = -4,   /* lpvc_next_stream_message timed out */
+    LPVC_ERR_CLOSED = -5     /* the server said BYE / SHUTTING_DOWN, or after lpvc_bye */
+};
+
+/* ---- Connection ----------------------------------------------------------- */
+
+/* The daemon's default socket (R1.1): $XDG_RUNTIME_DIR/lpvd.sock, else
+ * /tmp/lpvd-$UID.sock. Returns buf. */
+const char *lpvc_default_address(char *buf, size_t n);
+
+/* Connects and sends HELLO (with token when non-NULL). address: a Unix
+ * socket path, "unix:PATH", "HOST:PORT", "tcp:HOST:PORT" ("[v6]:PORT"), or
+ * NULL for the default socket. Returns NULL with a message in err on failure
+ * (the server's ERROR name and message when HELLO was refused). */
+lpvc *lpvc_connect(const char *address, const char *token, char *err, size_t n);
+
+typedef struct lpvc_connect_desc {
+    const char *address;      /* NULL: default socket */
+    const char *token;        /* NULL: none */
+    const char *client_name;  /* HELLO "client"; NULL: "lpvc" */
+    int timeout_ms;           /* per-reply receive timeout; 0: wait forever */
+} lpvc_connect_desc;
+lpvc *lpvc_connect_with(const lpvc_connect_desc *desc, char *err, size_t n);
+
+/* Closes the socket (without BYE) and frees everything. NULL is fine. */
+void lpvc_close(lpvc *c);
+
+/* The HELLO reply body (JSON text), e.g. its "session" and "limits". */
+const char *lpvc_hello_reply(const lpvc *c);
+
+int lpvc_error_code(const lpvc *c);
+const char *lpvc_error_name(const lpvc *c);
+const char *lpvc_error_message(const lpvc *c);
+const char *lpvc_last_reply(const lpvc *c);
+int64_t lpvc_last_revision(const lpvc *c);
+
+/* ---- Requests (SPEC section 4) -------------------------------------------- */
+
+/* SCENE_LOAD by path (resolved under the server's --scene-root, R4.3). */
+int lpvc_scene_load_file(lpvc *c, const char *path);
+/* SCENE_LOAD with .glb bytes as attachment (R4.4). */
+int lpvc_scene_load_glb(lpvc *c, const void *glb, size_t size);
+/* SCENE_UPDATE with a JSON object text {"nodes": [...], "materials": [...]}. */
+int lpvc_scene_update(lpvc *c, const char *json);
+
+typedef struct lpvc_light {
+    const char *id;            /* required */
+    const char *type;          /* "point" (NULL), "spot", "directional" */
+    float intensity;           /* W/sr (point, spot) or W/m^2 (directional), as the server's units */
+    const float *color;        /* [3] or NULL */
+    const float *position;     /* [3] or NULL */
+    const float *direction;    /* [3] or NULL */
+    float range;               /* 0: not sent */
+    float inner_cone;          /* radians; 0: not sent */
+    float outer_cone;          /* radians; 0: not sent */
+} lpvc_light;
+int lpvc_light_set(lpvc *c, const lpvc_light *light);
+int lpvc_light_remove(lpvc *c, const char *id);
+
+typedef struct lpvc_camera {
+    const float *eye;          /* [3], required unless scene_camera/scene_camera_name */
+    const float *target;       /* [3], required unless ... */
+    const float *up;           /* [3] or NULL */
+    float fov_deg;             /* 0: not sent */
+    int width, height;         /* 0: not sent */
+    const char *scene_camera_name; /* {"camera": name}: a camera of the scene */
+    int scene_camera;          /* {"camera": scene_camera - 1} when > 0 (1-based, so 0 = unset) */
+} lpvc_camera;
+int lpvc_camera_set(lpvc *c, const lpvc_camera *cam);
+
+typedef struct lpvc_config {
+    int grid[3];               /* all 0: not sent */
+    const float *bounds;       /* [6] x0 y0 z0 x1 y1 z1, or NULL */
+    int iterations;            /* 0: not sent */
+    int rsm_size;              /* 0: not sent */
+    int occlusion;             /* 0: not sent, 1: true, -1: false */
+    float indirect_gain;       /* 0: not sent */
+    int emissive_vpls;         /* 0: not sent */
+    float tick_rate_hz;        /* 0: not sent */
+} lpvc_config;
+int lpvc_config_set(lpvc *c, const lpvc_config *cfg);
+/* CONFIG with a JSON object text (any field, including zeros). The reply
+ * ({"revision", "config": {effective values}}) is lpvc_last_reply(). */
+int lpvc_config_json(lpvc *c, const char *json);
+
+/* TICK; *tick (may be NULL) receives the tick number. */
+int lpvc_tick(lpvc *c, int64_t *tick);
+
+enum lpvc_stream { LPVC_STREAM_VOLUME = 0, LPVC_STREAM_FRAME = 1 };
+typedef struct lpvc_subscribe_desc {
+    enum lpvc_stream stream;
+    const char *format;        /* volume: "fp16"|"fp32"; frame: "rgba8"|"png"|"exr"; NULL: server default */
+    const char *compression;   /* "zstd"|"none"; NULL: server default */
+    bool delta;                /* volume XOR deltas (R5.3); this library undoes them */
+} lpvc_subscribe_desc;
+int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc);
+int lpvc_unsubscribe(lpvc *c, enum lpvc_stream stream);
+
+/* A decoded volume (SPEC section 5): always float32 after decoding. */
+typedef struct lpvc_volume {
+    int64_t revision, tick;
+    int dims[3];
+    float origin[3];
+    float cell_size;
+    size_t cells;              /* dims[0] * dims[1] * dims[2] */
+    float *data;               /* cells * 12: per cell r0..r3 g0..g3 b0..b3, x fastest, W/sr */
+    char format[8];            /* wire format: "fp16" or "fp32" */
+    char compression[8];       /* wire compression */
+    bool keyframe;             /* false: was an XOR delta, already undone */
+    int64_t base_tick;         /* delta base (-1 for keyframes) */
+    char *header_json;         /* the header as received */
+} lpvc_volume;
+void lpvc_volume_free(lpvc_volume *v);
+
+typedef struct lpvc_volume_desc {
+    const char *format;        /* "fp16" | "fp32"; NULL: "fp32" */
+    const char *compression;   /* "zstd" | "none"; NULL: "zstd" */
+} lpvc_volume_desc;
+int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out);
+
+/* A frame (SPEC section 6). data: rgba8 pixels (decompressed, top row
+ * first), or the complete PNG / EXR file. */
+typedef struct lpvc_frame {
+    int64_t revision, tick;
+    int width, height;
+    char format[8];            /* "rgba8" | "png" | "exr" */
+    char terms[16];            /* "full" | "indirect" | "direct" */
+    unsigned char *data;
+    size_t size;
+    char *header_json;
+} lpvc_frame;
+void lpvc_frame_free(lpvc_frame *f);
+
+typedef struct lpvc_frame_desc {
+    const char *format;        /* "rgba8" | "png" | "exr"; NULL: server default */
+    const char *compression;   /* rgba8 only: "zstd" | "none"; NULL: server default */
+    const char *terms;         /* "full" | "indirect" | "direct"; NULL: server default */
+} lpvc_frame_desc;
+int lpvc_get_frame(lpvc *c, const lpvc_frame_desc *desc, lpvc_frame *out);
+
+/* QUERY_IRRADIANCE: points and normals are n * 3 floats each; rgb receives
+ * n * 3 floats of irradiance in W/m^2. */
+int lpvc_query_irradiance(lpvc *c, const float *points, const float *normals, size_t n, float *rgb);
+
+/* STATS: *json receives the reply body, malloc'd (free() it). */
+int lpvc_stats(lpvc *c, char **json);
+
+/* BYE: waits for the reply; the socket is then closed (lpvc_close still
+ * frees the object). */
+int lpvc_bye(lpvc *c);
+
+/* ACK a volume tick (no reply). lpvc_next_stream_message ACKs by itself
+ * unless lpvc_set_auto_ack(c, false); either way it keeps the last four
+ * streamed volumes, so a delta against any of them (once ACKed) decodes. */
+int lpvc_ack(lpvc *c, int64_t tick);
+void lpvc_set_auto_ack(lpvc *c, bool on);
+
+/* Sends any request type with a JSON body text and attachment and waits for
+ * its reply (escape hatch for tools and tests). The reply body is
+ * lpvc_last_reply(); *att / *att_len (may be NULL) receive its attachment,
+ * malloc'd. */
+int lpvc_request_raw(lpvc *c, uint16_t type, const char *json, const void *attachment,
+                     size_t att_len, void **att, size_t *att_n);
+
+/* ---- Streams -------------------------------------------------------------- */
+
+enum lpvc_message_type { LPVC_MSG_NONE = 0, LPVC_MSG_VOLUME, LPVC_MSG_FRAME, LPVC_MSG_BYE };
+typedef struct lpvc_message {
+    enum lpvc_message_type type;
+    lpvc_volume volume;        /* LPVC_MSG_VOLUME */
+    lpvc_frame frame;          /* LPVC_MSG_FRAME */
+} lpvc_message;
+void lpvc_message_free(lpvc_message *m);
+
+/* Waits up to timeout_ms (< 0: forever) for the next VOLUME or FRAME after
+ * SUBSCRIBE. Volumes are decoded (zstd, fp16, XOR delta against the acked
+ * volume of base_tick, R5.3) and, with auto-ACK, acknowledged. A BYE from
+ * the server gives type LPVC_MSG_BYE (and returns 0). Timeout: -1 with
+ * LPVC_ERR_TIMEOUT. */
+int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
+
+/* ---- Local lookup (docs/propagation.md section 6) -------------------------- */
+
+/* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
+ * server's QUERY_IRRADIANCE computes it. */
+void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LPVC_H */

@@ -1,0 +1,793 @@
+#!/usr/bin/env python3
+"""lpvd_client.py - a Python client for the lpvd wire protocol, version 1.
+
+Standard library only (socket, struct, json, array). numpy is used when it
+is importable (volumes and query answers then come back as float32 arrays);
+the ``zstandard`` module is used when importable, otherwise the client asks
+the server for ``"compression": "none"`` (the standard library has no zstd).
+
+    from lpvd_client import Client
+    with Client("/tmp/lpvd.sock") as c:      # connects and sends HELLO
+        c.tick()
+        vol = c.get_volume()                 # Volume: grid + 12 floats per cell
+        print(c.query_irradiance([(0, 1, 0)], [(0, 1, 0)]))
+
+The protocol is protocol/SPEC.md; section numbers below refer to it.
+
+Run ``python3 lpvd_client.py --self-test ADDRESS`` for a short end-to-end
+check against a running daemon (exit status 0 on success).
+"""
+
+import array
+import json
+import os
+import socket
+import struct
+import sys
+
+try:  # optional
+    import numpy as _np
+except ImportError:  # pragma: no cover - depends on the machine
+    _np = None
+
+try:  # optional
+    import zstandard as _zstd
+except ImportError:  # pragma: no cover - depends on the machine
+    _zstd = None
+
+__all__ = [
+    "Client", "LpvdError", "ProtocolError", "Volume", "Frame",
+    "default_address", "MSG", "HAVE_NUMPY", "HAVE_ZSTD",
+]
+
+HAVE_NUMPY = _np is not None
+HAVE_ZSTD = _zstd is not None
+
+MAGIC = b"LPVD"
+VERSION = 1
+HEADER = struct.Struct("<4sHHIIII")  # magic, version, type, request_id, flags, json_len, att_len
+assert HEADER.size == 24
+
+# Message types (SPEC section 4).
+MSG = {
+    "HELLO": 0x0001,
+    "SCENE_LOAD": 0x0002,
+    "SCENE_UPDATE": 0x0003,
+    "LIGHT_SET": 0x0004,
+    "LIGHT_REMOVE": 0x0005,
+    "CAMERA_SET": 0x0006,
+    "CONFIG": 0x0007,
+    "TICK": 0x0008,
+    "SUBSCRIBE": 0x0009,
+    "UNSUBSCRIBE": 0x000A,
+    "GET_VOLUME": 0x000B,
+    "GET_FRAME": 0x000C,
+    "QUERY_IRRADIANCE": 0x000D,
+    "STATS": 0x000E,
+    "BYE": 0x000F,
+    "ACK": 0x0010,
+    "VOLUME": 0x0101,
+    "FRAME": 0x0102,
+    "ERROR": 0xFFFF,
+}
+REPLY_BIT = 0x8000
+SERVER_BYE = MSG["BYE"] | REPLY_BIT
+
+# ERROR codes (SPEC R3.4).
+ERROR_NAMES = {
+    1: "BAD_MAGIC", 2: "BAD_VERSION", 3: "BAD_FRAME", 4: "TOO_LARGE",
+    5: "BAD_JSON", 6: "UNKNOWN_TYPE", 7: "BAD_FIELD", 8: "UNAUTHORIZED",
+    9: "HELLO_REQUIRED", 10: "NOT_READY", 11: "SCENE_INVALID",
+    12: "PATH_REFUSED", 13: "LIMIT", 14: "INTERNAL", 15: "SHUTTING_DOWN",
+}
+
+# Two-band SH constants of docs/propagation.md section 1.
+SH_LOBE0 = 0.886226925452758    # sqrt(pi) / 2
+SH_LOBE1 = 1.0233267079464885   # sqrt(pi / 3)
+
+
+class LpvdError(Exception):
+    """An ERROR reply (SPEC R3.4): ``code``, ``name``, ``message``."""
+
+    def __init__(self, code, name, message, body=None):
+        Exception.__init__(self, "%s (%d): %s" % (name, code, message))
+        self.code = code
+        self.name = name
+        self.message = message
+        self.body = body or {}
+
+
+class ProtocolError(Exception):
+    """The connection broke, or the server sent something the protocol forbids."""
+
+
+def default_address():
+    """The daemon's default socket (SPEC R1.1)."""
+    run = os.environ.get("XDG_RUNTIME_DIR")
+    if run:
+        return os.path.join(run, "lpvd.sock")
+    return "/tmp/lpvd-%d.sock" % os.getuid()
+
+
+def _parse_address(address):
+    """'unix:PATH', 'tcp:HOST:PORT', 'HOST:PORT' or a socket path."""
+    if address.startswith("unix:"):
+        return ("unix", address[5:])
+    if address.startswith("tcp:"):
+        address = address[4:]
+    elif "/" in address or ":" not in address:
+        return ("unix", address)
+    host, _, port = address.rpartition(":")
+    if host.startswith("[") and host.endswith("]"):
+        host = host[1:-1]
+    if not port.isdigit():
+        raise ValueError("bad address %r: expected HOST:PORT or a socket path" % address)
+    return ("tcp", (host or "127.0.0.1", int(port)))
+
+
+def _decompress(data, compression, raw_length):
+    if compression in (None, "none"):
+        return bytes(data)
+    if compression == "zstd":
+        if _zstd is None:
+            raise ProtocolError("zstd-compressed attachment but the 'zstandard' module is not installed")
+        return _zstd.ZstdDecompressor().decompress(data, max_output_size=max(raw_length, 1))
+    raise ProtocolError("unknown compression %r" % compression)
+
+
+def _default_compression():
+    return "zstd" if _zstd is not None else "none"
+
+
+def _xor(a, b):
+    """Byte-wise XOR of two equally long byte strings (SPEC R5.3)."""
+    if len(a) != len(b):
+        raise ProtocolError("XOR delta of %d bytes against a base of %d bytes" % (len(a), len(b)))
+    n = len(a)
+    return (int.from_bytes(a, "little") ^ int.from_bytes(b, "little")).to_bytes(n, "little")
+
+
+def _floats(raw, fmt):
+    """Raw little-endian fp16/fp32 bytes -> float32 numpy array or array('f')."""
+    if fmt == "fp32":
+        if len(raw) % 4:
+            raise ProtocolError("fp32 volume of %d bytes" % len(raw))
+        if _np is not None:
+            return _np.frombuffer(raw, dtype="<f4").copy()
+        out = array.array("f")
+        out.frombytes(raw)
+        if sys.byteorder != "little":
+            out.byteswap()
+        return out
+    if fmt == "fp16":
+        if len(raw) % 2:
+            raise ProtocolError("fp16 volume of %d bytes" % len(raw))
+        if _np is not None:
+            return _np.frombuffer(raw, dtype="<f2").astype(_np.float32)
+        return array.array("f", struct.unpack("<%de" % (len(raw) // 2), raw))
+    raise ProtocolError("unknown volume format %r" % fmt)
+
+
+class Volume(object):
+    """A decoded LPV (SPEC section 5).
+
+    ``data`` holds ``cells * 12`` float32 values, cell-major, x fastest
+    (``index = x + nx * (y + ny * z)``), per cell r0..r3 g0..g3 b0..b3 in
+    radiant intensity W/sr; a numpy array of shape (nz, ny, nx, 12) when
+    numpy is available, else a flat ``array('f')``.
+    """
+
+    def __init__(self, header, raw):
+        self.header = header
+        self.raw = raw  # the raw (decompressed, delta-resolved) bytes
+        grid = header.get("grid") or {}
+        self.dims = tuple(int(v) for v in grid.get("dims", (0, 0, 0)))
+        self.origin = tuple(float(v) for v in grid.get("origin", (0.0, 0.0, 0.0)))
+        self.cell_size = float(grid.get("cell_size", 0.0))
+        self.tick = header.get("tick")
+        self.revision = header.get("revision")
+        self.format = header.get("format")
+        self.keyframe = bool(header.get("keyframe", True))
+        self.base_tick = header.get("base_tick")
+        cells = self.dims[0] * self.dims[1] * self.dims[2]
+        values = _floats(raw, self.format)
+        if len(values) != cells * 12:
+            raise ProtocolError("volume of %d values for %d cells" % (len(values), cells))
+        if _np is not None:
+            values = values.reshape(self.dims[2], self.dims[1], self.dims[0], 12)
+        self.data = values
+
+    @property
+    def cells(self):
+        return self.dims[0] * self.dims[1] * self.dims[2]
+
+    def cell(self, x, y, z):
+        """The 12 coefficients of cell (x, y, z) as a list."""
+        if _np is not None:
+            return [float(v) for v in self.data[z, y, x]]
+        i = (x + self.dims[0] * (y + self.dims[1] * z)) * 12
+        return list(self.data[i:i + 12])
+
+    def total_flux(self):
+        """Sum over cells of c0 * sqrt(4 pi) per channel, in W."""
+        k = (4.0 * 3.141592653589793) ** 0.5
+        if _np is not None:
+            d = self.data.reshape(-1, 12)
+            return [float(d[:, 0].sum() * k), float(d[:, 4].sum() * k), float(d[:, 8].sum() * k)]
+        r = g = b = 0.0
+        for i in range(0, len(self.data), 12):
+            r += self.data[i]
+            g += self.data[i + 4]
+            b += self.data[i + 8]
+        return [r * k, g * k, b * k]
+
+    def sh_at(self, p):
+        """Trilinear interpolation of the 12 coefficients at world point p,
+        between cell centres, clamped to the outermost centres (GL_CLAMP_TO_EDGE),
+        as docs/propagation.md section 6. Returns None for a NaN coordinate."""
+        i0, i1, f = [0, 0, 0], [0, 0, 0], [0.0, 0.0, 0.0]
+        for a in range(3):
+            u = (p[a] - self.origin[a]) / self.cell_size
+            if u != u:
+                return None
+            n = self.dims[a]
+            u = min(max(u, 0.5), n - 0.5) - 0.5
+            base = float(int(u // 1))
+            if base > n - 2:
+                base = float(n - 2)
+            if base < 0:
+                base = 0.0
+            i0[a] = int(base)
+            i1[a] = i0[a] + 1 if i0[a] + 1 < n else i0[a]
+            f[a] = u - base
+        out = [0.0] * 12
+        for corner in range(8):
+            w = 1.0
+            idx = [0, 0, 0]
+            for a in range(3):
+                if corner >> a & 1:
+                    idx[a] = i1[a]
+                    w *= f[a]
+                else:
+                    idx[a] = i0[a]
+                    w *= 1.0 - f[a]
+            if w == 0.0:
+                continue
+            c = self.cell(idx[0], idx[1], idx[2])
+            for k in range(12):
+                out[k] += w * c[k]
+        return out
+
+    def irradiance(self, p, n):
+        """E(n) in W/m^2 (r, g, b) at surface point p with normal n, computed
+        locally exactly as the server's QUERY_IRRADIANCE (propagation.md §6):
+        sample half a cell in front of the surface, E = max(0, c . lobe(-n)) / s^2."""
+        ln = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) ** 0.5
+        if not (ln > 1e-8) or ln == float("inf") or any(v != v for v in n):
+            return (0.0, 0.0, 0.0)
+        un = [v / ln for v in n]
+        q = [p[a] + 0.5 * self.cell_size * un[a] for a in range(3)]
+        c = self.sh_at(q)
+        if c is None:
+            return (0.0, 0.0, 0.0)
+        lobe = (SH_LOBE0, -SH_LOBE1 * un[1], -SH_LOBE1 * un[2], -SH_LOBE1 * un[0])
+        inv = 1.0 / (self.cell_size * self.cell_size)
+        rgb = []
+        for ch in range(3):
+            d = sum(c[4 * ch + k] * lobe[k] for k in range(4))
+            rgb.append(max(0.0, d * inv))
+        return tuple(rgb)
+
+
+class Frame(object):
+    """A frame (SPEC section 6): ``header`` and ``data`` (bytes: rgba8 pixels,
+    or the complete PNG / EXR file)."""
+
+    def __init__(self, header, data):
+        self.header = header
+        self.data = data
+        self.width = header.get("width")
+        self.height = header.get("height")
+        self.format = header.get("format")
+        self.tick = header.get("tick")
+        self.revision = header.get("revision")
+
+    def save(self, path):
+        with open(path, "wb") as f:
+            f.write(self.data)
+
+
+class Client(object):
+    """One connection (one session) to an lpvd daemon.
+
+    ``address``: a Unix socket path, ``unix:PATH``, ``HOST:PORT`` or
+    ``tcp:HOST:PORT``; default: the daemon's default socket. The constructor
+    connects and sends HELLO (with ``token`` when given); ``hello_reply``
+    holds the server's answer. Every request method returns the reply body
+    (a dict) or raises ``LpvdError`` with the SPEC's error code and name.
+    """
+
+    def __init__(self, address=None, token=None, client_name="lpvd_client.py", timeout=None,
+                 connect=True):
+        self.address = address or default_address()
+        self.token = token
+        self.client_name = client_name
+        self.timeout = timeout
+        self.sock = None
+        self.hello_reply = None
+        self._next_id = 1
+        self._stream_queue = []      # (type, header, attachment) received while waiting for replies
+        self._acked = {}             # tick -> raw bytes of volumes we acknowledged (delta bases)
+        self._acked_order = []
+        self.keep_acked = 8
+        self.closed_by_server = None  # "BYE" or an LpvdError when the server closed us
+        if connect:
+            self.connect()
+
+    # -- connection -------------------------------------------------------
+
+    def connect(self):
+        kind, addr = _parse_address(self.address)
+        if kind == "unix":
+            s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        else:
+            infos = socket.getaddrinfo(addr[0], addr[1], 0, socket.SOCK_STREAM)
+            s = socket.socket(infos[0][0], socket.SOCK_STREAM)
+            addr = infos[0][4]
+        if self.timeout is not None:
+            s.settimeout(self.timeout)
+        try:
+            s.connect(addr)
+        except OSError:
+            s.close()
+            raise
+        if kind == "tcp":
+            s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.sock = s
+        self.hello_reply = self.hello()
+        return self.hello_reply
+
+    def close(self):
+        if self.sock is not None:
+            try:
+                self.sock.close()
+            finally:
+                self.sock = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        if self.sock is not None and exc[0] is None:
+            try:
+                self.bye()
+            except (LpvdError, ProtocolError, OSError):
+                pass
+        self.close()
+        return False
+
+    # -- framing ----------------------------------------------------------
+
+    def _recv_exact(self, n):
+        buf = bytearray()
+        while len(buf) < n:
+            chunk = self.sock.recv(min(n - len(buf), 1 << 20))
+            if not chunk:
+                raise ProtocolError("connection closed by the server (%d of %d bytes)" % (len(buf), n))
+            buf += chunk
+        return bytes(buf)
+
+    def send_frame(self, mtype, body=None, attachment=b"", request_id=None):
+        """Send one frame; returns its request_id."""
+        if self.sock is None:
+            raise ProtocolError("not connected")
+        if request_id is None:
+            request_id = self._next_id
+            self._next_id = (self._next_id % 0xFFFFFFFF) + 1
+        js = json.dumps(body if body is not None else {}, separators=(",", ":")).encode("utf-8")
+        att = bytes(attachment) if attachment else b""
+        self.sock.sendall(HEADER.pack(MAGIC, VERSION, mtype, request_id, 0, len(js), len(att)) + js + att)
+        return request_id
+
+    def recv_frame(self):
+        """Receive one frame: (type, request_id, body dict, attachment bytes)."""
+        if self.sock is None:
+            raise ProtocolError("not connected")
+        magic, version, mtype, rid, flags, jlen, alen = HEADER.unpack(self._recv_exact(HEADER.size))
+        if magic != MAGIC:
+            raise ProtocolError("bad magic %r from the server" % magic)
+        if version != VERSION:
+            raise ProtocolError("server speaks version %d" % version)
+        if jlen < 2:
+            raise ProtocolError("json_length %d < 2" % jlen)
+        raw = self._recv_exact(jlen)
+        att = self._recv_exact(alen) if alen else b""
+        try:
+            body = json.loads(raw.decode("utf-8"))
+        except ValueError as e:
+            raise ProtocolError("bad JSON body from the server: %s" % e)
+        if not isinstance(body, dict):
+            raise ProtocolError("JSON body is not an object")
+        return mtype, rid, body, att
+
+    @staticmethod
+    def _error(body):
+        code = body.get("code", 0)
+        return LpvdError(code, body.get("name", ERROR_NAMES.get(code, "ERROR")),
+                         body.get("message", ""), body)
+
+    def request(self, mtype, body=None, attachment=b""):
+        """Send a request and wait for its reply: (body, attachment).
+        Stream messages arriving meanwhile are queued for ``next_message``."""
+        rid = self.send_frame(mtype, body, attachment)
+        while True:
+            rtype, rrid, rbody, ratt = self.recv_frame()
+            if rid and rrid == rid and rtype == (mtype | REPLY_BIT):
+                return rbody, ratt
+            if rtype == MSG["ERROR"] and (rrid == rid or rrid == 0):
+                err = self._error(rbody)
+                if rrid == 0:
+                    self.closed_by_server = err
+                    self.close()
+                elif err.code in (1, 3, 4, 8, 15) or (err.code == 2 and mtype != MSG["HELLO"]):
+                    # errors that close the connection (SPEC R3.4; a HELLO's
+                    # BAD_VERSION leaves it open, R4.1)
+                    self.close()
+                raise err
+            if rtype in (MSG["VOLUME"], MSG["FRAME"]):
+                self._stream_queue.append((rtype, rbody, ratt))
+                continue
+            if rtype == SERVER_BYE and rrid == 0:
+                self.closed_by_server = "BYE"
+                self.close()
+                raise ProtocolError("the server said BYE")
+            raise ProtocolError("unexpected frame type 0x%04x request_id %d while waiting for 0x%04x #%d"
+                                % (rtype, rrid, mtype | REPLY_BIT, rid))
+
+    # -- requests (SPEC section 4) ---------------------------------------
+
+    def hello(self, version=VERSION):
+        body = {"version": version, "client": self.client_name}
+        if self.token is not None:
+            body["token"] = self.token
+        return self.request(MSG["HELLO"], body)[0]
+
+    def scene_load_file(self, path):
+        """SCENE_LOAD by path (resolved under the server's --scene-root)."""
+        return self.request(MSG["SCENE_LOAD"], {"path": path})[0]
+
+    def scene_load_glb(self, glb):
+        """SCENE_LOAD with the .glb bytes as attachment."""
+        return self.request(MSG["SCENE_LOAD"], {}, glb)[0]
+
+    def scene_update(self, nodes=None, materials=None):
+        body = {}
+        if nodes is not None:
+            body["nodes"] = list(nodes)
+        if materials is not None:
+            body["materials"] = list(materials)
+        return self.request(MSG["SCENE_UPDATE"], body)[0]
+
+    def light_set(self, id, type, intensity, color=None, position=None, direction=None,
+                  range=None, inner_cone=None, outer_cone=None):
+        body = {"id": id, "type": type, "intensity": intensity}
+        for k, v in (("color", color), ("position", position), ("direction", direction),
+                     ("range", range), ("inner_cone", inner_cone), ("outer_cone", outer_cone)):
+            if v is not None:
+                body[k] = list(v) if isinstance(v, (tuple, list)) else v
+        return self.request(MSG["LIGHT_SET"], body)[0]
+
+    def light_remove(self, id):
+        return self.request(MSG["LIGHT_REMOVE"], {"id": id})[0]
+
+    def camera_set(self, eye=None, target=None, up=None, fov_deg=None, width=None, height=None,
+                   camera=None):
+        """An explicit camera (eye, target, ...) or ``camera=`` a scene camera's index or name."""
+        if camera is not None:
+            body = {"camera": camera}
+        else:
+            if eye is None or target is None:
+                raise ValueError("camera_set needs eye and target, or camera=")
+            body = {"eye": list(eye), "target": list(target)}
+            for k, v in (("up", up), ("fov_deg", fov_deg), ("width", width), ("height", height)):
+                if v is not None:
+                    body[k] = list(v) if isinstance(v, (tuple, list)) else v
+        return self.request(MSG["CAMERA_SET"], body)[0]
+
+    def config(self, **settings):
+        """CONFIG: grid, bounds, iterations, rsm_size, occlusion, indirect_gain,
+        emissive_vpls, tick_rate_hz. Returns {"revision", "config": {...}}."""
+        body = {k: (list(v) if isinstance(v, tuple) else v) for k, v in settings.items() if v is not None}
+        return self.request(MSG["CONFIG"], body)[0]
+
+    def tick(self):
+        return self.request(MSG["TICK"], {})[0]
+
+    def subscribe(self, stream="volume", format=None, compression=None, delta=None):
+        body = {"stream": stream}
+        if stream == "volume":
+            body["format"] = format or "fp32"
+            body["compression"] = compression or _default_compression()
+            body["delta"] = True if delta is None else bool(delta)
+        else:
+            if format is not None:
+                body["format"] = format
+            body["compression"] = compression or _default_compression()
+            if delta is not None:
+                body["delta"] = bool(delta)
+        return self.request(MSG["SUBSCRIBE"], body)[0]
+
+    def unsubscribe(self, stream="volume"):
+        return self.request(MSG["UNSUBSCRIBE"], {"stream": stream})[0]
+
+    def get_volume(self, format="fp32", compression=None):
+        """GET_VOLUME, decoded to a ``Volume`` (a keyframe)."""
+        body = {"format": format, "compression": compression or _default_compression()}
+        hdr, att = self.request(MSG["GET_VOLUME"], body)
+        return self._decode_volume(hdr, att, ack=False)
+
+    def get_frame(self, format="rgba8", compression=None, terms="full"):
+        """GET_FRAME -> ``Frame`` (rgba8 pixels are decompressed)."""
+        body = {"format": format, "terms": terms}
+        if format == "rgba8":
+            body["compression"] = compression or _default_compression()
+        elif compression is not None:
+            body["compression"] = compression
+        hdr, att = self.request(MSG["GET_FRAME"], body)
+        return self._decode_frame(hdr, att)
+
+    def query_irradiance(self, points, normals):
+        """QUERY_IRRADIANCE for surface points and normals (sequences of 3
+        floats, or numpy (n, 3) arrays). Returns a numpy (n, 3) float32 array
+        of W/m^2, or a list of (r, g, b) tuples without numpy."""
+        n = len(points)
+        if len(normals) != n:
+            raise ValueError("%d points but %d normals" % (n, len(normals)))
+        if _np is not None:
+            pn = _np.empty((n, 6), dtype="<f4")
+            if n:
+                pn[:, 0:3] = _np.asarray(points, dtype=_np.float32).reshape(n, 3)
+                pn[:, 3:6] = _np.asarray(normals, dtype=_np.float32).reshape(n, 3)
+            att = pn.tobytes()
+        else:
+            flat = []
+            for p, q in zip(points, normals):
+                flat.extend((p[0], p[1], p[2], q[0], q[1], q[2]))
+            att = struct.pack("<%df" % (6 * n), *flat)
+        hdr, ratt = self.request(MSG["QUERY_IRRADIANCE"], {"count": n}, att)
+        if len(ratt) != 12 * n:
+            raise ProtocolError("QUERY_IRRADIANCE answered %d bytes for %d points" % (len(ratt), n))
+        self.last_query = hdr
+        if _np is not None:
+            return _np.frombuffer(ratt, dtype="<f4").reshape(n, 3).copy()
+        v = struct.unpack("<%df" % (3 * n), ratt)
+        return [tuple(v[3 * i:3 * i + 3]) for i in range(n)]
+
+    def stats(self):
+        return self.request(MSG["STATS"], {})[0]
+
+    def bye(self):
+        """BYE: the server replies and closes; the socket is closed here too."""
+        try:
+            return self.request(MSG["BYE"], {})[0]
+        finally:
+            self.close()
+
+    def ack(self, tick, stream="volume"):
+        """ACK a volume (no reply): the server may then send XOR deltas against it."""
+        self.send_frame(MSG["ACK"], {"stream": stream, "tick": int(tick)})
+
+    # -- streams ----------------------------------------------------------
+
+    def _remember(self, tick, raw):
+        if tick in self._acked:
+            return
+        self._acked[tick] = raw
+        self._acked_order.append(tick)
+        while len(self._acked_order) > self.keep_acked:
+            self._acked.pop(self._acked_order.pop(0), None)
+
+    def _decode_volume(self, hdr, att, ack):
+        raw = _decompress(att, hdr.get("compression", "none"), hdr.get("raw_length", len(att)))
+        if "raw_length" in hdr and len(raw) != hdr["raw_length"]:
+            raise ProtocolError("volume of %d bytes, header says raw_length %d" % (len(raw), hdr["raw_length"]))
+        if not hdr.get("keyframe", True):
+            base = hdr.get("base_tick")
+            if base not in self._acked:
+                raise ProtocolError("delta against tick %r which this client does not hold" % (base,))
+            raw = _xor(raw, self._acked[base])
+        vol = Volume(hdr, raw)
+        if ack and vol.tick is not None:
+            self._remember(vol.tick, raw)
+            self.ack(vol.tick)
+        return vol
+
+    def _decode_frame(self, hdr, att):
+        data = att
+        if hdr.get("format") == "rgba8":
+            data = _decompress(att, hdr.get("compression", "none"), hdr.get("raw_length", len(att)))
+        return Frame(hdr, bytes(data))
+
+    def next_message(self, ack=True):
+        """Wait for the next stream message (after SUBSCRIBE) and return a
+        ``Volume`` or ``Frame``. XOR deltas are undone against the volumes
+        this client acknowledged; each volume is acknowledged (ACK) unless
+        ``ack`` is False. Returns None when the server said BYE."""
+        if self._stream_queue:
+            rtype, body, att = self._stream_queue.pop(0)
+        else:
+            while True:
+                rtype, rid, body, att = self.recv_frame()
+                if rtype in (MSG["VOLUME"], MSG["FRAME"]):
+                    break
+                if rtype == SERVER_BYE:
+                    self.closed_by_server = "BYE"
+                    self.close()
+                    return None
+                if rtype == MSG["ERROR"]:
+                    err = self._error(body)
+                    if err.name == "SHUTTING_DOWN":
+                        self.closed_by_server = err
+                        self.close()
+                    raise err
+                raise ProtocolError("unexpected frame type 0x%04x (request_id %d) in the stream" % (rtype, rid))
+        if rtype == MSG["VOLUME"]:
+            return self._decode_volume(body, att, ack)
+        return self._decode_frame(body, att)
+
+    def stream(self, count=None, ack=True):
+        """Iterate over stream messages (``count`` of them, or until BYE)."""
+        n = 0
+        while count is None or n < count:
+            m = self.next_message(ack=ack)
+            if m is None:
+                return
+            yield m
+            n += 1
+
+
+# -- self-test -------------------------------------------------------------
+
+def _minimal_glb():
+    """A tiny valid .glb: a 2 m floor quad and a back wall (no light: the
+    server adds its default light, docs/units.md)."""
+    pos = [-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1,
+           -1, 0, -1, 1, 0, -1, 1, 2, -1, -1, 2, -1]
+    nrm = [0, 1, 0] * 4 + [0, 0, 1] * 4
+    idx = [0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7]
+    bin_ = struct.pack("<24f", *pos) + struct.pack("<24f", *nrm) + struct.pack("<12H", *idx)
+    while len(bin_) % 4:
+        bin_ += b"\0"
+    gltf = {
+        "asset": {"version": "2.0"},
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}}],
+        "buffers": [{"byteLength": len(bin_)}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 96},
+                        {"buffer": 0, "byteOffset": 96, "byteLength": 96},
+                        {"buffer": 0, "byteOffset": 192, "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3",
+             "min": [-1, 0, -1], "max": [1, 2, 1]},
+            {"bufferView": 1, "componentType": 5126, "count": 8, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5123, "count": 12, "type": "SCALAR"},
+        ],
+    }
+    js = json.dumps(gltf, separators=(",", ":")).encode()
+    while len(js) % 4:
+        js += b" "
+    total = 12 + 8 + len(js) + 8 + len(bin_)
+    return (struct.pack("<4sII", b"glTF", 2, total) + struct.pack("<I4s", len(js), b"JSON") + js
+            + struct.pack("<I4s", len(bin_), b"BIN\0") + bin_)
+
+
+def self_test(address, token=None, glb=None, out=sys.stdout):
+    """hello, (scene), tick, get_volume, query, stats, bye. Returns 0 on success."""
+    def say(msg):
+        out.write("self-test: %s\n" % msg)
+        out.flush()
+
+    c = Client(address, token=token, client_name="lpvd_client.py self-test", timeout=120)
+    say("HELLO -> %s" % json.dumps(c.hello_reply, sort_keys=True))
+    if c.hello_reply.get("version") != 1:
+        raise AssertionError("HELLO reply version %r" % c.hello_reply.get("version"))
+    if glb is not None:
+        with open(glb, "rb") as f:
+            r = c.scene_load_glb(f.read())
+        say("SCENE_LOAD (%s) -> revision %s, scene %s" % (glb, r.get("revision"), json.dumps(r.get("scene"))))
+    # A reply to an unloaded session may be NOT_READY: load a small scene then.
+    try:
+        t = c.tick()
+    except LpvdError as e:
+        if e.name != "NOT_READY":
+            raise
+        say("TICK -> NOT_READY (%s); loading a built-in minimal .glb" % e.message)
+        r = c.scene_load_glb(_minimal_glb())
+        say("SCENE_LOAD (minimal glb) -> revision %s" % r.get("revision"))
+        t = c.tick()
+    say("TICK -> tick %s, revision %s" % (t.get("tick"), t.get("revision")))
+    vol = c.get_volume(format="fp32")
+    flux = vol.total_flux()
+    say("GET_VOLUME -> dims %s, cell %.4g m, tick %s, total flux %s W"
+        % (list(vol.dims), vol.cell_size, vol.tick, ["%.4g" % v for v in flux]))
+    if vol.cells <= 0:
+        raise AssertionError("empty volume")
+    if not all(v == v and v >= 0 for v in flux):
+        raise AssertionError("volume flux %r is not finite and non-negative" % flux)
+    vol16 = c.get_volume(format="fp16")
+    if vol16.dims != vol.dims:
+        raise AssertionError("fp16 volume dims %r != fp32 dims %r" % (vol16.dims, vol.dims))
+    # Points through the middle of the grid, facing each axis direction.
+    centre = [vol.origin[a] + 0.5 * vol.dims[a] * vol.cell_size for a in range(3)]
+    normals = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+    points = [tuple(centre)] * len(normals)
+    e = c.query_irradiance(points, normals)
+    worst = 0.0
+    for i in range(len(normals)):
+        local = vol.irradiance(points[i], normals[i])
+        server = [float(v) for v in e[i]]
+        for a, b in zip(local, server):
+            worst = max(worst, abs(a - b) / max(1e-6, abs(a), abs(b)))
+    say("QUERY_IRRADIANCE at the grid centre -> %s W/m^2; local lookup differs by %.2e (relative)"
+        % (["%.4g,%.4g,%.4g" % tuple(float(v) for v in e[i]) for i in range(len(normals))], worst))
+    for row in e:
+        for v in row:
+            if not (v == v and v >= 0):
+                raise AssertionError("irradiance %r is not finite and non-negative" % (v,))
+    if worst > 1e-3:
+        raise AssertionError("server and local irradiance disagree (%.3g relative)" % worst)
+    fr = c.get_frame(format="png")
+    if fr.format != "png" or fr.data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise AssertionError("GET_FRAME png returned %r (%d bytes)" % (fr.format, len(fr.data)))
+    say("GET_FRAME png -> %dx%d, %d bytes" % (fr.width, fr.height, len(fr.data)))
+    # Volume stream with XOR deltas: each rebuilt volume equals a keyframe of the same tick.
+    c.subscribe("volume", format="fp16", delta=True)
+    kinds = []
+    for i in range(3):
+        if i == 2:  # change something, so the last delta is not all zeros
+            c.light_set("self-test", "point", 0.5, position=centre)
+        t = c.tick()
+        sv = c.next_message()
+        if not isinstance(sv, Volume) or sv.tick != t.get("tick"):
+            raise AssertionError("stream gave %r for tick %r" % (sv, t.get("tick")))
+        key = c.get_volume(format="fp16")
+        if key.tick != sv.tick or key.raw != sv.raw:
+            raise AssertionError("streamed volume of tick %s differs from GET_VOLUME's" % sv.tick)
+        kinds.append("keyframe" if sv.keyframe else "delta/%s" % sv.base_tick)
+    c.unsubscribe("volume")
+    say("VOLUME stream (fp16, delta) -> %s, each equal to GET_VOLUME of its tick" % ", ".join(kinds))
+    st = c.stats()
+    say("STATS -> keys %s" % sorted(st.keys()))
+    c.bye()
+    say("BYE -> ok")
+    return 0
+
+
+def main(argv):
+    import argparse
+    ap = argparse.ArgumentParser(description="lpvd Python client")
+    ap.add_argument("--self-test", metavar="ADDRESS", nargs="?", const="",
+                    help="run a short end-to-end check against the daemon at ADDRESS")
+    ap.add_argument("--token-file", help="file holding the token for HELLO")
+    ap.add_argument("--glb", help="a .glb to load (self-test) before ticking")
+    args = ap.parse_args(argv)
+    token = None
+    if args.token_file:
+        with open(args.token_file) as f:
+            token = f.read().strip()
+    if args.self_test is None:
+        ap.print_help()
+        return 2
+    address = args.self_test or default_address()
+    try:
+        rc = self_test(address, token=token, glb=args.glb)
+    except (LpvdError, ProtocolError, OSError, AssertionError, ValueError) as e:
+        sys.stderr.write("self-test FAILED: %s: %s\n" % (type(e).__name__, e))
+        return 1
+    print("self-test passed (numpy: %s, zstandard: %s)" % (HAVE_NUMPY, HAVE_ZSTD))
+    return rc
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,637 @@
+/*
+ * test_client.c - the C client library (clients/c/lpvc.h) against a real
+ * daemon: starts `lpvd serve --socket TMP/lpvd.sock` as a child process and
+ * talks to it through every request of SPEC section 4. The daemon is found
+ * at $LPVD_BINARY, else ../server/lpvd next to this test's directory; without
+ * one (or one without a 'serve' command) every test is skipped, saying why.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <math.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+#include <jansson.h>
+
+#include "lpvc.h"
+#include "test_util.h"
+
+static char g_daemon[PATH_MAX + 32];
+static char g_sock[PATH_MAX];
+static char g_log[PATH_MAX];
+static pid_t g_pid = -1;
+static char g_skip[PATH_MAX + 256];
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {.tv_sec = ms / 1000, .tv_nsec = (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+static void print_log(void)
+{
+    FILE *f = fopen(g_log, "r");
+    if (!f)
+        return;
+    char line[1024];
+    fprintf(stderr, "--- daemon log (%s) ---\n", g_log);
+    while (fgets(line, sizeof line, f))
+        fputs(line, stderr);
+    fclose(f);
+}
+
+/* Runs `lpvd serve --help` quietly: 0 when the binary has the command. */
+static int has_serve(const char *bin)
+{
+    pid_t p = fork();
+    if (p < 0)
+        return -1;
+    if (p == 0) {
+        int fd = open("/dev/null", O_WRONLY);
+        if (fd >= 0) {
+            dup2(fd, 1);
+            dup2(fd, 2);
+        }
+        execl(bin, bin, "serve", "--help", (char *)NULL);
+        _exit(127);
+    }
+    int st = 0;
+    if (waitpid(p, &st, 0) != p)
+        return -1;
+    return WIFEXITED(st) && WEXITSTATUS(st) == 0 ? 0 : -1;
+}
+
+static int find_daemon(void)
+{
+    const char *env = getenv("LPVD_BINARY");
+    if (env && *env) {
+        snprintf(g_daemon, sizeof g_daemon, "%s", env);
+    } else {
+        char self[PATH_MAX];
+        ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+        if (n <= 0) {
+            snprintf(g_skip, sizeof g_skip, "cannot read /proc/self/exe");
+            return -1;
+        }
+        self[n] = '\0';
+        char *slash = strrchr(self, '/');
+        if (slash)
+            *slash = '\0';
+        snprintf(g_daemon, sizeof g_daemon, "%s/../server/lpvd", self);
+    }
+    if (access(g_daemon, X_OK) != 0) {
+        snprintf(g_skip, sizeof g_skip, "no daemon binary at %s (set LPVD_BINARY)", g_daemon);
+        return -1;
+    }
+    if (has_serve(g_daemon) != 0) {
+        snprintf(g_skip, sizeof g_skip, "%s has no working 'serve' command", g_daemon);
+        return -1;
+    }
+    return 0;
+}
+
+static int group_setup(void **state)
+{
+    (void)state;
+    signal(SIGPIPE, SIG_IGN);
+    if (find_daemon() != 0) {
+        fprintf(stderr, "test_client: SKIP: %s\n", g_skip);
+        return 0;
+    }
+    const char *dir = lpvt_tmpdir();
+    snprintf(g_sock, sizeof g_sock, "%s/lpvd.sock", dir);
+    snprintf(g_log, sizeof g_log, "%s/daemon.log", dir);
+    g_pid = fork();
+    if (g_pid < 0) {
+        snprintf(g_skip, sizeof g_skip, "fork: %s", strerror(errno));
+        return -1;
+    }
+    if (g_pid == 0) {
+        int fd = open(g_log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd >= 0) {
+            dup2(fd, 1);
+            dup2(fd, 2);
+        }
+        execl(g_daemon, g_daemon, "serve", "--socket", g_sock, (char *)NULL);
+        _exit(127);
+    }
+    struct stat st;
+    for (int i = 0; i < 1200; i++) { /* 120 s: GL start-up on llvmpipe */
+        if (stat(g_sock, &st) == 0 && S_ISSOCK(st.st_mode))
+            return 0;
+        int status;
+        if (waitpid(g_pid, &status, WNOHANG) == g_pid) {
+            fprintf(stderr, "test_client: the daemon exited before creating %s\n", g_sock);
+            print_log();
+            g_pid = -1;
+            return -1;
+        }
+        sleep_ms(100);
+    }
+    fprintf(stderr, "test_client: no socket at %s after 120 s\n", g_sock);
+    print_log();
+    return -1;
+}
+
+static int group_teardown(void **state)
+{
+    (void)state;
+    if (g_pid > 0) {
+        kill(g_pid, SIGTERM);
+        int status = 0;
+        int done = 0;
+        for (int i = 0; i < 300 && !done; i++) { /* R7.4: finishes the tick in flight, then exits */
+            if (waitpid(g_pid, &status, WNOHANG) == g_pid)
+                done = 1;
+            else
+                sleep_ms(100);
+        }
+        if (!done) {
+            fprintf(stderr, "test_client: the daemon ignored SIGTERM for 30 s; killing it\n");
+            kill(g_pid, SIGKILL);
+            waitpid(g_pid, &status, 0);
+        } else if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+            fprintf(stderr, "test_client: note: the daemon's exit status after SIGTERM was not 0 (R7.4)\n");
+        }
+        g_pid = -1;
+    }
+    return 0;
+}
+
+#define REQUIRE_DAEMON()                                                                                     \
+    do {                                                                                                     \
+        if (g_pid <= 0) {                                                                                    \
+            print_message("skipped: %s\n", g_skip);                                                          \
+            skip();                                                                                          \
+        }                                                                                                    \
+    } while (0)
+
+static lpvc *open_client(void)
+{
+    char err[512];
+    lpvc_connect_desc d = {.address = g_sock, .client_name = "test_client", .timeout_ms = 300000};
+    lpvc *c = lpvc_connect_with(&d, err, sizeof err);
+    if (!c) {
+        fprintf(stderr, "connect: %s\n", err);
+        print_log();
+    }
+    assert_non_null(c);
+    return c;
+}
+
+/* Checks a call's status, printing the error when it failed. */
+#define OK(c, call)                                                                                          \
+    do {                                                                                                     \
+        if ((call) != 0) {                                                                                   \
+            fprintf(stderr, "%s:%d: %s failed: %s (%d): %s\n", __FILE__, __LINE__, #call, lpvc_error_name(c), \
+                    lpvc_error_code(c), lpvc_error_message(c));                                             \
+            fail();                                                                                          \
+        }                                                                                                    \
+    } while (0)
+
+static json_t *last_reply(lpvc *c)
+{
+    json_t *o = json_loads(lpvc_last_reply(c), 0, NULL);
+    assert_non_null(o);
+    return o;
+}
+
+/* ---- tests ----------------------------------------------------------------- */
+
+static void test_hello(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    json_t *h = json_loads(lpvc_hello_reply(c), 0, NULL);
+    assert_non_null(h);
+    assert_int_equal(json_integer_value(json_object_get(h, "version")), 1);
+    assert_true(json_is_string(json_object_get(h, "server")));
+    assert_true(json_is_integer(json_object_get(h, "session")));
+    json_decref(h);
+    OK(c, lpvc_bye(c));
+    /* After BYE the connection is closed: calls fail with CLOSED. */
+    assert_int_equal(lpvc_tick(c, NULL), -1);
+    assert_int_equal(lpvc_error_code(c), LPVC_ERR_CLOSED);
+    lpvc_close(c);
+}
+
+static void test_connect_refused(void **state)
+{
+    (void)state;
+    char err[512];
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/nobody-here.sock", lpvt_tmpdir());
+    lpvc *c = lpvc_connect(path, NULL, err, sizeof err);
+    assert_null(c);
+    assert_non_null(strstr(err, "nobody-here.sock"));
+}
+
+static void test_errors_keep_the_connection(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    /* R4.3: no --scene-root configured, every path is refused. */
+    assert_int_equal(lpvc_scene_load_file(c, "cornell-box.glb"), -1);
+    assert_int_equal(lpvc_error_code(c), 12);
+    assert_string_equal(lpvc_error_name(c), "PATH_REFUSED");
+    assert_true(strlen(lpvc_error_message(c)) > 0);
+    /* R4.4: garbage bytes are not a .glb. */
+    static const char junk[] = "this is not a glb file at all";
+    assert_int_equal(lpvc_scene_load_glb(c, junk, sizeof junk), -1);
+    assert_int_equal(lpvc_error_code(c), 11);
+    assert_string_equal(lpvc_error_name(c), "SCENE_INVALID");
+    /* R2.8: an unknown type. */
+    assert_int_equal(lpvc_request_raw(c, 0x0042, "{}", NULL, 0, NULL, NULL), -1);
+    assert_int_equal(lpvc_error_code(c), 6);
+    /* R4.7: the attachment must be count x 24 bytes. */
+    float six[6] = {0, 0, 0, 0, 1, 0};
+    assert_int_equal(lpvc_request_raw(c, 0x000D, "{\"count\": 2}", six, sizeof six, NULL, NULL), -1);
+    assert_int_equal(lpvc_error_code(c), 7);
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+    /* R2.9: a field of the wrong type. */
+    assert_int_equal(lpvc_config_json(c, "{\"iterations\": \"many\"}"), -1);
+    assert_int_equal(lpvc_error_code(c), 7);
+    assert_non_null(strstr(lpvc_error_message(c), "iterations"));
+    /* R4.6: a grid over the server's limit. */
+    lpvc_config big = {.grid = {100000, 100000, 100000}};
+    assert_int_equal(lpvc_config_set(c, &big), -1);
+    assert_int_equal(lpvc_error_code(c), 13);
+    /* Client-side refusal: not a JSON object. */
+    assert_int_equal(lpvc_scene_update(c, "[1, 2]"), -1);
+    assert_int_equal(lpvc_error_code(c), LPVC_ERR_USAGE);
+    /* None of these closed the connection. */
+    int64_t tick = -1;
+    OK(c, lpvc_tick(c, &tick));
+    assert_true(tick >= 1);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+static float max_abs(const float *v, size_t n)
+{
+    float m = 0.0f;
+    for (size_t i = 0; i < n; i++)
+        if (fabsf(v[i]) > m)
+            m = fabsf(v[i]);
+    return m;
+}
+
+static void test_tick_volume_query(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    int64_t tick = -1;
+    OK(c, lpvc_tick(c, &tick));
+    assert_true(tick >= 1);
+    json_t *r = last_reply(c);
+    assert_true(json_is_integer(json_object_get(r, "revision")));
+    assert_true(json_is_object(json_object_get(r, "stats")));
+    json_decref(r);
+
+    lpvc_volume v32, v16, vnone;
+    lpvc_volume_desc d32 = {.format = "fp32", .compression = "zstd"};
+    lpvc_volume_desc d16 = {.format = "fp16", .compression = "zstd"};
+    lpvc_volume_desc dnone = {.format = "fp32", .compression = "none"};
+    OK(c, lpvc_get_volume(c, &d32, &v32));
+    OK(c, lpvc_get_volume(c, &d16, &v16));
+    OK(c, lpvc_get_volume(c, &dnone, &vnone));
+    assert_true(v32.cells > 0);
+    assert_int_equal(v32.cells, (size_t)v32.dims[0] * v32.dims[1] * v32.dims[2]);
+    assert_true(v32.cell_size > 0.0f);
+    assert_string_equal(v32.format, "fp32");
+    assert_string_equal(v16.format, "fp16");
+    assert_true(v32.keyframe);
+    assert_int_equal(v32.tick, tick);
+    assert_int_equal(v16.tick, tick);
+    for (int a = 0; a < 3; a++)
+        assert_int_equal(v16.dims[a], v32.dims[a]);
+    /* zstd and none carry the same bytes. */
+    assert_memory_equal(v32.data, vnone.data, v32.cells * 12 * sizeof(float));
+    /* Finite, c0 >= 0 (propagation.md §4), some light somewhere. */
+    double flux = 0.0;
+    for (size_t i = 0; i < v32.cells; i++) {
+        const float *cell = v32.data + 12 * i;
+        for (int k = 0; k < 12; k++)
+            assert_true(isfinite(cell[k]));
+        for (int ch = 0; ch < 3; ch++) {
+            assert_true(cell[4 * ch] >= 0.0f);
+            flux += cell[4 * ch];
+        }
+    }
+    assert_true(flux > 0.0);
+    /* fp16 = fp32 rounded (R5.4): relative 2^-11 plus the subnormal step. */
+    float m = max_abs(v32.data, v32.cells * 12);
+    for (size_t i = 0; i < v32.cells * 12; i++) {
+        float a = v32.data[i], b = v16.data[i];
+        float tol = fabsf(a) * (1.0f / 1024.0f) + 1e-7f + (fabsf(a) > 65504.0f ? fabsf(a) : 0.0f);
+        if (!(fabsf(a - b) <= tol)) {
+            fprintf(stderr, "value %zu: fp32 %g fp16 %g (max %g)\n", i, (double)a, (double)b, (double)m);
+            fail();
+        }
+    }
+
+    /* QUERY_IRRADIANCE = the local lookup of propagation.md §6 on the fp32
+     * volume of the same tick. Points on a lattice through the grid, normals
+     * along the six axes and one diagonal. */
+    enum { N = 7 * 27 };
+    float pts[N * 3], nrm[N * 3], rgb[N * 3];
+    static const float dirs[7][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}};
+    size_t n = 0;
+    for (int i = 0; i < 27; i++)
+        for (int k = 0; k < 7; k++, n++) {
+            int f[3] = {i % 3, (i / 3) % 3, i / 9};
+            for (int a = 0; a < 3; a++) {
+                pts[3 * n + a] = v32.origin[a] + (0.1f + 0.4f * (float)f[a]) * (float)v32.dims[a] * v32.cell_size;
+                nrm[3 * n + a] = dirs[k][a];
+            }
+        }
+    OK(c, lpvc_query_irradiance(c, pts, nrm, N, rgb));
+    r = last_reply(c);
+    assert_int_equal(json_integer_value(json_object_get(r, "count")), N);
+    assert_int_equal(json_integer_value(json_object_get(r, "tick")), tick);
+    json_decref(r);
+    float local[N * 3];
+    for (size_t i = 0; i < N; i++)
+        lpvc_volume_irradiance(&v32, pts + 3 * i, nrm + 3 * i, local + 3 * i);
+    float emax = fmaxf(max_abs(local, N * 3), max_abs(rgb, N * 3));
+    assert_true(emax > 0.0f);
+    for (size_t i = 0; i < N * 3; i++) {
+        assert_true(isfinite(rgb[i]) && rgb[i] >= 0.0f);
+        if (!(fabsf(rgb[i] - local[i]) <= 1e-3f * emax)) {
+            fprintf(stderr, "query %zu: server %g, local %g (max %g)\n", i / 3, (double)rgb[i], (double)local[i],
+                    (double)emax);
+            fail();
+        }
+    }
+    /* An empty query is fine too. */
+    OK(c, lpvc_query_irradiance(c, NULL, NULL, 0, NULL));
+
+    lpvc_volume_free(&v32);
+    lpvc_volume_free(&v16);
+    lpvc_volume_free(&vnone);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+static void test_frames(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    float eye[3] = {0, 1, 3.9f}, target[3] = {0, 1, 0};
+    lpvc_camera cam = {.eye = eye, .target = target, .fov_deg = 40, .width = 48, .height = 32};
+    OK(c, lpvc_camera_set(c, &cam));
+    OK(c, lpvc_tick(c, NULL));
+
+    lpvc_frame f;
+    lpvc_frame_desc rgba = {.format = "rgba8", .compression = "zstd", .terms = "full"};
+    OK(c, lpvc_get_frame(c, &rgba, &f));
+    assert_string_equal(f.format, "rgba8");
+    assert_int_equal(f.width, 48);
+    assert_int_equal(f.height, 32);
+    assert_int_equal(f.size, (size_t)48 * 32 * 4);
+    size_t lit = 0;
+    for (size_t i = 0; i < f.size; i += 4)
+        lit += f.data[i] || f.data[i + 1] || f.data[i + 2];
+    assert_true(lit > 0);
+    lpvc_frame_free(&f);
+
+    lpvc_frame_desc png = {.format = "png", .terms = "indirect"};
+    OK(c, lpvc_get_frame(c, &png, &f));
+    assert_string_equal(f.format, "png");
+    assert_string_equal(f.terms, "indirect");
+    assert_true(f.size > 8);
+    assert_memory_equal(f.data, "\x89PNG\r\n\x1a\n", 8);
+    lpvc_frame_free(&f);
+
+    lpvc_frame_desc exr = {.format = "exr"};
+    OK(c, lpvc_get_frame(c, &exr, &f));
+    assert_true(f.size > 4);
+    assert_memory_equal(f.data, "\x76\x2f\x31\x01", 4); /* OpenEXR magic */
+    lpvc_frame_free(&f);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+static void test_state_changes_bump_revision(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    int64_t r0 = -1;
+    float pos[3] = {0, 1.5f, 0}, col[3] = {1, 0.5f, 0.25f};
+    lpvc_light l = {.id = "probe", .type = "point", .intensity = 3, .position = pos, .color = col};
+    OK(c, lpvc_light_set(c, &l));
+    r0 = lpvc_last_revision(c);
+    assert_true(r0 >= 1);
+    OK(c, lpvc_light_remove(c, "probe"));
+    assert_true(lpvc_last_revision(c) > r0);
+    r0 = lpvc_last_revision(c);
+    lpvc_config cfg = {.iterations = 4, .occlusion = -1};
+    OK(c, lpvc_config_set(c, &cfg));
+    assert_true(lpvc_last_revision(c) > r0);
+    json_t *r = last_reply(c);
+    json_t *eff = json_object_get(r, "config");
+    assert_true(json_is_object(eff));
+    assert_int_equal(json_integer_value(json_object_get(eff, "iterations")), 4);
+    assert_true(json_is_false(json_object_get(eff, "occlusion")));
+    json_decref(r);
+    r0 = lpvc_last_revision(c);
+    OK(c, lpvc_scene_update(c, "{\"materials\": [{\"material\": 0, \"base_color\": [0.5, 0.5, 0.5, 1]}]}"));
+    assert_true(lpvc_last_revision(c) > r0);
+    r0 = lpvc_last_revision(c);
+    OK(c, lpvc_tick(c, NULL));
+    assert_int_equal(lpvc_last_revision(c), r0); /* TICK reports the revision it reflects (R3.3) */
+    char *st = NULL;
+    OK(c, lpvc_stats(c, &st));
+    json_t *s = json_loads(st, 0, NULL);
+    assert_non_null(s);
+    assert_true(json_is_object(s));
+    assert_non_null(json_object_get(s, "ticks"));
+    json_decref(s);
+    free(st);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+/* Loads the shared Cornell box .glb when ../shared is there. */
+static void test_load_glb(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    const char *shared = lpvt_shared_dir();
+    if (!shared) {
+        print_message("skipped: no ../shared (LPVD_SHARED_DIR)\n");
+        skip();
+    }
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/scenes/cornell-box.glb", shared);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        print_message("skipped: no %s\n", path);
+        skip();
+    }
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    assert_true(size > 0);
+    unsigned char *glb = malloc((size_t)size);
+    assert_non_null(glb);
+    assert_int_equal(fread(glb, 1, (size_t)size, f), (size_t)size);
+    fclose(f);
+    lpvc *c = open_client();
+    OK(c, lpvc_scene_load_glb(c, glb, (size_t)size));
+    free(glb);
+    json_t *r = last_reply(c);
+    json_t *scene = json_object_get(r, "scene");
+    assert_true(json_integer_value(json_object_get(scene, "triangles")) > 0);
+    assert_int_equal(json_array_size(json_object_get(scene, "bounds")), 6);
+    json_decref(r);
+    OK(c, lpvc_camera_set(c, &(lpvc_camera){.scene_camera = 1}));
+    OK(c, lpvc_tick(c, NULL));
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+/* Volume stream with XOR deltas: every streamed volume, rebuilt by the
+ * client, equals a fresh keyframe of the same tick bit for bit. */
+static void test_stream_deltas(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    lpvc_subscribe_desc sd = {.stream = LPVC_STREAM_VOLUME, .format = "fp16", .compression = "zstd", .delta = true};
+    OK(c, lpvc_subscribe(c, &sd));
+    int deltas = 0;
+    for (int i = 0; i < 4; i++) {
+        if (i == 2) {
+            /* change the light so the volume changes between ticks */
+            float pos[3] = {0.3f, 1.2f, 0.1f};
+            lpvc_light l = {.id = "moving", .intensity = 2, .position = pos};
+            OK(c, lpvc_light_set(c, &l));
+        }
+        int64_t tick = -1;
+        OK(c, lpvc_tick(c, &tick));
+        lpvc_message m;
+        OK(c, lpvc_next_stream_message(c, &m, 120000));
+        assert_int_equal(m.type, LPVC_MSG_VOLUME);
+        /* R3.3: the stream volume of this tick (not an older one). */
+        assert_int_equal(m.volume.tick, tick);
+        assert_string_equal(m.volume.format, "fp16");
+        if (!m.volume.keyframe) {
+            deltas++;
+            assert_true(m.volume.base_tick < m.volume.tick);
+        }
+        lpvc_volume key;
+        lpvc_volume_desc d = {.format = "fp16", .compression = "none"};
+        OK(c, lpvc_get_volume(c, &d, &key));
+        assert_int_equal(key.tick, m.volume.tick);
+        assert_int_equal(key.cells, m.volume.cells);
+        assert_memory_equal(key.data, m.volume.data, key.cells * 12 * sizeof(float));
+        lpvc_volume_free(&key);
+        lpvc_message_free(&m);
+    }
+    /* Each volume was ACKed before the next TICK (R3.2 orders them), so the
+     * server had an acknowledged base for ticks 2.. (R5.3). */
+    assert_true(deltas >= 1);
+    OK(c, lpvc_unsubscribe(c, LPVC_STREAM_VOLUME));
+    /* Unsubscribed: a tick sends no volume. */
+    OK(c, lpvc_tick(c, NULL));
+    lpvc_message m;
+    assert_int_equal(lpvc_next_stream_message(c, &m, 1000), -1);
+    assert_int_equal(lpvc_error_code(c), LPVC_ERR_TIMEOUT);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+/* Without ACK no delta (R5.3: only against an acknowledged tick); after a
+ * manual ACK the next volume is a delta against exactly that tick. */
+static void test_manual_ack(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    lpvc_set_auto_ack(c, false);
+    lpvc_subscribe_desc sd = {.stream = LPVC_STREAM_VOLUME, .format = "fp32", .compression = "zstd", .delta = true};
+    OK(c, lpvc_subscribe(c, &sd));
+    int64_t first = -1;
+    for (int i = 0; i < 2; i++) {
+        OK(c, lpvc_tick(c, NULL));
+        lpvc_message m;
+        OK(c, lpvc_next_stream_message(c, &m, 120000));
+        assert_int_equal(m.type, LPVC_MSG_VOLUME);
+        assert_true(m.volume.keyframe); /* nothing acknowledged yet */
+        if (i == 0)
+            first = m.volume.tick;
+        lpvc_message_free(&m);
+    }
+    OK(c, lpvc_ack(c, first));
+    OK(c, lpvc_tick(c, NULL));
+    lpvc_message m;
+    OK(c, lpvc_next_stream_message(c, &m, 120000));
+    assert_int_equal(m.type, LPVC_MSG_VOLUME);
+    assert_false(m.volume.keyframe);
+    assert_int_equal(m.volume.base_tick, first);
+    lpvc_volume key;
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp32", .compression = "none"}, &key));
+    assert_int_equal(key.tick, m.volume.tick);
+    assert_memory_equal(key.data, m.volume.data, key.cells * 12 * sizeof(float));
+    lpvc_volume_free(&key);
+    lpvc_message_free(&m);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+static void test_frame_stream(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    float eye[3] = {0, 1, 3.9f}, target[3] = {0, 1, 0};
+    OK(c, lpvc_camera_set(c, &(lpvc_camera){.eye = eye, .target = target, .width = 32, .height = 32}));
+    lpvc_subscribe_desc sd = {.stream = LPVC_STREAM_FRAME, .format = "rgba8", .compression = "zstd"};
+    OK(c, lpvc_subscribe(c, &sd));
+    int64_t tick = -1;
+    OK(c, lpvc_tick(c, &tick));
+    lpvc_message m;
+    OK(c, lpvc_next_stream_message(c, &m, 120000));
+    assert_int_equal(m.type, LPVC_MSG_FRAME);
+    assert_int_equal(m.frame.tick, tick);
+    assert_int_equal(m.frame.size, (size_t)m.frame.width * m.frame.height * 4);
+    lpvc_message_free(&m);
+    OK(c, lpvc_unsubscribe(c, LPVC_STREAM_FRAME));
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_connect_refused),
+        cmocka_unit_test(test_hello),
+        cmocka_unit_test(test_errors_keep_the_connection),
+        cmocka_unit_test(test_tick_volume_query),
+        cmocka_unit_test(test_frames),
+        cmocka_unit_test(test_state_changes_bump_revision),
+        cmocka_unit_test(test_load_glb),
+        cmocka_unit_test(test_stream_deltas),
+        cmocka_unit_test(test_manual_ack),
+        cmocka_unit_test(test_frame_stream),
+    };
+    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+}
