@@ -8,7 +8,7 @@ PACKAGES="
   libegl-dev libgl-dev mesa-common-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
   libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev
   libopenimageio-dev
-  libcglm-dev libuv1-dev libzstd-dev libjansson-dev libembree-dev
+  libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev
   python3 gnuplot-nox
 "

@@ -20,3 +20,12 @@ ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
 UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
 LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
   ctest --test-dir build-asan --output-on-failure -j "$jobs"
+
+# Fuzz the wire protocol (frame parser, bodies, field getters, zstd) for a
+# bounded minute with libFuzzer + ASan + UBSan (clang); new inputs go to
+# build-fuzz/corpus, the seeds in tests/fuzz/corpus are only read.
+cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DLPVD_FUZZ=ON
+cmake --build build-fuzz --target fuzz_frame -j "$jobs"
+mkdir -p build-fuzz/corpus
+./build-fuzz/fuzz/fuzz_frame -max_total_time=60 -rss_limit_mb=2048 -max_len=65536 \
+  -print_final_stats=1 build-fuzz/corpus tests/fuzz/corpus
