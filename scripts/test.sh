@@ -1,8 +1,10 @@
 #!/bin/sh
 # Every test on a fresh Debian 12 machine: install, build, run the whole
-# suite (GL tests on Mesa's llvmpipe when there is no GPU), then build again
-# with AddressSanitizer + UndefinedBehaviorSanitizer and run the suite again.
-# Warnings are errors in both builds.
+# suite (GL tests on Mesa's llvmpipe when there is no GPU; the daemon's
+# conformance and reliability suites against fresh daemons), fuzz the wire
+# protocol for a bounded minute, then build again with AddressSanitizer +
+# UndefinedBehaviorSanitizer and run the whole suite again. Warnings are
+# errors in every build.
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/install-deps.sh
@@ -12,15 +14,6 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DLPVD_SANITIZE=ON
-cmake --build build-asan -j "$jobs"
-# Mesa and LLVM keep some allocations for the life of the process; the
-# suppressions name only their libraries, never lpvd's code.
-ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
-UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
-  ctest --test-dir build-asan --output-on-failure -j "$jobs"
-
 # Fuzz the wire protocol (frame parser, bodies, field getters, zstd) for a
 # bounded minute with libFuzzer + ASan + UBSan (clang); new inputs go to
 # build-fuzz/corpus, the seeds in tests/fuzz/corpus are only read.
@@ -29,3 +22,12 @@ cmake --build build-fuzz --target fuzz_frame -j "$jobs"
 mkdir -p build-fuzz/corpus
 ./build-fuzz/fuzz/fuzz_frame -max_total_time=60 -rss_limit_mb=2048 -max_len=65536 \
   -print_final_stats=1 build-fuzz/corpus tests/fuzz/corpus
+
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DLPVD_SANITIZE=ON
+cmake --build build-asan -j "$jobs"
+# Mesa and LLVM keep some allocations for the life of the process; the
+# suppressions name only their libraries, never lpvd's code.
+ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" \
+UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0" \
+  ctest --test-dir build-asan --output-on-failure -j "$jobs"

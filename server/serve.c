@@ -507,11 +507,14 @@ int lpvd_cmd_serve(int argc, char **argv)
     fprintf(stderr, "lpvd serve: default scene %s (%u triangles)%s%s\n", s->builtin->scene.source,
             s->builtin->scene.index_count / 3, cfg->scene_root[0] ? ", scene root " : "", cfg->scene_root);
     if (cfg->want_unix)
-        fprintf(stderr, "lpvd serve: listening on unix:%s (connect: lpvctl --socket %s)\n", cfg->socket_path,
-                cfg->socket_path);
+        fprintf(stderr,
+                "lpvd serve: listening on unix:%s (connect: lpvctl --address %s tick + volume, or the Python "
+                "client: clients/python/lpvd_client.py --self-test %s)\n",
+                cfg->socket_path, cfg->socket_path, cfg->socket_path);
     if (cfg->listen_host[0])
-        fprintf(stderr, "lpvd serve: listening on tcp:%s:%d%s\n", cfg->listen_host, cfg->listen_port,
-                cfg->has_token ? " (token required)" : "");
+        fprintf(stderr, "lpvd serve: listening on tcp:%s:%d%s (connect: lpvctl --address %s:%d%s hello)\n",
+                cfg->listen_host, cfg->listen_port, cfg->has_token ? " (token required)" : "", cfg->listen_host,
+                cfg->listen_port, cfg->has_token ? " --token-file FILE" : "");
     fflush(stderr);
 
     uv_run(s->loop, UV_RUN_DEFAULT);
