@@ -99,8 +99,7 @@ static lpvp_limits limits_or_default(const lpvp_limits *lim)
     return l;
 }
 
-static void set_err(char *err, size_t err_n, const char *fmt, ...) LPVP_PRINTF(3, 4);
-static void set_err(char *err, size_t err_n, const char *fmt, ...)
+void lpvp_set_error(char *err, size_t err_n, const char *fmt, ...)
 {
     va_list ap;
     if (!err || err_n == 0)
@@ -136,31 +135,31 @@ int lpvp_header_check(const uint8_t in[LPVP_HEADER_SIZE], const lpvp_limits *lim
 
     if (memcmp(in, LPVP_MAGIC, LPVP_MAGIC_LEN) != 0) { /* R2.2 */
         h->request_id = 0;
-        set_err(err, err_n, "bad magic %02x %02x %02x %02x (expected \"LPVD\")", in[0], in[1],
+        lpvp_set_error(err, err_n, "bad magic %02x %02x %02x %02x (expected \"LPVD\")", in[0], in[1],
                 in[2], in[3]);
         return LPVP_E_BAD_MAGIC;
     }
     if (h->version != LPVP_VERSION) { /* R2.3 */
-        set_err(err, err_n, "frame version %u not spoken (versions: [%d])", (unsigned)h->version,
+        lpvp_set_error(err, err_n, "frame version %u not spoken (versions: [%d])", (unsigned)h->version,
                 LPVP_VERSION);
         return LPVP_E_BAD_VERSION;
     }
     if (h->flags != 0) { /* R2.4 */
-        set_err(err, err_n, "flags 0x%08x must be 0", (unsigned)h->flags);
+        lpvp_set_error(err, err_n, "flags 0x%08x must be 0", (unsigned)h->flags);
         return LPVP_E_BAD_FRAME;
     }
     if (h->json_length < LPVP_MIN_JSON_LENGTH) { /* R2.1 */
-        set_err(err, err_n, "json_length %u is less than 2 (the body is at least {})",
+        lpvp_set_error(err, err_n, "json_length %u is less than 2 (the body is at least {})",
                 (unsigned)h->json_length);
         return LPVP_E_BAD_FRAME;
     }
     if (h->json_length > l.max_body) { /* R2.5 */
-        set_err(err, err_n, "json_length %u exceeds the body limit %u", (unsigned)h->json_length,
+        lpvp_set_error(err, err_n, "json_length %u exceeds the body limit %u", (unsigned)h->json_length,
                 (unsigned)l.max_body);
         return LPVP_E_TOO_LARGE;
     }
     if ((uint64_t)h->json_length + h->attachment_length > l.max_message) { /* R2.5 */
-        set_err(err, err_n,
+        lpvp_set_error(err, err_n,
                 "json_length %u + attachment_length %u exceeds the message limit %llu",
                 (unsigned)h->json_length, (unsigned)h->attachment_length,
                 (unsigned long long)l.max_message);
@@ -479,7 +478,7 @@ json_t *lpvp_body_parse(const char *body, size_t len, char *err, size_t err_n)
     if (err && err_n)
         err[0] = '\0';
     if (!body && len) {
-        set_err(err, err_n, "no body");
+        lpvp_set_error(err, err_n, "no body");
         return NULL;
     }
     /* R2.7: jansson checks UTF-8, refuses \u0000 (no JSON_ALLOW_NUL), trailing
@@ -487,14 +486,14 @@ json_t *lpvp_body_parse(const char *body, size_t len, char *err, size_t err_n)
      * refused so that no field has two meanings. */
     j = json_loadb(body ? body : "", len, JSON_REJECT_DUPLICATES, &je);
     if (!j) {
-        set_err(err, err_n, "invalid JSON body at byte %d: %s", je.position, je.text);
+        lpvp_set_error(err, err_n, "invalid JSON body at byte %d: %s", je.position, je.text);
         return NULL;
     }
     if (!json_is_object(j)) {
         static const char *const kinds[] = {"an object", "an array", "a string", "an integer",
                                             "a real", "true", "false", "null"};
         int t = json_typeof(j);
-        set_err(err, err_n, "the body must be a JSON object, not %s",
+        lpvp_set_error(err, err_n, "the body must be a JSON object, not %s",
                 (t >= 0 && t < 8) ? kinds[t] : "this");
         json_decref(j);
         return NULL;
@@ -527,7 +526,7 @@ static int lookup(const json_t *obj, const char *key, int required, json_t **v, 
     if (*v)
         return LPVP_FIELD_OK;
     if (required) {
-        set_err(err, err_n, "%s: missing required field", key);
+        lpvp_set_error(err, err_n, "%s: missing required field", key);
         return LPVP_FIELD_BAD;
     }
     return LPVP_FIELD_ABSENT;
@@ -558,14 +557,14 @@ static int check_int(const json_t *v, const char *key, const char *idx, int64_t 
     int64_t x;
     if (int_value(v, &x) != 0) {
         if (json_is_real(v))
-            set_err(err, err_n, "%s%s: expected an integer, got %.17g", key, idx,
+            lpvp_set_error(err, err_n, "%s%s: expected an integer, got %.17g", key, idx,
                     json_real_value(v));
         else
-            set_err(err, err_n, "%s%s: expected an integer, got %s", key, idx, type_word(v));
+            lpvp_set_error(err, err_n, "%s%s: expected an integer, got %s", key, idx, type_word(v));
         return LPVP_FIELD_BAD;
     }
     if (x < min || x > max) {
-        set_err(err, err_n, "%s%s: %lld is out of range [%lld, %lld]", key, idx, (long long)x,
+        lpvp_set_error(err, err_n, "%s%s: %lld is out of range [%lld, %lld]", key, idx, (long long)x,
                 (long long)min, (long long)max);
         return LPVP_FIELD_BAD;
     }
@@ -578,16 +577,16 @@ static int check_number(const json_t *v, const char *key, const char *idx, doubl
 {
     double d;
     if (!json_is_number(v)) {
-        set_err(err, err_n, "%s%s: expected a number, got %s", key, idx, type_word(v));
+        lpvp_set_error(err, err_n, "%s%s: expected a number, got %s", key, idx, type_word(v));
         return LPVP_FIELD_BAD;
     }
     d = json_number_value(v);
     if (!isfinite(d)) {
-        set_err(err, err_n, "%s%s: not a finite number", key, idx);
+        lpvp_set_error(err, err_n, "%s%s: not a finite number", key, idx);
         return LPVP_FIELD_BAD;
     }
     if (!(d >= min && d <= max)) {
-        set_err(err, err_n, "%s%s: %.9g is out of range [%.9g, %.9g]", key, idx, d, min, max);
+        lpvp_set_error(err, err_n, "%s%s: %.9g is out of range [%.9g, %.9g]", key, idx, d, min, max);
         return LPVP_FIELD_BAD;
     }
     *out = d;
@@ -621,7 +620,7 @@ int lpvp_get_float(const json_t *obj, const char *key, int required, double min,
     int st = lpvp_get_number(obj, key, required, min, max, &d, err, err_n);
     if (st == LPVP_FIELD_OK) {
         if (fabs(d) > 3.4028234663852886e38) {
-            set_err(err, err_n, "%s: %.9g does not fit in a float", key, d);
+            lpvp_set_error(err, err_n, "%s: %.9g does not fit in a float", key, d);
             return LPVP_FIELD_BAD;
         }
         *out = (float)d;
@@ -637,7 +636,7 @@ int lpvp_get_bool(const json_t *obj, const char *key, int required, int *out, ch
     if (st != LPVP_FIELD_OK)
         return st;
     if (!json_is_boolean(v)) {
-        set_err(err, err_n, "%s: expected true or false, got %s", key, type_word(v));
+        lpvp_set_error(err, err_n, "%s: expected true or false, got %s", key, type_word(v));
         return LPVP_FIELD_BAD;
     }
     *out = json_is_true(v) ? 1 : 0;
@@ -653,12 +652,12 @@ int lpvp_get_string(const json_t *obj, const char *key, int required, size_t max
     if (st != LPVP_FIELD_OK)
         return st;
     if (!json_is_string(v)) {
-        set_err(err, err_n, "%s: expected a string, got %s", key, type_word(v));
+        lpvp_set_error(err, err_n, "%s: expected a string, got %s", key, type_word(v));
         return LPVP_FIELD_BAD;
     }
     n = json_string_length(v);
     if (n > max_len) {
-        set_err(err, err_n, "%s: string of %zu bytes is longer than %zu", key, n, max_len);
+        lpvp_set_error(err, err_n, "%s: string of %zu bytes is longer than %zu", key, n, max_len);
         return LPVP_FIELD_BAD;
     }
     *out = json_string_value(v);
@@ -687,7 +686,7 @@ int lpvp_get_enum(const json_t *obj, const char *key, int required,
     }
     if (err && err_n) {
         size_t at;
-        set_err(err, err_n, "%s: expected one of ", key);
+        lpvp_set_error(err, err_n, "%s: expected one of ", key);
         at = strlen(err);
         for (size_t i = 0; i < n_choices && at + 1 < err_n; i++) {
             snprintf(err + at, err_n - at, "%s\"%s\"", i ? ", " : "", choices[i]);
@@ -707,10 +706,10 @@ static int get_array_n(const json_t *obj, const char *key, int required, size_t 
         return st;
     if (!json_is_array(*arr) || json_array_size(*arr) != count) {
         if (json_is_array(*arr))
-            set_err(err, err_n, "%s: expected an array of %zu numbers, got %zu elements", key,
+            lpvp_set_error(err, err_n, "%s: expected an array of %zu numbers, got %zu elements", key,
                     count, json_array_size(*arr));
         else
-            set_err(err, err_n, "%s: expected an array of %zu numbers, got %s", key, count,
+            lpvp_set_error(err, err_n, "%s: expected an array of %zu numbers, got %s", key, count,
                     type_word(*arr));
         return LPVP_FIELD_BAD;
     }
@@ -749,7 +748,7 @@ int lpvp_get_floats(const json_t *obj, const char *key, int required, size_t cou
             LPVP_FIELD_OK)
             return LPVP_FIELD_BAD;
         if (fabs(d) > 3.4028234663852886e38) {
-            set_err(err, err_n, "%s%s: %.9g does not fit in a float", key, idx, d);
+            lpvp_set_error(err, err_n, "%s%s: %.9g does not fit in a float", key, idx, d);
             return LPVP_FIELD_BAD;
         }
         out[i] = (float)d;
@@ -767,10 +766,10 @@ int lpvp_get_ints(const json_t *obj, const char *key, int required, size_t count
         return st;
     if (!json_is_array(a) || json_array_size(a) != count) {
         if (json_is_array(a))
-            set_err(err, err_n, "%s: expected an array of %zu integers, got %zu elements", key,
+            lpvp_set_error(err, err_n, "%s: expected an array of %zu integers, got %zu elements", key,
                     count, json_array_size(a));
         else
-            set_err(err, err_n, "%s: expected an array of %zu integers, got %s", key, count,
+            lpvp_set_error(err, err_n, "%s: expected an array of %zu integers, got %s", key, count,
                     type_word(a));
         return LPVP_FIELD_BAD;
     }
@@ -791,7 +790,7 @@ int lpvp_get_object(const json_t *obj, const char *key, int required, const json
     if (st != LPVP_FIELD_OK)
         return st;
     if (!json_is_object(v)) {
-        set_err(err, err_n, "%s: expected an object, got %s", key, type_word(v));
+        lpvp_set_error(err, err_n, "%s: expected an object, got %s", key, type_word(v));
         return LPVP_FIELD_BAD;
     }
     *out = v;
@@ -806,11 +805,11 @@ int lpvp_get_array(const json_t *obj, const char *key, int required, size_t max_
     if (st != LPVP_FIELD_OK)
         return st;
     if (!json_is_array(v)) {
-        set_err(err, err_n, "%s: expected an array, got %s", key, type_word(v));
+        lpvp_set_error(err, err_n, "%s: expected an array, got %s", key, type_word(v));
         return LPVP_FIELD_BAD;
     }
     if (json_array_size(v) > max_len) {
-        set_err(err, err_n, "%s: %zu elements, at most %zu allowed", key, json_array_size(v),
+        lpvp_set_error(err, err_n, "%s: %zu elements, at most %zu allowed", key, json_array_size(v),
                 max_len);
         return LPVP_FIELD_BAD;
     }

@@ -277,6 +277,10 @@ uint8_t *lpvp_frame_build_json(uint16_t type, uint32_t request_id, const json_t 
  * (R3.4); for LPVP_E_BAD_VERSION it also carries "versions": [1] (R2.3, R4.1).
  * A new reference (NULL only if memory runs out); add fields before building. */
 json_t *lpvp_error_body(int code, const char *fmt, ...) LPVP_PRINTF(2, 3);
+
+/* printf-formats a message into err (nothing when err is NULL or err_n 0):
+ * how every function of this library reports what was wrong. */
+void lpvp_set_error(char *err, size_t err_n, const char *fmt, ...) LPVP_PRINTF(3, 4);
 json_t *lpvp_error_vbody(int code, const char *fmt, va_list ap);
 
 /* A complete ERROR frame (type 0xFFFF) with lpvp_error_body(code, fmt, ...).

@@ -3,6 +3,7 @@
  * volume header (SPEC section 5). See volume_codec.h.
  */
 #include "volume_codec.h"
+#include "proto.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -11,20 +12,6 @@
 #include <string.h>
 #include <zstd.h>
 
-static void set_err(char *err, size_t err_n, const char *fmt, ...)
-#if defined(__GNUC__) || defined(__clang__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-static void set_err(char *err, size_t err_n, const char *fmt, ...)
-{
-    va_list ap;
-    if (!err || err_n == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(err, err_n, fmt, ap);
-    va_end(ap);
-}
 
 /* ---- binary16 ------------------------------------------------------------- */
 
@@ -222,7 +209,7 @@ size_t lpvp_zstd_compress_into(void *dst, size_t cap, const void *src, size_t n,
     /* ZSTD_compress records the content size in the frame header. */
     r = ZSTD_compress(dst, cap, n ? src : "", n, level);
     if (ZSTD_isError(r)) {
-        set_err(err, err_n, "zstd compression failed: %s", ZSTD_getErrorName(r));
+        lpvp_set_error(err, err_n, "zstd compression failed: %s", ZSTD_getErrorName(r));
         return 0;
     }
     return r;
@@ -235,12 +222,12 @@ int lpvp_zstd_compress(const void *src, size_t n, int level, uint8_t **out, size
     uint8_t *buf;
     size_t r;
     if (ZSTD_isError(cap) || cap == 0) {
-        set_err(err, err_n, "zstd: %zu bytes is too large to compress", n);
+        lpvp_set_error(err, err_n, "zstd: %zu bytes is too large to compress", n);
         return -1;
     }
     buf = malloc(cap);
     if (!buf) {
-        set_err(err, err_n, "zstd: out of memory (%zu bytes)", cap);
+        lpvp_set_error(err, err_n, "zstd: out of memory (%zu bytes)", cap);
         return -1;
     }
     r = lpvp_zstd_compress_into(buf, cap, src, n, level, err, err_n);
@@ -261,29 +248,29 @@ static unsigned long long frame_content_size(const void *src, size_t n, size_t m
     unsigned long long cs;
     size_t fsize;
     if (!src || n == 0) {
-        set_err(err, err_n, "zstd: empty input");
+        lpvp_set_error(err, err_n, "zstd: empty input");
         return (unsigned long long)-1;
     }
     cs = ZSTD_getFrameContentSize(src, n);
     if (cs == ZSTD_CONTENTSIZE_ERROR) {
-        set_err(err, err_n, "zstd: not a zstd frame");
+        lpvp_set_error(err, err_n, "zstd: not a zstd frame");
         return (unsigned long long)-1;
     }
     if (cs == ZSTD_CONTENTSIZE_UNKNOWN) {
-        set_err(err, err_n, "zstd: frame content size is not recorded");
+        lpvp_set_error(err, err_n, "zstd: frame content size is not recorded");
         return (unsigned long long)-1;
     }
     if (cs > max) {
-        set_err(err, err_n, "zstd: content size %llu exceeds the maximum %zu", cs, max);
+        lpvp_set_error(err, err_n, "zstd: content size %llu exceeds the maximum %zu", cs, max);
         return (unsigned long long)-1;
     }
     fsize = ZSTD_findFrameCompressedSize(src, n);
     if (ZSTD_isError(fsize)) {
-        set_err(err, err_n, "zstd: %s", ZSTD_getErrorName(fsize));
+        lpvp_set_error(err, err_n, "zstd: %s", ZSTD_getErrorName(fsize));
         return (unsigned long long)-1;
     }
     if (fsize != n) {
-        set_err(err, err_n, "zstd: %zu bytes after the frame", n - fsize);
+        lpvp_set_error(err, err_n, "zstd: %zu bytes after the frame", n - fsize);
         return (unsigned long long)-1;
     }
     return cs;
@@ -294,11 +281,11 @@ static int decompress_to(void *dst, size_t size, const void *src, size_t n, char
 {
     size_t r = ZSTD_decompress(dst, size, src, n);
     if (ZSTD_isError(r)) {
-        set_err(err, err_n, "zstd: %s", ZSTD_getErrorName(r));
+        lpvp_set_error(err, err_n, "zstd: %s", ZSTD_getErrorName(r));
         return -1;
     }
     if (r != size) {
-        set_err(err, err_n, "zstd: frame gave %zu bytes, its header says %zu", r, size);
+        lpvp_set_error(err, err_n, "zstd: frame gave %zu bytes, its header says %zu", r, size);
         return -1;
     }
     return 0;
@@ -313,7 +300,7 @@ int lpvp_zstd_decompress(const void *src, size_t n, size_t max_out, uint8_t **ou
         return -1;
     buf = malloc(cs ? (size_t)cs : 1);
     if (!buf) {
-        set_err(err, err_n, "zstd: out of memory (%llu bytes)", cs);
+        lpvp_set_error(err, err_n, "zstd: out of memory (%llu bytes)", cs);
         return -1;
     }
     if (decompress_to(buf, (size_t)cs, src, n, err, err_n) != 0) {
@@ -332,7 +319,7 @@ int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expe
     if (cs == (unsigned long long)-1)
         return -1;
     if (cs != expect) {
-        set_err(err, err_n, "zstd: content size %llu, expected %zu", cs, expect);
+        lpvp_set_error(err, err_n, "zstd: content size %llu, expected %zu", cs, expect);
         return -1;
     }
     return decompress_to(dst, expect, src, n, err, err_n);
@@ -399,11 +386,11 @@ static int need_int(const json_t *o, const char *key, long long min, long long *
 {
     json_t *v = json_object_get(o, key);
     if (!json_is_integer(v)) {
-        set_err(err, err_n, "%s: expected an integer", key);
+        lpvp_set_error(err, err_n, "%s: expected an integer", key);
         return -1;
     }
     if (json_integer_value(v) < min) {
-        set_err(err, err_n, "%s: %lld is less than %lld", key, (long long)json_integer_value(v),
+        lpvp_set_error(err, err_n, "%s: %lld is less than %lld", key, (long long)json_integer_value(v),
                 min);
         return -1;
     }
@@ -419,7 +406,7 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
     memset(vi, 0, sizeof *vi);
     vi->base_tick = -1;
     if (!json_is_object(obj)) {
-        set_err(err, err_n, "volume header: not an object");
+        lpvp_set_error(err, err_n, "volume header: not an object");
         return -1;
     }
     if (need_int(obj, "revision", 0, &x, err, err_n))
@@ -430,17 +417,17 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
     vi->tick = x;
     if (lpvp_volume_format_parse(json_string_value(json_object_get(obj, "format")),
                                  &vi->format) != 0) {
-        set_err(err, err_n, "format: expected \"fp16\" or \"fp32\"");
+        lpvp_set_error(err, err_n, "format: expected \"fp16\" or \"fp32\"");
         return -1;
     }
     if (lpvp_compression_parse(json_string_value(json_object_get(obj, "compression")),
                                &vi->compression) != 0) {
-        set_err(err, err_n, "compression: expected \"zstd\" or \"none\"");
+        lpvp_set_error(err, err_n, "compression: expected \"zstd\" or \"none\"");
         return -1;
     }
     v = json_object_get(obj, "keyframe");
     if (!json_is_boolean(v)) {
-        set_err(err, err_n, "keyframe: expected true or false");
+        lpvp_set_error(err, err_n, "keyframe: expected true or false");
         return -1;
     }
     vi->keyframe = json_is_true(v);
@@ -451,44 +438,44 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
     }
     grid = json_object_get(obj, "grid");
     if (!json_is_object(grid)) {
-        set_err(err, err_n, "grid: expected an object");
+        lpvp_set_error(err, err_n, "grid: expected an object");
         return -1;
     }
     a = json_object_get(grid, "dims");
     if (!json_is_array(a) || json_array_size(a) != 3) {
-        set_err(err, err_n, "grid.dims: expected an array of 3 integers");
+        lpvp_set_error(err, err_n, "grid.dims: expected an array of 3 integers");
         return -1;
     }
     for (size_t i = 0; i < 3; i++) {
         json_t *d = json_array_get(a, i);
         if (!json_is_integer(d) || json_integer_value(d) < 1 ||
             json_integer_value(d) > (1 << 20)) {
-            set_err(err, err_n, "grid.dims[%zu]: expected an integer in [1, 1048576]", i);
+            lpvp_set_error(err, err_n, "grid.dims[%zu]: expected an integer in [1, 1048576]", i);
             return -1;
         }
         vi->dims[i] = json_integer_value(d);
         if (cells > ((size_t)-1) / (size_t)vi->dims[i]) {
-            set_err(err, err_n, "grid.dims: too many cells");
+            lpvp_set_error(err, err_n, "grid.dims: too many cells");
             return -1;
         }
         cells *= (size_t)vi->dims[i];
     }
     a = json_object_get(grid, "origin");
     if (!json_is_array(a) || json_array_size(a) != 3) {
-        set_err(err, err_n, "grid.origin: expected an array of 3 numbers");
+        lpvp_set_error(err, err_n, "grid.origin: expected an array of 3 numbers");
         return -1;
     }
     for (size_t i = 0; i < 3; i++) {
         json_t *d = json_array_get(a, i);
         if (!json_is_number(d)) {
-            set_err(err, err_n, "grid.origin[%zu]: expected a number", i);
+            lpvp_set_error(err, err_n, "grid.origin[%zu]: expected a number", i);
             return -1;
         }
         vi->origin[i] = json_number_value(d);
     }
     v = json_object_get(grid, "cell_size");
     if (!json_is_number(v) || !(json_number_value(v) > 0.0) || !isfinite(json_number_value(v))) {
-        set_err(err, err_n, "grid.cell_size: expected a positive number");
+        lpvp_set_error(err, err_n, "grid.cell_size: expected a positive number");
         return -1;
     }
     vi->cell_size = json_number_value(v);
@@ -498,7 +485,7 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
     {
         size_t expect = lpvp_volume_raw_size(cells, vi->format);
         if (expect == 0 || (uint64_t)expect != vi->raw_length) {
-            set_err(err, err_n, "raw_length: %llu, but %zu cells of %s need %zu bytes", x, cells,
+            lpvp_set_error(err, err_n, "raw_length: %llu, but %zu cells of %s need %zu bytes", x, cells,
                     lpvp_volume_format_name(vi->format), expect);
             return -1;
         }
@@ -512,12 +499,12 @@ int lpvp_volume_decode(const lpvp_volume_info *vi, const void *attachment, size_
 {
     size_t raw_len = (size_t)vi->raw_length;
     if ((uint64_t)raw_len != vi->raw_length) {
-        set_err(err, err_n, "raw_length %llu does not fit in memory",
+        lpvp_set_error(err, err_n, "raw_length %llu does not fit in memory",
                 (unsigned long long)vi->raw_length);
         return -1;
     }
     if (!vi->keyframe && (!base_raw || base_len != raw_len)) {
-        set_err(err, err_n, "delta against tick %lld without a base volume of %zu bytes",
+        lpvp_set_error(err, err_n, "delta against tick %lld without a base volume of %zu bytes",
                 (long long)vi->base_tick, raw_len);
         return -1;
     }
@@ -526,7 +513,7 @@ int lpvp_volume_decode(const lpvp_volume_info *vi, const void *attachment, size_
             /* In place: decompress aside, then XOR into the base. */
             uint8_t *tmp = malloc(raw_len ? raw_len : 1);
             if (!tmp) {
-                set_err(err, err_n, "out of memory (%zu bytes)", raw_len);
+                lpvp_set_error(err, err_n, "out of memory (%zu bytes)", raw_len);
                 return -1;
             }
             if (lpvp_zstd_decompress_exact(attachment, att_len, tmp, raw_len, err, err_n) != 0) {
@@ -541,7 +528,7 @@ int lpvp_volume_decode(const lpvp_volume_info *vi, const void *attachment, size_
             return -1;
     } else {
         if (att_len != raw_len) {
-            set_err(err, err_n, "attachment of %zu bytes, raw_length is %zu", att_len, raw_len);
+            lpvp_set_error(err, err_n, "attachment of %zu bytes, raw_length is %zu", att_len, raw_len);
             return -1;
         }
         if (vi->keyframe) {
