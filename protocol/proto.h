@@ -278,6 +278,18 @@ uint8_t *lpvp_frame_build_json(uint16_t type, uint32_t request_id, const json_t 
  * A new reference (NULL only if memory runs out); add fields before building. */
 json_t *lpvp_error_body(int code, const char *fmt, ...) LPVP_PRINTF(2, 3);
 
+/* ---- Addresses (SPEC R1.1) ----------------------------------------------- */
+
+/* The default Unix socket: $XDG_RUNTIME_DIR/lpvd.sock when that variable
+ * names an existing absolute folder, else /tmp/lpvd-$UID.sock. The daemon and
+ * the C clients use this one rule so they always meet. */
+void lpvp_default_socket_path(char *out, size_t n);
+
+/* Splits "HOST:PORT", "[IPv6]:PORT", ":PORT" or "PORT" into a host (brackets
+ * removed; empty or absent = "127.0.0.1") and a port 0..65535. Returns 0, or
+ * -1 with a message naming the address. */
+int lpvp_split_host_port(const char *s, char *host, size_t host_n, unsigned *port, char *err, size_t err_n);
+
 /* printf-formats a message into err (nothing when err is NULL or err_n 0):
  * how every function of this library reports what was wrong. */
 void lpvp_set_error(char *err, size_t err_n, const char *fmt, ...) LPVP_PRINTF(3, 4);

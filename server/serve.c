@@ -284,16 +284,6 @@ static void signal_cb(uv_signal_t *h, int signum)
     begin_shutdown(h->data, signum);
 }
 
-static void default_socket_path(char *out, size_t n)
-{
-    const char *xdg = getenv("XDG_RUNTIME_DIR");
-    struct stat st;
-    if (xdg && xdg[0] == '/' && stat(xdg, &st) == 0 && S_ISDIR(st.st_mode))
-        snprintf(out, n, "%s/lpvd.sock", xdg);
-    else
-        snprintf(out, n, "/tmp/lpvd-%u.sock", (unsigned)getuid());
-}
-
 static void close_walk(uv_handle_t *h, void *arg)
 {
     (void)arg;
@@ -371,30 +361,13 @@ int lpvd_cmd_serve(int argc, char **argv)
             snprintf(cfg->socket_path, sizeof cfg->socket_path, "%s", v);
             have_socket = 1;
         } else if (!strcmp(name, "listen")) {
-            const char *colon = strrchr(v, ':');
-            char host[128];
-            if (!colon) {
-                snprintf(host, sizeof host, "127.0.0.1");
-                colon = v - 1;
-            } else {
-                size_t hl = (size_t)(colon - v);
-                if (hl >= sizeof host)
-                    hl = sizeof host - 1;
-                memcpy(host, v, hl);
-                host[hl] = '\0';
-                if (hl >= 2 && host[0] == '[' && host[hl - 1] == ']') {
-                    memmove(host, host + 1, hl - 2);
-                    host[hl - 2] = '\0';
-                }
-                if (!host[0])
-                    snprintf(host, sizeof host, "127.0.0.1");
-            }
-            if (parse_u64(colon + 1, 0, 65535, &u) != 0) {
-                fprintf(stderr, "lpvd serve: --listen %s: expected HOST:PORT or PORT (port 0..65535)\n", v);
+            unsigned port;
+            char perr[256];
+            if (lpvp_split_host_port(v, cfg->listen_host, sizeof cfg->listen_host, &port, perr, sizeof perr) != 0) {
+                fprintf(stderr, "lpvd serve: --listen %s\n", perr);
                 return 2;
             }
-            snprintf(cfg->listen_host, sizeof cfg->listen_host, "%s", host);
-            cfg->listen_port = (int)u;
+            cfg->listen_port = (int)port;
         } else if (!strcmp(name, "token-file")) {
             token_file = v;
         } else if (!strcmp(name, "scene-root")) {
@@ -466,7 +439,7 @@ int lpvd_cmd_serve(int argc, char **argv)
     if (have_socket || !cfg->listen_host[0]) {
         cfg->want_unix = 1;
         if (!have_socket)
-            default_socket_path(cfg->socket_path, sizeof cfg->socket_path);
+            lpvp_default_socket_path(cfg->socket_path, sizeof cfg->socket_path);
     }
     signal(SIGPIPE, SIG_IGN);
 

@@ -1224,6 +1224,39 @@ static void test_volume_header_and_decode(void **state)
                      -1);
 }
 
+/* R1.1: host/port splitting and the default socket rule shared by the
+ * daemon and the clients. */
+static void test_addresses(void **state)
+{
+    (void)state;
+    char host[64], err[128];
+    unsigned port = 1;
+    assert_int_equal(lpvp_split_host_port("127.0.0.1:7070", host, sizeof host, &port, err, sizeof err), 0);
+    assert_string_equal(host, "127.0.0.1");
+    assert_int_equal(port, 7070);
+    assert_int_equal(lpvp_split_host_port("[::1]:80", host, sizeof host, &port, err, sizeof err), 0);
+    assert_string_equal(host, "::1");
+    assert_int_equal(port, 80);
+    assert_int_equal(lpvp_split_host_port("9000", host, sizeof host, &port, err, sizeof err), 0);
+    assert_string_equal(host, "127.0.0.1");
+    assert_int_equal(port, 9000);
+    assert_int_equal(lpvp_split_host_port(":0", host, sizeof host, &port, err, sizeof err), 0);
+    assert_int_equal(port, 0);
+    const char *bad[] = {"host:", "host:65536", "host:-1", "host:12ab", "abc", ""};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        err[0] = '\0';
+        assert_int_equal(lpvp_split_host_port(bad[i], host, sizeof host, &port, err, sizeof err), -1);
+        assert_non_null(strstr(err, bad[i]));
+    }
+    char path[256];
+    setenv("XDG_RUNTIME_DIR", "/nonexistent-lpvd-dir", 1);
+    lpvp_default_socket_path(path, sizeof path);
+    assert_int_equal(strncmp(path, "/tmp/lpvd-", 10), 0);
+    setenv("XDG_RUNTIME_DIR", "/tmp", 1);
+    lpvp_default_socket_path(path, sizeof path);
+    assert_string_equal(path, "/tmp/lpvd.sock");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1243,6 +1276,7 @@ int main(void)
         cmocka_unit_test(test_xor_delta),
         cmocka_unit_test(test_zstd),
         cmocka_unit_test(test_volume_header_and_decode),
+        cmocka_unit_test(test_addresses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

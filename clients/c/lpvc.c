@@ -117,11 +117,7 @@ static void close_fd(lpvc *c)
 
 const char *lpvc_default_address(char *buf, size_t n)
 {
-    const char *run = getenv("XDG_RUNTIME_DIR");
-    if (run && *run)
-        snprintf(buf, n, "%s/lpvd.sock", run);
-    else
-        snprintf(buf, n, "/tmp/lpvd-%u.sock", (unsigned)getuid());
+    lpvp_default_socket_path(buf, n);
     return buf;
 }
 
@@ -164,30 +160,16 @@ static int open_socket(const char *address, char *err, size_t n)
         return fd;
     }
 
-    char host[256];
-    const char *colon = strrchr(rest, ':');
-    if (!colon || colon[1] == '\0') {
-        snprintf(err, n, "bad address '%s': expected HOST:PORT or a socket path", address);
+    char host[256], port_str[8];
+    unsigned port;
+    if (lpvp_split_host_port(rest, host, sizeof host, &port, err, n) != 0)
         return -1;
-    }
-    size_t hl = (size_t)(colon - rest);
-    if (hl >= sizeof host) {
-        snprintf(err, n, "host name too long in '%s'", address);
-        return -1;
-    }
-    memcpy(host, rest, hl);
-    host[hl] = '\0';
-    if (hl >= 2 && host[0] == '[' && host[hl - 1] == ']') {
-        memmove(host, host + 1, hl - 2);
-        host[hl - 2] = '\0';
-    }
-    if (!host[0])
-        snprintf(host, sizeof host, "127.0.0.1");
+    snprintf(port_str, sizeof port_str, "%u", port);
     struct addrinfo hints, *res = NULL;
     memset(&hints, 0, sizeof hints);
     hints.ai_family = AF_UNSPEC;
     hints.ai_socktype = SOCK_STREAM;
-    int rc = getaddrinfo(host, colon + 1, &hints, &res);
+    int rc = getaddrinfo(host, port_str, &hints, &res);
     if (rc != 0) {
         snprintf(err, n, "cannot resolve '%s': %s", address, gai_strerror(rc));
         return -1;

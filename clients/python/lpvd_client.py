@@ -104,7 +104,7 @@ class ProtocolError(Exception):
 def default_address():
     """The daemon's default socket (SPEC R1.1)."""
     run = os.environ.get("XDG_RUNTIME_DIR")
-    if run:
+    if run and os.path.isabs(run) and os.path.isdir(run):  # the daemon's rule (protocol/proto.c)
         return os.path.join(run, "lpvd.sock")
     return "/tmp/lpvd-%d.sock" % os.getuid()
 
