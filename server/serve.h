@@ -162,6 +162,10 @@ struct sv_world {
     int timer_init;
     double timer_rate;
     int periodic_pending;   /* a periodic tick job is queued or running */
+    sv_job *queued_tick;    /* the newest tick job submitted, until it completes;
+                               TICK requests join it while the GL thread has not
+                               started it (sv_world_join_tick) */
+    uint64_t ticks_computed, ticks_coalesced; /* STATS world_ticks_* */
     int jobs;               /* jobs queued or running for this world */
     int dying;              /* refs == 0, destroy job queued */
     sv_server *srv;
@@ -188,6 +192,13 @@ typedef enum sv_job_kind {
     SV_JOB_QUIT,
 } sv_job_kind;
 
+/* A TICK request that joined a tick job queued by another request (coalescing). */
+typedef struct sv_waiter {
+    sv_conn *conn;          /* ref */
+    uint32_t request_id;
+    struct sv_waiter *next;
+} sv_waiter;
+
 struct sv_job {
     sv_job_kind kind;
     sv_world *world;
@@ -196,7 +207,9 @@ struct sv_job {
     sv_conn *conn;          /* ref, NULL for periodic ticks */
     uint32_t request_id;
     int periodic;
-    unsigned terms_mask;    /* tick: which frames to render (1 << terms) */
+    int started;            /* taken by the GL thread; under srv->mu */
+    sv_waiter *joined;      /* tick: more requests answered by this job, in order */
+    unsigned terms_mask;    /* tick: which frames to render (1 << terms); under srv->mu until started */
     int terms;              /* render */
     float *points;          /* query: 6n floats */
     size_t count;
@@ -329,7 +342,8 @@ struct sv_server {
     lpv_gl_context *gl_ctx;
     /* counters */
     uint64_t bytes_sent;
-    uint64_t ticks;
+    uint64_t ticks;         /* ticks computed, all worlds */
+    uint64_t ticks_coalesced; /* TICK requests answered by another request's tick */
     uint64_t requests;
     int exit_code;
 };
@@ -360,7 +374,7 @@ const char *sv_error_name(int code);
 void sv_session_init(sv_conn *c);
 void sv_session_free(sv_conn *c);        /* on close: detach, free state */
 void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
-void sv_session_job_done(sv_job *j);     /* a GL job of a request finished */
+void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id); /* c's request j finished */
 void sv_session_stream(sv_conn *c, sv_result *r); /* after a tick of its world */
 
 /* serve_world.c */
@@ -380,6 +394,7 @@ void sv_scene_unref(sv_server *s, sv_scene *sc);
 sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
 unsigned sv_world_terms_mask(sv_world *w);
 void sv_world_update_timer(sv_world *w);
+int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: joined a queued tick */
 size_t sv_jobs_queued(sv_server *s);
 
 /* serve_encode.c */

@@ -1075,6 +1075,10 @@ static void submit(sv_conn *c, sv_job *j)
 
 static void do_tick(sv_conn *c, sv_request *r)
 {
+    if (c->world && sv_world_join_tick(c->world, c, r->request_id)) { /* shared with a queued tick (R7.2) */
+        c->busy = 1;
+        return;
+    }
     sv_job *j = c->world ? sv_job_new(SV_JOB_TICK, c->world) : NULL;
     if (!j) {
         reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
@@ -1082,6 +1086,7 @@ static void do_tick(sv_conn *c, sv_request *r)
     }
     j->request_id = r->request_id;
     j->terms_mask = sv_world_terms_mask(c->world);
+    c->world->queued_tick = j;
     submit(c, j);
 }
 
@@ -1273,6 +1278,12 @@ static void do_stats(sv_conn *c, sv_request *r)
         (json_int_t)c->bytes_sent, "ticks", (json_int_t)s->ticks, "world_ticks",
         (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
         "revision", (json_int_t)c->revision);
+    /* tick coalescing (R7.2): computed ticks vs TICK requests answered by a tick queued for another */
+    json_object_set_new(b, "ticks_computed", json_integer((json_int_t)s->ticks));
+    json_object_set_new(b, "ticks_coalesced", json_integer((json_int_t)s->ticks_coalesced));
+    json_object_set_new(b, "world_ticks_computed", json_integer((json_int_t)(c->world ? c->world->ticks_computed : 0)));
+    json_object_set_new(b, "world_ticks_coalesced",
+                        json_integer((json_int_t)(c->world ? c->world->ticks_coalesced : 0)));
     reply(c, LPVP_STATS, r->request_id, b);
 }
 
@@ -1290,26 +1301,25 @@ static void do_ack(sv_conn *c, sv_request *r, json_t *j)
 }
 
 /* ---- completions of GL jobs ---------------------------------------------- */
-void sv_session_job_done(sv_job *j)
+void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
 {
-    sv_conn *c = j->conn;
     c->busy = 0;
     if (c->closing || c->close_after_write)
         return;
     if (j->status) {
-        reply_err(c, j->request_id, j->status, 0, "%s", j->err);
+        reply_err(c, request_id, j->status, 0, "%s", j->err);
     } else if (j->kind == SV_JOB_TICK) {
         json_t *b = rev_body(c);
         json_object_set_new(b, "tick", json_integer((json_int_t)j->result->tick));
         json_object_set_new(b, "stats", tick_stats(j->result));
-        reply(c, LPVP_TICK, j->request_id, b);
+        reply(c, LPVP_TICK, request_id, b);
     } else if (j->kind == SV_JOB_RENDER) {
-        send_frame_reply(c, j->request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
+        send_frame_reply(c, request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
                          j->terms, j->tick);
     } else if (j->kind == SV_JOB_QUERY) {
         uint8_t *att = malloc(j->count ? j->count * 12 : 1);
         if (!att) {
-            reply_err(c, j->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            reply_err(c, request_id, LPVP_E_INTERNAL, 0, "out of memory");
         } else {
             for (size_t i = 0; i < j->count * 3; ++i) {
                 uint32_t u;
@@ -1318,7 +1328,7 @@ void sv_session_job_done(sv_job *j)
             }
             json_t *b = json_pack("{s:I, s:I, s:I}", "revision", (json_int_t)c->revision, "tick", (json_int_t)j->tick,
                                   "count", (json_int_t)j->count);
-            sv_send(c, LPVP_REPLY(LPVP_QUERY_IRRADIANCE), j->request_id, b, att, j->count * 12, SV_STREAM_NONE);
+            sv_send(c, LPVP_REPLY(LPVP_QUERY_IRRADIANCE), request_id, b, att, j->count * 12, SV_STREAM_NONE);
         }
     }
     sv_session_pump(c);

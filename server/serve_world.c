@@ -207,10 +207,18 @@ void sv_job_free(sv_job *j)
         return;
     if (j->world) {
         j->world->jobs--;
+        if (j->world->queued_tick == j)
+            j->world->queued_tick = NULL;
         inputs_release(j->world->srv, j->inputs);
     }
     if (j->conn)
         sv_conn_unref(j->conn);
+    while (j->joined) {
+        sv_waiter *wt = j->joined;
+        j->joined = wt->next;
+        sv_conn_unref(wt->conn);
+        free(wt);
+    }
     sv_result_unref(j->result);
     free(j->points);
     free(j->rgba);
@@ -427,6 +435,7 @@ static void *gl_main(void *arg)
         if (!s->jobs_head)
             s->jobs_tail = NULL;
         s->jobs_queued--;
+        j->started = 1; /* from now on no request joins it (sv_world_join_tick) */
         pthread_mutex_unlock(&s->mu);
 
         int quit = 0;
@@ -479,13 +488,25 @@ static void timer_closed(uv_handle_t *h)
     world_free(w);
 }
 
+/* Replies to the request of a job and to every request that joined it. */
+static void job_reply_all(sv_job *j)
+{
+    if (j->conn)
+        sv_session_job_done(j, j->conn, j->request_id);
+    for (sv_waiter *wt = j->joined; wt; wt = wt->next)
+        sv_session_job_done(j, wt->conn, wt->request_id);
+}
+
 static void tick_done(sv_server *s, sv_job *j)
 {
     sv_world *w = j->world;
     if (j->periodic)
         w->periodic_pending = 0;
+    if (w->queued_tick == j) /* before the replies: a session's next TICK must queue a new tick */
+        w->queued_tick = NULL;
     if (j->result) {
         s->ticks++;
+        w->ticks_computed++;
         if (!w->latest || j->result->tick > w->latest->tick) {
             sv_result_unref(w->latest);
             w->latest = sv_result_ref(j->result);
@@ -493,8 +514,7 @@ static void tick_done(sv_server *s, sv_job *j)
     } else if (j->periodic && j->status) {
         fprintf(stderr, "lpvd serve: world %llu: tick failed: %s\n", (unsigned long long)w->id, j->err);
     }
-    if (j->conn)
-        sv_session_job_done(j);
+    job_reply_all(j);
     if (j->result && !w->dying)
         for (sv_conn *c = s->conns; c; c = c->next)
             if (c->world == w && !c->closing)
@@ -518,10 +538,7 @@ static void done_cb(uv_async_t *a)
         switch (j->kind) {
         case SV_JOB_TICK: tick_done(s, j); break;
         case SV_JOB_RENDER:
-        case SV_JOB_QUERY:
-            if (j->conn)
-                sv_session_job_done(j);
-            break;
+        case SV_JOB_QUERY: job_reply_all(j); break;
         case SV_JOB_DESTROY: {
             sv_world *w = j->world;
             sv_job_free(j);
@@ -587,11 +604,9 @@ void sv_gl_stop(sv_server *s)
         } else {
             if (dropped->periodic && dropped->world)
                 dropped->world->periodic_pending = 0;
-            if (dropped->conn) {
-                dropped->status = SV_E_SHUTTING_DOWN;
-                snprintf(dropped->err, sizeof dropped->err, "the server is stopping");
-                sv_session_job_done(dropped);
-            }
+            dropped->status = SV_E_SHUTTING_DOWN;
+            snprintf(dropped->err, sizeof dropped->err, "the server is stopping");
+            job_reply_all(dropped);
             sv_job_free(dropped);
         }
         dropped = next;
@@ -616,11 +631,60 @@ unsigned sv_world_terms_mask(sv_world *w)
     return m;
 }
 
+/* The world's tick job that the GL thread has not started yet and that was
+ * queued for the world's current inputs, or NULL. Call with srv->mu held: the
+ * GL thread sets `started` under it. */
+static sv_job *joinable_tick_locked(sv_world *w)
+{
+    sv_job *q = w->queued_tick;
+    return q && !q->started && q->gen == w->gen ? q : NULL;
+}
+
+/* Tick coalescing (R7.2): a TICK for a world whose tick is still queued for
+ * the same inputs (generation) is answered by that tick instead of queuing an
+ * identical computation behind it: same tick number, each reply with its own
+ * session's revision. Same generation = the session's applied state, so R3.3
+ * holds. A tick the GL thread has started is never joined, so a reply never
+ * comes from a computation that began before its request arrived. The caller
+ * keeps the session busy until the reply, as for a tick of its own (R3.2). */
+int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id)
+{
+    sv_server *s = w->srv;
+    sv_waiter *wt = calloc(1, sizeof *wt);
+    if (!wt)
+        return 0;
+    unsigned mask = sv_world_terms_mask(w); /* frame subscriptions may be newer than the job's */
+    pthread_mutex_lock(&s->mu);
+    sv_job *q = joinable_tick_locked(w);
+    if (q)
+        q->terms_mask |= mask;
+    pthread_mutex_unlock(&s->mu);
+    if (!q) {
+        free(wt);
+        return 0;
+    }
+    wt->conn = c;
+    c->refs++;
+    wt->request_id = request_id;
+    sv_waiter **p = &q->joined; /* in arrival order */
+    while (*p)
+        p = &(*p)->next;
+    *p = wt;
+    w->ticks_coalesced++;
+    s->ticks_coalesced++;
+    return 1;
+}
+
 static void world_timer_cb(uv_timer_t *t)
 {
     sv_world *w = t->data;
     sv_server *s = w->srv;
     if (w->dying || s->stopping || w->periodic_pending)
+        return;
+    pthread_mutex_lock(&s->mu);
+    int queued = joinable_tick_locked(w) != NULL;
+    pthread_mutex_unlock(&s->mu);
+    if (queued) /* a requested tick of these inputs has not started: it serves as this period's */
         return;
     sv_job *j = sv_job_new(SV_JOB_TICK, w);
     if (!j)
@@ -628,6 +692,7 @@ static void world_timer_cb(uv_timer_t *t)
     j->periodic = 1;
     j->terms_mask = sv_world_terms_mask(w);
     w->periodic_pending = 1;
+    w->queued_tick = j;
     sv_job_submit(s, j);
 }
 

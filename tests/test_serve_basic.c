@@ -6,8 +6,9 @@
  * GET_VOLUME (fp32 and fp16+zstd agree), QUERY_IRRADIANCE, GET_FRAME (PNG),
  * LIGHT_SET / LIGHT_REMOVE revisions, SCENE_LOAD from an attachment and from
  * a path under --scene-root (and a refused path), SUBSCRIBE with deltas
- * (ACK, then an XOR delta that rebuilds the volume), BYE, and SIGTERM: BYE
- * to every client and exit status 0.
+ * (ACK, then an XOR delta that rebuilds the volume), BYE, tick coalescing
+ * of sessions sharing a world (R7.2), and SIGTERM: BYE to every client and
+ * exit status 0.
  */
 #include <errno.h>
 #include <math.h>
@@ -492,6 +493,94 @@ static void test_happy_path(void **state)
     conn_close(&c);
 }
 
+static json_int_t stat_int(const msg *m, const char *key)
+{
+    const json_t *v = json_object_get(m->j, key);
+    assert_true(json_is_integer(v));
+    return json_integer_value(v);
+}
+
+/* Tick coalescing (R7.2): TICKs that sessions sharing one world pipeline
+ * while a tick of that world is still queued are answered by that one
+ * computation; sessions with other configs never share it. A heavy tick of a
+ * third world keeps the GL thread busy while the TICKs arrive, so there is a
+ * queued tick to join. */
+static void test_sharing_coalesces(void **state)
+{
+    (void)state;
+    enum { N = 4, ROUNDS = 2, OTHERS = 2 };
+    conn blocker, same[N], other[OTHERS];
+    msg m;
+    conn_open(&blocker);
+    hello(&blocker);
+    request(&blocker, LPVP_CONFIG, "{\"grid\": [96, 96, 96], \"iterations\": 48, \"rsm_size\": 512}", NULL, 0, &m);
+    assert_int_equal(m.type, LPVP_REPLY(LPVP_CONFIG));
+    msg_free(&m);
+    for (int i = 0; i < N + OTHERS; ++i) {
+        conn *c = i < N ? &same[i] : &other[i - N];
+        char cfg[96];
+        snprintf(cfg, sizeof cfg, "{\"grid\": [8, 8, 8], \"iterations\": %d}", i < N ? 2 : 3 + (i - N));
+        conn_open(c);
+        hello(c);
+        request(c, LPVP_CONFIG, cfg, NULL, 0, &m);
+        assert_int_equal(m.type, LPVP_REPLY(LPVP_CONFIG));
+        msg_free(&m);
+    }
+
+    /* everything is sent before anything is read */
+    uint32_t blocker_rid = send_msg(&blocker, LPVP_TICK, "{}", NULL, 0);
+    struct timespec ts = {0, 50000000}; /* let the daemon take the heavy tick first */
+    nanosleep(&ts, NULL);
+    uint32_t rids[N][ROUNDS], other_rid[OTHERS];
+    for (int round = 0; round < ROUNDS; ++round)
+        for (int i = 0; i < N; ++i)
+            rids[i][round] = send_msg(&same[i], LPVP_TICK, "{}", NULL, 0);
+    for (int k = 0; k < OTHERS; ++k)
+        other_rid[k] = send_msg(&other[k], LPVP_TICK, "{}", NULL, 0);
+
+    for (int i = 0; i < N; ++i)
+        for (int round = 0; round < ROUNDS; ++round) {
+            assert_int_equal(recv_msg(&same[i], &m), 0);
+            assert_int_equal(m.type, LPVP_REPLY(LPVP_TICK));
+            assert_int_equal(m.rid, rids[i][round]);
+            assert_true(stat_int(&m, "tick") >= 1);
+            msg_free(&m);
+        }
+    for (int k = 0; k < OTHERS; ++k) { /* each computed with its own config: never coalesced */
+        assert_int_equal(recv_msg(&other[k], &m), 0);
+        assert_int_equal(m.type, LPVP_REPLY(LPVP_TICK));
+        assert_int_equal(m.rid, other_rid[k]);
+        json_t *counts = json_object_get(json_object_get(m.j, "stats"), "counts");
+        assert_int_equal(json_integer_value(json_object_get(counts, "iterations")), 3 + k);
+        msg_free(&m);
+        request(&other[k], LPVP_STATS, "{}", NULL, 0, &m);
+        assert_int_equal(stat_int(&m, "world_sessions"), 1);
+        assert_int_equal(stat_int(&m, "world_ticks_computed"), 1);
+        assert_int_equal(stat_int(&m, "world_ticks_coalesced"), 0);
+        msg_free(&m);
+    }
+    assert_int_equal(recv_msg(&blocker, &m), 0);
+    assert_int_equal(m.rid, blocker_rid);
+    msg_free(&m);
+
+    request(&same[0], LPVP_STATS, "{}", NULL, 0, &m);
+    assert_int_equal(m.type, LPVP_REPLY(LPVP_STATS));
+    assert_int_equal(stat_int(&m, "world_sessions"), N);
+    json_int_t computed = stat_int(&m, "world_ticks_computed"), coalesced = stat_int(&m, "world_ticks_coalesced");
+    assert_int_equal(computed + coalesced, N * ROUNDS); /* every TICK: computed or joined */
+    assert_true(computed < N * ROUNDS);
+    assert_true(coalesced > 0);
+    assert_true(stat_int(&m, "ticks_coalesced") >= coalesced);
+    assert_true(stat_int(&m, "ticks_computed") >= computed + OTHERS + 1);
+    msg_free(&m);
+
+    conn_close(&blocker);
+    for (int i = 0; i < N; ++i)
+        conn_close(&same[i]);
+    for (int k = 0; k < OTHERS; ++k)
+        conn_close(&other[k]);
+}
+
 static void test_sigterm_says_bye(void **state)
 {
     (void)state;
@@ -529,6 +618,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_happy_path),
+        cmocka_unit_test(test_sharing_coalesces),
         cmocka_unit_test(test_sigterm_says_bye),
     };
     return cmocka_run_group_tests(tests, start_daemon, stop_daemon);
