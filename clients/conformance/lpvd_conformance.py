@@ -1809,9 +1809,16 @@ def c_limit_clients(ctx):
         time.sleep(0.5)
     held = [first] + [ctx.session() for _ in range(lim - 1)]
     extra = ctx.connect()
+    rid = 0
     try:
-        rid = extra.send(HELLO, ctx.hello_body())
-        f = extra.recv_reply(timeout=5)
+        # A server may refuse at accept, before any request: read first, so
+        # the refusal is not lost to a reset caused by writing into a
+        # connection the server has already closed.
+        try:
+            f = extra.recv_reply(timeout=1)
+        except socket.timeout:
+            rid = extra.send(HELLO, ctx.hello_body())
+            f = extra.recv_reply(timeout=5)
     except Closed:
         raise Fail("connection %d was closed without ERROR LIMIT" % (lim + 1))
     except socket.timeout:
