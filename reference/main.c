@@ -1,0 +1,285 @@
+/*
+ * main.c - lpvd-reference: the path-traced reference image (or irradiance at
+ * points) for lpvd's indirect light. See docs/reference.md.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "image_io.h"
+#include "options.h"
+#include "pt.h"
+#include "scene_load.h"
+
+static const char USAGE[] =
+    "usage: lpvd-reference [SCENE.glb] -o OUT.exr [--stderr STDERR.exr] [options]\n"
+    "       lpvd-reference [SCENE.glb] --points IN.csv -o OUT.csv [options]\n"
+    "\n"
+    "Path-traced indirect light (docs/reference.md): the image is albedo/pi * E_ind\n"
+    "at the first surface of each pixel (what `lpvd render --indirect-only` shows);\n"
+    "points mode reads px,py,pz,nx,ny,nz lines and writes E_r,E_g,E_b,se_r,se_g,se_b\n"
+    "(W/m^2). Without SCENE: the built-in Cornell box.\n"
+    "\n"
+    "  -o PATH                 output image (.exr: float) or, with --points, CSV\n"
+    "  --stderr PATH           per-pixel standard error image\n"
+    "  --bounces N             diffuse bounces (default 1 = lpvd's LPV term)\n"
+    "  --spp N                 samples per pixel or point (default 64)\n"
+    "  --threads N             worker threads (default: the number of cores)\n"
+    "  --seed N                RNG seed (default 0)\n"
+    "  --points PATH           irradiance at the points of a CSV file\n"
+    "  --camera N|NAME         a camera of the glTF file, by index or name\n"
+    "  --eye X,Y,Z --target X,Y,Z --fov DEG   an explicit camera (fov vertical)\n"
+    "  --size WxH              image size (default 512 wide, height from the camera's aspect)\n";
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end || v < lo || v > hi)
+        return -1;
+    *out = (int)v;
+    return 0;
+}
+
+static int is_camera_flag(const char *name)
+{
+    return strcmp(name, "camera") == 0 || strcmp(name, "eye") == 0 || strcmp(name, "target") == 0 ||
+           strcmp(name, "fov") == 0 || strcmp(name, "size") == 0;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Reads px,py,pz,nx,ny,nz lines (lines that do not parse, e.g. a header or
+ * '#' comments, are skipped). Returns the count or -1. */
+static long read_points(const char *path, float **pts, float **nrm)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "lpvd-reference: %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    size_t cap = 0, n = 0;
+    float *p = NULL, *q = NULL;
+    char line[1024];
+    while (fgets(line, sizeof line, f)) {
+        float v[6];
+        if (line[0] == '#' || sscanf(line, " %f , %f , %f , %f , %f , %f", &v[0], &v[1], &v[2], &v[3], &v[4],
+                                     &v[5]) != 6)
+            continue;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 1024;
+            float *np = realloc(p, cap * 3 * sizeof *p), *nq = np ? realloc(q, cap * 3 * sizeof *q) : NULL;
+            if (np)
+                p = np;
+            if (nq)
+                q = nq;
+            if (!np || !nq) {
+                fprintf(stderr, "lpvd-reference: out of memory reading %s\n", path);
+                free(p);
+                free(q);
+                fclose(f);
+                return -1;
+            }
+        }
+        memcpy(&p[3 * n], v, 3 * sizeof *v);
+        memcpy(&q[3 * n], v + 3, 3 * sizeof *v);
+        n++;
+    }
+    fclose(f);
+    *pts = p;
+    *nrm = q;
+    return (long)n;
+}
+
+static int run_points(const lpv_ref *ref, const char *in, const char *out, int bounces, int spp)
+{
+    float *pts = NULL, *nrm = NULL;
+    long n = read_points(in, &pts, &nrm);
+    if (n < 0)
+        return 1;
+    float *e = malloc(((size_t)n + 1) * 3 * sizeof *e), *se = malloc(((size_t)n + 1) * 3 * sizeof *se);
+    int rc = 1;
+    if (!e || !se) {
+        fprintf(stderr, "lpvd-reference: out of memory\n");
+        goto done;
+    }
+    double t0 = now_s();
+    if (lpv_ref_irradiance(ref, pts, nrm, (size_t)n, bounces, spp, e, se) != 0) {
+        fprintf(stderr, "lpvd-reference: irradiance failed\n");
+        goto done;
+    }
+    double secs = now_s() - t0;
+    FILE *f = fopen(out, "w");
+    if (!f) {
+        fprintf(stderr, "lpvd-reference: %s: %s\n", out, strerror(errno));
+        goto done;
+    }
+    fprintf(f, "E_r,E_g,E_b,se_r,se_g,se_b\n");
+    double rel = 0.0;
+    long rel_n = 0;
+    for (long i = 0; i < n; ++i) {
+        fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", e[3 * i], e[3 * i + 1], e[3 * i + 2], se[3 * i],
+                se[3 * i + 1], se[3 * i + 2]);
+        for (int c = 0; c < 3; ++c)
+            if (e[3 * i + c] > 0.0f) {
+                rel += se[3 * i + c] / e[3 * i + c];
+                rel_n++;
+            }
+    }
+    if (fclose(f) != 0) {
+        fprintf(stderr, "lpvd-reference: writing %s failed\n", out);
+        goto done;
+    }
+    printf("lpvd-reference: %ld points, %d spp, %d bounce(s), %d threads, %.3f s, mean relative standard error "
+           "%.4g, wrote %s\n",
+           n, spp, bounces, lpv_ref_threads(ref), secs, rel_n ? rel / (double)rel_n : 0.0, out);
+    rc = 0;
+done:
+    free(pts);
+    free(nrm);
+    free(e);
+    free(se);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = NULL, *se_out = NULL, *points = NULL;
+    int bounces = 1, spp = 64, threads = 0;
+    unsigned long long seed = 0;
+    lpvd_options opt;
+    memset(&opt, 0, sizeof opt);
+    char err[512];
+
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            fputs(USAGE, stdout);
+            return 0;
+        }
+        if (a[0] != '-') {
+            if (scene_path) {
+                fprintf(stderr, "lpvd-reference: more than one scene given (%s, %s)\n", scene_path, a);
+                return 2;
+            }
+            scene_path = a;
+            continue;
+        }
+        const char *name = a[1] == '-' ? a + 2 : a + 1;
+        const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
+        int takes = strcmp(name, "o") == 0 || strcmp(name, "stderr") == 0 || strcmp(name, "bounces") == 0 ||
+                    strcmp(name, "spp") == 0 || strcmp(name, "threads") == 0 || strcmp(name, "seed") == 0 ||
+                    strcmp(name, "points") == 0 || is_camera_flag(name);
+        if (!takes) {
+            fprintf(stderr, "lpvd-reference: unknown flag %s\n%s", a, USAGE);
+            return 2;
+        }
+        if (!val) {
+            fprintf(stderr, "lpvd-reference: %s needs a value\n", a);
+            return 2;
+        }
+        ++i;
+        if (strcmp(name, "o") == 0) {
+            out = val;
+        } else if (strcmp(name, "stderr") == 0) {
+            se_out = val;
+        } else if (strcmp(name, "points") == 0) {
+            points = val;
+        } else if (strcmp(name, "bounces") == 0) {
+            if (parse_int(val, 1, 64, &bounces) != 0) {
+                fprintf(stderr, "lpvd-reference: --bounces %s: expected 1..64\n", val);
+                return 2;
+            }
+        } else if (strcmp(name, "spp") == 0) {
+            if (parse_int(val, 1, 1 << 24, &spp) != 0) {
+                fprintf(stderr, "lpvd-reference: --spp %s: expected 1..16777216\n", val);
+                return 2;
+            }
+        } else if (strcmp(name, "threads") == 0) {
+            if (parse_int(val, 1, 256, &threads) != 0) {
+                fprintf(stderr, "lpvd-reference: --threads %s: expected 1..256\n", val);
+                return 2;
+            }
+        } else if (strcmp(name, "seed") == 0) {
+            char *end = NULL;
+            errno = 0;
+            seed = strtoull(val, &end, 10);
+            if (errno || end == val || *end) {
+                fprintf(stderr, "lpvd-reference: --seed %s: expected a non-negative integer\n", val);
+                return 2;
+            }
+        } else if (lpvd_option_parse(&opt, name, val, err, sizeof err) != 1) {
+            fprintf(stderr, "lpvd-reference: %s\n", err);
+            return 2;
+        }
+    }
+    if (!out) {
+        fprintf(stderr, "lpvd-reference: -o is required\n%s", USAGE);
+        return 2;
+    }
+
+    lpv_scene scene;
+    if (lpv_scene_load(scene_path, &scene, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-reference: %s\n", err);
+        return 1;
+    }
+    lpv_ref *ref = NULL;
+    lpv_ref_desc desc = {.threads = threads, .seed = seed};
+    double t0 = now_s();
+    if (lpv_ref_create(&scene, &desc, &ref, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-reference: %s: %s\n", scene.source, err);
+        lpv_scene_free(&scene);
+        return 1;
+    }
+    double build_s = now_s() - t0;
+    int rc = 1;
+    if (points) {
+        lpv_scene_free(&scene);
+        rc = run_points(ref, points, out, bounces, spp);
+        lpv_ref_destroy(ref);
+        return rc;
+    }
+
+    lpv_view view;
+    if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-reference: %s\n", err);
+        goto done_scene;
+    }
+    size_t px = (size_t)view.width * (size_t)view.height;
+    float *img = malloc(px * 4 * sizeof *img), *se = malloc(px * 4 * sizeof *se);
+    if (!img || !se) {
+        fprintf(stderr, "lpvd-reference: out of memory for a %dx%d image\n", view.width, view.height);
+        free(img);
+        free(se);
+        goto done_scene;
+    }
+    t0 = now_s();
+    lpv_ref_render_indirect(ref, &view, bounces, spp, img, se);
+    double secs = now_s() - t0;
+    double rel = lpv_ref_mean_relative_stderr(img, se, view.width, view.height);
+    if (lpv_image_write_f32(out, view.width, view.height, 4, img, err, sizeof err) != 0 ||
+        (se_out && lpv_image_write_f32(se_out, view.width, view.height, 4, se, err, sizeof err) != 0)) {
+        fprintf(stderr, "lpvd-reference: %s\n", err);
+    } else {
+        printf("lpvd-reference: %s, %u triangles (build %.3f s), %dx%d, %d spp, %d bounce(s), %d threads, %.3f s, "
+               "mean relative standard error %.4g, wrote %s%s%s\n",
+               scene.source, lpv_ref_triangle_count(ref), build_s, view.width, view.height, spp, bounces,
+               lpv_ref_threads(ref), secs, rel, out, se_out ? " and " : "", se_out ? se_out : "");
+        rc = 0;
+    }
+    free(img);
+    free(se);
+done_scene:
+    lpv_ref_destroy(ref);
+    lpv_scene_free(&scene);
+    return rc;
+}

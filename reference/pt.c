@@ -1,0 +1,861 @@
+/* pt.c - see pt.h and docs/reference.md. */
+#include "pt.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define PT_PI 3.14159265358979323846
+#define PT_CHUNK 16 /* pixels or points a worker takes at a time */
+
+typedef struct ref_tri {
+    float p0[3], e1[3], e2[3]; /* corners p0, p0 + e1, p0 + e2 */
+    float vn[3][3];            /* vertex normals (unit; the front normal where the file's was bad) */
+    float uv[3][2];
+    float front[3]; /* unit geometric normal of the front (emitting) side */
+    int material;   /* -1 = none: black, not emissive */
+} ref_tri;
+
+typedef struct ref_material {
+    float albedo[3];
+    float emission[3];
+    int emits;
+    int texture; /* -1 = none */
+} ref_material;
+
+typedef struct ref_texture {
+    int width, height;
+    float *rgb; /* linear (sRGB-decoded), width*height*3 */
+} ref_texture;
+
+struct lpv_ref {
+    RTCDevice device;
+    RTCScene scene; /* NULL when there are no triangles */
+    ref_tri *tris;
+    uint32_t tri_count;
+    ref_material *materials;
+    uint32_t material_count;
+    ref_texture *textures;
+    uint32_t texture_count;
+    lpv_light *lights;
+    uint32_t light_count;
+    int threads;
+    uint64_t seed;
+    float eps;
+};
+
+/* ---- small vector helpers ---------------------------------------------- */
+
+static float dot3(const float a[3], const float b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Normalises v into out; returns 0 if v is not unit-able (out untouched). */
+static int unit3(const float v[3], float out[3])
+{
+    float l = sqrtf(dot3(v, v));
+    if (!(l > 1e-12f) || !isfinite(l))
+        return 0;
+    for (int i = 0; i < 3; ++i)
+        out[i] = v[i] / l;
+    return 1;
+}
+
+static int finite3(const float v[3])
+{
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+/* ---- RNG: PCG32 (O'Neill), one stream per (index, sample) ---------------- */
+
+typedef struct pcg32 {
+    uint64_t state, inc;
+} pcg32;
+
+static uint32_t pcg32_next(pcg32 *r)
+{
+    uint64_t old = r->state;
+    r->state = old * 6364136223846793005ULL + r->inc;
+    uint32_t xs = (uint32_t)(((old >> 18u) ^ old) >> 27u);
+    uint32_t rot = (uint32_t)(old >> 59u);
+    return (xs >> rot) | (xs << ((-rot) & 31u));
+}
+
+static uint64_t splitmix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15ULL;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+    return x ^ (x >> 31);
+}
+
+static void pcg32_seed(pcg32 *r, uint64_t seed, uint64_t index, uint64_t sample)
+{
+    uint64_t initstate = splitmix64(index ^ splitmix64(seed));
+    uint64_t initseq = splitmix64(sample + 0x632BE59BD9B4E019ULL * seed);
+    r->state = 0;
+    r->inc = (initseq << 1u) | 1u;
+    pcg32_next(r);
+    r->state += initstate;
+    pcg32_next(r);
+}
+
+static float pcg32_float(pcg32 *r)
+{
+    return (float)(pcg32_next(r) >> 8) * (1.0f / 16777216.0f);
+}
+
+/* ---- sampling ------------------------------------------------------------ */
+
+/* Orthonormal basis around unit n (Duff et al. 2017). */
+static void basis(const float n[3], float t[3], float b[3])
+{
+    float sign = copysignf(1.0f, n[2]);
+    float a = -1.0f / (sign + n[2]);
+    float c = n[0] * n[1] * a;
+    t[0] = 1.0f + sign * n[0] * n[0] * a;
+    t[1] = sign * c;
+    t[2] = -sign * n[0];
+    b[0] = c;
+    b[1] = sign + n[1] * n[1] * a;
+    b[2] = -n[1];
+}
+
+/* Cosine-weighted direction around unit n (pdf cos / pi). */
+static void sample_cosine(pcg32 *r, const float n[3], float out[3])
+{
+    float u1 = pcg32_float(r), u2 = pcg32_float(r);
+    float rad = sqrtf(u1), phi = (float)(2.0 * PT_PI) * u2;
+    float x = rad * cosf(phi), y = rad * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
+    float t[3], b[3];
+    basis(n, t, b);
+    for (int i = 0; i < 3; ++i)
+        out[i] = x * t[i] + y * b[i] + z * n[i];
+}
+
+/* ---- building ------------------------------------------------------------ */
+
+static float srgb_decode(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+static void set_err(char *err, size_t n, const char *msg)
+{
+    if (err && n)
+        snprintf(err, n, "%s", msg);
+}
+
+/* Keeps triangle `first` of the scene if it is usable. */
+static int make_tri(const lpv_scene *s, uint32_t first, int material, ref_tri *t)
+{
+    const lpv_vertex *v[3];
+    for (int k = 0; k < 3; ++k) {
+        uint32_t idx = s->indices[first + (uint32_t)k];
+        if (idx >= s->vertex_count)
+            return 0;
+        v[k] = &s->vertices[idx];
+        if (!finite3(v[k]->position))
+            return 0;
+    }
+    double e1[3], e2[3], c[3];
+    for (int i = 0; i < 3; ++i) {
+        e1[i] = (double)v[1]->position[i] - v[0]->position[i];
+        e2[i] = (double)v[2]->position[i] - v[0]->position[i];
+    }
+    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(len > 1e-12) || !isfinite(len))
+        return 0;
+    /* The front: the winding's normal, flipped to agree with the vertex
+     * normals (the same rule as core/emissive.c). */
+    double vn = 0.0;
+    for (int k = 0; k < 3; ++k)
+        if (finite3(v[k]->normal))
+            for (int i = 0; i < 3; ++i)
+                vn += c[i] * v[k]->normal[i];
+    double sign = vn < 0.0 ? -1.0 : 1.0;
+    for (int i = 0; i < 3; ++i) {
+        t->front[i] = (float)(sign * c[i] / len);
+        t->p0[i] = v[0]->position[i];
+        t->e1[i] = v[1]->position[i] - v[0]->position[i];
+        t->e2[i] = v[2]->position[i] - v[0]->position[i];
+    }
+    for (int k = 0; k < 3; ++k) {
+        if (!unit3(v[k]->normal, t->vn[k]))
+            memcpy(t->vn[k], t->front, sizeof t->front);
+        for (int i = 0; i < 2; ++i)
+            t->uv[k][i] = isfinite(v[k]->uv[i]) ? v[k]->uv[i] : 0.0f;
+    }
+    t->material = material;
+    return 1;
+}
+
+static int copy_materials(lpv_ref *r, const lpv_scene *s)
+{
+    if (s->material_count) {
+        r->materials = calloc(s->material_count, sizeof *r->materials);
+        if (!r->materials)
+            return -1;
+    }
+    r->material_count = s->material_count;
+    for (uint32_t m = 0; m < s->material_count; ++m) {
+        const lpv_material *src = &s->materials[m];
+        ref_material *dst = &r->materials[m];
+        for (int i = 0; i < 3; ++i) {
+            float a = src->base_color[i];
+            dst->albedo[i] = isfinite(a) ? fminf(fmaxf(a, 0.0f), 1.0f) : 0.0f;
+            float e = src->emission[i];
+            dst->emission[i] = (isfinite(e) && e > 0.0f) ? e : 0.0f;
+        }
+        dst->emits = dst->emission[0] > 0.0f || dst->emission[1] > 0.0f || dst->emission[2] > 0.0f;
+        int tex = src->base_color_texture;
+        dst->texture = (tex >= 0 && (uint32_t)tex < s->texture_count) ? tex : -1;
+    }
+    if (s->texture_count) {
+        r->textures = calloc(s->texture_count, sizeof *r->textures);
+        if (!r->textures)
+            return -1;
+    }
+    r->texture_count = s->texture_count;
+    float lut[256];
+    for (int i = 0; i < 256; ++i)
+        lut[i] = srgb_decode((float)i / 255.0f);
+    for (uint32_t t = 0; t < s->texture_count; ++t) {
+        const lpv_texture *src = &s->textures[t];
+        if (!src->rgba8 || src->width < 1 || src->height < 1)
+            continue;
+        size_t count = (size_t)src->width * (size_t)src->height;
+        float *rgb = malloc(count * 3 * sizeof *rgb);
+        if (!rgb)
+            return -1;
+        for (size_t i = 0; i < count; ++i)
+            for (int c = 0; c < 3; ++c)
+                rgb[3 * i + (size_t)c] = lut[src->rgba8[4 * i + (size_t)c]];
+        r->textures[t].width = src->width;
+        r->textures[t].height = src->height;
+        r->textures[t].rgb = rgb;
+    }
+    return 0;
+}
+
+static int resolve_threads(int want)
+{
+    if (want > 0)
+        return want > 256 ? 256 : want;
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : (n > 256 ? 256 : (int)n);
+}
+
+int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **out, char *err, size_t err_size)
+{
+    *out = NULL;
+    if (!scene) {
+        set_err(err, err_size, "no scene");
+        return -1;
+    }
+    lpv_ref_desc d = desc ? *desc : (lpv_ref_desc){0};
+    lpv_ref *r = calloc(1, sizeof *r);
+    if (!r) {
+        set_err(err, err_size, "out of memory");
+        return -1;
+    }
+    r->threads = resolve_threads(d.threads);
+    r->seed = d.seed;
+
+    /* Triangles. */
+    size_t cap = 0;
+    for (uint32_t i = 0; i < scene->draw_count; ++i)
+        cap += scene->draws[i].index_count / 3;
+    if (cap > 0x7fffffffu) {
+        set_err(err, err_size, "too many triangles");
+        goto fail;
+    }
+    if (cap) {
+        r->tris = malloc(cap * sizeof *r->tris);
+        if (!r->tris) {
+            set_err(err, err_size, "out of memory");
+            goto fail;
+        }
+    }
+    for (uint32_t i = 0; i < scene->draw_count; ++i) {
+        const lpv_draw *dr = &scene->draws[i];
+        int mat = (dr->material >= 0 && (uint32_t)dr->material < scene->material_count) ? dr->material : -1;
+        for (uint32_t k = 0; k + 3 <= dr->index_count; k += 3) {
+            uint64_t first = (uint64_t)dr->first_index + k;
+            if (!scene->indices || first + 3 > scene->index_count)
+                break;
+            if (make_tri(scene, (uint32_t)first, mat, &r->tris[r->tri_count]))
+                r->tri_count++;
+        }
+    }
+    if (copy_materials(r, scene) != 0) {
+        set_err(err, err_size, "out of memory");
+        goto fail;
+    }
+    if (scene->light_count) {
+        r->lights = malloc(scene->light_count * sizeof *r->lights);
+        if (!r->lights) {
+            set_err(err, err_size, "out of memory");
+            goto fail;
+        }
+        memcpy(r->lights, scene->lights, scene->light_count * sizeof *r->lights);
+        r->light_count = scene->light_count;
+    }
+
+    /* Ray offset from the kept triangles' bounds. */
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t = 0; t < r->tri_count; ++t)
+        for (int i = 0; i < 3; ++i) {
+            const ref_tri *tr = &r->tris[t];
+            float a = tr->p0[i], b = tr->p0[i] + tr->e1[i], c = tr->p0[i] + tr->e2[i];
+            lo[i] = fminf(lo[i], fminf(a, fminf(b, c)));
+            hi[i] = fmaxf(hi[i], fmaxf(a, fmaxf(b, c)));
+        }
+    float diag = 0.0f;
+    if (r->tri_count)
+        diag = sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    r->eps = (d.ray_epsilon > 0.0f && isfinite(d.ray_epsilon)) ? d.ray_epsilon : fmaxf(1e-5f * diag, 1e-6f);
+    if (!isfinite(r->eps))
+        r->eps = 1e-6f;
+
+    /* Embree: one triangle geometry, unshared vertices, primID = our index.
+     * One build thread keeps the build reproducible. */
+    r->device = rtcNewDevice("threads=1");
+    if (!r->device) {
+        set_err(err, err_size, "Embree: rtcNewDevice failed");
+        goto fail;
+    }
+    if (r->tri_count) {
+        r->scene = rtcNewScene(r->device);
+        rtcSetSceneFlags(r->scene, RTC_SCENE_FLAG_ROBUST);
+        rtcSetSceneBuildQuality(r->scene, RTC_BUILD_QUALITY_HIGH);
+        RTCGeometry g = rtcNewGeometry(r->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        /* Embree reads vertex buffers 16 bytes at a time: one spare vertex. */
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                            (size_t)r->tri_count * 3 + 1);
+        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                               r->tri_count);
+        if (!vb || !ib) {
+            rtcReleaseGeometry(g);
+            set_err(err, err_size, "Embree: out of memory");
+            goto fail;
+        }
+        for (uint32_t t = 0; t < r->tri_count; ++t) {
+            const ref_tri *tr = &r->tris[t];
+            for (int i = 0; i < 3; ++i) {
+                vb[9 * (size_t)t + (size_t)i] = tr->p0[i];
+                vb[9 * (size_t)t + 3 + (size_t)i] = tr->p0[i] + tr->e1[i];
+                vb[9 * (size_t)t + 6 + (size_t)i] = tr->p0[i] + tr->e2[i];
+                ib[3 * (size_t)t + (size_t)i] = 3 * t + (unsigned)i;
+            }
+        }
+        vb[9 * (size_t)r->tri_count] = vb[9 * (size_t)r->tri_count + 1] = vb[9 * (size_t)r->tri_count + 2] = 0.0f;
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(r->scene, g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(r->scene);
+        if (rtcGetDeviceError(r->device) != RTC_ERROR_NONE) {
+            set_err(err, err_size, "Embree: building the scene failed");
+            goto fail;
+        }
+    }
+    *out = r;
+    return 0;
+fail:
+    lpv_ref_destroy(r);
+    return -1;
+}
+
+void lpv_ref_destroy(lpv_ref *r)
+{
+    if (!r)
+        return;
+    if (r->scene)
+        rtcReleaseScene(r->scene);
+    if (r->device)
+        rtcReleaseDevice(r->device);
+    for (uint32_t t = 0; t < r->texture_count; ++t)
+        free(r->textures[t].rgb);
+    free(r->textures);
+    free(r->materials);
+    free(r->lights);
+    free(r->tris);
+    free(r);
+}
+
+uint32_t lpv_ref_triangle_count(const lpv_ref *r)
+{
+    return r ? r->tri_count : 0;
+}
+
+int lpv_ref_threads(const lpv_ref *r)
+{
+    return r ? r->threads : 0;
+}
+
+/* ---- rays ---------------------------------------------------------------- */
+
+typedef struct hit {
+    float p[3];
+    float ng[3];    /* unit geometric normal on the side the ray came from */
+    float ns[3];    /* unit shading normal on that side */
+    int front;      /* 1 if the ray arrived on the emitting side */
+    uint32_t tri;
+    float u, v;
+    float t;
+} hit;
+
+static int intersect(const lpv_ref *r, const float org[3], const float dir[3], float tmin, float tmax, hit *h)
+{
+    if (!r->scene)
+        return 0;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    memset(&rh, 0, sizeof rh);
+    rh.ray.org_x = org[0];
+    rh.ray.org_y = org[1];
+    rh.ray.org_z = org[2];
+    rh.ray.dir_x = dir[0];
+    rh.ray.dir_y = dir[1];
+    rh.ray.dir_z = dir[2];
+    rh.ray.tnear = tmin;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(r->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.primID >= r->tri_count)
+        return 0;
+    const ref_tri *tr = &r->tris[rh.hit.primID];
+    float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
+    h->tri = rh.hit.primID;
+    h->u = u;
+    h->v = v;
+    h->t = rh.ray.tfar;
+    for (int i = 0; i < 3; ++i)
+        h->p[i] = tr->p0[i] + u * tr->e1[i] + v * tr->e2[i];
+    float side = dot3(tr->front, dir) < 0.0f ? 1.0f : -1.0f;
+    h->front = side > 0.0f;
+    float ns[3];
+    for (int i = 0; i < 3; ++i) {
+        h->ng[i] = side * tr->front[i];
+        ns[i] = side * (w * tr->vn[0][i] + u * tr->vn[1][i] + v * tr->vn[2][i]);
+    }
+    if (!unit3(ns, h->ns) || dot3(h->ns, h->ng) <= 0.0f)
+        memcpy(h->ns, h->ng, sizeof h->ns);
+    return 1;
+}
+
+static int occluded(const lpv_ref *r, const float org[3], const float dir[3], float tmax)
+{
+    if (!r->scene)
+        return 0;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay ray;
+    memset(&ray, 0, sizeof ray);
+    ray.org_x = org[0];
+    ray.org_y = org[1];
+    ray.org_z = org[2];
+    ray.dir_x = dir[0];
+    ray.dir_y = dir[1];
+    ray.dir_z = dir[2];
+    ray.tnear = 0.0f;
+    ray.tfar = tmax;
+    ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(r->scene, &ctx, &ray);
+    return ray.tfar < 0.0f;
+}
+
+int lpv_ref_first_hit(const lpv_ref *r, const float org[3], const float dir[3], float tmin, float tmax, float *t,
+                      float p[3])
+{
+    hit h;
+    if (!r || !finite3(org) || !finite3(dir) || !intersect(r, org, dir, tmin, tmax, &h))
+        return 0;
+    if (t)
+        *t = h.t;
+    if (p)
+        memcpy(p, h.p, sizeof h.p);
+    return 1;
+}
+
+/* ---- materials ----------------------------------------------------------- */
+
+static void texture_sample(const ref_texture *t, float s, float tt, float out[3])
+{
+    float x = s * (float)t->width - 0.5f, y = tt * (float)t->height - 0.5f;
+    float fx = floorf(x), fy = floorf(y);
+    float ax = x - fx, ay = y - fy;
+    long ix = (long)fmodf(fx, (float)t->width), iy = (long)fmodf(fy, (float)t->height);
+    if (ix < 0)
+        ix += t->width;
+    if (iy < 0)
+        iy += t->height;
+    long ix1 = (ix + 1) % t->width, iy1 = (iy + 1) % t->height;
+    const float *a = &t->rgb[3 * ((size_t)iy * (size_t)t->width + (size_t)ix)];
+    const float *b = &t->rgb[3 * ((size_t)iy * (size_t)t->width + (size_t)ix1)];
+    const float *c = &t->rgb[3 * ((size_t)iy1 * (size_t)t->width + (size_t)ix)];
+    const float *d = &t->rgb[3 * ((size_t)iy1 * (size_t)t->width + (size_t)ix1)];
+    for (int i = 0; i < 3; ++i)
+        out[i] = (1.0f - ay) * ((1.0f - ax) * a[i] + ax * b[i]) + ay * ((1.0f - ax) * c[i] + ax * d[i]);
+}
+
+static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
+{
+    const ref_tri *tr = &r->tris[h->tri];
+    if (tr->material < 0) {
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
+    const ref_material *m = &r->materials[tr->material];
+    memcpy(out, m->albedo, 3 * sizeof(float));
+    if (m->texture >= 0 && r->textures[m->texture].rgb) {
+        float w = 1.0f - h->u - h->v, st[2];
+        for (int i = 0; i < 2; ++i)
+            st[i] = w * tr->uv[0][i] + h->u * tr->uv[1][i] + h->v * tr->uv[2][i];
+        if (isfinite(st[0]) && isfinite(st[1]) && fabsf(st[0]) < 1e6f && fabsf(st[1]) < 1e6f) {
+            float tex[3];
+            texture_sample(&r->textures[m->texture], st[0], st[1], tex);
+            for (int i = 0; i < 3; ++i)
+                out[i] *= tex[i];
+        }
+    }
+}
+
+static const float *hit_emission(const lpv_ref *r, const hit *h)
+{
+    const ref_tri *tr = &r->tris[h->tri];
+    if (!h->front || tr->material < 0 || !r->materials[tr->material].emits)
+        return NULL;
+    return r->materials[tr->material].emission;
+}
+
+/* ---- punctual lights (shaders/lights.glsl) -------------------------------- */
+
+static float spot_factor(const lpv_light *li, const float travel[3])
+{
+    if (li->type != LPV_LIGHT_SPOT)
+        return 1.0f;
+    float cos_inner = cosf(li->inner_cone), cos_outer = cosf(li->outer_cone);
+    float cd = dot3(travel, li->direction);
+    float scale = 1.0f / fmaxf(1e-3f, cos_inner - cos_outer);
+    float t = fminf(fmaxf((cd - cos_outer) * scale, 0.0f), 1.0f);
+    return t * t;
+}
+
+static float range_window(const lpv_light *li, float dist)
+{
+    if (!(li->range > 0.0f))
+        return 1.0f;
+    float q = dist / li->range;
+    float w = fminf(fmaxf(1.0f - q * q * q * q, 0.0f), 1.0f);
+    return w * w;
+}
+
+/* Direct irradiance at p: ns is the cosine's normal, ng the side's geometric
+ * normal (light behind it is cut off; shadow rays start eps along it). */
+static void direct(const lpv_ref *r, const float p[3], const float ns[3], const float ng[3], float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    float org[3];
+    for (int i = 0; i < 3; ++i)
+        org[i] = p[i] + r->eps * ng[i];
+    for (uint32_t l = 0; l < r->light_count; ++l) {
+        const lpv_light *li = &r->lights[l];
+        float to_light[3], e, dist = INFINITY;
+        if (li->type == LPV_LIGHT_DIRECTIONAL) {
+            float neg[3] = {-li->direction[0], -li->direction[1], -li->direction[2]};
+            if (!unit3(neg, to_light))
+                continue;
+            e = li->intensity;
+        } else {
+            float d[3] = {li->position[0] - p[0], li->position[1] - p[1], li->position[2] - p[2]};
+            float dist2 = fmaxf(dot3(d, d), 1e-12f);
+            dist = sqrtf(dist2);
+            for (int i = 0; i < 3; ++i)
+                to_light[i] = d[i] / dist;
+            float travel[3] = {-to_light[0], -to_light[1], -to_light[2]};
+            e = li->intensity * spot_factor(li, travel) * range_window(li, dist) / dist2;
+        }
+        float c = dot3(ns, to_light);
+        if (!(e > 0.0f) || !isfinite(e) || !(c > 0.0f) || !(dot3(ng, to_light) > 0.0f))
+            continue;
+        float tmax = isfinite(dist) ? dist - 2.0f * r->eps : INFINITY;
+        if (!(tmax > 0.0f))
+            continue;
+        if (occluded(r, org, to_light, tmax))
+            continue;
+        for (int i = 0; i < 3; ++i)
+            out[i] += li->color[i] * e * c;
+    }
+}
+
+void lpv_ref_direct_irradiance(const lpv_ref *r, const float p[3], const float n[3], float out_rgb[3])
+{
+    float nu[3];
+    out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
+    if (!r || !finite3(p) || !unit3(n, nu))
+        return;
+    direct(r, p, nu, nu, out_rgb);
+}
+
+/* ---- the estimator --------------------------------------------------------- */
+
+/* One sample of E_ind(p, ns, bounces) / pi, i.e. the radiance L arriving along
+ * one cosine-distributed direction, with next-event estimation at every hit. */
+static void sample_path(const lpv_ref *r, pcg32 *rng, const float p_in[3], const float ns_in[3], const float ng_in[3],
+                        int bounces, double out[3])
+{
+    float p[3], ns[3], ng[3], thr[3] = {1.0f, 1.0f, 1.0f};
+    memcpy(p, p_in, sizeof p);
+    memcpy(ns, ns_in, sizeof ns);
+    memcpy(ng, ng_in, sizeof ng);
+    out[0] = out[1] = out[2] = 0.0;
+    for (int depth = 1; depth <= bounces; ++depth) {
+        float dir[3], org[3];
+        sample_cosine(rng, ns, dir);
+        if (!(dot3(dir, ng) > 0.0f))
+            break; /* below the surface itself (shading normal != geometric) */
+        for (int i = 0; i < 3; ++i)
+            org[i] = p[i] + r->eps * ng[i];
+        hit h;
+        if (!intersect(r, org, dir, 0.0f, INFINITY, &h))
+            break;
+        float alb[3], ed[3] = {0.0f, 0.0f, 0.0f};
+        hit_albedo(r, &h, alb);
+        const float *le = hit_emission(r, &h);
+        if (alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f)
+            direct(r, h.p, h.ns, h.ng, ed);
+        for (int i = 0; i < 3; ++i)
+            out[i] += (double)thr[i] * ((le ? (double)le[i] : 0.0) + (double)alb[i] / PT_PI * (double)ed[i]);
+        if (depth == bounces)
+            break;
+        for (int i = 0; i < 3; ++i)
+            thr[i] *= alb[i];
+        if (!(thr[0] > 0.0f || thr[1] > 0.0f || thr[2] > 0.0f))
+            break;
+        memcpy(p, h.p, sizeof p);
+        memcpy(ns, h.ns, sizeof ns);
+        memcpy(ng, h.ng, sizeof ng);
+    }
+}
+
+/* E_ind and its standard error at one point, from `samples` samples of the
+ * streams (index, 0..samples-1). */
+static void estimate(const lpv_ref *r, uint64_t index, const float p[3], const float ns[3], const float ng[3],
+                     int bounces, int samples, float e[3], float se[3])
+{
+    double sum[3] = {0, 0, 0}, sq[3] = {0, 0, 0};
+    for (int s = 0; s < samples; ++s) {
+        pcg32 rng;
+        pcg32_seed(&rng, r->seed, index, (uint64_t)s);
+        double l[3];
+        sample_path(r, &rng, p, ns, ng, bounces, l);
+        for (int i = 0; i < 3; ++i) {
+            double v = PT_PI * l[i];
+            sum[i] += v;
+            sq[i] += v * v;
+        }
+    }
+    double n = (double)samples;
+    for (int i = 0; i < 3; ++i) {
+        double mean = sum[i] / n;
+        double var = samples > 1 ? fmax(0.0, (sq[i] - sum[i] * mean) / (n - 1.0)) : 0.0;
+        e[i] = (float)mean;
+        se[i] = (float)sqrt(var / n);
+    }
+}
+
+/* ---- threading ------------------------------------------------------------- */
+
+typedef struct job {
+    const lpv_ref *ref;
+    size_t count;
+    size_t next;
+    pthread_mutex_t lock;
+    void (*item)(struct job *j, size_t i);
+    /* points mode */
+    const float *points, *normals;
+    float *out, *out_se;
+    /* image mode */
+    const lpv_view *view;
+    float *rgba, *rgba_se;
+    int bounces, samples;
+} job;
+
+static void *worker(void *arg)
+{
+    job *j = arg;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        size_t begin = j->next;
+        j->next = begin + PT_CHUNK < j->count ? begin + PT_CHUNK : j->count;
+        size_t end = j->next;
+        pthread_mutex_unlock(&j->lock);
+        if (begin >= end)
+            return NULL;
+        for (size_t i = begin; i < end; ++i)
+            j->item(j, i);
+    }
+}
+
+static void run_job(job *j)
+{
+    int n = j->ref->threads;
+    if ((size_t)n > (j->count + PT_CHUNK - 1) / PT_CHUNK)
+        n = (int)((j->count + PT_CHUNK - 1) / PT_CHUNK);
+    pthread_mutex_init(&j->lock, NULL);
+    j->next = 0;
+    pthread_t tid[256];
+    int started = 0;
+    for (int t = 1; t < n; ++t) {
+        if (pthread_create(&tid[started], NULL, worker, j) != 0)
+            break; /* the calling thread finishes the work alone */
+        started++;
+    }
+    worker(j);
+    for (int t = 0; t < started; ++t)
+        pthread_join(tid[t], NULL);
+    pthread_mutex_destroy(&j->lock);
+}
+
+static void point_item(job *j, size_t i)
+{
+    float e[3] = {0, 0, 0}, se[3] = {0, 0, 0}, nu[3];
+    const float *p = &j->points[3 * i];
+    if (finite3(p) && unit3(&j->normals[3 * i], nu))
+        estimate(j->ref, (uint64_t)i, p, nu, nu, j->bounces, j->samples, e, se);
+    if (j->out)
+        memcpy(&j->out[3 * i], e, sizeof e);
+    if (j->out_se)
+        memcpy(&j->out_se[3 * i], se, sizeof se);
+}
+
+int lpv_ref_irradiance(const lpv_ref *r, const float *points, const float *normals, size_t n, int bounces,
+                       int samples, float *out_rgb, float *out_stderr_rgb)
+{
+    if (!r || (n && (!points || !normals)) || bounces < 1 || samples < 1)
+        return -1;
+    if (!n)
+        return 0;
+    job j = {.ref = r, .count = n, .item = point_item, .points = points, .normals = normals, .out = out_rgb,
+             .out_se = out_stderr_rgb, .bounces = bounces, .samples = samples};
+    run_job(&j);
+    return 0;
+}
+
+void lpv_ref_pixel_ray(const lpv_view *v, int x, int y, float org[3], float dir[3], float *tmin, float *tmax)
+{
+    /* The inverse of lpv_view_project (core/view.c): right = forward x up,
+     * true up = right x forward, pixel (0, 0) at the top-left. */
+    float f[3], r[3], u[3];
+    if (!unit3(v->forward, f)) {
+        f[0] = f[1] = 0.0f;
+        f[2] = -1.0f;
+    }
+    cross3(f, v->up, r);
+    if (!unit3(r, r)) {
+        r[0] = 1.0f;
+        r[1] = r[2] = 0.0f;
+    }
+    cross3(r, f, u);
+    float aspect = (float)v->width / (float)v->height;
+    float ndc_x = ((float)x + 0.5f) / (float)v->width * 2.0f - 1.0f;
+    float ndc_y = 1.0f - ((float)y + 0.5f) / (float)v->height * 2.0f;
+    float zn = v->znear > 0.0f ? v->znear : 0.0f, zf = v->zfar > 0.0f ? v->zfar : INFINITY;
+    if (v->orthographic) {
+        for (int i = 0; i < 3; ++i) {
+            org[i] = v->eye[i] + ndc_x * v->ymag * aspect * r[i] + ndc_y * v->ymag * u[i];
+            dir[i] = f[i];
+        }
+        *tmin = zn;
+        *tmax = zf;
+        return;
+    }
+    float th = tanf(0.5f * v->yfov), d[3];
+    for (int i = 0; i < 3; ++i) {
+        org[i] = v->eye[i];
+        d[i] = f[i] + ndc_x * th * aspect * r[i] + ndc_y * th * u[i];
+    }
+    float len = sqrtf(dot3(d, d));
+    for (int i = 0; i < 3; ++i)
+        dir[i] = d[i] / len;
+    float cz = dot3(dir, f); /* depth along forward per unit t */
+    *tmin = zn / cz;
+    *tmax = zf / cz;
+}
+
+static void pixel_item(job *j, size_t i)
+{
+    const lpv_view *v = j->view;
+    int x = (int)(i % (size_t)v->width), y = (int)(i / (size_t)v->width);
+    float org[3], dir[3], tmin, tmax;
+    float *px = &j->rgba[4 * i], *pse = j->rgba_se ? &j->rgba_se[4 * i] : NULL;
+    px[0] = px[1] = px[2] = px[3] = 0.0f;
+    if (pse)
+        pse[0] = pse[1] = pse[2] = pse[3] = 0.0f;
+    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
+    hit h;
+    if (!finite3(org) || !finite3(dir) || !intersect(j->ref, org, dir, tmin, tmax, &h))
+        return;
+    float alb[3], e[3] = {0, 0, 0}, se[3] = {0, 0, 0};
+    hit_albedo(j->ref, &h, alb);
+    if (alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f)
+        estimate(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, e, se);
+    for (int c = 0; c < 3; ++c) {
+        px[c] = (float)(alb[c] / PT_PI) * e[c];
+        if (pse)
+            pse[c] = (float)(alb[c] / PT_PI) * se[c];
+    }
+    px[3] = 1.0f;
+    if (pse)
+        pse[3] = 1.0f;
+}
+
+int lpv_ref_render_indirect(const lpv_ref *r, const lpv_view *view, int bounces, int spp, float *rgba, float *rgba_se)
+{
+    if (!r || !view || !rgba || view->width < 1 || view->height < 1 || bounces < 1 || spp < 1)
+        return -1;
+    job j = {.ref = r, .count = (size_t)view->width * (size_t)view->height, .item = pixel_item, .view = view,
+             .rgba = rgba, .rgba_se = rgba_se, .bounces = bounces, .samples = spp};
+    run_job(&j);
+    return 0;
+}
+
+double lpv_ref_mean_relative_stderr(const float *rgba, const float *rgba_se, int width, int height)
+{
+    double sum = 0.0;
+    size_t n = 0;
+    if (!rgba || !rgba_se || width < 1 || height < 1)
+        return 0.0;
+    for (size_t i = 0; i < (size_t)width * (size_t)height; ++i) {
+        if (!(rgba[4 * i + 3] > 0.0f))
+            continue;
+        for (int c = 0; c < 3; ++c) {
+            float v = rgba[4 * i + (size_t)c];
+            if (v > 0.0f && isfinite(v)) {
+                sum += (double)rgba_se[4 * i + (size_t)c] / (double)v;
+                n++;
+            }
+        }
+    }
+    return n ? sum / (double)n : 0.0;
+}

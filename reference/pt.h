@@ -1,0 +1,90 @@
+/*
+ * pt.h - the path-traced reference for lpvd's indirect light (issue 4,
+ * docs/reference.md).
+ *
+ * Built on Embree from the same lpv_scene lpvd renders, in the same
+ * radiometric units (W/m^2 irradiance, W/(m^2 sr) radiance). The quantity is
+ *
+ *   E_ind(p, n, b) = integral over the hemisphere of n of
+ *                    L_o^b(hit(p, w), -w) cos(n, w) dw
+ *   L_o^b(q)       = L_e(q) + albedo(q)/pi * (E_direct(q, n_q)
+ *                                             + [b > 1] E_ind(q, n_q, b - 1))
+ *
+ * with E_direct the shadowed irradiance from the punctual lights (exactly the
+ * KHR_lights_punctual falloffs of shaders/lights.glsl), L_e the material's
+ * emission on the front side of an emissive triangle (core/emissive.c's rule),
+ * n_q the surface normal on the side the ray arrived from. b = 1 is the term
+ * lpvd's LPV approximates (`lpvd render --indirect-only` = albedo/pi * E_lpv).
+ *
+ * Monte Carlo: cosine-weighted hemisphere samples, E = pi * mean(L); every
+ * estimate carries its standard error (sample std / sqrt(n)). Each pixel or
+ * point draws from its own PCG32 stream seeded by (index, sample), so results
+ * are bit-identical across runs and thread counts.
+ */
+#ifndef LPV_REFERENCE_PT_H
+#define LPV_REFERENCE_PT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "scene.h"
+#include "view.h"
+
+typedef struct lpv_ref lpv_ref;
+
+typedef struct lpv_ref_desc {
+    int threads;       /* worker threads; 0 = the number of online cores */
+    uint64_t seed;     /* mixed into every RNG stream; 0 = the default stream */
+    float ray_epsilon; /* m; ray offset off surfaces; 0 = 1e-4 x bounds diagonal (>= 1e-6) */
+} lpv_ref_desc;
+
+/* Builds the reference for a scene (copied: the scene may be freed after).
+ * Triangles with out-of-range indices, non-finite corners or zero area are
+ * skipped; a non-finite or zero vertex normal falls back to the geometric
+ * one. desc may be NULL (defaults). Returns 0, or -1 with a message in err. */
+int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **out, char *err, size_t err_size);
+void lpv_ref_destroy(lpv_ref *ref);
+
+/* Triangles kept (after skipping the degenerate ones). */
+uint32_t lpv_ref_triangle_count(const lpv_ref *ref);
+/* The resolved thread count. */
+int lpv_ref_threads(const lpv_ref *ref);
+
+/* Shadowed irradiance (W/m^2, rgb) at p on a surface with normal n (need not
+ * be unit) from the punctual lights only. Deterministic (no sampling): equals
+ * sum over lights of colour * intensity * spot * window / d^2 * max(0, cos),
+ * for each light whose shadow ray is unblocked. A non-finite p or degenerate n
+ * gives 0. */
+void lpv_ref_direct_irradiance(const lpv_ref *ref, const float p[3], const float n[3], float out_rgb[3]);
+
+/* E_ind at n points (points, normals: 3 floats each), `bounces` >= 1,
+ * `samples` >= 1 per point. out_rgb and out_stderr_rgb (either may be NULL)
+ * get 3 floats per point: the estimate and its standard error. A point with a
+ * non-finite position or degenerate normal gets 0 and 0. Returns 0, or -1 on
+ * bad arguments / allocation failure. */
+int lpv_ref_irradiance(const lpv_ref *ref, const float *points, const float *normals, size_t n, int bounces,
+                       int samples, float *out_rgb, float *out_stderr_rgb);
+
+/* The indirect-only image: per pixel (width * height * 4 floats, top row
+ * first) albedo/pi * E_ind(bounces) at the first surface the ray through the
+ * pixel centre hits (normal turned towards the camera), alpha 1; background 0
+ * with alpha 0. rgba_stderr (may be NULL) gets the standard error of each
+ * channel (alpha: as the image). Returns 0, or -1 on bad arguments. */
+int lpv_ref_render_indirect(const lpv_ref *ref, const lpv_view *view, int bounces, int samples_per_pixel,
+                            float *rgba_radiance, float *rgba_stderr);
+
+/* The primary ray of pixel (x, y) through its centre, the inverse of
+ * lpv_view_project: origin, unit direction, and the [tmin, tmax] range the
+ * view's znear/zfar allow (0 / INFINITY when unset). */
+void lpv_ref_pixel_ray(const lpv_view *view, int x, int y, float org[3], float dir[3], float *tmin, float *tmax);
+
+/* The first surface along a ray (dir need not be unit) within [tmin, tmax]:
+ * returns 1 and its distance t and point p (either may be NULL), or 0. */
+int lpv_ref_first_hit(const lpv_ref *ref, const float org[3], const float dir[3], float tmin, float tmax, float *t,
+                      float p[3]);
+
+/* Mean relative standard error of an image: the mean of se / value over the
+ * rgb channels of covered pixels (alpha > 0) whose value is > 0; 0 if none. */
+double lpv_ref_mean_relative_stderr(const float *rgba, const float *rgba_stderr, int width, int height);
+
+#endif /* LPV_REFERENCE_PT_H */
