@@ -1,0 +1,896 @@
+/*
+ * lpvd_accuracy.c - `lpvd-accuracy`: what accuracy costs in time. For each
+ * scene and each point of a sweep over the engine's quality knobs (grid,
+ * iterations, RSM size, occlusion), renders lpvd's indirect-only frame in
+ * process, times it (median GPU ms per tick after warm-up, timer queries),
+ * compares it with a path-traced reference (metrics.h) and writes
+ *
+ *   OUT/results.csv   one row per (scene, point), with the Pareto flag
+ *   OUT/results.md    one Markdown table per scene, Pareto points marked
+ *   OUT/plot.gp, OUT/plot.png   error vs ms per tick (log x), fronts connected
+ *   OUT/err/SCENE/g<grid>-i<iter>-r<rsm>-occ<on|off>.png   per-point error images
+ *   OUT/ref/SCENE-<key>.exr (+ .stderr.exr, .png)        the cached references
+ *
+ * The reference comes from the `lpvd-reference` command (reference/), run
+ * once per scene, camera, size and spp and cached under OUT/ref. See
+ * docs/accuracy.md. Nothing here asserts a time.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "context.h"
+#include "engine.h"
+#include "image_io.h"
+#include "metrics.h"
+#include "options.h"
+#include "scene_load.h"
+#include "tonemap.h"
+#include "pt.h"
+
+#ifndef LPVD_ACCURACY_SCENES_DIR
+#define LPVD_ACCURACY_SCENES_DIR "scenes"
+#endif
+
+#define MAX_POINTS 512
+#define MAX_SCENES 16
+#define MAX_TICKS 1000
+#define MAX_PASS 16
+
+/* The stages lpv_engine_stats reports, in CSV column order. */
+static const char *const STAGES[] = {"rsm", "vpl_extract", "inject", "gbuffer", "gv", "propagate", "shade"};
+#define NSTAGES ((int)(sizeof STAGES / sizeof STAGES[0]))
+
+/* The full factorial. */
+static const int GRIDS[] = {16, 32, 64};
+static const int ITERS[] = {4, 8, 16, 32};
+static const int RSMS[] = {128, 256, 512};
+static const int OCCS[] = {0, 1};
+
+typedef struct point {
+    int grid, iterations, rsm, occlusion;
+} point;
+
+/* --quick: a handful of points spanning cheap to expensive. */
+static const point QUICK[] = {
+    {16, 4, 128, 1}, {16, 8, 256, 1}, {32, 8, 256, 0}, {32, 8, 256, 1}, {32, 16, 256, 1}, {64, 32, 512, 1},
+};
+
+typedef struct result {
+    int scene;
+    point p;
+    double ms_total;
+    double stage_ms[8];
+    lpv_acc_metrics m;
+    int pareto;
+} result;
+
+typedef struct scene_entry {
+    char name[64];
+    const char *path; /* NULL = the built-in Cornell box */
+    char ref_exr[1024], ref_se[1024];
+    int have_se;
+} scene_entry;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick]\n"
+            "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
+            "                     [--reference PATH] [--no-plot] [lpvd flags: --backend, --camera, ...]\n"
+            "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
+            "  --out DIR          output folder (default accuracy-out)\n"
+            "  --size WxH         image size (default 128x128)\n"
+            "  --ref-spp N        reference samples per pixel (default 256)\n"
+            "  --scenes LIST      comma list: cornell (built-in), courtyard, blinds (scenes/*.glb),\n"
+            "                     or paths to .glb/.gltf files (default cornell,courtyard,blinds)\n"
+            "  --quick            %d points instead of the 72-point factorial\n"
+            "  --knobs SPEC       restrict knob values, e.g. grid=16/32,iterations=8,rsm=256,occlusion=on\n"
+            "  --points LIST      explicit points GRID:ITER:RSM:on|off, comma separated\n"
+            "  --ticks N          timed ticks per point, median reported (default 5)\n"
+            "  --warmup N         untimed ticks first (default 2)\n"
+            "  --reference PATH   run this reference command (lpvd-reference's CLI) instead of the\n"
+            "                     linked lpv_reference library (default: $LPVD_REFERENCE, else the\n"
+            "                     library when linked, else reference/lpvd-reference in this build tree)\n"
+            "  --no-plot          do not run gnuplot (plot.gp is still written)\n",
+            (int)(sizeof QUICK / sizeof QUICK[0]));
+}
+
+static int mkdir_p(const char *path)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *p = buf + 1; *p; ++p) {
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+            *p = '/';
+        }
+    }
+    return (mkdir(buf, 0777) != 0 && errno != EEXIST) ? -1 : 0;
+}
+
+static int file_exists(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= b[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static uint64_t hash_file(uint64_t h, const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return fnv1a(h, path, strlen(path));
+    unsigned char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        h = fnv1a(h, buf, n);
+    fclose(f);
+    return h;
+}
+
+/* Parses "16/32" style value lists into out; returns the count or -1. */
+static int parse_values(const char *s, int *out, int max, int is_switch)
+{
+    int n = 0;
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", s);
+    for (char *save = NULL, *tok = strtok_r(buf, "/", &save); tok; tok = strtok_r(NULL, "/", &save)) {
+        if (n >= max)
+            return -1;
+        if (is_switch) {
+            if (strcmp(tok, "on") == 0 || strcmp(tok, "1") == 0)
+                out[n++] = 1;
+            else if (strcmp(tok, "off") == 0 || strcmp(tok, "0") == 0)
+                out[n++] = 0;
+            else
+                return -1;
+        } else {
+            char *end = NULL;
+            long v = strtol(tok, &end, 10);
+            if (!end || *end || v < 1 || v > 4096)
+                return -1;
+            out[n++] = (int)v;
+        }
+    }
+    return n > 0 ? n : -1;
+}
+
+static int in_list(int v, const int *list, int n)
+{
+    if (n == 0)
+        return 1;
+    for (int i = 0; i < n; ++i)
+        if (list[i] == v)
+            return 1;
+    return 0;
+}
+
+/* --knobs SPEC: filters (value lists, empty = any) applied to the point set. */
+typedef struct knob_filter {
+    int grid[16], ngrid, iter[16], niter, rsm[16], nrsm, occ[2], nocc;
+} knob_filter;
+
+static int parse_knobs(const char *spec, knob_filter *kf)
+{
+    char buf[512];
+    snprintf(buf, sizeof buf, "%s", spec);
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(tok, '=');
+        if (!eq)
+            return -1;
+        *eq = '\0';
+        const char *v = eq + 1;
+        int r;
+        if (strcmp(tok, "grid") == 0)
+            r = kf->ngrid = parse_values(v, kf->grid, 16, 0);
+        else if (strcmp(tok, "iterations") == 0)
+            r = kf->niter = parse_values(v, kf->iter, 16, 0);
+        else if (strcmp(tok, "rsm") == 0)
+            r = kf->nrsm = parse_values(v, kf->rsm, 16, 0);
+        else if (strcmp(tok, "occlusion") == 0)
+            r = kf->nocc = parse_values(v, kf->occ, 2, 1);
+        else
+            return -1;
+        if (r < 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int parse_points(const char *list, point *pts, int max)
+{
+    int n = 0;
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", list);
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        char occ[8] = "";
+        point p;
+        if (n >= max || sscanf(tok, "%d:%d:%d:%7s", &p.grid, &p.iterations, &p.rsm, occ) != 4)
+            return -1;
+        if (strcmp(occ, "on") == 0)
+            p.occlusion = 1;
+        else if (strcmp(occ, "off") == 0)
+            p.occlusion = 0;
+        else
+            return -1;
+        if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192)
+            return -1;
+        pts[n++] = p;
+    }
+    return n > 0 ? n : -1;
+}
+
+/* The reference command: --reference, $LPVD_REFERENCE, else (returning 0)
+ * the linked lpv_reference library when built with it, else the build tree's
+ * reference/lpvd-reference (this binary is <build>/bench/accuracy/), PATH.
+ * Returns 1 when out names a command. */
+static int find_reference(const char *given, char *out, size_t n)
+{
+    if (given) {
+        snprintf(out, n, "%s", given);
+        return 1;
+    }
+    const char *env = getenv("LPVD_REFERENCE");
+    if (env && *env) {
+        snprintf(out, n, "%s", env);
+        return 1;
+    }
+    snprintf(out, n, "lpv_reference (linked, in process)");
+    return 0;
+    char self[1024];
+    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (len > 0) {
+        self[len] = '\0';
+        char *slash = strrchr(self, '/');
+        if (slash) {
+            *slash = '\0';
+            char cand[1200];
+            snprintf(cand, sizeof cand, "%s/../../reference/lpvd-reference", self);
+            if (access(cand, X_OK) == 0) {
+                snprintf(out, n, "%s", cand);
+                return 1;
+            }
+        }
+    }
+    snprintf(out, n, "lpvd-reference");
+    return 1;
+}
+
+/* Runs argv (execvp), waits; returns the exit status or -1. */
+static int run_command(char *const argv[])
+{
+    fflush(stdout);
+    fflush(stderr);
+    pid_t pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        execvp(argv[0], argv);
+        fprintf(stderr, "lpvd-accuracy: cannot run %s: %s\n", argv[0], strerror(errno));
+        _exit(127);
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0) {
+        if (errno != EINTR)
+            return -1;
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* The reference in process (lpv_reference): 1 bounce, spp samples per pixel. */
+static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, int spp, const char *exr,
+                                const char *se_exr)
+{
+    char err[1024] = "";
+    lpv_ref *ref = NULL;
+    size_t n = (size_t)view->width * (size_t)view->height * 4;
+    float *rgba = malloc(n * sizeof(float)), *se = malloc(n * sizeof(float));
+    int rc = -1;
+    if (!rgba || !se) {
+        fprintf(stderr, "lpvd-accuracy: out of memory for the reference\n");
+    } else if (lpv_ref_create(scene, NULL, &ref, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-accuracy: reference: %s\n", err);
+    } else if (lpv_ref_render_indirect(ref, view, 1, spp, rgba, se) != 0) {
+        fprintf(stderr, "lpvd-accuracy: reference: lpv_ref_render_indirect failed\n");
+    } else if (lpv_image_write_f32(exr, view->width, view->height, 4, rgba, err, sizeof err) != 0 ||
+               lpv_image_write_f32(se_exr, view->width, view->height, 4, se, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-accuracy: %s\n", err);
+    } else {
+        rc = 0;
+    }
+    lpv_ref_destroy(ref);
+    free(rgba);
+    free(se);
+    return rc;
+}
+
+/* Makes sure the scene's reference is cached; fills e->ref_exr / ref_se.
+ * ref_cmd NULL: the linked library (lpv_reference, in process). */
+static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const char *out_dir,
+                            int spp, const char *ref_cmd, char *const *cam_args, int ncam)
+{
+    uint64_t h = 1469598103934665603ull;
+    h = e->path ? hash_file(h, e->path) : fnv1a(h, "built-in:cornell-box", 20);
+    h = fnv1a(h, view, sizeof *view);
+    h = fnv1a(h, &spp, sizeof spp);
+    h = ref_cmd ? fnv1a(h, ref_cmd, strlen(ref_cmd)) : fnv1a(h, "lib:lpv_reference", 17);
+    char key[256];
+    if (snprintf(key, sizeof key, "%s-%dx%d-spp%d-%016llx", e->name, view->width, view->height, spp,
+                 (unsigned long long)h) >= (int)sizeof key ||
+        snprintf(e->ref_exr, sizeof e->ref_exr, "%s/ref/%s.exr", out_dir, key) >= (int)sizeof e->ref_exr ||
+        snprintf(e->ref_se, sizeof e->ref_se, "%s/ref/%s.stderr.exr", out_dir, key) >= (int)sizeof e->ref_se) {
+        fprintf(stderr, "lpvd-accuracy: output path too long\n");
+        return -1;
+    }
+    if (file_exists(e->ref_exr)) {
+        e->have_se = file_exists(e->ref_se);
+        fprintf(stderr, "lpvd-accuracy: %s: cached reference %s\n", e->name, e->ref_exr);
+        return 0;
+    }
+    char tmp_exr[1100], tmp_se[1100], spp_s[32], size_s[64];
+    snprintf(tmp_exr, sizeof tmp_exr, "%s/ref/%s.tmp%d.exr", out_dir, key, (int)getpid());
+    snprintf(tmp_se, sizeof tmp_se, "%s/ref/%s.stderr.tmp%d.exr", out_dir, key, (int)getpid());
+    if (!ref_cmd) {
+        fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, %d spp)\n", e->name,
+                spp);
+        if (render_reference_lib(scene, view, spp, tmp_exr, tmp_se) != 0 || rename(tmp_exr, e->ref_exr) != 0 ||
+            rename(tmp_se, e->ref_se) != 0) {
+            unlink(tmp_exr);
+            unlink(tmp_se);
+            return -1;
+        }
+        e->have_se = 1;
+        return 0;
+    }
+    snprintf(spp_s, sizeof spp_s, "%d", spp);
+    snprintf(size_s, sizeof size_s, "%dx%d", view->width, view->height);
+    char *argv[32 + MAX_PASS];
+    int a = 0;
+    argv[a++] = (char *)ref_cmd;
+    if (e->path)
+        argv[a++] = (char *)e->path;
+    argv[a++] = "-o";
+    argv[a++] = tmp_exr;
+    argv[a++] = "--stderr";
+    argv[a++] = tmp_se;
+    argv[a++] = "--spp";
+    argv[a++] = spp_s;
+    argv[a++] = "--size";
+    argv[a++] = size_s;
+    for (int i = 0; i < ncam; ++i)
+        argv[a++] = cam_args[i];
+    argv[a] = NULL;
+    fprintf(stderr, "lpvd-accuracy: %s: rendering the reference:", e->name);
+    for (int i = 0; i < a; ++i)
+        fprintf(stderr, " %s", argv[i]);
+    fputc('\n', stderr);
+    int rc = run_command(argv);
+    if (rc != 0 || !file_exists(tmp_exr)) {
+        fprintf(stderr, "lpvd-accuracy: %s: the reference command failed (status %d): %s\n", e->name, rc, ref_cmd);
+        unlink(tmp_exr);
+        unlink(tmp_se);
+        return -1;
+    }
+    if (rename(tmp_exr, e->ref_exr) != 0)
+        return -1;
+    e->have_se = file_exists(tmp_se) && rename(tmp_se, e->ref_se) == 0;
+    if (!e->have_se)
+        fprintf(stderr, "lpvd-accuracy: %s: warning: no stderr image; ref_noise will be 0\n", e->name);
+    return 0;
+}
+
+static const char *occ_name(int on)
+{
+    return on ? "on" : "off";
+}
+
+static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes)
+{
+    fprintf(f, "scene,grid,iterations,rsm,occlusion,ms_per_tick");
+    for (int k = 0; k < NSTAGES; ++k)
+        fprintf(f, ",ms_%s", STAGES[k]);
+    fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto\n");
+    for (int i = 0; i < n; ++i) {
+        fprintf(f, "%s,%d,%d,%d,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
+                occ_name(r[i].p.occlusion), r[i].ms_total);
+        for (int k = 0; k < NSTAGES; ++k)
+            fprintf(f, ",%.3f", r[i].stage_ms[k]);
+        fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d\n", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
+                r[i].m.rel_rmse_excess, r[i].m.rel_mae, r[i].m.pixels, r[i].pareto);
+    }
+}
+
+static int cmp_ms(const void *a, const void *b)
+{
+    const result *x = *(const result *const *)a, *y = *(const result *const *)b;
+    return (x->ms_total > y->ms_total) - (x->ms_total < y->ms_total);
+}
+
+/* The results of one scene sorted by ms; returns the count. */
+static int scene_rows(const result *r, int n, int scene, const result **rows)
+{
+    int k = 0;
+    for (int i = 0; i < n; ++i)
+        if (r[i].scene == scene)
+            rows[k++] = &r[i];
+    qsort(rows, (size_t)k, sizeof *rows, cmp_ms);
+    return k;
+}
+
+static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes, int nscenes, const char *header)
+{
+    fprintf(f, "# lpvd accuracy sweep\n\n%s\n", header);
+    fprintf(f, "Error metrics: docs/accuracy.md. ms/tick: median GPU ms of one tick + the indirect-only render "
+               "(sum of the stages). Pareto: no other point of the scene is both faster and more accurate "
+               "(rel. RMSE). Rows sorted by ms/tick; Pareto rows marked **◆**.\n\n");
+    const result **rows = malloc((size_t)n * sizeof *rows);
+    if (!rows)
+        return;
+    for (int s = 0; s < nscenes; ++s) {
+        int k = scene_rows(r, n, s, rows);
+        if (k == 0)
+            continue;
+        fprintf(f, "## %s\n\n", scenes[s].name);
+        fprintf(f, "reference: `%s`%s\n\n", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
+        fprintf(f, "| grid | iterations | RSM | occlusion | ms/tick | propagate ms | gv ms | rel. RMSE | rel. bias "
+                   "| rel. MAE | ref. noise | Pareto |\n");
+        fprintf(f, "|---:|---:|---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
+        for (int i = 0; i < k; ++i) {
+            const result *x = rows[i];
+            const char *b = x->pareto ? "**" : "";
+            fprintf(f, "| %s%d³%s | %d | %d² | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f | %s |\n",
+                    b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion), b, x->ms_total, b,
+                    x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
+                    x->pareto ? "**◆**" : "");
+        }
+        fputc('\n', f);
+    }
+    free(rows);
+}
+
+static int have_pngcairo(void)
+{
+    FILE *p = popen("gnuplot -e 'set terminal' 2>&1", "r");
+    if (!p)
+        return 0;
+    char line[512];
+    int found = 0;
+    while (fgets(line, sizeof line, p))
+        if (strstr(line, "pngcairo"))
+            found = 1;
+    pclose(p);
+    return found;
+}
+
+/* plot.gp + data files; runs gnuplot unless no_plot. */
+static int write_plot(const char *out_dir, const result *r, int n, const scene_entry *scenes, int nscenes,
+                      int no_plot)
+{
+    char path[1200];
+    const result **rows = malloc((size_t)n * sizeof *rows);
+    if (!rows)
+        return -1;
+    snprintf(path, sizeof path, "%s/plot", out_dir);
+    mkdir_p(path);
+    for (int s = 0; s < nscenes; ++s) {
+        int k = scene_rows(r, n, s, rows);
+        for (int front = 0; front < 2; ++front) {
+            snprintf(path, sizeof path, "%s/plot/%s%s.dat", out_dir, scenes[s].name, front ? "-pareto" : "");
+            FILE *f = fopen(path, "w");
+            if (!f) {
+                free(rows);
+                return -1;
+            }
+            fprintf(f, "# ms_per_tick rel_rmse grid iterations rsm occlusion\n");
+            for (int i = 0; i < k; ++i)
+                if (!front || rows[i]->pareto)
+                    fprintf(f, "%.4f %.5f %d %d %d %d\n", rows[i]->ms_total, rows[i]->m.rel_rmse, rows[i]->p.grid,
+                            rows[i]->p.iterations, rows[i]->p.rsm, rows[i]->p.occlusion);
+            fclose(f);
+        }
+    }
+    free(rows);
+    snprintf(path, sizeof path, "%s/plot.gp", out_dir);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    int cairo = no_plot ? 1 : have_pngcairo();
+    fprintf(f, "# lpvd-accuracy: error vs milliseconds per tick; run from %s: gnuplot plot.gp\n", out_dir);
+    fprintf(f, "set terminal %s size 960,640%s\n", cairo ? "pngcairo" : "png", cairo ? " font 'sans,11'" : "");
+    fprintf(f, "set output 'plot.png'\n");
+    fprintf(f, "set title 'lpvd indirect light vs path-traced reference: what accuracy costs in time'\n");
+    fprintf(f, "set xlabel 'GPU ms per tick (median; tick + indirect-only render)'\n");
+    fprintf(f, "set ylabel 'relative RMSE'\n");
+    fprintf(f, "set logscale x\nset grid xtics ytics mxtics\nset key outside right top\nset yrange [0:*]\n");
+    fprintf(f, "plot \\\n");
+    for (int s = 0; s < nscenes; ++s) {
+        fprintf(f,
+                "  'plot/%s.dat' using 1:2 with points pt 7 ps 0.8 lc %d title '%s', \\\n"
+                "  'plot/%s-pareto.dat' using 1:2 with linespoints pt 6 ps 1.6 lw 2 lc %d title '%s Pareto front'%s\n",
+                scenes[s].name, s + 1, scenes[s].name, scenes[s].name, s + 1, scenes[s].name,
+                s + 1 < nscenes ? ", \\" : "");
+    }
+    fclose(f);
+    if (no_plot)
+        return 0;
+    char cmd[1400];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot plot.gp", out_dir);
+    int rc = system(cmd);
+    if (rc != 0) {
+        fprintf(stderr, "lpvd-accuracy: gnuplot failed (status %d); plot.gp and plot/*.dat are written\n", rc);
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
+    const char *knobs = NULL, *points_arg = NULL;
+    int spp = 256, quick = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
+    lpvd_options opt = {0};
+    char *cam_args[MAX_PASS];
+    int ncam = 0;
+    char err[1024] = "";
+
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--quick") == 0) {
+            quick = 1;
+        } else if (strcmp(a, "--no-plot") == 0) {
+            no_plot = 1;
+        } else if (!v && a[0] == '-') {
+            fprintf(stderr, "lpvd-accuracy: %s needs a value (or is unknown; see --help)\n", a);
+            return 2;
+        } else if (strcmp(a, "--out") == 0) {
+            out_dir = argv[++i];
+        } else if (strcmp(a, "--scenes") == 0) {
+            scene_list = argv[++i];
+        } else if (strcmp(a, "--reference") == 0) {
+            ref_given = argv[++i];
+        } else if (strcmp(a, "--knobs") == 0) {
+            knobs = argv[++i];
+        } else if (strcmp(a, "--points") == 0) {
+            points_arg = argv[++i];
+        } else if (strcmp(a, "--ref-spp") == 0 || strcmp(a, "--ticks") == 0 || strcmp(a, "--warmup") == 0) {
+            char *end = NULL;
+            long x = strtol(argv[++i], &end, 10);
+            if (!end || *end || x < (a[2] == 'w' ? 0 : 1) || x > (a[2] == 'r' ? 1000000 : MAX_TICKS)) {
+                fprintf(stderr, "lpvd-accuracy: bad value for %s: %s\n", a, argv[i]);
+                return 2;
+            }
+            if (a[2] == 'r')
+                spp = (int)x;
+            else if (a[2] == 't')
+                ticks = (int)x;
+            else
+                warmup = (int)x;
+        } else if (a[0] == '-' && a[1] == '-' && lpvd_option_takes_value(a + 2) > 0) {
+            const char *name = a + 2;
+            if (strcmp(name, "grid") == 0 || strcmp(name, "iterations") == 0 || strcmp(name, "rsm-size") == 0 ||
+                strcmp(name, "occlusion") == 0) {
+                fprintf(stderr, "lpvd-accuracy: %s is a swept knob; use --knobs or --points\n", a);
+                return 2;
+            }
+            if (lpvd_option_parse(&opt, name, argv[++i], err, sizeof err) < 0) {
+                fprintf(stderr, "lpvd-accuracy: %s\n", err);
+                return 2;
+            }
+            if (strcmp(name, "size") == 0)
+                size_given = 1;
+            /* the camera choice goes to the reference command too */
+            if ((strcmp(name, "camera") == 0 || strcmp(name, "eye") == 0 || strcmp(name, "target") == 0 ||
+                 strcmp(name, "fov") == 0) &&
+                ncam + 2 <= MAX_PASS) {
+                cam_args[ncam++] = (char *)a;
+                cam_args[ncam++] = argv[i];
+            }
+        } else {
+            fprintf(stderr, "lpvd-accuracy: unknown argument %s (see --help)\n", a);
+            return 2;
+        }
+    }
+    if (!size_given)
+        opt.cam.width = opt.cam.height = 128;
+    if (opt.cam.height == 0) {
+        fprintf(stderr, "lpvd-accuracy: --size needs WxH\n");
+        return 2;
+    }
+
+    /* The point set. */
+    static point pts[MAX_POINTS];
+    int npts = 0;
+    if (points_arg) {
+        npts = parse_points(points_arg, pts, MAX_POINTS);
+        if (npts < 0) {
+            fprintf(stderr, "lpvd-accuracy: --points expects GRID:ITER:RSM:on|off[,...]\n");
+            return 2;
+        }
+    } else if (quick) {
+        npts = (int)(sizeof QUICK / sizeof QUICK[0]);
+        memcpy(pts, QUICK, sizeof QUICK);
+    } else {
+        for (size_t g = 0; g < sizeof GRIDS / sizeof *GRIDS; ++g)
+            for (size_t it = 0; it < sizeof ITERS / sizeof *ITERS; ++it)
+                for (size_t r = 0; r < sizeof RSMS / sizeof *RSMS; ++r)
+                    for (size_t o = 0; o < sizeof OCCS / sizeof *OCCS; ++o)
+                        pts[npts++] = (point){GRIDS[g], ITERS[it], RSMS[r], OCCS[o]};
+    }
+    if (knobs) {
+        knob_filter kf = {0};
+        if (parse_knobs(knobs, &kf) != 0) {
+            fprintf(stderr, "lpvd-accuracy: --knobs expects e.g. grid=16/32,iterations=8,rsm=256,occlusion=on\n");
+            return 2;
+        }
+        int k = 0;
+        for (int i = 0; i < npts; ++i)
+            if (in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
+                in_list(pts[i].rsm, kf.rsm, kf.nrsm) && in_list(pts[i].occlusion, kf.occ, kf.nocc))
+                pts[k++] = pts[i];
+        npts = k;
+        if (npts == 0) {
+            fprintf(stderr, "lpvd-accuracy: --knobs %s leaves no point\n", knobs);
+            return 2;
+        }
+    }
+
+    /* The scenes. */
+    static scene_entry scenes[MAX_SCENES];
+    static char scene_paths[MAX_SCENES][1024];
+    int nscenes = 0;
+    {
+        char buf[4096];
+        snprintf(buf, sizeof buf, "%s", scene_list);
+        for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+            if (nscenes >= MAX_SCENES) {
+                fprintf(stderr, "lpvd-accuracy: at most %d scenes\n", MAX_SCENES);
+                return 2;
+            }
+            scene_entry *e = &scenes[nscenes];
+            const char *base = strrchr(tok, '/') ? strrchr(tok, '/') + 1 : tok;
+            snprintf(e->name, sizeof e->name, "%s", base);
+            char *dot = strrchr(e->name, '.');
+            int is_file = strchr(tok, '/') || (dot && (strcmp(dot, ".glb") == 0 || strcmp(dot, ".gltf") == 0));
+            if (dot)
+                *dot = '\0';
+            for (char *c = e->name; *c; ++c)
+                if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+                      *c == '-' || *c == '_'))
+                    *c = '_';
+            if (is_file) {
+                snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s", tok);
+                e->path = scene_paths[nscenes];
+            } else if (strcmp(tok, "cornell") == 0) {
+                e->path = NULL;
+            } else {
+                snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s/%s.glb", LPVD_ACCURACY_SCENES_DIR,
+                         tok);
+                e->path = scene_paths[nscenes];
+            }
+            ++nscenes;
+        }
+    }
+    if (nscenes == 0) {
+        fprintf(stderr, "lpvd-accuracy: --scenes is empty\n");
+        return 2;
+    }
+
+    char ref_cmd[1200];
+    int ref_is_cmd = find_reference(ref_given, ref_cmd, sizeof ref_cmd);
+    char sub[1200];
+    snprintf(sub, sizeof sub, "%s/ref", out_dir);
+    if (mkdir_p(sub) != 0) {
+        fprintf(stderr, "lpvd-accuracy: cannot create %s: %s\n", sub, strerror(errno));
+        return 1;
+    }
+
+    lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt.backend}, err, sizeof err);
+    if (!ctx) {
+        fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+        return 1;
+    }
+    lpv_engine *engine = lpv_engine_create(err, sizeof err);
+    if (!engine) {
+        fprintf(stderr, "lpvd-accuracy: %s\n", err);
+        lpv_gl_context_destroy(ctx);
+        return 1;
+    }
+    char header[2048];
+    snprintf(header, sizeof header,
+             "backend %s, GL_RENDERER %s; image %dx%d; reference `%s` at %d spp; median of %d ticks after %d "
+             "warm-up; %d point(s) per scene.\n",
+             lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), opt.cam.width,
+             opt.cam.height, ref_cmd, spp, ticks, warmup, npts);
+    fprintf(stderr, "lpvd-accuracy: %s", header);
+
+    result *results = calloc((size_t)nscenes * (size_t)npts, sizeof *results);
+    int nres = 0, rc = 0;
+    for (int s = 0; s < nscenes && rc == 0; ++s) {
+        scene_entry *se = &scenes[s];
+        lpv_scene scene;
+        if (lpv_scene_load(se->path, &scene, err, sizeof err) != 0) {
+            fprintf(stderr, "lpvd-accuracy: %s\n", err);
+            rc = 1;
+            break;
+        }
+        lpv_view view;
+        float *ref = NULL, *ref_se = NULL, *rgba = NULL;
+        int rw = 0, rh = 0;
+        if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+            fprintf(stderr, "lpvd-accuracy: %s\n", err);
+            rc = 2;
+            goto next_scene;
+        }
+        if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args, ncam) != 0) {
+            rc = 1;
+            goto next_scene;
+        }
+        if (lpv_image_read_f32(se->ref_exr, 4, &rw, &rh, &ref, err, sizeof err) != 0) {
+            fprintf(stderr, "lpvd-accuracy: %s\n", err);
+            rc = 1;
+            goto next_scene;
+        }
+        if (rw != view.width || rh != view.height) {
+            fprintf(stderr, "lpvd-accuracy: %s is %dx%d, expected %dx%d\n", se->ref_exr, rw, rh, view.width,
+                    view.height);
+            rc = 1;
+            goto next_scene;
+        }
+        if (se->have_se) {
+            int sw = 0, sh = 0;
+            if (lpv_image_read_f32(se->ref_se, 4, &sw, &sh, &ref_se, err, sizeof err) != 0 || sw != rw ||
+                sh != rh) {
+                fprintf(stderr, "lpvd-accuracy: %s: unreadable or wrong size; ignoring it\n", se->ref_se);
+                free(ref_se);
+                ref_se = NULL;
+                se->have_se = 0;
+            }
+        }
+        { /* a tone-mapped preview of the reference next to it */
+            size_t np = (size_t)rw * (size_t)rh;
+            uint8_t *px = malloc(np * 4);
+            char prev[1100];
+            snprintf(prev, sizeof prev, "%.*s.png", (int)strlen(se->ref_exr) - 4, se->ref_exr);
+            if (px) {
+                lpv_tonemap_rgba8(ref, np, 1.0f, px);
+                if (lpv_image_write_u8(prev, rw, rh, 4, px, err, sizeof err) != 0)
+                    fprintf(stderr, "lpvd-accuracy: %s\n", err);
+                free(px);
+            }
+        }
+        if (snprintf(sub, sizeof sub, "%s/err/%s", out_dir, se->name) >= (int)sizeof sub || mkdir_p(sub) != 0) {
+            fprintf(stderr, "lpvd-accuracy: cannot create %s/err/%s\n", out_dir, se->name);
+            rc = 1;
+            goto next_scene;
+        }
+        rgba = malloc((size_t)view.width * (size_t)view.height * 4 * sizeof(float));
+        for (int p = 0; p < npts && rc == 0 && rgba; ++p) {
+            result *res = &results[nres];
+            res->scene = s;
+            res->p = pts[p];
+            lpv_settings st = opt.settings;
+            st.grid_dims[0] = st.grid_dims[1] = st.grid_dims[2] = pts[p].grid;
+            st.iterations = pts[p].iterations;
+            st.rsm_size = pts[p].rsm;
+            st.occlusion = pts[p].occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+            if (lpv_engine_set_settings(engine, &st, err, sizeof err) != 0 ||
+                lpv_engine_set_scene(engine, &scene, err, sizeof err) != 0 ||
+                lpv_engine_set_view(engine, &view, err, sizeof err) != 0) {
+                fprintf(stderr, "lpvd-accuracy: %s\n", err);
+                rc = 1;
+                break;
+            }
+            static double totals[MAX_TICKS], stage[8][MAX_TICKS];
+            for (int t = 0; t < warmup + ticks; ++t) {
+                if (lpv_engine_tick(engine, err, sizeof err) != 0 ||
+                    lpv_engine_render(engine, LPV_TERMS_INDIRECT_ONLY, rgba, err, sizeof err) != 0) {
+                    fprintf(stderr, "lpvd-accuracy: %s\n", err);
+                    rc = 1;
+                    break;
+                }
+                if (t < warmup)
+                    continue;
+                const lpv_engine_stats *es = lpv_engine_last_stats(engine);
+                double total = 0.0;
+                for (int k = 0; k < NSTAGES; ++k)
+                    stage[k][t - warmup] = 0.0;
+                for (int j = 0; j < es->stage_count; ++j) {
+                    total += es->stages[j].gpu_ms;
+                    for (int k = 0; k < NSTAGES; ++k)
+                        if (strcmp(es->stages[j].name, STAGES[k]) == 0)
+                            stage[k][t - warmup] = es->stages[j].gpu_ms;
+                }
+                totals[t - warmup] = total;
+            }
+            if (rc)
+                break;
+            res->ms_total = lpv_acc_median(totals, (size_t)ticks);
+            for (int k = 0; k < NSTAGES; ++k)
+                res->stage_ms[k] = lpv_acc_median(stage[k], (size_t)ticks);
+            if (lpv_acc_compare(rgba, ref, ref_se, view.width, view.height, &res->m) != 0)
+                fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both, or a black reference\n",
+                        se->name);
+            char ep[1400];
+            snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s.png", sub, pts[p].grid, pts[p].iterations, pts[p].rsm,
+                     occ_name(pts[p].occlusion));
+            if (lpv_acc_write_error_png(ep, rgba, ref, view.width, view.height, res->m.mean_ref, err, sizeof err) !=
+                0)
+                fprintf(stderr, "lpvd-accuracy: %s\n", err);
+            fprintf(stderr,
+                    "lpvd-accuracy: %s %d/%d: grid %d, iterations %d, rsm %d, occlusion %s: %.2f ms/tick, "
+                    "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f\n",
+                    se->name, p + 1, npts, pts[p].grid, pts[p].iterations, pts[p].rsm, occ_name(pts[p].occlusion),
+                    res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise);
+            ++nres;
+        }
+    next_scene:
+        free(rgba);
+        free(ref);
+        free(ref_se);
+        lpv_scene_free(&scene);
+    }
+    lpv_engine_destroy(engine);
+    lpv_gl_context_destroy(ctx);
+
+    /* The Pareto front per scene (ms per tick vs relative RMSE). */
+    for (int s = 0; s < nscenes; ++s) {
+        double cost[MAX_POINTS], error[MAX_POINTS];
+        int idx[MAX_POINTS], front[MAX_POINTS], k = 0;
+        for (int i = 0; i < nres; ++i)
+            if (results[i].scene == s) {
+                cost[k] = results[i].ms_total;
+                error[k] = results[i].m.rel_rmse;
+                idx[k++] = i;
+            }
+        lpv_acc_pareto(cost, error, (size_t)k, front);
+        for (int j = 0; j < k; ++j)
+            results[idx[j]].pareto = front[j];
+    }
+
+    char path[1200];
+    snprintf(path, sizeof path, "%s/results.csv", out_dir);
+    FILE *f = fopen(path, "w");
+    if (f) {
+        write_csv(f, results, nres, scenes);
+        fclose(f);
+    } else {
+        rc = 1;
+    }
+    snprintf(path, sizeof path, "%s/results.md", out_dir);
+    f = fopen(path, "w");
+    if (f) {
+        write_md(f, results, nres, scenes, nscenes, header);
+        fclose(f);
+    } else {
+        rc = 1;
+    }
+    if (nres > 0 && write_plot(out_dir, results, nres, scenes, nscenes, no_plot) != 0 && !no_plot)
+        fprintf(stderr, "lpvd-accuracy: no plot.png\n");
+    free(results);
+    fprintf(stderr, "lpvd-accuracy: %d point(s) written to %s/results.csv, results.md%s\n", nres, out_dir,
+            no_plot ? "" : ", plot.png");
+    return rc;
+}
