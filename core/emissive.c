@@ -12,38 +12,14 @@ static int material_emits(const lpv_scene *s, int m)
     return (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) && isfinite(e[0] + e[1] + e[2]);
 }
 
-/* Triangle t of draw d: corners, area and the unit normal of the emitting
- * side (the winding's normal, flipped to agree with the file's vertex normals
- * when they exist). Returns 0 for a degenerate triangle. */
+/* A usable triangle's corners, front normal and area (lpv_scene_triangle). */
 static int triangle(const lpv_scene *s, uint32_t first, const float *p[3], float n[3], double *area)
 {
     const lpv_vertex *v[3];
-    for (int k = 0; k < 3; ++k) {
-        uint32_t idx = s->indices[first + (uint32_t)k];
-        if (idx >= s->vertex_count)
-            return 0;
-        v[k] = &s->vertices[idx];
-        p[k] = v[k]->position;
-    }
-    double e1[3], e2[3], c[3];
-    for (int i = 0; i < 3; ++i) {
-        e1[i] = (double)p[1][i] - p[0][i];
-        e2[i] = (double)p[2][i] - p[0][i];
-    }
-    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    if (!(len > 1e-12) || !isfinite(len))
+    if (!lpv_scene_triangle(s, first, v, n, area))
         return 0;
-    double vn = 0.0;
     for (int k = 0; k < 3; ++k)
-        for (int i = 0; i < 3; ++i)
-            vn += c[i] * v[k]->normal[i];
-    double sign = vn < 0.0 ? -1.0 : 1.0;
-    for (int i = 0; i < 3; ++i)
-        n[i] = (float)(sign * c[i] / len);
-    *area = 0.5 * len;
+        p[k] = v[k]->position;
     return 1;
 }
 

@@ -134,3 +134,41 @@ int lpv_scene_ensure_light(lpv_scene *scene)
     scene->default_light_added = 1;
     return 0;
 }
+
+int lpv_scene_triangle(const lpv_scene *s, uint32_t first, const lpv_vertex *v[3], float front[3], double *area)
+{
+    if ((uint64_t)first + 3 > s->index_count)
+        return 0;
+    for (int k = 0; k < 3; ++k) {
+        uint32_t idx = s->indices[first + (uint32_t)k];
+        if (idx >= s->vertex_count)
+            return 0;
+        v[k] = &s->vertices[idx];
+        for (int i = 0; i < 3; ++i)
+            if (!isfinite(v[k]->position[i]))
+                return 0;
+    }
+    double e1[3], e2[3], c[3];
+    for (int i = 0; i < 3; ++i) {
+        e1[i] = (double)v[1]->position[i] - v[0]->position[i];
+        e2[i] = (double)v[2]->position[i] - v[0]->position[i];
+    }
+    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(len > 1e-12) || !isfinite(len))
+        return 0;
+    double vn = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        const float *n = v[k]->normal;
+        if (isfinite(n[0]) && isfinite(n[1]) && isfinite(n[2]))
+            for (int i = 0; i < 3; ++i)
+                vn += c[i] * n[i];
+    }
+    double sign = vn < 0.0 ? -1.0 : 1.0;
+    for (int i = 0; i < 3; ++i)
+        front[i] = (float)(sign * c[i] / len);
+    *area = 0.5 * len;
+    return 1;
+}

@@ -104,6 +104,13 @@ void lpv_scene_compute_bounds(lpv_scene *scene);
 /* Number of materials with non-zero emission that some draw uses. */
 uint32_t lpv_scene_emissive_draw_count(const lpv_scene *scene);
 
+/* Triangle at indices[first .. first+2]: its corners (v), area (m^2) and the
+ * unit normal of its front side: the winding's normal, flipped to agree with
+ * the file's (finite) vertex normals. Emission leaves through the front, for
+ * the emissive VPLs and the reference alike. Returns 0 for an index out of
+ * range, a non-finite corner or a degenerate triangle. */
+int lpv_scene_triangle(const lpv_scene *scene, uint32_t first, const lpv_vertex *v[3], float front[3], double *area);
+
 /* If the scene has no punctual light and no emissive surface, adds the
  * documented default light (docs/units.md: a point light 10% below the top of
  * the bounds, centred, giving 1 W/m^2 straight below it at the bounds' floor)

@@ -12,6 +12,11 @@ float lpv_srgb_encode(float x)
     return x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
 }
 
+float lpv_srgb_decode(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
 static uint8_t to_u8(float v)
 {
     return (uint8_t)lrintf(v * 255.0f);

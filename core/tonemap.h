@@ -13,7 +13,8 @@
  * Non-finite values become 0. */
 void lpv_tonemap_rgba8(const float *rgba, size_t n, float exposure, uint8_t *out);
 
-/* The sRGB encoding of a linear value in [0, 1]. */
+/* The sRGB encoding of a linear value in [0, 1], and its inverse. */
 float lpv_srgb_encode(float linear);
+float lpv_srgb_decode(float encoded);
 
 #endif

@@ -1,6 +1,9 @@
 /* pt.c - see pt.h and docs/reference.md. */
 #include "pt.h"
 
+#include "error.h"
+#include "tonemap.h"
+
 #include <embree3/rtcore.h>
 #include <math.h>
 #include <pthread.h>
@@ -147,50 +150,16 @@ static void sample_cosine(pcg32 *r, const float n[3], float out[3])
 
 /* ---- building ------------------------------------------------------------ */
 
-static float srgb_decode(float c)
-{
-    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
-}
-
-static void set_err(char *err, size_t n, const char *msg)
-{
-    if (err && n)
-        snprintf(err, n, "%s", msg);
-}
 
 /* Keeps triangle `first` of the scene if it is usable. */
 static int make_tri(const lpv_scene *s, uint32_t first, int material, ref_tri *t)
 {
+    /* The front is the same side core/emissive.c emits from. */
     const lpv_vertex *v[3];
-    for (int k = 0; k < 3; ++k) {
-        uint32_t idx = s->indices[first + (uint32_t)k];
-        if (idx >= s->vertex_count)
-            return 0;
-        v[k] = &s->vertices[idx];
-        if (!finite3(v[k]->position))
-            return 0;
-    }
-    double e1[3], e2[3], c[3];
-    for (int i = 0; i < 3; ++i) {
-        e1[i] = (double)v[1]->position[i] - v[0]->position[i];
-        e2[i] = (double)v[2]->position[i] - v[0]->position[i];
-    }
-    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    if (!(len > 1e-12) || !isfinite(len))
+    double area;
+    if (!lpv_scene_triangle(s, first, v, t->front, &area))
         return 0;
-    /* The front: the winding's normal, flipped to agree with the vertex
-     * normals (the same rule as core/emissive.c). */
-    double vn = 0.0;
-    for (int k = 0; k < 3; ++k)
-        if (finite3(v[k]->normal))
-            for (int i = 0; i < 3; ++i)
-                vn += c[i] * v[k]->normal[i];
-    double sign = vn < 0.0 ? -1.0 : 1.0;
     for (int i = 0; i < 3; ++i) {
-        t->front[i] = (float)(sign * c[i] / len);
         t->p0[i] = v[0]->position[i];
         t->e1[i] = v[1]->position[i] - v[0]->position[i];
         t->e2[i] = v[2]->position[i] - v[0]->position[i];
@@ -234,7 +203,7 @@ static int copy_materials(lpv_ref *r, const lpv_scene *s)
     r->texture_count = s->texture_count;
     float lut[256];
     for (int i = 0; i < 256; ++i)
-        lut[i] = srgb_decode((float)i / 255.0f);
+        lut[i] = lpv_srgb_decode((float)i / 255.0f);
     for (uint32_t t = 0; t < s->texture_count; ++t) {
         const lpv_texture *src = &s->textures[t];
         if (!src->rgba8 || src->width < 1 || src->height < 1)
@@ -265,13 +234,13 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
 {
     *out = NULL;
     if (!scene) {
-        set_err(err, err_size, "no scene");
+        lpv_error(err, err_size, "%s", "no scene");
         return -1;
     }
     lpv_ref_desc d = desc ? *desc : (lpv_ref_desc){0};
     lpv_ref *r = calloc(1, sizeof *r);
     if (!r) {
-        set_err(err, err_size, "out of memory");
+        lpv_error(err, err_size, "%s", "out of memory");
         return -1;
     }
     r->threads = resolve_threads(d.threads);
@@ -282,13 +251,13 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
     for (uint32_t i = 0; i < scene->draw_count; ++i)
         cap += scene->draws[i].index_count / 3;
     if (cap > 0x7fffffffu) {
-        set_err(err, err_size, "too many triangles");
+        lpv_error(err, err_size, "%s", "too many triangles");
         goto fail;
     }
     if (cap) {
         r->tris = malloc(cap * sizeof *r->tris);
         if (!r->tris) {
-            set_err(err, err_size, "out of memory");
+            lpv_error(err, err_size, "%s", "out of memory");
             goto fail;
         }
     }
@@ -304,13 +273,13 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
         }
     }
     if (copy_materials(r, scene) != 0) {
-        set_err(err, err_size, "out of memory");
+        lpv_error(err, err_size, "%s", "out of memory");
         goto fail;
     }
     if (scene->light_count) {
         r->lights = malloc(scene->light_count * sizeof *r->lights);
         if (!r->lights) {
-            set_err(err, err_size, "out of memory");
+            lpv_error(err, err_size, "%s", "out of memory");
             goto fail;
         }
         memcpy(r->lights, scene->lights, scene->light_count * sizeof *r->lights);
@@ -338,7 +307,7 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
      * One build thread keeps the build reproducible. */
     r->device = rtcNewDevice("threads=1");
     if (!r->device) {
-        set_err(err, err_size, "Embree: rtcNewDevice failed");
+        lpv_error(err, err_size, "%s", "Embree: rtcNewDevice failed");
         goto fail;
     }
     if (r->tri_count) {
@@ -353,7 +322,7 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
                                                r->tri_count);
         if (!vb || !ib) {
             rtcReleaseGeometry(g);
-            set_err(err, err_size, "Embree: out of memory");
+            lpv_error(err, err_size, "%s", "Embree: out of memory");
             goto fail;
         }
         for (uint32_t t = 0; t < r->tri_count; ++t) {
@@ -371,7 +340,7 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
         rtcReleaseGeometry(g);
         rtcCommitScene(r->scene);
         if (rtcGetDeviceError(r->device) != RTC_ERROR_NONE) {
-            set_err(err, err_size, "Embree: building the scene failed");
+            lpv_error(err, err_size, "%s", "Embree: building the scene failed");
             goto fail;
         }
     }
