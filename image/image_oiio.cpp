@@ -78,6 +78,25 @@ bool check_size(const char *path, int width, int height, int channels, const voi
     return true;
 }
 
+// The spec every written image gets, file or in-memory, so the daemon's PNG
+// and EXR frames are encoded exactly like `lpvd render`'s files: 8-bit sRGB,
+// or linear float for the formats lpv_image_is_float_format names. Our alpha
+// is straight (unassociated), as PNG stores it: OIIO must not un-premultiply;
+// EXR is written as is.
+ImageSpec output_spec(const char *name, int width, int height, int channels)
+{
+    const bool is_float = lpv_image_is_float_format(name) != 0;
+    ImageSpec spec(width, height, channels, is_float ? TypeDesc::FLOAT : TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", is_float ? "Linear" : "sRGB");
+    if (!is_float)
+        spec.attribute("oiio:UnassociatedAlpha", 1);
+    if (channels == 2)
+        spec.alpha_channel = 1;
+    else if (channels == 4)
+        spec.alpha_channel = 3;
+    return spec;
+}
+
 // Writes pixels of type `src_type` to path; the file's sample type follows the
 // extension.
 int write_image(const char *path, int width, int height, int channels, TypeDesc src_type, const void *pixels,
@@ -92,17 +111,7 @@ int write_image(const char *path, int width, int height, int channels, TypeDesc 
                                        one_line(OIIO::geterror()));
             return -1;
         }
-        const bool is_float = lpv_image_is_float_format(path) != 0;
-        ImageSpec spec(width, height, channels, is_float ? TypeDesc::FLOAT : TypeDesc::UINT8);
-        spec.attribute("oiio:ColorSpace", is_float ? "Linear" : "sRGB");
-        // Our alpha is straight (unassociated), as PNG stores it: tell OIIO not
-        // to un-premultiply. EXR is written as is (no conversion either way).
-        if (!is_float)
-            spec.attribute("oiio:UnassociatedAlpha", 1);
-        if (channels == 2)
-            spec.alpha_channel = 1;
-        else if (channels == 4)
-            spec.alpha_channel = 3;
+        ImageSpec spec = output_spec(path, width, height, channels);
         if (!out->open(path, spec)) {
             set_err(err, err_size, std::string(path) + ": cannot open for writing: " + one_line(out->geterror()));
             return -1;
@@ -264,15 +273,7 @@ int encode_image(const char *ext, int width, int height, int channels, TypeDesc 
             set_err(err, err_size, name + ": no in-memory image writer for this type: " + one_line(OIIO::geterror()));
             return -1;
         }
-        const bool is_float = lpv_image_is_float_format(name.c_str()) != 0;
-        ImageSpec spec(width, height, channels, is_float ? TypeDesc::FLOAT : TypeDesc::UINT8);
-        spec.attribute("oiio:ColorSpace", is_float ? "Linear" : "sRGB");
-        if (!is_float)
-            spec.attribute("oiio:UnassociatedAlpha", 1);
-        if (channels == 2)
-            spec.alpha_channel = 1;
-        else if (channels == 4)
-            spec.alpha_channel = 3;
+        ImageSpec spec = output_spec(name.c_str(), width, height, channels);
         OIIO::Filesystem::IOProxy *proxy = &vec;
         spec.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy);
         if (!img->open(name, spec)) {
