@@ -15,18 +15,23 @@ layout(std140, binding = LPV_UBO_VIEW) uniform ViewUBO { LpvViewBlock V; };
 
 layout(location = 0) out vec4 o_radiance;
 
-float shadow_visibility(int face, vec3 p, vec3 n)
+// Shadow test for light l at p with normal n. The receiver is offset along
+// its normal by about two shadow-map texels, and the face (of a point light's
+// cube) is chosen for the *offset* point: near a cube edge the offset can
+// cross into the neighbouring face, whose frustum is the one that holds it.
+float shadow_visibility(int l, vec3 p, vec3 n)
 {
-    LpvFaceGpu F = L.faces[face];
-    // Offset the receiver along its normal by about two shadow-map texels.
+    LpvLightGpu li = L.lights[l];
+    LpvFaceGpu F0 = L.faces[light_face_for(li, p)];
     float texel;
-    if (F.info.y == 0.0) {
-        texel = sqrt(F.info.z);
-    } else {
-        LpvLightGpu li = L.lights[int(F.info.x)];
-        texel = 2.0 * F.info.z * length(p - li.position_type.xyz) / F.info.w;
-    }
-    vec4 clip = F.view_proj * vec4(p + n * 2.0 * texel, 1.0);
+    if (F0.info.y == 0.0)
+        texel = sqrt(F0.info.z);
+    else // every face of one light shares its fov and size
+        texel = 2.0 * F0.info.z * length(p - li.position_type.xyz) / F0.info.w;
+    vec3 q = p + n * 2.0 * texel;
+    int face = light_face_for(li, q);
+    LpvFaceGpu F = L.faces[face];
+    vec4 clip = F.view_proj * vec4(q, 1.0);
     if (!(clip.w > 0.0))
         return 0.0;
     vec3 ndc = clip.xyz / clip.w;
@@ -60,7 +65,7 @@ void main()
             float cos_i = dot(n, to_light);
             if (cos_i <= 0.0)
                 continue;
-            e_direct += e * cos_i * shadow_visibility(light_face_for(li, p), p, n);
+            e_direct += e * cos_i * shadow_visibility(l, p, n);
         }
     }
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);
