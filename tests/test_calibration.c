@@ -226,6 +226,32 @@ static void test_wall_injected_flux_and_exitance(void **state)
     lpv_scene_free(&s);
 }
 
+/* The other source of indirect light: an emissive wall of radiance Le sends
+ * pi Le A through its front (emissive VPLs, core/emissive.c). */
+static void test_emissive_wall_injected_flux(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    const float le = 0.75f, h = WALL_HALF;
+    int m = lpv_scene_add_material(&s, "glow", (float[3]){0.5f, 0.5f, 0.5f}, (float[3]){le, le, le});
+    const float wall[4][3] = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
+    assert_true(lpv_scene_add_quad(&s, m, wall, NULL) >= 0);
+    lpv_scene_compute_bounds(&s);
+    lpv_settings set = {0};
+    engine_run(&s, &set, NULL);
+    const lpv_grid *g = lpv_engine_grid(engine);
+    size_t count = lpv_grid_cell_count(g);
+    lpv_cell *inj = calloc(count, sizeof *inj);
+    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_INJECTED, inj, count), count);
+    double flux[3], want = M_PI * le * 4.0 * h * h;
+    lpv_oracle_total_flux(g, inj, flux);
+    printf("calibration: emissive wall Le = %.2f W/(m^2 sr): injected flux %.4f W (pi Le A = %.4f)\n", (double)le,
+           flux[1], want);
+    assert_true(fabs(flux[1] - want) < 1e-4 * want);
+    free(inj);
+    lpv_scene_free(&s);
+}
+
 static void test_wall_probe_profile(void **state)
 {
     (void)state;
@@ -285,6 +311,7 @@ int main(void)
         cmocka_unit_test(test_lookup_reads_uniform_hemisphere_exactly),
         cmocka_unit_test(test_direct_point_light_over_plane),
         cmocka_unit_test(test_wall_injected_flux_and_exitance),
+        cmocka_unit_test(test_emissive_wall_injected_flux),
         cmocka_unit_test(test_wall_probe_profile),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
