@@ -3,33 +3,115 @@
  *
  * Zero means "default" for every field, so a zero-initialised struct is a
  * valid configuration after lpv_settings_resolve(). The one consequence to
- * know: iterations = 0 resolves to LPV_DEFAULT_ITERATIONS (8). Injection-only
- * runs (0 steps) are valid for lpv_settings_validate(), but only when the
- * caller skips resolve or sets iterations after it.
+ * know: iterations = 0 resolves to the preset's iteration count (balanced:
+ * 8). Injection-only runs (0 steps) are valid for lpv_settings_validate(),
+ * but only when the caller skips resolve or sets iterations after it.
  */
 #include "settings.h"
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "lpv_shared.h"
 
 #define LPV_MIN_RSM_SIZE 16
 #define LPV_MAX_EMISSIVE_VPLS (1 << 20)
 
+/* The named presets: ONE table, indexed by lpv_preset. The values are points
+ * on the accuracy sweep's Pareto front (bench/accuracy, docs/accuracy.md);
+ * re-run the sweep before changing a row. */
+typedef struct preset_row {
+    const char *name;
+    int grid, iterations, rsm_size;
+    lpv_switch occlusion;
+} preset_row;
+
+static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
+    [LPV_PRESET_DEFAULT] = {NULL, 0, 0, 0, LPV_SWITCH_DEFAULT}, /* not a row: resolves to BALANCED */
+    /* fast: the cheapest point kept on the front by the sweep (docs/accuracy.md) */
+    [LPV_PRESET_FAST] = {"fast", 16, 8, 128, LPV_SWITCH_ON},
+    /* balanced: the engine's default, a knee of the sweep's front (docs/accuracy.md) */
+    [LPV_PRESET_BALANCED] = {"balanced", LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
+                             LPV_SWITCH_ON},
+    /* accurate: lower error at a higher cost, from the sweep (docs/accuracy.md) */
+    [LPV_PRESET_ACCURATE] = {"accurate", 32, 16, 256, LPV_SWITCH_ON},
+};
+
+/* The table row of p (DEFAULT -> BALANCED), or NULL when p is out of range. */
+static const preset_row *preset_row_of(lpv_preset p)
+{
+    if (p == LPV_PRESET_DEFAULT)
+        p = LPV_PRESET_BALANCED;
+    if ((int)p <= (int)LPV_PRESET_DEFAULT || (int)p >= (int)LPV_PRESET_COUNT_)
+        return NULL;
+    return &PRESETS[p];
+}
+
+int lpv_preset_settings(lpv_preset p, lpv_settings *out)
+{
+    const preset_row *r = preset_row_of(p);
+    if (!r)
+        return -1;
+    *out = (lpv_settings){.preset = p == LPV_PRESET_DEFAULT ? LPV_PRESET_BALANCED : p,
+                          .grid_dims = {r->grid, r->grid, r->grid},
+                          .iterations = r->iterations,
+                          .rsm_size = r->rsm_size,
+                          .occlusion = r->occlusion};
+    return 0;
+}
+
+int lpv_preset_from_name(const char *name, lpv_preset *out)
+{
+    for (int p = LPV_PRESET_DEFAULT + 1; name && p < LPV_PRESET_COUNT_; ++p) {
+        if (strcmp(name, PRESETS[p].name) == 0) {
+            *out = (lpv_preset)p;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+const char *lpv_preset_name(lpv_preset p)
+{
+    const preset_row *r = preset_row_of(p);
+    return r ? r->name : NULL;
+}
+
+const char *lpv_preset_names(void)
+{
+    return "fast, balanced, accurate";
+}
+
+lpv_preset lpv_preset_match(const lpv_settings *s)
+{
+    for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_; ++p) {
+        const preset_row *r = &PRESETS[p];
+        if (s->grid_dims[0] == r->grid && s->grid_dims[1] == r->grid && s->grid_dims[2] == r->grid &&
+            s->iterations == r->iterations && s->rsm_size == r->rsm_size && s->occlusion == r->occlusion)
+            return (lpv_preset)p;
+    }
+    return LPV_PRESET_DEFAULT;
+}
+
 void lpv_settings_resolve(lpv_settings *s)
 {
-    for (int i = 0; i < 3; i++) {
-        if (s->grid_dims[i] == 0)
-            s->grid_dims[i] = LPV_DEFAULT_GRID_DIM;
+    if (s->preset == LPV_PRESET_DEFAULT)
+        s->preset = LPV_PRESET_BALANCED;
+    lpv_settings p;
+    if (lpv_preset_settings(s->preset, &p) == 0) { /* an unknown preset is validate's to report */
+        for (int i = 0; i < 3; i++) {
+            if (s->grid_dims[i] == 0)
+                s->grid_dims[i] = p.grid_dims[i];
+        }
+        if (s->iterations == 0)
+            s->iterations = p.iterations;
+        if (s->rsm_size == 0)
+            s->rsm_size = p.rsm_size;
+        if (s->occlusion == LPV_SWITCH_DEFAULT)
+            s->occlusion = p.occlusion;
     }
-    if (s->iterations == 0)
-        s->iterations = LPV_DEFAULT_ITERATIONS;
-    if (s->rsm_size == 0)
-        s->rsm_size = LPV_DEFAULT_RSM_SIZE;
-    if (s->occlusion == LPV_SWITCH_DEFAULT)
-        s->occlusion = LPV_SWITCH_ON;
     if (s->indirect_gain == 0.0f)
         s->indirect_gain = 1.0f;
     if (s->emissive_vpls == 0)
@@ -74,6 +156,9 @@ static int validate_bounds(const lpv_settings *s, char *err, unsigned long err_s
 
 int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_size)
 {
+    if (s->preset != LPV_PRESET_DEFAULT && !preset_row_of(s->preset))
+        return fail(err, err_size, "preset = %d is out of range (allowed 0 = default, 1 = fast, 2 = balanced, "
+                    "3 = accurate)", (int)s->preset);
     for (int i = 0; i < 3; i++) {
         if (s->grid_dims[i] < 1 || s->grid_dims[i] > LPV_MAX_GRID_DIM)
             return fail(err, err_size, "grid_dims[%d] = %d is out of range (allowed 1..%d)", i, s->grid_dims[i],

@@ -12,24 +12,63 @@ typedef enum lpv_switch {
     LPV_SWITCH_OFF = 2,
 } lpv_switch;
 
+/* Named quality presets: points on the accuracy sweep's Pareto front
+ * (docs/accuracy.md). A preset supplies grid_dims, iterations, rsm_size and
+ * occlusion; any of those set explicitly wins over it. 0 means "the default",
+ * which is BALANCED. */
+typedef enum lpv_preset {
+    LPV_PRESET_DEFAULT = 0,
+    LPV_PRESET_FAST = 1,
+    LPV_PRESET_BALANCED = 2,
+    LPV_PRESET_ACCURATE = 3,
+    LPV_PRESET_COUNT_ /* one past the last; not a preset */
+} lpv_preset;
+
 typedef struct lpv_settings {
-    int grid_dims[3];       /* cells per axis; default 32 x 32 x 32 */
+    int grid_dims[3];       /* cells per axis; default: the preset's (balanced: 32 x 32 x 32) */
     float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
     float bounds_max[3];    /*   bounds grown by half a cell on every side */
-    int iterations;         /* propagation steps; default 8 */
-    int rsm_size;           /* reflective shadow map side, texels; default 256 */
-    lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default on */
+    int iterations;         /* propagation steps; default: the preset's (balanced: 8) */
+    int rsm_size;           /* reflective shadow map side, texels; default: the preset's (balanced: 256) */
+    lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default: the preset's (on) */
     float indirect_gain;    /* artistic factor on the LPV term; default 1 (0 = default) */
     int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
+    lpv_preset preset;      /* supplies the four defaults marked "the preset's"; default balanced */
 } lpv_settings;
 
+/* The balanced preset's values, i.e. the engine's defaults. They mirror the
+ * preset table in settings.c (a test checks that they agree). */
 #define LPV_DEFAULT_GRID_DIM 32
 #define LPV_DEFAULT_ITERATIONS 8
 #define LPV_DEFAULT_RSM_SIZE 256
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096
 
-/* Fills defaults into zero fields. */
+/* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
+ * grid_dims / iterations / rsm_size / occlusion take the preset's values, the
+ * other zero fields the engine's defaults. An out-of-range preset is left as
+ * is (and its fields untouched) for lpv_settings_validate() to report. */
 void lpv_settings_resolve(lpv_settings *s);
+
+/* Writes a preset's values into *out: a zeroed lpv_settings with preset,
+ * grid_dims, iterations, rsm_size and occlusion set (DEFAULT gives balanced).
+ * Returns 0, or -1 for an unknown preset (out untouched). */
+int lpv_preset_settings(lpv_preset p, lpv_settings *out);
+
+/* "fast", "balanced" or "accurate" -> *out. Returns 0, or -1 for any other
+ * name (out untouched). */
+int lpv_preset_from_name(const char *name, lpv_preset *out);
+
+/* The preset's name ("balanced" for DEFAULT), or NULL for an unknown value. */
+const char *lpv_preset_name(lpv_preset p);
+
+/* The preset names, comma separated ("fast, balanced, accurate"), for help
+ * and error messages. */
+const char *lpv_preset_names(void);
+
+/* The preset whose grid_dims / iterations / rsm_size / occlusion equal those
+ * of the resolved settings s, or LPV_PRESET_DEFAULT when none does (the
+ * accuracy sweep labels its points with it). */
+lpv_preset lpv_preset_match(const lpv_settings *s);
 
 /* Checks ranges after resolve; on failure writes a message naming the setting
  * into err and returns -1. */

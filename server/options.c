@@ -9,12 +9,17 @@
 #include <string.h>
 
 const char LPVD_OPTIONS_HELP[] =
-    "Engine settings:\n"
-    "  --grid N | NxMxK        LPV cells per axis (default 32)\n"
+    "Engine settings (--grid, --iterations, --rsm-size and --occlusion win over --preset,\n"
+    "in any order):\n"
+    "  --preset NAME           quality preset (default balanced; docs/accuracy.md):\n"
+    "                            fast      grid 16, 8 iterations, RSM 128, occlusion on\n"
+    "                            balanced  grid 32, 8 iterations, RSM 256, occlusion on\n"
+    "                            accurate  grid 32, 16 iterations, RSM 256, occlusion on\n"
+    "  --grid N | NxMxK        LPV cells per axis (default: the preset's)\n"
     "  --bounds x0,y0,z0,x1,y1,z1  grid bounds in m (default: the scene's bounds)\n"
-    "  --iterations N          propagation steps (default 8)\n"
-    "  --rsm-size N            reflective shadow map side in texels (default 256)\n"
-    "  --occlusion on|off      fuzzy occlusion from the geometry volume (default on)\n"
+    "  --iterations N          propagation steps (default: the preset's)\n"
+    "  --rsm-size N            reflective shadow map side in texels (default: the preset's)\n"
+    "  --occlusion on|off      fuzzy occlusion from the geometry volume (default: the preset's)\n"
     "  --indirect-gain G       artistic factor on the LPV term (default 1)\n"
     "  --emissive-vpls N       VPLs sampled on emissive surfaces (default 4096)\n"
     "GL:\n"
@@ -25,8 +30,9 @@ const char LPVD_OPTIONS_HELP[] =
     "  --eye X,Y,Z --target X,Y,Z --fov DEG   an explicit camera (fov vertical)\n"
     "  --size WxH              image size (default 512 wide, height from the camera's aspect)\n";
 
-static const char *const WITH_VALUE[] = {"grid", "bounds", "iterations", "rsm-size", "occlusion", "indirect-gain",
-                                         "emissive-vpls", "backend", "camera", "eye", "target", "fov", "size", NULL};
+static const char *const WITH_VALUE[] = {"preset", "grid", "bounds", "iterations", "rsm-size",
+                                         "occlusion", "indirect-gain", "emissive-vpls", "backend", "camera",
+                                         "eye", "target", "fov", "size", NULL};
 
 int lpvd_option_takes_value(const char *name)
 {
@@ -74,7 +80,13 @@ static int bad(char *err, size_t n, const char *name, const char *value, const c
 int lpvd_option_parse(lpvd_options *o, const char *name, const char *v, char *err, size_t n)
 {
     lpv_settings *s = &o->settings;
-    if (strcmp(name, "grid") == 0) {
+    if (strcmp(name, "preset") == 0) {
+        /* only the preset is recorded: resolve fills the fields no other flag set */
+        if (lpv_preset_from_name(v, &s->preset) != 0) {
+            snprintf(err, n, "--preset %s: unknown preset (allowed: %s)", v ? v : "", lpv_preset_names());
+            return -1;
+        }
+    } else if (strcmp(name, "grid") == 0) {
         int d[3];
         if (parse_int(v, 1, LPV_MAX_GRID_DIM, &d[0]) == 0) {
             d[1] = d[2] = d[0];

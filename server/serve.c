@@ -425,6 +425,15 @@ int lpvd_cmd_serve(int argc, char **argv)
                 cfg->max_tick_rate);
         return 2;
     }
+    if (opt.settings.preset != LPV_PRESET_DEFAULT) { /* a preset's grid counts like --grid */
+        lpv_settings chk = opt.settings;
+        lpv_settings_resolve(&chk);
+        if (chk.grid_dims[0] > cfg->max_grid) {
+            fprintf(stderr, "lpvd serve: --preset %s: grid %d is over --max-grid %d\n",
+                    lpv_preset_name(chk.preset), chk.grid_dims[0], cfg->max_grid);
+            return 2;
+        }
+    }
     for (int i = 0; i < 3; ++i)
         if (opt.settings.grid_dims[i] > cfg->max_grid) {
             fprintf(stderr, "lpvd serve: --grid is over --max-grid %d\n", cfg->max_grid);

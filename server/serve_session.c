@@ -229,10 +229,12 @@ static json_t *config_json(sv_conn *c)
         bounds = json_pack("[f,f,f,f,f,f]", (double)s.bounds_min[0], (double)s.bounds_min[1], (double)s.bounds_min[2],
                            (double)s.bounds_max[0], (double)s.bounds_max[1], (double)s.bounds_max[2]);
     }
-    return json_pack("{s:[i,i,i], s:o, s:b, s:i, s:i, s:b, s:f, s:i, s:f}", "grid", s.grid_dims[0], s.grid_dims[1],
-                     s.grid_dims[2], "bounds", bounds, "bounds_auto", auto_bounds, "iterations", s.iterations,
-                     "rsm_size", s.rsm_size, "occlusion", s.occlusion != LPV_SWITCH_OFF, "indirect_gain",
-                     (double)s.indirect_gain, "emissive_vpls", s.emissive_vpls, "tick_rate_hz", c->tick_rate);
+    const char *preset = lpv_preset_name(s.preset); /* CONFIG validated it, so never NULL */
+    return json_pack("{s:s, s:[i,i,i], s:o, s:b, s:i, s:i, s:b, s:f, s:i, s:f}", "preset", preset ? preset : "",
+                     "grid", s.grid_dims[0], s.grid_dims[1], s.grid_dims[2], "bounds", bounds, "bounds_auto",
+                     auto_bounds, "iterations", s.iterations, "rsm_size", s.rsm_size, "occlusion",
+                     s.occlusion != LPV_SWITCH_OFF, "indirect_gain", (double)s.indirect_gain, "emissive_vpls",
+                     s.emissive_vpls, "tick_rate_hz", c->tick_rate);
 }
 
 static json_t *scene_json(const lpv_scene *sc)
@@ -964,6 +966,37 @@ static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
     reply(c, LPVP_CAMERA_SET, r->request_id, rev_body(c));
 }
 
+static const char *const PRESET_NAMES[] = {"fast", "balanced", "accurate"};
+static const lpv_preset PRESET_VALUES[] = {LPV_PRESET_FAST, LPV_PRESET_BALANCED, LPV_PRESET_ACCURATE};
+
+/* CONFIG's "preset": resets grid / iterations / rsm_size / occlusion to the
+ * preset's (by clearing them, so resolve fills them in), before the message's
+ * other fields override them. Returns LPVP_FIELD_OK or _ABSENT, LPVP_FIELD_BAD
+ * (message in err), or -2 when the preset is over a server limit (ERROR LIMIT
+ * already sent: --max-grid and --max-texture bound presets as well). */
+static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_settings *st, char *err, size_t n)
+{
+    int idx = 0;
+    int rc = lpvp_get_enum(j, "preset", 0, PRESET_NAMES, 3, &idx, err, n);
+    if (rc != LPVP_FIELD_OK)
+        return rc;
+    lpv_settings p;
+    lpv_preset_settings(PRESET_VALUES[idx], &p);
+    const sv_server *s = c->srv;
+    if (p.grid_dims[0] > s->cfg.max_grid || p.rsm_size > s->cfg.max_texture) {
+        reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                  "preset: %s (grid %d, rsm_size %d) is over the server's limits (--max-grid %d, --max-texture %d)",
+                  PRESET_NAMES[idx], p.grid_dims[0], p.rsm_size, s->cfg.max_grid, s->cfg.max_texture);
+        return -2;
+    }
+    st->preset = p.preset;
+    memset(st->grid_dims, 0, sizeof st->grid_dims);
+    st->iterations = 0;
+    st->rsm_size = 0;
+    st->occlusion = LPV_SWITCH_DEFAULT;
+    return LPVP_FIELD_OK;
+}
+
 static void do_config(sv_conn *c, sv_request *r, json_t *j)
 {
     sv_server *s = c->srv;
@@ -974,6 +1007,11 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
     float bounds[6], gain;
     int occl, gst;
     double lim_rate = s->cfg.max_tick_rate;
+    int pst = config_preset(c, r, j, &st, err, sizeof err);
+    if (pst == LPVP_FIELD_BAD)
+        goto bad;
+    if (pst < 0)
+        return; /* over a limit: already answered */
     const json_t *gj = json_object_get(j, "grid");
     if (gj && json_is_integer(gj)) { /* a single N is accepted as NxNxN */
         gst = lpvp_get_int(j, "grid", 1, 1, INT32_MAX, &grid[0], err, sizeof err);

@@ -658,6 +658,8 @@ int lpvc_config_set(lpvc *c, const lpvc_config *cfg)
     if (!cfg)
         cfg = &z;
     json_t *o = json_object();
+    if (cfg->preset)
+        json_object_set_new(o, "preset", json_string(cfg->preset));
     if (cfg->grid[0] || cfg->grid[1] || cfg->grid[2])
         json_object_set_new(o, "grid", json_pack("[i,i,i]", cfg->grid[0], cfg->grid[1], cfg->grid[2]));
     if (cfg->bounds)

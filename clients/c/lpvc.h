@@ -127,6 +127,8 @@ typedef struct lpvc_config {
     float indirect_gain;       /* 0: not sent */
     int emissive_vpls;         /* 0: not sent */
     float tick_rate_hz;        /* 0: not sent */
+    const char *preset;        /* "fast" | "balanced" | "accurate", or NULL: not sent. The server applies
+                                  it first; the fields above that are sent override its values */
 } lpvc_config;
 int lpvc_config_set(lpvc *c, const lpvc_config *cfg);
 /* CONFIG with a JSON object text (any field, including zeros). The reply

@@ -1298,6 +1298,61 @@ def c_config_atomic(ctx):
     return "config unchanged (revision %r -> %r)" % (rev0, rev1)
 
 
+def _preset_config(c, body):
+    f = expect_reply(c.request(CONFIG, body), CONFIG, what="CONFIG %s" % json.dumps(body))
+    cfg = f.body.get("config")
+    check(isinstance(cfg, dict), "CONFIG reply without \"config\": %r" % f.body)
+    return cfg
+
+
+@case("R4.10", "CONFIG preset sets grid, iterations, rsm_size, occlusion; other fields override it")
+def c_config_preset(ctx):
+    c = ctx.session()
+    _preset_config(c, {"grid": [12, 12, 12], "iterations": 5, "occlusion": False})
+    cfgs = {}
+    for name in ("fast", "balanced", "accurate"):
+        cfg = _preset_config(c, {"preset": name})
+        check(cfg.get("preset") == name,
+              "CONFIG preset %r: effective config names preset %r" % (name, cfg.get("preset")))
+        check(cfg.get("grid") != [12, 12, 12] or cfg.get("iterations") != 5 or cfg.get("occlusion") is not False,
+              "CONFIG preset %r left the explicit grid/iterations/occlusion in place: %r" % (name, cfg))
+        cfgs[name] = cfg
+    knobs = ("grid", "iterations", "rsm_size", "occlusion")
+    fast, acc = [tuple(json.dumps(cfgs[n].get(k)) for k in knobs) for n in ("fast", "accurate")]
+    check(fast != acc, "presets fast and accurate give the same grid/iterations/rsm_size/occlusion: %r" % (fast,))
+    again = _preset_config(c, {"preset": "fast"})
+    check(again == cfgs["fast"], "CONFIG preset fast twice differs: %r vs %r" % (cfgs["fast"], again))
+    over = _preset_config(c, {"preset": "accurate", "iterations": 3, "grid": [10, 10, 10]})
+    check(over.get("iterations") == 3 and over.get("grid") == [10, 10, 10],
+          "fields next to preset do not override it: %r" % over)
+    check(over.get("rsm_size") == cfgs["accurate"].get("rsm_size") and over.get("preset") == "accurate",
+          "preset accurate with overrides lost its other values: %r" % over)
+    keep = _preset_config(c, {"indirect_gain": 2.0})
+    check(keep.get("preset") == "accurate" and keep.get("iterations") == 3,
+          "a later CONFIG without preset changed the preset or its overrides: %r" % keep)
+    return "fast grid %s it %s, accurate grid %s it %s; overrides win" % (
+        cfgs["fast"].get("grid"), cfgs["fast"].get("iterations"), cfgs["accurate"].get("grid"),
+        cfgs["accurate"].get("iterations"))
+
+
+@case("R4.10 R4.6 R2.9", "CONFIG with an unknown preset gets BAD_FIELD naming preset and changes nothing")
+def c_config_preset_bad(ctx):
+    c = ctx.session()
+    cfg0 = _preset_config(c, {"grid": [12, 12, 12], "iterations": 5})
+    for body in ({"preset": "ultra"}, {"preset": "Fast"}, {"preset": ""}, {"preset": 1}, {"preset": None},
+                 {"preset": "fast", "iterations": 5, "grid": [12, 12, 12], "x": 0, "occlusion": "yes"}):
+        rid = c.send(CONFIG, body)
+        f = c.recv_reply(rid)
+        field = "occlusion" if "occlusion" in body else "preset"
+        try:
+            expect_error(f, "BAD_FIELD", rid, field)
+        except Fail as e:
+            raise Fail("CONFIG %s: %s" % (json.dumps(body), e))
+    cfg1 = _preset_config(c, {})
+    check(cfg1 == cfg0, "config changed by refused presets: %r -> %r" % (cfg0, cfg1))
+    return "6 CONFIGs with a bad preset (or a bad field next to a good one) refused, config unchanged"
+
+
 # ---------------------------------------------------------------------------
 # Cases: irradiance queries
 

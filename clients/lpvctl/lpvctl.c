@@ -40,8 +40,9 @@ static const char *g_usage =
     "            [--position X,Y,Z] [--direction X,Y,Z] [--range R] [--inner-cone RAD] [--outer-cone RAD]\n"
     "  light-remove ID\n"
     "  camera --eye X,Y,Z --target X,Y,Z [--up X,Y,Z] [--fov DEG] [--size WxH] | camera --scene NAME|INDEX\n"
-    "  config [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1] [--iterations N] [--rsm-size N]\n"
-    "         [--occlusion on|off] [--indirect-gain G] [--emissive-vpls N] [--tick-rate HZ] | config --json JSON\n"
+    "  config [--preset fast|balanced|accurate] [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1]\n"
+    "         [--iterations N] [--rsm-size N] [--occlusion on|off] [--indirect-gain G] [--emissive-vpls N]\n"
+    "         [--tick-rate HZ] | config --json JSON   (the other flags override the preset's values)\n"
     "  tick [N] [--stats]                      N ticks (default 1); --stats: the whole reply\n"
     "  subscribe [volume|frame] [--format F] [--compression zstd|none] [--delta] [-n COUNT]\n"
     "            [--tick] [--wait MS] [-o PREFIX]  print stream headers; save COUNT messages as\n"
@@ -368,6 +369,8 @@ static int cmd_config(int argc, char **argv)
             return usage_error("'%s' needs a value", a);
         if (strcmp(a, "--json") == 0) {
             json = v;
+        } else if (strcmp(a, "--preset") == 0) {
+            cfg.preset = v; /* the server checks the name (BAD_FIELD lists the allowed ones) */
         } else if (strcmp(a, "--grid") == 0) {
             if (sscanf(v, "%dx%dx%d", &cfg.grid[0], &cfg.grid[1], &cfg.grid[2]) == 3) {
             } else if (parse_int(v, 1, 100000, &n) == 0) {

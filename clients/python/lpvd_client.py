@@ -495,8 +495,10 @@ class Client(object):
         return self.request(MSG["CAMERA_SET"], body)[0]
 
     def config(self, **settings):
-        """CONFIG: grid, bounds, iterations, rsm_size, occlusion, indirect_gain,
-        emissive_vpls, tick_rate_hz. Returns {"revision", "config": {...}}."""
+        """CONFIG: preset ("fast", "balanced", "accurate"), grid, bounds,
+        iterations, rsm_size, occlusion, indirect_gain, emissive_vpls,
+        tick_rate_hz. A preset sets grid, iterations, rsm_size and occlusion;
+        the other fields given override it. Returns {"revision", "config": {...}}."""
         body = {k: (list(v) if isinstance(v, tuple) else v) for k, v in settings.items() if v is not None}
         return self.request(MSG["CONFIG"], body)[0]
 

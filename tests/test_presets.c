@@ -1,0 +1,173 @@
+/*
+ * test_presets.c - the named quality presets (core/settings.h): what zero
+ * settings resolve to, each preset's values, explicit fields winning over a
+ * preset (in lpv_settings and on the command line, in any flag order), the
+ * names, and validation of the enum.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "options.h"
+#include "settings.h"
+
+typedef struct expected {
+    lpv_preset preset;
+    const char *name;
+    int grid, iterations, rsm_size;
+    lpv_switch occlusion;
+} expected;
+
+/* The provisional table (settings.c); a change there must show up here. */
+static const expected PRESETS[] = {
+    {LPV_PRESET_FAST, "fast", 16, 8, 128, LPV_SWITCH_ON},
+    {LPV_PRESET_BALANCED, "balanced", 32, 8, 256, LPV_SWITCH_ON},
+    {LPV_PRESET_ACCURATE, "accurate", 32, 16, 256, LPV_SWITCH_ON},
+};
+#define NPRESETS ((int)(sizeof PRESETS / sizeof PRESETS[0]))
+
+static void assert_knobs(const lpv_settings *s, int grid, int iterations, int rsm_size, lpv_switch occlusion)
+{
+    for (int i = 0; i < 3; ++i)
+        assert_int_equal(s->grid_dims[i], grid);
+    assert_int_equal(s->iterations, iterations);
+    assert_int_equal(s->rsm_size, rsm_size);
+    assert_int_equal(s->occlusion, occlusion);
+}
+
+static void test_zero_resolves_to_balanced(void **state)
+{
+    (void)state;
+    char err[256];
+    lpv_settings s = {0};
+    lpv_settings_resolve(&s);
+    assert_int_equal(s.preset, LPV_PRESET_BALANCED);
+    assert_knobs(&s, 32, 8, 256, LPV_SWITCH_ON);
+    assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
+    /* the LPV_DEFAULT_* macros are the balanced preset */
+    assert_int_equal(s.grid_dims[0], LPV_DEFAULT_GRID_DIM);
+    assert_int_equal(s.iterations, LPV_DEFAULT_ITERATIONS);
+    assert_int_equal(s.rsm_size, LPV_DEFAULT_RSM_SIZE);
+    assert_int_equal(s.emissive_vpls, LPV_DEFAULT_EMISSIVE_VPLS);
+    assert_true(s.indirect_gain == 1.0f);
+}
+
+static void test_each_preset(void **state)
+{
+    (void)state;
+    char err[256];
+    for (int i = 0; i < NPRESETS; ++i) {
+        const expected *e = &PRESETS[i];
+        lpv_settings s = {.preset = e->preset};
+        lpv_settings_resolve(&s);
+        assert_int_equal(s.preset, e->preset);
+        assert_knobs(&s, e->grid, e->iterations, e->rsm_size, e->occlusion);
+        assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
+
+        lpv_settings p;
+        assert_int_equal(lpv_preset_settings(e->preset, &p), 0);
+        assert_int_equal(p.preset, e->preset);
+        assert_knobs(&p, e->grid, e->iterations, e->rsm_size, e->occlusion);
+        assert_int_equal(lpv_preset_match(&s), e->preset);
+    }
+    lpv_settings d;
+    assert_int_equal(lpv_preset_settings(LPV_PRESET_DEFAULT, &d), 0);
+    assert_int_equal(d.preset, LPV_PRESET_BALANCED);
+    assert_int_equal(lpv_preset_settings((lpv_preset)99, &d), -1);
+}
+
+static void test_explicit_fields_override(void **state)
+{
+    (void)state;
+    lpv_settings s = {.preset = LPV_PRESET_FAST, .grid_dims = {64, 64, 64}, .occlusion = LPV_SWITCH_OFF};
+    lpv_settings_resolve(&s);
+    assert_int_equal(s.preset, LPV_PRESET_FAST);
+    assert_knobs(&s, 64, 8, 128, LPV_SWITCH_OFF); /* iterations and rsm_size from fast */
+    assert_int_equal(lpv_preset_match(&s), LPV_PRESET_DEFAULT); /* no preset has these values */
+
+    lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .iterations = 4, .rsm_size = 512};
+    lpv_settings_resolve(&t);
+    assert_knobs(&t, 32, 4, 512, LPV_SWITCH_ON);
+}
+
+static void test_names_round_trip(void **state)
+{
+    (void)state;
+    for (int i = 0; i < NPRESETS; ++i) {
+        lpv_preset p = LPV_PRESET_DEFAULT;
+        assert_int_equal(lpv_preset_from_name(PRESETS[i].name, &p), 0);
+        assert_int_equal(p, PRESETS[i].preset);
+        assert_string_equal(lpv_preset_name(p), PRESETS[i].name);
+        assert_non_null(strstr(lpv_preset_names(), PRESETS[i].name));
+    }
+    assert_string_equal(lpv_preset_name(LPV_PRESET_DEFAULT), "balanced");
+    assert_null(lpv_preset_name((lpv_preset)-1));
+    assert_null(lpv_preset_name((lpv_preset)4));
+}
+
+static void test_bad_name_rejected(void **state)
+{
+    (void)state;
+    lpv_preset p = LPV_PRESET_ACCURATE;
+    const char *bad[] = {"", "Fast", "balanced ", "ultra", "default", NULL};
+    for (int i = 0; bad[i]; ++i) {
+        assert_int_equal(lpv_preset_from_name(bad[i], &p), -1);
+        assert_int_equal(p, LPV_PRESET_ACCURATE); /* untouched */
+    }
+    assert_int_equal(lpv_preset_from_name(NULL, &p), -1);
+
+    lpvd_options o = {0};
+    char err[256] = "";
+    assert_int_equal(lpvd_option_parse(&o, "preset", "ultra", err, sizeof err), -1);
+    assert_non_null(strstr(err, "--preset ultra"));
+    assert_non_null(strstr(err, "fast, balanced, accurate"));
+    assert_int_equal(o.settings.preset, LPV_PRESET_DEFAULT);
+}
+
+static void test_validate_rejects_out_of_range(void **state)
+{
+    (void)state;
+    char err[256];
+    const int bad[] = {-1, LPV_PRESET_COUNT_, 42};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        lpv_settings s = {.preset = (lpv_preset)bad[i]};
+        lpv_settings_resolve(&s); /* leaves the bad value for validate to name */
+        err[0] = '\0';
+        assert_int_equal(lpv_settings_validate(&s, err, sizeof err), -1);
+        assert_non_null(strstr(err, "preset"));
+    }
+}
+
+/* Shared flags: an explicit knob wins over --preset whichever comes first. */
+static void test_flags_override_in_any_order(void **state)
+{
+    (void)state;
+    char err[256];
+    const char *orders[2][4] = {{"grid", "64", "preset", "fast"}, {"preset", "fast", "grid", "64"}};
+    for (int k = 0; k < 2; ++k) {
+        lpvd_options o = {0};
+        assert_int_equal(lpvd_option_parse(&o, orders[k][0], orders[k][1], err, sizeof err), 1);
+        assert_int_equal(lpvd_option_parse(&o, orders[k][2], orders[k][3], err, sizeof err), 1);
+        lpv_settings s = o.settings;
+        lpv_settings_resolve(&s);
+        assert_int_equal(s.preset, LPV_PRESET_FAST);
+        assert_knobs(&s, 64, 8, 128, LPV_SWITCH_ON);
+    }
+    assert_int_equal(lpvd_option_takes_value("preset"), 1);
+    assert_non_null(strstr(LPVD_OPTIONS_HELP, "--preset"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_zero_resolves_to_balanced), cmocka_unit_test(test_each_preset),
+        cmocka_unit_test(test_explicit_fields_override),  cmocka_unit_test(test_names_round_trip),
+        cmocka_unit_test(test_bad_name_rejected),         cmocka_unit_test(test_validate_rejects_out_of_range),
+        cmocka_unit_test(test_flags_override_in_any_order),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
