@@ -4,8 +4,9 @@
   check_results.py RESULTS.csv [--scene NAME --better G:I:R:on|off --worse G:I:R:on|off] [--rows N]
 
 Fails (exit 1) unless every expected column is present and filled with a
-finite value in every row, pareto is 0 or 1, at least one row per scene is on
-the front, and (with --better/--worse) the "better" point of --scene has a
+finite value in every row (except preset: empty for a point that equals no
+named preset, else the preset's name), pareto is 0 or 1, at least one row per
+scene is on the front, and (with --better/--worse) the "better" point of --scene has a
 lower rel_rmse than the "worse" one. No timing is asserted. Standard library only.
 """
 import argparse
@@ -17,6 +18,8 @@ COLUMNS = ["scene", "grid", "iterations", "rsm", "occlusion", "ms_per_tick", "ms
            "ms_inject", "ms_gbuffer", "ms_gv", "ms_propagate", "ms_shade", "rel_rmse", "rel_bias", "ref_noise",
            "rel_rmse_excess", "rel_mae", "pixels", "pareto"]
 NUMERIC = COLUMNS[5:]
+# preset: the named preset the point equals; legitimately empty for most points.
+OPTIONAL = {"preset": ("fast", "balanced", "accurate")}
 
 
 def key(row):
@@ -34,7 +37,7 @@ def main():
     problems = []
     with open(a.csv, newline="") as f:
         reader = csv.DictReader(f)
-        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        missing = [c for c in COLUMNS + list(OPTIONAL) if c not in (reader.fieldnames or [])]
         if missing:
             sys.exit("FAIL: %s: missing columns %s" % (a.csv, ", ".join(missing)))
         rows = list(reader)
@@ -55,6 +58,10 @@ def main():
                     continue
                 if not math.isfinite(x):
                     problems.append("line %d: %s=%s is not finite" % (n, c, v))
+        for c, names in OPTIONAL.items():
+            v = (row.get(c) or "").strip()
+            if v and v not in names:
+                problems.append("line %d: %s=%r is not one of %s" % (n, c, v, ", ".join(names)))
         if row.get("pareto") not in ("0", "1"):
             problems.append("line %d: pareto=%r" % (n, row.get("pareto")))
     for scene in sorted({r["scene"] for r in rows}):
@@ -75,7 +82,7 @@ def main():
         for p in problems:
             print("  " + p)
         return 1
-    print("OK: %s: %d rows, every column filled" % (a.csv, len(rows)))
+    print("OK: %s: %d rows, every column filled (preset where the point is one)" % (a.csv, len(rows)))
     return 0
 
 

@@ -5,9 +5,11 @@
  * process, times it (median GPU ms per tick after warm-up, timer queries),
  * compares it with a path-traced reference (metrics.h) and writes
  *
- *   OUT/results.csv   one row per (scene, point), with the Pareto flag
+ *   OUT/results.csv   one row per (scene, point), with the Pareto flag and
+ *                     the named preset (settings.h) the point equals, if any
  *   OUT/results.md    one Markdown table per scene, Pareto points marked
- *   OUT/plot.gp, OUT/plot.png   error vs ms per tick (log x), fronts connected
+ *   OUT/plot.gp, OUT/plot.png   error vs ms per tick (log x), fronts connected,
+ *                     preset points labelled
  *   OUT/err/SCENE/g<grid>-i<iter>-r<rsm>-occ<on|off>.png   per-point error images
  *   OUT/ref/SCENE-<key>.exr (+ .stderr.exr, .png)        the cached references
  *
@@ -39,6 +41,8 @@
 #define LPVD_ACCURACY_SCENES_DIR "scenes"
 #endif
 
+#include "settings.h"
+
 #define MAX_POINTS 512
 #define MAX_SCENES 16
 #define MAX_TICKS 1000
@@ -63,6 +67,38 @@ static const point QUICK[] = {
     {16, 4, 128, 1}, {16, 8, 256, 1}, {32, 8, 256, 0}, {32, 8, 256, 1}, {32, 16, 256, 1}, {64, 32, 512, 1},
 };
 
+/* The engine settings of a point: exactly its four knobs, nothing from a preset. */
+static lpv_settings point_settings(const point *p)
+{
+    return (lpv_settings){.grid_dims = {p->grid, p->grid, p->grid},
+                          .iterations = p->iterations,
+                          .rsm_size = p->rsm,
+                          .occlusion = p->occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF};
+}
+
+/* The named preset the point equals (settings.h), or "" when none: the sweep
+ * labels the presets so one can see where they sit on the front. */
+static const char *point_preset(const point *p)
+{
+    lpv_settings s = point_settings(p);
+    lpv_preset m = lpv_preset_match(&s);
+    return m == LPV_PRESET_DEFAULT ? "" : lpv_preset_name(m);
+}
+
+/* --presets: exactly the named presets, in the table's order. */
+static int preset_points(point *pts)
+{
+    const lpv_preset order[] = {LPV_PRESET_FAST, LPV_PRESET_BALANCED, LPV_PRESET_ACCURATE};
+    int n = 0;
+    for (size_t i = 0; i < sizeof order / sizeof order[0]; ++i) {
+        lpv_settings s;
+        if (lpv_preset_settings(order[i], &s) != 0)
+            continue;
+        pts[n++] = (point){s.grid_dims[0], s.iterations, s.rsm_size, s.occlusion == LPV_SWITCH_ON};
+    }
+    return n;
+}
+
 typedef struct result {
     int scene;
     point p;
@@ -82,7 +118,7 @@ typedef struct scene_entry {
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick]\n"
+            "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick] [--presets]\n"
             "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
             "                     [--reference PATH] [--no-plot] [lpvd flags: --backend, --camera, ...]\n"
             "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
@@ -92,6 +128,7 @@ static void usage(FILE *f)
             "  --scenes LIST      comma list: cornell (built-in), courtyard, blinds (scenes/*.glb),\n"
             "                     or paths to .glb/.gltf files (default cornell,courtyard,blinds)\n"
             "  --quick            %d points instead of the 72-point factorial\n"
+            "  --presets          exactly the named presets (fast, balanced, accurate) as the points\n"
             "  --knobs SPEC       restrict knob values, e.g. grid=16/32,iterations=8,rsm=256,occlusion=on\n"
             "  --points LIST      explicit points GRID:ITER:RSM:on|off, comma separated\n"
             "  --ticks N          timed ticks per point, median reported (default 5)\n"
@@ -408,14 +445,14 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
     fprintf(f, "scene,grid,iterations,rsm,occlusion,ms_per_tick");
     for (int k = 0; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
-    fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto\n");
+    fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto,preset\n");
     for (int i = 0; i < n; ++i) {
         fprintf(f, "%s,%d,%d,%d,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
                 occ_name(r[i].p.occlusion), r[i].ms_total);
         for (int k = 0; k < NSTAGES; ++k)
             fprintf(f, ",%.3f", r[i].stage_ms[k]);
-        fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d\n", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
-                r[i].m.rel_rmse_excess, r[i].m.rel_mae, r[i].m.pixels, r[i].pareto);
+        fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d,%s\n", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
+                r[i].m.rel_rmse_excess, r[i].m.rel_mae, r[i].m.pixels, r[i].pareto, point_preset(&r[i].p));
     }
 }
 
@@ -441,7 +478,8 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
     fprintf(f, "# lpvd accuracy sweep\n\n%s\n", header);
     fprintf(f, "Error metrics: docs/accuracy.md. ms/tick: median GPU ms of one tick + the indirect-only render "
                "(sum of the stages). Pareto: no other point of the scene is both faster and more accurate "
-               "(rel. RMSE). Rows sorted by ms/tick; Pareto rows marked **◆**.\n\n");
+               "(rel. RMSE). Rows sorted by ms/tick; Pareto rows marked **◆**; preset: the named preset "
+               "(`--preset`) the point equals.\n\n");
     const result **rows = malloc((size_t)n * sizeof *rows);
     if (!rows)
         return;
@@ -451,14 +489,16 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             continue;
         fprintf(f, "## %s\n\n", scenes[s].name);
         fprintf(f, "reference: `%s`%s\n\n", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
-        fprintf(f, "| grid | iterations | RSM | occlusion | ms/tick | propagate ms | gv ms | rel. RMSE | rel. bias "
-                   "| rel. MAE | ref. noise | Pareto |\n");
-        fprintf(f, "|---:|---:|---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
+        fprintf(f, "| grid | iterations | RSM | occlusion | preset | ms/tick | propagate ms | gv ms | rel. RMSE "
+                   "| rel. bias | rel. MAE | ref. noise | Pareto |\n");
+        fprintf(f, "|---:|---:|---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
         for (int i = 0; i < k; ++i) {
             const result *x = rows[i];
             const char *b = x->pareto ? "**" : "";
-            fprintf(f, "| %s%d³%s | %d | %d² | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f | %s |\n",
-                    b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion), b, x->ms_total, b,
+            fprintf(f,
+                    "| %s%d³%s | %d | %d² | %s | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f | %s |\n",
+                    b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion), point_preset(&x->p), b,
+                    x->ms_total, b,
                     x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
                     x->pareto ? "**◆**" : "");
         }
@@ -481,11 +521,35 @@ static int have_pngcairo(void)
     return found;
 }
 
+/* plot/SCENE-presets.dat: "ms rel_rmse name" of the scene's points that equal
+ * a named preset, for gnuplot's labels. Returns how many, or -1. */
+static int write_preset_labels(const char *out_dir, const char *scene, const result *const *rows, int k)
+{
+    char path[1200];
+    if (snprintf(path, sizeof path, "%s/plot/%s-presets.dat", out_dir, scene) >= (int)sizeof path)
+        return -1; /* too long a path: no labels rather than a wrong file */
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    int count = 0;
+    fprintf(f, "# ms_per_tick rel_rmse preset\n");
+    for (int i = 0; i < k; ++i) {
+        const char *name = point_preset(&rows[i]->p);
+        if (*name) {
+            fprintf(f, "%.4f %.5f %s\n", rows[i]->ms_total, rows[i]->m.rel_rmse, name);
+            ++count;
+        }
+    }
+    fclose(f);
+    return count;
+}
+
 /* plot.gp + data files; runs gnuplot unless no_plot. */
 static int write_plot(const char *out_dir, const result *r, int n, const scene_entry *scenes, int nscenes,
                       int no_plot)
 {
     char path[1200];
+    int labels[MAX_SCENES] = {0};
     const result **rows = malloc((size_t)n * sizeof *rows);
     if (!rows)
         return -1;
@@ -493,9 +557,11 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
     mkdir_p(path);
     for (int s = 0; s < nscenes; ++s) {
         int k = scene_rows(r, n, s, rows);
+        labels[s] = write_preset_labels(out_dir, scenes[s].name, rows, k);
         for (int front = 0; front < 2; ++front) {
-            snprintf(path, sizeof path, "%s/plot/%s%s.dat", out_dir, scenes[s].name, front ? "-pareto" : "");
-            FILE *f = fopen(path, "w");
+            int len = snprintf(path, sizeof path, "%s/plot/%s%s.dat", out_dir, scenes[s].name,
+                               front ? "-pareto" : "");
+            FILE *f = len < (int)sizeof path ? fopen(path, "w") : NULL;
             if (!f) {
                 free(rows);
                 return -1;
@@ -525,9 +591,12 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
     for (int s = 0; s < nscenes; ++s) {
         fprintf(f,
                 "  'plot/%s.dat' using 1:2 with points pt 7 ps 0.8 lc %d title '%s', \\\n"
-                "  'plot/%s-pareto.dat' using 1:2 with linespoints pt 6 ps 1.6 lw 2 lc %d title '%s Pareto front'%s\n",
-                scenes[s].name, s + 1, scenes[s].name, scenes[s].name, s + 1, scenes[s].name,
-                s + 1 < nscenes ? ", \\" : "");
+                "  'plot/%s-pareto.dat' using 1:2 with linespoints pt 6 ps 1.6 lw 2 lc %d title '%s Pareto front'",
+                scenes[s].name, s + 1, scenes[s].name, scenes[s].name, s + 1, scenes[s].name);
+        if (labels[s] > 0) /* the named presets, labelled next to their points */
+            fprintf(f, ", \\\n  'plot/%s-presets.dat' using 1:2:3 with labels left offset 0.8,0.6 tc lt %d notitle",
+                    scenes[s].name, s + 1);
+        fprintf(f, "%s\n", s + 1 < nscenes ? ", \\" : "");
     }
     fclose(f);
     if (no_plot)
@@ -546,7 +615,7 @@ int main(int argc, char **argv)
 {
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
     const char *knobs = NULL, *points_arg = NULL;
-    int spp = 256, quick = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
+    int spp = 256, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
     lpvd_options opt = {0};
     char *cam_args[MAX_PASS];
     int ncam = 0;
@@ -560,6 +629,8 @@ int main(int argc, char **argv)
             return 0;
         } else if (strcmp(a, "--quick") == 0) {
             quick = 1;
+        } else if (strcmp(a, "--presets") == 0) {
+            presets = 1;
         } else if (strcmp(a, "--no-plot") == 0) {
             no_plot = 1;
         } else if (!v && a[0] == '-') {
@@ -591,8 +662,8 @@ int main(int argc, char **argv)
         } else if (a[0] == '-' && a[1] == '-' && lpvd_option_takes_value(a + 2) > 0) {
             const char *name = a + 2;
             if (strcmp(name, "grid") == 0 || strcmp(name, "iterations") == 0 || strcmp(name, "rsm-size") == 0 ||
-                strcmp(name, "occlusion") == 0) {
-                fprintf(stderr, "lpvd-accuracy: %s is a swept knob; use --knobs or --points\n", a);
+                strcmp(name, "occlusion") == 0 || strcmp(name, "preset") == 0) {
+                fprintf(stderr, "lpvd-accuracy: %s is a swept knob; use --knobs, --points or --presets\n", a);
                 return 2;
             }
             if (lpvd_option_parse(&opt, name, argv[++i], err, sizeof err) < 0) {
@@ -623,12 +694,18 @@ int main(int argc, char **argv)
     /* The point set. */
     static point pts[MAX_POINTS];
     int npts = 0;
+    if (points_arg && presets) {
+        fprintf(stderr, "lpvd-accuracy: --points and --presets both name the points; give one\n");
+        return 2;
+    }
     if (points_arg) {
         npts = parse_points(points_arg, pts, MAX_POINTS);
         if (npts < 0) {
             fprintf(stderr, "lpvd-accuracy: --points expects GRID:ITER:RSM:on|off[,...]\n");
             return 2;
         }
+    } else if (presets) {
+        npts = preset_points(pts);
     } else if (quick) {
         npts = (int)(sizeof QUICK / sizeof QUICK[0]);
         memcpy(pts, QUICK, sizeof QUICK);
