@@ -14,6 +14,7 @@
 
 #include "image_io.h"
 #include "metrics.h"
+#include "overall.h"
 #include "test_util.h"
 
 enum { W = 8, H = 6, N = W * H };
@@ -212,12 +213,39 @@ static void test_pareto(void **state)
     assert_true(isnan(lpv_acc_median(v, 0)));
 }
 
+/* The overall front: means over scenes, errors normalised by each scene's
+ * best; a point missing on one scene is left out. */
+static void test_overall_front(void **state)
+{
+    (void)state;
+    const lpv_acc_row rows[] = {
+        {0, {1, 0, 0, 0}, 10.0, 2.0}, {1, {1, 0, 0, 0}, 20.0, 8.0},  /* A: ms 15, (2/1 + 8/4)/2 = 2 */
+        {0, {2, 0, 0, 0}, 30.0, 1.0}, {1, {2, 0, 0, 0}, 50.0, 4.0},  /* B: ms 40, (1 + 1)/2 = 1 */
+        {0, {3, 0, 0, 0}, 40.0, 1.5}, {1, {3, 0, 0, 0}, 60.0, 16.0}, /* C: ms 50, (1.5 + 4)/2 = 2.75: dominated */
+        {0, {4, 0, 0, 0}, 1.0, 0.5},                                  /* D: scene 1 missing */
+    };
+    lpv_acc_overall o[8];
+    size_t n = lpv_acc_overall_front(rows, sizeof rows / sizeof rows[0], 2, o, 8);
+    assert_int_equal(n, 3);
+    assert_int_equal(o[0].key[0], 1);
+    assert_float_equal(o[0].ms, 15.0, 1e-12);
+    /* scene 0's best is D's 0.5 (any measured point counts) */
+    assert_float_equal(o[0].norm_rmse, (2.0 / 0.5 + 8.0 / 4.0) / 2.0, 1e-12);
+    assert_float_equal(o[1].norm_rmse, (1.0 / 0.5 + 1.0) / 2.0, 1e-12);
+    assert_float_equal(o[1].rel_rmse[1], 4.0, 0.0);
+    assert_int_equal(o[0].pareto, 1);
+    assert_int_equal(o[1].pareto, 1);
+    assert_int_equal(o[2].pareto, 0);
+    assert_int_equal(lpv_acc_overall_front(rows, 7, 0, o, 8), 0);
+    assert_int_equal(lpv_acc_overall_front(rows, 7, 2, o, 1), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_identical),        cmocka_unit_test(test_constant_factor),
         cmocka_unit_test(test_masked_pixels_ignored), cmocka_unit_test(test_noise_level),
-        cmocka_unit_test(test_error_colours),    cmocka_unit_test(test_pareto),
+        cmocka_unit_test(test_error_colours),    cmocka_unit_test(test_pareto), cmocka_unit_test(test_overall_front),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -32,6 +32,7 @@
 #include "engine.h"
 #include "image_io.h"
 #include "metrics.h"
+#include "overall.h"
 #include "options.h"
 #include "scene_load.h"
 #include "tonemap.h"
@@ -611,6 +612,109 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
     return 0;
 }
 
+/* ---- The overall front (overall.h), written when there are 2+ scenes ---- */
+
+static const char *key_preset(const int key[4])
+{
+    point p = {key[0], key[1], key[2], key[3]};
+    return point_preset(&p);
+}
+
+/* Appends the overall table to results.md, writes overall.csv, and
+ * overall.gp / plot/overall*.dat; runs gnuplot for overall.png unless
+ * no_plot. Returns 0, or -1 when a file cannot be written. */
+static int write_overall(const char *out_dir, const result *r, int n, const scene_entry *scenes, int nscenes,
+                         int no_plot)
+{
+    if (nscenes < 2 || nscenes > LPV_ACC_MAX_SCENES)
+        return 0;
+    lpv_acc_row *rows = malloc((size_t)n * sizeof *rows);
+    lpv_acc_overall *o = malloc((size_t)n * sizeof *o);
+    if (!rows || !o) {
+        free(rows);
+        free(o);
+        return -1;
+    }
+    for (int i = 0; i < n; ++i)
+        rows[i] = (lpv_acc_row){r[i].scene, {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion},
+                                r[i].ms_total, r[i].m.rel_rmse};
+    size_t k = lpv_acc_overall_front(rows, (size_t)n, nscenes, o, (size_t)n);
+    free(rows);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/results.md", out_dir);
+    FILE *md = fopen(path, "a");
+    snprintf(path, sizeof path, "%s/overall.csv", out_dir);
+    FILE *csv = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/plot/overall.dat", out_dir);
+    FILE *dat = fopen(path, "w");
+    int rc = md && csv && dat ? 0 : -1;
+    if (rc == 0) {
+        fprintf(md, "## all scenes: the overall front\n\nPoints measured on every scene, by mean ms/tick over the "
+                    "scenes and normalised RMSE = mean over the scenes of rel. RMSE / the scene's best rel. RMSE "
+                    "(1 = the best of this sweep on every scene; docs/accuracy.md). The presets are chosen from "
+                    "this front.\n\n| grid | iterations | RSM | occlusion | preset | mean ms/tick | normalised "
+                    "RMSE |");
+        fprintf(csv, "grid,iterations,rsm,occlusion,mean_ms_per_tick,norm_rmse");
+        for (int s = 0; s < nscenes; ++s) {
+            fprintf(md, " %s rel. RMSE |", scenes[s].name);
+            fprintf(csv, ",rel_rmse_%s", scenes[s].name);
+        }
+        fprintf(md, " Pareto |\n|---:|---:|---:|:---:|:---:|---:|---:|");
+        fprintf(csv, ",pareto,preset\n");
+        for (int s = 0; s < nscenes; ++s)
+            fprintf(md, "---:|");
+        fprintf(md, ":---:|\n");
+        fprintf(dat, "# mean_ms norm_rmse pareto preset\n");
+        for (size_t j = 0; j < k; ++j) {
+            const lpv_acc_overall *x = &o[j];
+            const char *b = x->pareto ? "**" : "", *pre = key_preset(x->key);
+            fprintf(md, "| %s%d³%s | %d | %d² | %s | %s | %s%.2f%s | %s%.3f%s |", b, x->key[0], b, x->key[1],
+                    x->key[2], occ_name(x->key[3]), pre, b, x->ms, b, b, x->norm_rmse, b);
+            fprintf(csv, "%d,%d,%d,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), x->ms,
+                    x->norm_rmse);
+            for (int s = 0; s < nscenes; ++s) {
+                fprintf(md, " %.3f |", x->rel_rmse[s]);
+                fprintf(csv, ",%.5f", x->rel_rmse[s]);
+            }
+            fprintf(md, " %s |\n", x->pareto ? "**◆**" : "");
+            fprintf(csv, ",%d,%s\n", x->pareto, pre);
+            fprintf(dat, "%.4f %.5f %d %s\n", x->ms, x->norm_rmse, x->pareto, *pre ? pre : "-");
+        }
+        fputc('\n', md);
+    }
+    if (md)
+        fclose(md);
+    if (csv)
+        fclose(csv);
+    if (dat)
+        fclose(dat);
+    free(o);
+    if (rc != 0)
+        return -1;
+    snprintf(path, sizeof path, "%s/overall.gp", out_dir);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    int cairo = no_plot ? 1 : have_pngcairo();
+    fprintf(f, "# lpvd-accuracy: the overall front; run from %s: gnuplot overall.gp\n", out_dir);
+    fprintf(f, "set terminal %s size 960,640%s\n", cairo ? "pngcairo" : "png", cairo ? " font 'sans,11'" : "");
+    fprintf(f, "set output 'overall.png'\n");
+    fprintf(f, "set title 'lpvd over all scenes: normalised error vs time (1 = best of the sweep on every scene)'\n");
+    fprintf(f, "set xlabel 'GPU ms per tick, mean over the scenes'\nset ylabel 'normalised relative RMSE'\n");
+    fprintf(f, "set logscale x\nset grid xtics ytics mxtics\nset key top right\n");
+    fprintf(f, "plot 'plot/overall.dat' using 1:2 with points pt 7 ps 0.8 lc 1 title 'setting', \\\n"
+               "  'plot/overall.dat' using 1:($3 > 0 ? $2 : 1/0) with linespoints pt 6 ps 1.6 lw 2 lc 2 "
+               "title 'Pareto front', \\\n"
+               "  'plot/overall.dat' using 1:2:(stringcolumn(4) eq '-' ? '' : stringcolumn(4)) with labels left "
+               "offset 0.8,0.6 notitle\n");
+    fclose(f);
+    if (no_plot)
+        return 0;
+    char cmd[1400];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot overall.gp", out_dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
 int main(int argc, char **argv)
 {
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
@@ -966,6 +1070,8 @@ int main(int argc, char **argv)
     }
     if (nres > 0 && write_plot(out_dir, results, nres, scenes, nscenes, no_plot) != 0 && !no_plot)
         fprintf(stderr, "lpvd-accuracy: no plot.png\n");
+    if (nres > 0 && write_overall(out_dir, results, nres, scenes, nscenes, no_plot) != 0)
+        fprintf(stderr, "lpvd-accuracy: no overall front (overall.csv, overall.png)\n");
     free(results);
     fprintf(stderr, "lpvd-accuracy: %d point(s) written to %s/results.csv, results.md%s\n", nres, out_dir,
             no_plot ? "" : ", plot.png");

@@ -1,0 +1,40 @@
+/*
+ * overall.h - one front over several scenes, to choose defaults from.
+ *
+ * Each scene has its own Pareto front, and a setting good on one can be poor
+ * on another. To name defaults the sweep also ranks every point measured on
+ * all scenes by
+ *   cost  = mean over the scenes of ms per tick
+ *   error = mean over the scenes of rel_rmse / (the scene's best rel_rmse)
+ * so error 1 would be "the best this sweep achieves, on every scene", and a
+ * scene whose errors are large in absolute terms does not outweigh the rest.
+ */
+#ifndef LPV_ACC_OVERALL_H
+#define LPV_ACC_OVERALL_H
+
+#include <stddef.h>
+
+#define LPV_ACC_MAX_SCENES 16
+
+/* One measured (scene, point): the point is identified by key[4]. */
+typedef struct lpv_acc_row {
+    int scene; /* 0 .. nscenes-1 */
+    int key[4];
+    double ms, rel_rmse;
+} lpv_acc_row;
+
+typedef struct lpv_acc_overall {
+    int key[4];
+    double ms;                          /* mean over the scenes */
+    double norm_rmse;                   /* mean of rel_rmse / best of the scene */
+    double rel_rmse[LPV_ACC_MAX_SCENES]; /* per scene */
+    int pareto;                         /* 1 = on the overall front */
+} lpv_acc_overall;
+
+/* Fills out (at most max entries, in first-seen order) with the points that
+ * have a finite rel_rmse on every one of nscenes scenes, and marks the
+ * front (lpv_acc_pareto on ms vs norm_rmse). Returns the count; 0 when
+ * nscenes < 1 or > LPV_ACC_MAX_SCENES. */
+size_t lpv_acc_overall_front(const lpv_acc_row *rows, size_t n, int nscenes, lpv_acc_overall *out, size_t max);
+
+#endif /* LPV_ACC_OVERALL_H */
