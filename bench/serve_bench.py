@@ -80,7 +80,7 @@ class Bench:
         c = self.conn()
         if load:
             self.req(c, lc.SCENE_LOAD, {}, self.glb)
-        self.req(c, lc.CONFIG, config or {"grid": GRID, "iterations": 8})
+        self.req(c, lc.CONFIG, config or {"grid": GRID, "iterations": 8, "rsm_size": 256})
         if light:
             self.req(c, lc.LIGHT_SET, light)
         return c

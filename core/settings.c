@@ -30,13 +30,17 @@ typedef struct preset_row {
 
 static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
     [LPV_PRESET_DEFAULT] = {NULL, 0, 0, 0, LPV_SWITCH_DEFAULT}, /* not a row: resolves to BALANCED */
-    /* fast: the cheapest point kept on the front by the sweep (docs/accuracy.md) */
-    [LPV_PRESET_FAST] = {"fast", 16, 8, 128, LPV_SWITCH_ON},
-    /* balanced: the engine's default, a knee of the sweep's front (docs/accuracy.md) */
+    /* Each row is a point on the overall front of the full sweep (3 scenes x
+     * 72 points; docs/accuracy.md, "Presets"). On every scene the lowest
+     * errors came with 4 iterations: more steps pile light up next to its
+     * source faster than they carry it away (docs/calibration.md, 4). */
+    /* fast: the cheapest front point with fuzzy occlusion (thin walls need it) */
+    [LPV_PRESET_FAST] = {"fast", 16, 4, 128, LPV_SWITCH_ON},
+    /* balanced, the default: nearly fast's cost, a 32^3 grid's finer detail */
     [LPV_PRESET_BALANCED] = {"balanced", LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
                              LPV_SWITCH_ON},
-    /* accurate: lower error at a higher cost, from the sweep (docs/accuracy.md) */
-    [LPV_PRESET_ACCURATE] = {"accurate", 32, 16, 256, LPV_SWITCH_ON},
+    /* accurate: the front's lowest error short of the 512^2 RSM's extra cost */
+    [LPV_PRESET_ACCURATE] = {"accurate", 64, 4, 256, LPV_SWITCH_ON},
 };
 
 /* The table row of p (DEFAULT -> BALANCED), or NULL when p is out of range. */

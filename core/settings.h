@@ -28,8 +28,8 @@ typedef struct lpv_settings {
     int grid_dims[3];       /* cells per axis; default: the preset's (balanced: 32 x 32 x 32) */
     float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
     float bounds_max[3];    /*   bounds grown by half a cell on every side */
-    int iterations;         /* propagation steps; default: the preset's (balanced: 8) */
-    int rsm_size;           /* reflective shadow map side, texels; default: the preset's (balanced: 256) */
+    int iterations;         /* propagation steps; default: the preset's (balanced: 4) */
+    int rsm_size;           /* reflective shadow map side, texels; default: the preset's (balanced: 128) */
     lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default: the preset's (on) */
     float indirect_gain;    /* artistic factor on the LPV term; default 1 (0 = default) */
     int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
@@ -39,8 +39,8 @@ typedef struct lpv_settings {
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
  * preset table in settings.c (a test checks that they agree). */
 #define LPV_DEFAULT_GRID_DIM 32
-#define LPV_DEFAULT_ITERATIONS 8
-#define LPV_DEFAULT_RSM_SIZE 256
+#define LPV_DEFAULT_ITERATIONS 4
+#define LPV_DEFAULT_RSM_SIZE 128
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero

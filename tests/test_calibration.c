@@ -298,7 +298,7 @@ static void test_wall_probe_profile(void **state)
                 assert_true(lpvd[it][k] <= lpvd[it][k - 1]);
     }
     /* One cell from the wall (the lookup reads the first cell layer): within
-     * [0.8, 1.6] of the truth at the default 8 iterations. A unit error of pi,
+     * [0.8, 1.6] of the truth at 8 iterations. A unit error of pi,
      * 4 (the paper's (s/2)^2) or 1/pi falls outside. */
     assert_true(first_ratio > 0.8f && first_ratio < 1.6f);
     lpv_ref_destroy(ref);
