@@ -59,6 +59,18 @@ static void engine_run(const lpv_scene *scene, const lpv_settings *set, const lp
         fail_msg("engine: %s", err);
 }
 
+/* Total flux (W per channel) of the last tick's injected LPV. */
+static void injected_flux(double flux[3])
+{
+    const lpv_grid *g = lpv_engine_grid(engine);
+    size_t count = lpv_grid_cell_count(g);
+    lpv_cell *inj = calloc(count, sizeof *inj);
+    assert_non_null(inj);
+    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_INJECTED, inj, count), count);
+    lpv_oracle_total_flux(g, inj, flux);
+    free(inj);
+}
+
 static lpv_ref *reference_of(const lpv_scene *scene)
 {
     lpv_ref *ref = NULL;
@@ -195,12 +207,8 @@ static void test_wall_injected_flux_and_exitance(void **state)
     make_wall(&s);
     lpv_settings set = {0};
     engine_run(&s, &set, NULL);
-    const lpv_grid *g = lpv_engine_grid(engine);
-    size_t count = lpv_grid_cell_count(g);
-    lpv_cell *inj = calloc(count, sizeof *inj);
-    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_INJECTED, inj, count), count);
     double flux[3];
-    lpv_oracle_total_flux(g, inj, flux);
+    injected_flux(flux);
     double area = 4.0 * WALL_HALF * WALL_HALF, want = WALL_ALBEDO * SUN_E * area;
 
     lpv_ref *ref = reference_of(&s);
@@ -221,7 +229,6 @@ static void test_wall_injected_flux_and_exitance(void **state)
     assert_true(fabs(flux[1] - want) <= rim);
     /* 1 cm in front of the centre the wall fills all but ~0.3 % of the view */
     assert_true(fabs(e[1] - m) < 3.0 * se[1] + 0.005 * m);
-    free(inj);
     lpv_ref_destroy(ref);
     lpv_scene_free(&s);
 }
@@ -239,16 +246,11 @@ static void test_emissive_wall_injected_flux(void **state)
     lpv_scene_compute_bounds(&s);
     lpv_settings set = {0};
     engine_run(&s, &set, NULL);
-    const lpv_grid *g = lpv_engine_grid(engine);
-    size_t count = lpv_grid_cell_count(g);
-    lpv_cell *inj = calloc(count, sizeof *inj);
-    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_INJECTED, inj, count), count);
     double flux[3], want = M_PI * le * 4.0 * h * h;
-    lpv_oracle_total_flux(g, inj, flux);
+    injected_flux(flux);
     printf("calibration: emissive wall Le = %.2f W/(m^2 sr): injected flux %.4f W (pi Le A = %.4f)\n", (double)le,
            flux[1], want);
     assert_true(fabs(flux[1] - want) < 1e-4 * want);
-    free(inj);
     lpv_scene_free(&s);
 }
 
