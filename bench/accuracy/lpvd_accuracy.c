@@ -545,6 +545,37 @@ static int write_preset_labels(const char *out_dir, const char *scene, const res
     return count;
 }
 
+/* OUT/NAME.gp opened for writing, with the terminal (pngcairo when there,
+ * else png) and the output OUT/NAME.png set; the caller adds the plot. */
+static FILE *open_gnuplot_script(const char *out_dir, const char *name, const char *what, int no_plot)
+{
+    char path[1200];
+    if (snprintf(path, sizeof path, "%s/%s.gp", out_dir, name) >= (int)sizeof path)
+        return NULL;
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return NULL;
+    int cairo = no_plot ? 1 : have_pngcairo();
+    fprintf(f, "# lpvd-accuracy: %s; run from %s: gnuplot %s.gp\n", what, out_dir, name);
+    fprintf(f, "set terminal %s size 960,640%s\n", cairo ? "pngcairo" : "png", cairo ? " font 'sans,11'" : "");
+    fprintf(f, "set output '%s.png'\n", name);
+    return f;
+}
+
+/* Runs gnuplot on OUT/NAME.gp in OUT. Returns 0, or -1 (and says so). */
+static int run_gnuplot(const char *out_dir, const char *name)
+{
+    char cmd[1400];
+    if (snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot %s.gp", out_dir, name) >= (int)sizeof cmd)
+        return -1;
+    int rc = system(cmd);
+    if (rc != 0) {
+        fprintf(stderr, "lpvd-accuracy: gnuplot failed (status %d); %s.gp and plot/*.dat are written\n", rc, name);
+        return -1;
+    }
+    return 0;
+}
+
 /* plot.gp + data files; runs gnuplot unless no_plot. */
 static int write_plot(const char *out_dir, const result *r, int n, const scene_entry *scenes, int nscenes,
                       int no_plot)
@@ -576,14 +607,9 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
         }
     }
     free(rows);
-    snprintf(path, sizeof path, "%s/plot.gp", out_dir);
-    FILE *f = fopen(path, "w");
+    FILE *f = open_gnuplot_script(out_dir, "plot", "error vs milliseconds per tick", no_plot);
     if (!f)
         return -1;
-    int cairo = no_plot ? 1 : have_pngcairo();
-    fprintf(f, "# lpvd-accuracy: error vs milliseconds per tick; run from %s: gnuplot plot.gp\n", out_dir);
-    fprintf(f, "set terminal %s size 960,640%s\n", cairo ? "pngcairo" : "png", cairo ? " font 'sans,11'" : "");
-    fprintf(f, "set output 'plot.png'\n");
     fprintf(f, "set title 'lpvd indirect light vs path-traced reference: what accuracy costs in time'\n");
     fprintf(f, "set xlabel 'GPU ms per tick (median; tick + indirect-only render)'\n");
     fprintf(f, "set ylabel 'relative RMSE'\n");
@@ -602,14 +628,7 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
     fclose(f);
     if (no_plot)
         return 0;
-    char cmd[1400];
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot plot.gp", out_dir);
-    int rc = system(cmd);
-    if (rc != 0) {
-        fprintf(stderr, "lpvd-accuracy: gnuplot failed (status %d); plot.gp and plot/*.dat are written\n", rc);
-        return -1;
-    }
-    return 0;
+    return run_gnuplot(out_dir, "plot");
 }
 
 /* ---- The overall front (overall.h), written when there are 2+ scenes ---- */
@@ -710,14 +729,9 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     free(o);
     if (rc != 0)
         return -1;
-    snprintf(path, sizeof path, "%s/overall.gp", out_dir);
-    FILE *f = fopen(path, "w");
+    FILE *f = open_gnuplot_script(out_dir, "overall", "the overall front", no_plot);
     if (!f)
         return -1;
-    int cairo = no_plot ? 1 : have_pngcairo();
-    fprintf(f, "# lpvd-accuracy: the overall front; run from %s: gnuplot overall.gp\n", out_dir);
-    fprintf(f, "set terminal %s size 960,640%s\n", cairo ? "pngcairo" : "png", cairo ? " font 'sans,11'" : "");
-    fprintf(f, "set output 'overall.png'\n");
     fprintf(f, "set title 'lpvd over all scenes: normalised error vs time (1 = best of the sweep on every scene)'\n");
     fprintf(f, "set xlabel 'GPU ms per tick, mean over the scenes'\nset ylabel 'normalised relative RMSE'\n");
     fprintf(f, "set logscale x\nset grid xtics ytics mxtics\nset key top right\n");
@@ -729,9 +743,7 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     fclose(f);
     if (no_plot)
         return 0;
-    char cmd[1400];
-    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot overall.gp", out_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return run_gnuplot(out_dir, "overall");
 }
 
 int main(int argc, char **argv)
