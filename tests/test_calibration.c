@@ -34,39 +34,24 @@
 #include "test_util.h"
 #include "view.h"
 
-static lpv_gl_context *ctx;
-static lpv_engine *engine;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lpvt_gl_open(&ctx, &engine);
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lpvt_gl_close(ctx, engine);
-    return 0;
-}
-
 static void engine_run(const lpv_scene *scene, const lpv_settings *set, const lpv_view *view)
 {
     char err[1024] = "";
-    if (lpv_engine_set_settings(engine, set, err, sizeof err) != 0 ||
-        lpv_engine_set_scene(engine, scene, err, sizeof err) != 0 ||
-        lpv_engine_set_view(engine, view, err, sizeof err) != 0 || lpv_engine_tick(engine, err, sizeof err) != 0)
+    if (lpv_engine_set_settings(lpvt_engine, set, err, sizeof err) != 0 ||
+        lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) != 0 ||
+        lpv_engine_set_view(lpvt_engine, view, err, sizeof err) != 0 ||
+        lpv_engine_tick(lpvt_engine, err, sizeof err) != 0)
         fail_msg("engine: %s", err);
 }
 
 /* Total flux (W per channel) of the last tick's injected LPV. */
 static void injected_flux(double flux[3])
 {
-    const lpv_grid *g = lpv_engine_grid(engine);
+    const lpv_grid *g = lpv_engine_grid(lpvt_engine);
     size_t count = lpv_grid_cell_count(g);
     lpv_cell *inj = calloc(count, sizeof *inj);
     assert_non_null(inj);
-    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_INJECTED, inj, count), count);
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_INJECTED, inj, count), count);
     lpv_oracle_total_flux(g, inj, flux);
     free(inj);
 }
@@ -103,7 +88,7 @@ static void test_direct_point_light_over_plane(void **state)
     engine_run(&s, &set, &view);
     float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
     char err[512] = "";
-    if (lpv_engine_render(engine, LPV_TERMS_DIRECT_ONLY, rgba, err, sizeof err) != 0)
+    if (lpv_engine_render(lpvt_engine, LPV_TERMS_DIRECT_ONLY, rgba, err, sizeof err) != 0)
         fail_msg("render: %s", err);
     lpv_ref *ref = reference_of(&s);
 
@@ -268,14 +253,14 @@ static void test_wall_probe_profile(void **state)
     for (int it = 0; it < 3; it++) {
         lpv_settings set = {.iterations = iters[it]};
         engine_run(&s, &set, NULL);
-        cell = lpv_engine_grid(engine)->cell_size;
+        cell = lpv_engine_grid(lpvt_engine)->cell_size;
         float pts[K * 3], nrm[K * 3], rgb[K * 3];
         for (int k = 0; k < K; k++) {
             pts[3 * k] = 0.0f, pts[3 * k + 1] = 0.0f, pts[3 * k + 2] = layers[k] * cell;
             nrm[3 * k] = 0.0f, nrm[3 * k + 1] = 0.0f, nrm[3 * k + 2] = -1.0f;
         }
         char err[256] = "";
-        if (lpv_engine_irradiance(engine, pts, nrm, K, rgb, err, sizeof err) != 0)
+        if (lpv_engine_irradiance(lpvt_engine, pts, nrm, K, rgb, err, sizeof err) != 0)
             fail_msg("%s", err);
         for (int k = 0; k < K; k++)
             lpvd[it][k] = rgb[3 * k + 1];
@@ -316,5 +301,5 @@ int main(void)
         cmocka_unit_test(test_emissive_wall_injected_flux),
         cmocka_unit_test(test_wall_probe_profile),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

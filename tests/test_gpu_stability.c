@@ -23,22 +23,6 @@
 #include "oracle.h"
 #include "test_util.h"
 
-static lpv_gl_context *ctx;
-static lpv_engine *engine;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lpvt_gl_open(&ctx, &engine);
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lpvt_gl_close(ctx, engine);
-    return 0;
-}
-
 /* Builds hard case `name` (bench/accuracy/hard_cases.h: the same scenes
  * lpvd-hard-cases compares with the reference). */
 static void build(const char *name, lpv_hard_scene *h)
@@ -61,19 +45,19 @@ static double tick_checked(const lpv_hard_scene *h, lpv_settings s, int with_vie
 {
     const lpv_scene *scene = &h->scene;
     char err[1024] = "";
-    if (lpv_engine_set_settings(engine, &s, err, sizeof err) != 0 ||
-        lpv_engine_set_scene(engine, scene, err, sizeof err) != 0)
+    if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) != 0 ||
+        lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) != 0)
         fail_msg("%s", err);
     lpv_view view;
     assert_int_equal(lpv_hard_case_view(h, 32, 32, &view), 0);
-    assert_int_equal(lpv_engine_set_view(engine, with_view ? &view : NULL, err, sizeof err), 0);
-    if (lpv_engine_tick(engine, err, sizeof err) != 0)
+    assert_int_equal(lpv_engine_set_view(lpvt_engine, with_view ? &view : NULL, err, sizeof err), 0);
+    if (lpv_engine_tick(lpvt_engine, err, sizeof err) != 0)
         fail_msg("tick: %s", err);
-    const lpv_grid *g = lpv_engine_grid(engine);
+    const lpv_grid *g = lpv_engine_grid(lpvt_engine);
     size_t cells = lpv_grid_cell_count(g);
     lpv_cell *acc = calloc(cells, sizeof *acc), *last = calloc(cells, sizeof *last);
-    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_ACCUMULATED, acc, cells), cells);
-    assert_int_equal(lpv_engine_read_grid(engine, LPV_GRID_LAST_STEP, last, cells), cells);
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, acc, cells), cells);
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_LAST_STEP, last, cells), cells);
     for (size_t i = 0; i < cells; ++i) {
         const float *a = (const float *)&acc[i];
         for (int k = 0; k < 12; ++k)
@@ -84,7 +68,7 @@ static double tick_checked(const lpv_hard_scene *h, lpv_settings s, int with_vie
     assert_true(isfinite(e));
     if (with_view) {
         float *rgba = calloc((size_t)32 * 32 * 4, sizeof *rgba);
-        assert_int_equal(lpv_engine_render(engine, LPV_TERMS_FULL, rgba, err, sizeof err), 0);
+        assert_int_equal(lpv_engine_render(lpvt_engine, LPV_TERMS_FULL, rgba, err, sizeof err), 0);
         for (size_t i = 0; i < (size_t)32 * 32 * 4; ++i)
             assert_true(isfinite(rgba[i]) && rgba[i] >= 0.0f);
         free(rgba);
@@ -208,5 +192,5 @@ int main(void)
         cmocka_unit_test(test_thousand_steps),
         cmocka_unit_test(test_tiny_and_flat_grids),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

@@ -23,22 +23,6 @@
 
 enum { W = 96, H = 96 };
 
-static lpv_gl_context *ctx;
-static lpv_engine *engine;
-
-static int setup(void **state)
-{
-    (void)state;
-    return lpvt_gl_open(&ctx, &engine);
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lpvt_gl_close(ctx, engine);
-    return 0;
-}
-
 static void render(const lpv_scene *scene, lpv_frame_terms terms, lpv_view *view, float *rgba)
 {
     char err[1024] = "";
@@ -48,9 +32,10 @@ static void render(const lpv_scene *scene, lpv_frame_terms terms, lpv_view *view
      * of green there (docs/accuracy.md, "Presets"). */
     lpv_settings s = {.iterations = 8, .rsm_size = 256};
     lpv_view_from_camera(&scene->cameras[0], W, H, view);
-    if (lpv_engine_set_settings(engine, &s, err, sizeof err) || lpv_engine_set_scene(engine, scene, err, sizeof err) ||
-        lpv_engine_set_view(engine, view, err, sizeof err) || lpv_engine_tick(engine, err, sizeof err) ||
-        lpv_engine_render(engine, terms, rgba, err, sizeof err))
+    if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) ||
+        lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) ||
+        lpv_engine_set_view(lpvt_engine, view, err, sizeof err) || lpv_engine_tick(lpvt_engine, err, sizeof err) ||
+        lpv_engine_render(lpvt_engine, terms, rgba, err, sizeof err))
         fail_msg("%s", err);
 }
 
@@ -200,5 +185,5 @@ int main(void)
         cmocka_unit_test(test_render_command_files),
         cmocka_unit_test(test_render_command_rejects_bad_input),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

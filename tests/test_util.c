@@ -76,3 +76,21 @@ void lpvt_gl_close(lpv_gl_context *ctx, lpv_engine *engine)
     lpv_engine_destroy(engine);
     lpv_gl_context_destroy(ctx);
 }
+
+static lpv_gl_context *lpvt_ctx;
+lpv_engine *lpvt_engine;
+
+int lpvt_gl_setup(void **state)
+{
+    (void)state;
+    return lpvt_gl_open(&lpvt_ctx, &lpvt_engine);
+}
+
+int lpvt_gl_teardown(void **state)
+{
+    (void)state;
+    lpvt_gl_close(lpvt_ctx, lpvt_engine);
+    lpvt_ctx = NULL;
+    lpvt_engine = NULL;
+    return 0;
+}

@@ -26,4 +26,11 @@ struct lpv_engine;
 int lpvt_gl_open(struct lpv_gl_context **ctx, struct lpv_engine **engine);
 void lpvt_gl_close(struct lpv_gl_context *ctx, struct lpv_engine *engine);
 
+/* cmocka group fixtures for files whose tests share one context and engine:
+ * cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown), then use
+ * lpvt_engine. */
+extern struct lpv_engine *lpvt_engine;
+int lpvt_gl_setup(void **state);
+int lpvt_gl_teardown(void **state);
+
 #endif
