@@ -20,6 +20,7 @@ void lpv_scene_free(lpv_scene *scene)
     free(scene->textures);
     free(scene->lights);
     free(scene->cameras);
+    free(scene->medium.density);
     memset(scene, 0, sizeof *scene);
 }
 

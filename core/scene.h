@@ -75,6 +75,20 @@ typedef struct lpv_draw {
     int material; /* index into materials */
 } lpv_draw;
 
+/* A participating medium (docs/scenes.md, "Media"): single scattering with an
+ * isotropic phase function. The coefficients hold at density 1; the density is
+ * 1 everywhere (homogeneous fog) unless a box is given: then it is the density
+ * texture inside the box (1 when density is NULL) and 0 outside. */
+typedef struct lpv_medium {
+    int present;          /* 0: no medium */
+    float sigma_s[3];     /* scattering coefficient, 1/m, rgb */
+    float sigma_a[3];     /* absorption coefficient, 1/m, rgb */
+    int has_box;          /* 0: unbounded */
+    float box_min[3], box_max[3];
+    int dims[3];          /* density texture cells per axis; 0 = none */
+    float *density;       /* dims product values >= 0, x fastest; owned by the scene */
+} lpv_medium;
+
 typedef struct lpv_scene {
     lpv_vertex *vertices;
     uint32_t vertex_count;
@@ -91,6 +105,7 @@ typedef struct lpv_scene {
     lpv_camera *cameras;
     uint32_t camera_count;
     float bounds_min[3], bounds_max[3]; /* of all vertices */
+    lpv_medium medium;                  /* participating medium, if any */
     int default_light_added;            /* 1 when lpv_scene_ensure_light added one */
     char source[256];                   /* file path, or "built-in:cornell-box" */
 } lpv_scene;

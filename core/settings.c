@@ -120,6 +120,26 @@ void lpv_settings_resolve(lpv_settings *s)
         s->indirect_gain = 1.0f;
     if (s->emissive_vpls == 0)
         s->emissive_vpls = LPV_DEFAULT_EMISSIVE_VPLS;
+    if (s->cascade_size == 0.0f)
+        s->cascade_size = LPV_DEFAULT_CASCADE_SIZE;
+    if (s->cascade_ratio == 0.0f)
+        s->cascade_ratio = LPV_DEFAULT_CASCADE_RATIO;
+    if (s->cascade_offset == 0.0f)
+        s->cascade_offset = LPV_DEFAULT_CASCADE_OFFSET; /* a negative value stays: it means 0 (none) */
+    if (s->bounces == LPV_SWITCH_DEFAULT)
+        s->bounces = LPV_SWITCH_OFF;
+    if (s->bounce_intensity == 0.0f)
+        s->bounce_intensity = 1.0f;
+    if (s->glossy == LPV_SWITCH_DEFAULT)
+        s->glossy = LPV_SWITCH_ON;
+    if (s->glossy_roughness == 0.0f)
+        s->glossy_roughness = LPV_DEFAULT_GLOSSY_ROUGHNESS;
+    if (s->media == LPV_SWITCH_DEFAULT)
+        s->media = LPV_SWITCH_ON;
+    if (s->media_step == 0.0f)
+        s->media_step = LPV_DEFAULT_MEDIA_STEP;
+    if (s->planner == LPV_SWITCH_DEFAULT)
+        s->planner = LPV_SWITCH_ON;
 }
 
 /* Writes a formatted message into err (when there is room) and returns -1. */
@@ -183,5 +203,38 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->emissive_vpls < 0 || s->emissive_vpls > LPV_MAX_EMISSIVE_VPLS)
         return fail(err, err_size, "emissive_vpls = %d is out of range (allowed 0..%d)", s->emissive_vpls,
                     LPV_MAX_EMISSIVE_VPLS);
+    if (s->cascades < 0 || s->cascades > LPV_MAX_CASCADES)
+        return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->cascades,
+                    LPV_MAX_CASCADES);
+    if (!isfinite(s->cascade_size) || s->cascade_size <= 0.0f || s->cascade_size > 1e6f)
+        return fail(err, err_size, "cascade_size = %g m is out of range (allowed > 0 and <= 1e6)",
+                    (double)s->cascade_size);
+    if (!isfinite(s->cascade_ratio) || s->cascade_ratio < 1.25f || s->cascade_ratio > 8.0f)
+        return fail(err, err_size, "cascade_ratio = %g is out of range (allowed 1.25..8)", (double)s->cascade_ratio);
+    if (!isfinite(s->cascade_offset) || s->cascade_offset > 0.5f)
+        return fail(err, err_size, "cascade_offset = %g is out of range (allowed <= 0.5; negative = 0)",
+                    (double)s->cascade_offset);
+    const struct {
+        const char *name;
+        lpv_switch v;
+    } switches[] = {{"bounces", s->bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner}};
+    for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
+        if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
+            return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
+                        switches[i].name, (int)switches[i].v);
+    if (!isfinite(s->bounce_intensity) || s->bounce_intensity < 0.0f || s->bounce_intensity > 1.0f)
+        return fail(err, err_size, "bounce_intensity = %g is out of range (allowed 0..1; above 1 would create "
+                    "energy)", (double)s->bounce_intensity);
+    if (!isfinite(s->damping) || s->damping < 0.0f || s->damping > 1.0f)
+        return fail(err, err_size, "damping = %g is out of range (allowed 0..1; 0 = off)", (double)s->damping);
+    if (!isfinite(s->glossy_roughness) || s->glossy_roughness < 0.0f || s->glossy_roughness > 1.0f)
+        return fail(err, err_size, "glossy_roughness = %g is out of range (allowed 0..1)",
+                    (double)s->glossy_roughness);
+    if (!isfinite(s->fog_sigma_s) || s->fog_sigma_s < 0.0f || s->fog_sigma_s > 1e3f ||
+        !isfinite(s->fog_sigma_a) || s->fog_sigma_a < 0.0f || s->fog_sigma_a > 1e3f)
+        return fail(err, err_size, "fog_sigma_s = %g, fog_sigma_a = %g per m are out of range (allowed 0..1000)",
+                    (double)s->fog_sigma_s, (double)s->fog_sigma_a);
+    if (!isfinite(s->media_step) || s->media_step < 0.05f || s->media_step > 4.0f)
+        return fail(err, err_size, "media_step = %g is out of range (allowed 0.05..4 cells)", (double)s->media_step);
     return validate_bounds(s, err, err_size);
 }

@@ -34,6 +34,34 @@ typedef struct lpv_settings {
     float indirect_gain;    /* artistic factor on the LPV term; default 1 (0 = default) */
     int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
     lpv_preset preset;      /* supplies the four defaults marked "the preset's"; default balanced */
+
+    /* Cascades (cascaded-LPV paper, section 4; docs/cascades.md). Every cascade
+     * has grid_dims cells; cascade k's cells are cascade_ratio^k times the
+     * finest cascade's. */
+    int cascades;           /* 0 = auto: one grid over the scene when the scene fits in
+                               the finest cascade, else LPV_DEFAULT_CASCADES; N = exactly N */
+    float cascade_size;     /* m, the finest cascade's extent along its longest axis; default 8 */
+    float cascade_ratio;    /* cell size ratio of consecutive cascades; default 2 */
+    float cascade_offset;   /* how far each cascade's centre sits ahead of the camera along
+                               the view direction, as a fraction of its extent; default 0.25,
+                               negative = 0 (centred on the camera) */
+
+    /* Section 7 effects and damping (section 3.4); docs/effects.md. */
+    lpv_switch bounces;     /* multiple bounces off the geometry volume's blockers; default off */
+    float bounce_intensity; /* factor on the blockers' albedo (1 = physical); default 1 */
+    float damping;          /* directional-derivative damping strength; 0 = off (default) */
+    lpv_switch glossy;      /* glossy reflections by marching the LPV; default on (run
+                               only when the scene has a glossy material) */
+    float glossy_roughness; /* materials with roughness below this are glossy; default 0.3 */
+    lpv_switch media;       /* participating media single scattering; default on (run only
+                               when the scene or the fog settings give a medium) */
+    float fog_sigma_s;      /* 1/m, homogeneous fog scattering coefficient; 0 = none (the
+                               scene's own medium, if any) */
+    float fog_sigma_a;      /* 1/m, homogeneous fog absorption coefficient; 0 = none */
+    float media_step;       /* ray-march step as a fraction of the cascade's cell; default 0.5 */
+
+    lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
+                               unchanged volume; off: run every pass every tick */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
@@ -42,6 +70,12 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_ITERATIONS 4
 #define LPV_DEFAULT_RSM_SIZE 128
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096
+#define LPV_DEFAULT_CASCADES 3
+#define LPV_DEFAULT_CASCADE_SIZE 8.0f
+#define LPV_DEFAULT_CASCADE_RATIO 2.0f
+#define LPV_DEFAULT_CASCADE_OFFSET 0.25f
+#define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f
+#define LPV_DEFAULT_MEDIA_STEP 0.5f
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the

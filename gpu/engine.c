@@ -571,6 +571,9 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
 const lpv_grid *lpv_engine_grid(const lpv_engine *e) { return &e->grid; }
 const lpv_settings *lpv_engine_settings(const lpv_engine *e) { return &e->settings; }
 const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e) { return &e->stats; }
+int lpv_engine_cascade_count(const lpv_engine *e) { (void)e; return 1; }
+const lpv_grid *lpv_engine_cascade(const lpv_engine *e, int k) { (void)k; return &e->grid; }
+const lpv_plan *lpv_engine_last_plan(const lpv_engine *e) { return &e->plan; }
 
 static size_t read_buffer(GLuint buf, size_t elem_size, size_t available, void *out, size_t max)
 {

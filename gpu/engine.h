@@ -19,6 +19,7 @@
 
 #include "grid.h"
 #include "oracle.h"
+#include "plan.h"
 #include "scene.h"
 #include "settings.h"
 #include "view.h"
@@ -79,7 +80,14 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
 int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
                           size_t err_size);
 
+/* The finest cascade (cascade 0). */
 const lpv_grid *lpv_engine_grid(const lpv_engine *e);
+/* Cascades in use after the last tick (1..LPV_MAX_CASCADES) and the placement
+ * of cascade k (0 = finest; every cascade has the same dims). */
+int lpv_engine_cascade_count(const lpv_engine *e);
+const lpv_grid *lpv_engine_cascade(const lpv_engine *e, int k);
+/* The plan of the last tick (passes run and skipped, with reasons). */
+const lpv_plan *lpv_engine_last_plan(const lpv_engine *e);
 const lpv_settings *lpv_engine_settings(const lpv_engine *e);
 const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e);
 
@@ -90,6 +98,8 @@ typedef enum lpv_grid_which {
     LPV_GRID_ACCUMULATED = 1,
     LPV_GRID_LAST_STEP = 2, /* the output of the last propagation step */
 } lpv_grid_which;
+/* Every cascade's cells, cascade 0 first (cascade k starts at k * cells of one
+ * cascade); with one cascade simply the grid. */
 size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max);
 size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max);
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);

@@ -84,6 +84,7 @@ struct lpv_engine {
 
     lpv_timer timer;
     lpv_engine_stats stats;
+    lpv_plan plan;
 };
 
 /* Builds a program whose sources get the named .glsl include files first

@@ -166,6 +166,7 @@ struct LpvViewBlock {
 
 /* ---- Limits ---------------------------------------------------------------- */
 #define LPV_MAX_GRID_DIM     256  /* cells per axis */
+#define LPV_MAX_CASCADES     4
 #define LPV_MAX_ITERATIONS   4096
 #define LPV_MAX_RSM_SIZE     2048
 #define LPV_FP16_MAX         65504.0f

@@ -1,0 +1,167 @@
+/*
+ * plan.c - the tick planner's rules (see plan.h). Each rule is one `if`
+ * with the sentence that explains it; the order of the checks is the order
+ * in which a reader would ask "why did this not run?".
+ */
+#include "plan.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "lpv_shared.h"
+
+static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
+    [LPV_PASS_RSM] = "rsm",         [LPV_PASS_EMISSIVE] = "emissive", [LPV_PASS_INJECT] = "inject",
+    [LPV_PASS_GBUFFER] = "gbuffer", [LPV_PASS_GV] = "gv",             [LPV_PASS_PROPAGATE] = "propagate",
+    [LPV_PASS_BOUNCE] = "bounce",   [LPV_PASS_GLOSSY] = "glossy",     [LPV_PASS_MEDIA] = "media",
+};
+
+const char *lpv_pass_name(lpv_pass_id id)
+{
+    return ((int)id >= 0 && id < LPV_PASS_COUNT) ? PASS_NAMES[id] : NULL;
+}
+
+static void say(char *dst, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(dst, n, fmt, ap);
+    va_end(ap);
+}
+
+int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t n)
+{
+    if (f->bounds_given) {
+        say(reason, n, "the settings fix the grid bounds: one grid over them");
+        return 1;
+    }
+    if (s->cascades > 0) {
+        say(reason, n, "cascades = %d set explicitly", s->cascades);
+        return s->cascades;
+    }
+    if (s->planner == LPV_SWITCH_OFF) {
+        say(reason, n, "planner off: the default %d cascades", LPV_DEFAULT_CASCADES);
+        return LPV_DEFAULT_CASCADES;
+    }
+    if (f->scene_extent <= s->cascade_size) {
+        say(reason, n, "the scene (%.3g m) fits in the finest cascade (%.3g m): one grid over the scene",
+            (double)f->scene_extent, (double)s->cascade_size);
+        return 1;
+    }
+    say(reason, n, "the scene (%.3g m) is larger than the finest cascade (%.3g m)", (double)f->scene_extent,
+        (double)s->cascade_size);
+    return LPV_DEFAULT_CASCADES;
+}
+
+/* Sets pass id to run (1) or skip (0) with a reason. */
+static void decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)
+{
+    p->pass[id].run = run;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(p->pass[id].reason, sizeof p->pass[id].reason, fmt, ap);
+    va_end(ap);
+}
+
+/* Whether the tick must recompute the volume, with the reason. */
+static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, int camera_in_gv, char *why, size_t n)
+{
+    if (s->planner == LPV_SWITCH_OFF)
+        return say(why, n, "planner off: every tick recomputes"), 1;
+    if (f->first_tick)
+        return say(why, n, "first tick"), 1;
+    if (f->scene_changed)
+        return say(why, n, "the scene changed"), 1;
+    if (f->lights_changed)
+        return say(why, n, "the lights changed"), 1;
+    if (f->settings_changed)
+        return say(why, n, "the settings changed"), 1;
+    if (f->placement_changed)
+        return say(why, n, "the camera moved a cascade to a new cell"), 1;
+    if (camera_in_gv && f->camera_move_cells >= 1.0f)
+        return say(why, n, "the camera moved %.2f cells and its surfels feed the geometry volume",
+                   (double)f->camera_move_cells), 1;
+    if (f->camera_move_cells > 0.0f)
+        return say(why, n, "only the camera moved (%.2f cells, within a cell of every cascade): cached volume served",
+                   (double)f->camera_move_cells), 0;
+    return say(why, n, "nothing changed: cached volume served"), 0;
+}
+
+void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+{
+    memset(p, 0, sizeof *p);
+    const int all = s->planner == LPV_SWITCH_OFF;
+    p->cascades = lpv_plan_cascades(s, f, p->cascades_reason, sizeof p->cascades_reason);
+
+    /* Render-time passes are decided first: they do not depend on a recompute. */
+    if (all)
+        decide(p, LPV_PASS_GLOSSY, 1, "planner off");
+    else if (s->glossy == LPV_SWITCH_OFF)
+        decide(p, LPV_PASS_GLOSSY, 0, "glossy off");
+    else if (!f->glossy_draws)
+        decide(p, LPV_PASS_GLOSSY, 0, "no material has roughness below %.2f", (double)s->glossy_roughness);
+    else
+        decide(p, LPV_PASS_GLOSSY, 1, "%zu draws are glossy", f->glossy_draws);
+    if (all)
+        decide(p, LPV_PASS_MEDIA, 1, "planner off");
+    else if (s->media == LPV_SWITCH_OFF)
+        decide(p, LPV_PASS_MEDIA, 0, "media off");
+    else if (!f->has_medium)
+        decide(p, LPV_PASS_MEDIA, 0, "no medium in the scene and no fog set");
+    else
+        decide(p, LPV_PASS_MEDIA, 1, "the scene has a participating medium");
+
+    const int occlusion = s->occlusion == LPV_SWITCH_ON;
+    const int gv = occlusion && (all || f->occluder_triangles > 0);
+    const int camera_in_gv = gv && f->has_view;
+    p->recompute = needs_recompute(s, f, camera_in_gv, p->recompute_reason, sizeof p->recompute_reason);
+    if (!p->recompute) {
+        for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
+            decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
+        return;
+    }
+
+    if (all || f->lights)
+        decide(p, LPV_PASS_RSM, 1, "%u punctual lights", f->lights);
+    else
+        decide(p, LPV_PASS_RSM, 0, "no punctual lights");
+    if (all || f->emissive_vpls)
+        decide(p, LPV_PASS_EMISSIVE, 1, "%zu emissive VPLs", f->emissive_vpls);
+    else
+        decide(p, LPV_PASS_EMISSIVE, 0, "no emissive surfaces");
+    const int inject = all || p->pass[LPV_PASS_RSM].run || p->pass[LPV_PASS_EMISSIVE].run;
+    if (inject)
+        decide(p, LPV_PASS_INJECT, 1, "%d cascades receive the VPLs", p->cascades);
+    else
+        decide(p, LPV_PASS_INJECT, 0, "no light sources");
+
+    if (!occlusion)
+        decide(p, LPV_PASS_GV, 0, "occlusion off");
+    else if (!gv)
+        decide(p, LPV_PASS_GV, 0, "no occluders (no non-emissive triangles)");
+    else
+        decide(p, LPV_PASS_GV, 1, "%zu occluder triangles", f->occluder_triangles);
+    if (!f->has_view)
+        decide(p, LPV_PASS_GBUFFER, 0, "no camera");
+    else if (!gv)
+        decide(p, LPV_PASS_GBUFFER, 0, "the geometry volume does not run (render draws its own)");
+    else
+        decide(p, LPV_PASS_GBUFFER, 1, "camera surfels for the geometry volume");
+
+    if (s->iterations == 0)
+        decide(p, LPV_PASS_PROPAGATE, 0, "iterations = 0");
+    else if (!inject)
+        decide(p, LPV_PASS_PROPAGATE, 0, "nothing injected");
+    else
+        decide(p, LPV_PASS_PROPAGATE, 1, "%d steps in %d cascades", s->iterations, p->cascades);
+
+    if (s->bounces != LPV_SWITCH_ON)
+        decide(p, LPV_PASS_BOUNCE, 0, "bounces off");
+    else if (!p->pass[LPV_PASS_GV].run)
+        decide(p, LPV_PASS_BOUNCE, 0, "needs the geometry volume, which does not run");
+    else if (!p->pass[LPV_PASS_PROPAGATE].run)
+        decide(p, LPV_PASS_BOUNCE, 0, "propagation does not run");
+    else
+        decide(p, LPV_PASS_BOUNCE, 1, "bounces on, intensity %.2f", (double)s->bounce_intensity);
+}

@@ -1,0 +1,74 @@
+/*
+ * plan.h - the tick planner: "simulate only the effects a scene calls for".
+ *
+ * Before every tick the engine gathers facts about the scene, the settings
+ * and what changed since the last computed tick, and lpv_plan_make decides
+ * how many cascades to use, whether anything must be recomputed at all, and
+ * which passes run. Every pass that does not run carries the reason, so
+ * --stats, the daemon's STATS reply and each stream header can say what ran
+ * and why. Pure logic, no GL: tests/test_plan.c checks every rule, the GPU
+ * tests check that a skipped pass really costs nothing.
+ */
+#ifndef LPV_PLAN_H
+#define LPV_PLAN_H
+
+#include <stddef.h>
+
+#include "settings.h"
+
+typedef enum lpv_pass_id {
+    LPV_PASS_RSM = 0,   /* reflective shadow maps of the punctual lights */
+    LPV_PASS_EMISSIVE,  /* injection of the emissive surfaces' VPLs */
+    LPV_PASS_INJECT,    /* VPL injection into the cascades */
+    LPV_PASS_GBUFFER,   /* the camera's G-buffer (surfels for the GV) */
+    LPV_PASS_GV,        /* geometry volume and transmittances (fuzzy occlusion) */
+    LPV_PASS_PROPAGATE, /* propagation steps */
+    LPV_PASS_BOUNCE,    /* multiple bounces off GV blockers (inside propagation) */
+    LPV_PASS_GLOSSY,    /* glossy march at render time */
+    LPV_PASS_MEDIA,     /* participating media single scattering at render time */
+    LPV_PASS_COUNT
+} lpv_pass_id;
+
+#define LPV_PLAN_REASON_MAX 128
+
+typedef struct lpv_plan_facts {
+    unsigned lights;           /* punctual lights */
+    size_t emissive_vpls;      /* VPLs sampled on emissive surfaces */
+    size_t occluder_triangles; /* triangles of non-emissive materials */
+    size_t glossy_draws;       /* draws whose material is glossy under the settings */
+    int has_medium;            /* the scene or the fog settings give a medium */
+    int has_view;              /* a camera is set */
+    float scene_extent;        /* m, the scene bounds' longest axis */
+    int bounds_given;          /* the settings fix the grid bounds */
+    /* what changed since the last computed tick */
+    int first_tick;            /* nothing computed yet */
+    int scene_changed;         /* geometry or materials */
+    int lights_changed;
+    int settings_changed;
+    int placement_changed;     /* a cascade's snapped placement differs */
+    float camera_move_cells;   /* camera travel since the last computed tick, in finest cells */
+} lpv_plan_facts;
+
+typedef struct lpv_plan {
+    int cascades;                           /* cascades in use */
+    char cascades_reason[LPV_PLAN_REASON_MAX];
+    int recompute;                          /* 0: the cached volume is served, no tick pass runs */
+    char recompute_reason[LPV_PLAN_REASON_MAX];
+    struct {
+        int run;
+        char reason[LPV_PLAN_REASON_MAX];   /* why it runs or why it is skipped */
+    } pass[LPV_PASS_COUNT];
+} lpv_plan;
+
+/* "rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce",
+ * "glossy", "media"; NULL for an unknown id. */
+const char *lpv_pass_name(lpv_pass_id id);
+
+/* Cascades the settings and facts call for (1..LPV_MAX_CASCADES) with the
+ * reason; independent of what changed. s must be resolved. */
+int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t reason_size);
+
+/* The whole plan for one tick. s must be resolved. */
+void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
+
+#endif /* LPV_PLAN_H */
