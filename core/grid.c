@@ -74,7 +74,7 @@ size_t lpv_grid_gv_count(const lpv_grid *g)
 int lpv_grid_cell_of(const lpv_grid *g, const float p[3], int cell[3])
 {
     for (int i = 0; i < 3; i++) {
-        float f = floorf((p[i] - g->origin[i]) / g->cell_size);
+        float f = floorf(p[i] / g->cell_size - g->origin[i] / g->cell_size); /* as grid.glsl */
         if (!(f >= 0.0f && f < (float)g->dims[i]))
             return 0;
         cell[i] = (int)f;
@@ -85,7 +85,7 @@ int lpv_grid_cell_of(const lpv_grid *g, const float p[3], int cell[3])
 int lpv_grid_gv_point_of(const lpv_grid *g, const float p[3], int point[3])
 {
     for (int i = 0; i < 3; i++) {
-        float f = floorf((p[i] - g->origin[i]) / g->cell_size + 0.5f);
+        float f = floorf(p[i] / g->cell_size - g->origin[i] / g->cell_size + 0.5f);
         if (!(f >= 0.0f && f <= (float)g->dims[i]))
             return 0;
         point[i] = (int)f;

@@ -15,7 +15,7 @@
  * NaN coordinate; +-Inf clamps like any other far point. */
 static int axis_lerp(const lpv_grid *g, int axis, float p, int *i0, int *i1, float *f)
 {
-    float u = (p - g->origin[axis]) / g->cell_size;
+    float u = p / g->cell_size - g->origin[axis] / g->cell_size; /* as grid.glsl */
     if (isnan(u))
         return 0;
     float hi = (float)g->dims[axis] - 0.5f;

@@ -139,6 +139,7 @@ static void free_scene(lpv_engine *e)
     e->texture_count = e->draw_count = e->material_count = 0;
     e->light_count = 0;
     e->emissive_vpl_count = 0;
+    e->occluder_triangles = 0;
     e->has_scene = 0;
 }
 
@@ -147,6 +148,7 @@ static void free_rsm(lpv_engine *e)
     delete_texture(&e->rsm_position);
     delete_texture(&e->rsm_normal);
     delete_texture(&e->rsm_flux);
+    delete_texture(&e->rsm_albedo);
     delete_texture(&e->rsm_depth);
     delete_framebuffer(&e->rsm_fbo);
     delete_buffer(&e->vpls);
@@ -164,14 +166,17 @@ static void free_grids(lpv_engine *e)
     delete_buffer(&e->lpv_acc);
     delete_buffer(&e->gv_total);
     delete_buffer(&e->transmit);
+    delete_buffer(&e->reflect);
     delete_buffer(&e->sigma[0]);
     delete_buffer(&e->sigma[1]);
     GLuint *views[] = {&e->tbo_injected, &e->tbo_ping, &e->tbo_pong, &e->tbo_sigma[0], &e->tbo_sigma[1],
-                       &e->tbo_acc, &e->tbo_transmit};
+                       &e->tbo_acc, &e->tbo_transmit, &e->tbo_reflect};
     for (size_t i = 0; i < sizeof views / sizeof views[0]; ++i)
         delete_texture(views[i]);
     e->grid_alloc_cells = 0;
+    e->grid_alloc_cascades = 0;
     e->ticked = 0;
+    e->computed = 0;
 }
 
 static void free_camera(lpv_engine *e)
@@ -231,42 +236,43 @@ static GLuint buffer_view(GLuint b, GLenum format)
     return t;
 }
 
-/* (Re)places the grid from the settings and the scene, and sizes its buffers. */
-static int place_grid(lpv_engine *e, char *err, size_t err_size)
+/* Uploads the placement of the cascades and (re)sizes their buffers when the
+ * dims or the cascade count changed. */
+static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, size_t err_size)
 {
-    const lpv_settings *s = &e->settings;
-    int given = 0;
-    for (int i = 0; i < 3; ++i)
-        given |= s->bounds_min[i] != 0.0f || s->bounds_max[i] != 0.0f;
-    const float *bmin = given ? s->bounds_min : e->scene_min;
-    const float *bmax = given ? s->bounds_max : e->scene_max;
-    lpv_grid g;
-    if (lpv_grid_place(s->grid_dims, bmin, bmax, &g) != 0)
-        return lpv_error(err, err_size, "grid %dx%dx%d cannot be placed", s->grid_dims[0], s->grid_dims[1],
-                               s->grid_dims[2]);
-    int same_dims = e->grid_alloc_cells && memcmp(g.dims, e->grid.dims, sizeof g.dims) == 0;
-    e->grid = g;
+    const lpv_grid *g = &set->grid[0];
+    e->cascades = *set;
+    e->grid = *g;
     struct LpvGridParams params = {
-        .origin_cell = {g.origin[0], g.origin[1], g.origin[2], g.cell_size},
-        .dims = {(float)g.dims[0], (float)g.dims[1], (float)g.dims[2], (float)lpv_grid_cell_count(&g)},
+        .dims = {(float)g->dims[0], (float)g->dims[1], (float)g->dims[2], (float)lpv_grid_cell_count(g)},
+        .info = {(float)set->count, set->count > 1 ? 1.0f : 0.0f, 0.0f, 0.0f},
     };
+    for (int k = 0; k < set->count; ++k) {
+        for (int i = 0; i < 3; ++i)
+            params.cascade[k][i] = set->origin_cells[k][i];
+        params.cascade[k][3] = set->grid[k].cell_size;
+    }
     glBindBuffer(GL_UNIFORM_BUFFER, e->grid_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
-    if (same_dims)
+    if (e->grid_alloc_cells && memcmp(g->dims, e->grid_alloc_dims, sizeof g->dims) == 0 &&
+        e->grid_alloc_cascades == set->count)
         return 0;
 
     free_grids(e);
-    size_t cells = lpv_grid_cell_count(&g), gv = lpv_grid_gv_count(&g);
-    int gv_dims[3] = {g.dims[0] + 1, g.dims[1] + 1, g.dims[2] + 1};
-    if (lpv_atlas_create(&e->lpv_atlas, g.dims, 3, err, err_size) != 0 ||
-        lpv_atlas_create(&e->gv_atlas, gv_dims, 1, err, err_size) != 0)
+    const size_t K = (size_t)set->count;
+    size_t cells = lpv_grid_cell_count(g) * K, gv = lpv_grid_gv_count(g) * K;
+    int lpv_dims[3] = {g->dims[0], g->dims[1], g->dims[2] * set->count};
+    int gv_dims[3] = {g->dims[0] + 1, g->dims[1] + 1, (g->dims[2] + 1) * set->count};
+    if (lpv_atlas_create(&e->lpv_atlas, lpv_dims, 3, err, err_size) != 0 ||
+        lpv_atlas_create(&e->gv_atlas, gv_dims, 2, err, err_size) != 0)
         return -1;
     e->lpv_injected = new_ssbo(cells * sizeof(lpv_cell));
     e->lpv_ping = new_ssbo(cells * sizeof(lpv_cell));
     e->lpv_pong = new_ssbo(cells * sizeof(lpv_cell));
     e->lpv_acc = new_ssbo(cells * sizeof(lpv_cell));
-    e->gv_total = new_ssbo(gv * 4 * sizeof(float));
+    e->gv_total = new_ssbo(gv * 2 * 4 * sizeof(float)); /* blocking SH, albedo */
     e->transmit = new_ssbo(cells * LPV_DIR_COUNT * sizeof(float));
+    e->reflect = new_ssbo(cells * LPV_DIR_COUNT * 4 * sizeof(float));
     e->sigma[0] = new_ssbo(cells * 4 * sizeof(float));
     e->sigma[1] = new_ssbo(cells * 4 * sizeof(float));
     e->tbo_injected = buffer_view(e->lpv_injected, GL_RGBA32F);
@@ -276,10 +282,47 @@ static int place_grid(lpv_engine *e, char *err, size_t err_size)
     e->tbo_sigma[1] = buffer_view(e->sigma[1], GL_RGBA32F);
     e->tbo_acc = buffer_view(e->lpv_acc, GL_RGBA32F);
     e->tbo_transmit = buffer_view(e->transmit, GL_R32F);
+    e->tbo_reflect = buffer_view(e->reflect, GL_RGBA32F);
     e->grid_alloc_cells = cells;
+    memcpy(e->grid_alloc_dims, g->dims, sizeof g->dims);
+    e->grid_alloc_cascades = set->count;
     if (glGetError() != GL_NO_ERROR)
-        return lpv_error(err, err_size, "could not allocate a %dx%dx%d grid", g.dims[0], g.dims[1], g.dims[2]);
+        return lpv_error(err, err_size, "could not allocate %d cascades of %dx%dx%d cells", set->count, g->dims[0],
+                         g->dims[1], g->dims[2]);
     return 0;
+}
+
+/* Where the cascades of `count` go now (settings, scene, camera). */
+static int place_cascades(const lpv_engine *e, int count, lpv_cascade_set *out, char *err, size_t err_size)
+{
+    const float *eye = e->has_view ? e->view.eye : NULL, *fwd = e->has_view ? e->view.forward : NULL;
+    float f[3];
+    if (fwd) {
+        float len = sqrtf(fwd[0] * fwd[0] + fwd[1] * fwd[1] + fwd[2] * fwd[2]);
+        for (int i = 0; i < 3; ++i)
+            f[i] = len > 0.0f ? fwd[i] / len : 0.0f;
+        fwd = f;
+    }
+    if (lpv_cascades_place(&e->settings, count, e->scene_min, e->scene_max, eye, fwd, out) != 0)
+        return lpv_error(err, err_size, "%d cascades of %dx%dx%d cells cannot be placed", count,
+                         e->settings.grid_dims[0], e->settings.grid_dims[1], e->settings.grid_dims[2]);
+    return 0;
+}
+
+/* Places the grid for the current settings and scene without a tick, so
+ * lpv_engine_grid() answers right after set_scene/set_settings. */
+static int place_grid(lpv_engine *e, char *err, size_t err_size)
+{
+    lpv_plan_facts f = {0};
+    f.scene_extent = fmaxf(e->scene_max[0] - e->scene_min[0],
+                           fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
+    for (int i = 0; i < 3; ++i)
+        f.bounds_given |= e->settings.bounds_min[i] != 0.0f || e->settings.bounds_max[i] != 0.0f;
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_cascade_set set;
+    if (place_cascades(e, lpv_plan_cascades(&e->settings, &f, why, sizeof why), &set, err, err_size) != 0)
+        return -1;
+    return apply_cascades(e, &set, err, err_size);
 }
 
 int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *err, size_t err_size)
@@ -288,7 +331,11 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     lpv_settings_resolve(&s);
     if (lpv_settings_validate(&s, err, err_size) != 0)
         return -1;
+    if (memcmp(&s, &e->settings, sizeof s) == 0)
+        return 0;
     e->settings = s;
+    e->settings_dirty = 1;
+    e->gbuf_stale = 1;
     e->ticked = 0;
     if (e->has_scene)
         return place_grid(e, err, err_size);
@@ -324,8 +371,60 @@ static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, siz
     return 0;
 }
 
+/* Longest side of the bounding box of a draw's finite vertices (m). */
+static float draw_size(const lpv_scene *scene, const lpv_draw *d)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < d->index_count; ++i) {
+        uint32_t v = scene->indices[d->first_index + i];
+        if (v >= scene->vertex_count)
+            continue;
+        const float *p = scene->vertices[v].position;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fminf(lo[k], p[k]);
+            hi[k] = fmaxf(hi[k], p[k]);
+        }
+    }
+    float size = 0.0f;
+    for (int k = 0; k < 3; ++k)
+        if (hi[k] >= lo[k])
+            size = fmaxf(size, hi[k] - lo[k]);
+    return size;
+}
+
+/* FNV-1a over bytes, chained from h. */
+static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+/* Geometry and materials, not lights: a scene update that only moves lights
+ * is reported as such by the planner. */
+static uint64_t geometry_signature(const lpv_scene *s)
+{
+    uint64_t h = 1469598103934665603ull;
+    h = hash_bytes(h, s->vertices, (size_t)s->vertex_count * sizeof *s->vertices);
+    h = hash_bytes(h, s->indices, (size_t)s->index_count * sizeof *s->indices);
+    h = hash_bytes(h, s->draws, (size_t)s->draw_count * sizeof *s->draws);
+    h = hash_bytes(h, s->materials, (size_t)s->material_count * sizeof *s->materials);
+    h = hash_bytes(h, &s->medium, sizeof s->medium);
+    return h;
+}
+
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
 {
+    uint64_t sig = geometry_signature(scene);
+    if (e->has_scene && sig == e->geometry_sig)
+        e->lights_dirty = 1;
+    else
+        e->scene_dirty = 1;
+    e->geometry_sig = sig;
+    e->gbuf_stale = 1;
     free_scene(e);
     e->ticked = 0;
     e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
@@ -336,13 +435,21 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         const lpv_draw *d = &scene->draws[i];
         if ((uint64_t)d->first_index + d->index_count > scene->index_count)
             return lpv_error(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
-        e->draws[e->draw_count++] = (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material};
+        e->draws[e->draw_count++] =
+            (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, draw_size(scene, d)};
+        const lpv_material *m = (d->material >= 0 && (uint32_t)d->material < scene->material_count)
+                                    ? &scene->materials[d->material]
+                                    : NULL;
+        int emissive = m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
+        if (!emissive)
+            e->occluder_triangles += d->index_count / 3;
     }
     for (uint32_t i = 0; i < scene->material_count; ++i) {
         const lpv_material *m = &scene->materials[i];
         lpv_gpu_material *g = &e->materials[i];
         memcpy(g->base_color, m->base_color, sizeof g->base_color);
         memcpy(g->emission, m->emission, sizeof g->emission);
+        g->roughness = m->roughness;
         g->texture = (m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < scene->texture_count)
                          ? m->base_color_texture
                          : -1;
@@ -372,6 +479,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     e->light_count = 0;
     for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
         e->lights[e->light_count++] = scene->lights[i];
+    e->has_medium = scene->medium.present;
     memcpy(e->scene_min, scene->bounds_min, sizeof e->scene_min);
     memcpy(e->scene_max, scene->bounds_max, sizeof e->scene_max);
 
@@ -394,10 +502,13 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
 {
     if (!view) {
         e->has_view = 0;
+        e->gbuf_stale = 1;
         return 0;
     }
     if (view->width < 1 || view->height < 1 || view->width > 16384 || view->height > 16384)
         return lpv_error(err, err_size, "image size %dx%d outside 1..16384", view->width, view->height);
+    if (!e->has_view || memcmp(&e->view, view, sizeof *view) != 0)
+        e->gbuf_stale = 1;
     e->view = *view;
     e->has_view = 1;
     return 0;
@@ -408,14 +519,18 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog)
     GLint loc_color = glGetUniformLocation(prog, "u_base_color");
     GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
     GLint loc_emission = glGetUniformLocation(prog, "u_emission");
+    GLint loc_roughness = glGetUniformLocation(prog, "u_roughness");
+    GLint loc_size = glGetUniformLocation(prog, "u_object_size");
     glBindVertexArray(e->vao);
     for (uint32_t i = 0; i < e->draw_count; ++i) {
         const lpv_gpu_draw *d = &e->draws[i];
-        static const lpv_gpu_material fallback = {{1, 1, 1, 1}, {0, 0, 0}, -1};
+        static const lpv_gpu_material fallback = {{1, 1, 1, 1}, {0, 0, 0}, 1.0f, -1};
         const lpv_gpu_material *m =
             (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
         glUniform4fv(loc_color, 1, m->base_color);
         glUniform3fv(loc_emission, 1, m->emission);
+        glUniform1f(loc_roughness, m->roughness);
+        glUniform1f(loc_size, d->size);
         glUniform1i(loc_has_tex, m->texture >= 0);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m->texture >= 0 ? e->textures[m->texture] : 0);
@@ -446,31 +561,114 @@ static void record_stats(lpv_engine *e)
     s->rsm_size = (unsigned)e->settings.rsm_size;
     s->vpls_rsm = e->rsm_texels;
     s->vpls_emissive = e->emissive_vpl_count;
-    s->surfels_rsm = e->settings.occlusion == LPV_SWITCH_ON ? e->rsm_texels : 0;
-    s->surfels_camera = (e->settings.occlusion == LPV_SWITCH_ON && e->has_view) ? (size_t)e->gbuf_w * e->gbuf_h : 0;
-    s->cells = lpv_grid_cell_count(&e->grid);
+    const int gv = e->plan.pass[LPV_PASS_GV].run;
+    s->surfels_rsm = gv ? e->rsm_texels : 0;
+    s->surfels_camera = (gv && e->plan.pass[LPV_PASS_GBUFFER].run) ? (size_t)e->gbuf_w * e->gbuf_h : 0;
+    s->cascades = e->cascades.count;
+    s->cells = lpv_engine_all_cells(e);
     s->iterations = e->settings.iterations;
-    s->cell_steps = (double)s->cells * e->settings.iterations;
-    s->occlusion = e->settings.occlusion == LPV_SWITCH_ON;
+    s->cell_steps = e->plan.pass[LPV_PASS_PROPAGATE].run ? (double)s->cells * e->settings.iterations : 0.0;
+    s->occlusion = gv;
+}
+
+/* Draws using a material rougher than nothing but below the glossy threshold. */
+static size_t glossy_draws(const lpv_engine *e)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < e->draw_count; ++i) {
+        int m = e->draws[i].material;
+        if (m >= 0 && (uint32_t)m < e->material_count && e->materials[m].roughness < e->settings.glossy_roughness)
+            ++n;
+    }
+    return n;
+}
+
+/* The planner's facts about the scene, the settings and what changed. */
+static void gather_facts(const lpv_engine *e, lpv_plan_facts *f)
+{
+    memset(f, 0, sizeof *f);
+    f->lights = e->light_count;
+    f->emissive_vpls = e->emissive_vpl_count;
+    f->occluder_triangles = e->occluder_triangles;
+    f->glossy_draws = glossy_draws(e);
+    f->has_medium = e->has_medium || e->settings.fog_sigma_s > 0.0f || e->settings.fog_sigma_a > 0.0f;
+    f->has_view = e->has_view;
+    f->scene_extent = fmaxf(e->scene_max[0] - e->scene_min[0],
+                            fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
+    for (int i = 0; i < 3; ++i)
+        f->bounds_given |= e->settings.bounds_min[i] != 0.0f || e->settings.bounds_max[i] != 0.0f;
+    f->first_tick = !e->computed;
+    f->scene_changed = e->scene_dirty;
+    f->lights_changed = e->lights_dirty;
+    f->settings_changed = e->settings_dirty;
+    if (e->has_view != e->computed_has_view) {
+        f->camera_move_cells = INFINITY;
+    } else if (e->has_view) {
+        float d2 = 0.0f;
+        for (int i = 0; i < 3; ++i)
+            d2 += (e->view.eye[i] - e->computed_eye[i]) * (e->view.eye[i] - e->computed_eye[i]);
+        f->camera_move_cells = sqrtf(d2) / e->grid.cell_size;
+    }
+}
+
+/* Zeroes the injected grid and the accumulation (nothing to inject). */
+static void clear_volume(lpv_engine *e)
+{
+    GLuint bufs[] = {e->lpv_injected, e->lpv_acc};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) {
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[i]);
+        glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_RGBA32F, GL_RGBA, GL_FLOAT, NULL);
+    }
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
 {
     if (!e->has_scene)
         return lpv_error(err, err_size, "no scene loaded");
+    lpv_plan_facts facts;
+    gather_facts(e, &facts);
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_cascade_set set;
+    if (place_cascades(e, lpv_plan_cascades(&e->settings, &facts, why, sizeof why), &set, err, err_size) != 0)
+        return -1;
+    facts.placement_changed = e->computed && !lpv_cascades_equal(&set, &e->cascades);
+    lpv_plan_make(&e->settings, &facts, &e->plan);
+    const lpv_plan *p = &e->plan;
+    if (!p->recompute) {
+        /* The cached volume stands: no pass runs, no stage is recorded. */
+        lpv_timer_collect(&e->timer);
+        e->stats.stage_count = 0;
+        e->ticked = 1;
+        return 0;
+    }
+    if (apply_cascades(e, &set, err, err_size) != 0)
+        return -1;
     if (lpv_pass_rsm_prepare(e, err, err_size) != 0)
         return -1;
-    lpv_pass_rsm_run(e);
-    lpv_pass_inject_run(e);
-    if (e->has_view)
+    if (p->pass[LPV_PASS_RSM].run)
+        lpv_pass_rsm_run(e);
+    if (p->pass[LPV_PASS_INJECT].run)
+        lpv_pass_inject_run(e, p->pass[LPV_PASS_RSM].run, p->pass[LPV_PASS_EMISSIVE].run);
+    else
+        clear_volume(e);
+    if (p->pass[LPV_PASS_GBUFFER].run) {
         lpv_pass_gbuffer_run(e);
-    if (e->settings.occlusion == LPV_SWITCH_ON)
-        lpv_pass_gv_run(e);
-    lpv_pass_propagate_run(e);
+        e->gbuf_stale = 0;
+    }
+    if (p->pass[LPV_PASS_GV].run)
+        lpv_pass_gv_run(e, p->pass[LPV_PASS_BOUNCE].run, p->pass[LPV_PASS_GBUFFER].run);
+    if (p->pass[LPV_PASS_PROPAGATE].run)
+        lpv_pass_propagate_run(e, p->pass[LPV_PASS_GV].run, p->pass[LPV_PASS_BOUNCE].run);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR)
         return lpv_error(err, err_size, "GL error 0x%04x during the tick", gl_err);
     e->ticked = 1;
+    e->computed = 1;
+    e->scene_dirty = e->lights_dirty = e->settings_dirty = 0;
+    e->computed_has_view = e->has_view;
+    if (e->has_view)
+        memcpy(e->computed_eye, e->view.eye, sizeof e->computed_eye);
     record_stats(e);
     return 0;
 }
@@ -481,6 +679,10 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return lpv_error(err, err_size, "render before a tick");
     if (!e->has_view)
         return lpv_error(err, err_size, "render needs a view (camera)");
+    if (e->gbuf_stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
+        lpv_pass_gbuffer_run(e);
+        e->gbuf_stale = 0;
+    }
     lpv_pass_shade_run(e, terms);
     const int w = e->gbuf_w, h = e->gbuf_h;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame_fbo);
@@ -549,6 +751,7 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
     glUseProgram(e->prog_query);
     glUniform1i(glGetUniformLocation(e->prog_query, "u_count"), (GLint)n);
+    glUniform1f(glGetUniformLocation(e->prog_query, "u_damping"), e->settings.damping);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
@@ -571,9 +774,13 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
 const lpv_grid *lpv_engine_grid(const lpv_engine *e) { return &e->grid; }
 const lpv_settings *lpv_engine_settings(const lpv_engine *e) { return &e->settings; }
 const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e) { return &e->stats; }
-int lpv_engine_cascade_count(const lpv_engine *e) { (void)e; return 1; }
-const lpv_grid *lpv_engine_cascade(const lpv_engine *e, int k) { (void)k; return &e->grid; }
 const lpv_plan *lpv_engine_last_plan(const lpv_engine *e) { return &e->plan; }
+int lpv_engine_cascade_count(const lpv_engine *e) { return e->cascades.count > 0 ? e->cascades.count : 1; }
+
+const lpv_grid *lpv_engine_cascade(const lpv_engine *e, int k)
+{
+    return (k >= 0 && k < e->cascades.count) ? &e->cascades.grid[k] : &e->grid;
+}
 
 static size_t read_buffer(GLuint buf, size_t elem_size, size_t available, void *out, size_t max)
 {
@@ -590,26 +797,37 @@ size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, 
 {
     if (!e->ticked)
         return 0;
+    const int steps = e->plan.pass[LPV_PASS_PROPAGATE].run ? e->settings.iterations : 0;
     GLuint b = e->lpv_acc;
-    if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && e->settings.iterations == 0))
+    if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && steps == 0))
         b = e->lpv_injected;
     else if (which == LPV_GRID_LAST_STEP)
-        b = (e->settings.iterations & 1) ? e->lpv_ping : e->lpv_pong;
-    return read_buffer(b, sizeof(lpv_cell), lpv_grid_cell_count(&e->grid), out, max);
+        b = (steps & 1) ? e->lpv_ping : e->lpv_pong;
+    return read_buffer(b, sizeof(lpv_cell), lpv_engine_all_cells(e), out, max);
 }
 
 size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max)
 {
-    if (!e->ticked || e->settings.occlusion != LPV_SWITCH_ON)
+    if (!e->ticked || !e->plan.pass[LPV_PASS_GV].run)
         return 0;
-    return read_buffer(e->gv_total, sizeof(vec4), lpv_grid_gv_count(&e->grid), out, max);
+    /* The total interleaves (blocking SH, albedo) per point; callers get the SH. */
+    size_t points = lpv_grid_gv_count(&e->grid) * (size_t)e->cascades.count;
+    size_t n = points < max ? points : max;
+    vec4 *pairs = malloc(n * 2 * sizeof *pairs);
+    if (!pairs)
+        return 0;
+    n = read_buffer(e->gv_total, sizeof(vec4), points * 2, pairs, n * 2) / 2;
+    for (size_t i = 0; i < n; ++i)
+        memcpy(out[i], pairs[2 * i], sizeof out[i]);
+    free(pairs);
+    return n;
 }
 
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats)
 {
-    if (!e->ticked || e->settings.occlusion != LPV_SWITCH_ON)
+    if (!e->ticked || !e->plan.pass[LPV_PASS_GV].run)
         return 0;
-    return read_buffer(e->transmit, sizeof(float), lpv_grid_cell_count(&e->grid) * LPV_DIR_COUNT, out, max_floats);
+    return read_buffer(e->transmit, sizeof(float), lpv_engine_all_cells(e) * LPV_DIR_COUNT, out, max_floats);
 }
 
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
@@ -629,7 +847,7 @@ size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
 
 size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max)
 {
-    if (!e->ticked || e->settings.occlusion != LPV_SWITCH_ON)
+    if (!e->ticked || !e->plan.pass[LPV_PASS_GV].run)
         return 0;
     size_t lights = (size_t)e->light_block.counts[0];
     if (buffer < lights) {

@@ -47,7 +47,8 @@ typedef struct lpv_engine_stats {
     unsigned lights, rsm_faces, rsm_size;
     size_t vpls_rsm, vpls_emissive, vpls_injected_capacity;
     size_t surfels_rsm, surfels_camera;
-    size_t cells;
+    int cascades;
+    size_t cells; /* of all cascades */
     int iterations;
     double cell_steps;
     int occlusion;

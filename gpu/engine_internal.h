@@ -5,6 +5,7 @@
 #ifndef LPV_ENGINE_INTERNAL_H
 #define LPV_ENGINE_INTERNAL_H
 
+#include "cascades.h"
 #include "engine.h"
 #include "error.h"
 #include "gl.h"
@@ -14,12 +15,14 @@
 typedef struct lpv_gpu_material {
     float base_color[4];
     float emission[3];
+    float roughness;
     int texture; /* index into lpv_engine.textures, -1 none */
 } lpv_gpu_material;
 
 typedef struct lpv_gpu_draw {
     uint32_t first_index, index_count;
     int material;
+    float size; /* m, longest side of the draw's bounding box (cascade fading) */
 } lpv_gpu_draw;
 
 /* A 2D atlas of z slices that points are blended into (see grid.glsl). */
@@ -32,8 +35,19 @@ typedef struct lpv_atlas {
 
 struct lpv_engine {
     lpv_settings settings;
-    lpv_grid grid;
+    lpv_grid grid;            /* the finest cascade (cascades.grid[0]) */
+    lpv_cascade_set cascades; /* placement of the last computed tick */
     int has_scene;
+
+    /* What changed since the last computed tick (the planner's facts). */
+    int computed;             /* a tick computed the volume at least once since set_scene/settings */
+    int scene_dirty, lights_dirty, settings_dirty;
+    uint64_t geometry_sig;    /* hash of vertices, indices, materials */
+    float computed_eye[3];
+    int computed_has_view;
+    size_t occluder_triangles;
+    int has_medium;           /* the scene has a participating medium */
+    int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
@@ -57,17 +71,18 @@ struct lpv_engine {
     struct LpvLightBlock light_block;
     GLuint light_ubo;
     int rsm_size, face_count, rsm_alloc_size, rsm_alloc_faces;
-    GLuint rsm_position, rsm_normal, rsm_flux, rsm_depth, rsm_fbo;
+    GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* one per RSM texel */
     size_t rsm_texels;    /* face_count * rsm_size^2 */
 
     /* grids */
     GLuint grid_ubo;
     lpv_atlas lpv_atlas, gv_atlas;
-    GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit;
+    GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit, reflect;
     GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
-    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit; /* buffer-texture views for reading */
-    size_t grid_alloc_cells;
+    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
+    size_t grid_alloc_cells; /* cells of all cascades */
+    int grid_alloc_dims[3], grid_alloc_cascades;
     int ticked;
 
     /* camera */
@@ -95,13 +110,20 @@ GLuint lpv_engine_program(const char *vert_or_comp, const char *geom, const char
 /* Draws every scene draw with the bound program (material uniforms set). */
 void lpv_engine_draw_scene(lpv_engine *e, GLuint prog);
 
+/* Cells of one cascade, and of all cascades in use. */
+static inline size_t lpv_engine_cascade_cells(const lpv_engine *e) { return lpv_grid_cell_count(&e->grid); }
+static inline size_t lpv_engine_all_cells(const lpv_engine *e)
+{
+    return lpv_grid_cell_count(&e->grid) * (size_t)e->cascades.count;
+}
+
 /* Per-pass set-up and work; each _run records its own timer stage. */
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
 void lpv_pass_rsm_run(lpv_engine *e);
-void lpv_pass_inject_run(lpv_engine *e);
+void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls);
 void lpv_pass_gbuffer_run(lpv_engine *e);
-void lpv_pass_gv_run(lpv_engine *e);
-void lpv_pass_propagate_run(lpv_engine *e);
+void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera);
+void lpv_pass_propagate_run(lpv_engine *e, int occlusion, int bounce);
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
 
 /* Light faces (RSM views) for the scene's lights: fills e->light_block. */
@@ -110,7 +132,8 @@ void lpv_light_faces_build(lpv_engine *e);
 /* Atlas helpers (pass_inject.c). */
 int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);
 void lpv_atlas_destroy(lpv_atlas *a);
-void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog);
+void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog);      /* clears it first */
+void lpv_atlas_begin_keep(lpv_engine *e, lpv_atlas *a, GLuint prog); /* adds to what it holds */
 void lpv_atlas_splat(lpv_engine *e, GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count);
 void lpv_atlas_end(void);
 

@@ -135,6 +135,10 @@ void lpv_pass_gbuffer_run(lpv_engine *e)
     glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[0]);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[1]);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[2]);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[3]);
     glUniform2i(glGetUniformLocation(e->prog_camera_surfels, "u_size"), v->width, v->height);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->camera_surfels);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
@@ -160,6 +164,7 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(e->prog_shade);
+    glUniform1f(glGetUniformLocation(e->prog_shade, "u_damping"), e->settings.damping);
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);

@@ -11,17 +11,20 @@ static void merge(lpv_engine *e)
 {
     glUseProgram(e->prog_gv_merge);
     glUniform1i(glGetUniformLocation(e->prog_gv_merge, "u_tiles_x"), e->gv_atlas.tiles_x);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, e->gv_atlas.tex[0]);
+    for (int i = 0; i < 2; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, e->gv_atlas.tex[i]);
+    }
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_GV_TOTAL, e->gv_total);
     glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0] + 1, LPV_WG_2D),
-                      lpv_div_up((size_t)e->grid.dims[1] + 1, LPV_WG_2D), (GLuint)e->grid.dims[2] + 1);
+                      lpv_div_up((size_t)e->grid.dims[1] + 1, LPV_WG_2D),
+                      (GLuint)((e->grid.dims[2] + 1) * e->cascades.count));
     lpv_timer_count(&e->timer, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void lpv_pass_gv_run(lpv_engine *e)
+void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera)
 {
     lpv_timer_begin(&e->timer, "gv");
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->gv_total);
@@ -37,7 +40,7 @@ void lpv_pass_gv_run(lpv_engine *e)
         lpv_atlas_end();
         merge(e);
     }
-    if (e->has_view) {
+    if (camera) {
         lpv_atlas_begin(e, &e->gv_atlas, e->prog_inject_gv);
         lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->camera_surfels, 0,
                         (size_t)e->gbuf_w * (size_t)e->gbuf_h);
@@ -49,8 +52,11 @@ void lpv_pass_gv_run(lpv_engine *e)
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_GV_TOTAL, e->gv_total);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_TRANSMIT, e->transmit);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_REFLECT, e->reflect);
+    glUniform1i(glGetUniformLocation(e->prog_transmit, "u_bounce"), bounce);
+    glUniform1f(glGetUniformLocation(e->prog_transmit, "u_bounce_intensity"), e->settings.bounce_intensity);
     glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D),
-                      (GLuint)e->grid.dims[2]);
+                      (GLuint)(e->grid.dims[2] * e->cascades.count));
     lpv_timer_count(&e->timer, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     lpv_timer_end(&e->timer);

@@ -51,14 +51,11 @@ void lpv_atlas_destroy(lpv_atlas *a)
     *a = (lpv_atlas){0};
 }
 
-/* Clears the atlas and sets the state for additive point splatting with prog. */
-void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog)
+/* Sets the state for additive point splatting with prog into the atlas as it is. */
+void lpv_atlas_begin_keep(lpv_engine *e, lpv_atlas *a, GLuint prog)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
     glViewport(0, 0, a->width, a->height);
-    static const float zero[4] = {0, 0, 0, 0};
-    for (int i = 0; i < a->attachments; ++i)
-        glClearBufferfv(GL_COLOR, i, zero);
     glDisable(GL_DEPTH_TEST);
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
@@ -71,15 +68,26 @@ void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog)
     glBindVertexArray(e->empty_vao);
 }
 
-/* Draws count points reading elements [first, first + count) of buffer at binding. */
+/* Draws count points reading elements [first, first + count) of buffer at
+ * binding, once per cascade (instanced: gl_InstanceID is the cascade). */
 void lpv_atlas_splat(lpv_engine *e, GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count)
 {
     if (!count)
         return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     glUniform1i(glGetUniformLocation(prog, "u_first"), (GLint)first);
-    glDrawArrays(GL_POINTS, 0, (GLsizei)count);
+    glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)count, (GLsizei)e->cascades.count);
     lpv_timer_count(&e->timer, 1);
+}
+
+/* Clears the atlas and sets the state for additive point splatting with prog. */
+void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
+    static const float zero[4] = {0, 0, 0, 0};
+    for (int i = 0; i < a->attachments; ++i)
+        glClearBufferfv(GL_COLOR, i, zero);
+    lpv_atlas_begin_keep(e, a, prog);
 }
 
 void lpv_atlas_end(void)
@@ -90,13 +98,25 @@ void lpv_atlas_end(void)
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
-void lpv_pass_inject_run(lpv_engine *e)
+void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls)
 {
     lpv_timer_begin(&e->timer, "inject");
     lpv_atlas_begin(e, &e->lpv_atlas, e->prog_inject_vpl);
-    lpv_atlas_splat(e, e->prog_inject_vpl, LPV_SSBO_VPLS, e->vpls, 0, e->rsm_texels);
-    lpv_atlas_splat(e, e->prog_inject_vpl, LPV_SSBO_VPLS, e->emissive_vpls, 0, e->emissive_vpl_count);
+    if (rsm_vpls)
+        lpv_atlas_splat(e, e->prog_inject_vpl, LPV_SSBO_VPLS, e->vpls, 0, e->rsm_texels);
     lpv_atlas_end();
+    lpv_timer_end(&e->timer);
+    /* Emissive surfaces are their own stage, so the plan's "emissive" pass
+     * shows its cost (and its absence). */
+    if (emissive_vpls) {
+        lpv_timer_begin(&e->timer, "emissive");
+        lpv_atlas_begin_keep(e, &e->lpv_atlas, e->prog_inject_vpl);
+        lpv_atlas_splat(e, e->prog_inject_vpl, LPV_SSBO_VPLS, e->emissive_vpls, 0, e->emissive_vpl_count);
+        lpv_atlas_end();
+        lpv_timer_end(&e->timer);
+    }
+
+    lpv_timer_begin(&e->timer, "pack");
 
     glUseProgram(e->prog_pack);
     glUniform1i(glGetUniformLocation(e->prog_pack, "u_tiles_x"), e->lpv_atlas.tiles_x);
@@ -109,7 +129,7 @@ void lpv_pass_inject_run(lpv_engine *e)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[0]);
     glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D),
-                      (GLuint)e->grid.dims[2]);
+                      (GLuint)(e->grid.dims[2] * e->cascades.count));
     lpv_timer_count(&e->timer, 1);
     /* propagation reads the packed grid and flux limits as buffer textures */
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);

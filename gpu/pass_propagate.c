@@ -6,18 +6,21 @@
  */
 #include "engine_internal.h"
 
-void lpv_pass_propagate_run(lpv_engine *e)
+void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
 {
     lpv_timer_begin(&e->timer, "propagate");
     glUseProgram(e->prog_propagate);
     GLint loc_occ = glGetUniformLocation(e->prog_propagate, "u_occlusion");
+    glUniform1i(glGetUniformLocation(e->prog_propagate, "u_bounce"), bounce);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_REFLECT);
+    glBindTexture(GL_TEXTURE_BUFFER, e->tbo_reflect);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_ACC_IN);
     glBindTexture(GL_TEXTURE_BUFFER, e->tbo_acc);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_TRANSMIT);
     glBindTexture(GL_TEXTURE_BUFFER, e->tbo_transmit);
-    const int occlusion = e->settings.occlusion == LPV_SWITCH_ON;
+    const int occlusion = occlusion_on;
     /* Step i reads (through buffer-texture views: on llvmpipe texel fetches
      * gather far faster than SSBO loads) what step i - 1 wrote with SSBO
      * stores: the injected grid first, then ping and pong in turn. */
@@ -32,7 +35,8 @@ void lpv_pass_propagate_run(lpv_engine *e)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[(i + 1) & 1]);
         glUniform1i(loc_occ, occlusion && i > 0);
         glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
-                          lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y), (GLuint)e->grid.dims[2]);
+                          lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y),
+                          (GLuint)(e->grid.dims[2] * e->cascades.count));
         lpv_timer_count(&e->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         in_view = (i & 1) ? e->tbo_pong : e->tbo_ping;

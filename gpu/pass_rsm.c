@@ -33,8 +33,8 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
         return 0;
 
     if (e->rsm_position) {
-        GLuint tex[] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_depth};
-        glDeleteTextures(4, tex);
+        GLuint tex[] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo, e->rsm_depth};
+        glDeleteTextures(5, tex);
         glDeleteFramebuffers(1, &e->rsm_fbo);
         glDeleteBuffers(1, &e->vpls);
         glDeleteBuffers(1, &e->surfels);
@@ -42,6 +42,7 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     e->rsm_position = array_texture(GL_RGBA32F, size, layers);
     e->rsm_normal = array_texture(GL_RGBA32F, size, layers);
     e->rsm_flux = array_texture(GL_RGBA32F, size, layers);
+    e->rsm_albedo = array_texture(GL_RGBA8, size, layers);
     e->rsm_depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
     /* The depth layers double as shadow maps: compare mode, 2x2 PCF. */
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->rsm_depth);
@@ -70,8 +71,9 @@ void lpv_pass_rsm_run(lpv_engine *e)
     const int size = e->rsm_size;
     lpv_timer_begin(&e->timer, "rsm");
     glBindFramebuffer(GL_FRAMEBUFFER, e->rsm_fbo);
-    static const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-    glDrawBuffers(3, bufs);
+    static const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                   GL_COLOR_ATTACHMENT3};
+    glDrawBuffers(4, bufs);
     glViewport(0, 0, size, size);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
@@ -86,9 +88,10 @@ void lpv_pass_rsm_run(lpv_engine *e)
         glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->rsm_position, 0, f);
         glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, e->rsm_normal, 0, f);
         glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, e->rsm_flux, 0, f);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, e->rsm_albedo, 0, f);
         glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->rsm_depth, 0, f);
         static const float zero[4] = {0, 0, 0, 0};
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 4; ++i)
             glClearBufferfv(GL_COLOR, i, zero);
         glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
@@ -102,8 +105,8 @@ void lpv_pass_rsm_run(lpv_engine *e)
     lpv_timer_begin(&e->timer, "vpl_extract");
     if (e->face_count > 0) {
         glUseProgram(e->prog_vpl_extract);
-        GLuint tex[3] = {e->rsm_position, e->rsm_normal, e->rsm_flux};
-        for (int i = 0; i < 3; ++i) {
+        GLuint tex[4] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo};
+        for (int i = 0; i < 4; ++i) {
             glActiveTexture(GL_TEXTURE0 + (GLenum)i);
             glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
         }

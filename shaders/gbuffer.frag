@@ -12,8 +12,8 @@ uniform vec3 u_forward;
 
 layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0 = covered
 layout(location = 1) out vec4 o_normal;   // xyz unit, facing the camera; w 1 = covered
-layout(location = 2) out vec4 o_albedo;   // rgb linear albedo
-layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr)
+layout(location = 2) out vec4 o_albedo;   // rgb linear albedo; a roughness
+layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr); a object size (m)
 
 void main()
 {
@@ -33,6 +33,6 @@ void main()
     }
     o_position = vec4(p, area);
     o_normal = vec4(n, 1.0);
-    o_albedo = vec4(material_albedo(v_uv).rgb, 1.0);
-    o_emission = vec4(u_emission, 1.0);
+    o_albedo = vec4(material_albedo(v_uv).rgb, u_roughness);
+    o_emission = vec4(u_emission, u_object_size);
 }

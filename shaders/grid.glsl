@@ -1,10 +1,18 @@
-// grid.glsl - grid placement, cell indexing, the SH basis and the cosine lobe
-// (the conventions of lpv_shared.h and core/grid.h, core/sh.c).
+// grid.glsl - cascade placement, cell indexing, the SH basis and the cosine
+// lobe (the conventions of lpv_shared.h and core/grid.h, core/sh.c).
+// Buffers hold the cascades one after another: cell c of cascade k is at
+// k * cells_per_cascade + cell_index(c).
 layout(std140, binding = LPV_UBO_GRID) uniform GridUBO { LpvGridParams G; };
 
 ivec3 grid_dims() { return ivec3(G.dims.xyz); }
-float grid_cell_size() { return G.origin_cell.w; }
-vec3 grid_origin() { return G.origin_cell.xyz; }
+int grid_cells() { return int(G.dims.w); }
+int cascade_count() { return int(G.info.x); }
+float cascade_cell(int k) { return G.cascade[k].w; }
+vec3 cascade_origin_cells(int k) { return G.cascade[k].xyz; }
+vec3 cascade_origin(int k) { return G.cascade[k].xyz * G.cascade[k].w; }
+// The finest cascade: what a single grid used to be.
+float grid_cell_size() { return cascade_cell(0); }
+vec3 grid_origin() { return cascade_origin(0); }
 
 int cell_index(ivec3 c)
 {
@@ -17,13 +25,39 @@ bool cell_inside(ivec3 c)
     return all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, grid_dims()));
 }
 
+// Continuous cell coordinates of world point p in cascade k (cell centres at
+// integer + 0.5): p / cell - origin, so whole-cell moves of a snapped cascade
+// shift every point by exactly whole cells.
+vec3 cascade_coords(int k, vec3 p) { return p / cascade_cell(k) - cascade_origin_cells(k); }
+
+// A compute invocation over every cascade: z runs over dims.z * cascades.
+// Returns the cascade and sets c to the cell within it.
+int cascade_of_invocation(ivec3 id, out ivec3 c)
+{
+    int dz = grid_dims().z;
+    c = ivec3(id.x, id.y, id.z % dz);
+    return id.z / dz;
+}
+
+// Weight of an object of size `size` (m) in cascade k: the finest cascade
+// takes everything; a coarser one fades out objects smaller than two of its
+// cells and drops those smaller than one (paper section 4), so an object
+// moving between sizes fades instead of popping. 0 = unknown size: kept.
+float cascade_object_weight(int k, float size)
+{
+    if (k == 0 || G.info.y == 0.0 || !(size > 0.0))
+        return 1.0;
+    return clamp(size / cascade_cell(k) - 1.0, 0.0, 1.0);
+}
+
 vec4 sh_basis(vec3 d) { return vec4(LPV_SH_C0, LPV_SH_C1 * d.y, LPV_SH_C1 * d.z, LPV_SH_C1 * d.x); }
 vec4 sh_lobe(vec3 n) { return vec4(LPV_SH_LOBE0, LPV_SH_LOBE1 * n.y, LPV_SH_LOBE1 * n.z, LPV_SH_LOBE1 * n.x); }
 
 bool finite3(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
 
 // Injection renders points into a 2D atlas: slice z of a (w, h, depth)
-// volume is the tile (z % tiles_x, z / tiles_x) of w x h texels.
+// volume is the tile (z % tiles_x, z / tiles_x) of w x h texels. Cascades
+// stack their slices: slice k * depth + z.
 uniform int u_tiles_x;
 
 ivec2 atlas_texel(ivec3 c, ivec2 tile_size)

@@ -1,5 +1,5 @@
-// inject_vpl.vert - one point per VPL into the LPV atlas, at the cell holding
-// position + half a cell along the normal, carrying lobe(n) * flux / pi per
+// inject_vpl.vert - one point per VPL and cascade (instance) into the LPV
+// atlas, at the cell holding position + half a cell along the normal, carrying lobe(n) * flux / pi per
 // channel. Additive blending sums VPLs in array order: portable, no float
 // atomics, deterministic.
 layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Vpls { LpvVpl vpls[]; };
@@ -14,6 +14,7 @@ flat out vec4 v_b;
 void main()
 {
     LpvVpl v = vpls[u_first + gl_VertexID];
+    int k = gl_InstanceID; // one instance per cascade
     gl_PointSize = 1.0;
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
     v_r = v_g = v_b = vec4(0.0);
@@ -22,14 +23,18 @@ void main()
     if (v.position.w == 0.0 || !finite3(v.position.xyz) || !finite3(v.flux.rgb) || !(len > 1e-8) || isinf(len))
         return;
     vec3 n = v.normal.xyz / len;
-    ivec3 c = ivec3(floor((v.position.xyz + 0.5 * grid_cell_size() * n - grid_origin()) / grid_cell_size()));
+    float w = cascade_object_weight(k, v.normal.w);
+    if (!(w > 0.0))
+        return;
+    ivec3 c = ivec3(floor(cascade_coords(k, v.position.xyz + 0.5 * cascade_cell(k) * n)));
     if (!cell_inside(c))
         return;
 
-    vec4 lobe = sh_lobe(n) / LPV_PI;
+    vec4 lobe = sh_lobe(n) * (w / LPV_PI);
     v_r = lobe * v.flux.r;
     v_g = lobe * v.flux.g;
     v_b = lobe * v.flux.b;
-    vec2 texel = vec2(atlas_texel(c, grid_dims().xy)) + 0.5;
+    ivec3 d = grid_dims();
+    vec2 texel = vec2(atlas_texel(ivec3(c.xy, k * d.z + c.z), d.xy)) + 0.5;
     gl_Position = vec4(texel / u_atlas_size * 2.0 - 1.0, 0.0, 1.0);
 }

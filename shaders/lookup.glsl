@@ -1,9 +1,69 @@
-// lookup.glsl - irradiance from the accumulated LPV (core/oracle_lookup.c is
-// the reference): trilinear interpolation between cell centres, clamped at
-// the grid's edge, at half a cell in front of the surface, then E = max(0, c . lobe(-n) / cell^2) per channel: the
-// stored intensity per cell cross-section read as radiance, integrated against
-// the cosine over the hemisphere the surface faces.
+// lookup.glsl - irradiance from the accumulated LPV cascades (core/oracle_lookup.c
+// is the single-grid reference). In one cascade: trilinear interpolation
+// between cell centres, clamped at the grid's edge, at half a cell in front
+// of the surface, then E = max(0, c . lobe(-n) / cell^2) per channel: the
+// stored intensity per cell cross-section read as radiance, integrated
+// against the cosine over the hemisphere the surface faces.
+// Across cascades (docs/cascades.md): the finest cascade containing the point
+// is used, blended into the next coarser one over the last cells before its
+// border, w = clamp((d - 1) / 2, 0, 1) with d the distance to the border in
+// its cells, so the irradiance is continuous across every border.
+// Damping (paper section 3.4, docs/effects.md): where the incoming light
+// grows toward the surface (its directional derivative along n is negative,
+// i.e. it arrives from behind a thin wall), the lookup is damped by
+// 1 - strength * (1 - E(1.5 cells out) / E(0.5 cells out)); strength 0 = off.
 layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer AccLookup { LpvCell lpv[]; };
+
+uniform float u_damping;
+
+// E at continuous cell coordinates q (cell centres at +0.5) of cascade k.
+vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
+{
+    ivec3 dims = grid_dims();
+    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) - 0.5;
+    ivec3 c0 = min(ivec3(floor(q)), dims - 1);
+    ivec3 c1 = min(c0 + 1, dims - 1);
+    vec3 f = q - vec3(c0);
+    int base = k * grid_cells();
+    vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
+    for (int j = 0; j < 8; ++j) {
+        ivec3 sel = ivec3(j & 1, (j >> 1) & 1, (j >> 2) & 1);
+        ivec3 c = mix(c0, c1, bvec3(sel));
+        vec3 w3 = mix(1.0 - f, f, vec3(sel));
+        float w = w3.x * w3.y * w3.z;
+        LpvCell cell = lpv[base + cell_index(c)];
+        r += w * cell.r;
+        g += w * cell.g;
+        b += w * cell.b;
+    }
+    vec4 lobe = sh_lobe(-n);
+    float cell = cascade_cell(k);
+    return max(vec3(dot(r, lobe), dot(g, lobe), dot(b, lobe)) / (cell * cell), 0.0);
+}
+
+vec3 cascade_irradiance(int k, vec3 p, vec3 n)
+{
+    // half a cell in front of the surface, mirroring the injection offset
+    vec3 q = cascade_coords(k, p + 0.5 * cascade_cell(k) * n);
+    vec3 e = cascade_irradiance_at(k, q, n);
+    if (u_damping > 0.0) {
+        vec3 far = cascade_irradiance_at(k, q + n, n);
+        float near_l = dot(e, vec3(0.2126, 0.7152, 0.0722));
+        float far_l = dot(far, vec3(0.2126, 0.7152, 0.0722));
+        float ratio = near_l > 0.0 ? clamp(far_l / near_l, 0.0, 1.0) : 1.0;
+        e *= 1.0 - u_damping * (1.0 - ratio);
+    }
+    return e;
+}
+
+// Weight of cascade k at p: 1 deep inside, 0 within a cell of its border.
+float cascade_weight(int k, vec3 p)
+{
+    vec3 q = cascade_coords(k, p);
+    vec3 d3 = min(q, vec3(grid_dims()) - q);
+    float d = min(d3.x, min(d3.y, d3.z));
+    return clamp((d - 1.0) * 0.5, 0.0, 1.0);
+}
 
 vec3 lpv_irradiance(vec3 p, vec3 n_in)
 {
@@ -11,25 +71,14 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
     if (!(len > 1e-8) || isinf(len) || !finite3(p))
         return vec3(0.0);
     vec3 n = n_in / len;
-    ivec3 dims = grid_dims();
-    // half a cell in front of the surface, mirroring the injection offset
-    vec3 q = (p + 0.5 * grid_cell_size() * n - grid_origin()) / grid_cell_size();
-    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) - 0.5;
-    ivec3 c0 = min(ivec3(floor(q)), dims - 1);
-    ivec3 c1 = min(c0 + 1, dims - 1);
-    vec3 f = q - vec3(c0);
-    vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
-    for (int k = 0; k < 8; ++k) {
-        ivec3 sel = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-        ivec3 c = mix(c0, c1, bvec3(sel));
-        vec3 w3 = mix(1.0 - f, f, vec3(sel));
-        float w = w3.x * w3.y * w3.z;
-        LpvCell cell = lpv[cell_index(c)];
-        r += w * cell.r;
-        g += w * cell.g;
-        b += w * cell.b;
+    int count = cascade_count();
+    vec3 e = vec3(0.0);
+    float remaining = 1.0;
+    for (int k = 0; k < count && remaining > 0.0; ++k) {
+        float w = k == count - 1 ? 1.0 : cascade_weight(k, p);
+        if (w > 0.0)
+            e += remaining * w * cascade_irradiance(k, p, n);
+        remaining *= 1.0 - w;
     }
-    vec4 lobe = sh_lobe(-n);
-    float inv_area = 1.0 / (grid_cell_size() * grid_cell_size());
-    return max(vec3(dot(r, lobe), dot(g, lobe), dot(b, lobe)) * inv_area, 0.0);
+    return e;
 }

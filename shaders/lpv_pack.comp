@@ -1,6 +1,7 @@
 // lpv_pack.comp - copies the injection atlas into the LPV buffer layout
-// (LpvCell per cell, x fastest) as both the injected grid and the initial
-// accumulation, with the cells' flux limits for the first step.
+// (LpvCell per cell, x fastest, cascades one after another) as both the
+// injected grid and the initial accumulation, with the cells' flux limits for
+// the first step.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = 0) uniform sampler2D u_atlas_r;
@@ -13,15 +14,17 @@ layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 si
 
 void main()
 {
-    ivec3 c = ivec3(gl_GlobalInvocationID);
-    if (!cell_inside(c))
+    ivec3 id = ivec3(gl_GlobalInvocationID);
+    ivec3 c;
+    int k = cascade_of_invocation(id, c);
+    if (!cell_inside(c) || k >= cascade_count())
         return;
-    ivec2 t = atlas_texel(c, grid_dims().xy);
+    ivec2 t = atlas_texel(id, grid_dims().xy);
     LpvCell cell;
     cell.r = texelFetch(u_atlas_r, t, 0);
     cell.g = texelFetch(u_atlas_g, t, 0);
     cell.b = texelFetch(u_atlas_b, t, 0);
-    int i = cell_index(c);
+    int i = k * grid_cells() + cell_index(c);
     injected[i] = cell;
     acc[i] = cell;
     sigma_out[i] = vec4(flux_limit(cell.r), flux_limit(cell.g), flux_limit(cell.b), 0.0);

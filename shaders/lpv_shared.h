@@ -63,6 +63,9 @@
 #define LPV_PROP_F 0.06376856085851985f
 #define LPV_PROP_G 0.06027651555929470f
 
+/* Cascades (cascaded-LPV paper section 4, docs/cascades.md). */
+#define LPV_MAX_CASCADES 4
+
 /* ---- Memory layouts (std430 SSBOs) -----------------------------------------
  * A light propagation volume is an array of LpvCell, x fastest:
  * index = x + dims.x * (y + dims.y * z). Each vec4 holds the 4 SH coefficients
@@ -77,20 +80,28 @@ struct LpvCell {
  * intensity is I(w) = (flux / pi) max(0, <n, w>), so that its integral is flux. */
 struct LpvVpl {
     vec4 position; /* xyz world position (m); w = 1 for a valid VPL, 0 = skip */
-    vec4 normal;   /* xyz unit normal; w unused */
+    vec4 normal;   /* xyz unit normal; w = size of the object it lies on (m), 0 = unknown */
     vec4 flux;     /* rgb flux (W); a unused */
 };
 
-/* A surfel for the geometry volume: an oriented patch that blocks light. */
+/* A surfel for the geometry volume: an oriented patch that blocks light and,
+ * with bounces on, reflects what it blocks. */
 struct LpvSurfel {
     vec4 position; /* xyz world position (m); w = area (m^2), 0 = skip */
-    vec4 normal;   /* xyz unit normal; w unused */
+    vec4 normal;   /* xyz unit normal; w = size of the object it lies on (m), 0 = unknown */
+    vec4 albedo;   /* rgb diffuse albedo; a unused */
 };
 
-/* Placement of a grid, as a uniform block (std140). */
+/* Placement of the cascades, as a uniform block (std140). Every cascade has
+ * the same dims; the buffers hold them one after another, cascade 0 (the
+ * finest) first. A cascade's origin is stored in units of its own cells, so
+ * the cell of a point is floor(p / cell - origin): for snapped cascades the
+ * origin is an integer and moving a cascade by whole cells shifts every
+ * injected point by exactly that many cells. */
 struct LpvGridParams {
-    vec4 origin_cell; /* xyz world position of the grid's lower corner (m); w = cell size (m) */
-    vec4 dims;        /* xyz number of cells per axis (integers stored as float); w = cell count */
+    vec4 dims;                             /* xyz cells per axis (integers as float); w = cells per cascade */
+    vec4 info;                             /* x cascade count; y 1 = fade small objects out of coarse cascades */
+    vec4 cascade[LPV_MAX_CASCADES];        /* xyz lower corner in cells of this cascade; w cell size (m) */
 };
 
 /* Six propagation directions, in this order everywhere (C and GLSL):
@@ -152,12 +163,14 @@ struct LpvViewBlock {
 #define LPV_SSBO_SURFELS  6
 #define LPV_SSBO_GV_TOTAL 7
 #define LPV_SSBO_SIGMA_OUT 8
+#define LPV_SSBO_REFLECT  9
 
 /* Texture units of the propagation's inputs (RGBA32F buffer textures). */
 #define LPV_TEX_LPV_IN    0
 #define LPV_TEX_SIGMA_IN  1
 #define LPV_TEX_ACC_IN    2
 #define LPV_TEX_TRANSMIT  3
+#define LPV_TEX_REFLECT   4
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
 #define LPV_PROP_WG_X 32
@@ -166,7 +179,6 @@ struct LpvViewBlock {
 
 /* ---- Limits ---------------------------------------------------------------- */
 #define LPV_MAX_GRID_DIM     256  /* cells per axis */
-#define LPV_MAX_CASCADES     4
 #define LPV_MAX_ITERATIONS   4096
 #define LPV_MAX_RSM_SIZE     2048
 #define LPV_FP16_MAX         65504.0f

@@ -1,9 +1,17 @@
-// propagate.comp - one propagation step, gathered per destination cell
-// (docs/propagation.md). Light from the neighbour at cell - dir, travelling
-// along dir, is the sparse matrix of lpv_shared.h applied to the neighbour's
-// coefficients, scaled by the neighbour's flux limit sigma (computed when the
-// neighbour was written: by lpv_pack.comp or the previous step) and by the face's
-// transmittance. The step's output is also added to the accumulated volume.
+// propagate.comp - one propagation step in every cascade, gathered per
+// destination cell (docs/propagation.md). Light from the neighbour at
+// cell - dir, travelling along dir, is the sparse matrix of lpv_shared.h
+// applied to the neighbour's coefficients, scaled by the neighbour's flux
+// limit sigma (computed when the neighbour was written: by lpv_pack.comp or
+// the previous step) and by the face's transmittance. Cascades never exchange
+// light: each is its own volume. The step's output is also added to the
+// accumulated volume.
+//
+// Bounces (paper section 7, docs/effects.md): the part of what this cell
+// sends along dir that the blocker on the face ahead stops (1 - transmittance)
+// is reflected back into this cell with the blocker's albedo times the bounce
+// intensity, as a diffuse lobe facing -dir. Transmitted plus reflected never
+// exceeds what was sent, so the energy stays bounded for albedo <= 1.
 layout(local_size_x = LPV_PROP_WG_X, local_size_y = LPV_PROP_WG_Y, local_size_z = 1) in;
 
 layout(binding = LPV_TEX_LPV_IN) uniform samplerBuffer u_in;       // LpvCell as 3 texels
@@ -12,9 +20,11 @@ layout(std430, binding = LPV_SSBO_LPV_ACC) writeonly buffer Acc { LpvCell acc[];
 layout(binding = LPV_TEX_ACC_IN) uniform samplerBuffer u_acc;           // LpvCell as 3 texels
 layout(binding = LPV_TEX_TRANSMIT) uniform samplerBuffer u_transmit;    // 6 per cell
 layout(binding = LPV_TEX_SIGMA_IN) uniform samplerBuffer u_sigma_in; // rgb flux limits
+layout(binding = LPV_TEX_REFLECT) uniform samplerBuffer u_reflect;   // rgb reflectance, 6 per cell
 layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 sigma_out[]; };
 
 uniform int u_occlusion; // 0 on the first step and when occlusion is off
+uniform int u_bounce;    // 1: reflect blocked light (only with u_occlusion)
 
 // The term one source channel c, with flux limit sigma (flux_limit.glsl),
 // sends along +-axis (slot 1 = y, 2 = z, 3 = x).
@@ -29,12 +39,30 @@ vec4 transfer(vec4 c, float sigma, int slot, float s)
     return o * sigma;
 }
 
+// DC of what channel c sends along +-axis: the flux it sends / sqrt(4 pi).
+float sent_dc(vec4 c, float sigma, int slot, float s)
+{
+    float f = LPV_PROP_A * c.x + s * LPV_PROP_B * c[slot];
+    return (f > 0.0 && sigma > 0.0) ? f * sigma : 0.0;
+}
+
+LpvCell fetch_cell(samplerBuffer b, int j)
+{
+    LpvCell n;
+    n.r = texelFetch(b, 3 * j);
+    n.g = texelFetch(b, 3 * j + 1);
+    n.b = texelFetch(b, 3 * j + 2);
+    return n;
+}
+
 void main()
 {
-    ivec3 c = ivec3(gl_GlobalInvocationID);
-    if (!cell_inside(c))
+    ivec3 c;
+    int k = cascade_of_invocation(ivec3(gl_GlobalInvocationID), c);
+    if (!cell_inside(c) || k >= cascade_count())
         return;
-    int i = cell_index(c);
+    int base = k * grid_cells();
+    int i = base + cell_index(c);
     LpvCell sum;
     sum.r = sum.g = sum.b = vec4(0.0);
     for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
@@ -46,23 +74,42 @@ void main()
             continue;
         int slot = axis == 0 ? 3 : axis; // x lives in slot 3, y in 1, z in 2
         float t = u_occlusion != 0 ? texelFetch(u_transmit, i * LPV_DIR_COUNT + dir).x : 1.0;
-        int j = cell_index(src);
-        LpvCell n;
-        n.r = texelFetch(u_in, 3 * j);
-        n.g = texelFetch(u_in, 3 * j + 1);
-        n.b = texelFetch(u_in, 3 * j + 2);
+        int j = base + cell_index(src);
+        LpvCell n = fetch_cell(u_in, j);
         vec4 sigma = texelFetch(u_sigma_in, j);
         sum.r += t * transfer(n.r, sigma.r, slot, s);
         sum.g += t * transfer(n.g, sigma.g, slot, s);
         sum.b += t * transfer(n.b, sigma.b, slot, s);
     }
+    if (u_bounce != 0 && u_occlusion != 0) {
+        LpvCell self = fetch_cell(u_in, i);
+        vec4 sigma = texelFetch(u_sigma_in, i);
+        for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
+            int axis = dir / 2;
+            float s = (dir & 1) == 0 ? 1.0 : -1.0;
+            ivec3 ahead = c;
+            ahead[axis] += int(s);
+            if (!cell_inside(ahead))
+                continue;
+            int slot = axis == 0 ? 3 : axis;
+            vec3 refl = texelFetch(u_reflect, (base + cell_index(ahead)) * LPV_DIR_COUNT + dir).rgb;
+            if (!any(greaterThan(refl, vec3(0.0))))
+                continue;
+            vec3 back = vec3(0.0);
+            back[axis] = -s;
+            vec4 lobe = sh_lobe(back) / LPV_SH_LOBE0; // DC 1: the reflected DC is refl x sent DC
+            sum.r += lobe * (refl.r * sent_dc(self.r, sigma.r, slot, s));
+            sum.g += lobe * (refl.g * sent_dc(self.g, sigma.g, slot, s));
+            sum.b += lobe * (refl.b * sent_dc(self.b, sigma.b, slot, s));
+        }
+    }
     cout[i] = sum;
     // The next step needs each source's flux limit; computing it here, once
     // per cell, saves recomputing it for each of the six destinations.
     sigma_out[i] = vec4(flux_limit(sum.r), flux_limit(sum.g), flux_limit(sum.b), 0.0);
-    LpvCell a;
-    a.r = texelFetch(u_acc, 3 * i) + sum.r;
-    a.g = texelFetch(u_acc, 3 * i + 1) + sum.g;
-    a.b = texelFetch(u_acc, 3 * i + 2) + sum.b;
+    LpvCell a = fetch_cell(u_acc, i);
+    a.r += sum.r;
+    a.g += sum.g;
+    a.b += sum.b;
     acc[i] = a;
 }

@@ -5,6 +5,7 @@ layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 layout(binding = 0) uniform sampler2DArray u_rsm_position;
 layout(binding = 1) uniform sampler2DArray u_rsm_normal;
 layout(binding = 2) uniform sampler2DArray u_rsm_flux;
+layout(binding = 3) uniform sampler2DArray u_rsm_albedo;
 
 layout(std430, binding = LPV_SSBO_VPLS) writeonly buffer Vpls { LpvVpl vpls[]; };
 layout(std430, binding = LPV_SSBO_SURFELS) writeonly buffer Surfels { LpvSurfel surfels[]; };
@@ -22,8 +23,9 @@ void main()
     vec4 f = texelFetch(u_rsm_flux, t, 0);
     bool covered = n.w > 0.5;
     vpls[i].position = vec4(p.xyz, covered ? 1.0 : 0.0);
-    vpls[i].normal = vec4(n.xyz, 0.0);
+    vpls[i].normal = vec4(n.xyz, f.a); // w: object size
     vpls[i].flux = vec4(f.rgb, 0.0);
     surfels[i].position = vec4(p.xyz, covered ? p.w : 0.0);
-    surfels[i].normal = vec4(n.xyz, 0.0);
+    surfels[i].normal = vec4(n.xyz, f.a);
+    surfels[i].albedo = vec4(texelFetch(u_rsm_albedo, t, 0).rgb, 0.0);
 }

@@ -1,0 +1,82 @@
+/*
+ * cascades.c - cascade placement (see cascades.h).
+ */
+#include "cascades.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "lpv_shared.h"
+
+_Static_assert(LPV_MAX_CASCADES == 4, "lpv_cascade_set's arrays hold LPV_MAX_CASCADES entries");
+
+static int bounds_given(const lpv_settings *s)
+{
+    for (int i = 0; i < 3; ++i)
+        if (s->bounds_min[i] != 0.0f || s->bounds_max[i] != 0.0f)
+            return 1;
+    return 0;
+}
+
+int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
+                       const float *forward, lpv_cascade_set *out)
+{
+    memset(out, 0, sizeof *out);
+    if (count < 1 || count > LPV_MAX_CASCADES)
+        return -1;
+    if (count == 1) {
+        const int given = bounds_given(s);
+        if (lpv_grid_place(s->grid_dims, given ? s->bounds_min : bmin, given ? s->bounds_max : bmax,
+                           &out->grid[0]) != 0)
+            return -1;
+        for (int i = 0; i < 3; ++i)
+            out->origin_cells[0][i] = out->grid[0].origin[i] / out->grid[0].cell_size;
+        out->count = 1;
+        return 0;
+    }
+    int longest = 1;
+    for (int i = 0; i < 3; ++i) {
+        if (s->grid_dims[i] < 1 || s->grid_dims[i] > LPV_MAX_GRID_DIM)
+            return -1;
+        if (s->grid_dims[i] > longest)
+            longest = s->grid_dims[i];
+    }
+    double centre_scene[3];
+    for (int i = 0; i < 3; ++i) {
+        centre_scene[i] = 0.5 * ((double)bmin[i] + (double)bmax[i]);
+        if (!isfinite(centre_scene[i]) || (eye && !isfinite(eye[i])) || (forward && !isfinite(forward[i])))
+            return -1;
+    }
+    const double offset = s->cascade_offset > 0.0f ? s->cascade_offset : 0.0;
+    double cell = (double)s->cascade_size / longest;
+    for (int k = 0; k < count; ++k, cell *= s->cascade_ratio) {
+        lpv_grid *g = &out->grid[k];
+        memcpy(g->dims, s->grid_dims, sizeof g->dims);
+        g->cell_size = (float)cell;
+        for (int i = 0; i < 3; ++i) {
+            double extent = cell * g->dims[i];
+            double centre = eye ? eye[i] + (forward ? forward[i] * offset * extent : 0.0) : centre_scene[i];
+            double o = floor(centre / cell) - (double)(g->dims[i] / 2);
+            if (!isfinite(o) || fabs(o) > 1e7)
+                return -1;
+            out->origin_cells[k][i] = (float)o;
+            g->origin[i] = (float)(o * cell);
+        }
+    }
+    out->count = count;
+    out->snapped = 1;
+    return 0;
+}
+
+int lpv_cascades_equal(const lpv_cascade_set *a, const lpv_cascade_set *b)
+{
+    if (a->count != b->count || a->snapped != b->snapped)
+        return 0;
+    for (int k = 0; k < a->count; ++k) {
+        if (memcmp(a->grid[k].dims, b->grid[k].dims, sizeof a->grid[k].dims) != 0 ||
+            a->grid[k].cell_size != b->grid[k].cell_size ||
+            memcmp(a->origin_cells[k], b->origin_cells[k], sizeof a->origin_cells[k]) != 0)
+            return 0;
+    }
+    return 1;
+}

@@ -1,0 +1,39 @@
+/*
+ * cascades.h - placement of the cascaded light propagation volumes
+ * (cascaded-LPV paper section 4; docs/cascades.md).
+ *
+ * One cascade is the classic single grid over the scene (or the settings'
+ * bounds): lpv_grid_place. Several cascades share the settings' grid_dims;
+ * cascade k's cells measure cascade_size / max(dims) * cascade_ratio^k. Each
+ * is centred ahead of the camera, at eye + forward * cascade_offset * extent_k
+ * (the scene's centre when there is no camera), and snapped: its lower
+ * corner sits on a whole multiple of its own cell size,
+ *   origin_cells = floor(centre / cell) - floor(dims / 2),
+ * so a camera moving by less than a cell leaves a cascade where it is (unless
+ * the centre crosses a cell boundary) and moving by one cell shifts it by
+ * exactly one cell.
+ */
+#ifndef LPV_CASCADES_H
+#define LPV_CASCADES_H
+
+#include "grid.h"
+#include "settings.h"
+
+typedef struct lpv_cascade_set {
+    int count;
+    lpv_grid grid[4];             /* LPV_MAX_CASCADES; cascade 0 the finest */
+    float origin_cells[4][3];     /* each grid's origin / cell_size; whole numbers when snapped */
+    int snapped;                  /* 1: camera-following, snapped cascades; 0: one grid over bounds */
+} lpv_cascade_set;
+
+/* Places `count` (1..LPV_MAX_CASCADES) cascades for resolved settings s over
+ * the scene bounds [bmin, bmax]; eye and forward (unit) may be NULL (no
+ * camera). Returns 0, or -1 when a grid cannot be placed (non-finite input,
+ * dims out of range). */
+int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
+                       const float *forward, lpv_cascade_set *out);
+
+/* 1 when both sets place the same grids (count, dims, origins, cell sizes). */
+int lpv_cascades_equal(const lpv_cascade_set *a, const lpv_cascade_set *b);
+
+#endif /* LPV_CASCADES_H */
