@@ -339,6 +339,70 @@ static json_t *vec_json(const double *v, size_t n)
     return a;
 }
 
+/* The cascades build and the totals use: vi's own, or one from the grid. */
+static int cascades_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
+{
+    if (vi->cascade_count == 0) {
+        memset(out, 0, sizeof *out);
+        out->cells = 1;
+        for (int i = 0; i < 3; i++) {
+            out->dims[i] = vi->dims[i];
+            out->origin[i] = vi->origin[i];
+            out->cells *= (uint64_t)(vi->dims[i] > 0 ? vi->dims[i] : 0);
+        }
+        out->cell_size = vi->cell_size;
+        return 1;
+    }
+    if (vi->cascade_count < 0 || vi->cascade_count > LPVP_MAX_CASCADES)
+        return -1;
+    for (int k = 0; k < vi->cascade_count; k++)
+        out[k] = vi->cascades[k];
+    return vi->cascade_count;
+}
+
+uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi)
+{
+    lpvp_cascade_info c[LPVP_MAX_CASCADES];
+    int n = cascades_of(vi, c);
+    uint64_t total = 0;
+    for (int k = 0; k < n; k++)
+        total += c[k].cells;
+    return n < 0 ? 0 : total;
+}
+
+uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k)
+{
+    lpvp_cascade_info c[LPVP_MAX_CASCADES];
+    int n = cascades_of(vi, c);
+    uint64_t first = 0;
+    for (int i = 0; i < k && i < n; i++)
+        first += c[i].cells;
+    return first;
+}
+
+static json_t *cascades_json(const lpvp_volume_info *vi)
+{
+    lpvp_cascade_info c[LPVP_MAX_CASCADES];
+    int n = cascades_of(vi, c);
+    json_t *a = json_array();
+    if (!a || n < 0) {
+        json_decref(a);
+        return NULL;
+    }
+    for (int k = 0; k < n; k++) {
+        json_t *e = json_pack("{s:[I,I,I], s:o, s:f, s:I}", "dims", (json_int_t)c[k].dims[0],
+                              (json_int_t)c[k].dims[1], (json_int_t)c[k].dims[2], "origin",
+                              vec_json(c[k].origin, 3), "cell_size",
+                              isfinite(c[k].cell_size) ? c[k].cell_size : 0.0, "cells",
+                              (json_int_t)c[k].cells);
+        if (!e || json_array_append_new(a, e) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
 json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
 {
     json_t *o = json_object();
@@ -366,6 +430,7 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
             bad |= json_object_set_new(o, "base_tick", json_integer(vi->base_tick)) != 0;
         bad |= json_object_set_new(o, "grid", grid) != 0;
         grid = NULL;
+        bad |= json_object_set_new(o, "cascades", cascades_json(vi)) != 0;
         bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
         bad |= json_object_set_new(o, "layout", json_string(LPVP_VOLUME_LAYOUT)) != 0;
         bad |= json_object_set_new(o, "sh", json_string(LPVP_VOLUME_SH)) != 0;
@@ -395,6 +460,110 @@ static int need_int(const json_t *o, const char *key, long long min, long long *
         return -1;
     }
     *out = (long long)json_integer_value(v);
+    return 0;
+}
+
+static int same_real(double a, double b)
+{
+    return fabs(a - b) <= 1e-9 * (fabs(a) > fabs(b) ? fabs(a) : fabs(b)) + 1e-12;
+}
+
+/* "cascades" (R5.6) into vi->cascades; the grid fields are already read.
+ * Absent: one cascade equal to the grid (a server before cascades). */
+static int parse_cascades(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    const json_t *a = json_object_get(obj, "cascades");
+    uint64_t total = 0;
+    if (!a) {
+        vi->cascade_count = 0;
+        cascades_of(vi, &vi->cascades[0]);
+        vi->cascade_count = 1;
+        return 0;
+    }
+    if (!json_is_array(a) || json_array_size(a) < 1 || json_array_size(a) > LPVP_MAX_CASCADES) {
+        lpvp_set_error(err, err_n, "cascades: expected an array of 1 to %d cascades", LPVP_MAX_CASCADES);
+        return -1;
+    }
+    vi->cascade_count = (int)json_array_size(a);
+    for (int k = 0; k < vi->cascade_count; k++) {
+        const json_t *c = json_array_get(a, (size_t)k), *d, *v;
+        lpvp_cascade_info *ci = &vi->cascades[k];
+        uint64_t cells = 1;
+        if (!json_is_object(c)) {
+            lpvp_set_error(err, err_n, "cascades[%d]: expected an object", k);
+            return -1;
+        }
+        d = json_object_get(c, "dims");
+        if (!json_is_array(d) || json_array_size(d) != 3) {
+            lpvp_set_error(err, err_n, "cascades[%d].dims: expected an array of 3 integers", k);
+            return -1;
+        }
+        for (size_t i = 0; i < 3; i++) {
+            v = json_array_get(d, i);
+            if (!json_is_integer(v) || json_integer_value(v) < 1 ||
+                json_integer_value(v) > (1 << 20)) {
+                lpvp_set_error(err, err_n, "cascades[%d].dims[%zu]: expected an integer in [1, 1048576]",
+                               k, i);
+                return -1;
+            }
+            ci->dims[i] = json_integer_value(v);
+            if (cells > ((uint64_t)1 << 62) / (uint64_t)ci->dims[i]) {
+                lpvp_set_error(err, err_n, "cascades[%d].dims: too many cells", k);
+                return -1;
+            }
+            cells *= (uint64_t)ci->dims[i];
+        }
+        d = json_object_get(c, "origin");
+        if (!json_is_array(d) || json_array_size(d) != 3) {
+            lpvp_set_error(err, err_n, "cascades[%d].origin: expected an array of 3 numbers", k);
+            return -1;
+        }
+        for (size_t i = 0; i < 3; i++) {
+            v = json_array_get(d, i);
+            if (!json_is_number(v) || !isfinite(json_number_value(v))) {
+                lpvp_set_error(err, err_n, "cascades[%d].origin[%zu]: expected a number", k, i);
+                return -1;
+            }
+            ci->origin[i] = json_number_value(v);
+        }
+        v = json_object_get(c, "cell_size");
+        if (!json_is_number(v) || !(json_number_value(v) > 0.0) || !isfinite(json_number_value(v))) {
+            lpvp_set_error(err, err_n, "cascades[%d].cell_size: expected a positive number", k);
+            return -1;
+        }
+        ci->cell_size = json_number_value(v);
+        v = json_object_get(c, "cells");
+        if (!json_is_integer(v) || json_integer_value(v) < 0 ||
+            (uint64_t)json_integer_value(v) != cells) {
+            lpvp_set_error(err, err_n, "cascades[%d].cells: expected %llu (the product of its dims)", k,
+                           (unsigned long long)cells);
+            return -1;
+        }
+        ci->cells = cells;
+        if (total > ((uint64_t)1 << 62) - cells) {
+            lpvp_set_error(err, err_n, "cascades: too many cells");
+            return -1;
+        }
+        total += cells;
+    }
+    for (int i = 0; i < 3; i++) {
+        if (vi->cascades[0].dims[i] != vi->dims[i]) {
+            lpvp_set_error(err, err_n, "grid.dims: differs from cascades[0].dims");
+            return -1;
+        }
+        if (!same_real(vi->cascades[0].origin[i], vi->origin[i])) {
+            lpvp_set_error(err, err_n, "grid.origin: differs from cascades[0].origin");
+            return -1;
+        }
+    }
+    if (!same_real(vi->cascades[0].cell_size, vi->cell_size)) {
+        lpvp_set_error(err, err_n, "grid.cell_size: differs from cascades[0].cell_size");
+        return -1;
+    }
+    if ((uint64_t)(size_t)total != total) {
+        lpvp_set_error(err, err_n, "cascades: too many cells");
+        return -1;
+    }
     return 0;
 }
 
@@ -479,6 +648,9 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
         return -1;
     }
     vi->cell_size = json_number_value(v);
+    if (parse_cascades(obj, vi, err, err_n) != 0)
+        return -1;
+    cells = (size_t)lpvp_volume_total_cells(vi);
     if (need_int(obj, "raw_length", 0, &x, err, err_n))
         return -1;
     vi->raw_length = (uint64_t)x;

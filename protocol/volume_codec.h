@@ -112,6 +112,16 @@ int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expe
 
 /* ---- Volume header JSON (SPEC section 5) ---------------------------------- */
 
+#define LPVP_MAX_CASCADES 4  /* entries of "cascades" (SPEC R5.6) */
+
+/* One cascade's placement (SPEC R5.6). */
+typedef struct lpvp_cascade_info {
+    int64_t dims[3];             /* cells per axis, each >= 1 */
+    double origin[3];            /* m, lower corner */
+    double cell_size;            /* m, > 0 */
+    uint64_t cells;              /* dims[0] x dims[1] x dims[2] */
+} lpvp_cascade_info;
+
 typedef struct lpvp_volume_info {
     int64_t revision;            /* R3.3 */
     int64_t tick;
@@ -123,16 +133,33 @@ typedef struct lpvp_volume_info {
     double origin[3];            /* m, lower corner */
     double cell_size;            /* m, > 0 */
     uint64_t raw_length;         /* bytes of the raw volume = cells x 12 x value size */
+    /* The cascades, finest first (R5.6); dims/origin/cell_size above equal
+     * cascades[0]. Parse always fills 1..LPVP_MAX_CASCADES. For build, 0
+     * means one cascade described by dims/origin/cell_size above. */
+    int cascade_count;
+    lpvp_cascade_info cascades[LPVP_MAX_CASCADES];
 } lpvp_volume_info;
 
+/* Cells of all cascades together (0 if the count is out of range); with
+ * cascade_count 0, the cells of dims. */
+uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi);
+
+/* Index of the first cell of cascade k in the raw volume (cascades are
+ * concatenated finest first, R5.6): the sum of the cells of cascades 0..k-1. */
+uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k);
+
 /* Builds the header object (new reference; NULL if memory runs out) with
- * every field of section 5 (base_tick only for deltas) plus the fixed
- * "units", "layout" and "sh" strings. */
+ * every field of section 5 (base_tick only for deltas), the "cascades" array
+ * (R5.6; one entry from dims/origin/cell_size when cascade_count is 0) plus
+ * the fixed "units", "layout" and "sh" strings. */
 json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
 
 /* Reads a header (client side). Checks types and ranges, that dims are
- * >= 1 with a product that fits, and that raw_length == cells x 12 x value
- * size. Returns 0, or -1 with "<field>: <what>" in err. */
+ * >= 1 with a product that fits, the "cascades" array (R5.6: 1..4 entries,
+ * dims >= 1, cells == the dims' product, cell_size > 0, the top-level grid
+ * equal to cascade 0), and that raw_length == all cascades' cells x 12 x
+ * value size. A header without "cascades" (an older server) is read as one
+ * cascade equal to the grid. Returns 0, or -1 with "<field>: <what>" in err. */
 int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n);
 
 /* Client-side decoding of a VOLUME / GET_VOLUME attachment into the raw

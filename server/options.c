@@ -2,13 +2,14 @@
 #include "options.h"
 
 #include "lpv_shared.h"
+#include "settings_fields.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-const char LPVD_OPTIONS_HELP[] =
+static const char OPTIONS_HELP_HEAD[] =
     "Engine settings (--grid, --iterations, --rsm-size and --occlusion win over --preset,\n"
     "in any order):\n"
     "  --preset NAME           quality preset (default balanced; docs/accuracy.md):\n"
@@ -21,7 +22,13 @@ const char LPVD_OPTIONS_HELP[] =
     "  --rsm-size N            reflective shadow map side in texels (default: the preset's)\n"
     "  --occlusion on|off      fuzzy occlusion from the geometry volume (default: the preset's)\n"
     "  --indirect-gain G       artistic factor on the LPV term (default 1)\n"
-    "  --emissive-vpls N       VPLs sampled on emissive surfaces (default 4096)\n"
+    "  --emissive-vpls N       VPLs sampled on emissive surfaces (default 4096)\n";
+
+/* The flags of the field table that the head above does not list. */
+static const char *const HEAD_FLAGS[] = {"iterations", "rsm-size", "occlusion", "indirect-gain", "emissive-vpls",
+                                         NULL};
+
+static const char OPTIONS_HELP_TAIL[] =
     "GL:\n"
     "  --backend NAME          auto | egl-device | egl-surfaceless | osmesa\n"
     "                          (default auto; or the LPVD_GL_BACKEND variable)\n"
@@ -30,8 +37,56 @@ const char LPVD_OPTIONS_HELP[] =
     "  --eye X,Y,Z --target X,Y,Z --fov DEG   an explicit camera (fov vertical)\n"
     "  --size WxH              image size (default 512 wide, height from the camera's aspect)\n";
 
-static const char *const WITH_VALUE[] = {"preset", "grid", "bounds", "iterations", "rsm-size",
-                                         "occlusion", "indirect-gain", "emissive-vpls", "backend", "camera",
+static int in_head(const char *flag)
+{
+    for (int i = 0; HEAD_FLAGS[i]; ++i)
+        if (strcmp(flag, HEAD_FLAGS[i]) == 0)
+            return 1;
+    return 0;
+}
+
+/* The allowed values in help's compact form: "0..4", "> 0, <= 1e+06", "on|off". */
+static void help_range(const lpv_field *f, char *buf, size_t n)
+{
+    if (f->kind == LPV_FIELD_SWITCH)
+        snprintf(buf, n, "on|off");
+    else if (f->min_exclusive)
+        snprintf(buf, n, "> %g, <= %g", f->min, f->max);
+    else
+        snprintf(buf, n, "%g..%g", f->min, f->max);
+}
+
+const char *lpvd_options_help(void)
+{
+    static char help[8192];
+    if (help[0])
+        return help;
+    size_t len = (size_t)snprintf(help, sizeof help, "%s", OPTIONS_HELP_HEAD);
+    len += (size_t)snprintf(help + len, sizeof help - len,
+                            "Cascades, effects and scheduling (docs/cascades.md, docs/effects.md):\n");
+    size_t count;
+    const lpv_field *fields = lpv_fields(&count);
+    for (size_t i = 0; i < count && len < sizeof help; ++i) {
+        const lpv_field *f = &fields[i];
+        if (in_head(f->flag))
+            continue;
+        char left[64], range[64];
+        snprintf(left, sizeof left, "%s %s", f->flag, lpv_field_metavar(f));
+        help_range(f, range, sizeof range);
+        if (f->kind == LPV_FIELD_SWITCH) /* "  --glossy on|off   help\n   (default on)" */
+            len += (size_t)snprintf(help + len, sizeof help - len, "  --%-22s%s\n%26s(default %s)\n", left, f->help,
+                                    "", f->deflt);
+        else /* "  --cascade-size X   help\n   (m; > 0, <= 1e+06; default 8)" */
+            len += (size_t)snprintf(help + len, sizeof help - len, "  --%-22s%s\n%26s(%s%s%s%s%s; default %s)\n", left,
+                                    f->help, "", f->unit, f->unit[0] ? "; " : "", range, f->note[0] ? ", " : "",
+                                    f->note, f->deflt);
+    }
+    if (len < sizeof help)
+        snprintf(help + len, sizeof help - len, "%s", OPTIONS_HELP_TAIL);
+    return help;
+}
+
+static const char *const WITH_VALUE[] = {"preset", "grid", "bounds", "backend", "camera",
                                          "eye", "target", "fov", "size", NULL};
 
 int lpvd_option_takes_value(const char *name)
@@ -39,6 +94,8 @@ int lpvd_option_takes_value(const char *name)
     for (int i = 0; WITH_VALUE[i]; ++i)
         if (strcmp(name, WITH_VALUE[i]) == 0)
             return 1;
+    if (lpv_field_by_flag(name))
+        return 1;
     return -1;
 }
 
@@ -101,27 +158,12 @@ int lpvd_option_parse(lpvd_options *o, const char *name, const char *v, char *er
             return bad(err, n, name, v, "x0,y0,z0,x1,y1,z1 with max > min");
         memcpy(s->bounds_min, b, sizeof s->bounds_min);
         memcpy(s->bounds_max, b + 3, sizeof s->bounds_max);
-    } else if (strcmp(name, "iterations") == 0) {
-        if (parse_int(v, 1, LPV_MAX_ITERATIONS, &s->iterations) != 0)
-            return bad(err, n, name, v, "1..4096");
-    } else if (strcmp(name, "rsm-size") == 0) {
-        if (parse_int(v, 16, LPV_MAX_RSM_SIZE, &s->rsm_size) != 0)
-            return bad(err, n, name, v, "16..2048");
-    } else if (strcmp(name, "occlusion") == 0) {
-        if (strcmp(v, "on") == 0)
-            s->occlusion = LPV_SWITCH_ON;
-        else if (strcmp(v, "off") == 0)
-            s->occlusion = LPV_SWITCH_OFF;
-        else
-            return bad(err, n, name, v, "on or off");
-    } else if (strcmp(name, "indirect-gain") == 0) {
-        float g;
-        if (parse_floats(v, &g, 1) != 0 || !(g > 0.0f))
-            return bad(err, n, name, v, "a number > 0");
-        s->indirect_gain = g;
-    } else if (strcmp(name, "emissive-vpls") == 0) {
-        if (parse_int(v, 1, 1 << 20, &s->emissive_vpls) != 0)
-            return bad(err, n, name, v, "1..1048576");
+    } else if (lpv_field_by_flag(name)) { /* the table's scalar knobs (core/settings_fields.c) */
+        char why[160];
+        if (lpv_field_set_string(s, lpv_field_by_flag(name), v, why, sizeof why) != 0) {
+            snprintf(err, n, "--%s %s: %s", name, v ? v : "", why);
+            return -1;
+        }
     } else if (strcmp(name, "backend") == 0) {
         if (lpv_backend_parse(v, &o->backend) != 0)
             return bad(err, n, name, v, "auto, egl-device, egl-surfaceless or osmesa");

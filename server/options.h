@@ -25,15 +25,18 @@ typedef struct lpvd_options {
     lpvd_camera_choice cam;
 } lpvd_options;
 
-/* Tries to consume one shared flag (name without dashes, its value or NULL).
+/* Tries to consume one shared flag (name without dashes, its value or NULL);
+ * the settings flags of core/settings_fields.h are among them.
  * Returns 1 if it was one, 0 if not, -1 on a bad value (message in err). */
 int lpvd_option_parse(lpvd_options *o, const char *name, const char *value, char *err, size_t err_size);
 
 /* Whether a shared flag takes a value (for the commands' parsers). -1 unknown. */
 int lpvd_option_takes_value(const char *name);
 
-/* The help text for the shared flags. */
-extern const char LPVD_OPTIONS_HELP[];
+/* The help text for the shared flags; the settings knobs of the field table
+ * (core/settings_fields.h) are listed from it. Built once, never freed. */
+const char *lpvd_options_help(void);
+#define LPVD_OPTIONS_HELP lpvd_options_help()
 
 /* Resolves the camera choice against a scene. Returns 0 or -1 (err). */
 int lpvd_resolve_view(const lpvd_camera_choice *c, const lpv_scene *scene, lpv_view *view, char *err,

@@ -30,6 +30,7 @@
 #include "scene.h"
 #include "settings.h"
 #include "view.h"
+#include "volume_codec.h"
 
 #define SV_PROTOCOL_VERSION 1
 #define SV_HEADER_SIZE 24
@@ -140,12 +141,15 @@ typedef struct sv_result {
     int refs;
     uint64_t tick;          /* world tick number, 1.. */
     uint64_t gen;           /* world generation it was computed for */
-    lpv_grid grid;
-    float *cells;           /* cells * 12 floats */
-    size_t cell_count;
+    lpv_grid grid;          /* cascade 0 (the finest) */
+    int cascade_count;      /* 1..LPVP_MAX_CASCADES */
+    lpv_grid cascades[LPVP_MAX_CASCADES]; /* finest first; every cascade has grid.dims */
+    float *cells;           /* cells * 12 floats: every cascade's, cascade 0 first */
+    size_t cell_count;      /* all cascades' cells */
     float *frames[3];       /* rgba float per lpv_frame_terms, NULL if not rendered */
     int width, height;
     lpv_engine_stats stats;
+    lpv_plan plan;          /* the plan of this tick, snapshotted with stats */
     double tick_ms;         /* wall time of the tick on the GL thread */
     /* main thread: keyframe attachments already encoded, [fp16][zstd] */
     uint8_t *enc[2][2];
@@ -402,8 +406,10 @@ size_t sv_jobs_queued(sv_server *s);
  * where the raw is remembered), or NULL. */
 int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
                      uint8_t **att, size_t *att_len, char *err, size_t n);
+/* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, uint64_t revision,
-                    uint64_t tick, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n);
+                    uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len,
+                    char *err, size_t n);
 void sv_sub_clear(sv_sub *sub);
 void sv_sub_ack(sv_sub *sub, uint64_t tick);
 

@@ -3,6 +3,8 @@
  * FRAME / GET_FRAME (section 6), through protocol/volume_codec.h: fp16/fp32
  * packing, XOR deltas against the last volume a subscriber ACKed, zstd; and
  * frames as tone-mapped rgba8, PNG or EXR (in-memory, image/image_io.h).
+ * A volume carries every cascade (R5.6, cascade 0 first) and both headers
+ * the tick's "plan" (lpvd_plan_json).
  */
 #include "serve.h"
 
@@ -11,6 +13,7 @@
 #include <string.h>
 
 #include "image_io.h"
+#include "stats_json.h"
 #include "tonemap.h"
 #include "volume_codec.h"
 
@@ -94,7 +97,18 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
         vi.origin[i] = r->grid.origin[i];
     }
     vi.cell_size = r->grid.cell_size;
-    vi.raw_length = raw_len;
+    vi.raw_length = raw_len; /* all cascades' cells (R5.6) */
+    vi.cascade_count = r->cascade_count < 1 ? 1 : r->cascade_count;
+    for (int k = 0; k < vi.cascade_count; ++k) {
+        const lpv_grid *g = r->cascade_count < 1 ? &r->grid : &r->cascades[k];
+        lpvp_cascade_info *ci = &vi.cascades[k];
+        for (int i = 0; i < 3; ++i) {
+            ci->dims[i] = g->dims[i];
+            ci->origin[i] = g->origin[i];
+        }
+        ci->cell_size = g->cell_size;
+        ci->cells = lpv_grid_cell_count(g);
+    }
 
     uint8_t *payload = raw; /* what gets compressed / sent */
     uint8_t *delta = NULL;
@@ -155,6 +169,10 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
         }
     }
     *body = lpvp_volume_header_build(&vi);
+    if (*body && json_object_set_new(*body, "plan", lpvd_plan_json(&r->plan)) != 0) {
+        json_decref(*body);
+        *body = NULL;
+    }
     if (!*body) {
         free(*att);
         *att = NULL;
@@ -168,7 +186,7 @@ static const char *const TERMS_NAMES[3] = {"full", "indirect", "direct"};
 static const char *const FMT_NAMES[3] = {"rgba8", "png", "exr"};
 
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, uint64_t revision, uint64_t tick,
-                    json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
+                    const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
 {
     size_t px = (size_t)w * (size_t)h;
     uint8_t *data = NULL;
@@ -213,6 +231,10 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
                       (json_int_t)tick, "format", FMT_NAMES[fmt], "compression", zstd ? "zstd" : "none", "width", w,
                       "height", h, "terms", TERMS_NAMES[terms], "units", fmt == 2 ? "W/(m^2 sr)" : "sRGB",
                       "raw_length", (json_int_t)raw_len);
+    if (*body && plan && json_object_set_new(*body, "plan", lpvd_plan_json(plan)) != 0) {
+        json_decref(*body);
+        *body = NULL;
+    }
     if (!*body) {
         free(data);
         *att = NULL;

@@ -20,6 +20,8 @@
 #include <unistd.h>
 
 #include "gltf_load.h"
+#include "stats_json.h"
+#include "settings_fields.h"
 #include "volume_codec.h"
 
 #define SV_MAX_LIGHTS 256
@@ -197,7 +199,7 @@ static json_t *tick_stats(const sv_result *r)
     double total = 0;
     for (int i = 0; i < st->stage_count; ++i)
         total += st->stages[i].gpu_ms;
-    return json_pack("{s:o, s:f, s:f, s:{s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b}, s:{s:[i,i,i], s:f, "
+    json_t *o = json_pack("{s:o, s:f, s:f, s:{s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b}, s:{s:[i,i,i], s:f, "
                      "s:[f,f,f]}}",
                      "stages", stats_stages(st), "total_gpu_ms", total, "tick_ms", r->tick_ms, "counts", "lights",
                      (int)st->lights, "rsm_faces", (int)st->rsm_faces, "vpls_rsm", (json_int_t)st->vpls_rsm,
@@ -206,6 +208,12 @@ static json_t *tick_stats(const sv_result *r)
                      st->iterations, "cell_steps", st->cell_steps, "occlusion", st->occlusion != 0, "grid", "dims",
                      r->grid.dims[0], r->grid.dims[1], r->grid.dims[2], "cell_size_m", (double)r->grid.cell_size,
                      "origin_m", (double)r->grid.origin[0], (double)r->grid.origin[1], (double)r->grid.origin[2]);
+    if (o) { /* the cascades' placements and this tick's plan, snapshotted with the stats (sv_result) */
+        json_object_set_new(o, "cascades", lpvd_cascades_json(r->cascade_count < 1 ? &r->grid : r->cascades,
+                                                             r->cascade_count < 1 ? 1 : r->cascade_count));
+        json_object_set_new(o, "plan", lpvd_plan_json(&r->plan));
+    }
+    return o;
 }
 
 static json_t *config_json(sv_conn *c)
@@ -230,11 +238,21 @@ static json_t *config_json(sv_conn *c)
                            (double)s.bounds_max[0], (double)s.bounds_max[1], (double)s.bounds_max[2]);
     }
     const char *preset = lpv_preset_name(s.preset); /* CONFIG validated it, so never NULL */
-    return json_pack("{s:s, s:[i,i,i], s:o, s:b, s:i, s:i, s:b, s:f, s:i, s:f}", "preset", preset ? preset : "",
-                     "grid", s.grid_dims[0], s.grid_dims[1], s.grid_dims[2], "bounds", bounds, "bounds_auto",
-                     auto_bounds, "iterations", s.iterations, "rsm_size", s.rsm_size, "occlusion",
-                     s.occlusion != LPV_SWITCH_OFF, "indirect_gain", (double)s.indirect_gain, "emissive_vpls",
-                     s.emissive_vpls, "tick_rate_hz", c->tick_rate);
+    json_t *o = json_pack("{s:s, s:[i,i,i], s:o, s:b}", "preset", preset ? preset : "", "grid", s.grid_dims[0],
+                          s.grid_dims[1], s.grid_dims[2], "bounds", bounds, "bounds_auto", auto_bounds);
+    /* every knob of the field table (core/settings_fields.h), resolved: iterations, rsm_size, occlusion, ... */
+    size_t nf;
+    const lpv_field *fields = lpv_fields(&nf);
+    for (size_t i = 0; o && i < nf; ++i) {
+        double v = lpv_field_get(&s, &fields[i]);
+        json_object_set_new(o, fields[i].key,
+                            fields[i].kind == LPV_FIELD_INT      ? json_integer((json_int_t)v)
+                            : fields[i].kind == LPV_FIELD_SWITCH ? json_boolean(v > 0.0)
+                                                                 : json_real(v));
+    }
+    if (o)
+        json_object_set_new(o, "tick_rate_hz", json_real(c->tick_rate));
+    return o;
 }
 
 static json_t *scene_json(const lpv_scene *sc)
@@ -997,15 +1015,45 @@ static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_setting
     return LPVP_FIELD_OK;
 }
 
+/* CONFIG's scalar knobs, one per entry of the field table (core/settings_fields.h):
+ * ints as JSON integers, floats as JSON numbers, switches as JSON booleans, each
+ * within the table's range. Returns 0, or -1 with a message naming the key. */
+static int config_fields(const json_t *j, lpv_settings *st, char *err, size_t n)
+{
+    size_t nf;
+    const lpv_field *fields = lpv_fields(&nf);
+    for (size_t i = 0; i < nf; ++i) {
+        const lpv_field *f = &fields[i];
+        int64_t iv;
+        double dv;
+        int bv, rc;
+        char why[160];
+        if (f->kind == LPV_FIELD_SWITCH) {
+            if ((rc = lpvp_get_bool(j, f->key, 0, &bv, err, n)) == LPVP_FIELD_OK)
+                lpv_field_set_bool(st, f, bv);
+        } else if (f->kind == LPV_FIELD_INT) {
+            if ((rc = lpvp_get_int(j, f->key, 0, (int64_t)f->min, (int64_t)f->max, &iv, err, n)) == LPVP_FIELD_OK)
+                lpv_field_set_number(st, f, (double)iv, NULL, 0);
+        } else if ((rc = lpvp_get_number(j, f->key, 0, f->min, f->max, &dv, err, n)) == LPVP_FIELD_OK &&
+                   lpv_field_set_number(st, f, dv, why, sizeof why) != 0) { /* an exclusive minimum */
+            snprintf(err, n, "%s: %s", f->key, why);
+            return -1;
+        }
+        if (rc == LPVP_FIELD_BAD)
+            return -1;
+    }
+    return 0;
+}
+
 static void do_config(sv_conn *c, sv_request *r, json_t *j)
 {
     sv_server *s = c->srv;
     char err[512];
     lpv_settings st = c->settings;
     double rate = c->tick_rate;
-    int64_t grid[3], iv;
-    float bounds[6], gain;
-    int occl, gst;
+    int64_t grid[3];
+    float bounds[6];
+    int gst;
     double lim_rate = s->cfg.max_tick_rate;
     int pst = config_preset(c, r, j, &st, err, sizeof err);
     if (pst == LPVP_FIELD_BAD)
@@ -1044,33 +1092,14 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
         memcpy(st.bounds_max, bounds + 3, sizeof st.bounds_max);
     }
     int ist;
-    if ((ist = lpvp_get_int(j, "iterations", 0, 1, LPV_MAX_ITERATIONS, &iv, err, sizeof err)) == LPVP_FIELD_BAD)
+    if (config_fields(j, &st, err, sizeof err) != 0) /* iterations, rsm_size, occlusion, ..., planner */
         goto bad;
-    if (ist == LPVP_FIELD_OK)
-        st.iterations = (int)iv;
-    if ((ist = lpvp_get_int(j, "rsm_size", 0, 16, LPV_MAX_RSM_SIZE, &iv, err, sizeof err)) == LPVP_FIELD_BAD)
-        goto bad;
-    if (ist == LPVP_FIELD_OK) {
-        if (iv > s->cfg.max_texture) {
-            reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
-                      "rsm_size: %lld is over the server's texture limit of %d (--max-texture)", (long long)iv,
-                      s->cfg.max_texture);
-            return;
-        }
-        st.rsm_size = (int)iv;
+    if (json_object_get(j, "rsm_size") && st.rsm_size > s->cfg.max_texture) {
+        reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                  "rsm_size: %d is over the server's texture limit of %d (--max-texture)", st.rsm_size,
+                  s->cfg.max_texture);
+        return;
     }
-    if ((ist = lpvp_get_bool(j, "occlusion", 0, &occl, err, sizeof err)) == LPVP_FIELD_BAD)
-        goto bad;
-    if (ist == LPVP_FIELD_OK)
-        st.occlusion = occl ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
-    if ((ist = lpvp_get_float(j, "indirect_gain", 0, 1e-30, 1e30, &gain, err, sizeof err)) == LPVP_FIELD_BAD)
-        goto bad;
-    if (ist == LPVP_FIELD_OK)
-        st.indirect_gain = gain;
-    if ((ist = lpvp_get_int(j, "emissive_vpls", 0, 1, 1 << 20, &iv, err, sizeof err)) == LPVP_FIELD_BAD)
-        goto bad;
-    if (ist == LPVP_FIELD_OK)
-        st.emissive_vpls = (int)iv;
     double rv;
     if ((ist = lpvp_get_number(j, "tick_rate_hz", 0, 0.0, 1e9, &rv, err, sizeof err)) == LPVP_FIELD_BAD)
         goto bad;
@@ -1196,11 +1225,15 @@ static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w, int h, int fmt, int zstd, int terms,
                              uint64_t tick)
 {
+    /* the plan of the tick shown, when it is still the world's latest */
+    const lpv_plan *plan = c->world && c->world->latest && c->world->latest->tick == tick ? &c->world->latest->plan
+                                                                                          : NULL;
     char err[512];
     json_t *b = NULL;
     uint8_t *att = NULL;
     size_t alen = 0;
-    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, c->revision, tick, &b, &att, &alen, err, sizeof err) != 0) {
+    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, c->revision, tick, plan, &b, &att, &alen, err, sizeof err) !=
+        0) {
         reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
         return;
     }
@@ -1394,7 +1427,7 @@ void sv_session_stream(sv_conn *c, sv_result *r)
         uint8_t *att = NULL;
         size_t alen = 0;
         if (sv_encode_frame(r->frames[fs->terms], r->width, r->height, fs->fmt, fs->zstd, fs->terms, c->revision,
-                            r->tick, &b, &att, &alen, err, sizeof err) == 0)
+                            r->tick, &r->plan, &b, &att, &alen, err, sizeof err) == 0)
             sv_send(c, LPVP_FRAME, 0, b, att, alen, SV_STREAM_FRAME);
         else
             fprintf(stderr, "lpvd serve: client %llu: frame: %s\n", (unsigned long long)c->id, err);

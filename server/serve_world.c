@@ -320,8 +320,18 @@ static void gl_tick(sv_server *s, sv_job *j)
     r->refs = 1;
     r->gen = j->gen;
     r->grid = *lpv_engine_grid(w->engine);
-    r->cell_count = lpv_grid_cell_count(&r->grid);
-    r->cells = malloc(r->cell_count * sizeof(lpv_cell));
+    r->cascade_count = lpv_engine_cascade_count(w->engine);
+    if (r->cascade_count < 1)
+        r->cascade_count = 1;
+    if (r->cascade_count > LPVP_MAX_CASCADES)
+        r->cascade_count = LPVP_MAX_CASCADES;
+    r->cell_count = 0;
+    for (int k = 0; k < r->cascade_count; ++k) {
+        const lpv_grid *g = lpv_engine_cascade(w->engine, k);
+        r->cascades[k] = g ? *g : r->grid;
+        r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
+    }
+    r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
     if (!r->cells) {
         j->status = SV_E_INTERNAL;
         snprintf(j->err, sizeof j->err, "out of memory for %zu cells", r->cell_count);
@@ -344,6 +354,7 @@ static void gl_tick(sv_server *s, sv_job *j)
         }
     }
     r->stats = *lpv_engine_last_stats(w->engine);
+    r->plan = *lpv_engine_last_plan(w->engine);
     r->tick = ++w->gl_ticks;
     r->tick_ms = wall_ms() - t0;
     j->result = r;

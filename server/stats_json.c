@@ -1,6 +1,54 @@
 /* stats_json.c - see stats_json.h. Field names are documented in README.md. */
 #include "stats_json.h"
 
+#include <string.h>
+
+/* A reason's length (it may fill its whole buffer without a NUL). */
+static int reason_len(const char *r)
+{
+    const char *end = memchr(r, '\0', LPV_PLAN_REASON_MAX);
+    return end ? (int)(end - r) : LPV_PLAN_REASON_MAX;
+}
+
+static json_t *grid_json(const lpv_grid *g)
+{
+    return json_pack("{s:[i,i,i], s:f, s:[f,f,f]}", "dims", g->dims[0], g->dims[1], g->dims[2], "cell_size_m",
+                     (double)g->cell_size, "origin_m", (double)g->origin[0], (double)g->origin[1],
+                     (double)g->origin[2]);
+}
+
+json_t *lpvd_cascades_json(const lpv_grid *cascades, int n)
+{
+    json_t *a = json_array();
+    for (int k = 0; a && k < n; ++k) {
+        if (json_array_append_new(a, grid_json(&cascades[k])) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+json_t *lpvd_plan_json(const lpv_plan *p)
+{
+    json_t *passes = json_array();
+    for (int i = 0; passes && i < LPV_PASS_COUNT; ++i) {
+        const char *name = lpv_pass_name((lpv_pass_id)i);
+        json_t *o = json_pack("{s:s, s:b, s:s#}", "name", name ? name : "", "run", p->pass[i].run != 0, "reason",
+                              p->pass[i].reason, reason_len(p->pass[i].reason));
+        if (json_array_append_new(passes, o) != 0) {
+            json_decref(passes);
+            return NULL;
+        }
+    }
+    if (!passes)
+        return NULL;
+    return json_pack("{s:i, s:s#, s:b, s:s#, s:o}", "cascades", p->cascades, "cascades_reason", p->cascades_reason,
+                     reason_len(p->cascades_reason), "recompute", p->recompute != 0,
+                     "recompute_reason", p->recompute_reason,
+                     reason_len(p->recompute_reason), "passes", passes);
+}
+
 json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const char *scene_source)
 {
     const lpv_engine_stats *s = lpv_engine_last_stats(e);
@@ -15,9 +63,17 @@ json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const ch
                                                 (int)s->stages[i].calls));
         total += s->stages[i].gpu_ms;
     }
-    json_t *grid = json_pack("{s:[i,i,i], s:f, s:[f,f,f]}", "dims", g->dims[0], g->dims[1], g->dims[2], "cell_size_m",
-                             (double)g->cell_size, "origin_m", (double)g->origin[0], (double)g->origin[1],
-                             (double)g->origin[2]);
+    json_t *grid = grid_json(g);
+    lpv_grid cascades[LPV_MAX_CASCADES];
+    int ncascades = lpv_engine_cascade_count(e);
+    if (ncascades < 1)
+        ncascades = 1;
+    if (ncascades > LPV_MAX_CASCADES)
+        ncascades = LPV_MAX_CASCADES;
+    for (int k = 0; k < ncascades; ++k) {
+        const lpv_grid *c = lpv_engine_cascade(e, k);
+        cascades[k] = c ? *c : *g;
+    }
     /* preset: the one the settings started from; explicit flags may have overridden its values */
     const char *preset = lpv_preset_name(set->preset);
     json_t *settings = json_pack("{s:s, s:i, s:i, s:b, s:f, s:i}", "preset", preset ? preset : "", "iterations",
@@ -29,8 +85,9 @@ json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const ch
                                (json_int_t)s->vpls_emissive, "surfels_rsm", (json_int_t)s->surfels_rsm,
                                "surfels_camera", (json_int_t)s->surfels_camera, "cells", (json_int_t)s->cells,
                                "cell_steps", s->cell_steps);
-    return json_pack("{s:s, s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:f}", "backend",
+    return json_pack("{s:s, s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:f}", "backend",
                      lpv_backend_name(lpv_gl_context_backend(ctx)), "gl_renderer", lpv_gl_context_renderer(ctx),
-                     "gl_version", lpv_gl_context_version(ctx), "scene", scene_source, "grid", grid, "settings",
-                     settings, "counts", counts, "stages", stages, "total_gpu_ms", total);
+                     "gl_version", lpv_gl_context_version(ctx), "scene", scene_source, "grid", grid, "cascades",
+                     lpvd_cascades_json(cascades, ncascades), "plan", lpvd_plan_json(lpv_engine_last_plan(e)),
+                     "settings", settings, "counts", counts, "stages", stages, "total_gpu_ms", total);
 }

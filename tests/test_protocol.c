@@ -1145,13 +1145,134 @@ static void test_zstd(void **state)
 
 /* ---- volume header and client decoding (section 5) ------------------------ */
 
+static void expect_cascade_error(json_t *h, const char *field)
+{
+    char err[256];
+    lpvp_volume_info back;
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), -1);
+    if (strstr(err, field) != err)
+        fail_msg("expected an error on %s, got \"%s\"", field, err);
+    json_decref(h);
+}
+
+/* R5.6: several cascades, finest first, the grid equal to cascade 0. */
+static void test_volume_cascades(void **state)
+{
+    (void)state;
+    char err[256];
+    lpvp_volume_info vi;
+    memset(&vi, 0, sizeof vi);
+    vi.revision = 3;
+    vi.tick = 9;
+    vi.format = LPVP_FMT_FP32;
+    vi.keyframe = 1;
+    vi.base_tick = -1;
+    vi.cascade_count = 3;
+    for (int k = 0; k < 3; k++) {
+        lpvp_cascade_info *c = &vi.cascades[k];
+        c->dims[0] = 4;
+        c->dims[1] = 3;
+        c->dims[2] = 2;
+        c->cells = 24;
+        c->cell_size = 0.25 * (double)(1 << k);
+        for (int i = 0; i < 3; i++)
+            c->origin[i] = -0.5 * c->cell_size * (double)c->dims[i] + 0.125;
+    }
+    for (int i = 0; i < 3; i++) {
+        vi.dims[i] = vi.cascades[0].dims[i];
+        vi.origin[i] = vi.cascades[0].origin[i];
+    }
+    vi.cell_size = vi.cascades[0].cell_size;
+    assert_int_equal(lpvp_volume_total_cells(&vi), 72);
+    assert_int_equal(lpvp_volume_cascade_first_cell(&vi, 0), 0);
+    assert_int_equal(lpvp_volume_cascade_first_cell(&vi, 2), 48);
+    vi.raw_length = 72 * 12 * 4;
+
+    json_t *h = lpvp_volume_header_build(&vi);
+    assert_non_null(h);
+    json_t *a = json_object_get(h, "cascades");
+    assert_true(json_is_array(a) && json_array_size(a) == 3);
+    assert_int_equal(json_integer_value(json_object_get(json_array_get(a, 1), "cells")), 24);
+    lpvp_volume_info back;
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_int_equal(back.cascade_count, 3);
+    assert_true(back.cascades[2].cell_size == 1.0);
+    assert_true(back.cascades[1].origin[1] == vi.cascades[1].origin[1]);
+    assert_int_equal(back.cascades[2].dims[2], 2);
+    assert_int_equal(back.raw_length, 72 * 48);
+    assert_int_equal(lpvp_volume_total_cells(&back), 72);
+
+    /* Inconsistencies, each with "<field>: <what>". */
+    json_t *c;
+    c = json_deep_copy(h);
+    json_object_set_new(c, "raw_length", json_integer(24 * 48)); /* one cascade's worth */
+    expect_cascade_error(c, "raw_length");
+    c = json_deep_copy(h);
+    json_object_set_new(c, "cascades", json_array());
+    expect_cascade_error(c, "cascades");
+    c = json_deep_copy(h);
+    for (int k = 0; k < 2; k++)
+        json_array_append(json_object_get(c, "cascades"), json_array_get(json_object_get(c, "cascades"), 0));
+    expect_cascade_error(c, "cascades"); /* 5 > LPVP_MAX_CASCADES */
+    c = json_deep_copy(h);
+    json_object_set_new(c, "cascades", json_string("no"));
+    expect_cascade_error(c, "cascades");
+    c = json_deep_copy(h);
+    json_array_set_new(json_object_get(json_array_get(json_object_get(c, "cascades"), 1), "dims"), 0,
+                       json_integer(0));
+    expect_cascade_error(c, "cascades[1].dims[0]");
+    c = json_deep_copy(h);
+    json_object_set_new(json_array_get(json_object_get(c, "cascades"), 2), "cell_size", json_real(0.0));
+    expect_cascade_error(c, "cascades[2].cell_size");
+    c = json_deep_copy(h);
+    json_object_set_new(json_array_get(json_object_get(c, "cascades"), 2), "cell_size", json_real(-1.0));
+    expect_cascade_error(c, "cascades[2].cell_size");
+    c = json_deep_copy(h);
+    json_object_set_new(json_array_get(json_object_get(c, "cascades"), 1), "cells", json_integer(23));
+    expect_cascade_error(c, "cascades[1].cells");
+    c = json_deep_copy(h);
+    json_object_del(json_array_get(json_object_get(c, "cascades"), 0), "origin");
+    expect_cascade_error(c, "cascades[0].origin");
+    c = json_deep_copy(h);
+    json_object_set_new(json_object_get(c, "grid"), "cell_size", json_real(0.5));
+    expect_cascade_error(c, "grid.cell_size");
+    c = json_deep_copy(h);
+    json_array_set_new(json_object_get(json_object_get(c, "grid"), "origin"), 1, json_real(7.0));
+    expect_cascade_error(c, "grid.origin");
+    c = json_deep_copy(h);
+    json_array_set_new(json_object_get(json_object_get(c, "grid"), "dims"), 0, json_integer(5));
+    json_array_set_new(json_object_get(json_array_get(json_object_get(c, "cascades"), 0), "dims"), 0,
+                       json_integer(5));
+    json_object_set_new(json_array_get(json_object_get(c, "cascades"), 0), "cells", json_integer(30));
+    json_object_set_new(c, "raw_length", json_integer(78 * 48));
+    assert_int_equal(lpvp_volume_header_parse(c, &back, err, sizeof err), 0); /* consistent again */
+    json_array_set_new(json_object_get(json_object_get(c, "grid"), "dims"), 0, json_integer(4));
+    json_object_set_new(c, "raw_length", json_integer(78 * 48));
+    expect_cascade_error(c, "grid.dims");
+    json_decref(h);
+
+    /* A header without "cascades" (an older server) reads as one cascade. */
+    vi.cascade_count = 0;
+    vi.raw_length = 24 * 48;
+    h = lpvp_volume_header_build(&vi);
+    assert_int_equal(json_array_size(json_object_get(h, "cascades")), 1);
+    json_object_del(h, "cascades");
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_int_equal(back.cascade_count, 1);
+    assert_int_equal(back.cascades[0].cells, 24);
+    assert_true(back.cascades[0].cell_size == 0.25);
+    json_decref(h);
+}
+
 static void test_volume_header_and_decode(void **state)
 {
     (void)state;
     char err[256];
     const size_t cells = 4 * 3 * 2;
-    lpvp_volume_info vi = {7, 12, LPVP_FMT_FP16, LPVP_COMP_ZSTD, 1, -1, {4, 3, 2},
-                           {-1, 0, 0.5}, 0.25, cells * 24};
+    lpvp_volume_info vi = {.revision = 7, .tick = 12, .format = LPVP_FMT_FP16,
+                           .compression = LPVP_COMP_ZSTD, .keyframe = 1, .base_tick = -1,
+                           .dims = {4, 3, 2}, .origin = {-1, 0, 0.5}, .cell_size = 0.25,
+                           .raw_length = cells * 24};
     json_t *h = lpvp_volume_header_build(&vi);
     assert_non_null(h);
     assert_string_equal(json_string_value(json_object_get(h, "layout")), LPVP_VOLUME_LAYOUT);
@@ -1276,6 +1397,7 @@ int main(void)
         cmocka_unit_test(test_xor_delta),
         cmocka_unit_test(test_zstd),
         cmocka_unit_test(test_volume_header_and_decode),
+        cmocka_unit_test(test_volume_cascades),
         cmocka_unit_test(test_addresses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -676,6 +676,28 @@ int lpvc_config_set(lpvc *c, const lpvc_config *cfg)
         json_object_set_new(o, "emissive_vpls", json_integer(cfg->emissive_vpls));
     if (cfg->tick_rate_hz != 0.0f)
         json_object_set_new(o, "tick_rate_hz", json_real(cfg->tick_rate_hz));
+    const struct {
+        const char *key;
+        const float *f; /* a number, or */
+        const int *i;   /* an integer (sw = 0) or a switch (sw = 1) */
+        int sw;
+    } knobs[] = {
+        {"cascades", NULL, &cfg->cascades, 0},          {"cascade_size", &cfg->cascade_size, NULL, 0},
+        {"cascade_ratio", &cfg->cascade_ratio, NULL, 0}, {"cascade_offset", &cfg->cascade_offset, NULL, 0},
+        {"bounces", NULL, &cfg->bounces, 1},            {"bounce_intensity", &cfg->bounce_intensity, NULL, 0},
+        {"damping", &cfg->damping, NULL, 0},            {"glossy", NULL, &cfg->glossy, 1},
+        {"glossy_roughness", &cfg->glossy_roughness, NULL, 0}, {"media", NULL, &cfg->media, 1},
+        {"fog_sigma_s", &cfg->fog_sigma_s, NULL, 0},    {"fog_sigma_a", &cfg->fog_sigma_a, NULL, 0},
+        {"media_step", &cfg->media_step, NULL, 0},      {"planner", NULL, &cfg->planner, 1},
+    };
+    for (size_t k = 0; k < sizeof knobs / sizeof knobs[0]; ++k) {
+        if (knobs[k].f && *knobs[k].f != 0.0f)
+            json_object_set_new(o, knobs[k].key, json_real(*knobs[k].f));
+        else if (knobs[k].i && *knobs[k].i && knobs[k].sw)
+            json_object_set_new(o, knobs[k].key, json_boolean(*knobs[k].i > 0));
+        else if (knobs[k].i && *knobs[k].i)
+            json_object_set_new(o, knobs[k].key, json_integer(*knobs[k].i));
+    }
     return simple(c, LPVP_CONFIG, o);
 }
 
@@ -752,6 +774,7 @@ void lpvc_volume_free(lpvc_volume *v)
         return;
     free(v->data);
     free(v->header_json);
+    free(v->plan_json);
     memset(v, 0, sizeof *v);
 }
 
@@ -794,7 +817,8 @@ static int decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t 
     char err[256];
     if (lpvp_volume_header_parse(hdr, &vi, err, sizeof err) != 0)
         return fail(c, LPVC_ERR_PROTOCOL, "bad volume header: %s", err);
-    size_t cells = (size_t)vi.dims[0] * (size_t)vi.dims[1] * (size_t)vi.dims[2];
+    /* every cascade's cells (R5.6); the parse checked raw_length against them */
+    size_t cells = (size_t)lpvp_volume_total_cells(&vi);
     const acked *base = NULL;
     if (!vi.keyframe) {
         base = find_acked(c, vi.base_tick);
@@ -826,8 +850,22 @@ static int decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t 
         out->origin[a] = (float)vi.origin[a];
     }
     out->cell_size = (float)vi.cell_size;
-    out->cells = cells;
+    out->cells = (size_t)vi.dims[0] * (size_t)vi.dims[1] * (size_t)vi.dims[2];
     out->data = data;
+    out->total_cells = cells;
+    out->cascade_count = vi.cascade_count;
+    for (int k = 0; k < vi.cascade_count && k < LPVC_MAX_CASCADES; k++) {
+        lpvc_cascade *cs = &out->cascades[k];
+        for (int a = 0; a < 3; a++) {
+            cs->dims[a] = (int)vi.cascades[k].dims[a];
+            cs->origin[a] = (float)vi.cascades[k].origin[a];
+        }
+        cs->cell_size = (float)vi.cascades[k].cell_size;
+        cs->cells = (size_t)vi.cascades[k].cells;
+        cs->data = data + 12 * (size_t)lpvp_volume_cascade_first_cell(&vi, k);
+    }
+    if (json_is_object(json_object_get(hdr, "plan")))
+        out->plan_json = json_dumps(json_object_get(hdr, "plan"), JSON_COMPACT);
     snprintf(out->format, sizeof out->format, "%s", lpvp_volume_format_name(vi.format));
     snprintf(out->compression, sizeof out->compression, "%s", lpvp_compression_name(vi.compression));
     out->keyframe = vi.keyframe != 0;
@@ -876,6 +914,7 @@ void lpvc_frame_free(lpvc_frame *f)
         return;
     free(f->data);
     free(f->header_json);
+    free(f->plan_json);
     memset(f, 0, sizeof *f);
 }
 
@@ -934,6 +973,8 @@ static int decode_frame(lpvc *c, const json_t *hdr, uint8_t *att, size_t att_len
     out->data = att;
     out->size = att_len;
     out->header_json = json_dumps(hdr, JSON_COMPACT);
+    if (json_is_object(json_object_get(hdr, "plan")))
+        out->plan_json = json_dumps(json_object_get(hdr, "plan"), JSON_COMPACT);
     return 0;
 }
 
@@ -1142,7 +1183,7 @@ int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms)
 
 /* ---- local lookup (docs/propagation.md section 6, core/oracle_lookup.c) ---- */
 
-static int axis_lerp(const lpvc_volume *v, int a, float p, int *i0, int *i1, float *f)
+static int axis_lerp(const lpvc_cascade *v, int a, float p, int *i0, int *i1, float *f)
 {
     float u = (p - v->origin[a]) / v->cell_size;
     if (isnan(u))
@@ -1160,7 +1201,7 @@ static int axis_lerp(const lpvc_volume *v, int a, float p, int *i0, int *i1, flo
     return 1;
 }
 
-void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3])
+void lpvc_cascade_irradiance(const lpvc_cascade *v, const float p[3], const float n[3], float rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
     if (!v || !v->data || v->cell_size <= 0.0f)
@@ -1203,4 +1244,56 @@ void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float 
         float d = c[4 * ch] * lobe[0] + c[4 * ch + 1] * lobe[1] + c[4 * ch + 2] * lobe[2] + c[4 * ch + 3] * lobe[3];
         rgb[ch] = fmaxf(0.0f, d * inv);
     }
+}
+
+/* Distance from p to the box of cs in its cells (the smallest over the six
+ * faces; negative outside, NaN for a NaN p). */
+static float border_cells(const lpvc_cascade *cs, const float p[3])
+{
+    float d = INFINITY;
+    for (int a = 0; a < 3; a++) {
+        float u = (p[a] - cs->origin[a]) / cs->cell_size;
+        d = fminf(d, fminf(u, (float)cs->dims[a] - u));
+        if (isnan(u))
+            return NAN;
+    }
+    return d;
+}
+
+void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!v || !v->data)
+        return;
+    lpvc_cascade one;
+    const lpvc_cascade *cs = v->cascades;
+    int count = v->cascade_count;
+    if (count < 1 || count > LPVC_MAX_CASCADES) { /* a volume built by hand: the grid alone */
+        for (int a = 0; a < 3; a++) {
+            one.dims[a] = v->dims[a];
+            one.origin[a] = v->origin[a];
+        }
+        one.cell_size = v->cell_size;
+        one.cells = v->cells;
+        one.data = v->data;
+        cs = &one;
+        count = 1;
+    }
+    /* R5.7: the finest cascade containing p (the coarsest if none does) */
+    int k = count - 1;
+    for (int i = 0; i < count; i++)
+        if (border_cells(&cs[i], p) >= 0.0f) {
+            k = i;
+            break;
+        }
+    lpvc_cascade_irradiance(&cs[k], p, n, rgb);
+    if (k + 1 >= count || !(border_cells(&cs[k + 1], p) >= 0.0f))
+        return;
+    float w = fminf(fmaxf((border_cells(&cs[k], p) - 1.0f) * 0.5f, 0.0f), 1.0f);
+    if (w >= 1.0f)
+        return;
+    float coarse[3];
+    lpvc_cascade_irradiance(&cs[k + 1], p, n, coarse);
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = w * rgb[ch] + (1.0f - w) * coarse[ch];
 }

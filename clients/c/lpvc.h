@@ -127,6 +127,22 @@ typedef struct lpvc_config {
     float indirect_gain;       /* 0: not sent */
     int emissive_vpls;         /* 0: not sent */
     float tick_rate_hz;        /* 0: not sent */
+    /* Cascades, effects and scheduling (SPEC R4.11). Numbers: 0 = not sent;
+     * switches: 0 = not sent, 1 = true, -1 = false (as occlusion). */
+    int cascades;              /* 1..4 (0 = auto cannot be sent from here; lpvc_config_json can) */
+    float cascade_size;        /* m */
+    float cascade_ratio;
+    float cascade_offset;      /* fraction of the extent; negative = centred on the camera */
+    int bounces;               /* switch */
+    float bounce_intensity;
+    float damping;
+    int glossy;                /* switch */
+    float glossy_roughness;
+    int media;                 /* switch */
+    float fog_sigma_s;         /* 1/m */
+    float fog_sigma_a;         /* 1/m */
+    float media_step;          /* cells */
+    int planner;               /* switch */
     const char *preset;        /* "fast" | "balanced" | "accurate", or NULL: not sent. The server applies
                                   it first; the fields above that are sent override its values */
 } lpvc_config;
@@ -148,19 +164,36 @@ typedef struct lpvc_subscribe_desc {
 int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc);
 int lpvc_unsubscribe(lpvc *c, enum lpvc_stream stream);
 
-/* A decoded volume (SPEC section 5): always float32 after decoding. */
+#define LPVC_MAX_CASCADES 4    /* entries of a volume header's "cascades" (SPEC R5.6) */
+
+/* One cascade of a decoded volume (SPEC R5.6). */
+typedef struct lpvc_cascade {
+    int dims[3];
+    float origin[3];           /* m, lower corner */
+    float cell_size;           /* m */
+    size_t cells;              /* dims[0] * dims[1] * dims[2] */
+    float *data;               /* cells * 12 floats inside the volume's data (not to be freed) */
+} lpvc_cascade;
+
+/* A decoded volume (SPEC section 5): always float32 after decoding. The
+ * top-level dims / origin / cell_size / cells are cascade 0's (the finest);
+ * data holds every cascade's cells, cascade 0 first (total_cells in all). */
 typedef struct lpvc_volume {
     int64_t revision, tick;
     int dims[3];
     float origin[3];
     float cell_size;
-    size_t cells;              /* dims[0] * dims[1] * dims[2] */
-    float *data;               /* cells * 12: per cell r0..r3 g0..g3 b0..b3, x fastest, W/sr */
+    size_t cells;              /* dims[0] * dims[1] * dims[2]: cascade 0's cells */
+    float *data;               /* total_cells * 12: per cell r0..r3 g0..g3 b0..b3, x fastest, W/sr */
     char format[8];            /* wire format: "fp16" or "fp32" */
     char compression[8];       /* wire compression */
     bool keyframe;             /* false: was an XOR delta, already undone */
     int64_t base_tick;         /* delta base (-1 for keyframes) */
     char *header_json;         /* the header as received */
+    int cascade_count;         /* 1..LPVC_MAX_CASCADES */
+    lpvc_cascade cascades[LPVC_MAX_CASCADES]; /* finest first */
+    size_t total_cells;        /* sum of the cascades' cells */
+    char *plan_json;           /* the tick's plan (SPEC section 8) as JSON text; NULL if the header had none */
 } lpvc_volume;
 void lpvc_volume_free(lpvc_volume *v);
 
@@ -180,6 +213,7 @@ typedef struct lpvc_frame {
     unsigned char *data;
     size_t size;
     char *header_json;
+    char *plan_json;           /* the tick's plan (SPEC section 8) as JSON text; NULL if the header had none */
 } lpvc_frame;
 void lpvc_frame_free(lpvc_frame *f);
 
@@ -234,8 +268,13 @@ int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
 /* ---- Local lookup (docs/propagation.md section 6) -------------------------- */
 
 /* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
- * server's QUERY_IRRADIANCE computes it. */
+ * server's QUERY_IRRADIANCE computes it: with several cascades, the finest
+ * containing p, blended to the next coarser within the last 3 cells of its
+ * border (SPEC R5.7). */
 void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3]);
+
+/* The same from one cascade alone. */
+void lpvc_cascade_irradiance(const lpvc_cascade *cs, const float p[3], const float n[3], float rgb[3]);
 
 #ifdef __cplusplus
 }

@@ -1353,6 +1353,76 @@ def c_config_preset_bad(ctx):
     return "6 CONFIGs with a bad preset (or a bad field next to a good one) refused, config unchanged"
 
 
+# R4.11's knobs: key -> (kind, default, values to set, out-of-range values, wrong-type values).
+CONFIG_KNOBS = {
+    "cascades": ("int", 0, (1, 4, 0), (5, -1), (1.5, "2", True)),
+    "cascade_size": ("num", 8, (12.5, 1e6), (0, -1, 2e6), ("8", False, [8])),
+    "cascade_ratio": ("num", 2, (1.25, 3, 8), (1.0, 9), ("2", None)),
+    "cascade_offset": ("num", 0.25, (0.5, -0.5, 0.1), (0.6, -2), ("x", True)),
+    "bounces": ("bool", False, (True, False), (), (1, "on", None)),
+    "bounce_intensity": ("num", 1, (0.5, 1), (0, 1.5, -0.1), ("1", False)),
+    "damping": ("num", 0, (0.25, 1, 0), (1.5, -0.1), ("0.2", True)),
+    "glossy": ("bool", True, (False, True), (), (0, "off")),
+    "glossy_roughness": ("num", 0.3, (0.5, 1), (0, 1.5), ("0.5", {})),
+    "media": ("bool", True, (False, True), (), (1, "true")),
+    "fog_sigma_s": ("num", 0, (0.05, 1000, 0), (-1, 2000), ("0.1", True)),
+    "fog_sigma_a": ("num", 0, (0.01, 1000, 0), (-0.5, 1001), ("0.1", [0.1])),
+    "media_step": ("num", 0.5, (0.05, 4, 1), (0.01, 5), ("1", False)),
+    "planner": ("bool", True, (False, True), (), (0, "off")),
+}
+
+
+def _same(kind, got, want):
+    if kind == "bool":
+        return got is want
+    if kind == "int":
+        return type(got) is int and got == want
+    return isinstance(got, (int, float)) and not isinstance(got, bool) and abs(got - want) <= 1e-6 * max(1, abs(want))
+
+
+@case("R4.11", "CONFIG accepts every cascade/effect/scheduling knob and echoes it resolved in the effective config")
+def c_config_knobs(ctx):
+    c = ctx.session()
+    cfg = _preset_config(c, {})
+    for key, (kind, default, _, _, _) in CONFIG_KNOBS.items():
+        check(key in cfg, "effective config lacks %r: %r" % (key, cfg))
+        check(_same(kind, cfg[key], default), "effective %s is %r, expected the default %r" % (key, cfg[key], default))
+    n = 0
+    for key, (kind, _, values, _, _) in CONFIG_KNOBS.items():
+        for v in values:
+            cfg = _preset_config(c, {key: v})
+            check(_same(kind, cfg.get(key), v), "CONFIG {%r: %r}: effective config says %r" % (key, v, cfg.get(key)))
+            n += 1
+    both = {"cascades": 2, "cascade_size": 6.0, "bounces": True, "damping": 0.5, "fog_sigma_s": 0.1,
+            "planner": False, "preset": "fast"}
+    cfg = _preset_config(c, both)
+    for key, v in both.items():
+        if key != "preset":
+            check(_same(CONFIG_KNOBS[key][0], cfg.get(key), v), "CONFIG %s: %s is %r" % (json.dumps(both), key,
+                                                                                      cfg.get(key)))
+    check(cfg.get("preset") == "fast", "preset next to the knobs lost: %r" % cfg)
+    return "%d knobs, %d values echoed" % (len(CONFIG_KNOBS), n)
+
+
+@case("R4.11 R4.6 R2.9", "out-of-range and wrongly typed knob values get BAD_FIELD naming the key; nothing changes")
+def c_config_knobs_bad(ctx):
+    c = ctx.session()
+    cfg0 = _preset_config(c, {"cascades": 2, "damping": 0.5, "glossy": False})
+    n = 0
+    for key, (_, _, _, out, wrong) in CONFIG_KNOBS.items():
+        for v in tuple(out) + tuple(wrong):
+            body = {key: v, "iterations": 6}
+            rid = c.send(CONFIG, body)
+            try:
+                expect_error(c.recv_reply(rid), "BAD_FIELD", rid, key)
+            except Fail as e:
+                raise Fail("CONFIG %s: %s" % (json.dumps(body), e))
+            n += 1
+    cfg1 = _preset_config(c, {})
+    check(cfg1 == cfg0, "config changed by refused knob values: %r -> %r" % (cfg0, cfg1))
+    return "%d bad values refused, config unchanged" % n
+
+
 # ---------------------------------------------------------------------------
 # Cases: irradiance queries
 
@@ -1452,11 +1522,67 @@ def _vol_header_checks(h, fmt, comp, dims=None):
           % g.get("cell_size"))
     if dims is not None:
         check(g["dims"] == list(dims), "grid.dims %r, expected the configured %r" % (g["dims"], list(dims)))
-    cells = g["dims"][0] * g["dims"][1] * g["dims"][2]
+    cells = _cascades_checks(h)
     want = cells * 12 * (2 if fmt == "fp16" else 4)
-    check(h["raw_length"] == want, "raw_length %r, expected cells(%d) x 12 x %d = %d"
+    check(h["raw_length"] == want, "raw_length %r, expected cells(%d, all cascades) x 12 x %d = %d"
           % (h["raw_length"], cells, 2 if fmt == "fp16" else 4, want))
+    _plan_checks(h.get("plan"), "volume header")
     return cells
+
+
+def _cascades_checks(h):
+    """R5.6: "cascades" present, 1..4 entries, each consistent, cascade 0 ==
+    grid. Returns the cells of all cascades."""
+    cs = h.get("cascades")
+    check(isinstance(cs, list) and 1 <= len(cs) <= 4, "volume header cascades %r: expected 1 to 4 entries" % (cs,))
+    total = 0
+    for k, e in enumerate(cs):
+        check(isinstance(e, dict), "cascades[%d] %r is not an object" % (k, e))
+        d = e.get("dims")
+        check(isinstance(d, list) and len(d) == 3 and all(isinstance(x, int) and x > 0 for x in d),
+              "cascades[%d].dims %r" % (k, d))
+        check(isinstance(e.get("origin"), list) and len(e["origin"]) == 3
+              and all(isinstance(x, (int, float)) for x in e["origin"]), "cascades[%d].origin %r" % (k, e.get("origin")))
+        check(isinstance(e.get("cell_size"), (int, float)) and e["cell_size"] > 0,
+              "cascades[%d].cell_size %r" % (k, e.get("cell_size")))
+        n = d[0] * d[1] * d[2]
+        check(e.get("cells") == n, "cascades[%d].cells %r, its dims give %d" % (k, e.get("cells"), n))
+        if k > 0:
+            check(e["cell_size"] > cs[k - 1]["cell_size"], "cascades[%d].cell_size %r is not coarser than "
+                  "cascades[%d]'s %r (finest first)" % (k, e["cell_size"], k - 1, cs[k - 1]["cell_size"]))
+        total += n
+    g = h["grid"]
+    check(cs[0]["dims"] == g["dims"], "cascades[0].dims %r != grid.dims %r" % (cs[0]["dims"], g["dims"]))
+    check(abs(cs[0]["cell_size"] - g["cell_size"]) <= 1e-9 * g["cell_size"]
+          and all(abs(a - b) <= 1e-9 * max(1.0, abs(b)) for a, b in zip(cs[0]["origin"], g["origin"])),
+          "cascades[0] %r differs from grid %r" % (cs[0], g))
+    return total
+
+
+PLAN_PASSES = ("rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce", "glossy", "media")
+
+
+def _plan_checks(plan, where, cascades=None):
+    """SPEC section 8: the plan object names every pass with run and a reason."""
+    check(isinstance(plan, dict), "%s has no plan object: %r" % (where, plan))
+    check(isinstance(plan.get("cascades"), int) and not isinstance(plan.get("cascades"), bool),
+          "%s plan.cascades %r" % (where, plan.get("cascades")))
+    check(isinstance(plan.get("cascades_reason"), str), "%s plan.cascades_reason %r"
+          % (where, plan.get("cascades_reason")))
+    check(isinstance(plan.get("recompute"), bool), "%s plan.recompute %r" % (where, plan.get("recompute")))
+    check(isinstance(plan.get("recompute_reason"), str), "%s plan.recompute_reason %r"
+          % (where, plan.get("recompute_reason")))
+    passes = plan.get("passes")
+    check(isinstance(passes, list), "%s plan.passes %r" % (where, passes))
+    names = [p.get("name") if isinstance(p, dict) else None for p in passes]
+    check(tuple(names[:len(PLAN_PASSES)]) == PLAN_PASSES, "%s plan passes %r, expected %r first (R8.1)"
+          % (where, names, list(PLAN_PASSES)))
+    for p in passes:
+        check(isinstance(p.get("run"), bool) and isinstance(p.get("reason"), str),
+              "%s plan pass %r: expected a boolean run and a reason string" % (where, p))
+    if cascades is not None:
+        check(plan["cascades"] == cascades, "%s plan.cascades %r, the volume has %d cascades (R8.2)"
+              % (where, plan["cascades"], cascades))
 
 
 @case("R5.1", "GET_VOLUME fp32/none: sizes match the grid dims; values finite")
@@ -1495,8 +1621,11 @@ def c_volume_layout(ctx):
     normals = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1),
                (1 / math.sqrt(3), 1 / math.sqrt(3), -1 / math.sqrt(3))]
     probes = []
+    # With several cascades the server blends cascade 0 with the next within
+    # 3 cells of its border (R5.7): probe only deeper than that.
+    m = 3 if len(v.body.get("cascades") or [1]) > 1 else 1
     for _ in range(60):
-        i, j, k = rnd.randrange(1, nx - 1), rnd.randrange(1, ny - 1), rnd.randrange(1, nz - 1)
+        i, j, k = rnd.randrange(m, nx - m), rnd.randrange(m, ny - m), rnd.randrange(m, nz - m)
         n = normals[rnd.randrange(len(normals))]
         q = [origin[a] + ((i, j, k)[a] + 0.5) * cell for a in range(3)]
         p = [q[a] - 0.5 * cell * n[a] for a in range(3)]
@@ -1594,8 +1723,11 @@ def c_volume_dims(ctx):
     c, cfg, t = ctx.scene_session(config={"grid": [8, 12, 6], "iterations": 4, "rsm_size": 64})
     f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
     cells = _vol_header_checks(f.body, "fp32", "none", [8, 12, 6])
-    check(len(f.att) == 8 * 12 * 6 * 48, "attachment %d bytes, expected %d" % (len(f.att), 8 * 12 * 6 * 48))
-    return "8x12x6 = %d cells" % cells
+    check(all(e["dims"] == [8, 12, 6] for e in f.body["cascades"]), "cascade dims %r, expected [8, 12, 6] each"
+          % [e["dims"] for e in f.body["cascades"]])
+    check(len(f.att) == cells * 48 == 8 * 12 * 6 * 48 * len(f.body["cascades"]),
+          "attachment %d bytes, expected %d" % (len(f.att), cells * 48))
+    return "8x12x6 x %d cascade(s) = %d cells" % (len(f.body["cascades"]), cells)
 
 
 # ---------------------------------------------------------------------------
@@ -1782,6 +1914,35 @@ def c_stats(ctx):
     return "clients %r, worlds %r, ticks %r" % (f.body["clients"], f.body["worlds"], f.body["ticks"])
 
 
+@case("R8.1 R8.2 R5.6", "the tick plan (every pass named, run + reason) is in STATS, the TICK reply, "
+      "GET_VOLUME and GET_FRAME; STATS lists the cascades as the volume does")
+def c_plan(ctx):
+    c, cfg, t = ctx.scene_session()
+    _plan_checks((t.body.get("stats") or {}).get("plan"), "TICK reply stats")
+    st = expect_reply(c.request(STATS, {}), STATS).body
+    tp = st.get("plan") or {}
+    check(tp.get("tick") == t.body.get("tick"), "STATS plan.tick %r, TICK %r" % (tp.get("tick"), t.body.get("tick")))
+    v = expect_reply(c.request(GET_VOLUME, {"format": "fp16", "compression": "none"}), GET_VOLUME).body
+    _vol_header_checks(v, "fp16", "none")
+    n = len(v["cascades"])
+    _plan_checks(tp.get("plan"), "STATS plan", cascades=n)
+    _plan_checks(v.get("plan"), "GET_VOLUME header", cascades=n)
+    cs = tp.get("cascades")
+    check(isinstance(cs, list) and len(cs) == n, "STATS plan.cascades %r, the volume has %d" % (cs, n))
+    for k, e in enumerate(cs):
+        check(e.get("dims") == v["cascades"][k]["dims"]
+              and abs(e.get("cell_size_m", 0) - v["cascades"][k]["cell_size"]) <= 1e-6 * v["cascades"][k]["cell_size"],
+              "STATS cascade %d %r differs from the volume's %r" % (k, e, v["cascades"][k]))
+    expect_reply(c.request(CAMERA_SET, {"eye": [0, 1, 3.5], "target": [0, 1, 0], "fov_deg": 40, "width": 32,
+                                        "height": 24}), CAMERA_SET)
+    t2 = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    fr = expect_reply(c.request(GET_FRAME, {"format": "png"}, timeout=ctx.tick_timeout), GET_FRAME).body
+    check(fr.get("tick") == t2.body.get("tick"), "GET_FRAME tick %r, TICK %r" % (fr.get("tick"), t2.body.get("tick")))
+    _plan_checks(fr.get("plan"), "GET_FRAME header")
+    run = [p["name"] for p in tp["plan"]["passes"] if p["run"]]
+    return "%d cascade(s); passes run: %s" % (n, ", ".join(run) if run else "none")
+
+
 @case("R4.8 R3.1", "BYE gets its reply, then the server closes")
 def c_bye(ctx):
     c = ctx.session()
@@ -1961,6 +2122,7 @@ def c_frame_stream(ctx):
           "FRAME format %r, %d bytes, raw_length %r" % (h.get("format"), len(f.att), h.get("raw_length")))
     check(h.get("tick") == t.body.get("tick"), "FRAME tick %r, TICK reply %r" % (h.get("tick"), t.body.get("tick")))
     check(isinstance(h.get("revision"), int), "FRAME without revision")
+    _plan_checks(h.get("plan"), "FRAME header")
     return "FRAME tick %r, %d bytes" % (h.get("tick"), len(f.att))
 
 

@@ -10,6 +10,7 @@
  * one per line.
  */
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,7 +43,11 @@ static const char *g_usage =
     "  camera --eye X,Y,Z --target X,Y,Z [--up X,Y,Z] [--fov DEG] [--size WxH] | camera --scene NAME|INDEX\n"
     "  config [--preset fast|balanced|accurate] [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1]\n"
     "         [--iterations N] [--rsm-size N] [--occlusion on|off] [--indirect-gain G] [--emissive-vpls N]\n"
-    "         [--tick-rate HZ] | config --json JSON   (the other flags override the preset's values)\n"
+    "         [--tick-rate HZ] [--cascades N] [--cascade-size M] [--cascade-ratio R] [--cascade-offset F]\n"
+    "         [--bounces on|off] [--bounce-intensity X] [--damping X] [--glossy on|off]\n"
+    "         [--glossy-roughness X] [--media on|off] [--fog-sigma-s PER_M] [--fog-sigma-a PER_M]\n"
+    "         [--media-step CELLS] [--planner on|off]\n"
+    "         | config --json JSON   (the other flags override the preset's values; SPEC R4.11 has the ranges)\n"
     "  tick [N] [--stats]                      N ticks (default 1); --stats: the whole reply\n"
     "  subscribe [volume|frame] [--format F] [--compression zstd|none] [--delta] [-n COUNT]\n"
     "            [--tick] [--wait MS] [-o PREFIX]  print stream headers; save COUNT messages as\n"
@@ -50,12 +55,14 @@ static const char *g_usage =
     "                                          --tick sends a TICK before each wait\n"
     "  unsubscribe [volume|frame]\n"
     "  volume [-o FILE.bin|FILE.json] [--format fp16|fp32] [--compression zstd|none]\n"
-    "                                          .bin: raw float32 (cells x 12) + FILE.bin.json sidecar;\n"
+    "                                          .bin: raw float32 (all cascades' cells x 12, finest first)\n"
+    "                                          + FILE.bin.json sidecar (with each cascade's placement);\n"
     "                                          .json: a summary; no -o: summary on stdout\n"
     "  frame -o OUT.png|OUT.exr|OUT.rgba [--terms full|indirect|direct] [--compression zstd|none]\n"
     "  query --csv IN.csv -o OUT.csv           CSV px,py,pz,nx,ny,nz -> E_r,E_g,E_b (W/m^2)\n"
     "  query --point X,Y,Z --normal X,Y,Z      one point, printed\n"
-    "  stats [--watch SECONDS] [--count N]\n"
+    "  stats [--watch SECONDS] [--count N]     the reply, then the cascades and the last tick's plan\n"
+    "                                          (each pass run or skipped, with its reason)\n"
     "  ack TICK                                ACK a volume tick (no reply)\n"
     "  bye\n"
     "  shell                                   read commands from stdin, one per line\n";
@@ -356,6 +363,48 @@ static int cmd_camera(int argc, char **argv)
     return 0;
 }
 
+/* CONFIG's cascade / effect / scheduling knobs (SPEC R4.11): the server checks
+ * the ranges. KNOB_WANT is indexed by the failure code config_knob leaves in *why. */
+static const char *const KNOB_WANT[] = {"", "a number", "an integer", "on|off"};
+
+static int config_knob(lpvc_config *cfg, const char *flag, const char *v, long *why)
+{
+    const struct {
+        const char *flag;
+        float *f; /* a number, or */
+        int *i;   /* an integer (sw = 0) or a switch (sw = 1) */
+        int sw;
+    } knobs[] = {
+        {"--cascades", NULL, &cfg->cascades, 0},          {"--cascade-size", &cfg->cascade_size, NULL, 0},
+        {"--cascade-ratio", &cfg->cascade_ratio, NULL, 0}, {"--cascade-offset", &cfg->cascade_offset, NULL, 0},
+        {"--bounces", NULL, &cfg->bounces, 1},            {"--bounce-intensity", &cfg->bounce_intensity, NULL, 0},
+        {"--damping", &cfg->damping, NULL, 0},            {"--glossy", NULL, &cfg->glossy, 1},
+        {"--glossy-roughness", &cfg->glossy_roughness, NULL, 0}, {"--media", NULL, &cfg->media, 1},
+        {"--fog-sigma-s", &cfg->fog_sigma_s, NULL, 0},    {"--fog-sigma-a", &cfg->fog_sigma_a, NULL, 0},
+        {"--media-step", &cfg->media_step, NULL, 0},      {"--planner", NULL, &cfg->planner, 1},
+    };
+    long n;
+    *why = 0;
+    for (size_t k = 0; k < sizeof knobs / sizeof knobs[0]; ++k) {
+        if (strcmp(flag, knobs[k].flag) != 0)
+            continue;
+        if (knobs[k].f) {
+            if (parse_float(v, knobs[k].f) != 0)
+                return (int)(*why = 1);
+        } else if (knobs[k].sw) {
+            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
+                return (int)(*why = 3);
+            *knobs[k].i = strcmp(v, "on") == 0 ? 1 : -1;
+        } else {
+            if (parse_int(v, INT_MIN, INT_MAX, &n) != 0)
+                return (int)(*why = 2);
+            *knobs[k].i = (int)n;
+        }
+        return 0;
+    }
+    return -1;
+}
+
 static int cmd_config(int argc, char **argv)
 {
     lpvc_config cfg = {0};
@@ -409,7 +458,12 @@ static int cmd_config(int argc, char **argv)
         } else if (strcmp(a, "--tick-rate") == 0) {
             if (parse_float(v, &cfg.tick_rate_hz) != 0)
                 return usage_error("bad --tick-rate '%s'", v);
-        } else {
+        } else if (config_knob(&cfg, a, v, &n) != 0) {
+            if (n) {
+                char msg[160];
+                snprintf(msg, sizeof msg, "bad %s '%s' (expected %s)", a, v, KNOB_WANT[n]);
+                return usage_error("%s", msg);
+            }
             return usage_error("unknown argument '%s'", a);
         }
         i++;
@@ -467,35 +521,95 @@ static int stream_of(const char *s, enum lpvc_stream *out)
     return 0;
 }
 
-/* Summary of a decoded volume as a JSON object (new reference). */
+/* The cells of all cascades (a volume from an older lpvc: cells). */
+static size_t volume_cells(const lpvc_volume *v)
+{
+    return v->cascade_count > 0 ? v->total_cells : v->cells;
+}
+
+/* Summary of a decoded volume as a JSON object (new reference): dims,
+ * origin and cell_size of cascade 0, "cells" of all cascades (what save
+ * writes), "cascades" each with its placement and flux; total_flux_W is
+ * cascade 0's (the cascades overlap). */
 static json_t *volume_summary(const lpvc_volume *v)
 {
     const double k = sqrt(4.0 * M_PI);
-    double flux[3] = {0, 0, 0}, maxc0 = 0.0;
-    size_t nonfinite = 0, negative_c0 = 0;
-    for (size_t i = 0; i < v->cells; i++) {
+    double flux[LPVC_MAX_CASCADES][3] = {{0}}, maxc0 = 0.0;
+    size_t nonfinite = 0, negative_c0 = 0, total = volume_cells(v), first = 0;
+    int kc = 0;
+    for (size_t i = 0; i < total; i++) {
         const float *c = v->data + 12 * i;
+        while (kc + 1 < v->cascade_count && i >= first + v->cascades[kc].cells)
+            first += v->cascades[kc++].cells;
         for (int j = 0; j < 12; j++)
             if (!isfinite(c[j]))
                 nonfinite++;
         for (int ch = 0; ch < 3; ch++) {
-            flux[ch] += c[4 * ch] * k;
+            flux[kc][ch] += c[4 * ch] * k;
             if (c[4 * ch] < 0.0f)
                 negative_c0++;
             if (c[4 * ch] > maxc0)
                 maxc0 = c[4 * ch];
         }
     }
+    json_t *cascades = json_array();
+    for (int i = 0; i < v->cascade_count && i < LPVC_MAX_CASCADES; i++) {
+        const lpvc_cascade *cs = &v->cascades[i];
+        json_array_append_new(cascades, json_pack("{s:[i,i,i], s:[f,f,f], s:f, s:I, s:[f,f,f]}", "dims", cs->dims[0],
+                                                  cs->dims[1], cs->dims[2], "origin", (double)cs->origin[0],
+                                                  (double)cs->origin[1], (double)cs->origin[2], "cell_size",
+                                                  (double)cs->cell_size, "cells", (json_int_t)cs->cells,
+                                                  "flux_W", flux[i][0], flux[i][1], flux[i][2]));
+    }
     json_t *hdr = json_loads(v->header_json ? v->header_json : "{}", 0, NULL);
     json_t *o = json_pack("{s:I, s:I, s:[i,i,i], s:[f,f,f], s:f, s:I, s:s, s:s, s:b, s:[f,f,f], s:f, s:I, s:I, s:o}",
                           "revision", (json_int_t)v->revision, "tick", (json_int_t)v->tick, "dims", v->dims[0],
                           v->dims[1], v->dims[2], "origin", (double)v->origin[0], (double)v->origin[1],
-                          (double)v->origin[2], "cell_size", (double)v->cell_size, "cells", (json_int_t)v->cells,
+                          (double)v->origin[2], "cell_size", (double)v->cell_size, "cells", (json_int_t)total,
                           "format", v->format, "compression", v->compression, "keyframe", (int)v->keyframe,
-                          "total_flux_W", flux[0], flux[1], flux[2], "max_c0_W_per_sr", maxc0, "non_finite",
+                          "total_flux_W", flux[0][0], flux[0][1], flux[0][2], "max_c0_W_per_sr", maxc0, "non_finite",
                           (json_int_t)nonfinite, "negative_c0", (json_int_t)negative_c0, "header",
                           hdr ? hdr : json_object());
+    json_object_set_new(o, "cascades", cascades);
+    if (v->plan_json)
+        json_object_set_new(o, "plan", json_loads(v->plan_json, 0, NULL));
     return o;
+}
+
+/* A tick plan (SPEC section 8) as lines "plan: ...", one per pass. */
+static void print_plan(const json_t *plan)
+{
+    if (!json_is_object(plan)) {
+        printf("plan: none\n");
+        return;
+    }
+    printf("plan: cascades %lld (%s)\n", (long long)json_integer_value(json_object_get(plan, "cascades")),
+           json_string_value(json_object_get(plan, "cascades_reason")) ? json_string_value(json_object_get(plan, "cascades_reason")) : "");
+    printf("plan: recompute %s (%s)\n", json_is_true(json_object_get(plan, "recompute")) ? "yes" : "no",
+           json_string_value(json_object_get(plan, "recompute_reason")) ? json_string_value(json_object_get(plan, "recompute_reason")) : "");
+    size_t i;
+    json_t *p;
+    json_array_foreach(json_object_get(plan, "passes"), i, p) {
+        const char *name = json_string_value(json_object_get(p, "name"));
+        const char *why = json_string_value(json_object_get(p, "reason"));
+        printf("plan:   %-10s %-4s %s\n", name ? name : "?", json_is_true(json_object_get(p, "run")) ? "run" : "skip",
+               why ? why : "");
+    }
+}
+
+/* The cascades of the stats' "cascades" as lines "cascade K: ...". */
+static void print_cascades(const json_t *cascades)
+{
+    size_t i;
+    json_t *c;
+    json_array_foreach(cascades, i, c) {
+        json_t *d = json_object_get(c, "dims"), *o = json_object_get(c, "origin_m");
+        printf("cascade %zu: %lldx%lldx%lld cells of %g m, origin %g,%g,%g\n", i,
+               (long long)json_integer_value(json_array_get(d, 0)), (long long)json_integer_value(json_array_get(d, 1)),
+               (long long)json_integer_value(json_array_get(d, 2)), json_number_value(json_object_get(c, "cell_size_m")),
+               json_number_value(json_array_get(o, 0)), json_number_value(json_array_get(o, 1)),
+               json_number_value(json_array_get(o, 2)));
+    }
 }
 
 /* FILE.bin: raw float32 little-endian (cells x 12) + FILE.bin.json sidecar. */
@@ -509,12 +623,12 @@ static int save_volume(const lpvc_volume *v, const char *path)
         if (rc)
             fprintf(stderr, "lpvctl: %s: cannot write %s\n", g_cmd, path);
     } else {
-        rc = write_file(path, v->data, v->cells * 12 * sizeof(float));
+        rc = write_file(path, v->data, volume_cells(v) * 12 * sizeof(float));
         if (rc == 0) {
             char side[4096];
             snprintf(side, sizeof side, "%s.json", path);
             json_object_set_new(sum, "data", json_pack("{s:s, s:s, s:s, s:s}", "file", path, "dtype", "float32 little-endian",
-                                                      "shape", "[dims[2]][dims[1]][dims[0]][12]", "units", "W/sr"));
+                                                      "shape", "per cascade in order: [dims[2]][dims[1]][dims[0]][12]", "units", "W/sr"));
             rc = json_dump_file(sum, side, JSON_INDENT(2)) == 0 ? 0 : -1;
             if (rc)
                 fprintf(stderr, "lpvctl: %s: cannot write %s\n", g_cmd, side);
@@ -773,6 +887,13 @@ static int cmd_stats(int argc, char **argv)
         if (lpvc_stats(g_c, &js) != 0)
             return server_error();
         printf("stats: %s\n", js);
+        json_t *st = json_loads(js, 0, NULL);
+        json_t *tp = json_object_get(st, "plan"); /* the world's last tick (SPEC section 8) */
+        if (json_object_get(tp, "cascades"))
+            print_cascades(json_object_get(tp, "cascades"));
+        if (json_object_get(tp, "tick"))
+            print_plan(json_object_get(tp, "plan"));
+        json_decref(st);
         fflush(stdout);
         free(js);
     }

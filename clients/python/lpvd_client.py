@@ -9,7 +9,7 @@ the server for ``"compression": "none"`` (the standard library has no zstd).
     from lpvd_client import Client
     with Client("/tmp/lpvd.sock") as c:      # connects and sends HELLO
         c.tick()
-        vol = c.get_volume()                 # Volume: grid + 12 floats per cell
+        vol = c.get_volume()                 # Volume: cascades, 12 floats per cell
         print(c.query_irradiance([(0, 1, 0)], [(0, 1, 0)]))
 
 The protocol is protocol/SPEC.md; section numbers below refer to it.
@@ -48,6 +48,16 @@ VERSION = 1
 HEADER = struct.Struct("<4sHHIIII")  # magic, version, type, request_id, flags, json_len, att_len
 assert HEADER.size == 24
 
+# CONFIG's scalar knobs and their JSON kinds (SPEC R4.11; the daemon's table is
+# core/settings_fields.c): "int" -> integer, "float" -> number, "switch" -> bool.
+CONFIG_KNOBS = {
+    "iterations": "int", "rsm_size": "int", "occlusion": "switch", "indirect_gain": "float",
+    "emissive_vpls": "int", "cascades": "int", "cascade_size": "float", "cascade_ratio": "float",
+    "cascade_offset": "float", "bounces": "switch", "bounce_intensity": "float", "damping": "float",
+    "glossy": "switch", "glossy_roughness": "float", "media": "switch", "fog_sigma_s": "float",
+    "fog_sigma_a": "float", "media_step": "float", "planner": "switch",
+}
+
 # Message types (SPEC section 4).
 MSG = {
     "HELLO": 0x0001,
@@ -84,6 +94,22 @@ ERROR_NAMES = {
 # Two-band SH constants of docs/propagation.md section 1.
 SH_LOBE0 = 0.886226925452758    # sqrt(pi) / 2
 SH_LOBE1 = 1.0233267079464885   # sqrt(pi / 3)
+
+MAX_CASCADES = 4  # entries of a volume header's "cascades" (SPEC R5.6)
+# The passes of a plan (SPEC section 8, R8.1), in order.
+PLAN_PASSES = ("rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce", "glossy", "media")
+
+
+def plan_lines(plan):
+    """A tick plan (SPEC section 8) as human-readable lines, e.g. for
+    printing STATS["plan"]["plan"] or a volume's ``plan``."""
+    if not plan:
+        return ["plan: none"]
+    out = ["cascades: %s (%s)" % (plan.get("cascades"), plan.get("cascades_reason", "")),
+           "recompute: %s (%s)" % ("yes" if plan.get("recompute") else "no", plan.get("recompute_reason", ""))]
+    for p in plan.get("passes", []):
+        out.append("  %-10s %-4s %s" % (p.get("name"), "run" if p.get("run") else "skip", p.get("reason", "")))
+    return out
 
 
 class LpvdError(Exception):
@@ -168,34 +194,42 @@ def _floats(raw, fmt):
     raise ProtocolError("unknown volume format %r" % fmt)
 
 
-class Volume(object):
-    """A decoded LPV (SPEC section 5).
-
-    ``data`` holds ``cells * 12`` float32 values, cell-major, x fastest
-    (``index = x + nx * (y + ny * z)``), per cell r0..r3 g0..g3 b0..b3 in
-    radiant intensity W/sr; a numpy array of shape (nz, ny, nx, 12) when
-    numpy is available, else a flat ``array('f')``.
+class Cascade(object):
+    """One cascade of a volume (SPEC R5.6): ``dims``, ``origin`` (m, lower
+    corner), ``cell_size`` (m) and ``data``: ``cells * 12`` float32 values,
+    cell-major, x fastest (``index = x + nx * (y + ny * z)``), per cell
+    r0..r3 g0..g3 b0..b3 in radiant intensity W/sr; a numpy array of shape
+    (nz, ny, nx, 12) when numpy is available, else a flat ``array('f')``.
     """
 
-    def __init__(self, header, raw):
-        self.header = header
-        self.raw = raw  # the raw (decompressed, delta-resolved) bytes
-        grid = header.get("grid") or {}
-        self.dims = tuple(int(v) for v in grid.get("dims", (0, 0, 0)))
-        self.origin = tuple(float(v) for v in grid.get("origin", (0.0, 0.0, 0.0)))
-        self.cell_size = float(grid.get("cell_size", 0.0))
-        self.tick = header.get("tick")
-        self.revision = header.get("revision")
-        self.format = header.get("format")
-        self.keyframe = bool(header.get("keyframe", True))
-        self.base_tick = header.get("base_tick")
+    def __init__(self, dims, origin, cell_size, values):
+        self.dims = tuple(int(v) for v in dims)
+        self.origin = tuple(float(v) for v in origin)
+        self.cell_size = float(cell_size)
         cells = self.dims[0] * self.dims[1] * self.dims[2]
-        values = _floats(raw, self.format)
         if len(values) != cells * 12:
-            raise ProtocolError("volume of %d values for %d cells" % (len(values), cells))
+            raise ProtocolError("cascade of %d values for %d cells" % (len(values), cells))
         if _np is not None:
             values = values.reshape(self.dims[2], self.dims[1], self.dims[0], 12)
         self.data = values
+
+    def contains(self, p):
+        """Whether world point p lies inside this cascade's box."""
+        for a in range(3):
+            u = (p[a] - self.origin[a]) / self.cell_size
+            if not (0.0 <= u <= self.dims[a]):
+                return False
+        return True
+
+    def border_cells(self, p):
+        """Distance from p to the box's border in this cascade's cells (the
+        smallest over the six faces; negative outside)."""
+        d = None
+        for a in range(3):
+            u = (p[a] - self.origin[a]) / self.cell_size
+            m = min(u, self.dims[a] - u)
+            d = m if d is None else min(d, m)
+        return d
 
     @property
     def cells(self):
@@ -259,9 +293,9 @@ class Volume(object):
         return out
 
     def irradiance(self, p, n):
-        """E(n) in W/m^2 (r, g, b) at surface point p with normal n, computed
-        locally exactly as the server's QUERY_IRRADIANCE (propagation.md §6):
-        sample half a cell in front of the surface, E = max(0, c . lobe(-n)) / s^2."""
+        """E(n) in W/m^2 (r, g, b) at surface point p with normal n from this
+        cascade alone (propagation.md §6): sample half a cell in front of the
+        surface, E = max(0, c . lobe(-n)) / s^2."""
         ln = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) ** 0.5
         if not (ln > 1e-8) or ln == float("inf") or any(v != v for v in n):
             return (0.0, 0.0, 0.0)
@@ -279,6 +313,77 @@ class Volume(object):
         return tuple(rgb)
 
 
+class Volume(Cascade):
+    """A decoded LPV (SPEC section 5) with every cascade (R5.6).
+
+    ``cascades`` lists the ``Cascade`` objects, finest first. The volume's
+    own ``dims``, ``origin``, ``cell_size``, ``data``, ``cell()`` and
+    ``total_flux()`` are cascade 0's (the finest; the whole volume when there
+    is one cascade); ``irradiance()`` blends the cascades as R5.7 (and the
+    server's QUERY_IRRADIANCE) do. ``plan`` is the tick's plan (SPEC section
+    8) or None.
+    """
+
+    def __init__(self, header, raw):
+        self.header = header
+        self.raw = raw  # the raw (decompressed, delta-resolved) bytes
+        self.tick = header.get("tick")
+        self.revision = header.get("revision")
+        self.format = header.get("format")
+        self.keyframe = bool(header.get("keyframe", True))
+        self.base_tick = header.get("base_tick")
+        self.plan = header.get("plan")
+        grid = header.get("grid") or {}
+        specs = header.get("cascades")
+        if specs is None:  # a server before cascades: the grid is the volume
+            specs = [dict(grid, cells=None)]
+        if not isinstance(specs, list) or not 1 <= len(specs) <= MAX_CASCADES:
+            raise ProtocolError("cascades: expected 1 to %d entries" % MAX_CASCADES)
+        values = _floats(raw, self.format)
+        self.cascades = []
+        first = 0
+        for k, c in enumerate(specs):
+            dims = [int(v) for v in c.get("dims", (0, 0, 0))]
+            if len(dims) != 3 or min(dims) < 1:
+                raise ProtocolError("cascades[%d].dims: expected 3 integers >= 1" % k)
+            cells = dims[0] * dims[1] * dims[2]
+            if c.get("cells") is not None and int(c["cells"]) != cells:
+                raise ProtocolError("cascades[%d].cells: %r, its dims give %d" % (k, c["cells"], cells))
+            cs = float(c.get("cell_size", 0.0))
+            if not cs > 0.0:
+                raise ProtocolError("cascades[%d].cell_size: expected a positive number" % k)
+            if first + cells * 12 > len(values):
+                raise ProtocolError("volume of %d values, the cascades need more" % len(values))
+            self.cascades.append(Cascade(dims, c.get("origin", (0.0, 0.0, 0.0)), cs,
+                                         values[first:first + cells * 12]))
+            first += cells * 12
+        if first != len(values):
+            raise ProtocolError("volume of %d values for %d cells" % (len(values), first // 12))
+        c0 = self.cascades[0]
+        if grid and (tuple(int(v) for v in grid.get("dims", ())) != c0.dims
+                     or abs(float(grid.get("cell_size", 0.0)) - c0.cell_size) > 1e-9 * c0.cell_size):
+            raise ProtocolError("grid: differs from cascades[0]")
+        self.dims, self.origin, self.cell_size, self.data = c0.dims, c0.origin, c0.cell_size, c0.data
+
+    def irradiance(self, p, n):
+        """E(n) in W/m^2 (r, g, b) at surface point p with normal n, computed
+        locally as the server's QUERY_IRRADIANCE (SPEC R5.7): the finest
+        cascade containing p, blended towards the next coarser one within the
+        last 3 cells of its border, w = clamp((d - 1) / 2, 0, 1); each
+        cascade's lookup as propagation.md §6."""
+        cs = self.cascades
+        k = next((i for i, c in enumerate(cs) if c.contains(p)), len(cs) - 1)
+        fine = Cascade.irradiance(cs[k], p, n)
+        if k + 1 >= len(cs) or not cs[k + 1].contains(p):
+            return fine
+        d = cs[k].border_cells(p)
+        w = min(max((d - 1.0) / 2.0, 0.0), 1.0)
+        if w >= 1.0:
+            return fine
+        coarse = Cascade.irradiance(cs[k + 1], p, n)
+        return tuple(w * f + (1.0 - w) * c for f, c in zip(fine, coarse))
+
+
 class Frame(object):
     """A frame (SPEC section 6): ``header`` and ``data`` (bytes: rgba8 pixels,
     or the complete PNG / EXR file)."""
@@ -291,6 +396,7 @@ class Frame(object):
         self.format = header.get("format")
         self.tick = header.get("tick")
         self.revision = header.get("revision")
+        self.plan = header.get("plan")  # the tick's plan (SPEC section 8) or None
 
     def save(self, path):
         with open(path, "wb") as f:
@@ -496,10 +602,18 @@ class Client(object):
 
     def config(self, **settings):
         """CONFIG: preset ("fast", "balanced", "accurate"), grid, bounds,
-        iterations, rsm_size, occlusion, indirect_gain, emissive_vpls,
-        tick_rate_hz. A preset sets grid, iterations, rsm_size and occlusion;
-        the other fields given override it. Returns {"revision", "config": {...}}."""
-        body = {k: (list(v) if isinstance(v, tuple) else v) for k, v in settings.items() if v is not None}
+        tick_rate_hz and the knobs of CONFIG_KNOBS (iterations, rsm_size,
+        occlusion, indirect_gain, emissive_vpls, cascades, cascade_size, ...,
+        planner; SPEC R4.11). A preset sets grid, iterations, rsm_size and
+        occlusion; the other fields given override it. Switches take True /
+        False (or "on" / "off"). Returns {"revision", "config": {...}}."""
+        body = {}
+        for k, v in settings.items():
+            if v is None:
+                continue
+            if CONFIG_KNOBS.get(k) == "switch" and v in ("on", "off"):
+                v = v == "on"
+            body[k] = list(v) if isinstance(v, tuple) else v
         return self.request(MSG["CONFIG"], body)[0]
 
     def tick(self):
@@ -713,6 +827,8 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
     flux = vol.total_flux()
     say("GET_VOLUME -> dims %s, cell %.4g m, tick %s, total flux %s W"
         % (list(vol.dims), vol.cell_size, vol.tick, ["%.4g" % v for v in flux]))
+    say("GET_VOLUME cascades -> %s" % ", ".join("%s cells of %.4g m at %s" % (
+        "x".join(str(d) for d in cc.dims), cc.cell_size, ["%.4g" % v for v in cc.origin]) for cc in vol.cascades))
     if vol.cells <= 0:
         raise AssertionError("empty volume")
     if not all(v == v and v >= 0 for v in flux):
@@ -761,6 +877,8 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
     say("VOLUME stream (fp16, delta) -> %s, each equal to GET_VOLUME of its tick" % ", ".join(kinds))
     st = c.stats()
     say("STATS -> keys %s" % sorted(st.keys()))
+    for line in plan_lines((st.get("plan") or {}).get("plan")):
+        say("STATS plan: %s" % line)
     c.bye()
     say("BYE -> ok")
     return 0

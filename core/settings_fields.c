@@ -1,0 +1,209 @@
+/*
+ * settings_fields.c - the lpv_settings field table (see settings_fields.h).
+ * The ranges mirror lpv_settings_validate() in settings.c, narrowed where a
+ * zero would silently resolve to a non-zero default; tests/test_settings_fields.c
+ * checks that the two agree.
+ */
+#include "settings_fields.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lpv_shared.h"
+
+#define F(name) offsetof(lpv_settings, name)
+
+static const lpv_field FIELDS[] = {
+    /* The older knobs (the preset supplies the defaults of three of them). */
+    {"iterations", "iterations", LPV_FIELD_INT, F(iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
+     "the preset's (balanced: 4)", "", "propagation steps"},
+    {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
+     "the preset's (balanced: 128)", "", "reflective shadow map side"},
+    {"occlusion", "occlusion", LPV_FIELD_SWITCH, F(occlusion), 0, 1, 0, "", "the preset's (on)", "",
+     "fuzzy occlusion from the geometry volume"},
+    {"indirect_gain", "indirect-gain", LPV_FIELD_FLOAT, F(indirect_gain), 0, 1e30, 1, "", "1", "",
+     "artistic factor on the LPV term"},
+    {"emissive_vpls", "emissive-vpls", LPV_FIELD_INT, F(emissive_vpls), 1, 1 << 20, 0, "", "4096", "",
+     "VPLs sampled on emissive surfaces"},
+
+    /* Cascades (docs/cascades.md). */
+    {"cascades", "cascades", LPV_FIELD_INT, F(cascades), 0, LPV_MAX_CASCADES, 0, "", "auto", "0 = auto",
+     "cascade count (auto: one grid if the scene fits the finest cascade, else 3)"},
+    {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(cascade_size), 0, 1e6, 1, "m", "8", "",
+     "the finest cascade's extent along its longest axis"},
+    {"cascade_ratio", "cascade-ratio", LPV_FIELD_FLOAT, F(cascade_ratio), 1.25, 8, 0, "", "2", "",
+     "cell size ratio of consecutive cascades"},
+    {"cascade_offset", "cascade-offset", LPV_FIELD_FLOAT, F(cascade_offset), -1, 0.5, 0, "", "0.25",
+     "negative = centred on the camera",
+     "cascade centre ahead of the camera, as a fraction of its extent"},
+
+    /* Effects and damping (docs/effects.md). */
+    {"bounces", "bounces", LPV_FIELD_SWITCH, F(bounces), 0, 1, 0, "", "off", "",
+     "multiple bounces off the geometry volume's blockers"},
+    {"bounce_intensity", "bounce-intensity", LPV_FIELD_FLOAT, F(bounce_intensity), 0, 1, 1, "", "1", "",
+     "factor on the blockers' albedo for bounces"},
+    {"damping", "damping", LPV_FIELD_FLOAT, F(damping), 0, 1, 0, "", "0", "0 = off",
+     "directional-derivative damping strength"},
+    {"glossy", "glossy", LPV_FIELD_SWITCH, F(glossy), 0, 1, 0, "", "on", "",
+     "glossy reflections by marching the LPV (if a material is glossy)"},
+    {"glossy_roughness", "glossy-roughness", LPV_FIELD_FLOAT, F(glossy_roughness), 0, 1, 1, "", "0.3", "",
+     "materials with roughness below this are glossy"},
+    {"media", "media", LPV_FIELD_SWITCH, F(media), 0, 1, 0, "", "on", "",
+     "participating media single scattering (if there is a medium)"},
+    {"fog_sigma_s", "fog-sigma-s", LPV_FIELD_FLOAT, F(fog_sigma_s), 0, 1000, 0, "1/m", "0", "0 = none",
+     "homogeneous fog scattering coefficient"},
+    {"fog_sigma_a", "fog-sigma-a", LPV_FIELD_FLOAT, F(fog_sigma_a), 0, 1000, 0, "1/m", "0", "0 = none",
+     "homogeneous fog absorption coefficient"},
+    {"media_step", "media-step", LPV_FIELD_FLOAT, F(media_step), 0.05, 4, 0, "cells", "0.5", "",
+     "media ray-march step"},
+    {"planner", "planner", LPV_FIELD_SWITCH, F(planner), 0, 1, 0, "", "on", "",
+     "run only the passes the scene needs (off: every pass every tick)"},
+};
+
+#undef F
+
+const lpv_field *lpv_fields(size_t *count)
+{
+    if (count)
+        *count = sizeof FIELDS / sizeof FIELDS[0];
+    return FIELDS;
+}
+
+const lpv_field *lpv_field_by_key(const char *key)
+{
+    for (size_t i = 0; key && i < sizeof FIELDS / sizeof FIELDS[0]; ++i)
+        if (strcmp(FIELDS[i].key, key) == 0)
+            return &FIELDS[i];
+    return NULL;
+}
+
+const lpv_field *lpv_field_by_flag(const char *flag)
+{
+    for (size_t i = 0; flag && i < sizeof FIELDS / sizeof FIELDS[0]; ++i)
+        if (strcmp(FIELDS[i].flag, flag) == 0)
+            return &FIELDS[i];
+    return NULL;
+}
+
+const char *lpv_field_expect(const lpv_field *f, char *buf, size_t n)
+{
+    if (f->kind == LPV_FIELD_SWITCH)
+        snprintf(buf, n, "on or off");
+    else if (f->kind == LPV_FIELD_INT)
+        snprintf(buf, n, "an integer in %.0f..%.0f", f->min, f->max);
+    else if (f->min_exclusive)
+        snprintf(buf, n, "a number > %g and <= %g", f->min, f->max);
+    else
+        snprintf(buf, n, "a number in %g..%g", f->min, f->max);
+    return buf;
+}
+
+const char *lpv_field_metavar(const lpv_field *f)
+{
+    switch (f->kind) {
+    case LPV_FIELD_SWITCH: return "on|off";
+    case LPV_FIELD_INT: return "N";
+    default: return "X";
+    }
+}
+
+static int in_range(const lpv_field *f, double v)
+{
+    if (!isfinite(v) || v > f->max)
+        return 0;
+    return f->min_exclusive ? v > f->min : v >= f->min;
+}
+
+int lpv_field_set_bool(lpv_settings *s, const lpv_field *f, int on)
+{
+    if (f->kind != LPV_FIELD_SWITCH)
+        return -1;
+    *(lpv_switch *)((char *)s + f->offset) = on ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+    return 0;
+}
+
+int lpv_field_set_number(lpv_settings *s, const lpv_field *f, double v, char *err, size_t n)
+{
+    char want[96];
+    if (f->kind == LPV_FIELD_SWITCH)
+        return lpv_field_set_bool(s, f, v != 0.0);
+    if (f->kind == LPV_FIELD_INT && isfinite(v) && v != floor(v)) {
+        if (err && n)
+            snprintf(err, n, "expected an integer, got %g", v);
+        return -1;
+    }
+    if (!in_range(f, v)) {
+        if (err && n)
+            snprintf(err, n, "%g is out of range (allowed: %s%s%s)", v, lpv_field_expect(f, want, sizeof want),
+                     f->note[0] ? "; " : "", f->note);
+        return -1;
+    }
+    char *p = (char *)s + f->offset;
+    if (f->kind == LPV_FIELD_INT)
+        *(int *)p = (int)v;
+    else
+        *(float *)p = (float)v;
+    return 0;
+}
+
+int lpv_field_set_string(lpv_settings *s, const lpv_field *f, const char *v, char *err, size_t n)
+{
+    char want[96];
+    lpv_field_expect(f, want, sizeof want);
+    if (!v)
+        v = "";
+    if (f->kind == LPV_FIELD_SWITCH) {
+        if (strcmp(v, "on") == 0)
+            return lpv_field_set_bool(s, f, 1);
+        if (strcmp(v, "off") == 0)
+            return lpv_field_set_bool(s, f, 0);
+    } else if (f->kind == LPV_FIELD_INT) {
+        char *end;
+        errno = 0;
+        long x = strtol(v, &end, 10);
+        if (end != v && !*end && errno == 0 && in_range(f, (double)x))
+            return lpv_field_set_number(s, f, (double)x, NULL, 0);
+    } else {
+        char *end;
+        double x = strtod(v, &end);
+        if (end != v && !*end && in_range(f, x))
+            return lpv_field_set_number(s, f, x, NULL, 0);
+    }
+    if (err && n)
+        snprintf(err, n, "expected %s%s%s", want, f->note[0] ? "; " : "", f->note);
+    return -1;
+}
+
+double lpv_field_get(const lpv_settings *s, const lpv_field *f)
+{
+    const char *p = (const char *)s + f->offset;
+    if (f->kind == LPV_FIELD_INT)
+        return (double)*(const int *)p;
+    if (f->kind == LPV_FIELD_SWITCH) {
+        lpv_switch w = *(const lpv_switch *)p;
+        return w == LPV_SWITCH_ON ? 1.0 : w == LPV_SWITCH_OFF ? 0.0 : -1.0;
+    }
+    float x = *(const float *)p;
+    char buf[48];
+    for (int prec = 6; prec <= 9; ++prec) { /* the shortest decimal that is the same float */
+        snprintf(buf, sizeof buf, "%.*g", prec, (double)x);
+        double d = strtod(buf, NULL);
+        if ((float)d == x)
+            return d;
+    }
+    return (double)x;
+}
+
+int lpv_field_is_default(const lpv_settings *s, const lpv_field *f)
+{
+    const char *p = (const char *)s + f->offset;
+    switch (f->kind) {
+    case LPV_FIELD_INT: return *(const int *)p == 0;
+    case LPV_FIELD_SWITCH: return *(const lpv_switch *)p == LPV_SWITCH_DEFAULT;
+    default: return *(const float *)p == 0.0f;
+    }
+}
