@@ -79,6 +79,11 @@ typedef struct lpv_draw {
  * isotropic phase function. The coefficients hold at density 1; the density is
  * 1 everywhere (homogeneous fog) unless a box is given: then it is the density
  * texture inside the box (1 when density is NULL) and 0 outside. */
+/* Limits a medium must respect (loader and scene_build refuse anything else). */
+#define LPV_MEDIUM_SIGMA_MAX 1000.0f  /* sigma_s, sigma_a: finite, 0 .. this, 1/m */
+#define LPV_MEDIUM_DIMS_MAX 256       /* density texture cells per axis: 1 .. this */
+#define LPV_MEDIUM_DENSITY_MAX 1.0e6f /* density values: finite, 0 .. this */
+
 typedef struct lpv_medium {
     int present;          /* 0: no medium */
     float sigma_s[3];     /* scattering coefficient, 1/m, rgb */

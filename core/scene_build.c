@@ -147,3 +147,91 @@ lpv_light *lpv_scene_add_directional_light(lpv_scene *s, const float dir[3], flo
     }
     return l;
 }
+
+int lpv_scene_set_material_roughness(lpv_scene *s, int material, float roughness)
+{
+    if (!s || material < 0 || (uint32_t)material >= s->material_count || !(roughness >= 0.0f && roughness <= 1.0f))
+        return -1;
+    s->materials[material].roughness = roughness;
+    return 0;
+}
+
+static int coefficients_ok(const float sigma_s[3], const float sigma_a[3])
+{
+    if (!sigma_s || !sigma_a)
+        return 0;
+    for (int k = 0; k < 3; k++) {
+        /* written so that NaN fails */
+        if (!(sigma_s[k] >= 0.0f && sigma_s[k] <= LPV_MEDIUM_SIGMA_MAX) ||
+            !(sigma_a[k] >= 0.0f && sigma_a[k] <= LPV_MEDIUM_SIGMA_MAX))
+            return 0;
+    }
+    return 1;
+}
+
+/* Replaces s->medium with m (taking its density), or clears it when every
+ * coefficient is 0 (freeing m's density). */
+static void put_medium(lpv_scene *s, lpv_medium *m)
+{
+    int any = 0;
+    for (int k = 0; k < 3; k++)
+        any |= m->sigma_s[k] > 0.0f || m->sigma_a[k] > 0.0f;
+    free(s->medium.density);
+    if (!any) {
+        free(m->density);
+        memset(&s->medium, 0, sizeof s->medium);
+        return;
+    }
+    m->present = 1;
+    s->medium = *m;
+}
+
+int lpv_scene_set_fog(lpv_scene *s, const float sigma_s[3], const float sigma_a[3])
+{
+    if (!s || !coefficients_ok(sigma_s, sigma_a))
+        return -1;
+    lpv_medium m;
+    memset(&m, 0, sizeof m);
+    memcpy(m.sigma_s, sigma_s, sizeof m.sigma_s);
+    memcpy(m.sigma_a, sigma_a, sizeof m.sigma_a);
+    put_medium(s, &m);
+    return 0;
+}
+
+int lpv_scene_set_medium_box(lpv_scene *s, const float sigma_s[3], const float sigma_a[3], const float box_min[3],
+                             const float box_max[3], const int dims[3], const float *density)
+{
+    if (!s || !coefficients_ok(sigma_s, sigma_a) || !box_min || !box_max)
+        return -1;
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(box_min[k]) || !isfinite(box_max[k]) || !(box_min[k] < box_max[k]))
+            return -1;
+    lpv_medium m;
+    memset(&m, 0, sizeof m);
+    memcpy(m.sigma_s, sigma_s, sizeof m.sigma_s);
+    memcpy(m.sigma_a, sigma_a, sizeof m.sigma_a);
+    m.has_box = 1;
+    memcpy(m.box_min, box_min, sizeof m.box_min);
+    memcpy(m.box_max, box_max, sizeof m.box_max);
+    int none = !dims || (dims[0] == 0 && dims[1] == 0 && dims[2] == 0);
+    if (none != !density)
+        return -1; /* a texture needs both dims and values */
+    if (!none) {
+        size_t count = 1;
+        for (int k = 0; k < 3; k++) {
+            if (dims[k] < 1 || dims[k] > LPV_MEDIUM_DIMS_MAX)
+                return -1;
+            count *= (size_t)dims[k];
+        }
+        for (size_t i = 0; i < count; i++)
+            if (!(density[i] >= 0.0f && density[i] <= LPV_MEDIUM_DENSITY_MAX))
+                return -1;
+        m.density = malloc(count * sizeof *m.density);
+        if (!m.density)
+            return -1;
+        memcpy(m.density, density, count * sizeof *m.density);
+        memcpy(m.dims, dims, sizeof m.dims);
+    }
+    put_medium(s, &m);
+    return 0;
+}

@@ -36,4 +36,24 @@ int lpv_scene_add_box(lpv_scene *s, int material, const float lo[3], const float
 lpv_light *lpv_scene_add_point_light(lpv_scene *s, const float pos[3], float intensity);
 lpv_light *lpv_scene_add_directional_light(lpv_scene *s, const float dir[3], float irradiance);
 
+/* Sets material m's roughness (0 mirror-like .. 1 matte; materials start at 1).
+ * Returns 0, or -1 for an index out of range or a roughness outside [0, 1]. */
+int lpv_scene_set_material_roughness(lpv_scene *s, int material, float roughness);
+
+/* Participating media (docs/scenes.md, "Media"). Both replace the scene's
+ * medium; sigma_s and sigma_a (1/m, rgb) must be finite and within
+ * 0 .. LPV_MEDIUM_SIGMA_MAX. All six zero removes the medium (present 0).
+ * On -1 (bad argument or out of memory) the old medium is left as it was. */
+
+/* Homogeneous fog filling all space (density 1 everywhere). */
+int lpv_scene_set_fog(lpv_scene *s, const float sigma_s[3], const float sigma_a[3]);
+
+/* A medium confined to the box [box_min, box_max] (min < max on every axis,
+ * finite). With dims all 0 and density NULL it is homogeneous (density 1)
+ * inside the box; otherwise dims are 1 .. LPV_MEDIUM_DIMS_MAX cells per axis
+ * and density holds dims[0]*dims[1]*dims[2] values (x fastest), each finite
+ * and within 0 .. LPV_MEDIUM_DENSITY_MAX; they are copied. */
+int lpv_scene_set_medium_box(lpv_scene *s, const float sigma_s[3], const float sigma_a[3], const float box_min[3],
+                             const float box_max[3], const int dims[3], const float *density);
+
 #endif /* LPV_SCENE_BUILD_H */

@@ -46,10 +46,12 @@ GLuint lpv_engine_program(const char *first, const char *geom, const char *frag,
 }
 
 static const char *const INC_GRID[] = {"grid.glsl", NULL};
-static const char *const INC_PROPAGATE[] = {"grid.glsl", "flux_limit.glsl", NULL};
+static const char *const INC_PROPAGATE[] = {"grid.glsl", "flux_limit.glsl", "medium.glsl", NULL};
 static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
 static const char *const INC_RSM[] = {"material.glsl", "lights.glsl", NULL};
-static const char *const INC_SHADE[] = {"grid.glsl", "lights.glsl", "lookup.glsl", NULL};
+static const char *const INC_SHADE[] = {"grid.glsl", "lights.glsl", "shadow.glsl", "lookup.glsl", NULL};
+static const char *const INC_MEDIA[] = {"grid.glsl", "lights.glsl", "shadow.glsl", "lookup.glsl", "medium.glsl",
+                                        NULL};
 static const char *const INC_LOOKUP[] = {"grid.glsl", "lookup.glsl", NULL};
 
 lpv_engine *lpv_engine_create(char *err, size_t err_size)
@@ -76,6 +78,8 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, NULL},
         {&e->prog_shade, "fullscreen.vert", "shade.frag", INC_SHADE},
         {&e->prog_query, "query.comp", NULL, INC_LOOKUP},
+        {&e->prog_glossy, "fullscreen.vert", "glossy.frag", INC_LOOKUP},
+        {&e->prog_media, "fullscreen.vert", "media.frag", INC_MEDIA},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog = lpv_engine_program(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
@@ -199,11 +203,13 @@ void lpv_engine_destroy(lpv_engine *e)
     free_rsm(e);
     free_grids(e);
     free_camera(e);
+    delete_texture(&e->medium_density);
     delete_buffer(&e->query_in);
     delete_buffer(&e->query_out);
     GLuint *progs[] = {&e->prog_rsm, &e->prog_vpl_extract, &e->prog_inject_vpl, &e->prog_inject_gv,
                        &e->prog_pack, &e->prog_gv_merge, &e->prog_transmit, &e->prog_propagate,
-                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade, &e->prog_query};
+                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade, &e->prog_query,
+                       &e->prog_glossy, &e->prog_media};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -450,6 +456,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         memcpy(g->base_color, m->base_color, sizeof g->base_color);
         memcpy(g->emission, m->emission, sizeof g->emission);
         g->roughness = m->roughness;
+        g->metallic = m->metallic;
         g->texture = (m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < scene->texture_count)
                          ? m->base_color_texture
                          : -1;
@@ -480,6 +487,8 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
         e->lights[e->light_count++] = scene->lights[i];
     e->has_medium = scene->medium.present;
+    if (lpv_medium_upload(e, scene, err, err_size) != 0)
+        return -1;
     memcpy(e->scene_min, scene->bounds_min, sizeof e->scene_min);
     memcpy(e->scene_max, scene->bounds_max, sizeof e->scene_max);
 
@@ -520,16 +529,18 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog)
     GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
     GLint loc_emission = glGetUniformLocation(prog, "u_emission");
     GLint loc_roughness = glGetUniformLocation(prog, "u_roughness");
+    GLint loc_metallic = glGetUniformLocation(prog, "u_metallic");
     GLint loc_size = glGetUniformLocation(prog, "u_object_size");
     glBindVertexArray(e->vao);
     for (uint32_t i = 0; i < e->draw_count; ++i) {
         const lpv_gpu_draw *d = &e->draws[i];
-        static const lpv_gpu_material fallback = {{1, 1, 1, 1}, {0, 0, 0}, 1.0f, -1};
+        static const lpv_gpu_material fallback = {{1, 1, 1, 1}, {0, 0, 0}, 1.0f, 0.0f, -1};
         const lpv_gpu_material *m =
             (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
         glUniform4fv(loc_color, 1, m->base_color);
         glUniform3fv(loc_emission, 1, m->emission);
         glUniform1f(loc_roughness, m->roughness);
+        glUniform1f(loc_metallic, m->metallic);
         glUniform1f(loc_size, d->size);
         glUniform1i(loc_has_tex, m->texture >= 0);
         glActiveTexture(GL_TEXTURE0);
@@ -684,6 +695,10 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         e->gbuf_stale = 0;
     }
     lpv_pass_shade_run(e, terms);
+    if (e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY)
+        lpv_pass_glossy_run(e);
+    if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
+        lpv_pass_media_run(e);
     const int w = e->gbuf_w, h = e->gbuf_h;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame_fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);

@@ -15,7 +15,7 @@
 typedef struct lpv_gpu_material {
     float base_color[4];
     float emission[3];
-    float roughness;
+    float roughness, metallic;
     int texture; /* index into lpv_engine.textures, -1 none */
 } lpv_gpu_material;
 
@@ -47,11 +47,14 @@ struct lpv_engine {
     int computed_has_view;
     size_t occluder_triangles;
     int has_medium;           /* the scene has a participating medium */
+    lpv_medium medium;        /* its coefficients and box (density in medium_density) */
+    GLuint medium_density;    /* 3D R32F texture, 0 = none */
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
-        prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query;
+        prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
+        prog_media;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -125,6 +128,13 @@ void lpv_pass_gbuffer_run(lpv_engine *e);
 void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera);
 void lpv_pass_propagate_run(lpv_engine *e, int occlusion, int bounce);
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
+void lpv_pass_glossy_run(lpv_engine *e);
+void lpv_pass_media_run(lpv_engine *e);
+
+/* The participating medium (pass_effects.c): upload at set_scene, and the
+ * uniforms of medium.glsl for prog (on = 0 binds "no medium"). */
+int lpv_medium_upload(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
+void lpv_medium_bind(lpv_engine *e, GLuint prog, int on);
 
 /* Light faces (RSM views) for the scene's lights: fills e->light_block. */
 void lpv_light_faces_build(lpv_engine *e);

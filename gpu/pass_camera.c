@@ -165,6 +165,9 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glDisable(GL_BLEND);
     glUseProgram(e->prog_shade);
     glUniform1f(glGetUniformLocation(e->prog_shade, "u_damping"), e->settings.damping);
+    glUniform1f(glGetUniformLocation(e->prog_shade, "u_glossy_roughness"),
+                e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
+                                                                                  : 0.0f);
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);

@@ -12,6 +12,7 @@ void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
     glUseProgram(e->prog_propagate);
     GLint loc_occ = glGetUniformLocation(e->prog_propagate, "u_occlusion");
     glUniform1i(glGetUniformLocation(e->prog_propagate, "u_bounce"), bounce);
+    lpv_medium_bind(e, e->prog_propagate, e->plan.pass[LPV_PASS_MEDIA].run);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_REFLECT);
     glBindTexture(GL_TEXTURE_BUFFER, e->tbo_reflect);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);

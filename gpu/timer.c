@@ -100,8 +100,13 @@ void lpv_timer_end(lpv_timer *t)
 {
     if (!t || t->open_stage < 0)
         return;
-    if (t->open_span >= 0)
+    if (t->open_span >= 0) {
+        /* llvmpipe (and tiled GPUs) defer draws until a flush: without the
+         * finish, a stage of draws would be billed to whichever later stage
+         * flushes them (the shading absorbed the glossy and media passes). */
+        glFinish();
         glQueryCounter(t->queries[2 * t->open_span + 1], GL_TIMESTAMP);
+    }
     t->stages[t->open_stage].cpu_ms += now_ms() - t->open_cpu_ms;
     t->last_stage = t->open_stage;
     t->open_stage = -1;

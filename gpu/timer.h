@@ -21,9 +21,11 @@
  *
  * Spans are begin/end pairs; they do not nest (begin while a span is open
  * ends the open one first). Each span is timed twice:
- *   - gpu_ms: glQueryCounter(GL_TIMESTAMP) at begin and at end, read back by
- *     lpv_timer_collect; this is the time the GL implementation spent on the
- *     commands between the two, and the number that matters (on llvmpipe too);
+ *   - gpu_ms: glQueryCounter(GL_TIMESTAMP) at begin and at end (after a
+ *     glFinish, so deferred draws are billed to their own stage), read back
+ *     by lpv_timer_collect; this is the time the GL implementation spent on
+ *     the commands between the two, and the number that matters (on llvmpipe
+ *     too);
  *   - cpu_ms: CLOCK_MONOTONIC around the same calls, i.e. the CPU time spent
  *     submitting them (no glFinish is added, so it is not the GPU cost).
  * Spans with the same stage name in one frame accumulate into one stage, in

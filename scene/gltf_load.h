@@ -5,8 +5,10 @@
  * the spec allows, normalized integers, sparse accessors), the node
  * hierarchy's transforms (matrix or TRS), base colour factor and texture,
  * emissive factor with KHR_materials_emissive_strength, metallic/roughness,
- * KHR_lights_punctual (directional, point, spot with cone angles and range)
- * and cameras. Photometric values are converted to radiometric ones with
+ * KHR_lights_punctual (directional, point, spot with cone angles and range),
+ * cameras, and lpvd's participating medium from the loaded scene's extras
+ * (scenes[scene].extras.lpvd_medium, else the document's extras.lpvd_medium;
+ * docs/scenes.md, "Media"), every field checked and named when refused. Photometric values are converted to radiometric ones with
  * LPV_LUMENS_PER_WATT (docs/units.md).
  *
  * Refused with a message naming the file and the problem, never a crash:

@@ -7,9 +7,18 @@ as glTF 2.0 binary files next to this script. Python standard library only.
   blinds.glb     THIN OCCLUDERS: a room divided by a 4 cm wall with a doorway,
                  a window with thin slats, lit by a spot light (candela) shining
                  through the slats; the front wall is left open for the camera.
+  glossy.glb     GLOSSY: a closed 4 m room of matte walls, one red wall, a floor of
+                 roughness 0.1 (every other material roughness 1), a point light
+                 and a camera looking at the floor and the red wall.
+  fog.glb        MEDIA: the room filled with homogeneous fog (scene extras
+                 "lpvd_medium", sigma_s 0.08, sigma_a 0.02 1/m) and a spot light
+                 whose beam crosses the view.
+  smoke.glb      MEDIA: the room with a boxed 8x8x8 density texture of a soft
+                 blob of smoke (sigma_s 0.5 1/m) lit by a spot light.
 
 Every object is an axis-aligned box (12 triangles); each material is one mesh.
-lpvd divides the photometric light units by 683 lm/W (docs/units.md).
+lpvd divides the photometric light units by 683 lm/W (docs/units.md); the
+medium format is in docs/scenes.md.
 
   python3 scenes/make_scenes.py            # rewrites scenes/*.glb
 """
@@ -74,14 +83,15 @@ def look_rotation(forward, up=(0.0, 1.0, 0.0)):
 
 class Scene:
     def __init__(self):
-        self.materials = []  # (name, rgb)
+        self.materials = []  # (name, rgb, roughness)
         self.boxes = {}      # material index -> list of (lo, hi)
         self.nodes = []
         self.lights = []
         self.cameras = []
+        self.medium = None   # lpvd_medium object for the scene's extras, or None
 
-    def material(self, name, rgb):
-        self.materials.append((name, rgb))
+    def material(self, name, rgb, roughness=1.0):
+        self.materials.append((name, rgb, roughness))
         self.boxes[len(self.materials) - 1] = []
         return len(self.materials) - 1
 
@@ -115,7 +125,7 @@ class Scene:
             blob.extend(data)
             return len(views) - 1
 
-        for m, (name, _) in enumerate(self.materials):
+        for m, (name, _, _) in enumerate(self.materials):
             pos, nrm, idx = [], [], []
             for lo, hi in self.boxes[m]:
                 p, n, i = box(lo, hi)
@@ -141,17 +151,20 @@ class Scene:
         while len(blob) % 4:
             blob.append(0)
         nodes = mesh_nodes + self.nodes
+        scene = {"nodes": list(range(len(nodes)))}
+        if self.medium is not None:
+            scene["extras"] = {"lpvd_medium": self.medium}
         doc = {
             "asset": {"version": "2.0", "generator": "lpvd scenes/make_scenes.py"},
             "extensionsUsed": ["KHR_lights_punctual"],
             "extensions": {"KHR_lights_punctual": {"lights": self.lights}},
             "scene": 0,
-            "scenes": [{"nodes": list(range(len(nodes)))}],
+            "scenes": [scene],
             "nodes": nodes,
             "meshes": meshes,
             "materials": [{"name": n, "pbrMetallicRoughness": {"baseColorFactor": list(c) + [1.0],
-                                                               "metallicFactor": 0.0, "roughnessFactor": 1.0}}
-                          for n, c in self.materials],
+                                                               "metallicFactor": 0.0, "roughnessFactor": r}}
+                          for n, c, r in self.materials],
             "cameras": self.cameras,
             "buffers": [{"byteLength": len(blob)}],
             "bufferViews": views,
@@ -223,9 +236,74 @@ def blinds():
     return s
 
 
+def room(s, floor_roughness=1.0):
+    """A closed room x, z in [-2, 2], y in [0, 3] (walls 10 cm thick), matte
+    except the floor; the left wall (x = -2) is red. Returns the floor material."""
+    wall = s.material("walls", (0.75, 0.75, 0.72))
+    red = s.material("red_wall", (0.70, 0.12, 0.10))
+    floor = s.material("floor", (0.45, 0.45, 0.45), floor_roughness)
+    t = 0.1
+    s.add_box(floor, (-2 - t, -t, -2 - t), (2 + t, 0, 2 + t))   # floor
+    s.add_box(wall, (-2 - t, 3, -2 - t), (2 + t, 3 + t, 2 + t))   # ceiling
+    s.add_box(wall, (-2, 0, -2 - t), (2, 3, -2))                  # back wall
+    s.add_box(wall, (-2, 0, 2), (2, 3, 2 + t))                    # front wall (behind the camera)
+    s.add_box(red, (-2 - t, 0, -2 - t), (-2, 3, 2 + t))           # left wall, coloured
+    s.add_box(wall, (2, 0, -2 - t), (2 + t, 3, 2 + t))            # right wall
+    return floor
+
+
+def glossy():
+    s = Scene()
+    room(s, floor_roughness=0.1)
+    block = s.material("block_white", (0.80, 0.80, 0.80))
+    s.add_box(block, (0.4, 0, -1.2), (1.2, 0.8, -0.4))
+    # 4600 cd = 6.7 W/sr: about 1 W/m^2 on the floor 2.6 m below
+    s.light("point", {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (0.3, 2.6, 0.2),
+            (0.3, 0.0, 0.2))
+    s.camera("Camera", (1.2, 1.6, 1.8), (-1.4, 0.4, -0.8), 60.0)
+    return s
+
+
+def fog():
+    s = Scene()
+    room(s)
+    s.medium = {"sigma_s": 0.08, "sigma_a": 0.02}
+    # a spot from the upper right-back corner down towards the left front floor
+    s.light("spot", {"type": "spot", "color": [1.0, 0.92, 0.8], "intensity": 30000.0,
+                     "spot": {"innerConeAngle": 0.12, "outerConeAngle": 0.22}},
+            (1.8, 2.9, -1.8), (-1.0, 0.0, 0.6))
+    s.camera("Camera", (1.0, 1.5, 1.9), (-0.6, 1.0, -1.0), 60.0)
+    return s
+
+
+def smoke_blob(n=8):
+    """n^3 densities (x fastest) of a soft Gaussian blob, rounded to keep the file small."""
+    values = []
+    for k in range(n):
+        for j in range(n):
+            for i in range(n):
+                x, y, z = ((c + 0.5) / n * 2.0 - 1.0 for c in (i, j, k))
+                values.append(round(math.exp(-2.5 * (x * x + 1.5 * y * y + z * z)), 3))
+    return values
+
+
+def smoke():
+    s = Scene()
+    room(s)
+    s.medium = {"sigma_s": 0.5, "sigma_a": 0.05,
+                "box": {"min": [-1.0, 0.2, -1.2], "max": [1.0, 2.2, 0.8]},
+                "density": {"dims": [8, 8, 8], "values": smoke_blob(8)}}
+    s.light("spot", {"type": "spot", "color": [1.0, 0.92, 0.8], "intensity": 30000.0,
+                     "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.35}},
+            (1.8, 2.9, -1.8), (0.0, 1.2, -0.2))
+    s.camera("Camera", (1.0, 1.5, 1.9), (-0.2, 1.1, -0.4), 60.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
-    for name, build in (("courtyard", courtyard), ("blinds", blinds)):
+    for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
+                        ("smoke", smoke)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

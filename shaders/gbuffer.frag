@@ -11,7 +11,7 @@ uniform float u_pixel_area;        // m^2 per pixel (orthographic)
 uniform vec3 u_forward;
 
 layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0 = covered
-layout(location = 1) out vec4 o_normal;   // xyz unit, facing the camera; w 1 = covered
+layout(location = 1) out vec4 o_normal;   // xyz unit, facing the camera; w 1 + metallic where covered
 layout(location = 2) out vec4 o_albedo;   // rgb linear albedo; a roughness
 layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr); a object size (m)
 
@@ -32,7 +32,7 @@ void main()
         area = u_pixel_area / cos_s;
     }
     o_position = vec4(p, area);
-    o_normal = vec4(n, 1.0);
+    o_normal = vec4(n, 1.0 + clamp(u_metallic, 0.0, 1.0)); // w >= 1: covered; w - 1: metallic
     o_albedo = vec4(material_albedo(v_uv).rgb, u_roughness);
     o_emission = vec4(u_emission, u_object_size);
 }

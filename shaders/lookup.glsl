@@ -16,8 +16,9 @@ layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer AccLookup { LpvCell l
 
 uniform float u_damping;
 
-// E at continuous cell coordinates q (cell centres at +0.5) of cascade k.
-vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
+// The trilinearly interpolated SH (r, g, b) at continuous cell coordinates q
+// (cell centres at +0.5) of cascade k, clamped at the grid's edge.
+void cascade_sh_at(int k, vec3 q, out vec4 r, out vec4 g, out vec4 b)
 {
     ivec3 dims = grid_dims();
     q = clamp(q, vec3(0.5), vec3(dims) - 0.5) - 0.5;
@@ -25,7 +26,9 @@ vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
     ivec3 c1 = min(c0 + 1, dims - 1);
     vec3 f = q - vec3(c0);
     int base = k * grid_cells();
-    vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
+    r = vec4(0.0);
+    g = vec4(0.0);
+    b = vec4(0.0);
     for (int j = 0; j < 8; ++j) {
         ivec3 sel = ivec3(j & 1, (j >> 1) & 1, (j >> 2) & 1);
         ivec3 c = mix(c0, c1, bvec3(sel));
@@ -36,9 +39,22 @@ vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
         g += w * cell.g;
         b += w * cell.b;
     }
-    vec4 lobe = sh_lobe(-n);
+}
+
+// (r, g, b) . v / cell^2 at q in cascade k, clamped at 0: with v = lobe(-n)
+// the irradiance of a surface facing n, with v = basis(w) the radiance
+// travelling along w, with v = (sqrt(4 pi), 0, 0, 0) the fluence.
+vec3 cascade_project_at(int k, vec3 q, vec4 v)
+{
+    vec4 r, g, b;
+    cascade_sh_at(k, q, r, g, b);
     float cell = cascade_cell(k);
-    return max(vec3(dot(r, lobe), dot(g, lobe), dot(b, lobe)) / (cell * cell), 0.0);
+    return max(vec3(dot(r, v), dot(g, v), dot(b, v)) / (cell * cell), 0.0);
+}
+
+vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
+{
+    return cascade_project_at(k, q, sh_lobe(-n));
 }
 
 vec3 cascade_irradiance(int k, vec3 p, vec3 n)
@@ -81,4 +97,30 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
         remaining *= 1.0 - w;
     }
     return e;
+}
+
+// (r, g, b) . v / cell^2 at world point x, blended across cascades like
+// lpv_irradiance (for the glossy march and the media's in-scattering).
+vec3 lpv_project(vec3 x, vec4 v)
+{
+    int count = cascade_count();
+    vec3 e = vec3(0.0);
+    float remaining = 1.0;
+    for (int k = 0; k < count && remaining > 0.0; ++k) {
+        float w = k == count - 1 ? 1.0 : cascade_weight(k, x);
+        if (w > 0.0)
+            e += remaining * w * cascade_project_at(k, cascade_coords(k, x), v);
+        remaining *= 1.0 - w;
+    }
+    return e;
+}
+
+// Cell size of the finest cascade holding x well inside (the march's scale).
+float lpv_cell_at(vec3 x)
+{
+    int count = cascade_count();
+    for (int k = 0; k < count - 1; ++k)
+        if (cascade_weight(k, x) >= 1.0)
+            return cascade_cell(k);
+    return cascade_cell(count - 1);
 }

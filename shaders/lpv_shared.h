@@ -171,6 +171,7 @@ struct LpvViewBlock {
 #define LPV_TEX_ACC_IN    2
 #define LPV_TEX_TRANSMIT  3
 #define LPV_TEX_REFLECT   4
+#define LPV_TEX_DENSITY   7 /* the medium's 3D density (units 0..6 are the shading's) */
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
 #define LPV_PROP_WG_X 32

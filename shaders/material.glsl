@@ -4,6 +4,7 @@ uniform vec4 u_base_color;      // linear RGBA factor
 uniform int u_has_texture;      // base colour texture bound to unit 0 (sRGB, decoded by GL)
 uniform vec3 u_emission;        // W/(m^2 sr)
 uniform float u_roughness;      // glTF roughness (0 mirror .. 1 matte)
+uniform float u_metallic;       // glTF metallic (0 dielectric .. 1 metal)
 uniform float u_object_size;    // m, the draw's longest bounding-box side (cascade fading)
 layout(binding = 0) uniform sampler2D u_base_texture;
 

@@ -103,6 +103,15 @@ void main()
             sum.b += lobe * (refl.b * sent_dc(self.b, sigma.b, slot, s));
         }
     }
+    if ((u_medium & 1) != 0) {
+        // light crossing this cell loses what the medium scatters or absorbs
+        // on the way: the media pass scatters it toward the eye instead
+        float cell = cascade_cell(k);
+        vec3 att = exp(-medium_sigma_t((vec3(c) + 0.5 + cascade_origin_cells(k)) * cell) * cell);
+        sum.r *= att.r;
+        sum.g *= att.g;
+        sum.b *= att.b;
+    }
     cout[i] = sum;
     // The next step needs each source's flux limit; computing it here, once
     // per cell, saves recomputing it for each of the six destinations.
