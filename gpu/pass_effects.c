@@ -96,6 +96,9 @@ static void draw_fullscreen(lpv_engine *e)
     lpv_timer_count(&e->timer, 1);
     glBindVertexArray(0);
     glDisable(GL_BLEND);
+    /* Mesa refuses draws into several attachments while a dual-source factor
+     * is set, even with blending off: leave the default behind. */
+    glBlendFunc(GL_ONE, GL_ZERO);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
