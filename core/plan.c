@@ -77,6 +77,8 @@ static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, int c
         return say(why, n, "the lights changed"), 1;
     if (f->settings_changed)
         return say(why, n, "the settings changed"), 1;
+    if (f->forced)
+        return say(why, n, "recompute requested"), 1;
     if (f->placement_changed)
         return say(why, n, "the camera moved a cascade to a new cell"), 1;
     if (camera_in_gv && f->camera_move_cells >= 1.0f)

@@ -45,6 +45,7 @@ typedef struct lpv_plan_facts {
     int scene_changed;         /* geometry or materials */
     int lights_changed;
     int settings_changed;
+    int forced;                /* the caller asked for a recompute (lpv_engine_invalidate) */
     int placement_changed;     /* a cascade's snapped placement differs */
     float camera_move_cells;   /* camera travel since the last computed tick, in finest cells */
 } lpv_plan_facts;

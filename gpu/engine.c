@@ -612,6 +612,7 @@ static void gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->scene_changed = e->scene_dirty;
     f->lights_changed = e->lights_dirty;
     f->settings_changed = e->settings_dirty;
+    f->forced = e->forced;
     if (e->has_view != e->computed_has_view) {
         f->camera_move_cells = INFINITY;
     } else if (e->has_view) {
@@ -631,6 +632,11 @@ static void clear_volume(lpv_engine *e)
         glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_RGBA32F, GL_RGBA, GL_FLOAT, NULL);
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+void lpv_engine_invalidate(lpv_engine *e)
+{
+    e->forced = 1;
 }
 
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
@@ -676,7 +682,7 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
         return lpv_error(err, err_size, "GL error 0x%04x during the tick", gl_err);
     e->ticked = 1;
     e->computed = 1;
-    e->scene_dirty = e->lights_dirty = e->settings_dirty = 0;
+    e->scene_dirty = e->lights_dirty = e->settings_dirty = e->forced = 0;
     e->computed_has_view = e->has_view;
     if (e->has_view)
         memcpy(e->computed_eye, e->view.eye, sizeof e->computed_eye);

@@ -68,6 +68,10 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
 /* Sets the camera (NULL: none; the GV then uses only the RSMs). */
 int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t err_size);
 
+/* Makes the next tick recompute everything even if nothing changed (the
+ * plan says "recompute requested"): for benchmarks that time full ticks. */
+void lpv_engine_invalidate(lpv_engine *e);
+
 /* Runs one tick: RSMs through propagation. */
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size);
 

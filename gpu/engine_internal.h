@@ -41,7 +41,7 @@ struct lpv_engine {
 
     /* What changed since the last computed tick (the planner's facts). */
     int computed;             /* a tick computed the volume at least once since set_scene/settings */
-    int scene_dirty, lights_dirty, settings_dirty;
+    int scene_dirty, lights_dirty, settings_dirty, forced;
     uint64_t geometry_sig;    /* hash of vertices, indices, materials */
     float computed_eye[3];
     int computed_has_view;

@@ -17,7 +17,10 @@ void main()
     vec4 p = texelFetch(u_gbuf_position, t, 0);
     vec4 n = texelFetch(u_gbuf_normal, t, 0);
     int i = t.x + u_size.x * t.y;
-    surfels[i].position = vec4(p.xyz, n.w > 0.5 ? p.w : 0.0);
+    // emitters are light sources only: they do not block in the GV (the
+    // planner counts only non-emissive triangles as occluders)
+    bool emitter = any(greaterThan(texelFetch(u_gbuf_emission, t, 0).rgb, vec3(0.0)));
+    surfels[i].position = vec4(p.xyz, n.w > 0.5 && !emitter ? p.w : 0.0);
     surfels[i].normal = vec4(n.xyz, texelFetch(u_gbuf_emission, t, 0).a);
     surfels[i].albedo = vec4(texelFetch(u_gbuf_albedo, t, 0).rgb, 0.0);
 }

@@ -10,7 +10,7 @@ uniform int u_face;
 layout(location = 0) out vec4 o_position; // xyz world (m); w surfel area (m^2)
 layout(location = 1) out vec4 o_normal;   // xyz unit normal facing the light; w 1 = covered
 layout(location = 2) out vec4 o_flux;     // rgb reflected flux (W); a object size (m)
-layout(location = 3) out vec4 o_albedo;   // rgb diffuse albedo (for bounces)
+layout(location = 3) out vec4 o_albedo;   // rgb diffuse albedo (for bounces); a 1 = occluder
 
 // Grazing surfels would get unbounded areas; their blocking saturates anyway.
 const float MIN_COS = 0.05;
@@ -47,5 +47,7 @@ void main()
     o_position = vec4(p, texel_area_perp / cos_s);
     o_normal = vec4(n, 1.0);
     o_flux = vec4(albedo * power, u_object_size);
-    o_albedo = vec4(albedo, 1.0);
+    // a: 1 = blocks light in the geometry volume; emitters do not (they are
+    // light sources, and the planner counts only non-emissive triangles)
+    o_albedo = vec4(albedo, any(greaterThan(u_emission, vec3(0.0))) ? 0.0 : 1.0);
 }

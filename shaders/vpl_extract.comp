@@ -25,7 +25,9 @@ void main()
     vpls[i].position = vec4(p.xyz, covered ? 1.0 : 0.0);
     vpls[i].normal = vec4(n.xyz, f.a); // w: object size
     vpls[i].flux = vec4(f.rgb, 0.0);
-    surfels[i].position = vec4(p.xyz, covered ? p.w : 0.0);
+    vec4 albedo = texelFetch(u_rsm_albedo, t, 0);
+    bool occluder = albedo.a > 0.5; // emitters do not block (see rsm.frag)
+    surfels[i].position = vec4(p.xyz, covered && occluder ? p.w : 0.0);
     surfels[i].normal = vec4(n.xyz, f.a);
-    surfels[i].albedo = vec4(texelFetch(u_rsm_albedo, t, 0).rgb, 0.0);
+    surfels[i].albedo = vec4(albedo.rgb, 0.0);
 }

@@ -50,7 +50,8 @@
 #define MAX_PASS 16
 
 /* The stages lpv_engine_stats reports, in CSV column order. */
-static const char *const STAGES[] = {"rsm", "vpl_extract", "inject", "gbuffer", "gv", "propagate", "shade"};
+static const char *const STAGES[] = {"rsm",       "vpl_extract", "inject",  "gbuffer", "gv",
+                                     "propagate", "shade",       "emissive", "pack"};
 #define NSTAGES ((int)(sizeof STAGES / sizeof STAGES[0]))
 
 /* The full factorial. */
@@ -61,7 +62,28 @@ static const int OCCS[] = {0, 1};
 
 typedef struct point {
     int grid, iterations, rsm, occlusion;
+    /* --features (one factor at a time around balanced); all 0 for the classic sweep */
+    int feat;           /* 1: a point of the features block */
+    int cascades;       /* settings.cascades (0 = auto) */
+    float cascade_size; /* m; 0 = default */
+    int bounces;        /* 1 = on */
+    float damping;      /* 0 = off */
+    char label[32];     /* the features block's name of the point */
 } point;
+
+/* --features: the knob varied, around the balanced preset with one grid over
+ * the scene (cascades 1), bounces off, damping 0. "cascades 3" uses the
+ * scene's cascade size (scene_entry.cascade_size). */
+typedef struct feature_def {
+    const char *label;
+    int cascades, bounces;
+    float damping;
+} feature_def;
+static const feature_def FEATURES[] = {
+    {"base", 1, 0, 0.0f},      {"cascades-3", 3, 0, 0.0f}, {"bounces-on", 1, 1, 0.0f},
+    {"damping-0.5", 1, 0, 0.5f}, {"damping-1", 1, 0, 1.0f},
+};
+#define NFEATURES ((int)(sizeof FEATURES / sizeof FEATURES[0]))
 
 /* --quick: a handful of points spanning cheap to expensive. */
 static const point QUICK[] = {
@@ -104,9 +126,13 @@ typedef struct result {
     int scene;
     point p;
     double ms_total;
-    double stage_ms[8];
+    double stage_ms[12];
     lpv_acc_metrics m;
     int pareto;
+    int cascades_used;          /* lpv_engine_cascade_count after the point's ticks */
+    int ref_bounces;            /* bounces of the reference m compares with */
+    double rel_rmse_1b;         /* vs the 1-bounce reference */
+    double rel_rmse_multi;      /* vs the multi-bounce reference; NAN when not rendered */
 } result;
 
 typedef struct scene_entry {
@@ -114,6 +140,11 @@ typedef struct scene_entry {
     const char *path; /* NULL = the built-in Cornell box */
     char ref_exr[1024], ref_se[1024];
     int have_se;
+    char mref_exr[1024], mref_se[1024]; /* the multi-bounce reference (bounces on) */
+    int have_mref, have_mse;
+    int has_cam; /* a camera of its own (cornell-inside) */
+    float eye[3], target[3], fov;
+    float cascade_size; /* m, for --features' "cascades-3" */
 } scene_entry;
 
 static void usage(FILE *f)
@@ -130,6 +161,10 @@ static void usage(FILE *f)
             "                     or paths to .glb/.gltf files (default cornell,courtyard,blinds)\n"
             "  --quick            %d points instead of the 72-point factorial\n"
             "  --presets          exactly the named presets (fast, balanced, accurate) as the points\n"
+            "  --features         one knob at a time around balanced: cascades 3, bounces on, damping\n"
+            "                     0.5 and 1 vs one grid (alone: scenes cornell-inside,courtyard,blinds;\n"
+            "                     with another point set: added to it); features.png\n"
+            "  --multi-bounces N  bounces of the reference for bounces on (--features; default 3)\n"
             "  --knobs SPEC       restrict knob values, e.g. grid=16/32,iterations=8,rsm=256,occlusion=on\n"
             "  --points LIST      explicit points GRID:ITER:RSM:on|off, comma separated\n"
             "  --ticks N          timed ticks per point, median reported (default 5)\n"
@@ -261,7 +296,7 @@ static int parse_points(const char *list, point *pts, int max)
     snprintf(buf, sizeof buf, "%s", list);
     for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         char occ[8] = "";
-        point p;
+        point p = {0};
         if (n >= max || sscanf(tok, "%d:%d:%d:%7s", &p.grid, &p.iterations, &p.rsm, occ) != 4)
             return -1;
         if (strcmp(occ, "on") == 0)
@@ -335,8 +370,8 @@ static int run_command(char *const argv[])
 }
 
 /* The reference in process (lpv_reference): 1 bounce, spp samples per pixel. */
-static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, int spp, const char *exr,
-                                const char *se_exr)
+static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, int bounces, int spp,
+                                const char *exr, const char *se_exr)
 {
     char err[1024] = "";
     lpv_ref *ref = NULL;
@@ -347,7 +382,7 @@ static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, in
         fprintf(stderr, "lpvd-accuracy: out of memory for the reference\n");
     } else if (lpv_ref_create(scene, NULL, &ref, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-accuracy: reference: %s\n", err);
-    } else if (lpv_ref_render_indirect(ref, view, 1, spp, rgba, se) != 0) {
+    } else if (lpv_ref_render_indirect(ref, view, bounces, spp, rgba, se) != 0) {
         fprintf(stderr, "lpvd-accuracy: reference: lpv_ref_render_indirect failed\n");
     } else if (lpv_image_write_f32(exr, view->width, view->height, 4, rgba, err, sizeof err) != 0 ||
                lpv_image_write_f32(se_exr, view->width, view->height, 4, se, err, sizeof err) != 0) {
@@ -364,43 +399,54 @@ static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, in
 /* Makes sure the scene's reference is cached; fills e->ref_exr / ref_se.
  * ref_cmd NULL: the linked library (lpv_reference, in process). */
 static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const char *out_dir,
-                            int spp, const char *ref_cmd, char *const *cam_args, int ncam)
+                            int spp, const char *ref_cmd, char *const *cam_args, int ncam, int bounces)
 {
+    /* bounces > 1: the multi-bounce reference, into e->mref_* (the 1-bounce
+     * key and file names stay as they were, so old caches still hit) */
+    char *ref_exr = bounces > 1 ? e->mref_exr : e->ref_exr, *ref_se = bounces > 1 ? e->mref_se : e->ref_se;
+    int *have_se = bounces > 1 ? &e->have_mse : &e->have_se;
+    char bsuffix[16] = "";
+    if (bounces > 1)
+        snprintf(bsuffix, sizeof bsuffix, "-b%d", bounces);
     uint64_t h = 1469598103934665603ull;
     h = e->path ? hash_file(h, e->path) : fnv1a(h, "built-in:cornell-box", 20);
     h = fnv1a(h, view, sizeof *view);
     h = fnv1a(h, &spp, sizeof spp);
     h = ref_cmd ? fnv1a(h, ref_cmd, strlen(ref_cmd)) : fnv1a(h, "lib:lpv_reference", 17);
+    if (bounces > 1)
+        h = fnv1a(h, &bounces, sizeof bounces);
     char key[256];
-    if (snprintf(key, sizeof key, "%s-%dx%d-spp%d-%016llx", e->name, view->width, view->height, spp,
+    if (snprintf(key, sizeof key, "%s-%dx%d-spp%d%s-%016llx", e->name, view->width, view->height, spp, bsuffix,
                  (unsigned long long)h) >= (int)sizeof key ||
-        snprintf(e->ref_exr, sizeof e->ref_exr, "%s/ref/%s.exr", out_dir, key) >= (int)sizeof e->ref_exr ||
-        snprintf(e->ref_se, sizeof e->ref_se, "%s/ref/%s.stderr.exr", out_dir, key) >= (int)sizeof e->ref_se) {
+        snprintf(ref_exr, sizeof e->ref_exr, "%s/ref/%s.exr", out_dir, key) >= (int)sizeof e->ref_exr ||
+        snprintf(ref_se, sizeof e->ref_se, "%s/ref/%s.stderr.exr", out_dir, key) >= (int)sizeof e->ref_se) {
         fprintf(stderr, "lpvd-accuracy: output path too long\n");
         return -1;
     }
-    if (file_exists(e->ref_exr)) {
-        e->have_se = file_exists(e->ref_se);
-        fprintf(stderr, "lpvd-accuracy: %s: cached reference %s\n", e->name, e->ref_exr);
+    if (file_exists(ref_exr)) {
+        *have_se = file_exists(ref_se);
+        fprintf(stderr, "lpvd-accuracy: %s: cached reference %s\n", e->name, ref_exr);
         return 0;
     }
     char tmp_exr[1100], tmp_se[1100], spp_s[32], size_s[64];
     snprintf(tmp_exr, sizeof tmp_exr, "%s/ref/%s.tmp%d.exr", out_dir, key, (int)getpid());
     snprintf(tmp_se, sizeof tmp_se, "%s/ref/%s.stderr.tmp%d.exr", out_dir, key, (int)getpid());
     if (!ref_cmd) {
-        fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, %d spp)\n", e->name,
-                spp);
-        if (render_reference_lib(scene, view, spp, tmp_exr, tmp_se) != 0 || rename(tmp_exr, e->ref_exr) != 0 ||
-            rename(tmp_se, e->ref_se) != 0) {
+        fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, %d bounce(s), %d spp)\n",
+                e->name, bounces, spp);
+        if (render_reference_lib(scene, view, bounces, spp, tmp_exr, tmp_se) != 0 || rename(tmp_exr, ref_exr) != 0 ||
+            rename(tmp_se, ref_se) != 0) {
             unlink(tmp_exr);
             unlink(tmp_se);
             return -1;
         }
-        e->have_se = 1;
+        *have_se = 1;
         return 0;
     }
     snprintf(spp_s, sizeof spp_s, "%d", spp);
     snprintf(size_s, sizeof size_s, "%dx%d", view->width, view->height);
+    char bounces_s[16];
+    snprintf(bounces_s, sizeof bounces_s, "%d", bounces);
     char *argv[32 + MAX_PASS];
     int a = 0;
     argv[a++] = (char *)ref_cmd;
@@ -416,6 +462,23 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     argv[a++] = size_s;
     for (int i = 0; i < ncam; ++i)
         argv[a++] = cam_args[i];
+    char cam_s[3][64];
+    if (e->has_cam) { /* the scene's own camera (cornell-inside) */
+        snprintf(cam_s[0], sizeof cam_s[0], "%g,%g,%g", (double)e->eye[0], (double)e->eye[1], (double)e->eye[2]);
+        snprintf(cam_s[1], sizeof cam_s[1], "%g,%g,%g", (double)e->target[0], (double)e->target[1],
+                 (double)e->target[2]);
+        snprintf(cam_s[2], sizeof cam_s[2], "%g", (double)e->fov);
+        argv[a++] = "--eye";
+        argv[a++] = cam_s[0];
+        argv[a++] = "--target";
+        argv[a++] = cam_s[1];
+        argv[a++] = "--fov";
+        argv[a++] = cam_s[2];
+    }
+    if (bounces > 1) {
+        argv[a++] = "--bounces";
+        argv[a++] = bounces_s;
+    }
     argv[a] = NULL;
     fprintf(stderr, "lpvd-accuracy: %s: rendering the reference:", e->name);
     for (int i = 0; i < a; ++i)
@@ -428,10 +491,10 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
         unlink(tmp_se);
         return -1;
     }
-    if (rename(tmp_exr, e->ref_exr) != 0)
+    if (rename(tmp_exr, ref_exr) != 0)
         return -1;
-    e->have_se = file_exists(tmp_se) && rename(tmp_se, e->ref_se) == 0;
-    if (!e->have_se)
+    *have_se = file_exists(tmp_se) && rename(tmp_se, ref_se) == 0;
+    if (!*have_se)
         fprintf(stderr, "lpvd-accuracy: %s: warning: no stderr image; ref_noise will be 0\n", e->name);
     return 0;
 }
@@ -446,14 +509,22 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
     fprintf(f, "scene,grid,iterations,rsm,occlusion,ms_per_tick");
     for (int k = 0; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
-    fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto,preset\n");
+    fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto,preset");
+    fprintf(f, ",block,label,cascades,cascade_size,bounces,damping,ref_bounces,rel_rmse_1b,rel_rmse_multi\n");
     for (int i = 0; i < n; ++i) {
         fprintf(f, "%s,%d,%d,%d,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
                 occ_name(r[i].p.occlusion), r[i].ms_total);
         for (int k = 0; k < NSTAGES; ++k)
             fprintf(f, ",%.3f", r[i].stage_ms[k]);
-        fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d,%s\n", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
-                r[i].m.rel_rmse_excess, r[i].m.rel_mae, r[i].m.pixels, r[i].pareto, point_preset(&r[i].p));
+        fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d,%s", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
+                r[i].m.rel_rmse_excess, r[i].m.rel_mae, r[i].m.pixels, r[i].pareto,
+                r[i].p.feat ? "" : point_preset(&r[i].p));
+        fprintf(f, ",%s,%s,%d,%g,%s,%g,%d,%.5f,", r[i].p.feat ? "features" : "sweep", r[i].p.label,
+                r[i].cascades_used, (double)r[i].p.cascade_size, occ_name(r[i].p.bounces), (double)r[i].p.damping,
+                r[i].ref_bounces, r[i].rel_rmse_1b);
+        if (isfinite(r[i].rel_rmse_multi))
+            fprintf(f, "%.5f", r[i].rel_rmse_multi);
+        fputc('\n', f);
     }
 }
 
@@ -468,7 +539,7 @@ static int scene_rows(const result *r, int n, int scene, const result **rows)
 {
     int k = 0;
     for (int i = 0; i < n; ++i)
-        if (r[i].scene == scene)
+        if (r[i].scene == scene && !r[i].p.feat)
             rows[k++] = &r[i];
     qsort(rows, (size_t)k, sizeof *rows, cmp_ms);
     return k;
@@ -484,6 +555,46 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
     const result **rows = malloc((size_t)n * sizeof *rows);
     if (!rows)
         return;
+    for (int s = 0; s < nscenes; ++s) {
+        const result *base = NULL;
+        int nf = 0;
+        for (int i = 0; i < n; ++i)
+            if (r[i].scene == s && r[i].p.feat) {
+                if (!base)
+                    base = &r[i];
+                ++nf;
+            }
+        if (nf == 0)
+            continue;
+        fprintf(f, "## %s: one factor at a time (--features)\n\n", scenes[s].name);
+        fprintf(f, "Each row changes one knob of `base` (balanced: 32³, 4 iterations, RSM 128², occlusion on; "
+                   "cascades 1 = one grid over the scene, bounces off, damping 0). rel. RMSE: against the "
+                   "reference with as many bounces as the point models (1 bounce with bounces off, %d with "
+                   "bounces on); the two columns after it compare every point with both references.%s\n\n",
+                base->ref_bounces > 1 ? base->ref_bounces : (scenes[s].have_mref ? 3 : 1),
+                scenes[s].has_cam ? " This scene uses its own camera inside the box (see docs), so that 1 m "
+                                    "cascades nest in the 2 m box." : "");
+        fprintf(f, "| point | cascades (size) | bounces | damping | ms/tick | Δ ms vs base | propagate ms | rel. RMSE "
+                   "| vs 1-bounce ref | vs multi-bounce ref | rel. bias | rel. MAE |\n");
+        fprintf(f, "|---|---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (int i = 0; i < n; ++i) {
+            const result *x = &r[i];
+            if (x->scene != s || !x->p.feat)
+                continue;
+            char csz[32] = "";
+            if (x->cascades_used > 1)
+                snprintf(csz, sizeof csz, " (%g m)", (double)x->p.cascade_size);
+            fprintf(f, "| %s | %d%s | %s | %g | %.2f | %+.2f | %.2f | %.3f | %.3f | ", x->p.label, x->cascades_used,
+                    csz, occ_name(x->p.bounces), (double)x->p.damping, x->ms_total, x->ms_total - base->ms_total,
+                    x->stage_ms[5], x->m.rel_rmse, x->rel_rmse_1b);
+            if (isfinite(x->rel_rmse_multi))
+                fprintf(f, "%.3f", x->rel_rmse_multi);
+            else
+                fprintf(f, "–");
+            fprintf(f, " | %+.3f | %.3f |\n", x->m.rel_bias, x->m.rel_mae);
+        }
+        fputc('\n', f);
+    }
     for (int s = 0; s < nscenes; ++s) {
         int k = scene_rows(r, n, s, rows);
         if (k == 0)
@@ -631,6 +742,67 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
     return run_gnuplot(out_dir, "plot");
 }
 
+/* features.gp + plot/features.dat: per knob of the features block, the ms per
+ * tick (top) and the rel. RMSE against the point's own reference (bottom),
+ * one bar per scene. Returns 0 (nothing to do without feature points). */
+static int write_features_plot(const char *out_dir, const result *r, int n, const scene_entry *scenes, int nscenes,
+                               int no_plot)
+{
+    int any = 0;
+    for (int i = 0; i < n; ++i)
+        any |= r[i].p.feat;
+    if (!any)
+        return 0;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/plot", out_dir);
+    mkdir_p(path);
+    snprintf(path, sizeof path, "%s/plot/features.dat", out_dir);
+    FILE *d = fopen(path, "w");
+    if (!d)
+        return -1;
+    fprintf(d, "# knob, then per scene: ms_per_tick rel_rmse (NaN = not measured)\n# knob");
+    for (int s = 0; s < nscenes; ++s)
+        fprintf(d, " ms_%s rmse_%s", scenes[s].name, scenes[s].name);
+    fputc('\n', d);
+    for (int k = 0; k < NFEATURES; ++k) {
+        fprintf(d, "%s", FEATURES[k].label);
+        for (int s = 0; s < nscenes; ++s) {
+            const result *x = NULL;
+            for (int i = 0; i < n; ++i)
+                if (r[i].scene == s && r[i].p.feat && strcmp(r[i].p.label, FEATURES[k].label) == 0)
+                    x = &r[i];
+            if (x)
+                fprintf(d, " %.4f %.5f", x->ms_total, x->m.rel_rmse);
+            else
+                fprintf(d, " NaN NaN");
+        }
+        fputc('\n', d);
+    }
+    fclose(d);
+    FILE *f = open_gnuplot_script(out_dir, "features", "what each new knob costs and buys", no_plot);
+    if (!f)
+        return -1;
+    fprintf(f, "set terminal pngcairo size 960,900 font 'sans,11'\nset output 'features.png'\n");
+    fprintf(f, "set multiplot layout 2,1 title 'one knob at a time around balanced (32^3, 4 it., RSM 128^2, "
+               "occlusion on, 1 cascade)'\n");
+    fprintf(f, "set style data histograms\nset style histogram clustered gap 1\nset style fill solid 0.8 border -1\n"
+               "set boxwidth 0.9\nset grid ytics\nset key top left\nset yrange [0:*]\nset datafile missing 'NaN'\n");
+    for (int panel = 0; panel < 2; ++panel) {
+        fprintf(f, "set ylabel '%s'\n", panel == 0 ? "GPU ms per tick (median)"
+                                                     : "relative RMSE vs its reference (bounces on: multi-bounce)");
+        fprintf(f, "plot ");
+        for (int s = 0; s < nscenes; ++s)
+            fprintf(f, "%s'plot/features.dat' using %d%s title '%s'", s ? ", " : "", 2 + 2 * s + panel,
+                    s == 0 ? ":xtic(1)" : "", scenes[s].name);
+        fputc('\n', f);
+    }
+    fprintf(f, "unset multiplot\n");
+    fclose(f);
+    if (no_plot)
+        return 0;
+    return run_gnuplot(out_dir, "features");
+}
+
 /* ---- The overall front (overall.h), written when there are 2+ scenes ---- */
 
 static const char *key_preset(const int key[4])
@@ -654,10 +826,17 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         free(o);
         return -1;
     }
-    for (int i = 0; i < n; ++i)
-        rows[i] = (lpv_acc_row){r[i].scene, {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion},
-                                r[i].ms_total, r[i].m.rel_rmse};
-    size_t k = lpv_acc_overall_front(rows, (size_t)n, nscenes, o, (size_t)n);
+    size_t nrows = 0;
+    for (int i = 0; i < n; ++i) /* the classic sweep's points only: features share their four knobs */
+        if (!r[i].p.feat)
+            rows[nrows++] = (lpv_acc_row){r[i].scene, {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion},
+                                          r[i].ms_total, r[i].m.rel_rmse};
+    if (nrows == 0) {
+        free(rows);
+        free(o);
+        return 0;
+    }
+    size_t k = lpv_acc_overall_front(rows, nrows, nscenes, o, (size_t)n);
     free(rows);
     char path[1200];
     snprintf(path, sizeof path, "%s/results.md", out_dir);
@@ -751,6 +930,7 @@ int main(int argc, char **argv)
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
     const char *knobs = NULL, *points_arg = NULL;
     int spp = 256, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
+    int features = 0, multi_bounces = 3, scenes_given = 0;
     lpvd_options opt = {0};
     char *cam_args[MAX_PASS];
     int ncam = 0;
@@ -766,6 +946,16 @@ int main(int argc, char **argv)
             quick = 1;
         } else if (strcmp(a, "--presets") == 0) {
             presets = 1;
+        } else if (strcmp(a, "--features") == 0) {
+            features = 1;
+        } else if (strcmp(a, "--multi-bounces") == 0 && v) {
+            char *end = NULL;
+            long x = strtol(argv[++i], &end, 10);
+            if (!end || *end || x < 2 || x > 64) {
+                fprintf(stderr, "lpvd-accuracy: --multi-bounces expects 2..64\n");
+                return 2;
+            }
+            multi_bounces = (int)x;
         } else if (strcmp(a, "--no-plot") == 0) {
             no_plot = 1;
         } else if (!v && a[0] == '-') {
@@ -775,6 +965,7 @@ int main(int argc, char **argv)
             out_dir = argv[++i];
         } else if (strcmp(a, "--scenes") == 0) {
             scene_list = argv[++i];
+            scenes_given = 1;
         } else if (strcmp(a, "--reference") == 0) {
             ref_given = argv[++i];
         } else if (strcmp(a, "--knobs") == 0) {
@@ -829,6 +1020,14 @@ int main(int argc, char **argv)
     /* The point set. */
     static point pts[MAX_POINTS];
     int npts = 0;
+    if (features && !points_arg && !presets && !quick && !knobs) {
+        /* --features alone: only the features block (its scenes by default
+         * cornell-inside, courtyard, blinds); otherwise the block is added to
+         * the chosen sweep points. */
+        if (!scenes_given)
+            scene_list = "cornell-inside,courtyard,blinds";
+        goto add_features;
+    }
     if (points_arg && presets) {
         fprintf(stderr, "lpvd-accuracy: --points and --presets both name the points; give one\n");
         return 2;
@@ -868,6 +1067,20 @@ int main(int argc, char **argv)
             return 2;
         }
     }
+add_features:
+    if (features) {
+        lpv_settings b;
+        lpv_preset_settings(LPV_PRESET_BALANCED, &b);
+        for (int k = 0; k < NFEATURES && npts < MAX_POINTS; ++k) {
+            point fp = {b.grid_dims[0], b.iterations, b.rsm_size, b.occlusion == LPV_SWITCH_ON};
+            fp.feat = 1;
+            fp.cascades = FEATURES[k].cascades;
+            fp.bounces = FEATURES[k].bounces;
+            fp.damping = FEATURES[k].damping;
+            snprintf(fp.label, sizeof fp.label, "%s", FEATURES[k].label);
+            pts[npts++] = fp;
+        }
+    }
 
     /* The scenes. */
     static scene_entry scenes[MAX_SCENES];
@@ -897,11 +1110,22 @@ int main(int argc, char **argv)
                 e->path = scene_paths[nscenes];
             } else if (strcmp(tok, "cornell") == 0) {
                 e->path = NULL;
+            } else if (strcmp(tok, "cornell-inside") == 0) {
+                /* the built-in box seen from inside its opening: the box's own
+                 * camera stands 2.9 m in front of it, and camera-following
+                 * cascades of 1 m would then hold no geometry */
+                e->path = NULL;
+                e->has_cam = 1;
+                e->eye[0] = 0.0f, e->eye[1] = 1.0f, e->eye[2] = 0.9f;
+                e->target[0] = 0.0f, e->target[1] = 1.0f, e->target[2] = -1.0f;
+                e->fov = 70.0f;
             } else {
                 snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s/%s.glb", LPVD_ACCURACY_SCENES_DIR,
                          tok);
                 e->path = scene_paths[nscenes];
             }
+            /* "cascades-3" of --features: a finest cascade well inside the scene */
+            e->cascade_size = e->path == NULL ? 1.0f : strcmp(e->name, "blinds") == 0 ? 4.0f : 8.0f;
             ++nscenes;
         }
     }
@@ -951,14 +1175,40 @@ int main(int argc, char **argv)
         lpv_view view;
         float *ref = NULL, *ref_se = NULL, *rgba = NULL;
         int rw = 0, rh = 0;
-        if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+        lpvd_camera_choice cam = opt.cam;
+        if (se->has_cam) {
+            cam.has_eye = cam.has_target = cam.has_fov = 1;
+            memcpy(cam.eye, se->eye, sizeof cam.eye);
+            memcpy(cam.target, se->target, sizeof cam.target);
+            cam.fov_deg = se->fov;
+        }
+        if (lpvd_resolve_view(&cam, &scene, &view, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-accuracy: %s\n", err);
             rc = 2;
             goto next_scene;
         }
-        if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args, ncam) != 0) {
+        if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args,
+                             se->has_cam ? 0 : ncam, 1) != 0) {
             rc = 1;
             goto next_scene;
+        }
+        float *mref = NULL, *mref_se = NULL;
+        if (features) { /* the multi-bounce reference: for bounces on, and to compare every point with */
+            int mw = 0, mh = 0;
+            if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args,
+                                 se->has_cam ? 0 : ncam, multi_bounces) != 0 ||
+                lpv_image_read_f32(se->mref_exr, 4, &mw, &mh, &mref, err, sizeof err) != 0 || mw != view.width ||
+                mh != view.height) {
+                fprintf(stderr, "lpvd-accuracy: %s: no multi-bounce reference\n", se->name);
+                rc = 1;
+                goto next_scene;
+            }
+            se->have_mref = 1;
+            if (se->have_mse && (lpv_image_read_f32(se->mref_se, 4, &mw, &mh, &mref_se, err, sizeof err) != 0 ||
+                                 mw != view.width || mh != view.height)) {
+                free(mref_se);
+                mref_se = NULL;
+            }
         }
         if (lpv_image_read_f32(se->ref_exr, 4, &rw, &rh, &ref, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-accuracy: %s\n", err);
@@ -1008,6 +1258,15 @@ int main(int argc, char **argv)
             st.iterations = pts[p].iterations;
             st.rsm_size = pts[p].rsm;
             st.occlusion = pts[p].occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+            if (pts[p].feat) {
+                st.cascades = pts[p].cascades;
+                if (pts[p].cascades > 1) {
+                    st.cascade_size = se->cascade_size;
+                    res->p.cascade_size = se->cascade_size;
+                }
+                st.bounces = pts[p].bounces ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+                st.damping = pts[p].damping;
+            }
             if (lpv_engine_set_settings(engine, &st, err, sizeof err) != 0 ||
                 lpv_engine_set_scene(engine, &scene, err, sizeof err) != 0 ||
                 lpv_engine_set_view(engine, &view, err, sizeof err) != 0) {
@@ -1015,8 +1274,11 @@ int main(int argc, char **argv)
                 rc = 1;
                 break;
             }
-            static double totals[MAX_TICKS], stage[8][MAX_TICKS];
+            static double totals[MAX_TICKS], stage[12][MAX_TICKS];
             for (int t = 0; t < warmup + ticks; ++t) {
+                /* With the planner on, a tick on an unchanged scene serves the
+                 * cached volume and runs no stage: every timed tick is a full one. */
+                lpv_engine_invalidate(engine);
                 if (lpv_engine_tick(engine, err, sizeof err) != 0 ||
                     lpv_engine_render(engine, LPV_TERMS_INDIRECT_ONLY, rgba, err, sizeof err) != 0) {
                     fprintf(stderr, "lpvd-accuracy: %s\n", err);
@@ -1042,22 +1304,44 @@ int main(int argc, char **argv)
             res->ms_total = lpv_acc_median(totals, (size_t)ticks);
             for (int k = 0; k < NSTAGES; ++k)
                 res->stage_ms[k] = lpv_acc_median(stage[k], (size_t)ticks);
+            res->cascades_used = lpv_engine_cascade_count(engine);
             if (lpv_acc_compare(rgba, ref, ref_se, view.width, view.height, &res->m) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both, or a black reference\n",
                         se->name);
+            res->rel_rmse_1b = res->m.rel_rmse;
+            res->ref_bounces = 1;
+            res->rel_rmse_multi = NAN;
+            const float *cmp_ref = ref;
+            if (mref) {
+                lpv_acc_metrics mm;
+                if (lpv_acc_compare(rgba, mref, mref_se, view.width, view.height, &mm) == 0) {
+                    res->rel_rmse_multi = mm.rel_rmse;
+                    if (pts[p].bounces) { /* bounces on models more than one bounce: its own reference */
+                        res->m = mm;
+                        res->ref_bounces = multi_bounces;
+                        cmp_ref = mref;
+                    }
+                }
+            }
             char ep[1400];
-            snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s.png", sub, pts[p].grid, pts[p].iterations, pts[p].rsm,
-                     occ_name(pts[p].occlusion));
-            if (lpv_acc_write_error_png(ep, rgba, ref, view.width, view.height, res->m.mean_ref, err, sizeof err) !=
-                0)
+            if (pts[p].feat)
+                snprintf(ep, sizeof ep, "%s/features-%s.png", sub, pts[p].label);
+            else
+                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s.png", sub, pts[p].grid, pts[p].iterations,
+                         pts[p].rsm, occ_name(pts[p].occlusion));
+            if (lpv_acc_write_error_png(ep, rgba, cmp_ref, view.width, view.height, res->m.mean_ref, err,
+                                        sizeof err) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s\n", err);
             fprintf(stderr,
                     "lpvd-accuracy: %s %d/%d: grid %d, iterations %d, rsm %d, occlusion %s: %.2f ms/tick, "
-                    "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f\n",
+                    "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
                     se->name, p + 1, npts, pts[p].grid, pts[p].iterations, pts[p].rsm, occ_name(pts[p].occlusion),
-                    res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise);
+                    res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
+                    pts[p].label);
             ++nres;
         }
+        free(mref);
+        free(mref_se);
     next_scene:
         free(rgba);
         free(ref);
@@ -1072,7 +1356,17 @@ int main(int argc, char **argv)
         double cost[MAX_POINTS], error[MAX_POINTS];
         int idx[MAX_POINTS], front[MAX_POINTS], k = 0;
         for (int i = 0; i < nres; ++i)
-            if (results[i].scene == s) {
+            if (results[i].scene == s && !results[i].p.feat) {
+                cost[k] = results[i].ms_total;
+                error[k] = results[i].m.rel_rmse;
+                idx[k++] = i;
+            }
+        lpv_acc_pareto(cost, error, (size_t)k, front);
+        for (int j = 0; j < k; ++j)
+            results[idx[j]].pareto = front[j];
+        k = 0; /* the features block: its own front */
+        for (int i = 0; i < nres; ++i)
+            if (results[i].scene == s && results[i].p.feat) {
                 cost[k] = results[i].ms_total;
                 error[k] = results[i].m.rel_rmse;
                 idx[k++] = i;
@@ -1099,8 +1393,13 @@ int main(int argc, char **argv)
     } else {
         rc = 1;
     }
-    if (nres > 0 && write_plot(out_dir, results, nres, scenes, nscenes, no_plot) != 0 && !no_plot)
+    int nclassic = 0;
+    for (int i = 0; i < nres; ++i)
+        nclassic += !results[i].p.feat;
+    if (nclassic > 0 && write_plot(out_dir, results, nres, scenes, nscenes, no_plot) != 0 && !no_plot)
         fprintf(stderr, "lpvd-accuracy: no plot.png\n");
+    if (nres > 0 && write_features_plot(out_dir, results, nres, scenes, nscenes, no_plot) != 0 && !no_plot)
+        fprintf(stderr, "lpvd-accuracy: no features.png\n");
     if (nres > 0 && write_overall(out_dir, results, nres, scenes, nscenes, no_plot) != 0)
         fprintf(stderr, "lpvd-accuracy: no overall front (overall.csv, overall.png)\n");
     free(results);

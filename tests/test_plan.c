@@ -1,0 +1,390 @@
+/*
+ * test_plan.c - the tick planner's rules (core/plan.c) and the cascade
+ * placement (core/cascades.c), pure C, no GL. Every planner rule is checked
+ * from a "baseline" set of facts (a lit, occluded, camera-less scene that is
+ * recomputed because it is the first tick) by changing the one fact the rule
+ * is about, so each check fails if that rule is removed or inverted.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "cascades.h"
+#include "plan.h"
+#include "settings.h"
+
+static lpv_settings resolved(lpv_settings s)
+{
+    lpv_settings_resolve(&s);
+    return s;
+}
+
+/* A scene that needs every tick pass except bounces: lights, emissive
+ * surfaces, occluders, a 4 m extent, first tick. */
+static lpv_plan_facts baseline(void)
+{
+    lpv_plan_facts f = {0};
+    f.lights = 1;
+    f.emissive_vpls = 100;
+    f.occluder_triangles = 12;
+    f.glossy_draws = 1;
+    f.has_medium = 1;
+    f.has_view = 0;
+    f.scene_extent = 4.0f;
+    f.first_tick = 1;
+    return f;
+}
+
+static lpv_plan plan_of(lpv_settings s, lpv_plan_facts f)
+{
+    lpv_plan p;
+    s = resolved(s);
+    lpv_plan_make(&s, &f, &p);
+    return p;
+}
+
+static void assert_reason(const char *reason)
+{
+    assert_non_null(reason);
+    assert_true(strlen(reason) > 0);
+}
+
+static void test_baseline_runs_everything_but_bounce(void **state)
+{
+    (void)state;
+    lpv_plan p = plan_of((lpv_settings){0}, baseline());
+    assert_true(p.recompute);
+    for (int i = 0; i < LPV_PASS_COUNT; ++i) {
+        assert_reason(p.pass[i].reason);
+        assert_int_equal(p.pass[i].run, i != LPV_PASS_BOUNCE && i != LPV_PASS_GBUFFER); /* no camera: no gbuffer */
+    }
+    assert_string_equal(lpv_pass_name(LPV_PASS_GV), "gv");
+    assert_null(lpv_pass_name(LPV_PASS_COUNT));
+}
+
+static void test_no_occluders_skips_gv_and_gbuffer(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.has_view = 1;
+    lpv_plan with = plan_of((lpv_settings){0}, f);
+    assert_true(with.pass[LPV_PASS_GV].run);
+    assert_true(with.pass[LPV_PASS_GBUFFER].run);
+    f.occluder_triangles = 0;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_GV].run);
+    assert_false(p.pass[LPV_PASS_GBUFFER].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_GV].reason, "no occluders"));
+    assert_true(p.pass[LPV_PASS_PROPAGATE].run); /* light still propagates, unoccluded */
+    /* occlusion off skips them too, with its own reason */
+    f.occluder_triangles = 12;
+    p = plan_of((lpv_settings){.occlusion = LPV_SWITCH_OFF}, f);
+    assert_false(p.pass[LPV_PASS_GV].run);
+    assert_false(p.pass[LPV_PASS_GBUFFER].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_GV].reason, "occlusion off"));
+}
+
+static void test_no_glossy_skips_glossy(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.glossy_draws = 0;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_GLOSSY].run);
+    assert_reason(p.pass[LPV_PASS_GLOSSY].reason);
+    f.glossy_draws = 2;
+    assert_true(plan_of((lpv_settings){0}, f).pass[LPV_PASS_GLOSSY].run);
+    assert_false(plan_of((lpv_settings){.glossy = LPV_SWITCH_OFF}, f).pass[LPV_PASS_GLOSSY].run);
+}
+
+static void test_no_medium_skips_media(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.has_medium = 0;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_MEDIA].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_MEDIA].reason, "no medium"));
+    f.has_medium = 1;
+    assert_true(plan_of((lpv_settings){0}, f).pass[LPV_PASS_MEDIA].run);
+    assert_false(plan_of((lpv_settings){.media = LPV_SWITCH_OFF}, f).pass[LPV_PASS_MEDIA].run);
+}
+
+static void test_no_emissive_skips_emissive(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.emissive_vpls = 0;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_EMISSIVE].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_EMISSIVE].reason, "no emissive"));
+    assert_true(p.pass[LPV_PASS_RSM].run);
+    assert_true(p.pass[LPV_PASS_INJECT].run);
+}
+
+static void test_no_lights_skips_rsm(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.lights = 0;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_RSM].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_RSM].reason, "no punctual lights"));
+    assert_true(p.pass[LPV_PASS_INJECT].run); /* the emissive VPLs still need injecting */
+    /* neither lights nor emission: nothing to inject or propagate */
+    f.emissive_vpls = 0;
+    p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_INJECT].run);
+    assert_false(p.pass[LPV_PASS_PROPAGATE].run);
+}
+
+static void test_cascade_count(void **state)
+{
+    (void)state;
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_settings s = resolved((lpv_settings){0});
+    lpv_plan_facts f = baseline();
+    /* fits: extent <= cascade_size (8 m by default; equality fits) */
+    f.scene_extent = 8.0f;
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), 1);
+    assert_reason(why);
+    f.scene_extent = 8.01f;
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_int_equal(LPV_DEFAULT_CASCADES, 3);
+    /* the threshold follows cascade_size */
+    lpv_settings small = resolved((lpv_settings){.cascade_size = 2.0f});
+    f.scene_extent = 4.0f;
+    assert_int_equal(lpv_plan_cascades(&small, &f, why, sizeof why), 3);
+    /* explicit wins, both ways */
+    lpv_settings two = resolved((lpv_settings){.cascades = 2});
+    f.scene_extent = 1.0f;
+    assert_int_equal(lpv_plan_cascades(&two, &f, why, sizeof why), 2);
+    lpv_settings one = resolved((lpv_settings){.cascades = 1});
+    f.scene_extent = 100.0f;
+    assert_int_equal(lpv_plan_cascades(&one, &f, why, sizeof why), 1);
+    /* bounds given: one grid over them, even when cascades are asked for */
+    lpv_settings bounds = resolved((lpv_settings){.cascades = 3, .bounds_min = {-1, -1, -1}, .bounds_max = {1, 1, 1}});
+    f.bounds_given = 1;
+    assert_int_equal(lpv_plan_cascades(&bounds, &f, why, sizeof why), 1);
+    assert_non_null(strstr(why, "bounds"));
+    /* the plan carries the same count */
+    f = baseline();
+    f.scene_extent = 20.0f;
+    assert_int_equal(plan_of((lpv_settings){0}, f).cascades, 3);
+}
+
+static lpv_plan_facts steady(void)
+{
+    lpv_plan_facts f = baseline();
+    f.first_tick = 0;
+    f.has_view = 1;
+    return f;
+}
+
+static void assert_cached(const lpv_plan *p)
+{
+    assert_false(p->recompute);
+    assert_reason(p->recompute_reason);
+    for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
+        assert_false(p->pass[i].run);
+}
+
+static void test_recompute_rules(void **state)
+{
+    (void)state;
+    lpv_settings on = {.bounces = LPV_SWITCH_ON};
+    /* nothing changed: cached, with the reason */
+    lpv_plan p = plan_of(on, steady());
+    assert_cached(&p);
+    assert_non_null(strstr(p.recompute_reason, "nothing changed"));
+    /* the camera moved 0.4 cells: cached even though its surfels feed the GV */
+    lpv_plan_facts f = steady();
+    f.camera_move_cells = 0.4f;
+    p = plan_of(on, f);
+    assert_cached(&p);
+    assert_non_null(strstr(p.recompute_reason, "only the camera moved"));
+    /* 1.5 cells with the camera in the GV: recompute */
+    f.camera_move_cells = 1.5f;
+    p = plan_of(on, f);
+    assert_true(p.recompute);
+    assert_non_null(strstr(p.recompute_reason, "surfels"));
+    assert_true(p.pass[LPV_PASS_GBUFFER].run && p.pass[LPV_PASS_GV].run && p.pass[LPV_PASS_PROPAGATE].run);
+    /* 1.5 cells with occlusion off (camera not in the GV): cached */
+    p = plan_of((lpv_settings){.occlusion = LPV_SWITCH_OFF}, f);
+    assert_cached(&p);
+    /* 1.5 cells without occluders (no GV at all): cached */
+    f.occluder_triangles = 0;
+    p = plan_of(on, f);
+    assert_cached(&p);
+    /* placement changed: recompute even with no GV */
+    f.placement_changed = 1;
+    p = plan_of((lpv_settings){.occlusion = LPV_SWITCH_OFF}, f);
+    assert_true(p.recompute);
+    assert_non_null(strstr(p.recompute_reason, "cell"));
+    /* each kind of change forces a recompute */
+    f = steady();
+    f.first_tick = 1;
+    assert_true(plan_of(on, f).recompute);
+    f = steady();
+    f.scene_changed = 1;
+    assert_true(plan_of(on, f).recompute);
+    f = steady();
+    f.lights_changed = 1;
+    assert_true(plan_of(on, f).recompute);
+    f = steady();
+    f.settings_changed = 1;
+    assert_true(plan_of(on, f).recompute);
+}
+
+static void test_planner_off_runs_everything(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = steady(); /* nothing changed */
+    f.lights = 0;
+    f.emissive_vpls = 0;
+    f.occluder_triangles = 0;
+    f.glossy_draws = 0;
+    f.has_medium = 0;
+    lpv_plan p = plan_of((lpv_settings){.planner = LPV_SWITCH_OFF, .bounces = LPV_SWITCH_ON}, f);
+    assert_true(p.recompute);
+    for (int i = 0; i < LPV_PASS_COUNT; ++i)
+        assert_true(p.pass[i].run);
+    /* planner on, same facts: almost nothing runs */
+    p = plan_of((lpv_settings){.bounces = LPV_SWITCH_ON}, f);
+    assert_false(p.recompute);
+}
+
+static void test_bounce_needs_gv(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    lpv_settings s = {.bounces = LPV_SWITCH_ON};
+    assert_true(plan_of(s, f).pass[LPV_PASS_BOUNCE].run);
+    f.occluder_triangles = 0; /* no GV */
+    lpv_plan p = plan_of(s, f);
+    assert_false(p.pass[LPV_PASS_BOUNCE].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_BOUNCE].reason, "geometry volume"));
+    f = baseline();
+    s.occlusion = LPV_SWITCH_OFF;
+    assert_false(plan_of(s, f).pass[LPV_PASS_BOUNCE].run);
+    /* bounces off: never */
+    assert_false(plan_of((lpv_settings){0}, baseline()).pass[LPV_PASS_BOUNCE].run);
+}
+
+/* ---- placement ---- */
+
+static lpv_settings cascade_settings(void)
+{
+    return resolved((lpv_settings){.grid_dims = {16, 16, 16}, .cascade_size = 8.0f});
+}
+
+static const float BMIN[3] = {-10, 0, -10}, BMAX[3] = {10, 3, 10};
+
+static void test_place_snapping_and_nesting(void **state)
+{
+    (void)state;
+    lpv_settings s = cascade_settings();
+    const float eye[3] = {1.37f, 1.61f, -2.93f}, fwd[3] = {0.6f, 0.0f, -0.8f};
+    lpv_cascade_set set;
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, fwd, &set), 0);
+    assert_int_equal(set.count, 3);
+    assert_true(set.snapped);
+    /* cascade 0's cell: cascade_size / max(dims) = 8 / 16 */
+    assert_float_equal(set.grid[0].cell_size, 0.5f, 0.0f);
+    for (int k = 0; k < 3; ++k) {
+        const lpv_grid *g = &set.grid[k];
+        assert_memory_equal(g->dims, s.grid_dims, sizeof g->dims);
+        if (k > 0) /* nesting: ratio (2) x the previous cell; 1e-6 relative: float rounding of the product */
+            assert_float_equal(g->cell_size, set.grid[k - 1].cell_size * s.cascade_ratio, 1e-6f * g->cell_size);
+        for (int i = 0; i < 3; ++i) {
+            float oc = set.origin_cells[k][i];
+            assert_float_equal(oc, floorf(oc), 0.0f); /* whole cells, exactly */
+            /* origin = origin_cells * cell (1e-6 relative: one float multiply) */
+            assert_float_equal(g->origin[i], oc * g->cell_size, 1e-6f * fabsf(oc * g->cell_size) + 1e-7f);
+            /* view offset: the grid's centre is eye + fwd * 0.25 * extent, snapped to whole cells, so within one
+             * cell (plus float slack) of it */
+            double extent = (double)g->cell_size * g->dims[i];
+            double want = eye[i] + fwd[i] * 0.25 * extent;
+            double centre = g->origin[i] + 0.5 * extent;
+            assert_true(fabs(centre - want) <= g->cell_size * (1.0 + 1e-5));
+            /* and without the snap formula being dropped: the lower corner is floor(want/cell) - dims/2 */
+            assert_float_equal(oc, (float)(floor(want / g->cell_size) - g->dims[i] / 2), 0.0f);
+        }
+    }
+    /* the offset really moves the grid: forward -z puts cascade 2's centre 0.25 * 32 m = 8 m ahead */
+    lpv_cascade_set none;
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, NULL, &none), 0);
+    double dz = (set.grid[2].origin[2] - none.grid[2].origin[2]);
+    assert_true(fabs(dz - (-0.8 * 0.25 * 32.0)) <= set.grid[2].cell_size);
+    /* no camera: centred on the scene's centre */
+    lpv_cascade_set scene;
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, NULL, NULL, &scene), 0);
+    for (int i = 0; i < 3; ++i) {
+        double c = scene.grid[0].origin[i] + 0.5 * 8.0, want = 0.5 * (BMIN[i] + BMAX[i]);
+        assert_true(fabs(c - want) <= 0.5 + 1e-6);
+    }
+    /* one cascade: the classic grid over the bounds, not snapped */
+    lpv_cascade_set one;
+    assert_int_equal(lpv_cascades_place(&s, 1, BMIN, BMAX, eye, fwd, &one), 0);
+    assert_int_equal(one.count, 1);
+    assert_false(one.snapped);
+    assert_int_equal(lpv_cascades_place(&s, 5, BMIN, BMAX, eye, fwd, &one), -1);
+    const float bad[3] = {NAN, 0, 0};
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, bad, fwd, &one), -1);
+}
+
+static void test_place_temporal(void **state)
+{
+    (void)state;
+    lpv_settings s = cascade_settings();
+    const float c0 = 0.5f; /* cascade 0's cell */
+    const float fwd[3] = {0.0f, 0.0f, -1.0f};
+    /* eye.x at 0.3 cells of cascade 0, i.e. 0.15 of cascade 1's and 0.075 of cascade 2's: moving it by 0.4 of a
+     * finest cell (0.2 m) keeps floor(x / cell) in every cascade; y and z stay put */
+    float eye[3] = {0.3f * c0, 1.26f, 0.77f};
+    lpv_cascade_set a, b, c;
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, fwd, &a), 0);
+    float moved[3] = {eye[0] + 0.4f * c0, eye[1], eye[2]};
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, moved, fwd, &b), 0);
+    assert_true(lpv_cascades_equal(&a, &b));
+    /* moving by exactly one finest cell along x: cascade 0 shifts by exactly one cell, the others (0.5 and 0.25
+     * of their cells, from 0.15 and 0.075) stay */
+    float step[3] = {eye[0] + c0, eye[1], eye[2]};
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, step, fwd, &c), 0);
+    assert_false(lpv_cascades_equal(&a, &c));
+    assert_float_equal(c.origin_cells[0][0], a.origin_cells[0][0] + 1.0f, 0.0f);
+    assert_float_equal(c.origin_cells[0][1], a.origin_cells[0][1], 0.0f);
+    assert_float_equal(c.origin_cells[0][2], a.origin_cells[0][2], 0.0f);
+    for (int k = 1; k < 3; ++k)
+        assert_memory_equal(c.origin_cells[k], a.origin_cells[k], sizeof c.origin_cells[k]);
+    /* a move that crosses a cell boundary of floor(centre / cell) changes the set even though it is small */
+    float cross[3] = {0.99f * c0, eye[1], eye[2]}, cross2[3] = {1.01f * c0, eye[1], eye[2]};
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, cross, fwd, &a), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, cross2, fwd, &b), 0);
+    assert_false(lpv_cascades_equal(&a, &b));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_baseline_runs_everything_but_bounce),
+        cmocka_unit_test(test_no_occluders_skips_gv_and_gbuffer),
+        cmocka_unit_test(test_no_glossy_skips_glossy),
+        cmocka_unit_test(test_no_medium_skips_media),
+        cmocka_unit_test(test_no_emissive_skips_emissive),
+        cmocka_unit_test(test_no_lights_skips_rsm),
+        cmocka_unit_test(test_cascade_count),
+        cmocka_unit_test(test_recompute_rules),
+        cmocka_unit_test(test_planner_off_runs_everything),
+        cmocka_unit_test(test_bounce_needs_gv),
+        cmocka_unit_test(test_place_snapping_and_nesting),
+        cmocka_unit_test(test_place_temporal),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
