@@ -89,6 +89,7 @@ void lpv_timer_begin(lpv_timer *t, const char *stage)
             t->span_stage[span] = s;
             t->open_span = span;
             glQueryCounter(t->queries[2 * span], GL_TIMESTAMP);
+            glFlush(); /* stamped at the flush on llvmpipe (see lpv_timer_end) */
         } else {
             t->dropped++;
         }
@@ -106,6 +107,10 @@ void lpv_timer_end(lpv_timer *t)
          * flushes them (the shading absorbed the glossy and media passes). */
         glFinish();
         glQueryCounter(t->queries[2 * t->open_span + 1], GL_TIMESTAMP);
+        /* llvmpipe stamps a timestamp query when the batch holding it is
+         * flushed, not when it is issued: flush now, or the next stage's
+         * work (a shader compile in its first draw) lands in this one. */
+        glFlush();
     }
     t->stages[t->open_stage].cpu_ms += now_ms() - t->open_cpu_ms;
     t->last_stage = t->open_stage;
