@@ -28,22 +28,8 @@
 
 /* ---- helpers ------------------------------------------------------------- */
 
-/* printf into a rotating static buffer, then ' -> ". */
-static const char *J(const char *fmt, ...)
-{
-    static char slots[4][65536];
-    static int next;
-    char *p = slots[next++ & 3];
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(p, sizeof slots[0], fmt, ap);
-    va_end(ap);
-    assert_true(n > 0 && (size_t)n < sizeof slots[0]);
-    for (char *c = p; *c; c++)
-        if (*c == '\'')
-            *c = '"';
-    return p;
-}
+/* JSON written with ' for " (test_util.h). */
+#define J lpvt_json
 
 static void load_scene_file(const char *name, lpv_scene *s)
 {

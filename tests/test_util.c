@@ -4,11 +4,16 @@
 #include "context.h"
 #include "engine.h"
 
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <cmocka.h>
 
 const char *lpvt_shared_dir(void)
 {
@@ -93,4 +98,20 @@ int lpvt_gl_teardown(void **state)
     lpvt_ctx = NULL;
     lpvt_engine = NULL;
     return 0;
+}
+
+const char *lpvt_json(const char *fmt, ...)
+{
+    static char slots[4][65536];
+    static int next;
+    char *p = slots[next++ & 3];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(p, sizeof slots[0], fmt, ap);
+    va_end(ap);
+    assert_true(n > 0 && (size_t)n < sizeof slots[0]);
+    for (char *c = p; *c; c++)
+        if (*c == '\'')
+            *c = '"';
+    return p;
 }

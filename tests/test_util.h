@@ -19,6 +19,10 @@ const char *lpvt_tmpdir(void);
  * rotated over 8 slots. Aborts on failure. */
 const char *lpvt_write_file(const char *dir, const char *name, const void *data, size_t size);
 
+/* printf into one of four rotating static buffers (64 KiB each), then every
+ * ' becomes ": JSON in C strings without escapes. Fails the test on overflow. */
+const char *lpvt_json(const char *fmt, ...);
+
 /* For GL tests: a context (auto backend) and an engine on it. Returns 0, or
  * -1 after printing why (cmocka then fails the group set-up). */
 struct lpv_gl_context;
