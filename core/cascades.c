@@ -10,14 +10,6 @@
 
 _Static_assert(LPV_MAX_CASCADES == 4, "lpv_cascade_set's arrays hold LPV_MAX_CASCADES entries");
 
-static int bounds_given(const lpv_settings *s)
-{
-    for (int i = 0; i < 3; ++i)
-        if (s->bounds_min[i] != 0.0f || s->bounds_max[i] != 0.0f)
-            return 1;
-    return 0;
-}
-
 int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
                        const float *forward, lpv_cascade_set *out)
 {
@@ -25,7 +17,7 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     if (count < 1 || count > LPV_MAX_CASCADES)
         return -1;
     if (count == 1) {
-        const int given = bounds_given(s);
+        const int given = lpv_settings_bounds_given(s);
         if (lpv_grid_place(s->grid_dims, given ? s->bounds_min : bmin, given ? s->bounds_max : bmax,
                            &out->grid[0]) != 0)
             return -1;

@@ -154,7 +154,7 @@ static int fail(char *err, unsigned long err_size, const char *fmt, ...)
     return -1;
 }
 
-static int bounds_given(const lpv_settings *s)
+int lpv_settings_bounds_given(const lpv_settings *s)
 {
     for (int i = 0; i < 3; i++) {
         if (s->bounds_min[i] != 0.0f || s->bounds_max[i] != 0.0f)
@@ -165,7 +165,7 @@ static int bounds_given(const lpv_settings *s)
 
 static int validate_bounds(const lpv_settings *s, char *err, unsigned long err_size)
 {
-    if (!bounds_given(s))
+    if (!lpv_settings_bounds_given(s))
         return 0; /* all zero: the scene's bounds */
     for (int i = 0; i < 3; i++) {
         float lo = s->bounds_min[i], hi = s->bounds_max[i];

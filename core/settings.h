@@ -104,6 +104,10 @@ const char *lpv_preset_names(void);
  * accuracy sweep labels its points with it). */
 lpv_preset lpv_preset_match(const lpv_settings *s);
 
+/* 1 when the settings fix the grid bounds (any of bounds_min/max non-zero);
+ * all six zero means "the scene's bounds". */
+int lpv_settings_bounds_given(const lpv_settings *s);
+
 /* Checks ranges after resolve; on failure writes a message naming the setting
  * into err and returns -1. */
 int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_size);

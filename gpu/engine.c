@@ -315,15 +315,14 @@ static int place_cascades(const lpv_engine *e, int count, lpv_cascade_set *out, 
     return 0;
 }
 
+static void gather_facts(const lpv_engine *e, lpv_plan_facts *f);
+
 /* Places the grid for the current settings and scene without a tick, so
  * lpv_engine_grid() answers right after set_scene/set_settings. */
 static int place_grid(lpv_engine *e, char *err, size_t err_size)
 {
-    lpv_plan_facts f = {0};
-    f.scene_extent = fmaxf(e->scene_max[0] - e->scene_min[0],
-                           fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
-    for (int i = 0; i < 3; ++i)
-        f.bounds_given |= e->settings.bounds_min[i] != 0.0f || e->settings.bounds_max[i] != 0.0f;
+    lpv_plan_facts f;
+    gather_facts(e, &f);
     char why[LPV_PLAN_REASON_MAX];
     lpv_cascade_set set;
     if (place_cascades(e, lpv_plan_cascades(&e->settings, &f, why, sizeof why), &set, err, err_size) != 0)
@@ -606,8 +605,7 @@ static void gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->has_view = e->has_view;
     f->scene_extent = fmaxf(e->scene_max[0] - e->scene_min[0],
                             fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
-    for (int i = 0; i < 3; ++i)
-        f->bounds_given |= e->settings.bounds_min[i] != 0.0f || e->settings.bounds_max[i] != 0.0f;
+    f->bounds_given = lpv_settings_bounds_given(&e->settings);
     f->first_tick = !e->computed;
     f->scene_changed = e->scene_dirty;
     f->lights_changed = e->lights_dirty;

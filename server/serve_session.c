@@ -221,10 +221,7 @@ static json_t *config_json(sv_conn *c)
     lpv_settings s = c->settings;
     lpv_settings_resolve(&s);
     json_t *bounds;
-    int auto_bounds = 1;
-    for (int i = 0; i < 3; ++i)
-        if (s.bounds_min[i] != 0.0f || s.bounds_max[i] != 0.0f)
-            auto_bounds = 0;
+    int auto_bounds = !lpv_settings_bounds_given(&s);
     if (auto_bounds && c->world && c->world->latest && c->world->latest->gen == c->world_gen) {
         const lpv_grid *g = &c->world->latest->grid;
         bounds = json_pack("[f,f,f,f,f,f]", (double)g->origin[0], (double)g->origin[1], (double)g->origin[2],

@@ -81,21 +81,31 @@ float cascade_weight(int k, vec3 p)
     return clamp((d - 1.0) * 0.5, 0.0, 1.0);
 }
 
+// Each cascade's share of the blend at p (see the top of this file): the
+// finest cascade holding p takes w, the rest goes to the next coarser one.
+void cascade_blend(vec3 p, out float share[LPV_MAX_CASCADES])
+{
+    int count = cascade_count();
+    float remaining = 1.0;
+    for (int k = 0; k < LPV_MAX_CASCADES; ++k) {
+        float w = k >= count ? 0.0 : (k == count - 1 ? 1.0 : cascade_weight(k, p));
+        share[k] = remaining * w;
+        remaining *= 1.0 - w;
+    }
+}
+
 vec3 lpv_irradiance(vec3 p, vec3 n_in)
 {
     float len = length(n_in);
     if (!(len > 1e-8) || isinf(len) || !finite3(p))
         return vec3(0.0);
     vec3 n = n_in / len;
-    int count = cascade_count();
+    float share[LPV_MAX_CASCADES];
+    cascade_blend(p, share);
     vec3 e = vec3(0.0);
-    float remaining = 1.0;
-    for (int k = 0; k < count && remaining > 0.0; ++k) {
-        float w = k == count - 1 ? 1.0 : cascade_weight(k, p);
-        if (w > 0.0)
-            e += remaining * w * cascade_irradiance(k, p, n);
-        remaining *= 1.0 - w;
-    }
+    for (int k = 0; k < LPV_MAX_CASCADES; ++k)
+        if (share[k] > 0.0)
+            e += share[k] * cascade_irradiance(k, p, n);
     return e;
 }
 
@@ -103,15 +113,12 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
 // lpv_irradiance (for the glossy march and the media's in-scattering).
 vec3 lpv_project(vec3 x, vec4 v)
 {
-    int count = cascade_count();
+    float share[LPV_MAX_CASCADES];
+    cascade_blend(x, share);
     vec3 e = vec3(0.0);
-    float remaining = 1.0;
-    for (int k = 0; k < count && remaining > 0.0; ++k) {
-        float w = k == count - 1 ? 1.0 : cascade_weight(k, x);
-        if (w > 0.0)
-            e += remaining * w * cascade_project_at(k, cascade_coords(k, x), v);
-        remaining *= 1.0 - w;
-    }
+    for (int k = 0; k < LPV_MAX_CASCADES; ++k)
+        if (share[k] > 0.0)
+            e += share[k] * cascade_project_at(k, cascade_coords(k, x), v);
     return e;
 }
 
