@@ -49,6 +49,31 @@ void lpv_oracle_propagate_step(const lpv_grid *g, const lpv_cell *in, const floa
 int lpv_oracle_propagate(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
                          lpv_cell *acc);
 
+/* The same with a transport (LPV_TRANSPORT_PAPER or LPV_TRANSPORT_CENTRAL,
+ * lpv_shared.h; docs/propagation.md section 4b). The functions above use the
+ * paper's. */
+void lpv_oracle_propagate_step_with(const lpv_grid *g, const lpv_cell *in, const float *t, int transport,
+                                    lpv_cell *out);
+int lpv_oracle_propagate_with(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
+                              int transport, lpv_cell *acc);
+
+/* Normal bins (docs/propagation.md section 6b). The bin of a unit normal: its
+ * dominant axis and sign in the direction order +x -x +y -y +z -z (ties go to
+ * the lower axis). */
+int lpv_oracle_normal_bin(const float n[3]);
+/* As lpv_oracle_inject_vpls, into the volume of each VPL's normal bin:
+ * cells holds LPV_NORMAL_BINS grids, bin b at b * cell count. */
+size_t lpv_oracle_inject_vpls_binned(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells);
+/* Irradiance from LPV_NORMAL_BINS accumulated grids (bin b at b * cell count):
+ * per bin, the intensity reconstructed on the bin's half-space and
+ * integrated against the surface's cosine (lpv_oracle_bin_weights), summed,
+ * / cell_size^2, clamped at 0 per channel. Same point offset and
+ * interpolation as lpv_oracle_irradiance. */
+void lpv_oracle_irradiance_binned(const lpv_grid *g, const lpv_cell *acc, const float p[3], const float n[3],
+                                  float rgb[3]);
+/* The weights W of bin b for a surface with unit normal n: E_b = dot(c, W). */
+void lpv_oracle_bin_weights(int b, const float n[3], float w[4]);
+
 /* Irradiance (W/m^2, rgb) at p for a surface with normal n (normalised here;
  * a degenerate n or NaN p gives 0): max(0, dot(c(q), lobe(-n)) / cell_size^2)
  * with q = p + 0.5 * cell_size * n (half a cell in front of the surface) and c

@@ -46,6 +46,25 @@ static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
     return 1;
 }
 
+int lpv_oracle_normal_bin(const float n[3])
+{
+    float a[3] = {fabsf(n[0]), fabsf(n[1]), fabsf(n[2])};
+    int axis = (a[0] >= a[1] && a[0] >= a[2]) ? 0 : (a[1] >= a[2] ? 1 : 2);
+    return 2 * axis + (n[axis] < 0.0f ? 1 : 0);
+}
+
+size_t lpv_oracle_inject_vpls_binned(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
+{
+    size_t injected = 0, count = lpv_grid_cell_count(g);
+    for (size_t i = 0; i < n; i++) {
+        float un[3];
+        if (!lpv_unit_direction(vpls[i].normal, un))
+            continue;
+        injected += (size_t)inject_vpl(g, &vpls[i], cells + (size_t)lpv_oracle_normal_bin(un) * count);
+    }
+    return injected;
+}
+
 size_t lpv_oracle_inject_vpls(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
 {
     size_t injected = 0;

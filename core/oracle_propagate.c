@@ -61,9 +61,11 @@ static void face_gv(const lpv_grid *g, const vec4 *gv, const int c[3], int d, fl
         out[i] *= 0.25f;
 }
 
-/* 1 - clamp(B(-dir_d), 0, 1): the blocking potential is evaluated towards
- * where the light comes from, so a surface facing the light blocks it. A
- * non-finite B blocks completely: NaN must never reach the propagation. */
+/* 1 - clamp(B(-dir_d) / peak, 0, 1): the blocking potential is evaluated
+ * towards where the light comes from, so a surface facing the light blocks it,
+ * normalised by the L1 lobe's peak (LPV_GV_PEAK) so a covered face blocks all
+ * of it. A non-finite B blocks completely: NaN must never reach the
+ * propagation. */
 static float face_transmittance(const float gv_face[4], int d)
 {
     float back[3] = {(float)-lpv_dir[d][0], (float)-lpv_dir[d][1], (float)-lpv_dir[d][2]};
@@ -72,7 +74,7 @@ static float face_transmittance(const float gv_face[4], int d)
     float b = lpv_sh_dot(gv_face, y);
     if (!isfinite(b))
         return 0.0f;
-    return 1.0f - fminf(fmaxf(b, 0.0f), 1.0f);
+    return 1.0f - fminf(fmaxf(b / LPV_GV_PEAK, 0.0f), 1.0f);
 }
 
 void lpv_oracle_transmittance(const lpv_grid *g, const vec4 *gv, float *t)
@@ -120,15 +122,24 @@ static float flux_limit(const float c[4], int d)
     return face_flux(c, d) > 0.0f ? c[0] / p : 0.0f;
 }
 
+/* The band-1 rows (E, F, G) of a transport (lpv_shared.h). */
+static void transport_rows(int transport, float efg[3])
+{
+    int central = transport == LPV_TRANSPORT_CENTRAL;
+    efg[0] = central ? LPV_PROP_CENTRAL_E : LPV_PROP_E;
+    efg[1] = central ? LPV_PROP_CENTRAL_F : LPV_PROP_F;
+    efg[2] = central ? LPV_PROP_CENTRAL_G : LPV_PROP_G;
+}
+
 /* out += w * M_d c with the sparse matrix of lpv_shared.h:
  * out0 = A c0 + s B ck, outk = s E c0 + F ck, outj = G cj (j != k). */
-static void add_transfer(const float c[4], int d, float w, float out[4])
+static void add_transfer(const float c[4], int d, float w, const float efg[3], float out[4])
 {
     float s = dir_sign(d);
     int k = lpv_axis_slot[dir_axis(d)];
     out[0] += w * face_flux(c, d);
     for (int j = 1; j < 4; j++) {
-        float m = j == k ? s * LPV_PROP_E * c[0] + LPV_PROP_F * c[k] : LPV_PROP_G * c[j];
+        float m = j == k ? s * efg[0] * c[0] + efg[1] * c[k] : efg[2] * c[j];
         out[j] += w * m;
     }
 }
@@ -140,7 +151,8 @@ static int inside(const lpv_grid *g, const int p[3])
 
 /* Gathers into destination cell x from its (up to) six neighbours. Terms with
  * zero weight are skipped, not multiplied: 0 * Inf would be a NaN. */
-static void gather(const lpv_grid *g, const lpv_cell *in, const float *t, const int x[3], lpv_cell *dst)
+static void gather(const lpv_grid *g, const lpv_cell *in, const float *t, const float efg[3], const int x[3],
+                   lpv_cell *dst)
 {
     size_t dst_idx = lpv_grid_index(g, x[0], x[1], x[2]);
     memset(dst, 0, sizeof *dst);
@@ -155,18 +167,26 @@ static void gather(const lpv_grid *g, const lpv_cell *in, const float *t, const 
             float w = tr * flux_limit(c, d);
             if (!(w > 0.0f))
                 continue;
-            add_transfer(c, d, w, channel_mut(dst, ch));
+            add_transfer(c, d, w, efg, channel_mut(dst, ch));
         }
     }
 }
 
 void lpv_oracle_propagate_step(const lpv_grid *g, const lpv_cell *in, const float *t, lpv_cell *out)
 {
+    lpv_oracle_propagate_step_with(g, in, t, LPV_TRANSPORT_PAPER, out);
+}
+
+void lpv_oracle_propagate_step_with(const lpv_grid *g, const lpv_cell *in, const float *t, int transport,
+                                    lpv_cell *out)
+{
+    float efg[3];
+    transport_rows(transport, efg);
     int x[3];
     for (x[2] = 0; x[2] < g->dims[2]; x[2]++) {
         for (x[1] = 0; x[1] < g->dims[1]; x[1]++) {
             for (x[0] = 0; x[0] < g->dims[0]; x[0]++)
-                gather(g, in, t, x, &out[lpv_grid_index(g, x[0], x[1], x[2])]);
+                gather(g, in, t, efg, x, &out[lpv_grid_index(g, x[0], x[1], x[2])]);
         }
     }
 }
@@ -187,6 +207,12 @@ static void accumulate(size_t count, const lpv_cell *src, lpv_cell *acc)
 int lpv_oracle_propagate(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
                          lpv_cell *acc)
 {
+    return lpv_oracle_propagate_with(g, injected, t, iterations, LPV_TRANSPORT_PAPER, acc);
+}
+
+int lpv_oracle_propagate_with(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
+                              int transport, lpv_cell *acc)
+{
     size_t count = lpv_grid_cell_count(g);
     size_t bytes = count * sizeof(lpv_cell);
     lpv_cell *cur = NULL, *next = NULL;
@@ -205,7 +231,7 @@ int lpv_oracle_propagate(const lpv_grid *g, const lpv_cell *injected, const floa
 
     for (int i = 0; i < iterations; i++) {
         /* No occlusion on the first step: a VPL's own surface would shadow it. */
-        lpv_oracle_propagate_step(g, cur, i == 0 ? NULL : t, next);
+        lpv_oracle_propagate_step_with(g, cur, i == 0 ? NULL : t, transport, next);
         accumulate(count, next, acc);
         lpv_cell *tmp = cur;
         cur = next;

@@ -140,6 +140,10 @@ void lpv_settings_resolve(lpv_settings *s)
         s->media_step = LPV_DEFAULT_MEDIA_STEP;
     if (s->planner == LPV_SWITCH_DEFAULT)
         s->planner = LPV_SWITCH_ON;
+    if (s->central_transport == LPV_SWITCH_DEFAULT)
+        s->central_transport = LPV_DEFAULT_CENTRAL_TRANSPORT;
+    if (s->normal_bins == LPV_SWITCH_DEFAULT)
+        s->normal_bins = LPV_DEFAULT_NORMAL_BINS;
 }
 
 /* Writes a formatted message into err (when there is room) and returns -1. */
@@ -217,7 +221,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     const struct {
         const char *name;
         lpv_switch v;
-    } switches[] = {{"bounces", s->bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner}};
+    } switches[] = {{"bounces", s->bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
+                    {"central_transport", s->central_transport}, {"normal_bins", s->normal_bins}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
             return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",

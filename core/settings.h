@@ -62,6 +62,12 @@ typedef struct lpv_settings {
 
     lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
                                unchanged volume; off: run every pass every tick */
+
+    /* Transport and lookup (docs/propagation.md sections 4b and 6b). */
+    lpv_switch central_transport; /* re-emit each face's flux along the face's central direction
+                                     instead of its normal (a departure from the paper) */
+    lpv_switch normal_bins;       /* one volume per dominant normal axis of the emitters, so a
+                                     surface never reads back its own light (6x the volumes) */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
@@ -76,6 +82,8 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f
 #define LPV_DEFAULT_MEDIA_STEP 0.5f
+#define LPV_DEFAULT_CENTRAL_TRANSPORT LPV_SWITCH_OFF
+#define LPV_DEFAULT_NORMAL_BINS LPV_SWITCH_OFF
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the

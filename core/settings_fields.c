@@ -62,6 +62,12 @@ static const lpv_field FIELDS[] = {
      "media ray-march step"},
     {"planner", "planner", LPV_FIELD_SWITCH, F(planner), 0, 1, 0, "", "on", "",
      "run only the passes the scene needs (off: every pass every tick)"},
+
+    /* Transport and lookup (docs/propagation.md). */
+    {"central_transport", "central-transport", LPV_FIELD_SWITCH, F(central_transport), 0, 1, 0, "", "off", "",
+     "re-emit each face's flux along its central direction (less diffusive than the paper)"},
+    {"normal_bins", "normal-bins", LPV_FIELD_SWITCH, F(normal_bins), 0, 1, 0, "", "off", "",
+     "one volume per emitter normal axis: surfaces never read back their own light"},
 };
 
 #undef F

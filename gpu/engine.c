@@ -249,9 +249,12 @@ static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, 
     const lpv_grid *g = &set->grid[0];
     e->cascades = *set;
     e->grid = *g;
+    e->bins = e->settings.normal_bins == LPV_SWITCH_ON ? LPV_NORMAL_BINS : 1;
     struct LpvGridParams params = {
         .dims = {(float)g->dims[0], (float)g->dims[1], (float)g->dims[2], (float)lpv_grid_cell_count(g)},
-        .info = {(float)set->count, set->count > 1 ? 1.0f : 0.0f, 0.0f, 0.0f},
+        .info = {(float)set->count, set->count > 1 ? 1.0f : 0.0f, (float)e->bins,
+                 e->settings.central_transport == LPV_SWITCH_ON ? (float)LPV_TRANSPORT_CENTRAL
+                                                                : (float)LPV_TRANSPORT_PAPER},
     };
     for (int k = 0; k < set->count; ++k) {
         for (int i = 0; i < 3; ++i)
@@ -261,26 +264,27 @@ static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, 
     glBindBuffer(GL_UNIFORM_BUFFER, e->grid_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
     if (e->grid_alloc_cells && memcmp(g->dims, e->grid_alloc_dims, sizeof g->dims) == 0 &&
-        e->grid_alloc_cascades == set->count)
+        e->grid_alloc_cascades == set->count && e->grid_alloc_bins == e->bins)
         return 0;
 
     free_grids(e);
     const size_t K = (size_t)set->count;
     size_t cells = lpv_grid_cell_count(g) * K, gv = lpv_grid_gv_count(g) * K;
-    int lpv_dims[3] = {g->dims[0], g->dims[1], g->dims[2] * set->count};
+    size_t vcells = cells * (size_t)e->bins; /* LPV volumes: cascades x bins */
+    int lpv_dims[3] = {g->dims[0], g->dims[1], g->dims[2] * set->count * e->bins};
     int gv_dims[3] = {g->dims[0] + 1, g->dims[1] + 1, (g->dims[2] + 1) * set->count};
     if (lpv_atlas_create(&e->lpv_atlas, lpv_dims, 3, err, err_size) != 0 ||
         lpv_atlas_create(&e->gv_atlas, gv_dims, 2, err, err_size) != 0)
         return -1;
-    e->lpv_injected = new_ssbo(cells * sizeof(lpv_cell));
-    e->lpv_ping = new_ssbo(cells * sizeof(lpv_cell));
-    e->lpv_pong = new_ssbo(cells * sizeof(lpv_cell));
-    e->lpv_acc = new_ssbo(cells * sizeof(lpv_cell));
+    e->lpv_injected = new_ssbo(vcells * sizeof(lpv_cell));
+    e->lpv_ping = new_ssbo(vcells * sizeof(lpv_cell));
+    e->lpv_pong = new_ssbo(vcells * sizeof(lpv_cell));
+    e->lpv_acc = new_ssbo(vcells * sizeof(lpv_cell));
     e->gv_total = new_ssbo(gv * 2 * 4 * sizeof(float)); /* blocking SH, albedo */
     e->transmit = new_ssbo(cells * LPV_DIR_COUNT * sizeof(float));
     e->reflect = new_ssbo(cells * LPV_DIR_COUNT * 4 * sizeof(float));
-    e->sigma[0] = new_ssbo(cells * 4 * sizeof(float));
-    e->sigma[1] = new_ssbo(cells * 4 * sizeof(float));
+    e->sigma[0] = new_ssbo(vcells * 4 * sizeof(float));
+    e->sigma[1] = new_ssbo(vcells * 4 * sizeof(float));
     e->tbo_injected = buffer_view(e->lpv_injected, GL_RGBA32F);
     e->tbo_ping = buffer_view(e->lpv_ping, GL_RGBA32F);
     e->tbo_pong = buffer_view(e->lpv_pong, GL_RGBA32F);
@@ -292,6 +296,7 @@ static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, 
     e->grid_alloc_cells = cells;
     memcpy(e->grid_alloc_dims, g->dims, sizeof g->dims);
     e->grid_alloc_cascades = set->count;
+    e->grid_alloc_bins = e->bins;
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "could not allocate %d cascades of %dx%dx%d cells", set->count, g->dims[0],
                          g->dims[1], g->dims[2]);
@@ -812,18 +817,56 @@ static size_t read_buffer(GLuint buf, size_t elem_size, size_t available, void *
     return n;
 }
 
+/* The buffer holding the chosen grid of every LPV volume. */
+static GLuint grid_buffer(const lpv_engine *e, lpv_grid_which which)
+{
+    const int steps = e->plan.pass[LPV_PASS_PROPAGATE].run ? e->settings.iterations : 0;
+    if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && steps == 0))
+        return e->lpv_injected;
+    if (which == LPV_GRID_LAST_STEP)
+        return (steps & 1) ? e->lpv_ping : e->lpv_pong;
+    return e->lpv_acc;
+}
+
 size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max)
 {
     if (!e->ticked)
         return 0;
-    const int steps = e->plan.pass[LPV_PASS_PROPAGATE].run ? e->settings.iterations : 0;
-    GLuint b = e->lpv_acc;
-    if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && steps == 0))
-        b = e->lpv_injected;
-    else if (which == LPV_GRID_LAST_STEP)
-        b = (steps & 1) ? e->lpv_ping : e->lpv_pong;
-    return read_buffer(b, sizeof(lpv_cell), lpv_engine_all_cells(e), out, max);
+    GLuint b = grid_buffer(e, which);
+    if (e->bins <= 1)
+        return read_buffer(b, sizeof(lpv_cell), lpv_engine_all_cells(e), out, max);
+    /* Normal bins: the physical field of a cascade is the sum of its bins. */
+    const size_t per = lpv_engine_cascade_cells(e), all = lpv_engine_volume_cells(e);
+    lpv_cell *raw = malloc(all * sizeof *raw);
+    if (!raw)
+        return 0;
+    read_buffer(b, sizeof(lpv_cell), all, raw, all);
+    size_t n = lpv_engine_all_cells(e) < max ? lpv_engine_all_cells(e) : max;
+    for (size_t i = 0; i < n; ++i) {
+        size_t k = i / per, c = i % per;
+        lpv_cell sum = raw[k * (size_t)e->bins * per + c];
+        for (int bin = 1; bin < e->bins; ++bin) {
+            const lpv_cell *x = &raw[(k * (size_t)e->bins + (size_t)bin) * per + c];
+            for (int j = 0; j < 4; ++j) {
+                sum.r[j] += x->r[j];
+                sum.g[j] += x->g[j];
+                sum.b[j] += x->b[j];
+            }
+        }
+        out[i] = sum;
+    }
+    free(raw);
+    return n;
 }
+
+size_t lpv_engine_read_volumes(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max)
+{
+    if (!e->ticked)
+        return 0;
+    return read_buffer(grid_buffer(e, which), sizeof(lpv_cell), lpv_engine_volume_cells(e), out, max);
+}
+
+int lpv_engine_bins(const lpv_engine *e) { return e->bins > 1 ? e->bins : 1; }
 
 size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max)
 {

@@ -106,6 +106,12 @@ typedef enum lpv_grid_which {
 /* Every cascade's cells, cascade 0 first (cascade k starts at k * cells of one
  * cascade); with one cascade simply the grid. */
 size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max);
+/* With normal bins on (settings.normal_bins) each cascade holds
+ * lpv_engine_bins() volumes, bin b of cascade k at (k * bins + b) * cells of
+ * one cascade; read_grid returns their sum per cascade (the physical field),
+ * read_volumes every volume as stored. With bins off the two agree. */
+size_t lpv_engine_read_volumes(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max);
+int lpv_engine_bins(const lpv_engine *e);
 size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max);
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);  /* RSM VPLs then emissive */

@@ -85,7 +85,8 @@ struct lpv_engine {
     GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
     GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
     size_t grid_alloc_cells; /* cells of all cascades */
-    int grid_alloc_dims[3], grid_alloc_cascades;
+    int grid_alloc_dims[3], grid_alloc_cascades, grid_alloc_bins;
+    int bins;                /* LPV volumes per cascade: 1, or LPV_NORMAL_BINS (normal_bins on) */
     int ticked;
 
     /* camera */
@@ -118,6 +119,13 @@ static inline size_t lpv_engine_cascade_cells(const lpv_engine *e) { return lpv_
 static inline size_t lpv_engine_all_cells(const lpv_engine *e)
 {
     return lpv_grid_cell_count(&e->grid) * (size_t)e->cascades.count;
+}
+/* LPV volumes (cascades x normal bins) and their cells: the size of the LPV
+ * buffers; the geometry volume and transmittances stay per cascade. */
+static inline int lpv_engine_volumes(const lpv_engine *e) { return e->cascades.count * (e->bins > 1 ? e->bins : 1); }
+static inline size_t lpv_engine_volume_cells(const lpv_engine *e)
+{
+    return lpv_grid_cell_count(&e->grid) * (size_t)lpv_engine_volumes(e);
 }
 
 /* Per-pass set-up and work; each _run records its own timer stage. */

@@ -129,7 +129,7 @@ void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[0]);
     glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D),
-                      (GLuint)(e->grid.dims[2] * e->cascades.count));
+                      (GLuint)(e->grid.dims[2] * lpv_engine_volumes(e)));
     lpv_timer_count(&e->timer, 1);
     /* propagation reads the packed grid and flux limits as buffer textures */
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);

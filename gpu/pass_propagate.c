@@ -37,7 +37,7 @@ void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
         glUniform1i(loc_occ, occlusion && i > 0);
         glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
                           lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y),
-                          (GLuint)(e->grid.dims[2] * e->cascades.count));
+                          (GLuint)(e->grid.dims[2] * lpv_engine_volumes(e)));
         lpv_timer_count(&e->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         in_view = (i & 1) ? e->tbo_pong : e->tbo_ping;

@@ -39,6 +39,34 @@ int cascade_of_invocation(ivec3 id, out ivec3 c)
     return id.z / dz;
 }
 
+// Volumes: with normal bins on, each cascade holds bin_count() volumes (one
+// per dominant axis of the emitting surface's normal); LPV buffers hold
+// volume v = cascade * bin_count() + bin at v * grid_cells(). The geometry
+// volume and the transmittances stay per cascade.
+int bin_count() { return max(int(G.info.z), 1); }
+int volume_count() { return cascade_count() * bin_count(); }
+int volume_cascade(int v) { return v / bin_count(); }
+int transport() { return int(G.info.w); }
+
+// The bin of a unit normal: its dominant axis and sign, in the direction
+// order +x -x +y -y +z -z (ties go to the lower axis).
+int normal_bin(vec3 n)
+{
+    vec3 a = abs(n);
+    int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
+    return 2 * axis + (n[axis] < 0.0 ? 1 : 0);
+}
+
+vec3 bin_axis(int b)
+{
+    vec3 e = vec3(0.0);
+    e[b / 2] = (b & 1) == 0 ? 1.0 : -1.0;
+    return e;
+}
+
+// A compute invocation over every LPV volume: z runs over dims.z * volumes.
+int volume_of_invocation(ivec3 id, out ivec3 c) { return cascade_of_invocation(id, c); }
+
 // Weight of an object of size `size` (m) in cascade k: the finest cascade
 // takes everything; a coarser one fades out objects smaller than two of its
 // cells and drops those smaller than one (paper section 4), so an object

@@ -1,6 +1,7 @@
 // inject_vpl.vert - one point per VPL and cascade (instance) into the LPV
-// atlas, at the cell holding position + half a cell along the normal, carrying lobe(n) * flux / pi per
-// channel. Additive blending sums VPLs in array order: portable, no float
+// atlas (the volume of its normal's bin when normal bins are on), at the cell
+// holding position + half a cell along the normal, carrying lobe(n) * flux / pi
+// per channel. Additive blending sums VPLs in array order: portable, no float
 // atomics, deterministic.
 layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Vpls { LpvVpl vpls[]; };
 
@@ -35,6 +36,7 @@ void main()
     v_g = lobe * v.flux.g;
     v_b = lobe * v.flux.b;
     ivec3 d = grid_dims();
-    vec2 texel = vec2(atlas_texel(ivec3(c.xy, k * d.z + c.z), d.xy)) + 0.5;
+    int vol = k * bin_count() + (bin_count() > 1 ? normal_bin(n) : 0);
+    vec2 texel = vec2(atlas_texel(ivec3(c.xy, vol * d.z + c.z), d.xy)) + 0.5;
     gl_Position = vec4(texel / u_atlas_size * 2.0 - 1.0, 0.0, 1.0);
 }

@@ -18,14 +18,14 @@ uniform float u_damping;
 
 // The trilinearly interpolated SH (r, g, b) at continuous cell coordinates q
 // (cell centres at +0.5) of cascade k, clamped at the grid's edge.
-void cascade_sh_at(int k, vec3 q, out vec4 r, out vec4 g, out vec4 b)
+void volume_sh_at(int v, vec3 q, out vec4 r, out vec4 g, out vec4 b)
 {
     ivec3 dims = grid_dims();
     q = clamp(q, vec3(0.5), vec3(dims) - 0.5) - 0.5;
     ivec3 c0 = min(ivec3(floor(q)), dims - 1);
     ivec3 c1 = min(c0 + 1, dims - 1);
     vec3 f = q - vec3(c0);
-    int base = k * grid_cells();
+    int base = v * grid_cells();
     r = vec4(0.0);
     g = vec4(0.0);
     b = vec4(0.0);
@@ -41,9 +41,23 @@ void cascade_sh_at(int k, vec3 q, out vec4 r, out vec4 g, out vec4 b)
     }
 }
 
+// The SH of cascade k at q summed over its volumes (the physical field).
+void cascade_sh_at(int k, vec3 q, out vec4 r, out vec4 g, out vec4 b)
+{
+    volume_sh_at(k * bin_count(), q, r, g, b);
+    for (int bin = 1; bin < bin_count(); ++bin) {
+        vec4 r1, g1, b1;
+        volume_sh_at(k * bin_count() + bin, q, r1, g1, b1);
+        r += r1;
+        g += g1;
+        b += b1;
+    }
+}
+
 // (r, g, b) . v / cell^2 at q in cascade k, clamped at 0: with v = lobe(-n)
-// the irradiance of a surface facing n, with v = basis(w) the radiance
-// travelling along w, with v = (sqrt(4 pi), 0, 0, 0) the fluence.
+// the irradiance of a surface facing n (without normal bins), with
+// v = basis(w) the radiance travelling along w, with v = (sqrt(4 pi), 0, 0, 0)
+// the fluence.
 vec3 cascade_project_at(int k, vec3 q, vec4 v)
 {
     vec4 r, g, b;
@@ -52,9 +66,51 @@ vec3 cascade_project_at(int k, vec3 q, vec4 v)
     return max(vec3(dot(r, v), dot(g, v), dot(b, v)) / (cell * cell), 0.0);
 }
 
+// The irradiance weights of a normal bin (docs/propagation.md section 6b).
+// Light of bin b travels into the half-space H = {w : <w, e> > 0}, e the
+// bin's axis. Its intensity is reconstructed on H as I(w) = a + <bv, w> with
+// the same band-0/1 moments as the stored SH c (a cosine lobe and a uniform
+// hemisphere are both reproduced exactly), and integrated against the
+// surface's cosine max(0, <m, w>), m = -n, over H:
+//   int_H max(0, <m,w>) dw   = pi (1 + cos t) / 2
+//   int_H max(0, <m,w>) w dw = 2/3 ((pi - t) m + sin t e),   cos t = <m, e>
+// Both are linear in c, so E = dot(c, W) with W returned here (per channel
+// the same). A surface facing e (m = -e) gets W = 0: it never reads light
+// emitted by surfaces that face its own way.
+vec4 bin_irradiance_weights(int b, vec3 n)
+{
+    vec3 e = bin_axis(b);
+    vec3 m = -n;
+    float ct = clamp(dot(m, e), -1.0, 1.0);
+    float t = acos(ct);
+    float k0 = LPV_PI * (1.0 + ct) * 0.5;
+    vec3 k1 = (2.0 / 3.0) * ((LPV_PI - t) * m + sin(t) * e);
+    // a  = (2/pi) (c0 / C0 - 1.5 <cv, e> / C1)
+    // bv = 3 / (2 pi) (cv / C1 - pi a e)
+    // E  = a k0 + <bv, k1>
+    //    = a (k0 - 1.5 <e, k1>) + 3 / (2 pi C1) <cv, k1>
+    float ek1 = dot(e, k1);
+    float wa = k0 - 1.5 * ek1;
+    vec3 wv = (-(2.0 / LPV_PI) * 1.5 / LPV_SH_C1 * wa) * e + (1.5 / (LPV_PI * LPV_SH_C1)) * k1;
+    float w0 = (2.0 / LPV_PI) / LPV_SH_C0 * wa;
+    return vec4(w0, wv.y, wv.z, wv.x); // slot order (1, y, z, x)
+}
+
 vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
 {
-    return cascade_project_at(k, q, sh_lobe(-n));
+    if (bin_count() == 1)
+        return cascade_project_at(k, q, sh_lobe(-n));
+    vec3 e = vec3(0.0);
+    for (int bin = 0; bin < bin_count(); ++bin) {
+        vec4 w = bin_irradiance_weights(bin, n);
+        if (dot(w, w) == 0.0)
+            continue;
+        vec4 r, g, b;
+        volume_sh_at(k * bin_count() + bin, q, r, g, b);
+        e += vec3(dot(r, w), dot(g, w), dot(b, w));
+    }
+    float cell = cascade_cell(k);
+    return max(e / (cell * cell), 0.0);
 }
 
 vec3 cascade_irradiance(int k, vec3 p, vec3 n)

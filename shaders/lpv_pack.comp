@@ -1,7 +1,7 @@
 // lpv_pack.comp - copies the injection atlas into the LPV buffer layout
-// (LpvCell per cell, x fastest, cascades one after another) as both the
-// injected grid and the initial accumulation, with the cells' flux limits for
-// the first step.
+// (LpvCell per cell, x fastest, volumes - cascades x normal bins - one after
+// another) as both the injected grid and the initial accumulation, with the
+// cells' flux limits for the first step.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = 0) uniform sampler2D u_atlas_r;
@@ -16,8 +16,8 @@ void main()
 {
     ivec3 id = ivec3(gl_GlobalInvocationID);
     ivec3 c;
-    int k = cascade_of_invocation(id, c);
-    if (!cell_inside(c) || k >= cascade_count())
+    int k = volume_of_invocation(id, c);
+    if (!cell_inside(c) || k >= volume_count())
         return;
     ivec2 t = atlas_texel(id, grid_dims().xy);
     LpvCell cell;

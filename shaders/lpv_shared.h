@@ -63,6 +63,36 @@
 #define LPV_PROP_F 0.06376856085851985f
 #define LPV_PROP_G 0.06027651555929470f
 
+/* The "central" transport (a measured departure from the paper, setting
+ * transport = central; docs/propagation.md section 4b): each face's flux is
+ * re-emitted as a cosine lobe along the face's central direction w_f instead
+ * of its normal n_f, i.e. M_d = sum_f (solid_angle_f / pi) lobe(w_f) Y(w_f)^T.
+ * Row 0 (A, B), and so every face flux and the flux limiter, is the same as
+ * the paper's; only the band-1 rows keep more of the light's direction:
+ *   E = L1 C0 (far + 8 side / sqrt5) / pi,  F = L1 C1 (far + 16 side / 5) / pi,
+ *   G = L1 C1 (2 side / 5) / pi. */
+#define LPV_PROP_CENTRAL_E 0.17601944571338730f
+#define LPV_PROP_CENTRAL_F 0.27942037883837060f
+#define LPV_PROP_CENTRAL_G 0.02695647724748134f
+
+/* Transports (LpvGridParams.info.w). */
+#define LPV_TRANSPORT_PAPER 0
+#define LPV_TRANSPORT_CENTRAL 1
+
+/* Normal bins (setting normal_bins; docs/propagation.md section 6b): with
+ * bins on, every cascade holds LPV_NORMAL_BINS volumes, one per dominant axis
+ * of the emitting surface's normal (+x -x +y -y +z -z, the direction order).
+ * Light from a surface facing e_b travels into the half-space <w, e_b> > 0;
+ * the lookup reconstructs each bin's intensity on that half-space, so a
+ * surface never reads back light emitted by surfaces that face its own way. */
+#define LPV_NORMAL_BINS 6
+
+/* Fuzzy occlusion (docs/propagation.md section 3): the L1 projection of the
+ * clamped cosine lobe evaluates to 0.75 at its peak (L0 C0 + L1 C1), so the
+ * blocking potential of a surface that covers a face is divided by it: a face
+ * fully covered by a surface facing the light blocks all of it, not 75 %. */
+#define LPV_GV_PEAK 0.75f
+
 /* Cascades (cascaded-LPV paper section 4, docs/cascades.md). */
 #define LPV_MAX_CASCADES 4
 
@@ -100,7 +130,8 @@ struct LpvSurfel {
  * injected point by exactly that many cells. */
 struct LpvGridParams {
     vec4 dims;                             /* xyz cells per axis (integers as float); w = cells per cascade */
-    vec4 info;                             /* x cascade count; y 1 = fade small objects out of coarse cascades */
+    vec4 info;                             /* x cascade count; y 1 = fade small objects out of coarse cascades;
+                                              z volumes per cascade (1, or LPV_NORMAL_BINS); w transport */
     vec4 cascade[LPV_MAX_CASCADES];        /* xyz lower corner in cells of this cascade; w cell size (m) */
 };
 

@@ -28,14 +28,18 @@ uniform int u_bounce;    // 1: reflect blocked light (only with u_occlusion)
 
 // The term one source channel c, with flux limit sigma (flux_limit.glsl),
 // sends along +-axis (slot 1 = y, 2 = z, 3 = x).
+// The band-1 rows of the transfer (E, F, G of lpv_shared.h) depend on the
+// transport; row 0 (A, B) does not.
+vec3 prop_efg;
+
 vec4 transfer(vec4 c, float sigma, int slot, float s)
 {
     float f = LPV_PROP_A * c.x + s * LPV_PROP_B * c[slot];
     if (!(f > 0.0) || !(sigma > 0.0))
         return vec4(0.0);
-    vec4 o = LPV_PROP_G * c;
+    vec4 o = prop_efg.z * c;
     o.x = f;
-    o[slot] = s * LPV_PROP_E * c.x + LPV_PROP_F * c[slot];
+    o[slot] = s * prop_efg.x * c.x + prop_efg.y * c[slot];
     return o * sigma;
 }
 
@@ -58,11 +62,16 @@ LpvCell fetch_cell(samplerBuffer b, int j)
 void main()
 {
     ivec3 c;
-    int k = cascade_of_invocation(ivec3(gl_GlobalInvocationID), c);
-    if (!cell_inside(c) || k >= cascade_count())
+    int v = volume_of_invocation(ivec3(gl_GlobalInvocationID), c);
+    if (!cell_inside(c) || v >= volume_count())
         return;
-    int base = k * grid_cells();
+    prop_efg = transport() == LPV_TRANSPORT_CENTRAL
+                ? vec3(LPV_PROP_CENTRAL_E, LPV_PROP_CENTRAL_F, LPV_PROP_CENTRAL_G)
+                : vec3(LPV_PROP_E, LPV_PROP_F, LPV_PROP_G);
+    int k = volume_cascade(v);     // the cascade: cell size, transmittances
+    int base = v * grid_cells();   // this volume's cells
     int i = base + cell_index(c);
+    int ti = k * grid_cells() + cell_index(c); // this cell in the per-cascade buffers
     LpvCell sum;
     sum.r = sum.g = sum.b = vec4(0.0);
     for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
@@ -73,7 +82,7 @@ void main()
         if (!cell_inside(src))
             continue;
         int slot = axis == 0 ? 3 : axis; // x lives in slot 3, y in 1, z in 2
-        float t = u_occlusion != 0 ? texelFetch(u_transmit, i * LPV_DIR_COUNT + dir).x : 1.0;
+        float t = u_occlusion != 0 ? texelFetch(u_transmit, ti * LPV_DIR_COUNT + dir).x : 1.0;
         int j = base + cell_index(src);
         LpvCell n = fetch_cell(u_in, j);
         vec4 sigma = texelFetch(u_sigma_in, j);
@@ -92,7 +101,7 @@ void main()
             if (!cell_inside(ahead))
                 continue;
             int slot = axis == 0 ? 3 : axis;
-            vec3 refl = texelFetch(u_reflect, (base + cell_index(ahead)) * LPV_DIR_COUNT + dir).rgb;
+            vec3 refl = texelFetch(u_reflect, (k * grid_cells() + cell_index(ahead)) * LPV_DIR_COUNT + dir).rgb;
             if (!any(greaterThan(refl, vec3(0.0))))
                 continue;
             vec3 back = vec3(0.0);

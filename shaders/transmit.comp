@@ -51,7 +51,7 @@ void main()
         travel[axis] = positive ? 1.0 : -1.0;
         float b = dot(avg, sh_basis(-travel));
         bool bad = isnan(b) || isinf(b);
-        float blocked = bad ? 1.0 : clamp(b, 0.0, 1.0);
+        float blocked = bad ? 1.0 : clamp(b / LPV_GV_PEAK, 0.0, 1.0);
         transmit[i * LPV_DIR_COUNT + dir] = 1.0 - blocked;
         if (u_bounce != 0) {
             vec3 a = weight > 0.0 ? clamp(albedo / weight, 0.0, 1.0) : vec3(0.0);

@@ -1332,6 +1332,18 @@ add_features:
             if (lpv_acc_write_error_png(ep, rgba, cmp_ref, view.width, view.height, res->m.mean_ref, err,
                                         sizeof err) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s\n", err);
+            { /* lpvd's own frame beside it, tone-mapped like the reference's preview */
+                size_t np = (size_t)view.width * (size_t)view.height;
+                uint8_t *px = malloc(np * 4);
+                char lp[1500];
+                snprintf(lp, sizeof lp, "%.*s.lpvd.png", (int)strlen(ep) - 4, ep);
+                if (px) {
+                    lpv_tonemap_rgba8(rgba, np, 1.0f, px);
+                    if (lpv_image_write_u8(lp, view.width, view.height, 4, px, err, sizeof err) != 0)
+                        fprintf(stderr, "lpvd-accuracy: %s\n", err);
+                    free(px);
+                }
+            }
             fprintf(stderr,
                     "lpvd-accuracy: %s %d/%d: grid %d, iterations %d, rsm %d, occlusion %s: %.2f ms/tick, "
                     "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
