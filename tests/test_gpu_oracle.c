@@ -217,6 +217,118 @@ static void test_lookup_matches_oracle(void **state)
     free(acc);
 }
 
+/* Central transport (docs/propagation.md section 4b): the GPU's steps with
+ * the central band-1 rows against the oracle's, with and without occlusion;
+ * and they must differ from the paper's (the setting reaches the shader). */
+static void test_central_transport_matches_oracle(void **state)
+{
+    fixture *f = *state;
+    for (int occ = 0; occ < 2; ++occ) {
+        lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 6,
+                          .occlusion = occ ? LPV_SWITCH_ON : LPV_SWITCH_OFF, .central_transport = LPV_SWITCH_ON};
+        tick(f, &s, 1);
+        const lpv_grid *g = lpv_engine_grid(f->engine);
+        size_t cells = lpv_grid_cell_count(g);
+        lpv_cell *inj = calloc(cells, sizeof *inj), *gpu = calloc(cells, sizeof *gpu),
+                 *ref = calloc(cells, sizeof *ref), *paper = calloc(cells, sizeof *paper);
+        float *t = occ ? calloc(cells * 6, sizeof *t) : NULL;
+        assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, inj, cells), cells);
+        assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_ACCUMULATED, gpu, cells), cells);
+        if (t)
+            assert_int_equal(lpv_engine_read_transmittance(f->engine, t, cells * 6), cells * 6);
+        assert_int_equal(lpv_oracle_propagate_with(g, inj, t, 6, LPV_TRANSPORT_CENTRAL, ref), 0);
+        assert_int_equal(lpv_oracle_propagate_with(g, inj, t, 6, LPV_TRANSPORT_PAPER, paper), 0);
+        assert_close(occ ? "accumulated LPV, central transport, occlusion on"
+                         : "accumulated LPV, central transport, occlusion off",
+                     (const float *)gpu, (const float *)ref, cells * 12);
+        double diff = 0.0;
+        for (size_t i = 0; i < cells * 12; ++i)
+            diff += fabs((double)((const float *)paper)[i] - ((const float *)gpu)[i]);
+        assert_true(diff > 1e-3); /* not the paper's transport */
+        free(inj);
+        free(gpu);
+        free(ref);
+        free(paper);
+        free(t);
+    }
+}
+
+/* Normal bins (docs/propagation.md section 6b): each bin's injected and
+ * accumulated volume against the oracle's binned injection and propagation,
+ * read_grid is their sum, and GPU irradiance queries against
+ * lpv_oracle_irradiance_binned. */
+static void test_normal_bins_match_oracle(void **state)
+{
+    fixture *f = *state;
+    lpv_settings s = {.grid_dims = {12, 12, 12}, .rsm_size = 64, .iterations = 5, .occlusion = LPV_SWITCH_ON,
+                      .normal_bins = LPV_SWITCH_ON, .central_transport = LPV_SWITCH_ON};
+    tick(f, &s, 1);
+    assert_int_equal(lpv_engine_bins(f->engine), LPV_NORMAL_BINS);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
+    const size_t cells = lpv_grid_cell_count(g), all = cells * LPV_NORMAL_BINS;
+    size_t vmax = 64 * 64 * 6 + 8192;
+    lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
+    size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
+    lpv_cell *gpu = calloc(all, sizeof *gpu), *ref = calloc(all, sizeof *ref), *acc = calloc(all, sizeof *acc),
+             *sum = calloc(cells, sizeof *sum);
+    float *t = calloc(cells * 6, sizeof *t);
+    assert_int_equal(lpv_engine_read_volumes(f->engine, LPV_GRID_INJECTED, gpu, all), all);
+    assert_true(lpv_oracle_inject_vpls_binned(g, vpls, nv, ref) > 1000);
+    assert_close("injected LPV, 6 normal bins", (const float *)gpu, (const float *)ref, all * 12);
+    int used = 0; /* the box's walls face five ways: five bins hold light */
+    for (int b = 0; b < LPV_NORMAL_BINS; ++b) {
+        double flux[3];
+        lpv_oracle_total_flux(g, ref + (size_t)b * cells, flux);
+        used += flux[0] > 0.0;
+    }
+    assert_true(used >= 4);
+
+    assert_int_equal(lpv_engine_read_transmittance(f->engine, t, cells * 6), cells * 6);
+    for (int b = 0; b < LPV_NORMAL_BINS; ++b)
+        assert_int_equal(lpv_oracle_propagate_with(g, ref + (size_t)b * cells, t, 5, LPV_TRANSPORT_CENTRAL,
+                                                   ref + (size_t)b * cells),
+                         0);
+    assert_int_equal(lpv_engine_read_volumes(f->engine, LPV_GRID_ACCUMULATED, acc, all), all);
+    assert_close("accumulated LPV, 6 normal bins", (const float *)acc, (const float *)ref, all * 12);
+
+    /* read_grid returns the physical field: the sum of the bins */
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_ACCUMULATED, sum, cells), cells);
+    for (size_t i = 0; i < cells; ++i)
+        for (int k = 0; k < 4; ++k) {
+            double want = 0.0;
+            for (int b = 0; b < LPV_NORMAL_BINS; ++b)
+                want += acc[(size_t)b * cells + i].r[k];
+            assert_true(fabs(sum[i].r[k] - want) <= 1e-5 * (fabs(want) + 1e-3));
+        }
+
+    enum { N = 400 };
+    float p[N * 3], n[N * 3], gq[N * 3], rq[N * 3];
+    unsigned seed = 777;
+    for (int i = 0; i < N; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            seed = seed * 1664525u + 1013904223u;
+            p[i * 3 + k] = -1.0f + 2.0f * (float)(seed >> 8) / 16777216.0f + (k == 1 ? 1.0f : 0.0f);
+            seed = seed * 1664525u + 1013904223u;
+            n[i * 3 + k] = (float)(seed >> 8) / 8388608.0f - 1.0f;
+        }
+        if (i % 5 == 0) { /* the walls' own normals, where the bins matter most */
+            n[i * 3] = n[i * 3 + 1] = n[i * 3 + 2] = 0.0f;
+            n[i * 3 + (i / 5) % 3] = (i % 10 == 0) ? 1.0f : -1.0f;
+        }
+    }
+    char err[256];
+    assert_int_equal(lpv_engine_irradiance(f->engine, p, n, N, gq, err, sizeof err), 0);
+    for (int i = 0; i < N; ++i)
+        lpv_oracle_irradiance_binned(g, acc, &p[i * 3], &n[i * 3], &rq[i * 3]);
+    assert_close("irradiance lookup, 6 normal bins", gq, rq, N * 3);
+    free(vpls);
+    free(gpu);
+    free(ref);
+    free(acc);
+    free(sum);
+    free(t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -224,6 +336,8 @@ int main(void)
         cmocka_unit_test(test_geometry_volume_matches_oracle),
         cmocka_unit_test(test_propagation_matches_oracle),
         cmocka_unit_test(test_lookup_matches_oracle),
+        cmocka_unit_test(test_central_transport_matches_oracle),
+        cmocka_unit_test(test_normal_bins_match_oracle),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

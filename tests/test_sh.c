@@ -239,7 +239,7 @@ static const int axis_slot[3] = {3, 1, 2};
 /* Dense M_d = sum over the destination's five faces of
  * (solid angle / pi) lobe(n_f) Y(w_c)^T, with w_c from the source centre to
  * the face centre and n_f the face's outward normal. */
-static void dense_matrix(int d, double m[4][4])
+static void dense_matrix_with(int d, int central, double m[4][4])
 {
     int k = d / 2;
     double s = (d & 1) ? -1.0 : 1.0;
@@ -261,6 +261,9 @@ static void dense_matrix(int d, double m[4][4])
             omega = LPV_FACE_SOLID_ANGLE_SIDE;
         }
         normalise(centre);
+        if (central) /* the central transport re-emits along w_c, not n_f */
+            for (int i = 0; i < 3; i++)
+                normal[i] = centre[i];
         float nf[3] = {(float)normal[0], (float)normal[1], (float)normal[2]}, lobe[4];
         lpv_sh_cosine_lobe(nf, lobe);
         double y[4];
@@ -271,25 +274,31 @@ static void dense_matrix(int d, double m[4][4])
     }
 }
 
-/* (6) The sparse A, B, E, F, G form equals the dense matrices. */
+/* (6) The sparse A, B, E, F, G form equals the dense matrices, for the
+ * paper's transport and for the central one (lpv_shared.h: only the band-1
+ * rows E, F, G differ). */
 static void test_sparse_matrices(void **state)
 {
     (void)state;
-    for (int d = 0; d < 6; d++) {
-        double m[4][4], sp[4][4] = {{0}};
-        double s = (d & 1) ? -1.0 : 1.0;
-        int k = axis_slot[d / 2];
-        dense_matrix(d, m);
-        sp[0][0] = LPV_PROP_A;
-        sp[0][k] = s * LPV_PROP_B;
-        sp[k][0] = s * LPV_PROP_E;
-        sp[k][k] = LPV_PROP_F;
-        for (int j = 1; j < 4; j++)
-            if (j != k)
-                sp[j][j] = LPV_PROP_G;
-        for (int r = 0; r < 4; r++)
-            for (int c = 0; c < 4; c++)
-                assert_near(m[r][c], sp[r][c], 1e-6);
+    for (int central = 0; central < 2; central++) {
+        double e = central ? LPV_PROP_CENTRAL_E : LPV_PROP_E, f = central ? LPV_PROP_CENTRAL_F : LPV_PROP_F,
+               g = central ? LPV_PROP_CENTRAL_G : LPV_PROP_G;
+        for (int d = 0; d < 6; d++) {
+            double m[4][4], sp[4][4] = {{0}};
+            double s = (d & 1) ? -1.0 : 1.0;
+            int k = axis_slot[d / 2];
+            dense_matrix_with(d, central, m);
+            sp[0][0] = LPV_PROP_A;
+            sp[0][k] = s * LPV_PROP_B;
+            sp[k][0] = s * e;
+            sp[k][k] = f;
+            for (int j = 1; j < 4; j++)
+                if (j != k)
+                    sp[j][j] = g;
+            for (int r = 0; r < 4; r++)
+                for (int c = 0; c < 4; c++)
+                    assert_near(m[r][c], sp[r][c], 1e-6);
+        }
     }
     /* A is exactly 1/6: the six neighbours share the source's flux. */
     assert_near(LPV_PROP_A, 1.0 / 6.0, 1e-8);
