@@ -24,6 +24,18 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
         for (int i = 0; i < 3; ++i)
             out->origin_cells[0][i] = out->grid[0].origin[i] / out->grid[0].cell_size;
         out->count = 1;
+        for (int k = 1; s->far_field == LPV_SWITCH_ON && k <= s->far_field_levels && k < LPV_MAX_CASCADES; ++k) {
+            lpv_grid *g = &out->grid[k];
+            *g = out->grid[k - 1];
+            g->cell_size = 2.0f * out->grid[k - 1].cell_size;
+            for (int i = 0; i < 3; ++i) {
+                double o = ((double)out->origin_cells[k - 1][i] - (double)(g->dims[i] / 2)) * 0.5;
+                out->origin_cells[k][i] = (float)o;
+                g->origin[i] = (float)(o * g->cell_size);
+            }
+            out->count = k + 1;
+            out->handoff = 1;
+        }
         return 0;
     }
     int longest = 1;
@@ -57,12 +69,13 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     }
     out->count = count;
     out->snapped = 1;
+    out->handoff = s->far_field == LPV_SWITCH_ON && s->cascade_ratio == 2.0f;
     return 0;
 }
 
 int lpv_cascades_equal(const lpv_cascade_set *a, const lpv_cascade_set *b)
 {
-    if (a->count != b->count || a->snapped != b->snapped)
+    if (a->count != b->count || a->snapped != b->snapped || a->handoff != b->handoff)
         return 0;
     for (int k = 0; k < a->count; ++k) {
         if (memcmp(a->grid[k].dims, b->grid[k].dims, sizeof a->grid[k].dims) != 0 ||

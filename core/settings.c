@@ -25,7 +25,7 @@
 typedef struct preset_row {
     const char *name;
     int grid, iterations, rsm_size;
-    lpv_switch occlusion;
+    lpv_switch occlusion, central_transport, normal_bins, far_field, scene_surfels;
 } preset_row;
 
 static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
@@ -35,12 +35,14 @@ static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
      * errors came with 4 iterations: more steps pile light up next to its
      * source faster than they carry it away (docs/calibration.md, 4). */
     /* fast: the cheapest front point with fuzzy occlusion (thin walls need it) */
-    [LPV_PRESET_FAST] = {"fast", 16, 4, 128, LPV_SWITCH_ON},
+    [LPV_PRESET_FAST] = {"fast", 16, 4, 128, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
+                         LPV_SWITCH_OFF},
     /* balanced, the default: nearly fast's cost, a 32^3 grid's finer detail */
     [LPV_PRESET_BALANCED] = {"balanced", LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
-                             LPV_SWITCH_ON},
+                             LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF, LPV_SWITCH_OFF, LPV_SWITCH_OFF},
     /* accurate: the front's lowest error short of the 512^2 RSM's extra cost */
-    [LPV_PRESET_ACCURATE] = {"accurate", 64, 4, 256, LPV_SWITCH_ON},
+    [LPV_PRESET_ACCURATE] = {"accurate", 64, 4, 256, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
+                             LPV_SWITCH_OFF, LPV_SWITCH_OFF},
 };
 
 /* The table row of p (DEFAULT -> BALANCED), or NULL when p is out of range. */
@@ -62,7 +64,11 @@ int lpv_preset_settings(lpv_preset p, lpv_settings *out)
                           .grid_dims = {r->grid, r->grid, r->grid},
                           .iterations = r->iterations,
                           .rsm_size = r->rsm_size,
-                          .occlusion = r->occlusion};
+                          .occlusion = r->occlusion,
+                          .central_transport = r->central_transport,
+                          .normal_bins = r->normal_bins,
+                          .far_field = r->far_field,
+                          .scene_surfels = r->scene_surfels};
     return 0;
 }
 
@@ -93,7 +99,9 @@ lpv_preset lpv_preset_match(const lpv_settings *s)
     for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_; ++p) {
         const preset_row *r = &PRESETS[p];
         if (s->grid_dims[0] == r->grid && s->grid_dims[1] == r->grid && s->grid_dims[2] == r->grid &&
-            s->iterations == r->iterations && s->rsm_size == r->rsm_size && s->occlusion == r->occlusion)
+            s->iterations == r->iterations && s->rsm_size == r->rsm_size && s->occlusion == r->occlusion &&
+            s->central_transport == r->central_transport && s->normal_bins == r->normal_bins &&
+            s->far_field == r->far_field && s->scene_surfels == r->scene_surfels)
             return (lpv_preset)p;
     }
     return LPV_PRESET_DEFAULT;
@@ -115,6 +123,14 @@ void lpv_settings_resolve(lpv_settings *s)
             s->rsm_size = p.rsm_size;
         if (s->occlusion == LPV_SWITCH_DEFAULT)
             s->occlusion = p.occlusion;
+        if (s->central_transport == LPV_SWITCH_DEFAULT)
+            s->central_transport = p.central_transport;
+        if (s->normal_bins == LPV_SWITCH_DEFAULT)
+            s->normal_bins = p.normal_bins;
+        if (s->far_field == LPV_SWITCH_DEFAULT)
+            s->far_field = p.far_field;
+        if (s->scene_surfels == LPV_SWITCH_DEFAULT)
+            s->scene_surfels = p.scene_surfels;
     }
     if (s->indirect_gain == 0.0f)
         s->indirect_gain = 1.0f;
@@ -140,10 +156,10 @@ void lpv_settings_resolve(lpv_settings *s)
         s->media_step = LPV_DEFAULT_MEDIA_STEP;
     if (s->planner == LPV_SWITCH_DEFAULT)
         s->planner = LPV_SWITCH_ON;
-    if (s->central_transport == LPV_SWITCH_DEFAULT)
-        s->central_transport = LPV_DEFAULT_CENTRAL_TRANSPORT;
-    if (s->normal_bins == LPV_SWITCH_DEFAULT)
-        s->normal_bins = LPV_DEFAULT_NORMAL_BINS;
+    if (s->far_field_levels == 0)
+        s->far_field_levels = LPV_DEFAULT_FAR_FIELD_LEVELS;
+    if (s->scene_surfel_count == 0)
+        s->scene_surfel_count = LPV_DEFAULT_SCENE_SURFEL_COUNT;
 }
 
 /* Writes a formatted message into err (when there is room) and returns -1. */
@@ -207,6 +223,12 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->emissive_vpls < 0 || s->emissive_vpls > LPV_MAX_EMISSIVE_VPLS)
         return fail(err, err_size, "emissive_vpls = %d is out of range (allowed 0..%d)", s->emissive_vpls,
                     LPV_MAX_EMISSIVE_VPLS);
+    if (s->scene_surfel_count < 1 || s->scene_surfel_count > (1 << 22))
+        return fail(err, err_size, "scene_surfel_count = %d is out of range (allowed 1..%d)", s->scene_surfel_count,
+                    1 << 22);
+    if (s->far_field_levels < 1 || s->far_field_levels > LPV_MAX_CASCADES - 1)
+        return fail(err, err_size, "far_field_levels = %d is out of range (allowed 1..%d)", s->far_field_levels,
+                    LPV_MAX_CASCADES - 1);
     if (s->cascades < 0 || s->cascades > LPV_MAX_CASCADES)
         return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->cascades,
                     LPV_MAX_CASCADES);
@@ -222,7 +244,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
         const char *name;
         lpv_switch v;
     } switches[] = {{"bounces", s->bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
-                    {"central_transport", s->central_transport}, {"normal_bins", s->normal_bins}};
+                    {"central_transport", s->central_transport}, {"normal_bins", s->normal_bins},
+                    {"far_field", s->far_field}, {"scene_surfels", s->scene_surfels}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
             return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",

@@ -13,9 +13,10 @@ typedef enum lpv_switch {
 } lpv_switch;
 
 /* Named quality presets: points on the accuracy sweep's Pareto front
- * (docs/accuracy.md). A preset supplies grid_dims, iterations, rsm_size and
- * occlusion; any of those set explicitly wins over it. 0 means "the default",
- * which is BALANCED. */
+ * (docs/accuracy.md). A preset supplies grid_dims, iterations, rsm_size,
+ * occlusion, central_transport, normal_bins, far_field and scene_surfels; any
+ * of those set explicitly wins over it. 0 means "the default", which is
+ * BALANCED. */
 typedef enum lpv_preset {
     LPV_PRESET_DEFAULT = 0,
     LPV_PRESET_FAST = 1,
@@ -63,11 +64,21 @@ typedef struct lpv_settings {
     lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
                                unchanged volume; off: run every pass every tick */
 
-    /* Transport and lookup (docs/propagation.md sections 4b and 6b). */
+    /* Transport, occlusion and lookup (docs/propagation.md sections 3b, 4b, 5b
+     * and 6b): measured departures from the paper. The preset supplies the
+     * four switches' defaults. */
     lpv_switch central_transport; /* re-emit each face's flux along the face's central direction
-                                     instead of its normal (a departure from the paper) */
+                                     instead of its normal */
     lpv_switch normal_bins;       /* one volume per dominant normal axis of the emitters, so a
                                      surface never reads back its own light (6x the volumes) */
+    lpv_switch far_field;         /* coarser levels carry on the light of the finest grid (one grid
+                                     over the scene gets far_field_levels of them; camera-following
+                                     cascades hand light from each to the next) */
+    int far_field_levels;         /* coarser levels for one grid over the scene, each doubling the cell
+                                     size and taking an equal share of the iterations; default 1 */
+    lpv_switch scene_surfels;     /* surfels sampled over every triangle join the geometry volume, so
+                                     walls no view sees still block */
+    int scene_surfel_count;       /* how many; default 65536 */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
@@ -82,8 +93,8 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f
 #define LPV_DEFAULT_MEDIA_STEP 0.5f
-#define LPV_DEFAULT_CENTRAL_TRANSPORT LPV_SWITCH_OFF
-#define LPV_DEFAULT_NORMAL_BINS LPV_SWITCH_OFF
+#define LPV_DEFAULT_FAR_FIELD_LEVELS 1
+#define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the

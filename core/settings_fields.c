@@ -63,11 +63,19 @@ static const lpv_field FIELDS[] = {
     {"planner", "planner", LPV_FIELD_SWITCH, F(planner), 0, 1, 0, "", "on", "",
      "run only the passes the scene needs (off: every pass every tick)"},
 
-    /* Transport and lookup (docs/propagation.md). */
-    {"central_transport", "central-transport", LPV_FIELD_SWITCH, F(central_transport), 0, 1, 0, "", "off", "",
-     "re-emit each face's flux along its central direction (less diffusive than the paper)"},
-    {"normal_bins", "normal-bins", LPV_FIELD_SWITCH, F(normal_bins), 0, 1, 0, "", "off", "",
+    /* Transport, occlusion and lookup (docs/propagation.md). */
+    {"central_transport", "central-transport", LPV_FIELD_SWITCH, F(central_transport), 0, 1, 0, "",
+     "the preset's", "", "re-emit each face's flux along its central direction (less diffusive than the paper)"},
+    {"normal_bins", "normal-bins", LPV_FIELD_SWITCH, F(normal_bins), 0, 1, 0, "", "the preset's", "",
      "one volume per emitter normal axis: surfaces never read back their own light"},
+    {"far_field", "far-field", LPV_FIELD_SWITCH, F(far_field), 0, 1, 0, "", "the preset's", "",
+     "coarser levels carry the light on (reach grows with 2^levels)"},
+    {"far_field_levels", "far-field-levels", LPV_FIELD_INT, F(far_field_levels), 1, LPV_MAX_CASCADES - 1, 0,
+     "levels", "1", "", "coarser levels (2x the cells each) over one grid"},
+    {"scene_surfels", "scene-surfels", LPV_FIELD_SWITCH, F(scene_surfels), 0, 1, 0, "", "the preset's", "",
+     "surfels over every triangle join the geometry volume (walls no view sees block)"},
+    {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",
+     "65536", "", "surfels sampled over the scene's triangles"},
 };
 
 #undef F

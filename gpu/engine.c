@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "emissive.h"
+#include "scene_surfels.h"
 #include "error.h"
 #include "engine_internal.h"
 #include "shader.h"
@@ -74,6 +75,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_gv_merge, "gv_merge.comp", NULL, INC_GRID},
         {&e->prog_transmit, "transmit.comp", NULL, INC_GRID},
         {&e->prog_propagate, "propagate.comp", NULL, INC_PROPAGATE},
+        {&e->prog_handoff, "lpv_handoff.comp", NULL, INC_PROPAGATE},
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, NULL},
         {&e->prog_shade, "fullscreen.vert", "shade.frag", INC_SHADE},
@@ -132,6 +134,8 @@ static void free_scene(lpv_engine *e)
     delete_buffer(&e->vbo);
     delete_buffer(&e->ibo);
     delete_buffer(&e->emissive_vpls);
+    delete_buffer(&e->scene_surfels);
+    e->scene_surfel_count = 0;
     if (e->texture_count)
         glDeleteTextures((GLsizei)e->texture_count, e->textures);
     free(e->textures);
@@ -209,7 +213,7 @@ void lpv_engine_destroy(lpv_engine *e)
     GLuint *progs[] = {&e->prog_rsm, &e->prog_vpl_extract, &e->prog_inject_vpl, &e->prog_inject_gv,
                        &e->prog_pack, &e->prog_gv_merge, &e->prog_transmit, &e->prog_propagate,
                        &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade, &e->prog_query,
-                       &e->prog_glossy, &e->prog_media};
+                       &e->prog_glossy, &e->prog_media, &e->prog_handoff};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -252,10 +256,11 @@ static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, 
     e->bins = e->settings.normal_bins == LPV_SWITCH_ON ? LPV_NORMAL_BINS : 1;
     struct LpvGridParams params = {
         .dims = {(float)g->dims[0], (float)g->dims[1], (float)g->dims[2], (float)lpv_grid_cell_count(g)},
-        .info = {(float)set->count, set->count > 1 ? 1.0f : 0.0f, (float)e->bins,
+        .info = {(float)set->count, set->count > 1 && !set->handoff ? 1.0f : 0.0f, (float)e->bins,
                  e->settings.central_transport == LPV_SWITCH_ON ? (float)LPV_TRANSPORT_CENTRAL
                                                                 : (float)LPV_TRANSPORT_PAPER},
     };
+    params.mode[0] = set->handoff ? 1.0f : 0.0f;
     for (int k = 0; k < set->count; ++k) {
         for (int i = 0; i < 3; ++i)
             params.cascade[k][i] = set->origin_cells[k][i];
@@ -505,6 +510,17 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     e->emissive_vpl_count = n;
     free(vpls);
 
+    size_t want = e->settings.scene_surfels == LPV_SWITCH_ON ? (size_t)e->settings.scene_surfel_count : 0;
+    lpv_surfel *surfels = want ? calloc(want + 1, sizeof *surfels) : NULL;
+    if (want && !surfels)
+        return lpv_error(err, err_size, "out of memory for %zu scene surfels", want);
+    size_t ns = surfels ? lpv_scene_surfels(scene, want, surfels, want + 1) : 0;
+    e->scene_surfels = new_ssbo(ns * sizeof(lpv_surfel));
+    if (ns)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(ns * sizeof(lpv_surfel)), surfels);
+    e->scene_surfel_count = ns;
+    free(surfels);
+
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "%s: GL error while uploading the scene", scene->source);
     e->has_scene = 1;
@@ -582,7 +598,8 @@ static void record_stats(lpv_engine *e)
     s->cascades = e->cascades.count;
     s->cells = lpv_engine_all_cells(e);
     s->iterations = e->settings.iterations;
-    s->cell_steps = e->plan.pass[LPV_PASS_PROPAGATE].run ? (double)s->cells * e->settings.iterations : 0.0;
+    s->cell_steps =
+        e->plan.pass[LPV_PASS_PROPAGATE].run ? (double)lpv_engine_volume_cells(e) * e->settings.iterations : 0.0;
     s->occlusion = gv;
 }
 
@@ -824,7 +841,7 @@ static GLuint grid_buffer(const lpv_engine *e, lpv_grid_which which)
     if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && steps == 0))
         return e->lpv_injected;
     if (which == LPV_GRID_LAST_STEP)
-        return (steps & 1) ? e->lpv_ping : e->lpv_pong;
+        return e->lpv_last;
     return e->lpv_acc;
 }
 
@@ -904,7 +921,7 @@ size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 
 size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
 {
-    return (size_t)e->light_block.counts[0] + (e->has_view ? 1 : 0);
+    return (size_t)e->light_block.counts[0] + (e->has_view ? 1 : 0) + (e->scene_surfel_count ? 1 : 0);
 }
 
 size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max)
@@ -925,5 +942,7 @@ size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, si
     }
     if (buffer == lights && e->has_view)
         return read_buffer(e->camera_surfels, sizeof(lpv_surfel), (size_t)e->gbuf_w * e->gbuf_h, out, max);
+    if (buffer == lights + (e->has_view ? 1 : 0) && e->scene_surfel_count)
+        return read_buffer(e->scene_surfels, sizeof(lpv_surfel), e->scene_surfel_count, out, max);
     return 0;
 }

@@ -115,7 +115,8 @@ int lpv_engine_bins(const lpv_engine *e);
 size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max);
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);  /* RSM VPLs then emissive */
-/* Surfels of one GV buffer: 0..light_count-1 = each light's RSM, light_count = the camera. */
+/* Surfels of one GV buffer: 0..light_count-1 = each light's RSM, then the camera (with a view),
+ * then the scene surfels (settings.scene_surfels on). */
 size_t lpv_engine_gv_buffer_count(const lpv_engine *e);
 size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max);
 

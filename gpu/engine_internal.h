@@ -54,7 +54,7 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
         prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
-        prog_media;
+        prog_media, prog_handoff;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -69,6 +69,8 @@ struct lpv_engine {
     float scene_min[3], scene_max[3];
     GLuint emissive_vpls;
     size_t emissive_vpl_count;
+    GLuint scene_surfels;     /* settings.scene_surfel_count over every triangle (GV), 0 = none */
+    size_t scene_surfel_count;
 
     /* lights and RSMs */
     struct LpvLightBlock light_block;
@@ -82,6 +84,7 @@ struct lpv_engine {
     GLuint grid_ubo;
     lpv_atlas lpv_atlas, gv_atlas;
     GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit, reflect;
+    GLuint lpv_last; /* the buffer the last propagation step (or hand-off) wrote */
     GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
     GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
     size_t grid_alloc_cells; /* cells of all cascades */

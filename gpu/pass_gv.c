@@ -1,6 +1,7 @@
 /*
  * pass_gv.c - the geometry volume for fuzzy occlusion. Each buffer that saw
- * surfaces (each light's RSM faces, and the camera's G-buffer) splats its
+ * surfaces (each light's RSM faces, the camera's G-buffer, and the surfels
+ * sampled over every triangle when settings.scene_surfels is on) splats its
  * surfels into the GV atlas and is then max-merged into the total, so a
  * surface seen by several buffers blocks once. Finally the per-cell, per-
  * direction transmittances are computed once for the whole propagation.
@@ -44,6 +45,12 @@ void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera)
         lpv_atlas_begin(e, &e->gv_atlas, e->prog_inject_gv);
         lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->camera_surfels, 0,
                         (size_t)e->gbuf_w * (size_t)e->gbuf_h);
+        lpv_atlas_end();
+        merge(e);
+    }
+    if (e->scene_surfel_count) { /* the geometry itself, seen or not */
+        lpv_atlas_begin(e, &e->gv_atlas, e->prog_inject_gv);
+        lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->scene_surfels, 0, e->scene_surfel_count);
         lpv_atlas_end();
         merge(e);
     }

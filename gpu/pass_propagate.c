@@ -24,23 +24,49 @@ void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
     const int occlusion = occlusion_on;
     /* Step i reads (through buffer-texture views: on llvmpipe texel fetches
      * gather far faster than SSBO loads) what step i - 1 wrote with SSBO
-     * stores: the injected grid first, then ping and pong in turn. */
-    GLuint in_view = e->tbo_injected;
-    for (int i = 0; i < e->settings.iterations; ++i) {
-        GLuint out = (i & 1) ? e->lpv_pong : e->lpv_ping;
+     * stores: the injected grid first, then ping and pong in turn. With the
+     * far field on, every `every` steps a hand-off moves the light in flight
+     * on to the next coarser cascade (lpv_handoff.comp), as one more turn of
+     * the ping-pong. */
+    const int iterations = e->settings.iterations, levels = e->cascades.handoff ? e->cascades.count : 1;
+    const int every = (iterations + levels - 1) / levels;
+    GLuint in_view = e->tbo_injected, cur = 0;
+    int sig = 0; /* the sigma buffer holding the flux limits of what is read next */
+    const GLuint groups[3] = {lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
+                              lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y),
+                              (GLuint)(e->grid.dims[2] * lpv_engine_volumes(e))};
+    for (int i = 0; i < iterations; ++i) {
+        GLuint out = cur == e->lpv_ping ? e->lpv_pong : e->lpv_ping;
+        glUseProgram(e->prog_propagate);
         glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
         glBindTexture(GL_TEXTURE_BUFFER, in_view);
         glActiveTexture(GL_TEXTURE0 + LPV_TEX_SIGMA_IN);
-        glBindTexture(GL_TEXTURE_BUFFER, e->tbo_sigma[i & 1]);
+        glBindTexture(GL_TEXTURE_BUFFER, e->tbo_sigma[sig]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[(i + 1) & 1]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[sig ^ 1]);
         glUniform1i(loc_occ, occlusion && i > 0);
-        glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
-                          lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y),
-                          (GLuint)(e->grid.dims[2] * lpv_engine_volumes(e)));
+        glDispatchCompute(groups[0], groups[1], groups[2]);
         lpv_timer_count(&e->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-        in_view = (i & 1) ? e->tbo_pong : e->tbo_ping;
+        cur = out;
+        in_view = out == e->lpv_ping ? e->tbo_ping : e->tbo_pong;
+        sig ^= 1;
+        if (levels > 1 && (i + 1) % every == 0 && i + 1 < iterations) {
+            out = cur == e->lpv_ping ? e->lpv_pong : e->lpv_ping;
+            glUseProgram(e->prog_handoff);
+            glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
+            glBindTexture(GL_TEXTURE_BUFFER, in_view);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[sig ^ 1]);
+            glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D),
+                              lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D), groups[2]);
+            lpv_timer_count(&e->timer, 1);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+            cur = out;
+            in_view = out == e->lpv_ping ? e->tbo_ping : e->tbo_pong;
+            sig ^= 1;
+        }
     }
+    e->lpv_last = cur ? cur : e->lpv_injected;
     lpv_timer_end(&e->timer);
 }

@@ -47,6 +47,9 @@ int bin_count() { return max(int(G.info.z), 1); }
 int volume_count() { return cascade_count() * bin_count(); }
 int volume_cascade(int v) { return v / bin_count(); }
 int transport() { return int(G.info.w); }
+// Far field (docs/propagation.md section 5b): cascade k + 1 carries on the
+// light of cascade k; a point's light is the sum over the cascades holding it.
+bool far_field() { return G.mode.x != 0.0; }
 
 // The bin of a unit normal: its dominant axis and sign, in the direction
 // order +x -x +y -y +z -z (ties go to the lower axis).

@@ -30,6 +30,11 @@ void main()
     ivec3 c = ivec3(floor(cascade_coords(k, v.position.xyz + 0.5 * cascade_cell(k) * n)));
     if (!cell_inside(c))
         return;
+    // far field: a VPL lives in the finest cascade holding it; coarser ones
+    // receive its light through the hand-off
+    if (far_field() && k > 0 &&
+        cell_inside(ivec3(floor(cascade_coords(k - 1, v.position.xyz + 0.5 * cascade_cell(k - 1) * n)))))
+        return;
 
     vec4 lobe = sh_lobe(n) * (w / LPV_PI);
     v_r = lobe * v.flux.r;

@@ -150,6 +150,25 @@ void cascade_blend(vec3 p, out float share[LPV_MAX_CASCADES])
     }
 }
 
+// 1 when p lies inside cascade k's cells, else 0 (the far field's sum).
+float cascade_holds(int k, vec3 p)
+{
+    vec3 q = cascade_coords(k, p);
+    return all(greaterThanEqual(q, vec3(0.0))) && all(lessThan(q, vec3(grid_dims()))) ? 1.0 : 0.0;
+}
+
+// Each cascade's share at p: the blend across borders, or with the far field
+// 1 for every cascade holding p (they hold light of different ages).
+void cascade_shares(vec3 p, out float share[LPV_MAX_CASCADES])
+{
+    if (!far_field()) {
+        cascade_blend(p, share);
+        return;
+    }
+    for (int k = 0; k < LPV_MAX_CASCADES; ++k)
+        share[k] = k < cascade_count() ? cascade_holds(k, p) : 0.0;
+}
+
 vec3 lpv_irradiance(vec3 p, vec3 n_in)
 {
     float len = length(n_in);
@@ -157,7 +176,7 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
         return vec3(0.0);
     vec3 n = n_in / len;
     float share[LPV_MAX_CASCADES];
-    cascade_blend(p, share);
+    cascade_shares(p, share);
     vec3 e = vec3(0.0);
     for (int k = 0; k < LPV_MAX_CASCADES; ++k)
         if (share[k] > 0.0)
@@ -170,7 +189,7 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
 vec3 lpv_project(vec3 x, vec4 v)
 {
     float share[LPV_MAX_CASCADES];
-    cascade_blend(x, share);
+    cascade_shares(x, share);
     vec3 e = vec3(0.0);
     for (int k = 0; k < LPV_MAX_CASCADES; ++k)
         if (share[k] > 0.0)

@@ -133,6 +133,9 @@ struct LpvGridParams {
     vec4 info;                             /* x cascade count; y 1 = fade small objects out of coarse cascades;
                                               z volumes per cascade (1, or LPV_NORMAL_BINS); w transport */
     vec4 cascade[LPV_MAX_CASCADES];        /* xyz lower corner in cells of this cascade; w cell size (m) */
+    vec4 mode;                             /* x 1 = far field (hand-off): cascade k + 1 carries on the light
+                                              cascade k propagated, lookups sum the cascades holding a point;
+                                              yzw unused */
 };
 
 /* Six propagation directions, in this order everywhere (C and GLSL):
