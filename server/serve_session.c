@@ -7,6 +7,7 @@
  * session busy; its next request waits until the reply has been queued.
  */
 #include "serve.h"
+#include "scene_defaults.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -254,11 +255,12 @@ static json_t *config_json(sv_conn *c)
 
 static json_t *scene_json(const lpv_scene *sc)
 {
-    return json_pack("{s:I, s:i, s:i, s:i, s:[f,f,f,f,f,f], s:s}", "triangles", (json_int_t)(sc->index_count / 3),
-                     "materials", (int)sc->material_count, "lights", (int)sc->light_count, "cameras",
-                     (int)sc->camera_count, "bounds", (double)sc->bounds_min[0], (double)sc->bounds_min[1],
-                     (double)sc->bounds_min[2], (double)sc->bounds_max[0], (double)sc->bounds_max[1],
-                     (double)sc->bounds_max[2], "source", sc->source);
+    return json_pack("{s:I, s:i, s:i, s:i, s:b, s:b, s:[f,f,f,f,f,f], s:s}", "triangles",
+                     (json_int_t)(sc->index_count / 3), "materials", (int)sc->material_count, "lights",
+                     (int)sc->light_count, "cameras", (int)sc->camera_count, "default_light", sc->default_light_added,
+                     "default_camera", sc->default_camera_added, "bounds", (double)sc->bounds_min[0],
+                     (double)sc->bounds_min[1], (double)sc->bounds_min[2], (double)sc->bounds_max[0],
+                     (double)sc->bounds_max[1], (double)sc->bounds_max[2], "source", sc->source);
 }
 
 /* ---- HELLO -------------------------------------------------------------- */
@@ -410,11 +412,10 @@ static void load_run(uv_work_t *req)
         w->status = LPVP_E_SCENE_INVALID;
         return;
     }
-    if (lpv_scene_ensure_light(&sc->scene) != 0) {
+    if (lpv_scene_add_defaults(&sc->scene, w->err, sizeof w->err) != 0) {
         lpv_scene_free(&sc->scene);
         free(sc);
         w->status = LPVP_E_INTERNAL;
-        snprintf(w->err, sizeof w->err, "out of memory adding the default light");
         return;
     }
     if (w->base_dir && !contains(w->glb, w->glb_size, "\"uri\"")) {
