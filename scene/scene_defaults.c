@@ -12,7 +12,9 @@
 
 #define PROBE_RAYS 64        /* directions per probe (a Fibonacci sphere) */
 #define LATTICE 5            /* candidate eye points per axis of the bounds */
-#define ENCLOSED_HITS 0.9f   /* a candidate is enclosed when this fraction of its rays hit */
+#define ENCLOSED_HITS 0.97f  /* a candidate is enclosed when this fraction of its rays hit */
+#define ROOM_SIZE 0.02f      /* ... and its mean free distance is at least this x S (not a gap between parts) */
+#define KEY_SHARE 0.95f      /* the first light candidate lighting this share of the best one's points wins */
 #define AZIMUTHS 16          /* view directions tried from an interior eye */
 #define FAN 5                /* rays per side of the fan that scores a view direction */
 #define LIGHT_RAYS 16        /* visible points per side sampled for the light */
@@ -169,7 +171,7 @@ static int interior_camera(const ctx *c, lpv_camera *cam)
                     p[a] = c->lo[a] + ((float)idx[a] + 0.5f) / LATTICE * (c->hi[a] - c->lo[a]);
                 probe pr = probe_point(c, p);
                 if ((float)pr.hits < ENCLOSED_HITS * PROBE_RAYS || 8 * pr.back > pr.hits ||
-                    !(pr.min > 0.1f * pr.mean))
+                    !(pr.min > 0.1f * pr.mean) || !(pr.mean > ROOM_SIZE * c->size))
                     continue;
                 if (!found || pr.mean > best_mean) {
                     memcpy(best, p, sizeof best);
@@ -289,8 +291,8 @@ static size_t visible_points(const ctx *c, const lpv_camera *cam, seen *out)
     return n;
 }
 
-/* Sum over the visible points of cos(n, to light) for those the light at L
- * reaches unblocked. */
+/* How many of the visible points the light at L reaches unblocked, at more
+ * than grazing incidence (cos > 0.05). */
 static float light_score(const ctx *c, const seen *pts, size_t n, const float L[3])
 {
     float score = 0.0f;
@@ -304,12 +306,12 @@ static float light_score(const ctx *c, const seen *pts, size_t n, const float L[
         for (int k = 0; k < 3; ++k)
             d[k] /= len;
         float cosn = dot3(d, pts[i].n);
-        if (!(cosn > 0.0f))
+        if (!(cosn > 0.05f))
             continue;
         for (int k = 0; k < 3; ++k)
             o[k] = pts[i].p[k] + 10.0f * c->eps * pts[i].n[k];
         if (!lpv_raycast_hit(c->rc, o, d, 0.0f, len - 10.0f * c->eps, NULL, NULL))
-            score += cosn;
+            score += 1.0f;
     }
     return score;
 }
@@ -317,9 +319,11 @@ static float light_score(const ctx *c, const seen *pts, size_t n, const float L[
 /* The light: candidate positions offset from camera 0 up and to either side
  * (a key light), by 1, 1/2, 1/4 of the median distance to what it sees, and
  * the eye itself; a candidate must be reachable from the eye without crossing
- * a surface and not inside closed geometry. The one lighting the most of what
- * the camera sees (cosine-weighted, shadowed) wins; its intensity gives
- * 1 W/m^2 (facing the light) at the median distance to the points it lights. */
+ * a surface and not inside closed geometry. Each is scored by how many of the
+ * camera's visible points it lights (unshadowed, cos > 0.05); the first in
+ * that order lighting at least KEY_SHARE of the best score wins. Its intensity
+ * gives 1 W/m^2 (facing the light) at the median distance to the points it
+ * lights. */
 static int add_light(lpv_scene *s, const ctx *c)
 {
     lpv_light *lights = realloc(s->lights, ((size_t)s->light_count + 1) * sizeof *lights);
@@ -348,10 +352,10 @@ static int add_light(lpv_scene *s, const ctx *c)
     cross3(r, f, u);
     static const float OFFSETS[3][2] = {{0.4f, 0.3f}, {0.4f, -0.3f}, {0.4f, 0.0f}}; /* (up, right) */
     static const float SCALES[3] = {1.0f, 0.5f, 0.25f};
-    float best[3], best_score = -1.0f;
-    memcpy(best, cam->eye, sizeof best);
+    float cand[10][3], score[10], best_score = 0.0f;
+    int nc = 0;
     for (int k = 0; k < 10; ++k) {
-        float L[3];
+        float *L = cand[nc];
         if (k < 9) {
             const float *o = OFFSETS[k % 3];
             float sc = SCALES[k / 3] * dmed;
@@ -370,14 +374,20 @@ static int add_light(lpv_scene *s, const ctx *c)
             if (probe_inside(&pr))
                 continue;
         } else {
-            memcpy(L, cam->eye, sizeof L);
+            memcpy(L, cam->eye, 3 * sizeof(float));
         }
-        float sc = light_score(c, pts, n, L);
-        if (sc > best_score) {
-            best_score = sc;
-            memcpy(best, L, sizeof best);
-        }
+        score[nc] = light_score(c, pts, n, L);
+        best_score = fmaxf(best_score, score[nc]);
+        nc++;
     }
+    /* a key light beside the camera rather than a flat headlight, unless it
+     * lights clearly less of the view */
+    float best[3];
+    for (int k = 0; k < nc; ++k)
+        if (score[k] >= KEY_SHARE * best_score) {
+            memcpy(best, cand[k], sizeof best);
+            break;
+        }
     size_t m = 0;
     for (size_t i = 0; i < n; ++i) {
         float d[3];
