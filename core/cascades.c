@@ -45,21 +45,48 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
         if (s->grid_dims[i] > longest)
             longest = s->grid_dims[i];
     }
-    double centre_scene[3];
+    double centre_scene[3], anchor[3];
     for (int i = 0; i < 3; ++i) {
         centre_scene[i] = 0.5 * ((double)bmin[i] + (double)bmax[i]);
         if (!isfinite(centre_scene[i]) || (eye && !isfinite(eye[i])) || (forward && !isfinite(forward[i])))
             return -1;
+        anchor[i] = eye ? eye[i] : centre_scene[i];
+    }
+    /* A camera outside the bounds: anchor where its view ray enters them, or
+     * at the point of the bounds nearest to it, so no cascade sits beside the
+     * scene. */
+    if (eye && !lpv_point_in_bounds(eye, bmin, bmax)) {
+        double t0 = 0.0, t1 = INFINITY;
+        for (int i = 0; i < 3 && forward; ++i) {
+            if (fabs(forward[i]) < 1e-12) {
+                if (eye[i] < bmin[i] || eye[i] > bmax[i])
+                    t0 = INFINITY;
+                continue;
+            }
+            double a = (bmin[i] - eye[i]) / forward[i], b = (bmax[i] - eye[i]) / forward[i];
+            t0 = fmax(t0, fmin(a, b));
+            t1 = fmin(t1, fmax(a, b));
+        }
+        int enters = forward && t0 <= t1 && isfinite(t0);
+        for (int i = 0; i < 3; ++i)
+            anchor[i] = enters ? eye[i] + forward[i] * t0 : fmin(fmax(eye[i], bmin[i]), bmax[i]);
     }
     const double offset = s->cascade_offset > 0.0f ? s->cascade_offset : 0.0;
-    double cell = (double)s->cascade_size / longest;
+    double cell = (double)lpv_cascade_finest_size(s, bmin, bmax) / longest;
     for (int k = 0; k < count; ++k, cell *= s->cascade_ratio) {
         lpv_grid *g = &out->grid[k];
         memcpy(g->dims, s->grid_dims, sizeof g->dims);
         g->cell_size = (float)cell;
         for (int i = 0; i < 3; ++i) {
             double extent = cell * g->dims[i];
-            double centre = eye ? eye[i] + (forward ? forward[i] * offset * extent : 0.0) : centre_scene[i];
+            double centre = anchor[i] + (eye && forward ? forward[i] * offset * extent : 0.0);
+            /* keep the cascade over the scene: centred on it along an axis it
+             * spans, else no further out than its own border */
+            double span = (double)bmax[i] - (double)bmin[i];
+            if (extent >= span)
+                centre = centre_scene[i];
+            else
+                centre = fmin(fmax(centre, bmin[i] + 0.5 * extent), bmax[i] - 0.5 * extent);
             double o = floor(centre / cell) - (double)(g->dims[i] / 2);
             if (!isfinite(o) || fabs(o) > 1e7)
                 return -1;
@@ -71,6 +98,24 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     out->snapped = 1;
     out->handoff = s->far_field == LPV_SWITCH_ON && s->cascade_ratio == 2.0f;
     return 0;
+}
+
+float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3])
+{
+    if (s->cascade_size > 0.0f)
+        return s->cascade_size;
+    float longest = 0.0f;
+    for (int i = 0; i < 3; ++i)
+        longest = fmaxf(longest, bmax[i] - bmin[i]);
+    return longest > 0.0f && isfinite(longest) ? LPV_CASCADE_AUTO_FRACTION * longest : 1.0f;
+}
+
+int lpv_point_in_bounds(const float p[3], const float bmin[3], const float bmax[3])
+{
+    for (int i = 0; i < 3; ++i)
+        if (!(p[i] >= bmin[i] && p[i] <= bmax[i]))
+            return 0;
+    return 1;
 }
 
 int lpv_cascades_equal(const lpv_cascade_set *a, const lpv_cascade_set *b)

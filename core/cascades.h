@@ -4,9 +4,15 @@
  *
  * One cascade is the classic single grid over the scene (or the settings'
  * bounds): lpv_grid_place. Several cascades share the settings' grid_dims;
- * cascade k's cells measure cascade_size / max(dims) * cascade_ratio^k. Each
- * is centred ahead of the camera, at eye + forward * cascade_offset * extent_k
- * (the scene's centre when there is no camera), and snapped: its lower
+ * cascade k's cells measure finest / max(dims) * cascade_ratio^k, with finest
+ * = lpv_cascade_finest_size (cascade_size, or a quarter of the scene's longest
+ * side when it is 0). Each is centred ahead of the camera, at
+ * anchor + forward * cascade_offset * extent_k, where the anchor is the eye
+ * (inside the scene's bounds), the point where the view ray enters the bounds
+ * (outside), else the point of the bounds nearest the eye (the scene's centre
+ * without a camera); the centre is then kept over the scene (the scene's
+ * centre along an axis the cascade spans, else at most half the cascade's
+ * extent inside the bounds), and snapped: its lower
  * corner sits on a whole multiple of its own cell size,
  *   origin_cells = floor(centre / cell) - floor(dims / 2),
  * so a camera moving by less than a cell leaves a cascade where it is (unless
@@ -41,6 +47,14 @@ typedef struct lpv_cascade_set {
  * all); camera-following cascades hand off when their ratio is 2. */
 int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
                        const float *forward, lpv_cascade_set *out);
+
+/* The finest cascade's extent (m): cascade_size, or with cascade_size 0
+ * (auto) LPV_CASCADE_AUTO_FRACTION x the longest side of [bmin, bmax]
+ * (1 when that is empty). */
+float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3]);
+
+/* 1 when p lies in the box [bmin, bmax] (faces included). */
+int lpv_point_in_bounds(const float p[3], const float bmin[3], const float bmax[3]);
 
 /* 1 when both sets place the same grids (count, dims, origins, cell sizes). */
 int lpv_cascades_equal(const lpv_cascade_set *a, const lpv_cascade_set *b);

@@ -44,13 +44,34 @@ int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reas
         say(reason, n, "planner off: the default %d cascades", LPV_DEFAULT_CASCADES);
         return LPV_DEFAULT_CASCADES;
     }
-    if (f->scene_extent <= s->cascade_size) {
-        say(reason, n, "the scene (%.3g m) fits in the finest cascade (%.3g m): one grid over the scene",
-            (double)f->scene_extent, (double)s->cascade_size);
+    if (s->cascade_size > 0.0f) { /* an explicit size in m: the scene fits in it or not */
+        if (f->scene_extent <= s->cascade_size) {
+            say(reason, n, "the scene (%.3g m) fits in the finest cascade (%.3g m): one grid over the scene",
+                (double)f->scene_extent, (double)s->cascade_size);
+            return 1;
+        }
+        say(reason, n, "the scene (%.3g m) is larger than the finest cascade (%.3g m)", (double)f->scene_extent,
+            (double)s->cascade_size);
+        return LPV_DEFAULT_CASCADES;
+    }
+    /* cascade_size auto (relative to the scene): cascades pay where the camera
+     * sees parts of the scene up close, i.e. stands inside it */
+    if (!f->has_view) {
+        say(reason, n, "no camera: one grid over the scene");
         return 1;
     }
-    say(reason, n, "the scene (%.3g m) is larger than the finest cascade (%.3g m)", (double)f->scene_extent,
-        (double)s->cascade_size);
+    if (!f->camera_inside) {
+        say(reason, n, "the camera stands outside the scene (%.3g m): one grid over all of it",
+            (double)f->scene_extent);
+        return 1;
+    }
+    if (f->scene_extent < LPV_CASCADE_WIDE_RATIO * f->scene_shortest) {
+        say(reason, n, "the camera is inside a scene of similar sides (%.3g m, shortest %.3g m): one grid over it",
+            (double)f->scene_extent, (double)f->scene_shortest);
+        return 1;
+    }
+    say(reason, n, "the camera is inside a wide scene (%.3g m, shortest side %.3g m): cascades from a quarter of it",
+        (double)f->scene_extent, (double)f->scene_shortest);
     return LPV_DEFAULT_CASCADES;
 }
 

@@ -38,7 +38,9 @@ typedef struct lpv_plan_facts {
     size_t glossy_draws;       /* draws whose material is glossy under the settings */
     int has_medium;            /* the scene or the fog settings give a medium */
     int has_view;              /* a camera is set */
+    int camera_inside;         /* the camera stands inside the scene's bounds */
     float scene_extent;        /* m, the scene bounds' longest axis */
+    float scene_shortest;      /* m, the scene bounds' shortest axis */
     int bounds_given;          /* the settings fix the grid bounds */
     /* what changed since the last computed tick */
     int first_tick;            /* nothing computed yet */

@@ -92,50 +92,6 @@ uint32_t lpv_scene_emissive_draw_count(const lpv_scene *scene)
     return count;
 }
 
-int lpv_scene_ensure_light(lpv_scene *scene)
-{
-    if (!scene)
-        return -1;
-    if (scene->light_count > 0 || lpv_scene_emissive_draw_count(scene) > 0)
-        return 0;
-
-    lpv_light *lights = realloc(scene->lights, ((size_t)scene->light_count + 1) * sizeof *lights);
-    if (!lights)
-        return -1;
-    scene->lights = lights;
-
-    const float *lo = scene->bounds_min, *hi = scene->bounds_max;
-    float height = hi[1] - lo[1];
-    if (!(height > 0.0f) || !isfinite(height))
-        height = 1.0f; /* a flat or empty scene: place the light 0.9 m up */
-    float cx = 0.5f * (lo[0] + hi[0]);
-    float cz = 0.5f * (lo[2] + hi[2]);
-    if (!isfinite(cx))
-        cx = 0.0f;
-    if (!isfinite(cz))
-        cz = 0.0f;
-    float base_y = isfinite(lo[1]) ? lo[1] : 0.0f;
-    float d = 0.9f * height; /* distance from the light down to the bounds' floor */
-
-    lpv_light *l = &lights[scene->light_count];
-    memset(l, 0, sizeof *l);
-    l->type = LPV_LIGHT_POINT;
-    strcpy(l->name, "default");
-    l->color[0] = l->color[1] = l->color[2] = 1.0f;
-    /* E = I / d^2 straight below: I = d^2 * 1 W/m^2 gives 1 W/m^2 at the floor. */
-    l->intensity = d * d * 1.0f;
-    l->range = 0.0f;
-    l->position[0] = cx;
-    l->position[1] = base_y + d;
-    l->position[2] = cz;
-    l->direction[0] = 0.0f;
-    l->direction[1] = -1.0f;
-    l->direction[2] = 0.0f;
-    scene->light_count++;
-    scene->default_light_added = 1;
-    return 0;
-}
-
 int lpv_scene_triangle(const lpv_scene *s, uint32_t first, const lpv_vertex *v[3], float front[3], double *area)
 {
     if ((uint64_t)first + 3 > s->index_count)

@@ -111,7 +111,8 @@ typedef struct lpv_scene {
     uint32_t camera_count;
     float bounds_min[3], bounds_max[3]; /* of all vertices */
     lpv_medium medium;                  /* participating medium, if any */
-    int default_light_added;            /* 1 when lpv_scene_ensure_light added one */
+    int default_light_added;            /* 1 when lpv_scene_add_defaults added a light (scene/scene_defaults.h) */
+    int default_camera_added;           /* 1 when lpv_scene_add_defaults added a camera */
     char source[256];                   /* file path, or "built-in:cornell-box" */
 } lpv_scene;
 
@@ -131,11 +132,6 @@ uint32_t lpv_scene_emissive_draw_count(const lpv_scene *scene);
  * range, a non-finite corner or a degenerate triangle. */
 int lpv_scene_triangle(const lpv_scene *scene, uint32_t first, const lpv_vertex *v[3], float front[3], double *area);
 
-/* If the scene has no punctual light and no emissive surface, adds the
- * documented default light (docs/units.md: a point light 10% below the top of
- * the bounds, centred, giving 1 W/m^2 straight below it at the bounds' floor)
- * and sets default_light_added. Returns 0, or -1 on allocation failure. */
-int lpv_scene_ensure_light(lpv_scene *scene);
 
 /* The built-in scene: the Cornell box (McGuire & Cardenas 2011 data, public
  * domain) with its emissive ceiling quad, a spot light under the ceiling and a

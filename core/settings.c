@@ -136,8 +136,7 @@ void lpv_settings_resolve(lpv_settings *s)
         s->indirect_gain = 1.0f;
     if (s->emissive_vpls == 0)
         s->emissive_vpls = LPV_DEFAULT_EMISSIVE_VPLS;
-    if (s->cascade_size == 0.0f)
-        s->cascade_size = LPV_DEFAULT_CASCADE_SIZE;
+    /* cascade_size 0 stays 0: auto, relative to the scene (lpv_cascade_finest_size) */
     if (s->cascade_ratio == 0.0f)
         s->cascade_ratio = LPV_DEFAULT_CASCADE_RATIO;
     if (s->cascade_offset == 0.0f)
@@ -232,8 +231,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->cascades < 0 || s->cascades > LPV_MAX_CASCADES)
         return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->cascades,
                     LPV_MAX_CASCADES);
-    if (!isfinite(s->cascade_size) || s->cascade_size <= 0.0f || s->cascade_size > 1e6f)
-        return fail(err, err_size, "cascade_size = %g m is out of range (allowed > 0 and <= 1e6)",
+    if (!isfinite(s->cascade_size) || s->cascade_size < 0.0f || s->cascade_size > 1e6f)
+        return fail(err, err_size, "cascade_size = %g m is out of range (allowed 0 = auto, or > 0 and <= 1e6)",
                     (double)s->cascade_size);
     if (!isfinite(s->cascade_ratio) || s->cascade_ratio < 1.25f || s->cascade_ratio > 8.0f)
         return fail(err, err_size, "cascade_ratio = %g is out of range (allowed 1.25..8)", (double)s->cascade_ratio);

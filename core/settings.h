@@ -39,9 +39,12 @@ typedef struct lpv_settings {
     /* Cascades (cascaded-LPV paper, section 4; docs/cascades.md). Every cascade
      * has grid_dims cells; cascade k's cells are cascade_ratio^k times the
      * finest cascade's. */
-    int cascades;           /* 0 = auto: one grid over the scene when the scene fits in
-                               the finest cascade, else LPV_DEFAULT_CASCADES; N = exactly N */
-    float cascade_size;     /* m, the finest cascade's extent along its longest axis; default 8 */
+    int cascades;           /* 0 = auto (core/plan.c): with an explicit cascade_size, one grid when
+                               the scene fits in it, else LPV_DEFAULT_CASCADES; with cascade_size
+                               auto, LPV_DEFAULT_CASCADES only when the camera stands inside a wide
+                               scene (LPV_CASCADE_WIDE_RATIO), else one grid; N = exactly N */
+    float cascade_size;     /* m, the finest cascade's extent along its longest axis; 0 (default)
+                               = auto: LPV_CASCADE_AUTO_FRACTION of the scene's longest side */
     float cascade_ratio;    /* cell size ratio of consecutive cascades; default 2 */
     float cascade_offset;   /* how far each cascade's centre sits ahead of the camera along
                                the view direction, as a fraction of its extent; default 0.25,
@@ -88,7 +91,11 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_RSM_SIZE 128
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096
 #define LPV_DEFAULT_CASCADES 3
-#define LPV_DEFAULT_CASCADE_SIZE 8.0f
+#define LPV_DEFAULT_CASCADE_SIZE 0.0f     /* auto, relative to the scene (any unit scale) */
+#define LPV_CASCADE_WIDE_RATIO 4.0f    /* auto cascades: only for a scene whose longest side is at least
+                                            this x its shortest (a level, not a room), seen from inside */
+#define LPV_CASCADE_AUTO_FRACTION 0.25f  /* auto cascade_size: this x the scene's longest side, so
+                                            3 cascades of ratio 2 span the whole scene */
 #define LPV_DEFAULT_CASCADE_RATIO 2.0f
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f

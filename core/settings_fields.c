@@ -32,9 +32,9 @@ static const lpv_field FIELDS[] = {
 
     /* Cascades (docs/cascades.md). */
     {"cascades", "cascades", LPV_FIELD_INT, F(cascades), 0, LPV_MAX_CASCADES, 0, "", "auto", "0 = auto",
-     "cascade count (auto: one grid if the scene fits the finest cascade, else 3)"},
-    {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(cascade_size), 0, 1e6, 1, "m", "8", "",
-     "the finest cascade's extent along its longest axis"},
+     "cascade count (auto: one grid unless the camera is inside the scene, else 3)"},
+    {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(cascade_size), 0, 1e6, 0, "m", "auto",
+     "0 = auto: a quarter of the scene's longest side", "the finest cascade's extent along its longest axis"},
     {"cascade_ratio", "cascade-ratio", LPV_FIELD_FLOAT, F(cascade_ratio), 1.25, 8, 0, "", "2", "",
      "cell size ratio of consecutive cascades"},
     {"cascade_offset", "cascade-offset", LPV_FIELD_FLOAT, F(cascade_offset), -1, 0.5, 0, "", "0.25",

@@ -625,8 +625,11 @@ static void gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->glossy_draws = glossy_draws(e);
     f->has_medium = e->has_medium || e->settings.fog_sigma_s > 0.0f || e->settings.fog_sigma_a > 0.0f;
     f->has_view = e->has_view;
+    f->camera_inside = e->has_view && lpv_point_in_bounds(e->view.eye, e->scene_min, e->scene_max);
     f->scene_extent = fmaxf(e->scene_max[0] - e->scene_min[0],
                             fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
+    f->scene_shortest = fminf(e->scene_max[0] - e->scene_min[0],
+                              fminf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
     f->bounds_given = lpv_settings_bounds_given(&e->settings);
     f->first_tick = !e->computed;
     f->scene_changed = e->scene_dirty;

@@ -466,6 +466,21 @@ int lpv_ref_first_hit(const lpv_ref *r, const float org[3], const float dir[3], 
     return 1;
 }
 
+int lpv_ref_first_surface(const lpv_ref *r, const float org[3], const float dir[3], float tmin, float tmax, float *t,
+                          float p[3], float n[3])
+{
+    hit h;
+    if (!r || !finite3(org) || !finite3(dir) || !intersect(r, org, dir, tmin, tmax, &h))
+        return 0;
+    if (t)
+        *t = h.t;
+    if (p)
+        memcpy(p, h.p, sizeof h.p);
+    if (n)
+        memcpy(n, h.ns, sizeof h.ns);
+    return 1;
+}
+
 /* ---- materials ----------------------------------------------------------- */
 
 static void texture_sample(const ref_texture *t, float s, float tt, float out[3])

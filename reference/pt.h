@@ -83,6 +83,12 @@ void lpv_ref_pixel_ray(const lpv_view *view, int x, int y, float org[3], float d
 int lpv_ref_first_hit(const lpv_ref *ref, const float org[3], const float dir[3], float tmin, float tmax, float *t,
                       float p[3]);
 
+/* As lpv_ref_first_hit, and n (may be NULL) gets the unit shading normal
+ * there, turned towards the side the ray came from (the normal
+ * lpv_ref_direct_irradiance wants for the surface the ray sees). */
+int lpv_ref_first_surface(const lpv_ref *ref, const float org[3], const float dir[3], float tmin, float tmax,
+                          float *t, float p[3], float n[3]);
+
 /* Mean relative standard error of an image: the mean of se / value over the
  * rgb channels of covered pixels (alpha > 0) whose value is > 0; 0 if none. */
 double lpv_ref_mean_relative_stderr(const float *rgba, const float *rgba_stderr, int width, int height);

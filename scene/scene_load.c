@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "gltf_load.h"
+#include "scene_defaults.h"
 
 int lpv_scene_load(const char *path, lpv_scene *out, char *err, size_t err_size)
 {
@@ -16,8 +17,7 @@ int lpv_scene_load(const char *path, lpv_scene *out, char *err, size_t err_size)
         lpv_scene_free(out);
         return -1;
     }
-    if (lpv_scene_ensure_light(out) != 0) {
-        snprintf(err, err_size, "%s: out of memory adding the default light", out->source);
+    if (lpv_scene_add_defaults(out, err, err_size) != 0) {
         lpv_scene_free(out);
         return -1;
     }

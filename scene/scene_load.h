@@ -1,7 +1,7 @@
 /*
  * scene_load.h - the one call commands use to get a scene: a glTF file, or
  * the built-in Cornell box when no path is given; either way a scene without
- * any light gets the documented default light (core/scene.h).
+ * a camera or without any light gets the documented defaults (scene_defaults.h).
  */
 #ifndef LPV_SCENE_LOAD_H
 #define LPV_SCENE_LOAD_H

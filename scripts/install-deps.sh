@@ -11,7 +11,11 @@ PACKAGES="
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev
   python3 gnuplot-nox
+  assimp-testmodels
 "
+# assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
+# tests/test_realscene.c and the accuracy sweep render as scenes the project
+# did not write.
 
 if [ "$(id -u)" -eq 0 ]; then
   SUDO=""

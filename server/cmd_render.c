@@ -26,7 +26,13 @@ static void usage(FILE *f)
             "                          (default render.png)\n"
             "  --indirect-only         only the LPV term: albedo/pi * gain * E_lpv\n"
             "  --direct-only           only direct light and emission\n"
-            "  --exposure E            PNG exposure factor before tone mapping (default 1)\n"
+            "  --exposure auto|EV      PNG exposure: metered from the frame (auto, default) or\n"
+            "                          fixed: the PNG shows 683 lm/W x radiance x 2^EV before the\n"
+            "                          tone curve (EV 0 = three.js / Khronos viewer at exposure 1;\n"
+            "                          a linear factor f is EV log2(f)); docs/units.md\n"
+            "  --background R,G,B      PNG background where no geometry is seen, sRGB 0..1\n"
+            "                          (default 0.25,0.25,0.25, opaque)\n"
+            "  --transparent           PNG background alpha 0 instead\n"
             "  --stats                 print per-stage GPU times and counts as JSON\n"
             "%s",
             LPVD_OPTIONS_HELP);
@@ -37,7 +43,8 @@ int lpvd_cmd_render(int argc, char **argv)
     lpvd_options opt = {0};
     const char *scene_path = NULL, *out_path = "render.png";
     lpv_frame_terms terms = LPV_TERMS_FULL;
-    float exposure = 1.0f;
+    lpv_display display;
+    lpv_display_default(&display);
     int stats = 0;
     char err[1024] = "";
 
@@ -60,12 +67,22 @@ int lpvd_cmd_render(int argc, char **argv)
         } else if (strcmp(a, "--stats") == 0) {
             stats = 1;
         } else if (strcmp(a, "--exposure") == 0) {
-            char *end = NULL;
-            exposure = (i + 1 < argc) ? strtof(argv[++i], &end) : -1.0f;
-            if (!end || *end || !(exposure > 0.0f)) {
-                fprintf(stderr, "lpvd render: --exposure expects a number > 0\n");
+            if (lpv_exposure_parse(i + 1 < argc ? argv[++i] : NULL, &display, err, sizeof err) != 0) {
+                fprintf(stderr, "lpvd render: --%s\n", err);
                 return 2;
             }
+        } else if (strcmp(a, "--transparent") == 0) {
+            display.transparent = 1;
+        } else if (strcmp(a, "--background") == 0) {
+            const char *v = i + 1 < argc ? argv[++i] : "";
+            float b[3];
+            char tail;
+            if (sscanf(v, "%f,%f,%f%c", &b[0], &b[1], &b[2], &tail) != 3 || !(b[0] >= 0.0f && b[0] <= 1.0f) ||
+                !(b[1] >= 0.0f && b[1] <= 1.0f) || !(b[2] >= 0.0f && b[2] <= 1.0f)) {
+                fprintf(stderr, "lpvd render: --background %s: expected R,G,B, sRGB values in 0..1\n", v);
+                return 2;
+            }
+            memcpy(display.background, b, sizeof b);
         } else if (a[0] == '-' && a[1] == '-') {
             const char *name = a + 2;
             if (lpvd_option_takes_value(name) < 0) {
@@ -143,7 +160,8 @@ int lpvd_cmd_render(int argc, char **argv)
             fprintf(stderr, "lpvd render: out of memory\n");
             goto done;
         }
-        lpv_tonemap_rgba8(rgba, pixels, exposure, rgba8);
+        float ev = lpv_display_rgba8(rgba, pixels, &display, rgba8);
+        fprintf(stderr, "lpvd render: exposure EV %.2f (%s)\n", (double)ev, display.exposure_auto ? "auto" : "fixed");
         if (lpv_image_write_u8(out_path, view.width, view.height, 4, rgba8, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd render: %s\n", err);
             goto done;

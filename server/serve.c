@@ -3,6 +3,7 @@
  * shutdown. The protocol is protocol/SPEC.md; the design is docs/server.md.
  */
 #include "serve.h"
+#include "scene_defaults.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -170,7 +171,7 @@ static int load_default_scene(sv_server *s, char *err, size_t n)
         }
         if (!buf || !dir ||
             lpv_gltf_load_memory_ex(buf, len, dir, path, NULL, 0, &sc->scene, err, n) != 0 ||
-            lpv_scene_ensure_light(&sc->scene) != 0) {
+            lpv_scene_add_defaults(&sc->scene, err, n) != 0) {
             if (!buf || !dir)
                 snprintf(err, n, "--scene %s: out of memory", path);
             lpv_scene_free(&sc->scene);

@@ -29,6 +29,7 @@
 #include "gltf_load.h"
 #include "scene.h"
 #include "settings.h"
+#include "tonemap.h"
 #include "view.h"
 #include "volume_codec.h"
 
@@ -215,6 +216,7 @@ struct sv_job {
     sv_waiter *joined;      /* tick: more requests answered by this job, in order */
     unsigned terms_mask;    /* tick: which frames to render (1 << terms); under srv->mu until started */
     int terms;              /* render */
+    lpv_display display;    /* render: how an rgba8/png frame is shown */
     float *points;          /* query: 6n floats */
     size_t count;
     /* results */
@@ -256,6 +258,7 @@ typedef struct sv_sub {
     int delta;              /* volume only */
     int fmt;                /* frame: 0 rgba8, 1 png, 2 exr */
     int terms;              /* frame terms */
+    lpv_display display;    /* frame: exposure and background of rgba8/png */
     sv_sent sent[SV_SENT_KEEP];
     sv_sent acked;          /* raw == NULL: none */
 } sv_sub;
@@ -407,7 +410,8 @@ size_t sv_jobs_queued(sv_server *s);
 int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
                      uint8_t **att, size_t *att_len, char *err, size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
-int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, uint64_t revision,
+int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
+                    uint64_t revision,
                     uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len,
                     char *err, size_t n);
 void sv_sub_clear(sv_sub *sub);

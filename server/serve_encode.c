@@ -185,10 +185,11 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
 static const char *const TERMS_NAMES[3] = {"full", "indirect", "direct"};
 static const char *const FMT_NAMES[3] = {"rgba8", "png", "exr"};
 
-int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, uint64_t revision, uint64_t tick,
-                    const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
+int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
+                    uint64_t revision, uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
 {
     size_t px = (size_t)w * (size_t)h;
+    float ev = 0.0f;
     uint8_t *data = NULL;
     size_t len = 0;
     if (fmt == 2) {
@@ -201,7 +202,7 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
             snprintf(err, n, "out of memory for a %dx%d frame", w, h);
             return -1;
         }
-        lpv_tonemap_rgba8(rgba, px, 1.0f, rgba8);
+        ev = lpv_display_rgba8(rgba, px, display, rgba8);
         if (fmt == 1) {
             int rc = lpv_image_encode_u8("png", w, h, 4, rgba8, &data, &len, err, n);
             free(rgba8);
@@ -231,6 +232,13 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
                       (json_int_t)tick, "format", FMT_NAMES[fmt], "compression", zstd ? "zstd" : "none", "width", w,
                       "height", h, "terms", TERMS_NAMES[terms], "units", fmt == 2 ? "W/(m^2 sr)" : "sRGB",
                       "raw_length", (json_int_t)raw_len);
+    if (*body && fmt != 2 &&
+        (json_object_set_new(*body, "exposure_ev", json_real(ev)) != 0 ||
+         json_object_set_new(*body, "exposure", json_string(display->exposure_auto ? "auto" : "fixed")) != 0 ||
+         json_object_set_new(*body, "transparent", json_boolean(display->transparent)) != 0)) {
+        json_decref(*body);
+        *body = NULL;
+    }
     if (*body && plan && json_object_set_new(*body, "plan", lpvd_plan_json(plan)) != 0) {
         json_decref(*body);
         *body = NULL;

@@ -7,6 +7,7 @@
  * session busy; its next request waits until the reply has been queued.
  */
 #include "serve.h"
+#include "scene_defaults.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -254,11 +255,12 @@ static json_t *config_json(sv_conn *c)
 
 static json_t *scene_json(const lpv_scene *sc)
 {
-    return json_pack("{s:I, s:i, s:i, s:i, s:[f,f,f,f,f,f], s:s}", "triangles", (json_int_t)(sc->index_count / 3),
-                     "materials", (int)sc->material_count, "lights", (int)sc->light_count, "cameras",
-                     (int)sc->camera_count, "bounds", (double)sc->bounds_min[0], (double)sc->bounds_min[1],
-                     (double)sc->bounds_min[2], (double)sc->bounds_max[0], (double)sc->bounds_max[1],
-                     (double)sc->bounds_max[2], "source", sc->source);
+    return json_pack("{s:I, s:i, s:i, s:i, s:b, s:b, s:[f,f,f,f,f,f], s:s}", "triangles",
+                     (json_int_t)(sc->index_count / 3), "materials", (int)sc->material_count, "lights",
+                     (int)sc->light_count, "cameras", (int)sc->camera_count, "default_light", sc->default_light_added,
+                     "default_camera", sc->default_camera_added, "bounds", (double)sc->bounds_min[0],
+                     (double)sc->bounds_min[1], (double)sc->bounds_min[2], (double)sc->bounds_max[0],
+                     (double)sc->bounds_max[1], (double)sc->bounds_max[2], "source", sc->source);
 }
 
 /* ---- HELLO -------------------------------------------------------------- */
@@ -410,11 +412,10 @@ static void load_run(uv_work_t *req)
         w->status = LPVP_E_SCENE_INVALID;
         return;
     }
-    if (lpv_scene_ensure_light(&sc->scene) != 0) {
+    if (lpv_scene_add_defaults(&sc->scene, w->err, sizeof w->err) != 0) {
         lpv_scene_free(&sc->scene);
         free(sc);
         w->status = LPVP_E_INTERNAL;
-        snprintf(w->err, sizeof w->err, "out of memory adding the default light");
         return;
     }
     if (w->base_dir && !contains(w->glb, w->glb_size, "\"uri\"")) {
@@ -1154,10 +1155,33 @@ static void do_tick(sv_conn *c, sv_request *r)
     submit(c, j);
 }
 
+/* GET_FRAME's and SUBSCRIBE frame's "exposure" ("auto" or an EV number) and
+ * "transparent" (SPEC R6.4). Returns LPVP_FIELD_BAD with err on a bad value. */
+static int get_display(const json_t *j, lpv_display *d, char *err, size_t n)
+{
+    lpv_display_default(d);
+    const json_t *e = json_object_get(j, "exposure");
+    if (e) {
+        char v[64];
+        if (json_is_string(e))
+            snprintf(v, sizeof v, "%s", json_string_value(e));
+        else if (json_is_number(e))
+            snprintf(v, sizeof v, "%.9g", json_number_value(e));
+        else
+            snprintf(v, sizeof v, "(not a string or number)");
+        if (lpv_exposure_parse(v, d, err, n) != 0)
+            return LPVP_FIELD_BAD;
+    }
+    return lpvp_get_bool(j, "transparent", 0, &d->transparent, err, n) == LPVP_FIELD_BAD ? LPVP_FIELD_BAD
+                                                                                         : LPVP_FIELD_OK;
+}
+
 static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
 {
     char err[512];
     int stream = 0, fmt = -1, comp = -1, delta = 0, terms = 0;
+    lpv_display display;
+    lpv_display_default(&display);
     if (lpvp_get_enum(j, "stream", 1, STREAMS, 2, &stream, err, sizeof err) != LPVP_FIELD_OK)
         goto bad;
     sv_sub *sub = &c->subs[stream];
@@ -1171,7 +1195,8 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
             LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_bool(j, "delta", 0, &delta, err, sizeof err) == LPVP_FIELD_BAD ||
-        (stream && lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD))
+        (stream && lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD) ||
+        (stream && get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD))
         goto bad;
     if (stream && delta) {
         snprintf(err, sizeof err, "delta: only the volume stream has deltas");
@@ -1187,6 +1212,7 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
         sub->fmt = fmt < 0 ? 1 : fmt; /* default png */
         sub->zstd = comp == 0;        /* default none (rgba8 only) */
         sub->terms = terms;
+        sub->display = display;
     }
     reply(c, LPVP_SUBSCRIBE, r->request_id, json_object());
     return;
@@ -1220,7 +1246,7 @@ static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 }
 
 static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w, int h, int fmt, int zstd, int terms,
-                             uint64_t tick)
+                             const lpv_display *display, uint64_t tick)
 {
     /* the plan of the tick shown, when it is still the world's latest */
     const lpv_plan *plan = c->world && c->world->latest && c->world->latest->tick == tick ? &c->world->latest->plan
@@ -1229,8 +1255,8 @@ static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w,
     json_t *b = NULL;
     uint8_t *att = NULL;
     size_t alen = 0;
-    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, c->revision, tick, plan, &b, &att, &alen, err, sizeof err) !=
-        0) {
+    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, display, c->revision, tick, plan, &b, &att, &alen, err,
+                        sizeof err) != 0) {
         reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
         return;
     }
@@ -1241,9 +1267,11 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int fmt = 1, comp = 1, terms = 0;
+    lpv_display display;
     if (lpvp_get_enum(j, "format", 0, FRAME_FMTS, 3, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD) {
+        lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD ||
+        get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) {
         reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
@@ -1255,7 +1283,7 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     const sv_result *res = c->world->latest;
     if (res->frames[terms]) { /* rendered with the tick already */
         send_frame_reply(c, r->request_id, res->frames[terms], res->width, res->height, fmt, comp == 0, terms,
-                         res->tick);
+                         &display, res->tick);
         return;
     }
     sv_job *jb = sv_job_new(SV_JOB_RENDER, c->world);
@@ -1265,6 +1293,7 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     }
     jb->request_id = r->request_id;
     jb->terms = terms;
+    jb->display = display;
     jb->count = (size_t)fmt | ((size_t)(comp == 0) << 4); /* encoding choice, read back in job_done */
     submit(c, jb);
 }
@@ -1383,7 +1412,7 @@ void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
         reply(c, LPVP_TICK, request_id, b);
     } else if (j->kind == SV_JOB_RENDER) {
         send_frame_reply(c, request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
-                         j->terms, j->tick);
+                         j->terms, &j->display, j->tick);
     } else if (j->kind == SV_JOB_QUERY) {
         uint8_t *att = malloc(j->count ? j->count * 12 : 1);
         if (!att) {
@@ -1423,7 +1452,8 @@ void sv_session_stream(sv_conn *c, sv_result *r)
         json_t *b = NULL;
         uint8_t *att = NULL;
         size_t alen = 0;
-        if (sv_encode_frame(r->frames[fs->terms], r->width, r->height, fs->fmt, fs->zstd, fs->terms, c->revision,
+        if (sv_encode_frame(r->frames[fs->terms], r->width, r->height, fs->fmt, fs->zstd, fs->terms, &fs->display,
+                            c->revision,
                             r->tick, &r->plan, &b, &att, &alen, err, sizeof err) == 0)
             sv_send(c, LPVP_FRAME, 0, b, att, alen, SV_STREAM_FRAME);
         else

@@ -32,7 +32,8 @@ static lpv_settings room_settings(void)
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 64;
     s.iterations = 4;
-    return s; /* cascades 0 = auto: 3, the room being 20 m */
+    s.cascade_size = 8.0f; /* explicit: 0.5, 1 and 2 m cells */
+    return s;              /* cascades 0 = auto: 3, the room (20 m) being larger than 8 m */
 }
 
 /* A 20 m x 20 m floor with 4 m walls and two point lights; optionally a box

@@ -419,6 +419,32 @@ static void test_frames(void **state)
     assert_memory_equal(f.data, "\x89PNG\r\n\x1a\n", 8);
     lpvc_frame_free(&f);
 
+    /* SPEC R6.4: a fixed EV and a transparent background are honoured and echoed; a bad exposure is refused */
+    lpvc_frame_desc fixed = {.format = "rgba8", .compression = "none", .exposure = "-3.5", .transparent = true};
+    OK(c, lpvc_get_frame(c, &fixed, &f));
+    json_t *hdr = json_loads(f.header_json, 0, NULL);
+    assert_non_null(hdr);
+    assert_true(json_real_value(json_object_get(hdr, "exposure_ev")) == -3.5);
+    assert_string_equal(json_string_value(json_object_get(hdr, "exposure")), "fixed");
+    assert_true(json_is_true(json_object_get(hdr, "transparent")));
+    json_decref(hdr);
+    size_t clear = 0;
+    for (size_t i = 0; i < f.size; i += 4)
+        clear += f.data[i + 3] == 0;
+    lpvc_frame_free(&f);
+    OK(c, lpvc_get_frame(c, &rgba, &f)); /* default: auto exposure, opaque */
+    hdr = json_loads(f.header_json, 0, NULL);
+    assert_non_null(hdr);
+    assert_string_equal(json_string_value(json_object_get(hdr, "exposure")), "auto");
+    json_decref(hdr);
+    for (size_t i = 0; i < f.size; i += 4)
+        assert_int_equal(f.data[i + 3], 255);
+    print_message("transparent frame: %zu of %zu pixels clear\n", clear, f.size / 4);
+    lpvc_frame_free(&f);
+    lpvc_frame_desc bad = {.format = "png", .exposure = "bright"};
+    assert_int_equal(lpvc_get_frame(c, &bad, &f), -1);
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+
     lpvc_frame_desc exr = {.format = "exr"};
     OK(c, lpvc_get_frame(c, &exr, &f));
     assert_true(f.size > 4);

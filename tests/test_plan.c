@@ -150,13 +150,33 @@ static void test_cascade_count(void **state)
     char why[LPV_PLAN_REASON_MAX];
     lpv_settings s = resolved((lpv_settings){0});
     lpv_plan_facts f = baseline();
-    /* fits: extent <= cascade_size (8 m by default; equality fits) */
-    f.scene_extent = 8.0f;
+    /* cascade_size auto (the default): one grid without a camera or with the camera outside the scene, whatever
+     * the scene's size (any unit scale); 3 with the camera inside it */
+    assert_true(s.cascade_size == 0.0f);
+    f.scene_extent = 743.0f;
     assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), 1);
-    assert_reason(why);
-    f.scene_extent = 8.01f;
+    assert_non_null(strstr(why, "no camera"));
+    f.has_view = 1;
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), 1);
+    assert_non_null(strstr(why, "outside"));
+    f.camera_inside = 1;
+    f.scene_shortest = 743.0f / 4.0f; /* a wide scene: longest >= 4 x shortest */
     assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
     assert_int_equal(LPV_DEFAULT_CASCADES, 3);
+    f.scene_shortest = 743.0f / 3.9f; /* a room-like one: one grid */
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), 1);
+    assert_non_null(strstr(why, "similar sides"));
+    f.scene_extent = 0.5f; /* the same in millimetres or in kilometres */
+    f.scene_shortest = 0.1f;
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_reason(why);
+    /* an explicit cascade_size: fits (extent <= cascade_size; equality fits) or not, camera anywhere */
+    lpv_settings eight = resolved((lpv_settings){.cascade_size = 8.0f});
+    f = baseline();
+    f.scene_extent = 8.0f;
+    assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), 1);
+    f.scene_extent = 8.01f;
+    assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
     /* the threshold follows cascade_size */
     lpv_settings small = resolved((lpv_settings){.cascade_size = 2.0f});
     f.scene_extent = 4.0f;
@@ -176,6 +196,8 @@ static void test_cascade_count(void **state)
     /* the plan carries the same count */
     f = baseline();
     f.scene_extent = 20.0f;
+    f.scene_shortest = 4.0f;
+    f.has_view = f.camera_inside = 1;
     assert_int_equal(plan_of((lpv_settings){0}, f).cascades, 3);
 }
 
@@ -311,23 +333,46 @@ static void test_place_snapping_and_nesting(void **state)
              * cell (plus float slack) of it */
             double extent = (double)g->cell_size * g->dims[i];
             double want = eye[i] + fwd[i] * 0.25 * extent;
+            /* kept over the scene: centred on it along an axis the cascade spans, else inside its bounds */
+            if (extent >= BMAX[i] - BMIN[i])
+                want = 0.5 * (BMIN[i] + BMAX[i]);
+            else
+                want = fmin(fmax(want, BMIN[i] + 0.5 * extent), BMAX[i] - 0.5 * extent);
             double centre = g->origin[i] + 0.5 * extent;
             assert_true(fabs(centre - want) <= g->cell_size * (1.0 + 1e-5));
             /* and without the snap formula being dropped: the lower corner is floor(want/cell) - dims/2 */
             assert_float_equal(oc, (float)(floor(want / g->cell_size) - g->dims[i] / 2), 0.0f);
         }
     }
-    /* the offset really moves the grid: forward -z puts cascade 2's centre 0.25 * 32 m = 8 m ahead */
+    /* the offset really moves the grid: forward -z puts cascade 0's centre 0.25 * 8 m = 2 m ahead (the coarser
+     * ones reach the scene's border and are kept over it) */
     lpv_cascade_set none;
     assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, NULL, &none), 0);
-    double dz = (set.grid[2].origin[2] - none.grid[2].origin[2]);
-    assert_true(fabs(dz - (-0.8 * 0.25 * 32.0)) <= set.grid[2].cell_size);
+    double dz = (set.grid[0].origin[2] - none.grid[0].origin[2]);
+    assert_true(fabs(dz - (-0.8 * 0.25 * 8.0)) <= set.grid[0].cell_size);
     /* no camera: centred on the scene's centre */
     lpv_cascade_set scene;
     assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, NULL, NULL, &scene), 0);
     for (int i = 0; i < 3; ++i) {
         double c = scene.grid[0].origin[i] + 0.5 * 8.0, want = 0.5 * (BMIN[i] + BMAX[i]);
         assert_true(fabs(c - want) <= 0.5 + 1e-6);
+    }
+    /* a camera far outside the scene, looking at it or away from it: every cascade lies over the scene (the
+     * whole of each cascade's extent inside the bounds along the axes it does not span), never beside it */
+    const float outside[3] = {100.0f, 1.5f, 40.0f}, at[3] = {-0.9285f, 0.0f, -0.3714f}, away[3] = {1, 0, 0};
+    const float *dirs[2] = {at, away};
+    for (int d = 0; d < 2; ++d) {
+        lpv_cascade_set o;
+        assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, outside, dirs[d], &o), 0);
+        for (int k = 0; k < 3; ++k)
+            for (int i = 0; i < 3; ++i) {
+                double lo = o.grid[k].origin[i], hi = lo + (double)o.grid[k].cell_size * o.grid[k].dims[i];
+                double cell = o.grid[k].cell_size;
+                if (hi - lo >= BMAX[i] - BMIN[i]) /* spans the axis: covers it, up to the snap */
+                    assert_true(lo <= BMIN[i] + cell && hi >= BMAX[i] - cell);
+                else
+                    assert_true(lo >= BMIN[i] - cell && hi <= BMAX[i] + cell);
+            }
     }
     /* one cascade: the classic grid over the bounds, not snapped */
     lpv_cascade_set one;

@@ -44,6 +44,8 @@
 
 #include "settings.h"
 
+/* glTF 2.0 models of Debian's assimp-testmodels (scripts/install-deps.sh) */
+#define ASSIMP_GLTF2_DIR "/usr/share/assimp/models/glTF2"
 #define MAX_POINTS 512
 #define MAX_SCENES 16
 #define MAX_TICKS 1000
@@ -144,7 +146,8 @@ typedef struct scene_entry {
     int have_mref, have_mse;
     int has_cam; /* a camera of its own (cornell-inside) */
     float eye[3], target[3], fov;
-    float cascade_size; /* m, for --features' "cascades-3" */
+    float cascade_size; /* m, for --features' "cascades-3" (0: auto) */
+    int scale_free;     /* a real scene in its own units (engine: millimetres) */
 } scene_entry;
 
 static void usage(FILE *f)
@@ -158,7 +161,10 @@ static void usage(FILE *f)
             "  --size WxH         image size (default 128x128)\n"
             "  --ref-spp N        reference samples per pixel (default 256)\n"
             "  --scenes LIST      comma list: cornell (built-in), courtyard, blinds (scenes/*.glb),\n"
-            "                     or paths to .glb/.gltf files (default cornell,courtyard,blinds)\n"
+            "                     engine, clearcoat (Debian's assimp-testmodels: 2CylinderEngine.glb,\n"
+            "                     a CAD model in mm under the default light; ClearCoatTest.gltf, spheres\n"
+            "                     lit by emissive labels), or paths to .glb/.gltf files\n"
+            "                     (default cornell,courtyard,blinds)\n"
             "  --quick            %d points instead of the 72-point factorial\n"
             "  --presets          exactly the named presets (fast, balanced, accurate) as the points\n"
             "  --features         one knob at a time around balanced: cascades 3, bounces on, damping\n"
@@ -1110,6 +1116,13 @@ add_features:
                 e->path = scene_paths[nscenes];
             } else if (strcmp(tok, "cornell") == 0) {
                 e->path = NULL;
+            } else if (strcmp(tok, "engine") == 0 || strcmp(tok, "clearcoat") == 0) {
+                /* real scenes the project did not write (scripts/install-deps.sh installs them) */
+                snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s/%s", ASSIMP_GLTF2_DIR,
+                         strcmp(tok, "engine") == 0 ? "2CylinderEngine-glTF-Binary/2CylinderEngine.glb"
+                                                    : "ClearCoat-glTF/ClearCoatTest.gltf");
+                e->path = scene_paths[nscenes];
+                e->scale_free = 1;
             } else if (strcmp(tok, "cornell-inside") == 0) {
                 /* the built-in box seen from inside its opening: the box's own
                  * camera stands 2.9 m in front of it, and camera-following
@@ -1125,7 +1138,8 @@ add_features:
                 e->path = scene_paths[nscenes];
             }
             /* "cascades-3" of --features: a finest cascade well inside the scene */
-            e->cascade_size = e->path == NULL ? 1.0f : strcmp(e->name, "blinds") == 0 ? 4.0f : 8.0f;
+            e->cascade_size = e->scale_free ? 0.0f /* auto: a quarter of the scene */
+                              : e->path == NULL ? 1.0f : strcmp(e->name, "blinds") == 0 ? 4.0f : 8.0f;
             ++nscenes;
         }
     }

@@ -995,6 +995,14 @@ int lpvc_get_frame(lpvc *c, const lpvc_frame_desc *desc, lpvc_frame *out)
         json_object_set_new(o, "compression", json_string(d.compression));
     if (d.terms)
         json_object_set_new(o, "terms", json_string(d.terms));
+    if (d.exposure) {
+        char *end = NULL;
+        double ev = strtod(d.exposure, &end);
+        json_object_set_new(o, "exposure",
+                            end != d.exposure && *end == '\0' ? json_real(ev) : json_string(d.exposure));
+    }
+    if (d.transparent)
+        json_object_set_new(o, "transparent", json_true());
     json_t *reply = NULL;
     uint8_t *att = NULL;
     size_t att_len = 0;

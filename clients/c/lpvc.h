@@ -221,6 +221,9 @@ typedef struct lpvc_frame_desc {
     const char *format;        /* "rgba8" | "png" | "exr"; NULL: server default */
     const char *compression;   /* rgba8 only: "zstd" | "none"; NULL: server default */
     const char *terms;         /* "full" | "indirect" | "direct"; NULL: server default */
+    const char *exposure;      /* rgba8/png: "auto" or an EV such as "-2.5" (sent as a number);
+                                  NULL: server default (auto). SPEC R6.4 */
+    bool transparent;          /* rgba8/png: background alpha 0 instead of the opaque grey */
 } lpvc_frame_desc;
 int lpvc_get_frame(lpvc *c, const lpvc_frame_desc *desc, lpvc_frame *out);
 

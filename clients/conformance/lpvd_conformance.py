@@ -1191,12 +1191,15 @@ def c_scene_attachment(ctx):
     check(sc.get("triangles") == 10, "triangles %r, expected 10" % sc.get("triangles"))
     check(sc.get("materials") == 3, "materials %r, expected 3" % sc.get("materials"))
     check(sc.get("lights") == 1, "lights %r, expected 1" % sc.get("lights"))
-    check(sc.get("cameras") == 0, "cameras %r, expected 0" % sc.get("cameras"))
+    # the glb has no camera: the server adds its default camera (docs/scenes.md, "Defaults")
+    check(sc.get("cameras") == 1, "cameras %r, expected 1 (the default camera)" % sc.get("cameras"))
+    check(sc.get("default_camera") is True, "default_camera %r, expected true" % sc.get("default_camera"))
+    check(sc.get("default_light") is False, "default_light %r, expected false" % sc.get("default_light"))
     b = sc.get("bounds")
     check(isinstance(b, list) and len(b) == 6, "bounds %r" % b)
     want = [-1, 0, -1, 1, 2, 1]
     check(all(abs(x - y) < 1e-4 for x, y in zip(b, want)), "bounds %r, expected %r" % (b, want))
-    return "10 triangles, 3 materials, 1 light"
+    return "10 triangles, 3 materials, 1 light, the default camera"
 
 
 @case("R4.4", "glb files that lie about their sizes get SCENE_INVALID; the session keeps its scene")
@@ -1356,7 +1359,7 @@ def c_config_preset_bad(ctx):
 # R4.11's knobs: key -> (kind, default, values to set, out-of-range values, wrong-type values).
 CONFIG_KNOBS = {
     "cascades": ("int", 0, (1, 4, 0), (5, -1), (1.5, "2", True)),
-    "cascade_size": ("num", 8, (12.5, 1e6), (0, -1, 2e6), ("8", False, [8])),
+    "cascade_size": ("num", 0, (12.5, 1e6, 0), (-1, 2e6), ("8", False, [8])),
     "cascade_ratio": ("num", 2, (1.25, 3, 8), (1.0, 9), ("2", None)),
     "cascade_offset": ("num", 0.25, (0.5, -0.5, 0.1), (0.6, -2), ("x", True)),
     "bounces": ("bool", False, (True, False), (), (1, "on", None)),

@@ -59,6 +59,7 @@ static const char *g_usage =
     "                                          + FILE.bin.json sidecar (with each cascade's placement);\n"
     "                                          .json: a summary; no -o: summary on stdout\n"
     "  frame -o OUT.png|OUT.exr|OUT.rgba [--terms full|indirect|direct] [--compression zstd|none]\n"
+    "        [--exposure auto|EV] [--transparent]\n"
     "  query --csv IN.csv -o OUT.csv           CSV px,py,pz,nx,ny,nz -> E_r,E_g,E_b (W/m^2)\n"
     "  query --point X,Y,Z --normal X,Y,Z      one point, printed\n"
     "  stats [--watch SECONDS] [--count N]     the reply, then the cascades and the last tick's plan\n"
@@ -695,12 +696,18 @@ static int cmd_frame(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "--transparent") == 0) {
+            d.transparent = true;
+            continue;
+        }
         if (!v)
             return usage_error("'%s' needs a value", a);
         if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0)
             out = v;
         else if (strcmp(a, "--terms") == 0)
             d.terms = v;
+        else if (strcmp(a, "--exposure") == 0)
+            d.exposure = v;
         else if (strcmp(a, "--compression") == 0)
             d.compression = v;
         else

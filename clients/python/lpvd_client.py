@@ -642,9 +642,15 @@ class Client(object):
         hdr, att = self.request(MSG["GET_VOLUME"], body)
         return self._decode_volume(hdr, att, ack=False)
 
-    def get_frame(self, format="rgba8", compression=None, terms="full"):
-        """GET_FRAME -> ``Frame`` (rgba8 pixels are decompressed)."""
+    def get_frame(self, format="rgba8", compression=None, terms="full", exposure=None, transparent=None):
+        """GET_FRAME -> ``Frame`` (rgba8 pixels are decompressed). exposure:
+        "auto" or an EV number (rgba8/png; None: the server's default, auto);
+        transparent: background alpha 0 (SPEC R6.4)."""
         body = {"format": format, "terms": terms}
+        if exposure is not None:
+            body["exposure"] = exposure
+        if transparent is not None:
+            body["transparent"] = bool(transparent)
         if format == "rgba8":
             body["compression"] = compression or _default_compression()
         elif compression is not None:
