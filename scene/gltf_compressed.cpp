@@ -77,33 +77,46 @@ std::string draco_decode(const unsigned char *data, size_t len, const std::map<s
     return "";
 }
 
-bool meshopt_placeholder_buffers(const char *json, size_t len, std::string *out)
+bool tinygltf_compat_json(const char *json, size_t len, std::string *out)
 {
     using Json = nlohmann::json;
     Json doc = Json::parse(json, json + len, nullptr, false);
     if (doc.is_discarded() || !doc.is_object())
         return false;
-    auto buffers = doc.find("buffers");
-    if (buffers == doc.end() || !buffers->is_array())
-        return false;
     bool changed = false;
-    for (Json &b : *buffers) {
-        if (!b.is_object() || b.contains("uri"))
-            continue;
-        auto e = b.find("extensions");
-        if (e == b.end() || !e->is_object())
-            continue;
-        auto mo = e->find("EXT_meshopt_compression");
-        if (mo == e->end() || !mo->is_object())
-            continue;
-        auto fb = mo->find("fallback");
-        if (fb == mo->end() || !fb->is_boolean() || !fb->get<bool>())
-            continue;
-        /* no data: a 4-byte placeholder, never read (only compressed views use it) */
-        b["uri"] = "data:application/octet-stream;base64,AAAAAA==";
-        b["byteLength"] = 4;
-        changed = true;
-    }
+    auto buffers = doc.find("buffers");
+    if (buffers != doc.end() && buffers->is_array())
+        for (Json &b : *buffers) {
+            if (!b.is_object() || b.contains("uri"))
+                continue;
+            auto e = b.find("extensions");
+            if (e == b.end() || !e->is_object())
+                continue;
+            auto mo = e->find("EXT_meshopt_compression");
+            if (mo == e->end() || !mo->is_object())
+                continue;
+            auto fb = mo->find("fallback");
+            if (fb == mo->end() || !fb->is_boolean() || !fb->get<bool>())
+                continue;
+            b["uri"] = "data:application/octet-stream;base64,AAAAAA==";
+            b["byteLength"] = 4;
+            changed = true;
+        }
+    auto meshes = doc.find("meshes");
+    if (meshes != doc.end() && meshes->is_array())
+        for (Json &m : *meshes) {
+            auto prims = m.is_object() ? m.find("primitives") : m.end();
+            if (!m.is_object() || prims == m.end() || !prims->is_array())
+                continue;
+            for (Json &p : *prims) {
+                auto e = p.is_object() ? p.find("extensions") : p.end();
+                if (!p.is_object() || e == p.end() || !e->is_object() || !e->contains("KHR_draco_mesh_compression") ||
+                    !p.contains("indices"))
+                    continue;
+                p.erase("indices");
+                changed = true;
+            }
+        }
     if (!changed)
         return false;
     *out = doc.dump();

@@ -33,12 +33,15 @@ struct DracoMesh {
 std::string draco_decode(const unsigned char *data, size_t len, const std::map<std::string, int> &ids,
                          const std::map<std::string, int> &components, size_t max_points, DracoMesh *out);
 
-/* EXT_meshopt_compression keeps the uncompressed data in a "fallback" buffer
- * that may have no data at all, which tinygltf refuses. When the JSON text
- * has such buffers, *out gets the text with each given a 4-byte placeholder
- * (a data: URI) and true is returned; false leaves *out untouched. Throws
- * nothing; a JSON problem returns false (the caller's parse reports it). */
-bool meshopt_placeholder_buffers(const char *json, size_t len, std::string *out);
+/* What tinygltf 2.7 (built without Draco) refuses in compressed files:
+ * EXT_meshopt_compression's "fallback" buffers without data, and the
+ * KHR_draco_mesh_compression primitives' "indices" accessors without a
+ * bufferView. When the JSON text has either, *out gets the text with each
+ * fallback buffer given a 4-byte placeholder (a data: URI, never read: the
+ * compressed views are decoded instead) and the Draco primitives' "indices"
+ * dropped (the bitstream holds them), and true is returned; false leaves *out
+ * untouched. A JSON problem returns false (the caller's parse reports it). */
+bool tinygltf_compat_json(const char *json, size_t len, std::string *out);
 
 /* Decodes bufferView bv's EXT_meshopt_compression (ATTRIBUTES, TRIANGLES or
  * INDICES, with the NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL filter) into

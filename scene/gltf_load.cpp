@@ -1824,14 +1824,16 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     loader.SetFsCallbacks(fs);
     loader.SetImageLoader(image_loader, &ctx);
 
-    /* EXT_meshopt_compression fallback buffers without data: a placeholder
-     * each, so that tinygltf accepts them (the views are decoded instead). */
+    /* Compressed files as tinygltf 2.7 accepts them (gltf_compressed.hpp):
+     * meshopt fallback buffers get placeholders, Draco primitives lose their
+     * data-less "indices"; the compressed data is decoded instead. */
     const char *const json_text = reinterpret_cast<const char *>(data) + json_off; /* the file's own JSON */
     std::vector<unsigned char> rewritten;
-    static const char meshopt_key[] = "EXT_meshopt_compression";
+    static const char meshopt_key[] = "EXT_meshopt_compression", draco_key[] = "KHR_draco_mesh_compression";
     std::string json2;
-    if (memmem(data + json_off, json_len, meshopt_key, sizeof meshopt_key - 1) &&
-        lpv_gltf::meshopt_placeholder_buffers(reinterpret_cast<const char *>(data) + json_off, json_len, &json2)) {
+    if ((memmem(json_text, json_len, meshopt_key, sizeof meshopt_key - 1) ||
+         memmem(json_text, json_len, draco_key, sizeof draco_key - 1)) &&
+        lpv_gltf::tinygltf_compat_json(json_text, json_len, &json2)) {
         if (is_glb) {
             size_t jpad = (json2.size() + 3) & ~size_t(3);
             size_t rest = size - (json_off + json_len); /* the BIN chunk, if any */
