@@ -49,6 +49,20 @@ struct Uses {
     }
 };
 
+/* A name from the file, printable and at most 64 bytes, for a message. */
+std::string clean(const std::string &name)
+{
+    std::string out;
+    for (unsigned char c : name) {
+        if (out.size() >= 64) {
+            out += "...";
+            break;
+        }
+        out += (c < 0x20 || c == 0x7f) ? '?' : char(c);
+    }
+    return out;
+}
+
 void note_extensions(std::map<std::string, Uses> &ext, const tinygltf::ExtensionMap &e, const char *kind, int index)
 {
     for (const auto &kv : e)
@@ -120,7 +134,7 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene)
         if (extension_supported(kv.first))
             continue;
         std::string where = kv.second.total ? " (" + kv.second.describe() + ")" : " (listed in extensionsUsed)";
-        out.push_back("extension " + kv.first + where + ": " + what_instead(kv.first));
+        out.push_back("extension " + clean(kv.first) + where + ": " + what_instead(kv.first));
     }
 
     /* Materials lpvd approximates or reads only in part. */
@@ -184,13 +198,13 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene)
                     continue;
                 if (n.compare(0, 9, "TEXCOORD_") == 0)
                     continue; /* reported with the textures that ask for them */
-                std::string key = n;
+                std::string key;
                 if (n.compare(0, 6, "COLOR_") == 0)
-                    key = "vertex colours (" + n + ")";
+                    key = "vertex colours (" + clean(n) + ")";
                 else if (n.compare(0, 7, "JOINTS_") == 0 || n.compare(0, 8, "WEIGHTS_") == 0)
-                    key = "skinning attributes (" + n + ")";
+                    key = "skinning attributes (" + clean(n) + ")";
                 else
-                    key = "vertex attribute " + n;
+                    key = "vertex attribute " + clean(n);
                 attrs[key].add("mesh", int(i));
             }
             if (!p.targets.empty())
