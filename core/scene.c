@@ -50,6 +50,36 @@ void lpv_scene_compute_bounds(lpv_scene *scene)
     }
 }
 
+float lpv_material_alpha_cutoff(const lpv_material *m)
+{
+    switch (m->alpha_mode) {
+    case LPV_ALPHA_MASK:
+        return m->alpha_cutoff > 0.0f ? m->alpha_cutoff : 0.0f; /* NaN: nothing is cut */
+    case LPV_ALPHA_BLEND:
+        return LPV_ALPHA_BLEND_THRESHOLD;
+    default:
+        return 0.0f;
+    }
+}
+
+void lpv_uv_transform_matrix(const lpv_uv_transform *t, float m[6])
+{
+    if (!t->has_transform) {
+        m[0] = 1.0f, m[1] = 0.0f, m[2] = 0.0f;
+        m[3] = 0.0f, m[4] = 1.0f, m[5] = 0.0f;
+        return;
+    }
+    /* KHR_texture_transform: T(offset) * R(rotation) * S(scale), with
+     * R = [cos sin; -sin cos] acting on column vectors (u, v). */
+    const float c = cosf(t->rotation), s = sinf(t->rotation);
+    m[0] = c * t->scale[0];
+    m[1] = s * t->scale[1];
+    m[2] = t->offset[0];
+    m[3] = -s * t->scale[0];
+    m[4] = c * t->scale[1];
+    m[5] = t->offset[1];
+}
+
 static int material_emits(const lpv_material *m)
 {
     /* NaN compares false, so a NaN emission does not count as a light. */

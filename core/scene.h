@@ -49,8 +49,28 @@ typedef struct lpv_camera {
 
 typedef struct lpv_texture {
     int width, height;
-    uint8_t *rgba8; /* width*height*4 bytes, sRGB-encoded base colour */
+    uint8_t *rgba8; /* width*height*4 bytes: sRGB-encoded colour, or linear data when `linear` */
+    int linear;     /* 0: sRGB colour (base colour); 1: linear data (normal map) */
 } lpv_texture;
+
+/* Alpha modes of glTF materials (docs/scenes.md, "Alpha"). */
+typedef enum lpv_alpha_mode {
+    LPV_ALPHA_OPAQUE = 0, /* alpha ignored */
+    LPV_ALPHA_MASK = 1,   /* cut away where alpha < alpha_cutoff */
+    LPV_ALPHA_BLEND = 2,  /* approximated: cut away where alpha < LPV_ALPHA_BLEND_THRESHOLD */
+} lpv_alpha_mode;
+#define LPV_ALPHA_BLEND_THRESHOLD 0.5f
+
+/* Which uv set a texture reads and its KHR_texture_transform:
+ * uv' = T(offset) R(rotation) S(scale) uv, with R(a) = [cos a, sin a; -sin a, cos a]
+ * as the extension defines it. All zero = TEXCOORD_0 untransformed. */
+typedef struct lpv_uv_transform {
+    int texcoord;      /* 0 = TEXCOORD_0, 1 = TEXCOORD_1 */
+    int has_transform; /* 0: offset, rotation and scale are ignored (identity) */
+    float offset[2];
+    float rotation; /* rad */
+    float scale[2];
+} lpv_uv_transform;
 
 typedef struct lpv_material {
     char name[LPV_NAME_MAX];
@@ -59,13 +79,21 @@ typedef struct lpv_material {
     float emission[3];      /* radiance, W/(m^2 sr) (factor x strength / 683) */
     float metallic;
     float roughness;
-    int double_sided;
+    int double_sided;       /* 0: the camera culls back faces (light views never do; docs/scenes.md) */
+    int alpha_mode;         /* lpv_alpha_mode */
+    float alpha_cutoff;     /* MASK only: alpha below it is cut away (glTF default 0.5) */
+    lpv_uv_transform base_color_uv;
+    int normal_texture;     /* index into textures, -1 = none; must be a linear texture to be used */
+    float normal_scale;     /* glTF normalTexture.scale: tangent-space x, y multiplied by it */
+    lpv_uv_transform normal_uv;
 } lpv_material;
 
 typedef struct lpv_vertex {
     float position[3]; /* world, m */
     float normal[3];   /* world, unit (zero if the file had a degenerate one) */
-    float uv[2];
+    float uv[2];       /* TEXCOORD_0 */
+    float uv1[2];      /* TEXCOORD_1 (zero when absent) */
+    float tangent[4];  /* world xyz unit and handedness w = +-1 (the file's TANGENT); all zero = none */
 } lpv_vertex;
 
 /* A run of triangles (3 indices each) sharing one material. */
@@ -121,6 +149,14 @@ void lpv_scene_free(lpv_scene *scene);
 
 /* Recomputes bounds_min/max from the vertices. */
 void lpv_scene_compute_bounds(lpv_scene *scene);
+
+/* The alpha below which a material's surface is cut away (alpha_mode, the
+ * cutoff, LPV_ALPHA_BLEND_THRESHOLD for BLEND); 0 (nothing is cut) for OPAQUE. */
+float lpv_material_alpha_cutoff(const lpv_material *m);
+
+/* A texture's uv transform as the 2x3 matrix (rows) applied to (u, v, 1):
+ * u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]. */
+void lpv_uv_transform_matrix(const lpv_uv_transform *t, float m[6]);
 
 /* Number of materials with non-zero emission that some draw uses. */
 uint32_t lpv_scene_emissive_draw_count(const lpv_scene *scene);

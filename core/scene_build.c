@@ -30,6 +30,8 @@ int lpv_scene_add_material(lpv_scene *s, const char *name, const float albedo[3]
     memcpy(m->base_color, albedo, 3 * sizeof(float));
     m->base_color[3] = 1.0f;
     m->base_color_texture = -1;
+    m->normal_texture = -1;
+    m->double_sided = 1; /* code-built surfaces have always been two-sided */
     if (emission)
         memcpy(m->emission, emission, sizeof m->emission);
     m->roughness = 1.0f;

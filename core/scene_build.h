@@ -15,7 +15,8 @@
 
 #include "scene.h"
 
-/* A diffuse material (metallic 0, roughness 1, single-sided) with linear
+/* A diffuse material (metallic 0, roughness 1, double-sided, opaque, no
+ * normal map) with linear
  * albedo rgb and emitted radiance emission (W/(m^2 sr), NULL = none).
  * Returns its index, or -1. */
 int lpv_scene_add_material(lpv_scene *s, const char *name, const float albedo[3], const float emission[3]);

@@ -147,6 +147,7 @@ int lpv_scene_builtin_cornell(lpv_scene *scene)
         m->base_color[2] = obj->kd[2];
         m->base_color[3] = 1.0f;
         m->base_color_texture = -1;
+        m->normal_texture = -1;
         memcpy(m->emission, obj->emission, sizeof m->emission);
         m->metallic = 0.0f;
         m->roughness = 0.9f;

@@ -370,12 +370,13 @@ static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, siz
         const lpv_texture *t = &scene->textures[i];
         glBindTexture(GL_TEXTURE_2D, e->textures[i]);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        /* colour is sRGB-encoded (GL decodes it); normal maps are linear data */
+        const GLint format = t->linear ? GL_RGBA8 : GL_SRGB8_ALPHA8;
         if (t->rgba8 && t->width > 0 && t->height > 0)
-            glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                         t->rgba8);
+            glTexImage2D(GL_TEXTURE_2D, 0, format, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE, t->rgba8);
         else {
             const uint8_t white[4] = {255, 255, 255, 255};
-            glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, white);
+            glTexImage2D(GL_TEXTURE_2D, 0, format, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, white);
         }
         glGenerateMipmap(GL_TEXTURE_2D);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
@@ -469,6 +470,18 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         g->texture = (m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < scene->texture_count)
                          ? m->base_color_texture
                          : -1;
+        g->alpha_cutoff = lpv_material_alpha_cutoff(m);
+        g->double_sided = m->double_sided;
+        g->base_uv_set = m->base_color_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->base_color_uv, g->base_uv);
+        /* a normal map must be linear data (a memset material's 0 is not one) */
+        g->normal_texture = (m->normal_texture >= 0 && (uint32_t)m->normal_texture < scene->texture_count &&
+                             scene->textures[m->normal_texture].linear)
+                                ? m->normal_texture
+                                : -1;
+        g->normal_scale = m->normal_scale;
+        g->normal_uv_set = m->normal_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->normal_uv, g->normal_uv);
     }
     e->material_count = scene->material_count;
     if (upload_textures(e, scene, err, err_size) != 0)
@@ -490,6 +503,10 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, normal));
     glEnableVertexAttribArray(2);
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, uv));
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, uv1));
+    glEnableVertexAttribArray(4);
+    glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, tangent));
     glBindVertexArray(0);
 
     e->light_count = 0;
@@ -543,7 +560,7 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
     return 0;
 }
 
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog)
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
 {
     GLint loc_color = glGetUniformLocation(prog, "u_base_color");
     GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
@@ -551,10 +568,23 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog)
     GLint loc_roughness = glGetUniformLocation(prog, "u_roughness");
     GLint loc_metallic = glGetUniformLocation(prog, "u_metallic");
     GLint loc_size = glGetUniformLocation(prog, "u_object_size");
+    GLint loc_cutoff = glGetUniformLocation(prog, "u_alpha_cutoff");
+    GLint loc_base_set = glGetUniformLocation(prog, "u_base_uv_set");
+    GLint loc_base_row0 = glGetUniformLocation(prog, "u_base_uv_row0");
+    GLint loc_base_row1 = glGetUniformLocation(prog, "u_base_uv_row1");
+    GLint loc_has_normal = glGetUniformLocation(prog, "u_has_normal_texture");
+    GLint loc_normal_scale = glGetUniformLocation(prog, "u_normal_scale");
+    GLint loc_normal_set = glGetUniformLocation(prog, "u_normal_uv_set");
+    GLint loc_normal_row0 = glGetUniformLocation(prog, "u_normal_uv_row0");
+    GLint loc_normal_row1 = glGetUniformLocation(prog, "u_normal_uv_row1");
     glBindVertexArray(e->vao);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW); /* glTF's front faces; the loader rewinds mirrored nodes */
     for (uint32_t i = 0; i < e->draw_count; ++i) {
         const lpv_gpu_draw *d = &e->draws[i];
-        static const lpv_gpu_material fallback = {{1, 1, 1, 1}, {0, 0, 0}, 1.0f, 0.0f, -1};
+        static const lpv_gpu_material fallback = {
+            .base_color = {1, 1, 1, 1}, .roughness = 1.0f, .texture = -1, .double_sided = 1,
+            .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0}};
         const lpv_gpu_material *m =
             (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
         glUniform4fv(loc_color, 1, m->base_color);
@@ -562,14 +592,31 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog)
         glUniform1f(loc_roughness, m->roughness);
         glUniform1f(loc_metallic, m->metallic);
         glUniform1f(loc_size, d->size);
+        glUniform1f(loc_cutoff, m->alpha_cutoff);
         glUniform1i(loc_has_tex, m->texture >= 0);
+        glUniform1i(loc_base_set, m->base_uv_set);
+        glUniform3fv(loc_base_row0, 1, &m->base_uv[0]);
+        glUniform3fv(loc_base_row1, 1, &m->base_uv[3]);
+        glUniform1i(loc_has_normal, m->normal_texture >= 0);
+        glUniform1f(loc_normal_scale, m->normal_scale);
+        glUniform1i(loc_normal_set, m->normal_uv_set);
+        glUniform3fv(loc_normal_row0, 1, &m->normal_uv[0]);
+        glUniform3fv(loc_normal_row1, 1, &m->normal_uv[3]);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m->texture >= 0 ? e->textures[m->texture] : 0);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, m->normal_texture >= 0 ? e->textures[m->normal_texture] : 0);
+        glActiveTexture(GL_TEXTURE0);
+        if (cull_single_sided && !m->double_sided)
+            glEnable(GL_CULL_FACE);
+        else
+            glDisable(GL_CULL_FACE);
         if (d->index_count)
             glDrawElements(GL_TRIANGLES, (GLsizei)d->index_count, GL_UNSIGNED_INT,
                            (void *)(uintptr_t)(d->first_index * sizeof(uint32_t)));
         lpv_timer_count(&e->timer, 1);
     }
+    glDisable(GL_CULL_FACE);
     glBindVertexArray(0);
 }
 

@@ -17,6 +17,14 @@ typedef struct lpv_gpu_material {
     float emission[3];
     float roughness, metallic;
     int texture; /* index into lpv_engine.textures, -1 none */
+    float alpha_cutoff;   /* lpv_material_alpha_cutoff: 0 = opaque */
+    int double_sided;     /* 0: the camera culls back faces */
+    int base_uv_set;      /* 0 TEXCOORD_0, 1 TEXCOORD_1 */
+    float base_uv[6];     /* lpv_uv_transform_matrix rows */
+    int normal_texture;   /* index into lpv_engine.textures (linear), -1 none */
+    float normal_scale;
+    int normal_uv_set;
+    float normal_uv[6];
 } lpv_gpu_material;
 
 typedef struct lpv_gpu_draw {
@@ -115,7 +123,10 @@ GLuint lpv_engine_program(const char *vert_or_comp, const char *geom, const char
                           char *err, size_t err_size);
 
 /* Draws every scene draw with the bound program (material uniforms set). */
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog);
+/* Draws every draw with its material's uniforms and textures. cull_single_sided:
+ * back faces of materials that are not double-sided are culled (the camera's
+ * view, as glTF says; light views pass 0 and see both sides). */
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided);
 
 /* Cells of one cascade, and of all cascades in use. */
 static inline size_t lpv_engine_cascade_cells(const lpv_engine *e) { return lpv_grid_cell_count(&e->grid); }

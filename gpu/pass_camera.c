@@ -126,7 +126,7 @@ void lpv_pass_gbuffer_run(lpv_engine *e)
     float pixel = 2.0f * e->view_block.forward[3] / (float)v->height; /* tan-plane or metres per pixel */
     glUniform1f(glGetUniformLocation(p, "u_pixel_solid_angle"), v->orthographic ? 0.0f : pixel * pixel);
     glUniform1f(glGetUniformLocation(p, "u_pixel_area"), v->orthographic ? pixel * pixel : 0.0f);
-    lpv_engine_draw_scene(e, p);
+    lpv_engine_draw_scene(e, p, 1);
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 

@@ -96,7 +96,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
         glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
         glUniform1i(loc_face, f);
-        lpv_engine_draw_scene(e, e->prog_rsm);
+        lpv_engine_draw_scene(e, e->prog_rsm, 0); /* lights see both sides */
     }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -27,6 +27,9 @@ extern "C" {
 #include "scene.h"
 }
 #include "gltf_load.h"
+#include "gltf_compressed.hpp"
+#include "gltf_features.hpp"
+#include "gltf_material.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -58,7 +61,7 @@ constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 29;       /* 2 GiB of RGBA8 
 constexpr uint64_t kMaxFileBytes = uint64_t(1) << 30;         /* main file and each external file */
 constexpr int kMaxJsonDepth = 256;
 constexpr int kMaxNodeDepth = 64;
-constexpr size_t kMaxWarnings = 16;
+constexpr size_t kMaxWarnings = LPV_GLTF_WARNINGS_MAX;
 
 /* ---- errors ---------------------------------------------------------------- */
 struct Failure {
@@ -148,14 +151,20 @@ struct Ctx {
     std::string image_error;     /* fatal image problem (size cap, bad range) */
     const tinygltf::Model *model = nullptr;
     uint64_t texels = 0;
-    std::vector<std::string> warnings;
+    std::vector<std::string> warnings; /* each line once */
+    size_t warnings_dropped = 0;       /* past kMaxWarnings */
     const lpv_gltf_node_override *overrides = nullptr; /* lpv_gltf_load_memory_ex */
     size_t override_count = 0;
+    lpv_gltf_warnings *sink = nullptr; /* NULL: warnings go to stderr */
 
     void warn(const std::string &w)
     {
+        if (std::find(warnings.begin(), warnings.end(), w) != warnings.end())
+            return;
         if (warnings.size() < kMaxWarnings)
             warnings.push_back(w);
+        else
+            warnings_dropped++;
     }
 };
 
@@ -788,8 +797,10 @@ class Builder {
     const tinygltf::Model &m_;
     Ctx &ctx_;
     int default_material_ = -1;
-    std::map<int, int> image_texture_; /* glTF image -> index in textures (-1: unusable) */
+    std::map<std::pair<int, int>, int> image_texture_; /* (glTF image, linear) -> index in textures (-1: unusable) */
     std::vector<unsigned char> visited_;
+    std::map<int, std::vector<unsigned char>> meshopt_; /* bufferView -> its EXT_meshopt_compression data */
+    std::vector<unsigned char> material_uv1_;            /* material index -> some texture reads TEXCOORD_1 */
 
     /* A validated byte range of a buffer view. */
     struct View {
@@ -804,7 +815,9 @@ class Builder {
     void check_buffer_views();
     void check_node_graph();
     void convert_materials();
-    int texture_for(int material_index, const tinygltf::TextureInfo &info);
+    int texture_for(int material_index, const char *what, int index, bool linear);
+    void texture_uv(int material_index, const char *what, int tex_coord, const tinygltf::ExtensionMap &ext,
+                    lpv_uv_transform *out);
     void visit(int node, const Mat4 &parent, int depth);
     void add_mesh(int mesh, const Mat4 &world);
     void add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world);
@@ -835,6 +848,19 @@ Builder::View Builder::view(int bv_index, const char *what, int owner)
     const tinygltf::BufferView &bv = m_.bufferViews[size_t(bv_index)];
     if (bv.buffer < 0 || size_t(bv.buffer) >= m_.buffers.size())
         fail("bufferView %d refers to buffer %d, which does not exist (out of range)", bv_index, bv.buffer);
+    if (bv.extensions.count("EXT_meshopt_compression")) {
+        /* decoded once; the view's own range is the (maybe empty) fallback */
+        auto it = meshopt_.find(bv_index);
+        if (it == meshopt_.end()) {
+            std::vector<unsigned char> data;
+            size_t stride = 0;
+            std::string e = lpv_gltf::meshopt_decode(m_, bv_index, size_t(kMaxFileBytes), &data, &stride);
+            if (!e.empty())
+                fail("%s", e.c_str());
+            it = meshopt_.emplace(bv_index, std::move(data)).first;
+        }
+        return View{it->second.data(), it->second.size(), bv.byteStride};
+    }
     const tinygltf::Buffer &b = m_.buffers[size_t(bv.buffer)];
     size_t have = b.data.size();
     if (bv.byteOffset > have || bv.byteLength > have - bv.byteOffset)
@@ -1012,32 +1038,36 @@ int Builder::default_material()
         copy_name(mat.name, "default", "default");
         mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = mat.base_color[3] = 1.0f;
         mat.base_color_texture = -1;
+        mat.normal_texture = -1;
         mat.metallic = 0.0f;
         mat.roughness = 1.0f;
         mat.double_sided = 0;
+        mat.alpha_cutoff = 0.5f;
+        mat.base_color_uv.scale[0] = mat.base_color_uv.scale[1] = 1.0f;
+        mat.normal_uv.scale[0] = mat.normal_uv.scale[1] = 1.0f;
         materials.push_back(mat);
         default_material_ = int(materials.size() - 1);
     }
     return default_material_;
 }
 
-int Builder::texture_for(int material_index, const tinygltf::TextureInfo &info)
+/* The scene texture of glTF texture `index` for a material's `what` (a
+ * message's words): decoded pixels, sRGB colour or linear data (normal maps);
+ * -1 when the texture has no usable image (a warning). */
+int Builder::texture_for(int material_index, const char *what, int index, bool linear)
 {
-    if (info.index < 0)
+    if (index < 0)
         return -1;
-    if (size_t(info.index) >= m_.textures.size())
-        fail("material %d: baseColorTexture %d does not exist (out of range)", material_index, info.index);
-    if (info.texCoord != 0)
-        ctx_.warn(strf("material %d: base colour texture uses TEXCOORD_%d; lpvd reads TEXCOORD_0", material_index,
-                         info.texCoord));
-    int src = m_.textures[size_t(info.index)].source;
+    if (size_t(index) >= m_.textures.size())
+        fail("material %d: %s %d does not exist (out of range)", material_index, what, index);
+    int src = m_.textures[size_t(index)].source;
     if (src < 0) {
-        ctx_.warn(strf("texture %d has no source image (extension-only?); ignored", info.index));
+        ctx_.warn(strf("texture %d has no source image (extension-only?); ignored", index));
         return -1;
     }
     if (size_t(src) >= m_.images.size())
-        fail("texture %d: source image %d does not exist (out of range)", info.index, src);
-    auto it = image_texture_.find(src);
+        fail("texture %d: source image %d does not exist (out of range)", index, src);
+    auto it = image_texture_.find({src, linear ? 1 : 0});
     if (it != image_texture_.end())
         return it->second;
     const tinygltf::Image &img = m_.images[size_t(src)];
@@ -1046,8 +1076,10 @@ int Builder::texture_for(int material_index, const tinygltf::TextureInfo &info)
         img.width <= kMaxTextureSize && img.height <= kMaxTextureSize &&
         img.image.size() == size_t(img.width) * size_t(img.height) * 4) {
         lpv_texture t;
+        memset(&t, 0, sizeof t);
         t.width = img.width;
         t.height = img.height;
+        t.linear = linear ? 1 : 0;
         t.rgba8 = static_cast<uint8_t *>(malloc(img.image.size()));
         if (!t.rgba8)
             throw std::bad_alloc();
@@ -1062,8 +1094,23 @@ int Builder::texture_for(int material_index, const tinygltf::TextureInfo &info)
     } else {
         ctx_.warn(strf("image %d has no decoded RGBA8 pixels; texture ignored", src));
     }
-    image_texture_[src] = result;
+    image_texture_[{src, linear ? 1 : 0}] = result;
     return result;
+}
+
+/* A texture reference's uv set and KHR_texture_transform into out. */
+void Builder::texture_uv(int material_index, const char *what, int tex_coord, const tinygltf::ExtensionMap &ext,
+                         lpv_uv_transform *out)
+{
+    std::string e = lpv_gltf::read_uv_transform(tex_coord, ext, out);
+    if (!e.empty())
+        fail("material %d: %s: %s", material_index, what, e.c_str());
+    if (out->texcoord > 1)
+        out->texcoord = 0; /* reported once among the unused features */
+    if (out->texcoord == 1) {
+        material_uv1_.resize(m_.materials.size(), 0);
+        material_uv1_[size_t(material_index)] = 1;
+    }
 }
 
 void Builder::convert_materials()
@@ -1079,7 +1126,18 @@ void Builder::convert_materials()
             fail("material %d: baseColorFactor must hold 4 finite numbers", mi);
         for (int k = 0; k < 4; k++)
             mat.base_color[k] = float(pbr.baseColorFactor[size_t(k)]);
-        mat.base_color_texture = texture_for(mi, pbr.baseColorTexture);
+        mat.base_color_texture = texture_for(mi, "baseColorTexture", pbr.baseColorTexture.index, false);
+        texture_uv(mi, "baseColorTexture", pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
+                   &mat.base_color_uv);
+        const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
+        mat.normal_texture = texture_for(mi, "normalTexture", nt.index, true);
+        texture_uv(mi, "normalTexture", nt.texCoord, nt.extensions, &mat.normal_uv);
+        if (!std::isfinite(nt.scale))
+            fail("material %d: normalTexture.scale must be a finite number", mi);
+        mat.normal_scale = float(nt.scale);
+        std::string alpha = lpv_gltf::read_alpha(gm, &mat);
+        if (!alpha.empty())
+            fail("material %d: %s", mi, alpha.c_str());
         if (gm.emissiveFactor.size() != 3 || !finite_all(gm.emissiveFactor))
             fail("material %d: emissiveFactor must hold 3 finite numbers", mi);
         double strength = 1.0;
@@ -1116,34 +1174,82 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         ctx_.warn(strf("mesh %d primitive %d has no POSITION; skipped", mesh, prim));
         return;
     }
+    /* KHR_draco_mesh_compression: the attributes and indices come from the
+     * Draco bitstream instead of the accessors (which hold no data). */
+    lpv_gltf::DracoMesh draco;
+    bool is_draco = false;
+    auto dext = p.extensions.find("KHR_draco_mesh_compression");
+    if (dext != p.extensions.end()) {
+        const tinygltf::Value &d = dext->second;
+        const tinygltf::Value none;
+        const tinygltf::Value &bvv = d.IsObject() && d.Has("bufferView") ? d.Get("bufferView") : none;
+        const tinygltf::Value &attrs = d.IsObject() && d.Has("attributes") ? d.Get("attributes") : none;
+        if (!bvv.IsNumber() || !attrs.IsObject())
+            fail("mesh %d primitive %d: KHR_draco_mesh_compression needs a bufferView and attributes", mesh, prim);
+        std::map<std::string, int> ids, comps = {{"POSITION", 3}, {"NORMAL", 3}, {"TEXCOORD_0", 2},
+                                                 {"TEXCOORD_1", 2}, {"TANGENT", 4}};
+        for (const std::string &k : attrs.Keys()) {
+            const tinygltf::Value &id = attrs.Get(k);
+            double v = id.IsNumber() ? id.GetNumberAsDouble() : -1.0;
+            if (!(v >= 0.0 && v <= double(INT_MAX)) || v != std::floor(v))
+                fail("mesh %d primitive %d: KHR_draco_mesh_compression.attributes.%s must be an integer >= 0", mesh,
+                     prim, show(k).c_str());
+            ids[k] = int(v);
+        }
+        if (!ids.count("POSITION"))
+            fail("mesh %d primitive %d: KHR_draco_mesh_compression has no POSITION attribute", mesh, prim);
+        double bvd = bvv.GetNumberAsDouble();
+        if (!(bvd >= 0.0 && bvd < double(m_.bufferViews.size())) || bvd != std::floor(bvd))
+            fail("mesh %d primitive %d: KHR_draco_mesh_compression bufferView %g does not exist (out of range)", mesh,
+                 prim, bvd);
+        View dv = view(int(bvd), "KHR_draco_mesh_compression of mesh", mesh);
+        std::string e = lpv_gltf::draco_decode(dv.data, dv.length, ids, comps, size_t(kMaxAccessorCount), &draco);
+        if (!e.empty())
+            fail("mesh %d primitive %d: %s", mesh, prim, e.c_str());
+        is_draco = true;
+    }
+    /* One vertex attribute: from the Draco data, else its accessor. */
     char what[96];
-    snprintf(what, sizeof what, "mesh %d primitive %d POSITION", mesh, prim);
+    auto attribute = [&](const char *name, int ncomp, std::vector<float> &out) -> bool {
+        auto it = p.attributes.find(name);
+        if (is_draco) {
+            auto d = draco.attributes.find(name);
+            if (d != draco.attributes.end()) {
+                out = d->second;
+                return true;
+            }
+        }
+        if (it == p.attributes.end())
+            return false;
+        snprintf(what, sizeof what, "mesh %d primitive %d %s", mesh, prim, name);
+        if (is_draco && m_.accessors.size() > size_t(it->second) && m_.accessors[size_t(it->second)].bufferView < 0 &&
+            !m_.accessors[size_t(it->second)].sparse.isSparse)
+            return false; /* listed, but neither compressed nor stored: no data */
+        read_accessor(it->second, ncomp, what, out);
+        return true;
+    };
     std::vector<float> pos;
-    read_accessor(pos_it->second, 3, what, pos);
+    attribute("POSITION", 3, pos);
     const size_t nv = pos.size() / 3;
     for (size_t i = 0; i < pos.size(); i++)
         if (!std::isfinite(pos[i]))
             fail("mesh %d primitive %d: POSITION of vertex %zu is not finite (NaN or Inf)", mesh, prim, i / 3);
 
-    std::vector<float> nrm, uv;
-    auto nrm_it = p.attributes.find("NORMAL");
-    if (nrm_it != p.attributes.end()) {
-        snprintf(what, sizeof what, "mesh %d primitive %d NORMAL", mesh, prim);
-        read_accessor(nrm_it->second, 3, what, nrm);
-        if (nrm.size() / 3 != nv)
-            fail("mesh %d primitive %d: NORMAL has %zu elements but POSITION has %zu", mesh, prim, nrm.size() / 3, nv);
-    }
-    auto uv_it = p.attributes.find("TEXCOORD_0");
-    if (uv_it != p.attributes.end()) {
-        snprintf(what, sizeof what, "mesh %d primitive %d TEXCOORD_0", mesh, prim);
-        read_accessor(uv_it->second, 2, what, uv);
-        if (uv.size() / 2 != nv)
-            fail("mesh %d primitive %d: TEXCOORD_0 has %zu elements but POSITION has %zu", mesh, prim, uv.size() / 2,
-                 nv);
-    }
+    std::vector<float> nrm, uv, uv1, tan;
+    struct {
+        const char *name;
+        int ncomp;
+        std::vector<float> *out;
+    } extra[] = {{"NORMAL", 3, &nrm}, {"TEXCOORD_0", 2, &uv}, {"TEXCOORD_1", 2, &uv1}, {"TANGENT", 4, &tan}};
+    for (const auto &a : extra)
+        if (attribute(a.name, a.ncomp, *a.out) && a.out->size() / size_t(a.ncomp) != nv)
+            fail("mesh %d primitive %d: %s has %zu elements but POSITION has %zu", mesh, prim, a.name,
+                 a.out->size() / size_t(a.ncomp), nv);
 
     std::vector<uint32_t> idx;
-    if (p.indices >= 0) {
+    if (is_draco) {
+        idx = draco.indices;
+    } else if (p.indices >= 0) {
         read_indices(p.indices, idx);
     } else {
         idx.resize(nv);
@@ -1186,6 +1292,10 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         material = default_material();
     }
 
+    if (uv1.empty() && size_t(material) < material_uv1_.size() && material_uv1_[size_t(material)])
+        ctx_.warn(strf("material %d reads TEXCOORD_1, which mesh %d primitive %d lacks; (0, 0) is used there",
+                       material, mesh, prim));
+
     const bool flip = det3(world) < 0.0;
     double nm[9];
     normal_matrix(world, nm);
@@ -1202,6 +1312,24 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         out.uv[1] = uv.empty() ? 0.0f : uv[v * 2 + 1];
         if (!std::isfinite(out.uv[0]) || !std::isfinite(out.uv[1]))
             out.uv[0] = out.uv[1] = 0.0f;
+        out.uv1[0] = uv1.empty() ? 0.0f : uv1[v * 2];
+        out.uv1[1] = uv1.empty() ? 0.0f : uv1[v * 2 + 1];
+        if (!std::isfinite(out.uv1[0]) || !std::isfinite(out.uv1[1]))
+            out.uv1[0] = out.uv1[1] = 0.0f;
+        /* TANGENT: xyz moves with the model matrix, w (handedness) flips with
+         * a mirroring one; a degenerate or non-finite tangent is dropped (the
+         * shader then builds its own frame) */
+        out.tangent[0] = out.tangent[1] = out.tangent[2] = out.tangent[3] = 0.0f;
+        if (!tan.empty()) {
+            double lt[3] = {tan[v * 4], tan[v * 4 + 1], tan[v * 4 + 2]}, wt[3];
+            xform_dir(world, lt, wt);
+            const double w = tan[v * 4 + 3];
+            if (normalize3(wt) && std::isfinite(w)) {
+                for (int k = 0; k < 3; k++)
+                    out.tangent[k] = float(wt[k]);
+                out.tangent[3] = ((w < 0.0) != flip) ? -1.0f : 1.0f;
+            }
+        }
     };
 
     const uint64_t add_vertices = nrm.empty() ? uint64_t(ntri) * 3 : uint64_t(nv);
@@ -1406,17 +1534,13 @@ void Builder::visit(int node, const Mat4 &parent, int depth)
 
 void Builder::build()
 {
-    static const char *const supported_required[] = {
-        "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization",
-        "KHR_texture_transform", "KHR_materials_unlit",
-    };
-    for (const std::string &e : m_.extensionsRequired) {
-        bool ok = false;
-        for (const char *s : supported_required)
-            ok = ok || e == s;
-        if (!ok)
-            fail("the file requires the unsupported extension %s", show(e).c_str());
-    }
+    std::string unsupported;
+    for (const std::string &e : m_.extensionsRequired)
+        if (!lpv_gltf::extension_supported(e))
+            unsupported += (unsupported.empty() ? "" : ", ") + show(e);
+    if (!unsupported.empty())
+        fail("the file requires extension%s lpvd does not implement: %s (extensionsRequired)",
+             unsupported.find(',') == std::string::npos ? "" : "s", unsupported.c_str());
     check_buffer_views();
     check_node_graph();
     convert_materials();
@@ -1442,6 +1566,8 @@ void Builder::build()
     const Mat4 id = identity();
     for (int r : roots)
         visit(r, id, 1);
+    for (const std::string &w : lpv_gltf::unused_features(m_, scene))
+        ctx_.warn(w);
 }
 
 /* ---- lpvd_medium (docs/scenes.md, "Media") ----------------------------- */
@@ -1698,6 +1824,38 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     loader.SetFsCallbacks(fs);
     loader.SetImageLoader(image_loader, &ctx);
 
+    /* Compressed files as tinygltf 2.7 accepts them (gltf_compressed.hpp):
+     * meshopt fallback buffers get placeholders, Draco primitives lose their
+     * data-less "indices"; the compressed data is decoded instead. */
+    const char *const json_text = reinterpret_cast<const char *>(data) + json_off; /* the file's own JSON */
+    std::vector<unsigned char> rewritten;
+    static const char meshopt_key[] = "EXT_meshopt_compression", draco_key[] = "KHR_draco_mesh_compression";
+    std::string json2;
+    if ((memmem(json_text, json_len, meshopt_key, sizeof meshopt_key - 1) ||
+         memmem(json_text, json_len, draco_key, sizeof draco_key - 1)) &&
+        lpv_gltf::tinygltf_compat_json(json_text, json_len, &json2)) {
+        if (is_glb) {
+            size_t jpad = (json2.size() + 3) & ~size_t(3);
+            size_t rest = size - (json_off + json_len); /* the BIN chunk, if any */
+            rewritten.assign(20 + jpad + rest, ' ');
+            memcpy(rewritten.data(), data, 12);
+            auto put32 = [&](size_t at, uint32_t v) {
+                for (int k = 0; k < 4; k++)
+                    rewritten[at + size_t(k)] = (unsigned char)(v >> (8 * k));
+            };
+            put32(8, uint32_t(rewritten.size()));
+            put32(12, uint32_t(jpad));
+            memcpy(rewritten.data() + 16, data + 16, 4);
+            memcpy(rewritten.data() + 20, json2.data(), json2.size());
+            if (rest)
+                memcpy(rewritten.data() + 20 + jpad, data + json_off + json_len, rest);
+        } else {
+            rewritten.assign(json2.begin(), json2.end());
+        }
+        data = rewritten.data();
+        size = rewritten.size();
+    }
+
     tinygltf::Model model;
     ctx.model = &model;
     std::string terr, twarn;
@@ -1755,7 +1913,7 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     b.build();
     lpv_medium medium;
     std::vector<float> density;
-    read_medium(reinterpret_cast<const char *>(data) + json_off, json_len, model, ctx, medium, density);
+    read_medium(json_text, json_len, model, ctx, medium, density);
 
     if (b.vertices.size() > UINT32_MAX || b.indices.size() > UINT32_MAX)
         fail("scene too large (absurd size)");
@@ -1789,8 +1947,17 @@ int run_load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out, c
 {
     try {
         load(data, size, ctx, out);
-        for (const std::string &w : ctx.warnings)
-            fprintf(stderr, "lpvd: %s: warning: %s\n", ctx.label.c_str(), w.c_str());
+        if (ctx.sink) {
+            for (const std::string &w : ctx.warnings)
+                snprintf(ctx.sink->line[ctx.sink->count++], LPV_GLTF_WARNING_LEN, "%s", w.c_str());
+            ctx.sink->dropped = int(ctx.warnings_dropped);
+        } else {
+            for (const std::string &w : ctx.warnings)
+                fprintf(stderr, "lpvd: %s: warning: %s\n", ctx.label.c_str(), w.c_str());
+            if (ctx.warnings_dropped)
+                fprintf(stderr, "lpvd: %s: warning: %zu more warnings not shown\n", ctx.label.c_str(),
+                        ctx.warnings_dropped);
+        }
         return 0;
     } catch (const Failure &f) {
         set_error(err, err_size, ctx.label, f.msg);
@@ -1809,6 +1976,14 @@ int run_load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out, c
 
 extern "C" int lpv_gltf_load_file(const char *path, lpv_scene *out, char *err, size_t err_size)
 {
+    return lpv_gltf_load_file_w(path, out, nullptr, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_warnings *warnings, char *err,
+                                    size_t err_size)
+{
+    if (warnings)
+        memset(warnings, 0, sizeof *warnings);
     if (err && err_size)
         err[0] = '\0';
     if (!out) {
@@ -1825,6 +2000,7 @@ extern "C" int lpv_gltf_load_file(const char *path, lpv_scene *out, char *err, s
     try {
         Ctx ctx;
         ctx.label = path;
+        ctx.sink = warnings;
         std::string p(path);
         size_t slash = p.find_last_of('/');
         ctx.base_dir = slash == std::string::npos ? std::string(".") : (slash == 0 ? std::string("/") : p.substr(0, slash));
@@ -1901,6 +2077,15 @@ extern "C" int lpv_gltf_load_memory_ex(const void *data, size_t size, const char
                                        const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out,
                                        char *err, size_t err_size)
 {
+    return lpv_gltf_load_memory_w(data, size, base_dir, label, nodes, node_count, out, nullptr, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_memory_w(const void *data, size_t size, const char *base_dir, const char *label,
+                                      const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out,
+                                      lpv_gltf_warnings *warnings, char *err, size_t err_size)
+{
+    if (warnings)
+        memset(warnings, 0, sizeof *warnings);
     const char *name = label && label[0] ? label : "<memory>";
     if (err && err_size)
         err[0] = '\0';
@@ -1918,6 +2103,7 @@ extern "C" int lpv_gltf_load_memory_ex(const void *data, size_t size, const char
     try {
         Ctx ctx;
         ctx.label = name;
+        ctx.sink = warnings;
         ctx.overrides = nodes;
         ctx.override_count = nodes ? node_count : 0;
         if (base_dir) {

@@ -5,6 +5,10 @@
  * the spec allows, normalized integers, sparse accessors), the node
  * hierarchy's transforms (matrix or TRS), base colour factor and texture,
  * emissive factor with KHR_materials_emissive_strength, metallic/roughness,
+ * alphaMode and alphaCutoff, doubleSided, normal maps (with the file's
+ * TANGENTs, else per-pixel frames), KHR_texture_transform and TEXCOORD_1,
+ * KHR_draco_mesh_compression (libdraco) and EXT_meshopt_compression
+ * (libmeshoptimizer) (docs/scenes.md, "Materials", "Compressed meshes"),
  * KHR_lights_punctual (directional, point, spot with cone angles and range),
  * cameras, and lpvd's participating medium from the loaded scene's extras
  * (scenes[scene].extras.lpvd_medium, else the document's extras.lpvd_medium;
@@ -14,8 +18,16 @@
  * Refused with a message naming the file and the problem, never a crash:
  * truncated or mis-sized .glb, wrong magic, invalid JSON, accessors or
  * buffer views out of range, indices past the vertex count, NaN or infinite
- * positions, missing buffers, and external URIs that leave the scene's folder
- * (refused before anything is read).
+ * positions, missing buffers, external URIs that leave the scene's folder
+ * (refused before anything is read), and extensionsRequired that lpvd does not
+ * implement (named).
+ *
+ * Everything else in the file that lpvd does not use (extensions it does not
+ * implement, occlusion/emissive/metallic-roughness textures, vertex colours,
+ * skins, morph targets, animations, ...) is a warning, one line per feature
+ * (docs/scenes.md, "Supported and warned"): printed on stderr as
+ * "lpvd: <file>: warning: <line>", or handed to the caller through the _w
+ * functions below.
  */
 #ifndef LPV_GLTF_LOAD_H
 #define LPV_GLTF_LOAD_H
@@ -26,6 +38,16 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The loader's warnings, for callers that report them themselves (the
+ * daemon's SCENE_LOAD reply). Each line is one feature, at most once. */
+#define LPV_GLTF_WARNINGS_MAX 32
+#define LPV_GLTF_WARNING_LEN 320
+typedef struct lpv_gltf_warnings {
+    int count;   /* lines in line[] */
+    int dropped; /* further warnings that did not fit */
+    char line[LPV_GLTF_WARNINGS_MAX][LPV_GLTF_WARNING_LEN]; /* without the "<file>: warning: " prefix */
+} lpv_gltf_warnings;
 
 /* Loads a .gltf or .glb file (chosen by content: glb magic, else JSON).
  * External resources must lie inside the file's folder. Returns 0, or -1 with
@@ -56,6 +78,14 @@ typedef struct lpv_gltf_node_override {
 int lpv_gltf_load_memory_ex(const void *data, size_t size, const char *base_dir, const char *label,
                             const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out, char *err,
                             size_t err_size);
+
+/* The loaders above with the warnings stored in *warnings (zeroed first)
+ * instead of printed on stderr; warnings NULL prints them as above. */
+int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_warnings *warnings, char *err,
+                         size_t err_size);
+int lpv_gltf_load_memory_w(const void *data, size_t size, const char *base_dir, const char *label,
+                           const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out,
+                           lpv_gltf_warnings *warnings, char *err, size_t err_size);
 
 #ifdef __cplusplus
 }

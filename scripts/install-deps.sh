@@ -6,7 +6,7 @@ set -eu
 PACKAGES="
   build-essential cmake pkg-config clang libclang-rt-14-dev
   libegl-dev libgl-dev mesa-common-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
-  libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev
+  libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev libdraco-dev libmeshoptimizer-dev
   libopenimageio-dev
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev

@@ -339,6 +339,7 @@ typedef struct load_work {
     int status;
     char err[1024];
     sv_scene *scene;
+    lpv_gltf_warnings warnings; /* the loader's, for the SCENE_LOAD reply */
 } load_work;
 
 static char *dir_of(const char *path)
@@ -405,8 +406,8 @@ static void load_run(uv_work_t *req)
         return;
     }
     const char *label = w->path ? w->path : "attachment";
-    int rc = lpv_gltf_load_memory_ex(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
-                                     w->err, sizeof w->err);
+    int rc = lpv_gltf_load_memory_w(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
+                                    &w->warnings, w->err, sizeof w->err);
     if (rc != 0) {
         free(sc);
         w->status = LPVP_E_SCENE_INVALID;
@@ -536,8 +537,16 @@ static void load_done(uv_work_t *req, int status)
                 }
                 session_changed(c);
                 json_t *b = rev_body(c);
-                if (w->type == LPVP_SCENE_LOAD)
-                    json_object_set_new(b, "scene", scene_json(&sc->scene));
+                if (w->type == LPVP_SCENE_LOAD) {
+                    json_t *sj = scene_json(&sc->scene), *wa = json_array();
+                    for (int i = 0; wa && i < w->warnings.count; ++i)
+                        json_array_append_new(wa, json_string(w->warnings.line[i]));
+                    if (sj && wa)
+                        json_object_set_new(sj, "warnings", wa);
+                    else
+                        json_decref(wa);
+                    json_object_set_new(b, "scene", sj);
+                }
                 reply(c, w->type, w->request_id, b);
             }
             free(old_file);

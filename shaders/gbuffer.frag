@@ -1,9 +1,12 @@
 // gbuffer.frag - the camera's view of the scene: position, normal facing the
 // camera, albedo and emission per pixel (also the camera's surfels for the
-// geometry volume).
+// geometry volume). Alpha-masked texels are cut away (no pixel, no surfel);
+// the shading normal follows the normal map (docs/scenes.md, "Materials").
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
+in vec2 v_uv1;
+in vec4 v_tangent;
 
 uniform vec3 u_eye;
 uniform float u_pixel_solid_angle; // sr per pixel at the image centre (perspective), 0 = orthographic
@@ -11,7 +14,7 @@ uniform float u_pixel_area;        // m^2 per pixel (orthographic)
 uniform vec3 u_forward;
 
 layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0 = covered
-layout(location = 1) out vec4 o_normal;   // xyz unit, facing the camera; w 1 + metallic where covered
+layout(location = 1) out vec4 o_normal;   // xyz unit shading normal, on the camera's side; w 1 + metallic where covered
 layout(location = 2) out vec4 o_albedo;   // rgb linear albedo; a roughness
 layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr); a object size (m)
 
@@ -19,8 +22,16 @@ void main()
 {
     vec3 p = v_position;
     vec3 to_eye = normalize(u_eye - p);
-    vec3 n = surface_normal(v_normal, p, to_eye);
-    float cos_s = max(dot(n, to_eye), 0.05);
+    float side;
+    vec3 n = surface_normal(v_normal, p, to_eye, side);
+    // the surfel's area from the geometric facing (before the normal map)
+    float cos_s = max(abs(dot(n, to_eye)), 0.05);
+    if (u_has_normal_texture != 0) {
+        vec2 uvn = texture_uv(u_normal_uv_set, u_normal_uv_row0, u_normal_uv_row1, v_uv, v_uv1);
+        // mapped on the front side, then turned with the side seen (glTF)
+        n = side * normal_mapped(side * n, p, v_tangent, uvn);
+    }
+    vec4 base = material_albedo(v_uv, v_uv1);
     float area;
     if (u_pixel_solid_angle > 0.0) {
         vec3 d = p - u_eye;
@@ -31,8 +42,11 @@ void main()
     } else {
         area = u_pixel_area / cos_s;
     }
+    // after every derivative: cut-away texels leave no pixel (and no depth)
+    if (base.a < u_alpha_cutoff)
+        discard;
     o_position = vec4(p, area);
     o_normal = vec4(n, 1.0 + clamp(u_metallic, 0.0, 1.0)); // w >= 1: covered; w - 1: metallic
-    o_albedo = vec4(material_albedo(v_uv).rgb, u_roughness);
+    o_albedo = vec4(base.rgb, u_roughness);
     o_emission = vec4(u_emission, u_object_size);
 }

@@ -1,37 +1,98 @@
 // material.glsl - the per-draw material and the surface normal, shared by the
-// RSM and G-buffer fragment shaders.
+// RSM and G-buffer fragment shaders (docs/scenes.md, "Materials").
 uniform vec4 u_base_color;      // linear RGBA factor
 uniform int u_has_texture;      // base colour texture bound to unit 0 (sRGB, decoded by GL)
 uniform vec3 u_emission;        // W/(m^2 sr)
 uniform float u_roughness;      // glTF roughness (0 mirror .. 1 matte)
 uniform float u_metallic;       // glTF metallic (0 dielectric .. 1 metal)
 uniform float u_object_size;    // m, the draw's longest bounding-box side (cascade fading)
+uniform float u_alpha_cutoff;   // alpha below it is cut away (MASK, BLEND as MASK at 0.5); 0 = opaque
+// A texture's uv: set (0 TEXCOORD_0, 1 TEXCOORD_1) and the rows of its
+// KHR_texture_transform matrix applied to (u, v, 1).
+uniform int u_base_uv_set;
+uniform vec3 u_base_uv_row0;
+uniform vec3 u_base_uv_row1;
+uniform int u_has_normal_texture; // tangent-space normal map bound to unit 1 (linear)
+uniform float u_normal_scale;     // glTF normalTexture.scale
+uniform int u_normal_uv_set;
+uniform vec3 u_normal_uv_row0;
+uniform vec3 u_normal_uv_row1;
 layout(binding = 0) uniform sampler2D u_base_texture;
+layout(binding = 1) uniform sampler2D u_normal_texture;
 
-vec4 material_albedo(vec2 uv)
+vec2 texture_uv(int set, vec3 row0, vec3 row1, vec2 uv0, vec2 uv1)
+{
+    vec3 uv = vec3(set == 1 ? uv1 : uv0, 1.0);
+    return vec2(dot(row0, uv), dot(row1, uv));
+}
+
+vec4 material_albedo(vec2 uv0, vec2 uv1)
 {
     vec4 c = u_base_color;
     if (u_has_texture != 0)
-        c *= texture(u_base_texture, uv);
+        c *= texture(u_base_texture, texture_uv(u_base_uv_set, u_base_uv_row0, u_base_uv_row1, uv0, uv1));
     return c;
 }
 
 #ifdef LPV_STAGE_FRAGMENT
-// The interpolated normal, or the face normal when the file's normal is
-// zero-length or not finite; oriented towards `toward` (a unit direction from
-// the surface to the viewer or light), since lpvd treats surfaces as seen
-// from the side they are lit or looked at.
-vec3 surface_normal(vec3 interpolated, vec3 position, vec3 toward)
+// The interpolated normal (the face normal when the file's normal is
+// zero-length or not finite), for the side of the surface seen from `toward`
+// (a unit direction from the surface to the viewer or light): the side is
+// told by the geometric normal from the position's derivatives, and the
+// normal is flipped when the back of the surface (against the file's
+// normals) is seen, as glTF does for double-sided back faces. side is +1 on
+// the front, -1 on the back.
+vec3 surface_normal(vec3 interpolated, vec3 position, vec3 toward, out float side)
 {
+    vec3 g = cross(dFdx(position), dFdy(position));
+    float glen = length(g);
+    bool g_ok = glen > 1e-20 && !isinf(glen);
+    if (g_ok)
+        g = dot(g, toward) < 0.0 ? -g / glen : g / glen;
+    else
+        g = toward;
     vec3 n = interpolated;
     float len = length(n);
     if (!(len > 1e-8) || isinf(len)) {
-        n = cross(dFdx(position), dFdy(position));
-        len = length(n);
-        if (!(len > 1e-20) || isinf(len))
-            return toward;
+        side = 1.0;
+        return g;
     }
     n /= len;
-    return dot(n, toward) < 0.0 ? -n : n;
+    side = dot(n, g) < 0.0 ? -1.0 : 1.0;
+    return n * side;
+}
+
+// The normal map's normal (glTF: tangent space, +X along +u, +Y towards
+// decreasing v, i.e. up in the image, +Z out of the surface; xy scaled by
+// u_normal_scale) in world space. n is the front-side normal, tangent the
+// file's TANGENT (xyz, w handedness; zero = none: then the frame comes from
+// the derivatives of position and uv per pixel).
+vec3 normal_mapped(vec3 n, vec3 position, vec4 tangent, vec2 uv)
+{
+    vec3 t = texture(u_normal_texture, uv).xyz * 2.0 - 1.0;
+    t.xy *= u_normal_scale;
+    vec3 T, B;
+    float tlen = length(tangent.xyz);
+    if (tlen > 1e-8 && !isinf(tlen)) {
+        T = normalize(tangent.xyz - n * dot(n, tangent.xyz));
+        B = cross(n, T) * (tangent.w < 0.0 ? -1.0 : 1.0);
+    } else {
+        // Schueler's cotangent frame (ShaderX5, "Normal mapping without
+        // precomputed tangents"): T along +u; B along -v for glTF's +Y.
+        vec3 dp1 = dFdx(position), dp2 = dFdy(position);
+        vec2 duv1 = dFdx(uv), duv2 = dFdy(uv);
+        vec3 dp2perp = cross(dp2, n), dp1perp = cross(n, dp1);
+        T = dp2perp * duv1.x + dp1perp * duv2.x;
+        B = -(dp2perp * duv1.y + dp1perp * duv2.y);
+        float m = max(dot(T, T), dot(B, B));
+        if (!(m > 1e-30) || isinf(m))
+            return n; // no uv variation: nothing to map
+        float inv = inversesqrt(m);
+        T *= inv;
+        B *= inv;
+    }
+    vec3 w = t.x * T + t.y * B + t.z * n;
+    float wl = length(w);
+    return wl > 1e-8 && !isinf(wl) ? w / wl : n;
 }
 #endif

@@ -1,9 +1,15 @@
 // rsm.frag - reflective shadow map: for every texel the light sees, the
 // surfel's position and area, its normal (facing the light) and the flux it
 // reflects (W), so each texel becomes one VPL and one blocking surfel.
+// Alpha-masked texels are cut away: they neither block light (no depth, so no
+// shadow) nor reflect it. Normal maps are not applied here: an RSM texel is
+// far larger than a normal map's detail, and the reflected flux below does
+// not depend on the normal (docs/scenes.md, "Materials").
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
+in vec2 v_uv1;
+in vec4 v_tangent;
 
 uniform int u_face;
 
@@ -23,7 +29,8 @@ void main()
 
     vec3 to_light;
     vec3 e_perp = light_irradiance_normal(li, p, to_light);
-    vec3 n = surface_normal(v_normal, p, to_light);
+    float side;
+    vec3 n = surface_normal(v_normal, p, to_light, side);
     float cos_s = max(dot(n, to_light), MIN_COS);
 
     // Power arriving through this texel: irradiance x footprint for an
@@ -42,7 +49,10 @@ void main()
         texel_area_perp = omega * dist2;
     }
     vec3 power = e_perp * texel_area_perp;
-    vec3 albedo = material_albedo(v_uv).rgb;
+    vec4 base = material_albedo(v_uv, v_uv1);
+    vec3 albedo = base.rgb;
+    if (base.a < u_alpha_cutoff) // after every derivative
+        discard;
 
     o_position = vec4(p, texel_area_perp / cos_s);
     o_normal = vec4(n, 1.0);

@@ -410,6 +410,13 @@ static void test_happy_path(void **state)
         assert_int_equal(m.type, LPVP_REPLY(LPVP_SCENE_LOAD));
         assert_true(revision_of(&m) > rev);
         assert_int_equal(json_integer_value(json_object_get(json_object_get(m.j, "scene"), "triangles")), 36);
+        /* the loader's warnings (SPEC R4.4a): the file uses KHR_materials_specular, which lpvd does not */
+        const json_t *warn = json_object_get(json_object_get(m.j, "scene"), "warnings");
+        assert_true(json_is_array(warn));
+        int named = 0;
+        for (size_t i = 0; i < json_array_size(warn); ++i)
+            named += strstr(json_string_value(json_array_get(warn, i)), "KHR_materials_specular") != NULL;
+        assert_int_equal(named, 1);
         msg_free(&m);
         request(&c, LPVP_SCENE_LOAD, "{\"path\": \"box.glb\"}", NULL, 0, &m);
         assert_int_equal(m.type, LPVP_REPLY(LPVP_SCENE_LOAD));

@@ -384,7 +384,9 @@ def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=T
         for q in qs:
             base = len(pos)
             pos += q
-            idx += [base, base + 1, base + 2, base, base + 2, base + 3]
+            # counter-clockwise seen from the side each quad faces (glTF's front;
+            # the materials are single-sided, so a viewer culls the other side)
+            idx += [base, base + 2, base + 1, base, base + 3, base + 2]
         pb = b"".join(struct.pack("<3f", *p) for p in pos)
         ib = struct.pack("<%dH" % len(idx), *idx)
         ib += b"\0" * (-len(ib) % 4)
