@@ -56,14 +56,23 @@ static const char *const STAGES[] = {"rsm",       "vpl_extract", "inject",  "gbu
                                      "propagate", "shade",       "emissive", "pack"};
 #define NSTAGES ((int)(sizeof STAGES / sizeof STAGES[0]))
 
-/* The full factorial. */
-static const int GRIDS[] = {16, 32, 64};
-static const int ITERS[] = {4, 8, 16, 32};
-static const int RSMS[] = {128, 256, 512};
-static const int OCCS[] = {0, 1};
+/* The full factorial's default values (--knobs replaces any list). RSM and
+ * occlusion stay at 128^2 / on by default: the first sweep (docs/accuracy.md,
+ * "History") found larger RSMs buy nothing and occlusion always helps. */
+static const int GRIDS[] = {6, 8, 12, 16, 32};
+static const int ITERS[] = {4, 8, 16};
+static const int RSMS[] = {128};
+static const int OCCS[] = {1};
+static const int MODS[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
+/* The departures from the paper a point switches on (docs/propagation.md),
+ * as bits of point.mods; their one-letter names in labels ("cbfs"). */
+enum { MOD_CENTRAL = 1, MOD_BINS = 2, MOD_FAR = 4, MOD_SURFELS = 8, MOD_ALL = 15 };
+static const char MOD_LETTERS[] = "cbfs";
 
 typedef struct point {
     int grid, iterations, rsm, occlusion;
+    int mods;           /* MOD_* bits */
     /* --features (one factor at a time around balanced); all 0 for the classic sweep */
     int feat;           /* 1: a point of the features block */
     int cascades;       /* settings.cascades (0 = auto) */
@@ -89,16 +98,41 @@ static const feature_def FEATURES[] = {
 
 /* --quick: a handful of points spanning cheap to expensive. */
 static const point QUICK[] = {
-    {16, 4, 128, 1}, {16, 8, 256, 1}, {32, 8, 256, 0}, {32, 8, 256, 1}, {32, 16, 256, 1}, {64, 32, 512, 1},
+    {16, 4, 128, 1, 0}, {32, 4, 128, 1, 0}, {8, 8, 128, 1, MOD_CENTRAL | MOD_FAR},
+    {12, 8, 128, 1, MOD_ALL}, {16, 8, 128, 1, MOD_ALL}, {32, 8, 256, 1, MOD_ALL},
 };
 
-/* The engine settings of a point: exactly its four knobs, nothing from a preset. */
+static lpv_switch on_off(int on)
+{
+    return on ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+}
+
+/* The engine settings of a point: exactly its knobs, nothing from a preset. */
 static lpv_settings point_settings(const point *p)
 {
     return (lpv_settings){.grid_dims = {p->grid, p->grid, p->grid},
                           .iterations = p->iterations,
                           .rsm_size = p->rsm,
-                          .occlusion = p->occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF};
+                          .occlusion = on_off(p->occlusion),
+                          .central_transport = on_off(p->mods & MOD_CENTRAL),
+                          .normal_bins = on_off(p->mods & MOD_BINS),
+                          .far_field = on_off(p->mods & MOD_FAR),
+                          .scene_surfels = on_off(p->mods & MOD_SURFELS)};
+}
+
+/* "cbfs" with '-' for the switches that are off: the point's departures. */
+static const char *mods_name(int mods, char buf[5])
+{
+    for (int i = 0; i < 4; ++i)
+        buf[i] = (mods >> i) & 1 ? MOD_LETTERS[i] : '-';
+    buf[4] = '\0';
+    return buf;
+}
+
+static int mods_of_settings(const lpv_settings *s)
+{
+    return (s->central_transport == LPV_SWITCH_ON ? MOD_CENTRAL : 0) | (s->normal_bins == LPV_SWITCH_ON ? MOD_BINS : 0) |
+           (s->far_field == LPV_SWITCH_ON ? MOD_FAR : 0) | (s->scene_surfels == LPV_SWITCH_ON ? MOD_SURFELS : 0);
 }
 
 /* The named preset the point equals (settings.h), or "" when none: the sweep
@@ -119,7 +153,8 @@ static int preset_points(point *pts)
         lpv_settings s;
         if (lpv_preset_settings(order[i], &s) != 0)
             continue;
-        pts[n++] = (point){s.grid_dims[0], s.iterations, s.rsm_size, s.occlusion == LPV_SWITCH_ON};
+        pts[n++] = (point){s.grid_dims[0], s.iterations, s.rsm_size, s.occlusion == LPV_SWITCH_ON,
+                           mods_of_settings(&s)};
     }
     return n;
 }
@@ -135,7 +170,32 @@ typedef struct result {
     int ref_bounces;            /* bounces of the reference m compares with */
     double rel_rmse_1b;         /* vs the 1-bounce reference */
     double rel_rmse_multi;      /* vs the multi-bounce reference; NAN when not rendered */
+    double black, constant;     /* the baselines' rel_rmse (lpv_acc_baselines) */
+    double region_share[LPV_ACC_REGIONS], region_rmse[LPV_ACC_REGIONS], region_ratio[LPV_ACC_REGIONS];
 } result;
+
+/* Each pixel's region (metrics.h) from the reference's primary rays. */
+static uint8_t *region_map(const lpv_scene *scene, const lpv_view *view)
+{
+    char err[512];
+    lpv_ref *ref = NULL;
+    size_t n = (size_t)view->width * (size_t)view->height;
+    uint8_t *m = malloc(n);
+    if (!m || lpv_ref_create(scene, NULL, &ref, err, sizeof err) != 0) {
+        free(m);
+        return NULL;
+    }
+    for (int y = 0; y < view->height; ++y)
+        for (int x = 0; x < view->width; ++x) {
+            float o[3], d[3], t0, t1, nn[3];
+            lpv_ref_pixel_ray(view, x, y, o, d, &t0, &t1);
+            size_t i = (size_t)y * (size_t)view->width + (size_t)x; /* row 0 at the top, as the images */
+            m[i] = lpv_ref_first_surface(ref, o, d, t0, t1, NULL, NULL, nn) ? (uint8_t)lpv_acc_region_of(nn)
+                                                                             : (uint8_t)LPV_ACC_REGION_NONE;
+        }
+    lpv_ref_destroy(ref);
+    return m;
+}
 
 typedef struct scene_entry {
     char name[64];
@@ -165,14 +225,17 @@ static void usage(FILE *f)
             "                     a CAD model in mm under the default light; ClearCoatTest.gltf, spheres\n"
             "                     lit by emissive labels), or paths to .glb/.gltf files\n"
             "                     (default cornell,courtyard,blinds)\n"
-            "  --quick            %d points instead of the 72-point factorial\n"
+            "  --quick            %d points instead of the 240-point factorial (grid 6/8/12/16/32 x\n"
+            "                     iterations 4/8/16 x the 16 combinations of the mods below; RSM 128, occlusion on)\n"
             "  --presets          exactly the named presets (fast, balanced, accurate) as the points\n"
             "  --features         one knob at a time around balanced: cascades 3, bounces on, damping\n"
             "                     0.5 and 1 vs one grid (alone: scenes cornell-inside,courtyard,blinds;\n"
             "                     with another point set: added to it); features.png\n"
             "  --multi-bounces N  bounces of the reference for bounces on (--features; default 3)\n"
-            "  --knobs SPEC       restrict knob values, e.g. grid=16/32,iterations=8,rsm=256,occlusion=on\n"
-            "  --points LIST      explicit points GRID:ITER:RSM:on|off, comma separated\n"
+            "  --knobs SPEC       the factorial's values per knob (any given list replaces the default), e.g.\n"
+            "                     grid=16/32,iterations=8,rsm=256,occlusion=on,central=on,bins=off/on,far=on,\n"
+            "                     surfels=on (mods: central transport, normal bins, far field, scene surfels)\n"
+            "  --points LIST      explicit points GRID:ITER:RSM:on|off[:MODS], MODS letters of cbfs\n"
             "  --ticks N          timed ticks per point, median reported (default 5)\n"
             "  --warmup N         untimed ticks first (default 2)\n"
             "  --reference PATH   run this reference command (lpvd-reference's CLI) instead of the\n"
@@ -266,7 +329,10 @@ static int in_list(int v, const int *list, int n)
 /* --knobs SPEC: filters (value lists, empty = any) applied to the point set. */
 typedef struct knob_filter {
     int grid[16], ngrid, iter[16], niter, rsm[16], nrsm, occ[2], nocc;
+    int sw[4][2], nsw[4]; /* central, bins, far, surfels: off/on */
 } knob_filter;
+
+static const char *const MOD_KNOBS[4] = {"central", "bins", "far", "surfels"};
 
 static int parse_knobs(const char *spec, knob_filter *kf)
 {
@@ -287,8 +353,14 @@ static int parse_knobs(const char *spec, knob_filter *kf)
             r = kf->nrsm = parse_values(v, kf->rsm, 16, 0);
         else if (strcmp(tok, "occlusion") == 0)
             r = kf->nocc = parse_values(v, kf->occ, 2, 1);
-        else
-            return -1;
+        else {
+            r = -1;
+            for (int m = 0; m < 4; ++m)
+                if (strcmp(tok, MOD_KNOBS[m]) == 0)
+                    r = kf->nsw[m] = parse_values(v, kf->sw[m], 2, 1);
+            if (r < 0)
+                return -1;
+        }
         if (r < 0)
             return -1;
     }
@@ -301,9 +373,10 @@ static int parse_points(const char *list, point *pts, int max)
     char buf[4096];
     snprintf(buf, sizeof buf, "%s", list);
     for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        char occ[8] = "";
+        char occ[8] = "", mods[8] = "";
         point p = {0};
-        if (n >= max || sscanf(tok, "%d:%d:%d:%7s", &p.grid, &p.iterations, &p.rsm, occ) != 4)
+        int got = n < max ? sscanf(tok, "%d:%d:%d:%7[a-z]:%7s", &p.grid, &p.iterations, &p.rsm, occ, mods) : 0;
+        if (got != 4 && got != 5)
             return -1;
         if (strcmp(occ, "on") == 0)
             p.occlusion = 1;
@@ -311,6 +384,13 @@ static int parse_points(const char *list, point *pts, int max)
             p.occlusion = 0;
         else
             return -1;
+        for (const char *c = got == 5 ? mods : ""; *c; ++c) { /* letters of cbfs, '-' for off */
+            const char *at = strchr(MOD_LETTERS, *c);
+            if (*c != '-' && !at)
+                return -1;
+            if (*c != '-')
+                p.mods |= 1 << (at - MOD_LETTERS);
+        }
         if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192)
             return -1;
         pts[n++] = p;
@@ -512,14 +592,17 @@ static const char *occ_name(int on)
 
 static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes)
 {
-    fprintf(f, "scene,grid,iterations,rsm,occlusion,ms_per_tick");
+    fprintf(f, "scene,grid,iterations,rsm,occlusion,mods,ms_per_tick");
     for (int k = 0; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
     fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto,preset");
-    fprintf(f, ",block,label,cascades,cascade_size,bounces,damping,ref_bounces,rel_rmse_1b,rel_rmse_multi\n");
+    fprintf(f, ",block,label,cascades,cascade_size,bounces,damping,ref_bounces,rel_rmse_1b,rel_rmse_multi");
+    fprintf(f, ",black_rmse,constant_rmse,share_floor,share_ceiling,share_walls,rmse_floor,rmse_ceiling,rmse_walls,"
+               "ratio_floor,ratio_ceiling,ratio_walls\n");
     for (int i = 0; i < n; ++i) {
-        fprintf(f, "%s,%d,%d,%d,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
-                occ_name(r[i].p.occlusion), r[i].ms_total);
+        char mb[5];
+        fprintf(f, "%s,%d,%d,%d,%s,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
+                occ_name(r[i].p.occlusion), mods_name(r[i].p.mods, mb), r[i].ms_total);
         for (int k = 0; k < NSTAGES; ++k)
             fprintf(f, ",%.3f", r[i].stage_ms[k]);
         fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d,%s", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
@@ -530,6 +613,13 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
                 r[i].ref_bounces, r[i].rel_rmse_1b);
         if (isfinite(r[i].rel_rmse_multi))
             fprintf(f, "%.5f", r[i].rel_rmse_multi);
+        fprintf(f, ",%.5f,%.5f", r[i].black, r[i].constant);
+        for (int g = 0; g < LPV_ACC_REGIONS; ++g)
+            fprintf(f, ",%.5f", r[i].region_share[g]);
+        for (int g = 0; g < LPV_ACC_REGIONS; ++g)
+            fprintf(f, ",%.5f", r[i].region_rmse[g]);
+        for (int g = 0; g < LPV_ACC_REGIONS; ++g)
+            fprintf(f, ",%.5f", r[i].region_ratio[g]);
         fputc('\n', f);
     }
 }
@@ -607,15 +697,17 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             continue;
         fprintf(f, "## %s\n\n", scenes[s].name);
         fprintf(f, "reference: `%s`%s\n\n", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
-        fprintf(f, "| grid | iterations | RSM | occlusion | preset | ms/tick | propagate ms | gv ms | rel. RMSE "
+        fprintf(f, "| grid | iterations | RSM | occlusion | mods | preset | ms/tick | propagate ms | gv ms | rel. RMSE "
                    "| rel. bias | rel. MAE | ref. noise | Pareto |\n");
-        fprintf(f, "|---:|---:|---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
+        fprintf(f, "|---:|---:|---:|:---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
         for (int i = 0; i < k; ++i) {
             const result *x = rows[i];
             const char *b = x->pareto ? "**" : "";
             fprintf(f,
-                    "| %s%d³%s | %d | %d² | %s | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f | %s |\n",
-                    b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion), point_preset(&x->p), b,
+                    "| %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f | %s "
+                    "|\n",
+                    b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion),
+                    mods_name(x->p.mods, (char[5]){0}), point_preset(&x->p), b,
                     x->ms_total, b,
                     x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
                     x->pareto ? "**◆**" : "");
@@ -811,9 +903,9 @@ static int write_features_plot(const char *out_dir, const result *r, int n, cons
 
 /* ---- The overall front (overall.h), written when there are 2+ scenes ---- */
 
-static const char *key_preset(const int key[4])
+static const char *key_preset(const int key[LPV_ACC_KEY])
 {
-    point p = {key[0], key[1], key[2], key[3]};
+    point p = {key[0], key[1], key[2], key[3], key[4]};
     return point_preset(&p);
 }
 
@@ -835,7 +927,8 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     size_t nrows = 0;
     for (int i = 0; i < n; ++i) /* the classic sweep's points only: features share their four knobs */
         if (!r[i].p.feat)
-            rows[nrows++] = (lpv_acc_row){r[i].scene, {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion},
+            rows[nrows++] = (lpv_acc_row){r[i].scene,
+                                          {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion, r[i].p.mods},
                                           r[i].ms_total, r[i].m.rel_rmse};
     if (nrows == 0) {
         free(rows);
@@ -856,14 +949,15 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         fprintf(md, "## all scenes: the overall front\n\nPoints measured on every scene, by mean ms/tick over the "
                     "scenes and normalised RMSE = mean over the scenes of rel. RMSE / the scene's best rel. RMSE "
                     "(1 = the best of this sweep on every scene; docs/accuracy.md). The presets are chosen from "
-                    "this front.\n\n| grid | iterations | RSM | occlusion | preset | mean ms/tick | normalised "
-                    "RMSE |");
-        fprintf(csv, "grid,iterations,rsm,occlusion,mean_ms_per_tick,norm_rmse");
+                    "this front. mods: the departures from the paper switched on, c = central transport, b = "
+                    "normal bins, f = far field, s = scene surfels (docs/propagation.md).\n\n| grid | iterations | "
+                    "RSM | occlusion | mods | preset | mean ms/tick | normalised RMSE |");
+        fprintf(csv, "grid,iterations,rsm,occlusion,mods,mean_ms_per_tick,norm_rmse");
         for (int s = 0; s < nscenes; ++s) {
             fprintf(md, " %s rel. RMSE |", scenes[s].name);
             fprintf(csv, ",rel_rmse_%s", scenes[s].name);
         }
-        fprintf(md, " Pareto |\n|---:|---:|---:|:---:|:---:|---:|---:|");
+        fprintf(md, " Pareto |\n|---:|---:|---:|:---:|:---:|:---:|---:|---:|");
         fprintf(csv, ",pareto,preset\n");
         for (int s = 0; s < nscenes; ++s)
             fprintf(md, "---:|");
@@ -872,9 +966,10 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         for (size_t j = 0; j < k; ++j) {
             const lpv_acc_overall *x = &o[j];
             const char *b = x->pareto ? "**" : "", *pre = key_preset(x->key);
-            fprintf(md, "| %s%d³%s | %d | %d² | %s | %s | %s%.2f%s | %s%.3f%s |", b, x->key[0], b, x->key[1],
-                    x->key[2], occ_name(x->key[3]), pre, b, x->ms, b, b, x->norm_rmse, b);
-            fprintf(csv, "%d,%d,%d,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), x->ms,
+            char mb[5];
+            fprintf(md, "| %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %s%.3f%s |", b, x->key[0], b, x->key[1],
+                    x->key[2], occ_name(x->key[3]), mods_name(x->key[4], mb), pre, b, x->ms, b, b, x->norm_rmse, b);
+            fprintf(csv, "%d,%d,%d,%s,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), mb, x->ms,
                     x->norm_rmse);
             for (int s = 0; s < nscenes; ++s) {
                 fprintf(md, " %.3f |", x->rel_rmse[s]);
@@ -994,7 +1089,9 @@ int main(int argc, char **argv)
         } else if (a[0] == '-' && a[1] == '-' && lpvd_option_takes_value(a + 2) > 0) {
             const char *name = a + 2;
             if (strcmp(name, "grid") == 0 || strcmp(name, "iterations") == 0 || strcmp(name, "rsm-size") == 0 ||
-                strcmp(name, "occlusion") == 0 || strcmp(name, "preset") == 0) {
+                strcmp(name, "occlusion") == 0 || strcmp(name, "preset") == 0 || strcmp(name, "central-transport") == 0 ||
+                strcmp(name, "normal-bins") == 0 || strcmp(name, "far-field") == 0 ||
+                strcmp(name, "scene-surfels") == 0) {
                 fprintf(stderr, "lpvd-accuracy: %s is a swept knob; use --knobs, --points or --presets\n", a);
                 return 2;
             }
@@ -1049,24 +1146,38 @@ int main(int argc, char **argv)
     } else if (quick) {
         npts = (int)(sizeof QUICK / sizeof QUICK[0]);
         memcpy(pts, QUICK, sizeof QUICK);
-    } else {
-        for (size_t g = 0; g < sizeof GRIDS / sizeof *GRIDS; ++g)
-            for (size_t it = 0; it < sizeof ITERS / sizeof *ITERS; ++it)
-                for (size_t r = 0; r < sizeof RSMS / sizeof *RSMS; ++r)
-                    for (size_t o = 0; o < sizeof OCCS / sizeof *OCCS; ++o)
-                        pts[npts++] = (point){GRIDS[g], ITERS[it], RSMS[r], OCCS[o]};
+    }
+    knob_filter kf = {0};
+    if (knobs && parse_knobs(knobs, &kf) != 0) {
+        fprintf(stderr, "lpvd-accuracy: --knobs expects e.g. grid=16/32,iterations=8,rsm=256,occlusion=on,"
+                        "central=on,bins=off/on,far=on,surfels=on\n");
+        return 2;
+    }
+    if (!points_arg && !presets && !quick) {
+        /* the factorial: each knob's --knobs list, else its default values */
+        const int *gl = kf.ngrid ? kf.grid : GRIDS, *il = kf.niter ? kf.iter : ITERS, *rl = kf.nrsm ? kf.rsm : RSMS,
+                  *ol = kf.nocc ? kf.occ : OCCS;
+        int ng = kf.ngrid ? kf.ngrid : (int)(sizeof GRIDS / sizeof *GRIDS),
+            ni = kf.niter ? kf.niter : (int)(sizeof ITERS / sizeof *ITERS),
+            nr = kf.nrsm ? kf.nrsm : (int)(sizeof RSMS / sizeof *RSMS),
+            no = kf.nocc ? kf.nocc : (int)(sizeof OCCS / sizeof *OCCS);
+        for (int g = 0; g < ng; ++g)
+            for (int it = 0; it < ni; ++it)
+                for (int r = 0; r < nr; ++r)
+                    for (int o = 0; o < no; ++o)
+                        for (size_t m = 0; m < sizeof MODS / sizeof *MODS && npts < MAX_POINTS; ++m)
+                            pts[npts++] = (point){gl[g], il[it], rl[r], ol[o], MODS[m]};
     }
     if (knobs) {
-        knob_filter kf = {0};
-        if (parse_knobs(knobs, &kf) != 0) {
-            fprintf(stderr, "lpvd-accuracy: --knobs expects e.g. grid=16/32,iterations=8,rsm=256,occlusion=on\n");
-            return 2;
-        }
         int k = 0;
-        for (int i = 0; i < npts; ++i)
-            if (in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
-                in_list(pts[i].rsm, kf.rsm, kf.nrsm) && in_list(pts[i].occlusion, kf.occ, kf.nocc))
+        for (int i = 0; i < npts; ++i) {
+            int keep = in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
+                       in_list(pts[i].rsm, kf.rsm, kf.nrsm) && in_list(pts[i].occlusion, kf.occ, kf.nocc);
+            for (int m = 0; m < 4; ++m)
+                keep = keep && in_list((pts[i].mods >> m) & 1, kf.sw[m], kf.nsw[m]);
+            if (keep)
                 pts[k++] = pts[i];
+        }
         npts = k;
         if (npts == 0) {
             fprintf(stderr, "lpvd-accuracy: --knobs %s leaves no point\n", knobs);
@@ -1188,6 +1299,7 @@ add_features:
         }
         lpv_view view;
         float *ref = NULL, *ref_se = NULL, *rgba = NULL;
+        uint8_t *regions = NULL;
         int rw = 0, rh = 0;
         lpvd_camera_choice cam = opt.cam;
         if (se->has_cam) {
@@ -1263,6 +1375,7 @@ add_features:
             goto next_scene;
         }
         rgba = malloc((size_t)view.width * (size_t)view.height * 4 * sizeof(float));
+        regions = region_map(&scene, &view);
         for (int p = 0; p < npts && rc == 0 && rgba; ++p) {
             result *res = &results[nres];
             res->scene = s;
@@ -1272,6 +1385,10 @@ add_features:
             st.iterations = pts[p].iterations;
             st.rsm_size = pts[p].rsm;
             st.occlusion = pts[p].occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+            st.central_transport = on_off(pts[p].mods & MOD_CENTRAL);
+            st.normal_bins = on_off(pts[p].mods & MOD_BINS);
+            st.far_field = on_off(pts[p].mods & MOD_FAR);
+            st.scene_surfels = on_off(pts[p].mods & MOD_SURFELS);
             if (pts[p].feat) {
                 st.cascades = pts[p].cascades;
                 if (pts[p].cascades > 1) {
@@ -1322,6 +1439,12 @@ add_features:
             if (lpv_acc_compare(rgba, ref, ref_se, view.width, view.height, &res->m) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both, or a black reference\n",
                         se->name);
+            lpv_acc_baselines(rgba, ref, view.width, view.height, &res->black, &res->constant);
+            for (int g = 0; g < LPV_ACC_REGIONS; ++g)
+                res->region_share[g] = res->region_rmse[g] = res->region_ratio[g] = NAN;
+            if (regions)
+                lpv_acc_region_errors(rgba, ref, regions, view.width, view.height, res->region_share, res->region_rmse,
+                                      res->region_ratio);
             res->rel_rmse_1b = res->m.rel_rmse;
             res->ref_bounces = 1;
             res->rel_rmse_multi = NAN;
@@ -1341,8 +1464,8 @@ add_features:
             if (pts[p].feat)
                 snprintf(ep, sizeof ep, "%s/features-%s.png", sub, pts[p].label);
             else
-                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s.png", sub, pts[p].grid, pts[p].iterations,
-                         pts[p].rsm, occ_name(pts[p].occlusion));
+                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s.png", sub, pts[p].grid, pts[p].iterations,
+                         pts[p].rsm, occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}));
             if (lpv_acc_write_error_png(ep, rgba, cmp_ref, view.width, view.height, res->m.mean_ref, err,
                                         sizeof err) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s\n", err);
@@ -1359,9 +1482,10 @@ add_features:
                 }
             }
             fprintf(stderr,
-                    "lpvd-accuracy: %s %d/%d: grid %d, iterations %d, rsm %d, occlusion %s: %.2f ms/tick, "
+                    "lpvd-accuracy: %s %d/%d: grid %d, iterations %d, rsm %d, occlusion %s, mods %s: %.2f ms/tick, "
                     "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
                     se->name, p + 1, npts, pts[p].grid, pts[p].iterations, pts[p].rsm, occ_name(pts[p].occlusion),
+                    mods_name(pts[p].mods, (char[5]){0}),
                     res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
                     pts[p].label);
             ++nres;
@@ -1369,6 +1493,7 @@ add_features:
         free(mref);
         free(mref_se);
     next_scene:
+        free(regions);
         free(rgba);
         free(ref);
         free(ref_se);

@@ -56,6 +56,71 @@ int lpv_acc_compare(const float *lpv, const float *ref, const float *ref_stderr,
     return 0;
 }
 
+void lpv_acc_baselines(const float *lpv, const float *ref, int width, int height, double *black, double *constant)
+{
+    size_t n = (width > 0 && height > 0) ? (size_t)width * (size_t)height : 0, count = 0;
+    double sum = 0.0, sum2 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!seen(lpv + 4 * i) || !seen(ref + 4 * i))
+            continue;
+        ++count;
+        for (int c = 0; c < 3; ++c) {
+            sum += ref[4 * i + (size_t)c];
+            sum2 += (double)ref[4 * i + (size_t)c] * ref[4 * i + (size_t)c];
+        }
+    }
+    *black = *constant = NAN;
+    double k = 3.0 * (double)count, mean = count ? sum / k : 0.0;
+    if (!(mean > 0.0))
+        return;
+    *black = sqrt(sum2 / k) / mean;
+    double var = sum2 / k - mean * mean;
+    *constant = sqrt(var > 0.0 ? var : 0.0) / mean;
+}
+
+int lpv_acc_region_of(const float n[3])
+{
+    return n[1] > 0.7f ? LPV_ACC_REGION_FLOOR : (n[1] < -0.7f ? LPV_ACC_REGION_CEILING : LPV_ACC_REGION_WALLS);
+}
+
+void lpv_acc_region_errors(const float *lpv, const float *ref, const uint8_t *region, int width, int height,
+                           double share[LPV_ACC_REGIONS], double rmse[LPV_ACC_REGIONS],
+                           double ratio[LPV_ACC_REGIONS])
+{
+    size_t n = (width > 0 && height > 0) ? (size_t)width * (size_t)height : 0, count = 0;
+    double d2[LPV_ACC_REGIONS] = {0}, sl[LPV_ACC_REGIONS] = {0}, sr[LPV_ACC_REGIONS] = {0}, total_d2 = 0.0,
+           total_r = 0.0;
+    size_t px[LPV_ACC_REGIONS] = {0};
+    for (size_t i = 0; i < n; ++i) {
+        const float *l = lpv + 4 * i, *r = ref + 4 * i;
+        if (!seen(l) || !seen(r))
+            continue;
+        ++count;
+        int g = region[i] < LPV_ACC_REGIONS ? region[i] : -1;
+        for (int c = 0; c < 3; ++c) {
+            double d = (double)l[c] - (double)r[c];
+            total_d2 += d * d;
+            total_r += r[c];
+            if (g >= 0) {
+                d2[g] += d * d;
+                sl[g] += l[c];
+                sr[g] += r[c];
+            }
+        }
+        if (g >= 0)
+            ++px[g];
+    }
+    double mean = count ? total_r / (3.0 * (double)count) : 0.0;
+    for (int g = 0; g < LPV_ACC_REGIONS; ++g) {
+        share[g] = rmse[g] = ratio[g] = NAN;
+        if (!px[g] || !(mean > 0.0))
+            continue;
+        share[g] = total_d2 > 0.0 ? d2[g] / total_d2 : 0.0;
+        rmse[g] = sqrt(d2[g] / (3.0 * (double)px[g])) / mean;
+        ratio[g] = sr[g] > 0.0 ? sl[g] / sr[g] : NAN;
+    }
+}
+
 double lpv_acc_pixel_error(const float *lpv_px, const float *ref_px, double mean_ref)
 {
     double l = ((double)lpv_px[0] + lpv_px[1] + lpv_px[2]) / 3.0;

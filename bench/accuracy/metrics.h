@@ -43,6 +43,31 @@ typedef struct lpv_acc_metrics {
 int lpv_acc_compare(const float *lpv, const float *ref, const float *ref_stderr, int width, int height,
                     lpv_acc_metrics *out);
 
+/* What a rel_rmse is worth, over the pixels seen by both: the rel_rmse an
+ * all-black image would score (sqrt(mean(R^2)) / mean(R)) and an image
+ * holding mean(R) everywhere (the reference's own spread, std(R) / mean(R)).
+ * An LPV scoring above `constant` places its light worse than no placement
+ * at all. NaN when no pixel is seen by both or mean(R) <= 0. */
+void lpv_acc_baselines(const float *lpv, const float *ref, int width, int height, double *black, double *constant);
+
+/* Regions of the image by the facing of the surface a pixel sees (from the
+ * reference's primary rays): up-facing (floors, tops), down-facing (ceilings)
+ * and the rest (walls). */
+enum { LPV_ACC_REGION_FLOOR = 0, LPV_ACC_REGION_CEILING = 1, LPV_ACC_REGION_WALLS = 2, LPV_ACC_REGIONS = 3,
+       LPV_ACC_REGION_NONE = 255 };
+/* The region of a unit normal: n.y > 0.7 floor, n.y < -0.7 ceiling, else walls. */
+int lpv_acc_region_of(const float n[3]);
+
+/* Per region r: share[r] = the region's part of the squared error (sum of
+ * (L-R)^2 over its pixels / the sum over all pixels seen by both), rmse[r] =
+ * sqrt(mean over its pixels of (L-R)^2) / the global mean(R) (so the regions'
+ * rmse^2 weighted by their pixel fractions add up to rel_rmse^2), and
+ * ratio[r] = mean(L) / mean(R) over its pixels. NaN where a region has no
+ * pixel. region: one byte per pixel (LPV_ACC_REGION_*). */
+void lpv_acc_region_errors(const float *lpv, const float *ref, const uint8_t *region, int width, int height,
+                           double share[LPV_ACC_REGIONS], double rmse[LPV_ACC_REGIONS],
+                           double ratio[LPV_ACC_REGIONS]);
+
 /* The signed relative error of one pixel, as the error image shows it:
  *   e = (l - r) / max(r, floor_frac * mean(R))
  * with l, r the pixel's mean over R, G, B, so dark reference pixels do not

@@ -7,9 +7,9 @@
 
 #include "metrics.h"
 
-static int same_key(const int a[4], const int b[4])
+static int same_key(const int a[LPV_ACC_KEY], const int b[LPV_ACC_KEY])
 {
-    return memcmp(a, b, 4 * sizeof a[0]) == 0;
+    return memcmp(a, b, LPV_ACC_KEY * sizeof a[0]) == 0;
 }
 
 size_t lpv_acc_overall_front(const lpv_acc_row *rows, size_t n, int nscenes, lpv_acc_overall *out, size_t max)

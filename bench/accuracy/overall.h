@@ -16,15 +16,16 @@
 
 #define LPV_ACC_MAX_SCENES 16
 
-/* One measured (scene, point): the point is identified by key[4]. */
+/* One measured (scene, point): the point is identified by key[LPV_ACC_KEY]. */
+#define LPV_ACC_KEY 5
 typedef struct lpv_acc_row {
     int scene; /* 0 .. nscenes-1 */
-    int key[4];
+    int key[LPV_ACC_KEY];
     double ms, rel_rmse;
 } lpv_acc_row;
 
 typedef struct lpv_acc_overall {
-    int key[4];
+    int key[LPV_ACC_KEY];
     double ms;                          /* mean over the scenes */
     double norm_rmse;                   /* mean of rel_rmse / best of the scene */
     double rel_rmse[LPV_ACC_MAX_SCENES]; /* per scene */

@@ -1,0 +1,122 @@
+/*
+ * test_leaks.c - a lamp inside a closed box must not light the room.
+ *
+ * A point light stands inside a closed 1 m box on an 8 m floor. Its light
+ * reaches only the box's inner faces; the floor outside must get no light,
+ * direct (the shadow map) or indirect (the LPV: the inner faces' VPLs must not
+ * propagate through the box's walls, which the geometry volume holds from the
+ * light's own RSM faces and from the scene surfels). The same lamp without
+ * the box lights the floor, so the comparison is about something.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "engine.h"
+#include "scene.h"
+#include "scene_build.h"
+#include "test_util.h"
+
+enum { RING = 64 };
+
+/* Mean indirect and direct irradiance (W/m^2, luminance-free: the green
+ * channel, the light is white) on a ring of floor points 1.5 to 3 m from the
+ * lamp, with or without the box around it. */
+static void floor_light(const lpv_settings *settings, int boxed, float half, double *indirect, double *direct)
+{
+    lpv_scene s = {0};
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.7f, 0.7f, 0.7f}, NULL);
+    const float floor_quad[4][3] = {{-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}};
+    assert_true(lpv_scene_add_quad(&s, grey, floor_quad, NULL) >= 0);
+    if (boxed)
+        assert_true(lpv_scene_add_box(&s, grey, (float[3]){-half, 0.001f, -half}, (float[3]){half, 0.5f + half, half}) >= 0);
+    else /* the same lamp and a tiny box under it, so the scene bounds match */
+        assert_true(lpv_scene_add_box(&s, grey, (float[3]){-0.05f, 0.001f, -0.05f}, (float[3]){0.05f, 0.1f, 0.05f}) >= 0);
+    const float corner[4][3] = {{-4, 2.5f, -4}, {-3.9f, 2.5f, -4}, {-3.9f, 2.5f, -3.9f}, {-4, 2.5f, -3.9f}};
+    assert_true(lpv_scene_add_quad(&s, grey, corner, NULL) >= 0); /* bounds reach 2.5 m up either way */
+    assert_true(lpv_scene_add_point_light(&s, (float[3]){0.0f, 0.5f, 0.0f}, 10.0f) != NULL);
+    lpv_scene_compute_bounds(&s);
+
+    char err[1024] = "";
+    assert_int_equal(lpv_engine_set_settings(lpvt_engine, settings, err, sizeof err), 0);
+    assert_int_equal(lpv_engine_set_scene(lpvt_engine, &s, err, sizeof err), 0);
+    lpv_view view;
+    const float eye[3] = {0.0f, 6.0f, 0.01f}, target[3] = {0.0f, 0.0f, 0.0f};
+    assert_int_equal(lpv_view_look_at(eye, target, 1.2f, 64, 64, &view), 0);
+    assert_int_equal(lpv_engine_set_view(lpvt_engine, &view, err, sizeof err), 0);
+    if (lpv_engine_tick(lpvt_engine, err, sizeof err) != 0)
+        fail_msg("tick: %s", err);
+
+    float p[RING * 3], n[RING * 3], e[RING * 3];
+    for (int i = 0; i < RING; ++i) {
+        double a = 2.0 * M_PI * i / RING, r = 1.5 + 1.5 * (i % 4) / 3.0;
+        p[3 * i] = (float)(r * cos(a));
+        p[3 * i + 1] = 0.0f;
+        p[3 * i + 2] = (float)(r * sin(a));
+        n[3 * i] = n[3 * i + 2] = 0.0f;
+        n[3 * i + 1] = 1.0f;
+    }
+    assert_int_equal(lpv_engine_irradiance(lpvt_engine, p, n, RING, e, err, sizeof err), 0);
+    *indirect = 0.0;
+    for (int i = 0; i < RING; ++i) {
+        assert_true(isfinite(e[3 * i + 1]) && e[3 * i + 1] >= 0.0f);
+        *indirect += e[3 * i + 1] / RING;
+    }
+
+    /* direct light: the full frame minus the indirect term, seen from above */
+    float *full = malloc(64 * 64 * 4 * sizeof *full);
+    assert_int_equal(lpv_engine_render(lpvt_engine, LPV_TERMS_DIRECT_ONLY, full, err, sizeof err), 0);
+    /* pixels on the floor 1.5 - 3 m from the lamp: the image spans about
+     * +-4.1 m at the floor (fov 1.2 rad from 6 m) */
+    double sum = 0.0;
+    int count = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            double wx = ((x + 0.5) / 64.0 * 2.0 - 1.0) * 6.0 * tan(0.6), wz = ((y + 0.5) / 64.0 * 2.0 - 1.0) * 6.0 * tan(0.6);
+            double r = sqrt(wx * wx + wz * wz);
+            if (r < 1.5 || r > 3.0)
+                continue;
+            sum += full[4 * (y * 64 + x) + 1];
+            ++count;
+        }
+    assert_true(count > 100);
+    *direct = sum / count; /* radiance, W/(m^2 sr): albedo / pi x irradiance */
+    free(full);
+    lpv_scene_free(&s);
+}
+
+static void check(const lpv_settings *s, const char *label, float half)
+{
+    double ind_open, dir_open, ind_box, dir_box;
+    floor_light(s, 0, half, &ind_open, &dir_open);
+    floor_light(s, 1, half, &ind_box, &dir_box);
+    printf("%s, box %.2f m: floor 1.5-3 m from the lamp: indirect %.4g W/m^2 open, %.4g boxed (%.2f %%); direct "
+           "radiance %.4g open, %.4g boxed\n",
+           label, 2.0 * half, ind_open, ind_box, 100.0 * ind_box / ind_open, dir_open, dir_box);
+    assert_true(dir_open > 0.01);    /* the lamp lights the open floor */
+    assert_true(ind_open > 1e-4);    /* and its bounce reaches it */
+    assert_true(dir_box < 1e-3 * dir_open);
+    assert_true(ind_box < 0.02 * ind_open);
+}
+
+static void test_lamp_in_closed_box_default(void **state)
+{
+    (void)state;
+    lpv_settings s = {0};
+    check(&s, "default", 0.5f);  /* a 1 m box: two cells or more at the default grid */
+    check(&s, "default", 0.15f); /* a 0.3 m lamp shade: about one cell */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_lamp_in_closed_box_default),
+    };
+    return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
+}
