@@ -62,6 +62,13 @@ typedef struct lpv_settings {
 
     lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
                                unchanged volume; off: run every pass every tick */
+
+    /* Emissive surfaces as direct area lights (docs/area-lights.md). */
+    lpv_switch area_lights; /* on (default): emitters light the scene directly through
+                               area_light_samples shadow-mapped samples and stop injecting
+                               their own VPLs; off: emitters reach the scene only as
+                               emissive_vpls VPLs in the LPV */
+    int area_light_samples; /* samples the emitters are reduced to; default 8 */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
@@ -76,6 +83,7 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f
 #define LPV_DEFAULT_MEDIA_STEP 0.5f
+#define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the
