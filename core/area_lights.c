@@ -60,20 +60,19 @@ static double weight(const lpv_emitter_tri *t)
     return ((double)t->emission[0] + t->emission[1] + t->emission[2]) * t->area;
 }
 
-/* A point of the triangle for u in [0, 1): u's base-4 digits pick, level by
- * level, one of the four midpoint-subdivision children (corner a, the middle,
- * corner b, corner c, each next to the one before), so an interval of u is a
- * compact patch of the triangle and equal intervals have equal areas. */
-static void tri_map(double u, const float p[3][3], double out[3])
+/* Cell `index` of the triangle's midpoint subdivision at depth `depth`
+ * (4^depth cells of equal area): its centroid. The index's base-4 digits,
+ * most significant first, pick one of the four children level by level
+ * (corner a, the middle, corner b, corner c, each next to the one before),
+ * so a run of indices is a compact patch of the triangle. */
+#define PATCH_DEPTH 5 /* 1024 cells */
+static void cell_centroid(unsigned index, int depth, const float p[3][3], double out[3])
 {
     double a[3], b[3], c[3];
     for (int i = 0; i < 3; ++i)
         a[i] = p[0][i], b[i] = p[1][i], c[i] = p[2][i];
-    for (int level = 0; level < 12; ++level) {
-        double x = u * 4.0;
-        int k = (int)x;
-        k = k < 0 ? 0 : k > 3 ? 3 : k;
-        u = x - k;
+    for (int level = depth - 1; level >= 0; --level) {
+        unsigned k = (index >> (2 * level)) & 3u;
         double ab[3], bc[3], ca[3];
         for (int i = 0; i < 3; ++i) {
             ab[i] = 0.5 * (a[i] + b[i]);
@@ -95,18 +94,38 @@ static void tri_map(double u, const float p[3][3], double out[3])
         out[i] = (a[i] + b[i] + c[i]) / 3.0;
 }
 
-/* The centroid of the patch [u0, u1) of the triangle (16 points of the map:
- * exact for a whole triangle and for any run of whole quarter children). */
+/* The centroid of the patch [u0, u1) (fractions of the triangle's area along
+ * the subdivision order): exact for the whole triangle, else the
+ * area-weighted mean of the depth-5 cells it covers. */
 static void patch_centroid(const lpv_emitter_tri *t, double u0, double u1, double out[3])
 {
-    enum { N = 16 };
     out[0] = out[1] = out[2] = 0.0;
-    for (int k = 0; k < N; ++k) {
-        double q[3];
-        tri_map(u0 + (u1 - u0) * (k + 0.5) / N, t->p, q);
-        for (int i = 0; i < 3; ++i)
-            out[i] += q[i] / N;
+    if (u0 <= 0.0 && u1 >= 1.0) {
+        for (int v = 0; v < 3; ++v)
+            for (int i = 0; i < 3; ++i)
+                out[i] += t->p[v][i] / 3.0;
+        return;
     }
+    const unsigned cells = 1u << (2 * PATCH_DEPTH);
+    double x0 = fmax(0.0, u0) * cells, x1 = fmin(1.0, u1) * cells, wsum = 0.0;
+    unsigned first = (unsigned)floor(x0), last = (unsigned)ceil(x1);
+    if (last > cells)
+        last = cells;
+    for (unsigned i = first; i < last; ++i) {
+        double w = fmin(x1, (double)i + 1.0) - fmax(x0, (double)i);
+        if (!(w > 0.0))
+            continue;
+        double q[3];
+        cell_centroid(i, PATCH_DEPTH, t->p, q);
+        for (int k = 0; k < 3; ++k)
+            out[k] += w * q[k];
+        wsum += w;
+    }
+    if (wsum > 0.0)
+        for (int k = 0; k < 3; ++k)
+            out[k] /= wsum;
+    else
+        cell_centroid(first < cells ? first : cells - 1, PATCH_DEPTH, t->p, out);
 }
 
 size_t lpv_area_lights_sample(const lpv_emitter_list *list, size_t k, lpv_area_sample *out)

@@ -100,9 +100,10 @@ static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, floa
         struct LpvLightGpu *g = &b->lights[l];
         vec3 nrm = {a->normal[0], a->normal[1], a->normal[2]}, pos, t, bt, up;
         glm_vec3_normalize(nrm);
-        /* Off the emitter by the near plane: its own surface stays out of its maps. */
-        glm_vec3_scale(nrm, 2.0f * near_z, pos);
-        glm_vec3_add(pos, (float *)a->position, pos);
+        /* The light and its maps' eye sit on the emitter: its own surface
+         * (and anything flush with it) is edge-on to the side faces and
+         * behind the front face's near plane, so it stays out of the maps. */
+        glm_vec3_copy((float *)a->position, pos);
         glm_vec3_copy(pos, g->position_type);
         g->position_type[3] = (float)LPV_LIGHT_TYPE_AREA;
         glm_vec3_copy(nrm, g->direction_range);
