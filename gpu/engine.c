@@ -597,7 +597,9 @@ static void record_stats(lpv_engine *e)
     s->vpls_rsm = e->rsm_texels;
     s->vpls_emissive = e->plan.pass[LPV_PASS_EMISSIVE].run ? e->emissive_vpl_count : 0;
     const int gv = e->plan.pass[LPV_PASS_GV].run;
-    s->surfels_rsm = gv ? e->rsm_texels : 0;
+    s->surfels_rsm = 0;
+    for (size_t b = 0, first, count; gv && (lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0); ++b)
+        s->surfels_rsm += count;
     s->surfels_camera = (gv && e->plan.pass[LPV_PASS_GBUFFER].run) ? (size_t)e->gbuf_w * e->gbuf_h : 0;
     s->cascades = e->cascades.count;
     s->cells = lpv_engine_all_cells(e);
@@ -909,8 +911,15 @@ void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *firs
         *first = (size_t)l->cone_faces[2] * per_layer; /* a punctual face is a layer */
         *count = (size_t)l->cone_faces[3] * per_layer;
     } else if (buffer == lights && area_gv_buffers(e)) {
+        /* only the layers holding the first sample's faces: the other
+         * samples' surfels are left out of the GV anyway (rsm.frag) */
+        const int side = e->area_face_side > 0 ? e->area_face_side : e->rsm_size;
+        const int per_row = e->rsm_size / side, faces_per_layer = per_row * per_row;
+        int layers = (LPV_AREA_FACES + faces_per_layer - 1) / faces_per_layer;
+        if (layers > e->rsm_layers - e->punctual_faces)
+            layers = e->rsm_layers - e->punctual_faces;
         *first = (size_t)e->punctual_faces * per_layer;
-        *count = (size_t)(e->rsm_layers - e->punctual_faces) * per_layer;
+        *count = (size_t)layers * per_layer;
     }
 }
 
