@@ -60,7 +60,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size);
 void lpv_engine_destroy(lpv_engine *e);
 
 /* Uploads the scene (geometry, materials, textures, lights) and samples its
- * emissive surfaces into VPLs. The scene may be freed afterwards. The grid is
+ * emissive surfaces into VPLs and keeps them for the area light samples. The scene may be freed afterwards. The grid is
  * re-placed from the settings and the scene's bounds. */
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
 
