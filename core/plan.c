@@ -145,12 +145,24 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
         return;
     }
 
-    if (all || f->lights)
+    char area[LPV_PLAN_REASON_MAX];
+    say(area, sizeof area, "area lights: %u emissive surfaces -> %zu samples", f->emissive_surfaces,
+        f->area_light_samples);
+    if (f->lights && f->area_light_samples)
+        decide(p, LPV_PASS_RSM, 1, "%u punctual lights; %s", f->lights, area);
+    else if (f->area_light_samples)
+        decide(p, LPV_PASS_RSM, 1, "%s", area);
+    else if (all || f->lights)
         decide(p, LPV_PASS_RSM, 1, "%u punctual lights", f->lights);
     else
         decide(p, LPV_PASS_RSM, 0, "no punctual lights");
-    if (all || f->emissive_vpls)
-        decide(p, LPV_PASS_EMISSIVE, 1, "%zu emissive VPLs", f->emissive_vpls);
+    /* Not a saving but correctness, so also with the planner off: emitters
+     * that light the scene directly must not enter the LPV a second time. */
+    if (f->area_light_samples)
+        decide(p, LPV_PASS_EMISSIVE, 0, "%s light the scene directly (their VPLs would count it twice)", area);
+    else if (all || f->emissive_vpls)
+        decide(p, LPV_PASS_EMISSIVE, 1, "%zu emissive VPLs%s", f->emissive_vpls,
+               s->area_lights == LPV_SWITCH_OFF && f->emissive_vpls ? " (area lights off)" : "");
     else
         decide(p, LPV_PASS_EMISSIVE, 0, "no emissive surfaces");
     const int inject = all || p->pass[LPV_PASS_RSM].run || p->pass[LPV_PASS_EMISSIVE].run;

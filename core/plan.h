@@ -17,8 +17,8 @@
 #include "settings.h"
 
 typedef enum lpv_pass_id {
-    LPV_PASS_RSM = 0,   /* reflective shadow maps of the punctual lights */
-    LPV_PASS_EMISSIVE,  /* injection of the emissive surfaces' VPLs */
+    LPV_PASS_RSM = 0,   /* reflective shadow maps of the punctual lights and area light samples */
+    LPV_PASS_EMISSIVE,  /* injection of the emissive surfaces' VPLs (only with area lights off) */
     LPV_PASS_INJECT,    /* VPL injection into the cascades */
     LPV_PASS_GBUFFER,   /* the camera's G-buffer (surfels for the GV) */
     LPV_PASS_GV,        /* geometry volume and transmittances (fuzzy occlusion) */
@@ -34,6 +34,9 @@ typedef enum lpv_pass_id {
 typedef struct lpv_plan_facts {
     unsigned lights;           /* punctual lights */
     size_t emissive_vpls;      /* VPLs sampled on emissive surfaces */
+    unsigned emissive_surfaces; /* emissive draws (surfaces) */
+    size_t area_light_samples; /* samples the emitters light the scene through directly; 0 = area lights
+                                  off or nothing emits */
     size_t occluder_triangles; /* triangles of non-emissive materials */
     size_t glossy_draws;       /* draws whose material is glossy under the settings */
     int has_medium;            /* the scene or the fog settings give a medium */

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "area_lights.h"
 #include "lpv_shared.h"
 
 #define LPV_MIN_RSM_SIZE 16
@@ -159,6 +160,10 @@ void lpv_settings_resolve(lpv_settings *s)
         s->far_field_levels = LPV_DEFAULT_FAR_FIELD_LEVELS;
     if (s->scene_surfel_count == 0)
         s->scene_surfel_count = LPV_DEFAULT_SCENE_SURFEL_COUNT;
+    if (s->area_lights == LPV_SWITCH_DEFAULT)
+        s->area_lights = LPV_SWITCH_ON;
+    if (s->area_light_samples == 0)
+        s->area_light_samples = LPV_DEFAULT_AREA_LIGHT_SAMPLES;
 }
 
 /* Writes a formatted message into err (when there is room) and returns -1. */
@@ -244,7 +249,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
         lpv_switch v;
     } switches[] = {{"bounces", s->bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
                     {"central_transport", s->central_transport}, {"normal_bins", s->normal_bins},
-                    {"far_field", s->far_field}, {"scene_surfels", s->scene_surfels}};
+                    {"far_field", s->far_field}, {"scene_surfels", s->scene_surfels},
+                    {"area_lights", s->area_lights}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
             return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
@@ -263,5 +269,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
                     (double)s->fog_sigma_s, (double)s->fog_sigma_a);
     if (!isfinite(s->media_step) || s->media_step < 0.05f || s->media_step > 4.0f)
         return fail(err, err_size, "media_step = %g is out of range (allowed 0.05..4 cells)", (double)s->media_step);
+    if (s->area_light_samples < 0 || s->area_light_samples > LPV_MAX_AREA_SAMPLES)
+        return fail(err, err_size, "area_light_samples = %d is out of range (allowed 1..%d; 0 = the default %d)",
+                    s->area_light_samples, LPV_MAX_AREA_SAMPLES, LPV_DEFAULT_AREA_LIGHT_SAMPLES);
     return validate_bounds(s, err, err_size);
 }

@@ -82,6 +82,12 @@ typedef struct lpv_settings {
     lpv_switch scene_surfels;     /* surfels sampled over every triangle join the geometry volume, so
                                      walls no view sees still block */
     int scene_surfel_count;       /* how many; default 65536 */
+    /* Emissive surfaces as direct area lights (docs/area-lights.md). */
+    lpv_switch area_lights; /* on (default): emitters light the scene directly through
+                               area_light_samples shadow-mapped samples and stop injecting
+                               their own VPLs; off: emitters reach the scene only as
+                               emissive_vpls VPLs in the LPV */
+    int area_light_samples; /* samples the emitters are reduced to; default 8 */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
@@ -102,6 +108,7 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_MEDIA_STEP 0.5f
 #define LPV_DEFAULT_FAR_FIELD_LEVELS 1
 #define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
+#define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "area_lights.h"
 #include "lpv_shared.h"
 
 #define F(name) offsetof(lpv_settings, name)
@@ -76,6 +77,11 @@ static const lpv_field FIELDS[] = {
      "surfels over every triangle join the geometry volume (walls no view sees block)"},
     {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",
      "65536", "", "surfels sampled over the scene's triangles"},
+    /* Emissive surfaces as direct area lights (docs/area-lights.md). */
+    {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", "on", "",
+     "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)"},
+    {"area_light_samples", "area-light-samples", LPV_FIELD_INT, F(area_light_samples), 1, LPV_MAX_AREA_SAMPLES, 0,
+     "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)"},
 };
 
 #undef F

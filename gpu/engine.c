@@ -90,6 +90,14 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
             return NULL;
         }
     }
+    GLint max_block = 0;
+    glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
+    if ((size_t)max_block < sizeof(struct LpvLightBlock)) {
+        lpv_error(err, err_size, "the light block needs %zu bytes of uniform block, GL allows %d",
+                  sizeof(struct LpvLightBlock), max_block);
+        lpv_engine_destroy(e);
+        return NULL;
+    }
     glGenVertexArrays(1, &e->empty_vao);
     glGenBuffers(1, &e->grid_ubo);
     glGenBuffers(1, &e->light_ubo);
@@ -147,6 +155,8 @@ static void free_scene(lpv_engine *e)
     e->texture_count = e->draw_count = e->material_count = 0;
     e->light_count = 0;
     e->emissive_vpl_count = 0;
+    lpv_emitters_free(&e->emitters);
+    e->area_sample_count = 0;
     e->occluder_triangles = 0;
     e->has_scene = 0;
 }
@@ -340,6 +350,16 @@ static int place_grid(lpv_engine *e, char *err, size_t err_size)
     return apply_cascades(e, &set, err, err_size);
 }
 
+/* The emitters as area light samples under the current settings (0 when
+ * area lights are off or nothing emits). */
+static void update_area_samples(lpv_engine *e)
+{
+    e->area_sample_count = 0;
+    if (e->settings.area_lights == LPV_SWITCH_ON && e->emitters.count)
+        e->area_sample_count =
+            lpv_area_lights_sample(&e->emitters, (size_t)e->settings.area_light_samples, e->area_samples);
+}
+
 int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *err, size_t err_size)
 {
     lpv_settings s = *settings;
@@ -352,6 +372,7 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     e->settings_dirty = 1;
     e->gbuf_stale = 1;
     e->ticked = 0;
+    update_area_samples(e);
     if (e->has_scene)
         return place_grid(e, err, err_size);
     return 0;
@@ -526,6 +547,9 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof(lpv_vpl)), vpls);
     e->emissive_vpl_count = n;
     free(vpls);
+    if (lpv_emitters_collect(scene, &e->emitters) != 0)
+        return lpv_error(err, err_size, "%s: out of memory for the emissive triangles", scene->source);
+    update_area_samples(e);
 
     size_t want = e->settings.scene_surfels == LPV_SWITCH_ON ? (size_t)e->settings.scene_surfel_count : 0;
     lpv_surfel *surfels = want ? calloc(want + 1, sizeof *surfels) : NULL;
@@ -634,13 +658,16 @@ static void record_stats(lpv_engine *e)
         s->stages[i].calls = st->count;
         s->stage_count = i + 1;
     }
-    s->lights = (unsigned)e->light_block.counts[0];
+    s->lights = (unsigned)e->light_block.counts[2];
+    s->area_lights = (unsigned)(e->light_block.counts[0] - e->light_block.counts[2]);
     s->rsm_faces = (unsigned)e->face_count;
     s->rsm_size = (unsigned)e->settings.rsm_size;
     s->vpls_rsm = e->rsm_texels;
-    s->vpls_emissive = e->emissive_vpl_count;
+    s->vpls_emissive = e->plan.pass[LPV_PASS_EMISSIVE].run ? e->emissive_vpl_count : 0;
     const int gv = e->plan.pass[LPV_PASS_GV].run;
-    s->surfels_rsm = gv ? e->rsm_texels : 0;
+    s->surfels_rsm = 0;
+    for (size_t b = 0, first, count; gv && (lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0); ++b)
+        s->surfels_rsm += count;
     s->surfels_camera = (gv && e->plan.pass[LPV_PASS_GBUFFER].run) ? (size_t)e->gbuf_w * e->gbuf_h : 0;
     s->cascades = e->cascades.count;
     s->cells = lpv_engine_all_cells(e);
@@ -668,6 +695,8 @@ static void gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     memset(f, 0, sizeof *f);
     f->lights = e->light_count;
     f->emissive_vpls = e->emissive_vpl_count;
+    f->emissive_surfaces = e->emitters.surfaces;
+    f->area_light_samples = e->area_sample_count;
     f->occluder_triangles = e->occluder_triangles;
     f->glossy_draws = glossy_draws(e);
     f->has_medium = e->has_medium || e->settings.fog_sigma_s > 0.0f || e->settings.fog_sigma_a > 0.0f;
@@ -964,25 +993,55 @@ size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
     if (!e->ticked)
         return 0;
     size_t n = read_buffer(e->vpls, sizeof(lpv_vpl), e->rsm_texels, out, max);
-    if (n < max)
+    if (n < max && e->plan.pass[LPV_PASS_EMISSIVE].run) /* what the LPV got */
         n += read_buffer(e->emissive_vpls, sizeof(lpv_vpl), e->emissive_vpl_count, out + n, max - n);
     return n;
 }
 
+/* GV buffers: each punctual light, then (if any) the area light samples as
+ * one (their first sample's faces; rsm.frag leaves the others' out), then the
+ * camera. */
+static size_t area_gv_buffers(const lpv_engine *e)
+{
+    return e->light_block.counts[0] > e->light_block.counts[2] ? 1 : 0;
+}
+
 size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
 {
-    return (size_t)e->light_block.counts[0] + (e->has_view ? 1 : 0) + (e->scene_surfel_count ? 1 : 0);
+    return (size_t)e->light_block.counts[2] + area_gv_buffers(e) + (e->has_view ? 1 : 0) +
+           (e->scene_surfel_count ? 1 : 0);
+}
+
+void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *first, size_t *count)
+{
+    const size_t per_layer = (size_t)e->rsm_size * (size_t)e->rsm_size;
+    const size_t lights = (size_t)e->light_block.counts[2];
+    *first = *count = 0;
+    if (buffer < lights) {
+        const struct LpvLightGpu *l = &e->light_block.lights[buffer];
+        *first = (size_t)l->cone_faces[2] * per_layer; /* a punctual face is a layer */
+        *count = (size_t)l->cone_faces[3] * per_layer;
+    } else if (buffer == lights && area_gv_buffers(e)) {
+        /* only the layers holding the first sample's faces: the other
+         * samples' surfels are left out of the GV anyway (rsm.frag) */
+        const int side = e->area_face_side > 0 ? e->area_face_side : e->rsm_size;
+        const int per_row = e->rsm_size / side, faces_per_layer = per_row * per_row;
+        int layers = (LPV_AREA_FACES + faces_per_layer - 1) / faces_per_layer;
+        if (layers > e->rsm_layers - e->punctual_faces)
+            layers = e->rsm_layers - e->punctual_faces;
+        *first = (size_t)e->punctual_faces * per_layer;
+        *count = (size_t)layers * per_layer;
+    }
 }
 
 size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max)
 {
     if (!e->ticked || !e->plan.pass[LPV_PASS_GV].run)
         return 0;
-    size_t lights = (size_t)e->light_block.counts[0];
-    if (buffer < lights) {
-        const struct LpvLightGpu *l = &e->light_block.lights[buffer];
-        size_t per_face = (size_t)e->rsm_size * (size_t)e->rsm_size;
-        size_t first = (size_t)l->cone_faces[2] * per_face, count = (size_t)l->cone_faces[3] * per_face;
+    size_t rsm_buffers = (size_t)e->light_block.counts[2] + area_gv_buffers(e);
+    if (buffer < rsm_buffers) {
+        size_t first, count;
+        lpv_engine_gv_buffer_range(e, buffer, &first, &count);
         size_t n = count < max ? count : max;
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
@@ -990,9 +1049,9 @@ size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, si
                            (GLsizeiptr)(n * sizeof(lpv_surfel)), out);
         return n;
     }
-    if (buffer == lights && e->has_view)
+    if (buffer == rsm_buffers && e->has_view)
         return read_buffer(e->camera_surfels, sizeof(lpv_surfel), (size_t)e->gbuf_w * e->gbuf_h, out, max);
-    if (buffer == lights + (e->has_view ? 1 : 0) && e->scene_surfel_count)
+    if (buffer == rsm_buffers + (e->has_view ? 1 : 0) && e->scene_surfel_count)
         return read_buffer(e->scene_surfels, sizeof(lpv_surfel), e->scene_surfel_count, out, max);
     return 0;
 }

@@ -3,11 +3,12 @@
  *
  * One engine per GL context. Give it a scene and settings, optionally a view
  * (camera), then each tick runs, in order:
- *   RSMs (one per light face) -> VPL and surfel extraction -> VPL injection
- *   (+ emissive-surface VPLs) -> geometry volume (one per RSM light and the
- *   camera, max-merged) -> transmittances -> propagation -> accumulation,
+ *   RSMs (one per light face; emissive surfaces as area light samples) -> VPL
+ *   and surfel extraction -> VPL injection (+ emissive-surface VPLs when area
+ *   lights are off) -> geometry volume (one per RSM light and the camera,
+ *   max-merged) -> transmittances -> propagation -> accumulation,
  * and lpv_engine_render shades the camera's view with direct light (shadow
- * maps) and the LPV's irradiance. Every stage is timed with GL timer queries.
+ * maps, punctual and area lights) and the LPV's irradiance. Every stage is timed with GL timer queries.
  *
  * All functions need the engine's GL context current on the calling thread.
  */
@@ -44,7 +45,8 @@ typedef struct lpv_engine_stats {
         double cpu_ms;
         unsigned calls; /* dispatches + draws */
     } stages[LPV_STAGE_MAX];
-    unsigned lights, rsm_faces, rsm_size;
+    unsigned lights, rsm_faces, rsm_size; /* lights: punctual ones */
+    unsigned area_lights;                  /* area light samples (emissive surfaces) */
     size_t vpls_rsm, vpls_emissive, vpls_injected_capacity;
     size_t surfels_rsm, surfels_camera;
     int cascades;
@@ -58,7 +60,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size);
 void lpv_engine_destroy(lpv_engine *e);
 
 /* Uploads the scene (geometry, materials, textures, lights) and samples its
- * emissive surfaces into VPLs. The scene may be freed afterwards. The grid is
+ * emissive surfaces into VPLs and keeps them for the area light samples. The scene may be freed afterwards. The grid is
  * re-placed from the settings and the scene's bounds. */
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
 
@@ -114,9 +116,12 @@ size_t lpv_engine_read_volumes(lpv_engine *e, lpv_grid_which which, lpv_cell *ou
 int lpv_engine_bins(const lpv_engine *e);
 size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max);
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);
-size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);  /* RSM VPLs then emissive */
-/* Surfels of one GV buffer: 0..light_count-1 = each light's RSM, then the camera (with a view),
- * then the scene surfels (settings.scene_surfels on). */
+/* RSM VPLs (punctual lights' and area light samples'), then the emissive VPLs
+ * when the last tick injected them (area lights off). */
+size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);
+/* Surfels of one GV buffer: 0..P-1 = each punctual light's RSM; P = the area
+ * light samples' (when there are any); then the camera (with a view); then
+ * the scene surfels (settings.scene_surfels on). */
 size_t lpv_engine_gv_buffer_count(const lpv_engine *e);
 size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, size_t max);
 

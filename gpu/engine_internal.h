@@ -5,6 +5,7 @@
 #ifndef LPV_ENGINE_INTERNAL_H
 #define LPV_ENGINE_INTERNAL_H
 
+#include "area_lights.h"
 #include "cascades.h"
 #include "engine.h"
 #include "error.h"
@@ -79,14 +80,20 @@ struct lpv_engine {
     size_t emissive_vpl_count;
     GLuint scene_surfels;     /* settings.scene_surfel_count over every triangle (GV), 0 = none */
     size_t scene_surfel_count;
+    lpv_emitter_list emitters;                          /* emissive triangles (area lights) */
+    lpv_area_sample area_samples[LPV_MAX_AREA_LIGHTS];  /* the emitters as area light samples */
+    size_t area_sample_count;                           /* 0: area lights off or no emitter */
 
     /* lights and RSMs */
     struct LpvLightBlock light_block;
     GLuint light_ubo;
     int rsm_size, face_count, rsm_alloc_size, rsm_alloc_faces;
+    int punctual_faces;   /* faces (= layers) of the punctual lights; area faces follow */
+    int rsm_layers;       /* layers in use: punctual faces + those the area faces' tiles fill */
+    int area_face_side;   /* texels of an area light face's tile */
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* one per RSM texel */
-    size_t rsm_texels;    /* face_count * rsm_size^2 */
+    size_t rsm_texels;    /* rsm_layers * rsm_size^2 */
 
     /* grids */
     GLuint grid_ubo;
@@ -158,7 +165,12 @@ void lpv_pass_media_run(lpv_engine *e);
 int lpv_medium_upload(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
 void lpv_medium_bind(lpv_engine *e, GLuint prog, int on);
 
-/* Light faces (RSM views) for the scene's lights: fills e->light_block. */
+/* Surfels [first, first + count) of the RSM surfel buffer that GV buffer
+ * `buffer` splats (0, 0 for the camera's or one past the end). */
+void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *first, size_t *count);
+
+/* Light faces (RSM views) for the scene's lights and area light samples:
+ * fills e->light_block, face_count, punctual_faces, rsm_layers. */
 void lpv_light_faces_build(lpv_engine *e);
 
 /* Atlas helpers (pass_inject.c). */

@@ -1,7 +1,8 @@
 /*
  * pass_gv.c - the geometry volume for fuzzy occlusion. Each buffer that saw
- * surfaces (each light's RSM faces, the camera's G-buffer, and the surfels
- * sampled over every triangle when settings.scene_surfels is on) splats its
+ * surfaces (each punctual light's RSM faces, the area light samples' faces
+ * as one, the camera's G-buffer, and the surfels sampled over every triangle
+ * when settings.scene_surfels is on) splats its
  * surfels into the GV atlas and is then max-merged into the total, so a
  * surface seen by several buffers blocks once. Finally the per-cell, per-
  * direction transmittances are computed once for the whole propagation.
@@ -31,13 +32,10 @@ void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->gv_total);
     glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_RGBA32F, GL_RGBA, GL_FLOAT, NULL);
 
-    const size_t per_face = (size_t)e->rsm_size * (size_t)e->rsm_size;
-    const int lights = (int)e->light_block.counts[0];
-    for (int l = 0; l < lights; ++l) {
-        const struct LpvLightGpu *g = &e->light_block.lights[l];
+    /* each punctual light's faces, then the area light samples' (one buffer) */
+    for (size_t b = 0, first, count; lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0; ++b) {
         lpv_atlas_begin(e, &e->gv_atlas, e->prog_inject_gv);
-        lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->surfels, (size_t)g->cone_faces[2] * per_face,
-                        (size_t)g->cone_faces[3] * per_face);
+        lpv_atlas_splat(e, e->prog_inject_gv, LPV_SSBO_SURFELS, e->surfels, first, count);
         lpv_atlas_end();
         merge(e);
     }

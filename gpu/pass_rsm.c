@@ -1,9 +1,12 @@
 /*
  * pass_rsm.c - reflective shadow maps: every light face renders the scene's
- * position/area, normal and reflected flux into one layer of three 2D array
- * textures (plus depth, which direct shading reuses as its shadow map); a
- * compute pass then turns every texel into one VPL and one surfel.
+ * position/area, normal and reflected flux into one layer (an area light's
+ * face: one tile of a layer) of three 2D array textures (plus depth, which
+ * direct shading reuses as its shadow map); a compute pass then turns every
+ * texel into one VPL and one surfel.
  */
+#include <math.h>
+
 #include "engine_internal.h"
 
 static GLuint array_texture(GLenum format, int size, int layers)
@@ -26,9 +29,9 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof e->light_block, &e->light_block);
 
     const int size = e->settings.rsm_size;
-    const int layers = e->face_count > 0 ? e->face_count : 1;
+    const int layers = e->rsm_layers > 0 ? e->rsm_layers : 1;
     e->rsm_size = size;
-    e->rsm_texels = (size_t)e->face_count * (size_t)size * (size_t)size;
+    e->rsm_texels = (size_t)e->rsm_layers * (size_t)size * (size_t)size;
     if (e->rsm_alloc_size == size && e->rsm_alloc_faces == layers)
         return 0;
 
@@ -84,16 +87,26 @@ void lpv_pass_rsm_run(lpv_engine *e)
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     GLint loc_vp = glGetUniformLocation(e->prog_rsm, "u_view_proj");
     GLint loc_face = glGetUniformLocation(e->prog_rsm, "u_face");
+    int bound_layer = -1;
     for (int f = 0; f < e->face_count; ++f) {
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->rsm_position, 0, f);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, e->rsm_normal, 0, f);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, e->rsm_flux, 0, f);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, e->rsm_albedo, 0, f);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->rsm_depth, 0, f);
-        static const float zero[4] = {0, 0, 0, 0};
-        for (int i = 0; i < 4; ++i)
-            glClearBufferfv(GL_COLOR, i, zero);
-        glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+        /* A face fills its layer, or (area lights) one tile of it: a layer is
+         * attached and cleared once, before its first face draws. */
+        const float *tile = e->light_block.faces[f].tile;
+        const int layer = (int)tile[3];
+        if (layer != bound_layer) {
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->rsm_position, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, e->rsm_normal, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, e->rsm_flux, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, e->rsm_albedo, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->rsm_depth, 0, layer);
+            static const float zero[4] = {0, 0, 0, 0};
+            for (int i = 0; i < 4; ++i)
+                glClearBufferfv(GL_COLOR, i, zero);
+            glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
+            bound_layer = layer;
+        }
+        const int side = (int)lroundf(tile[2] * (float)size);
+        glViewport((int)lroundf(tile[0] * (float)size), (int)lroundf(tile[1] * (float)size), side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
         glUniform1i(loc_face, f);
         lpv_engine_draw_scene(e, e->prog_rsm, 0); /* lights see both sides */
@@ -103,7 +116,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
     lpv_timer_end(&e->timer);
 
     lpv_timer_begin(&e->timer, "vpl_extract");
-    if (e->face_count > 0) {
+    if (e->rsm_layers > 0) {
         glUseProgram(e->prog_vpl_extract);
         GLuint tex[4] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo};
         for (int i = 0; i < 4; ++i) {
@@ -115,7 +128,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->surfels);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
         glDispatchCompute(lpv_div_up((size_t)size, LPV_WG_2D), lpv_div_up((size_t)size, LPV_WG_2D),
-                          (GLuint)e->face_count);
+                          (GLuint)e->rsm_layers);
         lpv_timer_count(&e->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }

@@ -20,12 +20,16 @@ static const char USAGE[] =
     "\n"
     "Path-traced indirect light (docs/reference.md): the image is albedo/pi * E_ind\n"
     "at the first surface of each pixel (what `lpvd render --indirect-only` shows);\n"
-    "points mode reads px,py,pz,nx,ny,nz lines and writes E_r,E_g,E_b,se_r,se_g,se_b\n"
-    "(W/m^2). Without SCENE: the built-in Cornell box.\n"
+    "with --full, the whole frame (what `lpvd render` shows); points mode reads\n"
+    "px,py,pz,nx,ny,nz lines and writes E_r,E_g,E_b,se_r,se_g,se_b (W/m^2).\n"
+    "Without SCENE: the built-in Cornell box.\n"
     "\n"
     "  -o PATH                 output image (.exr: float) or, with --points, CSV\n"
     "  --stderr PATH           per-pixel standard error image\n"
-    "  --bounces N             diffuse bounces (default 1 = lpvd's LPV term)\n"
+    "  --full                  the full frame: emission + direct + bounced light\n"
+    "  --area-lights on|off    on (default, as lpvd): emissive surfaces are lights, their\n"
+    "                          direct light is not in E_ind; off: it is (lpvd --area-lights off)\n"
+    "  --bounces N             diffuse bounces (default 1 = lpvd's LPV term; --full: 0..64)\n"
     "  --spp N                 samples per pixel or point (default 64)\n"
     "  --threads N             worker threads (default: the number of cores)\n"
     "  --seed N                RNG seed (default 0)\n"
@@ -154,7 +158,7 @@ done:
 int main(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *se_out = NULL, *points = NULL;
-    int bounces = 1, spp = 64, threads = 0;
+    int bounces = 1, spp = 64, threads = 0, full = 0, area_lights = 1;
     unsigned long long seed = 0;
     lpvd_options opt;
     memset(&opt, 0, sizeof opt);
@@ -176,9 +180,13 @@ int main(int argc, char **argv)
         }
         const char *name = a[1] == '-' ? a + 2 : a + 1;
         const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
+        if (strcmp(name, "full") == 0) {
+            full = 1;
+            continue;
+        }
         int takes = strcmp(name, "o") == 0 || strcmp(name, "stderr") == 0 || strcmp(name, "bounces") == 0 ||
                     strcmp(name, "spp") == 0 || strcmp(name, "threads") == 0 || strcmp(name, "seed") == 0 ||
-                    strcmp(name, "points") == 0 || is_camera_flag(name);
+                    strcmp(name, "points") == 0 || strcmp(name, "area-lights") == 0 || is_camera_flag(name);
         if (!takes) {
             fprintf(stderr, "lpvd-reference: unknown flag %s\n%s", a, USAGE);
             return 2;
@@ -194,9 +202,15 @@ int main(int argc, char **argv)
             se_out = val;
         } else if (strcmp(name, "points") == 0) {
             points = val;
+        } else if (strcmp(name, "area-lights") == 0) {
+            if (strcmp(val, "on") != 0 && strcmp(val, "off") != 0) {
+                fprintf(stderr, "lpvd-reference: --area-lights %s: expected on or off\n", val);
+                return 2;
+            }
+            area_lights = strcmp(val, "on") == 0;
         } else if (strcmp(name, "bounces") == 0) {
-            if (parse_int(val, 1, 64, &bounces) != 0) {
-                fprintf(stderr, "lpvd-reference: --bounces %s: expected 1..64\n", val);
+            if (parse_int(val, 0, 64, &bounces) != 0) {
+                fprintf(stderr, "lpvd-reference: --bounces %s: expected 1..64 (0..64 with --full)\n", val);
                 return 2;
             }
         } else if (strcmp(name, "spp") == 0) {
@@ -226,6 +240,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "lpvd-reference: -o is required\n%s", USAGE);
         return 2;
     }
+    if (bounces == 0 && !full) {
+        fprintf(stderr, "lpvd-reference: --bounces 0 needs --full (the indirect light has at least one bounce)\n");
+        return 2;
+    }
+    if (full && points) {
+        fprintf(stderr, "lpvd-reference: --full renders an image; it does not go with --points\n");
+        return 2;
+    }
 
     lpv_scene scene;
     if (lpv_scene_load(scene_path, &scene, err, sizeof err) != 0) {
@@ -233,7 +255,7 @@ int main(int argc, char **argv)
         return 1;
     }
     lpv_ref *ref = NULL;
-    lpv_ref_desc desc = {.threads = threads, .seed = seed};
+    lpv_ref_desc desc = {.threads = threads, .seed = seed, .emitters_are_lights = area_lights};
     double t0 = now_s();
     if (lpv_ref_create(&scene, &desc, &ref, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-reference: %s: %s\n", scene.source, err);
@@ -263,16 +285,21 @@ int main(int argc, char **argv)
         goto done_scene;
     }
     t0 = now_s();
-    lpv_ref_render_indirect(ref, &view, bounces, spp, img, se);
+    if (full)
+        lpv_ref_render_full(ref, &view, bounces, spp, img, se);
+    else
+        lpv_ref_render_indirect(ref, &view, bounces, spp, img, se);
     double secs = now_s() - t0;
     double rel = lpv_ref_mean_relative_stderr(img, se, view.width, view.height);
     if (lpv_image_write_f32(out, view.width, view.height, 4, img, err, sizeof err) != 0 ||
         (se_out && lpv_image_write_f32(se_out, view.width, view.height, 4, se, err, sizeof err) != 0)) {
         fprintf(stderr, "lpvd-reference: %s\n", err);
     } else {
-        printf("lpvd-reference: %s, %u triangles (build %.3f s), %dx%d, %d spp, %d bounce(s), %d threads, %.3f s, "
-               "mean relative standard error %.4g, wrote %s%s%s\n",
-               scene.source, lpv_ref_triangle_count(ref), build_s, view.width, view.height, spp, bounces,
+        printf("lpvd-reference: %s, %u triangles (build %.3f s), %dx%d, %s, %d spp, %d bounce(s), %d threads, "
+               "%.3f s, mean relative standard error %.4g, wrote %s%s%s\n",
+               scene.source, lpv_ref_triangle_count(ref), build_s, view.width, view.height,
+               full ? "full frame" : area_lights ? "indirect, area lights on" : "indirect, area lights off", spp,
+               bounces,
                lpv_ref_threads(ref), secs, rel, out, se_out ? " and " : "", se_out ? se_out : "");
         rc = 0;
     }

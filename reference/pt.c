@@ -46,6 +46,11 @@ struct lpv_ref {
     uint32_t texture_count;
     lpv_light *lights;
     uint32_t light_count;
+    /* emissive triangles for next-event estimation, by emitted power */
+    uint32_t *emitters;  /* triangle indices */
+    double *emitter_cdf; /* emitter_count + 1 running sums of (L_r + L_g + L_b) A */
+    uint32_t emitter_count;
+    int emitters_are_lights;
     int threads;
     uint64_t seed;
     float eps;
@@ -222,6 +227,39 @@ static int copy_materials(lpv_ref *r, const lpv_scene *s)
     return 0;
 }
 
+static double tri_area(const ref_tri *t)
+{
+    float c[3];
+    cross3(t->e1, t->e2, c);
+    return 0.5 * sqrt((double)dot3(c, c));
+}
+
+/* The emissive triangles and their power CDF, for next-event estimation. */
+static int build_emitters(lpv_ref *r)
+{
+    uint32_t n = 0;
+    for (uint32_t t = 0; t < r->tri_count; ++t)
+        n += r->tris[t].material >= 0 && r->materials[r->tris[t].material].emits;
+    if (!n)
+        return 0;
+    r->emitters = malloc(n * sizeof *r->emitters);
+    r->emitter_cdf = malloc((n + 1) * sizeof *r->emitter_cdf);
+    if (!r->emitters || !r->emitter_cdf)
+        return -1;
+    r->emitter_cdf[0] = 0.0;
+    for (uint32_t t = 0; t < r->tri_count; ++t) {
+        const ref_tri *tr = &r->tris[t];
+        if (tr->material < 0 || !r->materials[tr->material].emits)
+            continue;
+        const float *e = r->materials[tr->material].emission;
+        r->emitters[r->emitter_count] = t;
+        r->emitter_cdf[r->emitter_count + 1] =
+            r->emitter_cdf[r->emitter_count] + ((double)e[0] + e[1] + e[2]) * tri_area(tr);
+        r->emitter_count++;
+    }
+    return 0;
+}
+
 static int resolve_threads(int want)
 {
     if (want > 0)
@@ -245,6 +283,7 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
     }
     r->threads = resolve_threads(d.threads);
     r->seed = d.seed;
+    r->emitters_are_lights = d.emitters_are_lights != 0;
 
     /* Triangles. */
     size_t cap = 0;
@@ -284,6 +323,11 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
         }
         memcpy(r->lights, scene->lights, scene->light_count * sizeof *r->lights);
         r->light_count = scene->light_count;
+    }
+
+    if (build_emitters(r) != 0) {
+        lpv_error(err, err_size, "%s", "out of memory");
+        goto fail;
     }
 
     /* Ray offset from the kept triangles' bounds. */
@@ -364,6 +408,8 @@ void lpv_ref_destroy(lpv_ref *r)
     free(r->textures);
     free(r->materials);
     free(r->lights);
+    free(r->emitters);
+    free(r->emitter_cdf);
     free(r->tris);
     free(r);
 }
@@ -592,6 +638,53 @@ static void direct(const lpv_ref *r, const float p[3], const float ns[3], const 
     }
 }
 
+/* One sample of the irradiance at p from the emissive surfaces (front sides),
+ * by next-event estimation: a triangle by emitted power, a uniform point on
+ * it, a shadow ray. Unbiased; ns the cosine's normal, ng the side's. */
+static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const float ns[3], const float ng[3],
+                           double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    if (!r->emitter_count)
+        return;
+    const double total = r->emitter_cdf[r->emitter_count];
+    double u = (double)pcg32_float(rng) * total;
+    uint32_t lo = 0, hi = r->emitter_count - 1; /* first k with cdf[k + 1] > u */
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (r->emitter_cdf[mid + 1] > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    const ref_tri *tr = &r->tris[r->emitters[lo]];
+    const float *le = r->materials[tr->material].emission;
+    float s1 = sqrtf(pcg32_float(rng)), s2 = pcg32_float(rng);
+    float b1 = s1 * (1.0f - s2), b2 = s1 * s2, q[3], d[3];
+    for (int i = 0; i < 3; ++i) {
+        q[i] = tr->p0[i] + b1 * tr->e1[i] + b2 * tr->e2[i];
+        d[i] = q[i] - p[i];
+    }
+    float dist2 = dot3(d, d), dist = sqrtf(dist2), w[3];
+    if (!(dist > 2.0f * r->eps) || !isfinite(dist))
+        return;
+    for (int i = 0; i < 3; ++i)
+        w[i] = d[i] / dist;
+    float cos_r = dot3(ns, w), cos_e = -dot3(tr->front, w);
+    if (!(cos_r > 0.0f) || !(cos_e > 0.0f) || !(dot3(ng, w) > 0.0f))
+        return;
+    float org[3];
+    for (int i = 0; i < 3; ++i)
+        org[i] = p[i] + r->eps * ng[i];
+    if (occluded(r, org, w, dist - 2.0f * r->eps))
+        return;
+    /* pdf per unit area of the point: weight(tr) / total */
+    double weight = ((double)le[0] + le[1] + le[2]);
+    double g = (double)cos_r * cos_e / dist2 * total / weight;
+    for (int i = 0; i < 3; ++i)
+        out[i] = le[i] * g;
+}
+
 void lpv_ref_direct_irradiance(const lpv_ref *r, const float p[3], const float n[3], float out_rgb[3])
 {
     float nu[3];
@@ -642,19 +735,67 @@ static void sample_path(const lpv_ref *r, pcg32 *rng, const float p_in[3], const
     }
 }
 
+/* With the emissive surfaces as lights (next-event estimation, never hit
+ * by chance): one sample of (with_direct: the emitters' direct irradiance at
+ * p, plus) pi x the radiance arriving along one cosine-distributed direction
+ * after 1..bounces diffuse reflections of direct light (punctual and
+ * emitted) - already an irradiance, unlike sample_path's radiance. */
+static void sample_path_lights(const lpv_ref *r, pcg32 *rng, const float p_in[3], const float ns_in[3],
+                               const float ng_in[3], int bounces, int with_direct, double out[3])
+{
+    float p[3], ns[3], ng[3];
+    double thr[3] = {1.0, 1.0, 1.0};
+    memcpy(p, p_in, sizeof p);
+    memcpy(ns, ns_in, sizeof ns);
+    memcpy(ng, ng_in, sizeof ng);
+    out[0] = out[1] = out[2] = 0.0;
+    if (with_direct)
+        emitter_direct(r, rng, p, ns, ng, out);
+    for (int depth = 1; depth <= bounces; ++depth) {
+        float dir[3], org[3];
+        sample_cosine(rng, ns, dir);
+        if (!(dot3(dir, ng) > 0.0f))
+            break;
+        for (int i = 0; i < 3; ++i)
+            org[i] = p[i] + r->eps * ng[i];
+        hit h;
+        if (!intersect(r, org, dir, 0.0f, INFINITY, &h))
+            break;
+        float alb[3], ed[3] = {0.0f, 0.0f, 0.0f};
+        double ee[3] = {0.0, 0.0, 0.0};
+        hit_albedo(r, &h, alb);
+        if (!(alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f))
+            break;
+        direct(r, h.p, h.ns, h.ng, ed);
+        emitter_direct(r, rng, h.p, h.ns, h.ng, ee);
+        /* E = pi L, L = albedo / pi * E_direct(q): pi cancels */
+        for (int i = 0; i < 3; ++i) {
+            thr[i] *= alb[i];
+            out[i] += thr[i] * ((double)ed[i] + ee[i]);
+        }
+        memcpy(p, h.p, sizeof p);
+        memcpy(ns, h.ns, sizeof ns);
+        memcpy(ng, h.ng, sizeof ng);
+    }
+}
+
 /* E_ind and its standard error at one point, from `samples` samples of the
- * streams (index, 0..samples-1). */
-static void estimate(const lpv_ref *r, uint64_t index, const float p[3], const float ns[3], const float ng[3],
-                     int bounces, int samples, float e[3], float se[3])
+ * streams (index, 0..samples-1). with_direct (emitters as lights only): add
+ * the emitters' direct irradiance (the full image's estimate). */
+static void estimate_mode(const lpv_ref *r, uint64_t index, const float p[3], const float ns[3], const float ng[3],
+                          int bounces, int samples, int lights_mode, int with_direct, float e[3], float se[3])
 {
     double sum[3] = {0, 0, 0}, sq[3] = {0, 0, 0};
     for (int s = 0; s < samples; ++s) {
         pcg32 rng;
         pcg32_seed(&rng, r->seed, index, (uint64_t)s);
         double l[3];
-        sample_path(r, &rng, p, ns, ng, bounces, l);
+        if (lights_mode)
+            sample_path_lights(r, &rng, p, ns, ng, bounces, with_direct, l);
+        else
+            sample_path(r, &rng, p, ns, ng, bounces, l);
         for (int i = 0; i < 3; ++i) {
-            double v = PT_PI * l[i];
+            double v = lights_mode ? l[i] : PT_PI * l[i];
             sum[i] += v;
             sq[i] += v * v;
         }
@@ -666,6 +807,12 @@ static void estimate(const lpv_ref *r, uint64_t index, const float p[3], const f
         e[i] = (float)mean;
         se[i] = (float)sqrt(var / n);
     }
+}
+
+static void estimate(const lpv_ref *r, uint64_t index, const float p[3], const float ns[3], const float ng[3],
+                     int bounces, int samples, float e[3], float se[3])
+{
+    estimate_mode(r, index, p, ns, ng, bounces, samples, r->emitters_are_lights, 0, e, se);
 }
 
 /* ---- threading ------------------------------------------------------------- */
@@ -683,6 +830,7 @@ typedef struct job {
     const lpv_view *view;
     float *rgba, *rgba_se;
     int bounces, samples;
+    int full;  /* image mode: the full frame */
 } job;
 
 static void *worker(void *arg)
@@ -800,12 +948,19 @@ static void pixel_item(job *j, size_t i)
     hit h;
     if (!finite3(org) || !finite3(dir) || !intersect(j->ref, org, dir, tmin, tmax, &h))
         return;
-    float alb[3], e[3] = {0, 0, 0}, se[3] = {0, 0, 0};
+    float alb[3], e[3] = {0, 0, 0}, se[3] = {0, 0, 0}, ed[3] = {0, 0, 0};
     hit_albedo(j->ref, &h, alb);
-    if (alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f)
-        estimate(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, e, se);
+    if (alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f) {
+        if (j->full) { /* direct light (punctual exactly, emitters sampled) and the bounces */
+            estimate_mode(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, 1, 1, e, se);
+            direct(j->ref, h.p, h.ns, h.ng, ed);
+        } else {
+            estimate(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, e, se);
+        }
+    }
+    const float *le = j->full ? hit_emission(j->ref, &h) : NULL;
     for (int c = 0; c < 3; ++c) {
-        px[c] = (float)(alb[c] / PT_PI) * e[c];
+        px[c] = (float)(alb[c] / PT_PI) * (e[c] + ed[c]) + (le ? le[c] : 0.0f);
         if (pse)
             pse[c] = (float)(alb[c] / PT_PI) * se[c];
     }
@@ -821,6 +976,48 @@ int lpv_ref_render_indirect(const lpv_ref *r, const lpv_view *view, int bounces,
     job j = {.ref = r, .count = (size_t)view->width * (size_t)view->height, .item = pixel_item, .view = view,
              .rgba = rgba, .rgba_se = rgba_se, .bounces = bounces, .samples = spp};
     run_job(&j);
+    return 0;
+}
+
+int lpv_ref_render_full(const lpv_ref *r, const lpv_view *view, int bounces, int spp, float *rgba, float *rgba_se)
+{
+    if (!r || !view || !rgba || view->width < 1 || view->height < 1 || bounces < 0 || spp < 1)
+        return -1;
+    job j = {.ref = r, .count = (size_t)view->width * (size_t)view->height, .item = pixel_item, .view = view,
+             .rgba = rgba, .rgba_se = rgba_se, .bounces = bounces, .samples = spp, .full = 1};
+    run_job(&j);
+    return 0;
+}
+
+int lpv_ref_emitter_irradiance(const lpv_ref *r, const float *points, const float *normals, size_t n, int samples,
+                               float *out_rgb, float *out_stderr_rgb)
+{
+    if (!r || (n && (!points || !normals)) || samples < 1)
+        return -1;
+    for (size_t i = 0; i < n; ++i) {
+        float nu[3];
+        double sum[3] = {0, 0, 0}, sq[3] = {0, 0, 0};
+        const float *p = &points[3 * i];
+        if (finite3(p) && unit3(&normals[3 * i], nu))
+            for (int s = 0; s < samples; ++s) {
+                pcg32 rng;
+                pcg32_seed(&rng, r->seed, (uint64_t)i, (uint64_t)s);
+                double v[3];
+                emitter_direct(r, &rng, p, nu, nu, v);
+                for (int c = 0; c < 3; ++c) {
+                    sum[c] += v[c];
+                    sq[c] += v[c] * v[c];
+                }
+            }
+        for (int c = 0; c < 3; ++c) {
+            double mean = sum[c] / samples;
+            double var = samples > 1 ? fmax(0.0, (sq[c] - sum[c] * mean) / (samples - 1.0)) : 0.0;
+            if (out_rgb)
+                out_rgb[3 * i + (size_t)c] = (float)mean;
+            if (out_stderr_rgb)
+                out_stderr_rgb[3 * i + (size_t)c] = (float)sqrt(var / samples);
+        }
+    }
     return 0;
 }
 

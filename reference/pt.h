@@ -14,7 +14,16 @@
  * KHR_lights_punctual falloffs of shaders/lights.glsl), L_e the material's
  * emission on the front side of an emissive triangle (core/emissive.c's rule),
  * n_q the surface normal on the side the ray arrived from. b = 1 is the term
- * lpvd's LPV approximates (`lpvd render --indirect-only` = albedo/pi * E_lpv).
+ * lpvd's LPV approximates with area lights off (`lpvd render --indirect-only
+ * --area-lights off` = albedo/pi * E_lpv).
+ *
+ * With emitters_are_lights (lpvd's default, area lights on) the emissive
+ * surfaces are light sources like the punctual lights: E_direct(q) also holds
+ * their shadowed irradiance (next-event estimation on the emitters by power),
+ * L_e is never counted when a path hits an emitter, and E_ind(p, n, b) is
+ * b diffuse reflections of that direct light, without the direct light at p.
+ * The full image (lpv_ref_render_full) is the same in both modes:
+ *   L = L_e(p) + albedo/pi * (E_direct(p) + E_ind(p, n, b))   (emitters as lights)
  *
  * Monte Carlo: cosine-weighted hemisphere samples, E = pi * mean(L); every
  * estimate carries its standard error (sample std / sqrt(n)). Each pixel or
@@ -36,6 +45,9 @@ typedef struct lpv_ref_desc {
     int threads;       /* worker threads; 0 = the number of online cores */
     uint64_t seed;     /* mixed into every RNG stream; 0 = the default stream */
     float ray_epsilon; /* m; ray offset off surfaces; 0 = 1e-4 x bounds diagonal (>= 1e-6) */
+    int emitters_are_lights; /* 1: emissive surfaces are lights (their direct light is not in E_ind),
+                                the split lpvd makes with area lights on; 0: emission seen directly
+                                is part of E_ind (area lights off) */
 } lpv_ref_desc;
 
 /* Builds the reference for a scene (copied: the scene may be freed after).
@@ -72,6 +84,23 @@ int lpv_ref_irradiance(const lpv_ref *ref, const float *points, const float *nor
  * channel (alpha: as the image). Returns 0, or -1 on bad arguments. */
 int lpv_ref_render_indirect(const lpv_ref *ref, const lpv_view *view, int bounces, int samples_per_pixel,
                             float *rgba_radiance, float *rgba_stderr);
+
+/* The full image: per pixel L_e (front side) + albedo/pi * (E_direct +
+ * E_ind(bounces)) at the first surface, emitters as lights whatever the
+ * desc says: bounces = diffuse reflections of direct light, punctual and
+ * emitted alike (1 = what lpvd's full frame approximates; 0 = direct only).
+ * Punctual light is exact, the emitters' direct light and the bounces are
+ * sampled (samples_per_pixel each); rgba_stderr (may be NULL) as in
+ * lpv_ref_render_indirect. Returns 0, or -1 on bad arguments. */
+int lpv_ref_render_full(const lpv_ref *ref, const lpv_view *view, int bounces, int samples_per_pixel,
+                        float *rgba_radiance, float *rgba_stderr);
+
+/* The emissive surfaces' shadowed direct irradiance (W/m^2, rgb) at n points
+ * (normals need not be unit), by next-event estimation with `samples`
+ * samples each; out_stderr_rgb (may be NULL) its standard error. Returns 0,
+ * or -1 on bad arguments. */
+int lpv_ref_emitter_irradiance(const lpv_ref *ref, const float *points, const float *normals, size_t n, int samples,
+                               float *out_rgb, float *out_stderr_rgb);
 
 /* The primary ray of pixel (x, y) through its centre, the inverse of
  * lpv_view_project: origin, unit direction, and the [tmin, tmax] range the

@@ -15,8 +15,14 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  whose beam crosses the view.
   smoke.glb      MEDIA: the room with a boxed 8x8x8 density texture of a soft
                  blob of smoke (sigma_s 0.5 1/m) lit by a spot light.
+  emissive-room.glb  EMISSIVE ONLY (issue 10, docs/area-lights.md): the room lit
+                 by two emissive surfaces and nothing else: a ceiling panel
+                 (one quad facing down) and a wall strip (one quad facing into
+                 the room); a table and a block cast their shadows.
 
-Every object is an axis-aligned box (12 triangles); each material is one mesh.
+Every object is an axis-aligned box (12 triangles) or a quad (2 triangles, its
+front the side its corners run counter-clockwise around); each material is one
+mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits).
 lpvd divides the photometric light units by 683 lm/W (docs/units.md); the
 medium format is in docs/scenes.md.
 
@@ -83,20 +89,25 @@ def look_rotation(forward, up=(0.0, 1.0, 0.0)):
 
 class Scene:
     def __init__(self):
-        self.materials = []  # (name, rgb, roughness)
+        self.materials = []  # (name, rgb, roughness, emission): emission None or (rgb factor, strength in nits)
         self.boxes = {}      # material index -> list of (lo, hi)
+        self.quads = {}      # material index -> list of 4 corners (counter-clockwise seen from the front)
         self.nodes = []
         self.lights = []
         self.cameras = []
         self.medium = None   # lpvd_medium object for the scene's extras, or None
 
-    def material(self, name, rgb, roughness=1.0):
-        self.materials.append((name, rgb, roughness))
+    def material(self, name, rgb, roughness=1.0, emission=None):
+        self.materials.append((name, rgb, roughness, emission))
         self.boxes[len(self.materials) - 1] = []
+        self.quads[len(self.materials) - 1] = []
         return len(self.materials) - 1
 
     def add_box(self, mat, lo, hi):
         self.boxes[mat].append((lo, hi))
+
+    def add_quad(self, mat, corners):
+        self.quads[mat].append(corners)
 
     def light(self, name, light, position, target):
         self.lights.append(dict(light, name=name))
@@ -125,13 +136,21 @@ class Scene:
             blob.extend(data)
             return len(views) - 1
 
-        for m, (name, _, _) in enumerate(self.materials):
+        for m, (name, _, _, _) in enumerate(self.materials):
             pos, nrm, idx = [], [], []
             for lo, hi in self.boxes[m]:
                 p, n, i = box(lo, hi)
                 idx.extend(len(pos) + k for k in i)
                 pos.extend(p)
                 nrm.extend(n)
+            for q in self.quads[m]:
+                e1 = tuple(b - a for a, b in zip(q[0], q[1]))
+                e2 = tuple(b - a for a, b in zip(q[0], q[2]))
+                n = normalize(cross(e1, e2))
+                base = len(pos)
+                pos.extend(q)
+                nrm.extend([n] * 4)
+                idx.extend([base, base + 1, base + 2, base, base + 2, base + 3])
             if not pos:
                 continue
             triangles += len(idx) // 3
@@ -154,22 +173,31 @@ class Scene:
         scene = {"nodes": list(range(len(nodes)))}
         if self.medium is not None:
             scene["extras"] = {"lpvd_medium": self.medium}
-        doc = {
-            "asset": {"version": "2.0", "generator": "lpvd scenes/make_scenes.py"},
-            "extensionsUsed": ["KHR_lights_punctual"],
-            "extensions": {"KHR_lights_punctual": {"lights": self.lights}},
+        materials = []
+        for n, c, r, e in self.materials:
+            mat = {"name": n, "pbrMetallicRoughness": {"baseColorFactor": list(c) + [1.0],
+                                                       "metallicFactor": 0.0, "roughnessFactor": r}}
+            if e is not None:
+                mat["emissiveFactor"] = list(e[0])
+                mat["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": e[1]}}
+            materials.append(mat)
+        used = ["KHR_lights_punctual"] if self.lights else []
+        if any(e is not None for _, _, _, e in self.materials):
+            used.append("KHR_materials_emissive_strength")
+        doc = {"asset": {"version": "2.0", "generator": "lpvd scenes/make_scenes.py"}, "extensionsUsed": used}
+        if self.lights:
+            doc["extensions"] = {"KHR_lights_punctual": {"lights": self.lights}}
+        doc.update({
             "scene": 0,
             "scenes": [scene],
             "nodes": nodes,
             "meshes": meshes,
-            "materials": [{"name": n, "pbrMetallicRoughness": {"baseColorFactor": list(c) + [1.0],
-                                                               "metallicFactor": 0.0, "roughnessFactor": r}}
-                          for n, c, r in self.materials],
+            "materials": materials,
             "cameras": self.cameras,
             "buffers": [{"byteLength": len(blob)}],
             "bufferViews": views,
             "accessors": accessors,
-        }
+        })
         js = json.dumps(doc, separators=(",", ":")).encode()
         js += b" " * (-len(js) % 4)
         out = struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(js) + 8 + len(blob))
@@ -300,10 +328,29 @@ def smoke():
     return s
 
 
+def emissive_room():
+    s = Scene()
+    room(s)
+    wood = s.material("table_wood", (0.55, 0.35, 0.18))
+    block = s.material("block_white", (0.80, 0.80, 0.80))
+    # 2 W/(m^2 sr) (1366 nits / 683 lm/W): a 1.2 x 0.6 m panel 5 cm under the ceiling, facing down
+    panel = s.material("ceiling_panel", (0.9, 0.9, 0.9), emission=((1.0, 0.95, 0.85), 1366.0))
+    s.add_quad(panel, [(-0.6, 2.95, -0.3), (0.6, 2.95, -0.3), (0.6, 2.95, 0.3), (-0.6, 2.95, 0.3)])
+    # a warm strip on the back wall, 1.6 x 0.15 m at 1.8 m, facing into the room (+z)
+    strip = s.material("wall_strip", (0.9, 0.9, 0.9), emission=((1.0, 0.6, 0.3), 2049.0))
+    s.add_quad(strip, [(-0.8, 1.75, -1.99), (0.8, 1.75, -1.99), (0.8, 1.9, -1.99), (-0.8, 1.9, -1.99)])
+    s.add_box(wood, (-0.7, 0.72, -0.5), (0.5, 0.77, 0.3))     # table top under the panel
+    for x, z in ((-0.65, -0.45), (0.45, -0.45), (-0.65, 0.25), (0.45, 0.25)):
+        s.add_box(wood, (x, 0.0, z), (x + 0.05, 0.72, z + 0.05))  # its legs
+    s.add_box(block, (0.9, 0.0, -1.5), (1.5, 1.1, -0.9))      # a block near the back wall
+    s.camera("Camera", (1.4, 1.7, 1.9), (-0.5, 0.7, -0.8), 65.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
-                        ("smoke", smoke)):
+                        ("smoke", smoke), ("emissive-room", emissive_room)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

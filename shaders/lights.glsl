@@ -1,5 +1,6 @@
 // lights.glsl - punctual lights (KHR_lights_punctual semantics, radiometric
-// units): the power each light delivers, shared by the RSMs and direct shading.
+// units) and area light samples (docs/area-lights.md): the power each light
+// delivers, shared by the RSMs and direct shading.
 layout(std140, binding = LPV_UBO_LIGHT) uniform LightUBO { LpvLightBlock L; };
 
 // glTF's recommended smooth cone falloff: (clamp((cos - cos_outer) / (cos_inner - cos_outer)))^2.
@@ -36,6 +37,8 @@ vec3 light_irradiance_normal(LpvLightGpu li, vec3 p, out vec3 to_light)
     float dist2 = max(dot(d, d), 1e-12);
     float dist = sqrt(dist2);
     to_light = d / dist;
+    if (int(li.position_type.w) == LPV_LIGHT_TYPE_AREA) // cosine emission; a disc of area A on its axis
+        return li.intensity.rgb * max(0.0, dot(-to_light, li.direction_range.xyz)) / (dist2 + li.intensity.a);
     return li.intensity.rgb * spot_factor(li, -to_light) * range_window(li, dist) / dist2;
 }
 
@@ -44,6 +47,14 @@ vec3 light_irradiance_normal(LpvLightGpu li, vec3 p, out vec3 to_light)
 int light_face_for(LpvLightGpu li, vec3 p)
 {
     int first = int(li.cone_faces.z);
+    if (int(li.position_type.w) == LPV_LIGHT_TYPE_AREA) { // the face whose axis is nearest p's direction
+        vec3 d = p - li.position_type.xyz;
+        int best = first;
+        for (int k = 1; k < int(li.cone_faces.w); ++k)
+            if (dot(d, L.faces[first + k].axis.xyz) > dot(d, L.faces[best].axis.xyz))
+                best = first + k;
+        return best;
+    }
     if (int(li.cone_faces.w) < 6)
         return first;
     vec3 d = p - li.position_type.xyz;

@@ -145,19 +145,28 @@ struct LpvGridParams {
 /* ---- Lights and their shadow-map faces (uniform block, std140) ------------
  * Every light renders a reflective shadow map (RSM) into one or more layers
  * of 2D array textures: 1 for directional and spot lights, 6 (cube faces)
- * for point lights and for spots wider than LPV_SPOT_MAX_SINGLE_FACE. */
-#define LPV_MAX_LIGHTS 16
-#define LPV_MAX_FACES 48
+ * for point lights and for spots wider than LPV_SPOT_MAX_SINGLE_FACE.
+ * Area light samples (emissive surfaces, docs/area-lights.md) come after the
+ * punctual lights: 5 faces each (the front and the four sides of a cube
+ * around the emitter's normal; the back face would see no emission), each a
+ * square tile of a layer (gpu/light_faces.c says how big). */
+#define LPV_MAX_LIGHTS 16      /* punctual lights */
+#define LPV_MAX_AREA_LIGHTS 64 /* area light samples */
+#define LPV_AREA_FACES 5
+#define LPV_MAX_FACES (48 + LPV_AREA_FACES * LPV_MAX_AREA_LIGHTS)
 #define LPV_SPOT_MAX_SINGLE_FACE 1.3962634f /* 80 deg half angle */
 
 #define LPV_LIGHT_TYPE_DIRECTIONAL 0
 #define LPV_LIGHT_TYPE_POINT 1
 #define LPV_LIGHT_TYPE_SPOT 2
+#define LPV_LIGHT_TYPE_AREA 3 /* a sample of an emitter: I(w) = I max(0, <n, w>) */
 
 struct LpvLightGpu {
     vec4 position_type;   /* xyz world position (m); w = LPV_LIGHT_TYPE_* */
-    vec4 direction_range; /* xyz unit travel direction; w = range (m), 0 = unlimited */
-    vec4 intensity;       /* rgb: W/sr (point, spot) or W/m^2 (directional); a unused */
+    vec4 direction_range; /* xyz unit travel direction (area: the emitter's normal); w = range (m), 0 = unlimited */
+    vec4 intensity;       /* rgb: W/sr (point, spot; area: along the normal) or W/m^2 (directional);
+                             a: area only, A/pi (m^2) for the samples' A m^2 of emitter: the
+                             falloff is 1/(d^2 + A/pi), a disc of area A's on its axis */
     vec4 cone_faces;      /* x cos(inner), y cos(outer), z first face, w face count */
 };
 
@@ -165,13 +174,16 @@ struct LpvFaceGpu {
     mat4 view_proj;       /* world -> clip of this RSM / shadow-map face */
     vec4 info;            /* x light index; y 1 perspective, 0 orthographic;
                              z texel footprint: m^2 (ortho) or tan(fov/2) (persp);
-                             w RSM size in texels */
-    vec4 axis;            /* xyz unit view axis of the face; w unused */
+                             w this face's side in texels */
+    vec4 axis;            /* xyz unit view axis of the face; w 1 = its surfels stay out of the
+                             geometry volume (another face already sees those surfaces) */
+    vec4 tile;            /* where the face lies in the RSM textures: xy lower-left corner (uv),
+                             z side (uv, 1 = the whole layer), w layer */
 };
 
 struct LpvLightBlock {
-    vec4 counts;          /* x lights, y faces */
-    LPV_STRUCT(LpvLightGpu) lights[LPV_MAX_LIGHTS];
+    vec4 counts;          /* x lights (punctual first, then area samples), y faces, z punctual lights */
+    LPV_STRUCT(LpvLightGpu) lights[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
     LPV_STRUCT(LpvFaceGpu) faces[LPV_MAX_FACES];
 };
 

@@ -58,6 +58,8 @@ void main()
     o_normal = vec4(n, 1.0);
     o_flux = vec4(albedo * power, u_object_size);
     // a: 1 = blocks light in the geometry volume; emitters do not (they are
-    // light sources, and the planner counts only non-emissive triangles)
-    o_albedo = vec4(albedo, any(greaterThan(u_emission, vec3(0.0))) ? 0.0 : 1.0);
+    // light sources, and the planner counts only non-emissive triangles), nor
+    // do surfaces seen from a face marked so (F.axis.w: another area light
+    // sample already brings them)
+    o_albedo = vec4(albedo, any(greaterThan(u_emission, vec3(0.0))) || F.axis.w != 0.0 ? 0.0 : 1.0);
 }

@@ -25,6 +25,10 @@ float shadow_visibility(int l, vec3 p, vec3 n)
     if (any(greaterThan(abs(ndc.xy), vec2(1.0))))
         return F.info.y == 0.0 ? 1.0 : 0.0;
     vec3 uvz = ndc * 0.5 + 0.5;
-    return texture(u_shadow, vec4(uvz.xy, float(face), uvz.z - 1e-4));
+    // F.tile: the face's square of its layer (area light faces are tiles),
+    // kept half a texel inside so the filter never reads a neighbouring tile
+    float half_texel = 0.5 * F.tile.z / F.info.w;
+    vec2 uv = clamp(F.tile.xy + uvz.xy * F.tile.z, F.tile.xy + half_texel, F.tile.xy + F.tile.z - half_texel);
+    return texture(u_shadow, vec4(uv, F.tile.w, uvz.z - 1e-4));
 }
 

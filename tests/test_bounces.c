@@ -56,6 +56,10 @@ static lpv_settings box_settings(int iterations, lpv_switch bounces, float inten
     s.occlusion = LPV_SWITCH_ON;
     s.bounces = bounces;
     s.bounce_intensity = intensity;
+    /* The panel's light must enter the LPV itself (as VPLs) for these tests,
+     * which watch what the propagation does with it; with area lights on it
+     * would light the box directly and only the walls' reflection would. */
+    s.area_lights = LPV_SWITCH_OFF;
     return s;
 }
 

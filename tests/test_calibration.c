@@ -218,8 +218,11 @@ static void test_wall_injected_flux_and_exitance(void **state)
     lpv_scene_free(&s);
 }
 
-/* The other source of indirect light: an emissive wall of radiance Le sends
- * pi Le A through its front (emissive VPLs, core/emissive.c). */
+/* An emissive wall of radiance Le emits pi Le A through its front. With area
+ * lights off that flux enters the LPV as the emitter's own VPLs
+ * (core/emissive.c); with area lights on (the default) it lights the scene
+ * directly and the emitter injects nothing of its own: alone in the scene,
+ * the injected LPV is exactly 0 (no double count, docs/area-lights.md). */
 static void test_emissive_wall_injected_flux(void **state)
 {
     (void)state;
@@ -229,13 +232,18 @@ static void test_emissive_wall_injected_flux(void **state)
     const float wall[4][3] = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
     assert_true(lpv_scene_add_quad(&s, m, wall, NULL) >= 0);
     lpv_scene_compute_bounds(&s);
-    lpv_settings set = {0};
+    lpv_settings set = {.area_lights = LPV_SWITCH_OFF};
     engine_run(&s, &set, NULL);
     double flux[3], want = M_PI * le * 4.0 * h * h;
     injected_flux(flux);
-    printf("calibration: emissive wall Le = %.2f W/(m^2 sr): injected flux %.4f W (pi Le A = %.4f)\n", (double)le,
-           flux[1], want);
+    printf("calibration: emissive wall Le = %.2f W/(m^2 sr), area lights off: injected flux %.4f W (pi Le A = %.4f)\n",
+           (double)le, flux[1], want);
     assert_true(fabs(flux[1] - want) < 1e-4 * want);
+    set.area_lights = LPV_SWITCH_ON;
+    engine_run(&s, &set, NULL);
+    injected_flux(flux);
+    printf("calibration: the same wall, area lights on: injected flux %.4g W (its light is direct now)\n", flux[1]);
+    assert_true(flux[0] == 0.0 && flux[1] == 0.0 && flux[2] == 0.0);
     lpv_scene_free(&s);
 }
 

@@ -1,7 +1,9 @@
 /*
- * test_emissive.c - emissive surfaces as VPLs: the samples carry exactly
- * the surfaces' emitted flux (pi * L * A), sit on the emitters, face the way
- * the emitter faces, and are the same every time.
+ * test_emissive.c - emissive surfaces as VPLs (area lights off) and as area
+ * light samples (core/area_lights.h): either way the samples carry exactly
+ * the surfaces' emitted flux (pi * L * A, per channel), sit on the emitters,
+ * face the way the emitter faces, and are the same every time; area light
+ * samples are exactly as many as asked for.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -12,7 +14,9 @@
 
 #include <cmocka.h>
 
+#include "area_lights.h"
 #include "emissive.h"
+#include "scene_build.h"
 #include "scene.h"
 
 static void test_cornell_light_quad(void **state)
@@ -68,11 +72,130 @@ static void test_no_emitters(void **state)
     lpv_scene_free(&s);
 }
 
+/* Flux per channel of the samples (pi x intensity, W). */
+static void samples_flux(const lpv_area_sample *a, size_t n, double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c)
+            out[c] += M_PI * a[i].intensity[c];
+}
+
+static void test_area_samples_cornell(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    assert_int_equal(lpv_scene_builtin_cornell(&s), 0);
+    lpv_emitter_list l;
+    assert_int_equal(lpv_emitters_collect(&s, &l), 0);
+    assert_int_equal(l.count, 2);
+    assert_int_equal(l.surfaces, 1);
+    double total[3];
+    lpv_emissive_total_flux(&s, total);
+    lpv_area_sample a[LPV_MAX_AREA_SAMPLES], b[LPV_MAX_AREA_SAMPLES];
+    const size_t counts[] = {1, 2, 3, 8, 13, LPV_MAX_AREA_SAMPLES};
+    for (size_t k = 0; k < sizeof counts / sizeof counts[0]; ++k) {
+        size_t n = lpv_area_lights_sample(&l, counts[k], a);
+        assert_int_equal(n, counts[k]);
+        double f[3], area = 0.0;
+        samples_flux(a, n, f);
+        for (int c = 0; c < 3; ++c)
+            assert_true(fabs(f[c] - total[c]) < 1e-5 * total[c]);
+        for (size_t i = 0; i < n; ++i) {
+            assert_true(fabsf(a[i].position[1] - 1.98f) < 1e-4f); /* on the quad */
+            assert_true(a[i].position[0] >= -0.25f && a[i].position[0] <= 0.24f);
+            assert_true(a[i].normal[1] < -0.99f);                  /* facing down into the room */
+            assert_true(a[i].area > 0.0f);
+            area += a[i].area;
+        }
+        assert_true(fabs(area - 0.47 * 0.38) < 2e-3 * 0.47 * 0.38); /* the quad's area, shared out */
+        /* equal power each */
+        for (size_t i = 0; i < n; ++i)
+            assert_true(fabs(M_PI * a[i].intensity[0] - total[0] / (double)n) < 1e-4 * total[0]);
+        assert_int_equal(lpv_area_lights_sample(&l, counts[k], b), n); /* deterministic */
+        assert_memory_equal(a, b, n * sizeof *a);
+    }
+    /* one sample: the quad's centre (its two triangles are coplanar) */
+    assert_int_equal(lpv_area_lights_sample(&l, 1, a), 1);
+    double cx = 0.0, cz = 0.0;
+    for (size_t t = 0; t < l.count; ++t)
+        for (int v = 0; v < 3; ++v) {
+            cx += l.tris[t].p[v][0] * l.tris[t].area;
+            cz += l.tris[t].p[v][2] * l.tris[t].area;
+        }
+    double wsum = 3.0 * (l.tris[0].area + l.tris[1].area);
+    assert_true(fabs(a[0].position[0] - cx / wsum) < 1e-3 && fabs(a[0].position[2] - cz / wsum) < 1e-3);
+    /* four samples: four different places */
+    assert_int_equal(lpv_area_lights_sample(&l, 4, a), 4);
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+            assert_true(hypotf(a[i].position[0] - a[j].position[0], a[i].position[2] - a[j].position[2]) > 0.05f);
+    lpv_emitters_free(&l);
+    lpv_scene_free(&s);
+}
+
+/* Two emitters of different colours and many small triangles: more
+ * triangles than samples, and each channel's flux is still exact. */
+static void test_area_samples_many_triangles(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    int warm = lpv_scene_add_material(&s, "warm", (float[3]){0, 0, 0}, (float[3]){3.0f, 1.0f, 0.2f});
+    int cold = lpv_scene_add_material(&s, "cold", (float[3]){0, 0, 0}, (float[3]){0.1f, 0.5f, 2.0f});
+    for (int i = 0; i < 40; ++i) { /* 40 small quads facing down in a row, then a box glowing all round */
+        float x = 0.1f * (float)i;
+        const float q[4][3] = {{x, 2, 0}, {x + 0.1f, 2, 0}, {x + 0.1f, 2, 0.1f}, {x, 2, 0.1f}};
+        assert_true(lpv_scene_add_quad(&s, warm, q, NULL) >= 0);
+    }
+    assert_true(lpv_scene_add_box(&s, cold, (float[3]){-1, 0, -1}, (float[3]){-0.5f, 0.5f, -0.5f}) >= 0);
+    lpv_scene_compute_bounds(&s);
+    lpv_emitter_list l;
+    assert_int_equal(lpv_emitters_collect(&s, &l), 0);
+    assert_int_equal(l.count, 40 * 2 + 12);
+    assert_int_equal(l.surfaces, 41);
+    double total[3];
+    lpv_emissive_total_flux(&s, total);
+    lpv_area_sample a[LPV_MAX_AREA_SAMPLES];
+    for (size_t k = 1; k <= LPV_MAX_AREA_SAMPLES; k *= 2) {
+        assert_int_equal(lpv_area_lights_sample(&l, k, a), k);
+        double f[3];
+        samples_flux(a, k, f);
+        for (int c = 0; c < 3; ++c)
+            assert_true(fabs(f[c] - total[c]) < 1e-5 * total[c]);
+        for (size_t i = 0; i < k; ++i) { /* on an emitter, facing out of it */
+            int on_row = fabsf(a[i].position[1] - 2.0f) < 1e-4f && a[i].normal[1] < -0.99f;
+            int on_box = a[i].position[0] >= -1.0001f && a[i].position[0] <= -0.4999f && a[i].position[1] >= -1e-4f &&
+                         a[i].position[1] <= 0.5001f;
+            assert_true(on_row || on_box);
+        }
+    }
+    lpv_emitters_free(&l);
+    lpv_scene_free(&s);
+}
+
+static void test_area_samples_none(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.5f, 0.5f, 0.5f}, NULL);
+    const float q[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+    assert_true(lpv_scene_add_quad(&s, grey, q, NULL) >= 0);
+    lpv_emitter_list l;
+    assert_int_equal(lpv_emitters_collect(&s, &l), 0);
+    assert_int_equal(l.count, 0);
+    lpv_area_sample a[4];
+    assert_int_equal(lpv_area_lights_sample(&l, 4, a), 0);
+    assert_int_equal(lpv_area_lights_sample(NULL, 4, a), 0);
+    lpv_emitters_free(&l);
+    lpv_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_cornell_light_quad),
-        cmocka_unit_test(test_no_emitters),
+        cmocka_unit_test(test_cornell_light_quad),         cmocka_unit_test(test_no_emitters),
+        cmocka_unit_test(test_area_samples_cornell),       cmocka_unit_test(test_area_samples_many_triangles),
+        cmocka_unit_test(test_area_samples_none),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

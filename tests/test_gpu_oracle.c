@@ -91,10 +91,13 @@ static void test_injection_matches_oracle(void **state)
     tick(f, &s, 0);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
-    size_t vmax = 64 * 64 * 6 + 8192;
+    /* the spot's RSM layer and the 8 area light samples' 40 faces as 32^2
+     * tiles, 4 to a layer (docs/area-lights.md): 11 layers of 64^2 */
+    size_t vmax = 64 * 64 * 16;
     lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
     size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
-    assert_true(nv > 64 * 64); /* the spot's RSM plus the emissive ceiling quad */
+    assert_int_equal(lpv_engine_last_stats(f->engine)->area_lights, 8);
+    assert_int_equal(nv, 64 * 64 * 11);
     lpv_cell *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref);
     assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, gpu, cells), cells);
     size_t injected = lpv_oracle_inject_vpls(g, vpls, nv, ref);
@@ -113,10 +116,10 @@ static void test_geometry_volume_matches_oracle(void **state)
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t gv_n = lpv_grid_gv_count(g), cells = lpv_grid_cell_count(g);
     vec4 *ref = calloc(gv_n, sizeof *ref), *tmp = calloc(gv_n, sizeof *tmp), *gpu = calloc(gv_n, sizeof *gpu);
-    size_t smax = 64 * 64 * 6 + 48 * 48;
+    size_t smax = 64 * 64 * 16;
     lpv_surfel *surfels = calloc(smax, sizeof *surfels);
     size_t buffers = lpv_engine_gv_buffer_count(f->engine);
-    assert_int_equal(buffers, 2); /* the spot light's RSM and the camera */
+    assert_int_equal(buffers, 3); /* the spot light's RSM, the area light samples' RSMs and the camera */
     for (size_t b = 0; b < buffers; ++b) {
         size_t n = lpv_engine_read_surfels(f->engine, b, surfels, smax);
         assert_true(n > 0);
@@ -266,7 +269,7 @@ static void test_normal_bins_match_oracle(void **state)
     assert_int_equal(lpv_engine_bins(f->engine), LPV_NORMAL_BINS);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     const size_t cells = lpv_grid_cell_count(g), all = cells * LPV_NORMAL_BINS;
-    size_t vmax = 64 * 64 * 6 + 8192;
+    size_t vmax = 64 * 64 * 16;
     lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
     size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
     lpv_cell *gpu = calloc(all, sizeof *gpu), *ref = calloc(all, sizeof *ref), *acc = calloc(all, sizeof *acc),

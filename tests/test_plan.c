@@ -144,6 +144,33 @@ static void test_no_lights_skips_rsm(void **state)
     assert_false(p.pass[LPV_PASS_PROPAGATE].run);
 }
 
+/* Emitters that light the scene directly (area lights) need the RSM pass and
+ * must not be injected as VPLs too, even with the planner off. */
+static void test_area_lights_replace_emissive_vpls(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.lights = 0;
+    f.emissive_surfaces = 2;
+    f.area_light_samples = 16;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_true(p.pass[LPV_PASS_RSM].run);
+    assert_string_equal(p.pass[LPV_PASS_RSM].reason, "area lights: 2 emissive surfaces -> 16 samples");
+    assert_false(p.pass[LPV_PASS_EMISSIVE].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_EMISSIVE].reason, "count it twice"));
+    assert_true(p.pass[LPV_PASS_INJECT].run);
+    f.lights = 3;
+    p = plan_of((lpv_settings){0}, f);
+    assert_string_equal(p.pass[LPV_PASS_RSM].reason, "3 punctual lights; area lights: 2 emissive surfaces -> 16 samples");
+    p = plan_of((lpv_settings){.planner = LPV_SWITCH_OFF}, f);
+    assert_false(p.pass[LPV_PASS_EMISSIVE].run);
+    /* area lights off (the engine then reports 0 samples): the VPLs again */
+    f.area_light_samples = 0;
+    p = plan_of((lpv_settings){.area_lights = LPV_SWITCH_OFF}, f);
+    assert_true(p.pass[LPV_PASS_EMISSIVE].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_EMISSIVE].reason, "area lights off"));
+}
+
 static void test_cascade_count(void **state)
 {
     (void)state;
@@ -424,6 +451,7 @@ int main(void)
         cmocka_unit_test(test_no_medium_skips_media),
         cmocka_unit_test(test_no_emissive_skips_emissive),
         cmocka_unit_test(test_no_lights_skips_rsm),
+        cmocka_unit_test(test_area_lights_replace_emissive_vpls),
         cmocka_unit_test(test_cascade_count),
         cmocka_unit_test(test_recompute_rules),
         cmocka_unit_test(test_planner_off_runs_everything),

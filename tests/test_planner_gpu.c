@@ -32,6 +32,11 @@ static lpv_settings small_settings(void)
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
     s.iterations = 4;
+    /* The emissive-only scene's black lamps must be the LPV's source (VPLs):
+     * with area lights on they would light the (absent) surfaces directly and
+     * the LPV would stay empty, making the volume comparisons vacuous. The
+     * area lights' own plan is checked in test_area_lights. */
+    s.area_lights = LPV_SWITCH_OFF;
     return s;
 }
 

@@ -29,6 +29,7 @@
 #include <unistd.h>
 
 #include "context.h"
+#include "emissive_full.h"
 #include "engine.h"
 #include "image_io.h"
 #include "metrics.h"
@@ -241,7 +242,10 @@ static void usage(FILE *f)
             "  --reference PATH   run this reference command (lpvd-reference's CLI) instead of the\n"
             "                     linked lpv_reference library (default: $LPVD_REFERENCE, else the\n"
             "                     library when linked, else reference/lpvd-reference in this build tree)\n"
-            "  --no-plot          do not run gnuplot (plot.gp is still written)\n",
+            "  --no-plot          do not run gnuplot (plot.gp is still written)\n"
+            "  --emissive         only the emissive-lit scenes: lpvd's FULL frame vs the reference's\n"
+            "                     full frame, area lights off and on with 1..64 samples\n"
+            "                     (emissive.csv, emissive.md; docs/area-lights.md)\n",
             (int)(sizeof QUICK / sizeof QUICK[0]));
 }
 
@@ -457,7 +461,7 @@ static int run_command(char *const argv[])
 
 /* The reference in process (lpv_reference): 1 bounce, spp samples per pixel. */
 static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, int bounces, int spp,
-                                const char *exr, const char *se_exr)
+                                int area_lights, const char *exr, const char *se_exr)
 {
     char err[1024] = "";
     lpv_ref *ref = NULL;
@@ -466,7 +470,8 @@ static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, in
     int rc = -1;
     if (!rgba || !se) {
         fprintf(stderr, "lpvd-accuracy: out of memory for the reference\n");
-    } else if (lpv_ref_create(scene, NULL, &ref, err, sizeof err) != 0) {
+    } else if (lpv_ref_create(scene, &(lpv_ref_desc){.emitters_are_lights = area_lights}, &ref, err, sizeof err) !=
+               0) {
         fprintf(stderr, "lpvd-accuracy: reference: %s\n", err);
     } else if (lpv_ref_render_indirect(ref, view, bounces, spp, rgba, se) != 0) {
         fprintf(stderr, "lpvd-accuracy: reference: lpv_ref_render_indirect failed\n");
@@ -485,7 +490,8 @@ static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, in
 /* Makes sure the scene's reference is cached; fills e->ref_exr / ref_se.
  * ref_cmd NULL: the linked library (lpv_reference, in process). */
 static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const char *out_dir,
-                            int spp, const char *ref_cmd, char *const *cam_args, int ncam, int bounces)
+                            int spp, const char *ref_cmd, char *const *cam_args, int ncam, int bounces,
+                            int area_lights)
 {
     /* bounces > 1: the multi-bounce reference, into e->mref_* (the 1-bounce
      * key and file names stay as they were, so old caches still hit) */
@@ -494,6 +500,10 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     char bsuffix[16] = "";
     if (bounces > 1)
         snprintf(bsuffix, sizeof bsuffix, "-b%d", bounces);
+    /* lpvd with area lights on keeps the emitters' direct light out of its
+     * indirect term, and so does the reference it is compared with */
+    if (area_lights)
+        strcat(bsuffix, "-al");
     uint64_t h = 1469598103934665603ull;
     h = e->path ? hash_file(h, e->path) : fnv1a(h, "built-in:cornell-box", 20);
     h = fnv1a(h, view, sizeof *view);
@@ -520,7 +530,8 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     if (!ref_cmd) {
         fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, %d bounce(s), %d spp)\n",
                 e->name, bounces, spp);
-        if (render_reference_lib(scene, view, bounces, spp, tmp_exr, tmp_se) != 0 || rename(tmp_exr, ref_exr) != 0 ||
+        if (render_reference_lib(scene, view, bounces, spp, area_lights, tmp_exr, tmp_se) != 0 ||
+            rename(tmp_exr, ref_exr) != 0 ||
             rename(tmp_se, ref_se) != 0) {
             unlink(tmp_exr);
             unlink(tmp_se);
@@ -565,6 +576,8 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
         argv[a++] = "--bounces";
         argv[a++] = bounces_s;
     }
+    argv[a++] = "--area-lights";
+    argv[a++] = area_lights ? "on" : "off";
     argv[a] = NULL;
     fprintf(stderr, "lpvd-accuracy: %s: rendering the reference:", e->name);
     for (int i = 0; i < a; ++i)
@@ -1031,7 +1044,7 @@ int main(int argc, char **argv)
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
     const char *knobs = NULL, *points_arg = NULL;
     int spp = 256, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
-    int features = 0, multi_bounces = 3, scenes_given = 0;
+    int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0;
     lpvd_options opt = {0};
     char *cam_args[MAX_PASS];
     int ncam = 0;
@@ -1049,6 +1062,8 @@ int main(int argc, char **argv)
             presets = 1;
         } else if (strcmp(a, "--features") == 0) {
             features = 1;
+        } else if (strcmp(a, "--emissive") == 0) {
+            emissive = 1;
         } else if (strcmp(a, "--multi-bounces") == 0 && v) {
             char *end = NULL;
             long x = strtol(argv[++i], &end, 10);
@@ -1118,6 +1133,30 @@ int main(int argc, char **argv)
     if (opt.cam.height == 0) {
         fprintf(stderr, "lpvd-accuracy: --size needs WxH\n");
         return 2;
+    }
+    lpv_settings resolved = opt.settings;
+    lpv_settings_resolve(&resolved);
+    const int area_lights = resolved.area_lights == LPV_SWITCH_ON;
+    if (emissive) {
+        lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt.backend}, err, sizeof err);
+        if (!ctx) {
+            fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+            return 1;
+        }
+        lpv_engine *engine = lpv_engine_create(err, sizeof err);
+        int rc = 1;
+        if (!engine) {
+            fprintf(stderr, "lpvd-accuracy: %s\n", err);
+        } else {
+            fprintf(stderr, "lpvd-accuracy: backend %s, GL_RENDERER %s\n",
+                    lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx));
+            lpv_acc_emissive_desc d = {.out_dir = out_dir, .scenes_dir = LPVD_ACCURACY_SCENES_DIR, .opt = &opt,
+                                       .spp = spp, .ticks = ticks, .warmup = warmup};
+            rc = lpv_acc_emissive_run(engine, &d);
+        }
+        lpv_engine_destroy(engine);
+        lpv_gl_context_destroy(ctx);
+        return rc;
     }
 
     /* The point set. */
@@ -1314,7 +1353,7 @@ add_features:
             goto next_scene;
         }
         if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args,
-                             se->has_cam ? 0 : ncam, 1) != 0) {
+                             se->has_cam ? 0 : ncam, 1, area_lights) != 0) {
             rc = 1;
             goto next_scene;
         }
@@ -1322,7 +1361,7 @@ add_features:
         if (features) { /* the multi-bounce reference: for bounces on, and to compare every point with */
             int mw = 0, mh = 0;
             if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args,
-                                 se->has_cam ? 0 : ncam, multi_bounces) != 0 ||
+                                 se->has_cam ? 0 : ncam, multi_bounces, area_lights) != 0 ||
                 lpv_image_read_f32(se->mref_exr, 4, &mw, &mh, &mref, err, sizeof err) != 0 || mw != view.width ||
                 mh != view.height) {
                 fprintf(stderr, "lpvd-accuracy: %s: no multi-bounce reference\n", se->name);

@@ -1374,6 +1374,8 @@ CONFIG_KNOBS = {
     "fog_sigma_a": ("num", 0, (0.01, 1000, 0), (-0.5, 1001), ("0.1", [0.1])),
     "media_step": ("num", 0.5, (0.05, 4, 1), (0.01, 5), ("1", False)),
     "planner": ("bool", True, (False, True), (), (0, "off")),
+    "area_lights": ("bool", True, (False, True), (), (1, "on")),
+    "area_light_samples": ("int", 8, (1, 64, 16), (0, 65, -1), (8.5, "8", True)),
 }
 
 

@@ -55,7 +55,8 @@ CONFIG_KNOBS = {
     "emissive_vpls": "int", "cascades": "int", "cascade_size": "float", "cascade_ratio": "float",
     "cascade_offset": "float", "bounces": "switch", "bounce_intensity": "float", "damping": "float",
     "glossy": "switch", "glossy_roughness": "float", "media": "switch", "fog_sigma_s": "float",
-    "fog_sigma_a": "float", "media_step": "float", "planner": "switch",
+    "fog_sigma_a": "float", "media_step": "float", "planner": "switch", "area_lights": "switch",
+    "area_light_samples": "int",
 }
 
 # Message types (SPEC section 4).
