@@ -32,18 +32,21 @@ typedef struct preset_row {
 static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
     [LPV_PRESET_DEFAULT] = {NULL, 0, 0, 0, LPV_SWITCH_DEFAULT}, /* not a row: resolves to BALANCED */
     /* Each row is a point on the overall front of the full sweep (3 scenes x
-     * 72 points; docs/accuracy.md, "Presets"). On every scene the lowest
-     * errors came with 4 iterations: more steps pile light up next to its
-     * source faster than they carry it away (docs/calibration.md, 4). */
-    /* fast: the cheapest front point with fuzzy occlusion (thin walls need it) */
-    [LPV_PRESET_FAST] = {"fast", 16, 4, 128, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
+     * grid 6..32 x iterations 2..16 x the 16 combinations of the departures
+     * from the paper; docs/accuracy.md, "Presets"). Coarse grids win: light
+     * in an LPV moves about a cell per step and diffuses, so a grid whose
+     * cells span the scene's rooms in a few steps gets the light where the
+     * path tracer has it; finer grids sharpen but stay dark far from the
+     * lit surfaces (docs/calibration.md, 4). */
+    /* fast: the cheapest front point below the paper configuration's error */
+    [LPV_PRESET_FAST] = {"fast", 8, 4, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
                          LPV_SWITCH_OFF},
-    /* balanced, the default: nearly fast's cost, a 32^3 grid's finer detail */
+    /* balanced, the default: all four departures on, the front's knee */
     [LPV_PRESET_BALANCED] = {"balanced", LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
-                             LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF, LPV_SWITCH_OFF, LPV_SWITCH_OFF},
-    /* accurate: the front's lowest error short of the 512^2 RSM's extra cost */
-    [LPV_PRESET_ACCURATE] = {"accurate", 64, 4, 256, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
-                             LPV_SWITCH_OFF, LPV_SWITCH_OFF},
+                             LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON},
+    /* accurate: the front's lowest error */
+    [LPV_PRESET_ACCURATE] = {"accurate", 12, 8, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON,
+                             LPV_SWITCH_ON},
 };
 
 /* The table row of p (DEFAULT -> BALANCED), or NULL when p is out of range. */

@@ -26,7 +26,7 @@ typedef enum lpv_preset {
 } lpv_preset;
 
 typedef struct lpv_settings {
-    int grid_dims[3];       /* cells per axis; default: the preset's (balanced: 32 x 32 x 32) */
+    int grid_dims[3];       /* cells per axis; default: the preset's (balanced: 8 x 8 x 8) */
     float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
     float bounds_max[3];    /*   bounds grown by half a cell on every side */
     int iterations;         /* propagation steps; default: the preset's (balanced: 4) */
@@ -92,7 +92,7 @@ typedef struct lpv_settings {
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
  * preset table in settings.c (a test checks that they agree). */
-#define LPV_DEFAULT_GRID_DIM 32
+#define LPV_DEFAULT_GRID_DIM 8
 #define LPV_DEFAULT_ITERATIONS 4
 #define LPV_DEFAULT_RSM_SIZE 128
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096

@@ -47,9 +47,23 @@ static int teardown(void **state)
     return 0;
 }
 
-static void tick(fixture *f, const lpv_settings *s, int with_view)
+/* The oracle follows the paper's pipeline; a test that wants a departure
+ * (central transport, normal bins) sets it, the rest stay off here. */
+static lpv_settings paper_unless_set(const lpv_settings *in)
+{
+    lpv_settings s = *in;
+    lpv_switch *sw[] = {&s.central_transport, &s.normal_bins, &s.far_field, &s.scene_surfels};
+    for (size_t i = 0; i < sizeof sw / sizeof sw[0]; ++i)
+        if (*sw[i] == LPV_SWITCH_DEFAULT)
+            *sw[i] = LPV_SWITCH_OFF;
+    return s;
+}
+
+static void tick(fixture *f, const lpv_settings *in, int with_view)
 {
     char err[1024] = "";
+    lpv_settings s0 = paper_unless_set(in);
+    const lpv_settings *s = &s0;
     assert_int_equal(lpv_engine_set_settings(f->engine, s, err, sizeof err), 0);
     assert_int_equal(lpv_engine_set_scene(f->engine, &f->scene, err, sizeof err), 0);
     lpv_view view;

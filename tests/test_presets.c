@@ -19,15 +19,18 @@ typedef struct expected {
     lpv_preset preset;
     const char *name;
     int grid, iterations, rsm_size;
-    lpv_switch occlusion;
+    lpv_switch occlusion, central_transport, normal_bins, far_field, scene_surfels;
 } expected;
+
+#define ON LPV_SWITCH_ON
+#define OFF LPV_SWITCH_OFF
 
 /* The table chosen from the sweep's overall front (settings.c,
  * docs/accuracy.md); a change there must show up here. */
 static const expected PRESETS[] = {
-    {LPV_PRESET_FAST, "fast", 16, 4, 128, LPV_SWITCH_ON},
-    {LPV_PRESET_BALANCED, "balanced", 32, 4, 128, LPV_SWITCH_ON},
-    {LPV_PRESET_ACCURATE, "accurate", 64, 4, 256, LPV_SWITCH_ON},
+    {LPV_PRESET_FAST, "fast", 8, 4, 128, ON, ON, OFF, OFF, OFF},
+    {LPV_PRESET_BALANCED, "balanced", 8, 4, 128, ON, ON, ON, ON, ON},
+    {LPV_PRESET_ACCURATE, "accurate", 12, 8, 128, ON, ON, ON, ON, ON},
 };
 #define NPRESETS ((int)(sizeof PRESETS / sizeof PRESETS[0]))
 
@@ -40,6 +43,14 @@ static void assert_knobs(const lpv_settings *s, int grid, int iterations, int rs
     assert_int_equal(s->occlusion, occlusion);
 }
 
+static void assert_departures(const lpv_settings *s, const expected *e)
+{
+    assert_int_equal(s->central_transport, e->central_transport);
+    assert_int_equal(s->normal_bins, e->normal_bins);
+    assert_int_equal(s->far_field, e->far_field);
+    assert_int_equal(s->scene_surfels, e->scene_surfels);
+}
+
 static void test_zero_resolves_to_balanced(void **state)
 {
     (void)state;
@@ -47,7 +58,8 @@ static void test_zero_resolves_to_balanced(void **state)
     lpv_settings s = {0};
     lpv_settings_resolve(&s);
     assert_int_equal(s.preset, LPV_PRESET_BALANCED);
-    assert_knobs(&s, 32, 4, 128, LPV_SWITCH_ON);
+    assert_knobs(&s, 8, 4, 128, LPV_SWITCH_ON);
+    assert_departures(&s, &PRESETS[1]);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
     /* the LPV_DEFAULT_* macros are the balanced preset */
     assert_int_equal(s.grid_dims[0], LPV_DEFAULT_GRID_DIM);
@@ -67,12 +79,14 @@ static void test_each_preset(void **state)
         lpv_settings_resolve(&s);
         assert_int_equal(s.preset, e->preset);
         assert_knobs(&s, e->grid, e->iterations, e->rsm_size, e->occlusion);
+        assert_departures(&s, e);
         assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
 
         lpv_settings p;
         assert_int_equal(lpv_preset_settings(e->preset, &p), 0);
         assert_int_equal(p.preset, e->preset);
         assert_knobs(&p, e->grid, e->iterations, e->rsm_size, e->occlusion);
+        assert_departures(&p, e);
         assert_int_equal(lpv_preset_match(&s), e->preset);
     }
     lpv_settings d;
@@ -90,9 +104,11 @@ static void test_explicit_fields_override(void **state)
     assert_knobs(&s, 64, 4, 128, LPV_SWITCH_OFF); /* iterations and rsm_size from fast */
     assert_int_equal(lpv_preset_match(&s), LPV_PRESET_DEFAULT); /* no preset has these values */
 
-    lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .iterations = 12, .rsm_size = 512};
+    lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .iterations = 12, .rsm_size = 512, .normal_bins = OFF};
     lpv_settings_resolve(&t);
-    assert_knobs(&t, 64, 12, 512, LPV_SWITCH_ON);
+    assert_knobs(&t, 12, 12, 512, LPV_SWITCH_ON);
+    assert_int_equal(t.normal_bins, OFF); /* explicit wins over the preset's on */
+    assert_int_equal(t.far_field, ON);
 }
 
 static void test_names_round_trip(void **state)
