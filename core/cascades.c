@@ -24,7 +24,7 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
         for (int i = 0; i < 3; ++i)
             out->origin_cells[0][i] = out->grid[0].origin[i] / out->grid[0].cell_size;
         out->count = 1;
-        for (int k = 1; s->far_field == LPV_SWITCH_ON && k <= s->far_field_levels && k < LPV_MAX_CASCADES; ++k) {
+        for (int k = 1; k < lpv_cascades_count(s, 1); ++k) {
             lpv_grid *g = &out->grid[k];
             *g = out->grid[k - 1];
             g->cell_size = 2.0f * out->grid[k - 1].cell_size;
@@ -98,6 +98,14 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     out->snapped = 1;
     out->handoff = s->far_field == LPV_SWITCH_ON && s->cascade_ratio == 2.0f;
     return 0;
+}
+
+int lpv_cascades_count(const lpv_settings *s, int count)
+{
+    if (count != 1 || s->far_field != LPV_SWITCH_ON)
+        return count;
+    int levels = s->far_field_levels < 0 ? 0 : s->far_field_levels;
+    return 1 + levels < LPV_MAX_CASCADES ? 1 + levels : LPV_MAX_CASCADES;
 }
 
 float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3])

@@ -48,6 +48,11 @@ typedef struct lpv_cascade_set {
 int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
                        const float *forward, lpv_cascade_set *out);
 
+/* How many grids lpv_cascades_place(s, count, ...) places: count, or for one
+ * grid over the bounds with the far field on 1 + far_field_levels (at most
+ * LPV_MAX_CASCADES). */
+int lpv_cascades_count(const lpv_settings *s, int count);
+
 /* The finest cascade's extent (m): cascade_size, or with cascade_size 0
  * (auto) LPV_CASCADE_AUTO_FRACTION x the longest side of [bmin, bmax]
  * (1 when that is empty). */

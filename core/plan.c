@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cascades.h"
 #include "lpv_shared.h"
 
 static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
@@ -116,6 +117,13 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
     memset(p, 0, sizeof *p);
     const int all = s->planner == LPV_SWITCH_OFF;
     p->cascades = lpv_plan_cascades(s, f, p->cascades_reason, sizeof p->cascades_reason);
+    const int in_use = lpv_cascades_count(s, p->cascades);
+    if (in_use > p->cascades) {
+        size_t len = strlen(p->cascades_reason);
+        say(p->cascades_reason + len, sizeof p->cascades_reason - len, "; far field: %d coarser levels",
+            in_use - p->cascades);
+        p->cascades = in_use;
+    }
 
     /* Render-time passes are decided first: they do not depend on a recompute. */
     if (all)

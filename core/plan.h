@@ -56,7 +56,8 @@ typedef struct lpv_plan_facts {
 } lpv_plan_facts;
 
 typedef struct lpv_plan {
-    int cascades;                           /* cascades in use */
+    int cascades;                           /* grids in use: lpv_plan_cascades' count, with the far
+                                               field's levels added to one grid (lpv_cascades_count) */
     char cascades_reason[LPV_PLAN_REASON_MAX];
     int recompute;                          /* 0: the cached volume is served, no tick pass runs */
     char recompute_reason[LPV_PLAN_REASON_MAX];
@@ -71,7 +72,9 @@ typedef struct lpv_plan {
 const char *lpv_pass_name(lpv_pass_id id);
 
 /* Cascades the settings and facts call for (1..LPV_MAX_CASCADES) with the
- * reason; independent of what changed. s must be resolved. */
+ * reason, the count to hand to lpv_cascades_place (1: one grid over the
+ * scene, far field levels not counted); independent of what changed. s must
+ * be resolved. */
 int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t reason_size);
 
 /* The whole plan for one tick. s must be resolved. */

@@ -4,11 +4,28 @@
 #include <math.h>
 #include <string.h>
 
+/* The draw's material, or NULL when it has none. */
+static const lpv_material *material_of(const lpv_scene *s, const lpv_draw *dr)
+{
+    return dr->material >= 0 && (uint32_t)dr->material < s->material_count ? &s->materials[dr->material] : NULL;
+}
+
+/* Emitters are light sources only in the geometry volume, as in the RSM and
+ * camera surfels (camera_surfels.comp), and the planner counts only
+ * non-emissive triangles as occluders. */
+static int is_emitter(const lpv_scene *s, const lpv_draw *dr)
+{
+    const lpv_material *m = material_of(s, dr);
+    return m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
+}
+
 static double total_area(const lpv_scene *s)
 {
     double sum = 0.0;
     for (uint32_t d = 0; d < s->draw_count; ++d) {
         const lpv_draw *dr = &s->draws[d];
+        if (is_emitter(s, dr))
+            continue;
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
             const lpv_vertex *v[3];
             float n[3];
@@ -33,9 +50,10 @@ size_t lpv_scene_surfels(const lpv_scene *s, size_t target, lpv_surfel *out, siz
     size_t count = 0;
     for (uint32_t d = 0; d < s->draw_count && count < max; ++d) {
         const lpv_draw *dr = &s->draws[d];
-        const float *albedo = (dr->material >= 0 && (uint32_t)dr->material < s->material_count)
-                                  ? s->materials[dr->material].base_color
-                                  : NULL;
+        if (is_emitter(s, dr))
+            continue;
+        const lpv_material *m = material_of(s, dr);
+        const float *albedo = m ? m->base_color : NULL;
         for (uint32_t t = 0; t + 3 <= dr->index_count && count < max; t += 3) {
             const lpv_vertex *v[3];
             float n[3];

@@ -15,7 +15,9 @@
 #include "scene.h"
 
 /* Writes up to max surfels, about `target` in all, spread over the scene's
- * non-degenerate triangles in proportion to their area on a deterministic
+ * non-degenerate, non-emissive triangles (emitters are light sources only in
+ * the geometry volume, as in the RSM and camera surfels, and the planner
+ * counts only non-emissive triangles as occluders) in proportion to their area on a deterministic
  * low-discrepancy pattern. Each carries its triangle's front normal, its
  * material's base colour (the bounces' albedo) and an area such that the
  * surfels' areas sum to the triangles' total area (a triangle too small for

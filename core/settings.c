@@ -38,9 +38,9 @@ static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
      * cells span the scene's rooms in a few steps gets the light where the
      * path tracer has it; finer grids sharpen but stay dark far from the
      * lit surfaces (docs/calibration.md, 4). */
-    /* fast: the cheapest front point below the paper configuration's error */
+    /* fast: the front's knee below a third of balanced's cost (central transport and scene surfels) */
     [LPV_PRESET_FAST] = {"fast", 8, 4, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
-                         LPV_SWITCH_OFF},
+                         LPV_SWITCH_ON},
     /* balanced, the default: all four departures on, the front's knee */
     [LPV_PRESET_BALANCED] = {"balanced", LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
                              LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON},

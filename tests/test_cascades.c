@@ -33,7 +33,11 @@ static lpv_settings room_settings(void)
     s.rsm_size = 64;
     s.iterations = 4;
     s.cascade_size = 8.0f; /* explicit: 0.5, 1 and 2 m cells */
-    return s;              /* cascades 0 = auto: 3, the room (20 m) being larger than 8 m */
+    /* the cascaded-LPV paper's cascades: each holds its own injected light and the lookup blends them across
+     * borders (far field off), one volume per cascade read with the plain SH lookup (normal bins off) */
+    s.far_field = LPV_SWITCH_OFF;
+    s.normal_bins = LPV_SWITCH_OFF;
+    return s; /* cascades 0 = auto: 3, the room (20 m) being larger than 8 m */
 }
 
 /* A 20 m x 20 m floor with 4 m walls and two point lights; optionally a box
@@ -87,12 +91,15 @@ static lpv_view room_view(void)
     return v;
 }
 
-static void test_placement_and_volumes(void **state)
+/* Placement and volumes with the paper's cascades (departures = 0) and with the defaults' departures on (far
+ * field: light handed from each cascade to the next; normal bins: read_grid returns the bins' sum). */
+static void check_placement_and_volumes(int departures)
 {
-    (void)state;
     lpv_scene scene;
     build_room(&scene, NULL, NULL, 0);
     lpv_settings s = room_settings();
+    if (departures)
+        s.far_field = s.normal_bins = LPV_SWITCH_DEFAULT;
     lpv_view v = room_view();
     load(&scene, &s, &v);
     assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 3);
@@ -121,11 +128,21 @@ static void test_placement_and_volumes(void **state)
             assert_true(acc[i].r[0] >= 0.0f && acc[i].g[0] >= 0.0f && acc[i].b[0] >= 0.0f);
             dc += acc[i].r[0];
         }
-        print_message("cascade %d: total red DC %.4g\n", k, dc);
+        print_message("%s: cascade %d: total red DC %.4g\n", departures ? "defaults" : "paper", k, dc);
         assert_true(dc > 0.0); /* every cascade received light */
     }
     free(acc);
     lpv_scene_free(&scene);
+}
+
+static void test_placement_and_volumes(void **state)
+{
+    (void)state;
+    check_placement_and_volumes(0);
+    check_placement_and_volumes(1);
+    const lpv_settings *r = lpv_engine_settings(lpvt_engine);
+    assert_int_equal(r->far_field, LPV_SWITCH_ON); /* the second run did check the departures */
+    assert_int_equal(r->normal_bins, LPV_SWITCH_ON);
 }
 
 /* E (red) at p facing n from cascade k alone, on the CPU (core/oracle_lookup.c: the same lookup as lookup.glsl's

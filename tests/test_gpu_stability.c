@@ -5,7 +5,11 @@
  * must never grow from one step to the next (1e-6 relative slack for float
  * rounding, see docs/propagation.md). The scenes are the hard cases of
  * bench/accuracy/hard_cases.h, which lpvd-hard-cases also compares with the
- * path-traced reference (docs/hard-cases.md).
+ * path-traced reference (docs/hard-cases.md). Every case runs twice: with the
+ * paper's pipeline (the four departures of docs/propagation.md off) and with
+ * the case's own settings, whose departures are the defaults (on). With the
+ * far field the light in flight moves from level to level, so "a step's
+ * output" is every level's (and every normal bin's) together.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -30,6 +34,9 @@ static void build(const char *name, lpv_hard_scene *h)
     assert_int_equal(lpv_hard_case_build(name, h), 0);
 }
 
+/* 1: the paper's pipeline (set from the test's state, see main) */
+static int paper;
+
 static double total_flux(const lpv_cell *cells, size_t n)
 {
     double f[3];
@@ -45,6 +52,8 @@ static double tick_checked(const lpv_hard_scene *h, lpv_settings s, int with_vie
 {
     const lpv_scene *scene = &h->scene;
     char err[1024] = "";
+    if (paper)
+        s.central_transport = s.normal_bins = s.far_field = s.scene_surfels = LPV_SWITCH_OFF;
     if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) != 0 ||
         lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) != 0)
         fail_msg("%s", err);
@@ -54,7 +63,14 @@ static double tick_checked(const lpv_hard_scene *h, lpv_settings s, int with_vie
     if (lpv_engine_tick(lpvt_engine, err, sizeof err) != 0)
         fail_msg("tick: %s", err);
     const lpv_grid *g = lpv_engine_grid(lpvt_engine);
-    size_t cells = lpv_grid_cell_count(g);
+    const lpv_settings *r = lpv_engine_settings(lpvt_engine);
+    if (paper)
+        assert_true(r->far_field == LPV_SWITCH_OFF && r->normal_bins == LPV_SWITCH_OFF);
+    else /* the hard cases leave the departures to the defaults: they are checked here */
+        assert_true(r->far_field == LPV_SWITCH_ON && r->normal_bins == LPV_SWITCH_ON &&
+                    r->central_transport == LPV_SWITCH_ON && r->scene_surfels == LPV_SWITCH_ON);
+    /* every cascade (far-field level), each the sum of its normal bins */
+    size_t cells = lpv_grid_cell_count(g) * (size_t)lpv_engine_cascade_count(lpvt_engine);
     lpv_cell *acc = calloc(cells, sizeof *acc), *last = calloc(cells, sizeof *last);
     assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, acc, cells), cells);
     assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_LAST_STEP, last, cells), cells);
@@ -92,7 +108,7 @@ static void assert_energy_non_increasing(const lpv_hard_scene *scene, lpv_settin
 
 static void test_degenerate_normals_and_triangles(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("degenerate_geometry", &h);
     double e = tick_checked(&h, h.settings, 1);
@@ -103,7 +119,7 @@ static void test_degenerate_normals_and_triangles(void **state)
 
 static void test_light_on_cell_corner(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("light_on_cell_corner", &h);
     assert_true(tick_checked(&h, h.settings, 1) > 0.0);
@@ -113,7 +129,7 @@ static void test_light_on_cell_corner(void **state)
 
 static void test_vpls_on_grid_boundary(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("vpls_on_grid_boundary", &h);
     tick_checked(&h, h.settings, 1);
@@ -123,7 +139,7 @@ static void test_vpls_on_grid_boundary(void **state)
 
 static void test_dynamic_range_1e6(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("dynamic_range_1e6", &h);
     tick_checked(&h, h.settings, 1);
@@ -133,7 +149,7 @@ static void test_dynamic_range_1e6(void **state)
 
 static void test_extreme_intensity(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("extreme_intensity_1e30", &h);
     tick_checked(&h, h.settings, 1);
@@ -142,7 +158,7 @@ static void test_extreme_intensity(void **state)
 
 static void test_thin_wall(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("thin_wall", &h);
     assert_true(tick_checked(&h, h.settings, 1) > 0.0);
@@ -152,7 +168,7 @@ static void test_thin_wall(void **state)
 
 static void test_thousand_steps(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene h;
     build("steps_1000", &h);
     assert_int_equal(h.settings.iterations, 1000);
@@ -168,7 +184,7 @@ static void test_thousand_steps(void **state)
 
 static void test_tiny_and_flat_grids(void **state)
 {
-    (void)state;
+    paper = *(const int *)*state;
     lpv_hard_scene one, flat;
     build("one_cell_grid", &one);
     tick_checked(&one, one.settings, 1);
@@ -182,15 +198,18 @@ static void test_tiny_and_flat_grids(void **state)
 
 int main(void)
 {
+    static int PAPER = 1, DEFAULTS = 0;
+#define BOTH(t) cmocka_unit_test_prestate(t, &PAPER), cmocka_unit_test_prestate(t, &DEFAULTS)
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_degenerate_normals_and_triangles),
-        cmocka_unit_test(test_light_on_cell_corner),
-        cmocka_unit_test(test_vpls_on_grid_boundary),
-        cmocka_unit_test(test_dynamic_range_1e6),
-        cmocka_unit_test(test_extreme_intensity),
-        cmocka_unit_test(test_thin_wall),
-        cmocka_unit_test(test_thousand_steps),
-        cmocka_unit_test(test_tiny_and_flat_grids),
+        BOTH(test_degenerate_normals_and_triangles),
+        BOTH(test_light_on_cell_corner),
+        BOTH(test_vpls_on_grid_boundary),
+        BOTH(test_dynamic_range_1e6),
+        BOTH(test_extreme_intensity),
+        BOTH(test_thin_wall),
+        BOTH(test_thousand_steps),
+        BOTH(test_tiny_and_flat_grids),
     };
+#undef BOTH
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

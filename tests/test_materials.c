@@ -321,6 +321,7 @@ typedef struct occ_result {
     double top_red, top_green; /* camera pixel over the occluder's z>0 half: r and g */
     double rsm_area;      /* RSM surfel area on the occluder plane, m^2 */
     double cam_area;      /* camera surfel area on the occluder plane, m^2 */
+    double scene_area;    /* scene surfel area on the occluder plane, m^2 (settings.scene_surfels) */
 } occ_result;
 
 static double surfel_area_at_height(size_t buffer, float y)
@@ -358,7 +359,12 @@ static occ_result run_occluder(const char *occluder_material)
     r.top_red = px[0];
     r.top_green = px[1];
     r.rsm_area = surfel_area_at_height(0, 1.0f);
-    r.cam_area = surfel_area_at_height(lpv_engine_gv_buffer_count(lpvt_engine) - 1, 1.0f);
+    /* the GV buffers: the RSM's, then the camera's, then the scene surfels' (on in the defaults) */
+    const size_t buffers = lpv_engine_gv_buffer_count(lpvt_engine);
+    assert_int_equal(lpv_engine_settings(lpvt_engine)->scene_surfels, LPV_SWITCH_ON);
+    assert_int_equal(buffers, 3);
+    r.cam_area = surfel_area_at_height(buffers - 2, 1.0f);
+    r.scene_area = surfel_area_at_height(buffers - 1, 1.0f);
     free(rgba);
     lpv_scene_free(&s);
     return r;
@@ -367,8 +373,8 @@ static occ_result run_occluder(const char *occluder_material)
 static void print_result(const char *what, const occ_result *r)
 {
     printf("%-14s floor under z<0 half %.4f, under z>0 half %.4f, unshadowed %.4f (W/(m^2 sr), rgb sum); "
-           "pixel over z>0 half r %.4f g %.4f; occluder surfels: RSM %.3f m^2, camera %.3f m^2\n",
-           what, r->a, r->b, r->c, r->top_red, r->top_green, r->rsm_area, r->cam_area);
+           "pixel over z>0 half r %.4f g %.4f; occluder surfels: RSM %.3f m^2, camera %.3f m^2, scene %.3f m^2\n",
+           what, r->a, r->b, r->c, r->top_red, r->top_green, r->rsm_area, r->cam_area, r->scene_area);
 }
 
 /* MASK: the cut-away half lets light through (floor lit as if unshadowed),

@@ -226,6 +226,13 @@ static void test_cascade_count(void **state)
     f.scene_shortest = 4.0f;
     f.has_view = f.camera_inside = 1;
     assert_int_equal(plan_of((lpv_settings){0}, f).cascades, 3);
+    /* one grid over the scene: the plan counts the grids in use, the far field's levels too (on by default) */
+    f = baseline();
+    lpv_plan p1 = plan_of((lpv_settings){0}, f);
+    assert_int_equal(p1.cascades, 1 + LPV_DEFAULT_FAR_FIELD_LEVELS);
+    assert_non_null(strstr(p1.cascades_reason, "far field"));
+    assert_int_equal(plan_of((lpv_settings){.far_field = LPV_SWITCH_OFF}, f).cascades, 1);
+    assert_int_equal(plan_of((lpv_settings){.far_field_levels = 2}, f).cascades, 3);
 }
 
 static lpv_plan_facts steady(void)
@@ -328,9 +335,11 @@ static void test_bounce_needs_gv(void **state)
 
 /* ---- placement ---- */
 
+/* The cascaded-LPV paper's placement: far field off (it adds coarser levels
+ * to one grid over the scene, checked on its own below). */
 static lpv_settings cascade_settings(void)
 {
-    return resolved((lpv_settings){.grid_dims = {16, 16, 16}, .cascade_size = 8.0f});
+    return resolved((lpv_settings){.grid_dims = {16, 16, 16}, .cascade_size = 8.0f, .far_field = LPV_SWITCH_OFF});
 }
 
 static const float BMIN[3] = {-10, 0, -10}, BMAX[3] = {10, 3, 10};
@@ -406,6 +415,31 @@ static void test_place_snapping_and_nesting(void **state)
     assert_int_equal(lpv_cascades_place(&s, 1, BMIN, BMAX, eye, fwd, &one), 0);
     assert_int_equal(one.count, 1);
     assert_false(one.snapped);
+    assert_false(one.handoff);
+    /* the same with far field on (the defaults): the grid over the bounds, unchanged, gets far_field_levels
+     * coarser levels, each twice the previous cell, its cells unions of 2^3 of the previous level's and its
+     * origin dims / 2 of the previous level's cells further out */
+    lpv_settings ff = cascade_settings();
+    ff.far_field = LPV_SWITCH_ON;
+    assert_int_equal(resolved((lpv_settings){0}).far_field, LPV_SWITCH_ON);
+    lpv_cascade_set far;
+    assert_int_equal(lpv_cascades_place(&ff, 1, BMIN, BMAX, eye, fwd, &far), 0);
+    assert_int_equal(far.count, 1 + ff.far_field_levels);
+    assert_false(far.snapped);
+    assert_true(far.handoff);
+    assert_memory_equal(&far.grid[0], &one.grid[0], sizeof far.grid[0]);
+    for (int k = 1; k < far.count; ++k) {
+        const lpv_grid *g = &far.grid[k], *f0 = &far.grid[k - 1];
+        assert_memory_equal(g->dims, f0->dims, sizeof g->dims);
+        assert_float_equal(g->cell_size, 2.0f * f0->cell_size, 0.0f);
+        for (int i = 0; i < 3; ++i) {
+            double want = f0->origin[i] - (double)(g->dims[i] / 2) * f0->cell_size;
+            assert_true(fabs(g->origin[i] - want) <= 1e-5 * g->cell_size * g->dims[i]);
+            /* in the finer level's cells, the coarser origin is a whole number of cells away */
+            double d = (g->origin[i] - f0->origin[i]) / f0->cell_size;
+            assert_true(fabs(d - round(d)) <= 1e-4);
+        }
+    }
     assert_int_equal(lpv_cascades_place(&s, 5, BMIN, BMAX, eye, fwd, &one), -1);
     const float bad[3] = {NAN, 0, 0};
     assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, bad, fwd, &one), -1);

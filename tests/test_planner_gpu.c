@@ -271,6 +271,7 @@ static void test_one_cascade_when_scene_fits(void **state)
     build_lit_room(&scene);
     lpv_view v = room_view(0);
     lpv_settings s = small_settings(); /* cascades auto; the room (2.1 m) fits in 8 m */
+    s.far_field = LPV_SWITCH_OFF;      /* the planner's choice of cascades alone (far field: below) */
     size_t n, n2;
     lpv_cell *autos = volume_of(&scene, s, &v, &n);
     assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 1);
@@ -289,6 +290,18 @@ static void test_one_cascade_when_scene_fits(void **state)
     set_all(&scene, s, &v);
     tick();
     assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 3);
+    /* with the far field on (the defaults), the one grid over the room gets its coarser levels, and the plan and
+     * the stats report every grid in use */
+    s = small_settings();
+    set_all(&scene, s, &v);
+    tick();
+    const lpv_settings *r = lpv_engine_settings(lpvt_engine);
+    assert_int_equal(r->far_field, LPV_SWITCH_ON);
+    assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 1 + r->far_field_levels);
+    assert_int_equal(plan()->cascades, 1 + r->far_field_levels);
+    assert_non_null(strstr(plan()->cascades_reason, "far field"));
+    assert_int_equal(lpv_engine_last_stats(lpvt_engine)->cascades, 1 + r->far_field_levels);
+    assert_memory_equal(&g, lpv_engine_cascade(lpvt_engine, 0), sizeof g); /* the finest level: the same grid */
     free(autos);
     free(explicit1);
     lpv_scene_free(&scene);

@@ -25,9 +25,16 @@
 #define ITER 4
 #define CELL0 0.25f
 
+/* departures: 0 = the cascaded-LPV paper's cascades, each holding its own light (far field and normal bins off:
+ * what the snapping checks below reason about); 1 = the defaults (far field hands light from cascade 0 on to the
+ * coarser ones, so they see cascade 0's moves). */
+static int departures;
+
 static lpv_settings temporal_settings(void)
 {
     lpv_settings s = {0};
+    if (!departures)
+        s.far_field = s.normal_bins = LPV_SWITCH_OFF;
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
     s.iterations = ITER;
@@ -87,9 +94,8 @@ static void origins(float out[3][3])
 
 static const size_t PER = (size_t)DIM * DIM * DIM;
 
-static void test_subcell_move_is_bit_identical(void **state)
+static void check_subcell_move_is_bit_identical(void)
 {
-    (void)state;
     lpv_scene scene;
     build_room(&scene, (float[3]){-0.4f, 1.8f, 0.2f});
     /* x = 0.3 and 0.7 finest cells: floor(x / cell) is 0 in every cascade (cells 0.25, 0.5, 1 m) */
@@ -110,6 +116,18 @@ static void test_subcell_move_is_bit_identical(void **state)
     free(va);
     free(vb);
     lpv_scene_free(&scene);
+}
+
+/* No cascade moves, so the volume must not change: with the paper's cascades and with the defaults. */
+static void test_subcell_move_is_bit_identical(void **state)
+{
+    (void)state;
+    departures = 0;
+    check_subcell_move_is_bit_identical();
+    departures = 1;
+    check_subcell_move_is_bit_identical();
+    assert_int_equal(lpv_engine_settings(lpvt_engine)->far_field, LPV_SWITCH_ON);
+    departures = 0;
 }
 
 static void test_one_cell_move_shifts_cascade_0(void **state)

@@ -61,7 +61,7 @@ static const char *const STAGES[] = {"rsm",       "vpl_extract", "inject",  "gbu
  * occlusion stay at 128^2 / on by default: the first sweep (docs/accuracy.md,
  * "History") found larger RSMs buy nothing and occlusion always helps. */
 static const int GRIDS[] = {6, 8, 12, 16, 32};
-static const int ITERS[] = {4, 8, 16};
+static const int ITERS[] = {2, 4, 8, 16};
 static const int RSMS[] = {128};
 static const int OCCS[] = {1};
 static const int MODS[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
@@ -226,8 +226,8 @@ static void usage(FILE *f)
             "                     a CAD model in mm under the default light; ClearCoatTest.gltf, spheres\n"
             "                     lit by emissive labels), or paths to .glb/.gltf files\n"
             "                     (default cornell,courtyard,blinds)\n"
-            "  --quick            %d points instead of the 240-point factorial (grid 6/8/12/16/32 x\n"
-            "                     iterations 4/8/16 x the 16 combinations of the mods below; RSM 128, occlusion on)\n"
+            "  --quick            %d points instead of the 320-point factorial (grid 6/8/12/16/32 x\n"
+            "                     iterations 2/4/8/16 x the 16 combinations of the mods below; RSM 128, occlusion on)\n"
             "  --presets          exactly the named presets (fast, balanced, accurate) as the points\n"
             "  --features         one knob at a time around balanced: cascades 3, bounces on, damping\n"
             "                     0.5 and 1 vs one grid (alone: scenes cornell-inside,courtyard,blinds;\n"

@@ -56,7 +56,8 @@ CONFIG_KNOBS = {
     "cascade_offset": "float", "bounces": "switch", "bounce_intensity": "float", "damping": "float",
     "glossy": "switch", "glossy_roughness": "float", "media": "switch", "fog_sigma_s": "float",
     "fog_sigma_a": "float", "media_step": "float", "planner": "switch", "area_lights": "switch",
-    "area_light_samples": "int",
+    "area_light_samples": "int", "central_transport": "switch", "normal_bins": "switch", "far_field": "switch",
+    "far_field_levels": "int", "scene_surfels": "switch", "scene_surfel_count": "int",
 }
 
 # Message types (SPEC section 4).
@@ -815,6 +816,10 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
     say("HELLO -> %s" % json.dumps(c.hello_reply, sort_keys=True))
     if c.hello_reply.get("version") != 1:
         raise AssertionError("HELLO reply version %r" % c.hello_reply.get("version"))
+    # The local lookup below is R5.7's: exact for one volume per cascade, so
+    # normal bins and the far field (the defaults) are off (docs/protocol.md,
+    # "Volumes and the defaults").
+    c.config(normal_bins=False, far_field=False)
     if glb is not None:
         with open(glb, "rb") as f:
             r = c.scene_load_glb(f.read())

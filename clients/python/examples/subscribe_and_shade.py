@@ -98,6 +98,9 @@ def main(argv):
     if args.glb:
         with open(args.glb, "rb") as f:
             print("loaded: %s" % c.scene_load_glb(f.read()))
+    # This example shades with R5.7's lookup, which is the server's exactly for
+    # one volume per cascade: normal bins and the far field (the defaults) off.
+    c.config(normal_bins=False, far_field=False)
     c.subscribe("volume", format=args.format, delta=True)
     fixed = read_points(args.points) if args.points else None
 
