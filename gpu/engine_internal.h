@@ -10,6 +10,7 @@
 #include "error.h"
 #include "gl.h"
 #include "lpv_shared.h"
+#include "memory_budget.h"
 #include "timer.h"
 
 typedef struct lpv_gpu_material {
@@ -54,7 +55,7 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
         prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
-        prog_media;
+        prog_media, prog_shadow;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -77,6 +78,14 @@ struct lpv_engine {
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* one per RSM texel */
     size_t rsm_texels;    /* face_count * rsm_size^2 */
+
+    /* shadow maps of direct light (pass_shadow.c), rendered at render time */
+    struct LpvShadowBlock shadow_block; /* the faces the maps hold */
+    GLuint shadow_ubo, shadow_tex, shadow_fbo;
+    int shadow_alloc_size, shadow_alloc_faces;
+    int shadow_valid;     /* 0: the maps must be redrawn (scene, settings, invalidate) */
+
+    lpv_memory_limits mem_limits; /* of the context, read at create */
 
     /* grids */
     GLuint grid_ubo;
@@ -124,7 +133,7 @@ static inline size_t lpv_engine_all_cells(const lpv_engine *e)
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
 void lpv_pass_rsm_run(lpv_engine *e);
 void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls);
-void lpv_pass_gbuffer_run(lpv_engine *e);
+int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the targets could not be allocated */
 void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera);
 void lpv_pass_propagate_run(lpv_engine *e, int occlusion, int bounce);
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
@@ -138,6 +147,26 @@ void lpv_medium_bind(lpv_engine *e, GLuint prog, int on);
 
 /* Light faces (RSM views) for the scene's lights: fills e->light_block. */
 void lpv_light_faces_build(lpv_engine *e);
+
+/* RSM faces and shadow-map faces the scene's lights will need (the rule of
+ * lpv_light_faces_build, without building them). */
+void lpv_light_face_counts(const lpv_engine *e, int *rsm_faces, int *shadow_faces);
+
+/* The shadow-map faces for e->light_block's lights at shadow_size, the
+ * directional cascades fitted to e->view. Returns 0 or -1 with err. */
+int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *err, size_t err_size);
+
+/* Shadow maps (pass_shadow.c): builds the faces, (re)allocates the maps when
+ * their size or count changed, and redraws them when anything they show
+ * changed; records the "shadow" stage when it draws. Returns 0 or -1. */
+int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size);
+void lpv_pass_shadow_free(lpv_engine *e);
+
+/* The storage the engine's inputs call for, with the grid of `cascades`
+ * (NULL: the current one), and the check against the context's limits
+ * (core/memory_budget.h). Returns 0, or -1 with a message naming the setting. */
+void lpv_engine_memory_need(const lpv_engine *e, const lpv_cascade_set *cascades, lpv_memory_need *n);
+int lpv_engine_memory_check(const lpv_engine *e, const lpv_memory_need *n, char *err, size_t err_size);
 
 /* Atlas helpers (pass_inject.c). */
 int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);
