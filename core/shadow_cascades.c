@@ -80,7 +80,19 @@ int lpv_shadow_cascades_fit(const lpv_view *view, const float light_dir[3], cons
         d_hi = fminf(d_hi, view->zfar);
     if (!(d_hi > d_lo)) /* the scene lies behind the camera: cover a sliver in front */
         d_hi = d_lo + scene_radius;
+    /* Round the range outwards to quarter octaves, so a camera that moves a
+     * little keeps its splits (and texel sizes) instead of changing them
+     * every frame. */
+    d_hi = exp2f(ceilf(4.0f * log2f(d_hi)) / 4.0f);
+    if (d_lo > near_z)
+        d_lo = fmaxf(near_z, exp2f(floorf(4.0f * log2f(d_lo)) / 4.0f));
+    if (view->zfar > 0.0f && d_hi > view->zfar)
+        d_hi = fmaxf(view->zfar, d_lo + 1e-3f);
     const float log_base = fmaxf(d_lo, near_z);
+
+    /* No cascade needs to be larger than the scene's bounding sphere. */
+    vec3 scene_centre;
+    glm_vec3_center((float *)scene_min, (float *)scene_max, scene_centre);
 
     /* The light's frame: a rotation that depends only on its direction. */
     vec3 lup = {0.0f, 1.0f, 0.0f};
@@ -116,6 +128,10 @@ int lpv_shadow_cascades_fit(const lpv_view *view, const float light_dir[3], cons
         float r = 0.0f;
         for (int k = 0; k < 8; ++k)
             r = fmaxf(r, glm_vec3_distance(centre, corners[k]));
+        if (r >= scene_radius) {
+            glm_vec3_copy(scene_centre, centre);
+            r = scene_radius;
+        }
         r = stable_radius(fmaxf(r, 1e-4f));
         float half = r * scale;
         float texel = 2.0f * half / (float)size;

@@ -3,8 +3,10 @@
  */
 #include "memory_limits.h"
 
+#include <errno.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -49,6 +51,17 @@ void lpv_memory_limits_query(lpv_memory_limits *out)
     out->budget = memory / 2;
     snprintf(out->budget_source, sizeof out->budget_source, "half of the %.2f GB of %s", (double)memory / 1e9,
              source);
+    /* LPVD_MEMORY_BUDGET_MB can only lower it (a GPU shared with others). */
+    const char *cap = getenv("LPVD_MEMORY_BUDGET_MB");
+    if (cap && *cap) {
+        char *end;
+        errno = 0;
+        unsigned long long mb = strtoull(cap, &end, 10);
+        if (end != cap && !*end && errno == 0 && mb > 0 && mb * 1000000ull < out->budget) {
+            out->budget = mb * 1000000ull;
+            snprintf(out->budget_source, sizeof out->budget_source, "LPVD_MEMORY_BUDGET_MB=%llu", mb);
+        }
+    }
 
     /* GLSL addresses shader storage with 32-bit offsets (llvmpipe faults
      * past 2 GiB), and the grids are also read as buffer textures. */

@@ -2,7 +2,8 @@
  * memory_limits.h - the current GL context's storage limits for
  * core/memory_budget.h: the budget (half of the video memory the driver
  * reports through GL_NVX_gpu_memory_info or GL_ATI_meminfo, else half of the
- * machine's RAM, which is the memory of llvmpipe), the largest shader storage
+ * machine's RAM, which is the memory of llvmpipe; the environment variable
+ * LPVD_MEMORY_BUDGET_MB, in 10^6 bytes, lowers it), the largest shader storage
  * buffer, texture side and array layers. The engine's side of the check
  * (lpv_engine_memory_need / _check) is declared in engine_internal.h.
  */
