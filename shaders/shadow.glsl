@@ -53,14 +53,16 @@ float shadow_texel(int f, vec3 x, vec3 light_pos)
     return F.info.x * max(dot(x - light_pos, F.axis.xyz), 0.0);
 }
 
-// Visibility (0..1) of light l from a receiver at p with unit normal n. The
+// Visibility (0..1) of light l from a receiver at p with unit normal n,
+// filtered over the kernel (taps = 1: one bilinear compare, for callers that
+// average many lookups themselves, such as the media's ray march). The
 // receiver bias is in texels of the map at p (texel size T), so it does not
 // grow with the scene: p moves LPV_SHADOW_NORMAL_OFFSET * T * sin(theta)
 // along n, which lifts it off its own plane by what that plane rises across
 // the kernel, then (LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan(theta))
 // * T towards the light (the slope-scaled depth bias; moving along the ray to
 // the light keeps the texel the same).
-float shadow_visibility(int l, vec3 p, vec3 n)
+float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
 {
     LpvLightGpu li = L.lights[l];
     if (int(S.lights[l].y) == 0)
@@ -91,5 +93,13 @@ float shadow_visibility(int l, vec3 p, vec3 n)
     if (any(greaterThan(abs(ndc.xy), vec2(1.0))))
         return S.faces[f].info.y == 0.0 ? 1.0 : 0.0; // outside a spot's face is outside its cone
     vec3 uvz = ndc * 0.5 + 0.5;
+    if (taps == 1)
+        return texture(u_shadow, vec4(uvz.xy, float(f), uvz.z));
     return shadow_pcf(f, uvz.xy, uvz.z);
+}
+
+// The filtered visibility for surfaces (shade.frag).
+float shadow_visibility(int l, vec3 p, vec3 n)
+{
+    return shadow_visibility_taps(l, p, n, 0);
 }
