@@ -791,8 +791,20 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
     if (e->query_capacity < n) {
         delete_buffer(&e->query_in);
         delete_buffer(&e->query_out);
+        for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
+        }
         e->query_in = new_ssbo(n * 8 * sizeof(float));
         e->query_out = new_ssbo(n * 4 * sizeof(float));
+        GLenum alloc_err = glGetError();
+        if (alloc_err != GL_NO_ERROR) {
+            delete_buffer(&e->query_in);
+            delete_buffer(&e->query_out);
+            e->query_capacity = 0;
+            free(in);
+            free(out);
+            return lpv_error(err, err_size, "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)",
+                             n, (double)n * 48.0 / 1e9, alloc_err);
+        }
         e->query_capacity = n;
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_in);
