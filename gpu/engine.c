@@ -802,8 +802,9 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
             e->query_capacity = 0;
             free(in);
             free(out);
-            return lpv_error(err, err_size, "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)",
-                             n, (double)n * 48.0 / 1e9, alloc_err);
+            return lpv_error(err, err_size,
+                             "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)", n,
+                             (double)n * 48.0 / 1e9, alloc_err);
         }
         e->query_capacity = n;
     }
