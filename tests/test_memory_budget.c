@@ -9,7 +9,10 @@
  *  3. under LPVD_MEMORY_BUDGET_MB a shadow_size whose maps do not fit is
  *     refused at render time, naming shadow_size and the budget, and
  *     `lpvd render` exits with status 1 and the message instead of crashing;
- *     a shadow_size past the table's range is refused by the flag parser.
+ *     a shadow_size past the table's range is refused by the flag parser;
+ *  4. area light samples are counted: 8 samples of an emitter have 40
+ *     shadow-map faces, tiles four to a layer, so 10 layers of shadow_size^2
+ *     (4096: 0.67 GB, refused under a 100 MB budget; 256 fits and lights).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -169,12 +172,57 @@ static void test_shadow_size_over_the_budget_is_refused(void **state)
     assert_int_equal(lpvd_cmd_render(5, (char **)absurd_rsm), 2);
 }
 
+/* A grey floor under a 0.5 m emitter facing down, no punctual light: its
+ * light comes only through the area light samples. */
+static void emitter_only(lpv_scene *s)
+{
+    memset(s, 0, sizeof *s);
+    int grey = lpv_scene_add_material(s, "grey", (float[3]){0.5f, 0.5f, 0.5f}, NULL);
+    int lamp = lpv_scene_add_material(s, "lamp", (float[3]){0, 0, 0}, (float[3]){2.0f, 2.0f, 2.0f});
+    const float plane[4][3] = {{-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}};
+    const float lamp_q[4][3] = {{-0.25f, 1, -0.25f}, {0.25f, 1, -0.25f}, {0.25f, 1, 0.25f}, {-0.25f, 1, 0.25f}};
+    assert_true(lpv_scene_add_quad(s, grey, plane, NULL) >= 0);
+    assert_true(lpv_scene_add_quad(s, lamp, lamp_q, NULL) >= 0);
+    lpv_scene_compute_bounds(s);
+}
+
+static void test_area_light_faces_are_counted(void **state)
+{
+    (void)state;
+    assert_int_equal(setenv("LPVD_MEMORY_BUDGET_MB", "100", 1), 0);
+    lpv_gl_context *ctx;
+    lpv_engine *e;
+    assert_int_equal(lpvt_gl_open(&ctx, &e), 0);
+    assert_int_equal(unsetenv("LPVD_MEMORY_BUDGET_MB"), 0);
+    lpv_scene s;
+    emitter_only(&s);
+    lpv_view v;
+    assert_int_equal(lpv_view_look_at((float[3]){0, 3, 3}, (float[3]){0, 0, 0}, 1.0f, 32, 32, &v), 0);
+    float rgba[32 * 32 * 4];
+    char err[1024] = "";
+    lpv_settings big = {.grid_dims = {8, 8, 8}, .rsm_size = 32, .shadow_size = 4096, .area_light_samples = 8};
+    assert_int_equal(run_engine(e, &s, &big, &v, rgba, err, sizeof err), -1);
+    printf("refused: %s\n", err);
+    /* 8 x 5 faces of 2048^2, four to a 4096^2 layer: 10 layers of 67 MB */
+    assert_non_null(strstr(err, "shadow_size 4096 x 10 shadow-map faces needs 0.67 GB"));
+    lpv_settings ok = {.grid_dims = {8, 8, 8}, .rsm_size = 32, .shadow_size = 256, .area_light_samples = 8};
+    if (run_engine(e, &s, &ok, &v, rgba, err, sizeof err) != 0)
+        fail_msg("after the refusal: %s", err);
+    double sum = 0.0;
+    for (int i = 0; i < 32 * 32 * 4; i += 4)
+        sum += rgba[i + 1];
+    assert_true(sum > 0.0);
+    lpvt_gl_close(ctx, e);
+    lpv_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_estimates_and_check),
         cmocka_unit_test(test_rsm_size_that_crashed_is_refused),
         cmocka_unit_test(test_shadow_size_over_the_budget_is_refused),
+        cmocka_unit_test(test_area_light_faces_are_counted),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
