@@ -18,6 +18,7 @@
 #include "lpv_shared.h"
 
 #define LPV_MIN_RSM_SIZE 16
+#define LPV_MIN_SHADOW_SIZE 16
 #define LPV_MAX_EMISSIVE_VPLS (1 << 20)
 
 /* The named presets: ONE table, indexed by lpv_preset. The values are points
@@ -136,6 +137,8 @@ void lpv_settings_resolve(lpv_settings *s)
         if (s->scene_surfels == LPV_SWITCH_DEFAULT)
             s->scene_surfels = p.scene_surfels;
     }
+    if (s->shadow_size == 0)
+        s->shadow_size = LPV_DEFAULT_SHADOW_SIZE;
     if (s->indirect_gain == 0.0f)
         s->indirect_gain = 1.0f;
     if (s->emissive_vpls == 0)
@@ -221,6 +224,9 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->rsm_size < LPV_MIN_RSM_SIZE || s->rsm_size > LPV_MAX_RSM_SIZE)
         return fail(err, err_size, "rsm_size = %d is out of range (allowed %d..%d)", s->rsm_size, LPV_MIN_RSM_SIZE,
                     LPV_MAX_RSM_SIZE);
+    if (s->shadow_size < LPV_MIN_SHADOW_SIZE || s->shadow_size > LPV_MAX_SHADOW_SIZE)
+        return fail(err, err_size, "shadow_size = %d is out of range (allowed %d..%d)", s->shadow_size,
+                    LPV_MIN_SHADOW_SIZE, LPV_MAX_SHADOW_SIZE);
     if (s->occlusion != LPV_SWITCH_DEFAULT && s->occlusion != LPV_SWITCH_ON && s->occlusion != LPV_SWITCH_OFF)
         return fail(err, err_size, "occlusion = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
                     (int)s->occlusion);

@@ -31,6 +31,8 @@ typedef struct lpv_settings {
     float bounds_max[3];    /*   bounds grown by half a cell on every side */
     int iterations;         /* propagation steps; default: the preset's (balanced: 4) */
     int rsm_size;           /* reflective shadow map side, texels; default: the preset's (balanced: 128) */
+    int shadow_size;        /* side of each light face's shadow map for direct light, texels;
+                               default LPV_DEFAULT_SHADOW_SIZE (docs/shadows.md) */
     lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default: the preset's (on) */
     float indirect_gain;    /* artistic factor on the LPV term; default 1 (0 = default) */
     int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
@@ -95,6 +97,7 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_GRID_DIM 8
 #define LPV_DEFAULT_ITERATIONS 4
 #define LPV_DEFAULT_RSM_SIZE 128
+#define LPV_DEFAULT_SHADOW_SIZE 1024
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096
 #define LPV_DEFAULT_CASCADES 3
 #define LPV_DEFAULT_CASCADE_SIZE 0.0f     /* auto, relative to the scene (any unit scale) */

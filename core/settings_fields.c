@@ -24,6 +24,8 @@ static const lpv_field FIELDS[] = {
      "the preset's (balanced: 4)", "", "propagation steps"},
     {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
      "the preset's (balanced: 128)", "", "reflective shadow map side"},
+    {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", "1024", "",
+     "shadow map side per light face, for direct light (docs/shadows.md)"},
     {"occlusion", "occlusion", LPV_FIELD_SWITCH, F(occlusion), 0, 1, 0, "", "the preset's (on)", "",
      "fuzzy occlusion from the geometry volume"},
     {"indirect_gain", "indirect-gain", LPV_FIELD_FLOAT, F(indirect_gain), 0, 1e30, 1, "", "1", "",

@@ -12,6 +12,7 @@
 #include "scene_surfels.h"
 #include "error.h"
 #include "engine_internal.h"
+#include "memory_limits.h"
 #include "shader.h"
 
 GLuint lpv_engine_program(const char *first, const char *geom, const char *frag, const char *const *includes,
@@ -82,6 +83,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_query, "query.comp", NULL, INC_LOOKUP},
         {&e->prog_glossy, "fullscreen.vert", "glossy.frag", INC_LOOKUP},
         {&e->prog_media, "fullscreen.vert", "media.frag", INC_MEDIA},
+        {&e->prog_shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog = lpv_engine_program(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
@@ -92,9 +94,9 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     }
     GLint max_block = 0;
     glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
-    if ((size_t)max_block < sizeof(struct LpvLightBlock)) {
-        lpv_error(err, err_size, "the light block needs %zu bytes of uniform block, GL allows %d",
-                  sizeof(struct LpvLightBlock), max_block);
+    if ((size_t)max_block < sizeof(struct LpvLightBlock) || (size_t)max_block < sizeof(struct LpvShadowBlock)) {
+        lpv_error(err, err_size, "the light and shadow blocks need %zu and %zu bytes of uniform block, GL allows %d",
+                  sizeof(struct LpvLightBlock), sizeof(struct LpvShadowBlock), max_block);
         lpv_engine_destroy(e);
         return NULL;
     }
@@ -102,6 +104,9 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     glGenBuffers(1, &e->grid_ubo);
     glGenBuffers(1, &e->light_ubo);
     glGenBuffers(1, &e->view_ubo);
+    glGenBuffers(1, &e->shadow_ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, e->shadow_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvShadowBlock), NULL, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_UNIFORM_BUFFER, e->light_ubo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvLightBlock), NULL, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
@@ -110,6 +115,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
     lpv_timer_init(&e->timer);
     lpv_settings_resolve(&e->settings);
+    lpv_memory_limits_query(&e->mem_limits);
     return e;
 }
 
@@ -217,13 +223,14 @@ void lpv_engine_destroy(lpv_engine *e)
     free_rsm(e);
     free_grids(e);
     free_camera(e);
+    lpv_pass_shadow_free(e);
     delete_texture(&e->medium_density);
     delete_buffer(&e->query_in);
     delete_buffer(&e->query_out);
     GLuint *progs[] = {&e->prog_rsm, &e->prog_vpl_extract, &e->prog_inject_vpl, &e->prog_inject_gv,
                        &e->prog_pack, &e->prog_gv_merge, &e->prog_transmit, &e->prog_propagate,
                        &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade, &e->prog_query,
-                       &e->prog_glossy, &e->prog_media, &e->prog_handoff};
+                       &e->prog_glossy, &e->prog_media, &e->prog_handoff, &e->prog_shadow};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -232,6 +239,7 @@ void lpv_engine_destroy(lpv_engine *e)
     delete_buffer(&e->grid_ubo);
     delete_buffer(&e->light_ubo);
     delete_buffer(&e->view_ubo);
+    delete_buffer(&e->shadow_ubo);
     lpv_timer_destroy(&e->timer);
     free(e);
 }
@@ -282,6 +290,10 @@ static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, 
         e->grid_alloc_cascades == set->count && e->grid_alloc_bins == e->bins)
         return 0;
 
+    lpv_memory_need need;
+    lpv_engine_memory_need(e, set, &need);
+    if (lpv_engine_memory_check(e, &need, err, err_size) != 0)
+        return -1;
     free_grids(e);
     const size_t K = (size_t)set->count;
     size_t cells = lpv_grid_cell_count(g) * K, gv = lpv_grid_gv_count(g) * K;
@@ -370,6 +382,7 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
         return 0;
     e->settings = s;
     e->settings_dirty = 1;
+    e->shadow_valid = 0;
     e->gbuf_stale = 1;
     e->ticked = 0;
     update_area_samples(e);
@@ -462,6 +475,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         e->scene_dirty = 1;
     e->geometry_sig = sig;
     e->gbuf_stale = 1;
+    e->shadow_valid = 0;
     free_scene(e);
     e->ticked = 0;
     e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
@@ -577,6 +591,14 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
     }
     if (view->width < 1 || view->height < 1 || view->width > 16384 || view->height > 16384)
         return lpv_error(err, err_size, "image size %dx%d outside 1..16384", view->width, view->height);
+    if (e->has_scene) { /* the image's storage must fit next to the rest */
+        lpv_memory_need need;
+        lpv_engine_memory_need(e, NULL, &need);
+        need.image_w = view->width;
+        need.image_h = view->height;
+        if (lpv_engine_memory_check(e, &need, err, err_size) != 0)
+            return -1;
+    }
     if (!e->has_view || memcmp(&e->view, view, sizeof *view) != 0)
         e->gbuf_stale = 1;
     e->view = *view;
@@ -736,6 +758,7 @@ static void clear_volume(lpv_engine *e)
 void lpv_engine_invalidate(lpv_engine *e)
 {
     e->forced = 1;
+    e->shadow_valid = 0;
 }
 
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
@@ -769,7 +792,8 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
     else
         clear_volume(e);
     if (p->pass[LPV_PASS_GBUFFER].run) {
-        lpv_pass_gbuffer_run(e);
+        if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
+            return -1;
         e->gbuf_stale = 0;
     }
     if (p->pass[LPV_PASS_GV].run)
@@ -796,9 +820,14 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     if (!e->has_view)
         return lpv_error(err, err_size, "render needs a view (camera)");
     if (e->gbuf_stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
-        lpv_pass_gbuffer_run(e);
+        if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
+            return -1;
         e->gbuf_stale = 0;
     }
+    /* Direct light needs the shadow maps (media's in-scattering too, which
+     * only a full frame has); they are redrawn only when what they show changed. */
+    if (terms != LPV_TERMS_INDIRECT_ONLY && lpv_pass_shadow_update(e, err, err_size) != 0)
+        return -1;
     lpv_pass_shade_run(e, terms);
     if (e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY)
         lpv_pass_glossy_run(e);
@@ -863,8 +892,21 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
     if (e->query_capacity < n) {
         delete_buffer(&e->query_in);
         delete_buffer(&e->query_out);
+        for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
+        }
         e->query_in = new_ssbo(n * 8 * sizeof(float));
         e->query_out = new_ssbo(n * 4 * sizeof(float));
+        GLenum alloc_err = glGetError();
+        if (alloc_err != GL_NO_ERROR) {
+            delete_buffer(&e->query_in);
+            delete_buffer(&e->query_out);
+            e->query_capacity = 0;
+            free(in);
+            free(out);
+            return lpv_error(err, err_size,
+                             "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)", n,
+                             (double)n * 48.0 / 1e9, alloc_err);
+        }
         e->query_capacity = n;
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_in);

@@ -11,6 +11,7 @@
 #include "error.h"
 #include "gl.h"
 #include "lpv_shared.h"
+#include "memory_budget.h"
 #include "timer.h"
 
 typedef struct lpv_gpu_material {
@@ -63,7 +64,7 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
         prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
-        prog_media, prog_handoff;
+        prog_media, prog_handoff, prog_shadow;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -94,6 +95,14 @@ struct lpv_engine {
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* one per RSM texel */
     size_t rsm_texels;    /* rsm_layers * rsm_size^2 */
+
+    /* shadow maps of direct light (pass_shadow.c), rendered at render time */
+    struct LpvShadowBlock shadow_block; /* the faces the maps hold */
+    GLuint shadow_ubo, shadow_tex, shadow_fbo;
+    int shadow_alloc_size, shadow_alloc_faces;
+    int shadow_valid;     /* 0: the maps must be redrawn (scene, settings, invalidate) */
+
+    lpv_memory_limits mem_limits; /* of the context, read at create */
 
     /* grids */
     GLuint grid_ubo;
@@ -153,7 +162,7 @@ static inline size_t lpv_engine_volume_cells(const lpv_engine *e)
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
 void lpv_pass_rsm_run(lpv_engine *e);
 void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls);
-void lpv_pass_gbuffer_run(lpv_engine *e);
+int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the targets could not be allocated */
 void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera);
 void lpv_pass_propagate_run(lpv_engine *e, int occlusion, int bounce);
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
@@ -172,6 +181,29 @@ void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *firs
 /* Light faces (RSM views) for the scene's lights and area light samples:
  * fills e->light_block, face_count, punctual_faces, rsm_layers. */
 void lpv_light_faces_build(lpv_engine *e);
+
+/* RSM layers and shadow-map layers the scene's lights and area light samples
+ * will need (the rules of lpv_light_faces_build and lpv_shadow_faces_build,
+ * without building them): a punctual light's face fills a layer, area light
+ * faces are tiles, four to a layer. */
+void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers);
+
+/* The shadow-map faces for e->light_block's lights (punctual lights and area
+ * light samples) at shadow_size, the directional cascades fitted to e->view.
+ * Returns 0 or -1 with err. */
+int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *err, size_t err_size);
+
+/* Shadow maps (pass_shadow.c): builds the faces, (re)allocates the maps when
+ * their size or count changed, and redraws them when anything they show
+ * changed; records the "shadow" stage when it draws. Returns 0 or -1. */
+int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size);
+void lpv_pass_shadow_free(lpv_engine *e);
+
+/* The storage the engine's inputs call for, with the grid of `cascades`
+ * (NULL: the current one), and the check against the context's limits
+ * (core/memory_budget.h). Returns 0, or -1 with a message naming the setting. */
+void lpv_engine_memory_need(const lpv_engine *e, const lpv_cascade_set *cascades, lpv_memory_need *n);
+int lpv_engine_memory_check(const lpv_engine *e, const lpv_memory_need *n, char *err, size_t err_size);
 
 /* Atlas helpers (pass_inject.c). */
 int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);

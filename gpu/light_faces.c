@@ -15,6 +15,16 @@
  *     doubling the samples).
  * Every punctual face fills its own layer. Lights past LPV_MAX_LIGHTS or
  * LPV_MAX_FACES are left out (reported in the stats as the light count used).
+ *
+ * The shadow maps of direct light (docs/shadows.md) have their own faces at
+ * shadow_size: the same perspective and cube faces, widened by
+ * LPV_SHADOW_BORDER_TEXELS so the filter near a cube edge reads inside the
+ * face, and for a directional light LPV_SHADOW_CASCADES orthographic
+ * cascades fitted to the camera's view (core/shadow_cascades.c). Spots
+ * wider than LPV_SHADOW_SPOT_MAX_SINGLE_FACE (45 degrees, not the RSM's 80)
+ * get cube faces: one face that wide would have coarser texels. An area
+ * light sample's five faces get shadow-map faces too, tiled by the same rule
+ * at N = shadow_size (four to a layer), widened like the cube faces.
  */
 #include <math.h>
 #include <string.h>
@@ -22,6 +32,7 @@
 #include <cglm/cglm.h>
 
 #include "engine_internal.h"
+#include "shadow_cascades.h"
 
 static void any_up(const vec3 dir, vec3 up)
 {
@@ -57,6 +68,12 @@ static float far_from(const lpv_engine *e, const vec3 p)
     return sqrtf(far2) * 1.01f + 1e-3f;
 }
 
+/* Point lights and spots wider than one face get six cube faces. */
+static int light_is_wide(const lpv_light *src)
+{
+    return src->type == LPV_LIGHT_POINT || (src->type == LPV_LIGHT_SPOT && src->outer_cone > LPV_SPOT_MAX_SINGLE_FACE);
+}
+
 static void perspective_face(struct LpvFaceGpu *f, const vec3 eye, const vec3 dir, float half_fov, float near_z,
                              float far_z, int light, int size)
 {
@@ -75,8 +92,8 @@ static void perspective_face(struct LpvFaceGpu *f, const vec3 eye, const vec3 di
     f->axis[3] = 0.0f;
 }
 
-/* The side of an area light face (texels) for RSM side n, and how many fit
- * along a layer's side. */
+/* The side of an area light face (texels) in layers of side n (rsm_size for
+ * the RSMs, shadow_size for the shadow maps). */
 static int area_face_side(int n)
 {
     int side = n / 2;
@@ -84,13 +101,52 @@ static int area_face_side(int n)
     return side > floor_side ? side : floor_side;
 }
 
+/* Area light faces one layer of side n holds. */
+static int area_faces_per_layer(int n)
+{
+    const int per_row = n / area_face_side(n);
+    return per_row * per_row;
+}
+
+/* Layers that `faces` area light faces fill in layers of side n. */
+static int area_layers(int n, int faces)
+{
+    const int per_layer = area_faces_per_layer(n);
+    return (faces + per_layer - 1) / per_layer;
+}
+
+/* Tile of area light face j (counted over all samples) in layers of side n
+ * from `layer` on: xy lower-left corner (uv), z side (uv), w layer. */
+static void area_tile(int n, int j, int layer, float tile[4])
+{
+    const int side = area_face_side(n), per_row = n / side, per_layer = per_row * per_row;
+    const int in_layer = j % per_layer;
+    tile[0] = (float)((in_layer % per_row) * side) / (float)n;
+    tile[1] = (float)((in_layer / per_row) * side) / (float)n;
+    tile[2] = (float)side / (float)n;
+    tile[3] = (float)(layer + j / per_layer);
+}
+
+/* Area light samples lpv_light_faces_build will add after `lights` punctual
+ * lights holding `faces` faces. */
+static int area_samples_fitting(const lpv_engine *e, int lights, int faces)
+{
+    int n = 0;
+    for (size_t k = 0; k < e->area_sample_count; ++k) {
+        if (lights + n >= LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS || faces + LPV_AREA_FACES > LPV_MAX_FACES)
+            break;
+        faces += LPV_AREA_FACES;
+        ++n;
+    }
+    return n;
+}
+
 /* The area light samples after the punctual lights: lights [lights, ...),
  * faces [faces, ...), layers from `layer` on. Returns the samples added. */
 static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, float near_z)
 {
     struct LpvLightBlock *b = &e->light_block;
-    const int n = e->settings.rsm_size, side = area_face_side(n), per_row = n / side;
-    const int per_layer = per_row * per_row;
+    const int n = e->settings.rsm_size, side = area_face_side(n);
     int added = 0;
     for (size_t k = 0; k < e->area_sample_count; ++k) {
         if (lights + added >= LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS || faces + LPV_AREA_FACES > LPV_MAX_FACES)
@@ -130,17 +186,13 @@ static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, floa
             perspective_face(f, pos, axes[i], (float)(M_PI / 4.0), near_z, far_from(e, pos), l, side);
             /* Every sample sees the same surfaces: only the first one's feed the GV. */
             f->axis[3] = k == 0 ? 0.0f : 1.0f;
-            const int j = (int)k * LPV_AREA_FACES + i, in_layer = j % per_layer;
-            f->tile[0] = (float)((in_layer % per_row) * side) / (float)n;
-            f->tile[1] = (float)((in_layer / per_row) * side) / (float)n;
-            f->tile[2] = (float)side / (float)n;
-            f->tile[3] = (float)(layer + j / per_layer);
+            area_tile(n, (int)k * LPV_AREA_FACES + i, layer, f->tile);
             ++faces;
         }
         ++added;
     }
     e->area_face_side = side;
-    e->rsm_layers = layer + (added * LPV_AREA_FACES + per_layer - 1) / per_layer;
+    e->rsm_layers = layer + area_layers(n, added * LPV_AREA_FACES);
     return added;
 }
 
@@ -157,8 +209,7 @@ void lpv_light_faces_build(lpv_engine *e)
 
     for (uint32_t l = 0; l < e->light_count && lights < LPV_MAX_LIGHTS; ++l) {
         const lpv_light *src = &e->lights[l];
-        int wide = src->type == LPV_LIGHT_POINT ||
-                   (src->type == LPV_LIGHT_SPOT && src->outer_cone > LPV_SPOT_MAX_SINGLE_FACE);
+        int wide = light_is_wide(src);
         int need = wide ? 6 : 1;
         if (faces + need > LPV_MAX_FACES)
             break;
@@ -223,4 +274,129 @@ void lpv_light_faces_build(lpv_engine *e)
     b->counts[0] = (float)lights;
     b->counts[1] = (float)faces;
     e->face_count = faces;
+}
+
+void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers)
+{
+    int faces = 0, shadows = 0, lights = 0;
+    for (uint32_t l = 0; l < e->light_count && lights < LPV_MAX_LIGHTS; ++l) {
+        const lpv_light *src = &e->lights[l];
+        int need = light_is_wide(src) ? 6 : 1;
+        if (faces + need > LPV_MAX_FACES)
+            break;
+        faces += need;
+        ++lights;
+        shadows += src->type == LPV_LIGHT_DIRECTIONAL ? LPV_SHADOW_CASCADES
+                   : (src->type == LPV_LIGHT_SPOT && src->outer_cone <= LPV_SHADOW_SPOT_MAX_SINGLE_FACE) ? 1
+                                                                                                          : 6;
+    }
+    /* Area light samples: their faces' tiles, four to a layer, in both. */
+    const int area_faces = area_samples_fitting(e, lights, faces) * LPV_AREA_FACES;
+    *rsm_layers = faces + area_layers(e->settings.rsm_size, area_faces);
+    *shadow_layers = shadows + area_layers(e->settings.shadow_size, area_faces);
+}
+
+static void shadow_perspective_face(struct LpvShadowFaceGpu *f, const vec3 eye, const vec3 dir, float tan_half,
+                                    float near_z, float far_z, int light, int size)
+{
+    /* Widen the face so the central 2 tan_half of it keeps
+     * LPV_SHADOW_BORDER_TEXELS free on each side. */
+    float t = tan_half * (float)size / ((float)size - 2.0f * LPV_SHADOW_BORDER_TEXELS);
+    mat4 view, proj;
+    vec3 centre, up;
+    glm_vec3_add((float *)eye, (float *)dir, centre);
+    any_up(dir, up);
+    glm_lookat((float *)eye, centre, up, view);
+    glm_perspective(2.0f * atanf(t), 1.0f, near_z, far_z, proj);
+    glm_mat4_mul(proj, view, f->view_proj);
+    f->info[0] = 2.0f * t / (float)size; /* m per texel per m of depth */
+    f->info[1] = 1.0f;
+    f->info[2] = (float)light;
+    f->info[3] = 0.0f;
+    glm_vec3_copy((float *)dir, f->axis);
+    f->axis[3] = 0.0f;
+}
+
+int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *err, size_t err_size)
+{
+    memset(b, 0, sizeof *b);
+    const struct LpvLightBlock *lb = &e->light_block;
+    const int size = e->settings.shadow_size;
+    vec3 centre;
+    float radius;
+    scene_sphere(e, centre, &radius);
+    const float near_z = 1e-3f * radius;
+    int faces = 0, area_faces = 0;
+    const int punctual = (int)lb->counts[2];
+    for (int l = 0; l < (int)lb->counts[0]; ++l) {
+        const struct LpvLightGpu *g = &lb->lights[l];
+        const int type = (int)g->position_type[3];
+        vec3 pos = {g->position_type[0], g->position_type[1], g->position_type[2]};
+        vec3 dir = {g->direction_range[0], g->direction_range[1], g->direction_range[2]};
+        const int first = faces;
+        if (type == LPV_LIGHT_TYPE_AREA) {
+            /* The RSM's five faces (front, four sides), each a tile in the
+             * layers after the punctual lights' (whose count is known once
+             * they are all placed: the layer index is rebased below). */
+            if (faces + LPV_AREA_FACES > LPV_MAX_SHADOW_FACES)
+                return lpv_error(err, err_size, "too many shadow-map faces");
+            const int side = area_face_side(size);
+            for (int k = 0; k < LPV_AREA_FACES; ++k) {
+                const float *axis = lb->faces[(int)g->cone_faces[2] + k].axis;
+                vec3 ax = {axis[0], axis[1], axis[2]};
+                struct LpvShadowFaceGpu *f = &b->faces[faces++];
+                shadow_perspective_face(f, pos, ax, 1.0f, near_z, far_from(e, pos), l, side);
+                area_tile(size, area_faces++, 0, f->tile);
+            }
+        } else if (type == LPV_LIGHT_TYPE_DIRECTIONAL) {
+            lpv_shadow_cascade c[LPV_SHADOW_CASCADES];
+            if (faces + LPV_SHADOW_CASCADES > LPV_MAX_SHADOW_FACES)
+                return lpv_error(err, err_size, "too many shadow-map faces");
+            if (lpv_shadow_cascades_fit(&e->view, dir, e->scene_min, e->scene_max, size, LPV_SHADOW_BORDER_TEXELS,
+                                        LPV_SHADOW_CASCADES, c) != 0)
+                return lpv_error(err, err_size, "light %d: shadow cascades cannot be fitted to this view", l);
+            for (int k = 0; k < LPV_SHADOW_CASCADES; ++k) {
+                struct LpvShadowFaceGpu *f = &b->faces[faces++];
+                glm_mat4_copy(c[k].view_proj, f->view_proj);
+                f->info[0] = c[k].texel;
+                f->info[1] = 0.0f;
+                f->info[2] = (float)l;
+                f->info[3] = (float)k;
+                glm_vec3_copy(dir, f->axis);
+            }
+        } else if (type == LPV_LIGHT_TYPE_SPOT &&
+                   acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f)) <= LPV_SHADOW_SPOT_MAX_SINGLE_FACE) {
+            if (faces + 1 > LPV_MAX_SHADOW_FACES)
+                return lpv_error(err, err_size, "too many shadow-map faces");
+            float outer = acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
+            float half = outer > 1e-3f ? outer : 1e-3f;
+            shadow_perspective_face(&b->faces[faces++], pos, dir, tanf(half), near_z, far_from(e, pos), l, size);
+        } else {
+            if (faces + 6 > LPV_MAX_SHADOW_FACES)
+                return lpv_error(err, err_size, "too many shadow-map faces");
+            static const float axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            for (int k = 0; k < 6; ++k)
+                shadow_perspective_face(&b->faces[faces++], pos, axes[k], 1.0f, near_z, far_from(e, pos), l, size);
+        }
+        b->lights[l][0] = (float)first;
+        b->lights[l][1] = (float)(faces - first);
+        b->lights[l][2] = type == LPV_LIGHT_TYPE_DIRECTIONAL ? 1.0f : type == LPV_LIGHT_TYPE_AREA ? 2.0f : 0.0f;
+    }
+    /* Punctual faces fill one layer each, in order; area tiles follow. */
+    int punctual_faces = 0;
+    for (int l = 0; l < punctual && l < (int)lb->counts[0]; ++l)
+        punctual_faces += (int)b->lights[l][1];
+    for (int f = 0; f < faces; ++f) {
+        if (f < punctual_faces) {
+            b->faces[f].tile[0] = b->faces[f].tile[1] = 0.0f;
+            b->faces[f].tile[2] = 1.0f;
+            b->faces[f].tile[3] = (float)f;
+        } else
+            b->faces[f].tile[3] += (float)punctual_faces;
+    }
+    b->counts[3] = (float)(punctual_faces + area_layers(size, area_faces));
+    b->counts[0] = (float)faces;
+    b->counts[1] = (float)size;
+    b->counts[2] = 1.0f / (float)size;
+    return 0;
 }

@@ -1,7 +1,7 @@
 /*
  * pass_camera.c - the camera's passes: the G-buffer (position/surfel area,
  * normal, albedo, emission) with its pixels as GV surfels, and the final
- * shading of direct light (through the RSM depth as shadow maps) plus the
+ * shading of direct light (through the shadow maps of pass_shadow.c) plus the
  * LPV's irradiance into a linear-radiance frame.
  */
 #include <math.h>
@@ -24,11 +24,8 @@ static GLuint texture_2d(GLenum format, int w, int h)
     return t;
 }
 
-static void ensure_targets(lpv_engine *e)
+static void free_targets(lpv_engine *e)
 {
-    const int w = e->view.width, h = e->view.height;
-    if (e->gbuf_w == w && e->gbuf_h == h)
-        return;
     if (e->gbuf_fbo) {
         glDeleteTextures(4, e->gbuf_tex);
         glDeleteTextures(1, &e->gbuf_depth);
@@ -36,6 +33,21 @@ static void ensure_targets(lpv_engine *e)
         glDeleteFramebuffers(1, &e->gbuf_fbo);
         glDeleteFramebuffers(1, &e->frame_fbo);
         glDeleteBuffers(1, &e->camera_surfels);
+    }
+    memset(e->gbuf_tex, 0, sizeof e->gbuf_tex);
+    e->gbuf_depth = e->frame_tex = e->gbuf_fbo = e->frame_fbo = e->camera_surfels = 0;
+    e->gbuf_w = e->gbuf_h = 0;
+}
+
+/* (Re)allocates the G-buffer, the frame and the camera's surfels for the
+ * view's size (lpv_engine_set_view checked that they fit the budget). */
+static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
+{
+    const int w = e->view.width, h = e->view.height;
+    if (e->gbuf_w == w && e->gbuf_h == h)
+        return 0;
+    free_targets(e);
+    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
     static const GLenum formats[4] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F};
     glGenFramebuffers(1, &e->gbuf_fbo);
@@ -59,8 +71,15 @@ static void ensure_targets(lpv_engine *e)
     glGenBuffers(1, &e->camera_surfels);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->camera_surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)w * h * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR) {
+        free_targets(e);
+        return lpv_error(err, err_size, "could not allocate the %dx%d G-buffer, frame and surfels (GL error 0x%04x)", w,
+                         h, gl_err);
+    }
     e->gbuf_w = w;
     e->gbuf_h = h;
+    return 0;
 }
 
 /* The view block: matrices from the lpv_view, far plane from the bounds. */
@@ -102,10 +121,11 @@ static void build_view_block(lpv_engine *e)
     b->viewport[2] = aspect;
 }
 
-void lpv_pass_gbuffer_run(lpv_engine *e)
+int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
 {
+    if (ensure_targets(e, err, err_size) != 0)
+        return -1;
     lpv_timer_begin(&e->timer, "gbuffer");
-    ensure_targets(e);
     build_view_block(e);
     const lpv_view *v = &e->view;
     glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
@@ -146,6 +166,7 @@ void lpv_pass_gbuffer_run(lpv_engine *e)
     lpv_timer_count(&e->timer, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     lpv_timer_end(&e->timer);
+    return 0;
 }
 
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
@@ -173,7 +194,8 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
         glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
     }
     glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->rsm_depth);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);

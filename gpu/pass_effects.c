@@ -123,7 +123,8 @@ void lpv_pass_media_run(lpv_engine *e)
     GLuint p = e->prog_media;
     glUseProgram(p);
     glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->rsm_depth);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
     lpv_medium_bind(e, p, 1);
     glUniform1f(glGetUniformLocation(p, "u_media_step"), e->settings.media_step);
     glUniform1f(glGetUniformLocation(p, "u_damping"), 0.0f);

@@ -1,9 +1,9 @@
 /*
  * pass_rsm.c - reflective shadow maps: every light face renders the scene's
  * position/area, normal and reflected flux into one layer (an area light's
- * face: one tile of a layer) of three 2D array textures (plus depth, which
- * direct shading reuses as its shadow map); a compute pass then turns every
- * texel into one VPL and one surfel.
+ * face: one tile of a layer) of three 2D array textures (plus the depth its
+ * own depth test needs; direct light has its own shadow maps, pass_shadow.c);
+ * a compute pass then turns every texel into one VPL and one surfel.
  */
 #include <math.h>
 
@@ -22,6 +22,24 @@ static GLuint array_texture(GLenum format, int size, int layers)
     return t;
 }
 
+/* Deletes the RSM textures and buffers (a partly failed allocation too). */
+static void free_rsm_storage(lpv_engine *e)
+{
+    GLuint tex[] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo, e->rsm_depth};
+    for (int i = 0; i < 5; ++i)
+        if (tex[i])
+            glDeleteTextures(1, &tex[i]);
+    if (e->rsm_fbo)
+        glDeleteFramebuffers(1, &e->rsm_fbo);
+    if (e->vpls)
+        glDeleteBuffers(1, &e->vpls);
+    if (e->surfels)
+        glDeleteBuffers(1, &e->surfels);
+    e->rsm_position = e->rsm_normal = e->rsm_flux = e->rsm_albedo = e->rsm_depth = e->rsm_fbo = 0;
+    e->vpls = e->surfels = 0;
+    e->rsm_alloc_size = e->rsm_alloc_faces = 0;
+}
+
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
 {
     lpv_light_faces_build(e);
@@ -30,29 +48,28 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
 
     const int size = e->settings.rsm_size;
     const int layers = e->rsm_layers > 0 ? e->rsm_layers : 1;
-    e->rsm_size = size;
-    e->rsm_texels = (size_t)e->rsm_layers * (size_t)size * (size_t)size;
-    if (e->rsm_alloc_size == size && e->rsm_alloc_faces == layers)
+    if (e->rsm_alloc_size == size && e->rsm_alloc_faces == layers) {
+        e->rsm_size = size;
+        e->rsm_texels = (size_t)e->rsm_layers * (size_t)size * (size_t)size;
         return 0;
-
-    if (e->rsm_position) {
-        GLuint tex[] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo, e->rsm_depth};
-        glDeleteTextures(5, tex);
-        glDeleteFramebuffers(1, &e->rsm_fbo);
-        glDeleteBuffers(1, &e->vpls);
-        glDeleteBuffers(1, &e->surfels);
     }
+    e->rsm_size = 0;
+    e->rsm_texels = 0;
+    /* Estimate before allocating: past what the device holds, drivers fail
+     * in ways that crash (llvmpipe segfaults on shader storage past 2 GiB). */
+    lpv_memory_need need;
+    lpv_engine_memory_need(e, NULL, &need);
+    if (lpv_engine_memory_check(e, &need, err, err_size) != 0)
+        return -1;
+    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
+    }
+
+    free_rsm_storage(e);
     e->rsm_position = array_texture(GL_RGBA32F, size, layers);
     e->rsm_normal = array_texture(GL_RGBA32F, size, layers);
     e->rsm_flux = array_texture(GL_RGBA32F, size, layers);
     e->rsm_albedo = array_texture(GL_RGBA8, size, layers);
     e->rsm_depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
-    /* The depth layers double as shadow maps: compare mode, 2x2 PCF. */
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->rsm_depth);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
     glGenFramebuffers(1, &e->rsm_fbo);
 
     size_t texels = (size_t)layers * (size_t)size * (size_t)size;
@@ -62,10 +79,16 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     glGenBuffers(1, &e->surfels);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
-    if (glGetError() != GL_NO_ERROR)
-        return lpv_error(err, err_size, "could not allocate %d RSM faces of %d^2 texels", layers, size);
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR) {
+        free_rsm_storage(e);
+        return lpv_error(err, err_size, "could not allocate the RSMs: rsm_size %d x %d layers = %.2f GB (GL error "
+                         "0x%04x)", size, layers, (double)lpv_memory_rsm_bytes(&need) / 1e9, gl_err);
+    }
     e->rsm_alloc_size = size;
     e->rsm_alloc_faces = layers;
+    e->rsm_size = size;
+    e->rsm_texels = (size_t)e->rsm_layers * (size_t)size * (size_t)size;
     return 0;
 }
 

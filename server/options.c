@@ -63,7 +63,8 @@ const char *lpvd_options_help(void)
         return help;
     size_t len = (size_t)snprintf(help, sizeof help, "%s", OPTIONS_HELP_HEAD);
     len += (size_t)snprintf(help + len, sizeof help - len,
-                            "Cascades, effects and scheduling (docs/cascades.md, docs/effects.md):\n");
+                            "Shadows, cascades, effects and scheduling (docs/shadows.md, docs/cascades.md,\n"
+                            "docs/effects.md):\n");
     size_t count;
     const lpv_field *fields = lpv_fields(&count);
     for (size_t i = 0; i < count && len < sizeof help; ++i) {

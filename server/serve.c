@@ -58,7 +58,7 @@ static void usage(FILE *f)
             "  --max-body BYTES        json of one message (default 1048576)\n"
             "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
             "  --max-triangles N       per scene (default 10000000)\n"
-            "  --max-texture N         texels per texture side, and the largest rsm_size (default 8192)\n"
+            "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
             "  --idle-timeout S        a silent session is sent BYE and closed (default 300)\n"

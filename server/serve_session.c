@@ -1107,6 +1107,12 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
                   s->cfg.max_texture);
         return;
     }
+    if (json_object_get(j, "shadow_size") && st.shadow_size > s->cfg.max_texture) {
+        reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                  "shadow_size: %d is over the server's texture limit of %d (--max-texture)", st.shadow_size,
+                  s->cfg.max_texture);
+        return;
+    }
     double rv;
     if ((ist = lpvp_get_number(j, "tick_rate_hz", 0, 0.0, 1e9, &rv, err, sizeof err)) == LPVP_FIELD_BAD)
         goto bad;

@@ -76,12 +76,13 @@ json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const ch
     }
     /* preset: the one the settings started from; explicit flags may have overridden its values */
     const char *preset = lpv_preset_name(set->preset);
-    json_t *settings = json_pack("{s:s, s:i, s:i, s:b, s:f, s:i}", "preset", preset ? preset : "", "iterations",
-                                 set->iterations, "rsm_size", set->rsm_size, "occlusion",
-                                 set->occlusion == LPV_SWITCH_ON, "indirect_gain", (double)set->indirect_gain,
-                                 "emissive_vpls", set->emissive_vpls);
+    json_t *settings = json_pack("{s:s, s:i, s:i, s:i, s:b, s:f, s:i}", "preset", preset ? preset : "", "iterations",
+                                 set->iterations, "rsm_size", set->rsm_size, "shadow_size", set->shadow_size,
+                                 "occlusion", set->occlusion == LPV_SWITCH_ON, "indirect_gain",
+                                 (double)set->indirect_gain, "emissive_vpls", set->emissive_vpls);
     json_t *counts = json_pack("{s:i, s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:f}", "lights", (int)s->lights,
-                               "area_lights", (int)s->area_lights, "rsm_faces", (int)s->rsm_faces, "vpls_rsm", (json_int_t)s->vpls_rsm, "vpls_emissive",
+                               "area_lights", (int)s->area_lights, "rsm_faces", (int)s->rsm_faces, "vpls_rsm",
+                               (json_int_t)s->vpls_rsm, "vpls_emissive",
                                (json_int_t)s->vpls_emissive, "surfels_rsm", (json_int_t)s->surfels_rsm,
                                "surfels_camera", (json_int_t)s->surfels_camera, "cells", (json_int_t)s->cells,
                                "cell_steps", s->cell_steps);

@@ -187,6 +187,57 @@ struct LpvLightBlock {
     LPV_STRUCT(LpvFaceGpu) faces[LPV_MAX_FACES];
 };
 
+/* ---- Shadow maps for direct light (uniform block, std140; docs/shadows.md) --
+ * Depth-only maps at shadow_size texels per side, separate from the RSMs:
+ * a spot light (half angle <= LPV_SHADOW_SPOT_MAX_SINGLE_FACE) has one
+ * perspective face, a point light (and a wider spot) six cube faces, a
+ * directional light LPV_SHADOW_CASCADES orthographic cascades fitted to the
+ * camera's view. A single face of half angle a spreads its texels over
+ * 2 tan(a) per metre of depth, a cube face over 2: past 45 degrees the cube's
+ * texels are the smaller ones.
+ * An area light sample has five faces (the RSM's: front and four sides
+ * around the emitter's normal), each a square tile of a layer after the
+ * punctual lights' layers, the RSM's tile rule at shadow_size
+ * (gpu/light_faces.c): four faces to a layer. */
+#define LPV_SHADOW_CASCADES 4
+#define LPV_SHADOW_SPOT_MAX_SINGLE_FACE 0.78539816f /* 45 deg half angle */
+#define LPV_MAX_SHADOW_FACES (6 * LPV_MAX_LIGHTS + LPV_AREA_FACES * LPV_MAX_AREA_LIGHTS)
+/* PCF: (2 R + 1)^2 hardware-compare bilinear taps one texel apart, so the
+ * filter reaches R + 1 texels from the lookup and a shadow edge ramps over
+ * 2 R + 1 texels. */
+#define LPV_SHADOW_PCF_RADIUS 1
+/* Texels kept free at each face's border so the kernel and the normal offset
+ * stay inside the face that is chosen (cube faces are widened by as much). */
+#define LPV_SHADOW_BORDER_TEXELS 4.0f
+/* Receiver bias, in texels of the shadow map at the receiver (footprint T):
+ *   normal offset  LPV_SHADOW_NORMAL_OFFSET * T * sin(theta) along the normal,
+ *   depth bias     (LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS *
+ *                   min(tan(theta), LPV_SHADOW_MAX_SLOPE)) * T towards the light,
+ * theta the angle between the normal and the light. The normal offset lifts
+ * the receiver off its plane by exactly what the plane rises across the
+ * kernel's reach (R + 1 texels); the depth bias is the margin. */
+#define LPV_SHADOW_NORMAL_OFFSET 2.0f
+#define LPV_SHADOW_DEPTH_BIAS 0.5f
+#define LPV_SHADOW_SLOPE_BIAS 0.5f
+#define LPV_SHADOW_MAX_SLOPE 8.0f
+
+struct LpvShadowFaceGpu {
+    mat4 view_proj;       /* world -> clip of this shadow-map face */
+    vec4 info;            /* x texel footprint: m (ortho) or m per m of depth along
+                             axis (persp); y 1 perspective, 0 orthographic;
+                             z light index; w cascade index (directional) */
+    vec4 axis;            /* xyz unit view axis; w unused */
+    vec4 tile;            /* where the face lies in the maps: xy lower-left corner (uv of the layer),
+                             z side (uv, 1 = the whole layer), w layer */
+};
+
+struct LpvShadowBlock {
+    vec4 counts;          /* x faces, y shadow_size (texels), z 1 / shadow_size, w layers */
+    vec4 lights[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* per light (as LpvLightBlock's): x first face,
+                                                          y face count, z 1 = cascades, 2 = area sample */
+    LPV_STRUCT(LpvShadowFaceGpu) faces[LPV_MAX_SHADOW_FACES];
+};
+
 /* The camera, as a uniform block (std140). */
 struct LpvViewBlock {
     mat4 view_proj;       /* world -> clip */
@@ -201,6 +252,7 @@ struct LpvViewBlock {
 #define LPV_UBO_GRID      0
 #define LPV_UBO_VIEW      1
 #define LPV_UBO_LIGHT     2
+#define LPV_UBO_SHADOW    3
 
 #define LPV_SSBO_LPV_OUT  1
 #define LPV_SSBO_LPV_ACC  2
@@ -228,6 +280,7 @@ struct LpvViewBlock {
 #define LPV_MAX_GRID_DIM     256  /* cells per axis */
 #define LPV_MAX_ITERATIONS   4096
 #define LPV_MAX_RSM_SIZE     2048
+#define LPV_MAX_SHADOW_SIZE  8192 /* texels per side of a shadow map */
 #define LPV_FP16_MAX         65504.0f
 
 #endif /* LPV_SHARED_H */

@@ -74,7 +74,7 @@ void main()
                 vec3 to_light;
                 vec3 e = light_irradiance_normal(L.lights[l], x, to_light);
                 if (any(greaterThan(e, vec3(0.0))))
-                    source += e * shadow_visibility(l, x, to_light);
+                    source += e * shadow_visibility_taps(l, x, to_light, 1); // the march averages
             }
             // integral over the step of T(t) sigma_s source / (4 pi), exactly for constant coefficients
             vec3 step_t = exp(-sigma_t * dt);

@@ -1,34 +1,116 @@
-// shadow.glsl - shadow-map visibility of the lights (RSM depth layers),
-// shared by the shading and the media's in-scattering.
+// shadow.glsl - visibility of the lights through their shadow maps
+// (pass_shadow.c, docs/shadows.md), shared by the shading and the media's
+// in-scattering. Needs lights.glsl.
 layout(binding = 4) uniform sampler2DArrayShadow u_shadow;
+layout(std140, binding = LPV_UBO_SHADOW) uniform ShadowUBO { LpvShadowBlock S; };
 
-// Shadow test for light l at p with normal n. The receiver is offset along
-// its normal by about two shadow-map texels, and the face (of a point light's
-// cube) is chosen for the *offset* point: near a cube edge the offset can
-// cross into the neighbouring face, whose frustum is the one that holds it.
-float shadow_visibility(int l, vec3 p, vec3 n)
+// Percentage-closer filtering: (2R + 1)^2 hardware-compare bilinear taps one
+// texel apart (a separable tent of 2R + 2 texels; R = 0: one bilinear
+// compare), 1 = lit. uv is the face's own (0..1); every tap is kept half a
+// texel inside the face's tile (area light faces share a layer), so the
+// filter never reads a neighbouring face.
+float shadow_pcf(int face, vec2 uv, float depth, int R)
+{
+    float texel = S.counts.z;
+    vec4 tile = S.faces[face].tile;
+    vec2 at = tile.xy + uv * tile.z, lo = tile.xy + 0.5 * texel, hi = tile.xy + tile.z - 0.5 * texel;
+    float sum = 0.0;
+    for (int y = -R; y <= R; ++y)
+        for (int x = -R; x <= R; ++x)
+            sum += texture(u_shadow, vec4(clamp(at + vec2(x, y) * texel, lo, hi), tile.w, depth));
+    return sum / float((2 * R + 1) * (2 * R + 1));
+}
+
+// The shadow-map face of light l that holds x: the cube face of the major
+// axis of x - light, the area light face whose axis is nearest x - light, the
+// single face of a spot, or the finest cascade whose
+// square holds x with LPV_SHADOW_BORDER_TEXELS to spare; -1 if none does.
+int shadow_face(int l, vec3 x)
+{
+    vec4 info = S.lights[l];
+    int first = int(info.x), count = int(info.y);
+    if (info.z == 2.0) { // area light sample: the face whose axis is nearest x's direction
+        vec3 d = x - L.lights[l].position_type.xyz;
+        int best = first;
+        for (int k = 1; k < count; ++k)
+            if (dot(d, S.faces[first + k].axis.xyz) > dot(d, S.faces[best].axis.xyz))
+                best = first + k;
+        return best;
+    }
+    if (count == 6) {
+        vec3 d = x - L.lights[l].position_type.xyz;
+        vec3 a = abs(d);
+        if (a.x >= a.y && a.x >= a.z)
+            return first + (d.x >= 0.0 ? 0 : 1);
+        if (a.y >= a.z)
+            return first + (d.y >= 0.0 ? 2 : 3);
+        return first + (d.z >= 0.0 ? 4 : 5);
+    }
+    if (info.z == 0.0)
+        return first;
+    float inner = 1.0 - 2.0 * LPV_SHADOW_BORDER_TEXELS * S.counts.z;
+    for (int k = 0; k < count; ++k) {
+        vec4 c = S.faces[first + k].view_proj * vec4(x, 1.0); // orthographic: w = 1
+        if (all(lessThanEqual(abs(c.xy), vec2(inner))))
+            return first + k;
+    }
+    return -1;
+}
+
+// Size (m) of one texel of face f at x.
+float shadow_texel(int f, vec3 x, vec3 light_pos)
+{
+    LpvShadowFaceGpu F = S.faces[f];
+    if (F.info.y == 0.0)
+        return F.info.x;
+    return F.info.x * max(dot(x - light_pos, F.axis.xyz), 0.0);
+}
+
+// Visibility (0..1) of light l from a receiver at p with unit normal n,
+// filtered over the kernel (taps = 1: one bilinear compare, for callers that
+// average many lookups themselves, such as the media's ray march). The
+// receiver bias is in texels of the map at p (texel size T), so it does not
+// grow with the scene: p moves LPV_SHADOW_NORMAL_OFFSET * T * sin(theta)
+// along n, which lifts it off its own plane by what that plane rises across
+// the kernel, then (LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan(theta))
+// * T towards the light (the slope-scaled depth bias; moving along the ray to
+// the light keeps the texel the same).
+float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
 {
     LpvLightGpu li = L.lights[l];
-    LpvFaceGpu F0 = L.faces[light_face_for(li, p)];
-    float texel;
-    if (F0.info.y == 0.0)
-        texel = sqrt(F0.info.z);
-    else // every face of one light shares its fov and size
-        texel = 2.0 * F0.info.z * length(p - li.position_type.xyz) / F0.info.w;
-    vec3 q = p + n * 2.0 * texel;
-    int face = light_face_for(li, q);
-    LpvFaceGpu F = L.faces[face];
-    vec4 clip = F.view_proj * vec4(q, 1.0);
+    if (int(S.lights[l].y) == 0)
+        return 1.0;
+    vec3 lp = li.position_type.xyz;
+    vec3 to_light = int(li.position_type.w) == LPV_LIGHT_TYPE_DIRECTIONAL ? -li.direction_range.xyz
+                                                                          : normalize(lp - p);
+    float c = clamp(dot(n, to_light), 0.0, 1.0);
+    float s = sqrt(max(1.0 - c * c, 0.0));
+    float tan_t = min(s / max(c, 1e-4), LPV_SHADOW_MAX_SLOPE);
+    int f = shadow_face(l, p);
+    vec3 q = p;
+    for (int pass = 0; pass < 2 && f >= 0; ++pass) {
+        float T = shadow_texel(f, p, lp);
+        q = p + n * (LPV_SHADOW_NORMAL_OFFSET * T * s) +
+            to_light * ((LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan_t) * T);
+        int g = shadow_face(l, q); // the offset may cross into a neighbouring face or cascade
+        if (g == f)
+            break;
+        f = g;
+    }
+    if (f < 0)
+        return 1.0; // outside every cascade: no shadow information
+    vec4 clip = S.faces[f].view_proj * vec4(q, 1.0);
     if (!(clip.w > 0.0))
         return 0.0;
     vec3 ndc = clip.xyz / clip.w;
     if (any(greaterThan(abs(ndc.xy), vec2(1.0))))
-        return F.info.y == 0.0 ? 1.0 : 0.0;
+        return S.faces[f].info.y == 0.0 ? 1.0 : 0.0; // outside a spot's face is outside its cone
     vec3 uvz = ndc * 0.5 + 0.5;
-    // F.tile: the face's square of its layer (area light faces are tiles),
-    // kept half a texel inside so the filter never reads a neighbouring tile
-    float half_texel = 0.5 * F.tile.z / F.info.w;
-    vec2 uv = clamp(F.tile.xy + uvz.xy * F.tile.z, F.tile.xy + half_texel, F.tile.xy + F.tile.z - half_texel);
-    return texture(u_shadow, vec4(uv, F.tile.w, uvz.z - 1e-4));
+    return shadow_pcf(f, uvz.xy, uvz.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
 }
 
+// The filtered visibility for surfaces (shade.frag).
+float shadow_visibility(int l, vec3 p, vec3 n)
+{
+    return shadow_visibility_taps(l, p, n, 0);
+}

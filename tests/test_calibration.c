@@ -125,8 +125,9 @@ static void test_direct_point_light_over_plane(void **state)
            n, 100.0 * worst_lpvd, 100.0 * sum_lpvd / n, worst_ref);
     assert_true(n > W * H / 4);
     assert_true(worst_ref < 1e-5);
-    /* The frame stores float radiance; the shadow-map offset moves the
-     * receiver by two texels, which changes 1/r^2 by far less than this. */
+    /* The frame stores float radiance; the shadow lookup's receiver bias
+     * (docs/shadows.md) moves only the point the shadow map is read at, not
+     * the shaded point. */
     assert_true(worst_lpvd < 5e-3);
     free(rgba);
     lpv_ref_destroy(ref);

@@ -74,16 +74,22 @@ static void test_cornell_colour_bleeding(void **state)
     patch(&view, ind, near_green, ig);
     patch(&view, dir, near_red, dr);
     patch(&view, dir, near_green, dg);
+    printf("direct near red wall %.4g %.4g %.4g, near green wall %.4g %.4g %.4g\n", dr[0], dr[1], dr[2], dg[0], dg[1],
+           dg[2]);
     printf("indirect near red wall %.4g %.4g %.4g, near green wall %.4g %.4g %.4g\n", ir[0], ir[1], ir[2], ig[0], ig[1],
            ig[2]);
     assert_true(ir[0] > 0.0 && ig[1] > 0.0);
     /* The criterion, literally. */
     assert_true(ir[0] > ir[1]);
     assert_true(ig[1] > ig[0]);
-    /* And relative to the (warm, white-ish) direct light at the same pixels,
-     * so the warm spot colour alone cannot pass it. */
+    /* And relative to the (warm, white-ish) direct light on the same floor,
+     * so the warm spot colour alone cannot pass it. The floor point near the
+     * green wall lies in the short box's shadow (the path tracer agrees:
+     * docs/shadows.md), so the floor's lit colour is read near the red wall
+     * for both. */
+    assert_true(dr[0] > 0.0 && dr[1] > 0.0);
     assert_true(ir[0] / ir[1] > dr[0] / dr[1]);
-    assert_true(ig[1] / ig[0] > dg[1] / dg[0]);
+    assert_true(ig[1] / ig[0] > dr[1] / dr[0]);
     free(ind);
     free(dir);
     lpv_scene_free(&scene);

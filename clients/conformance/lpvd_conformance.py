@@ -1364,6 +1364,7 @@ def c_config_preset_bad(ctx):
 
 # R4.11's knobs: key -> (kind, default, values to set, out-of-range values, wrong-type values).
 CONFIG_KNOBS = {
+    "shadow_size": ("int", 1024, (16, 2048, 1024), (8, 9000), (1.5, "64", True)),
     "cascades": ("int", 0, (1, 4, 0), (5, -1), (1.5, "2", True)),
     "cascade_size": ("num", 0, (12.5, 1e6, 0), (-1, 2e6), ("8", False, [8])),
     "cascade_ratio": ("num", 2, (1.25, 3, 8), (1.0, 9), ("2", None)),

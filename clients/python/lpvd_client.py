@@ -51,7 +51,7 @@ assert HEADER.size == 24
 # CONFIG's scalar knobs and their JSON kinds (SPEC R4.11; the daemon's table is
 # core/settings_fields.c): "int" -> integer, "float" -> number, "switch" -> bool.
 CONFIG_KNOBS = {
-    "iterations": "int", "rsm_size": "int", "occlusion": "switch", "indirect_gain": "float",
+    "iterations": "int", "rsm_size": "int", "shadow_size": "int", "occlusion": "switch", "indirect_gain": "float",
     "emissive_vpls": "int", "cascades": "int", "cascade_size": "float", "cascade_ratio": "float",
     "cascade_offset": "float", "bounces": "switch", "bounce_intensity": "float", "damping": "float",
     "glossy": "switch", "glossy_roughness": "float", "media": "switch", "fog_sigma_s": "float",

@@ -1,0 +1,134 @@
+/*
+ * memory_budget.c - storage estimates and the check against the device's
+ * limits (see memory_budget.h).
+ */
+#include "memory_budget.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+
+static uint64_t texels(int size, int faces)
+{
+    return (uint64_t)(size > 0 ? size : 0) * (uint64_t)(size > 0 ? size : 0) * (uint64_t)(faces > 0 ? faces : 0);
+}
+
+static uint64_t pixels(const lpv_memory_need *n)
+{
+    return (uint64_t)(n->image_w > 0 ? n->image_w : 0) * (uint64_t)(n->image_h > 0 ? n->image_h : 0);
+}
+
+uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n)
+{
+    return texels(n->rsm_size, n->rsm_faces) * (LPV_MEM_RSM_TEXEL + LPV_MEM_VPL + LPV_MEM_SURFEL);
+}
+
+uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n)
+{
+    return texels(n->shadow_size, n->shadow_faces) * LPV_MEM_SHADOW_TEXEL;
+}
+
+uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
+{
+    return (uint64_t)n->cells * LPV_MEM_CELL + (uint64_t)n->gv_points * LPV_MEM_GV_POINT;
+}
+
+uint64_t lpv_memory_image_bytes(const lpv_memory_need *n)
+{
+    return pixels(n) * (LPV_MEM_PIXEL + LPV_MEM_SURFEL);
+}
+
+uint64_t lpv_memory_total_bytes(const lpv_memory_need *n)
+{
+    return lpv_memory_rsm_bytes(n) + lpv_memory_shadow_bytes(n) + lpv_memory_grid_bytes(n) +
+           lpv_memory_image_bytes(n);
+}
+
+static double gb(uint64_t bytes)
+{
+    return (double)bytes / 1e9;
+}
+
+static int fail(char *err, size_t err_size, const char *fmt, ...)
+{
+    if (err && err_size) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, err_size, fmt, ap);
+        va_end(ap);
+    }
+    return -1;
+}
+
+/* "rsm_size 2048 x 48 light faces" and the like, for part k. */
+static void part_name(const lpv_memory_need *n, int k, char *buf, size_t size)
+{
+    switch (k) {
+    case 0: snprintf(buf, size, "rsm_size %d x %d light faces", n->rsm_size, n->rsm_faces); break;
+    case 1: snprintf(buf, size, "shadow_size %d x %d shadow-map faces", n->shadow_size, n->shadow_faces); break;
+    case 2:
+        snprintf(buf, size, "grid %dx%dx%d x %d cascade%s", n->grid_dims[0], n->grid_dims[1], n->grid_dims[2],
+                 n->cascades, n->cascades == 1 ? "" : "s");
+        break;
+    default: snprintf(buf, size, "image size %dx%d", n->image_w, n->image_h); break;
+    }
+}
+
+int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, char *err, size_t err_size)
+{
+    char what[96];
+    /* Texture dimensions the GL cannot make at all. */
+    if (n->rsm_faces > 0 && n->rsm_size > lim->max_texture_size)
+        return fail(err, err_size, "rsm_size %d is over this GL's largest texture (%d texels per side)", n->rsm_size,
+                    lim->max_texture_size);
+    if (n->shadow_faces > 0 && n->shadow_size > lim->max_texture_size)
+        return fail(err, err_size, "shadow_size %d is over this GL's largest texture (%d texels per side)",
+                    n->shadow_size, lim->max_texture_size);
+    if (n->rsm_faces > lim->max_layers || n->shadow_faces > lim->max_layers)
+        return fail(err, err_size, "%d RSM faces / %d shadow-map faces are over this GL's %d array layers",
+                    n->rsm_faces, n->shadow_faces, lim->max_layers);
+
+    /* Single buffers a shader must address. */
+    uint64_t vpl = texels(n->rsm_size, n->rsm_faces) * LPV_MEM_VPL;
+    if (vpl > lim->max_buffer) {
+        part_name(n, 0, what, sizeof what);
+        return fail(err, err_size,
+                    "%s needs %.2f GB for one VPL buffer (%u B per texel); one shader storage buffer may hold "
+                    "at most %.2f GB: lower rsm_size or use fewer lights",
+                    what, gb(vpl), LPV_MEM_VPL, gb(lim->max_buffer));
+    }
+    uint64_t cell_buffer = (uint64_t)n->cells * LPV_MEM_CELL_BUFFER;
+    if (cell_buffer > lim->max_buffer) {
+        part_name(n, 2, what, sizeof what);
+        return fail(err, err_size,
+                    "%s needs %.2f GB for one LPV buffer (%u B per cell); one shader storage buffer may hold at "
+                    "most %.2f GB: lower grid or cascades",
+                    what, gb(cell_buffer), LPV_MEM_CELL_BUFFER, gb(lim->max_buffer));
+    }
+    uint64_t surfels = pixels(n) * LPV_MEM_SURFEL;
+    if (surfels > lim->max_buffer) {
+        part_name(n, 3, what, sizeof what);
+        return fail(err, err_size,
+                    "%s needs %.2f GB for its surfel buffer (%u B per pixel); one shader storage buffer may hold "
+                    "at most %.2f GB",
+                    what, gb(surfels), LPV_MEM_SURFEL, gb(lim->max_buffer));
+    }
+
+    /* Everything together against the budget; the largest part is named. */
+    uint64_t part[4] = {lpv_memory_rsm_bytes(n), lpv_memory_shadow_bytes(n), lpv_memory_grid_bytes(n),
+                        lpv_memory_image_bytes(n)};
+    uint64_t total = part[0] + part[1] + part[2] + part[3];
+    if (total <= lim->budget)
+        return 0;
+    int big = 0;
+    for (int k = 1; k < 4; ++k)
+        if (part[k] > part[big])
+            big = k;
+    static const char *const kind[4] = {"of RSM textures and VPL/surfel buffers", "of shadow maps",
+                                        "of grid buffers", "of G-buffer and frame"};
+    part_name(n, big, what, sizeof what);
+    return fail(err, err_size,
+                "%s needs %.2f GB %s; with the rest (RSMs %.2f GB, shadow maps %.2f GB, grid %.2f GB, image "
+                "%.2f GB) the engine needs %.2f GB, and the limit is %.2f GB (%s)",
+                what, gb(part[big]), kind[big], gb(part[0]), gb(part[1]), gb(part[2]), gb(part[3]), gb(total),
+                gb(lim->budget), lim->budget_source);
+}

@@ -1,0 +1,62 @@
+/*
+ * memory_budget.h - what the engine's GPU storage costs, checked before it
+ * is allocated (docs/shadows.md, "Memory"). Every knob that sizes storage
+ * (rsm_size and shadow_size per light face, the grid and its cascades, the
+ * image) is estimated here, and a configuration that does not fit is refused
+ * with a message naming the setting and the estimate, instead of failing
+ * inside the driver (llvmpipe segfaults on shader storage past 2 GiB).
+ * Pure arithmetic, no GL: the limits come from gpu/memory_limits.c.
+ */
+#ifndef LPV_MEMORY_BUDGET_H
+#define LPV_MEMORY_BUDGET_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Bytes per element of each kind of storage (the GL formats in gpu/). */
+#define LPV_MEM_RSM_TEXEL 56u     /* 3 x RGBA32F + RGBA8 + DEPTH32F per RSM texel */
+#define LPV_MEM_VPL 48u           /* one LpvVpl per RSM texel */
+#define LPV_MEM_SURFEL 48u        /* one LpvSurfel per RSM texel or pixel */
+#define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
+#define LPV_MEM_CELL 392u         /* per cell: 4 LPV buffers (4 x 48), transmittances (24), reflectances
+                                     (96), flux limits (2 x 16), the injection atlas (3 x RGBA32F) */
+#define LPV_MEM_GV_POINT 64u      /* per geometry-volume point: its buffer (32) and atlas (2 x RGBA32F) */
+#define LPV_MEM_CELL_BUFFER 48u   /* the largest single grid buffer (one LpvCell per cell) */
+#define LPV_MEM_PIXEL 76u         /* G-buffer (RGBA32F x3, RGBA16F), depth, frame (RGBA32F) per pixel */
+
+/* What the device allows. */
+typedef struct lpv_memory_limits {
+    uint64_t budget;        /* bytes the engine may hold in all */
+    char budget_source[160]; /* where the budget comes from, in words */
+    uint64_t max_buffer;    /* bytes one shader storage buffer may hold */
+    int max_texture_size;   /* texels per side */
+    int max_layers;         /* layers of an array texture */
+} lpv_memory_limits;
+
+/* What a configuration asks for. */
+typedef struct lpv_memory_need {
+    /* faces: layers of side rsm_size / shadow_size; a punctual light's face
+     * fills one, an area light sample's five faces are tiles, four to a layer */
+    int rsm_size, rsm_faces;       /* texels per side, light faces with an RSM */
+    int shadow_size, shadow_faces; /* texels per side, shadow-map faces */
+    size_t cells;                  /* grid cells of every cascade */
+    size_t gv_points;              /* geometry-volume points of every cascade */
+    int cascades;                  /* for the message */
+    int grid_dims[3];
+    int image_w, image_h;          /* 0 x 0 = no camera */
+} lpv_memory_need;
+
+/* Bytes of each part, and of all. */
+uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n);    /* RSM textures + VPL + surfel buffers */
+uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n); /* shadow maps */
+uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n);
+uint64_t lpv_memory_image_bytes(const lpv_memory_need *n);
+uint64_t lpv_memory_total_bytes(const lpv_memory_need *n);
+
+/* 0 when n fits the limits; else -1 with a message that names the setting
+ * that asks for the most, its estimate and the limit, e.g.
+ * "rsm_size 2048 x 48 light faces needs 9.66 GB for one VPL buffer; a shader
+ * storage buffer may hold at most 2.15 GB". */
+int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, char *err, size_t err_size);
+
+#endif /* LPV_MEMORY_BUDGET_H */
