@@ -22,7 +22,7 @@ static int bounds_finite(const float bmin[3], const float bmax[3])
 }
 
 /* max_i extent_i / max(dims_i - 1, 1): every axis keeps at least half a cell
- * of margin on each side (a hair more, below). Computed in double so that huge finite bounds do
+ * of margin on each side. Computed in double so that huge finite bounds do
  * not overflow before the division. */
 static double cell_size_for(const int dims[3], const float bmin[3], const float bmax[3])
 {
@@ -36,11 +36,7 @@ static double cell_size_for(const int dims[3], const float bmin[3], const float 
     }
     if (!(size >= LPV_MIN_CELL_SIZE && size <= LPV_MAX_CELL_SIZE))
         return 1.0;
-    /* 0.1 % more than half a cell of margin: a VPL on the bounds' outer face
-     * moves half a cell out, and must land inside the grid whatever the
-     * rounding of the scene's scale (a millimetre scene and the same scene in
-     * metres keep the same VPLs; tests/test_defaults.c) */
-    return size * 1.001;
+    return size;
 }
 
 int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], lpv_grid *out)

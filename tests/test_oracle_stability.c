@@ -45,8 +45,7 @@ static void *xcalloc(size_t n, size_t size)
     return p;
 }
 
-/* A grid with origin (0, 0, 0) and cell size 1 (lpv_grid_place keeps a
- * margin a hair over half a cell, so the unit grid is written directly). */
+/* A grid with origin (0, 0, 0) and cell size 1. */
 static lpv_grid unit_grid(int nx, int ny, int nz)
 {
     lpv_grid g = {.dims = {nx, ny, nz}, .origin = {0.0f, 0.0f, 0.0f}, .cell_size = 1.0f};
@@ -627,14 +626,11 @@ static void test_grid_place_rejects_and_degenerates(void **state)
     assert_int_equal(lpv_grid_place(dims, huge_lo, huge_hi, &g), 0);
     assert_true(isfinite(g.cell_size) && g.cell_size > 0.0f);
     /* Ordinary bounds: max over axes of extent / max(dims - 1, 1), here
-     * max(1/4, 2/2, 3/1) = 3, times 1.001 (the margin a hair over half a
-     * cell), centred on the bounds. */
+     * max(1/4, 2/2, 3/1) = 3, centred on the bounds. */
     int d2[3] = {5, 3, 1};
     assert_int_equal(lpv_grid_place(d2, lo, hi, &g), 0);
-    assert_true(g.cell_size == (float)(3.0 * 1.001));
-    const float c = (float)(3.0 * 1.001);
-    assert_true(fabsf(g.origin[0] - (0.5f - 2.5f * c)) < 1e-5f && fabsf(g.origin[1] - (1.0f - 1.5f * c)) < 1e-5f &&
-                fabsf(g.origin[2] - (1.5f - 0.5f * c)) < 1e-5f);
+    assert_true(g.cell_size == 3.0f);
+    assert_true(g.origin[0] == -7.0f && g.origin[1] == -3.5f && g.origin[2] == 0.0f);
 }
 
 static void test_settings_ranges(void **state)
