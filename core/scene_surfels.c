@@ -10,13 +10,16 @@ static const lpv_material *material_of(const lpv_scene *s, const lpv_draw *dr)
     return dr->material >= 0 && (uint32_t)dr->material < s->material_count ? &s->materials[dr->material] : NULL;
 }
 
-/* Emitters are light sources only in the geometry volume, as in the RSM and
- * camera surfels (camera_surfels.comp), and the planner counts only
- * non-emissive triangles as occluders. */
-static int is_emitter(const lpv_scene *s, const lpv_draw *dr)
+/* Draws left out: emitters are light sources only in the geometry volume,
+ * as in the RSM and camera surfels (camera_surfels.comp), and the planner
+ * counts only non-emissive triangles as occluders; cut-out materials (alpha
+ * MASK and BLEND) block only where the RSM and the camera see them opaque,
+ * since these surfels do not sample the alpha texture. */
+static int left_out(const lpv_scene *s, const lpv_draw *dr)
 {
     const lpv_material *m = material_of(s, dr);
-    return m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
+    return m && ((m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f) ||
+                 m->alpha_mode == LPV_ALPHA_MASK || m->alpha_mode == LPV_ALPHA_BLEND);
 }
 
 static double total_area(const lpv_scene *s)
@@ -24,7 +27,7 @@ static double total_area(const lpv_scene *s)
     double sum = 0.0;
     for (uint32_t d = 0; d < s->draw_count; ++d) {
         const lpv_draw *dr = &s->draws[d];
-        if (is_emitter(s, dr))
+        if (left_out(s, dr))
             continue;
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
             const lpv_vertex *v[3];
@@ -50,7 +53,7 @@ size_t lpv_scene_surfels(const lpv_scene *s, size_t target, lpv_surfel *out, siz
     size_t count = 0;
     for (uint32_t d = 0; d < s->draw_count && count < max; ++d) {
         const lpv_draw *dr = &s->draws[d];
-        if (is_emitter(s, dr))
+        if (left_out(s, dr))
             continue;
         const lpv_material *m = material_of(s, dr);
         const float *albedo = m ? m->base_color : NULL;

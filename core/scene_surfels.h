@@ -15,10 +15,11 @@
 #include "scene.h"
 
 /* Writes up to max surfels, about `target` in all, spread over the scene's
- * non-degenerate, non-emissive triangles (emitters are light sources only in
- * the geometry volume, as in the RSM and camera surfels, and the planner
- * counts only non-emissive triangles as occluders) in proportion to their area on a deterministic
- * low-discrepancy pattern. Each carries its triangle's front normal, its
+ * non-degenerate triangles of opaque, non-emissive materials (emitters are
+ * light sources only in the geometry volume, as in the RSM and camera
+ * surfels, and the planner counts only non-emissive triangles as occluders;
+ * alpha cut-outs block where the RSM and camera see them opaque) in
+ * proportion to their area on a deterministic low-discrepancy pattern. Each carries its triangle's front normal, its
  * material's base colour (the bounces' albedo) and an area such that the
  * surfels' areas sum to the triangles' total area (a triangle too small for
  * a sample of its own hands its area to the next sample). Returns the count. */

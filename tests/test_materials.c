@@ -404,6 +404,10 @@ static void test_alpha_mask_shadows_only_where_opaque(void **state)
     assert_true(mk.rsm_area > 0.4 * op.rsm_area && mk.rsm_area < 0.6 * op.rsm_area);
     assert_true(op.cam_area > 0.5);
     assert_true(mk.cam_area > 0.35 * op.cam_area && mk.cam_area < 0.65 * op.cam_area);
+    /* scene surfels: the opaque occluder is sampled, the cut-out one is left
+     * to the RSM and the camera (they do not read the alpha texture) */
+    assert_true(op.scene_area > 1.0);
+    assert_true(mk.scene_area == 0.0);
 }
 
 /* BLEND is cut at alpha 0.5 (docs/scenes.md): alpha 0.3 vanishes, 0.7 is
