@@ -225,24 +225,10 @@ static void render(const lpv_scene *scene, const lpv_view *view, float *rgba)
         fail_msg("%s", err);
 }
 
-/* Mean radiance (rgb) over the 3x3 pixels where world point p lands. */
+/* Mean radiance over the 3x3 pixels around world point p (test_util). */
 static void patch(const lpv_view *v, const float *rgba, const float p[3], double out[3])
 {
-    float px, py;
-    assert_int_equal(lpv_view_project(v, p, &px, &py), 0);
-    int cx = (int)px, cy = (int)py, n = 0;
-    out[0] = out[1] = out[2] = 0.0;
-    for (int y = cy - 1; y <= cy + 1; ++y)
-        for (int x = cx - 1; x <= cx + 1; ++x) {
-            assert_true(x >= 0 && x < W && y >= 0 && y < H);
-            const float *q = &rgba[((size_t)y * W + (size_t)x) * 4];
-            assert_true(q[3] > 0.5f); /* geometry was hit */
-            for (int c = 0; c < 3; ++c)
-                out[c] += q[c];
-            ++n;
-        }
-    for (int c = 0; c < 3; ++c)
-        out[c] /= n;
+    lpvt_patch(v, rgba, W, H, p, 1, out);
 }
 
 static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }

@@ -39,24 +39,10 @@ static void render(const lpv_scene *scene, lpv_frame_terms terms, lpv_view *view
         fail_msg("%s", err);
 }
 
-/* Mean radiance over the 5x5 pixels around world point p. */
+/* Mean radiance over the 5x5 pixels around world point p (test_util). */
 static void patch(const lpv_view *v, const float *rgba, const float p[3], double out[3])
 {
-    float px, py;
-    assert_int_equal(lpv_view_project(v, p, &px, &py), 0);
-    int cx = (int)px, cy = (int)py, n = 0;
-    out[0] = out[1] = out[2] = 0.0;
-    for (int y = cy - 2; y <= cy + 2; ++y)
-        for (int x = cx - 2; x <= cx + 2; ++x) {
-            assert_true(x >= 0 && x < W && y >= 0 && y < H);
-            const float *q = &rgba[((size_t)y * W + (size_t)x) * 4];
-            assert_true(q[3] > 0.5f); /* geometry was hit */
-            for (int c = 0; c < 3; ++c)
-                out[c] += q[c];
-            ++n;
-        }
-    for (int c = 0; c < 3; ++c)
-        out[c] /= n;
+    lpvt_patch(v, rgba, W, H, p, 2, out);
 }
 
 static void test_cornell_colour_bleeding(void **state)

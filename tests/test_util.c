@@ -3,6 +3,7 @@
 
 #include "context.h"
 #include "engine.h"
+#include "view.h"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -114,4 +115,24 @@ const char *lpvt_json(const char *fmt, ...)
         if (*c == '\'')
             *c = '"';
     return p;
+}
+
+void lpvt_patch(const lpv_view *v, const float *rgba, int width, int height, const float p[3], int radius,
+                double out[3])
+{
+    float px, py;
+    assert_int_equal(lpv_view_project(v, p, &px, &py), 0);
+    int cx = (int)px, cy = (int)py, n = 0;
+    out[0] = out[1] = out[2] = 0.0;
+    for (int y = cy - radius; y <= cy + radius; ++y)
+        for (int x = cx - radius; x <= cx + radius; ++x) {
+            assert_true(x >= 0 && x < width && y >= 0 && y < height);
+            const float *q = &rgba[((size_t)y * (size_t)width + (size_t)x) * 4];
+            assert_true(q[3] > 0.5f); /* geometry was hit */
+            for (int c = 0; c < 3; ++c)
+                out[c] += q[c];
+            ++n;
+        }
+    for (int c = 0; c < 3; ++c)
+        out[c] /= n;
 }

@@ -37,4 +37,11 @@ extern struct lpv_engine *lpvt_engine;
 int lpvt_gl_setup(void **state);
 int lpvt_gl_teardown(void **state);
 
+/* Mean radiance (rgb) over the (2 radius + 1)^2 pixels of a width x height
+ * RGBA float frame where world point p lands in view v; fails the test when
+ * the patch leaves the frame or a pixel saw no geometry. */
+struct lpv_view;
+void lpvt_patch(const struct lpv_view *v, const float *rgba, int width, int height, const float p[3], int radius,
+                double out[3]);
+
 #endif
