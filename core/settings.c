@@ -164,6 +164,8 @@ void lpv_settings_resolve(lpv_settings *s)
         s->planner = LPV_SWITCH_ON;
     if (s->far_field_levels == 0)
         s->far_field_levels = LPV_DEFAULT_FAR_FIELD_LEVELS;
+    if (s->far_field_steps == 0)
+        s->far_field_steps = LPV_DEFAULT_FAR_FIELD_STEPS;
     if (s->scene_surfel_count == 0)
         s->scene_surfel_count = LPV_DEFAULT_SCENE_SURFEL_COUNT;
     if (s->area_lights == LPV_SWITCH_DEFAULT)
@@ -242,6 +244,9 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->far_field_levels < 1 || s->far_field_levels > LPV_MAX_CASCADES - 1)
         return fail(err, err_size, "far_field_levels = %d is out of range (allowed 1..%d)", s->far_field_levels,
                     LPV_MAX_CASCADES - 1);
+    if (s->far_field_steps < 1 || s->far_field_steps > LPV_MAX_ITERATIONS)
+        return fail(err, err_size, "far_field_steps = %d is out of range (allowed 1..%d)", s->far_field_steps,
+                    LPV_MAX_ITERATIONS);
     if (s->cascades < 0 || s->cascades > LPV_MAX_CASCADES)
         return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->cascades,
                     LPV_MAX_CASCADES);

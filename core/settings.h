@@ -80,7 +80,10 @@ typedef struct lpv_settings {
                                      over the scene gets far_field_levels of them; camera-following
                                      cascades hand light from each to the next) */
     int far_field_levels;         /* coarser levels for one grid over the scene, each doubling the cell
-                                     size and taking an equal share of the iterations; default 1 */
+                                     size; default 1 */
+    int far_field_steps;          /* steps each level but the coarsest takes before handing its light
+                                     on; the coarsest takes the rest of the iterations, so more
+                                     iterations only add steps there; default 1 */
     lpv_switch scene_surfels;     /* surfels sampled over every triangle join the geometry volume, so
                                      walls no view sees still block */
     int scene_surfel_count;       /* how many; default 65536 */
@@ -110,6 +113,7 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f
 #define LPV_DEFAULT_MEDIA_STEP 0.5f
 #define LPV_DEFAULT_FAR_FIELD_LEVELS 1
+#define LPV_DEFAULT_FAR_FIELD_STEPS 1
 #define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 

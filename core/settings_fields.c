@@ -75,6 +75,8 @@ static const lpv_field FIELDS[] = {
      "coarser levels carry the light on (reach grows with 2^levels)"},
     {"far_field_levels", "far-field-levels", LPV_FIELD_INT, F(far_field_levels), 1, LPV_MAX_CASCADES - 1, 0,
      "levels", "1", "", "coarser levels (2x the cells each) over one grid"},
+    {"far_field_steps", "far-field-steps", LPV_FIELD_INT, F(far_field_steps), 1, LPV_MAX_ITERATIONS, 0, "steps",
+     "1", "", "steps each far-field level but the coarsest takes before handing its light on"},
     {"scene_surfels", "scene-surfels", LPV_FIELD_SWITCH, F(scene_surfels), 0, 1, 0, "", "the preset's", "",
      "surfels over every triangle join the geometry volume (walls no view sees block)"},
     {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",

@@ -25,11 +25,16 @@ void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
     /* Step i reads (through buffer-texture views: on llvmpipe texel fetches
      * gather far faster than SSBO loads) what step i - 1 wrote with SSBO
      * stores: the injected grid first, then ping and pong in turn. With the
-     * far field on, every `every` steps a hand-off moves the light in flight
-     * on to the next coarser cascade (lpv_handoff.comp), as one more turn of
-     * the ping-pong. */
+     * far field on, each level but the coarsest takes far_field_steps steps,
+     * then a hand-off moves the light in flight on to the next coarser
+     * cascade (lpv_handoff.comp), as one more turn of the ping-pong; the
+     * coarsest takes the rest. The schedule's start does not depend on the
+     * iteration count, so more iterations only add steps at the coarsest
+     * level: the accumulation can only grow (an even share per level moved
+     * light out of the finer levels later as the count grew, and the Cornell
+     * box got worse from 4 to 16 steps). */
     const int iterations = e->settings.iterations, levels = e->cascades.handoff ? e->cascades.count : 1;
-    const int every = (iterations + levels - 1) / levels;
+    const int every = e->settings.far_field_steps > 0 ? e->settings.far_field_steps : 1;
     GLuint in_view = e->tbo_injected, cur = 0;
     int sig = 0; /* the sigma buffer holding the flux limits of what is read next */
     const GLuint groups[3] = {lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
@@ -51,7 +56,7 @@ void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
         cur = out;
         in_view = out == e->lpv_ping ? e->tbo_ping : e->tbo_pong;
         sig ^= 1;
-        if (levels > 1 && (i + 1) % every == 0 && i + 1 < iterations) {
+        if ((i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations) {
             out = cur == e->lpv_ping ? e->lpv_pong : e->lpv_ping;
             glUseProgram(e->prog_handoff);
             glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);

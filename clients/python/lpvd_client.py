@@ -57,7 +57,7 @@ CONFIG_KNOBS = {
     "glossy": "switch", "glossy_roughness": "float", "media": "switch", "fog_sigma_s": "float",
     "fog_sigma_a": "float", "media_step": "float", "planner": "switch", "area_lights": "switch",
     "area_light_samples": "int", "central_transport": "switch", "normal_bins": "switch", "far_field": "switch",
-    "far_field_levels": "int", "scene_surfels": "switch", "scene_surfel_count": "int",
+    "far_field_levels": "int", "far_field_steps": "int", "scene_surfels": "switch", "scene_surfel_count": "int",
 }
 
 # Message types (SPEC section 4).
