@@ -20,7 +20,8 @@
 #define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
 #define LPV_MEM_CELL 392u         /* per cell: 4 LPV buffers (4 x 48), transmittances (24), reflectances
                                      (96), flux limits (2 x 16), the injection atlas (3 x RGBA32F) */
-#define LPV_MEM_GV_POINT 64u      /* per geometry-volume point: its buffer (32) and atlas (2 x RGBA32F) */
+#define LPV_MEM_GV_POINT 80u      /* per geometry-volume point: the total (48, an LpvGvPoint) and atlas
+                                     (2 x RGBA32F) */
 #define LPV_MEM_CELL_BUFFER 48u   /* the largest single grid buffer (one LpvCell per cell) */
 #define LPV_MEM_PIXEL 76u         /* G-buffer (RGBA32F x3, RGBA16F), depth, frame (RGBA32F) per pixel */
 

@@ -16,6 +16,7 @@
 typedef struct LpvCell lpv_cell;
 typedef struct LpvVpl lpv_vpl;
 typedef struct LpvSurfel lpv_surfel;
+typedef struct LpvGvPoint lpv_gv_point;
 
 /* Adds each valid VPL (position.w != 0, finite, unit-able normal) to the cell
  * containing position + 0.5 * cell_size * normal, as lobe(normal) * flux / pi
@@ -28,16 +29,21 @@ size_t lpv_oracle_inject_vpls(const lpv_grid *g, const lpv_vpl *vpls, size_t n, 
  * entries. Returns the number injected. */
 size_t lpv_oracle_inject_surfels(const lpv_grid *g, const lpv_surfel *surfels, size_t n, vec4 *gv);
 
-/* Merges one buffer's GV into the total: per GV point, the total keeps the
- * coefficient vector with the larger DC term, so a surface seen by two buffers
- * is not counted twice. */
-void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, vec4 *dst);
+/* Merges one buffer's GV (SH per point, as lpv_oracle_inject_surfels builds
+ * it) into the total: per GV point and travel direction d (+x -x +y -y +z -z)
+ * the total keeps the larger of its blocking and B(-d) = dot(src, Y(-d)); a
+ * NaN wins and stays. So a surface seen by two buffers is not counted twice,
+ * and a wall two buffers saw from opposite sides blocks both ways. A zeroed
+ * total is the empty one. Only the blocking is merged: the oracle has no
+ * albedo, the total's albedo is left as it is. */
+void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, lpv_gv_point *dst);
 
 /* Per cell and direction (order +x -x +y -y +z -z, the direction light
- * travels), the transmittance 1 - clamp(B(-d), 0, 1) of the face through which
- * light from the neighbour at cell - d enters, with B the GV averaged over the
- * face's four corners. t has 6 * cell_count floats. */
-void lpv_oracle_transmittance(const lpv_grid *g, const vec4 *gv, float *t);
+ * travels), the transmittance 1 - clamp(B / LPV_GV_PEAK, 0, 1) of the face
+ * through which light from the neighbour at cell - d enters, with B the
+ * total's blocking for d averaged over the face's four corners (a non-finite
+ * B gives 0). t has 6 * cell_count floats. */
+void lpv_oracle_transmittance(const lpv_grid *g, const lpv_gv_point *gv, float *t);
 
 /* One propagation step, flux-limited (docs/propagation.md): in -> out (out is
  * overwritten). t NULL means no occlusion. */

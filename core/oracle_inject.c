@@ -101,15 +101,24 @@ size_t lpv_oracle_inject_surfels(const lpv_grid *g, const lpv_surfel *surfels, s
     return injected;
 }
 
-/* Per GV point keep the vector with the larger DC term (ties keep dst): a
- * surface seen by the camera and by an RSM must block once, not twice. */
-void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, vec4 *dst)
+/* Per GV point and travel direction d keep the larger blocking potential
+ * B(-d), towards where the light comes from: a surface seen by the camera and
+ * by an RSM must block once, not twice, and a wall seen from inside by a
+ * lamp's RSM and from outside by the scene surfels must block both ways (a
+ * whole SH vector holds one side's lobe only). A NaN wins and then stays
+ * (nothing compares greater), so the transmittance blocks it fully. */
+void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, lpv_gv_point *dst)
 {
     size_t count = lpv_grid_gv_count(g);
     for (size_t i = 0; i < count; i++) {
-        if (src[i][0] > dst[i][0]) {
-            for (int k = 0; k < 4; k++)
-                dst[i][k] = src[i][k];
+        for (int d = 0; d < LPV_DIR_COUNT; d++) {
+            float back[3] = {0.0f, 0.0f, 0.0f}, y[4];
+            back[d / 2] = (d & 1) ? 1.0f : -1.0f;
+            lpv_sh_basis(back, y);
+            float b = lpv_sh_dot(src[i], y);
+            float *slot = &dst[i].blocking[d / 4][d % 4];
+            if (b > *slot || isnan(b))
+                *slot = b;
         }
     }
 }

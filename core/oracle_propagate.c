@@ -9,7 +9,6 @@
 #include <string.h>
 
 #include "oracle.h"
-#include "sh.h"
 
 /* Directions in the order +x -x +y -y +z -z: axis d / 2, sign + for even d. */
 static const int lpv_dir[LPV_DIR_COUNT][3] = {
@@ -34,12 +33,13 @@ static float *channel_mut(lpv_cell *c, int ch)
 
 /* ---- Transmittance ------------------------------------------------------ */
 
-/* GV averaged over the four corners of the face of cell c through which
- * light travelling along d enters: the face at centre - 0.5 dir_d, i.e. the
- * lower face on axis k for a positive direction, the upper for negative.
- * e1, e2 are the other two axes in x, y, z order; the corners are summed in
- * the order base, +e1, +e2, +e1+e2 (as transmit.comp does). */
-static void face_gv(const lpv_grid *g, const vec4 *gv, const int c[3], int d, float out[4])
+/* The total's blocking for travel direction d averaged over the four corners
+ * of the face of cell c through which light travelling along d enters: the
+ * face at centre - 0.5 dir_d, i.e. the lower face on axis k for a positive
+ * direction, the upper for negative. e1, e2 are the other two axes in x, y, z
+ * order; the corners are summed in the order base, +e1, +e2, +e1+e2 (as
+ * transmit.comp does). */
+static float face_blocking(const lpv_grid *g, const lpv_gv_point *gv, const int c[3], int d)
 {
     int k = dir_axis(d);
     int e1 = k == 0 ? 1 : 0, e2 = k == 2 ? 1 : 2;
@@ -47,37 +47,29 @@ static void face_gv(const lpv_grid *g, const vec4 *gv, const int c[3], int d, fl
     if (d & 1)
         base[k] += 1;
     static const int steps[4][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
-    for (int i = 0; i < 4; i++)
-        out[i] = 0.0f;
+    float sum = 0.0f;
     for (int corner = 0; corner < 4; corner++) {
         int p[3] = {base[0], base[1], base[2]};
         p[e1] += steps[corner][0];
         p[e2] += steps[corner][1];
-        const float *v = gv[lpv_grid_gv_index(g, p[0], p[1], p[2])];
-        for (int i = 0; i < 4; i++)
-            out[i] += v[i];
+        sum += gv[lpv_grid_gv_index(g, p[0], p[1], p[2])].blocking[d / 4][d % 4];
     }
-    for (int i = 0; i < 4; i++)
-        out[i] *= 0.25f;
+    return 0.25f * sum;
 }
 
-/* 1 - clamp(B(-dir_d) / peak, 0, 1): the blocking potential is evaluated
- * towards where the light comes from, so a surface facing the light blocks it,
+/* 1 - clamp(B / peak, 0, 1): B is the blocking towards where the light comes
+ * from (lpv_oracle_gv_merge), so a surface facing the light blocks it,
  * normalised by the L1 lobe's peak (LPV_GV_PEAK) so a covered face blocks all
  * of it. A non-finite B blocks completely: NaN must never reach the
  * propagation. */
-static float face_transmittance(const float gv_face[4], int d)
+static float face_transmittance(float b)
 {
-    float back[3] = {(float)-lpv_dir[d][0], (float)-lpv_dir[d][1], (float)-lpv_dir[d][2]};
-    float y[4];
-    lpv_sh_basis(back, y);
-    float b = lpv_sh_dot(gv_face, y);
     if (!isfinite(b))
         return 0.0f;
     return 1.0f - fminf(fmaxf(b / LPV_GV_PEAK, 0.0f), 1.0f);
 }
 
-void lpv_oracle_transmittance(const lpv_grid *g, const vec4 *gv, float *t)
+void lpv_oracle_transmittance(const lpv_grid *g, const lpv_gv_point *gv, float *t)
 {
     int cell[3];
     for (cell[2] = 0; cell[2] < g->dims[2]; cell[2]++) {
@@ -85,9 +77,7 @@ void lpv_oracle_transmittance(const lpv_grid *g, const vec4 *gv, float *t)
             for (cell[0] = 0; cell[0] < g->dims[0]; cell[0]++) {
                 size_t idx = lpv_grid_index(g, cell[0], cell[1], cell[2]);
                 for (int d = 0; d < LPV_DIR_COUNT; d++) {
-                    float face[4];
-                    face_gv(g, gv, cell, d, face);
-                    t[idx * LPV_DIR_COUNT + d] = face_transmittance(face, d);
+                    t[idx * LPV_DIR_COUNT + d] = face_transmittance(face_blocking(g, gv, cell, d));
                 }
             }
         }

@@ -307,7 +307,7 @@ static int apply_cascades(lpv_engine *e, const lpv_cascade_set *set, char *err, 
     e->lpv_ping = new_ssbo(vcells * sizeof(lpv_cell));
     e->lpv_pong = new_ssbo(vcells * sizeof(lpv_cell));
     e->lpv_acc = new_ssbo(vcells * sizeof(lpv_cell));
-    e->gv_total = new_ssbo(gv * 2 * 4 * sizeof(float)); /* blocking SH, albedo */
+    e->gv_total = new_ssbo(gv * sizeof(lpv_gv_point));
     e->transmit = new_ssbo(cells * LPV_DIR_COUNT * sizeof(float));
     e->reflect = new_ssbo(cells * LPV_DIR_COUNT * 4 * sizeof(float));
     e->sigma[0] = new_ssbo(vcells * 4 * sizeof(float));
@@ -1006,21 +1006,11 @@ size_t lpv_engine_read_volumes(lpv_engine *e, lpv_grid_which which, lpv_cell *ou
 
 int lpv_engine_bins(const lpv_engine *e) { return e->bins > 1 ? e->bins : 1; }
 
-size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max)
+size_t lpv_engine_read_gv(lpv_engine *e, lpv_gv_point *out, size_t max)
 {
     if (!e->ticked || !e->plan.pass[LPV_PASS_GV].run)
         return 0;
-    /* The total interleaves (blocking SH, albedo) per point; callers get the SH. */
-    size_t points = lpv_grid_gv_count(&e->grid) * (size_t)e->cascades.count;
-    size_t n = points < max ? points : max;
-    vec4 *pairs = malloc(n * 2 * sizeof *pairs);
-    if (!pairs)
-        return 0;
-    n = read_buffer(e->gv_total, sizeof(vec4), points * 2, pairs, n * 2) / 2;
-    for (size_t i = 0; i < n; ++i)
-        memcpy(out[i], pairs[2 * i], sizeof out[i]);
-    free(pairs);
-    return n;
+    return read_buffer(e->gv_total, sizeof *out, lpv_grid_gv_count(&e->grid) * (size_t)e->cascades.count, out, max);
 }
 
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats)

@@ -114,7 +114,10 @@ size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, 
  * read_volumes every volume as stored. With bins off the two agree. */
 size_t lpv_engine_read_volumes(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max);
 int lpv_engine_bins(const lpv_engine *e);
-size_t lpv_engine_read_gv(lpv_engine *e, vec4 *out, size_t max);
+/* The geometry volume's total (LpvGvPoint: per travel direction the largest
+ * blocking any buffer holds, and the albedo), every cascade's points,
+ * cascade 0 first. */
+size_t lpv_engine_read_gv(lpv_engine *e, lpv_gv_point *out, size_t max);
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);
 /* RSM VPLs (punctual lights' and area light samples'), then the emissive VPLs
  * when the last tick injected them (area lights off). */

@@ -3,9 +3,11 @@
  * surfaces (each punctual light's RSM faces, the area light samples' faces
  * as one, the camera's G-buffer, and the surfels sampled over every triangle
  * when settings.scene_surfels is on) splats its
- * surfels into the GV atlas and is then max-merged into the total, so a
- * surface seen by several buffers blocks once. Finally the per-cell, per-
- * direction transmittances are computed once for the whole propagation.
+ * surfels into the GV atlas and is then max-merged into the total per travel
+ * direction, so a surface seen by several buffers blocks once and a wall
+ * seen from each side by a different buffer blocks both ways. Finally the
+ * per-cell, per-direction transmittances are computed once for the whole
+ * propagation.
  */
 #include "engine_internal.h"
 

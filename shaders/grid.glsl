@@ -60,12 +60,16 @@ int normal_bin(vec3 n)
     return 2 * axis + (n[axis] < 0.0 ? 1 : 0);
 }
 
-vec3 bin_axis(int b)
+// The unit vector of direction d in the order +x -x +y -y +z -z.
+vec3 dir_vector(int d)
 {
     vec3 e = vec3(0.0);
-    e[b / 2] = (b & 1) == 0 ? 1.0 : -1.0;
+    e[d / 2] = (d & 1) == 0 ? 1.0 : -1.0;
     return e;
 }
+
+// Bins follow the direction order.
+vec3 bin_axis(int b) { return dir_vector(b); }
 
 // A compute invocation over every LPV volume: z runs over dims.z * volumes.
 int volume_of_invocation(ivec3 id, out ivec3 c) { return cascade_of_invocation(id, c); }

@@ -142,6 +142,20 @@ struct LpvGridParams {
  * +x, -x, +y, -y, +z, -z. Per-cell transmittances are stored the same way. */
 #define LPV_DIR_COUNT 6
 
+/* A point of the geometry volume's total (docs/propagation.md section 2),
+ * the max-merge of every buffer's GV. The merge is per travel direction, not
+ * per SH vector: one SH vector holds a single lobe's worth of direction, so
+ * keeping one buffer's would drop the other side of a wall that another
+ * buffer saw from behind. blocking[d / 4][d % 4] is, for light travelling
+ * along direction d, the largest blocking potential B(-d) (towards where the
+ * light comes from, in units of cell^2) any buffer holds here; 0 where none
+ * blocks. The GV's array is per cascade, x fastest, as the cells'. */
+struct LpvGvPoint {
+    vec4 blocking[2]; /* travel +x -x +y -y, then +z -z; [1].zw unused (0) */
+    vec4 albedo;      /* rgb the mean albedo of the buffer with the largest DC term here (the one that
+                         saw the most surface), for bounces; w that DC term, 0 = no surface */
+};
+
 /* ---- Lights and their shadow-map faces (uniform block, std140) ------------
  * Every light renders a reflective shadow map (RSM) into one or more layers
  * of 2D array textures: 1 for directional and spot lights, 6 (cube faces)

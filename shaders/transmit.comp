@@ -1,12 +1,13 @@
 // transmit.comp - per cascade, cell and direction (+x -x +y -y +z -z, the
 // direction light travels), the fraction of light from the neighbour at
-// cell - dir that passes the face between them: 1 - clamp(B(-dir)), B the GV
-// averaged over the face's four corners. With bounces, also the face's
-// reflectance: the blocked fraction times the blockers' mean albedo times the
+// cell - dir that passes the face between them: 1 - clamp(B(-dir) / peak), B
+// the total's blocking for dir (gv_merge.comp) averaged over the face's four
+// corners. With bounces, also the face's reflectance: the blocked fraction
+// times the corners' albedo weighted by what each blocks of dir, times the
 // bounce intensity. Computed once per tick; propagation only multiplies.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
-layout(std430, binding = LPV_SSBO_GV_TOTAL) readonly buffer GvTotal { vec4 gv_total[]; }; // SH, albedo pairs
+layout(std430, binding = LPV_SSBO_GV_TOTAL) readonly buffer GvTotal { LpvGvPoint gv_total[]; };
 layout(std430, binding = LPV_SSBO_TRANSMIT) writeonly buffer Transmit { float transmit[]; };
 layout(std430, binding = LPV_SSBO_REFLECT) writeonly buffer Reflect { vec4 reflectance[]; };
 
@@ -35,21 +36,18 @@ void main()
         if (!positive)
             base[axis] += 1;
         ivec3 corner[4] = ivec3[4](base, base + e1, base + e2, base + e1 + e2);
-        vec4 avg = vec4(0.0);
+        float b = 0.0;
         vec3 albedo = vec3(0.0);
         float weight = 0.0;
         for (int q = 0; q < 4; ++q) {
             int g = gv_index(k, corner[q]);
-            vec4 v = gv_total[2 * g];
-            avg += 0.25 * v;
-            if (u_bounce != 0 && v.x > 0.0) {
-                albedo += v.x * gv_total[2 * g + 1].rgb;
-                weight += v.x;
+            float v = gv_total[g].blocking[dir / 4][dir % 4];
+            b += 0.25 * v;
+            if (u_bounce != 0 && v > 0.0) {
+                albedo += v * gv_total[g].albedo.rgb;
+                weight += v;
             }
         }
-        vec3 travel = vec3(0.0);
-        travel[axis] = positive ? 1.0 : -1.0;
-        float b = dot(avg, sh_basis(-travel));
         bool bad = isnan(b) || isinf(b);
         float blocked = bad ? 1.0 : clamp(b / LPV_GV_PEAK, 0.0, 1.0);
         transmit[i * LPV_DIR_COUNT + dir] = 1.0 - blocked;

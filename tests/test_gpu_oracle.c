@@ -122,6 +122,16 @@ static void test_injection_matches_oracle(void **state)
     free(ref);
 }
 
+/* The blocking of n GV points, LPV_DIR_COUNT floats each. */
+static float *blocking_of(const lpv_gv_point *gv, size_t n)
+{
+    float *b = calloc(n * LPV_DIR_COUNT, sizeof *b);
+    for (size_t i = 0; i < n; ++i)
+        for (int d = 0; d < LPV_DIR_COUNT; ++d)
+            b[i * LPV_DIR_COUNT + d] = gv[i].blocking[d / 4][d % 4];
+    return b;
+}
+
 static void test_geometry_volume_matches_oracle(void **state)
 {
     fixture *f = *state;
@@ -129,7 +139,9 @@ static void test_geometry_volume_matches_oracle(void **state)
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t gv_n = lpv_grid_gv_count(g), cells = lpv_grid_cell_count(g);
-    vec4 *ref = calloc(gv_n, sizeof *ref), *tmp = calloc(gv_n, sizeof *tmp), *gpu = calloc(gv_n, sizeof *gpu);
+    lpv_gv_point *ref = calloc(gv_n, sizeof *ref), *gpu = calloc(gv_n, sizeof *gpu);
+    vec4 *tmp = calloc(gv_n, sizeof *tmp);
+    float *dc = calloc(gv_n, sizeof *dc); /* the largest DC term of any buffer: the albedo's owner */
     size_t smax = 64 * 64 * 16;
     lpv_surfel *surfels = calloc(smax, sizeof *surfels);
     size_t buffers = lpv_engine_gv_buffer_count(f->engine);
@@ -140,14 +152,26 @@ static void test_geometry_volume_matches_oracle(void **state)
         memset(tmp, 0, gv_n * sizeof *tmp);
         assert_true(lpv_oracle_inject_surfels(g, surfels, n, tmp) > 100);
         lpv_oracle_gv_merge(g, tmp, ref);
+        for (size_t i = 0; i < gv_n; ++i)
+            dc[i] = fmaxf(dc[i], tmp[i][0]);
     }
     assert_int_equal(lpv_engine_read_gv(f->engine, gpu, gv_n), gv_n);
-    assert_close("geometry volume", (const float *)gpu, (const float *)ref, gv_n * 4);
+    float *b_gpu = blocking_of(gpu, gv_n), *b_ref = blocking_of(ref, gv_n), *dc_gpu = calloc(gv_n, sizeof *dc_gpu);
+    assert_close("geometry volume blocking", b_gpu, b_ref, gv_n * LPV_DIR_COUNT);
+    size_t surfaced = 0;
+    for (size_t i = 0; i < gv_n; ++i) {
+        dc_gpu[i] = gpu[i].albedo[3];
+        for (int k = 0; k < 3; ++k)
+            assert_true(gpu[i].albedo[k] >= 0.0f && gpu[i].albedo[k] <= 1.0f);
+        surfaced += gpu[i].albedo[3] > 0.0f && gpu[i].albedo[1] > 0.0f;
+    }
+    assert_close("geometry volume albedo's DC term", dc_gpu, dc, gv_n);
+    assert_true(surfaced > 100); /* the walls' albedo is there for the bounces */
 
     /* Transmittances from the GPU's GV: only the arithmetic is compared. */
     float *t_gpu = calloc(cells * 6, sizeof *t_gpu), *t_ref = calloc(cells * 6, sizeof *t_ref);
     assert_int_equal(lpv_engine_read_transmittance(f->engine, t_gpu, cells * 6), cells * 6);
-    lpv_oracle_transmittance(g, (const vec4 *)gpu, t_ref);
+    lpv_oracle_transmittance(g, gpu, t_ref);
     size_t blocked = 0;
     for (size_t i = 0; i < cells * 6; ++i) {
         assert_true(t_gpu[i] >= 0.0f && t_gpu[i] <= 1.0f);
@@ -158,6 +182,10 @@ static void test_geometry_volume_matches_oracle(void **state)
     free(ref);
     free(tmp);
     free(gpu);
+    free(dc);
+    free(dc_gpu);
+    free(b_gpu);
+    free(b_ref);
     free(surfels);
     free(t_gpu);
     free(t_ref);

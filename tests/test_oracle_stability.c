@@ -89,7 +89,7 @@ typedef struct pipeline {
     lpv_grid g;
     lpv_cell *injected;
     lpv_cell *acc;
-    vec4 *gv;
+    lpv_gv_point *gv;
     float *t;
     size_t vpls_injected;
     size_t surfels_injected;
@@ -104,14 +104,14 @@ static void build_gv(pipeline *p, const lpv_surfel *s, size_t ns)
     p->surfels_injected = 0;
     for (size_t i = 0; i < ns; i++)
         p->surfels_injected += lpv_oracle_inject_surfels(&p->g, &s[i], 1, (i & 1) ? odd : even);
-    p->gv = xcalloc(count, sizeof(vec4));
+    p->gv = xcalloc(count, sizeof(lpv_gv_point));
     lpv_oracle_gv_merge(&p->g, even, p->gv);
     lpv_oracle_gv_merge(&p->g, odd, p->gv);
     free(even);
     free(odd);
     for (size_t i = 0; i < count; i++)
-        for (int k = 0; k < 4; k++)
-            assert_true(isfinite(p->gv[i][k]));
+        for (int d = 0; d < LPV_DIR_COUNT; d++)
+            assert_true(isfinite(p->gv[i].blocking[d / 4][d % 4]));
 }
 
 static void pipeline_run(pipeline *p, const lpv_grid *g, const lpv_vpl *v, size_t nv, const lpv_surfel *s, size_t ns,
@@ -519,10 +519,13 @@ static void check_magnitude(float magnitude)
             cells[i].b[k] = k == 0 ? magnitude : 0.0f; /* isotropic */
         }
     }
-    vec4 *gv = xcalloc(lpv_grid_gv_count(&g), sizeof(vec4));
+    lpv_gv_point *gv = xcalloc(lpv_grid_gv_count(&g), sizeof(lpv_gv_point));
     float *t = xcalloc(n * 6, sizeof(float));
-    for (size_t i = 0; i < lpv_grid_gv_count(&g); i++)
-        gv[i][0] = (float)rnd(0, 2);
+    for (size_t i = 0; i < lpv_grid_gv_count(&g); i++) {
+        float b = (float)rnd(0, 2) * LPV_SH_C0; /* a random isotropic partial blocker */
+        for (int d = 0; d < LPV_DIR_COUNT; d++)
+            gv[i].blocking[d / 4][d % 4] = b;
+    }
     lpv_oracle_transmittance(&g, gv, t);
     check_steps(&g, cells, t, 200);
     check_steps(&g, cells, NULL, 200);

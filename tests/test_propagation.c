@@ -84,21 +84,20 @@ static void random_field(const lpv_grid *g, lpv_cell *cells, double ratio)
     }
 }
 
-/* Random GV whose blocking potential goes below 0 and above 1, so the clamp
- * is exercised on both sides. */
-static vec4 *random_gv(const lpv_grid *g)
+/* Random GV totals whose blocking goes below 0 and above LPV_GV_PEAK, so the
+ * clamp is exercised on both sides (a merged total is never negative, but the
+ * transmittance must clamp whatever it is given). */
+static lpv_gv_point *random_gv(const lpv_grid *g)
 {
     size_t n = lpv_grid_gv_count(g);
-    vec4 *gv = xcalloc(n, sizeof(vec4));
-    for (size_t i = 0; i < n; i++) {
-        gv[i][0] = (float)rnd(-0.5, 3.0);
-        for (int k = 1; k < 4; k++)
-            gv[i][k] = (float)rnd(-3.0, 3.0);
-    }
+    lpv_gv_point *gv = xcalloc(n, sizeof(lpv_gv_point));
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < LPV_DIR_COUNT; d++)
+            gv[i].blocking[d / 4][d % 4] = (float)rnd(-1.0, 2.0);
     return gv;
 }
 
-static float *transmittance_of(const lpv_grid *g, const vec4 *gv)
+static float *transmittance_of(const lpv_grid *g, const lpv_gv_point *gv)
 {
     float *t = xcalloc(lpv_grid_cell_count(g) * 6, sizeof(float));
     lpv_oracle_transmittance(g, gv, t);
@@ -338,7 +337,7 @@ static void test_energy_1000_steps_occluded(void **state)
 {
     (void)state;
     lpv_grid g = make_grid(16, 16, 16);
-    vec4 *gv = random_gv(&g);
+    lpv_gv_point *gv = random_gv(&g);
     float *t = transmittance_of(&g, gv);
     run_energy(t);
     free(t);
@@ -368,7 +367,7 @@ static void test_c0_stays_non_negative(void **state)
         vpls[i] = v;
     }
     assert_true(lpv_oracle_inject_vpls(&g, vpls, 300, cur) > 200);
-    vec4 *gv = random_gv(&g);
+    lpv_gv_point *gv = random_gv(&g);
     float *t = transmittance_of(&g, gv);
     assert_int_equal(lpv_oracle_propagate(&g, cur, t, 50, acc), 0);
     assert_c0_non_negative(&g, acc);
@@ -426,7 +425,7 @@ static void test_linearity(void **state)
     (void)state;
     check_linearity(NULL);
     lpv_grid g = make_grid(7, 6, 5);
-    vec4 *gv = random_gv(&g);
+    lpv_gv_point *gv = random_gv(&g);
     float *t = transmittance_of(&g, gv);
     check_linearity(t);
     free(t);
@@ -444,7 +443,7 @@ static void test_propagate_accumulates(void **state)
     lpv_cell *inj = new_cells(&g), *acc = new_cells(&g), *cur = new_cells(&g), *next = new_cells(&g);
     lpv_cell *sum = new_cells(&g);
     random_field(&g, inj, 1.0);
-    vec4 *gv = random_gv(&g);
+    lpv_gv_point *gv = random_gv(&g);
     float *t = transmittance_of(&g, gv);
 
     assert_int_equal(lpv_oracle_propagate(&g, inj, t, 5, acc), 0);
@@ -485,23 +484,54 @@ static void test_propagate_accumulates(void **state)
     free(sum);
 }
 
-/* A wall of surfels facing -x on the GV plane x = 3 blocks light travelling
- * +x into it and lets light travelling -x (hitting its back) through. */
-static void test_occlusion_direction(void **state)
+/* One buffer's GV holding a wall of surfels of area 2 cell^2 on the GV plane
+ * x = 3 (the face between cells 2 and 3), normals (nx, 0, 0), merged into the
+ * total. Facing the light, each corner blocks B = 2 * 0.75 >= LPV_GV_PEAK;
+ * its back (2 * -0.25) blocks nothing. */
+static void merge_wall(const lpv_grid *g, float nx, lpv_gv_point *total)
 {
-    (void)state;
-    lpv_grid g = make_grid(6, 4, 4);
-    size_t n = lpv_grid_cell_count(&g);
-    vec4 *gv = xcalloc(lpv_grid_gv_count(&g), sizeof(vec4));
+    vec4 *sh = xcalloc(lpv_grid_gv_count(g), sizeof(vec4));
     lpv_surfel wall[25];
     int count = 0;
     for (int y = 0; y <= 4; y++)
         for (int z = 0; z <= 4; z++) {
-            /* area 2 cell^2: B(-x) = 2 * 0.75 >= 1, B(+x) = 2 * -0.25 < 0 */
-            lpv_surfel s = {{3.0f, (float)y, (float)z, 2.0f}, {-1.0f, 0.0f, 0.0f, 0.0f}};
+            lpv_surfel s = {{3.0f, (float)y, (float)z, 2.0f}, {nx, 0.0f, 0.0f, 0.0f}};
             wall[count++] = s;
         }
-    assert_int_equal(lpv_oracle_inject_surfels(&g, wall, 25, gv), 25);
+    assert_int_equal(lpv_oracle_inject_surfels(g, wall, 25, sh), 25);
+    lpv_oracle_gv_merge(g, sh, total);
+    free(sh);
+}
+
+/* Propagates red from cell (1, 1, 1) and green from (5, 2, 2) past the wall
+ * of merge_wall: whether each crossed it, and that something propagated. */
+static void cross_wall(const lpv_grid *g, const float *t, int *red_crossed, int *green_crossed)
+{
+    size_t n = lpv_grid_cell_count(g);
+    lpv_cell *inj = new_cells(g), *acc = new_cells(g);
+    inj[lpv_grid_index(g, 1, 1, 1)].r[0] = 1.0f;
+    inj[lpv_grid_index(g, 5, 2, 2)].g[0] = 1.0f;
+    assert_int_equal(lpv_oracle_propagate(g, inj, t, 20, acc), 0);
+    *red_crossed = *green_crossed = 0;
+    for (size_t i = 0; i < n; i++) {
+        int x = (int)(i % (size_t)g->dims[0]);
+        *red_crossed |= x >= 3 && acc[i].r[0] != 0.0f;
+        *green_crossed |= x < 3 && acc[i].g[0] != 0.0f;
+    }
+    assert_true(acc[lpv_grid_index(g, 0, 1, 1)].r[0] > 0.0f); /* red spread on its side */
+    assert_true(acc[lpv_grid_index(g, 4, 2, 2)].g[0] > 0.0f);
+    free(inj);
+    free(acc);
+}
+
+/* A wall of surfels facing -x blocks light travelling +x into it and lets
+ * light travelling -x (hitting its back) through. */
+static void test_occlusion_direction(void **state)
+{
+    (void)state;
+    lpv_grid g = make_grid(6, 4, 4);
+    lpv_gv_point *gv = xcalloc(lpv_grid_gv_count(&g), sizeof(lpv_gv_point));
+    merge_wall(&g, -1.0f, gv);
     float *t = transmittance_of(&g, gv);
     for (int y = 0; y < 4; y++)
         for (int z = 0; z < 4; z++) {
@@ -509,19 +539,10 @@ static void test_occlusion_direction(void **state)
             assert_true(t[lpv_grid_index(&g, 2, y, z) * 6 + 1] == 1.0f); /* -x out of the back */
             assert_true(t[lpv_grid_index(&g, 1, y, z) * 6 + 0] == 1.0f); /* away from the wall */
         }
-
-    lpv_cell *inj = new_cells(&g), *acc = new_cells(&g);
-    inj[lpv_grid_index(&g, 1, 1, 1)].r[0] = 1.0f;
-    inj[lpv_grid_index(&g, 5, 2, 2)].g[0] = 1.0f;
-    assert_int_equal(lpv_oracle_propagate(&g, inj, t, 20, acc), 0);
-    for (size_t i = 0; i < n; i++) {
-        int x = (int)(i % 6);
-        if (x >= 3)
-            assert_true(acc[i].r[0] == 0.0f); /* red starts at x = 1, in front */
-    }
-    assert_true(acc[lpv_grid_index(&g, 0, 2, 2)].g[0] > 0.0f); /* green passed the back */
-    free(inj);
-    free(acc);
+    int red_crossed, green_crossed;
+    cross_wall(&g, t, &red_crossed, &green_crossed);
+    assert_false(red_crossed);  /* red starts at x = 1, in front */
+    assert_true(green_crossed); /* green passed the back */
     free(t);
     free(gv);
 }
