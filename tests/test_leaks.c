@@ -104,15 +104,17 @@ static void check(const lpv_settings *s, const char *label, float half)
     assert_true(ind_box < 0.05 * dir_open); /* under a twentieth of the direct light */
 }
 
-/* A box of 12 cells (3 m in a 32^3 grid over this 8 m scene) with the
- * paper's transport must hold its lamp's light (the central transport and
- * the far field carry light through partly blocked faces further). The
- * default grid
- * (8^3, 1 m cells) cannot: its walls and its light share cells, and it leaks
- * about as much indirect light outside the box as the lamp's direct light
- * gives the open floor there. That figure is printed, not asserted: the LPV's
- * known limit (docs/propagation.md, "Limits"). Direct light never leaks
- * (the shadow map). */
+/* A box of 12 cells (3 m in a 32^3 grid over this 8 m scene) must hold its
+ * lamp's light, with the paper's transport and with the default departures
+ * (central transport, normal bins, far field, scene surfels): the departures
+ * leak more on coarser grids (the far field's hand-off sums a coarse cell's
+ * eight children, inside and outside a wall that crosses it), so the box is
+ * sized where both hold. The default grid (8^3, 1.14 m cells) cannot: its
+ * walls and its light share cells, and it leaks more than half of the
+ * lamp's direct light on the open floor there. That figure is printed, not
+ * asserted: the LPV's known limit (docs/propagation.md, "Limits";
+ * LPVT_LEAK_DIAG=1 prints the leak against the box's size in cells). Direct
+ * light never leaks (the shadow map). */
 static void test_lamp_in_closed_box(void **state)
 {
     (void)state;
@@ -120,6 +122,8 @@ static void test_lamp_in_closed_box(void **state)
     lpv_settings fine = {.grid_dims = {32, 32, 32}, .iterations = 8, .central_transport = LPV_SWITCH_OFF,
                          .far_field = LPV_SWITCH_OFF};
     check(&fine, "32^3, 8 iterations, paper transport, no far field", 1.5f);
+    lpv_settings departures = {.grid_dims = {32, 32, 32}};
+    check(&departures, "32^3, the default departures and iterations", 1.5f);
     lpv_settings s = {0};
     for (int k = 0; k < 2; ++k) {
         const float half = k ? 0.5f : 1.5f;
@@ -183,6 +187,25 @@ static void test_leak_diagnosis(void **state)
         floor_light(&v[i], 1, 1.5f, &a, &b);
         floor_light(&v[i], 1, 0.5f, &c, &d);
         printf("%s: boxed indirect %.4g (3 m box), %.4g (1 m box)\n", names[i], a, c);
+    }
+    /* The defaults' departures on finer grids: the leak against the box's
+     * size in cells (8 m / (grid - 1) per cell), and what the central
+     * transport and the far field add to it (docs/propagation.md, 6c). */
+    const int grids[] = {8, 12, 16, 24, 32};
+    for (size_t g = 0; g < sizeof grids / sizeof grids[0]; ++g) {
+        lpv_settings x = {.grid_dims = {grids[g], grids[g], grids[g]}};
+        double ind_open, dir_open, leak, dir, leak_paper, leak_near;
+        floor_light(&x, 0, 1.5f, &ind_open, &dir_open);
+        floor_light(&x, 1, 1.5f, &leak, &dir);
+        x.central_transport = OFF;
+        floor_light(&x, 1, 1.5f, &leak_paper, &dir);
+        x.central_transport = ON;
+        x.far_field = OFF;
+        floor_light(&x, 1, 1.5f, &leak_near, &dir);
+        printf("defaults on %d^3 (3 m box = %.1f cells): leak %.1f %% of the open floor's direct; central transport "
+               "off %.1f %%; far field off %.1f %%\n",
+               grids[g], 3.0 * (grids[g] - 1) / 8.0, 100.0 * leak / dir_open, 100.0 * leak_paper / dir_open,
+               100.0 * leak_near / dir_open);
     }
 }
 
