@@ -26,11 +26,11 @@ typedef enum lpv_preset {
 } lpv_preset;
 
 typedef struct lpv_settings {
-    int grid_dims[3];       /* cells per axis; default: the preset's (balanced: 8 x 8 x 8) */
+    int grid_dims[3];       /* cells per axis; default: the preset's */
     float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
     float bounds_max[3];    /*   bounds grown by half a cell on every side */
-    int iterations;         /* propagation steps; default: the preset's (balanced: 4) */
-    int rsm_size;           /* reflective shadow map side, texels; default: the preset's (balanced: 128) */
+    int iterations;         /* propagation steps; default: the preset's */
+    int rsm_size;           /* reflective shadow map side, texels; default: the preset's */
     int shadow_size;        /* side of each light face's shadow map for direct light, texels;
                                default LPV_DEFAULT_SHADOW_SIZE (docs/shadows.md) */
     lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default: the preset's (on) */
@@ -98,7 +98,7 @@ typedef struct lpv_settings {
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
  * preset table in settings.c (a test checks that they agree). */
 #define LPV_DEFAULT_GRID_DIM 8
-#define LPV_DEFAULT_ITERATIONS 4
+#define LPV_DEFAULT_ITERATIONS 8
 #define LPV_DEFAULT_RSM_SIZE 128
 #define LPV_DEFAULT_SHADOW_SIZE 1024
 #define LPV_DEFAULT_EMISSIVE_VPLS 4096

@@ -12,10 +12,10 @@
 static const char OPTIONS_HELP_HEAD[] =
     "Engine settings (--grid, --iterations, --rsm-size and --occlusion win over --preset,\n"
     "in any order):\n"
-    "  --preset NAME           quality preset (default balanced; docs/accuracy.md):\n"
-    "                            fast      grid 16, 4 iterations, RSM 128, occlusion on\n"
-    "                            balanced  grid 32, 4 iterations, RSM 128, occlusion on\n"
-    "                            accurate  grid 64, 4 iterations, RSM 256, occlusion on\n"
+    "  --preset NAME           quality preset (default balanced; docs/accuracy.md):\n";
+
+/* After the preset lines, which come from the preset table. */
+static const char OPTIONS_HELP_KNOBS[] =
     "  --grid N | NxMxK        LPV cells per axis (default: the preset's)\n"
     "  --bounds x0,y0,z0,x1,y1,z1  grid bounds in m (default: the scene's bounds)\n"
     "  --iterations N          propagation steps (default: the preset's)\n"
@@ -62,6 +62,21 @@ const char *lpvd_options_help(void)
     if (help[0])
         return help;
     size_t len = (size_t)snprintf(help, sizeof help, "%s", OPTIONS_HELP_HEAD);
+    for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_ && len < sizeof help; ++p) {
+        lpv_settings s;
+        lpv_preset_settings((lpv_preset)p, &s);
+        const lpv_switch mods[4] = {s.central_transport, s.normal_bins, s.far_field, s.scene_surfels};
+        char letters[5] = "cbfs";
+        for (int m = 0; m < 4; ++m)
+            if (mods[m] != LPV_SWITCH_ON)
+                letters[m] = '-';
+        len += (size_t)snprintf(help + len, sizeof help - len,
+                                "%28s%-10sgrid %d, %d iterations, RSM %d, occlusion %s, departures %s\n", "",
+                                lpv_preset_name((lpv_preset)p), s.grid_dims[0], s.iterations, s.rsm_size,
+                                s.occlusion == LPV_SWITCH_ON ? "on" : "off", letters);
+    }
+    if (len < sizeof help)
+        len += (size_t)snprintf(help + len, sizeof help - len, "%s", OPTIONS_HELP_KNOBS);
     len += (size_t)snprintf(help + len, sizeof help - len,
                             "Shadows, cascades, effects and scheduling (docs/shadows.md, docs/cascades.md,\n"
                             "docs/effects.md):\n");

@@ -29,8 +29,8 @@ typedef struct expected {
  * docs/accuracy.md); a change there must show up here. */
 static const expected PRESETS[] = {
     {LPV_PRESET_FAST, "fast", 8, 4, 128, ON, ON, OFF, OFF, ON},
-    {LPV_PRESET_BALANCED, "balanced", 8, 4, 128, ON, ON, ON, ON, ON},
-    {LPV_PRESET_ACCURATE, "accurate", 12, 8, 128, ON, ON, ON, ON, ON},
+    {LPV_PRESET_BALANCED, "balanced", 8, 8, 128, ON, ON, ON, ON, ON},
+    {LPV_PRESET_ACCURATE, "accurate", 16, 16, 128, ON, ON, ON, ON, ON},
 };
 #define NPRESETS ((int)(sizeof PRESETS / sizeof PRESETS[0]))
 
@@ -58,7 +58,7 @@ static void test_zero_resolves_to_balanced(void **state)
     lpv_settings s = {0};
     lpv_settings_resolve(&s);
     assert_int_equal(s.preset, LPV_PRESET_BALANCED);
-    assert_knobs(&s, 8, 4, 128, LPV_SWITCH_ON);
+    assert_knobs(&s, PRESETS[1].grid, PRESETS[1].iterations, PRESETS[1].rsm_size, PRESETS[1].occlusion);
     assert_departures(&s, &PRESETS[1]);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
     /* the LPV_DEFAULT_* macros are the balanced preset */
@@ -106,7 +106,7 @@ static void test_explicit_fields_override(void **state)
 
     lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .iterations = 12, .rsm_size = 512, .normal_bins = OFF};
     lpv_settings_resolve(&t);
-    assert_knobs(&t, 12, 12, 512, LPV_SWITCH_ON);
+    assert_knobs(&t, PRESETS[2].grid, 12, 512, LPV_SWITCH_ON);
     assert_int_equal(t.normal_bins, OFF); /* explicit wins over the preset's on */
     assert_int_equal(t.far_field, ON);
 }
