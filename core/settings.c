@@ -78,6 +78,15 @@ int lpv_preset_settings(lpv_preset p, lpv_settings *out)
     return 0;
 }
 
+const char *lpv_settings_departures(const lpv_settings *s, char buf[5])
+{
+    const lpv_switch on[4] = {s->central_transport, s->normal_bins, s->far_field, s->scene_surfels};
+    for (int i = 0; i < 4; ++i)
+        buf[i] = on[i] == LPV_SWITCH_ON ? "cbfs"[i] : '-';
+    buf[4] = '\0';
+    return buf;
+}
+
 int lpv_preset_from_name(const char *name, lpv_preset *out)
 {
     for (int p = LPV_PRESET_DEFAULT + 1; name && p < LPV_PRESET_COUNT_; ++p) {

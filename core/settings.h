@@ -144,6 +144,12 @@ const char *lpv_preset_names(void);
  * accuracy sweep labels its points with it). */
 lpv_preset lpv_preset_match(const lpv_settings *s);
 
+/* The four departures from the paper (docs/propagation.md) as the letters
+ * "cbfs" (central transport, normal bins, far field, scene surfels), '-' for
+ * each that is not on; the sweep's, the bench's and --help's name for them.
+ * Writes 5 bytes to buf and returns it. */
+const char *lpv_settings_departures(const lpv_settings *s, char buf[5]);
+
 /* 1 when the settings fix the grid bounds (any of bounds_min/max non-zero);
  * all six zero means "the scene's bounds". */
 int lpv_settings_bounds_given(const lpv_settings *s);

@@ -65,15 +65,11 @@ const char *lpvd_options_help(void)
     for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_ && len < sizeof help; ++p) {
         lpv_settings s;
         lpv_preset_settings((lpv_preset)p, &s);
-        const lpv_switch mods[4] = {s.central_transport, s.normal_bins, s.far_field, s.scene_surfels};
-        char letters[5] = "cbfs";
-        for (int m = 0; m < 4; ++m)
-            if (mods[m] != LPV_SWITCH_ON)
-                letters[m] = '-';
+        char letters[5];
         len += (size_t)snprintf(help + len, sizeof help - len,
                                 "%28s%-10sgrid %d, %d iterations, RSM %d, occlusion %s, departures %s\n", "",
                                 lpv_preset_name((lpv_preset)p), s.grid_dims[0], s.iterations, s.rsm_size,
-                                s.occlusion == LPV_SWITCH_ON ? "on" : "off", letters);
+                                s.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&s, letters));
     }
     if (len < sizeof help)
         len += (size_t)snprintf(help + len, sizeof help - len, "%s", OPTIONS_HELP_KNOBS);

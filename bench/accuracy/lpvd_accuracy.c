@@ -67,9 +67,9 @@ static const int OCCS[] = {1};
 static const int MODS[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
 /* The departures from the paper a point switches on (docs/propagation.md),
- * as bits of point.mods; their one-letter names in labels ("cbfs"). */
+ * as bits of point.mods, in the order of their letters "cbfs"
+ * (lpv_settings_departures). */
 enum { MOD_CENTRAL = 1, MOD_BINS = 2, MOD_FAR = 4, MOD_SURFELS = 8, MOD_ALL = 15 };
-static const char MOD_LETTERS[] = "cbfs";
 
 typedef struct point {
     int grid, iterations, rsm, occlusion;
@@ -124,10 +124,15 @@ static lpv_settings point_settings(const point *p)
 /* "cbfs" with '-' for the switches that are off: the point's departures. */
 static const char *mods_name(int mods, char buf[5])
 {
-    for (int i = 0; i < 4; ++i)
-        buf[i] = (mods >> i) & 1 ? MOD_LETTERS[i] : '-';
-    buf[4] = '\0';
-    return buf;
+    lpv_settings s = point_settings(&(point){.mods = mods});
+    return lpv_settings_departures(&s, buf);
+}
+
+/* The four letters, in the order of the MOD_* bits. */
+static const char *mod_letters(void)
+{
+    static char all[5];
+    return mods_name(MOD_ALL, all);
 }
 
 static int mods_of_settings(const lpv_settings *s)
@@ -389,11 +394,11 @@ static int parse_points(const char *list, point *pts, int max)
         else
             return -1;
         for (const char *c = got == 5 ? mods : ""; *c; ++c) { /* letters of cbfs, '-' for off */
-            const char *at = strchr(MOD_LETTERS, *c);
+            const char *at = strchr(mod_letters(), *c);
             if (*c != '-' && !at)
                 return -1;
             if (*c != '-')
-                p.mods |= 1 << (at - MOD_LETTERS);
+                p.mods |= 1 << (at - mod_letters());
         }
         if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192)
             return -1;
