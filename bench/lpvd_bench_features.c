@@ -7,8 +7,8 @@
  *
  *   lpvd-bench-features [--repeat N] [--warmup N] [--scenes-dir DIR] [--size WxH] [--backend NAME]
  *
- * Every configuration starts from the balanced preset (32^3, 4 iterations,
- * RSM 128^2, occlusion on). With the planner on, a tick on an unchanged scene
+ * Every configuration starts from the settings given on the command line
+ * (default: the balanced preset; the header line says which). With the planner on, a tick on an unchanged scene
  * serves the cached volume and runs no stage, so to time the stages every
  * timed tick first calls lpv_engine_invalidate (a full recompute). The
  * planner table instead measures exactly the ticks the
@@ -395,10 +395,14 @@ int main(int argc, char **argv)
         }
         if (!printed_header) {
             first_view = view;
+            lpv_settings base = opt.settings;
+            lpv_settings_resolve(&base);
+            char departures[5];
             printf("# lpvd-bench-features: backend %s, GL_RENDERER %s, image %dx%d, median of %d ticks after %d "
-                   "warm-up; balanced preset (32^3, 4 iterations, RSM 128^2, occlusion on) unless stated\n",
+                   "warm-up; %d^3, %d iterations, RSM %d^2, occlusion %s, departures %s unless stated\n",
                    lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), view.width,
-                   view.height, repeat, warmup);
+                   view.height, repeat, warmup, base.grid_dims[0], base.iterations, base.rsm_size,
+                   base.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&base, departures));
             printed_header = 1;
         }
         float *rgba = malloc((size_t)view.width * view.height * 4 * sizeof(float));
