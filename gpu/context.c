@@ -29,11 +29,15 @@
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
-/* osmesa.h includes <GL/gl.h>, whose declarations clash with glcorearb.h
- * (already included by gl.h). Only the OSMesa constants and types are used
- * (the library is opened with dlopen), so skip <GL/gl.h> and give osmesa.h
- * the one macro it needs from it. */
+/* osmesa.h includes <GL/gl.h>, whose prototypes clash with gl.h's table
+ * (glClear would be both a function and a pointer). Only the OSMesa constants
+ * and types are used (the library is opened with dlopen), so skip <GL/gl.h>
+ * and give osmesa.h the two macros it needs from it; the GL types and enums
+ * it names come from gl.h. */
 #define __gl_h_ 1
+#ifndef GLAPI
+#define GLAPI extern
+#endif
 #ifndef GLAPIENTRY
 #define GLAPIENTRY
 #endif

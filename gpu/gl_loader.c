@@ -1,4 +1,5 @@
-/* gl_loader.c - the GL function table declared in gl.h, and its loader. */
+/* gl_loader.c - the GL function table declared in gl.h, and its loader. The
+ * list of functions is generated (gl_api.h, from gpu/gl_api.txt). */
 #include "gl.h"
 
 #include <stdio.h>
@@ -6,7 +7,6 @@
 /* One definition per entry point: PFN... lpv_gl_glName = NULL. */
 #define LPV_GL_DEFINE_(type, name) type lpv_gl_##name = NULL;
 LPV_GL_FUNCTIONS(LPV_GL_DEFINE_)
-LPV_GL_OPTIONAL_FUNCTIONS(LPV_GL_DEFINE_)
 #undef LPV_GL_DEFINE_
 
 static unsigned g_generation;
@@ -22,11 +22,10 @@ const size_t lpv_gl_function_count = 0 LPV_GL_FUNCTIONS(LPV_GL_COUNT_);
 
 void lpv_gl_unload(void)
 {
-    /* `name` (not lpv_gl_##name) goes through gl.h's #define, so an entry of
-     * the list without its #define does not compile. */
+    /* `name` (not lpv_gl_##name) goes through gl_api.h's #define, so an
+     * entry of the list without its #define does not compile. */
 #define LPV_GL_CLEAR_(type, name) name = NULL;
     LPV_GL_FUNCTIONS(LPV_GL_CLEAR_)
-    LPV_GL_OPTIONAL_FUNCTIONS(LPV_GL_CLEAR_)
 #undef LPV_GL_CLEAR_
     g_generation++;
 }
@@ -53,9 +52,6 @@ int lpv_gl_load(void *(*get_proc)(const char *name), char *err, size_t err_size)
     name = (type)p;
     LPV_GL_FUNCTIONS(LPV_GL_LOAD_)
 #undef LPV_GL_LOAD_
-#define LPV_GL_LOAD_OPTIONAL_(type, name) name = (type)get_proc(#name);
-    LPV_GL_OPTIONAL_FUNCTIONS(LPV_GL_LOAD_OPTIONAL_)
-#undef LPV_GL_LOAD_OPTIONAL_
     g_generation++;
     return 0;
 }

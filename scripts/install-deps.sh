@@ -6,6 +6,7 @@ set -eu
 PACKAGES="
   build-essential cmake pkg-config clang libclang-rt-14-dev
   libegl-dev libgl-dev mesa-common-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
+  khronos-api
   libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev libdraco-dev libmeshoptimizer-dev
   libopenimageio-dev
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
@@ -13,6 +14,8 @@ PACKAGES="
   python3 gnuplot-nox
   assimp-testmodels
 "
+# khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
+# into gpu/gl_api.h at build time (docs/gl-backends.md).
 # assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
 # tests/test_realscene.c and the accuracy sweep render as scenes the project
 # did not write.
