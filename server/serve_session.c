@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "gltf_load.h"
+#include "settings_json.h"
 #include "stats_json.h"
 #include "settings_fields.h"
 #include "volume_codec.h"
@@ -181,37 +182,12 @@ void sv_session_free(sv_conn *c)
 }
 
 /* ---- stats -------------------------------------------------------------- */
-static json_t *stats_stages(const lpv_engine_stats *st)
-{
-    json_t *a = json_array();
-    for (int i = 0; i < st->stage_count; ++i)
-        json_array_append_new(a, json_pack("{s:s, s:f, s:f, s:i}", "name", st->stages[i].name, "gpu_ms",
-                                           st->stages[i].gpu_ms, "cpu_ms", st->stages[i].cpu_ms, "calls",
-                                           (int)st->stages[i].calls));
-    return a;
-}
-
+/* The tick's stats in the one shape of lpvd_tick_stats_json (stats_json.h). */
 static json_t *tick_stats(const sv_result *r)
 {
-    const lpv_engine_stats *st = &r->stats;
-    double total = 0;
-    for (int i = 0; i < st->stage_count; ++i)
-        total += st->stages[i].gpu_ms;
-    json_t *o = json_pack("{s:o, s:f, s:f, s:{s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b}, s:{s:[i,i,i], s:f, "
-                     "s:[f,f,f]}}",
-                     "stages", stats_stages(st), "total_gpu_ms", total, "tick_ms", r->tick_ms, "counts", "lights",
-                     (int)st->lights, "rsm_faces", (int)st->rsm_faces, "vpls_rsm", (json_int_t)st->vpls_rsm,
-                     "vpls_emissive", (json_int_t)st->vpls_emissive, "surfels_rsm", (json_int_t)st->surfels_rsm,
-                     "surfels_camera", (json_int_t)st->surfels_camera, "cells", (json_int_t)st->cells, "iterations",
-                     st->iterations, "cell_steps", st->cell_steps, "occlusion", st->occlusion != 0, "grid", "dims",
-                     r->grid.dims[0], r->grid.dims[1], r->grid.dims[2], "cell_size_m", (double)r->grid.cell_size,
-                     "origin_m", (double)r->grid.origin[0], (double)r->grid.origin[1], (double)r->grid.origin[2]);
-    if (o) { /* the cascades' placements and this tick's plan, snapshotted with the stats (sv_result) */
-        json_object_set_new(o, "cascades", lpvd_cascades_json(r->cascade_count < 1 ? &r->grid : r->cascades,
-                                                             r->cascade_count < 1 ? 1 : r->cascade_count));
-        json_object_set_new(o, "plan", lpvd_plan_json(&r->plan));
-    }
-    return o;
+    int one = r->cascade_count < 1;
+    return lpvd_tick_stats_json(&r->stats, &r->plan, one ? &r->grid : r->cascades, one ? 1 : r->cascade_count,
+                                r->tick_ms);
 }
 
 static json_t *config_json(sv_conn *c)
@@ -315,6 +291,12 @@ static void do_hello(sv_conn *c, sv_request *r, json_t *j)
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);
+    /* R4.12: CONFIG's knobs and presets, described from core's tables so no client keeps a copy */
+    if (b && (json_object_set_new(b, "knobs", lpvd_knobs_json(&s->cfg.settings, s->cfg.max_texture)) != 0 ||
+              json_object_set_new(b, "presets", lpvd_presets_json()) != 0)) {
+        json_decref(b);
+        b = NULL;
+    }
     reply(c, LPVP_HELLO, r->request_id, b);
 }
 
@@ -1359,10 +1341,16 @@ static void do_stats(sv_conn *c, sv_request *r)
     json_t *stages = json_array(), *plan = json_object();
     if (c->world && c->world->latest) {
         const sv_result *res = c->world->latest;
-        json_decref(stages);
-        stages = stats_stages(&res->stats);
         json_decref(plan);
         plan = tick_stats(res);
+        json_decref(stages); /* STATS keeps a top-level copy of the tick's stages (SPEC section 4) */
+        stages = json_deep_copy(json_object_get(plan, "stages"));
+        if (!plan || !stages) { /* out of memory: answer with what is left */
+            json_decref(stages);
+            stages = json_array();
+            if (!plan)
+                plan = json_object();
+        }
         json_object_set_new(plan, "tick", json_integer((json_int_t)res->tick));
         json_object_set_new(plan, "current", json_boolean(res->gen == c->world_gen));
     }

@@ -23,6 +23,7 @@
 
 #include <jansson.h>
 
+#include "lpvc_knobs.h"
 #include "proto.h"
 #include "volume_codec.h"
 
@@ -57,6 +58,7 @@ struct lpvc {
     char *last_reply;
     int64_t last_revision;
     char *hello;
+    lpvc_knobset knobs;     /* the server's knob description (HELLO, R4.12) */
     queued *q_head, *q_tail;
     acked acked[LPVC_KEEP_ACKED];
     uint64_t ack_clock;
@@ -510,7 +512,12 @@ lpvc *lpvc_connect_with(const lpvc_connect_desc *desc, char *err, size_t n)
         return NULL;
     }
     c->hello = json_dumps(reply, JSON_COMPACT);
+    rc = lpvc_knobset_read(&c->knobs, reply, err, n);
     json_decref(reply);
+    if (rc != 0) {
+        lpvc_close(c);
+        return NULL;
+    }
     return c;
 }
 
@@ -536,7 +543,27 @@ void lpvc_close(lpvc *c)
         free(c->acked[i].raw);
     free(c->last_reply);
     free(c->hello);
+    lpvc_knobset_free(&c->knobs);
     free(c);
+}
+
+size_t lpvc_knobs(const lpvc *c, const lpvc_knob **knobs)
+{
+    if (knobs)
+        *knobs = c ? c->knobs.knobs : NULL;
+    return c ? c->knobs.count : 0;
+}
+
+const lpvc_knob *lpvc_knob_find(const lpvc *c, const char *name)
+{
+    return c ? lpvc_knobset_find(&c->knobs, name) : NULL;
+}
+
+const char *const *lpvc_presets(const lpvc *c, size_t *count)
+{
+    if (count)
+        *count = c ? c->knobs.preset_count : 0;
+    return c ? c->knobs.presets : NULL;
 }
 
 /* ---- requests -------------------------------------------------------------- */
@@ -664,39 +691,12 @@ int lpvc_config_set(lpvc *c, const lpvc_config *cfg)
         json_object_set_new(o, "grid", json_pack("[i,i,i]", cfg->grid[0], cfg->grid[1], cfg->grid[2]));
     if (cfg->bounds)
         json_object_set_new(o, "bounds", vec(cfg->bounds, 6));
-    if (cfg->iterations)
-        json_object_set_new(o, "iterations", json_integer(cfg->iterations));
-    if (cfg->rsm_size)
-        json_object_set_new(o, "rsm_size", json_integer(cfg->rsm_size));
-    if (cfg->occlusion)
-        json_object_set_new(o, "occlusion", json_boolean(cfg->occlusion > 0));
-    if (cfg->indirect_gain != 0.0f)
-        json_object_set_new(o, "indirect_gain", json_real(cfg->indirect_gain));
-    if (cfg->emissive_vpls)
-        json_object_set_new(o, "emissive_vpls", json_integer(cfg->emissive_vpls));
     if (cfg->tick_rate_hz != 0.0f)
         json_object_set_new(o, "tick_rate_hz", json_real(cfg->tick_rate_hz));
-    const struct {
-        const char *key;
-        const float *f; /* a number, or */
-        const int *i;   /* an integer (sw = 0) or a switch (sw = 1) */
-        int sw;
-    } knobs[] = {
-        {"cascades", NULL, &cfg->cascades, 0},          {"cascade_size", &cfg->cascade_size, NULL, 0},
-        {"cascade_ratio", &cfg->cascade_ratio, NULL, 0}, {"cascade_offset", &cfg->cascade_offset, NULL, 0},
-        {"bounces", NULL, &cfg->bounces, 1},            {"bounce_intensity", &cfg->bounce_intensity, NULL, 0},
-        {"damping", &cfg->damping, NULL, 0},            {"glossy", NULL, &cfg->glossy, 1},
-        {"glossy_roughness", &cfg->glossy_roughness, NULL, 0}, {"media", NULL, &cfg->media, 1},
-        {"fog_sigma_s", &cfg->fog_sigma_s, NULL, 0},    {"fog_sigma_a", &cfg->fog_sigma_a, NULL, 0},
-        {"media_step", &cfg->media_step, NULL, 0},      {"planner", NULL, &cfg->planner, 1},
-    };
-    for (size_t k = 0; k < sizeof knobs / sizeof knobs[0]; ++k) {
-        if (knobs[k].f && *knobs[k].f != 0.0f)
-            json_object_set_new(o, knobs[k].key, json_real(*knobs[k].f));
-        else if (knobs[k].i && *knobs[k].i && knobs[k].sw)
-            json_object_set_new(o, knobs[k].key, json_boolean(*knobs[k].i > 0));
-        else if (knobs[k].i && *knobs[k].i)
-            json_object_set_new(o, knobs[k].key, json_integer(*knobs[k].i));
+    char err[512];
+    if (lpvc_knobset_add(&c->knobs, o, cfg->settings, cfg->settings ? cfg->setting_count : 0, err, sizeof err) != 0) {
+        json_decref(o);
+        return fail(c, LPVC_ERR_USAGE, "%s", err);
     }
     return simple(c, LPVP_CONFIG, o);
 }
