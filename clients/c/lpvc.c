@@ -26,6 +26,7 @@
 #include "lpvc_knobs.h"
 #include "proto.h"
 #include "volume_codec.h"
+#include "volume_lookup.h"
 
 /* Streamed volumes kept as possible XOR delta bases (R5.3). The server
  * deltas against a tick we acknowledged; ACKs are asynchronous, so it may use
@@ -1189,83 +1190,24 @@ int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms)
     return rc;
 }
 
-/* ---- local lookup (docs/propagation.md section 6, core/oracle_lookup.c) ---- */
+/* ---- local lookup: SPEC R5.7, the protocol library's (volume_lookup.h) ----- */
 
-static int axis_lerp(const lpvc_cascade *v, int a, float p, int *i0, int *i1, float *f)
+static lpvp_lookup_cascade lookup_cascade(const lpvc_cascade *cs)
 {
-    float u = (p - v->origin[a]) / v->cell_size;
-    if (isnan(u))
-        return 0;
-    float hi = (float)v->dims[a] - 0.5f;
-    u = fminf(fmaxf(u, 0.5f), hi) - 0.5f;
-    float base = floorf(u);
-    if (base > (float)(v->dims[a] - 2))
-        base = (float)(v->dims[a] - 2);
-    if (base < 0.0f)
-        base = 0.0f;
-    *i0 = (int)base;
-    *i1 = *i0 + 1 < v->dims[a] ? *i0 + 1 : *i0;
-    *f = u - base;
-    return 1;
+    lpvp_lookup_cascade l = {.dims = {cs->dims[0], cs->dims[1], cs->dims[2]},
+                             .origin = {cs->origin[0], cs->origin[1], cs->origin[2]},
+                             .cell_size = cs->cell_size,
+                             .cells = cs->data};
+    return l;
 }
 
-void lpvc_cascade_irradiance(const lpvc_cascade *v, const float p[3], const float n[3], float rgb[3])
+void lpvc_cascade_irradiance(const lpvc_cascade *cs, const float p[3], const float n[3], float rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
-    if (!v || !v->data || v->cell_size <= 0.0f)
+    if (!cs)
         return;
-    if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2]))
-        return;
-    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 1e-8f) || !isfinite(len))
-        return;
-    float un[3] = {n[0] / len, n[1] / len, n[2] / len};
-    int i0[3], i1[3];
-    float f[3];
-    for (int a = 0; a < 3; a++)
-        if (!axis_lerp(v, a, p[a] + 0.5f * v->cell_size * un[a], &i0[a], &i1[a], &f[a]))
-            return;
-    float c[12] = {0};
-    for (int corner = 0; corner < 8; corner++) {
-        int idx[3];
-        float w = 1.0f;
-        for (int a = 0; a < 3; a++) {
-            if (corner >> a & 1) {
-                idx[a] = i1[a];
-                w *= f[a];
-            } else {
-                idx[a] = i0[a];
-                w *= 1.0f - f[a];
-            }
-        }
-        if (w == 0.0f)
-            continue;
-        const float *cell = v->data + 12 * ((size_t)idx[0] + (size_t)v->dims[0] * ((size_t)idx[1] + (size_t)v->dims[1] * (size_t)idx[2]));
-        for (int k = 0; k < 12; k++)
-            c[k] += w * cell[k];
-    }
-    /* lobe(-n) = (L0, -L1 n.y, -L1 n.z, -L1 n.x), L0 = sqrt(pi)/2, L1 = sqrt(pi/3) */
-    const float L0 = 0.886226925f, L1 = 1.02332671f;
-    float lobe[4] = {L0, -L1 * un[1], -L1 * un[2], -L1 * un[0]};
-    float inv = 1.0f / (v->cell_size * v->cell_size);
-    for (int ch = 0; ch < 3; ch++) {
-        float d = c[4 * ch] * lobe[0] + c[4 * ch + 1] * lobe[1] + c[4 * ch + 2] * lobe[2] + c[4 * ch + 3] * lobe[3];
-        rgb[ch] = fmaxf(0.0f, d * inv);
-    }
-}
-
-/* Distance from p to the box of cs in its cells (the smallest over the six
- * faces; negative outside, NaN for a NaN p). */
-static float border_cells(const lpvc_cascade *cs, const float p[3])
-{
-    float d = INFINITY;
-    for (int a = 0; a < 3; a++) {
-        float u = (p[a] - cs->origin[a]) / cs->cell_size;
-        d = fminf(d, fminf(u, (float)cs->dims[a] - u));
-        if (isnan(u))
-            return NAN;
-    }
-    return d;
+    lpvp_lookup_cascade l = lookup_cascade(cs);
+    lpvp_cascade_irradiance(&l, p, n, rgb);
 }
 
 void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3])
@@ -1273,35 +1215,17 @@ void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float 
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
     if (!v || !v->data)
         return;
-    lpvc_cascade one;
-    const lpvc_cascade *cs = v->cascades;
+    lpvp_lookup_cascade l[LPVC_MAX_CASCADES];
     int count = v->cascade_count;
     if (count < 1 || count > LPVC_MAX_CASCADES) { /* a volume built by hand: the grid alone */
-        for (int a = 0; a < 3; a++) {
-            one.dims[a] = v->dims[a];
-            one.origin[a] = v->origin[a];
-        }
-        one.cell_size = v->cell_size;
-        one.cells = v->cells;
-        one.data = v->data;
-        cs = &one;
+        l[0] = (lpvp_lookup_cascade){.dims = {v->dims[0], v->dims[1], v->dims[2]},
+                                     .origin = {v->origin[0], v->origin[1], v->origin[2]},
+                                     .cell_size = v->cell_size,
+                                     .cells = v->data};
         count = 1;
+    } else {
+        for (int k = 0; k < count; k++)
+            l[k] = lookup_cascade(&v->cascades[k]);
     }
-    /* R5.7: the finest cascade containing p (the coarsest if none does) */
-    int k = count - 1;
-    for (int i = 0; i < count; i++)
-        if (border_cells(&cs[i], p) >= 0.0f) {
-            k = i;
-            break;
-        }
-    lpvc_cascade_irradiance(&cs[k], p, n, rgb);
-    if (k + 1 >= count || !(border_cells(&cs[k + 1], p) >= 0.0f))
-        return;
-    float w = fminf(fmaxf((border_cells(&cs[k], p) - 1.0f) * 0.5f, 0.0f), 1.0f);
-    if (w >= 1.0f)
-        return;
-    float coarse[3];
-    lpvc_cascade_irradiance(&cs[k + 1], p, n, coarse);
-    for (int ch = 0; ch < 3; ch++)
-        rgb[ch] = w * rgb[ch] + (1.0f - w) * coarse[ch];
+    lpvp_volume_irradiance(l, count, p, n, rgb);
 }

@@ -296,7 +296,7 @@ void lpvc_message_free(lpvc_message *m);
  * LPVC_ERR_TIMEOUT. */
 int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
 
-/* ---- Local lookup (docs/propagation.md section 6) -------------------------- */
+/* ---- Local lookup (SPEC R5.7; protocol/volume_lookup.h over core's oracle) ---- */
 
 /* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
  * server's QUERY_IRRADIANCE computes it: with several cascades, the finest
