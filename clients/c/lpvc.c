@@ -727,7 +727,7 @@ int lpvc_tick(lpvc *c, int64_t *tick)
 
 static const char *stream_name(enum lpvc_stream s)
 {
-    return s == LPVC_STREAM_FRAME ? "frame" : "volume";
+    return lpvp_stream_names[s == LPVC_STREAM_FRAME ? LPVP_STREAM_FRAME : LPVP_STREAM_VOLUME];
 }
 
 int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc)
@@ -759,7 +759,7 @@ int lpvc_ack(lpvc *c, int64_t tick)
     if (!c)
         return -1;
     clear_error(c);
-    json_t *o = json_pack("{s:s, s:I}", "stream", "volume", "tick", (json_int_t)tick);
+    json_t *o = json_pack("{s:s, s:I}", "stream", lpvp_stream_names[LPVP_STREAM_VOLUME], "tick", (json_int_t)tick);
     if (!o)
         return fail(c, LPVC_ERR_USAGE, "out of memory");
     uint32_t id = send_frame(c, LPVP_ACK, o, NULL, 0);
@@ -893,8 +893,8 @@ int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out)
     lpvc_volume_desc d = {0};
     if (desc)
         d = *desc;
-    json_t *o = json_pack("{s:s, s:s}", "format", d.format ? d.format : "fp32", "compression",
-                          d.compression ? d.compression : "zstd");
+    json_t *o = json_pack("{s:s, s:s}", "format", d.format ? d.format : lpvp_volume_format_names[LPVP_FMT_FP32],
+                          "compression", d.compression ? d.compression : lpvp_compression_names[LPVP_COMP_ZSTD]);
     json_t *reply = NULL;
     uint8_t *att = NULL;
     size_t att_len = 0;
@@ -943,7 +943,7 @@ static int decode_frame(lpvc *c, const json_t *hdr, uint8_t *att, size_t att_len
     get_str(hdr, "terms", out->terms, sizeof out->terms);
     char comp[16];
     get_str(hdr, "compression", comp, sizeof comp);
-    if (strcmp(out->format, "rgba8") == 0) {
+    if (strcmp(out->format, lpvp_frame_format_names[LPVP_FRAME_RGBA8]) == 0) {
         int64_t raw_length = get_i64(hdr, "raw_length", -1);
         size_t expect = (size_t)out->width * (size_t)out->height * 4u;
         if (out->width <= 0 || out->height <= 0 || (raw_length >= 0 && (size_t)raw_length != expect)) {
@@ -951,7 +951,7 @@ static int decode_frame(lpvc *c, const json_t *hdr, uint8_t *att, size_t att_len
             return fail(c, LPVC_ERR_PROTOCOL, "rgba8 frame %dx%d with raw_length %lld", out->width, out->height,
                         (long long)raw_length);
         }
-        if (strcmp(comp, "zstd") == 0) {
+        if (strcmp(comp, lpvp_compression_names[LPVP_COMP_ZSTD]) == 0) {
             uint8_t *raw = malloc(expect ? expect : 1);
             char err[256];
             if (!raw || lpvp_zstd_decompress_exact(att, att_len, raw, expect, err, sizeof err) != 0) {
