@@ -30,6 +30,11 @@ typedef struct preset_row {
     lpv_switch occlusion, central_transport, normal_bins, far_field, scene_surfels;
 } preset_row;
 
+/* The presets' names, once: the table below and lpv_preset_names() use them. */
+#define NAME_FAST "fast"
+#define NAME_BALANCED "balanced"
+#define NAME_ACCURATE "accurate"
+
 static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
     [LPV_PRESET_DEFAULT] = {NULL, 0, 0, 0, LPV_SWITCH_DEFAULT}, /* not a row: resolves to BALANCED */
     /* Each row is a point on the overall front of the full sweep (3 scenes x
@@ -40,14 +45,14 @@ static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
      * path tracer has it; finer grids sharpen but stay dark far from the
      * lit surfaces (docs/calibration.md, 4). */
     /* fast: the front's knee below a third of balanced's cost (central transport and scene surfels) */
-    [LPV_PRESET_FAST] = {"fast", 8, 4, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
+    [LPV_PRESET_FAST] = {NAME_FAST, 8, 4, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_OFF, LPV_SWITCH_OFF,
                          LPV_SWITCH_ON},
     /* balanced, the default: all four departures on, the front's knee (8 steps cost 2 % more
      * than 4 and buy 0.04 on the Cornell box: the far field's coarse level carries them) */
-    [LPV_PRESET_BALANCED] = {"balanced", LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
+    [LPV_PRESET_BALANCED] = {NAME_BALANCED, LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
                              LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON},
     /* accurate: the front's lowest error */
-    [LPV_PRESET_ACCURATE] = {"accurate", 16, 16, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON,
+    [LPV_PRESET_ACCURATE] = {NAME_ACCURATE, 16, 16, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON,
                              LPV_SWITCH_ON},
 };
 
@@ -106,7 +111,7 @@ const char *lpv_preset_name(lpv_preset p)
 
 const char *lpv_preset_names(void)
 {
-    return "fast, balanced, accurate";
+    return NAME_FAST ", " NAME_BALANCED ", " NAME_ACCURATE; /* the table's names, in its order */
 }
 
 lpv_preset lpv_preset_match(const lpv_settings *s)

@@ -88,40 +88,50 @@ float lpvp_f16_to_f32(uint16_t h)
 
 /* ---- Names ---------------------------------------------------------------- */
 
+const char *const lpvp_volume_format_names[2] = {[LPVP_FMT_FP16] = "fp16", [LPVP_FMT_FP32] = "fp32"};
+const char *const lpvp_compression_names[2] = {[LPVP_COMP_NONE] = "none", [LPVP_COMP_ZSTD] = "zstd"};
+const char *const lpvp_frame_terms_names[LPVP_TERMS_COUNT] = {
+    [LPVP_TERMS_FULL] = "full", [LPVP_TERMS_INDIRECT] = "indirect", [LPVP_TERMS_DIRECT] = "direct"};
+const char *const lpvp_frame_format_names[LPVP_FRAME_FORMAT_COUNT] = {
+    [LPVP_FRAME_RGBA8] = "rgba8", [LPVP_FRAME_PNG] = "png", [LPVP_FRAME_EXR] = "exr"};
+const char *const lpvp_stream_names[LPVP_STREAM_COUNT] = {[LPVP_STREAM_VOLUME] = "volume",
+                                                          [LPVP_STREAM_FRAME] = "frame"};
+
+/* Index of s in names[0..n), or -1. */
+static int name_index(const char *const *names, int n, const char *s)
+{
+    for (int i = 0; s && i < n; ++i)
+        if (strcmp(s, names[i]) == 0)
+            return i;
+    return -1;
+}
+
 const char *lpvp_volume_format_name(lpvp_volume_format fmt)
 {
-    return fmt == LPVP_FMT_FP32 ? "fp32" : "fp16";
+    return lpvp_volume_format_names[fmt == LPVP_FMT_FP32 ? LPVP_FMT_FP32 : LPVP_FMT_FP16];
 }
 
 int lpvp_volume_format_parse(const char *s, lpvp_volume_format *out)
 {
-    if (s && strcmp(s, "fp16") == 0) {
-        *out = LPVP_FMT_FP16;
-        return 0;
-    }
-    if (s && strcmp(s, "fp32") == 0) {
-        *out = LPVP_FMT_FP32;
-        return 0;
-    }
-    return -1;
+    int i = name_index(lpvp_volume_format_names, 2, s);
+    if (i < 0)
+        return -1;
+    *out = (lpvp_volume_format)i;
+    return 0;
 }
 
 const char *lpvp_compression_name(lpvp_compression c)
 {
-    return c == LPVP_COMP_ZSTD ? "zstd" : "none";
+    return lpvp_compression_names[c == LPVP_COMP_ZSTD ? LPVP_COMP_ZSTD : LPVP_COMP_NONE];
 }
 
 int lpvp_compression_parse(const char *s, lpvp_compression *out)
 {
-    if (s && strcmp(s, "none") == 0) {
-        *out = LPVP_COMP_NONE;
-        return 0;
-    }
-    if (s && strcmp(s, "zstd") == 0) {
-        *out = LPVP_COMP_ZSTD;
-        return 0;
-    }
-    return -1;
+    int i = name_index(lpvp_compression_names, 2, s);
+    if (i < 0)
+        return -1;
+    *out = (lpvp_compression)i;
+    return 0;
 }
 
 /* ---- Raw volumes ---------------------------------------------------------- */

@@ -49,7 +49,33 @@ typedef enum lpvp_compression {
     LPVP_COMP_ZSTD = 1  /* "zstd" (R5.2) */
 } lpvp_compression;
 
-/* "fp16"/"fp32", "none"/"zstd"; parse returns 0 on success, -1 if unknown. */
+/* The SPEC's names, indexed by the enums above (lpvp_get_enum takes them as its
+ * choices): "fp16", "fp32"; "none", "zstd". */
+extern const char *const lpvp_volume_format_names[2];
+extern const char *const lpvp_compression_names[2];
+
+/* Frame terms and formats (SPEC section 6). The terms' order is the engine's
+ * lpv_frame_terms (full, indirect only, direct only). */
+typedef enum lpvp_frame_terms {
+    LPVP_TERMS_FULL = 0,     /* "full" */
+    LPVP_TERMS_INDIRECT = 1, /* "indirect" */
+    LPVP_TERMS_DIRECT = 2,   /* "direct" */
+    LPVP_TERMS_COUNT = 3
+} lpvp_frame_terms;
+typedef enum lpvp_frame_format {
+    LPVP_FRAME_RGBA8 = 0, /* "rgba8": 8-bit sRGB, zstd or none */
+    LPVP_FRAME_PNG = 1,   /* "png" */
+    LPVP_FRAME_EXR = 2,   /* "exr": linear radiance */
+    LPVP_FRAME_FORMAT_COUNT = 3
+} lpvp_frame_format;
+extern const char *const lpvp_frame_terms_names[LPVP_TERMS_COUNT];
+extern const char *const lpvp_frame_format_names[LPVP_FRAME_FORMAT_COUNT];
+
+/* The streams of SUBSCRIBE / UNSUBSCRIBE / ACK (R5.5): "volume", "frame". */
+enum { LPVP_STREAM_VOLUME = 0, LPVP_STREAM_FRAME = 1, LPVP_STREAM_COUNT = 2 };
+extern const char *const lpvp_stream_names[LPVP_STREAM_COUNT];
+
+/* Name of a value / value of a name; parse returns 0 on success, -1 if unknown. */
 const char *lpvp_volume_format_name(lpvp_volume_format fmt);
 int lpvp_volume_format_parse(const char *s, lpvp_volume_format *out);
 const char *lpvp_compression_name(lpvp_compression c);

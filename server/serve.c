@@ -26,16 +26,6 @@ uint64_t sv_now_ms(void)
     return (uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u;
 }
 
-uint64_t sv_hash_bytes(uint64_t h, const void *data, size_t n)
-{
-    const uint8_t *p = data;
-    for (size_t i = 0; i < n; ++i) {
-        h ^= p[i];
-        h *= 1099511628211ull;
-    }
-    return h;
-}
-
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -192,9 +182,9 @@ static int load_default_scene(sv_server *s, char *err, size_t n)
             dir = NULL;
         }
         sc->base_dir = dir;
-        sc->hash = sv_hash_bytes(SV_HASH_INIT, buf, len);
+        sc->hash = lpv_hash_bytes(LPV_HASH_INIT, buf, len);
         if (dir)
-            sc->hash = sv_hash_bytes(sc->hash, dir, strlen(dir));
+            sc->hash = lpv_hash_bytes(sc->hash, dir, strlen(dir));
         if (!sc->hash)
             sc->hash = 1;
         uint64_t tris = sc->scene.index_count / 3;

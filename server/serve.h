@@ -27,57 +27,17 @@
 #include "proto.h"
 #include "engine.h"
 #include "gltf_load.h"
+#include "hash.h"
 #include "scene.h"
 #include "settings.h"
 #include "tonemap.h"
 #include "view.h"
 #include "volume_codec.h"
 
-#define SV_PROTOCOL_VERSION 1
-#define SV_HEADER_SIZE 24
-
-/* message types (SPEC section 4) */
-enum {
-    SV_HELLO = 0x0001,
-    SV_SCENE_LOAD = 0x0002,
-    SV_SCENE_UPDATE = 0x0003,
-    SV_LIGHT_SET = 0x0004,
-    SV_LIGHT_REMOVE = 0x0005,
-    SV_CAMERA_SET = 0x0006,
-    SV_CONFIG = 0x0007,
-    SV_TICK = 0x0008,
-    SV_SUBSCRIBE = 0x0009,
-    SV_UNSUBSCRIBE = 0x000A,
-    SV_GET_VOLUME = 0x000B,
-    SV_GET_FRAME = 0x000C,
-    SV_QUERY_IRRADIANCE = 0x000D,
-    SV_STATS = 0x000E,
-    SV_BYE = 0x000F,
-    SV_ACK = 0x0010,
-    SV_VOLUME = 0x0101,
-    SV_FRAME = 0x0102,
-    SV_REPLY = 0x8000,
-    SV_ERROR = 0xFFFF,
-};
-
-/* error codes (SPEC R3.4) */
-enum {
-    SV_E_BAD_MAGIC = 1,
-    SV_E_BAD_VERSION = 2,
-    SV_E_BAD_FRAME = 3,
-    SV_E_TOO_LARGE = 4,
-    SV_E_BAD_JSON = 5,
-    SV_E_UNKNOWN_TYPE = 6,
-    SV_E_BAD_FIELD = 7,
-    SV_E_UNAUTHORIZED = 8,
-    SV_E_HELLO_REQUIRED = 9,
-    SV_E_NOT_READY = 10,
-    SV_E_SCENE_INVALID = 11,
-    SV_E_PATH_REFUSED = 12,
-    SV_E_LIMIT = 13,
-    SV_E_INTERNAL = 14,
-    SV_E_SHUTTING_DOWN = 15,
-};
+/* Message types, error codes (LPVP_*), their names and the frame constants
+ * are the protocol library's (proto.h); the names of formats, compressions,
+ * terms and streams too (volume_codec.h). The content hash is core's
+ * (hash.h). */
 
 typedef struct sv_server sv_server;
 typedef struct sv_conn sv_conn;
@@ -220,7 +180,7 @@ struct sv_job {
     float *points;          /* query: 6n floats */
     size_t count;
     /* results */
-    int status;             /* 0 ok, else an SV_E_ code */
+    int status;             /* 0 ok, else an LPVP_E_ code */
     char err[512];
     sv_result *result;      /* tick */
     float *rgba;            /* render */
@@ -357,8 +317,6 @@ struct sv_server {
 
 /* serve.c */
 uint64_t sv_now_ms(void);
-uint64_t sv_hash_bytes(uint64_t h, const void *data, size_t n);
-#define SV_HASH_INIT 1469598103934665603ull
 
 /* serve_net.c */
 int sv_net_listen(sv_server *s, char *err, size_t n);
@@ -375,7 +333,6 @@ void sv_conn_close(sv_conn *c);
 void sv_conn_close_after_write(sv_conn *c);
 void sv_conn_unref(sv_conn *c);
 void sv_net_resume_reading(sv_conn *c);
-const char *sv_error_name(int code);
 
 /* serve_session.c */
 void sv_session_init(sv_conn *c);

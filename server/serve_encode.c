@@ -182,9 +182,6 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
     return 0;
 }
 
-static const char *const TERMS_NAMES[3] = {"full", "indirect", "direct"};
-static const char *const FMT_NAMES[3] = {"rgba8", "png", "exr"};
-
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
                     uint64_t revision, uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
 {
@@ -192,7 +189,7 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
     float ev = 0.0f;
     uint8_t *data = NULL;
     size_t len = 0;
-    if (fmt == 2) {
+    if (fmt == LPVP_FRAME_EXR) {
         if (lpv_image_encode_f32("exr", w, h, 4, rgba, &data, &len, err, n) != 0)
             return -1;
         zstd = 0;
@@ -203,7 +200,7 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
             return -1;
         }
         ev = lpv_display_rgba8(rgba, px, display, rgba8);
-        if (fmt == 1) {
+        if (fmt == LPVP_FRAME_PNG) {
             int rc = lpv_image_encode_u8("png", w, h, 4, rgba8, &data, &len, err, n);
             free(rgba8);
             if (rc != 0)
@@ -229,10 +226,11 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
     *att = data;
     *att_len = len;
     *body = json_pack("{s:I, s:I, s:s, s:s, s:i, s:i, s:s, s:s, s:I}", "revision", (json_int_t)revision, "tick",
-                      (json_int_t)tick, "format", FMT_NAMES[fmt], "compression", zstd ? "zstd" : "none", "width", w,
-                      "height", h, "terms", TERMS_NAMES[terms], "units", fmt == 2 ? "W/(m^2 sr)" : "sRGB",
+                      (json_int_t)tick, "format", lpvp_frame_format_names[fmt], "compression",
+                      lpvp_compression_name(zstd ? LPVP_COMP_ZSTD : LPVP_COMP_NONE), "width", w,
+                      "height", h, "terms", lpvp_frame_terms_names[terms], "units", fmt == LPVP_FRAME_EXR ? "W/(m^2 sr)" : "sRGB",
                       "raw_length", (json_int_t)raw_len);
-    if (*body && fmt != 2 &&
+    if (*body && fmt != LPVP_FRAME_EXR &&
         (json_object_set_new(*body, "exposure_ev", json_real(ev)) != 0 ||
          json_object_set_new(*body, "exposure", json_string(display->exposure_auto ? "auto" : "fixed")) != 0 ||
          json_object_set_new(*body, "transparent", json_boolean(display->transparent)) != 0)) {

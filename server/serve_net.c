@@ -35,11 +35,6 @@ typedef struct sv_wreq {
     int stream;
 } sv_wreq;
 
-const char *sv_error_name(int code)
-{
-    return lpvp_error_name(code);
-}
-
 static void wreq_free(sv_wreq *w)
 {
     if (!w)

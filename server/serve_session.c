@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "gltf_load.h"
+#include "settings_json.h"
 #include "stats_json.h"
 #include "settings_fields.h"
 #include "volume_codec.h"
@@ -29,11 +30,8 @@
 #define SV_MAX_VIEW_SIDE 4096
 #define SV_DEFAULT_VIEW_SIDE 256
 
-static const char *const TERMS[] = {"full", "indirect", "direct"};
-static const char *const FRAME_FMTS[] = {"rgba8", "png", "exr"};
-static const char *const VOL_FMTS[] = {"fp16", "fp32"};
-static const char *const COMPS[] = {"zstd", "none"};
-static const char *const STREAMS[] = {"volume", "frame"};
+/* The names of formats, compressions, terms and streams are the protocol
+ * library's (volume_codec.h), indexed by its enums. */
 
 /* ERROR reply; closes the connection when the code does (R3.4), unless
  * noclose (HELLO's BAD_VERSION, R4.1). */
@@ -184,37 +182,12 @@ void sv_session_free(sv_conn *c)
 }
 
 /* ---- stats -------------------------------------------------------------- */
-static json_t *stats_stages(const lpv_engine_stats *st)
-{
-    json_t *a = json_array();
-    for (int i = 0; i < st->stage_count; ++i)
-        json_array_append_new(a, json_pack("{s:s, s:f, s:f, s:i}", "name", st->stages[i].name, "gpu_ms",
-                                           st->stages[i].gpu_ms, "cpu_ms", st->stages[i].cpu_ms, "calls",
-                                           (int)st->stages[i].calls));
-    return a;
-}
-
+/* The tick's stats in the one shape of lpvd_tick_stats_json (stats_json.h). */
 static json_t *tick_stats(const sv_result *r)
 {
-    const lpv_engine_stats *st = &r->stats;
-    double total = 0;
-    for (int i = 0; i < st->stage_count; ++i)
-        total += st->stages[i].gpu_ms;
-    json_t *o = json_pack("{s:o, s:f, s:f, s:{s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b}, s:{s:[i,i,i], s:f, "
-                     "s:[f,f,f]}}",
-                     "stages", stats_stages(st), "total_gpu_ms", total, "tick_ms", r->tick_ms, "counts", "lights",
-                     (int)st->lights, "rsm_faces", (int)st->rsm_faces, "vpls_rsm", (json_int_t)st->vpls_rsm,
-                     "vpls_emissive", (json_int_t)st->vpls_emissive, "surfels_rsm", (json_int_t)st->surfels_rsm,
-                     "surfels_camera", (json_int_t)st->surfels_camera, "cells", (json_int_t)st->cells, "iterations",
-                     st->iterations, "cell_steps", st->cell_steps, "occlusion", st->occlusion != 0, "grid", "dims",
-                     r->grid.dims[0], r->grid.dims[1], r->grid.dims[2], "cell_size_m", (double)r->grid.cell_size,
-                     "origin_m", (double)r->grid.origin[0], (double)r->grid.origin[1], (double)r->grid.origin[2]);
-    if (o) { /* the cascades' placements and this tick's plan, snapshotted with the stats (sv_result) */
-        json_object_set_new(o, "cascades", lpvd_cascades_json(r->cascade_count < 1 ? &r->grid : r->cascades,
-                                                             r->cascade_count < 1 ? 1 : r->cascade_count));
-        json_object_set_new(o, "plan", lpvd_plan_json(&r->plan));
-    }
-    return o;
+    int one = r->cascade_count < 1;
+    return lpvd_tick_stats_json(&r->stats, &r->plan, one ? &r->grid : r->cascades, one ? 1 : r->cascade_count,
+                                r->tick_ms);
 }
 
 static json_t *config_json(sv_conn *c)
@@ -318,6 +291,12 @@ static void do_hello(sv_conn *c, sv_request *r, json_t *j)
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);
+    /* R4.12: CONFIG's knobs and presets, described from core's tables so no client keeps a copy */
+    if (b && (json_object_set_new(b, "knobs", lpvd_knobs_json(&s->cfg.settings, s->cfg.max_texture)) != 0 ||
+              json_object_set_new(b, "presets", lpvd_presets_json()) != 0)) {
+        json_decref(b);
+        b = NULL;
+    }
     reply(c, LPVP_HELLO, r->request_id, b);
 }
 
@@ -425,11 +404,11 @@ static void load_run(uv_work_t *req)
         free(w->base_dir);
         w->base_dir = NULL;
     }
-    uint64_t h = sv_hash_bytes(SV_HASH_INIT, w->glb, w->glb_size);
+    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, w->glb, w->glb_size);
     if (w->base_dir)
-        h = sv_hash_bytes(h, w->base_dir, strlen(w->base_dir));
+        h = lpv_hash_bytes(h, w->base_dir, strlen(w->base_dir));
     if (w->node_count)
-        h = sv_hash_bytes(h, w->nodes, sizeof *w->nodes * w->node_count);
+        h = lpv_hash_bytes(h, w->nodes, sizeof *w->nodes * w->node_count);
     sc->hash = h ? h : 1;
     sc->glb = w->glb;
     sc->glb_size = w->glb_size;
@@ -991,8 +970,6 @@ static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
     reply(c, LPVP_CAMERA_SET, r->request_id, rev_body(c));
 }
 
-static const char *const PRESET_NAMES[] = {"fast", "balanced", "accurate"};
-static const lpv_preset PRESET_VALUES[] = {LPV_PRESET_FAST, LPV_PRESET_BALANCED, LPV_PRESET_ACCURATE};
 
 /* CONFIG's "preset": resets grid / iterations / rsm_size / occlusion to the
  * preset's (by clearing them, so resolve fills them in), before the message's
@@ -1001,17 +978,21 @@ static const lpv_preset PRESET_VALUES[] = {LPV_PRESET_FAST, LPV_PRESET_BALANCED,
  * already sent: --max-grid and --max-texture bound presets as well). */
 static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_settings *st, char *err, size_t n)
 {
-    int idx = 0;
-    int rc = lpvp_get_enum(j, "preset", 0, PRESET_NAMES, 3, &idx, err, n);
+    /* the choices are core's preset table (lpv_preset_name), in its order */
+    const char *names[LPV_PRESET_COUNT_];
+    int count = 0, idx = 0;
+    for (int q = LPV_PRESET_DEFAULT + 1; q < LPV_PRESET_COUNT_; ++q)
+        names[count++] = lpv_preset_name((lpv_preset)q);
+    int rc = lpvp_get_enum(j, "preset", 0, names, (size_t)count, &idx, err, n);
     if (rc != LPVP_FIELD_OK)
         return rc;
     lpv_settings p;
-    lpv_preset_settings(PRESET_VALUES[idx], &p);
+    lpv_preset_settings((lpv_preset)(LPV_PRESET_DEFAULT + 1 + idx), &p);
     const sv_server *s = c->srv;
     if (p.grid_dims[0] > s->cfg.max_grid || p.rsm_size > s->cfg.max_texture) {
         reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
                   "preset: %s (grid %d, rsm_size %d) is over the server's limits (--max-grid %d, --max-texture %d)",
-                  PRESET_NAMES[idx], p.grid_dims[0], p.rsm_size, s->cfg.max_grid, s->cfg.max_texture);
+                  names[idx], p.grid_dims[0], p.rsm_size, s->cfg.max_grid, s->cfg.max_texture);
         return -2;
     }
     st->preset = p.preset;
@@ -1197,7 +1178,7 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
     int stream = 0, fmt = -1, comp = -1, delta = 0, terms = 0;
     lpv_display display;
     lpv_display_default(&display);
-    if (lpvp_get_enum(j, "stream", 1, STREAMS, 2, &stream, err, sizeof err) != LPVP_FIELD_OK)
+    if (lpvp_get_enum(j, "stream", 1, lpvp_stream_names, LPVP_STREAM_COUNT, &stream, err, sizeof err) != LPVP_FIELD_OK)
         goto bad;
     sv_sub *sub = &c->subs[stream];
     if (!on) {
@@ -1206,11 +1187,12 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
         reply(c, LPVP_UNSUBSCRIBE, r->request_id, json_object());
         return;
     }
-    if (lpvp_get_enum(j, "format", 0, stream ? FRAME_FMTS : VOL_FMTS, stream ? 3 : 2, &fmt, err, sizeof err) ==
+    if (lpvp_get_enum(j, "format", 0, stream ? lpvp_frame_format_names : lpvp_volume_format_names,
+                      stream ? LPVP_FRAME_FORMAT_COUNT : 2, &fmt, err, sizeof err) ==
             LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_bool(j, "delta", 0, &delta, err, sizeof err) == LPVP_FIELD_BAD ||
-        (stream && lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD) ||
+        (stream && lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD) ||
         (stream && get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD))
         goto bad;
     if (stream && delta) {
@@ -1220,12 +1202,12 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
     sv_sub_clear(sub);
     sub->on = 1;
     if (stream == SV_STREAM_VOLUME) {
-        sub->fp16 = fmt != 1;
-        sub->zstd = comp != 1; /* default zstd */
+        sub->fp16 = fmt != LPVP_FMT_FP32;
+        sub->zstd = comp != LPVP_COMP_NONE; /* default zstd */
         sub->delta = delta;
     } else {
-        sub->fmt = fmt < 0 ? 1 : fmt; /* default png */
-        sub->zstd = comp == 0;        /* default none (rgba8 only) */
+        sub->fmt = fmt < 0 ? LPVP_FRAME_PNG : fmt; /* default png */
+        sub->zstd = comp == LPVP_COMP_ZSTD;         /* default none (rgba8 only) */
         sub->terms = terms;
         sub->display = display;
     }
@@ -1238,9 +1220,9 @@ bad:
 static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
-    int fmt = 0, comp = 0;
-    if (lpvp_get_enum(j, "format", 0, VOL_FMTS, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD) {
+    int fmt = LPVP_FMT_FP16, comp = LPVP_COMP_ZSTD;
+    if (lpvp_get_enum(j, "format", 0, lpvp_volume_format_names, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD) {
         reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
@@ -1252,7 +1234,7 @@ static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
     json_t *b = NULL;
     uint8_t *att = NULL;
     size_t alen = 0;
-    if (sv_encode_volume(c->world->latest, fmt == 0, comp == 0, NULL, c->revision, &b, &att, &alen, err,
+    if (sv_encode_volume(c->world->latest, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD, NULL, c->revision, &b, &att, &alen, err,
                          sizeof err) != 0) {
         reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
         return;
@@ -1281,11 +1263,11 @@ static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w,
 static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
-    int fmt = 1, comp = 1, terms = 0;
+    int fmt = LPVP_FRAME_PNG, comp = LPVP_COMP_NONE, terms = LPVP_TERMS_FULL;
     lpv_display display;
-    if (lpvp_get_enum(j, "format", 0, FRAME_FMTS, 3, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "compression", 0, COMPS, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "terms", 0, TERMS, 3, &terms, err, sizeof err) == LPVP_FIELD_BAD ||
+    if (lpvp_get_enum(j, "format", 0, lpvp_frame_format_names, LPVP_FRAME_FORMAT_COUNT, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD ||
         get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) {
         reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
@@ -1297,7 +1279,7 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     }
     const sv_result *res = c->world->latest;
     if (res->frames[terms]) { /* rendered with the tick already */
-        send_frame_reply(c, r->request_id, res->frames[terms], res->width, res->height, fmt, comp == 0, terms,
+        send_frame_reply(c, r->request_id, res->frames[terms], res->width, res->height, fmt, comp == LPVP_COMP_ZSTD, terms,
                          &display, res->tick);
         return;
     }
@@ -1309,7 +1291,7 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     jb->request_id = r->request_id;
     jb->terms = terms;
     jb->display = display;
-    jb->count = (size_t)fmt | ((size_t)(comp == 0) << 4); /* encoding choice, read back in job_done */
+    jb->count = (size_t)fmt | ((size_t)(comp == LPVP_COMP_ZSTD) << 4); /* encoding choice, read back in job_done */
     submit(c, jb);
 }
 
@@ -1359,10 +1341,16 @@ static void do_stats(sv_conn *c, sv_request *r)
     json_t *stages = json_array(), *plan = json_object();
     if (c->world && c->world->latest) {
         const sv_result *res = c->world->latest;
-        json_decref(stages);
-        stages = stats_stages(&res->stats);
         json_decref(plan);
         plan = tick_stats(res);
+        json_decref(stages); /* STATS keeps a top-level copy of the tick's stages (SPEC section 4) */
+        stages = json_deep_copy(json_object_get(plan, "stages"));
+        if (!plan || !stages) { /* out of memory: answer with what is left */
+            json_decref(stages);
+            stages = json_array();
+            if (!plan)
+                plan = json_object();
+        }
         json_object_set_new(plan, "tick", json_integer((json_int_t)res->tick));
         json_object_set_new(plan, "current", json_boolean(res->gen == c->world_gen));
     }
@@ -1404,7 +1392,7 @@ static void do_ack(sv_conn *c, sv_request *r, json_t *j)
     char err[512];
     int stream = 0;
     int64_t tick = 0;
-    if (lpvp_get_enum(j, "stream", 1, STREAMS, 1, &stream, err, sizeof err) != LPVP_FIELD_OK ||
+    if (lpvp_get_enum(j, "stream", 1, lpvp_stream_names, 1, &stream, err, sizeof err) != LPVP_FIELD_OK ||
         lpvp_get_int(j, "tick", 1, 0, INT64_MAX, &tick, err, sizeof err) != LPVP_FIELD_OK) {
         reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err); /* ACK has no reply, but a bad one is an error */
         return;

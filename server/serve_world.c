@@ -162,7 +162,7 @@ sv_inputs *sv_inputs_build(sv_conn *c)
     key_put(&in->key, &in->key_len, &cap, &in->view, sizeof in->view);
     if (!in->key)
         goto fail;
-    in->key_hash = sv_hash_bytes(SV_HASH_INIT, in->key, in->key_len);
+    in->key_hash = lpv_hash_bytes(LPV_HASH_INIT, in->key, in->key_len);
     if (in->scene)
         in->scene->refs++;
     return in;
@@ -251,13 +251,13 @@ size_t sv_jobs_queued(sv_server *s)
 /* ---- GL thread ---------------------------------------------------------- */
 static uint64_t scene_sig(const sv_inputs *in)
 {
-    uint64_t h = sv_hash_bytes(SV_HASH_INIT, &in->scene, sizeof in->scene);
+    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, &in->scene, sizeof in->scene);
     if (in->material_count)
-        h = sv_hash_bytes(h, in->materials, sizeof(lpv_material) * in->material_count);
-    h = sv_hash_bytes(h, &in->material_count, sizeof in->material_count);
+        h = lpv_hash_bytes(h, in->materials, sizeof(lpv_material) * in->material_count);
+    h = lpv_hash_bytes(h, &in->material_count, sizeof in->material_count);
     if (in->light_count)
-        h = sv_hash_bytes(h, in->lights, sizeof(lpv_light) * in->light_count);
-    h = sv_hash_bytes(h, &in->light_count, sizeof in->light_count);
+        h = lpv_hash_bytes(h, in->lights, sizeof(lpv_light) * in->light_count);
+    h = lpv_hash_bytes(h, &in->light_count, sizeof in->light_count);
     return h;
 }
 
@@ -306,14 +306,14 @@ static void gl_tick(sv_server *s, sv_job *j)
     double t0 = wall_ms();
     if (gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err) != 0 ||
         lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
         return;
     }
     w->gl_ticked = 1;
     w->gl_ticked_gen = j->gen;
     sv_result *r = calloc(1, sizeof *r);
     if (!r) {
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
         snprintf(j->err, sizeof j->err, "out of memory");
         return;
     }
@@ -333,7 +333,7 @@ static void gl_tick(sv_server *s, sv_job *j)
     }
     r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
     if (!r->cells) {
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
         snprintf(j->err, sizeof j->err, "out of memory for %zu cells", r->cell_count);
         result_free(r);
         return;
@@ -363,7 +363,7 @@ static void gl_tick(sv_server *s, sv_job *j)
 static int gl_ready_for(sv_world *w, sv_job *j)
 {
     if (!w->engine || !w->gl_ticked || w->gl_ticked_gen != j->gen || w->gl_applied_gen != j->gen) {
-        j->status = SV_E_NOT_READY;
+        j->status = LPVP_E_NOT_READY;
         snprintf(j->err, sizeof j->err, "no tick since the last change of this session's scene, lights, camera or "
                                         "config: send TICK first");
         return 0;
@@ -380,12 +380,12 @@ static void gl_render(sv_job *j)
     j->height = j->inputs->view.height;
     j->rgba = malloc((size_t)j->width * (size_t)j->height * 4 * sizeof(float));
     if (!j->rgba) {
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
         snprintf(j->err, sizeof j->err, "out of memory for a %dx%d frame", j->width, j->height);
         return;
     }
     if (lpv_engine_render(w->engine, (lpv_frame_terms)j->terms, j->rgba, j->err, sizeof j->err) != 0)
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
     j->tick = w->gl_ticks;
 }
 
@@ -400,7 +400,7 @@ static void gl_query(sv_job *j)
     if (!j->out || !p || !nr) {
         free(p);
         free(nr);
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
         snprintf(j->err, sizeof j->err, "out of memory for %zu points", n);
         return;
     }
@@ -410,7 +410,7 @@ static void gl_query(sv_job *j)
             nr[i * 3 + k] = j->points[i * 6 + 3 + k];
         }
     if (n && lpv_engine_irradiance(w->engine, p, nr, n, j->out, j->err, sizeof j->err) != 0)
-        j->status = SV_E_INTERNAL;
+        j->status = LPVP_E_INTERNAL;
     for (size_t i = 0; i < n * 3; ++i)
         if (!isfinite(j->out[i]))
             j->out[i] = 0.0f;
@@ -615,7 +615,7 @@ void sv_gl_stop(sv_server *s)
         } else {
             if (dropped->periodic && dropped->world)
                 dropped->world->periodic_pending = 0;
-            dropped->status = SV_E_SHUTTING_DOWN;
+            dropped->status = LPVP_E_SHUTTING_DOWN;
             snprintf(dropped->err, sizeof dropped->err, "the server is stopping");
             job_reply_all(dropped);
             sv_job_free(dropped);

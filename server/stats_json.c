@@ -49,21 +49,37 @@ json_t *lpvd_plan_json(const lpv_plan *p)
                      reason_len(p->recompute_reason), "passes", passes);
 }
 
-json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const char *scene_source)
+json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, const lpv_grid *cascades, int n,
+                             double tick_ms)
 {
-    const lpv_engine_stats *s = lpv_engine_last_stats(e);
-    const lpv_settings *set = lpv_engine_settings(e);
-    const lpv_grid *g = lpv_engine_grid(e);
-
     json_t *stages = json_array();
     double total = 0.0;
-    for (int i = 0; i < s->stage_count; ++i) {
-        json_array_append_new(stages, json_pack("{s:s, s:f, s:f, s:i}", "name", s->stages[i].name, "gpu_ms",
-                                                s->stages[i].gpu_ms, "cpu_ms", s->stages[i].cpu_ms, "calls",
-                                                (int)s->stages[i].calls));
-        total += s->stages[i].gpu_ms;
+    for (int i = 0; stages && i < st->stage_count; ++i) {
+        json_array_append_new(stages, json_pack("{s:s, s:f, s:f, s:i}", "name", st->stages[i].name, "gpu_ms",
+                                                st->stages[i].gpu_ms, "cpu_ms", st->stages[i].cpu_ms, "calls",
+                                                (int)st->stages[i].calls));
+        total += st->stages[i].gpu_ms;
     }
-    json_t *grid = grid_json(g);
+    json_t *counts = json_pack("{s:i, s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b}", "lights", (int)st->lights,
+                               "area_lights", (int)st->area_lights, "rsm_faces", (int)st->rsm_faces, "vpls_rsm",
+                               (json_int_t)st->vpls_rsm, "vpls_emissive", (json_int_t)st->vpls_emissive,
+                               "surfels_rsm", (json_int_t)st->surfels_rsm, "surfels_camera",
+                               (json_int_t)st->surfels_camera, "cells", (json_int_t)st->cells, "iterations",
+                               st->iterations, "cell_steps", st->cell_steps, "occlusion", st->occlusion != 0);
+    json_t *o = json_pack("{s:o, s:f, s:o, s:o, s:o, s:o}", "stages", stages, "total_gpu_ms", total, "counts", counts,
+                          "grid", grid_json(&cascades[0]), "cascades", lpvd_cascades_json(cascades, n), "plan",
+                          lpvd_plan_json(plan));
+    if (o && tick_ms >= 0.0 && json_object_set_new(o, "tick_ms", json_real(tick_ms)) != 0) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
+json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const char *scene_source)
+{
+    const lpv_settings *set = lpv_engine_settings(e);
+    const lpv_grid *g = lpv_engine_grid(e);
     lpv_grid cascades[LPV_MAX_CASCADES];
     int ncascades = lpv_engine_cascade_count(e);
     if (ncascades < 1)
@@ -74,21 +90,21 @@ json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const ch
         const lpv_grid *c = lpv_engine_cascade(e, k);
         cascades[k] = c ? *c : *g;
     }
+    json_t *o = lpvd_tick_stats_json(lpv_engine_last_stats(e), lpv_engine_last_plan(e), cascades, ncascades, -1.0);
     /* preset: the one the settings started from; explicit flags may have overridden its values */
     const char *preset = lpv_preset_name(set->preset);
     json_t *settings = json_pack("{s:s, s:i, s:i, s:i, s:b, s:f, s:i}", "preset", preset ? preset : "", "iterations",
                                  set->iterations, "rsm_size", set->rsm_size, "shadow_size", set->shadow_size,
                                  "occlusion", set->occlusion == LPV_SWITCH_ON, "indirect_gain",
                                  (double)set->indirect_gain, "emissive_vpls", set->emissive_vpls);
-    json_t *counts = json_pack("{s:i, s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:f}", "lights", (int)s->lights,
-                               "area_lights", (int)s->area_lights, "rsm_faces", (int)s->rsm_faces, "vpls_rsm",
-                               (json_int_t)s->vpls_rsm, "vpls_emissive",
-                               (json_int_t)s->vpls_emissive, "surfels_rsm", (json_int_t)s->surfels_rsm,
-                               "surfels_camera", (json_int_t)s->surfels_camera, "cells", (json_int_t)s->cells,
-                               "cell_steps", s->cell_steps);
-    return json_pack("{s:s, s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:f}", "backend",
-                     lpv_backend_name(lpv_gl_context_backend(ctx)), "gl_renderer", lpv_gl_context_renderer(ctx),
-                     "gl_version", lpv_gl_context_version(ctx), "scene", scene_source, "grid", grid, "cascades",
-                     lpvd_cascades_json(cascades, ncascades), "plan", lpvd_plan_json(lpv_engine_last_plan(e)),
-                     "settings", settings, "counts", counts, "stages", stages, "total_gpu_ms", total);
+    json_t *extra = json_pack("{s:s, s:s, s:s, s:s, s:o}", "backend", lpv_backend_name(lpv_gl_context_backend(ctx)),
+                              "gl_renderer", lpv_gl_context_renderer(ctx), "gl_version",
+                              lpv_gl_context_version(ctx), "scene", scene_source, "settings", settings);
+    if (!o || !extra || json_object_update(o, extra) != 0) {
+        json_decref(o);
+        json_decref(extra);
+        return NULL;
+    }
+    json_decref(extra);
+    return o;
 }

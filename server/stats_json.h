@@ -17,8 +17,20 @@ json_t *lpvd_plan_json(const lpv_plan *p);
  * "origin_m": [3]}] (the keys of the stats' "grid"). */
 json_t *lpvd_cascades_json(const lpv_grid *cascades, int n);
 
-/* A new JSON object describing the last tick/render of e on context ctx
- * (with "grid" = cascade 0, "cascades" and the last tick's "plan"). */
+/* The stats of one tick, the one shape both `lpvd render --stats` and the
+ * daemon (TICK's "stats", STATS's "plan") send (docs/protocol.md, "Stats"):
+ *   {"stages": [{"name", "gpu_ms", "cpu_ms", "calls"}], "total_gpu_ms",
+ *    "tick_ms" (only when tick_ms >= 0: the daemon's wall time of the tick),
+ *    "counts": {"lights", "area_lights", "rsm_faces", "vpls_rsm",
+ *               "vpls_emissive", "surfels_rsm", "surfels_camera", "cells",
+ *               "iterations", "cell_steps", "occlusion"},
+ *    "grid": cascade 0, "cascades": n placements, "plan": lpvd_plan_json}
+ * cascades: n >= 1 grids, finest first. A new reference (NULL if memory runs out). */
+json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, const lpv_grid *cascades, int n,
+                             double tick_ms);
+
+/* lpvd_tick_stats_json of the last tick/render of e on context ctx, plus
+ * "backend", "gl_renderer", "gl_version", "scene" and the engine's "settings". */
 json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const char *scene_source);
 
 #endif

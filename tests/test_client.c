@@ -228,6 +228,59 @@ static void test_hello(void **state)
     lpvc_close(c);
 }
 
+/* R4.12: the knobs come from the server's description; the library checks
+ * values against it before sending, and what it lets through CONFIG takes. */
+static void test_knob_description(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    const lpvc_knob *k = NULL;
+    size_t n = lpvc_knobs(c, &k);
+    assert_true(n > 0);
+    for (size_t i = 0; i < n; i++) {
+        assert_non_null(k[i].name);
+        assert_true(k[i].min <= k[i].max);
+        char err[256];
+        /* the default is allowed, and CONFIG takes it and echoes it */
+        assert_int_equal(lpvc_knob_check(&k[i], k[i].def, err, sizeof err), 0);
+        lpvc_setting one = {k[i].name, k[i].def};
+        lpvc_config cfg = {.settings = &one, .setting_count = 1};
+        OK(c, lpvc_config_set(c, &cfg));
+        json_t *r = last_reply(c);
+        json_t *v = json_object_get(json_object_get(r, "config"), k[i].name);
+        assert_non_null(v);
+        double got = json_is_boolean(v) ? (json_is_true(v) ? 1.0 : 0.0) : json_number_value(v);
+        assert_true(fabs(got - k[i].def) <= 1e-6 * fmax(1.0, fabs(k[i].def)));
+        json_decref(r);
+        if (k[i].type == LPVC_KNOB_BOOL)
+            continue;
+        /* above the range: refused here, naming the knob, without a request */
+        lpvc_setting over = {k[i].name, k[i].max + fmax(1.0, fabs(k[i].max))};
+        cfg.settings = &over;
+        assert_int_equal(lpvc_config_set(c, &cfg), -1);
+        assert_int_equal(lpvc_error_code(c), LPVC_ERR_USAGE);
+        assert_non_null(strstr(lpvc_error_message(c), k[i].name));
+        double parsed;
+        assert_int_equal(lpvc_knob_parse(&k[i], "x", &parsed, err, sizeof err), -1);
+        assert_non_null(strstr(err, k[i].name));
+    }
+    lpvc_setting unknown = {"no_such_knob", 1};
+    lpvc_config cfg = {.settings = &unknown, .setting_count = 1};
+    assert_int_equal(lpvc_config_set(c, &cfg), -1);
+    assert_int_equal(lpvc_error_code(c), LPVC_ERR_USAGE);
+    size_t np = 0;
+    const char *const *presets = lpvc_presets(c, &np);
+    assert_true(np > 0);
+    json_t *h = json_loads(lpvc_hello_reply(c), 0, NULL);
+    assert_int_equal(np, json_array_size(json_object_get(h, "presets")));
+    json_decref(h);
+    lpvc_config pc = {.preset = presets[np - 1]};
+    OK(c, lpvc_config_set(c, &pc));
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
 static void test_connect_refused(void **state)
 {
     (void)state;
@@ -471,7 +524,8 @@ static void test_state_changes_bump_revision(void **state)
     OK(c, lpvc_light_remove(c, "probe"));
     assert_true(lpvc_last_revision(c) > r0);
     r0 = lpvc_last_revision(c);
-    lpvc_config cfg = {.iterations = 4, .occlusion = -1};
+    lpvc_setting knobs[] = {{"iterations", 4}, {"occlusion", 0}};
+    lpvc_config cfg = {.settings = knobs, .setting_count = 2};
     OK(c, lpvc_config_set(c, &cfg));
     assert_true(lpvc_last_revision(c) > r0);
     json_t *r = last_reply(c);
@@ -653,6 +707,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_connect_refused),
         cmocka_unit_test(test_hello),
+        cmocka_unit_test(test_knob_description),
         cmocka_unit_test(test_errors_keep_the_connection),
         cmocka_unit_test(test_tick_volume_query),
         cmocka_unit_test(test_frames),

@@ -23,8 +23,10 @@
 
 #include <jansson.h>
 
+#include "lpvc_knobs.h"
 #include "proto.h"
 #include "volume_codec.h"
+#include "volume_lookup.h"
 
 /* Streamed volumes kept as possible XOR delta bases (R5.3). The server
  * deltas against a tick we acknowledged; ACKs are asynchronous, so it may use
@@ -57,6 +59,7 @@ struct lpvc {
     char *last_reply;
     int64_t last_revision;
     char *hello;
+    lpvc_knobset knobs;     /* the server's knob description (HELLO, R4.12) */
     queued *q_head, *q_tail;
     acked acked[LPVC_KEEP_ACKED];
     uint64_t ack_clock;
@@ -510,7 +513,12 @@ lpvc *lpvc_connect_with(const lpvc_connect_desc *desc, char *err, size_t n)
         return NULL;
     }
     c->hello = json_dumps(reply, JSON_COMPACT);
+    rc = lpvc_knobset_read(&c->knobs, reply, err, n);
     json_decref(reply);
+    if (rc != 0) {
+        lpvc_close(c);
+        return NULL;
+    }
     return c;
 }
 
@@ -536,7 +544,27 @@ void lpvc_close(lpvc *c)
         free(c->acked[i].raw);
     free(c->last_reply);
     free(c->hello);
+    lpvc_knobset_free(&c->knobs);
     free(c);
+}
+
+size_t lpvc_knobs(const lpvc *c, const lpvc_knob **knobs)
+{
+    if (knobs)
+        *knobs = c ? c->knobs.knobs : NULL;
+    return c ? c->knobs.count : 0;
+}
+
+const lpvc_knob *lpvc_knob_find(const lpvc *c, const char *name)
+{
+    return c ? lpvc_knobset_find(&c->knobs, name) : NULL;
+}
+
+const char *const *lpvc_presets(const lpvc *c, size_t *count)
+{
+    if (count)
+        *count = c ? c->knobs.preset_count : 0;
+    return c ? c->knobs.presets : NULL;
 }
 
 /* ---- requests -------------------------------------------------------------- */
@@ -664,39 +692,12 @@ int lpvc_config_set(lpvc *c, const lpvc_config *cfg)
         json_object_set_new(o, "grid", json_pack("[i,i,i]", cfg->grid[0], cfg->grid[1], cfg->grid[2]));
     if (cfg->bounds)
         json_object_set_new(o, "bounds", vec(cfg->bounds, 6));
-    if (cfg->iterations)
-        json_object_set_new(o, "iterations", json_integer(cfg->iterations));
-    if (cfg->rsm_size)
-        json_object_set_new(o, "rsm_size", json_integer(cfg->rsm_size));
-    if (cfg->occlusion)
-        json_object_set_new(o, "occlusion", json_boolean(cfg->occlusion > 0));
-    if (cfg->indirect_gain != 0.0f)
-        json_object_set_new(o, "indirect_gain", json_real(cfg->indirect_gain));
-    if (cfg->emissive_vpls)
-        json_object_set_new(o, "emissive_vpls", json_integer(cfg->emissive_vpls));
     if (cfg->tick_rate_hz != 0.0f)
         json_object_set_new(o, "tick_rate_hz", json_real(cfg->tick_rate_hz));
-    const struct {
-        const char *key;
-        const float *f; /* a number, or */
-        const int *i;   /* an integer (sw = 0) or a switch (sw = 1) */
-        int sw;
-    } knobs[] = {
-        {"cascades", NULL, &cfg->cascades, 0},          {"cascade_size", &cfg->cascade_size, NULL, 0},
-        {"cascade_ratio", &cfg->cascade_ratio, NULL, 0}, {"cascade_offset", &cfg->cascade_offset, NULL, 0},
-        {"bounces", NULL, &cfg->bounces, 1},            {"bounce_intensity", &cfg->bounce_intensity, NULL, 0},
-        {"damping", &cfg->damping, NULL, 0},            {"glossy", NULL, &cfg->glossy, 1},
-        {"glossy_roughness", &cfg->glossy_roughness, NULL, 0}, {"media", NULL, &cfg->media, 1},
-        {"fog_sigma_s", &cfg->fog_sigma_s, NULL, 0},    {"fog_sigma_a", &cfg->fog_sigma_a, NULL, 0},
-        {"media_step", &cfg->media_step, NULL, 0},      {"planner", NULL, &cfg->planner, 1},
-    };
-    for (size_t k = 0; k < sizeof knobs / sizeof knobs[0]; ++k) {
-        if (knobs[k].f && *knobs[k].f != 0.0f)
-            json_object_set_new(o, knobs[k].key, json_real(*knobs[k].f));
-        else if (knobs[k].i && *knobs[k].i && knobs[k].sw)
-            json_object_set_new(o, knobs[k].key, json_boolean(*knobs[k].i > 0));
-        else if (knobs[k].i && *knobs[k].i)
-            json_object_set_new(o, knobs[k].key, json_integer(*knobs[k].i));
+    char err[512];
+    if (lpvc_knobset_add(&c->knobs, o, cfg->settings, cfg->settings ? cfg->setting_count : 0, err, sizeof err) != 0) {
+        json_decref(o);
+        return fail(c, LPVC_ERR_USAGE, "%s", err);
     }
     return simple(c, LPVP_CONFIG, o);
 }
@@ -726,7 +727,7 @@ int lpvc_tick(lpvc *c, int64_t *tick)
 
 static const char *stream_name(enum lpvc_stream s)
 {
-    return s == LPVC_STREAM_FRAME ? "frame" : "volume";
+    return lpvp_stream_names[s == LPVC_STREAM_FRAME ? LPVP_STREAM_FRAME : LPVP_STREAM_VOLUME];
 }
 
 int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc)
@@ -758,7 +759,7 @@ int lpvc_ack(lpvc *c, int64_t tick)
     if (!c)
         return -1;
     clear_error(c);
-    json_t *o = json_pack("{s:s, s:I}", "stream", "volume", "tick", (json_int_t)tick);
+    json_t *o = json_pack("{s:s, s:I}", "stream", lpvp_stream_names[LPVP_STREAM_VOLUME], "tick", (json_int_t)tick);
     if (!o)
         return fail(c, LPVC_ERR_USAGE, "out of memory");
     uint32_t id = send_frame(c, LPVP_ACK, o, NULL, 0);
@@ -892,8 +893,8 @@ int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out)
     lpvc_volume_desc d = {0};
     if (desc)
         d = *desc;
-    json_t *o = json_pack("{s:s, s:s}", "format", d.format ? d.format : "fp32", "compression",
-                          d.compression ? d.compression : "zstd");
+    json_t *o = json_pack("{s:s, s:s}", "format", d.format ? d.format : lpvp_volume_format_names[LPVP_FMT_FP32],
+                          "compression", d.compression ? d.compression : lpvp_compression_names[LPVP_COMP_ZSTD]);
     json_t *reply = NULL;
     uint8_t *att = NULL;
     size_t att_len = 0;
@@ -942,7 +943,7 @@ static int decode_frame(lpvc *c, const json_t *hdr, uint8_t *att, size_t att_len
     get_str(hdr, "terms", out->terms, sizeof out->terms);
     char comp[16];
     get_str(hdr, "compression", comp, sizeof comp);
-    if (strcmp(out->format, "rgba8") == 0) {
+    if (strcmp(out->format, lpvp_frame_format_names[LPVP_FRAME_RGBA8]) == 0) {
         int64_t raw_length = get_i64(hdr, "raw_length", -1);
         size_t expect = (size_t)out->width * (size_t)out->height * 4u;
         if (out->width <= 0 || out->height <= 0 || (raw_length >= 0 && (size_t)raw_length != expect)) {
@@ -950,7 +951,7 @@ static int decode_frame(lpvc *c, const json_t *hdr, uint8_t *att, size_t att_len
             return fail(c, LPVC_ERR_PROTOCOL, "rgba8 frame %dx%d with raw_length %lld", out->width, out->height,
                         (long long)raw_length);
         }
-        if (strcmp(comp, "zstd") == 0) {
+        if (strcmp(comp, lpvp_compression_names[LPVP_COMP_ZSTD]) == 0) {
             uint8_t *raw = malloc(expect ? expect : 1);
             char err[256];
             if (!raw || lpvp_zstd_decompress_exact(att, att_len, raw, expect, err, sizeof err) != 0) {
@@ -1189,83 +1190,24 @@ int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms)
     return rc;
 }
 
-/* ---- local lookup (docs/propagation.md section 6, core/oracle_lookup.c) ---- */
+/* ---- local lookup: SPEC R5.7, the protocol library's (volume_lookup.h) ----- */
 
-static int axis_lerp(const lpvc_cascade *v, int a, float p, int *i0, int *i1, float *f)
+static lpvp_lookup_cascade lookup_cascade(const lpvc_cascade *cs)
 {
-    float u = (p - v->origin[a]) / v->cell_size;
-    if (isnan(u))
-        return 0;
-    float hi = (float)v->dims[a] - 0.5f;
-    u = fminf(fmaxf(u, 0.5f), hi) - 0.5f;
-    float base = floorf(u);
-    if (base > (float)(v->dims[a] - 2))
-        base = (float)(v->dims[a] - 2);
-    if (base < 0.0f)
-        base = 0.0f;
-    *i0 = (int)base;
-    *i1 = *i0 + 1 < v->dims[a] ? *i0 + 1 : *i0;
-    *f = u - base;
-    return 1;
+    lpvp_lookup_cascade l = {.dims = {cs->dims[0], cs->dims[1], cs->dims[2]},
+                             .origin = {cs->origin[0], cs->origin[1], cs->origin[2]},
+                             .cell_size = cs->cell_size,
+                             .cells = cs->data};
+    return l;
 }
 
-void lpvc_cascade_irradiance(const lpvc_cascade *v, const float p[3], const float n[3], float rgb[3])
+void lpvc_cascade_irradiance(const lpvc_cascade *cs, const float p[3], const float n[3], float rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
-    if (!v || !v->data || v->cell_size <= 0.0f)
+    if (!cs)
         return;
-    if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2]))
-        return;
-    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 1e-8f) || !isfinite(len))
-        return;
-    float un[3] = {n[0] / len, n[1] / len, n[2] / len};
-    int i0[3], i1[3];
-    float f[3];
-    for (int a = 0; a < 3; a++)
-        if (!axis_lerp(v, a, p[a] + 0.5f * v->cell_size * un[a], &i0[a], &i1[a], &f[a]))
-            return;
-    float c[12] = {0};
-    for (int corner = 0; corner < 8; corner++) {
-        int idx[3];
-        float w = 1.0f;
-        for (int a = 0; a < 3; a++) {
-            if (corner >> a & 1) {
-                idx[a] = i1[a];
-                w *= f[a];
-            } else {
-                idx[a] = i0[a];
-                w *= 1.0f - f[a];
-            }
-        }
-        if (w == 0.0f)
-            continue;
-        const float *cell = v->data + 12 * ((size_t)idx[0] + (size_t)v->dims[0] * ((size_t)idx[1] + (size_t)v->dims[1] * (size_t)idx[2]));
-        for (int k = 0; k < 12; k++)
-            c[k] += w * cell[k];
-    }
-    /* lobe(-n) = (L0, -L1 n.y, -L1 n.z, -L1 n.x), L0 = sqrt(pi)/2, L1 = sqrt(pi/3) */
-    const float L0 = 0.886226925f, L1 = 1.02332671f;
-    float lobe[4] = {L0, -L1 * un[1], -L1 * un[2], -L1 * un[0]};
-    float inv = 1.0f / (v->cell_size * v->cell_size);
-    for (int ch = 0; ch < 3; ch++) {
-        float d = c[4 * ch] * lobe[0] + c[4 * ch + 1] * lobe[1] + c[4 * ch + 2] * lobe[2] + c[4 * ch + 3] * lobe[3];
-        rgb[ch] = fmaxf(0.0f, d * inv);
-    }
-}
-
-/* Distance from p to the box of cs in its cells (the smallest over the six
- * faces; negative outside, NaN for a NaN p). */
-static float border_cells(const lpvc_cascade *cs, const float p[3])
-{
-    float d = INFINITY;
-    for (int a = 0; a < 3; a++) {
-        float u = (p[a] - cs->origin[a]) / cs->cell_size;
-        d = fminf(d, fminf(u, (float)cs->dims[a] - u));
-        if (isnan(u))
-            return NAN;
-    }
-    return d;
+    lpvp_lookup_cascade l = lookup_cascade(cs);
+    lpvp_cascade_irradiance(&l, p, n, rgb);
 }
 
 void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3])
@@ -1273,35 +1215,17 @@ void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float 
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
     if (!v || !v->data)
         return;
-    lpvc_cascade one;
-    const lpvc_cascade *cs = v->cascades;
+    lpvp_lookup_cascade l[LPVC_MAX_CASCADES];
     int count = v->cascade_count;
     if (count < 1 || count > LPVC_MAX_CASCADES) { /* a volume built by hand: the grid alone */
-        for (int a = 0; a < 3; a++) {
-            one.dims[a] = v->dims[a];
-            one.origin[a] = v->origin[a];
-        }
-        one.cell_size = v->cell_size;
-        one.cells = v->cells;
-        one.data = v->data;
-        cs = &one;
+        l[0] = (lpvp_lookup_cascade){.dims = {v->dims[0], v->dims[1], v->dims[2]},
+                                     .origin = {v->origin[0], v->origin[1], v->origin[2]},
+                                     .cell_size = v->cell_size,
+                                     .cells = v->data};
         count = 1;
+    } else {
+        for (int k = 0; k < count; k++)
+            l[k] = lookup_cascade(&v->cascades[k]);
     }
-    /* R5.7: the finest cascade containing p (the coarsest if none does) */
-    int k = count - 1;
-    for (int i = 0; i < count; i++)
-        if (border_cells(&cs[i], p) >= 0.0f) {
-            k = i;
-            break;
-        }
-    lpvc_cascade_irradiance(&cs[k], p, n, rgb);
-    if (k + 1 >= count || !(border_cells(&cs[k + 1], p) >= 0.0f))
-        return;
-    float w = fminf(fmaxf((border_cells(&cs[k], p) - 1.0f) * 0.5f, 0.0f), 1.0f);
-    if (w >= 1.0f)
-        return;
-    float coarse[3];
-    lpvc_cascade_irradiance(&cs[k + 1], p, n, coarse);
-    for (int ch = 0; ch < 3; ch++)
-        rgb[ch] = w * rgb[ch] + (1.0f - w) * coarse[ch];
+    lpvp_volume_irradiance(l, count, p, n, rgb);
 }

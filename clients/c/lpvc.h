@@ -118,33 +118,61 @@ typedef struct lpvc_camera {
 } lpvc_camera;
 int lpvc_camera_set(lpvc *c, const lpvc_camera *cam);
 
+/* ---- Settings knobs (SPEC R4.12) --------------------------------------------
+ * The daemon describes CONFIG's knobs in its HELLO reply ("knobs", built
+ * from its settings table); the connection keeps that description, so this
+ * library, lpvctl and the tests hold no list of knobs of their own. */
+typedef enum lpvc_knob_type {
+    LPVC_KNOB_INT = 0,      /* a JSON integer */
+    LPVC_KNOB_NUMBER = 1,   /* a JSON number */
+    LPVC_KNOB_BOOL = 2      /* a JSON boolean ("on" / "off" as text) */
+} lpvc_knob_type;
+
+typedef struct lpvc_knob {
+    const char *name;       /* the CONFIG key, e.g. "damping" */
+    lpvc_knob_type type;
+    double min, max;        /* allowed values (int and number; bool: 0 and 1) */
+    bool min_exclusive;     /* the value must be > min */
+    double def;             /* the value a session starts with (bool: 0 or 1) */
+    const char *default_text; /* the default in words ("auto", "the preset's (on)") */
+    const char *unit;       /* "m", "texels", ... or "" */
+    const char *note;       /* what special values mean ("0 = auto"), or "" */
+    const char *help;       /* one line */
+} lpvc_knob;
+
+/* The description from HELLO: *knobs (may be NULL) receives the array, valid
+ * while c lives; returns its length (0 from a server that sends none). */
+size_t lpvc_knobs(const lpvc *c, const lpvc_knob **knobs);
+/* The knob named name, or NULL. */
+const lpvc_knob *lpvc_knob_find(const lpvc *c, const char *name);
+/* The preset names the server offers (HELLO "presets"), *count of them. */
+const char *const *lpvc_presets(const lpvc *c, size_t *count);
+
+/* The allowed values in words: "an integer in 1..4096", "a number > 0 and <= 1",
+ * "on or off". Returns buf. */
+const char *lpvc_knob_expect(const lpvc_knob *k, char *buf, size_t n);
+/* 0 when v is allowed (integral for ints, in range), else -1 with
+ * "<name>: <why>" in err. */
+int lpvc_knob_check(const lpvc_knob *k, double v, char *err, size_t n);
+/* Text -> value: "on"/"off" (also "true"/"false") for bools, a decimal
+ * number otherwise; then lpvc_knob_check. Returns 0, or -1 with err set. */
+int lpvc_knob_parse(const lpvc_knob *k, const char *text, double *v, char *err, size_t n);
+
+/* One knob to send: bools are 0 (false) or non-zero (true). */
+typedef struct lpvc_setting {
+    const char *name;
+    double value;
+} lpvc_setting;
+
 typedef struct lpvc_config {
     int grid[3];               /* all 0: not sent */
     const float *bounds;       /* [6] x0 y0 z0 x1 y1 z1, or NULL */
-    int iterations;            /* 0: not sent */
-    int rsm_size;              /* 0: not sent */
-    int occlusion;             /* 0: not sent, 1: true, -1: false */
-    float indirect_gain;       /* 0: not sent */
-    int emissive_vpls;         /* 0: not sent */
     float tick_rate_hz;        /* 0: not sent */
-    /* Cascades, effects and scheduling (SPEC R4.11). Numbers: 0 = not sent;
-     * switches: 0 = not sent, 1 = true, -1 = false (as occlusion). */
-    int cascades;              /* 1..4 (0 = auto cannot be sent from here; lpvc_config_json can) */
-    float cascade_size;        /* m */
-    float cascade_ratio;
-    float cascade_offset;      /* fraction of the extent; negative = centred on the camera */
-    int bounces;               /* switch */
-    float bounce_intensity;
-    float damping;
-    int glossy;                /* switch */
-    float glossy_roughness;
-    int media;                 /* switch */
-    float fog_sigma_s;         /* 1/m */
-    float fog_sigma_a;         /* 1/m */
-    float media_step;          /* cells */
-    int planner;               /* switch */
-    const char *preset;        /* "fast" | "balanced" | "accurate", or NULL: not sent. The server applies
-                                  it first; the fields above that are sent override its values */
+    const char *preset;        /* one of lpvc_presets(), or NULL: not sent. The server applies it
+                                  first; the knobs that are sent override its values */
+    const lpvc_setting *settings; /* knobs of the description, each checked against it before sending
+                                     (an unknown name or a value out of range fails with LPVC_ERR_USAGE) */
+    size_t setting_count;
 } lpvc_config;
 int lpvc_config_set(lpvc *c, const lpvc_config *cfg);
 /* CONFIG with a JSON object text (any field, including zeros). The reply
@@ -268,7 +296,7 @@ void lpvc_message_free(lpvc_message *m);
  * LPVC_ERR_TIMEOUT. */
 int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
 
-/* ---- Local lookup (docs/propagation.md section 6) -------------------------- */
+/* ---- Local lookup (SPEC R5.7; protocol/volume_lookup.h over core's oracle) ---- */
 
 /* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
  * server's QUERY_IRRADIANCE computes it: with several cascades, the finest

@@ -568,6 +568,7 @@ class Ctx:
         self.timeout = args.timeout
         self.tick_timeout = args.tick_timeout
         self.limits = None
+        self.hello_reply = None  # the body of the last session's HELLO reply
         self.open = []
 
     def connect(self, ep=None, **kw):
@@ -596,6 +597,7 @@ class Ctx:
         expect_reply(r, HELLO, rid, "HELLO")
         if self.limits is None and isinstance(r.body.get("limits"), dict):
             self.limits = r.body["limits"]
+        self.hello_reply = r.body
         return c
 
     def ping(self, c, what="connection stays open"):
@@ -1362,26 +1364,63 @@ def c_config_preset_bad(ctx):
     return "6 CONFIGs with a bad preset (or a bad field next to a good one) refused, config unchanged"
 
 
-# R4.11's knobs: key -> (kind, default, values to set, out-of-range values, wrong-type values).
-CONFIG_KNOBS = {
-    "shadow_size": ("int", 1024, (16, 2048, 1024), (8, 9000), (1.5, "64", True)),
-    "cascades": ("int", 0, (1, 4, 0), (5, -1), (1.5, "2", True)),
-    "cascade_size": ("num", 0, (12.5, 1e6, 0), (-1, 2e6), ("8", False, [8])),
-    "cascade_ratio": ("num", 2, (1.25, 3, 8), (1.0, 9), ("2", None)),
-    "cascade_offset": ("num", 0.25, (0.5, -0.5, 0.1), (0.6, -2), ("x", True)),
-    "bounces": ("bool", False, (True, False), (), (1, "on", None)),
-    "bounce_intensity": ("num", 1, (0.5, 1), (0, 1.5, -0.1), ("1", False)),
-    "damping": ("num", 0, (0.25, 1, 0), (1.5, -0.1), ("0.2", True)),
-    "glossy": ("bool", True, (False, True), (), (0, "off")),
-    "glossy_roughness": ("num", 0.3, (0.5, 1), (0, 1.5), ("0.5", {})),
-    "media": ("bool", True, (False, True), (), (1, "true")),
-    "fog_sigma_s": ("num", 0, (0.05, 1000, 0), (-1, 2000), ("0.1", True)),
-    "fog_sigma_a": ("num", 0, (0.01, 1000, 0), (-0.5, 1001), ("0.1", [0.1])),
-    "media_step": ("num", 0.5, (0.05, 4, 1), (0.01, 5), ("1", False)),
-    "planner": ("bool", True, (False, True), (), (0, "off")),
-    "area_lights": ("bool", True, (False, True), (), (1, "on")),
-    "area_light_samples": ("int", 8, (1, 64, 16), (0, 65, -1), (8.5, "8", True)),
-}
+# R4.12: the knobs are the server's own description (HELLO "knobs"), not a
+# list kept here; these cases check that the description is true: what it
+# says CONFIG accepts, CONFIG accepts, and what it says is out of range or of
+# the wrong type, CONFIG refuses naming the knob.
+KNOB_TYPES = ("int", "number", "bool")
+
+
+def _knobs(ctx):
+    """A fresh session and the server's knob description, checked for shape (R4.12)."""
+    c = ctx.session()
+    knobs = ctx.hello_reply.get("knobs")
+    check(isinstance(knobs, list) and knobs, "R4.12: HELLO reply has no non-empty \"knobs\" array: %r"
+          % (ctx.hello_reply,))
+    names = set()
+    for k in knobs:
+        check(isinstance(k, dict) and isinstance(k.get("name"), str) and k["name"], "R4.12: knob without a name: %r" % (k,))
+        check(k["name"] not in names, "R4.12: knob %r described twice" % k["name"])
+        names.add(k["name"])
+        check(k.get("type") in KNOB_TYPES, "R4.12: knob %s has type %r, expected one of %r" % (k["name"],
+                                                                                           k.get("type"), KNOB_TYPES))
+        for key in ("default_text", "unit", "note", "help"):
+            check(isinstance(k.get(key), str), "R4.12: knob %s has no string %r" % (k["name"], key))
+        check(_same(k["type"], k.get("default"), k.get("default")),
+              "R4.12: knob %s: default %r is not a %s" % (k["name"], k.get("default"), k["type"]))
+        if k["type"] != "bool":
+            lo, hi = k.get("min"), k.get("max")
+            check(_same(k["type"], lo, lo) and _same(k["type"], hi, hi) and lo <= hi,
+                  "R4.12: knob %s: min %r / max %r are not %ss with min <= max" % (k["name"], lo, hi, k["type"]))
+            check(isinstance(k.get("min_exclusive"), bool), "R4.12: knob %s has no boolean min_exclusive" % k["name"])
+    presets = ctx.hello_reply.get("presets")
+    check(isinstance(presets, list) and presets and all(isinstance(p, str) for p in presets),
+          "R4.12: HELLO reply has no non-empty \"presets\" array of names: %r" % (presets,))
+    return c, knobs, presets
+
+
+def _in_range(k):
+    """Values the description allows: the default, both ends (min only when inclusive), the middle."""
+    if k["type"] == "bool":
+        return [True, False, k["default"]]
+    lo, hi = k["min"], k["max"]
+    mid = (lo + hi) / 2.0
+    if k["type"] == "int":
+        mid = int(mid)
+    vals = [k["default"], hi, mid] + ([] if k["min_exclusive"] else [lo])
+    return [v for v in vals if (v > lo or (v == lo and not k["min_exclusive"])) and v <= hi]
+
+
+def _out_of_range(k):
+    if k["type"] == "bool":
+        return []
+    lo, hi = k["min"], k["max"]
+    if k["type"] == "int":
+        return [hi + 1] + ([lo] if k["min_exclusive"] else [lo - 1])
+    return [hi + 0.5 * max(1.0, abs(hi))] + ([lo] if k["min_exclusive"] else [lo - 0.5 * max(1.0, abs(lo))])
+
+
+WRONG_TYPES = {"int": (1.5, "1", True), "number": ("1", True, [1]), "bool": (1, "on", None)}
 
 
 def _same(kind, got, want):
@@ -1392,43 +1431,58 @@ def _same(kind, got, want):
     return isinstance(got, (int, float)) and not isinstance(got, bool) and abs(got - want) <= 1e-6 * max(1, abs(want))
 
 
-@case("R4.11", "CONFIG accepts every cascade/effect/scheduling knob and echoes it resolved in the effective config")
-def c_config_knobs(ctx):
-    c = ctx.session()
+@case("R4.12 R4.11", "HELLO describes every knob of the effective config with its type, range and default")
+def c_knob_description(ctx):
+    c, knobs, presets = _knobs(ctx)
     cfg = _preset_config(c, {})
-    for key, (kind, default, _, _, _) in CONFIG_KNOBS.items():
-        check(key in cfg, "effective config lacks %r: %r" % (key, cfg))
-        check(_same(kind, cfg[key], default), "effective %s is %r, expected the default %r" % (key, cfg[key], default))
+    for k in knobs:
+        check(k["name"] in cfg, "R4.12: described knob %s is not in the effective config %r" % (k["name"], cfg))
+        check(_same(k["type"], cfg[k["name"]], k["default"]),
+              "R4.12: effective %s is %r, the description's default is %r" % (k["name"], cfg[k["name"]], k["default"]))
+    check(cfg.get("preset") in presets, "effective preset %r is not one of the described %r" % (cfg.get("preset"), presets))
+    for p in presets:
+        _preset_config(c, {"preset": p})
+    return "%d knobs, %d presets (%s)" % (len(knobs), len(presets), ", ".join(presets))
+
+
+@case("R4.12 R4.11", "CONFIG accepts every described knob across its described range and echoes it resolved")
+def c_config_knobs(ctx):
+    c, knobs, presets = _knobs(ctx)
     n = 0
-    for key, (kind, _, values, _, _) in CONFIG_KNOBS.items():
-        for v in values:
-            cfg = _preset_config(c, {key: v})
-            check(_same(kind, cfg.get(key), v), "CONFIG {%r: %r}: effective config says %r" % (key, v, cfg.get(key)))
+    for k in knobs:
+        for v in _in_range(k):
+            cfg = _preset_config(c, {k["name"]: v})
+            check(_same(k["type"], cfg.get(k["name"]), v),
+                  "CONFIG {%r: %r}: effective config says %r" % (k["name"], v, cfg.get(k["name"])))
             n += 1
-    both = {"cascades": 2, "cascade_size": 6.0, "bounces": True, "damping": 0.5, "fog_sigma_s": 0.1,
-            "planner": False, "preset": "fast"}
+    # every knob at once, next to a preset: each one's value wins over the preset's
+    both = {k["name"]: _in_range(k)[1] for k in knobs}
+    both["preset"] = presets[0]
     cfg = _preset_config(c, both)
-    for key, v in both.items():
-        if key != "preset":
-            check(_same(CONFIG_KNOBS[key][0], cfg.get(key), v), "CONFIG %s: %s is %r" % (json.dumps(both), key,
-                                                                                      cfg.get(key)))
-    check(cfg.get("preset") == "fast", "preset next to the knobs lost: %r" % cfg)
-    return "%d knobs, %d values echoed" % (len(CONFIG_KNOBS), n)
+    for k in knobs:
+        check(_same(k["type"], cfg.get(k["name"]), both[k["name"]]),
+              "CONFIG %s: %s is %r" % (json.dumps(both), k["name"], cfg.get(k["name"])))
+    check(cfg.get("preset") == presets[0], "preset next to the knobs lost: %r" % cfg)
+    return "%d knobs, %d values echoed" % (len(knobs), n)
 
 
-@case("R4.11 R4.6 R2.9", "out-of-range and wrongly typed knob values get BAD_FIELD naming the key; nothing changes")
+@case("R4.12 R4.11 R4.6 R2.9", "out-of-range and wrongly typed knob values are refused naming the knob; nothing changes")
 def c_config_knobs_bad(ctx):
-    c = ctx.session()
-    cfg0 = _preset_config(c, {"cascades": 2, "damping": 0.5, "glossy": False})
+    c, knobs, _ = _knobs(ctx)
+    cfg0 = _preset_config(c, {})
     n = 0
-    for key, (_, _, _, out, wrong) in CONFIG_KNOBS.items():
-        for v in tuple(out) + tuple(wrong):
-            body = {key: v, "iterations": 6}
+    for k in knobs:
+        for v, names in [(v, ("BAD_FIELD", "LIMIT")) for v in _out_of_range(k)] + \
+                        [(v, ("BAD_FIELD",)) for v in WRONG_TYPES[k["type"]]]:
+            body = {k["name"]: v}
             rid = c.send(CONFIG, body)
-            try:
-                expect_error(c.recv_reply(rid), "BAD_FIELD", rid, key)
-            except Fail as e:
-                raise Fail("CONFIG %s: %s" % (json.dumps(body), e))
+            f = c.recv_reply(rid)
+            check(f.type == ERROR, "CONFIG %s: accepted, expected %s" % (json.dumps(body), " or ".join(names)))
+            check_error_shape(f)
+            check(f.body["name"] in names, "CONFIG %s: ERROR %s, expected %s" % (json.dumps(body), f.body["name"],
+                                                                                  " or ".join(names)))
+            check(k["name"] in f.body["message"], "CONFIG %s: message %r does not name the knob (R2.9)"
+                  % (json.dumps(body), f.body["message"]))
             n += 1
     cfg1 = _preset_config(c, {})
     check(cfg1 == cfg0, "config changed by refused knob values: %r -> %r" % (cfg0, cfg1))

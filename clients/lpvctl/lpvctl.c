@@ -41,13 +41,12 @@ static const char *g_usage =
     "            [--position X,Y,Z] [--direction X,Y,Z] [--range R] [--inner-cone RAD] [--outer-cone RAD]\n"
     "  light-remove ID\n"
     "  camera --eye X,Y,Z --target X,Y,Z [--up X,Y,Z] [--fov DEG] [--size WxH] | camera --scene NAME|INDEX\n"
-    "  config [--preset fast|balanced|accurate] [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1]\n"
-    "         [--iterations N] [--rsm-size N] [--occlusion on|off] [--indirect-gain G] [--emissive-vpls N]\n"
-    "         [--tick-rate HZ] [--cascades N] [--cascade-size M] [--cascade-ratio R] [--cascade-offset F]\n"
-    "         [--bounces on|off] [--bounce-intensity X] [--damping X] [--glossy on|off]\n"
-    "         [--glossy-roughness X] [--media on|off] [--fog-sigma-s PER_M] [--fog-sigma-a PER_M]\n"
-    "         [--media-step CELLS] [--planner on|off]\n"
-    "         | config --json JSON   (the other flags override the preset's values; SPEC R4.11 has the ranges)\n"
+    "  config [--preset NAME] [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1] [--tick-rate HZ]\n"
+    "         [--KNOB VALUE]...     every knob the daemon describes in HELLO (SPEC R4.12), e.g.\n"
+    "                               --damping 0.5 --normal-bins off; values are checked against its ranges\n"
+    "         | config --json JSON   (the other flags override the preset's values)\n"
+    "  knobs                                   the daemon's knobs: name, type, range, default, unit, help;\n"
+    "                                          and its presets\n"
     "  tick [N] [--stats]                      N ticks (default 1); --stats: the whole reply\n"
     "  subscribe [volume|frame] [--format F] [--compression zstd|none] [--delta] [-n COUNT]\n"
     "            [--tick] [--wait MS] [-o PREFIX]  print stream headers; save COUNT messages as\n"
@@ -364,46 +363,46 @@ static int cmd_camera(int argc, char **argv)
     return 0;
 }
 
-/* CONFIG's cascade / effect / scheduling knobs (SPEC R4.11): the server checks
- * the ranges. KNOB_WANT is indexed by the failure code config_knob leaves in *why. */
-static const char *const KNOB_WANT[] = {"", "a number", "an integer", "on|off"};
-
-static int config_knob(lpvc_config *cfg, const char *flag, const char *v, long *why)
+/* A flag naming a knob of the daemon's description: "--normal-bins" or
+ * "--normal_bins" for the knob "normal_bins". NULL if it names none. */
+static const lpvc_knob *knob_of_flag(const char *flag)
 {
-    const struct {
-        const char *flag;
-        float *f; /* a number, or */
-        int *i;   /* an integer (sw = 0) or a switch (sw = 1) */
-        int sw;
-    } knobs[] = {
-        {"--cascades", NULL, &cfg->cascades, 0},          {"--cascade-size", &cfg->cascade_size, NULL, 0},
-        {"--cascade-ratio", &cfg->cascade_ratio, NULL, 0}, {"--cascade-offset", &cfg->cascade_offset, NULL, 0},
-        {"--bounces", NULL, &cfg->bounces, 1},            {"--bounce-intensity", &cfg->bounce_intensity, NULL, 0},
-        {"--damping", &cfg->damping, NULL, 0},            {"--glossy", NULL, &cfg->glossy, 1},
-        {"--glossy-roughness", &cfg->glossy_roughness, NULL, 0}, {"--media", NULL, &cfg->media, 1},
-        {"--fog-sigma-s", &cfg->fog_sigma_s, NULL, 0},    {"--fog-sigma-a", &cfg->fog_sigma_a, NULL, 0},
-        {"--media-step", &cfg->media_step, NULL, 0},      {"--planner", NULL, &cfg->planner, 1},
-    };
-    long n;
-    *why = 0;
-    for (size_t k = 0; k < sizeof knobs / sizeof knobs[0]; ++k) {
-        if (strcmp(flag, knobs[k].flag) != 0)
-            continue;
-        if (knobs[k].f) {
-            if (parse_float(v, knobs[k].f) != 0)
-                return (int)(*why = 1);
-        } else if (knobs[k].sw) {
-            if (strcmp(v, "on") != 0 && strcmp(v, "off") != 0)
-                return (int)(*why = 3);
-            *knobs[k].i = strcmp(v, "on") == 0 ? 1 : -1;
-        } else {
-            if (parse_int(v, INT_MIN, INT_MAX, &n) != 0)
-                return (int)(*why = 2);
-            *knobs[k].i = (int)n;
-        }
-        return 0;
+    char key[96];
+    if (strncmp(flag, "--", 2) != 0 || strlen(flag + 2) >= sizeof key)
+        return NULL;
+    snprintf(key, sizeof key, "%s", flag + 2);
+    for (char *p = key; *p; ++p)
+        if (*p == '-')
+            *p = '_';
+    return lpvc_knob_find(g_c, key);
+}
+
+/* knobs: the daemon's description, one knob per line, then the presets. */
+static int cmd_knobs(int argc, char **argv)
+{
+    (void)argv;
+    if (argc != 1)
+        return usage_error("takes no arguments%s", NULL);
+    const lpvc_knob *k = NULL;
+    size_t n = lpvc_knobs(g_c, &k);
+    for (size_t i = 0; i < n; ++i) {
+        char want[96], flag[96];
+        snprintf(flag, sizeof flag, "%s", k[i].name);
+        for (char *p = flag; *p; ++p)
+            if (*p == '_')
+                *p = '-';
+        printf("--%-22s %s; default %s%s%s%s%s: %s\n", flag, lpvc_knob_expect(&k[i], want, sizeof want),
+               k[i].default_text, k[i].unit[0] ? "; unit " : "", k[i].unit, k[i].note[0] ? "; " : "", k[i].note,
+               k[i].help);
     }
-    return -1;
+    size_t np = 0;
+    const char *const *presets = lpvc_presets(g_c, &np);
+    printf("presets:");
+    for (size_t i = 0; i < np; ++i)
+        printf(" %s", presets[i]);
+    printf("\n");
+    fflush(stdout);
+    return 0;
 }
 
 static int cmd_config(int argc, char **argv)
@@ -411,10 +410,13 @@ static int cmd_config(int argc, char **argv)
     lpvc_config cfg = {0};
     float bounds[6];
     const char *json = NULL;
+    lpvc_setting set[MAX_ARGS];
+    size_t nset = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         long n;
+        const lpvc_knob *k;
         if (!v)
             return usage_error("'%s' needs a value", a);
         if (strcmp(a, "--json") == 0) {
@@ -432,43 +434,24 @@ static int cmd_config(int argc, char **argv)
             if (parse_floats(v, bounds, 6) != 0)
                 return usage_error("bad --bounds '%s' (x0,y0,z0,x1,y1,z1)", v);
             cfg.bounds = bounds;
-        } else if (strcmp(a, "--iterations") == 0) {
-            if (parse_int(v, 0, 1 << 20, &n) != 0)
-                return usage_error("bad --iterations '%s'", v);
-            if (n == 0)
-                return usage_error("--iterations 0: use --json '{\"iterations\":0}'%s", NULL);
-            cfg.iterations = (int)n;
-        } else if (strcmp(a, "--rsm-size") == 0) {
-            if (parse_int(v, 1, 1 << 16, &n) != 0)
-                return usage_error("bad --rsm-size '%s'", v);
-            cfg.rsm_size = (int)n;
-        } else if (strcmp(a, "--occlusion") == 0) {
-            if (strcmp(v, "on") == 0)
-                cfg.occlusion = 1;
-            else if (strcmp(v, "off") == 0)
-                cfg.occlusion = -1;
-            else
-                return usage_error("bad --occlusion '%s' (on|off)", v);
-        } else if (strcmp(a, "--indirect-gain") == 0) {
-            if (parse_float(v, &cfg.indirect_gain) != 0)
-                return usage_error("bad --indirect-gain '%s'", v);
-        } else if (strcmp(a, "--emissive-vpls") == 0) {
-            if (parse_int(v, 0, 1 << 30, &n) != 0)
-                return usage_error("bad --emissive-vpls '%s'", v);
-            cfg.emissive_vpls = (int)n;
         } else if (strcmp(a, "--tick-rate") == 0) {
             if (parse_float(v, &cfg.tick_rate_hz) != 0)
                 return usage_error("bad --tick-rate '%s'", v);
-        } else if (config_knob(&cfg, a, v, &n) != 0) {
-            if (n) {
-                char msg[160];
-                snprintf(msg, sizeof msg, "bad %s '%s' (expected %s)", a, v, KNOB_WANT[n]);
-                return usage_error("%s", msg);
-            }
-            return usage_error("unknown argument '%s'", a);
+        } else if ((k = knob_of_flag(a)) != NULL) {
+            char err[256];
+            if (nset >= MAX_ARGS)
+                return usage_error("too many knobs%s", NULL);
+            set[nset].name = k->name;
+            if (lpvc_knob_parse(k, v, &set[nset].value, err, sizeof err) != 0)
+                return usage_error("bad %s", err);
+            nset++;
+        } else {
+            return usage_error("unknown argument '%s' (lpvctl knobs lists the daemon's knobs)", a);
         }
         i++;
     }
+    cfg.settings = set;
+    cfg.setting_count = nset;
     int rc = json ? lpvc_config_json(g_c, json) : lpvc_config_set(g_c, &cfg);
     if (rc != 0)
         return server_error();
@@ -1021,7 +1004,7 @@ static const struct {
 } g_cmds[] = {
     {"hello", cmd_hello},         {"load", cmd_load},         {"update", cmd_update},
     {"light-set", cmd_light_set}, {"light-remove", cmd_light_remove}, {"camera", cmd_camera},
-    {"config", cmd_config},       {"tick", cmd_tick},         {"subscribe", cmd_subscribe},
+    {"config", cmd_config},       {"knobs", cmd_knobs},       {"tick", cmd_tick},         {"subscribe", cmd_subscribe},
     {"unsubscribe", cmd_unsubscribe}, {"volume", cmd_volume}, {"frame", cmd_frame},
     {"query", cmd_query},         {"stats", cmd_stats},       {"ack", cmd_ack},
     {"bye", cmd_bye},

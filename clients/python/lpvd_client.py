@@ -48,18 +48,6 @@ VERSION = 1
 HEADER = struct.Struct("<4sHHIIII")  # magic, version, type, request_id, flags, json_len, att_len
 assert HEADER.size == 24
 
-# CONFIG's scalar knobs and their JSON kinds (SPEC R4.11; the daemon's table is
-# core/settings_fields.c): "int" -> integer, "float" -> number, "switch" -> bool.
-CONFIG_KNOBS = {
-    "iterations": "int", "rsm_size": "int", "shadow_size": "int", "occlusion": "switch", "indirect_gain": "float",
-    "emissive_vpls": "int", "cascades": "int", "cascade_size": "float", "cascade_ratio": "float",
-    "cascade_offset": "float", "bounces": "switch", "bounce_intensity": "float", "damping": "float",
-    "glossy": "switch", "glossy_roughness": "float", "media": "switch", "fog_sigma_s": "float",
-    "fog_sigma_a": "float", "media_step": "float", "planner": "switch", "area_lights": "switch",
-    "area_light_samples": "int", "central_transport": "switch", "normal_bins": "switch", "far_field": "switch",
-    "far_field_levels": "int", "far_field_steps": "int", "scene_surfels": "switch", "scene_surfel_count": "int",
-}
-
 # Message types (SPEC section 4).
 MSG = {
     "HELLO": 0x0001,
@@ -602,19 +590,53 @@ class Client(object):
                     body[k] = list(v) if isinstance(v, (tuple, list)) else v
         return self.request(MSG["CAMERA_SET"], body)[0]
 
+    @property
+    def knobs(self):
+        """CONFIG's knobs as the server describes them in HELLO (SPEC R4.12):
+        name -> {"type": "int" | "number" | "bool", "min", "max",
+        "min_exclusive", "default", "default_text", "unit", "note", "help"}."""
+        return {k["name"]: k for k in (self.hello_reply or {}).get("knobs", [])}
+
+    @property
+    def presets(self):
+        """The preset names the server offers (HELLO "presets")."""
+        return list((self.hello_reply or {}).get("presets", []))
+
+    @staticmethod
+    def knob_value(knob, v):
+        """v checked against a knob's description and typed for CONFIG:
+        bools take True / False or "on" / "off"; ints an integral number;
+        numbers a number in range. Raises ValueError naming the knob."""
+        name, kind = knob["name"], knob["type"]
+        if kind == "bool":
+            if v in ("on", "off"):
+                return v == "on"
+            if isinstance(v, bool):
+                return v
+            raise ValueError("%s: expected on or off, got %r" % (name, v))
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or v != v:
+            raise ValueError("%s: expected a number, got %r" % (name, v))
+        lo, hi = knob["min"], knob["max"]
+        if kind == "int" and v != int(v):
+            raise ValueError("%s: expected an integer, got %r" % (name, v))
+        if v > hi or v < lo or (knob.get("min_exclusive") and v == lo):
+            raise ValueError("%s: %r is outside %s%s..%s%s" % (name, v, "(" if knob.get("min_exclusive") else "[",
+                                                               lo, hi, "]"))
+        return int(v) if kind == "int" else v
+
     def config(self, **settings):
-        """CONFIG: preset ("fast", "balanced", "accurate"), grid, bounds,
-        tick_rate_hz and the knobs of CONFIG_KNOBS (iterations, rsm_size,
-        occlusion, indirect_gain, emissive_vpls, cascades, cascade_size, ...,
-        planner; SPEC R4.11). A preset sets grid, iterations, rsm_size and
-        occlusion; the other fields given override it. Switches take True /
-        False (or "on" / "off"). Returns {"revision", "config": {...}}."""
+        """CONFIG: preset (one of ``presets``), grid, bounds, tick_rate_hz and
+        any knob the server describes (``knobs``; SPEC R4.12). A knob's value is
+        checked against the description before sending. A preset sets grid,
+        iterations, rsm_size and occlusion; the other fields given override it.
+        Returns {"revision", "config": {...}}."""
+        knobs = self.knobs
         body = {}
         for k, v in settings.items():
             if v is None:
                 continue
-            if CONFIG_KNOBS.get(k) == "switch" and v in ("on", "off"):
-                v = v == "on"
+            if k in knobs:
+                v = self.knob_value(knobs[k], v)
             body[k] = list(v) if isinstance(v, tuple) else v
         return self.request(MSG["CONFIG"], body)[0]
 
@@ -816,6 +838,18 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
     say("HELLO -> %s" % json.dumps(c.hello_reply, sort_keys=True))
     if c.hello_reply.get("version") != 1:
         raise AssertionError("HELLO reply version %r" % c.hello_reply.get("version"))
+    knobs = c.knobs
+    if not knobs or "normal_bins" not in knobs or "far_field" not in knobs:
+        raise AssertionError("HELLO describes no normal_bins / far_field knobs: %r" % sorted(knobs))
+    for k in knobs.values():  # every default passes the client's own check of the description
+        Client.knob_value(k, k["default"])
+    try:
+        c.config(damping=knobs["damping"]["max"] + 1)
+        raise AssertionError("a damping above the described range was sent")
+    except ValueError as e:
+        if "damping" not in str(e):
+            raise AssertionError("the refusal does not name damping: %s" % e)
+    say("HELLO describes %d knobs and the presets %s" % (len(knobs), ", ".join(c.presets)))
     # The local lookup below is R5.7's: exact for one volume per cascade, so
     # normal bins and the far field (the defaults) are off (docs/protocol.md,
     # "Volumes and the defaults").

@@ -1,0 +1,74 @@
+/*
+ * volume_lookup.c - SPEC R5.7 on a decoded volume (see volume_lookup.h): the
+ * cascade choice and border blend here, the SH lookup from core's oracle.
+ */
+#include "volume_lookup.h"
+
+#include <math.h>
+#include <stdalign.h>
+#include <stdint.h>
+
+#include "oracle.h"
+
+/* The wire's 12 values per cell are core's lpv_cell, r g b vec4 each (R5.1). */
+_Static_assert(sizeof(lpv_cell) == 12 * sizeof(float), "lpv_cell is the wire's 12 floats");
+
+static int usable(const lpvp_lookup_cascade *cs)
+{
+    return cs && cs->cells && ((uintptr_t)cs->cells % alignof(lpv_cell)) == 0 && cs->dims[0] >= 1 &&
+           cs->dims[1] >= 1 && cs->dims[2] >= 1 && cs->cell_size > 0.0f && isfinite(cs->cell_size);
+}
+
+int lpvp_cascade_irradiance(const lpvp_lookup_cascade *cs, const float p[3], const float n[3], float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!usable(cs))
+        return -1;
+    lpv_grid g = {.dims = {cs->dims[0], cs->dims[1], cs->dims[2]},
+                  .origin = {cs->origin[0], cs->origin[1], cs->origin[2]},
+                  .cell_size = cs->cell_size};
+    lpv_oracle_irradiance(&g, (const lpv_cell *)(const void *)cs->cells, p, n, rgb);
+    return 0;
+}
+
+/* Distance from p to the box of cs in its cells (the smallest over the six
+ * faces; negative outside, NaN for a NaN p). */
+static float border_cells(const lpvp_lookup_cascade *cs, const float p[3])
+{
+    float d = INFINITY;
+    for (int a = 0; a < 3; a++) {
+        float u = (p[a] - cs->origin[a]) / cs->cell_size;
+        if (isnan(u))
+            return NAN;
+        d = fminf(d, fminf(u, (float)cs->dims[a] - u));
+    }
+    return d;
+}
+
+int lpvp_volume_irradiance(const lpvp_lookup_cascade *cs, int count, const float p[3], const float n[3],
+                           float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!cs || count < 1 || count > LPV_MAX_CASCADES)
+        return -1;
+    for (int i = 0; i < count; i++)
+        if (!usable(&cs[i]))
+            return -1;
+    int k = count - 1; /* the finest cascade containing p, the coarsest if none does */
+    for (int i = 0; i < count; i++)
+        if (border_cells(&cs[i], p) >= 0.0f) {
+            k = i;
+            break;
+        }
+    lpvp_cascade_irradiance(&cs[k], p, n, rgb);
+    if (k + 1 >= count || !(border_cells(&cs[k + 1], p) >= 0.0f))
+        return 0;
+    float w = fminf(fmaxf((border_cells(&cs[k], p) - 1.0f) * 0.5f, 0.0f), 1.0f);
+    if (w >= 1.0f)
+        return 0;
+    float coarse[3];
+    lpvp_cascade_irradiance(&cs[k + 1], p, n, coarse);
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = w * rgb[ch] + (1.0f - w) * coarse[ch];
+    return 0;
+}

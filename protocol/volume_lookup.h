@@ -1,0 +1,44 @@
+/*
+ * volume_lookup.h - irradiance from a decoded volume (SPEC R5.7), for
+ * clients: the cascade to read at a point and the blend across cascade
+ * borders. The SH lookup inside one cascade is core's reference lookup
+ * (core/oracle.h lpv_oracle_irradiance: the half-cell offset, trilinear
+ * filtering clamped at the edge, the cosine lobe, / cell_size^2), so the
+ * client's answer and the oracle tests' are the same code; this file adds only
+ * what the SPEC defines on top of it. Part of the lpv_protocol library, which
+ * therefore links lpv_core (protocol -> core; core never includes protocol).
+ */
+#ifndef LPVP_VOLUME_LOOKUP_H
+#define LPVP_VOLUME_LOOKUP_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* One cascade of a decoded volume (R5.6). */
+typedef struct lpvp_lookup_cascade {
+    int dims[3];          /* cells per axis, each >= 1 */
+    float origin[3];      /* m, lower corner */
+    float cell_size;      /* m, > 0 */
+    const float *cells;   /* dims' product x 12 floats in the wire order (R5.1), 16-byte aligned
+                             (malloc'd buffers are; each cascade starts a multiple of 48 bytes in) */
+} lpvp_lookup_cascade;
+
+/* Irradiance (W/m^2, rgb) at p for a surface with normal n from one cascade
+ * (lpv_oracle_irradiance). Returns 0, or -1 (rgb zero) for a cascade that
+ * is not usable: no cells, misaligned cells, dims < 1 or a cell size <= 0. */
+int lpvp_cascade_irradiance(const lpvp_lookup_cascade *cs, const float p[3], const float n[3], float rgb[3]);
+
+/* R5.7 over count (1..4) cascades, finest first: the finest cascade whose
+ * box contains p (the coarsest when none does); within 3 of its cells of its
+ * border, blended with the next coarser one containing p,
+ * E = lerp(E_coarser, E_fine, clamp((d - 1) / 2, 0, 1)), d the distance to
+ * the border in the finer cascade's cells. Returns 0, or -1 as above. */
+int lpvp_volume_irradiance(const lpvp_lookup_cascade *cs, int count, const float p[3], const float n[3],
+                           float rgb[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LPVP_VOLUME_LOOKUP_H */

@@ -1,0 +1,25 @@
+/* settings_json.h - the daemon's description of its settings knobs (SPEC
+ * R4.12), built from core's field table so clients need no copy of it. */
+#ifndef LPVD_SETTINGS_JSON_H
+#define LPVD_SETTINGS_JSON_H
+
+#include <jansson.h>
+
+#include "settings.h"
+
+/* One object per entry of core/settings_fields.c's table, in its order:
+ *   {"name", "type": "int" | "number" | "bool",
+ *    "min", "max", "min_exclusive" (int and number only),
+ *    "default": the value a session starts with (defaults, resolved; typed
+ *               like the knob), "default_text": the default in words,
+ *    "unit", "note", "help"}
+ * defaults: the daemon's default CONFIG (zero fields = the engine's
+ * defaults). max_texture: the daemon's --max-texture, which also bounds the
+ * knobs measured in texels (rsm_size, shadow_size), so the range described
+ * is the range CONFIG accepts. A new reference (NULL if memory runs out). */
+json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture);
+
+/* The preset names of core's preset table, in its order: ["fast", ...]. */
+json_t *lpvd_presets_json(void);
+
+#endif
