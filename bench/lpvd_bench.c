@@ -3,7 +3,7 @@
  * repeated ticks, after warm-up ticks that absorb shader compilation) and
  * the propagation throughput in cell-steps per second.
  *
- *   lpvd-bench [--repeat N] [--warmup N] [--size WxH] [--backend NAME] [SCENE]
+ *   lpvd-bench [--repeat N] [--warmup N] [lpvd flags: --size WxH, --backend NAME, ...] [SCENE]
  *
  * Configurations: the default preset (balanced), and the paper's pipeline
  * (the four departures of docs/propagation.md off) at 32^3 / 8 iterations /
@@ -39,29 +39,55 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+enum { B_REPEAT, B_WARMUP, B_HELP, B_COUNT };
+
+static const lpv_flag FLAGS[B_COUNT] = {
+    [B_REPEAT] = {"repeat", 0, "N", "timed ticks per configuration, 1..1000 (default 15)"},
+    [B_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 3)"},
+    [B_HELP] = {"help", 'h', NULL, "this text"},
+};
+
+static void usage(FILE *f)
+{
+    char help[2048];
+    size_t len = 0;
+    lpv_flags_help(help, sizeof help, &len, FLAGS, B_COUNT);
+    fprintf(f, "usage: lpvd-bench [--repeat N] [--warmup N] [lpvd flags] [SCENE]\n%s%s", help, LPVD_OPTIONS_HELP);
+}
+
 int main(int argc, char **argv)
 {
     int repeat = 15, warmup = 3;
     const char *scene_path = NULL;
     lpvd_options opt = {0};
     char err[1024];
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
-            repeat = atoi(argv[++i]);
-        } else if (strcmp(argv[i], "--warmup") == 0 && i + 1 < argc) {
-            warmup = atoi(argv[++i]);
-        } else if (argv[i][0] == '-' && argv[i][1] == '-' && lpvd_option_takes_value(argv[i] + 2) > 0 &&
-                   i + 1 < argc) {
-            if (lpvd_option_parse(&opt, argv[i] + 2, argv[i + 1], err, sizeof err) < 0) {
-                fprintf(stderr, "lpvd-bench: %s\n", err);
-                return 2;
-            }
-            ++i;
-        } else if (argv[i][0] != '-') {
-            scene_path = argv[i];
-        } else {
-            fprintf(stderr, "usage: lpvd-bench [--repeat N] [--warmup N] [--size WxH] [--backend NAME] [SCENE]\n");
+    lpv_flag_group groups[4] = {{FLAGS, B_COUNT, NULL, NULL}};
+    int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 1);
+    lpv_flags p;
+    if (lpv_flags_begin(&p, argc, argv, groups, ngroups, 0) != 0) {
+        fprintf(stderr, "lpvd-bench: %s\n", p.err);
+        return 2;
+    }
+    int g;
+    const lpv_flag *fl;
+    const char *v;
+    for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
+        if (it == LPV_FLAGS_BAD_VALUE) {
+            fprintf(stderr, "lpvd-bench: %s\n", p.err);
             return 2;
+        } else if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_NO_VALUE) {
+            fprintf(stderr, "lpvd-bench: %s %s (see --help)\n", p.arg,
+                    it == LPV_FLAGS_UNKNOWN ? "is unknown" : "needs a value");
+            return 2;
+        } else if (it == LPV_FLAGS_POSITIONAL) {
+            scene_path = v; /* the last one given */
+        } else if (fl == &FLAGS[B_HELP]) {
+            usage(stdout);
+            return 0;
+        } else if (fl == &FLAGS[B_REPEAT]) {
+            repeat = atoi(v);
+        } else if (fl == &FLAGS[B_WARMUP]) {
+            warmup = atoi(v);
         }
     }
     if (repeat < 1 || repeat > 1000 || warmup < 0) {
@@ -75,7 +101,7 @@ int main(int argc, char **argv)
         return 1;
     }
     lpv_view view;
-    if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+    if (lpv_view_resolve(&opt.cam, &scene, &view, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-bench: %s\n", err);
         return 2;
     }

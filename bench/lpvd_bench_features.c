@@ -5,7 +5,7 @@
  * scenes/glossy.glb for glossy), plus what the tick planner saves on a
  * scene where nothing changed and where only the camera moved within a cell.
  *
- *   lpvd-bench-features [--repeat N] [--warmup N] [--scenes-dir DIR] [--size WxH] [--backend NAME]
+ *   lpvd-bench-features [--repeat N] [--warmup N] [--scenes-dir DIR] [lpvd flags: --size WxH, --backend NAME, ...]
  *
  * Every configuration starts from the settings given on the command line
  * (default: the balanced preset; the header line says which). With the planner on, a tick on an unchanged scene
@@ -106,14 +106,14 @@ static int load_view(const bench_scene *bs, const lpvd_options *opt, lpv_scene *
 {
     if (lpv_scene_load(bs->builtin ? NULL : bs->path, scene, err, n) != 0)
         return -1;
-    lpvd_camera_choice cam = opt->cam;
+    lpv_view_choice cam = opt->cam;
     if (bs->has_cam) {
         cam.has_eye = cam.has_target = cam.has_fov = 1;
         memcpy(cam.eye, bs->eye, sizeof cam.eye);
         memcpy(cam.target, bs->target, sizeof cam.target);
         cam.fov_deg = bs->fov;
     }
-    if (lpvd_resolve_view(&cam, scene, view, err, n) != 0) {
+    if (lpv_view_resolve(&cam, scene, view, err, n) != 0) {
         lpv_scene_free(scene);
         return -1;
     }
@@ -314,34 +314,65 @@ fail:
     return -1;
 }
 
+enum { B_REPEAT, B_WARMUP, B_SCENES_DIR, B_PLANNER_ONLY, B_STAGES_ONLY, B_HELP, B_COUNT };
+
+static const lpv_flag FLAGS[B_COUNT] = {
+    [B_REPEAT] = {"repeat", 0, "N", "timed ticks per configuration, 1..200 (default 7)"},
+    [B_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 2)"},
+    [B_SCENES_DIR] = {"scenes-dir", 0, "DIR", "where courtyard.glb and glossy.glb are (default: scenes/ of the\n"
+                                              "source tree)"},
+    [B_PLANNER_ONLY] = {"planner-only", 0, NULL, "only the planner's table (default: both tables)"},
+    [B_STAGES_ONLY] = {"stages-only", 0, NULL, "only the per-stage table"},
+    [B_HELP] = {"help", 'h', NULL, "this text"},
+};
+
+static void usage(FILE *f)
+{
+    char help[2048];
+    size_t len = 0;
+    lpv_flags_help(help, sizeof help, &len, FLAGS, B_COUNT);
+    fprintf(f, "usage: lpvd-bench-features [--repeat N] [--warmup N] [--scenes-dir DIR] [--planner-only | "
+               "--stages-only] [lpvd flags]\n%s%s",
+            help, LPVD_OPTIONS_HELP);
+}
+
 int main(int argc, char **argv)
 {
     int repeat = 7, warmup = 2, skip_stages = 0, skip_planner = 0;
     const char *scenes_dir = LPVD_BENCH_SCENES_DIR;
     lpvd_options opt = {0};
     char err[1024];
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
-            repeat = atoi(argv[++i]);
-        } else if (strcmp(argv[i], "--warmup") == 0 && i + 1 < argc) {
-            warmup = atoi(argv[++i]);
-        } else if (strcmp(argv[i], "--planner-only") == 0) {
-            skip_stages = 1;
-        } else if (strcmp(argv[i], "--stages-only") == 0) {
-            skip_planner = 1;
-        } else if (strcmp(argv[i], "--scenes-dir") == 0 && i + 1 < argc) {
-            scenes_dir = argv[++i];
-        } else if (argv[i][0] == '-' && argv[i][1] == '-' && lpvd_option_takes_value(argv[i] + 2) > 0 &&
-                   i + 1 < argc) {
-            if (lpvd_option_parse(&opt, argv[i] + 2, argv[i + 1], err, sizeof err) < 0) {
-                fprintf(stderr, "lpvd-bench-features: %s\n", err);
-                return 2;
-            }
-            ++i;
-        } else {
-            fprintf(stderr, "usage: lpvd-bench-features [--repeat N] [--warmup N] [--scenes-dir DIR] [--size WxH] "
-                            "[--backend NAME] [--planner-only | --stages-only]\n");
+    lpv_flag_group groups[4] = {{FLAGS, B_COUNT, NULL, NULL}};
+    int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 1);
+    lpv_flags p;
+    if (lpv_flags_begin(&p, argc, argv, groups, ngroups, 0) != 0) {
+        fprintf(stderr, "lpvd-bench-features: %s\n", p.err);
+        return 2;
+    }
+    int g;
+    const lpv_flag *fl;
+    const char *v;
+    for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
+        if (it == LPV_FLAGS_BAD_VALUE) {
+            fprintf(stderr, "lpvd-bench-features: %s\n", p.err);
             return 2;
+        } else if (it != LPV_FLAGS_FLAG) {
+            fprintf(stderr, "lpvd-bench-features: %s %s (see --help)\n", it == LPV_FLAGS_POSITIONAL ? v : p.arg,
+                    it == LPV_FLAGS_NO_VALUE ? "needs a value" : it == LPV_FLAGS_POSITIONAL ? "is no flag" : "is unknown");
+            return 2;
+        } else if (fl == &FLAGS[B_HELP]) {
+            usage(stdout);
+            return 0;
+        } else if (fl == &FLAGS[B_REPEAT]) {
+            repeat = atoi(v);
+        } else if (fl == &FLAGS[B_WARMUP]) {
+            warmup = atoi(v);
+        } else if (fl == &FLAGS[B_SCENES_DIR]) {
+            scenes_dir = v;
+        } else if (fl == &FLAGS[B_PLANNER_ONLY]) {
+            skip_stages = 1;
+        } else if (fl == &FLAGS[B_STAGES_ONLY]) {
+            skip_planner = 1;
         }
     }
     if (repeat < 1 || repeat > MAX_REPEAT || warmup < 0) {

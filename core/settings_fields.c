@@ -21,7 +21,7 @@
 static const lpv_field FIELDS[] = {
     /* The older knobs (the preset supplies the defaults of three of them). */
     {"iterations", "iterations", LPV_FIELD_INT, F(iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
-     "the preset's (balanced: 4)", "", "propagation steps"},
+     "the preset's", "", "propagation steps"},
     {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
      "the preset's (balanced: 128)", "", "reflective shadow map side"},
     {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", "1024", "",

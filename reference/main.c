@@ -10,11 +10,11 @@
 #include <time.h>
 
 #include "image_io.h"
-#include "options.h"
 #include "pt.h"
 #include "scene_load.h"
+#include "view_choice.h"
 
-static const char USAGE[] =
+static const char USAGE_HEAD[] =
     "usage: lpvd-reference [SCENE.glb] -o OUT.exr [--stderr STDERR.exr] [options]\n"
     "       lpvd-reference [SCENE.glb] --points IN.csv -o OUT.csv [options]\n"
     "\n"
@@ -23,20 +23,37 @@ static const char USAGE[] =
     "with --full, the whole frame (what `lpvd render` shows); points mode reads\n"
     "px,py,pz,nx,ny,nz lines and writes E_r,E_g,E_b,se_r,se_g,se_b (W/m^2).\n"
     "Without SCENE: the built-in Cornell box.\n"
-    "\n"
-    "  -o PATH                 output image (.exr: float) or, with --points, CSV\n"
-    "  --stderr PATH           per-pixel standard error image\n"
-    "  --full                  the full frame: emission + direct + bounced light\n"
-    "  --area-lights on|off    on (default, as lpvd): emissive surfaces are lights, their\n"
-    "                          direct light is not in E_ind; off: it is (lpvd --area-lights off)\n"
-    "  --bounces N             diffuse bounces (default 1 = lpvd's LPV term; --full: 0..64)\n"
-    "  --spp N                 samples per pixel or point (default 64)\n"
-    "  --threads N             worker threads (default: the number of cores)\n"
-    "  --seed N                RNG seed (default 0)\n"
-    "  --points PATH           irradiance at the points of a CSV file\n"
-    "  --camera N|NAME         a camera of the glTF file, by index or name\n"
-    "  --eye X,Y,Z --target X,Y,Z --fov DEG   an explicit camera (fov vertical)\n"
-    "  --size WxH              image size (default 512 wide, height from the camera's aspect)\n";
+    "\n";
+
+enum { F_OUT, F_STDERR, F_FULL, F_AREA, F_BOUNCES, F_SPP, F_THREADS, F_SEED, F_POINTS, F_HELP, F_COUNT };
+
+/* Long-only parsing: "-spp 64" is "--spp 64", as it always was here. */
+static const lpv_flag FLAGS[F_COUNT] = {
+    [F_OUT] = {"output", 'o', "PATH", "output image (.exr: float) or, with --points, CSV (required)"},
+    [F_STDERR] = {"stderr", 0, "PATH", "per-pixel standard error image (default: none)"},
+    [F_FULL] = {"full", 0, NULL, "the full frame: emission + direct + bounced light"},
+    [F_AREA] = {"area-lights", 0, "on|off", "on (default, as lpvd): emissive surfaces are lights, their\n"
+                                            "direct light is not in E_ind; off: it is (lpvd --area-lights off)"},
+    [F_BOUNCES] = {"bounces", 0, "N", "diffuse bounces (default 1 = lpvd's LPV term; --full: 0..64)"},
+    [F_SPP] = {"spp", 0, "N", "samples per pixel or point (default 64)"},
+    [F_THREADS] = {"threads", 0, "N", "worker threads (default: the number of cores)"},
+    [F_SEED] = {"seed", 0, "N", "RNG seed (default 0)"},
+    [F_POINTS] = {"points", 0, "PATH", "irradiance at the points of a CSV file (default: an image)"},
+    [F_HELP] = {"help", 'h', NULL, "this text"},
+};
+
+/* The usage: the head, this program's flags and the camera's, from their tables. */
+static const char *usage(void)
+{
+    static char text[8192];
+    if (!text[0]) {
+        size_t len = 0;
+        lpv_flags_append(text, sizeof text, &len, "%s", USAGE_HEAD);
+        lpv_flags_help(text, sizeof text, &len, FLAGS, F_COUNT);
+        lpv_flags_append(text, sizeof text, &len, "%s", lpv_view_flags_help());
+    }
+    return text;
+}
 
 static int parse_int(const char *s, int lo, int hi, int *out)
 {
@@ -47,12 +64,6 @@ static int parse_int(const char *s, int lo, int hi, int *out)
         return -1;
     *out = (int)v;
     return 0;
-}
-
-static int is_camera_flag(const char *name)
-{
-    return strcmp(name, "camera") == 0 || strcmp(name, "eye") == 0 || strcmp(name, "target") == 0 ||
-           strcmp(name, "fov") == 0 || strcmp(name, "size") == 0;
 }
 
 static double now_s(void)
@@ -160,70 +171,72 @@ int main(int argc, char **argv)
     const char *scene_path = NULL, *out = NULL, *se_out = NULL, *points = NULL;
     int bounces = 1, spp = 64, threads = 0, full = 0, area_lights = 1;
     unsigned long long seed = 0;
-    lpvd_options opt;
-    memset(&opt, 0, sizeof opt);
+    lpv_view_choice cam;
+    memset(&cam, 0, sizeof cam);
     char err[512];
 
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            fputs(USAGE, stdout);
-            return 0;
+    lpv_flag_group groups[2] = {{FLAGS, F_COUNT, NULL, NULL}, lpv_view_flag_group(&cam)};
+    lpv_flags p;
+    if (lpv_flags_begin(&p, argc, argv, groups, 2, 1) != 0) {
+        fprintf(stderr, "lpvd-reference: %s\n", p.err);
+        return 2;
+    }
+    int g;
+    const lpv_flag *fl;
+    const char *val;
+    for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &val)) != LPV_FLAGS_END;) {
+        if (it == LPV_FLAGS_UNKNOWN) {
+            fprintf(stderr, "lpvd-reference: unknown flag %s\n%s", p.arg, usage());
+            return 2;
         }
-        if (a[0] != '-') {
+        if (it == LPV_FLAGS_NO_VALUE) {
+            fprintf(stderr, "lpvd-reference: %s needs a value\n", p.arg);
+            return 2;
+        }
+        if (it == LPV_FLAGS_BAD_VALUE) {
+            fprintf(stderr, "lpvd-reference: %s\n", p.err);
+            return 2;
+        }
+        if (it == LPV_FLAGS_POSITIONAL) {
             if (scene_path) {
-                fprintf(stderr, "lpvd-reference: more than one scene given (%s, %s)\n", scene_path, a);
+                fprintf(stderr, "lpvd-reference: more than one scene given (%s, %s)\n", scene_path, val);
                 return 2;
             }
-            scene_path = a;
+            scene_path = val;
             continue;
         }
-        const char *name = a[1] == '-' ? a + 2 : a + 1;
-        const char *val = (i + 1 < argc) ? argv[i + 1] : NULL;
-        if (strcmp(name, "full") == 0) {
-            full = 1;
-            continue;
-        }
-        int takes = strcmp(name, "o") == 0 || strcmp(name, "stderr") == 0 || strcmp(name, "bounces") == 0 ||
-                    strcmp(name, "spp") == 0 || strcmp(name, "threads") == 0 || strcmp(name, "seed") == 0 ||
-                    strcmp(name, "points") == 0 || strcmp(name, "area-lights") == 0 || is_camera_flag(name);
-        if (!takes) {
-            fprintf(stderr, "lpvd-reference: unknown flag %s\n%s", a, USAGE);
-            return 2;
-        }
-        if (!val) {
-            fprintf(stderr, "lpvd-reference: %s needs a value\n", a);
-            return 2;
-        }
-        ++i;
-        if (strcmp(name, "o") == 0) {
-            out = val;
-        } else if (strcmp(name, "stderr") == 0) {
-            se_out = val;
-        } else if (strcmp(name, "points") == 0) {
-            points = val;
-        } else if (strcmp(name, "area-lights") == 0) {
+        switch (fl - FLAGS) {
+        case F_HELP: fputs(usage(), stdout); return 0;
+        case F_OUT: out = val; break;
+        case F_STDERR: se_out = val; break;
+        case F_POINTS: points = val; break;
+        case F_FULL: full = 1; break;
+        case F_AREA:
             if (strcmp(val, "on") != 0 && strcmp(val, "off") != 0) {
                 fprintf(stderr, "lpvd-reference: --area-lights %s: expected on or off\n", val);
                 return 2;
             }
             area_lights = strcmp(val, "on") == 0;
-        } else if (strcmp(name, "bounces") == 0) {
+            break;
+        case F_BOUNCES:
             if (parse_int(val, 0, 64, &bounces) != 0) {
                 fprintf(stderr, "lpvd-reference: --bounces %s: expected 1..64 (0..64 with --full)\n", val);
                 return 2;
             }
-        } else if (strcmp(name, "spp") == 0) {
+            break;
+        case F_SPP:
             if (parse_int(val, 1, 1 << 24, &spp) != 0) {
                 fprintf(stderr, "lpvd-reference: --spp %s: expected 1..16777216\n", val);
                 return 2;
             }
-        } else if (strcmp(name, "threads") == 0) {
+            break;
+        case F_THREADS:
             if (parse_int(val, 1, 256, &threads) != 0) {
                 fprintf(stderr, "lpvd-reference: --threads %s: expected 1..256\n", val);
                 return 2;
             }
-        } else if (strcmp(name, "seed") == 0) {
+            break;
+        case F_SEED: {
             char *end = NULL;
             errno = 0;
             seed = strtoull(val, &end, 10);
@@ -231,13 +244,12 @@ int main(int argc, char **argv)
                 fprintf(stderr, "lpvd-reference: --seed %s: expected a non-negative integer\n", val);
                 return 2;
             }
-        } else if (lpvd_option_parse(&opt, name, val, err, sizeof err) != 1) {
-            fprintf(stderr, "lpvd-reference: %s\n", err);
-            return 2;
+            break;
+        }
         }
     }
     if (!out) {
-        fprintf(stderr, "lpvd-reference: -o is required\n%s", USAGE);
+        fprintf(stderr, "lpvd-reference: -o is required\n%s", usage());
         return 2;
     }
     if (bounces == 0 && !full) {
@@ -272,7 +284,7 @@ int main(int argc, char **argv)
     }
 
     lpv_view view;
-    if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+    if (lpv_view_resolve(&cam, &scene, &view, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-reference: %s\n", err);
         goto done_scene;
     }

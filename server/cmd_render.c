@@ -16,26 +16,35 @@
 #include "stats_json.h"
 #include "tonemap.h"
 
+enum { R_OUTPUT, R_INDIRECT, R_DIRECT, R_EXPOSURE, R_BACKGROUND, R_TRANSPARENT, R_STATS, R_HELP, R_COUNT };
+
+static const lpv_flag RENDER_FLAGS[R_COUNT] = {
+    [R_OUTPUT] = {"output", 'o', "PATH", "image file, .png (8-bit sRGB) or .exr (linear float)\n"
+                                         "(default render.png)"},
+    [R_INDIRECT] = {"indirect-only", 0, NULL, "only the LPV term: albedo/pi * gain * E_lpv"},
+    [R_DIRECT] = {"direct-only", 0, NULL, "only direct light and emission"},
+    [R_EXPOSURE] = {"exposure", 0, "auto|EV",
+                    "PNG exposure: metered from the frame (auto, default) or\n"
+                    "fixed: the PNG shows 683 lm/W x radiance x 2^EV before the\n"
+                    "tone curve (EV 0 = three.js / Khronos viewer at exposure 1;\n"
+                    "a linear factor f is EV log2(f)); docs/units.md"},
+    [R_BACKGROUND] = {"background", 0, "R,G,B", "PNG background where no geometry is seen, sRGB 0..1\n"
+                                                "(default 0.25,0.25,0.25, opaque)"},
+    [R_TRANSPARENT] = {"transparent", 0, NULL, "PNG background alpha 0 instead"},
+    [R_STATS] = {"stats", 0, NULL, "print per-stage GPU times and counts as JSON"},
+    [R_HELP] = {"help", 'h', NULL, "this text"},
+};
+
 static void usage(FILE *f)
 {
+    char help[4096];
+    size_t len = 0;
+    lpv_flags_help(help, sizeof help, &len, RENDER_FLAGS, R_COUNT);
     fprintf(f,
             "usage: lpvd render [SCENE.gltf|SCENE.glb] [-o OUT.png|OUT.exr] [flags]\n"
             "Renders SCENE (default: the built-in Cornell box) from its camera.\n"
-            "Output:\n"
-            "  -o, --output PATH       image file, .png (8-bit sRGB) or .exr (linear float)\n"
-            "                          (default render.png)\n"
-            "  --indirect-only         only the LPV term: albedo/pi * gain * E_lpv\n"
-            "  --direct-only           only direct light and emission\n"
-            "  --exposure auto|EV      PNG exposure: metered from the frame (auto, default) or\n"
-            "                          fixed: the PNG shows 683 lm/W x radiance x 2^EV before the\n"
-            "                          tone curve (EV 0 = three.js / Khronos viewer at exposure 1;\n"
-            "                          a linear factor f is EV log2(f)); docs/units.md\n"
-            "  --background R,G,B      PNG background where no geometry is seen, sRGB 0..1\n"
-            "                          (default 0.25,0.25,0.25, opaque)\n"
-            "  --transparent           PNG background alpha 0 instead\n"
-            "  --stats                 print per-stage GPU times and counts as JSON\n"
-            "%s",
-            LPVD_OPTIONS_HELP);
+            "Output:\n%s%s",
+            help, LPVD_OPTIONS_HELP);
 }
 
 int lpvd_cmd_render(int argc, char **argv)
@@ -48,33 +57,52 @@ int lpvd_cmd_render(int argc, char **argv)
     int stats = 0;
     char err[1024] = "";
 
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage(stdout);
-            return 0;
+    lpv_flag_group groups[4] = {{RENDER_FLAGS, R_COUNT, NULL, NULL}};
+    int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 1);
+    lpv_flags p;
+    if (lpv_flags_begin(&p, argc, argv, groups, ngroups, 0) != 0) {
+        fprintf(stderr, "lpvd render: %s\n", p.err);
+        return 2;
+    }
+    int g;
+    const lpv_flag *fl;
+    const char *v;
+    for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
+        if (it == LPV_FLAGS_UNKNOWN) {
+            fprintf(stderr, "lpvd render: unknown flag %s (see lpvd render --help)\n", p.arg);
+            return 2;
         }
-        if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-            if (++i >= argc) {
-                fprintf(stderr, "lpvd render: %s needs a path\n", a);
+        if (it == LPV_FLAGS_NO_VALUE) {
+            fprintf(stderr, "lpvd render: %s needs a %s\n", p.arg,
+                    strcmp(p.arg, "-o") == 0 || strcmp(p.arg, "--output") == 0 ? "path" : "value");
+            return 2;
+        }
+        if (it == LPV_FLAGS_BAD_VALUE) {
+            fprintf(stderr, "lpvd render: %s\n", p.err);
+            return 2;
+        }
+        if (it == LPV_FLAGS_POSITIONAL) {
+            if (scene_path) {
+                fprintf(stderr, "lpvd render: more than one scene given (%s, %s)\n", scene_path, v);
                 return 2;
             }
-            out_path = argv[i];
-        } else if (strcmp(a, "--indirect-only") == 0) {
-            terms = LPV_TERMS_INDIRECT_ONLY;
-        } else if (strcmp(a, "--direct-only") == 0) {
-            terms = LPV_TERMS_DIRECT_ONLY;
-        } else if (strcmp(a, "--stats") == 0) {
-            stats = 1;
-        } else if (strcmp(a, "--exposure") == 0) {
-            if (lpv_exposure_parse(i + 1 < argc ? argv[++i] : NULL, &display, err, sizeof err) != 0) {
+            scene_path = v;
+            continue;
+        }
+        switch (fl - RENDER_FLAGS) {
+        case R_HELP: usage(stdout); return 0;
+        case R_OUTPUT: out_path = v; break;
+        case R_INDIRECT: terms = LPV_TERMS_INDIRECT_ONLY; break;
+        case R_DIRECT: terms = LPV_TERMS_DIRECT_ONLY; break;
+        case R_STATS: stats = 1; break;
+        case R_TRANSPARENT: display.transparent = 1; break;
+        case R_EXPOSURE:
+            if (lpv_exposure_parse(v, &display, err, sizeof err) != 0) {
                 fprintf(stderr, "lpvd render: --%s\n", err);
                 return 2;
             }
-        } else if (strcmp(a, "--transparent") == 0) {
-            display.transparent = 1;
-        } else if (strcmp(a, "--background") == 0) {
-            const char *v = i + 1 < argc ? argv[++i] : "";
+            break;
+        case R_BACKGROUND: {
             float b[3];
             char tail;
             if (sscanf(v, "%f,%f,%f%c", &b[0], &b[1], &b[2], &tail) != 3 || !(b[0] >= 0.0f && b[0] <= 1.0f) ||
@@ -83,28 +111,8 @@ int lpvd_cmd_render(int argc, char **argv)
                 return 2;
             }
             memcpy(display.background, b, sizeof b);
-        } else if (a[0] == '-' && a[1] == '-') {
-            const char *name = a + 2;
-            if (lpvd_option_takes_value(name) < 0) {
-                fprintf(stderr, "lpvd render: unknown flag %s (see lpvd render --help)\n", a);
-                return 2;
-            }
-            if (i + 1 >= argc) {
-                fprintf(stderr, "lpvd render: %s needs a value\n", a);
-                return 2;
-            }
-            if (lpvd_option_parse(&opt, name, argv[++i], err, sizeof err) < 0) {
-                fprintf(stderr, "lpvd render: %s\n", err);
-                return 2;
-            }
-        } else if (a[0] == '-') {
-            fprintf(stderr, "lpvd render: unknown flag %s (see lpvd render --help)\n", a);
-            return 2;
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            fprintf(stderr, "lpvd render: more than one scene given (%s, %s)\n", scene_path, a);
-            return 2;
+            break;
+        }
         }
     }
 
@@ -114,7 +122,7 @@ int lpvd_cmd_render(int argc, char **argv)
         return 1;
     }
     lpv_view view;
-    if (lpvd_resolve_view(&opt.cam, &scene, &view, err, sizeof err) != 0) {
+    if (lpv_view_resolve(&opt.cam, &scene, &view, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd render: %s\n", err);
         lpv_scene_free(&scene);
         return 2;

@@ -145,7 +145,7 @@ static int run_scene(lpv_engine *e, const lpv_acc_emissive_desc *d, const char *
 {
     char err[1024] = "", path[1400];
     lpv_view view;
-    if (lpvd_resolve_view(&d->opt->cam, scene, &view, err, sizeof err) != 0) {
+    if (lpv_view_resolve(&d->opt->cam, scene, &view, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-accuracy: %s: %s\n", name, err);
         return -1;
     }

@@ -216,42 +216,72 @@ typedef struct scene_entry {
     int scale_free;     /* a real scene in its own units (engine: millimetres) */
 } scene_entry;
 
+enum {
+    A_OUT, A_REF_SPP, A_SCENES, A_QUICK, A_PRESETS, A_FEATURES, A_MULTI_BOUNCES, A_KNOBS, A_POINTS,
+    A_TICKS, A_WARMUP, A_REFERENCE, A_NO_PLOT, A_EMISSIVE, A_HELP, A_COUNT
+};
+
+static const lpv_flag FLAGS[A_COUNT] = {
+    [A_OUT] = {"out", 0, "DIR", "output folder (default accuracy-out)"},
+    [A_REF_SPP] = {"ref-spp", 0, "N", "reference samples per pixel (default 256)"},
+    [A_SCENES] = {"scenes", 0, "LIST",
+                  "comma list: cornell (built-in), courtyard, blinds (scenes/*.glb),\n"
+                  "engine, clearcoat (Debian's assimp-testmodels: 2CylinderEngine.glb,\n"
+                  "a CAD model in mm under the default light; ClearCoatTest.gltf, spheres\n"
+                  "lit by emissive labels), or paths to .glb/.gltf files\n"
+                  "(default cornell,courtyard,blinds)"},
+    [A_QUICK] = {"quick", 0, NULL, "the quick points (count below) instead of the 320-point factorial\n"
+                                   "(grid 6/8/12/16/32 x iterations 2/4/8/16 x the 16 combinations of the\n"
+                                   "mods below; RSM 128, occlusion on)"},
+    [A_PRESETS] = {"presets", 0, NULL, "exactly the named presets (fast, balanced, accurate) as the points"},
+    [A_FEATURES] = {"features", 0, NULL, "one knob at a time around balanced: cascades 3, bounces on, damping\n"
+                                         "0.5 and 1 vs one grid (alone: scenes cornell-inside,courtyard,blinds;\n"
+                                         "with another point set: added to it); features.png"},
+    [A_MULTI_BOUNCES] = {"multi-bounces", 0, "N", "bounces of the reference for bounces on (--features; 2..64,\n"
+                                                  "default 3)"},
+    [A_KNOBS] = {"knobs", 0, "SPEC", "the factorial's values per knob (any given list replaces the default), e.g.\n"
+                                     "grid=16/32,iterations=8,rsm=256,occlusion=on,central=on,bins=off/on,\n"
+                                     "far=on,surfels=on (mods: central transport, normal bins, far field,\n"
+                                     "scene surfels)"},
+    [A_POINTS] = {"points", 0, "LIST", "explicit points GRID:ITER:RSM:on|off[:MODS], MODS letters of cbfs"},
+    [A_TICKS] = {"ticks", 0, "N", "timed ticks per point, median reported (default 5)"},
+    [A_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 2)"},
+    [A_REFERENCE] = {"reference", 0, "PATH", "run this reference command (lpvd-reference's CLI) instead of the\n"
+                                             "linked lpv_reference library (default: $LPVD_REFERENCE, else the\n"
+                                             "library when linked, else reference/lpvd-reference in this build tree)"},
+    [A_NO_PLOT] = {"no-plot", 0, NULL, "do not run gnuplot (plot.gp is still written)"},
+    [A_EMISSIVE] = {"emissive", 0, NULL, "only the emissive-lit scenes: lpvd's FULL frame vs the reference's\n"
+                                         "full frame, area lights off and on with 1..64 samples\n"
+                                         "(emissive.csv, emissive.md; docs/area-lights.md)"},
+    [A_HELP] = {"help", 'h', NULL, "this text"},
+};
+
+/* The shared flags this program refuses: the sweep sets them per point. */
+static const char *const SWEPT[] = {"grid", "iterations", "rsm-size", "occlusion", "preset", "central-transport",
+                                    "normal-bins", "far-field", "scene-surfels", NULL};
+
+static int is_swept(const char *name)
+{
+    for (int i = 0; SWEPT[i]; ++i)
+        if (strcmp(name, SWEPT[i]) == 0)
+            return 1;
+    return 0;
+}
+
 static void usage(FILE *f)
 {
+    static char help[8192];
+    size_t len = 0;
+    lpv_flags_help(help, sizeof help, &len, FLAGS, A_COUNT);
     fprintf(f,
             "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick] [--presets]\n"
             "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
             "                     [--reference PATH] [--no-plot] [lpvd flags: --backend, --camera, ...]\n"
             "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
-            "  --out DIR          output folder (default accuracy-out)\n"
-            "  --size WxH         image size (default 128x128)\n"
-            "  --ref-spp N        reference samples per pixel (default 256)\n"
-            "  --scenes LIST      comma list: cornell (built-in), courtyard, blinds (scenes/*.glb),\n"
-            "                     engine, clearcoat (Debian's assimp-testmodels: 2CylinderEngine.glb,\n"
-            "                     a CAD model in mm under the default light; ClearCoatTest.gltf, spheres\n"
-            "                     lit by emissive labels), or paths to .glb/.gltf files\n"
-            "                     (default cornell,courtyard,blinds)\n"
-            "  --quick            %d points instead of the 320-point factorial (grid 6/8/12/16/32 x\n"
-            "                     iterations 2/4/8/16 x the 16 combinations of the mods below; RSM 128, occlusion on)\n"
-            "  --presets          exactly the named presets (fast, balanced, accurate) as the points\n"
-            "  --features         one knob at a time around balanced: cascades 3, bounces on, damping\n"
-            "                     0.5 and 1 vs one grid (alone: scenes cornell-inside,courtyard,blinds;\n"
-            "                     with another point set: added to it); features.png\n"
-            "  --multi-bounces N  bounces of the reference for bounces on (--features; default 3)\n"
-            "  --knobs SPEC       the factorial's values per knob (any given list replaces the default), e.g.\n"
-            "                     grid=16/32,iterations=8,rsm=256,occlusion=on,central=on,bins=off/on,far=on,\n"
-            "                     surfels=on (mods: central transport, normal bins, far field, scene surfels)\n"
-            "  --points LIST      explicit points GRID:ITER:RSM:on|off[:MODS], MODS letters of cbfs\n"
-            "  --ticks N          timed ticks per point, median reported (default 5)\n"
-            "  --warmup N         untimed ticks first (default 2)\n"
-            "  --reference PATH   run this reference command (lpvd-reference's CLI) instead of the\n"
-            "                     linked lpv_reference library (default: $LPVD_REFERENCE, else the\n"
-            "                     library when linked, else reference/lpvd-reference in this build tree)\n"
-            "  --no-plot          do not run gnuplot (plot.gp is still written)\n"
-            "  --emissive         only the emissive-lit scenes: lpvd's FULL frame vs the reference's\n"
-            "                     full frame, area lights off and on with 1..64 samples\n"
-            "                     (emissive.csv, emissive.md; docs/area-lights.md)\n",
-            (int)(sizeof QUICK / sizeof QUICK[0]));
+            "%s(--quick: %d points; --size: default 128x128 here)\n"
+            "lpvd flags (all but the swept knobs: --preset, --grid, --iterations, --rsm-size, --occlusion,\n"
+            "--central-transport, --normal-bins, --far-field, --scene-surfels):\n%s",
+            help, (int)(sizeof QUICK / sizeof QUICK[0]), LPVD_OPTIONS_HELP);
 }
 
 static int mkdir_p(const char *path)
@@ -1052,85 +1082,97 @@ int main(int argc, char **argv)
     int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0;
     lpvd_options opt = {0};
     char *cam_args[MAX_PASS];
+    char cam_flags[MAX_PASS / 2][16];
     int ncam = 0;
     char err[1024] = "";
 
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--quick") == 0) {
-            quick = 1;
-        } else if (strcmp(a, "--presets") == 0) {
-            presets = 1;
-        } else if (strcmp(a, "--features") == 0) {
-            features = 1;
-        } else if (strcmp(a, "--emissive") == 0) {
-            emissive = 1;
-        } else if (strcmp(a, "--multi-bounces") == 0 && v) {
+    /* The shared groups come back unparsed: the swept knobs are refused and
+     * the camera choice is also handed on to a reference command. */
+    lpv_flag_group groups[4] = {{FLAGS, A_COUNT, NULL, NULL}};
+    int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 0, groups + 1);
+    lpv_flags cli;
+    if (lpv_flags_begin(&cli, argc, argv, groups, ngroups, 0) != 0) {
+        fprintf(stderr, "lpvd-accuracy: %s\n", cli.err);
+        return 2;
+    }
+    int cg;
+    const lpv_flag *fl;
+    const char *v;
+    for (lpv_flags_item it; (it = lpv_flags_next(&cli, &cg, &fl, &v)) != LPV_FLAGS_END;) {
+        if (it == LPV_FLAGS_NO_VALUE) {
+            fprintf(stderr, "lpvd-accuracy: %s needs a value (or is unknown; see --help)\n", cli.arg);
+            return 2;
+        }
+        if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_POSITIONAL) {
+            fprintf(stderr, "lpvd-accuracy: unknown argument %s (see --help)\n", it == LPV_FLAGS_UNKNOWN ? cli.arg : v);
+            return 2;
+        }
+        if (cg > 0) { /* a shared flag */
+            if (is_swept(fl->name)) {
+                fprintf(stderr, "lpvd-accuracy: --%s is a swept knob; use --knobs, --points or --presets\n",
+                        fl->name);
+                return 2;
+            }
+            if (lpvd_option_parse(&opt, fl->name, v, err, sizeof err) < 0) {
+                fprintf(stderr, "lpvd-accuracy: %s\n", err);
+                return 2;
+            }
+            if (strcmp(fl->name, "size") == 0)
+                size_given = 1;
+            /* the camera choice goes to the reference command too */
+            if ((strcmp(fl->name, "camera") == 0 || strcmp(fl->name, "eye") == 0 || strcmp(fl->name, "target") == 0 ||
+                 strcmp(fl->name, "fov") == 0) &&
+                ncam + 2 <= MAX_PASS) {
+                snprintf(cam_flags[ncam / 2], sizeof cam_flags[0], "--%s", fl->name);
+                cam_args[ncam] = cam_flags[ncam / 2];
+                cam_args[ncam + 1] = (char *)v;
+                ncam += 2;
+            }
+            continue;
+        }
+        const int id = (int)(fl - FLAGS);
+        switch (id) {
+        case A_HELP: usage(stdout); return 0;
+        case A_QUICK: quick = 1; break;
+        case A_PRESETS: presets = 1; break;
+        case A_FEATURES: features = 1; break;
+        case A_EMISSIVE: emissive = 1; break;
+        case A_NO_PLOT: no_plot = 1; break;
+        case A_OUT: out_dir = v; break;
+        case A_SCENES:
+            scene_list = v;
+            scenes_given = 1;
+            break;
+        case A_REFERENCE: ref_given = v; break;
+        case A_KNOBS: knobs = v; break;
+        case A_POINTS: points_arg = v; break;
+        case A_MULTI_BOUNCES: {
             char *end = NULL;
-            long x = strtol(argv[++i], &end, 10);
+            long x = strtol(v, &end, 10);
             if (!end || *end || x < 2 || x > 64) {
                 fprintf(stderr, "lpvd-accuracy: --multi-bounces expects 2..64\n");
                 return 2;
             }
             multi_bounces = (int)x;
-        } else if (strcmp(a, "--no-plot") == 0) {
-            no_plot = 1;
-        } else if (!v && a[0] == '-') {
-            fprintf(stderr, "lpvd-accuracy: %s needs a value (or is unknown; see --help)\n", a);
-            return 2;
-        } else if (strcmp(a, "--out") == 0) {
-            out_dir = argv[++i];
-        } else if (strcmp(a, "--scenes") == 0) {
-            scene_list = argv[++i];
-            scenes_given = 1;
-        } else if (strcmp(a, "--reference") == 0) {
-            ref_given = argv[++i];
-        } else if (strcmp(a, "--knobs") == 0) {
-            knobs = argv[++i];
-        } else if (strcmp(a, "--points") == 0) {
-            points_arg = argv[++i];
-        } else if (strcmp(a, "--ref-spp") == 0 || strcmp(a, "--ticks") == 0 || strcmp(a, "--warmup") == 0) {
+            break;
+        }
+        case A_REF_SPP:
+        case A_TICKS:
+        case A_WARMUP: {
             char *end = NULL;
-            long x = strtol(argv[++i], &end, 10);
-            if (!end || *end || x < (a[2] == 'w' ? 0 : 1) || x > (a[2] == 'r' ? 1000000 : MAX_TICKS)) {
-                fprintf(stderr, "lpvd-accuracy: bad value for %s: %s\n", a, argv[i]);
+            long x = strtol(v, &end, 10);
+            if (!end || *end || x < (id == A_WARMUP ? 0 : 1) || x > (id == A_REF_SPP ? 1000000 : MAX_TICKS)) {
+                fprintf(stderr, "lpvd-accuracy: bad value for --%s: %s\n", fl->name, v);
                 return 2;
             }
-            if (a[2] == 'r')
+            if (id == A_REF_SPP)
                 spp = (int)x;
-            else if (a[2] == 't')
+            else if (id == A_TICKS)
                 ticks = (int)x;
             else
                 warmup = (int)x;
-        } else if (a[0] == '-' && a[1] == '-' && lpvd_option_takes_value(a + 2) > 0) {
-            const char *name = a + 2;
-            if (strcmp(name, "grid") == 0 || strcmp(name, "iterations") == 0 || strcmp(name, "rsm-size") == 0 ||
-                strcmp(name, "occlusion") == 0 || strcmp(name, "preset") == 0 || strcmp(name, "central-transport") == 0 ||
-                strcmp(name, "normal-bins") == 0 || strcmp(name, "far-field") == 0 ||
-                strcmp(name, "scene-surfels") == 0) {
-                fprintf(stderr, "lpvd-accuracy: %s is a swept knob; use --knobs, --points or --presets\n", a);
-                return 2;
-            }
-            if (lpvd_option_parse(&opt, name, argv[++i], err, sizeof err) < 0) {
-                fprintf(stderr, "lpvd-accuracy: %s\n", err);
-                return 2;
-            }
-            if (strcmp(name, "size") == 0)
-                size_given = 1;
-            /* the camera choice goes to the reference command too */
-            if ((strcmp(name, "camera") == 0 || strcmp(name, "eye") == 0 || strcmp(name, "target") == 0 ||
-                 strcmp(name, "fov") == 0) &&
-                ncam + 2 <= MAX_PASS) {
-                cam_args[ncam++] = (char *)a;
-                cam_args[ncam++] = argv[i];
-            }
-        } else {
-            fprintf(stderr, "lpvd-accuracy: unknown argument %s (see --help)\n", a);
-            return 2;
+            break;
+        }
         }
     }
     if (!size_given)
@@ -1345,14 +1387,14 @@ add_features:
         float *ref = NULL, *ref_se = NULL, *rgba = NULL;
         uint8_t *regions = NULL;
         int rw = 0, rh = 0;
-        lpvd_camera_choice cam = opt.cam;
+        lpv_view_choice cam = opt.cam;
         if (se->has_cam) {
             cam.has_eye = cam.has_target = cam.has_fov = 1;
             memcpy(cam.eye, se->eye, sizeof cam.eye);
             memcpy(cam.target, se->target, sizeof cam.target);
             cam.fov_deg = se->fov;
         }
-        if (lpvd_resolve_view(&cam, &scene, &view, err, sizeof err) != 0) {
+        if (lpv_view_resolve(&cam, &scene, &view, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-accuracy: %s\n", err);
             rc = 2;
             goto next_scene;

@@ -337,18 +337,30 @@ static void write_md(FILE *f, const case_result *r, int n, const char *header)
     }
 }
 
-static void usage(FILE *f)
+enum { H_OUT, H_CASES, H_REF_SPP, H_HELP, H_COUNT };
+
+static const lpv_flag FLAGS[H_COUNT] = {
+    [H_OUT] = {"out", 0, "DIR", "output folder (default hard-cases-out)"},
+    [H_CASES] = {"cases", 0, "LIST", "comma list of case names (default all, below)"},
+    [H_REF_SPP] = {"ref-spp", 0, "N", "reference samples per pixel (default 256)"},
+    [H_HELP] = {"help", 'h', NULL, "this text"},
+};
+
+static void usage(FILE *f, const lpv_flag *size_flag, const lpv_flag_group *backend)
 {
-    fprintf(f, "usage: lpvd-hard-cases [--out DIR] [--size WxH] [--ref-spp N] [--cases LIST] [--backend B]\n"
-               "Renders each hard case (docs/hard-cases.md) with lpvd and the path-traced reference and checks\n"
-               "it stays finite and energy-bounded. Exit status 1 when a case fails.\n"
-               "  --out DIR       output folder (default hard-cases-out)\n"
-               "  --size WxH      image size (default 64x64)\n"
-               "  --ref-spp N     reference samples per pixel (default 256)\n"
-               "  --cases LIST    comma list of case names (default all):\n");
+    char help[4096];
+    size_t len = 0;
+    lpv_flags_help(help, sizeof help, &len, FLAGS, H_COUNT);
+    lpv_flags_help(help, sizeof help, &len, size_flag, 1);
+    lpv_flags_help(help, sizeof help, &len, backend->flags, backend->count);
+    fprintf(f,
+            "usage: lpvd-hard-cases [--out DIR] [--size WxH] [--ref-spp N] [--cases LIST] [--backend B]\n"
+            "Renders each hard case (docs/hard-cases.md) with lpvd and the path-traced reference and checks\n"
+            "it stays finite and energy-bounded. Exit status 1 when a case fails. --size defaults to 64x64\n"
+            "here.\n%sThe cases:\n",
+            help);
     for (size_t i = 0; i < lpv_hard_case_count(); ++i)
-        fprintf(f, "                    %-24s %s\n", lpv_hard_case_get(i)->name, lpv_hard_case_get(i)->what);
-    fprintf(f, "  --backend B     auto, egl-device, egl-surfaceless or osmesa\n");
+        fprintf(f, "  %-24s %s\n", lpv_hard_case_get(i)->name, lpv_hard_case_get(i)->what);
 }
 
 int main(int argc, char **argv)
@@ -358,22 +370,37 @@ int main(int argc, char **argv)
     lpvd_options opt = {0};
     opt.cam.width = opt.cam.height = 64;
     char err[1024] = "";
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage(stdout);
-            return 0;
-        }
-        if (!v) {
-            fprintf(stderr, "lpvd-hard-cases: %s needs a value (or is unknown; see --help)\n", a);
+    /* Only --size and --backend of the shared flags: the cases fix settings and cameras. */
+    lpv_flag_group groups[3] = {{FLAGS, H_COUNT, NULL, NULL}, lpv_view_flag_group(&opt.cam)};
+    groups[1].flags = lpv_flag_find(groups[1].flags, groups[1].count, "size");
+    groups[1].count = 1;
+    lpvd_options_groups(&opt, LPVD_GROUP_BACKEND, 1, &groups[2]);
+    lpv_flags p;
+    if (lpv_flags_begin(&p, argc, argv, groups, 3, 0) != 0) {
+        fprintf(stderr, "lpvd-hard-cases: %s\n", p.err);
+        return 2;
+    }
+    int g;
+    const lpv_flag *fl;
+    const char *v;
+    for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
+        if (it == LPV_FLAGS_NO_VALUE) {
+            fprintf(stderr, "lpvd-hard-cases: %s needs a value (or is unknown; see --help)\n", p.arg);
             return 2;
-        }
-        ++i;
-        if (strcmp(a, "--out") == 0) {
+        } else if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_POSITIONAL) {
+            fprintf(stderr, "lpvd-hard-cases: unknown argument %s (see --help)\n", it == LPV_FLAGS_UNKNOWN ? p.arg : v);
+            return 2;
+        } else if (it == LPV_FLAGS_BAD_VALUE) {
+            fprintf(stderr, "lpvd-hard-cases: %s\n", p.err);
+            return 2;
+        } else if (fl == &FLAGS[H_HELP]) {
+            usage(stdout, groups[1].flags, &groups[2]);
+            return 0;
+        } else if (fl == &FLAGS[H_OUT]) {
             out_dir = v;
-        } else if (strcmp(a, "--cases") == 0) {
+        } else if (fl == &FLAGS[H_CASES]) {
             case_list = v;
-        } else if (strcmp(a, "--ref-spp") == 0) {
+        } else if (fl == &FLAGS[H_REF_SPP]) {
             char *end = NULL;
             long x = strtol(v, &end, 10);
             if (!end || *end || x < 1 || x > 1000000) {
@@ -381,15 +408,6 @@ int main(int argc, char **argv)
                 return 2;
             }
             spp = (int)x;
-        } else if (strcmp(a, "--size") == 0 || strcmp(a, "--backend") == 0) {
-            /* the shared lpvd parsers; the cases fix settings and cameras */
-            if (lpvd_option_parse(&opt, a + 2, v, err, sizeof err) < 0) {
-                fprintf(stderr, "lpvd-hard-cases: %s\n", err);
-                return 2;
-            }
-        } else {
-            fprintf(stderr, "lpvd-hard-cases: unknown argument %s (see --help)\n", a);
-            return 2;
         }
     }
 
