@@ -23,7 +23,7 @@ static const lpv_field FIELDS[] = {
     {"iterations", "iterations", LPV_FIELD_INT, F(iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
      "the preset's", "", "propagation steps"},
     {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
-     "the preset's (balanced: 128)", "", "reflective shadow map side"},
+     "the preset's", "", "reflective shadow map side"},
     {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", "1024", "",
      "shadow map side per light face, for direct light (docs/shadows.md)"},
     {"occlusion", "occlusion", LPV_FIELD_SWITCH, F(occlusion), 0, 1, 0, "", "the preset's (on)", "",
