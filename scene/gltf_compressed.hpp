@@ -1,5 +1,5 @@
 /*
- * gltf_compressed.hpp - compressed glTF geometry for gltf_load.cpp (C++ only,
+ * gltf_compressed.hpp - compressed glTF geometry for the glTF adapter (C++ only,
  * inside the scene library): KHR_draco_mesh_compression through Google's
  * Draco library and EXT_meshopt_compression through meshoptimizer, both the
  * Debian packages (docs/scenes.md, "Compressed meshes"). Every problem comes

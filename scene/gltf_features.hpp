@@ -1,6 +1,6 @@
 /*
  * gltf_features.hpp - what of a glTF file lpvd uses and what it does not, for
- * gltf_load.cpp (C++ only, inside the scene library; docs/scenes.md,
+ * gltf_build.cpp (C++ only, inside the scene library; docs/scenes.md,
  * "Supported and warned").
  */
 #ifndef LPV_GLTF_FEATURES_HPP

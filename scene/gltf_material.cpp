@@ -1,13 +1,24 @@
 /*
- * gltf_material.cpp - alpha and texture transforms of glTF materials
- * (gltf_material.hpp; docs/scenes.md, "Materials").
+ * gltf_material.cpp - the Builder's materials (gltf_internal.hpp; docs/scenes.md,
+ * "Materials"): base colour, emission (with KHR_materials_emissive_strength,
+ * nits to radiance), metallic/roughness, alpha mode and cutoff, double-sided,
+ * normal maps, each texture reference's uv set and KHR_texture_transform, and
+ * the textures' decoded pixels (sRGB colour or linear data). Problems refuse
+ * the file with a message naming the material and the field.
  */
-#include "gltf_material.hpp"
+#include "gltf_internal.hpp"
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
 
 namespace lpv_gltf {
 
+namespace {
+
+/* alphaMode ("OPAQUE", "MASK", "BLEND") and alphaCutoff (finite, >= 0) into
+ * mat. Returns "" or the problem ("alphaMode \"X\" is not ..."). */
 std::string read_alpha(const tinygltf::Material &gm, lpv_material *mat)
 {
     if (gm.alphaMode == "OPAQUE")
@@ -29,8 +40,6 @@ std::string read_alpha(const tinygltf::Material &gm, lpv_material *mat)
     return "";
 }
 
-namespace {
-
 bool numbers(const tinygltf::Value &v, size_t n, double *out)
 {
     if (!v.IsArray() || v.ArrayLen() != n)
@@ -44,8 +53,10 @@ bool numbers(const tinygltf::Value &v, size_t n, double *out)
     return true;
 }
 
-} // namespace
-
+/* A texture reference's uv set and transform: texCoord, then
+ * KHR_texture_transform's offset, rotation, scale and texCoord override.
+ * Returns "" or the problem, naming the field (e.g. "KHR_texture_transform.scale
+ * must hold 2 finite numbers"). */
 std::string read_uv_transform(int tex_coord, const tinygltf::ExtensionMap &ext, lpv_uv_transform *out)
 {
     *out = lpv_uv_transform{};
@@ -85,6 +96,139 @@ std::string read_uv_transform(int tex_coord, const tinygltf::ExtensionMap &ext, 
     }
     out->has_transform = 1;
     return "";
+}
+
+} // namespace
+
+int Builder::default_material()
+{
+    if (default_material_ < 0) {
+        lpv_material mat;
+        memset(&mat, 0, sizeof mat);
+        copy_name(mat.name, "default", "default");
+        mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = mat.base_color[3] = 1.0f;
+        mat.base_color_texture = -1;
+        mat.normal_texture = -1;
+        mat.metallic = 0.0f;
+        mat.roughness = 1.0f;
+        mat.double_sided = 0;
+        mat.alpha_cutoff = 0.5f;
+        mat.base_color_uv.scale[0] = mat.base_color_uv.scale[1] = 1.0f;
+        mat.normal_uv.scale[0] = mat.normal_uv.scale[1] = 1.0f;
+        materials.push_back(mat);
+        default_material_ = int(materials.size() - 1);
+    }
+    return default_material_;
+}
+
+/* The scene texture of glTF texture `index` for a material's `what` (a
+ * message's words): decoded pixels, sRGB colour or linear data (normal maps);
+ * -1 when the texture has no usable image (a warning). */
+int Builder::texture_for(int material_index, const char *what, int index, bool linear)
+{
+    if (index < 0)
+        return -1;
+    if (size_t(index) >= m_.textures.size())
+        fail("material %d: %s %d does not exist (out of range)", material_index, what, index);
+    int src = m_.textures[size_t(index)].source;
+    if (src < 0) {
+        ctx_.warn(strf("texture %d has no source image (extension-only?); ignored", index));
+        return -1;
+    }
+    if (size_t(src) >= m_.images.size())
+        fail("texture %d: source image %d does not exist (out of range)", index, src);
+    auto it = image_texture_.find({src, linear ? 1 : 0});
+    if (it != image_texture_.end())
+        return it->second;
+    const tinygltf::Image &img = m_.images[size_t(src)];
+    int result = -1;
+    if (!img.image.empty() && img.component == 4 && img.bits == 8 && img.width > 0 && img.height > 0 &&
+        img.width <= kMaxTextureSize && img.height <= kMaxTextureSize &&
+        img.image.size() == size_t(img.width) * size_t(img.height) * 4) {
+        lpv_texture t;
+        memset(&t, 0, sizeof t);
+        t.width = img.width;
+        t.height = img.height;
+        t.linear = linear ? 1 : 0;
+        t.rgba8 = static_cast<uint8_t *>(malloc(img.image.size()));
+        if (!t.rgba8)
+            throw std::bad_alloc();
+        memcpy(t.rgba8, img.image.data(), img.image.size());
+        try {
+            textures.push_back(t);
+        } catch (...) {
+            free(t.rgba8);
+            throw;
+        }
+        result = int(textures.size() - 1);
+    } else {
+        ctx_.warn(strf("image %d has no decoded RGBA8 pixels; texture ignored", src));
+    }
+    image_texture_[{src, linear ? 1 : 0}] = result;
+    return result;
+}
+
+/* A texture reference's uv set and KHR_texture_transform into out. */
+void Builder::texture_uv(int material_index, const char *what, int tex_coord, const tinygltf::ExtensionMap &ext,
+                         lpv_uv_transform *out)
+{
+    std::string e = read_uv_transform(tex_coord, ext, out);
+    if (!e.empty())
+        fail("material %d: %s: %s", material_index, what, e.c_str());
+    if (out->texcoord > 1)
+        out->texcoord = 0; /* reported once among the unused features */
+    if (out->texcoord == 1) {
+        material_uv1_.resize(m_.materials.size(), 0);
+        material_uv1_[size_t(material_index)] = 1;
+    }
+}
+
+void Builder::convert_materials()
+{
+    for (size_t i = 0; i < m_.materials.size(); i++) {
+        const tinygltf::Material &gm = m_.materials[i];
+        const int mi = int(i);
+        lpv_material mat;
+        memset(&mat, 0, sizeof mat);
+        copy_name(mat.name, gm.name, strf("material%d", mi));
+        const auto &pbr = gm.pbrMetallicRoughness;
+        if (pbr.baseColorFactor.size() != 4 || !finite_all(pbr.baseColorFactor))
+            fail("material %d: baseColorFactor must hold 4 finite numbers", mi);
+        for (int k = 0; k < 4; k++)
+            mat.base_color[k] = float(pbr.baseColorFactor[size_t(k)]);
+        mat.base_color_texture = texture_for(mi, "baseColorTexture", pbr.baseColorTexture.index, false);
+        texture_uv(mi, "baseColorTexture", pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
+                   &mat.base_color_uv);
+        const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
+        mat.normal_texture = texture_for(mi, "normalTexture", nt.index, true);
+        texture_uv(mi, "normalTexture", nt.texCoord, nt.extensions, &mat.normal_uv);
+        if (!std::isfinite(nt.scale))
+            fail("material %d: normalTexture.scale must be a finite number", mi);
+        mat.normal_scale = float(nt.scale);
+        std::string alpha = read_alpha(gm, &mat);
+        if (!alpha.empty())
+            fail("material %d: %s", mi, alpha.c_str());
+        if (gm.emissiveFactor.size() != 3 || !finite_all(gm.emissiveFactor))
+            fail("material %d: emissiveFactor must hold 3 finite numbers", mi);
+        double strength = 1.0;
+        auto ext = gm.extensions.find("KHR_materials_emissive_strength");
+        if (ext != gm.extensions.end() && ext->second.IsObject() && ext->second.Has("emissiveStrength")) {
+            const tinygltf::Value &v = ext->second.Get("emissiveStrength");
+            if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()) || v.GetNumberAsDouble() < 0.0)
+                fail("material %d: emissiveStrength must be a finite number >= 0", mi);
+            strength = v.GetNumberAsDouble();
+        }
+        for (int k = 0; k < 3; k++) {
+            /* nits (cd/m^2) -> W/(m^2 sr): a unit conversion, docs/units.md */
+            mat.emission[k] = float(gm.emissiveFactor[size_t(k)] * strength / double(LPV_LUMENS_PER_WATT));
+        }
+        if (!std::isfinite(pbr.metallicFactor) || !std::isfinite(pbr.roughnessFactor))
+            fail("material %d: metallicFactor and roughnessFactor must be finite", mi);
+        mat.metallic = float(pbr.metallicFactor);
+        mat.roughness = float(pbr.roughnessFactor);
+        mat.double_sided = gm.doubleSided ? 1 : 0;
+        materials.push_back(mat);
+    }
 }
 
 } // namespace lpv_gltf

@@ -255,16 +255,23 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The surface points camera 0 sees through LIGHT_RAYS^2 pixel rays. */
-static size_t visible_points(const ctx *c, const lpv_camera *cam, seen *out)
+/* The camera's unit forward f, right r = f x up and up u = r x f. */
+static void camera_basis(const lpv_camera *cam, float f[3], float r[3], float u[3])
 {
-    float f[3], up[3], r[3], u[3];
-    memcpy(f, cam->forward, sizeof f);
+    float up[3];
+    memcpy(f, cam->forward, 3 * sizeof *f);
     memcpy(up, cam->up, sizeof up);
     norm3(f);
     cross3(f, up, r);
     norm3(r);
     cross3(r, f, u);
+}
+
+/* The surface points camera 0 sees through LIGHT_RAYS^2 pixel rays. */
+static size_t visible_points(const ctx *c, const lpv_camera *cam, seen *out)
+{
+    float f[3], r[3], u[3];
+    camera_basis(cam, f, r, u);
     float aspect = cam->aspect > 0.0f ? cam->aspect : 1.0f;
     float ty = cam->orthographic ? (cam->ymag > 0.0f ? cam->ymag : 1.0f) : tanf(0.5f * (cam->yfov > 0.0f ? cam->yfov : 0.8f));
     size_t n = 0;
@@ -343,13 +350,8 @@ static int add_light(lpv_scene *s, const ctx *c)
         dist[i] = pts[i].t;
     qsort(dist, n, sizeof *dist, cmp_float);
     float dmed = n ? dist[n / 2] : 0.5f * c->size;
-    float f[3], up[3], r[3], u[3];
-    memcpy(f, cam->forward, sizeof f);
-    memcpy(up, cam->up, sizeof up);
-    norm3(f);
-    cross3(f, up, r);
-    norm3(r);
-    cross3(r, f, u);
+    float f[3], r[3], u[3];
+    camera_basis(cam, f, r, u);
     static const float OFFSETS[3][2] = {{0.4f, 0.3f}, {0.4f, -0.3f}, {0.4f, 0.0f}}; /* (up, right) */
     static const float SCALES[3] = {1.0f, 0.5f, 0.25f};
     float cand[10][3], score[10], best_score = 0.0f;

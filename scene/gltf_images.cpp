@@ -1,0 +1,155 @@
+/*
+ * gltf_images.cpp - the images of a glTF file (gltf_internal.hpp): tinygltf's
+ * image callback, which checks an image's bufferView range (tinygltf 2.7 does
+ * not), reads PNG and JPEG sizes from their headers and refuses absurd ones
+ * before decoding, then decodes to RGBA8 with stb, as tinygltf itself would.
+ */
+#include "gltf_internal.hpp"
+
+#include <climits>
+#include <cstring>
+
+#include <stb_image.h>
+
+namespace lpv_gltf {
+
+namespace {
+
+uint32_t be32(const unsigned char *p)
+{
+    return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
+}
+
+/* Width and height from a PNG's IHDR or a JPEG's SOF marker, without decoding.
+ * Dimensions beyond INT_MAX come back as INT_MAX. */
+bool image_header_size(const unsigned char *d, size_t n, int *w, int *h)
+{
+    auto clamp = [](uint32_t v) { return v > uint32_t(INT_MAX) ? INT_MAX : int(v); };
+    static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (n >= 24 && memcmp(d, png_sig, 8) == 0 && memcmp(d + 12, "IHDR", 4) == 0) {
+        *w = clamp(be32(d + 16));
+        *h = clamp(be32(d + 20));
+        return true;
+    }
+    if (n >= 4 && d[0] == 0xFF && d[1] == 0xD8) {
+        size_t i = 2;
+        while (i + 4 <= n) {
+            if (d[i] != 0xFF)
+                return false;
+            unsigned char m = d[i + 1];
+            if (m == 0xFF) { /* fill byte */
+                i++;
+                continue;
+            }
+            if (m == 0x01 || (m >= 0xD0 && m <= 0xD8)) { /* no payload */
+                i += 2;
+                continue;
+            }
+            if (m == 0xD9 || m == 0xDA) /* end of image, start of scan */
+                return false;
+            size_t len = size_t(d[i + 2]) << 8 | d[i + 3];
+            if (len < 2)
+                return false;
+            bool sof = m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC;
+            if (sof) {
+                if (i + 9 > n || len < 7)
+                    return false;
+                *h = int(size_t(d[i + 5]) << 8 | d[i + 6]);
+                *w = int(size_t(d[i + 7]) << 8 | d[i + 8]);
+                return true;
+            }
+            i += 2 + len;
+        }
+    }
+    return false;
+}
+
+/* A fatal image problem: the first one is kept for the load's message. */
+bool refuse(Ctx *ctx, std::string *err, const std::string &problem)
+{
+    if (ctx->image_error.empty())
+        ctx->image_error = problem;
+    if (err)
+        *err += ctx->image_error;
+    return false;
+}
+
+std::string too_large(int image_idx, int w, int h)
+{
+    return strf("image %d is %dx%d texels, over the %dx%d texture limit (absurd size)", image_idx, w, h,
+                kMaxTextureSize, kMaxTextureSize);
+}
+
+} // namespace
+
+/* Decodes an image to RGBA8 with stb after checking its size, and checks an
+ * image's bufferView range, which tinygltf 2.7 does not. Undecodable images
+ * are kept without pixels (a warning; the texture is then ignored). */
+bool image_loader(tinygltf::Image *image, const int image_idx, std::string *err, std::string *,
+                  int, int, const unsigned char *bytes, int size, void *user)
+{
+    Ctx *ctx = static_cast<Ctx *>(user);
+    if (image->bufferView >= 0) {
+        const tinygltf::Model *m = ctx->model;
+        bool ok = m && size_t(image->bufferView) < m->bufferViews.size();
+        if (ok) {
+            const tinygltf::BufferView &bv = m->bufferViews[size_t(image->bufferView)];
+            ok = bv.buffer >= 0 && size_t(bv.buffer) < m->buffers.size();
+            if (ok) {
+                size_t have = m->buffers[size_t(bv.buffer)].data.size();
+                ok = bv.byteOffset <= have && bv.byteLength <= have - bv.byteOffset &&
+                     bv.byteLength <= size_t(INT_MAX);
+            }
+        }
+        if (!ok)
+            return refuse(ctx, err,
+                          strf("image %d: its bufferView %d is out of range of its buffer", image_idx,
+                               image->bufferView));
+    }
+    if (!bytes || size <= 0) {
+        ctx->warn(strf("image %d has no data; texture ignored", image_idx));
+        return true;
+    }
+    int w = 0, h = 0, comp = 0;
+    /* Our own reading of PNG and JPEG headers first: stb refuses some large
+     * images itself and would make them look merely corrupt. */
+    if (image_header_size(bytes, size_t(size), &w, &h) &&
+        (w < 1 || h < 1 || w > kMaxTextureSize || h > kMaxTextureSize))
+        return refuse(ctx, err, too_large(image_idx, w, h));
+    if (!stbi_info_from_memory(bytes, size, &w, &h, &comp)) {
+        ctx->warn(strf("image %d: unsupported or corrupt image data (%s); texture ignored", image_idx,
+                         stbi_failure_reason() ? stbi_failure_reason() : "unknown"));
+        return true;
+    }
+    if (w < 1 || h < 1 || w > kMaxTextureSize || h > kMaxTextureSize)
+        return refuse(ctx, err, too_large(image_idx, w, h));
+    if (ctx->texels + uint64_t(w) * uint64_t(h) > kMaxTotalTexels)
+        return refuse(ctx, err,
+                      strf("image %d: the textures together exceed %llu texels (absurd size)", image_idx,
+                           (unsigned long long)kMaxTotalTexels));
+    int w2 = 0, h2 = 0, comp2 = 0;
+    unsigned char *px = stbi_load_from_memory(bytes, size, &w2, &h2, &comp2, 4);
+    if (!px || w2 != w || h2 != h) {
+        if (px)
+            stbi_image_free(px);
+        ctx->warn(strf("image %d could not be decoded (%s); texture ignored", image_idx,
+                         stbi_failure_reason() ? stbi_failure_reason() : "size changed"));
+        return true;
+    }
+    try {
+        image->image.assign(px, px + size_t(w) * size_t(h) * 4);
+    } catch (...) {
+        stbi_image_free(px);
+        throw;
+    }
+    stbi_image_free(px);
+    image->width = w;
+    image->height = h;
+    image->component = 4;
+    image->bits = 8;
+    image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    ctx->texels += uint64_t(w) * uint64_t(h);
+    return true;
+}
+
+} // namespace lpv_gltf

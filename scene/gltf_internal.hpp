@@ -1,0 +1,195 @@
+/*
+ * gltf_internal.hpp - what the files of the glTF adapter share (C++ only,
+ * inside the scene library; the C API is gltf_load.h).
+ *
+ * One load runs through them in this order:
+ *   gltf_load.cpp       the entry points, the tinygltf call, the hand-over
+ *   gltf_files.cpp      the main file and every external URI (paths checked)
+ *   gltf_container.cpp  .glb container and JSON pre-scan, before tinygltf
+ *   gltf_images.cpp     image size caps and decoding, tinygltf's callback
+ *   gltf_build.cpp      the Builder: the node forest walked into draws
+ *   gltf_transform.cpp  node transforms and the caller's node overrides
+ *   gltf_accessor.cpp   buffer views and accessors, every range checked
+ *   gltf_mesh.cpp       primitives into world-space triangles
+ *   gltf_material.cpp   materials and their textures
+ *   gltf_lights_cameras.cpp  KHR_lights_punctual and cameras
+ *   gltf_medium.cpp     lpvd_medium from the raw JSON
+ *   gltf_messages.cpp   message formatting, failures and warnings
+ * beside the helpers with their own headers (gltf_compressed.hpp,
+ * gltf_features.hpp).
+ *
+ * Errors travel as a Failure exception inside the adapter and leave it in
+ * gltf_load.cpp as "<path or label>: <problem>" and -1; nothing is thrown
+ * into C.
+ */
+#ifndef LPV_GLTF_INTERNAL_HPP
+#define LPV_GLTF_INTERNAL_HPP
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <tiny_gltf.h>
+
+extern "C" {
+#include "scene.h"
+}
+#include "gltf_load.h"
+
+namespace lpv_gltf {
+
+/* ---- limits ---------------------------------------------------------------- */
+constexpr uint64_t kMaxTriangles = uint64_t(1) << 24;     /* 16M triangles */
+constexpr uint64_t kMaxVertices = 3 * kMaxTriangles;      /* flat normals un-share */
+constexpr uint64_t kMaxAccessorCount = 3 * kMaxTriangles; /* elements of one accessor */
+constexpr int kMaxTextureSize = 16384;                    /* texels per side */
+constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 29;   /* 2 GiB of RGBA8 */
+constexpr uint64_t kMaxFileBytes = uint64_t(1) << 30;     /* main file and each external file */
+constexpr int kMaxJsonDepth = 256;
+constexpr int kMaxNodeDepth = 64;
+constexpr size_t kMaxWarnings = LPV_GLTF_WARNINGS_MAX;
+
+/* ---- messages (gltf_messages.cpp) ------------------------------------------ */
+struct Failure {
+    std::string msg;
+};
+
+std::string strf(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+/* Throws Failure with the formatted message. */
+[[noreturn]] void fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+/* tinygltf's multi-line messages as one line. */
+std::string one_line(const std::string &s);
+/* Shortens a value taken from the file for a message (and keeps it printable). */
+std::string show(const std::string &s);
+
+/* ---- load context, shared with tinygltf's callbacks ------------------------- */
+struct Ctx {
+    std::string label;
+    bool allow_external = false; /* false for memory loads without base_dir */
+    std::string base_dir;        /* as handed to tinygltf */
+    std::string root_real;       /* realpath(base_dir) */
+    std::string refusal;         /* first security refusal: always fatal */
+    std::string missing;         /* first external file that could not be read */
+    std::string image_error;     /* fatal image problem (size cap, bad range) */
+    const tinygltf::Model *model = nullptr;
+    uint64_t texels = 0;
+    std::vector<std::string> warnings; /* each line once */
+    size_t warnings_dropped = 0;       /* past kMaxWarnings */
+    const lpv_gltf_node_override *overrides = nullptr; /* lpv_gltf_load_memory_ex */
+    size_t override_count = 0;
+    lpv_gltf_warnings *sink = nullptr; /* NULL: warnings go to stderr */
+
+    void warn(const std::string &w); /* gltf_messages.cpp */
+};
+
+/* ---- files (gltf_files.cpp) ------------------------------------------------- */
+/* Routes every file access of tinygltf through checks that keep it inside
+ * ctx's folder (or refuse it for memory loads without one). */
+void set_fs_callbacks(tinygltf::TinyGLTF &loader, Ctx *ctx);
+/* The main file's bytes into *data; "" or the problem (for "<path>: ..."). */
+std::string read_main_file(const char *path, std::vector<unsigned char> *data);
+
+/* ---- container and images (gltf_container.cpp, gltf_images.cpp) ------------- */
+/* Checks size, format (glb magic or JSON), the .glb container and the JSON's
+ * syntax and depth; returns whether it is a .glb, and where its JSON lies. */
+bool check_container(const unsigned char *data, size_t size, size_t *json_off, size_t *json_len);
+/* Compressed files as tinygltf 2.7 accepts them (gltf_compressed.hpp,
+ * tinygltf_compat_json): when the file needs it, *rewritten gets the file with
+ * its JSON rewritten (a .glb's BIN chunk kept) and true is returned. */
+bool tinygltf_compat_file(const unsigned char *data, size_t size, bool is_glb, size_t json_off, size_t json_len,
+                          std::vector<unsigned char> *rewritten);
+/* tinygltf's image callback (user data: the Ctx). */
+bool image_loader(tinygltf::Image *image, const int image_idx, std::string *err, std::string *warn, int req_width,
+                  int req_height, const unsigned char *bytes, int size, void *user);
+
+/* ---- transforms (gltf_transform.cpp; column-major, like glTF) --------------- */
+struct Mat4 {
+    double m[16];
+};
+Mat4 identity();
+Mat4 mul(const Mat4 &a, const Mat4 &b);
+void xform_point(const Mat4 &a, const double p[3], double out[3]);
+void xform_dir(const Mat4 &a, const double v[3], double out[3]);
+double det3(const Mat4 &a);
+/* The normal matrix: the inverse-transpose of the upper 3x3, up to a positive
+ * scale. Row-major 3x3. */
+void normal_matrix(const Mat4 &a, double n[9]);
+bool normalize3(double v[3]);
+bool finite_all(const std::vector<double> &v);
+/* Node `index`'s local transform (matrix or TRS), every number checked. */
+Mat4 node_local(const tinygltf::Node &n, int index);
+/* The caller's node overrides (lpv_gltf_load_memory_ex) applied to model. */
+void apply_node_overrides(tinygltf::Model &model, const lpv_gltf_node_override *o, size_t count);
+
+/* ---- the medium (gltf_medium.cpp) ------------------------------------------- */
+/* The medium of the scene that is loaded (scenes[scene].extras.lpvd_medium),
+ * else of the document (extras.lpvd_medium). json is the file's JSON text. */
+void read_medium(const char *json, size_t len, const tinygltf::Model &model, Ctx &ctx, lpv_medium &m,
+                 std::vector<float> &values);
+
+/* A name from the file into a fixed-size scene name (gltf_build.cpp). */
+void copy_name(char *dst, const std::string &src, const std::string &fallback);
+
+/* ---- the builder: tinygltf's model into the scene's arrays ------------------- */
+class Builder {
+  public:
+    Builder(const tinygltf::Model &model, Ctx &ctx) : m_(model), ctx_(ctx) {}
+
+    void build(); /* gltf_build.cpp */
+
+    std::vector<lpv_vertex> vertices;
+    std::vector<uint32_t> indices;
+    std::vector<lpv_draw> draws;
+    std::vector<lpv_material> materials;
+    std::vector<lpv_light> lights;
+    std::vector<lpv_camera> cameras;
+    /* Owned RGBA8 pixels (malloc) until handed to the scene. */
+    std::vector<lpv_texture> textures;
+
+    ~Builder();
+    Builder(const Builder &) = delete;
+    Builder &operator=(const Builder &) = delete;
+
+  private:
+    const tinygltf::Model &m_;
+    Ctx &ctx_;
+    int default_material_ = -1;
+    std::map<std::pair<int, int>, int> image_texture_; /* (glTF image, linear) -> index in textures (-1: unusable) */
+    std::vector<unsigned char> visited_;
+    std::map<int, std::vector<unsigned char>> meshopt_; /* bufferView -> its EXT_meshopt_compression data */
+    std::vector<unsigned char> material_uv1_;            /* material index -> some texture reads TEXCOORD_1 */
+
+    /* A validated byte range of a buffer view. */
+    struct View {
+        const unsigned char *data;
+        size_t length;
+        size_t stride;
+    };
+    /* gltf_accessor.cpp */
+    View view(int bv_index, const char *what, int owner);
+    template <class T> void read_accessor(int index, int want_ncomp, const char *what, std::vector<T> &out);
+    void read_indices(int index, std::vector<uint32_t> &out);
+    void check_buffer_views();
+    /* gltf_build.cpp */
+    void check_node_graph();
+    void visit(int node, const Mat4 &parent, int depth);
+    void add_mesh(int mesh, const Mat4 &world);
+    /* gltf_material.cpp */
+    void convert_materials();
+    int texture_for(int material_index, const char *what, int index, bool linear);
+    void texture_uv(int material_index, const char *what, int tex_coord, const tinygltf::ExtensionMap &ext,
+                    lpv_uv_transform *out);
+    int default_material();
+    /* gltf_mesh.cpp */
+    void add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world);
+    /* gltf_lights_cameras.cpp */
+    void add_light(int node, int light, const Mat4 &world);
+    void add_camera(int node, int camera, const Mat4 &world);
+};
+
+} // namespace lpv_gltf
+
+#endif

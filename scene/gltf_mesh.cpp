@@ -1,0 +1,254 @@
+/*
+ * gltf_mesh.cpp - the Builder's primitives (gltf_internal.hpp): a triangle,
+ * strip or fan primitive, its attributes from the accessors or from
+ * KHR_draco_mesh_compression (gltf_compressed.hpp), into world-space vertices
+ * and one draw. Normals move with the normal matrix, a mirroring transform
+ * flips the winding, and a primitive without normals gets flat ones from its
+ * world winding (its vertices un-shared).
+ */
+#include "gltf_internal.hpp"
+#include "gltf_compressed.hpp"
+
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+namespace lpv_gltf {
+
+void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world)
+{
+    const int mode = p.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        if (mode < TINYGLTF_MODE_POINTS || mode > TINYGLTF_MODE_TRIANGLE_FAN)
+            ctx_.warn(strf("mesh %d primitive %d: unknown mode %d skipped", mesh, prim, mode));
+        return; /* points and lines carry no surface */
+    }
+    auto pos_it = p.attributes.find("POSITION");
+    if (pos_it == p.attributes.end()) {
+        ctx_.warn(strf("mesh %d primitive %d has no POSITION; skipped", mesh, prim));
+        return;
+    }
+    /* KHR_draco_mesh_compression: the attributes and indices come from the
+     * Draco bitstream instead of the accessors (which hold no data). */
+    DracoMesh draco;
+    bool is_draco = false;
+    auto dext = p.extensions.find("KHR_draco_mesh_compression");
+    if (dext != p.extensions.end()) {
+        const tinygltf::Value &d = dext->second;
+        const tinygltf::Value none;
+        const tinygltf::Value &bvv = d.IsObject() && d.Has("bufferView") ? d.Get("bufferView") : none;
+        const tinygltf::Value &attrs = d.IsObject() && d.Has("attributes") ? d.Get("attributes") : none;
+        if (!bvv.IsNumber() || !attrs.IsObject())
+            fail("mesh %d primitive %d: KHR_draco_mesh_compression needs a bufferView and attributes", mesh, prim);
+        std::map<std::string, int> ids, comps = {{"POSITION", 3}, {"NORMAL", 3}, {"TEXCOORD_0", 2},
+                                                 {"TEXCOORD_1", 2}, {"TANGENT", 4}};
+        for (const std::string &k : attrs.Keys()) {
+            const tinygltf::Value &id = attrs.Get(k);
+            double v = id.IsNumber() ? id.GetNumberAsDouble() : -1.0;
+            if (!(v >= 0.0 && v <= double(INT_MAX)) || v != std::floor(v))
+                fail("mesh %d primitive %d: KHR_draco_mesh_compression.attributes.%s must be an integer >= 0", mesh,
+                     prim, show(k).c_str());
+            ids[k] = int(v);
+        }
+        if (!ids.count("POSITION"))
+            fail("mesh %d primitive %d: KHR_draco_mesh_compression has no POSITION attribute", mesh, prim);
+        double bvd = bvv.GetNumberAsDouble();
+        if (!(bvd >= 0.0 && bvd < double(m_.bufferViews.size())) || bvd != std::floor(bvd))
+            fail("mesh %d primitive %d: KHR_draco_mesh_compression bufferView %g does not exist (out of range)", mesh,
+                 prim, bvd);
+        View dv = view(int(bvd), "KHR_draco_mesh_compression of mesh", mesh);
+        std::string e = draco_decode(dv.data, dv.length, ids, comps, size_t(kMaxAccessorCount), &draco);
+        if (!e.empty())
+            fail("mesh %d primitive %d: %s", mesh, prim, e.c_str());
+        is_draco = true;
+    }
+    /* One vertex attribute: from the Draco data, else its accessor. */
+    char what[96];
+    auto attribute = [&](const char *name, int ncomp, std::vector<float> &out) -> bool {
+        auto it = p.attributes.find(name);
+        if (is_draco) {
+            auto d = draco.attributes.find(name);
+            if (d != draco.attributes.end()) {
+                out = d->second;
+                return true;
+            }
+        }
+        if (it == p.attributes.end())
+            return false;
+        snprintf(what, sizeof what, "mesh %d primitive %d %s", mesh, prim, name);
+        if (is_draco && m_.accessors.size() > size_t(it->second) && m_.accessors[size_t(it->second)].bufferView < 0 &&
+            !m_.accessors[size_t(it->second)].sparse.isSparse)
+            return false; /* listed, but neither compressed nor stored: no data */
+        read_accessor(it->second, ncomp, what, out);
+        return true;
+    };
+    std::vector<float> pos;
+    attribute("POSITION", 3, pos);
+    const size_t nv = pos.size() / 3;
+    for (size_t i = 0; i < pos.size(); i++)
+        if (!std::isfinite(pos[i]))
+            fail("mesh %d primitive %d: POSITION of vertex %zu is not finite (NaN or Inf)", mesh, prim, i / 3);
+
+    std::vector<float> nrm, uv, uv1, tan;
+    struct {
+        const char *name;
+        int ncomp;
+        std::vector<float> *out;
+    } extra[] = {{"NORMAL", 3, &nrm}, {"TEXCOORD_0", 2, &uv}, {"TEXCOORD_1", 2, &uv1}, {"TANGENT", 4, &tan}};
+    for (const auto &a : extra)
+        if (attribute(a.name, a.ncomp, *a.out) && a.out->size() / size_t(a.ncomp) != nv)
+            fail("mesh %d primitive %d: %s has %zu elements but POSITION has %zu", mesh, prim, a.name,
+                 a.out->size() / size_t(a.ncomp), nv);
+
+    std::vector<uint32_t> idx;
+    if (is_draco) {
+        idx = draco.indices;
+    } else if (p.indices >= 0) {
+        read_indices(p.indices, idx);
+    } else {
+        idx.resize(nv);
+        for (size_t i = 0; i < nv; i++)
+            idx[i] = uint32_t(i);
+    }
+    for (size_t i = 0; i < idx.size(); i++)
+        if (idx[i] >= nv)
+            fail("mesh %d primitive %d: index %u at position %zu is out of range (vertex count %zu)", mesh, prim,
+                 idx[i], i, nv);
+
+    /* Triangle list in glTF's vertex order per mode. */
+    std::vector<uint32_t> tri;
+    const size_t ni = idx.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        tri.assign(idx.begin(), idx.begin() + ptrdiff_t(ni - ni % 3));
+    } else if (ni >= 3) {
+        tri.reserve((ni - 2) * 3);
+        for (size_t i = 0; i + 2 < ni; i++) {
+            if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                size_t b = i + 1 + (i % 2), c = i + 2 - (i % 2);
+                tri.insert(tri.end(), {idx[i], idx[b], idx[c]});
+            } else {
+                tri.insert(tri.end(), {idx[i + 1], idx[i + 2], idx[0]});
+            }
+        }
+    }
+    const size_t ntri = tri.size() / 3;
+    if (ntri == 0)
+        return;
+    if (uint64_t(indices.size()) / 3 + ntri > kMaxTriangles)
+        fail("more than %llu triangles (absurd size)", (unsigned long long)kMaxTriangles);
+
+    int material;
+    if (p.material >= 0) {
+        if (size_t(p.material) >= m_.materials.size())
+            fail("mesh %d primitive %d: material %d does not exist (out of range)", mesh, prim, p.material);
+        material = p.material;
+    } else {
+        material = default_material();
+    }
+
+    if (uv1.empty() && size_t(material) < material_uv1_.size() && material_uv1_[size_t(material)])
+        ctx_.warn(strf("material %d reads TEXCOORD_1, which mesh %d primitive %d lacks; (0, 0) is used there",
+                       material, mesh, prim));
+
+    const bool flip = det3(world) < 0.0;
+    double nm[9];
+    normal_matrix(world, nm);
+
+    auto world_vertex = [&](size_t v, lpv_vertex &out) {
+        double lp[3] = {pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2]}, wp[3];
+        xform_point(world, lp, wp);
+        for (int k = 0; k < 3; k++) {
+            out.position[k] = float(wp[k]);
+            if (!std::isfinite(out.position[k]))
+                fail("mesh %d primitive %d: world position of vertex %zu is not finite (NaN or Inf)", mesh, prim, v);
+        }
+        out.uv[0] = uv.empty() ? 0.0f : uv[v * 2];
+        out.uv[1] = uv.empty() ? 0.0f : uv[v * 2 + 1];
+        if (!std::isfinite(out.uv[0]) || !std::isfinite(out.uv[1]))
+            out.uv[0] = out.uv[1] = 0.0f;
+        out.uv1[0] = uv1.empty() ? 0.0f : uv1[v * 2];
+        out.uv1[1] = uv1.empty() ? 0.0f : uv1[v * 2 + 1];
+        if (!std::isfinite(out.uv1[0]) || !std::isfinite(out.uv1[1]))
+            out.uv1[0] = out.uv1[1] = 0.0f;
+        /* TANGENT: xyz moves with the model matrix, w (handedness) flips with
+         * a mirroring one; a degenerate or non-finite tangent is dropped (the
+         * shader then builds its own frame) */
+        out.tangent[0] = out.tangent[1] = out.tangent[2] = out.tangent[3] = 0.0f;
+        if (!tan.empty()) {
+            double lt[3] = {tan[v * 4], tan[v * 4 + 1], tan[v * 4 + 2]}, wt[3];
+            xform_dir(world, lt, wt);
+            const double w = tan[v * 4 + 3];
+            if (normalize3(wt) && std::isfinite(w)) {
+                for (int k = 0; k < 3; k++)
+                    out.tangent[k] = float(wt[k]);
+                out.tangent[3] = ((w < 0.0) != flip) ? -1.0f : 1.0f;
+            }
+        }
+    };
+
+    const uint64_t add_vertices = nrm.empty() ? uint64_t(ntri) * 3 : uint64_t(nv);
+    if (uint64_t(vertices.size()) + add_vertices > kMaxVertices)
+        fail("more than %llu vertices (absurd size)", (unsigned long long)kMaxVertices);
+
+    lpv_draw draw;
+    draw.first_index = uint32_t(indices.size());
+    draw.index_count = uint32_t(ntri * 3);
+    draw.material = material;
+
+    if (!nrm.empty()) {
+        const uint32_t base = uint32_t(vertices.size());
+        vertices.resize(vertices.size() + nv);
+        for (size_t v = 0; v < nv; v++) {
+            lpv_vertex &out = vertices[base + v];
+            world_vertex(v, out);
+            double ln[3] = {nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]}, wn[3];
+            for (int r = 0; r < 3; r++)
+                wn[r] = nm[r * 3] * ln[0] + nm[r * 3 + 1] * ln[1] + nm[r * 3 + 2] * ln[2];
+            if (!normalize3(wn))
+                wn[0] = wn[1] = wn[2] = 0.0; /* degenerate normal: kept as zero */
+            for (int k = 0; k < 3; k++)
+                out.normal[k] = float(wn[k]);
+        }
+        indices.reserve(indices.size() + ntri * 3);
+        for (size_t t = 0; t < ntri; t++) {
+            uint32_t a = tri[t * 3], b = tri[t * 3 + 1], c = tri[t * 3 + 2];
+            if (flip)
+                std::swap(b, c);
+            indices.insert(indices.end(), {base + a, base + b, base + c});
+        }
+    } else {
+        /* No normals: flat per triangle from the (world) winding; vertices un-shared. */
+        vertices.reserve(vertices.size() + ntri * 3);
+        indices.reserve(indices.size() + ntri * 3);
+        for (size_t t = 0; t < ntri; t++) {
+            uint32_t corner[3] = {tri[t * 3], tri[t * 3 + 1], tri[t * 3 + 2]};
+            if (flip)
+                std::swap(corner[1], corner[2]);
+            lpv_vertex vx[3];
+            memset(vx, 0, sizeof vx);
+            for (int k = 0; k < 3; k++)
+                world_vertex(corner[k], vx[k]);
+            double e1[3], e2[3], n[3];
+            for (int k = 0; k < 3; k++) {
+                e1[k] = double(vx[1].position[k]) - vx[0].position[k];
+                e2[k] = double(vx[2].position[k]) - vx[0].position[k];
+            }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            if (!normalize3(n))
+                n[0] = n[1] = n[2] = 0.0;
+            const uint32_t base = uint32_t(vertices.size());
+            for (int k = 0; k < 3; k++) {
+                for (int j = 0; j < 3; j++)
+                    vx[k].normal[j] = float(n[j]);
+                vertices.push_back(vx[k]);
+            }
+            indices.insert(indices.end(), {base, base + 1, base + 2});
+        }
+    }
+    draws.push_back(draw);
+}
+
+} // namespace lpv_gltf

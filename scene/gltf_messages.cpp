@@ -1,0 +1,96 @@
+/*
+ * gltf_messages.cpp - how the glTF adapter words its problems (gltf_internal.hpp):
+ * printf-style formatting, the Failure that refuses a file, values from the
+ * file shortened for a message, and the warnings, each line once.
+ */
+#include "gltf_internal.hpp"
+
+#include <algorithm>
+#include <cstdarg>
+#include <cstdio>
+
+namespace lpv_gltf {
+
+namespace {
+
+std::string vformat(const char *fmt, va_list ap)
+{
+    va_list ap2;
+    va_copy(ap2, ap);
+    int n = vsnprintf(nullptr, 0, fmt, ap2);
+    va_end(ap2);
+    if (n < 0)
+        return std::string(fmt);
+    std::string s(size_t(n) + 1, '\0');
+    vsnprintf(&s[0], s.size(), fmt, ap);
+    s.resize(size_t(n));
+    return s;
+}
+
+} // namespace
+
+std::string strf(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    std::string s = vformat(fmt, ap);
+    va_end(ap);
+    return s;
+}
+
+[[noreturn]] void fail(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    std::string s = vformat(fmt, ap);
+    va_end(ap);
+    throw Failure{s};
+}
+
+std::string one_line(const std::string &s)
+{
+    std::string out;
+    bool sep = false;
+    for (char c : s) {
+        if (c == '\n' || c == '\r') {
+            sep = !out.empty();
+            continue;
+        }
+        if (sep) {
+            out += "; ";
+            sep = false;
+        }
+        out += c;
+    }
+    return out;
+}
+
+std::string show(const std::string &s)
+{
+    std::string out = "\"";
+    size_t n = 0;
+    for (unsigned char c : s) {
+        if (n++ >= 80) {
+            out += "...";
+            break;
+        }
+        if (c < 0x20 || c == 0x7f)
+            out += strf("\\x%02x", c);
+        else
+            out += char(c);
+    }
+    out += "\"";
+    return out;
+}
+
+void Ctx::warn(const std::string &w)
+{
+    if (std::find(warnings.begin(), warnings.end(), w) != warnings.end())
+        return;
+    if (warnings.size() < kMaxWarnings)
+        warnings.push_back(w);
+    else
+        warnings_dropped++;
+}
+
+} // namespace lpv_gltf
