@@ -207,4 +207,8 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
         decide(p, LPV_PASS_BOUNCE, 0, "propagation does not run");
     else
         decide(p, LPV_PASS_BOUNCE, 1, "bounces on, intensity %.2f", (double)s->bounce_intensity);
+
+    p->consumes.emissive_vpls = p->pass[LPV_PASS_EMISSIVE].run;
+    p->consumes.surfels = p->pass[LPV_PASS_GV].run;
+    p->consumes.camera_surfels = p->pass[LPV_PASS_GV].run && p->pass[LPV_PASS_GBUFFER].run;
 }

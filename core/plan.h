@@ -65,6 +65,14 @@ typedef struct lpv_plan {
         int run;
         char reason[LPV_PLAN_REASON_MAX];   /* why it runs or why it is skipped */
     } pass[LPV_PASS_COUNT];
+    /* Which of the engine's shared producers' outputs the technique's
+     * passes read this tick (the engine gates their read-backs and stats on
+     * these, not on the technique's pass ids). */
+    struct {
+        int emissive_vpls;  /* the emissive surfaces' VPLs */
+        int surfels;        /* the RSMs' and the scene's surfels (occlusion) */
+        int camera_surfels; /* the camera's surfels */
+    } consumes;
 } lpv_plan;
 
 /* "rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce",

@@ -1,6 +1,8 @@
 /*
- * engine_internal.h - the engine's GL objects, shared by engine.c and the
- * pass files (pass_*.c). Not part of the public API.
+ * engine_internal.h - the engine's state: the shared producers' GL objects
+ * (scene, RSMs, camera, shadow maps, medium) and the technique it drives
+ * (technique.h). Shared by engine*.c and the shared producers' pass files
+ * (pass_*.c, light_faces.c); a technique never sees it. Not public API.
  */
 #ifndef LPV_ENGINE_INTERNAL_H
 #define LPV_ENGINE_INTERNAL_H
@@ -10,8 +12,11 @@
 #include "engine.h"
 #include "error.h"
 #include "gl.h"
+#include "gl_util.h"
 #include "lpv_shared.h"
+#include "medium.h"
 #include "memory_budget.h"
+#include "technique.h"
 #include "timer.h"
 
 typedef struct lpv_gpu_material {
@@ -35,18 +40,10 @@ typedef struct lpv_gpu_draw {
     float size; /* m, longest side of the draw's bounding box (cascade fading) */
 } lpv_gpu_draw;
 
-/* A 2D atlas of z slices that points are blended into (see grid.glsl). */
-typedef struct lpv_atlas {
-    int tiles_x, width, height;
-    int attachments;
-    GLuint tex[3];
-    GLuint fbo;
-} lpv_atlas;
-
 struct lpv_engine {
     lpv_settings settings;
-    lpv_grid grid;            /* the finest cascade (cascades.grid[0]) */
-    lpv_cascade_set cascades; /* placement of the last computed tick */
+    lpv_technique *tech;      /* the GI technique (gpu/technique.h) */
+    lpv_volume_desc desc;     /* its volume after the last commit */
     int has_scene;
 
     /* What changed since the last computed tick (the planner's facts). */
@@ -56,15 +53,12 @@ struct lpv_engine {
     float computed_eye[3];
     int computed_has_view;
     size_t occluder_triangles;
-    int has_medium;           /* the scene has a participating medium */
-    lpv_medium medium;        /* its coefficients and box (density in medium_density) */
-    GLuint medium_density;    /* 3D R32F texture, 0 = none */
+    lpv_medium_gpu medium;    /* the scene's participating medium (medium.present), if any */
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge,
-        prog_transmit, prog_propagate, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
-        prog_media, prog_handoff, prog_shadow;
+    GLuint prog_rsm, prog_vpl_extract, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
+        prog_media, prog_shadow;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -104,17 +98,7 @@ struct lpv_engine {
 
     lpv_memory_limits mem_limits; /* of the context, read at create */
 
-    /* grids */
-    GLuint grid_ubo;
-    lpv_atlas lpv_atlas, gv_atlas;
-    GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit, reflect;
-    GLuint lpv_last; /* the buffer the last propagation step (or hand-off) wrote */
-    GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
-    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
-    size_t grid_alloc_cells; /* cells of all cascades */
-    int grid_alloc_dims[3], grid_alloc_cascades, grid_alloc_bins;
-    int bins;                /* LPV volumes per cascade: 1, or LPV_NORMAL_BINS (normal_bins on) */
-    int ticked;
+    int ticked;               /* a tick ran since the last change that discards the volume */
 
     /* camera */
     int has_view;
@@ -133,46 +117,23 @@ struct lpv_engine {
     lpv_plan plan;
 };
 
-/* Builds a program whose sources get the named .glsl include files first
- * (after lpv_shared.h). includes is a NULL-terminated list. */
-GLuint lpv_engine_program(const char *vert_or_comp, const char *geom, const char *frag, const char *const *includes,
-                          char *err, size_t err_size);
-
-/* Draws every scene draw with the bound program (material uniforms set). */
 /* Draws every draw with its material's uniforms and textures. cull_single_sided:
  * back faces of materials that are not double-sided are culled (the camera's
  * view, as glTF says; light views pass 0 and see both sides). */
 void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided);
 
-/* Cells of one cascade, and of all cascades in use. */
-static inline size_t lpv_engine_cascade_cells(const lpv_engine *e) { return lpv_grid_cell_count(&e->grid); }
-static inline size_t lpv_engine_all_cells(const lpv_engine *e)
-{
-    return lpv_grid_cell_count(&e->grid) * (size_t)e->cascades.count;
-}
-/* LPV volumes (cascades x normal bins) and their cells: the size of the LPV
- * buffers; the geometry volume and transmittances stay per cascade. */
-static inline int lpv_engine_volumes(const lpv_engine *e) { return e->cascades.count * (e->bins > 1 ? e->bins : 1); }
-static inline size_t lpv_engine_volume_cells(const lpv_engine *e)
-{
-    return lpv_grid_cell_count(&e->grid) * (size_t)lpv_engine_volumes(e);
-}
+/* The scene's GPU objects (engine_scene.c): freed, and the emitters as area
+ * light samples under the current settings (none when area lights are off). */
+void lpv_engine_free_scene(lpv_engine *e);
+void lpv_engine_update_area_samples(lpv_engine *e);
 
 /* Per-pass set-up and work; each _run records its own timer stage. */
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
 void lpv_pass_rsm_run(lpv_engine *e);
-void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls);
 int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the targets could not be allocated */
-void lpv_pass_gv_run(lpv_engine *e, int bounce, int camera);
-void lpv_pass_propagate_run(lpv_engine *e, int occlusion, int bounce);
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
 void lpv_pass_glossy_run(lpv_engine *e);
 void lpv_pass_media_run(lpv_engine *e);
-
-/* The participating medium (pass_effects.c): upload at set_scene, and the
- * uniforms of medium.glsl for prog (on = 0 binds "no medium"). */
-int lpv_medium_upload(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
-void lpv_medium_bind(lpv_engine *e, GLuint prog, int on);
 
 /* Surfels [first, first + count) of the RSM surfel buffer that GV buffer
  * `buffer` splats (0, 0 for the camera's or one past the end). */
@@ -199,23 +160,23 @@ int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *
 int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size);
 void lpv_pass_shadow_free(lpv_engine *e);
 
-/* The storage the engine's inputs call for, with the grid of `cascades`
- * (NULL: the current one), and the check against the context's limits
- * (core/memory_budget.h). Returns 0, or -1 with a message naming the setting. */
-void lpv_engine_memory_need(const lpv_engine *e, const lpv_cascade_set *cascades, lpv_memory_need *n);
-int lpv_engine_memory_check(const lpv_engine *e, const lpv_memory_need *n, char *err, size_t err_size);
+/* The storage the engine's own producers call for (RSMs, shadow maps, the
+ * image; memory_limits.c); the technique adds its own. */
+void lpv_engine_memory_need(const lpv_engine *e, lpv_memory_need *n);
+/* The engine's and the technique's storage at the current inputs against
+ * the context's limits (core/memory_budget.h). Returns 0, or -1 with a
+ * message naming the setting. */
+int lpv_engine_memory_check(const lpv_engine *e, char *err, size_t err_size);
 
-/* Atlas helpers (pass_inject.c). */
-int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);
-void lpv_atlas_destroy(lpv_atlas *a);
-void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog);      /* clears it first */
-void lpv_atlas_begin_keep(lpv_engine *e, lpv_atlas *a, GLuint prog); /* adds to what it holds */
-void lpv_atlas_splat(lpv_engine *e, GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count);
-void lpv_atlas_end(void);
-
-static inline GLuint lpv_div_up(size_t n, unsigned d)
-{
-    return (GLuint)((n + d - 1) / d);
-}
+/* The planner's facts about the scene, the settings and what changed
+ * (engine_tick.c). */
+void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f);
+/* Where the technique's volume must go now, under facts f. */
+void lpv_engine_where(const lpv_engine *e, const lpv_plan_facts *f, lpv_technique_where *w);
+/* Places and commits the technique's volume for the current inputs without a
+ * tick, so lpv_engine_grid() answers right after set_scene/set_settings. */
+int lpv_engine_place_volume(lpv_engine *e, char *err, size_t err_size);
+/* After a commit: the volume's description, and what a storage reset drops. */
+void lpv_engine_committed(lpv_engine *e, int reset);
 
 #endif /* LPV_ENGINE_INTERNAL_H */

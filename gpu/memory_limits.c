@@ -77,26 +77,22 @@ void lpv_memory_limits_query(lpv_memory_limits *out)
     out->max_layers = layers > 0 ? layers : 256;
 }
 
-void lpv_engine_memory_need(const lpv_engine *e, const lpv_cascade_set *cascades, lpv_memory_need *n)
+void lpv_engine_memory_need(const lpv_engine *e, lpv_memory_need *n)
 {
     memset(n, 0, sizeof *n);
     lpv_light_face_counts(e, &n->rsm_faces, &n->shadow_faces);
     n->rsm_size = e->settings.rsm_size;
     n->shadow_size = e->settings.shadow_size;
-    const lpv_cascade_set *c = cascades ? cascades : &e->cascades;
-    const lpv_grid *g = c->count > 0 ? &c->grid[0] : &e->grid;
-    const size_t k = (size_t)(c->count > 0 ? c->count : 1);
-    n->cells = lpv_grid_cell_count(g) * k;
-    n->gv_points = lpv_grid_gv_count(g) * k;
-    n->cascades = (int)k;
-    memcpy(n->grid_dims, g->dims, sizeof n->grid_dims);
     if (e->has_view) {
         n->image_w = e->view.width;
         n->image_h = e->view.height;
     }
 }
 
-int lpv_engine_memory_check(const lpv_engine *e, const lpv_memory_need *n, char *err, size_t err_size)
+int lpv_engine_memory_check(const lpv_engine *e, char *err, size_t err_size)
 {
-    return lpv_memory_check(n, &e->mem_limits, err, err_size);
+    lpv_memory_need need;
+    lpv_engine_memory_need(e, &need);
+    e->tech->cls->memory_need(e->tech, &need);
+    return lpv_memory_check(&need, &e->mem_limits, err, err_size);
 }

@@ -2,7 +2,7 @@
  * pass_camera.c - the camera's passes: the G-buffer (position/surfel area,
  * normal, albedo, emission) with its pixels as GV surfels, and the final
  * shading of direct light (through the shadow maps of pass_shadow.c) plus the
- * LPV's irradiance into a linear-radiance frame.
+ * technique's irradiance (its lookup, technique.h) into a linear-radiance frame.
  */
 #include <math.h>
 #include <string.h>
@@ -185,7 +185,7 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(e->prog_shade);
-    glUniform1f(glGetUniformLocation(e->prog_shade, "u_damping"), e->settings.damping);
+    e->tech->cls->bind_lookup(e->tech, e->prog_shade, e->settings.damping);
     glUniform1f(glGetUniformLocation(e->prog_shade, "u_glossy_roughness"),
                 e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
                                                                                   : 0.0f);
@@ -196,10 +196,8 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
     glBindVertexArray(e->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     lpv_timer_count(&e->timer, 1);

@@ -58,8 +58,8 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     /* Estimate before allocating: past what the device holds, drivers fail
      * in ways that crash (llvmpipe segfaults on shader storage past 2 GiB). */
     lpv_memory_need need;
-    lpv_engine_memory_need(e, NULL, &need);
-    if (lpv_engine_memory_check(e, &need, err, err_size) != 0)
+    lpv_engine_memory_need(e, &need);
+    if (lpv_engine_memory_check(e, err, err_size) != 0)
         return -1;
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }

@@ -27,8 +27,8 @@ void lpv_pass_shadow_free(lpv_engine *e)
 static int allocate(lpv_engine *e, int size, int layers, char *err, size_t err_size)
 {
     lpv_memory_need need;
-    lpv_engine_memory_need(e, NULL, &need);
-    if (lpv_engine_memory_check(e, &need, err, err_size) != 0)
+    lpv_engine_memory_need(e, &need);
+    if (lpv_engine_memory_check(e, err, err_size) != 0)
         return -1;
     lpv_pass_shadow_free(e);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */

@@ -210,3 +210,35 @@ GLuint lpv_program_graphics(const char *vert, const char *geom, const char *frag
         err[0] = '\0';
     return prog;
 }
+
+GLuint lpv_program_build(const char *first, const char *geom, const char *frag, const char *const *includes,
+                         char *err, size_t err_size)
+{
+    /* The includes use the shared header's types, so it goes first; its
+     * include guard makes the copy shader.c adds afterwards a no-op. */
+    const char *shared = lpv_shader_text("lpv_shared.h");
+    size_t len = strlen(shared) + 2;
+    for (const char *const *i = includes; i && *i; ++i) {
+        const char *t = lpv_shader_text(*i);
+        if (!t) {
+            lpv_error(err, err_size, "shader include %s is not embedded", *i);
+            return 0;
+        }
+        len += strlen(t) + 64;
+    }
+    char *prelude = malloc(len);
+    if (!prelude) {
+        lpv_error(err, err_size, "out of memory building %s", first);
+        return 0;
+    }
+    strcpy(prelude, shared);
+    strcat(prelude, "\n");
+    for (const char *const *i = includes; i && *i; ++i) {
+        strcat(prelude, lpv_shader_text(*i));
+        strcat(prelude, "\n");
+    }
+    GLuint p = frag ? lpv_program_graphics(first, geom, frag, prelude, err, err_size)
+                    : lpv_program_compute(first, prelude, err, err_size);
+    free(prelude);
+    return p;
+}

@@ -23,4 +23,10 @@ GLuint lpv_program_compute(const char *comp, const char *defines, char *err, siz
 GLuint lpv_program_graphics(const char *vert, const char *geom, const char *frag, const char *defines,
                             char *err, size_t err_size);
 
+/* A program whose stages get lpv_shared.h and then the named .glsl include
+ * files (a NULL-terminated list, in order) before their own text; frag NULL
+ * builds a compute program from first. Returns 0 with err on failure. */
+GLuint lpv_program_build(const char *first, const char *geom, const char *frag, const char *const *includes,
+                         char *err, size_t err_size);
+
 #endif /* LPV_SHADER_H */

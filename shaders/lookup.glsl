@@ -1,3 +1,7 @@
+// The cascaded LPV's side of the technique seam (gpu/technique.h): with
+// grid.glsl it is the "lpv" technique's lookup_includes, and defines what the
+// engine's shade/glossy/media/query shaders call: lpv_irradiance, lpv_project,
+// lpv_cell_at and the u_damping uniform.
 // lookup.glsl - irradiance from the accumulated LPV cascades (core/oracle_lookup.c
 // is the single-grid reference). In one cascade: trilinear interpolation
 // between cell centres, clamped at the grid's edge, at half a cell in front

@@ -4,23 +4,24 @@
  * the injection pass initialised with the injected grid). Occlusion is
  * skipped on the first step (the paper's rule against self-shadowing).
  */
-#include "engine_internal.h"
+#include "lpv_internal.h"
 
-void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
+void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int occlusion_on, int bounce)
 {
-    lpv_timer_begin(&e->timer, "propagate");
-    glUseProgram(e->prog_propagate);
-    GLint loc_occ = glGetUniformLocation(e->prog_propagate, "u_occlusion");
-    glUniform1i(glGetUniformLocation(e->prog_propagate, "u_bounce"), bounce);
-    lpv_medium_bind(e, e->prog_propagate, e->plan.pass[LPV_PASS_MEDIA].run);
+    lpv_timer *timer = in->timer;
+    lpv_timer_begin(timer, "propagate");
+    glUseProgram(c->prog_propagate);
+    GLint loc_occ = glGetUniformLocation(c->prog_propagate, "u_occlusion");
+    glUniform1i(glGetUniformLocation(c->prog_propagate, "u_bounce"), bounce);
+    lpv_medium_bind(in->medium, in->settings, c->prog_propagate, in->plan->pass[LPV_PASS_MEDIA].run);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_REFLECT);
-    glBindTexture(GL_TEXTURE_BUFFER, e->tbo_reflect);
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
+    glBindTexture(GL_TEXTURE_BUFFER, c->tbo_reflect);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, c->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, c->lpv_acc);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_ACC_IN);
-    glBindTexture(GL_TEXTURE_BUFFER, e->tbo_acc);
+    glBindTexture(GL_TEXTURE_BUFFER, c->tbo_acc);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_TRANSMIT);
-    glBindTexture(GL_TEXTURE_BUFFER, e->tbo_transmit);
+    glBindTexture(GL_TEXTURE_BUFFER, c->tbo_transmit);
     const int occlusion = occlusion_on;
     /* Step i reads (through buffer-texture views: on llvmpipe texel fetches
      * gather far faster than SSBO loads) what step i - 1 wrote with SSBO
@@ -33,45 +34,45 @@ void lpv_pass_propagate_run(lpv_engine *e, int occlusion_on, int bounce)
      * level: the accumulation can only grow (an even share per level moved
      * light out of the finer levels later as the count grew, and the Cornell
      * box got worse from 4 to 16 steps). */
-    const int iterations = e->settings.iterations, levels = e->cascades.handoff ? e->cascades.count : 1;
-    const int every = e->settings.far_field_steps > 0 ? e->settings.far_field_steps : 1;
-    GLuint in_view = e->tbo_injected, cur = 0;
+    const int iterations = in->settings->iterations, levels = c->cascades.handoff ? c->cascades.count : 1;
+    const int every = in->settings->far_field_steps > 0 ? in->settings->far_field_steps : 1;
+    GLuint in_view = c->tbo_injected, cur = 0;
     int sig = 0; /* the sigma buffer holding the flux limits of what is read next */
-    const GLuint groups[3] = {lpv_div_up((size_t)e->grid.dims[0], LPV_PROP_WG_X),
-                              lpv_div_up((size_t)e->grid.dims[1], LPV_PROP_WG_Y),
-                              (GLuint)(e->grid.dims[2] * lpv_engine_volumes(e))};
+    const GLuint groups[3] = {lpv_div_up((size_t)c->grid.dims[0], LPV_PROP_WG_X),
+                              lpv_div_up((size_t)c->grid.dims[1], LPV_PROP_WG_Y),
+                              (GLuint)(c->grid.dims[2] * lpv_volumes(c))};
     for (int i = 0; i < iterations; ++i) {
-        GLuint out = cur == e->lpv_ping ? e->lpv_pong : e->lpv_ping;
-        glUseProgram(e->prog_propagate);
+        GLuint out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
+        glUseProgram(c->prog_propagate);
         glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
         glBindTexture(GL_TEXTURE_BUFFER, in_view);
         glActiveTexture(GL_TEXTURE0 + LPV_TEX_SIGMA_IN);
-        glBindTexture(GL_TEXTURE_BUFFER, e->tbo_sigma[sig]);
+        glBindTexture(GL_TEXTURE_BUFFER, c->tbo_sigma[sig]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[sig ^ 1]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, c->sigma[sig ^ 1]);
         glUniform1i(loc_occ, occlusion && i > 0);
         glDispatchCompute(groups[0], groups[1], groups[2]);
-        lpv_timer_count(&e->timer, 1);
+        lpv_timer_count(timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         cur = out;
-        in_view = out == e->lpv_ping ? e->tbo_ping : e->tbo_pong;
+        in_view = out == c->lpv_ping ? c->tbo_ping : c->tbo_pong;
         sig ^= 1;
         if ((i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations) {
-            out = cur == e->lpv_ping ? e->lpv_pong : e->lpv_ping;
-            glUseProgram(e->prog_handoff);
+            out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
+            glUseProgram(c->prog_handoff);
             glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
             glBindTexture(GL_TEXTURE_BUFFER, in_view);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[sig ^ 1]);
-            glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D),
-                              lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D), groups[2]);
-            lpv_timer_count(&e->timer, 1);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, c->sigma[sig ^ 1]);
+            glDispatchCompute(lpv_div_up((size_t)c->grid.dims[0], LPV_WG_2D),
+                              lpv_div_up((size_t)c->grid.dims[1], LPV_WG_2D), groups[2]);
+            lpv_timer_count(timer, 1);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             cur = out;
-            in_view = out == e->lpv_ping ? e->tbo_ping : e->tbo_pong;
+            in_view = out == c->lpv_ping ? c->tbo_ping : c->tbo_pong;
             sig ^= 1;
         }
     }
-    e->lpv_last = cur ? cur : e->lpv_injected;
-    lpv_timer_end(&e->timer);
+    c->lpv_last = cur ? cur : c->lpv_injected;
+    lpv_timer_end(timer);
 }

@@ -1,14 +1,15 @@
 /*
- * pass_inject.c - VPL injection. Each VPL (from the RSMs and from emissive
- * surfaces) is one point rendered with additive blending into a 2D atlas of
- * the grid's z slices (fp32, three attachments for r, g, b): the paper's
- * point-splatting injection, portable because it needs no float atomics and
- * deterministic because blending follows primitive order. A compute pass
- * then copies the atlas into the LPV buffer layout.
+ * lpv_atlas.c - the 2D atlases of z slices that the LPV's injection and its
+ * geometry volume blend points into (fp32 render targets, one attachment per
+ * colour channel or per half of a point's data): the paper's point
+ * splatting, portable because it needs no float atomics and deterministic
+ * because blending follows primitive order. The LPV state owns both atlases
+ * (lpv_storage.c sizes them with the cascades); the passes get them passed.
  */
 #include <math.h>
 
-#include "engine_internal.h"
+#include "error.h"
+#include "lpv_internal.h"
 
 int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size)
 {
@@ -52,7 +53,7 @@ void lpv_atlas_destroy(lpv_atlas *a)
 }
 
 /* Sets the state for additive point splatting with prog into the atlas as it is. */
-void lpv_atlas_begin_keep(lpv_engine *e, lpv_atlas *a, GLuint prog)
+void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
     glViewport(0, 0, a->width, a->height);
@@ -62,32 +63,33 @@ void lpv_atlas_begin_keep(lpv_engine *e, lpv_atlas *a, GLuint prog)
     glBlendFunc(GL_ONE, GL_ONE);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glUseProgram(prog);
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, grid_ubo);
     glUniform1i(glGetUniformLocation(prog, "u_tiles_x"), a->tiles_x);
     glUniform2f(glGetUniformLocation(prog, "u_atlas_size"), (float)a->width, (float)a->height);
-    glBindVertexArray(e->empty_vao);
+    glBindVertexArray(empty_vao);
 }
 
 /* Draws count points reading elements [first, first + count) of buffer at
  * binding, once per cascade (instanced: gl_InstanceID is the cascade). */
-void lpv_atlas_splat(lpv_engine *e, GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count)
+void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int cascades,
+                     lpv_timer *timer)
 {
     if (!count)
         return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     glUniform1i(glGetUniformLocation(prog, "u_first"), (GLint)first);
-    glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)count, (GLsizei)e->cascades.count);
-    lpv_timer_count(&e->timer, 1);
+    glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)count, (GLsizei)cascades);
+    lpv_timer_count(timer, 1);
 }
 
 /* Clears the atlas and sets the state for additive point splatting with prog. */
-void lpv_atlas_begin(lpv_engine *e, lpv_atlas *a, GLuint prog)
+void lpv_atlas_begin(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
     static const float zero[4] = {0, 0, 0, 0};
     for (int i = 0; i < a->attachments; ++i)
         glClearBufferfv(GL_COLOR, i, zero);
-    lpv_atlas_begin_keep(e, a, prog);
+    lpv_atlas_begin_keep(a, prog, grid_ubo, empty_vao);
 }
 
 void lpv_atlas_end(void)
@@ -96,42 +98,4 @@ void lpv_atlas_end(void)
     glBindVertexArray(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-}
-
-void lpv_pass_inject_run(lpv_engine *e, int rsm_vpls, int emissive_vpls)
-{
-    lpv_timer_begin(&e->timer, "inject");
-    lpv_atlas_begin(e, &e->lpv_atlas, e->prog_inject_vpl);
-    if (rsm_vpls)
-        lpv_atlas_splat(e, e->prog_inject_vpl, LPV_SSBO_VPLS, e->vpls, 0, e->rsm_texels);
-    lpv_atlas_end();
-    lpv_timer_end(&e->timer);
-    /* Emissive surfaces are their own stage, so the plan's "emissive" pass
-     * shows its cost (and its absence). */
-    if (emissive_vpls) {
-        lpv_timer_begin(&e->timer, "emissive");
-        lpv_atlas_begin_keep(e, &e->lpv_atlas, e->prog_inject_vpl);
-        lpv_atlas_splat(e, e->prog_inject_vpl, LPV_SSBO_VPLS, e->emissive_vpls, 0, e->emissive_vpl_count);
-        lpv_atlas_end();
-        lpv_timer_end(&e->timer);
-    }
-
-    lpv_timer_begin(&e->timer, "pack");
-
-    glUseProgram(e->prog_pack);
-    glUniform1i(glGetUniformLocation(e->prog_pack, "u_tiles_x"), e->lpv_atlas.tiles_x);
-    for (int i = 0; i < 3; ++i) {
-        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        glBindTexture(GL_TEXTURE_2D, e->lpv_atlas.tex[i]);
-    }
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, e->grid_ubo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, e->lpv_injected);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, e->lpv_acc);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, e->sigma[0]);
-    glDispatchCompute(lpv_div_up((size_t)e->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)e->grid.dims[1], LPV_WG_2D),
-                      (GLuint)(e->grid.dims[2] * lpv_engine_volumes(e)));
-    lpv_timer_count(&e->timer, 1);
-    /* propagation reads the packed grid and flux limits as buffer textures */
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    lpv_timer_end(&e->timer);
 }

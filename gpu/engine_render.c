@@ -1,0 +1,131 @@
+/*
+ * engine_render.c - after a tick: the camera's frame (G-buffer if stale,
+ * shadow maps if stale, shading, glossy, media; read back top row first) and
+ * irradiance queries at arbitrary points, both through the technique's
+ * lookup.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "engine_internal.h"
+#include "error.h"
+
+int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *err, size_t err_size)
+{
+    if (!e->ticked)
+        return lpv_error(err, err_size, "render before a tick");
+    if (!e->has_view)
+        return lpv_error(err, err_size, "render needs a view (camera)");
+    if (e->gbuf_stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
+        if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
+            return -1;
+        e->gbuf_stale = 0;
+    }
+    /* Direct light needs the shadow maps (media's in-scattering too, which
+     * only a full frame has); they are redrawn only when what they show changed. */
+    if (terms != LPV_TERMS_INDIRECT_ONLY && lpv_pass_shadow_update(e, err, err_size) != 0)
+        return -1;
+    lpv_pass_shade_run(e, terms);
+    if (e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY)
+        lpv_pass_glossy_run(e);
+    if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
+        lpv_pass_media_run(e);
+    const int w = e->gbuf_w, h = e->gbuf_h;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame_fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    /* GL rows run bottom-up; files and callers want the top row first. */
+    size_t row = (size_t)w * 4;
+    for (int y = 0; y < h / 2; ++y) {
+        float *a = rgba + (size_t)y * row, *b = rgba + (size_t)(h - 1 - y) * row;
+        for (size_t i = 0; i < row; ++i) {
+            float t = a[i];
+            a[i] = b[i];
+            b[i] = t;
+        }
+    }
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR)
+        return lpv_error(err, err_size, "GL error 0x%04x during rendering", gl_err);
+    /* Append the shading stage to the tick's stats. */
+    lpv_timer_collect(&e->timer);
+    lpv_engine_stats *s = &e->stats;
+    for (int i = 0; i < e->timer.stage_count && s->stage_count < LPV_STAGE_MAX; ++i) {
+        const lpv_timer_stage *st = &e->timer.stages[i];
+        int k = s->stage_count++;
+        snprintf(s->stages[k].name, sizeof s->stages[k].name, "%s", st->name);
+        s->stages[k].gpu_ms = st->gpu_ms;
+        s->stages[k].cpu_ms = st->cpu_ms;
+        s->stages[k].calls = st->count;
+    }
+    return 0;
+}
+
+int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
+                          size_t err_size)
+{
+    if (!e->ticked)
+        return lpv_error(err, err_size, "irradiance query before a tick");
+    if (n == 0)
+        return 0;
+    if (n > (size_t)1 << 26)
+        return lpv_error(err, err_size, "%zu query points, at most %zu per call", n, (size_t)1 << 26);
+    float *in = malloc(n * 8 * sizeof(float));
+    float *out = malloc(n * 4 * sizeof(float));
+    if (!in || !out) {
+        free(in);
+        free(out);
+        return lpv_error(err, err_size, "out of memory for %zu query points", n);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            in[i * 8 + (size_t)k] = points[i * 3 + (size_t)k];
+            in[i * 8 + 4 + (size_t)k] = normals[i * 3 + (size_t)k];
+        }
+        in[i * 8 + 3] = in[i * 8 + 7] = 0.0f;
+    }
+    if (e->query_capacity < n) {
+        lpv_gl_delete_buffer(&e->query_in);
+        lpv_gl_delete_buffer(&e->query_out);
+        for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
+        }
+        e->query_in = lpv_gl_new_ssbo(n * 8 * sizeof(float));
+        e->query_out = lpv_gl_new_ssbo(n * 4 * sizeof(float));
+        GLenum alloc_err = glGetError();
+        if (alloc_err != GL_NO_ERROR) {
+            lpv_gl_delete_buffer(&e->query_in);
+            lpv_gl_delete_buffer(&e->query_out);
+            e->query_capacity = 0;
+            free(in);
+            free(out);
+            return lpv_error(err, err_size,
+                             "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)", n,
+                             (double)n * 48.0 / 1e9, alloc_err);
+        }
+        e->query_capacity = n;
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_in);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
+    glUseProgram(e->prog_query);
+    glUniform1i(glGetUniformLocation(e->prog_query, "u_count"), (GLint)n);
+    e->tech->cls->bind_lookup(e->tech, e->prog_query, e->settings.damping);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
+    glDispatchCompute(lpv_div_up(n, 64), 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_out);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 4 * sizeof(float)), out);
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+            rgb[i * 3 + (size_t)k] = out[i * 4 + (size_t)k];
+    free(in);
+    free(out);
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR)
+        return lpv_error(err, err_size, "GL error 0x%04x during the irradiance query", gl_err);
+    return 0;
+}
+

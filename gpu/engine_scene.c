@@ -1,0 +1,302 @@
+/*
+ * engine_scene.c - the scene on the GPU: geometry, materials and textures,
+ * lights, the medium, the emissive surfaces (as VPLs and as area light
+ * samples) and the scene surfels; and drawing it for the RSM, G-buffer and
+ * shadow passes.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "emissive.h"
+#include "engine_internal.h"
+#include "error.h"
+#include "scene_surfels.h"
+
+void lpv_engine_free_scene(lpv_engine *e)
+{
+    if (e->vao)
+        glDeleteVertexArrays(1, &e->vao);
+    e->vao = 0;
+    lpv_gl_delete_buffer(&e->vbo);
+    lpv_gl_delete_buffer(&e->ibo);
+    lpv_gl_delete_buffer(&e->emissive_vpls);
+    lpv_gl_delete_buffer(&e->scene_surfels);
+    e->scene_surfel_count = 0;
+    if (e->texture_count)
+        glDeleteTextures((GLsizei)e->texture_count, e->textures);
+    free(e->textures);
+    free(e->draws);
+    free(e->materials);
+    e->textures = NULL;
+    e->draws = NULL;
+    e->materials = NULL;
+    e->texture_count = e->draw_count = e->material_count = 0;
+    e->light_count = 0;
+    e->emissive_vpl_count = 0;
+    lpv_emitters_free(&e->emitters);
+    e->area_sample_count = 0;
+    e->occluder_triangles = 0;
+    e->has_scene = 0;
+}
+
+/* The emitters as area light samples under the current settings (0 when
+ * area lights are off or nothing emits). */
+void lpv_engine_update_area_samples(lpv_engine *e)
+{
+    e->area_sample_count = 0;
+    if (e->settings.area_lights == LPV_SWITCH_ON && e->emitters.count)
+        e->area_sample_count =
+            lpv_area_lights_sample(&e->emitters, (size_t)e->settings.area_light_samples, e->area_samples);
+}
+
+static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
+{
+    if (!scene->texture_count)
+        return 0;
+    e->textures = calloc(scene->texture_count, sizeof(GLuint));
+    if (!e->textures)
+        return lpv_error(err, err_size, "out of memory for textures");
+    e->texture_count = scene->texture_count;
+    glGenTextures((GLsizei)scene->texture_count, e->textures);
+    for (uint32_t i = 0; i < scene->texture_count; ++i) {
+        const lpv_texture *t = &scene->textures[i];
+        glBindTexture(GL_TEXTURE_2D, e->textures[i]);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        /* colour is sRGB-encoded (GL decodes it); normal maps are linear data */
+        const GLint format = t->linear ? GL_RGBA8 : GL_SRGB8_ALPHA8;
+        if (t->rgba8 && t->width > 0 && t->height > 0)
+            glTexImage2D(GL_TEXTURE_2D, 0, format, t->width, t->height, 0, GL_RGBA, GL_UNSIGNED_BYTE, t->rgba8);
+        else {
+            const uint8_t white[4] = {255, 255, 255, 255};
+            glTexImage2D(GL_TEXTURE_2D, 0, format, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, white);
+        }
+        glGenerateMipmap(GL_TEXTURE_2D);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    }
+    return 0;
+}
+
+/* Longest side of the bounding box of a draw's finite vertices (m). */
+static float draw_size(const lpv_scene *scene, const lpv_draw *d)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < d->index_count; ++i) {
+        uint32_t v = scene->indices[d->first_index + i];
+        if (v >= scene->vertex_count)
+            continue;
+        const float *p = scene->vertices[v].position;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fminf(lo[k], p[k]);
+            hi[k] = fmaxf(hi[k], p[k]);
+        }
+    }
+    float size = 0.0f;
+    for (int k = 0; k < 3; ++k)
+        if (hi[k] >= lo[k])
+            size = fmaxf(size, hi[k] - lo[k]);
+    return size;
+}
+
+/* FNV-1a over bytes, chained from h. */
+static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+/* Geometry and materials, not lights: a scene update that only moves lights
+ * is reported as such by the planner. */
+static uint64_t geometry_signature(const lpv_scene *s)
+{
+    uint64_t h = 1469598103934665603ull;
+    h = hash_bytes(h, s->vertices, (size_t)s->vertex_count * sizeof *s->vertices);
+    h = hash_bytes(h, s->indices, (size_t)s->index_count * sizeof *s->indices);
+    h = hash_bytes(h, s->draws, (size_t)s->draw_count * sizeof *s->draws);
+    h = hash_bytes(h, s->materials, (size_t)s->material_count * sizeof *s->materials);
+    h = hash_bytes(h, &s->medium, sizeof s->medium);
+    return h;
+}
+
+int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
+{
+    uint64_t sig = geometry_signature(scene);
+    if (e->has_scene && sig == e->geometry_sig)
+        e->lights_dirty = 1;
+    else
+        e->scene_dirty = 1;
+    e->geometry_sig = sig;
+    e->gbuf_stale = 1;
+    e->shadow_valid = 0;
+    lpv_engine_free_scene(e);
+    e->ticked = 0;
+    e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
+    e->materials = calloc(scene->material_count ? scene->material_count : 1, sizeof *e->materials);
+    if (!e->draws || !e->materials)
+        return lpv_error(err, err_size, "out of memory for the scene");
+    for (uint32_t i = 0; i < scene->draw_count; ++i) {
+        const lpv_draw *d = &scene->draws[i];
+        if ((uint64_t)d->first_index + d->index_count > scene->index_count)
+            return lpv_error(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
+        e->draws[e->draw_count++] =
+            (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, draw_size(scene, d)};
+        const lpv_material *m = (d->material >= 0 && (uint32_t)d->material < scene->material_count)
+                                    ? &scene->materials[d->material]
+                                    : NULL;
+        int emissive = m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
+        if (!emissive)
+            e->occluder_triangles += d->index_count / 3;
+    }
+    for (uint32_t i = 0; i < scene->material_count; ++i) {
+        const lpv_material *m = &scene->materials[i];
+        lpv_gpu_material *g = &e->materials[i];
+        memcpy(g->base_color, m->base_color, sizeof g->base_color);
+        memcpy(g->emission, m->emission, sizeof g->emission);
+        g->roughness = m->roughness;
+        g->metallic = m->metallic;
+        g->texture = (m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < scene->texture_count)
+                         ? m->base_color_texture
+                         : -1;
+        g->alpha_cutoff = lpv_material_alpha_cutoff(m);
+        g->double_sided = m->double_sided;
+        g->base_uv_set = m->base_color_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->base_color_uv, g->base_uv);
+        /* a normal map must be linear data (a memset material's 0 is not one) */
+        g->normal_texture = (m->normal_texture >= 0 && (uint32_t)m->normal_texture < scene->texture_count &&
+                             scene->textures[m->normal_texture].linear)
+                                ? m->normal_texture
+                                : -1;
+        g->normal_scale = m->normal_scale;
+        g->normal_uv_set = m->normal_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->normal_uv, g->normal_uv);
+    }
+    e->material_count = scene->material_count;
+    if (upload_textures(e, scene, err, err_size) != 0)
+        return -1;
+
+    glGenVertexArrays(1, &e->vao);
+    glBindVertexArray(e->vao);
+    glGenBuffers(1, &e->vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(scene->vertex_count * sizeof(lpv_vertex)), scene->vertices,
+                 GL_STATIC_DRAW);
+    glGenBuffers(1, &e->ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(scene->index_count * sizeof(uint32_t)), scene->indices,
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, position));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, normal));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, uv));
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, uv1));
+    glEnableVertexAttribArray(4);
+    glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, tangent));
+    glBindVertexArray(0);
+
+    e->light_count = 0;
+    for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
+        e->lights[e->light_count++] = scene->lights[i];
+    if (lpv_medium_upload(&e->medium, scene, err, err_size) != 0)
+        return -1;
+    memcpy(e->scene_min, scene->bounds_min, sizeof e->scene_min);
+    memcpy(e->scene_max, scene->bounds_max, sizeof e->scene_max);
+
+    size_t target = (size_t)e->settings.emissive_vpls;
+    lpv_vpl *vpls = target ? calloc(target * 2 + 1024, sizeof *vpls) : NULL;
+    size_t n = vpls ? lpv_emissive_sample(scene, target, vpls, target * 2 + 1024) : 0;
+    e->emissive_vpls = lpv_gl_new_ssbo(n * sizeof(lpv_vpl));
+    if (n)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof(lpv_vpl)), vpls);
+    e->emissive_vpl_count = n;
+    free(vpls);
+    if (lpv_emitters_collect(scene, &e->emitters) != 0)
+        return lpv_error(err, err_size, "%s: out of memory for the emissive triangles", scene->source);
+    lpv_engine_update_area_samples(e);
+
+    size_t want = e->settings.scene_surfels == LPV_SWITCH_ON ? (size_t)e->settings.scene_surfel_count : 0;
+    lpv_surfel *surfels = want ? calloc(want + 1, sizeof *surfels) : NULL;
+    if (want && !surfels)
+        return lpv_error(err, err_size, "out of memory for %zu scene surfels", want);
+    size_t ns = surfels ? lpv_scene_surfels(scene, want, surfels, want + 1) : 0;
+    e->scene_surfels = lpv_gl_new_ssbo(ns * sizeof(lpv_surfel));
+    if (ns)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(ns * sizeof(lpv_surfel)), surfels);
+    e->scene_surfel_count = ns;
+    free(surfels);
+
+    if (glGetError() != GL_NO_ERROR)
+        return lpv_error(err, err_size, "%s: GL error while uploading the scene", scene->source);
+    e->has_scene = 1;
+    return lpv_engine_place_volume(e, err, err_size);
+}
+
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
+{
+    GLint loc_color = glGetUniformLocation(prog, "u_base_color");
+    GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
+    GLint loc_emission = glGetUniformLocation(prog, "u_emission");
+    GLint loc_roughness = glGetUniformLocation(prog, "u_roughness");
+    GLint loc_metallic = glGetUniformLocation(prog, "u_metallic");
+    GLint loc_size = glGetUniformLocation(prog, "u_object_size");
+    GLint loc_cutoff = glGetUniformLocation(prog, "u_alpha_cutoff");
+    GLint loc_base_set = glGetUniformLocation(prog, "u_base_uv_set");
+    GLint loc_base_row0 = glGetUniformLocation(prog, "u_base_uv_row0");
+    GLint loc_base_row1 = glGetUniformLocation(prog, "u_base_uv_row1");
+    GLint loc_has_normal = glGetUniformLocation(prog, "u_has_normal_texture");
+    GLint loc_normal_scale = glGetUniformLocation(prog, "u_normal_scale");
+    GLint loc_normal_set = glGetUniformLocation(prog, "u_normal_uv_set");
+    GLint loc_normal_row0 = glGetUniformLocation(prog, "u_normal_uv_row0");
+    GLint loc_normal_row1 = glGetUniformLocation(prog, "u_normal_uv_row1");
+    glBindVertexArray(e->vao);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW); /* glTF's front faces; the loader rewinds mirrored nodes */
+    for (uint32_t i = 0; i < e->draw_count; ++i) {
+        const lpv_gpu_draw *d = &e->draws[i];
+        static const lpv_gpu_material fallback = {
+            .base_color = {1, 1, 1, 1}, .roughness = 1.0f, .texture = -1, .double_sided = 1,
+            .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0}};
+        const lpv_gpu_material *m =
+            (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
+        glUniform4fv(loc_color, 1, m->base_color);
+        glUniform3fv(loc_emission, 1, m->emission);
+        glUniform1f(loc_roughness, m->roughness);
+        glUniform1f(loc_metallic, m->metallic);
+        glUniform1f(loc_size, d->size);
+        glUniform1f(loc_cutoff, m->alpha_cutoff);
+        glUniform1i(loc_has_tex, m->texture >= 0);
+        glUniform1i(loc_base_set, m->base_uv_set);
+        glUniform3fv(loc_base_row0, 1, &m->base_uv[0]);
+        glUniform3fv(loc_base_row1, 1, &m->base_uv[3]);
+        glUniform1i(loc_has_normal, m->normal_texture >= 0);
+        glUniform1f(loc_normal_scale, m->normal_scale);
+        glUniform1i(loc_normal_set, m->normal_uv_set);
+        glUniform3fv(loc_normal_row0, 1, &m->normal_uv[0]);
+        glUniform3fv(loc_normal_row1, 1, &m->normal_uv[3]);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m->texture >= 0 ? e->textures[m->texture] : 0);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, m->normal_texture >= 0 ? e->textures[m->normal_texture] : 0);
+        glActiveTexture(GL_TEXTURE0);
+        if (cull_single_sided && !m->double_sided)
+            glEnable(GL_CULL_FACE);
+        else
+            glDisable(GL_CULL_FACE);
+        if (d->index_count)
+            glDrawElements(GL_TRIANGLES, (GLsizei)d->index_count, GL_UNSIGNED_INT,
+                           (void *)(uintptr_t)(d->first_index * sizeof(uint32_t)));
+        lpv_timer_count(&e->timer, 1);
+    }
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(0);
+}
+

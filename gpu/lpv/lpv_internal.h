@@ -1,0 +1,88 @@
+/*
+ * lpv_internal.h - the cascaded LPV technique's state, shared by its files
+ * (technique_lpv.c: the lpv_technique_class; lpv_storage.c: placement and
+ * buffers; lpv_atlas.c; lpv_inject.c; lpv_gv.c; lpv_propagate.c;
+ * lpv_read.c). Not seen outside gpu/lpv/. Each pass takes the state it works
+ * on and the tick's inputs, never the engine.
+ */
+#ifndef LPV_LPV_INTERNAL_H
+#define LPV_LPV_INTERNAL_H
+
+#include "cascades.h"
+#include "gl_util.h"
+#include "technique.h"
+
+/* A 2D atlas of z slices that points are blended into (see grid.glsl). */
+typedef struct lpv_atlas {
+    int tiles_x, width, height;
+    int attachments;
+    GLuint tex[3];
+    GLuint fbo;
+} lpv_atlas;
+
+typedef struct lpv_cascaded {
+    lpv_technique base;
+    lpv_settings settings;
+    lpv_grid grid;            /* the finest cascade (cascades.grid[0]) */
+    lpv_cascade_set cascades; /* placement of the last commit */
+    lpv_cascade_set pending;  /* placement of the last place */
+    int bins;                 /* LPV volumes per cascade: 1, or LPV_NORMAL_BINS (normal_bins on) */
+
+    GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate, prog_handoff;
+    GLuint empty_vao;
+
+    GLuint grid_ubo;
+    lpv_atlas lpv_atlas, gv_atlas; /* injection's and the geometry volume's */
+    GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit, reflect;
+    GLuint lpv_last; /* the buffer the last propagation step (or hand-off) wrote */
+    GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
+    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
+    size_t grid_alloc_cells; /* cells of all cascades */
+    int grid_alloc_dims[3], grid_alloc_cascades, grid_alloc_bins;
+} lpv_cascaded;
+
+/* Cells of one cascade, and of all cascades in use. */
+static inline size_t lpv_cascade_cells(const lpv_cascaded *c) { return lpv_grid_cell_count(&c->grid); }
+static inline size_t lpv_all_cells(const lpv_cascaded *c)
+{
+    return lpv_grid_cell_count(&c->grid) * (size_t)c->cascades.count;
+}
+/* LPV volumes (cascades x normal bins) and their cells: the size of the LPV
+ * buffers; the geometry volume and transmittances stay per cascade. */
+static inline int lpv_volumes(const lpv_cascaded *c) { return c->cascades.count * (c->bins > 1 ? c->bins : 1); }
+static inline size_t lpv_volume_cells(const lpv_cascaded *c)
+{
+    return lpv_grid_cell_count(&c->grid) * (size_t)lpv_volumes(c);
+}
+
+/* Placement and storage (lpv_storage.c). */
+int lpv_cascaded_place(lpv_cascaded *c, const lpv_technique_where *w, int *moved, char *err, size_t err_size);
+int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *reset, char *err, size_t err_size);
+void lpv_cascaded_free_storage(lpv_cascaded *c);
+void lpv_cascaded_memory_need(const lpv_cascaded *c, lpv_memory_need *n);
+
+/* Atlas (lpv_atlas.c): created per placement, owned by the state. */
+int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);
+void lpv_atlas_destroy(lpv_atlas *a);
+/* Sets the state for additive point splatting with prog into a, cleared
+ * first (begin) or as it is (begin_keep); the grid block and an empty VAO
+ * bound. */
+void lpv_atlas_begin(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
+void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
+/* Draws count points of elements [first, first + count) of buffer at binding,
+ * once per cascade (instanced: gl_InstanceID is the cascade). */
+void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int cascades,
+                     lpv_timer *timer);
+void lpv_atlas_end(void);
+
+/* The passes; each records its own timer stage. */
+void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rsm_vpls, int emissive_vpls);
+void lpv_pass_clear_run(lpv_cascaded *c); /* nothing injected: zero the injected grid and the accumulation */
+void lpv_pass_gv_run(lpv_cascaded *c, const lpv_technique_inputs *in, int bounce);
+void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int occlusion, int bounce);
+
+/* Read-backs (lpv_read.c). */
+size_t lpv_cascaded_read(lpv_cascaded *c, const lpv_plan *last, lpv_volume_part part, lpv_grid_which which,
+                         void *out, size_t max);
+
+#endif /* LPV_LPV_INTERNAL_H */
