@@ -11,6 +11,7 @@
 #include "emissive.h"
 #include "engine_internal.h"
 #include "error.h"
+#include "hash.h"
 #include "scene_surfels.h"
 
 void lpv_engine_free_scene(lpv_engine *e)
@@ -103,25 +104,16 @@ static float draw_size(const lpv_scene *scene, const lpv_draw *d)
     return size;
 }
 
-/* FNV-1a over bytes, chained from h. */
-static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ b[i]) * 1099511628211ull;
-    return h;
-}
-
 /* Geometry and materials, not lights: a scene update that only moves lights
  * is reported as such by the planner. */
 static uint64_t geometry_signature(const lpv_scene *s)
 {
-    uint64_t h = 1469598103934665603ull;
-    h = hash_bytes(h, s->vertices, (size_t)s->vertex_count * sizeof *s->vertices);
-    h = hash_bytes(h, s->indices, (size_t)s->index_count * sizeof *s->indices);
-    h = hash_bytes(h, s->draws, (size_t)s->draw_count * sizeof *s->draws);
-    h = hash_bytes(h, s->materials, (size_t)s->material_count * sizeof *s->materials);
-    h = hash_bytes(h, &s->medium, sizeof s->medium);
+    uint64_t h = LPV_HASH_INIT;
+    h = lpv_hash_bytes(h, s->vertices, (size_t)s->vertex_count * sizeof *s->vertices);
+    h = lpv_hash_bytes(h, s->indices, (size_t)s->index_count * sizeof *s->indices);
+    h = lpv_hash_bytes(h, s->draws, (size_t)s->draw_count * sizeof *s->draws);
+    h = lpv_hash_bytes(h, s->materials, (size_t)s->material_count * sizeof *s->materials);
+    h = lpv_hash_bytes(h, &s->medium, sizeof s->medium);
     return h;
 }
 

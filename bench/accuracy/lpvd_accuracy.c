@@ -31,6 +31,7 @@
 #include "context.h"
 #include "emissive_full.h"
 #include "engine.h"
+#include "hash.h"
 #include "image_io.h"
 #include "metrics.h"
 #include "overall.h"
@@ -305,25 +306,15 @@ static int file_exists(const char *p)
     return stat(p, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
-{
-    const unsigned char *b = data;
-    for (size_t i = 0; i < n; ++i) {
-        h ^= b[i];
-        h *= 1099511628211ull;
-    }
-    return h;
-}
-
 static uint64_t hash_file(uint64_t h, const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
-        return fnv1a(h, path, strlen(path));
+        return lpv_hash_bytes(h, path, strlen(path));
     unsigned char buf[65536];
     size_t n;
     while ((n = fread(buf, 1, sizeof buf, f)) > 0)
-        h = fnv1a(h, buf, n);
+        h = lpv_hash_bytes(h, buf, n);
     fclose(f);
     return h;
 }
@@ -539,13 +530,13 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
      * indirect term, and so does the reference it is compared with */
     if (area_lights)
         strcat(bsuffix, "-al");
-    uint64_t h = 1469598103934665603ull;
-    h = e->path ? hash_file(h, e->path) : fnv1a(h, "built-in:cornell-box", 20);
-    h = fnv1a(h, view, sizeof *view);
-    h = fnv1a(h, &spp, sizeof spp);
-    h = ref_cmd ? fnv1a(h, ref_cmd, strlen(ref_cmd)) : fnv1a(h, "lib:lpv_reference", 17);
+    uint64_t h = LPV_HASH_INIT;
+    h = e->path ? hash_file(h, e->path) : lpv_hash_bytes(h, "built-in:cornell-box", 20);
+    h = lpv_hash_bytes(h, view, sizeof *view);
+    h = lpv_hash_bytes(h, &spp, sizeof spp);
+    h = ref_cmd ? lpv_hash_bytes(h, ref_cmd, strlen(ref_cmd)) : lpv_hash_bytes(h, "lib:lpv_reference", 17);
     if (bounces > 1)
-        h = fnv1a(h, &bounces, sizeof bounces);
+        h = lpv_hash_bytes(h, &bounces, sizeof bounces);
     char key[256];
     if (snprintf(key, sizeof key, "%s-%dx%d-spp%d%s-%016llx", e->name, view->width, view->height, spp, bsuffix,
                  (unsigned long long)h) >= (int)sizeof key ||
