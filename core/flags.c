@@ -1,8 +1,10 @@
 /* flags.c - see flags.h. */
 #include "flags.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* getopt_long's val for long option i; above every char, so never a short letter. */
@@ -159,4 +161,23 @@ void lpv_flags_help(char *buf, size_t size, size_t *len, const lpv_flag *flags, 
             h = nl + 1;
         }
     }
+}
+
+int lpv_flag_parse_floats(const char *v, float *out, int n)
+{
+    const char *p = v;
+    for (int i = 0; i < n; ++i) {
+        char *end;
+        double x = strtod(p, &end);
+        if (end == p || !isfinite(x))
+            return -1;
+        out[i] = (float)x;
+        p = end;
+        if (i + 1 < n) {
+            if (*p != ',')
+                return -1;
+            ++p;
+        }
+    }
+    return *p ? -1 : 0;
 }

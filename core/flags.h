@@ -77,6 +77,10 @@ lpv_flags_item lpv_flags_next(lpv_flags *p, int *group, const lpv_flag **flag, c
 /* The flag named name (without dashes) in a table, or NULL. */
 const lpv_flag *lpv_flag_find(const lpv_flag *flags, size_t count, const char *name);
 
+/* n comma-separated finite numbers ("1,2.5,-3") into out. Returns 0, or -1
+ * when v is not exactly that (the caller names the flag in its message). */
+int lpv_flag_parse_floats(const char *v, float *out, int n);
+
 /* Appends printf-style text to buf at *len, truncating at size. */
 void lpv_flags_append(char *buf, size_t size, size_t *len, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));

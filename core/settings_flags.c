@@ -50,25 +50,6 @@ static int parse_int(const char *v, int lo, int hi, int *out)
     return 0;
 }
 
-static int parse_floats(const char *v, float *out, int n)
-{
-    const char *p = v;
-    for (int i = 0; i < n; ++i) {
-        char *end;
-        double x = strtod(p, &end);
-        if (end == p || !isfinite(x))
-            return -1;
-        out[i] = (float)x;
-        p = end;
-        if (i + 1 < n) {
-            if (*p != ',')
-                return -1;
-            ++p;
-        }
-    }
-    return *p ? -1 : 0;
-}
-
 int lpv_settings_flag_parse(lpv_settings *s, const char *name, const char *v, char *err, size_t n)
 {
     if (!v)
@@ -90,7 +71,7 @@ int lpv_settings_flag_parse(lpv_settings *s, const char *name, const char *v, ch
         memcpy(s->grid_dims, d, sizeof d);
     } else if (strcmp(name, "bounds") == 0) {
         float b[6];
-        if (parse_floats(v, b, 6) != 0 || !(b[3] > b[0] && b[4] > b[1] && b[5] > b[2])) {
+        if (lpv_flag_parse_floats(v, b, 6) != 0 || !(b[3] > b[0] && b[4] > b[1] && b[5] > b[2])) {
             snprintf(err, n, "--bounds %s: expected x0,y0,z0,x1,y1,z1 with max > min", v);
             return -1;
         }

@@ -23,25 +23,6 @@ const lpv_flag *lpv_view_flags(size_t *count)
     return FLAGS;
 }
 
-static int parse_floats(const char *v, float *out, int n)
-{
-    const char *p = v;
-    for (int i = 0; i < n; ++i) {
-        char *end;
-        double x = strtod(p, &end);
-        if (end == p || !isfinite(x))
-            return -1;
-        out[i] = (float)x;
-        p = end;
-        if (i + 1 < n) {
-            if (*p != ',')
-                return -1;
-            ++p;
-        }
-    }
-    return *p ? -1 : 0;
-}
-
 static int bad(char *err, size_t n, const char *name, const char *value, const char *want)
 {
     snprintf(err, n, "--%s %s: expected %s", name, value, want);
@@ -55,15 +36,15 @@ int lpv_view_flag_parse(lpv_view_choice *c, const char *name, const char *v, cha
     if (strcmp(name, "camera") == 0) {
         c->camera = v;
     } else if (strcmp(name, "eye") == 0) {
-        if (parse_floats(v, c->eye, 3) != 0)
+        if (lpv_flag_parse_floats(v, c->eye, 3) != 0)
             return bad(err, n, name, v, "X,Y,Z");
         c->has_eye = 1;
     } else if (strcmp(name, "target") == 0) {
-        if (parse_floats(v, c->target, 3) != 0)
+        if (lpv_flag_parse_floats(v, c->target, 3) != 0)
             return bad(err, n, name, v, "X,Y,Z");
         c->has_target = 1;
     } else if (strcmp(name, "fov") == 0) {
-        if (parse_floats(v, &c->fov_deg, 1) != 0 || !(c->fov_deg > 0.0f && c->fov_deg < 179.0f))
+        if (lpv_flag_parse_floats(v, &c->fov_deg, 1) != 0 || !(c->fov_deg > 0.0f && c->fov_deg < 179.0f))
             return bad(err, n, name, v, "degrees in (0, 179)");
         c->has_fov = 1;
     } else if (strcmp(name, "size") == 0) {
