@@ -97,6 +97,8 @@ static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, int c
         return say(why, n, "the scene changed"), 1;
     if (f->lights_changed)
         return say(why, n, "the lights changed"), 1;
+    if (f->settings_changed && f->settings_knob[0])
+        return say(why, n, "the settings changed (%s)", f->settings_knob), 1;
     if (f->settings_changed)
         return say(why, n, "the settings changed"), 1;
     if (f->forced)

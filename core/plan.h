@@ -49,7 +49,8 @@ typedef struct lpv_plan_facts {
     int first_tick;            /* nothing computed yet */
     int scene_changed;         /* geometry or materials */
     int lights_changed;
-    int settings_changed;
+    int settings_changed;      /* a knob that shapes the volume changed (core/settings_fields.h) */
+    char settings_knob[32];    /* its key, for the reason ("" unknown) */
     int forced;                /* the caller asked for a recompute (lpv_engine_invalidate) */
     int placement_changed;     /* a cascade's snapped placement differs */
     float camera_move_cells;   /* camera travel since the last computed tick, in finest cells */

@@ -24,6 +24,38 @@ void lpv_scene_free(lpv_scene *scene)
     memset(scene, 0, sizeof *scene);
 }
 
+static void *dup_array(const void *src, size_t count, size_t size)
+{
+    if (!src || !count)
+        return NULL;
+    void *p = malloc(count * size);
+    if (p)
+        memcpy(p, src, count * size);
+    return p;
+}
+
+int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src)
+{
+    memset(dst, 0, sizeof *dst);
+    dst->vertices = dup_array(src->vertices, src->vertex_count, sizeof *src->vertices);
+    dst->indices = dup_array(src->indices, src->index_count, sizeof *src->indices);
+    dst->draws = dup_array(src->draws, src->draw_count, sizeof *src->draws);
+    dst->materials = dup_array(src->materials, src->material_count, sizeof *src->materials);
+    if ((src->vertex_count && !dst->vertices) || (src->index_count && !dst->indices) ||
+        (src->draw_count && !dst->draws) || (src->material_count && !dst->materials)) {
+        lpv_scene_free(dst);
+        return -1;
+    }
+    dst->vertex_count = src->vertex_count;
+    dst->index_count = src->index_count;
+    dst->draw_count = src->draw_count;
+    dst->material_count = src->material_count;
+    memcpy(dst->bounds_min, src->bounds_min, sizeof dst->bounds_min);
+    memcpy(dst->bounds_max, src->bounds_max, sizeof dst->bounds_max);
+    memcpy(dst->source, src->source, sizeof dst->source);
+    return 0;
+}
+
 void lpv_scene_compute_bounds(lpv_scene *scene)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY};

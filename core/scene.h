@@ -147,6 +147,14 @@ typedef struct lpv_scene {
 /* Frees everything the scene owns and zeroes it. Safe on a zeroed scene. */
 void lpv_scene_free(lpv_scene *scene);
 
+/* A deep copy of the scene's geometry: vertices, indices, draws and
+ * materials, the bounds and the source; no textures, lights, cameras or
+ * medium. What the engine keeps to
+ * re-sample the scene when a knob changes without the scene being sent again.
+ * Returns 0, or -1 out of memory (dst then zeroed; free it with
+ * lpv_scene_free either way). */
+int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src);
+
 /* Recomputes bounds_min/max from the vertices. */
 void lpv_scene_compute_bounds(lpv_scene *scene);
 

@@ -17,78 +17,87 @@
 #include "lpv_shared.h"
 
 #define F(name) offsetof(lpv_settings, name)
+/* The touches column (settings_fields.h, lpv_touch). */
+#define T_VOL LPV_TOUCH_VOLUME
+#define T_SAMPLES LPV_TOUCH_SAMPLES
+#define T_SHADOWS LPV_TOUCH_SHADOWS
+#define T_SHADE LPV_TOUCH_SHADING
 
 static const lpv_field FIELDS[] = {
     /* The older knobs (the preset supplies the defaults of three of them). */
     {"iterations", "iterations", LPV_FIELD_INT, F(iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
-     "the preset's", "", "propagation steps"},
+     "the preset's", "", "propagation steps", T_VOL},
     {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
-     "the preset's", "", "reflective shadow map side"},
+     "the preset's", "", "reflective shadow map side", T_VOL},
     {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", "1024", "",
-     "shadow map side per light face, for direct light (docs/shadows.md)"},
+     "shadow map side per light face, for direct light (docs/shadows.md)", T_SHADOWS},
     {"occlusion", "occlusion", LPV_FIELD_SWITCH, F(occlusion), 0, 1, 0, "", "the preset's (on)", "",
-     "fuzzy occlusion from the geometry volume"},
+     "fuzzy occlusion from the geometry volume", T_VOL},
     {"indirect_gain", "indirect-gain", LPV_FIELD_FLOAT, F(indirect_gain), 0, 1e30, 1, "", "1", "",
-     "artistic factor on the LPV term"},
+     "artistic factor on the LPV term", T_SHADE},
     {"emissive_vpls", "emissive-vpls", LPV_FIELD_INT, F(emissive_vpls), 1, 1 << 20, 0, "", "4096", "",
-     "VPLs sampled on emissive surfaces"},
+     "VPLs sampled on emissive surfaces", T_VOL | T_SAMPLES},
 
     /* Cascades (docs/cascades.md). */
     {"cascades", "cascades", LPV_FIELD_INT, F(cascades), 0, LPV_MAX_CASCADES, 0, "", "auto", "0 = auto",
-     "cascade count (auto: one grid unless the camera is inside the scene, else 3)"},
+     "cascade count (auto: one grid unless the camera is inside the scene, else 3)", T_VOL},
     {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(cascade_size), 0, 1e6, 0, "m", "auto",
-     "0 = auto: a quarter of the scene's longest side", "the finest cascade's extent along its longest axis"},
+     "0 = auto: a quarter of the scene's longest side", "the finest cascade's extent along its longest axis", T_VOL},
     {"cascade_ratio", "cascade-ratio", LPV_FIELD_FLOAT, F(cascade_ratio), 1.25, 8, 0, "", "2", "",
-     "cell size ratio of consecutive cascades"},
+     "cell size ratio of consecutive cascades", T_VOL},
     {"cascade_offset", "cascade-offset", LPV_FIELD_FLOAT, F(cascade_offset), -1, 0.5, 0, "", "0.25",
      "negative = centred on the camera",
-     "cascade centre ahead of the camera, as a fraction of its extent"},
+     "cascade centre ahead of the camera, as a fraction of its extent", T_VOL},
 
     /* Effects and damping (docs/effects.md). */
     {"bounces", "bounces", LPV_FIELD_SWITCH, F(bounces), 0, 1, 0, "", "off", "",
-     "multiple bounces off the geometry volume's blockers"},
+     "multiple bounces off the geometry volume's blockers", T_VOL},
     {"bounce_intensity", "bounce-intensity", LPV_FIELD_FLOAT, F(bounce_intensity), 0, 1, 1, "", "1", "",
-     "factor on the blockers' albedo for bounces"},
+     "factor on the blockers' albedo for bounces", T_VOL},
     {"damping", "damping", LPV_FIELD_FLOAT, F(damping), 0, 1, 0, "", "0", "0 = off",
-     "directional-derivative damping strength"},
+     "directional-derivative damping strength", T_SHADE},
     {"glossy", "glossy", LPV_FIELD_SWITCH, F(glossy), 0, 1, 0, "", "on", "",
-     "glossy reflections by marching the LPV (if a material is glossy)"},
+     "glossy reflections by marching the LPV (if a material is glossy)", T_SHADE},
     {"glossy_roughness", "glossy-roughness", LPV_FIELD_FLOAT, F(glossy_roughness), 0, 1, 1, "", "0.3", "",
-     "materials with roughness below this are glossy"},
+     "materials with roughness below this are glossy", T_SHADE},
     {"media", "media", LPV_FIELD_SWITCH, F(media), 0, 1, 0, "", "on", "",
-     "participating media single scattering (if there is a medium)"},
+     "participating media single scattering (if there is a medium)", T_VOL | T_SHADE},
     {"fog_sigma_s", "fog-sigma-s", LPV_FIELD_FLOAT, F(fog_sigma_s), 0, 1000, 0, "1/m", "0", "0 = none",
-     "homogeneous fog scattering coefficient"},
+     "homogeneous fog scattering coefficient", T_VOL | T_SHADE},
     {"fog_sigma_a", "fog-sigma-a", LPV_FIELD_FLOAT, F(fog_sigma_a), 0, 1000, 0, "1/m", "0", "0 = none",
-     "homogeneous fog absorption coefficient"},
+     "homogeneous fog absorption coefficient", T_VOL | T_SHADE},
     {"media_step", "media-step", LPV_FIELD_FLOAT, F(media_step), 0.05, 4, 0, "cells", "0.5", "",
-     "media ray-march step"},
+     "media ray-march step", T_SHADE},
     {"planner", "planner", LPV_FIELD_SWITCH, F(planner), 0, 1, 0, "", "on", "",
-     "run only the passes the scene needs (off: every pass every tick)"},
+     "run only the passes the scene needs (off: every pass every tick)", T_VOL},
 
     /* Transport, occlusion and lookup (docs/propagation.md). */
     {"central_transport", "central-transport", LPV_FIELD_SWITCH, F(central_transport), 0, 1, 0, "",
-     "the preset's", "", "re-emit each face's flux along its central direction (less diffusive than the paper)"},
+     "the preset's", "", "re-emit each face's flux along its central direction (less diffusive than the paper)", T_VOL},
     {"normal_bins", "normal-bins", LPV_FIELD_SWITCH, F(normal_bins), 0, 1, 0, "", "the preset's", "",
-     "one volume per emitter normal axis: surfaces never read back their own light"},
+     "one volume per emitter normal axis: surfaces never read back their own light", T_VOL},
     {"far_field", "far-field", LPV_FIELD_SWITCH, F(far_field), 0, 1, 0, "", "the preset's", "",
-     "coarser levels carry the light on (reach grows with 2^levels)"},
+     "coarser levels carry the light on (reach grows with 2^levels)", T_VOL},
     {"far_field_levels", "far-field-levels", LPV_FIELD_INT, F(far_field_levels), 1, LPV_MAX_CASCADES - 1, 0,
-     "levels", "1", "", "coarser levels (2x the cells each) over one grid"},
+     "levels", "1", "", "coarser levels (2x the cells each) over one grid", T_VOL},
     {"far_field_steps", "far-field-steps", LPV_FIELD_INT, F(far_field_steps), 1, LPV_MAX_ITERATIONS, 0, "steps",
-     "1", "", "steps each far-field level but the coarsest takes before handing its light on"},
+     "1", "", "steps each far-field level but the coarsest takes before handing its light on", T_VOL},
     {"scene_surfels", "scene-surfels", LPV_FIELD_SWITCH, F(scene_surfels), 0, 1, 0, "", "the preset's", "",
-     "surfels over every triangle join the geometry volume (walls no view sees block)"},
+     "surfels over every triangle join the geometry volume (walls no view sees block)", T_VOL | T_SAMPLES},
     {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",
-     "65536", "", "surfels sampled over the scene's triangles"},
+     "65536", "", "surfels sampled over the scene's triangles", T_VOL | T_SAMPLES},
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", "on", "",
-     "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)"},
+     "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)", T_VOL | T_SHADOWS},
     {"area_light_samples", "area-light-samples", LPV_FIELD_INT, F(area_light_samples), 1, LPV_MAX_AREA_SAMPLES, 0,
-     "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)"},
+     "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)", T_VOL | T_SHADOWS},
 };
 
 #undef F
+#undef T_VOL
+#undef T_SAMPLES
+#undef T_SHADOWS
+#undef T_SHADE
 
 const lpv_field *lpv_fields(size_t *count)
 {
@@ -230,4 +239,55 @@ int lpv_field_is_default(const lpv_settings *s, const lpv_field *f)
     case LPV_FIELD_SWITCH: return *(const lpv_switch *)p == LPV_SWITCH_DEFAULT;
     default: return *(const float *)p == 0.0f;
     }
+}
+
+/* A field's value as stored: ints, floats and switches are each 4 bytes, so
+ * a byte comparison tells a change (and -0 from 0, which no knob accepts). */
+static int field_differs(const lpv_settings *a, const lpv_settings *b, const lpv_field *f)
+{
+    const size_t size = f->kind == LPV_FIELD_FLOAT ? sizeof(float)
+                        : f->kind == LPV_FIELD_INT ? sizeof(int)
+                                                   : sizeof(lpv_switch);
+    return memcmp((const char *)a + f->offset, (const char *)b + f->offset, size) != 0;
+}
+
+static void note_first(char *first, size_t n, const char *key)
+{
+    if (first && n && !first[0])
+        snprintf(first, n, "%s", key);
+}
+
+unsigned lpv_settings_touches(const lpv_settings *a, const lpv_settings *b, char *first, size_t first_size)
+{
+    unsigned touches = 0;
+    if (first && first_size)
+        first[0] = '\0';
+    /* the knobs with their own syntax (not in the table) all shape the volume */
+    if (memcmp(a->grid_dims, b->grid_dims, sizeof a->grid_dims) != 0) {
+        touches |= LPV_TOUCH_VOLUME;
+        note_first(first, first_size, "grid");
+    }
+    if (memcmp(a->bounds_min, b->bounds_min, sizeof a->bounds_min) != 0 ||
+        memcmp(a->bounds_max, b->bounds_max, sizeof a->bounds_max) != 0) {
+        touches |= LPV_TOUCH_VOLUME;
+        note_first(first, first_size, "bounds");
+    }
+    if (a->preset != b->preset) {
+        touches |= LPV_TOUCH_VOLUME;
+        note_first(first, first_size, "preset");
+    }
+    for (size_t i = 0; i < sizeof FIELDS / sizeof FIELDS[0]; ++i) {
+        if (!field_differs(a, b, &FIELDS[i]))
+            continue;
+        touches |= FIELDS[i].touches;
+        if (FIELDS[i].touches & LPV_TOUCH_VOLUME)
+            note_first(first, first_size, FIELDS[i].key);
+    }
+    /* a field the table does not know (added to lpv_settings without a row)
+     * recomputes everything rather than nothing */
+    if (!touches && memcmp(a, b, sizeof *a) != 0) {
+        touches = LPV_TOUCH_VOLUME | LPV_TOUCH_SAMPLES | LPV_TOUCH_SHADOWS | LPV_TOUCH_SHADING;
+        note_first(first, first_size, "settings");
+    }
+    return touches;
 }

@@ -27,6 +27,15 @@ typedef enum lpv_field_kind {
     LPV_FIELD_SWITCH = 2, /* lpv_switch field; CLI: on|off; CONFIG: a JSON boolean */
 } lpv_field_kind;
 
+/* What a knob's value reaches, so a change recomputes only that
+ * (lpv_settings_touches; the engine acts on it in lpv_engine_set_settings). */
+typedef enum lpv_touch {
+    LPV_TOUCH_VOLUME = 1u << 0,  /* the tick's volume: injection, occlusion, propagation (recompute) */
+    LPV_TOUCH_SAMPLES = 1u << 1, /* the engine's samples of the scene (emissive VPLs, scene surfels) */
+    LPV_TOUCH_SHADOWS = 1u << 2, /* direct light's shadow maps */
+    LPV_TOUCH_SHADING = 1u << 3, /* render-time only: the lookup, glossy and media marches, the gain */
+} lpv_touch;
+
 typedef struct lpv_field {
     const char *key;      /* CONFIG key and effective-config key (snake_case) */
     const char *flag;     /* CLI flag without the leading "--" (kebab-case) */
@@ -38,6 +47,7 @@ typedef struct lpv_field {
     const char *deflt;    /* the default, in words ("8", "auto", "on", "the preset's") */
     const char *note;     /* what special values mean ("0 = auto"), or "" */
     const char *help;     /* one line */
+    unsigned touches;     /* lpv_touch bits: what a change of this knob must recompute */
 } lpv_field;
 
 /* The table, and its length in *count (may be NULL). */
@@ -71,6 +81,14 @@ int lpv_field_set_bool(lpv_settings *s, const lpv_field *f, int on);
  * back to the same float (0.3f reads 0.3, not 0.30000001192...); switches as
  * 1 (ON), 0 (OFF) or -1 (DEFAULT, i.e. not resolved). */
 double lpv_field_get(const lpv_settings *s, const lpv_field *f);
+
+/* What changing the settings from a to b must recompute: the OR of the
+ * lpv_touch bits of every knob whose value differs (grid_dims, bounds and
+ * the preset touch the volume). Compare resolved settings, so a preset's
+ * values count as the knobs they set. When `first` is not NULL it receives
+ * the key of the first differing knob that touches the volume ("" if none),
+ * for the planner's reason. */
+unsigned lpv_settings_touches(const lpv_settings *a, const lpv_settings *b, char *first, size_t first_size);
 
 /* Whether f holds its zero ("the default") value. */
 int lpv_field_is_default(const lpv_settings *s, const lpv_field *f);

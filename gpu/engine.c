@@ -12,6 +12,7 @@
 #include "engine_internal.h"
 #include "error.h"
 #include "memory_limits.h"
+#include "settings_fields.h"
 #include "shader.h"
 
 static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
@@ -166,19 +167,30 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     lpv_settings_resolve(&s);
     if (lpv_settings_validate(&s, err, err_size) != 0)
         return -1;
-    if (memcmp(&s, &e->settings, sizeof s) == 0)
+    char knob[sizeof e->settings_knob];
+    const unsigned touches = lpv_settings_touches(&e->settings, &s, knob, sizeof knob);
+    if (!touches)
         return 0;
     e->settings = s;
     e->tech->cls->configure(e->tech, &e->settings);
-    e->settings_dirty = 1;
-    e->shadow_valid = 0;
-    e->gbuf_stale = 1;
-    e->ticked = 0;
+    e->ticked = 0; /* a render or read-back follows a tick under the new settings */
+    if (touches & LPV_TOUCH_VOLUME) {
+        if (!e->settings_dirty)
+            memcpy(e->settings_knob, knob, sizeof knob);
+        e->settings_dirty = 1;
+        e->gbuf_stale = 1;
+    }
+    if (touches & LPV_TOUCH_SHADOWS)
+        e->shadow_valid = 0;
     lpv_engine_update_area_samples(e);
-    if (e->has_scene)
-        return lpv_engine_place_volume(e, err, err_size);
-    return 0;
+    if (!e->has_scene)
+        return 0;
+    if ((touches & LPV_TOUCH_SAMPLES) && lpv_engine_sample_scene(e, err, err_size) != 0)
+        return -1;
+    return lpv_engine_place_volume(e, err, err_size);
 }
+
+lpv_engine_counters lpv_engine_get_counters(const lpv_engine *e) { return e->counters; }
 
 int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t err_size)
 {

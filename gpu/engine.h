@@ -54,17 +54,35 @@ typedef struct lpv_engine_stats {
     int iterations;
     double cell_steps;
     int occlusion;
+    unsigned long scene_uploads, scene_samplings; /* lpv_engine_counters, as of this tick */
 } lpv_engine_stats;
+
+/* The engine's costly scene work since it was created, for tests and the
+ * daemon's stats: a CONFIG or a light move must not redo what it does not
+ * touch (core/settings_fields.h, lpv_touch). */
+typedef struct lpv_engine_counters {
+    unsigned long scene_uploads;   /* geometry, materials and textures sent to the GPU */
+    unsigned long scene_samplings; /* emissive VPLs and scene surfels drawn from the scene */
+} lpv_engine_counters;
+
+lpv_engine_counters lpv_engine_get_counters(const lpv_engine *e);
 
 lpv_engine *lpv_engine_create(char *err, size_t err_size);
 void lpv_engine_destroy(lpv_engine *e);
 
 /* Uploads the scene (geometry, materials, textures, lights) and samples its
- * emissive surfaces into VPLs and keeps them for the area light samples. The scene may be freed afterwards. The grid is
- * re-placed from the settings and the scene's bounds. */
+ * emissive surfaces into VPLs and keeps them for the area light samples. The
+ * scene may be freed afterwards (the engine keeps a copy of its geometry to
+ * re-sample it when a knob changes). A scene whose geometry, materials,
+ * textures and medium equal the current one's only updates the lights:
+ * nothing is uploaded again. The grid is re-placed from the settings and the
+ * scene's bounds. */
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
 
-/* Copies, resolves and validates settings (zero fields get defaults). */
+/* Copies, resolves and validates settings (zero fields get defaults). A
+ * change recomputes only what the changed knobs touch (lpv_touch): the
+ * scene's samples, the volume (the next tick recomputes, the planner naming
+ * the knob), the shadow maps, or nothing but the next render's shading. */
 int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *err, size_t err_size);
 
 /* Sets the camera (NULL: none; the GV then uses only the RSMs). */

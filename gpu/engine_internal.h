@@ -49,6 +49,7 @@ struct lpv_engine {
     /* What changed since the last computed tick (the planner's facts). */
     int computed;             /* a tick computed the volume at least once since set_scene/settings */
     int scene_dirty, lights_dirty, settings_dirty, forced;
+    char settings_knob[32];   /* the first knob that touched the volume since the last computed tick */
     uint64_t geometry_sig;    /* hash of vertices, indices, materials */
     float computed_eye[3];
     int computed_has_view;
@@ -71,6 +72,7 @@ struct lpv_engine {
     lpv_light lights[LPV_MAX_LIGHTS];
     uint32_t light_count;
     float scene_min[3], scene_max[3];
+    lpv_scene geometry;       /* the CPU copy the samples below are drawn from (lpv_scene_copy_geometry) */
     GLuint emissive_vpls;
     size_t emissive_vpl_count;
     GLuint scene_surfels;     /* settings.scene_surfel_count over every triangle (GV), 0 = none */
@@ -112,6 +114,7 @@ struct lpv_engine {
     GLuint query_in, query_out; /* irradiance queries */
     size_t query_capacity;
 
+    lpv_engine_counters counters;
     lpv_timer timer;
     lpv_engine_stats stats;
     lpv_plan plan;
@@ -126,6 +129,9 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided);
  * light samples under the current settings (none when area lights are off). */
 void lpv_engine_free_scene(lpv_engine *e);
 void lpv_engine_update_area_samples(lpv_engine *e);
+/* The emissive VPLs and scene surfels under the current settings, from
+ * e->geometry (engine_scene.c). */
+int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size);
 
 /* Per-pass set-up and work; each _run records its own timer stage. */
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */

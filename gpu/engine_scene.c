@@ -14,6 +14,14 @@
 #include "hash.h"
 #include "scene_surfels.h"
 
+static void free_samples(lpv_engine *e)
+{
+    lpv_gl_delete_buffer(&e->emissive_vpls);
+    lpv_gl_delete_buffer(&e->scene_surfels);
+    e->emissive_vpl_count = 0;
+    e->scene_surfel_count = 0;
+}
+
 void lpv_engine_free_scene(lpv_engine *e)
 {
     if (e->vao)
@@ -21,9 +29,8 @@ void lpv_engine_free_scene(lpv_engine *e)
     e->vao = 0;
     lpv_gl_delete_buffer(&e->vbo);
     lpv_gl_delete_buffer(&e->ibo);
-    lpv_gl_delete_buffer(&e->emissive_vpls);
-    lpv_gl_delete_buffer(&e->scene_surfels);
-    e->scene_surfel_count = 0;
+    free_samples(e);
+    lpv_scene_free(&e->geometry);
     if (e->texture_count)
         glDeleteTextures((GLsizei)e->texture_count, e->textures);
     free(e->textures);
@@ -34,7 +41,6 @@ void lpv_engine_free_scene(lpv_engine *e)
     e->materials = NULL;
     e->texture_count = e->draw_count = e->material_count = 0;
     e->light_count = 0;
-    e->emissive_vpl_count = 0;
     lpv_emitters_free(&e->emitters);
     e->area_sample_count = 0;
     e->occluder_triangles = 0;
@@ -104,11 +110,20 @@ static float draw_size(const lpv_scene *scene, const lpv_draw *d)
     return size;
 }
 
-/* Geometry and materials, not lights: a scene update that only moves lights
- * is reported as such by the planner. */
+/* Geometry, materials, textures and the medium, not lights: a scene update
+ * that only moves lights re-uploads nothing and is reported as such by the
+ * planner. */
 static uint64_t geometry_signature(const lpv_scene *s)
 {
     uint64_t h = LPV_HASH_INIT;
+    for (uint32_t i = 0; i < s->texture_count; ++i) {
+        const lpv_texture *t = &s->textures[i];
+        h = lpv_hash_bytes(h, &t->width, sizeof t->width);
+        h = lpv_hash_bytes(h, &t->height, sizeof t->height);
+        h = lpv_hash_bytes(h, &t->linear, sizeof t->linear);
+        if (t->rgba8 && t->width > 0 && t->height > 0)
+            h = lpv_hash_bytes(h, t->rgba8, (size_t)t->width * (size_t)t->height * 4);
+    }
     h = lpv_hash_bytes(h, s->vertices, (size_t)s->vertex_count * sizeof *s->vertices);
     h = lpv_hash_bytes(h, s->indices, (size_t)s->index_count * sizeof *s->indices);
     h = lpv_hash_bytes(h, s->draws, (size_t)s->draw_count * sizeof *s->draws);
@@ -117,18 +132,63 @@ static uint64_t geometry_signature(const lpv_scene *s)
     return h;
 }
 
+/* The scene's samples under the current settings, from the engine's copy of
+ * its geometry: the emissive surfaces' VPLs (emissive_vpls) and the scene
+ * surfels (scene_surfels, scene_surfel_count). Redone by set_settings when
+ * one of those knobs changes, without the scene being sent again. */
+int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size)
+{
+    const lpv_scene *scene = &e->geometry;
+    free_samples(e);
+    e->counters.scene_samplings++;
+
+    size_t target = (size_t)e->settings.emissive_vpls;
+    lpv_vpl *vpls = target ? calloc(target * 2 + 1024, sizeof *vpls) : NULL;
+    size_t n = vpls ? lpv_emissive_sample(scene, target, vpls, target * 2 + 1024) : 0;
+    e->emissive_vpls = lpv_gl_new_ssbo(n * sizeof(lpv_vpl));
+    if (n)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof(lpv_vpl)), vpls);
+    e->emissive_vpl_count = n;
+    free(vpls);
+
+    size_t want = e->settings.scene_surfels == LPV_SWITCH_ON ? (size_t)e->settings.scene_surfel_count : 0;
+    lpv_surfel *surfels = want ? calloc(want + 1, sizeof *surfels) : NULL;
+    if (want && !surfels)
+        return lpv_error(err, err_size, "out of memory for %zu scene surfels", want);
+    size_t ns = surfels ? lpv_scene_surfels(scene, want, surfels, want + 1) : 0;
+    e->scene_surfels = lpv_gl_new_ssbo(ns * sizeof(lpv_surfel));
+    if (ns)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(ns * sizeof(lpv_surfel)), surfels);
+    e->scene_surfel_count = ns;
+    free(surfels);
+    if (glGetError() != GL_NO_ERROR)
+        return lpv_error(err, err_size, "%s: GL error while storing the scene's samples", scene->source);
+    return 0;
+}
+
+static void set_lights(lpv_engine *e, const lpv_scene *scene)
+{
+    e->light_count = 0;
+    for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
+        e->lights[e->light_count++] = scene->lights[i];
+}
+
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
 {
     uint64_t sig = geometry_signature(scene);
-    if (e->has_scene && sig == e->geometry_sig)
+    e->shadow_valid = 0;
+    e->ticked = 0;
+    if (e->has_scene && sig == e->geometry_sig) {
+        /* the same geometry, materials and textures: only the lights are new */
         e->lights_dirty = 1;
-    else
-        e->scene_dirty = 1;
+        set_lights(e, scene);
+        return lpv_engine_place_volume(e, err, err_size);
+    }
+    e->scene_dirty = 1;
     e->geometry_sig = sig;
     e->gbuf_stale = 1;
-    e->shadow_valid = 0;
     lpv_engine_free_scene(e);
-    e->ticked = 0;
+    e->counters.scene_uploads++;
     e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
     e->materials = calloc(scene->material_count ? scene->material_count : 1, sizeof *e->materials);
     if (!e->draws || !e->materials)
@@ -195,36 +255,19 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, tangent));
     glBindVertexArray(0);
 
-    e->light_count = 0;
-    for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
-        e->lights[e->light_count++] = scene->lights[i];
+    set_lights(e, scene);
     if (lpv_medium_upload(&e->medium, scene, err, err_size) != 0)
         return -1;
     memcpy(e->scene_min, scene->bounds_min, sizeof e->scene_min);
     memcpy(e->scene_max, scene->bounds_max, sizeof e->scene_max);
 
-    size_t target = (size_t)e->settings.emissive_vpls;
-    lpv_vpl *vpls = target ? calloc(target * 2 + 1024, sizeof *vpls) : NULL;
-    size_t n = vpls ? lpv_emissive_sample(scene, target, vpls, target * 2 + 1024) : 0;
-    e->emissive_vpls = lpv_gl_new_ssbo(n * sizeof(lpv_vpl));
-    if (n)
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof(lpv_vpl)), vpls);
-    e->emissive_vpl_count = n;
-    free(vpls);
     if (lpv_emitters_collect(scene, &e->emitters) != 0)
         return lpv_error(err, err_size, "%s: out of memory for the emissive triangles", scene->source);
     lpv_engine_update_area_samples(e);
-
-    size_t want = e->settings.scene_surfels == LPV_SWITCH_ON ? (size_t)e->settings.scene_surfel_count : 0;
-    lpv_surfel *surfels = want ? calloc(want + 1, sizeof *surfels) : NULL;
-    if (want && !surfels)
-        return lpv_error(err, err_size, "out of memory for %zu scene surfels", want);
-    size_t ns = surfels ? lpv_scene_surfels(scene, want, surfels, want + 1) : 0;
-    e->scene_surfels = lpv_gl_new_ssbo(ns * sizeof(lpv_surfel));
-    if (ns)
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(ns * sizeof(lpv_surfel)), surfels);
-    e->scene_surfel_count = ns;
-    free(surfels);
+    if (lpv_scene_copy_geometry(&e->geometry, scene) != 0)
+        return lpv_error(err, err_size, "%s: out of memory for the engine's copy of the geometry", scene->source);
+    if (lpv_engine_sample_scene(e, err, err_size) != 0)
+        return -1;
 
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "%s: GL error while uploading the scene", scene->source);

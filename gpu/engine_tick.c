@@ -45,6 +45,7 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->scene_changed = e->scene_dirty;
     f->lights_changed = e->lights_dirty;
     f->settings_changed = e->settings_dirty;
+    memcpy(f->settings_knob, e->settings_knob, sizeof f->settings_knob);
     f->forced = e->forced;
     if (e->has_view != e->computed_has_view) {
         f->camera_move_cells = INFINITY;
@@ -120,6 +121,8 @@ static void record_stats(lpv_engine *e)
     for (size_t b = 0, first, count; gv && (lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0); ++b)
         s->surfels_rsm += count;
     s->surfels_camera = e->plan.consumes.camera_surfels ? (size_t)e->gbuf_w * e->gbuf_h : 0;
+    s->scene_uploads = e->counters.scene_uploads;
+    s->scene_samplings = e->counters.scene_samplings;
     e->tech->cls->stats(e->tech, &e->plan, s);
 }
 
@@ -142,6 +145,8 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
         /* The cached volume stands: no pass runs, no stage is recorded. */
         lpv_timer_collect(&e->timer);
         e->stats.stage_count = 0;
+        e->stats.scene_uploads = e->counters.scene_uploads;
+        e->stats.scene_samplings = e->counters.scene_samplings;
         e->ticked = 1;
         return 0;
     }
@@ -170,6 +175,7 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
     e->ticked = 1;
     e->computed = 1;
     e->scene_dirty = e->lights_dirty = e->settings_dirty = e->forced = 0;
+    e->settings_knob[0] = '\0';
     e->computed_has_view = e->has_view;
     if (e->has_view)
         memcpy(e->computed_eye, e->view.eye, sizeof e->computed_eye);

@@ -279,7 +279,9 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     w->gl_has_applied = 0;
     if (settings_changed && lpv_engine_set_settings(w->engine, &in->settings, err, n) != 0)
         return -1;
-    if (scene_changed || settings_changed) {
+    /* the engine re-samples the scene itself when a knob needs it: a CONFIG
+     * sends no geometry again (lpv_engine_set_settings) */
+    if (scene_changed) {
         lpv_scene sc = in->scene->scene;
         sc.materials = in->materials;
         sc.material_count = in->material_count;

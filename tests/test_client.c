@@ -552,6 +552,67 @@ static void test_state_changes_bump_revision(void **state)
     lpvc_close(c);
 }
 
+/* STATS' plan (the session's latest tick, R4.13): its counts and plan. */
+static json_t *latest_tick(lpvc *c)
+{
+    char *st = NULL;
+    OK(c, lpvc_stats(c, &st));
+    json_t *s = json_loads(st, 0, NULL);
+    free(st);
+    assert_non_null(s);
+    json_t *tick = json_incref(json_object_get(s, "plan"));
+    json_decref(s);
+    assert_true(json_is_object(tick));
+    return tick;
+}
+
+static json_int_t tick_count(json_t *tick, const char *name)
+{
+    json_t *v = json_object_get(json_object_get(tick, "counts"), name);
+    assert_true(json_is_integer(v));
+    return json_integer_value(v);
+}
+
+/* A CONFIG recomputes only what its knobs touch (issue 11): the world's
+ * engine (this session's alone) sends no geometry again, a shading knob
+ * serves the cached volume, and a sampling knob re-samples the scene the
+ * engine kept. */
+static void test_config_recomputes_only_what_it_touches(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    /* a setting no other test uses: this session's world is its own */
+    OK(c, lpvc_config_json(c, "{\"damping\": 0.125}"));
+    OK(c, lpvc_tick(c, NULL));
+    json_t *t0 = latest_tick(c);
+    const json_int_t uploads = tick_count(t0, "scene_uploads"), samplings = tick_count(t0, "scene_samplings");
+    assert_true(uploads >= 1);
+
+    OK(c, lpvc_config_json(c, "{\"damping\": 0.25, \"indirect_gain\": 2}"));
+    OK(c, lpvc_tick(c, NULL));
+    json_t *t1 = latest_tick(c);
+    assert_int_equal(tick_count(t1, "scene_uploads"), uploads);
+    assert_int_equal(tick_count(t1, "scene_samplings"), samplings);
+    json_t *plan = json_object_get(t1, "plan");
+    assert_true(json_is_false(json_object_get(plan, "recompute")));
+
+    OK(c, lpvc_config_json(c, "{\"scene_surfel_count\": 4096}"));
+    OK(c, lpvc_tick(c, NULL));
+    json_t *t2 = latest_tick(c);
+    assert_int_equal(tick_count(t2, "scene_uploads"), uploads);
+    assert_int_equal(tick_count(t2, "scene_samplings"), samplings + 1);
+    plan = json_object_get(t2, "plan");
+    assert_true(json_is_true(json_object_get(plan, "recompute")));
+    assert_string_equal(json_string_value(json_object_get(plan, "recompute_reason")),
+                        "the settings changed (scene_surfel_count)");
+    json_decref(t0);
+    json_decref(t1);
+    json_decref(t2);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
 /* Loads the shared Cornell box .glb when ../shared is there. */
 static void test_load_glb(void **state)
 {
@@ -712,6 +773,7 @@ int main(void)
         cmocka_unit_test(test_tick_volume_query),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_state_changes_bump_revision),
+        cmocka_unit_test(test_config_recomputes_only_what_it_touches),
         cmocka_unit_test(test_load_glb),
         cmocka_unit_test(test_stream_deltas),
         cmocka_unit_test(test_manual_ack),
