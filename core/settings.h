@@ -5,6 +5,10 @@
 #ifndef LPV_SETTINGS_H
 #define LPV_SETTINGS_H
 
+/* The GI techniques' names (gpu/technique.h's class names; the wire's and the
+ * knob description's "technique"). */
+#define LPV_TECHNIQUE_LPV "lpv" /* cascaded light propagation volumes (gpu/lpv/) */
+
 /* Tri-state switch: 0 means "the default". */
 typedef enum lpv_switch {
     LPV_SWITCH_DEFAULT = 0,

@@ -48,6 +48,8 @@ typedef struct lpv_field {
     const char *note;     /* what special values mean ("0 = auto"), or "" */
     const char *help;     /* one line */
     unsigned touches;     /* lpv_touch bits: what a change of this knob must recompute */
+    const char *technique; /* the GI technique the knob tunes (its class name, LPV_TECHNIQUE_LPV), or
+                              "" for the engine's shared producers and shading */
 } lpv_field;
 
 /* The table, and its length in *count (may be NULL). */

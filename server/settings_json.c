@@ -20,6 +20,25 @@ static json_t *typed(const lpv_field *f, double v)
     return json_real(v);
 }
 
+/* A knob's lpv_touch bits as names, in a fixed order. */
+static json_t *touches_json(unsigned t)
+{
+    static const struct {
+        unsigned bit;
+        const char *name;
+    } names[] = {{LPV_TOUCH_VOLUME, "volume"},
+                 {LPV_TOUCH_SAMPLES, "samples"},
+                 {LPV_TOUCH_SHADOWS, "shadows"},
+                 {LPV_TOUCH_SHADING, "shading"}};
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < sizeof names / sizeof names[0]; ++i)
+        if ((t & names[i].bit) && json_array_append_new(a, json_string(names[i].name)) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    return a;
+}
+
 json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture)
 {
     lpv_settings d = *defaults;
@@ -32,9 +51,10 @@ json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture)
         double max = f->max;
         if (strcmp(f->unit, "texels") == 0 && max > (double)max_texture) /* CONFIG refuses more with LIMIT */
             max = (double)max_texture;
-        json_t *o = json_pack("{s:s, s:s, s:o, s:s, s:s, s:s, s:s}", "name", f->key, "type", type_name(f->kind),
-                              "default", typed(f, lpv_field_get(&d, f)), "default_text", f->deflt, "unit", f->unit,
-                              "note", f->note, "help", f->help);
+        json_t *o = json_pack("{s:s, s:s, s:o, s:s, s:s, s:s, s:s, s:s, s:o}", "name", f->key, "type",
+                              type_name(f->kind), "default", typed(f, lpv_field_get(&d, f)), "default_text", f->deflt,
+                              "unit", f->unit, "note", f->note, "help", f->help, "technique", f->technique, "touches",
+                              touches_json(f->touches));
         if (o && f->kind != LPV_FIELD_SWITCH &&
             (json_object_set_new(o, "min", typed(f, f->min)) != 0 || json_object_set_new(o, "max", typed(f, max)) != 0 ||
              json_object_set_new(o, "min_exclusive", json_boolean(f->min_exclusive)) != 0)) {

@@ -274,6 +274,20 @@ static void test_knob_description(void **state)
     assert_true(np > 0);
     json_t *h = json_loads(lpvc_hello_reply(c), 0, NULL);
     assert_int_equal(np, json_array_size(json_object_get(h, "presets")));
+    /* R4.12: each knob names its technique and what a change recomputes */
+    json_t *knobs = json_object_get(h, "knobs");
+    int lpv_knobs = 0, shading_only = 0;
+    for (size_t i = 0; i < json_array_size(knobs); i++) {
+        json_t *kj = json_array_get(knobs, i);
+        const char *tech = json_string_value(json_object_get(kj, "technique"));
+        json_t *touches = json_object_get(kj, "touches");
+        assert_non_null(tech);
+        assert_true(json_is_array(touches) && json_array_size(touches) >= 1);
+        lpv_knobs += strcmp(tech, "lpv") == 0;
+        shading_only += json_array_size(touches) == 1 &&
+                        strcmp(json_string_value(json_array_get(touches, 0)), "shading") == 0;
+    }
+    assert_true(lpv_knobs > 0 && shading_only > 0);
     json_decref(h);
     lpvc_config pc = {.preset = presets[np - 1]};
     OK(c, lpvc_config_set(c, &pc));

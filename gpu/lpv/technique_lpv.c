@@ -149,7 +149,7 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
 }
 
 const lpv_technique_class lpv_technique_cascaded_lpv = {
-    .name = "lpv",
+    .name = LPV_TECHNIQUE_LPV,
     .lookup_includes = LOOKUP,
     .create = create,
     .destroy = destroy,
