@@ -121,6 +121,7 @@ static void record_stats(lpv_engine *e)
         s->surfels_rsm += count;
     s->surfels_camera = e->plan.consumes.camera_surfels ? (size_t)e->gbuf_w * e->gbuf_h : 0;
     e->tech->cls->stats(e->tech, &e->plan, s);
+    s->volume = e->desc;
 }
 
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)

@@ -19,6 +19,7 @@ void lpvc_volume_free(lpvc_volume *v)
     if (!v)
         return;
     free(v->data);
+    free(v->index);
     free(v->header_json);
     free(v->plan_json);
     memset(v, 0, sizeof *v);
@@ -74,19 +75,31 @@ int lpvci_decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t a
             return lpvci_fail(c, LPVC_ERR_PROTOCOL, "delta of %llu bytes against a base of %zu bytes",
                         (unsigned long long)vi.raw_length, base->len);
     }
+    /* decoded by the description (R5.11): per level, its volumes of cells x
+     * values_per_cell values; the parse checked raw_length against it */
+    const lpvp_volume_layout *lay = &vi.layout;
+    size_t per_cell = (size_t)lay->values_per_cell * (size_t)lay->volumes_per_level;
+    size_t values = cells * per_cell;
+    const lpvp_index_info *ix = lay->has_index ? &lay->index : NULL;
+    size_t index_count = ix ? (size_t)ix->cells * (size_t)ix->values_per_cell : 0;
     uint8_t *raw = malloc(vi.raw_length ? (size_t)vi.raw_length : 1);
-    float *data = malloc(cells * 12 * sizeof(float));
-    if (!raw || !data) {
+    float *data = malloc((values ? values : 1) * sizeof(float));
+    uint32_t *index = ix ? malloc((index_count ? index_count : 1) * sizeof(uint32_t)) : NULL;
+    if (!raw || !data || (ix && !index)) {
         free(raw);
         free(data);
+        free(index);
         return lpvci_fail(c, LPVC_ERR_IO, "out of memory for a %zu-cell volume", cells);
     }
     if (lpvp_volume_decode(&vi, att, att_len, base ? base->raw : NULL, base ? base->len : 0, raw, err, sizeof err) != 0) {
         free(raw);
         free(data);
+        free(index);
         return lpvci_fail(c, LPVC_ERR_PROTOCOL, "cannot decode the volume: %s", err);
     }
-    lpvp_volume_unpack(raw, cells, vi.format, data);
+    lpvp_values_unpack(raw, values, vi.format, data);
+    for (size_t i = 0; i < index_count; i++) /* R5.12: little-endian u32 whatever the format */
+        index[i] = lpvp_get_u32(raw + ix->raw_offset + LPVP_INDEX_VALUE_SIZE * i);
 
     out->revision = vi.revision;
     out->tick = vi.tick;
@@ -107,7 +120,21 @@ int lpvci_decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t a
         }
         cs->cell_size = (float)vi.cascades[k].cell_size;
         cs->cells = (size_t)vi.cascades[k].cells;
-        cs->data = data + 12 * (size_t)lpvp_volume_cascade_first_cell(&vi, k);
+        cs->data = data + per_cell * (size_t)lpvp_volume_cascade_first_cell(&vi, k);
+    }
+    out->layout_version = lay->layout_version;
+    snprintf(out->technique, sizeof out->technique, "%s", lay->technique);
+    out->values_per_cell = lay->values_per_cell;
+    out->volumes_per_level = lay->volumes_per_level;
+    out->far_field = lay->far_field != 0;
+    out->sh_values = lay->sh_values != 0;
+    out->index = index;
+    out->index_count = index_count;
+    if (ix) {
+        out->index_level = ix->level;
+        for (int a = 0; a < 3; a++)
+            out->index_dims[a] = (int)ix->dims[a];
+        out->index_values_per_cell = ix->values_per_cell;
     }
     if (json_is_object(json_object_get(hdr, "plan")))
         out->plan_json = json_dumps(json_object_get(hdr, "plan"), JSON_COMPACT);
@@ -171,11 +198,38 @@ void lpvc_cascade_irradiance(const lpvc_cascade *cs, const float p[3], const flo
     lpvp_cascade_irradiance(&l, p, n, rgb);
 }
 
-void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3])
+/* The layout the lookup reads, as the protocol library words its refusal. A
+ * volume built by hand (no layout_version, values_per_cell 0) is R5.1's. */
+static lpvp_volume_layout layout_of(const lpvc_volume *v)
+{
+    lpvp_volume_layout l;
+    memset(&l, 0, sizeof l);
+    l.present = v->layout_version != 0 || v->values_per_cell != 0;
+    l.layout_version = v->layout_version;
+    snprintf(l.technique, sizeof l.technique, "%s", v->technique);
+    l.values_per_cell = v->values_per_cell;
+    l.volumes_per_level = v->volumes_per_level;
+    l.sh_values = v->sh_values;
+    l.has_index = v->index != NULL;
+    return l;
+}
+
+int lpvc_volume_lookup_check(const lpvc_volume *v, char *err, size_t n)
+{
+    if (!v || !v->data) {
+        snprintf(err, n, "no volume data");
+        return -1;
+    }
+    lpvp_volume_layout l = layout_of(v);
+    return lpvp_volume_layout_lookup_check(&l, err, n);
+}
+
+int lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
-    if (!v || !v->data)
-        return;
+    char err[8];
+    if (lpvc_volume_lookup_check(v, err, sizeof err) != 0)
+        return -1;
     lpvp_lookup_cascade l[LPVC_MAX_CASCADES];
     int count = v->cascade_count;
     if (count < 1 || count > LPVC_MAX_CASCADES) { /* a volume built by hand: the grid alone */
@@ -188,5 +242,5 @@ void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float 
         for (int k = 0; k < count; k++)
             l[k] = lookup_cascade(&v->cascades[k]);
     }
-    lpvp_volume_irradiance(l, count, p, n, rgb);
+    return lpvp_volume_irradiance(l, count, p, n, rgb);
 }
