@@ -19,6 +19,7 @@
 #include <stdint.h>
 
 #include "grid.h"
+#include "lpv_shared.h"
 #include "oracle.h"
 #include "plan.h"
 #include "scene.h"
@@ -37,6 +38,17 @@ typedef enum lpv_frame_terms {
 
 /* What the last tick and render did: GPU milliseconds per stage (timer
  * queries), dispatches and draws per stage, and counts. */
+/* What the volume is: its levels (cascades) and what a cell holds, as the
+ * technique describes it (lpv_technique_class.describe, technique.h). */
+typedef struct lpv_volume_desc {
+    const char *technique;        /* the class's name (static) */
+    int levels;                   /* 1..LPV_MAX_CASCADES */
+    lpv_grid level[LPV_MAX_CASCADES];
+    int far_field;                /* level k + 1 carries on the light of level k */
+    int volumes_per_level;        /* 1, or the normal bins */
+    int values_per_cell;          /* floats: 12 = SH bands 0-1 of r, g, b */
+} lpv_volume_desc;
+
 typedef struct lpv_engine_stats {
     int stage_count;
     struct {
@@ -55,6 +67,9 @@ typedef struct lpv_engine_stats {
     double cell_steps;
     int occlusion;
     unsigned long scene_uploads, scene_samplings; /* lpv_engine_counters, as of this tick */
+    /* the volume these stats' tick computed: a copy, so a reader on another
+     * thread (the daemon's encoder) gets it with the tick's cells */
+    lpv_volume_desc volume;
 } lpv_engine_stats;
 
 /* The engine's costly scene work since it was created, for tests and the

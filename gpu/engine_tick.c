@@ -124,6 +124,7 @@ static void record_stats(lpv_engine *e)
     s->scene_uploads = e->counters.scene_uploads;
     s->scene_samplings = e->counters.scene_samplings;
     e->tech->cls->stats(e->tech, &e->plan, s);
+    s->volume = e->desc;
 }
 
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)

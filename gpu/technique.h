@@ -75,15 +75,8 @@ typedef struct lpv_technique_inputs {
     const lpv_medium_gpu *medium; /* attenuation during transport */
 } lpv_technique_inputs;
 
-/* What the volume is: its levels (cascades) and what a cell holds. */
-typedef struct lpv_volume_desc {
-    const char *technique;        /* the class's name */
-    int levels;                   /* 1..LPV_MAX_CASCADES */
-    lpv_grid level[LPV_MAX_CASCADES];
-    int far_field;                /* level k + 1 carries on the light of level k */
-    int volumes_per_level;        /* 1, or the normal bins */
-    int values_per_cell;          /* floats: 12 = SH bands 0-1 of r, g, b */
-} lpv_volume_desc;
+/* What the volume is: lpv_volume_desc (engine.h, where the tick's stats
+ * carry it to readers on other threads). */
 
 /* What read returns. */
 typedef enum lpv_volume_part {

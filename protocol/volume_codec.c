@@ -171,9 +171,8 @@ void lpvp_volume_pack(const float *cells12, size_t cells, lpvp_volume_format fmt
     }
 }
 
-void lpvp_volume_unpack(const uint8_t *raw, size_t cells, lpvp_volume_format fmt, float *out)
+void lpvp_values_unpack(const uint8_t *raw, size_t n, lpvp_volume_format fmt, float *out)
 {
-    size_t n = cells * LPVP_VALUES_PER_CELL;
     if (fmt == LPVP_FMT_FP16) {
         for (size_t i = 0; i < n; i++)
             out[i] = lpvp_f16_to_f32((uint16_t)(raw[2 * i] | (raw[2 * i + 1] << 8)));
@@ -184,6 +183,11 @@ void lpvp_volume_unpack(const uint8_t *raw, size_t cells, lpvp_volume_format fmt
             out[i] = bits_f32(u);
         }
     }
+}
+
+void lpvp_volume_unpack(const uint8_t *raw, size_t cells, lpvp_volume_format fmt, float *out)
+{
+    lpvp_values_unpack(raw, cells * LPVP_VALUES_PER_CELL, fmt, out);
 }
 
 /* ---- XOR ------------------------------------------------------------------ */
@@ -335,6 +339,95 @@ int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expe
     return decompress_to(dst, expect, src, n, err, err_n);
 }
 
+/* ---- Volume description (SPEC R5.9 - R5.12) ------------------------------ */
+
+/* R5.1's order: per channel c0 (Y00), then y (Y1-1), z (Y10), x (Y11), as
+ * LPVP_VOLUME_SH says. */
+const char *const lpvp_sh_value_names[LPVP_VALUES_PER_CELL] = {
+    "r.Y00", "r.Y1-1", "r.Y10", "r.Y11", "g.Y00", "g.Y1-1", "g.Y10", "g.Y11",
+    "b.Y00", "b.Y1-1", "b.Y10", "b.Y11"};
+const char *const lpvp_level_role_names[LPVP_ROLE_COUNT] = {[LPVP_ROLE_CASCADE] = "cascade",
+                                                            [LPVP_ROLE_FAR_FIELD] = "far_field"};
+
+void lpvp_volume_layout_sh(lpvp_volume_layout *l, const char *technique, int far_field, int levels)
+{
+    memset(l, 0, sizeof *l);
+    l->present = 1;
+    l->layout_version = LPVP_VOLUME_LAYOUT_VERSION;
+    snprintf(l->technique, sizeof l->technique, "%s", technique ? technique : "");
+    l->far_field = far_field != 0;
+    for (int k = 0; k < LPVP_MAX_CASCADES; k++)
+        l->role[k] = (l->far_field && k > 0 && k < levels) ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
+    l->volumes_per_level = 1;
+    l->values_per_cell = LPVP_VALUES_PER_CELL;
+    l->sh_values = 1;
+}
+
+uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi)
+{
+    uint64_t vpc = vi->layout.values_per_cell, vpl = vi->layout.volumes_per_level;
+    if (!vi->layout.present && vpc == 0) { /* an info filled by hand before descriptions: R5.1 */
+        vpc = LPVP_VALUES_PER_CELL;
+        vpl = 1;
+    }
+    if (vpc < 1 || vpc > LPVP_MAX_VALUES_PER_CELL || vpl < 1 || vpl > LPVP_MAX_VOLUMES_PER_LEVEL)
+        return 0;
+    uint64_t cells = lpvp_volume_total_cells(vi);
+    uint64_t per = vpc * vpl * (uint64_t)lpvp_volume_value_size(vi->format);
+    if (cells > (((uint64_t)1 << 62) / per))
+        return 0;
+    return cells * per;
+}
+
+int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n)
+{
+    if ((l->sh_values || (!l->present && l->values_per_cell == 0)) && l->volumes_per_level <= 1 && !l->has_index)
+        return 0;
+    lpvp_set_error(err, err_n,
+                   "volume layout of technique \"%s\" (layout_version %d, %d values per cell%s, %d volumes per "
+                   "level%s) is not R5.1's 12 SH values in one volume per level, the only layout R5.7's lookup reads",
+                   l->technique, l->layout_version, l->values_per_cell, l->sh_values ? ", the SH values" : "",
+                   l->volumes_per_level, l->has_index ? ", with an index volume" : "");
+    return -1;
+}
+
+/* The description object (R5.9): levels from the cascades, values from the
+ * SH names (the only values this library builds). */
+static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
+{
+    const lpvp_volume_layout *l = &vi->layout;
+    json_t *levels = json_deep_copy(cascades), *values = json_array();
+    json_t *o = json_object();
+    int bad = !levels || !values || !o || !l->sh_values || l->values_per_cell != LPVP_VALUES_PER_CELL;
+    for (size_t k = 0; !bad && k < json_array_size(levels); k++) {
+        int r = l->role[k] == LPVP_ROLE_FAR_FIELD ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
+        bad |= json_object_set_new(json_array_get(levels, k), "role", json_string(lpvp_level_role_names[r])) != 0;
+    }
+    for (int i = 0; !bad && i < LPVP_VALUES_PER_CELL; i++)
+        bad |= json_array_append_new(values, json_string(lpvp_sh_value_names[i])) != 0;
+    if (!bad) {
+        bad |= json_object_set_new(o, "layout_version", json_integer(l->layout_version)) != 0;
+        bad |= json_object_set_new(o, "technique", json_string(l->technique)) != 0;
+        bad |= json_object_set_new(o, "levels", levels) != 0;
+        levels = NULL;
+        bad |= json_object_set_new(o, "far_field", json_boolean(l->far_field)) != 0;
+        bad |= json_object_set_new(o, "volumes_per_level", json_integer(l->volumes_per_level)) != 0;
+        bad |= json_object_set_new(o, "values_per_cell", json_integer(l->values_per_cell)) != 0;
+        bad |= json_object_set_new(o, "values", values) != 0;
+        values = NULL;
+        bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
+        /* this library builds no index volume (R5.12 reserves the key) */
+        bad |= json_object_set_new(o, "index", json_null()) != 0;
+    }
+    json_decref(levels);
+    json_decref(values);
+    if (bad) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
 /* ---- Volume header -------------------------------------------------------- */
 
 static json_t *vec_json(const double *v, size_t n)
@@ -440,11 +533,14 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
             bad |= json_object_set_new(o, "base_tick", json_integer(vi->base_tick)) != 0;
         bad |= json_object_set_new(o, "grid", grid) != 0;
         grid = NULL;
-        bad |= json_object_set_new(o, "cascades", cascades_json(vi)) != 0;
+        json_t *cascades = cascades_json(vi);
+        bad |= json_object_set_new(o, "cascades", cascades) != 0;
         bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
         bad |= json_object_set_new(o, "layout", json_string(LPVP_VOLUME_LAYOUT)) != 0;
         bad |= json_object_set_new(o, "sh", json_string(LPVP_VOLUME_SH)) != 0;
         bad |= json_object_set_new(o, "raw_length", json_integer((json_int_t)vi->raw_length)) != 0;
+        if (!bad && vi->layout.present)
+            bad |= json_object_set_new(o, LPVP_VOLUME_DESC_KEY, layout_json(vi, cascades)) != 0;
     }
     json_decref(dims);
     json_decref(grid);
@@ -577,6 +673,211 @@ static int parse_cascades(const json_t *obj, lpvp_volume_info *vi, char *err, si
     return 0;
 }
 
+/* The description (R5.9 - R5.12) into vi->layout; the cascades are already
+ * read. Absent: R5.1's 12 values (layout.present 0). Each MUST-reject rule of
+ * R5.9 - R5.12 is one check here, its message naming the field. */
+static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    lpvp_volume_layout *l = &vi->layout;
+    const json_t *d = json_object_get(obj, LPVP_VOLUME_DESC_KEY), *v, *a;
+    const char *K = LPVP_VOLUME_DESC_KEY;
+    long long x;
+    char key[96];
+    if (!d) {
+        lpvp_volume_layout_sh(l, "", 0, vi->cascade_count);
+        l->present = 0;
+        l->layout_version = 0;
+        return 0;
+    }
+    memset(l, 0, sizeof *l);
+    l->present = 1;
+    if (!json_is_object(d)) {
+        lpvp_set_error(err, err_n, "%s: expected an object", K);
+        return -1;
+    }
+    snprintf(key, sizeof key, "%s.layout_version", K);
+    v = json_object_get(d, "layout_version");
+    if (!json_is_integer(v)) {
+        lpvp_set_error(err, err_n, "%s: expected an integer", key);
+        return -1;
+    }
+    if (json_integer_value(v) != LPVP_VOLUME_LAYOUT_VERSION) {
+        lpvp_set_error(err, err_n, "%s: %lld is not a layout this client reads (it reads %d)", key,
+                       (long long)json_integer_value(v), LPVP_VOLUME_LAYOUT_VERSION);
+        return -1;
+    }
+    l->layout_version = (int)json_integer_value(v);
+    v = json_object_get(d, "technique");
+    if (!json_is_string(v) || json_string_length(v) == 0 || json_string_length(v) >= sizeof l->technique) {
+        lpvp_set_error(err, err_n, "%s.technique: expected a name of 1 to %zu characters", K,
+                       sizeof l->technique - 1);
+        return -1;
+    }
+    snprintf(l->technique, sizeof l->technique, "%s", json_string_value(v));
+    v = json_object_get(d, "far_field");
+    if (!json_is_boolean(v)) {
+        lpvp_set_error(err, err_n, "%s.far_field: expected true or false", K);
+        return -1;
+    }
+    l->far_field = json_is_true(v);
+
+    /* R5.10: the levels are the cascades, each with a role agreeing with far_field */
+    a = json_object_get(d, "levels");
+    if (!json_is_array(a) || json_array_size(a) != (size_t)vi->cascade_count) {
+        lpvp_set_error(err, err_n, "%s.levels: expected an array of %d levels (one per cascade)", K,
+                       vi->cascade_count);
+        return -1;
+    }
+    for (int k = 0; k < vi->cascade_count; k++) {
+        const json_t *e = json_array_get(a, (size_t)k);
+        const lpvp_cascade_info *ci = &vi->cascades[k];
+        if (!json_is_object(e)) {
+            lpvp_set_error(err, err_n, "%s.levels[%d]: expected an object", K, k);
+            return -1;
+        }
+        const json_t *dims = json_object_get(e, "dims"), *org = json_object_get(e, "origin");
+        int same = json_is_array(dims) && json_array_size(dims) == 3 && json_is_array(org) &&
+                   json_array_size(org) == 3;
+        for (size_t i = 0; same && i < 3; i++) {
+            same = json_is_integer(json_array_get(dims, i)) &&
+                   json_integer_value(json_array_get(dims, i)) == ci->dims[i] &&
+                   json_is_number(json_array_get(org, i)) &&
+                   same_real(json_number_value(json_array_get(org, i)), ci->origin[i]);
+        }
+        v = json_object_get(e, "cell_size");
+        same = same && json_is_number(v) && same_real(json_number_value(v), ci->cell_size);
+        v = json_object_get(e, "cells");
+        same = same && json_is_integer(v) && (uint64_t)json_integer_value(v) == ci->cells;
+        if (!same) {
+            lpvp_set_error(err, err_n, "%s.levels[%d]: dims, origin, cell_size and cells differ from cascades[%d]", K,
+                           k, k);
+            return -1;
+        }
+        v = json_object_get(e, "role");
+        int role = -1;
+        for (int r = 0; json_is_string(v) && r < LPVP_ROLE_COUNT; r++)
+            if (strcmp(json_string_value(v), lpvp_level_role_names[r]) == 0)
+                role = r;
+        if (role < 0) {
+            lpvp_set_error(err, err_n, "%s.levels[%d].role: expected \"%s\" or \"%s\"", K, k,
+                           lpvp_level_role_names[LPVP_ROLE_CASCADE], lpvp_level_role_names[LPVP_ROLE_FAR_FIELD]);
+            return -1;
+        }
+        int want = (l->far_field && k > 0) ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
+        if (role != want) {
+            lpvp_set_error(err, err_n, "%s.levels[%d].role: \"%s\" with far_field %s (level 0 is a \"%s\"; levels "
+                           "1.. are \"%s\" exactly when far_field is true)", K, k, lpvp_level_role_names[role],
+                           l->far_field ? "true" : "false", lpvp_level_role_names[LPVP_ROLE_CASCADE],
+                           lpvp_level_role_names[LPVP_ROLE_FAR_FIELD]);
+            return -1;
+        }
+        l->role[k] = (lpvp_level_role)role;
+    }
+
+    /* R5.11: what a cell holds */
+    snprintf(key, sizeof key, "%s.volumes_per_level", K);
+    if (need_int(d, "volumes_per_level", 1, &x, err, err_n) != 0 || x > LPVP_MAX_VOLUMES_PER_LEVEL) {
+        lpvp_set_error(err, err_n, "%s: expected an integer in [1, %d]", key, LPVP_MAX_VOLUMES_PER_LEVEL);
+        return -1;
+    }
+    l->volumes_per_level = (int)x;
+    snprintf(key, sizeof key, "%s.values_per_cell", K);
+    if (need_int(d, "values_per_cell", 1, &x, err, err_n) != 0 || x > LPVP_MAX_VALUES_PER_CELL) {
+        lpvp_set_error(err, err_n, "%s: expected an integer in [1, %d]", key, LPVP_MAX_VALUES_PER_CELL);
+        return -1;
+    }
+    l->values_per_cell = (int)x;
+    a = json_object_get(d, "values");
+    if (!json_is_array(a) || json_array_size(a) != (size_t)l->values_per_cell) {
+        lpvp_set_error(err, err_n, "%s.values: expected an array of values_per_cell (%d) names", K,
+                       l->values_per_cell);
+        return -1;
+    }
+    l->sh_values = l->values_per_cell == LPVP_VALUES_PER_CELL;
+    for (size_t i = 0; i < json_array_size(a); i++) {
+        v = json_array_get(a, i);
+        if (!json_is_string(v) || json_string_length(v) == 0) {
+            lpvp_set_error(err, err_n, "%s.values[%zu]: expected a non-empty name", K, i);
+            return -1;
+        }
+        for (size_t j = 0; j < i; j++) {
+            if (strcmp(json_string_value(v), json_string_value(json_array_get(a, j))) == 0) {
+                lpvp_set_error(err, err_n, "%s.values[%zu]: \"%s\" is named twice (also values[%zu])", K, i,
+                               json_string_value(v), j);
+                return -1;
+            }
+        }
+        if (l->sh_values && strcmp(json_string_value(v), lpvp_sh_value_names[i]) != 0)
+            l->sh_values = 0;
+    }
+    v = json_object_get(d, "units");
+    const json_t *top_units = json_object_get(obj, "units");
+    if (!json_is_string(v) || (json_is_string(top_units) && !json_equal(v, top_units))) {
+        lpvp_set_error(err, err_n, "%s.units: expected a string equal to the header's \"units\"", K);
+        return -1;
+    }
+
+    /* R5.12: an index volume after the levels' values */
+    v = json_object_get(d, "index");
+    if (v && !json_is_null(v)) {
+        lpvp_index_info *ix = &l->index;
+        if (!json_is_object(v)) {
+            lpvp_set_error(err, err_n, "%s.index: expected null or an object", K);
+            return -1;
+        }
+        snprintf(key, sizeof key, "%s.index.level", K);
+        if (need_int(v, "level", 0, &x, err, err_n) != 0 || x >= vi->cascade_count) {
+            lpvp_set_error(err, err_n, "%s: expected a level in [0, %d]", key, vi->cascade_count - 1);
+            return -1;
+        }
+        ix->level = (int)x;
+        const json_t *dims = json_object_get(v, "dims");
+        if (!json_is_array(dims) || json_array_size(dims) != 3) {
+            lpvp_set_error(err, err_n, "%s.index.dims: expected an array of 3 integers", K);
+            return -1;
+        }
+        ix->cells = 1;
+        for (size_t i = 0; i < 3; i++) {
+            const json_t *e = json_array_get(dims, i);
+            if (!json_is_integer(e) || json_integer_value(e) < 1 || json_integer_value(e) > (1 << 20)) {
+                lpvp_set_error(err, err_n, "%s.index.dims[%zu]: expected an integer in [1, 1048576]", K, i);
+                return -1;
+            }
+            ix->dims[i] = json_integer_value(e);
+            ix->cells *= (uint64_t)ix->dims[i];
+        }
+        snprintf(key, sizeof key, "%s.index.values_per_cell", K);
+        if (need_int(v, "values_per_cell", 1, &x, err, err_n) != 0 || x > LPVP_MAX_VALUES_PER_CELL) {
+            lpvp_set_error(err, err_n, "%s: expected an integer in [1, %d]", key, LPVP_MAX_VALUES_PER_CELL);
+            return -1;
+        }
+        ix->values_per_cell = (int)x;
+        const json_t *vt = json_object_get(v, "value_type");
+        if (!json_is_string(vt) || strcmp(json_string_value(vt), LPVP_INDEX_VALUE_TYPE) != 0) {
+            lpvp_set_error(err, err_n, "%s.index.value_type: expected \"%s\"", K, LPVP_INDEX_VALUE_TYPE);
+            return -1;
+        }
+        uint64_t values = lpvp_volume_values_bytes(vi);
+        snprintf(key, sizeof key, "%s.index.raw_offset", K);
+        if (need_int(v, "raw_offset", 0, &x, err, err_n) != 0 || (uint64_t)x != values) {
+            lpvp_set_error(err, err_n, "%s: expected %llu (right after the levels' values)", key,
+                           (unsigned long long)values);
+            return -1;
+        }
+        ix->raw_offset = (uint64_t)x;
+        uint64_t want = ix->cells * (uint64_t)ix->values_per_cell * LPVP_INDEX_VALUE_SIZE;
+        snprintf(key, sizeof key, "%s.index.raw_length", K);
+        if (need_int(v, "raw_length", 0, &x, err, err_n) != 0 || (uint64_t)x != want) {
+            lpvp_set_error(err, err_n, "%s: expected %llu (dims' product x values_per_cell x %d bytes)", key,
+                           (unsigned long long)want, LPVP_INDEX_VALUE_SIZE);
+            return -1;
+        }
+        ix->raw_length = want;
+        l->has_index = 1;
+    }
+    return 0;
+}
+
 int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n)
 {
     long long x;
@@ -658,17 +959,23 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
         return -1;
     }
     vi->cell_size = json_number_value(v);
-    if (parse_cascades(obj, vi, err, err_n) != 0)
+    if (parse_cascades(obj, vi, err, err_n) != 0 || parse_layout(obj, vi, err, err_n) != 0)
         return -1;
     cells = (size_t)lpvp_volume_total_cells(vi);
     if (need_int(obj, "raw_length", 0, &x, err, err_n))
         return -1;
     vi->raw_length = (uint64_t)x;
     {
-        size_t expect = lpvp_volume_raw_size(cells, vi->format);
-        if (expect == 0 || (uint64_t)expect != vi->raw_length) {
-            lpvp_set_error(err, err_n, "raw_length: %llu, but %zu cells of %s need %zu bytes", x, cells,
-                    lpvp_volume_format_name(vi->format), expect);
+        /* R5.6 / R5.11: the levels' values as described, then the index (R5.12) */
+        uint64_t values = lpvp_volume_values_bytes(vi);
+        uint64_t index = vi->layout.has_index ? vi->layout.index.raw_length : 0;
+        uint64_t expect = values + index;
+        if (values == 0 || (uint64_t)(size_t)expect != expect || expect != vi->raw_length) {
+            lpvp_set_error(err, err_n,
+                           "raw_length: %llu, but %zu cells x %d volumes x %d values of %s%s need %llu bytes", x,
+                           cells, vi->layout.volumes_per_level, vi->layout.values_per_cell,
+                           lpvp_volume_format_name(vi->format), index ? " + the index" : "",
+                           (unsigned long long)expect);
             return -1;
         }
     }

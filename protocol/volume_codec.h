@@ -97,6 +97,10 @@ void lpvp_volume_pack(const float *cells12, size_t cells, lpvp_volume_format fmt
 /* The inverse: raw (lpvp_volume_raw_size bytes) -> cells x 12 floats. */
 void lpvp_volume_unpack(const uint8_t *raw, size_t cells, lpvp_volume_format fmt, float *out);
 
+/* Any count of values (a described layout, R5.11): raw (count x value size
+ * bytes) -> count floats. */
+void lpvp_values_unpack(const uint8_t *raw, size_t count, lpvp_volume_format fmt, float *out);
+
 /* ---- XOR delta (R5.3) ----------------------------------------------------- */
 
 /* dst[i] = a[i] ^ b[i] for i < n. dst may be a or b (in place). The delta of
@@ -148,6 +152,65 @@ typedef struct lpvp_cascade_info {
     uint64_t cells;              /* dims[0] x dims[1] x dims[2] */
 } lpvp_cascade_info;
 
+/* ---- Volume description (SPEC R5.9 - R5.12) ------------------------------ */
+
+/* The version of the description's layout this library reads and writes
+ * (R5.9). New techniques fill the same layout; only an incompatible change
+ * of it bumps the version. */
+#define LPVP_VOLUME_LAYOUT_VERSION 1
+
+/* The header key of the description. */
+#define LPVP_VOLUME_DESC_KEY "volume"
+
+/* Values per cell a description may declare (R5.11), and the longest value
+ * name this library keeps. */
+#define LPVP_MAX_VALUES_PER_CELL 256
+#define LPVP_MAX_VOLUMES_PER_LEVEL 64
+
+/* The names of the 12 values of R5.1's layout, in order ("r.Y00", "r.Y1-1",
+ * "r.Y10", "r.Y11", then g and b): SH bands 0-1 of each channel in the order
+ * of LPVP_VOLUME_SH. The layout R5.7's lookup reads. */
+extern const char *const lpvp_sh_value_names[LPVP_VALUES_PER_CELL];
+
+/* A level's role (R5.10): "cascade" (levels blended as R5.7 says) or
+ * "far_field" (a coarser level carrying on the light of the finer ones; the
+ * server sums such levels). */
+typedef enum lpvp_level_role {
+    LPVP_ROLE_CASCADE = 0,
+    LPVP_ROLE_FAR_FIELD = 1,
+    LPVP_ROLE_COUNT = 2
+} lpvp_level_role;
+extern const char *const lpvp_level_role_names[LPVP_ROLE_COUNT];
+
+/* An index volume (R5.12): value type and its size. */
+#define LPVP_INDEX_VALUE_TYPE "u32"
+#define LPVP_INDEX_VALUE_SIZE 4
+
+typedef struct lpvp_index_info {
+    int level;                   /* the level whose box it covers */
+    int64_t dims[3];             /* entries per axis, each >= 1 */
+    uint64_t cells;              /* dims' product */
+    int values_per_cell;         /* u32 values per entry, >= 1 */
+    uint64_t raw_offset;         /* bytes into the raw volume: right after the levels' values */
+    uint64_t raw_length;         /* cells x values_per_cell x 4 */
+} lpvp_index_info;
+
+/* What a volume carries (R5.9 - R5.12). The levels' placement is the info's
+ * cascades (R5.10 requires the two lists to agree). */
+typedef struct lpvp_volume_layout {
+    int present;                 /* build: send the description; parse: the header had one (0: an
+                                    older server, filled from the legacy keys as R5.1 describes) */
+    int layout_version;          /* LPVP_VOLUME_LAYOUT_VERSION (0 when not present) */
+    char technique[64];          /* the technique's name, e.g. "cascaded_lpv"; "" when not present */
+    int far_field;               /* levels 1.. are far-field levels */
+    lpvp_level_role role[LPVP_MAX_CASCADES];
+    int volumes_per_level;       /* >= 1; 1: one (summed) volume per level */
+    int values_per_cell;         /* 1..LPVP_MAX_VALUES_PER_CELL */
+    int sh_values;               /* the values are lpvp_sh_value_names in order (build: send them) */
+    int has_index;
+    lpvp_index_info index;       /* when has_index */
+} lpvp_volume_layout;
+
 typedef struct lpvp_volume_info {
     int64_t revision;            /* R3.3 */
     int64_t tick;
@@ -164,7 +227,24 @@ typedef struct lpvp_volume_info {
      * means one cascade described by dims/origin/cell_size above. */
     int cascade_count;
     lpvp_cascade_info cascades[LPVP_MAX_CASCADES];
+    /* The description (R5.9 - R5.12). Build sends it when layout.present
+     * (levels from the cascades, values from lpvp_sh_value_names when
+     * sh_values); parse always fills it. */
+    lpvp_volume_layout layout;
 } lpvp_volume_info;
+
+/* The 12-value SH layout of R5.1 for technique (one summed volume per
+ * level, no index), roles from far_field; present set. */
+void lpvp_volume_layout_sh(lpvp_volume_layout *l, const char *technique, int far_field, int levels);
+
+/* Bytes of the levels' values: all cells x volumes_per_level x
+ * values_per_cell x value size (0 on overflow or a bad layout). With
+ * layout.present 0 and values_per_cell 0, the legacy 12 values. */
+uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi);
+
+/* 0 when R5.7's lookup reads this layout (the SH values, one volume per
+ * level); else -1 with err naming the layout. */
+int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n);
 
 /* Cells of all cascades together (0 if the count is out of range); with
  * cascade_count 0, the cells of dims. */
@@ -183,9 +263,14 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
 /* Reads a header (client side). Checks types and ranges, that dims are
  * >= 1 with a product that fits, the "cascades" array (R5.6: 1..4 entries,
  * dims >= 1, cells == the dims' product, cell_size > 0, the top-level grid
- * equal to cascade 0), and that raw_length == all cascades' cells x 12 x
- * value size. A header without "cascades" (an older server) is read as one
- * cascade equal to the grid. Returns 0, or -1 with "<field>: <what>" in err. */
+ * equal to cascade 0), the description "volume" (R5.9 - R5.12: a layout
+ * version this library knows, levels equal to the cascades, roles agreeing
+ * with far_field, values naming values_per_cell distinct values, units as the
+ * top level's, an index that fits), and that raw_length == the levels'
+ * values (+ the index) as described. A header without "cascades" (an older
+ * server) is read as one cascade equal to the grid; one without "volume" as
+ * R5.1's 12 values (layout.present 0). Returns 0, or -1 with
+ * "<field>: <what>" in err. */
 int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n);
 
 /* Client-side decoding of a VOLUME / GET_VOLUME attachment into the raw

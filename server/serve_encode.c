@@ -109,6 +109,18 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
         ci->cell_size = g->cell_size;
         ci->cells = lpv_grid_cell_count(g);
     }
+    /* What the volume carries (R5.9 - R5.11), from the technique's own
+     * description of the tick's volume (snapshotted with the tick's stats).
+     * The cells are the engine's summed read-back (lpv_engine_read_grid): one
+     * volume per level whatever its normal bins, R5.1's 12 values a cell. */
+    const lpv_volume_desc *d = &r->stats.volume;
+    if (!d->technique || d->values_per_cell != LPVP_VALUES_PER_CELL) {
+        free(raw);
+        snprintf(err, n, "the tick's volume is described as %d values per cell of technique %s; this encoder sends "
+                 "R5.1's %d", d->values_per_cell, d->technique ? d->technique : "(none)", LPVP_VALUES_PER_CELL);
+        return -1;
+    }
+    lpvp_volume_layout_sh(&vi.layout, d->technique, d->far_field, vi.cascade_count);
 
     uint8_t *payload = raw; /* what gets compressed / sent */
     uint8_t *delta = NULL;

@@ -26,6 +26,7 @@
 #include <jansson.h>
 
 #include "lpvc.h"
+#include "volume_codec.h"
 #include "test_util.h"
 
 static char g_daemon[PATH_MAX + 32];
@@ -435,9 +436,29 @@ static void test_tick_volume_query(void **state)
     assert_int_equal(json_integer_value(json_object_get(r, "count")), N);
     assert_int_equal(json_integer_value(json_object_get(r, "tick")), tick);
     json_decref(r);
+    /* the volume describes itself (SPEC R5.9 - R5.11): the technique's SH layout */
+    assert_int_equal(v32.layout_version, LPVP_VOLUME_LAYOUT_VERSION);
+    assert_true(v32.technique[0] != '\0');
+    assert_int_equal(v32.values_per_cell, LPVP_VALUES_PER_CELL);
+    assert_int_equal(v32.volumes_per_level, 1);
+    assert_true(v32.sh_values);
+    assert_null(v32.index);
+    char why[256];
+    assert_int_equal(lpvc_volume_lookup_check(&v32, why, sizeof why), 0);
     float local[N * 3];
     for (size_t i = 0; i < N; i++)
-        lpvc_volume_irradiance(&v32, pts + 3 * i, nrm + 3 * i, local + 3 * i);
+        assert_int_equal(lpvc_volume_irradiance(&v32, pts + 3 * i, nrm + 3 * i, local + 3 * i), 0);
+    {
+        /* a layout the lookup does not read is refused, naming it */
+        lpvc_volume other = v32;
+        other.values_per_cell = 4;
+        other.sh_values = false;
+        float e[3] = {1, 1, 1};
+        assert_int_equal(lpvc_volume_irradiance(&other, pts, nrm, e), -1);
+        assert_true(e[0] == 0.0f && e[1] == 0.0f && e[2] == 0.0f);
+        assert_int_equal(lpvc_volume_lookup_check(&other, why, sizeof why), -1);
+        assert_non_null(strstr(why, "4 values per cell"));
+    }
     float emax = fmaxf(max_abs(local, N * 3), max_abs(rgb, N * 3));
     assert_true(emax > 0.0f);
     for (size_t i = 0; i < N * 3; i++) {

@@ -1347,6 +1347,159 @@ static void test_volume_header_and_decode(void **state)
 
 /* R1.1: host/port splitting and the default socket rule shared by the
  * daemon and the clients. */
+/* A two-level far-field volume with its description (R5.9 - R5.11). */
+static void described_volume(lpvp_volume_info *vi)
+{
+    memset(vi, 0, sizeof *vi);
+    vi->revision = 1;
+    vi->tick = 4;
+    vi->format = LPVP_FMT_FP16;
+    vi->keyframe = 1;
+    vi->base_tick = -1;
+    vi->cascade_count = 2;
+    for (int k = 0; k < 2; k++) {
+        lpvp_cascade_info *c = &vi->cascades[k];
+        c->dims[0] = c->dims[1] = c->dims[2] = 2;
+        c->cells = 8;
+        c->cell_size = 0.5 * (double)(1 << k);
+        for (int i = 0; i < 3; i++)
+            c->origin[i] = -c->cell_size;
+    }
+    for (int i = 0; i < 3; i++) {
+        vi->dims[i] = vi->cascades[0].dims[i];
+        vi->origin[i] = vi->cascades[0].origin[i];
+    }
+    vi->cell_size = vi->cascades[0].cell_size;
+    vi->raw_length = 16 * 12 * 2;
+    lpvp_volume_layout_sh(&vi->layout, "cascaded_lpv", 1, 2);
+}
+
+/* Parses h (taking it) and expects a refusal whose message contains what. */
+static void expect_refused(json_t *h, const char *what)
+{
+    char err[256] = "";
+    lpvp_volume_info back;
+    int rc = lpvp_volume_header_parse(h, &back, err, sizeof err);
+    if (rc == 0 || !strstr(err, what))
+        fail_msg("expected a refusal naming '%s', got rc %d: '%s'", what, rc, err);
+    json_decref(h);
+}
+
+/* R5.9 - R5.12: the description is built, read back, and every
+ * inconsistent variant is refused naming the field. */
+static void test_volume_description(void **state)
+{
+    (void)state;
+    char err[256];
+    lpvp_volume_info vi, back;
+    described_volume(&vi);
+    json_t *h = lpvp_volume_header_build(&vi);
+    assert_non_null(h);
+    json_t *d = json_object_get(h, LPVP_VOLUME_DESC_KEY);
+    assert_true(json_is_object(d));
+    assert_int_equal(json_integer_value(json_object_get(d, "layout_version")), LPVP_VOLUME_LAYOUT_VERSION);
+    assert_string_equal(json_string_value(json_object_get(d, "technique")), "cascaded_lpv");
+    assert_true(json_is_true(json_object_get(d, "far_field")));
+    assert_int_equal(json_integer_value(json_object_get(d, "values_per_cell")), LPVP_VALUES_PER_CELL);
+    assert_int_equal(json_array_size(json_object_get(d, "values")), LPVP_VALUES_PER_CELL);
+    assert_string_equal(json_string_value(json_array_get(json_object_get(d, "values"), 1)), "r.Y1-1");
+    assert_true(json_is_null(json_object_get(d, "index")));
+    json_t *lv = json_object_get(d, "levels");
+    assert_int_equal(json_array_size(lv), 2);
+    assert_string_equal(json_string_value(json_object_get(json_array_get(lv, 0), "role")), "cascade");
+    assert_string_equal(json_string_value(json_object_get(json_array_get(lv, 1), "role")), "far_field");
+
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_true(back.layout.present);
+    assert_string_equal(back.layout.technique, "cascaded_lpv");
+    assert_true(back.layout.far_field && back.layout.sh_values && !back.layout.has_index);
+    assert_int_equal(back.layout.role[1], LPVP_ROLE_FAR_FIELD);
+    assert_int_equal(back.layout.volumes_per_level, 1);
+    assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), 0);
+
+    /* an older server: no description, R5.1's layout */
+    json_t *old = json_deep_copy(h);
+    json_object_del(old, LPVP_VOLUME_DESC_KEY);
+    assert_int_equal(lpvp_volume_header_parse(old, &back, err, sizeof err), 0);
+    assert_false(back.layout.present);
+    assert_int_equal(back.layout.values_per_cell, LPVP_VALUES_PER_CELL);
+    assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), 0);
+    json_decref(old);
+
+#define BAD(edit, what)                                                                                       \
+    do {                                                                                                      \
+        json_t *b = json_deep_copy(h), *bd = json_object_get(b, LPVP_VOLUME_DESC_KEY);                        \
+        (void)bd;                                                                                             \
+        edit;                                                                                                 \
+        expect_refused(b, what);                                                                              \
+    } while (0)
+    BAD(json_object_set_new(bd, "layout_version", json_integer(2)), "layout_version");
+    BAD(json_object_del(bd, "layout_version"), "layout_version");
+    BAD(json_object_set_new(bd, "technique", json_string("")), "technique");
+    BAD(json_object_set_new(b, LPVP_VOLUME_DESC_KEY, json_string("x")), LPVP_VOLUME_DESC_KEY);
+    BAD(json_array_remove(json_object_get(bd, "levels"), 1), "levels");
+    BAD(json_object_set_new(json_array_get(json_object_get(bd, "levels"), 1), "cell_size", json_real(2.0)),
+        "levels[1]");
+    BAD(json_object_set_new(json_array_get(json_object_get(bd, "levels"), 0), "cells", json_integer(9)),
+        "levels[0]");
+    BAD(json_object_set_new(json_array_get(json_object_get(bd, "levels"), 1), "role", json_string("cascade")),
+        "levels[1].role");
+    BAD(json_object_set_new(json_array_get(json_object_get(bd, "levels"), 0), "role", json_string("far_field")),
+        "levels[0].role");
+    BAD(json_object_set_new(bd, "far_field", json_false()), "levels[1].role");
+    BAD(json_object_set_new(json_array_get(json_object_get(bd, "levels"), 1), "role", json_string("octree")),
+        "levels[1].role");
+    BAD(json_array_remove(json_object_get(bd, "values"), 11), "values");
+    BAD(json_object_set_new(bd, "values_per_cell", json_integer(0)), "values_per_cell");
+    BAD(json_array_set_new(json_object_get(bd, "values"), 3, json_string("r.Y00")), "values[3]");
+    BAD(json_object_set_new(bd, "volumes_per_level", json_integer(0)), "volumes_per_level");
+    BAD(json_object_set_new(bd, "volumes_per_level", json_integer(6)), "raw_length");
+    BAD(json_object_set_new(bd, "units", json_string("W/m^2")), "units");
+    BAD(json_object_set_new(bd, "index", json_integer(1)), "index");
+
+    /* A layout the lookup does not read: 4 values per cell, then an index
+     * volume after them (R5.12), as an octree technique would send. */
+    json_t *o = json_deep_copy(h);
+    json_t *od = json_object_get(o, LPVP_VOLUME_DESC_KEY);
+    json_object_set_new(od, "technique", json_string("octree_lpv"));
+    json_object_set_new(od, "values_per_cell", json_integer(4));
+    json_object_set_new(od, "values", json_pack("[s,s,s,s]", "a", "b", "c", "d"));
+    json_object_set_new(od, "index", json_pack("{s:i, s:[i,i,i], s:i, s:s, s:I, s:I}", "level", 0, "dims", 1, 1, 2,
+                                               "values_per_cell", 1, "value_type", LPVP_INDEX_VALUE_TYPE,
+                                               "raw_offset", (json_int_t)(16 * 4 * 2), "raw_length",
+                                               (json_int_t)(2 * 4)));
+    json_object_set_new(o, "raw_length", json_integer(16 * 4 * 2 + 2 * 4));
+    assert_int_equal(lpvp_volume_header_parse(o, &back, err, sizeof err), 0);
+    assert_int_equal(back.layout.values_per_cell, 4);
+    assert_false(back.layout.sh_values);
+    assert_true(back.layout.has_index);
+    assert_int_equal(back.layout.index.raw_offset, 128);
+    assert_int_equal(lpvp_volume_values_bytes(&back), 128);
+    assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), -1);
+    assert_non_null(strstr(err, "octree_lpv"));
+    assert_non_null(strstr(err, "4 values per cell"));
+    {
+        json_t *b = json_deep_copy(o);
+        json_object_set_new(json_object_get(json_object_get(b, LPVP_VOLUME_DESC_KEY), "index"), "raw_offset",
+                            json_integer(0));
+        expect_refused(b, "index.raw_offset");
+        b = json_deep_copy(o);
+        json_object_set_new(json_object_get(json_object_get(b, LPVP_VOLUME_DESC_KEY), "index"), "raw_length",
+                            json_integer(4));
+        expect_refused(b, "index.raw_length");
+        b = json_deep_copy(o);
+        json_object_set_new(json_object_get(json_object_get(b, LPVP_VOLUME_DESC_KEY), "index"), "level",
+                            json_integer(2));
+        expect_refused(b, "index.level");
+        b = json_deep_copy(o);
+        json_object_set_new(b, "raw_length", json_integer(16 * 4 * 2));
+        expect_refused(b, "raw_length");
+    }
+    json_decref(o);
+#undef BAD
+    json_decref(h);
+}
+
 static void test_addresses(void **state)
 {
     (void)state;
@@ -1398,6 +1551,7 @@ int main(void)
         cmocka_unit_test(test_zstd),
         cmocka_unit_test(test_volume_header_and_decode),
         cmocka_unit_test(test_volume_cascades),
+        cmocka_unit_test(test_volume_description),
         cmocka_unit_test(test_addresses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

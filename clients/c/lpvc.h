@@ -200,7 +200,8 @@ typedef struct lpvc_cascade {
     float origin[3];           /* m, lower corner */
     float cell_size;           /* m */
     size_t cells;              /* dims[0] * dims[1] * dims[2] */
-    float *data;               /* cells * 12 floats inside the volume's data (not to be freed) */
+    float *data;               /* cells * values_per_cell floats (x volumes_per_level) inside the
+                                  volume's data (not to be freed) */
 } lpvc_cascade;
 
 /* A decoded volume (SPEC section 5): always float32 after decoding. The
@@ -212,7 +213,8 @@ typedef struct lpvc_volume {
     float origin[3];
     float cell_size;
     size_t cells;              /* dims[0] * dims[1] * dims[2]: cascade 0's cells */
-    float *data;               /* total_cells * 12: per cell r0..r3 g0..g3 b0..b3, x fastest, W/sr */
+    float *data;               /* total_cells * volumes_per_level * values_per_cell floats; for R5.1's
+                                  layout (sh_values) per cell r0..r3 g0..g3 b0..b3, x fastest, W/sr */
     char format[8];            /* wire format: "fp16" or "fp32" */
     char compression[8];       /* wire compression */
     bool keyframe;             /* false: was an XOR delta, already undone */
@@ -222,6 +224,22 @@ typedef struct lpvc_volume {
     lpvc_cascade cascades[LPVC_MAX_CASCADES]; /* finest first */
     size_t total_cells;        /* sum of the cascades' cells */
     char *plan_json;           /* the tick's plan (SPEC section 8) as JSON text; NULL if the header had none */
+    /* What the volume carries (SPEC R5.9 - R5.12): the header's "volume"
+     * description, or R5.1's layout from an older server's legacy keys. data
+     * holds, per cascade (level), volumes_per_level volumes of cells x
+     * values_per_cell floats; each cascade's data points at its first. The
+     * values' names are in header_json ("volume"."values"). */
+    int layout_version;        /* 0: the server sent no description */
+    char technique[64];        /* e.g. "cascaded_lpv"; "" without a description */
+    int values_per_cell;       /* 12 for R5.1's SH values */
+    int volumes_per_level;     /* 1: one (summed) volume per level */
+    bool far_field;            /* cascades 1.. are far-field levels the server sums (R5.10) */
+    bool sh_values;            /* the values are R5.1's 12 SH values: the lookup below reads them */
+    uint32_t *index;           /* the index volume (R5.12), index_count values; NULL when none */
+    size_t index_count;
+    int index_level;           /* the level it covers */
+    int index_dims[3];
+    int index_values_per_cell;
 } lpvc_volume;
 void lpvc_volume_free(lpvc_volume *v);
 
@@ -301,8 +319,13 @@ int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
 /* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
  * server's QUERY_IRRADIANCE computes it: with several cascades, the finest
  * containing p, blended to the next coarser within the last 3 cells of its
- * border (SPEC R5.7). */
-void lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3]);
+ * border (SPEC R5.7). Returns 0, or -1 with rgb zero for a volume whose
+ * layout the lookup does not read (lpvc_volume_lookup_check says why). */
+int lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3]);
+
+/* 0 when lpvc_volume_irradiance reads v's layout (R5.1's 12 SH values, one
+ * volume per level); else -1 with a message naming the layout in err. */
+int lpvc_volume_lookup_check(const lpvc_volume *v, char *err, size_t n);
 
 /* The same from one cascade alone. */
 void lpvc_cascade_irradiance(const lpvc_cascade *cs, const float p[3], const float n[3], float rgb[3]);

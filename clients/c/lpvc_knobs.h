@@ -1,7 +1,8 @@
 /*
  * lpvc_knobs.h - internal to the C client: the daemon's description of its
  * settings knobs (SPEC R4.12) read from a HELLO reply, and CONFIG bodies
- * built against it. No I/O; lpvc.c keeps one lpvc_knobset per connection.
+ * built against it. No I/O; the connection (lpvc_internal.h)
+ * keeps one lpvc_knobset.
  */
 #ifndef LPVC_KNOBS_H
 #define LPVC_KNOBS_H

@@ -1589,11 +1589,70 @@ def _vol_header_checks(h, fmt, comp, dims=None):
     if dims is not None:
         check(g["dims"] == list(dims), "grid.dims %r, expected the configured %r" % (g["dims"], list(dims)))
     cells = _cascades_checks(h)
-    want = cells * 12 * (2 if fmt == "fp16" else 4)
-    check(h["raw_length"] == want, "raw_length %r, expected cells(%d, all cascades) x 12 x %d = %d"
-          % (h["raw_length"], cells, 2 if fmt == "fp16" else 4, want))
+    _description_checks(h)
     _plan_checks(h.get("plan"), "volume header")
     return cells
+
+
+INDEX_VALUE_SIZE = 4  # R5.12: index values are little-endian u32
+
+
+def _description_checks(h):
+    """R5.9 - R5.12: the header's "volume" description, checked against the
+    legacy keys, the cascades and raw_length. Everything it says is read
+    from the header, so a technique with other values passes as long as it is
+    consistent. Returns the description."""
+    d = h.get("volume")
+    check(isinstance(d, dict), "volume header has no \"volume\" description object (R5.9): %r" % (d,))
+    check(isinstance(d.get("layout_version"), int) and not isinstance(d.get("layout_version"), bool)
+          and d["layout_version"] >= 1, "volume.layout_version %r: expected an integer >= 1 (R5.9)"
+          % (d.get("layout_version"),))
+    check(isinstance(d.get("technique"), str) and d["technique"], "volume.technique %r: expected a name (R5.9)"
+          % (d.get("technique"),))
+    check(d.get("units") == h.get("units"), "volume.units %r differs from the header's units %r (R5.11)"
+          % (d.get("units"), h.get("units")))
+    check(isinstance(d.get("far_field"), bool), "volume.far_field %r: expected a boolean (R5.10)"
+          % (d.get("far_field"),))
+    levels, cs = d.get("levels"), h["cascades"]
+    check(isinstance(levels, list) and len(levels) == len(cs), "volume.levels %r: expected %d levels, one per "
+          "cascade (R5.10)" % (levels, len(cs)))
+    for k, (lv, c) in enumerate(zip(levels, cs)):
+        for key in ("dims", "origin", "cell_size", "cells"):
+            check(isinstance(lv, dict) and lv.get(key) == c.get(key), "volume.levels[%d].%s %r differs from "
+                  "cascades[%d].%s %r (R5.10)" % (k, key, lv.get(key) if isinstance(lv, dict) else lv, k, key,
+                                                  c.get(key)))
+        want = "far_field" if d["far_field"] and k > 0 else "cascade"
+        check(lv.get("role") == want, "volume.levels[%d].role %r with far_field %r, expected %r (R5.10)"
+              % (k, lv.get("role"), d["far_field"], want))
+    vpc, vpl = d.get("values_per_cell"), d.get("volumes_per_level")
+    for key, v in (("values_per_cell", vpc), ("volumes_per_level", vpl)):
+        check(isinstance(v, int) and not isinstance(v, bool) and v >= 1, "volume.%s %r: expected an integer "
+              ">= 1 (R5.11)" % (key, v))
+    vals = d.get("values")
+    check(isinstance(vals, list) and len(vals) == vpc, "volume.values has %s names, values_per_cell is %d (R5.11)"
+          % (len(vals) if isinstance(vals, list) else repr(vals), vpc))
+    check(all(isinstance(v, str) and v for v in vals) and len(set(vals)) == len(vals),
+          "volume.values %r: expected distinct non-empty names (R5.11)" % (vals,))
+    size = 2 if h["format"] == "fp16" else 4
+    cells = sum(c["cells"] for c in cs)
+    values_bytes = cells * vpl * vpc * size
+    index, index_bytes = d.get("index", None), 0
+    check("index" in d, "volume has no \"index\" key (null when there is none, R5.12)")
+    if index is not None:
+        check(isinstance(index, dict), "volume.index %r: expected null or an object (R5.12)" % (index,))
+        n = 1
+        for x in index.get("dims", []):
+            n *= x
+        index_bytes = n * index.get("values_per_cell", 0) * INDEX_VALUE_SIZE
+        check(index.get("raw_offset") == values_bytes, "volume.index.raw_offset %r, the levels' values end at %d "
+              "(R5.12)" % (index.get("raw_offset"), values_bytes))
+        check(index.get("raw_length") == index_bytes, "volume.index.raw_length %r, expected %d (R5.12)"
+              % (index.get("raw_length"), index_bytes))
+    check(h["raw_length"] == values_bytes + index_bytes, "raw_length %r, expected cells(%d, all levels) x %d "
+          "volume(s) x %d values x %d bytes%s = %d (R5.6, R5.11)" % (
+              h["raw_length"], cells, vpl, vpc, size, " + index %d" % index_bytes if index_bytes else "",
+              values_bytes + index_bytes))
+    return d
 
 
 def _cascades_checks(h):
@@ -1649,6 +1708,64 @@ def _plan_checks(plan, where, cascades=None):
     if cascades is not None:
         check(plan["cascades"] == cascades, "%s plan.cascades %r, the volume has %d cascades (R8.2)"
               % (where, plan["cascades"], cascades))
+
+
+@case("R5.9", "GET_VOLUME and VOLUME headers carry a versioned \"volume\" description naming the technique")
+def c_volume_description(ctx):
+    c, cfg, t = ctx.scene_session()
+    seen = []
+    for fmt in ("fp32", "fp16"):
+        f = expect_reply(c.request(GET_VOLUME, {"format": fmt, "compression": "none"}), GET_VOLUME)
+        _vol_header_checks(f.body, fmt, "none")
+        check(len(f.att) == f.body["raw_length"], "attachment %d bytes, raw_length %d" % (len(f.att),
+                                                                                        f.body["raw_length"]))
+        seen.append(f.body["volume"])
+    expect_reply(c.request(SUBSCRIBE, {"stream": "volume", "format": "fp32", "compression": "none"}), SUBSCRIBE)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v = c.recv_stream(VOLUME, timeout=ctx.tick_timeout)
+    _vol_header_checks(v.body, "fp32", "none")
+    # the description says what the cells are, not how they are sent
+    check(v.body["volume"] == seen[0] == seen[1], "the description differs between fp32, fp16 and the stream: %r"
+          % ([seen[0], seen[1], v.body["volume"]],))
+    d = seen[0]
+    return "layout %d, technique %s, %d values x %d volume(s) per cell" % (
+        d["layout_version"], d["technique"], d["values_per_cell"], d["volumes_per_level"])
+
+
+@case("R5.10", "the description's levels are the cascades (placement) with roles that agree with far_field")
+def c_volume_description_levels(ctx):
+    out = []
+    for ff in (False, True):
+        c, cfg, t = ctx.scene_session(config=dict(SMALL_CONFIG, far_field=ff))
+        f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+        _vol_header_checks(f.body, "fp32", "none")
+        d = f.body["volume"]
+        check(d["far_field"] == ff, "CONFIG far_field %r, the description says far_field %r" % (ff, d["far_field"]))
+        out.append("far_field %s: %s" % (ff, [lv["role"] for lv in d["levels"]]))
+        c.close()
+    return "; ".join(out)
+
+
+@case("R5.11 R5.1", "values per cell are named (values_per_cell names) and drive raw_length; the 12 SH values "
+      "agree with the legacy layout")
+def c_volume_description_values(ctx):
+    c, cfg, t = ctx.scene_session()
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    d = _description_checks(f.body)
+    vpc, vpl = d["values_per_cell"], d["volumes_per_level"]
+    cells = sum(cc["cells"] for cc in f.body["cascades"])
+    check(len(f.att) == cells * vpl * vpc * 4, "attachment %d bytes, the description gives %d cells x %d x %d x 4"
+          % (len(f.att), cells, vpl, vpc))
+    # R5.1's legacy keys describe 12 values per cell r0..r3 g0..g3 b0..b3 in
+    # one volume per level: a description of them must say the same count
+    # with one name per channel and coefficient, channel-major.
+    if "layout" in f.body:
+        check(vpc == 12 and vpl == 1, "legacy \"layout\" %r sent, but the description has %d values x %d volumes"
+              % (f.body["layout"], vpc, vpl))
+        chans = [v.split(".", 1)[0] for v in d["values"]]
+        check(chans == [chans[0]] * 4 + [chans[4]] * 4 + [chans[8]] * 4 and len(set(chans)) == 3,
+              "values %r are not 4 per channel, channel-major, as the layout %r" % (d["values"], f.body["layout"]))
+    return "%d values: %s" % (vpc, ", ".join(d["values"]))
 
 
 @case("R5.1", "GET_VOLUME fp32/none: sizes match the grid dims; values finite")

@@ -511,6 +511,15 @@ static size_t volume_cells(const lpvc_volume *v)
     return v->cascade_count > 0 ? v->total_cells : v->cells;
 }
 
+/* Floats of data: as the volume's description says (SPEC R5.11); 12 a cell
+ * for a volume without one. */
+static size_t volume_floats(const lpvc_volume *v)
+{
+    if (v->values_per_cell <= 0)
+        return volume_cells(v) * 12;
+    return volume_cells(v) * (size_t)v->values_per_cell * (size_t)(v->volumes_per_level > 0 ? v->volumes_per_level : 1);
+}
+
 /* Summary of a decoded volume as a JSON object (new reference): dims,
  * origin and cell_size of cascade 0, "cells" of all cascades (what save
  * writes), "cascades" each with its placement and flux; total_flux_W is
@@ -521,6 +530,9 @@ static json_t *volume_summary(const lpvc_volume *v)
     double flux[LPVC_MAX_CASCADES][3] = {{0}}, maxc0 = 0.0;
     size_t nonfinite = 0, negative_c0 = 0, total = volume_cells(v), first = 0;
     int kc = 0;
+    char why[256];
+    if (lpvc_volume_lookup_check(v, why, sizeof why) != 0)
+        total = 0; /* fluxes are SH c0 sums: not for a layout of other values */
     for (size_t i = 0; i < total; i++) {
         const float *c = v->data + 12 * i;
         while (kc + 1 < v->cascade_count && i >= first + v->cascades[kc].cells)
@@ -607,7 +619,7 @@ static int save_volume(const lpvc_volume *v, const char *path)
         if (rc)
             fprintf(stderr, "lpvctl: %s: cannot write %s\n", g_cmd, path);
     } else {
-        rc = write_file(path, v->data, volume_cells(v) * 12 * sizeof(float));
+        rc = write_file(path, v->data, volume_floats(v) * sizeof(float));
         if (rc == 0) {
             char side[4096];
             snprintf(side, sizeof side, "%s.json", path);

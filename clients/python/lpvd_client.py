@@ -86,6 +86,13 @@ SH_LOBE0 = 0.886226925452758    # sqrt(pi) / 2
 SH_LOBE1 = 1.0233267079464885   # sqrt(pi / 3)
 
 MAX_CASCADES = 4  # entries of a volume header's "cascades" (SPEC R5.6)
+# The description's layout version this client reads (SPEC R5.9); what a
+# volume carries is read from the description itself.
+VOLUME_LAYOUT_VERSION = 1
+# The values, in order, that this client's lookup (Cascade.irradiance: the
+# cosine lobe on SH bands 0-1 per channel) reads; a volume whose description
+# names other values is decoded but not looked up (SPEC R5.11).
+LOOKUP_VALUES = tuple("%s.%s" % (ch, y) for ch in "rgb" for y in ("Y00", "Y1-1", "Y10", "Y11"))
 # The passes of a plan (SPEC section 8, R8.1), in order.
 PLAN_PASSES = ("rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce", "glossy", "media")
 
@@ -115,6 +122,11 @@ class LpvdError(Exception):
 
 class ProtocolError(Exception):
     """The connection broke, or the server sent something the protocol forbids."""
+
+
+class LayoutError(ValueError):
+    """A lookup on a volume whose described layout (SPEC R5.11) it does not read;
+    the message names the layout."""
 
 
 def default_address():
@@ -185,23 +197,38 @@ def _floats(raw, fmt):
 
 
 class Cascade(object):
-    """One cascade of a volume (SPEC R5.6): ``dims``, ``origin`` (m, lower
-    corner), ``cell_size`` (m) and ``data``: ``cells * 12`` float32 values,
-    cell-major, x fastest (``index = x + nx * (y + ny * z)``), per cell
-    r0..r3 g0..g3 b0..b3 in radiant intensity W/sr; a numpy array of shape
-    (nz, ny, nx, 12) when numpy is available, else a flat ``array('f')``.
+    """One cascade (level) of a volume (SPEC R5.6, R5.10): ``dims``,
+    ``origin`` (m, lower corner), ``cell_size`` (m), ``values_per_cell`` and
+    ``volumes`` (the description's volumes_per_level; 1 and 12 for R5.1's
+    layout) and ``data``: ``volumes * cells * values_per_cell`` float32
+    values, cell-major, x fastest (``index = x + nx * (y + ny * z)``); for
+    R5.1's layout per cell r0..r3 g0..g3 b0..b3 in radiant intensity W/sr. A
+    numpy array of shape (nz, ny, nx, values_per_cell) (one volume) or
+    (volumes, nz, ny, nx, values_per_cell) when numpy is available, else a
+    flat ``array('f')``. ``role`` is "cascade" or "far_field".
     """
 
-    def __init__(self, dims, origin, cell_size, values):
+    def __init__(self, dims, origin, cell_size, values, values_per_cell=12, volumes=1, role="cascade",
+                 lookup_refusal=None):
         self.dims = tuple(int(v) for v in dims)
         self.origin = tuple(float(v) for v in origin)
         self.cell_size = float(cell_size)
+        self.values_per_cell = int(values_per_cell)
+        self.volumes = int(volumes)
+        self.role = role
+        self._lookup_refusal = lookup_refusal
         cells = self.dims[0] * self.dims[1] * self.dims[2]
-        if len(values) != cells * 12:
-            raise ProtocolError("cascade of %d values for %d cells" % (len(values), cells))
+        if len(values) != cells * self.values_per_cell * self.volumes:
+            raise ProtocolError("cascade of %d values for %d cells x %d volumes x %d values" % (
+                len(values), cells, self.volumes, self.values_per_cell))
         if _np is not None:
-            values = values.reshape(self.dims[2], self.dims[1], self.dims[0], 12)
+            shape = (self.dims[2], self.dims[1], self.dims[0], self.values_per_cell)
+            values = values.reshape(shape if self.volumes == 1 else (self.volumes,) + shape)
         self.data = values
+
+    def _check_lookup(self):
+        if self._lookup_refusal:
+            raise LayoutError(self._lookup_refusal)
 
     def contains(self, p):
         """Whether world point p lies inside this cascade's box."""
@@ -227,6 +254,7 @@ class Cascade(object):
 
     def cell(self, x, y, z):
         """The 12 coefficients of cell (x, y, z) as a list."""
+        self._check_lookup()
         if _np is not None:
             return [float(v) for v in self.data[z, y, x]]
         i = (x + self.dims[0] * (y + self.dims[1] * z)) * 12
@@ -234,6 +262,7 @@ class Cascade(object):
 
     def total_flux(self):
         """Sum over cells of c0 * sqrt(4 pi) per channel, in W."""
+        self._check_lookup()
         k = (4.0 * 3.141592653589793) ** 0.5
         if _np is not None:
             d = self.data.reshape(-1, 12)
@@ -285,7 +314,9 @@ class Cascade(object):
     def irradiance(self, p, n):
         """E(n) in W/m^2 (r, g, b) at surface point p with normal n from this
         cascade alone (propagation.md §6): sample half a cell in front of the
-        surface, E = max(0, c . lobe(-n)) / s^2."""
+        surface, E = max(0, c . lobe(-n)) / s^2. Raises LayoutError for a
+        volume whose values are not LOOKUP_VALUES in one volume per level."""
+        self._check_lookup()
         ln = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) ** 0.5
         if not (ln > 1e-8) or ln == float("inf") or any(v != v for v in n):
             return (0.0, 0.0, 0.0)
@@ -329,7 +360,28 @@ class Volume(Cascade):
             specs = [dict(grid, cells=None)]
         if not isinstance(specs, list) or not 1 <= len(specs) <= MAX_CASCADES:
             raise ProtocolError("cascades: expected 1 to %d entries" % MAX_CASCADES)
-        values = _floats(raw, self.format)
+        self.description = self._describe(header, specs)
+        desc = self.description
+        vpc, vpl = desc["values_per_cell"], desc["volumes_per_level"]
+        self.values_per_cell, self.volumes_per_level = vpc, vpl
+        self.technique, self.far_field = desc["technique"], desc["far_field"]
+        refusal = None
+        if vpl != 1 or desc["index"] is not None or (
+                desc["values"] is not None and tuple(desc["values"]) != LOOKUP_VALUES):
+            refusal = ("volume layout of technique %r (layout_version %d, %d values per cell %s, %d volumes per "
+                       "level%s) is not the 12 SH values %s in one volume per level, the only layout this "
+                       "client's lookup reads (SPEC R5.7, R5.11)" % (
+                           desc["technique"], desc["layout_version"], vpc, desc["values"], vpl,
+                           ", with an index volume" if desc["index"] is not None else "", list(LOOKUP_VALUES)))
+        self.lookup_refusal = refusal
+        size = 2 if self.format == "fp16" else 4
+        index = desc["index"]
+        values_end = int(index["raw_offset"]) if index is not None else len(raw)
+        values = _floats(raw[:values_end], self.format)
+        self.index = None
+        if index is not None:  # R5.12: little-endian u32 after the levels' values
+            ib = raw[values_end:values_end + int(index["raw_length"])]
+            self.index = array.array("I", struct.unpack("<%dI" % (len(ib) // 4), ib))
         self.cascades = []
         first = 0
         for k, c in enumerate(specs):
@@ -342,25 +394,65 @@ class Volume(Cascade):
             cs = float(c.get("cell_size", 0.0))
             if not cs > 0.0:
                 raise ProtocolError("cascades[%d].cell_size: expected a positive number" % k)
-            if first + cells * 12 > len(values):
+            n = cells * vpc * vpl
+            if first + n > len(values):
                 raise ProtocolError("volume of %d values, the cascades need more" % len(values))
-            self.cascades.append(Cascade(dims, c.get("origin", (0.0, 0.0, 0.0)), cs,
-                                         values[first:first + cells * 12]))
-            first += cells * 12
+            self.cascades.append(Cascade(dims, c.get("origin", (0.0, 0.0, 0.0)), cs, values[first:first + n],
+                                         vpc, vpl, desc["levels"][k].get("role", "cascade"), refusal))
+            first += n
         if first != len(values):
-            raise ProtocolError("volume of %d values for %d cells" % (len(values), first // 12))
+            raise ProtocolError("volume of %d values (%d bytes of %s) for %d values as described" % (
+                len(values), len(values) * size, self.format, first))
         c0 = self.cascades[0]
         if grid and (tuple(int(v) for v in grid.get("dims", ())) != c0.dims
                      or abs(float(grid.get("cell_size", 0.0)) - c0.cell_size) > 1e-9 * c0.cell_size):
             raise ProtocolError("grid: differs from cascades[0]")
         self.dims, self.origin, self.cell_size, self.data = c0.dims, c0.origin, c0.cell_size, c0.data
+        self._lookup_refusal = refusal
 
+    @staticmethod
+    def _describe(header, specs):
+        """The header's description (SPEC R5.9 - R5.12), checked; or, from a
+        server without one, R5.1's layout from the legacy keys (layout_version
+        0, values None: named by the "layout" string)."""
+        d = header.get("volume")
+        if d is None:
+            return {"layout_version": 0, "technique": "", "far_field": False, "volumes_per_level": 1,
+                    "values_per_cell": 12, "values": None, "units": header.get("units"), "index": None,
+                    "levels": [dict(c, role="cascade") for c in specs]}
+        if not isinstance(d, dict):
+            raise ProtocolError("volume: expected an object")
+        if d.get("layout_version") != VOLUME_LAYOUT_VERSION:
+            raise ProtocolError("volume.layout_version: %r is not a layout this client reads (it reads %d)" % (
+                d.get("layout_version"), VOLUME_LAYOUT_VERSION))
+        vpc, vpl = d.get("values_per_cell"), d.get("volumes_per_level")
+        if not isinstance(vpc, int) or vpc < 1:
+            raise ProtocolError("volume.values_per_cell: expected an integer >= 1, got %r" % (vpc,))
+        if not isinstance(vpl, int) or vpl < 1:
+            raise ProtocolError("volume.volumes_per_level: expected an integer >= 1, got %r" % (vpl,))
+        vals = d.get("values")
+        if not isinstance(vals, list) or len(vals) != vpc or len(set(vals)) != vpc:
+            raise ProtocolError("volume.values: expected %d distinct names (values_per_cell), got %r" % (vpc, vals))
+        levels = d.get("levels")
+        if not isinstance(levels, list) or len(levels) != len(specs):
+            raise ProtocolError("volume.levels: expected %d levels (one per cascade)" % len(specs))
+        for k, (lv, c) in enumerate(zip(levels, specs)):
+            if any(lv.get(key) != c.get(key) for key in ("dims", "origin", "cell_size", "cells")):
+                raise ProtocolError("volume.levels[%d]: differs from cascades[%d]" % (k, k))
+        if d.get("index") is not None:
+            ix = d["index"]
+            if not isinstance(ix, dict) or not isinstance(ix.get("raw_offset"), int) \
+                    or not isinstance(ix.get("raw_length"), int):
+                raise ProtocolError("volume.index: expected null or an object with raw_offset and raw_length")
+        return d
     def irradiance(self, p, n):
         """E(n) in W/m^2 (r, g, b) at surface point p with normal n, computed
         locally as the server's QUERY_IRRADIANCE (SPEC R5.7): the finest
         cascade containing p, blended towards the next coarser one within the
         last 3 cells of its border, w = clamp((d - 1) / 2, 0, 1); each
-        cascade's lookup as propagation.md §6."""
+        cascade's lookup as propagation.md §6. Raises LayoutError (naming
+        the layout) for a volume this lookup does not read."""
+        self._check_lookup()
         cs = self.cascades
         k = next((i for i, c in enumerate(cs) if c.contains(p)), len(cs) - 1)
         fine = Cascade.irradiance(cs[k], p, n)
@@ -875,6 +967,12 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
         % (list(vol.dims), vol.cell_size, vol.tick, ["%.4g" % v for v in flux]))
     say("GET_VOLUME cascades -> %s" % ", ".join("%s cells of %.4g m at %s" % (
         "x".join(str(d) for d in cc.dims), cc.cell_size, ["%.4g" % v for v in cc.origin]) for cc in vol.cascades))
+    d = vol.description
+    say("GET_VOLUME description -> layout %s, technique %s, %d values per cell %s, %d volume(s) per level, "
+        "far field %s, roles %s" % (d["layout_version"], d["technique"], d["values_per_cell"], d["values"],
+                                    d["volumes_per_level"], d["far_field"], [lv["role"] for lv in d["levels"]]))
+    if vol.lookup_refusal is not None:
+        raise AssertionError("the daemon's volume is not the lookup's layout: %s" % vol.lookup_refusal)
     if vol.cells <= 0:
         raise AssertionError("empty volume")
     if not all(v == v and v >= 0 for v in flux):
