@@ -6,7 +6,7 @@
  * QUERY_IRRADIANCE) or a worker (SCENE_LOAD, SCENE_UPDATE of nodes) mark the
  * session busy; its next request waits until the reply has been queued.
  */
-#include "serve.h"
+#include "serve_session_internal.h"
 #include "scene_defaults.h"
 
 #include <errno.h>
@@ -28,16 +28,12 @@
 
 #define SV_MAX_LIGHTS 256
 #define SV_MAX_VIEW_SIDE 4096
-#define SV_DEFAULT_VIEW_SIDE 256
 
 /* The names of formats, compressions, terms and streams are the protocol
  * library's (volume_codec.h), indexed by its enums. */
 
-/* ERROR reply; closes the connection when the code does (R3.4), unless
- * noclose (HELLO's BAD_VERSION, R4.1). */
-static void reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
-    __attribute__((format(printf, 5, 6)));
-static void reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
+/* ---- replies ------------------------------------------------------------ */
+void sv_reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
 {
     char msg[1024];
     va_list ap;
@@ -49,12 +45,12 @@ static void reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const cha
         sv_conn_close_after_write(c);
 }
 
-static void reply(sv_conn *c, uint16_t type, uint32_t rid, json_t *body)
+void sv_reply(sv_conn *c, uint16_t type, uint32_t rid, json_t *body)
 {
     sv_send(c, LPVP_REPLY(type), rid, body ? body : json_object(), NULL, 0, SV_STREAM_NONE);
 }
 
-static json_t *rev_body(sv_conn *c)
+json_t *sv_rev_body(sv_conn *c)
 {
     return json_pack("{s:I}", "revision", (json_int_t)c->revision);
 }
@@ -85,8 +81,7 @@ static void default_view(sv_conn *c)
         lpv_view_frame_bounds(sc, w, h, &c->view);
 }
 
-/* The scene's lights with clean names (their ids). NULL when it has none. */
-static lpv_light *named_lights(const lpv_scene *sc, int *fail)
+lpv_light *sv_named_lights(const lpv_scene *sc, int *fail)
 {
     *fail = 0;
     if (!sc->light_count)
@@ -107,9 +102,7 @@ static lpv_light *named_lights(const lpv_scene *sc, int *fail)
     return l;
 }
 
-/* Takes the scene (a reference) as the session's, with its materials and
- * lights; resets the camera unless an explicit one was set. */
-static int session_set_scene(sv_conn *c, sv_scene *sc)
+int sv_session_set_scene(sv_conn *c, sv_scene *sc)
 {
     lpv_material *m = NULL;
     lpv_light *l = NULL;
@@ -120,7 +113,7 @@ static int session_set_scene(sv_conn *c, sv_scene *sc)
         memcpy(m, sc->scene.materials, sizeof *m * sc->scene.material_count);
     }
     int lfail = 0;
-    l = named_lights(&sc->scene, &lfail);
+    l = sv_named_lights(&sc->scene, &lfail);
     if (lfail) {
         free(m);
         return -1;
@@ -142,7 +135,7 @@ static int session_set_scene(sv_conn *c, sv_scene *sc)
     return 0;
 }
 
-static void session_changed(sv_conn *c)
+void sv_session_changed(sv_conn *c)
 {
     c->revision++;
     sv_inputs *in = sv_inputs_build(c);
@@ -158,7 +151,7 @@ void sv_session_init(sv_conn *c)
     c->tick_rate = s->cfg.tick_rate;
     c->subs[0].fp16 = 1;
     s->builtin->refs++;
-    if (session_set_scene(c, s->builtin) != 0) {
+    if (sv_session_set_scene(c, s->builtin) != 0) {
         sv_conn_close(c);
         return;
     }
@@ -190,7 +183,7 @@ static json_t *tick_stats(const sv_result *r)
                                 r->tick_ms);
 }
 
-static json_t *config_json(sv_conn *c)
+json_t *sv_config_json(sv_conn *c)
 {
     lpv_settings s = c->settings;
     lpv_settings_resolve(&s);
@@ -248,36 +241,36 @@ static int token_equal(const char *a, size_t alen, const char *b, size_t blen)
     return diff == 0;
 }
 
-static void do_hello(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
 {
     sv_server *s = c->srv;
     char err[256];
     int64_t v = 0;
     if (lpvp_get_int(j, "version", 1, INT32_MIN, INT32_MAX, &v, err, sizeof err) != LPVP_FIELD_OK) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     if (v != LPVP_VERSION) {
-        reply_err(c, r->request_id, LPVP_E_BAD_VERSION, 1, "HELLO version %lld is not spoken; this server speaks 1",
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_VERSION, 1, "HELLO version %lld is not spoken; this server speaks 1",
                   (long long)v);
         return;
     }
     const char *client = NULL, *token = NULL;
     size_t tlen = 0;
     if (lpvp_get_string(j, "client", 0, 256, &client, NULL, err, sizeof err) == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     int tst = lpvp_get_string(j, "token", 0, 4096, &token, &tlen, err, sizeof err);
     if (s->cfg.has_token) {
         if (tst != LPVP_FIELD_OK ||
             !token_equal(token, tlen, s->cfg.token, strlen(s->cfg.token))) {
-            reply_err(c, r->request_id, LPVP_E_UNAUTHORIZED, 0, "%s",
+            sv_reply_err(c, r->request_id, LPVP_E_UNAUTHORIZED, 0, "%s",
                       tst == LPVP_FIELD_OK ? "wrong token" : "this server requires a token in HELLO (\"token\")");
             return;
         }
     } else if (tst == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     c->hello = 1;
@@ -297,7 +290,7 @@ static void do_hello(sv_conn *c, sv_request *r, json_t *j)
         json_decref(b);
         b = NULL;
     }
-    reply(c, LPVP_HELLO, r->request_id, b);
+    sv_reply(c, LPVP_HELLO, r->request_id, b);
 }
 
 /* ---- SCENE_LOAD / SCENE_UPDATE (worker thread) --------------------------- */
@@ -458,13 +451,13 @@ static void load_done(uv_work_t *req, int status)
         char err[1024];
         if (w->status == LPVP_E_SCENE_INVALID && w->type == LPVP_SCENE_UPDATE) {
             /* the file loaded before: the new node transforms are at fault */
-            reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "nodes: %s", w->err);
+            sv_reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "nodes: %s", w->err);
         } else if (w->status) {
-            reply_err(c, w->request_id, w->status, 0, "%s", w->err);
+            sv_reply_err(c, w->request_id, w->status, 0, "%s", w->err);
         } else if (scene_over_limits(s, &w->scene->scene, err, sizeof err)) {
             free_sv_scene_unlisted(w->scene);
             w->scene = NULL;
-            reply_err(c, w->request_id, LPVP_E_LIMIT, 0, "%s", err);
+            sv_reply_err(c, w->request_id, LPVP_E_LIMIT, 0, "%s", err);
         } else {
             sv_scene *sc = sv_scene_intern(s, w->scene);
             w->scene = NULL;
@@ -474,7 +467,7 @@ static void load_done(uv_work_t *req, int status)
             uint32_t keep_mn = 0, keep_ln = 0, old_n = 0;
             int ofail = 0;
             if (w->type == LPVP_SCENE_UPDATE) {
-                old_file = named_lights(&c->scene->scene, &ofail);
+                old_file = sv_named_lights(&c->scene->scene, &ofail);
                 old_n = c->scene->scene.light_count;
                 keep_m = c->materials;
                 keep_mn = c->material_count;
@@ -483,13 +476,13 @@ static void load_done(uv_work_t *req, int status)
                 c->materials = NULL;
                 c->lights = NULL;
             }
-            if (session_set_scene(c, sc) != 0) {
+            if (sv_session_set_scene(c, sc) != 0) {
                 sv_scene_unref(s, sc);
                 if (w->type == LPVP_SCENE_UPDATE) { /* the session keeps what it had */
                     c->materials = keep_m;
                     c->lights = keep_l;
                 }
-                reply_err(c, w->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+                sv_reply_err(c, w->request_id, LPVP_E_INTERNAL, 0, "out of memory");
             } else {
                 if (w->type == LPVP_SCENE_UPDATE) {
                     if (keep_mn == c->material_count) {
@@ -514,8 +507,8 @@ static void load_done(uv_work_t *req, int status)
                     free(keep_m);
                     free(keep_l);
                 }
-                session_changed(c);
-                json_t *b = rev_body(c);
+                sv_session_changed(c);
+                json_t *b = sv_rev_body(c);
                 if (w->type == LPVP_SCENE_LOAD) {
                     json_t *sj = scene_json(&sc->scene), *wa = json_array();
                     for (int i = 0; wa && i < w->warnings.count; ++i)
@@ -526,7 +519,7 @@ static void load_done(uv_work_t *req, int status)
                         json_decref(wa);
                     json_object_set_new(b, "scene", sj);
                 }
-                reply(c, w->type, w->request_id, b);
+                sv_reply(c, w->type, w->request_id, b);
             }
             free(old_file);
         }
@@ -603,18 +596,18 @@ static int resolve_scene_path(sv_server *s, const char *p, char **out, char *err
     return 0;
 }
 
-static void do_scene_load(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[1024];
     const char *path = NULL;
     int pst = lpvp_get_string(j, "path", 0, 4096, &path, NULL, err, sizeof err);
     if (pst == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     load_work *w = calloc(1, sizeof *w);
     if (!w) {
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
         return;
     }
     w->request_id = r->request_id;
@@ -622,20 +615,20 @@ static void do_scene_load(sv_conn *c, sv_request *r, json_t *j)
     if (pst == LPVP_FIELD_OK) {
         if (r->att_len) {
             free(w);
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
                       "path: give either \"path\" or a .glb attachment, not both");
             return;
         }
         int rc = resolve_scene_path(c->srv, path, &w->path, err, sizeof err);
         if (rc != 0) {
             free(w);
-            reply_err(c, r->request_id, rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
+            sv_reply_err(c, r->request_id, rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
             return;
         }
     } else {
         if (!r->att_len) {
             free(w);
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
                       "path: required (a path under --scene-root), or send the .glb as the attachment");
             return;
         }
@@ -648,17 +641,17 @@ static void do_scene_load(sv_conn *c, sv_request *r, json_t *j)
         free(w->path);
         free(w->glb);
         free(w);
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene load");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene load");
     }
 }
 
-static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     const json_t *nodes = NULL, *mats = NULL;
     if (lpvp_get_array(j, "nodes", 0, 65536, &nodes, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_array(j, "materials", 0, 65536, &mats, err, sizeof err) == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     /* materials: validated into a copy, applied only if all are good */
@@ -666,7 +659,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
     if (mats && json_array_size(mats)) {
         m = malloc(sizeof *m * (c->material_count ? c->material_count : 1));
         if (!m) {
-            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
             return;
         }
         if (c->material_count)
@@ -696,7 +689,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
                 if (strncmp(err, "materials[", 10) != 0)
                     lpvp_err_prefix(err, sizeof err, "materials[%zu].", i);
                 free(m);
-                reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+                sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
                 return;
             }
         }
@@ -707,7 +700,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
     if (nodes && json_array_size(nodes)) {
         if (!c->scene->glb) {
             free(m);
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
                       "nodes: the built-in scene has no glTF nodes; SCENE_LOAD a .glb first");
             return;
         }
@@ -715,7 +708,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
         ov = calloc(nov, sizeof *ov);
         if (!ov) {
             free(m);
-            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
             return;
         }
         for (size_t i = 0; i < nov; ++i) {
@@ -753,7 +746,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
         bad_node:
             free(ov);
             free(m);
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
             return;
         }
     }
@@ -762,8 +755,8 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
             free(c->materials);
             c->materials = m;
         }
-        session_changed(c);
-        reply(c, LPVP_SCENE_UPDATE, r->request_id, rev_body(c));
+        sv_session_changed(c);
+        sv_reply(c, LPVP_SCENE_UPDATE, r->request_id, sv_rev_body(c));
         return;
     }
     load_work *w = calloc(1, sizeof *w);
@@ -775,7 +768,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
         free(bd);
         free(ov);
         free(m);
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
         return;
     }
     memcpy(glb, c->scene->glb, c->scene->glb_size);
@@ -799,7 +792,7 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
             free(w->base_dir);
             free(w->nodes);
             free(w);
-            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
             return;
         }
         memcpy(all, c->scene->nodes, sizeof *all * c->scene->node_count);
@@ -813,12 +806,12 @@ static void do_scene_update(sv_conn *c, sv_request *r, json_t *j)
         free(w->base_dir);
         free(w->nodes);
         free(w);
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene rebuild");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene rebuild");
     }
 }
 
 /* ---- lights, camera, config ---------------------------------------------- */
-static void do_light_set(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j)
 {
     static const char *const TYPES[] = {"directional", "point", "spot"}; /* = lpv_light_type */
     char err[512];
@@ -839,23 +832,23 @@ static void do_light_set(sv_conn *c, sv_request *r, json_t *j)
         lpvp_get_float(j, "range", 0, 0.0, 1e30, &l.range, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_float(j, "inner_cone", 0, 0.0, M_PI / 2.0, &l.inner_cone, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_float(j, "outer_cone", 0, 0.0, M_PI / 2.0, &l.outer_cone, err, sizeof err) == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     if (idlen == 0) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: must not be empty");
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: must not be empty");
         return;
     }
     float dl = sqrtf(l.direction[0] * l.direction[0] + l.direction[1] * l.direction[1] +
                      l.direction[2] * l.direction[2]);
     if (!(dl > 1e-12f) || !isfinite(dl)) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "direction: must be a non-zero vector");
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "direction: must be a non-zero vector");
         return;
     }
     for (int i = 0; i < 3; ++i)
         l.direction[i] /= dl;
     if (type == LPV_LIGHT_SPOT && l.inner_cone > l.outer_cone) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "inner_cone: must not exceed outer_cone");
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "inner_cone: must not exceed outer_cone");
         return;
     }
     if (type != LPV_LIGHT_SPOT)
@@ -867,50 +860,50 @@ static void do_light_set(sv_conn *c, sv_request *r, json_t *j)
         ++i;
     if (i == c->light_count) {
         if (c->light_count >= SV_MAX_LIGHTS) {
-            reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "a session has at most %d lights", SV_MAX_LIGHTS);
+            sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "a session has at most %d lights", SV_MAX_LIGHTS);
             return;
         }
         lpv_light *nl = realloc(c->lights, sizeof *nl * (c->light_count + 1));
         if (!nl) {
-            reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
             return;
         }
         c->lights = nl;
         c->light_count++;
     }
     c->lights[i] = l;
-    session_changed(c);
-    reply(c, LPVP_LIGHT_SET, r->request_id, rev_body(c));
+    sv_session_changed(c);
+    sv_reply(c, LPVP_LIGHT_SET, r->request_id, sv_rev_body(c));
 }
 
-static void do_light_remove(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_light_remove(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     const char *id = NULL;
     if (lpvp_get_string(j, "id", 1, 4096, &id, NULL, err, sizeof err) != LPVP_FIELD_OK) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     uint32_t i = 0;
     while (i < c->light_count && strcmp(c->lights[i].name, id) != 0)
         ++i;
     if (i == c->light_count) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: no light \"%s\" in this session", id);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: no light \"%s\" in this session", id);
         return;
     }
     memmove(&c->lights[i], &c->lights[i + 1], sizeof *c->lights * (c->light_count - i - 1));
     c->light_count--;
-    session_changed(c);
-    reply(c, LPVP_LIGHT_REMOVE, r->request_id, rev_body(c));
+    sv_session_changed(c);
+    sv_reply(c, LPVP_LIGHT_REMOVE, r->request_id, sv_rev_body(c));
 }
 
-static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_camera_set(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int64_t w = c->view_w ? c->view_w : SV_DEFAULT_VIEW_SIDE, h = c->view_h ? c->view_h : SV_DEFAULT_VIEW_SIDE;
     if (lpvp_get_int(j, "width", 0, 1, SV_MAX_VIEW_SIDE, &w, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_int(j, "height", 0, 1, SV_MAX_VIEW_SIDE, &h, err, sizeof err) == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     const json_t *cam = json_object_get(j, "camera");
@@ -923,12 +916,12 @@ static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
         else if (json_is_string(cam))
             snprintf(key, sizeof key, "%s", json_string_value(cam));
         else {
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: expected an index or a name");
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: expected an index or a name");
             return;
         }
         int idx = lpv_view_find_camera(sc, key);
         if (idx < 0) {
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: the scene has %u camera(s) and none is \"%s\"",
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: the scene has %u camera(s) and none is \"%s\"",
                       sc->camera_count, key);
             return;
         }
@@ -942,11 +935,11 @@ static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
             lpvp_get_floats(j, "target", 1, 3, -1e30, 1e30, target, err, sizeof err) != LPVP_FIELD_OK ||
             (has_up = lpvp_get_floats(j, "up", 0, 3, -1e30, 1e30, up, err, sizeof err)) == LPVP_FIELD_BAD ||
             lpvp_get_float(j, "fov_deg", 0, 0.01, 179.0, &fov, err, sizeof err) == LPVP_FIELD_BAD) {
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
             return;
         }
         if (lpv_view_look_at(eye, target, fov * (float)(M_PI / 180.0), (int)w, (int)h, &v) != 0) {
-            reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "target: must differ from eye");
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "target: must differ from eye");
             return;
         }
         if (has_up == LPVP_FIELD_OK) { /* up, made orthogonal to forward */
@@ -954,7 +947,7 @@ static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
             float u[3] = {up[0] - d * v.forward[0], up[1] - d * v.forward[1], up[2] - d * v.forward[2]};
             float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
             if (!(ul > 1e-6f) || !isfinite(ul)) {
-                reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "up: must not be parallel to target - eye");
+                sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "up: must not be parallel to target - eye");
                 return;
             }
             for (int i = 0; i < 3; ++i)
@@ -966,8 +959,8 @@ static void do_camera_set(sv_conn *c, sv_request *r, json_t *j)
     c->view_w = (int)w;
     c->view_h = (int)h;
     c->view = v;
-    session_changed(c);
-    reply(c, LPVP_CAMERA_SET, r->request_id, rev_body(c));
+    sv_session_changed(c);
+    sv_reply(c, LPVP_CAMERA_SET, r->request_id, sv_rev_body(c));
 }
 
 
@@ -990,7 +983,7 @@ static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_setting
     lpv_preset_settings((lpv_preset)(LPV_PRESET_DEFAULT + 1 + idx), &p);
     const sv_server *s = c->srv;
     if (p.grid_dims[0] > s->cfg.max_grid || p.rsm_size > s->cfg.max_texture) {
-        reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
                   "preset: %s (grid %d, rsm_size %d) is over the server's limits (--max-grid %d, --max-texture %d)",
                   names[idx], p.grid_dims[0], p.rsm_size, s->cfg.max_grid, s->cfg.max_texture);
         return -2;
@@ -1033,7 +1026,7 @@ static int config_fields(const json_t *j, lpv_settings *st, char *err, size_t n)
     return 0;
 }
 
-static void do_config(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
 {
     sv_server *s = c->srv;
     char err[512];
@@ -1060,7 +1053,7 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
     if (gst == LPVP_FIELD_OK) {
         for (int i = 0; i < 3; ++i)
             if (grid[i] > s->cfg.max_grid) {
-                reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
                           "grid: %lld cells on an axis is over the server's limit of %d (--max-grid)",
                           (long long)grid[i], s->cfg.max_grid);
                 return;
@@ -1083,13 +1076,13 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
     if (config_fields(j, &st, err, sizeof err) != 0) /* iterations, rsm_size, occlusion, ..., planner */
         goto bad;
     if (json_object_get(j, "rsm_size") && st.rsm_size > s->cfg.max_texture) {
-        reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
                   "rsm_size: %d is over the server's texture limit of %d (--max-texture)", st.rsm_size,
                   s->cfg.max_texture);
         return;
     }
     if (json_object_get(j, "shadow_size") && st.shadow_size > s->cfg.max_texture) {
-        reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
                   "shadow_size: %d is over the server's texture limit of %d (--max-texture)", st.shadow_size,
                   s->cfg.max_texture);
         return;
@@ -1099,7 +1092,7 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
         goto bad;
     if (ist == LPVP_FIELD_OK) {
         if (rv > lim_rate) {
-            reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+            sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
                       "tick_rate_hz: %g is over the server's limit of %g Hz (--max-tick-rate)", rv, lim_rate);
             return;
         }
@@ -1111,13 +1104,13 @@ static void do_config(sv_conn *c, sv_request *r, json_t *j)
         goto bad;
     c->settings = st;
     c->tick_rate = rate;
-    session_changed(c);
-    json_t *b = rev_body(c);
-    json_object_set_new(b, "config", config_json(c));
-    reply(c, LPVP_CONFIG, r->request_id, b);
+    sv_session_changed(c);
+    json_t *b = sv_rev_body(c);
+    json_object_set_new(b, "config", sv_config_json(c));
+    sv_reply(c, LPVP_CONFIG, r->request_id, b);
     return;
 bad:
-    reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+    sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
 }
 
 /* ---- ticks, volumes, frames, queries -------------------------------------- */
@@ -1134,7 +1127,7 @@ static void submit(sv_conn *c, sv_job *j)
     sv_job_submit(c->srv, j);
 }
 
-static void do_tick(sv_conn *c, sv_request *r)
+void sv_do_tick(sv_conn *c, sv_request *r)
 {
     if (c->world && sv_world_join_tick(c->world, c, r->request_id)) { /* shared with a queued tick (R7.2) */
         c->busy = 1;
@@ -1142,7 +1135,7 @@ static void do_tick(sv_conn *c, sv_request *r)
     }
     sv_job *j = c->world ? sv_job_new(SV_JOB_TICK, c->world) : NULL;
     if (!j) {
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
         return;
     }
     j->request_id = r->request_id;
@@ -1153,7 +1146,7 @@ static void do_tick(sv_conn *c, sv_request *r)
 
 /* GET_FRAME's and SUBSCRIBE frame's "exposure" ("auto" or an EV number) and
  * "transparent" (SPEC R6.4). Returns LPVP_FIELD_BAD with err on a bad value. */
-static int get_display(const json_t *j, lpv_display *d, char *err, size_t n)
+int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n)
 {
     lpv_display_default(d);
     const json_t *e = json_object_get(j, "exposure");
@@ -1172,7 +1165,7 @@ static int get_display(const json_t *j, lpv_display *d, char *err, size_t n)
                                                                                          : LPVP_FIELD_OK;
 }
 
-static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
+void sv_do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
 {
     char err[512];
     int stream = 0, fmt = -1, comp = -1, delta = 0, terms = 0;
@@ -1184,7 +1177,7 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
     if (!on) {
         sub->on = 0;
         sv_sub_clear(sub);
-        reply(c, LPVP_UNSUBSCRIBE, r->request_id, json_object());
+        sv_reply(c, LPVP_UNSUBSCRIBE, r->request_id, json_object());
         return;
     }
     if (lpvp_get_enum(j, "format", 0, stream ? lpvp_frame_format_names : lpvp_volume_format_names,
@@ -1193,7 +1186,7 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
         lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_bool(j, "delta", 0, &delta, err, sizeof err) == LPVP_FIELD_BAD ||
         (stream && lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD) ||
-        (stream && get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD))
+        (stream && sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD))
         goto bad;
     if (stream && delta) {
         snprintf(err, sizeof err, "delta: only the volume stream has deltas");
@@ -1211,23 +1204,23 @@ static void do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
         sub->terms = terms;
         sub->display = display;
     }
-    reply(c, LPVP_SUBSCRIBE, r->request_id, json_object());
+    sv_reply(c, LPVP_SUBSCRIBE, r->request_id, json_object());
     return;
 bad:
-    reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+    sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
 }
 
-static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int fmt = LPVP_FMT_FP16, comp = LPVP_COMP_ZSTD;
     if (lpvp_get_enum(j, "format", 0, lpvp_volume_format_names, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     if (!world_current(c)) {
-        reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
                   "no volume yet for this session's current scene, lights, camera and config: send TICK first");
         return;
     }
@@ -1236,7 +1229,7 @@ static void do_get_volume(sv_conn *c, sv_request *r, json_t *j)
     size_t alen = 0;
     if (sv_encode_volume(c->world->latest, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD, NULL, c->revision, &b, &att, &alen, err,
                          sizeof err) != 0) {
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
         return;
     }
     sv_send(c, LPVP_REPLY(LPVP_GET_VOLUME), r->request_id, b, att, alen, SV_STREAM_NONE);
@@ -1254,13 +1247,13 @@ static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w,
     size_t alen = 0;
     if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, display, c->revision, tick, plan, &b, &att, &alen, err,
                         sizeof err) != 0) {
-        reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
+        sv_reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
         return;
     }
     sv_send(c, LPVP_REPLY(LPVP_GET_FRAME), rid, b, att, alen, SV_STREAM_NONE);
 }
 
-static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int fmt = LPVP_FRAME_PNG, comp = LPVP_COMP_NONE, terms = LPVP_TERMS_FULL;
@@ -1268,12 +1261,12 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     if (lpvp_get_enum(j, "format", 0, lpvp_frame_format_names, LPVP_FRAME_FORMAT_COUNT, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD ||
-        get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     if (!world_current(c)) {
-        reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
                   "no tick yet for this session's current scene, lights, camera and config: send TICK first");
         return;
     }
@@ -1285,7 +1278,7 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     }
     sv_job *jb = sv_job_new(SV_JOB_RENDER, c->world);
     if (!jb) {
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
         return;
     }
     jb->request_id = r->request_id;
@@ -1295,23 +1288,23 @@ static void do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     submit(c, jb);
 }
 
-static void do_query(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_query(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int64_t count = 0;
     if (lpvp_get_int(j, "count", 1, 0, (int64_t)(c->srv->cfg.max_message / 24), &count, err, sizeof err) !=
         LPVP_FIELD_OK) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
     if (r->att_len != (size_t)count * 24) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
                   "attachment: expected count x 24 = %lld bytes (px py pz nx ny nz float32 per point), got %zu",
                   (long long)count * 24, r->att_len);
         return;
     }
     if (!world_current(c)) {
-        reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+        sv_reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
                   "no tick yet for this session's current scene, lights, camera and config: send TICK first");
         return;
     }
@@ -1320,7 +1313,7 @@ static void do_query(sv_conn *c, sv_request *r, json_t *j)
     if (!jb || !pts) {
         free(pts);
         sv_job_free(jb);
-        reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
         return;
     }
     for (int64_t i = 0; i < count * 6; ++i) { /* little-endian float32 */
@@ -1335,7 +1328,7 @@ static void do_query(sv_conn *c, sv_request *r, json_t *j)
     submit(c, jb);
 }
 
-static void do_stats(sv_conn *c, sv_request *r)
+void sv_do_stats(sv_conn *c, sv_request *r)
 {
     sv_server *s = c->srv;
     json_t *stages = json_array(), *plan = json_object();
@@ -1356,7 +1349,7 @@ static void do_stats(sv_conn *c, sv_request *r)
     }
     json_object_set_new(plan, "backend", json_string(s->gl_backend));
     json_object_set_new(plan, "gl_renderer", json_string(s->gl_renderer));
-    json_object_set_new(plan, "config", config_json(c));
+    json_object_set_new(plan, "config", sv_config_json(c));
     size_t pend = 0, wq = 0, drops = 0;
     int sessions = 0;
     for (sv_conn *o = s->conns; o; o = o->next) {
@@ -1384,17 +1377,17 @@ static void do_stats(sv_conn *c, sv_request *r)
     json_object_set_new(b, "world_ticks_computed", json_integer((json_int_t)(c->world ? c->world->ticks_computed : 0)));
     json_object_set_new(b, "world_ticks_coalesced",
                         json_integer((json_int_t)(c->world ? c->world->ticks_coalesced : 0)));
-    reply(c, LPVP_STATS, r->request_id, b);
+    sv_reply(c, LPVP_STATS, r->request_id, b);
 }
 
-static void do_ack(sv_conn *c, sv_request *r, json_t *j)
+void sv_do_ack(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int stream = 0;
     int64_t tick = 0;
     if (lpvp_get_enum(j, "stream", 1, lpvp_stream_names, 1, &stream, err, sizeof err) != LPVP_FIELD_OK ||
         lpvp_get_int(j, "tick", 1, 0, INT64_MAX, &tick, err, sizeof err) != LPVP_FIELD_OK) {
-        reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err); /* ACK has no reply, but a bad one is an error */
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err); /* ACK has no reply, but a bad one is an error */
         return;
     }
     sv_sub_ack(&c->subs[SV_STREAM_VOLUME], (uint64_t)tick);
@@ -1407,19 +1400,19 @@ void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
     if (c->closing || c->close_after_write)
         return;
     if (j->status) {
-        reply_err(c, request_id, j->status, 0, "%s", j->err);
+        sv_reply_err(c, request_id, j->status, 0, "%s", j->err);
     } else if (j->kind == SV_JOB_TICK) {
-        json_t *b = rev_body(c);
+        json_t *b = sv_rev_body(c);
         json_object_set_new(b, "tick", json_integer((json_int_t)j->result->tick));
         json_object_set_new(b, "stats", tick_stats(j->result));
-        reply(c, LPVP_TICK, request_id, b);
+        sv_reply(c, LPVP_TICK, request_id, b);
     } else if (j->kind == SV_JOB_RENDER) {
         send_frame_reply(c, request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
                          j->terms, &j->display, j->tick);
     } else if (j->kind == SV_JOB_QUERY) {
         uint8_t *att = malloc(j->count ? j->count * 12 : 1);
         if (!att) {
-            reply_err(c, request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            sv_reply_err(c, request_id, LPVP_E_INTERNAL, 0, "out of memory");
         } else {
             for (size_t i = 0; i < j->count * 3; ++i) {
                 uint32_t u;
@@ -1470,45 +1463,45 @@ static void dispatch(sv_conn *c, sv_request *r)
     sv_server *s = c->srv;
     s->requests++;
     if (!lpvp_type_is_request(r->type)) {
-        reply_err(c, r->request_id, LPVP_E_UNKNOWN_TYPE, 0, "message type 0x%04x is not a request this server knows",
+        sv_reply_err(c, r->request_id, LPVP_E_UNKNOWN_TYPE, 0, "message type 0x%04x is not a request this server knows",
                   r->type);
         return;
     }
     char err[512];
     json_t *j = lpvp_body_parse(r->json, r->json_len, err, sizeof err);
     if (!j) {
-        reply_err(c, r->request_id, LPVP_E_BAD_JSON, 0, "%s", err);
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_JSON, 0, "%s", err);
         return;
     }
     if (s->stopping) {
-        reply_err(c, r->request_id, LPVP_E_SHUTTING_DOWN, 0, "the server is stopping");
+        sv_reply_err(c, r->request_id, LPVP_E_SHUTTING_DOWN, 0, "the server is stopping");
     } else if (r->type == LPVP_HELLO) {
-        do_hello(c, r, j);
+        sv_do_hello(c, r, j);
     } else if (!c->hello) {
-        reply_err(c, r->request_id, LPVP_E_HELLO_REQUIRED, 0, "%s before HELLO: send HELLO first",
+        sv_reply_err(c, r->request_id, LPVP_E_HELLO_REQUIRED, 0, "%s before HELLO: send HELLO first",
                   lpvp_type_name(r->type));
     } else {
         switch (r->type) {
-        case LPVP_SCENE_LOAD: do_scene_load(c, r, j); break;
-        case LPVP_SCENE_UPDATE: do_scene_update(c, r, j); break;
-        case LPVP_LIGHT_SET: do_light_set(c, r, j); break;
-        case LPVP_LIGHT_REMOVE: do_light_remove(c, r, j); break;
-        case LPVP_CAMERA_SET: do_camera_set(c, r, j); break;
-        case LPVP_CONFIG: do_config(c, r, j); break;
-        case LPVP_TICK: do_tick(c, r); break;
-        case LPVP_SUBSCRIBE: do_subscribe(c, r, j, 1); break;
-        case LPVP_UNSUBSCRIBE: do_subscribe(c, r, j, 0); break;
-        case LPVP_GET_VOLUME: do_get_volume(c, r, j); break;
-        case LPVP_GET_FRAME: do_get_frame(c, r, j); break;
-        case LPVP_QUERY_IRRADIANCE: do_query(c, r, j); break;
-        case LPVP_STATS: do_stats(c, r); break;
+        case LPVP_SCENE_LOAD: sv_do_scene_load(c, r, j); break;
+        case LPVP_SCENE_UPDATE: sv_do_scene_update(c, r, j); break;
+        case LPVP_LIGHT_SET: sv_do_light_set(c, r, j); break;
+        case LPVP_LIGHT_REMOVE: sv_do_light_remove(c, r, j); break;
+        case LPVP_CAMERA_SET: sv_do_camera_set(c, r, j); break;
+        case LPVP_CONFIG: sv_do_config(c, r, j); break;
+        case LPVP_TICK: sv_do_tick(c, r); break;
+        case LPVP_SUBSCRIBE: sv_do_subscribe(c, r, j, 1); break;
+        case LPVP_UNSUBSCRIBE: sv_do_subscribe(c, r, j, 0); break;
+        case LPVP_GET_VOLUME: sv_do_get_volume(c, r, j); break;
+        case LPVP_GET_FRAME: sv_do_get_frame(c, r, j); break;
+        case LPVP_QUERY_IRRADIANCE: sv_do_query(c, r, j); break;
+        case LPVP_STATS: sv_do_stats(c, r); break;
         case LPVP_BYE:
-            reply(c, LPVP_BYE, r->request_id, json_object());
+            sv_reply(c, LPVP_BYE, r->request_id, json_object());
             sv_conn_close_after_write(c);
             break;
-        case LPVP_ACK: do_ack(c, r, j); break;
+        case LPVP_ACK: sv_do_ack(c, r, j); break;
         default:
-            reply_err(c, r->request_id, LPVP_E_UNKNOWN_TYPE, 0, "message type 0x%04x is not handled", r->type);
+            sv_reply_err(c, r->request_id, LPVP_E_UNKNOWN_TYPE, 0, "message type 0x%04x is not handled", r->type);
         }
     }
     json_decref(j);
