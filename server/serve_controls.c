@@ -8,7 +8,6 @@
  */
 #include "serve_session_internal.h"
 
-#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>

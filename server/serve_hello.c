@@ -1,8 +1,9 @@
 /*
  * serve_hello.c - HELLO, the first request of every session: the protocol
  * version (SPEC R4.1), the --token check (R4.2), and the reply that tells the
- * client the server's limits, knobs and presets (R4.12). Until it succeeds, dispatch
- * (serve_session.c) answers every other request with HELLO_REQUIRED.
+ * client the server's limits, knobs and presets (R4.12). Until it succeeds,
+ * dispatch (serve_session.c) answers every other request with
+ * HELLO_REQUIRED.
  */
 #include "serve_session_internal.h"
 
