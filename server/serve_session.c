@@ -127,9 +127,17 @@ void sv_session_changed(sv_conn *c)
         sv_world_attach(c, in);
 }
 
+/* What the session's world calls when its GL jobs come back and after each
+ * tick (serve.h); set before anything can submit a job. */
+static const sv_world_listener world_listener = {
+    .job_done = sv_session_job_done,
+    .tick_result = sv_session_stream,
+};
+
 void sv_session_init(sv_conn *c)
 {
     sv_server *s = c->srv;
+    c->listener = &world_listener;
     c->view_camera = -1;
     c->settings = s->cfg.settings;
     c->tick_rate = s->cfg.tick_rate;

@@ -50,7 +50,7 @@ json_t *sv_config_json(sv_conn *c); /* CONFIG and STATS "config" (serve_controls
  * (serve_results.c) */
 int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n);
 
-/* ---- the completions the world reports (serve.h's sv_world_listener) ---- */
+/* ---- what the world reports, through sv_world_listener (serve.h) ---- */
 void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id); /* serve_results.c */
 void sv_session_stream(sv_conn *c, sv_result *r);                     /* serve_streams.c */
 
