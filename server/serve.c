@@ -174,7 +174,7 @@ static int load_default_scene(sv_server *s, char *err, size_t n)
         free(real);
         sc->glb = buf;
         sc->glb_size = len;
-        int external = 0; /* any "uri": the folder matters (as in serve_session.c) */
+        int external = 0; /* any "uri": the folder matters (as in serve_scene.c) */
         for (size_t i = 0; i + 5 <= len && !external; ++i)
             external = buf[i] == '"' && memcmp(buf + i, "\"uri\"", 5) == 0;
         if (!external) {

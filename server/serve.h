@@ -3,8 +3,12 @@
  *
  *   serve.c          the command: flags, start-up, signals, shutdown
  *   serve_net.c      libuv listeners, connections, frame reading, bounded writes
- *   serve_session.c  per-connection state, request dispatch, revisions, streams
- *   serve_world.c    worlds (shared computations) and the GL thread
+ *   serve_session.c  per-connection state, request dispatch, revisions; its
+ *                    handlers are in serve_hello.c, serve_scene.c,
+ *                    serve_controls.c, serve_results.c and serve_streams.c
+ *                    (serve_session_internal.h)
+ *   serve_world.c    worlds (shared computations) and the GL thread; they
+ *                    report to sessions through sv_world_listener
  *   serve_encode.c   VOLUME / FRAME payloads (fp16, XOR delta, zstd, PNG, EXR)
  *
  * Threads: the libuv loop runs on the main thread and owns every structure
@@ -225,6 +229,21 @@ typedef struct sv_sub {
 
 struct sv_wreq; /* one frame being written (serve_net.c) */
 
+/* How a world reports back to the sessions that use it, so the world layer
+ * (serve_world.c) never calls up into the session layer: the session layer
+ * points each connection's listener at its callbacks when the session starts
+ * (sv_session_init). Both run on the loop thread: from done_async, or from
+ * sv_gl_stop for the jobs it drops at shutdown. */
+typedef struct sv_world_listener {
+    /* c's request request_id, answered by job j (the job's own request, then
+     * each one that joined it, in arrival order), is done: reply, then go on
+     * with c's next request. */
+    void (*job_done)(sv_job *j, sv_conn *c, uint32_t request_id);
+    /* A tick of c's world produced r: called for each session attached to the
+     * world after every reply of that tick. */
+    void (*tick_result)(sv_conn *c, sv_result *r);
+} sv_world_listener;
+
 enum { SV_STREAM_NONE = -1, SV_STREAM_VOLUME = 0, SV_STREAM_FRAME = 1 };
 
 struct sv_conn {
@@ -256,6 +275,7 @@ struct sv_conn {
     uint64_t bytes_sent;
     uint64_t stream_dropped;
     /* session */
+    const sv_world_listener *listener; /* how its world reports to it */
     int hello;
     uint64_t revision;
     sv_scene *scene;        /* ref */
@@ -338,8 +358,6 @@ void sv_net_resume_reading(sv_conn *c);
 void sv_session_init(sv_conn *c);
 void sv_session_free(sv_conn *c);        /* on close: detach, free state */
 void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
-void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id); /* c's request j finished */
-void sv_session_stream(sv_conn *c, sv_result *r); /* after a tick of its world */
 
 /* serve_world.c */
 int sv_gl_start(sv_server *s, char *err, size_t n);

@@ -8,7 +8,9 @@
  * generations are no longer answered from). The GL thread is the only thread
  * that touches GL: it creates the context, owns every engine, and runs jobs
  * (tick, render, query, destroy) one at a time in FIFO order; finished jobs go
- * back to the loop through done_async.
+ * back to the loop through done_async. Replies and streams reach the sessions
+ * through each connection's sv_world_listener (serve.h), never by calling the
+ * session layer.
  */
 #include "serve.h"
 
@@ -505,9 +507,9 @@ static void timer_closed(uv_handle_t *h)
 static void job_reply_all(sv_job *j)
 {
     if (j->conn)
-        sv_session_job_done(j, j->conn, j->request_id);
+        j->conn->listener->job_done(j, j->conn, j->request_id);
     for (sv_waiter *wt = j->joined; wt; wt = wt->next)
-        sv_session_job_done(j, wt->conn, wt->request_id);
+        wt->conn->listener->job_done(j, wt->conn, wt->request_id);
 }
 
 static void tick_done(sv_server *s, sv_job *j)
@@ -531,7 +533,7 @@ static void tick_done(sv_server *s, sv_job *j)
     if (j->result && !w->dying)
         for (sv_conn *c = s->conns; c; c = c->next)
             if (c->world == w && !c->closing)
-                sv_session_stream(c, j->result);
+                c->listener->tick_result(c, j->result);
 }
 
 static void done_cb(uv_async_t *a)

@@ -1,0 +1,359 @@
+/*
+ * serve_controls.c - the requests that change a session's inputs other than
+ * its scene: LIGHT_SET, LIGHT_REMOVE, CAMERA_SET and CONFIG (SPEC R4.6,
+ * R4.10, R4.11).
+ * Each validates the whole message before it changes anything, then bumps
+ * the revision and moves the session to the world of its new inputs
+ * (sv_session_changed).
+ */
+#include "serve_session_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "settings_fields.h"
+
+#define SV_MAX_LIGHTS 256
+#define SV_MAX_VIEW_SIDE 4096
+
+void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j)
+{
+    static const char *const TYPES[] = {"directional", "point", "spot"}; /* = lpv_light_type */
+    char err[512];
+    const char *id = NULL;
+    size_t idlen = 0;
+    int type = 0;
+    lpv_light l;
+    memset(&l, 0, sizeof l);
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    l.direction[1] = -1.0f;
+    l.outer_cone = (float)(M_PI / 4.0);
+    if (lpvp_get_string(j, "id", 1, LPV_NAME_MAX - 1, &id, &idlen, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_enum(j, "type", 1, TYPES, 3, &type, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_floats(j, "color", 0, 3, 0.0, 1e30, l.color, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "intensity", 1, 0.0, 1e30, &l.intensity, err, sizeof err) != LPVP_FIELD_OK ||
+        lpvp_get_floats(j, "position", 0, 3, -1e30, 1e30, l.position, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_floats(j, "direction", 0, 3, -1e30, 1e30, l.direction, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "range", 0, 0.0, 1e30, &l.range, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "inner_cone", 0, 0.0, M_PI / 2.0, &l.inner_cone, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "outer_cone", 0, 0.0, M_PI / 2.0, &l.outer_cone, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (idlen == 0) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: must not be empty");
+        return;
+    }
+    float dl = sqrtf(l.direction[0] * l.direction[0] + l.direction[1] * l.direction[1] +
+                     l.direction[2] * l.direction[2]);
+    if (!(dl > 1e-12f) || !isfinite(dl)) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "direction: must be a non-zero vector");
+        return;
+    }
+    for (int i = 0; i < 3; ++i)
+        l.direction[i] /= dl;
+    if (type == LPV_LIGHT_SPOT && l.inner_cone > l.outer_cone) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "inner_cone: must not exceed outer_cone");
+        return;
+    }
+    if (type != LPV_LIGHT_SPOT)
+        l.inner_cone = l.outer_cone = 0.0f;
+    l.type = (lpv_light_type)type;
+    memcpy(l.name, id, idlen);
+    uint32_t i = 0;
+    while (i < c->light_count && strcmp(c->lights[i].name, l.name) != 0)
+        ++i;
+    if (i == c->light_count) {
+        if (c->light_count >= SV_MAX_LIGHTS) {
+            sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "a session has at most %d lights", SV_MAX_LIGHTS);
+            return;
+        }
+        lpv_light *nl = realloc(c->lights, sizeof *nl * (c->light_count + 1));
+        if (!nl) {
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        c->lights = nl;
+        c->light_count++;
+    }
+    c->lights[i] = l;
+    sv_session_changed(c);
+    sv_reply(c, LPVP_LIGHT_SET, r->request_id, sv_rev_body(c));
+}
+
+void sv_do_light_remove(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    const char *id = NULL;
+    if (lpvp_get_string(j, "id", 1, 4096, &id, NULL, err, sizeof err) != LPVP_FIELD_OK) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    uint32_t i = 0;
+    while (i < c->light_count && strcmp(c->lights[i].name, id) != 0)
+        ++i;
+    if (i == c->light_count) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: no light \"%s\" in this session", id);
+        return;
+    }
+    memmove(&c->lights[i], &c->lights[i + 1], sizeof *c->lights * (c->light_count - i - 1));
+    c->light_count--;
+    sv_session_changed(c);
+    sv_reply(c, LPVP_LIGHT_REMOVE, r->request_id, sv_rev_body(c));
+}
+
+void sv_do_camera_set(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int64_t w = c->view_w ? c->view_w : SV_DEFAULT_VIEW_SIDE, h = c->view_h ? c->view_h : SV_DEFAULT_VIEW_SIDE;
+    if (lpvp_get_int(j, "width", 0, 1, SV_MAX_VIEW_SIDE, &w, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_int(j, "height", 0, 1, SV_MAX_VIEW_SIDE, &h, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    const json_t *cam = json_object_get(j, "camera");
+    const lpv_scene *sc = &c->scene->scene;
+    lpv_view v;
+    if (cam) {
+        char key[64];
+        if (json_is_integer(cam))
+            snprintf(key, sizeof key, "%lld", (long long)json_integer_value(cam));
+        else if (json_is_string(cam))
+            snprintf(key, sizeof key, "%s", json_string_value(cam));
+        else {
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: expected an index or a name");
+            return;
+        }
+        int idx = lpv_view_find_camera(sc, key);
+        if (idx < 0) {
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "camera: the scene has %u camera(s) and none is \"%s\"",
+                      sc->camera_count, key);
+            return;
+        }
+        lpv_view_from_camera(&sc->cameras[idx], (int)w, (int)h, &v);
+        c->view_camera = idx;
+        c->view_explicit = 0;
+    } else {
+        float eye[3], target[3], up[3] = {0, 1, 0}, fov = 45.0f;
+        int has_up;
+        if (lpvp_get_floats(j, "eye", 1, 3, -1e30, 1e30, eye, err, sizeof err) != LPVP_FIELD_OK ||
+            lpvp_get_floats(j, "target", 1, 3, -1e30, 1e30, target, err, sizeof err) != LPVP_FIELD_OK ||
+            (has_up = lpvp_get_floats(j, "up", 0, 3, -1e30, 1e30, up, err, sizeof err)) == LPVP_FIELD_BAD ||
+            lpvp_get_float(j, "fov_deg", 0, 0.01, 179.0, &fov, err, sizeof err) == LPVP_FIELD_BAD) {
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+            return;
+        }
+        if (lpv_view_look_at(eye, target, fov * (float)(M_PI / 180.0), (int)w, (int)h, &v) != 0) {
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "target: must differ from eye");
+            return;
+        }
+        if (has_up == LPVP_FIELD_OK) { /* up, made orthogonal to forward */
+            float d = up[0] * v.forward[0] + up[1] * v.forward[1] + up[2] * v.forward[2];
+            float u[3] = {up[0] - d * v.forward[0], up[1] - d * v.forward[1], up[2] - d * v.forward[2]};
+            float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (!(ul > 1e-6f) || !isfinite(ul)) {
+                sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "up: must not be parallel to target - eye");
+                return;
+            }
+            for (int i = 0; i < 3; ++i)
+                v.up[i] = u[i] / ul;
+        }
+        c->view_explicit = 1;
+        c->view_camera = -1;
+    }
+    c->view_w = (int)w;
+    c->view_h = (int)h;
+    c->view = v;
+    sv_session_changed(c);
+    sv_reply(c, LPVP_CAMERA_SET, r->request_id, sv_rev_body(c));
+}
+
+
+/* CONFIG's "preset": resets grid / iterations / rsm_size / occlusion to the
+ * preset's (by clearing them, so resolve fills them in), before the message's
+ * other fields override them. Returns LPVP_FIELD_OK or _ABSENT, LPVP_FIELD_BAD
+ * (message in err), or -2 when the preset is over a server limit (ERROR LIMIT
+ * already sent: --max-grid and --max-texture bound presets as well). */
+static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_settings *st, char *err, size_t n)
+{
+    /* the choices are core's preset table (lpv_preset_name), in its order */
+    const char *names[LPV_PRESET_COUNT_];
+    int count = 0, idx = 0;
+    for (int q = LPV_PRESET_DEFAULT + 1; q < LPV_PRESET_COUNT_; ++q)
+        names[count++] = lpv_preset_name((lpv_preset)q);
+    int rc = lpvp_get_enum(j, "preset", 0, names, (size_t)count, &idx, err, n);
+    if (rc != LPVP_FIELD_OK)
+        return rc;
+    lpv_settings p;
+    lpv_preset_settings((lpv_preset)(LPV_PRESET_DEFAULT + 1 + idx), &p);
+    const sv_server *s = c->srv;
+    if (p.grid_dims[0] > s->cfg.max_grid || p.rsm_size > s->cfg.max_texture) {
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                  "preset: %s (grid %d, rsm_size %d) is over the server's limits (--max-grid %d, --max-texture %d)",
+                  names[idx], p.grid_dims[0], p.rsm_size, s->cfg.max_grid, s->cfg.max_texture);
+        return -2;
+    }
+    st->preset = p.preset;
+    memset(st->grid_dims, 0, sizeof st->grid_dims);
+    st->iterations = 0;
+    st->rsm_size = 0;
+    st->occlusion = LPV_SWITCH_DEFAULT;
+    return LPVP_FIELD_OK;
+}
+
+/* CONFIG's scalar knobs, one per entry of the field table (core/settings_fields.h):
+ * ints as JSON integers, floats as JSON numbers, switches as JSON booleans, each
+ * within the table's range. Returns 0, or -1 with a message naming the key. */
+static int config_fields(const json_t *j, lpv_settings *st, char *err, size_t n)
+{
+    size_t nf;
+    const lpv_field *fields = lpv_fields(&nf);
+    for (size_t i = 0; i < nf; ++i) {
+        const lpv_field *f = &fields[i];
+        int64_t iv;
+        double dv;
+        int bv, rc;
+        char why[160];
+        if (f->kind == LPV_FIELD_SWITCH) {
+            if ((rc = lpvp_get_bool(j, f->key, 0, &bv, err, n)) == LPVP_FIELD_OK)
+                lpv_field_set_bool(st, f, bv);
+        } else if (f->kind == LPV_FIELD_INT) {
+            if ((rc = lpvp_get_int(j, f->key, 0, (int64_t)f->min, (int64_t)f->max, &iv, err, n)) == LPVP_FIELD_OK)
+                lpv_field_set_number(st, f, (double)iv, NULL, 0);
+        } else if ((rc = lpvp_get_number(j, f->key, 0, f->min, f->max, &dv, err, n)) == LPVP_FIELD_OK &&
+                   lpv_field_set_number(st, f, dv, why, sizeof why) != 0) { /* an exclusive minimum */
+            snprintf(err, n, "%s: %s", f->key, why);
+            return -1;
+        }
+        if (rc == LPVP_FIELD_BAD)
+            return -1;
+    }
+    return 0;
+}
+
+void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
+{
+    sv_server *s = c->srv;
+    char err[512];
+    lpv_settings st = c->settings;
+    double rate = c->tick_rate;
+    int64_t grid[3];
+    float bounds[6];
+    int gst;
+    double lim_rate = s->cfg.max_tick_rate;
+    int pst = config_preset(c, r, j, &st, err, sizeof err);
+    if (pst == LPVP_FIELD_BAD)
+        goto bad;
+    if (pst < 0)
+        return; /* over a limit: already answered */
+    const json_t *gj = json_object_get(j, "grid");
+    if (gj && json_is_integer(gj)) { /* a single N is accepted as NxNxN */
+        gst = lpvp_get_int(j, "grid", 1, 1, INT32_MAX, &grid[0], err, sizeof err);
+        grid[1] = grid[2] = grid[0];
+    } else {
+        gst = lpvp_get_ints(j, "grid", 0, 3, 1, INT32_MAX, grid, err, sizeof err);
+    }
+    if (gst == LPVP_FIELD_BAD)
+        goto bad;
+    if (gst == LPVP_FIELD_OK) {
+        for (int i = 0; i < 3; ++i)
+            if (grid[i] > s->cfg.max_grid) {
+                sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                          "grid: %lld cells on an axis is over the server's limit of %d (--max-grid)",
+                          (long long)grid[i], s->cfg.max_grid);
+                return;
+            }
+        for (int i = 0; i < 3; ++i)
+            st.grid_dims[i] = (int)grid[i];
+    }
+    int bst = lpvp_get_floats(j, "bounds", 0, 6, -1e30, 1e30, bounds, err, sizeof err);
+    if (bst == LPVP_FIELD_BAD)
+        goto bad;
+    if (bst == LPVP_FIELD_OK) {
+        if (!(bounds[3] > bounds[0] && bounds[4] > bounds[1] && bounds[5] > bounds[2])) {
+            snprintf(err, sizeof err, "bounds: expected [x0, y0, z0, x1, y1, z1] with max > min");
+            goto bad;
+        }
+        memcpy(st.bounds_min, bounds, sizeof st.bounds_min);
+        memcpy(st.bounds_max, bounds + 3, sizeof st.bounds_max);
+    }
+    int ist;
+    if (config_fields(j, &st, err, sizeof err) != 0) /* iterations, rsm_size, occlusion, ..., planner */
+        goto bad;
+    if (json_object_get(j, "rsm_size") && st.rsm_size > s->cfg.max_texture) {
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                  "rsm_size: %d is over the server's texture limit of %d (--max-texture)", st.rsm_size,
+                  s->cfg.max_texture);
+        return;
+    }
+    if (json_object_get(j, "shadow_size") && st.shadow_size > s->cfg.max_texture) {
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                  "shadow_size: %d is over the server's texture limit of %d (--max-texture)", st.shadow_size,
+                  s->cfg.max_texture);
+        return;
+    }
+    double rv;
+    if ((ist = lpvp_get_number(j, "tick_rate_hz", 0, 0.0, 1e9, &rv, err, sizeof err)) == LPVP_FIELD_BAD)
+        goto bad;
+    if (ist == LPVP_FIELD_OK) {
+        if (rv > lim_rate) {
+            sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                      "tick_rate_hz: %g is over the server's limit of %g Hz (--max-tick-rate)", rv, lim_rate);
+            return;
+        }
+        rate = rv;
+    }
+    lpv_settings chk = st;
+    lpv_settings_resolve(&chk);
+    if (lpv_settings_validate(&chk, err, sizeof err) != 0)
+        goto bad;
+    c->settings = st;
+    c->tick_rate = rate;
+    sv_session_changed(c);
+    json_t *b = sv_rev_body(c);
+    json_object_set_new(b, "config", sv_config_json(c));
+    sv_reply(c, LPVP_CONFIG, r->request_id, b);
+    return;
+bad:
+    sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+}
+
+/* CONFIG's reply and STATS' "config": the session's settings, resolved. */
+json_t *sv_config_json(sv_conn *c)
+{
+    lpv_settings s = c->settings;
+    lpv_settings_resolve(&s);
+    json_t *bounds;
+    int auto_bounds = !lpv_settings_bounds_given(&s);
+    if (auto_bounds && c->world && c->world->latest && c->world->latest->gen == c->world_gen) {
+        const lpv_grid *g = &c->world->latest->grid;
+        bounds = json_pack("[f,f,f,f,f,f]", (double)g->origin[0], (double)g->origin[1], (double)g->origin[2],
+                           g->origin[0] + (double)g->cell_size * g->dims[0],
+                           g->origin[1] + (double)g->cell_size * g->dims[1],
+                           g->origin[2] + (double)g->cell_size * g->dims[2]);
+    } else if (auto_bounds) {
+        bounds = json_null(); /* the scene's, placed at the next tick */
+    } else {
+        bounds = json_pack("[f,f,f,f,f,f]", (double)s.bounds_min[0], (double)s.bounds_min[1], (double)s.bounds_min[2],
+                           (double)s.bounds_max[0], (double)s.bounds_max[1], (double)s.bounds_max[2]);
+    }
+    const char *preset = lpv_preset_name(s.preset); /* CONFIG validated it, so never NULL */
+    json_t *o = json_pack("{s:s, s:[i,i,i], s:o, s:b}", "preset", preset ? preset : "", "grid", s.grid_dims[0],
+                          s.grid_dims[1], s.grid_dims[2], "bounds", bounds, "bounds_auto", auto_bounds);
+    /* every knob of the field table (core/settings_fields.h), resolved: iterations, rsm_size, occlusion, ... */
+    size_t nf;
+    const lpv_field *fields = lpv_fields(&nf);
+    for (size_t i = 0; o && i < nf; ++i) {
+        double v = lpv_field_get(&s, &fields[i]);
+        json_object_set_new(o, fields[i].key,
+                            fields[i].kind == LPV_FIELD_INT      ? json_integer((json_int_t)v)
+                            : fields[i].kind == LPV_FIELD_SWITCH ? json_boolean(v > 0.0)
+                                                                 : json_real(v));
+    }
+    if (o)
+        json_object_set_new(o, "tick_rate_hz", json_real(c->tick_rate));
+    return o;
+}

@@ -1,0 +1,77 @@
+/*
+ * serve_hello.c - HELLO, the first request of every session: the protocol
+ * version (SPEC R4.1), the --token check (R4.2), and the reply that tells the
+ * client the server's limits, knobs and presets (R4.12). Until it succeeds,
+ * dispatch (serve_session.c) answers every other request with
+ * HELLO_REQUIRED.
+ */
+#include "serve_session_internal.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "settings_json.h"
+
+static int token_equal(const char *a, size_t alen, const char *b, size_t blen)
+{
+    /* constant time in the secret's length: every byte of b is visited */
+    unsigned diff = (unsigned)(alen ^ blen);
+    for (size_t i = 0; i < blen; ++i) {
+        unsigned char x = i < alen ? (unsigned char)a[i] : 0;
+        diff |= x ^ (unsigned char)b[i];
+    }
+    return diff == 0;
+}
+
+void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
+{
+    sv_server *s = c->srv;
+    char err[256];
+    int64_t v = 0;
+    if (lpvp_get_int(j, "version", 1, INT32_MIN, INT32_MAX, &v, err, sizeof err) != LPVP_FIELD_OK) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (v != LPVP_VERSION) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_VERSION, 1, "HELLO version %lld is not spoken; this server speaks 1",
+                  (long long)v);
+        return;
+    }
+    const char *client = NULL, *token = NULL;
+    size_t tlen = 0;
+    if (lpvp_get_string(j, "client", 0, 256, &client, NULL, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    int tst = lpvp_get_string(j, "token", 0, 4096, &token, &tlen, err, sizeof err);
+    if (s->cfg.has_token) {
+        if (tst != LPVP_FIELD_OK ||
+            !token_equal(token, tlen, s->cfg.token, strlen(s->cfg.token))) {
+            sv_reply_err(c, r->request_id, LPVP_E_UNAUTHORIZED, 0, "%s",
+                      tst == LPVP_FIELD_OK ? "wrong token" : "this server requires a token in HELLO (\"token\")");
+            return;
+        }
+    } else if (tst == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    c->hello = 1;
+    char server[64];
+    snprintf(server, sizeof server, "lpvd %s", LPVD_VERSION);
+    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I}", "max_body", (json_int_t)s->cfg.max_body,
+                            "max_message", (json_int_t)s->cfg.max_message, "max_clients", s->cfg.max_clients,
+                            "max_triangles", (json_int_t)s->cfg.max_triangles, "max_texture", s->cfg.max_texture,
+                            "max_grid", s->cfg.max_grid, "max_tick_rate", s->cfg.max_tick_rate, "idle_timeout",
+                            s->cfg.idle_timeout, "max_queue", (json_int_t)s->cfg.max_queue);
+    json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
+                          (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
+                          "revision", (json_int_t)c->revision);
+    /* R4.12: CONFIG's knobs and presets, described from core's tables so no client keeps a copy */
+    if (b && (json_object_set_new(b, "knobs", lpvd_knobs_json(&s->cfg.settings, s->cfg.max_texture)) != 0 ||
+              json_object_set_new(b, "presets", lpvd_presets_json()) != 0)) {
+        json_decref(b);
+        b = NULL;
+    }
+    sv_reply(c, LPVP_HELLO, r->request_id, b);
+}

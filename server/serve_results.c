@@ -1,0 +1,278 @@
+/*
+ * serve_results.c - the requests answered from the session's world: TICK,
+ * GET_VOLUME, GET_FRAME, QUERY_IRRADIANCE and STATS, and the replies of the
+ * GL jobs they submit (sv_session_job_done, which the world calls through
+ * its listener when a job comes back to the loop). A request that needs the
+ * GL thread keeps the session busy until its reply is queued (R3.2).
+ */
+#include "serve_session_internal.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "stats_json.h"
+
+/* The tick's stats in the one shape of lpvd_tick_stats_json (stats_json.h). */
+static json_t *tick_stats(const sv_result *r)
+{
+    int one = r->cascade_count < 1;
+    return lpvd_tick_stats_json(&r->stats, &r->plan, one ? &r->grid : r->cascades, one ? 1 : r->cascade_count,
+                                r->tick_ms);
+}
+
+static int world_current(sv_conn *c)
+{
+    return c->world && c->world->latest && c->world->latest->gen == c->world_gen;
+}
+
+static void submit(sv_conn *c, sv_job *j)
+{
+    j->conn = c;
+    c->refs++;
+    c->busy = 1;
+    sv_job_submit(c->srv, j);
+}
+
+void sv_do_tick(sv_conn *c, sv_request *r)
+{
+    if (c->world && sv_world_join_tick(c->world, c, r->request_id)) { /* shared with a queued tick (R7.2) */
+        c->busy = 1;
+        return;
+    }
+    sv_job *j = c->world ? sv_job_new(SV_JOB_TICK, c->world) : NULL;
+    if (!j) {
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    j->request_id = r->request_id;
+    j->terms_mask = sv_world_terms_mask(c->world);
+    c->world->queued_tick = j;
+    submit(c, j);
+}
+
+/* GET_FRAME's and SUBSCRIBE frame's "exposure" ("auto" or an EV number) and
+ * "transparent" (SPEC R6.4). Returns LPVP_FIELD_BAD with err on a bad value. */
+int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n)
+{
+    lpv_display_default(d);
+    const json_t *e = json_object_get(j, "exposure");
+    if (e) {
+        char v[64];
+        if (json_is_string(e))
+            snprintf(v, sizeof v, "%s", json_string_value(e));
+        else if (json_is_number(e))
+            snprintf(v, sizeof v, "%.9g", json_number_value(e));
+        else
+            snprintf(v, sizeof v, "(not a string or number)");
+        if (lpv_exposure_parse(v, d, err, n) != 0)
+            return LPVP_FIELD_BAD;
+    }
+    return lpvp_get_bool(j, "transparent", 0, &d->transparent, err, n) == LPVP_FIELD_BAD ? LPVP_FIELD_BAD
+                                                                                         : LPVP_FIELD_OK;
+}
+
+void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int fmt = LPVP_FMT_FP16, comp = LPVP_COMP_ZSTD;
+    if (lpvp_get_enum(j, "format", 0, lpvp_volume_format_names, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (!world_current(c)) {
+        sv_reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+                  "no volume yet for this session's current scene, lights, camera and config: send TICK first");
+        return;
+    }
+    json_t *b = NULL;
+    uint8_t *att = NULL;
+    size_t alen = 0;
+    if (sv_encode_volume(c->world->latest, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD, NULL, c->revision, &b, &att, &alen, err,
+                         sizeof err) != 0) {
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
+        return;
+    }
+    sv_send(c, LPVP_REPLY(LPVP_GET_VOLUME), r->request_id, b, att, alen, SV_STREAM_NONE);
+}
+
+static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w, int h, int fmt, int zstd, int terms,
+                             const lpv_display *display, uint64_t tick)
+{
+    /* the plan of the tick shown, when it is still the world's latest */
+    const lpv_plan *plan = c->world && c->world->latest && c->world->latest->tick == tick ? &c->world->latest->plan
+                                                                                          : NULL;
+    char err[512];
+    json_t *b = NULL;
+    uint8_t *att = NULL;
+    size_t alen = 0;
+    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, display, c->revision, tick, plan, &b, &att, &alen, err,
+                        sizeof err) != 0) {
+        sv_reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
+        return;
+    }
+    sv_send(c, LPVP_REPLY(LPVP_GET_FRAME), rid, b, att, alen, SV_STREAM_NONE);
+}
+
+void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int fmt = LPVP_FRAME_PNG, comp = LPVP_COMP_NONE, terms = LPVP_TERMS_FULL;
+    lpv_display display;
+    if (lpvp_get_enum(j, "format", 0, lpvp_frame_format_names, LPVP_FRAME_FORMAT_COUNT, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD ||
+        sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (!world_current(c)) {
+        sv_reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+                  "no tick yet for this session's current scene, lights, camera and config: send TICK first");
+        return;
+    }
+    const sv_result *res = c->world->latest;
+    if (res->frames[terms]) { /* rendered with the tick already */
+        send_frame_reply(c, r->request_id, res->frames[terms], res->width, res->height, fmt, comp == LPVP_COMP_ZSTD, terms,
+                         &display, res->tick);
+        return;
+    }
+    sv_job *jb = sv_job_new(SV_JOB_RENDER, c->world);
+    if (!jb) {
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    jb->request_id = r->request_id;
+    jb->terms = terms;
+    jb->display = display;
+    jb->count = (size_t)fmt | ((size_t)(comp == LPVP_COMP_ZSTD) << 4); /* encoding choice, read back in job_done */
+    submit(c, jb);
+}
+
+void sv_do_query(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    int64_t count = 0;
+    if (lpvp_get_int(j, "count", 1, 0, (int64_t)(c->srv->cfg.max_message / 24), &count, err, sizeof err) !=
+        LPVP_FIELD_OK) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (r->att_len != (size_t)count * 24) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                  "attachment: expected count x 24 = %lld bytes (px py pz nx ny nz float32 per point), got %zu",
+                  (long long)count * 24, r->att_len);
+        return;
+    }
+    if (!world_current(c)) {
+        sv_reply_err(c, r->request_id, LPVP_E_NOT_READY, 0,
+                  "no tick yet for this session's current scene, lights, camera and config: send TICK first");
+        return;
+    }
+    sv_job *jb = sv_job_new(SV_JOB_QUERY, c->world);
+    float *pts = malloc(count ? (size_t)count * 24 : 1);
+    if (!jb || !pts) {
+        free(pts);
+        sv_job_free(jb);
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    for (int64_t i = 0; i < count * 6; ++i) { /* little-endian float32 */
+        uint32_t u = lpvp_get_u32(r->att + i * 4);
+        float f;
+        memcpy(&f, &u, 4);
+        pts[i] = f;
+    }
+    jb->points = pts;
+    jb->count = (size_t)count;
+    jb->request_id = r->request_id;
+    submit(c, jb);
+}
+
+void sv_do_stats(sv_conn *c, sv_request *r)
+{
+    sv_server *s = c->srv;
+    json_t *stages = json_array(), *plan = json_object();
+    if (c->world && c->world->latest) {
+        const sv_result *res = c->world->latest;
+        json_decref(plan);
+        plan = tick_stats(res);
+        json_decref(stages); /* STATS keeps a top-level copy of the tick's stages (SPEC section 4) */
+        stages = json_deep_copy(json_object_get(plan, "stages"));
+        if (!plan || !stages) { /* out of memory: answer with what is left */
+            json_decref(stages);
+            stages = json_array();
+            if (!plan)
+                plan = json_object();
+        }
+        json_object_set_new(plan, "tick", json_integer((json_int_t)res->tick));
+        json_object_set_new(plan, "current", json_boolean(res->gen == c->world_gen));
+    }
+    json_object_set_new(plan, "backend", json_string(s->gl_backend));
+    json_object_set_new(plan, "gl_renderer", json_string(s->gl_renderer));
+    json_object_set_new(plan, "config", sv_config_json(c));
+    size_t pend = 0, wq = 0, drops = 0;
+    int sessions = 0;
+    for (sv_conn *o = s->conns; o; o = o->next) {
+        pend += o->pending_count;
+        wq += o->wq_bytes;
+        drops += o->stream_dropped;
+        if (o->hello)
+            sessions++;
+    }
+    int shared = 0;
+    if (c->world)
+        shared = c->world->refs;
+    json_t *b = json_pack(
+        "{s:o, s:o, s:i, s:i, s:i, s:{s:I, s:I, s:I, s:I, s:I, s:I}, s:I, s:I, s:I, s:I, s:i, s:I}", "stages", stages,
+        "plan", plan, "clients", s->conn_count, "sessions", sessions, "worlds", s->world_count, "queues", "gl_jobs",
+        (json_int_t)sv_jobs_queued(s), "requests_pending", (json_int_t)pend, "write_bytes", (json_int_t)wq,
+        "session_requests_pending", (json_int_t)c->pending_count, "session_write_bytes", (json_int_t)c->wq_bytes,
+        "stream_dropped", (json_int_t)drops, "bytes_sent", (json_int_t)s->bytes_sent, "session_bytes_sent",
+        (json_int_t)c->bytes_sent, "ticks", (json_int_t)s->ticks, "world_ticks",
+        (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
+        "revision", (json_int_t)c->revision);
+    /* tick coalescing (R7.2): computed ticks vs TICK requests answered by a tick queued for another */
+    json_object_set_new(b, "ticks_computed", json_integer((json_int_t)s->ticks));
+    json_object_set_new(b, "ticks_coalesced", json_integer((json_int_t)s->ticks_coalesced));
+    json_object_set_new(b, "world_ticks_computed", json_integer((json_int_t)(c->world ? c->world->ticks_computed : 0)));
+    json_object_set_new(b, "world_ticks_coalesced",
+                        json_integer((json_int_t)(c->world ? c->world->ticks_coalesced : 0)));
+    sv_reply(c, LPVP_STATS, r->request_id, b);
+}
+
+/* ---- completions of GL jobs ---------------------------------------------- */
+void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
+{
+    c->busy = 0;
+    if (c->closing || c->close_after_write)
+        return;
+    if (j->status) {
+        sv_reply_err(c, request_id, j->status, 0, "%s", j->err);
+    } else if (j->kind == SV_JOB_TICK) {
+        json_t *b = sv_rev_body(c);
+        json_object_set_new(b, "tick", json_integer((json_int_t)j->result->tick));
+        json_object_set_new(b, "stats", tick_stats(j->result));
+        sv_reply(c, LPVP_TICK, request_id, b);
+    } else if (j->kind == SV_JOB_RENDER) {
+        send_frame_reply(c, request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
+                         j->terms, &j->display, j->tick);
+    } else if (j->kind == SV_JOB_QUERY) {
+        uint8_t *att = malloc(j->count ? j->count * 12 : 1);
+        if (!att) {
+            sv_reply_err(c, request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        } else {
+            for (size_t i = 0; i < j->count * 3; ++i) {
+                uint32_t u;
+                memcpy(&u, &j->out[i], 4);
+                lpvp_put_u32(att + i * 4, u);
+            }
+            json_t *b = json_pack("{s:I, s:I, s:I}", "revision", (json_int_t)c->revision, "tick", (json_int_t)j->tick,
+                                  "count", (json_int_t)j->count);
+            sv_send(c, LPVP_REPLY(LPVP_QUERY_IRRADIANCE), request_id, b, att, j->count * 12, SV_STREAM_NONE);
+        }
+    }
+    sv_session_pump(c);
+}

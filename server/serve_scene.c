@@ -1,0 +1,548 @@
+/*
+ * serve_scene.c - SCENE_LOAD (SPEC R4.3-R4.5) and SCENE_UPDATE. A load reads
+ * and parses the .glb on a libuv worker thread (load_run) so a large scene
+ * never stalls the loop, then takes it as the session's on the loop
+ * (load_done); the session stays busy in between (R3.2). SCENE_UPDATE of
+ * materials applies at once; of nodes, it rebuilds the scene from its bytes
+ * with the node overrides through the same worker.
+ */
+#include "serve_session_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "gltf_load.h"
+#include "scene_defaults.h"
+
+/* The SCENE_LOAD reply's "scene". */
+static json_t *scene_json(const lpv_scene *sc)
+{
+    return json_pack("{s:I, s:i, s:i, s:i, s:b, s:b, s:[f,f,f,f,f,f], s:s}", "triangles",
+                     (json_int_t)(sc->index_count / 3), "materials", (int)sc->material_count, "lights",
+                     (int)sc->light_count, "cameras", (int)sc->camera_count, "default_light", sc->default_light_added,
+                     "default_camera", sc->default_camera_added, "bounds", (double)sc->bounds_min[0],
+                     (double)sc->bounds_min[1], (double)sc->bounds_min[2], (double)sc->bounds_max[0],
+                     (double)sc->bounds_max[1], (double)sc->bounds_max[2], "source", sc->source);
+}
+
+typedef struct load_work {
+    uv_work_t req;
+    sv_conn *c;
+    uint32_t request_id;
+    uint16_t type;
+    /* in */
+    char *path;            /* resolved real path, or NULL */
+    uint8_t *glb;          /* attachment or the session scene's bytes (owned copy) */
+    size_t glb_size;
+    char *base_dir;
+    lpv_gltf_node_override *nodes;
+    size_t node_count;
+    uint64_t base_hash;
+    /* out */
+    int status;
+    char err[1024];
+    sv_scene *scene;
+    lpv_gltf_warnings warnings; /* the loader's, for the SCENE_LOAD reply */
+} load_work;
+
+static char *dir_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t n = slash ? (size_t)(slash - path) : 0;
+    char *d = malloc(n + 2);
+    if (!d)
+        return NULL;
+    if (n == 0) {
+        strcpy(d, slash ? "/" : ".");
+    } else {
+        memcpy(d, path, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+static int contains(const uint8_t *hay, size_t n, const char *needle)
+{
+    size_t k = strlen(needle);
+    for (size_t i = 0; i + k <= n; ++i)
+        if (hay[i] == (uint8_t)needle[0] && memcmp(hay + i, needle, k) == 0)
+            return 1;
+    return 0;
+}
+
+static void load_run(uv_work_t *req)
+{
+    load_work *w = req->data;
+    if (w->path) {
+        int fd = open(w->path, O_RDONLY | O_CLOEXEC);
+        struct stat st;
+        if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+            snprintf(w->err, sizeof w->err, "%s: %s", w->path, fd < 0 ? strerror(errno) : "not a regular file");
+            if (fd >= 0)
+                close(fd);
+            w->status = LPVP_E_SCENE_INVALID;
+            return;
+        }
+        w->glb_size = (size_t)st.st_size;
+        w->glb = malloc(w->glb_size ? w->glb_size : 1);
+        size_t got = 0;
+        while (w->glb && got < w->glb_size) {
+            ssize_t n = read(fd, w->glb + got, w->glb_size - got);
+            if (n < 0 && errno == EINTR)
+                continue;
+            if (n <= 0)
+                break;
+            got += (size_t)n;
+        }
+        close(fd);
+        if (!w->glb || got != w->glb_size) {
+            snprintf(w->err, sizeof w->err, "%s: cannot read", w->path);
+            w->status = LPVP_E_SCENE_INVALID;
+            return;
+        }
+        w->base_dir = dir_of(w->path);
+    }
+    sv_scene *sc = calloc(1, sizeof *sc);
+    if (!sc) {
+        w->status = LPVP_E_INTERNAL;
+        snprintf(w->err, sizeof w->err, "out of memory");
+        return;
+    }
+    const char *label = w->path ? w->path : "attachment";
+    int rc = lpv_gltf_load_memory_w(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
+                                    &w->warnings, w->err, sizeof w->err);
+    if (rc != 0) {
+        free(sc);
+        w->status = LPVP_E_SCENE_INVALID;
+        return;
+    }
+    if (lpv_scene_add_defaults(&sc->scene, w->err, sizeof w->err) != 0) {
+        lpv_scene_free(&sc->scene);
+        free(sc);
+        w->status = LPVP_E_INTERNAL;
+        return;
+    }
+    if (w->base_dir && !contains(w->glb, w->glb_size, "\"uri\"")) {
+        /* self-contained: the folder plays no part, so a path load and an
+         * attachment of the same bytes are the same scene (and share worlds) */
+        free(w->base_dir);
+        w->base_dir = NULL;
+    }
+    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, w->glb, w->glb_size);
+    if (w->base_dir)
+        h = lpv_hash_bytes(h, w->base_dir, strlen(w->base_dir));
+    if (w->node_count)
+        h = lpv_hash_bytes(h, w->nodes, sizeof *w->nodes * w->node_count);
+    sc->hash = h ? h : 1;
+    sc->glb = w->glb;
+    sc->glb_size = w->glb_size;
+    sc->base_dir = w->base_dir;
+    sc->nodes = w->nodes;
+    sc->node_count = w->node_count;
+    w->glb = NULL;
+    w->base_dir = NULL;
+    w->nodes = NULL;
+    w->node_count = 0;
+    w->scene = sc;
+}
+
+static int scene_over_limits(sv_server *s, const lpv_scene *sc, char *err, size_t n)
+{
+    uint64_t tris = sc->index_count / 3;
+    if (tris > s->cfg.max_triangles) {
+        snprintf(err, n, "%s has %llu triangles, over the server's limit of %llu (--max-triangles)", sc->source,
+                 (unsigned long long)tris, (unsigned long long)s->cfg.max_triangles);
+        return 1;
+    }
+    for (uint32_t i = 0; i < sc->texture_count; ++i)
+        if (sc->textures[i].width > s->cfg.max_texture || sc->textures[i].height > s->cfg.max_texture) {
+            snprintf(err, n, "%s: texture %u is %dx%d, over the server's limit of %d texels per side (--max-texture)",
+                     sc->source, i, sc->textures[i].width, sc->textures[i].height, s->cfg.max_texture);
+            return 1;
+        }
+    return 0;
+}
+
+static void free_sv_scene_unlisted(sv_scene *sc)
+{
+    lpv_scene_free(&sc->scene);
+    free(sc->glb);
+    free(sc->base_dir);
+    free(sc->nodes);
+    free(sc);
+}
+
+static void load_done(uv_work_t *req, int status)
+{
+    load_work *w = req->data;
+    sv_conn *c = w->c;
+    sv_server *s = c->srv;
+    (void)status;
+    if (!c->closing && !c->close_after_write) {
+        char err[1024];
+        if (w->status == LPVP_E_SCENE_INVALID && w->type == LPVP_SCENE_UPDATE) {
+            /* the file loaded before: the new node transforms are at fault */
+            sv_reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "nodes: %s", w->err);
+        } else if (w->status) {
+            sv_reply_err(c, w->request_id, w->status, 0, "%s", w->err);
+        } else if (scene_over_limits(s, &w->scene->scene, err, sizeof err)) {
+            free_sv_scene_unlisted(w->scene);
+            w->scene = NULL;
+            sv_reply_err(c, w->request_id, LPVP_E_LIMIT, 0, "%s", err);
+        } else {
+            sv_scene *sc = sv_scene_intern(s, w->scene);
+            w->scene = NULL;
+            /* SCENE_UPDATE of nodes keeps the session's material edits and lights */
+            lpv_material *keep_m = NULL;
+            lpv_light *keep_l = NULL, *old_file = NULL;
+            uint32_t keep_mn = 0, keep_ln = 0, old_n = 0;
+            int ofail = 0;
+            if (w->type == LPVP_SCENE_UPDATE) {
+                old_file = sv_named_lights(&c->scene->scene, &ofail);
+                old_n = c->scene->scene.light_count;
+                keep_m = c->materials;
+                keep_mn = c->material_count;
+                keep_l = c->lights;
+                keep_ln = c->light_count;
+                c->materials = NULL;
+                c->lights = NULL;
+            }
+            if (sv_session_set_scene(c, sc) != 0) {
+                sv_scene_unref(s, sc);
+                if (w->type == LPVP_SCENE_UPDATE) { /* the session keeps what it had */
+                    c->materials = keep_m;
+                    c->lights = keep_l;
+                }
+                sv_reply_err(c, w->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            } else {
+                if (w->type == LPVP_SCENE_UPDATE) {
+                    if (keep_mn == c->material_count) {
+                        free(c->materials);
+                        c->materials = keep_m;
+                    } else {
+                        free(keep_m);
+                    }
+                    /* file lights the session did not edit follow their nodes */
+                    for (uint32_t i = 0; i < keep_ln && old_file && !ofail && c->lights; ++i)
+                        for (uint32_t k = 0; k < old_n && k < c->light_count; ++k)
+                            if (strcmp(keep_l[i].name, old_file[k].name) == 0 &&
+                                memcmp(&keep_l[i], &old_file[k], sizeof keep_l[i]) == 0 &&
+                                strcmp(c->lights[k].name, old_file[k].name) == 0) {
+                                keep_l[i] = c->lights[k];
+                                break;
+                            }
+                    free(c->lights);
+                    c->lights = keep_l;
+                    c->light_count = keep_ln;
+                } else {
+                    free(keep_m);
+                    free(keep_l);
+                }
+                sv_session_changed(c);
+                json_t *b = sv_rev_body(c);
+                if (w->type == LPVP_SCENE_LOAD) {
+                    json_t *sj = scene_json(&sc->scene), *wa = json_array();
+                    for (int i = 0; wa && i < w->warnings.count; ++i)
+                        json_array_append_new(wa, json_string(w->warnings.line[i]));
+                    if (sj && wa)
+                        json_object_set_new(sj, "warnings", wa);
+                    else
+                        json_decref(wa);
+                    json_object_set_new(b, "scene", sj);
+                }
+                sv_reply(c, w->type, w->request_id, b);
+            }
+            free(old_file);
+        }
+    }
+    if (w->scene)
+        free_sv_scene_unlisted(w->scene);
+    free(w->path);
+    free(w->glb);
+    free(w->base_dir);
+    free(w->nodes);
+    c->busy = 0;
+    free(w);
+    sv_session_pump(c);
+    sv_conn_unref(c);
+}
+
+static int start_load(sv_conn *c, load_work *w)
+{
+    w->req.data = w;
+    w->c = c;
+    c->refs++;
+    c->busy = 1;
+    if (uv_queue_work(c->srv->loop, &w->req, load_run, load_done) != 0) {
+        c->busy = 0;
+        c->refs--;
+        return -1;
+    }
+    return 0;
+}
+
+/* R4.3: relative, no "..", resolved (symlinks too) inside the root. */
+static int resolve_scene_path(sv_server *s, const char *p, char **out, char *err, size_t n)
+{
+    if (!s->cfg.scene_root[0]) {
+        snprintf(err, n, "path %s: this server has no --scene-root; send the .glb as an attachment", p);
+        return -1;
+    }
+    if (!p[0] || p[0] == '/') {
+        snprintf(err, n, "path %s: absolute paths are refused; give a path relative to the scene root", p);
+        return -1;
+    }
+    const char *q = p;
+    while (*q) {
+        const char *e = strchr(q, '/');
+        size_t len = e ? (size_t)(e - q) : strlen(q);
+        if (len == 2 && q[0] == '.' && q[1] == '.') {
+            snprintf(err, n, "path %s: \"..\" components are refused", p);
+            return -1;
+        }
+        q += len;
+        if (*q == '/')
+            q++;
+    }
+    size_t need = strlen(s->cfg.scene_root) + strlen(p) + 2;
+    char *joined = malloc(need);
+    if (!joined) {
+        snprintf(err, n, "out of memory");
+        return -1;
+    }
+    snprintf(joined, need, "%s/%s", s->cfg.scene_root, p);
+    char *real = realpath(joined, NULL);
+    free(joined);
+    if (!real) {
+        snprintf(err, n, "path %s: %s under the scene root", p, strerror(errno));
+        return 1; /* not a refusal: the file does not exist */
+    }
+    size_t rl = strlen(s->cfg.scene_root);
+    if (strncmp(real, s->cfg.scene_root, rl) != 0 || (real[rl] != '/' && !(rl == 1 && s->cfg.scene_root[0] == '/'))) {
+        snprintf(err, n, "path %s: leaves the scene root (through a symbolic link)", p);
+        free(real);
+        return -1;
+    }
+    *out = real;
+    return 0;
+}
+
+void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[1024];
+    const char *path = NULL;
+    int pst = lpvp_get_string(j, "path", 0, 4096, &path, NULL, err, sizeof err);
+    if (pst == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    load_work *w = calloc(1, sizeof *w);
+    if (!w) {
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    w->request_id = r->request_id;
+    w->type = LPVP_SCENE_LOAD;
+    if (pst == LPVP_FIELD_OK) {
+        if (r->att_len) {
+            free(w);
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                      "path: give either \"path\" or a .glb attachment, not both");
+            return;
+        }
+        int rc = resolve_scene_path(c->srv, path, &w->path, err, sizeof err);
+        if (rc != 0) {
+            free(w);
+            sv_reply_err(c, r->request_id, rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
+            return;
+        }
+    } else {
+        if (!r->att_len) {
+            free(w);
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                      "path: required (a path under --scene-root), or send the .glb as the attachment");
+            return;
+        }
+        w->glb = r->att; /* take the attachment */
+        w->glb_size = r->att_len;
+        r->att = NULL;
+        r->att_len = 0;
+    }
+    if (start_load(c, w) != 0) {
+        free(w->path);
+        free(w->glb);
+        free(w);
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene load");
+    }
+}
+
+void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j)
+{
+    char err[512];
+    const json_t *nodes = NULL, *mats = NULL;
+    if (lpvp_get_array(j, "nodes", 0, 65536, &nodes, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_array(j, "materials", 0, 65536, &mats, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    /* materials: validated into a copy, applied only if all are good */
+    lpv_material *m = NULL;
+    if (mats && json_array_size(mats)) {
+        m = malloc(sizeof *m * (c->material_count ? c->material_count : 1));
+        if (!m) {
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        if (c->material_count)
+            memcpy(m, c->materials, sizeof *m * c->material_count);
+        for (size_t i = 0; i < json_array_size(mats); ++i) {
+            const json_t *e = json_array_get(mats, i);
+            int64_t idx;
+            int bad = 0;
+            if (!json_is_object(e)) {
+                snprintf(err, sizeof err, "materials[%zu]: expected an object", i);
+                bad = 1;
+            } else if (lpvp_get_int(e, "material", 1, 0, (int64_t)c->material_count - 1, &idx, err, sizeof err) !=
+                       LPVP_FIELD_OK) {
+                if (c->material_count == 0)
+                    snprintf(err, sizeof err, "material: the scene has no materials");
+                bad = 1;
+            } else {
+                lpv_material *t = &m[idx];
+                if (lpvp_get_floats(e, "base_color", 0, 4, 0.0, 1.0, t->base_color, err, sizeof err) ==
+                        LPVP_FIELD_BAD ||
+                    lpvp_get_floats(e, "emission", 0, 3, 0.0, 1e30, t->emission, err, sizeof err) == LPVP_FIELD_BAD ||
+                    lpvp_get_float(e, "metallic", 0, 0.0, 1.0, &t->metallic, err, sizeof err) == LPVP_FIELD_BAD ||
+                    lpvp_get_float(e, "roughness", 0, 0.0, 1.0, &t->roughness, err, sizeof err) == LPVP_FIELD_BAD)
+                    bad = 1;
+            }
+            if (bad) {
+                if (strncmp(err, "materials[", 10) != 0)
+                    lpvp_err_prefix(err, sizeof err, "materials[%zu].", i);
+                free(m);
+                sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+                return;
+            }
+        }
+    }
+    /* nodes: parsed into overrides; the scene is rebuilt from its bytes */
+    lpv_gltf_node_override *ov = NULL;
+    size_t nov = 0;
+    if (nodes && json_array_size(nodes)) {
+        if (!c->scene->glb) {
+            free(m);
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                      "nodes: the built-in scene has no glTF nodes; SCENE_LOAD a .glb first");
+            return;
+        }
+        nov = json_array_size(nodes);
+        ov = calloc(nov, sizeof *ov);
+        if (!ov) {
+            free(m);
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        for (size_t i = 0; i < nov; ++i) {
+            const json_t *e = json_array_get(nodes, i);
+            lpv_gltf_node_override *o = &ov[i];
+            int64_t idx;
+            int st[4];
+            if (!json_is_object(e)) {
+                snprintf(err, sizeof err, "nodes[%zu]: expected an object", i);
+                goto bad_node;
+            }
+            if (lpvp_get_int(e, "node", 1, 0, INT32_MAX, &idx, err, sizeof err) != LPVP_FIELD_OK)
+                goto bad_node_prefix;
+            o->node = (int)idx;
+            if ((st[0] = lpvp_get_floats(e, "matrix", 0, 16, -1e30, 1e30, o->matrix, err, sizeof err)) ==
+                    LPVP_FIELD_BAD ||
+                (st[1] = lpvp_get_floats(e, "translation", 0, 3, -1e30, 1e30, o->translation, err, sizeof err)) ==
+                    LPVP_FIELD_BAD ||
+                (st[2] = lpvp_get_floats(e, "rotation", 0, 4, -1e30, 1e30, o->rotation, err, sizeof err)) ==
+                    LPVP_FIELD_BAD ||
+                (st[3] = lpvp_get_floats(e, "scale", 0, 3, -1e30, 1e30, o->scale, err, sizeof err)) ==
+                    LPVP_FIELD_BAD)
+                goto bad_node_prefix;
+            o->has_matrix = st[0] == LPVP_FIELD_OK;
+            o->has_translation = st[1] == LPVP_FIELD_OK;
+            o->has_rotation = st[2] == LPVP_FIELD_OK;
+            o->has_scale = st[3] == LPVP_FIELD_OK;
+            if (o->has_matrix && (o->has_translation || o->has_rotation || o->has_scale)) {
+                snprintf(err, sizeof err, "matrix: give either \"matrix\" or translation/rotation/scale");
+                goto bad_node_prefix;
+            }
+            continue;
+        bad_node_prefix:
+            lpvp_err_prefix(err, sizeof err, "nodes[%zu].", i);
+        bad_node:
+            free(ov);
+            free(m);
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+            return;
+        }
+    }
+    if (!ov) {
+        if (m) {
+            free(c->materials);
+            c->materials = m;
+        }
+        sv_session_changed(c);
+        sv_reply(c, LPVP_SCENE_UPDATE, r->request_id, sv_rev_body(c));
+        return;
+    }
+    load_work *w = calloc(1, sizeof *w);
+    uint8_t *glb = malloc(c->scene->glb_size ? c->scene->glb_size : 1);
+    char *bd = c->scene->base_dir ? strdup(c->scene->base_dir) : NULL;
+    if (!w || !glb || (c->scene->base_dir && !bd)) {
+        free(w);
+        free(glb);
+        free(bd);
+        free(ov);
+        free(m);
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+        return;
+    }
+    memcpy(glb, c->scene->glb, c->scene->glb_size);
+    /* materials: apply now (the rebuilt scene keeps the session's material list) */
+    if (m) {
+        free(c->materials);
+        c->materials = m;
+    }
+    w->request_id = r->request_id;
+    w->type = LPVP_SCENE_UPDATE;
+    w->glb = glb;
+    w->glb_size = c->scene->glb_size;
+    w->base_dir = bd;
+    w->nodes = ov;
+    w->node_count = nov;
+    /* the overrides the scene already has come first (later ones win) */
+    if (c->scene->node_count) {
+        lpv_gltf_node_override *all = calloc(c->scene->node_count + nov, sizeof *all);
+        if (!all) {
+            free(w->glb);
+            free(w->base_dir);
+            free(w->nodes);
+            free(w);
+            sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
+            return;
+        }
+        memcpy(all, c->scene->nodes, sizeof *all * c->scene->node_count);
+        memcpy(all + c->scene->node_count, ov, sizeof *all * nov);
+        free(w->nodes);
+        w->nodes = all;
+        w->node_count = c->scene->node_count + nov;
+    }
+    if (start_load(c, w) != 0) {
+        free(w->glb);
+        free(w->base_dir);
+        free(w->nodes);
+        free(w);
+        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene rebuild");
+    }
+}

@@ -1,0 +1,73 @@
+/*
+ * serve_session_internal.h - what the files of the session layer share, and
+ * nothing outside it includes (serve.h is the daemon's common header):
+ *
+ *   serve_session.c   session state, replies, dispatch, the request pump
+ *   serve_hello.c     HELLO and the token check
+ *   serve_scene.c     SCENE_LOAD, SCENE_UPDATE and their load worker
+ *   serve_controls.c  LIGHT_SET, LIGHT_REMOVE, CAMERA_SET, CONFIG
+ *   serve_results.c   TICK, GET_VOLUME, GET_FRAME, QUERY_IRRADIANCE, STATS
+ *                     and the replies of GL jobs
+ *   serve_streams.c   SUBSCRIBE, UNSUBSCRIBE, ACK and the VOLUME / FRAME
+ *                     streams after each tick
+ *
+ * Everything here runs on the loop thread. Each sv_do_* handles one request
+ * type for dispatch (serve_session.c): it either replies before it returns or
+ * marks the session busy and replies later (R3.2).
+ */
+#ifndef LPVD_SERVE_SESSION_INTERNAL_H
+#define LPVD_SERVE_SESSION_INTERNAL_H
+
+#include "serve.h"
+
+/* The names of formats, compressions, terms and streams are the protocol
+ * library's (volume_codec.h, through serve.h), indexed by its enums. */
+
+/* the side of the default view, used until CAMERA_SET gives a size */
+#define SV_DEFAULT_VIEW_SIDE 256
+
+/* ---- replies (serve_session.c) ---- */
+/* ERROR reply; closes the connection when the code does (R3.4), unless
+ * noclose (HELLO's BAD_VERSION, R4.1). */
+void sv_reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+void sv_reply(sv_conn *c, uint16_t type, uint32_t rid, json_t *body); /* body NULL: {} */
+json_t *sv_rev_body(sv_conn *c); /* {"revision": the session's} */
+
+/* ---- session state (serve_session.c) ---- */
+/* The scene's lights with clean names (their ids). NULL when it has none. */
+lpv_light *sv_named_lights(const lpv_scene *sc, int *fail);
+/* Takes the scene (a reference) as the session's, with its materials and
+ * lights; resets the camera unless an explicit one was set. */
+int sv_session_set_scene(sv_conn *c, sv_scene *sc);
+/* After any change of the session's inputs: a new revision and the world of
+ * the new inputs. */
+void sv_session_changed(sv_conn *c);
+
+/* ---- shapes shared by several replies ---- */
+json_t *sv_config_json(sv_conn *c); /* CONFIG and STATS "config" (serve_controls.c) */
+/* GET_FRAME's and SUBSCRIBE frame's "exposure" and "transparent"
+ * (serve_results.c) */
+int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n);
+
+/* ---- what the world reports, through sv_world_listener (serve.h) ---- */
+void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id); /* serve_results.c */
+void sv_session_stream(sv_conn *c, sv_result *r);                     /* serve_streams.c */
+
+/* ---- one handler per request type ---- */
+void sv_do_hello(sv_conn *c, sv_request *r, json_t *j);        /* serve_hello.c */
+void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j);   /* serve_scene.c */
+void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j);    /* serve_controls.c */
+void sv_do_light_remove(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_camera_set(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_config(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_tick(sv_conn *c, sv_request *r);                    /* serve_results.c */
+void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_query(sv_conn *c, sv_request *r, json_t *j);
+void sv_do_stats(sv_conn *c, sv_request *r);
+void sv_do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on); /* serve_streams.c; on 0: UNSUBSCRIBE */
+void sv_do_ack(sv_conn *c, sv_request *r, json_t *j);
+
+#endif
