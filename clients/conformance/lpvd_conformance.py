@@ -1369,6 +1369,7 @@ def c_config_preset_bad(ctx):
 # says CONFIG accepts, CONFIG accepts, and what it says is out of range or of
 # the wrong type, CONFIG refuses naming the knob.
 KNOB_TYPES = ("int", "number", "bool")
+KNOB_TOUCHES = ["volume", "samples", "shadows", "shading"]
 
 
 def _knobs(ctx):
@@ -1393,6 +1394,11 @@ def _knobs(ctx):
             check(_same(k["type"], lo, lo) and _same(k["type"], hi, hi) and lo <= hi,
                   "R4.12: knob %s: min %r / max %r are not %ss with min <= max" % (k["name"], lo, hi, k["type"]))
             check(isinstance(k.get("min_exclusive"), bool), "R4.12: knob %s has no boolean min_exclusive" % k["name"])
+        check(isinstance(k.get("technique"), str), "R4.12: knob %s has no string technique" % k["name"])
+        t = k.get("touches")
+        check(isinstance(t, list) and t and all(x in KNOB_TOUCHES for x in t)
+              and t == sorted(t, key=KNOB_TOUCHES.index),
+              "R4.12: knob %s: touches %r is not a non-empty subset of %r in that order" % (k["name"], t, KNOB_TOUCHES))
     presets = ctx.hello_reply.get("presets")
     check(isinstance(presets, list) and presets and all(isinstance(p, str) for p in presets),
           "R4.12: HELLO reply has no non-empty \"presets\" array of names: %r" % (presets,))
@@ -1443,6 +1449,37 @@ def c_knob_description(ctx):
     for p in presets:
         _preset_config(c, {"preset": p})
     return "%d knobs, %d presets (%s)" % (len(knobs), len(presets), ", ".join(presets))
+
+
+@case("R4.12 R4.13", "a knob that touches only the shading leaves the next TICK's volume as it was; one that "
+      "touches the volume recomputes it")
+def c_knob_touches(ctx):
+    c, knobs, _ = _knobs(ctx)
+    shading = [k for k in knobs if k["touches"] == ["shading"] and k["type"] != "bool"]
+    volume = [k for k in knobs if "volume" in k["touches"] and k["type"] == "int" and k["name"] == "iterations"]
+    check(shading, "R4.12: no number knob touches only the shading")
+    c, _, _ = ctx.scene_session(light=unique_light("touch"))
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    a = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    k = shading[0]
+    v = k["max"] if k["max"] != k["default"] else k["min"]
+    _preset_config(c, {k["name"]: v})
+    t = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    plan = (t.body.get("stats") or {}).get("plan") or {}
+    check(plan.get("recompute") is False,
+          "CONFIG %s touches only the shading, yet the TICK recomputed: %r" % (k["name"], plan.get("recompute_reason")))
+    b = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    check(b.att == a.att, "CONFIG %s (touches shading only) changed the volume" % k["name"])
+    said = "%s -> cached volume (%s)" % (k["name"], plan.get("recompute_reason"))
+    if volume:
+        k = volume[0]
+        _preset_config(c, {k["name"]: k["default"] + 1 if k["default"] < k["max"] else k["default"] - 1})
+        t = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+        plan = (t.body.get("stats") or {}).get("plan") or {}
+        check(plan.get("recompute") is True, "CONFIG %s touches the volume, yet the TICK served the cached one"
+              % k["name"])
+        said += "; %s -> %s" % (k["name"], plan.get("recompute_reason"))
+    return said
 
 
 @case("R4.12 R4.11", "CONFIG accepts every described knob across its described range and echoes it resolved")
