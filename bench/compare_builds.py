@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""compare_builds.py - this build's lpvd-bench against an earlier build's, on
+one machine in one run, as per-stage ratios.
+
+Machines drift (other jobs, turbo, thermal state), so absolute times from
+different days do not compare. This runs the two benches alternately, A B A
+B ..., with the same arguments, and for every configuration and stage prints
+the median of the per-round ratios new/old (below 1: the new build is
+faster) beside both medians.
+
+    python3 bench/compare_builds.py --old ../old/build/bench/lpvd-bench \\
+        --new build/bench/lpvd-bench --rounds 5 -- --repeat 5 --warmup 2
+
+An earlier build: `git worktree add ../old REV && cmake -S ../old -B
+../old/build -DCMAKE_BUILD_TYPE=RelWithDebInfo && cmake --build ../old/build
+--target lpvd-bench`. Standard library only; prints Markdown.
+"""
+import argparse
+import re
+import statistics
+import subprocess
+import sys
+
+SECTION = re.compile(r"^## (.*)$")
+ROW = re.compile(r"^\| (\*\*)?([a-z_]+)(\*\*)? \| (\*\*)?([0-9.]+)(\*\*)? \|$")
+
+
+def parse(text):
+    """{configuration: {stage: ms}} from lpvd-bench's Markdown."""
+    out, current = {}, None
+    for line in text.splitlines():
+        m = SECTION.match(line)
+        if m:
+            current = out.setdefault(m.group(1).strip(), {})
+            continue
+        m = ROW.match(line.strip())
+        if m and current is not None:
+            current[m.group(2)] = float(m.group(5))
+    return out
+
+
+def run(binary, args):
+    p = subprocess.run([binary] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        sys.exit("compare_builds: %s exited with %d:\n%s" % (binary, p.returncode, p.stderr[-2000:]))
+    return parse(p.stdout), p.stdout.splitlines()[0] if p.stdout else ""
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--old", required=True, help="the earlier build's lpvd-bench")
+    ap.add_argument("--new", required=True, help="this build's lpvd-bench")
+    ap.add_argument("--rounds", type=int, default=5, help="A/B rounds (default 5)")
+    ap.add_argument("bench_args", nargs="*", help="after --: arguments for both benches")
+    a = ap.parse_args()
+    if a.rounds < 1:
+        ap.error("--rounds must be at least 1")
+    olds, news, head = [], [], ""
+    for i in range(a.rounds):
+        o, _ = run(a.old, a.bench_args)
+        n, head = run(a.new, a.bench_args)
+        olds.append(o)
+        news.append(n)
+        print("compare_builds: round %d/%d done" % (i + 1, a.rounds), file=sys.stderr)
+    print("# new / old, %d alternating rounds, medians of per-round ratios" % a.rounds)
+    print()
+    print("new: `%s`, old: `%s`, arguments `%s`" % (a.new, a.old, " ".join(a.bench_args)))
+    print()
+    print(head.lstrip("# "))
+    for conf in news[0]:
+        if not all(conf in o for o in olds):
+            print("\n## %s\n\n(not measured by the old build)" % conf)
+            continue
+        print("\n## %s\n" % conf)
+        print("| stage | old ms (median) | new ms (median) | new / old (median of rounds) |")
+        print("|---|---:|---:|---:|")
+        for stage in news[0][conf]:
+            pairs = [(o[conf].get(stage), n[conf].get(stage)) for o, n in zip(olds, news)]
+            pairs = [(x, y) for x, y in pairs if x is not None and y is not None]
+            if not pairs:
+                print("| %s | – | %.2f | new stage |" % (stage, statistics.median(n[conf][stage] for n in news)))
+                continue
+            ratios = [y / x for x, y in pairs if x > 0]
+            print("| %s | %.2f | %.2f | %s |" % (stage, statistics.median(x for x, _ in pairs),
+                                               statistics.median(y for _, y in pairs),
+                                               "%.3f" % statistics.median(ratios) if ratios else "–"))
+
+
+if __name__ == "__main__":
+    main()
