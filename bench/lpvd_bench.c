@@ -126,11 +126,11 @@ int main(int argc, char **argv)
         lpv_settings s = opt.settings;
         if (configs[c].grid) {
             s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = configs[c].grid;
-            s.iterations = configs[c].iterations;
+            s.lpv.iterations = configs[c].iterations;
             s.rsm_size = configs[c].rsm;
         }
         if (configs[c].paper)
-            s.central_transport = s.normal_bins = s.far_field = s.scene_surfels = LPV_SWITCH_OFF;
+            s.lpv.central_transport = s.lpv.normal_bins = s.lpv.far_field = s.scene_surfels = LPV_SWITCH_OFF;
         lpv_settings_resolve(&s);
         if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0 || lpv_engine_set_scene(e, &scene, err, sizeof err) ||
             lpv_engine_set_view(e, &view, err, sizeof err) != 0) {
@@ -169,7 +169,7 @@ int main(int argc, char **argv)
         const lpv_engine_stats *st = lpv_engine_last_stats(e);
         char letters[5];
         printf("## %s: %d^3 cells, %d iterations, RSM %d^2, occlusion %s, departures %s (%d cascades)\n\n",
-               configs[c].grid ? "the paper's pipeline" : lpv_preset_name(s.preset), s.grid_dims[0], s.iterations,
+               configs[c].grid ? "the paper's pipeline" : lpv_preset_name(s.preset), s.grid_dims[0], s.lpv.iterations,
                s.rsm_size, st->occlusion ? "on" : "off", lpv_settings_departures(&s, letters), st->cascades);
         printf("| stage | GPU ms (median) |\n|---|---:|\n");
         double prop_ms = 0.0;

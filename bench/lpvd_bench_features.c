@@ -126,10 +126,10 @@ static int run_config(lpv_engine *e, const lpv_scene *scene, const lpv_view *vie
 {
     char err[1024];
     lpv_settings s = opt->settings;
-    s.cascades = c->cascades;
+    s.lpv.cascades = c->cascades;
     if (c->cascades > 1)
-        s.cascade_size = bs->cascade_size;
-    s.bounces = c->bounces ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+        s.lpv.cascade_size = bs->cascade_size;
+    s.lpv.bounces = c->bounces ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
     if (c->glossy >= 0)
         s.glossy = c->glossy ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
     s.fog_sigma_s = c->fog_sigma_s;
@@ -245,7 +245,7 @@ static int run_planner(lpv_engine *e, const lpv_scene *scene, const lpv_view *vi
         lpv_settings s = opt->settings;
         s.planner = m == 0 ? LPV_SWITCH_OFF : LPV_SWITCH_ON;
         if (m == 0)
-            s.cascades = cascades;
+            s.lpv.cascades = cascades;
         if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0 || lpv_engine_set_scene(e, scene, err, sizeof err) ||
             lpv_engine_set_view(e, view, err, sizeof err) != 0)
             goto mode_fail;
@@ -432,8 +432,8 @@ int main(int argc, char **argv)
             printf("# lpvd-bench-features: backend %s, GL_RENDERER %s, image %dx%d, median of %d ticks after %d "
                    "warm-up; %d^3, %d iterations, RSM %d^2, occlusion %s, departures %s unless stated\n",
                    lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), view.width,
-                   view.height, repeat, warmup, base.grid_dims[0], base.iterations, base.rsm_size,
-                   base.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&base, departures));
+                   view.height, repeat, warmup, base.grid_dims[0], base.lpv.iterations, base.rsm_size,
+                   base.lpv.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&base, departures));
             printed_header = 1;
         }
         float *rgba = malloc((size_t)view.width * view.height * 4 * sizeof(float));

@@ -71,9 +71,9 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
         for (int i = 0; i < 3; ++i)
             anchor[i] = enters ? eye[i] + forward[i] * t0 : fmin(fmax(eye[i], bmin[i]), bmax[i]);
     }
-    const double offset = s->cascade_offset > 0.0f ? s->cascade_offset : 0.0;
+    const double offset = s->lpv.cascade_offset > 0.0f ? s->lpv.cascade_offset : 0.0;
     double cell = (double)lpv_cascade_finest_size(s, bmin, bmax) / longest;
-    for (int k = 0; k < count; ++k, cell *= s->cascade_ratio) {
+    for (int k = 0; k < count; ++k, cell *= s->lpv.cascade_ratio) {
         lpv_grid *g = &out->grid[k];
         memcpy(g->dims, s->grid_dims, sizeof g->dims);
         g->cell_size = (float)cell;
@@ -96,22 +96,22 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     }
     out->count = count;
     out->snapped = 1;
-    out->handoff = s->far_field == LPV_SWITCH_ON && s->cascade_ratio == 2.0f;
+    out->handoff = s->lpv.far_field == LPV_SWITCH_ON && s->lpv.cascade_ratio == 2.0f;
     return 0;
 }
 
 int lpv_cascades_count(const lpv_settings *s, int count)
 {
-    if (count != 1 || s->far_field != LPV_SWITCH_ON)
+    if (count != 1 || s->lpv.far_field != LPV_SWITCH_ON)
         return count;
-    int levels = s->far_field_levels < 0 ? 0 : s->far_field_levels;
+    int levels = s->lpv.far_field_levels < 0 ? 0 : s->lpv.far_field_levels;
     return 1 + levels < LPV_MAX_CASCADES ? 1 + levels : LPV_MAX_CASCADES;
 }
 
 float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3])
 {
-    if (s->cascade_size > 0.0f)
-        return s->cascade_size;
+    if (s->lpv.cascade_size > 0.0f)
+        return s->lpv.cascade_size;
     float longest = 0.0f;
     for (int i = 0; i < 3; ++i)
         longest = fmaxf(longest, bmax[i] - bmin[i]);

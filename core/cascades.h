@@ -30,7 +30,7 @@ typedef struct lpv_cascade_set {
     lpv_grid grid[4];             /* LPV_MAX_CASCADES; cascade 0 the finest */
     float origin_cells[4][3];     /* each grid's origin / cell_size; whole numbers when snapped */
     int snapped;                  /* 1: camera-following, snapped cascades; 0: one grid over bounds */
-    int handoff;                  /* 1: far field (settings.far_field on): cascade k + 1 carries on the
+    int handoff;                  /* 1: far field (settings.lpv.far_field on): cascade k + 1 carries on the
                                      light of cascade k; every cascade's cells are unions of 2^3 of
                                      the next finer one's */
 } lpv_cascade_set;
@@ -40,7 +40,7 @@ typedef struct lpv_cascade_set {
  * camera). Returns 0, or -1 when a grid cannot be placed (non-finite input,
  * dims out of range).
  *
- * Far field (s->far_field on, L = s->far_field_levels): one grid over the bounds gets L coarser
+ * Far field (s->lpv.far_field on, L = s->lpv.far_field_levels): one grid over the bounds gets L coarser
  * levels around it, level k with cells 2^k times the grid's and the same
  * dims, its origin (o_{k-1} - floor(dims / 2)) / 2 in its own cells so its
  * cells are unions of 2^3 cells of level k - 1 (at most LPV_MAX_CASCADES in

@@ -37,22 +37,22 @@ int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reas
         say(reason, n, "the settings fix the grid bounds: one grid over them");
         return 1;
     }
-    if (s->cascades > 0) {
-        say(reason, n, "cascades = %d set explicitly", s->cascades);
-        return s->cascades;
+    if (s->lpv.cascades > 0) {
+        say(reason, n, "cascades = %d set explicitly", s->lpv.cascades);
+        return s->lpv.cascades;
     }
     if (s->planner == LPV_SWITCH_OFF) {
         say(reason, n, "planner off: the default %d cascades", LPV_DEFAULT_CASCADES);
         return LPV_DEFAULT_CASCADES;
     }
-    if (s->cascade_size > 0.0f) { /* an explicit size in m: the scene fits in it or not */
-        if (f->scene_extent <= s->cascade_size) {
+    if (s->lpv.cascade_size > 0.0f) { /* an explicit size in m: the scene fits in it or not */
+        if (f->scene_extent <= s->lpv.cascade_size) {
             say(reason, n, "the scene (%.3g m) fits in the finest cascade (%.3g m): one grid over the scene",
-                (double)f->scene_extent, (double)s->cascade_size);
+                (double)f->scene_extent, (double)s->lpv.cascade_size);
             return 1;
         }
         say(reason, n, "the scene (%.3g m) is larger than the finest cascade (%.3g m)", (double)f->scene_extent,
-            (double)s->cascade_size);
+            (double)s->lpv.cascade_size);
         return LPV_DEFAULT_CASCADES;
     }
     /* cascade_size auto (relative to the scene): cascades pay where the camera
@@ -145,7 +145,7 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
     else
         decide(p, LPV_PASS_MEDIA, 1, "the scene has a participating medium");
 
-    const int occlusion = s->occlusion == LPV_SWITCH_ON;
+    const int occlusion = s->lpv.occlusion == LPV_SWITCH_ON;
     const int gv = occlusion && (all || f->occluder_triangles > 0);
     const int camera_in_gv = gv && f->has_view;
     p->recompute = needs_recompute(s, f, camera_in_gv, p->recompute_reason, sizeof p->recompute_reason);
@@ -194,21 +194,21 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
     else
         decide(p, LPV_PASS_GBUFFER, 1, "camera surfels for the geometry volume");
 
-    if (s->iterations == 0)
+    if (s->lpv.iterations == 0)
         decide(p, LPV_PASS_PROPAGATE, 0, "iterations = 0");
     else if (!inject)
         decide(p, LPV_PASS_PROPAGATE, 0, "nothing injected");
     else
-        decide(p, LPV_PASS_PROPAGATE, 1, "%d steps in %d cascades", s->iterations, p->cascades);
+        decide(p, LPV_PASS_PROPAGATE, 1, "%d steps in %d cascades", s->lpv.iterations, p->cascades);
 
-    if (s->bounces != LPV_SWITCH_ON)
+    if (s->lpv.bounces != LPV_SWITCH_ON)
         decide(p, LPV_PASS_BOUNCE, 0, "bounces off");
     else if (!p->pass[LPV_PASS_GV].run)
         decide(p, LPV_PASS_BOUNCE, 0, "needs the geometry volume, which does not run");
     else if (!p->pass[LPV_PASS_PROPAGATE].run)
         decide(p, LPV_PASS_BOUNCE, 0, "propagation does not run");
     else
-        decide(p, LPV_PASS_BOUNCE, 1, "bounces on, intensity %.2f", (double)s->bounce_intensity);
+        decide(p, LPV_PASS_BOUNCE, 1, "bounces on, intensity %.2f", (double)s->lpv.bounce_intensity);
 
     p->consumes.emissive_vpls = p->pass[LPV_PASS_EMISSIVE].run;
     p->consumes.surfels = p->pass[LPV_PASS_GV].run;

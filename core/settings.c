@@ -3,9 +3,9 @@
  *
  * Zero means "default" for every field, so a zero-initialised struct is a
  * valid configuration after lpv_settings_resolve(). The one consequence to
- * know: iterations = 0 resolves to the preset's iteration count.
+ * know: lpv.iterations = 0 resolves to the preset's iteration count.
  * Injection-only runs (0 steps) are valid for lpv_settings_validate(),
- * but only when the caller skips resolve or sets iterations after it.
+ * but only when the caller skips resolve or sets lpv.iterations after it.
  */
 #include "settings.h"
 
@@ -73,19 +73,19 @@ int lpv_preset_settings(lpv_preset p, lpv_settings *out)
         return -1;
     *out = (lpv_settings){.preset = p == LPV_PRESET_DEFAULT ? LPV_PRESET_BALANCED : p,
                           .grid_dims = {r->grid, r->grid, r->grid},
-                          .iterations = r->iterations,
+                          .lpv.iterations = r->iterations,
                           .rsm_size = r->rsm_size,
-                          .occlusion = r->occlusion,
-                          .central_transport = r->central_transport,
-                          .normal_bins = r->normal_bins,
-                          .far_field = r->far_field,
+                          .lpv.occlusion = r->occlusion,
+                          .lpv.central_transport = r->central_transport,
+                          .lpv.normal_bins = r->normal_bins,
+                          .lpv.far_field = r->far_field,
                           .scene_surfels = r->scene_surfels};
     return 0;
 }
 
 const char *lpv_settings_departures(const lpv_settings *s, char buf[5])
 {
-    const lpv_switch on[4] = {s->central_transport, s->normal_bins, s->far_field, s->scene_surfels};
+    const lpv_switch on[4] = {s->lpv.central_transport, s->lpv.normal_bins, s->lpv.far_field, s->scene_surfels};
     for (int i = 0; i < 4; ++i)
         buf[i] = on[i] == LPV_SWITCH_ON ? "cbfs"[i] : '-';
     buf[4] = '\0';
@@ -119,9 +119,9 @@ lpv_preset lpv_preset_match(const lpv_settings *s)
     for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_; ++p) {
         const preset_row *r = &PRESETS[p];
         if (s->grid_dims[0] == r->grid && s->grid_dims[1] == r->grid && s->grid_dims[2] == r->grid &&
-            s->iterations == r->iterations && s->rsm_size == r->rsm_size && s->occlusion == r->occlusion &&
-            s->central_transport == r->central_transport && s->normal_bins == r->normal_bins &&
-            s->far_field == r->far_field && s->scene_surfels == r->scene_surfels)
+            s->lpv.iterations == r->iterations && s->rsm_size == r->rsm_size && s->lpv.occlusion == r->occlusion &&
+            s->lpv.central_transport == r->central_transport && s->lpv.normal_bins == r->normal_bins &&
+            s->lpv.far_field == r->far_field && s->scene_surfels == r->scene_surfels)
             return (lpv_preset)p;
     }
     return LPV_PRESET_DEFAULT;
@@ -137,18 +137,18 @@ void lpv_settings_resolve(lpv_settings *s)
             if (s->grid_dims[i] == 0)
                 s->grid_dims[i] = p.grid_dims[i];
         }
-        if (s->iterations == 0)
-            s->iterations = p.iterations;
+        if (s->lpv.iterations == 0)
+            s->lpv.iterations = p.lpv.iterations;
         if (s->rsm_size == 0)
             s->rsm_size = p.rsm_size;
-        if (s->occlusion == LPV_SWITCH_DEFAULT)
-            s->occlusion = p.occlusion;
-        if (s->central_transport == LPV_SWITCH_DEFAULT)
-            s->central_transport = p.central_transport;
-        if (s->normal_bins == LPV_SWITCH_DEFAULT)
-            s->normal_bins = p.normal_bins;
-        if (s->far_field == LPV_SWITCH_DEFAULT)
-            s->far_field = p.far_field;
+        if (s->lpv.occlusion == LPV_SWITCH_DEFAULT)
+            s->lpv.occlusion = p.lpv.occlusion;
+        if (s->lpv.central_transport == LPV_SWITCH_DEFAULT)
+            s->lpv.central_transport = p.lpv.central_transport;
+        if (s->lpv.normal_bins == LPV_SWITCH_DEFAULT)
+            s->lpv.normal_bins = p.lpv.normal_bins;
+        if (s->lpv.far_field == LPV_SWITCH_DEFAULT)
+            s->lpv.far_field = p.lpv.far_field;
         if (s->scene_surfels == LPV_SWITCH_DEFAULT)
             s->scene_surfels = p.scene_surfels;
     }
@@ -159,14 +159,14 @@ void lpv_settings_resolve(lpv_settings *s)
     if (s->emissive_vpls == 0)
         s->emissive_vpls = LPV_DEFAULT_EMISSIVE_VPLS;
     /* cascade_size 0 stays 0: auto, relative to the scene (lpv_cascade_finest_size) */
-    if (s->cascade_ratio == 0.0f)
-        s->cascade_ratio = LPV_DEFAULT_CASCADE_RATIO;
-    if (s->cascade_offset == 0.0f)
-        s->cascade_offset = LPV_DEFAULT_CASCADE_OFFSET; /* a negative value stays: it means 0 (none) */
-    if (s->bounces == LPV_SWITCH_DEFAULT)
-        s->bounces = LPV_SWITCH_OFF;
-    if (s->bounce_intensity == 0.0f)
-        s->bounce_intensity = 1.0f;
+    if (s->lpv.cascade_ratio == 0.0f)
+        s->lpv.cascade_ratio = LPV_DEFAULT_CASCADE_RATIO;
+    if (s->lpv.cascade_offset == 0.0f)
+        s->lpv.cascade_offset = LPV_DEFAULT_CASCADE_OFFSET; /* a negative value stays: it means 0 (none) */
+    if (s->lpv.bounces == LPV_SWITCH_DEFAULT)
+        s->lpv.bounces = LPV_SWITCH_OFF;
+    if (s->lpv.bounce_intensity == 0.0f)
+        s->lpv.bounce_intensity = 1.0f;
     if (s->glossy == LPV_SWITCH_DEFAULT)
         s->glossy = LPV_SWITCH_ON;
     if (s->glossy_roughness == 0.0f)
@@ -177,10 +177,10 @@ void lpv_settings_resolve(lpv_settings *s)
         s->media_step = LPV_DEFAULT_MEDIA_STEP;
     if (s->planner == LPV_SWITCH_DEFAULT)
         s->planner = LPV_SWITCH_ON;
-    if (s->far_field_levels == 0)
-        s->far_field_levels = LPV_DEFAULT_FAR_FIELD_LEVELS;
-    if (s->far_field_steps == 0)
-        s->far_field_steps = LPV_DEFAULT_FAR_FIELD_STEPS;
+    if (s->lpv.far_field_levels == 0)
+        s->lpv.far_field_levels = LPV_DEFAULT_FAR_FIELD_LEVELS;
+    if (s->lpv.far_field_steps == 0)
+        s->lpv.far_field_steps = LPV_DEFAULT_FAR_FIELD_STEPS;
     if (s->scene_surfel_count == 0)
         s->scene_surfel_count = LPV_DEFAULT_SCENE_SURFEL_COUNT;
     if (s->area_lights == LPV_SWITCH_DEFAULT)
@@ -235,18 +235,19 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
             return fail(err, err_size, "grid_dims[%d] = %d is out of range (allowed 1..%d)", i, s->grid_dims[i],
                         LPV_MAX_GRID_DIM);
     }
-    if (s->iterations < 0 || s->iterations > LPV_MAX_ITERATIONS)
+    if (s->lpv.iterations < 0 || s->lpv.iterations > LPV_MAX_ITERATIONS)
         return fail(err, err_size, "iterations = %d is out of range (allowed 0..%d; 0 = injection only)",
-                    s->iterations, LPV_MAX_ITERATIONS);
+                    s->lpv.iterations, LPV_MAX_ITERATIONS);
     if (s->rsm_size < LPV_MIN_RSM_SIZE || s->rsm_size > LPV_MAX_RSM_SIZE)
         return fail(err, err_size, "rsm_size = %d is out of range (allowed %d..%d)", s->rsm_size, LPV_MIN_RSM_SIZE,
                     LPV_MAX_RSM_SIZE);
     if (s->shadow_size < LPV_MIN_SHADOW_SIZE || s->shadow_size > LPV_MAX_SHADOW_SIZE)
         return fail(err, err_size, "shadow_size = %d is out of range (allowed %d..%d)", s->shadow_size,
                     LPV_MIN_SHADOW_SIZE, LPV_MAX_SHADOW_SIZE);
-    if (s->occlusion != LPV_SWITCH_DEFAULT && s->occlusion != LPV_SWITCH_ON && s->occlusion != LPV_SWITCH_OFF)
+    if (s->lpv.occlusion != LPV_SWITCH_DEFAULT && s->lpv.occlusion != LPV_SWITCH_ON &&
+        s->lpv.occlusion != LPV_SWITCH_OFF)
         return fail(err, err_size, "occlusion = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
-                    (int)s->occlusion);
+                    (int)s->lpv.occlusion);
     if (!isfinite(s->indirect_gain) || s->indirect_gain < 0.0f)
         return fail(err, err_size, "indirect_gain = %g is out of range (allowed finite and >= 0)",
                     (double)s->indirect_gain);
@@ -256,39 +257,40 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->scene_surfel_count < 1 || s->scene_surfel_count > (1 << 22))
         return fail(err, err_size, "scene_surfel_count = %d is out of range (allowed 1..%d)", s->scene_surfel_count,
                     1 << 22);
-    if (s->far_field_levels < 1 || s->far_field_levels > LPV_MAX_CASCADES - 1)
-        return fail(err, err_size, "far_field_levels = %d is out of range (allowed 1..%d)", s->far_field_levels,
+    if (s->lpv.far_field_levels < 1 || s->lpv.far_field_levels > LPV_MAX_CASCADES - 1)
+        return fail(err, err_size, "far_field_levels = %d is out of range (allowed 1..%d)", s->lpv.far_field_levels,
                     LPV_MAX_CASCADES - 1);
-    if (s->far_field_steps < 1 || s->far_field_steps > LPV_MAX_ITERATIONS)
-        return fail(err, err_size, "far_field_steps = %d is out of range (allowed 1..%d)", s->far_field_steps,
+    if (s->lpv.far_field_steps < 1 || s->lpv.far_field_steps > LPV_MAX_ITERATIONS)
+        return fail(err, err_size, "far_field_steps = %d is out of range (allowed 1..%d)", s->lpv.far_field_steps,
                     LPV_MAX_ITERATIONS);
-    if (s->cascades < 0 || s->cascades > LPV_MAX_CASCADES)
-        return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->cascades,
+    if (s->lpv.cascades < 0 || s->lpv.cascades > LPV_MAX_CASCADES)
+        return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->lpv.cascades,
                     LPV_MAX_CASCADES);
-    if (!isfinite(s->cascade_size) || s->cascade_size < 0.0f || s->cascade_size > 1e6f)
+    if (!isfinite(s->lpv.cascade_size) || s->lpv.cascade_size < 0.0f || s->lpv.cascade_size > 1e6f)
         return fail(err, err_size, "cascade_size = %g m is out of range (allowed 0 = auto, or > 0 and <= 1e6)",
-                    (double)s->cascade_size);
-    if (!isfinite(s->cascade_ratio) || s->cascade_ratio < 1.25f || s->cascade_ratio > 8.0f)
-        return fail(err, err_size, "cascade_ratio = %g is out of range (allowed 1.25..8)", (double)s->cascade_ratio);
-    if (!isfinite(s->cascade_offset) || s->cascade_offset > 0.5f)
+                    (double)s->lpv.cascade_size);
+    if (!isfinite(s->lpv.cascade_ratio) || s->lpv.cascade_ratio < 1.25f || s->lpv.cascade_ratio > 8.0f)
+        return fail(err, err_size, "cascade_ratio = %g is out of range (allowed 1.25..8)",
+                    (double)s->lpv.cascade_ratio);
+    if (!isfinite(s->lpv.cascade_offset) || s->lpv.cascade_offset > 0.5f)
         return fail(err, err_size, "cascade_offset = %g is out of range (allowed <= 0.5; negative = 0)",
-                    (double)s->cascade_offset);
+                    (double)s->lpv.cascade_offset);
     const struct {
         const char *name;
         lpv_switch v;
-    } switches[] = {{"bounces", s->bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
-                    {"central_transport", s->central_transport}, {"normal_bins", s->normal_bins},
-                    {"far_field", s->far_field}, {"scene_surfels", s->scene_surfels},
+    } switches[] = {{"bounces", s->lpv.bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
+                    {"central_transport", s->lpv.central_transport}, {"normal_bins", s->lpv.normal_bins},
+                    {"far_field", s->lpv.far_field}, {"scene_surfels", s->scene_surfels},
                     {"area_lights", s->area_lights}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
             return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
                         switches[i].name, (int)switches[i].v);
-    if (!isfinite(s->bounce_intensity) || s->bounce_intensity < 0.0f || s->bounce_intensity > 1.0f)
+    if (!isfinite(s->lpv.bounce_intensity) || s->lpv.bounce_intensity < 0.0f || s->lpv.bounce_intensity > 1.0f)
         return fail(err, err_size, "bounce_intensity = %g is out of range (allowed 0..1; above 1 would create "
-                    "energy)", (double)s->bounce_intensity);
-    if (!isfinite(s->damping) || s->damping < 0.0f || s->damping > 1.0f)
-        return fail(err, err_size, "damping = %g is out of range (allowed 0..1; 0 = off)", (double)s->damping);
+                    "energy)", (double)s->lpv.bounce_intensity);
+    if (!isfinite(s->lpv.damping) || s->lpv.damping < 0.0f || s->lpv.damping > 1.0f)
+        return fail(err, err_size, "damping = %g is out of range (allowed 0..1; 0 = off)", (double)s->lpv.damping);
     if (!isfinite(s->glossy_roughness) || s->glossy_roughness < 0.0f || s->glossy_roughness > 1.0f)
         return fail(err, err_size, "glossy_roughness = %g is out of range (allowed 0..1)",
                     (double)s->glossy_roughness);

@@ -29,18 +29,13 @@ typedef enum lpv_preset {
     LPV_PRESET_COUNT_ /* one past the last; not a preset */
 } lpv_preset;
 
-typedef struct lpv_settings {
-    int grid_dims[3];       /* cells per axis; default: the preset's */
-    float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
-    float bounds_max[3];    /*   bounds grown by half a cell on every side */
+/* The cascaded LPV's own knobs (LPV_TECHNIQUE_LPV, gpu/lpv/; the first
+ * seed): how its volume propagates, occludes, cascades and is read. Every
+ * technique gets a struct like this one inside lpv_settings, zero meaning
+ * "the default" as everywhere. */
+typedef struct lpv_lpv_settings {
     int iterations;         /* propagation steps; default: the preset's */
-    int rsm_size;           /* reflective shadow map side, texels; default: the preset's */
-    int shadow_size;        /* side of each light face's shadow map for direct light, texels;
-                               default LPV_DEFAULT_SHADOW_SIZE (docs/shadows.md) */
     lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default: the preset's (on) */
-    float indirect_gain;    /* artistic factor on the LPV term; default 1 (0 = default) */
-    int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
-    lpv_preset preset;      /* supplies the four defaults marked "the preset's"; default balanced */
 
     /* Cascades (cascaded-LPV paper, section 4; docs/cascades.md). Every cascade
      * has grid_dims cells; cascade k's cells are cascade_ratio^k times the
@@ -56,26 +51,14 @@ typedef struct lpv_settings {
                                the view direction, as a fraction of its extent; default 0.25,
                                negative = 0 (centred on the camera) */
 
-    /* Section 7 effects and damping (section 3.4); docs/effects.md. */
+    /* Section 7's multiple bounces and section 3.4's damping; docs/effects.md. */
     lpv_switch bounces;     /* multiple bounces off the geometry volume's blockers; default off */
     float bounce_intensity; /* factor on the blockers' albedo (1 = physical); default 1 */
     float damping;          /* directional-derivative damping strength; 0 = off (default) */
-    lpv_switch glossy;      /* glossy reflections by marching the LPV; default on (run
-                               only when the scene has a glossy material) */
-    float glossy_roughness; /* materials with roughness below this are glossy; default 0.3 */
-    lpv_switch media;       /* participating media single scattering; default on (run only
-                               when the scene or the fog settings give a medium) */
-    float fog_sigma_s;      /* 1/m, homogeneous fog scattering coefficient; 0 = none (the
-                               scene's own medium, if any) */
-    float fog_sigma_a;      /* 1/m, homogeneous fog absorption coefficient; 0 = none */
-    float media_step;       /* ray-march step as a fraction of the cascade's cell; default 0.5 */
 
-    lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
-                               unchanged volume; off: run every pass every tick */
-
-    /* Transport, occlusion and lookup (docs/propagation.md sections 3b, 4b, 5b
-     * and 6b): measured departures from the paper. The preset supplies the
-     * four switches' defaults. */
+    /* Transport and lookup (docs/propagation.md sections 4b, 5b and 6b):
+     * measured departures from the paper. The preset supplies the three
+     * switches' defaults. */
     lpv_switch central_transport; /* re-emit each face's flux along the face's central direction
                                      instead of its normal */
     lpv_switch normal_bins;       /* one volume per dominant normal axis of the emitters, so a
@@ -88,15 +71,48 @@ typedef struct lpv_settings {
     int far_field_steps;          /* steps each level but the coarsest takes before handing its light
                                      on; the coarsest takes the rest of the iterations, so more
                                      iterations only add steps there; default 1 */
+} lpv_lpv_settings;
+
+/* Everything the engine is told: the volume's resolution and bounds, the
+ * shared producers (RSMs, shadow maps, samples of the scene), the shading's
+ * effects, the planner, and one nested struct per GI technique. */
+typedef struct lpv_settings {
+    int grid_dims[3];       /* cells per axis; default: the preset's */
+    float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
+    float bounds_max[3];    /*   bounds grown by half a cell on every side */
+    int rsm_size;           /* reflective shadow map side, texels; default: the preset's */
+    int shadow_size;        /* side of each light face's shadow map for direct light, texels;
+                               default LPV_DEFAULT_SHADOW_SIZE (docs/shadows.md) */
+    float indirect_gain;    /* artistic factor on the indirect term; default 1 (0 = default) */
+    int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
+    lpv_preset preset;      /* supplies the defaults marked "the preset's"; default balanced */
+
+    /* Effects read at render time (docs/effects.md). */
+    lpv_switch glossy;      /* glossy reflections by marching the volume; default on (run
+                               only when the scene has a glossy material) */
+    float glossy_roughness; /* materials with roughness below this are glossy; default 0.3 */
+    lpv_switch media;       /* participating media single scattering; default on (run only
+                               when the scene or the fog settings give a medium) */
+    float fog_sigma_s;      /* 1/m, homogeneous fog scattering coefficient; 0 = none (the
+                               scene's own medium, if any) */
+    float fog_sigma_a;      /* 1/m, homogeneous fog absorption coefficient; 0 = none */
+    float media_step;       /* ray-march step as a fraction of the volume's cell; default 0.5 */
+
+    lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
+                               unchanged volume; off: run every pass every tick */
+
+    /* Samples of the scene for occlusion (docs/propagation.md section 3b). */
     lpv_switch scene_surfels;     /* surfels sampled over every triangle join the geometry volume, so
-                                     walls no view sees still block */
+                                     walls no view sees still block; default: the preset's */
     int scene_surfel_count;       /* how many; default 65536 */
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     lpv_switch area_lights; /* on (default): emitters light the scene directly through
                                area_light_samples shadow-mapped samples and stop injecting
                                their own VPLs; off: emitters reach the scene only as
-                               emissive_vpls VPLs in the LPV */
+                               emissive_vpls VPLs in the volume */
     int area_light_samples; /* samples the emitters are reduced to; default 8 */
+
+    lpv_lpv_settings lpv;   /* the cascaded LPV's knobs (LPV_TECHNIQUE_LPV) */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the

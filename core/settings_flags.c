@@ -125,8 +125,8 @@ const char *lpv_settings_flags_help(void)
         lpv_preset_settings((lpv_preset)p, &s);
         char letters[5];
         lpv_flags_append(help, sz, &len, "%28s%-10sgrid %d, %d iterations, RSM %d, occlusion %s, departures %s\n", "",
-                         lpv_preset_name((lpv_preset)p), s.grid_dims[0], s.iterations, s.rsm_size,
-                         s.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&s, letters));
+                         lpv_preset_name((lpv_preset)p), s.grid_dims[0], s.lpv.iterations, s.rsm_size,
+                         s.lpv.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&s, letters));
     }
     lpv_flags_help(help, sz, &len, &OWN_SYNTAX[1], N_OWN - 1);
     lpv_flags_append(help, sz, &len,

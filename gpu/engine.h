@@ -141,7 +141,7 @@ typedef enum lpv_grid_which {
 /* Every cascade's cells, cascade 0 first (cascade k starts at k * cells of one
  * cascade); with one cascade simply the grid. */
 size_t lpv_engine_read_grid(lpv_engine *e, lpv_grid_which which, lpv_cell *out, size_t max);
-/* With normal bins on (settings.normal_bins) each cascade holds
+/* With normal bins on (settings.lpv.normal_bins) each cascade holds
  * lpv_engine_bins() volumes, bin b of cascade k at (k * bins + b) * cells of
  * one cascade; read_grid returns their sum per cascade (the physical field),
  * read_volumes every volume as stored. With bins off the two agree. */

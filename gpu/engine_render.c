@@ -111,7 +111,7 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
     glUseProgram(e->prog_query);
     glUniform1i(glGetUniformLocation(e->prog_query, "u_count"), (GLint)n);
-    e->tech->cls->bind_lookup(e->tech, e->prog_query, e->settings.damping);
+    e->tech->cls->bind_lookup(e->tech, e->prog_query, e->settings.lpv.damping);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
     glDispatchCompute(lpv_div_up(n, 64), 1, 1);

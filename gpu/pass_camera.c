@@ -185,7 +185,7 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(e->prog_shade);
-    e->tech->cls->bind_lookup(e->tech, e->prog_shade, e->settings.damping);
+    e->tech->cls->bind_lookup(e->tech, e->prog_shade, e->settings.lpv.damping);
     glUniform1f(glGetUniformLocation(e->prog_shade, "u_glossy_roughness"),
                 e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
                                                                                   : 0.0f);

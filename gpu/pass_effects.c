@@ -47,7 +47,7 @@ void lpv_pass_glossy_run(lpv_engine *e)
     glBlendFunc(GL_ONE, GL_ONE);
     glUseProgram(e->prog_glossy);
     glUniform1f(glGetUniformLocation(e->prog_glossy, "u_glossy_roughness"), e->settings.glossy_roughness);
-    e->tech->cls->bind_lookup(e->tech, e->prog_glossy, e->settings.damping);
+    e->tech->cls->bind_lookup(e->tech, e->prog_glossy, e->settings.lpv.damping);
     draw_fullscreen(e);
     lpv_timer_end(&e->timer);
 }

@@ -198,9 +198,9 @@ static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_setting
     }
     st->preset = p.preset;
     memset(st->grid_dims, 0, sizeof st->grid_dims);
-    st->iterations = 0;
+    st->lpv.iterations = 0;
     st->rsm_size = 0;
-    st->occlusion = LPV_SWITCH_DEFAULT;
+    st->lpv.occlusion = LPV_SWITCH_DEFAULT;
     return LPVP_FIELD_OK;
 }
 

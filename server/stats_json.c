@@ -95,8 +95,8 @@ json_t *lpvd_stats_json(const lpv_engine *e, const lpv_gl_context *ctx, const ch
     /* preset: the one the settings started from; explicit flags may have overridden its values */
     const char *preset = lpv_preset_name(set->preset);
     json_t *settings = json_pack("{s:s, s:i, s:i, s:i, s:b, s:f, s:i}", "preset", preset ? preset : "", "iterations",
-                                 set->iterations, "rsm_size", set->rsm_size, "shadow_size", set->shadow_size,
-                                 "occlusion", set->occlusion == LPV_SWITCH_ON, "indirect_gain",
+                                 set->lpv.iterations, "rsm_size", set->rsm_size, "shadow_size", set->shadow_size,
+                                 "occlusion", set->lpv.occlusion == LPV_SWITCH_ON, "indirect_gain",
                                  (double)set->indirect_gain, "emissive_vpls", set->emissive_vpls);
     json_t *extra = json_pack("{s:s, s:s, s:s, s:s, s:o}", "backend", lpv_backend_name(lpv_gl_context_backend(ctx)),
                               "gl_renderer", lpv_gl_context_renderer(ctx), "gl_version",

@@ -303,7 +303,7 @@ static void test_energy_no_double_count(void **state)
      * what reaches it (the point-to-square form factor of a 20 m floor 1 m
      * below: 0.9969), and nothing from the emitter itself */
     const double caught = 4.0 * corner(big, big, HEIGHT) / M_PI;
-    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 256, .cascades = 1}; /* all of it in one grid */
+    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 256, .lpv.cascades = 1}; /* all of it in one grid */
     run(&s, set, NULL);
     double on = injected_flux();
     const lpv_plan *p = lpv_engine_last_plan(lpvt_engine);

@@ -164,12 +164,12 @@ static void test_paper_configuration_shows_the_pattern(void **state)
 {
     (void)state;
     lpv_settings s = {.grid_dims = {32, 32, 32},
-                      .iterations = 4,
+                      .lpv.iterations = 4,
                       .rsm_size = 128,
-                      .occlusion = LPV_SWITCH_ON,
-                      .central_transport = LPV_SWITCH_OFF,
-                      .normal_bins = LPV_SWITCH_OFF,
-                      .far_field = LPV_SWITCH_OFF,
+                      .lpv.occlusion = LPV_SWITCH_ON,
+                      .lpv.central_transport = LPV_SWITCH_OFF,
+                      .lpv.normal_bins = LPV_SWITCH_OFF,
+                      .lpv.far_field = LPV_SWITCH_OFF,
                       .scene_surfels = LPV_SWITCH_OFF};
     pattern w = worst_pattern(&s, "paper", 1);
     assert_true(w.black > 0.05);

@@ -1,5 +1,5 @@
 /*
- * test_bounces.c - multiple bounces (settings.bounces, paper section 7)
+ * test_bounces.c - multiple bounces (settings.lpv.bounces, paper section 7)
  * through the real GL pipeline (llvmpipe in CI): a closed 2 m box lit from
  * inside by a point light (whose RSM gives the geometry volume its blockers
  * and their albedo) and an emissive panel (light that does not depend on the
@@ -52,10 +52,10 @@ static lpv_settings box_settings(int iterations, lpv_switch bounces, float inten
     lpv_settings s = {0};
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
-    s.iterations = iterations;
-    s.occlusion = LPV_SWITCH_ON;
-    s.bounces = bounces;
-    s.bounce_intensity = intensity;
+    s.lpv.iterations = iterations;
+    s.lpv.occlusion = LPV_SWITCH_ON;
+    s.lpv.bounces = bounces;
+    s.lpv.bounce_intensity = intensity;
     /* The panel's light must enter the LPV itself (as VPLs) for these tests,
      * which watch what the propagation does with it; with area lights on it
      * would light the box directly and only the walls' reflection would. */
@@ -82,7 +82,7 @@ static double run(const lpv_scene *scene, lpv_settings s, double *acc_flux)
         fail_msg("%s", err);
     const lpv_plan *p = lpv_engine_last_plan(lpvt_engine);
     assert_true(p->pass[LPV_PASS_GV].run);
-    assert_int_equal(p->pass[LPV_PASS_BOUNCE].run, s.bounces == LPV_SWITCH_ON);
+    assert_int_equal(p->pass[LPV_PASS_BOUNCE].run, s.lpv.bounces == LPV_SWITCH_ON);
     size_t n = lpv_grid_cell_count(lpv_engine_grid(lpvt_engine)) * (size_t)lpv_engine_cascade_count(lpvt_engine);
     lpv_cell *acc = calloc(n, sizeof *acc), *last = calloc(n, sizeof *last);
     assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, acc, n), n);

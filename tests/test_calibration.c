@@ -262,10 +262,10 @@ static void wall_probe_profile(int paper)
     float lpvd[3][K];
     float cell = 0.0f;
     for (int it = 0; it < 3; it++) {
-        lpv_settings set = {.iterations = iters[it]};
+        lpv_settings set = {.lpv.iterations = iters[it]};
         if (paper) {
             set.grid_dims[0] = set.grid_dims[1] = set.grid_dims[2] = 32;
-            set.central_transport = set.normal_bins = set.far_field = set.scene_surfels = LPV_SWITCH_OFF;
+            set.lpv.central_transport = set.lpv.normal_bins = set.lpv.far_field = set.scene_surfels = LPV_SWITCH_OFF;
         }
         engine_run(&s, &set, NULL);
         cell = lpv_engine_grid(lpvt_engine)->cell_size;

@@ -31,12 +31,12 @@ static lpv_settings room_settings(void)
     lpv_settings s = {0};
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 64;
-    s.iterations = 4;
-    s.cascade_size = 8.0f; /* explicit: 0.5, 1 and 2 m cells */
+    s.lpv.iterations = 4;
+    s.lpv.cascade_size = 8.0f; /* explicit: 0.5, 1 and 2 m cells */
     /* the cascaded-LPV paper's cascades: each holds its own injected light and the lookup blends them across
      * borders (far field off), one volume per cascade read with the plain SH lookup (normal bins off) */
-    s.far_field = LPV_SWITCH_OFF;
-    s.normal_bins = LPV_SWITCH_OFF;
+    s.lpv.far_field = LPV_SWITCH_OFF;
+    s.lpv.normal_bins = LPV_SWITCH_OFF;
     return s; /* cascades 0 = auto: 3, the room (20 m) being larger than 8 m */
 }
 
@@ -99,7 +99,7 @@ static void check_placement_and_volumes(int departures)
     build_room(&scene, NULL, NULL, 0);
     lpv_settings s = room_settings();
     if (departures)
-        s.far_field = s.normal_bins = LPV_SWITCH_DEFAULT;
+        s.lpv.far_field = s.lpv.normal_bins = LPV_SWITCH_DEFAULT;
     lpv_view v = room_view();
     load(&scene, &s, &v);
     assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 3);
@@ -141,8 +141,8 @@ static void test_placement_and_volumes(void **state)
     check_placement_and_volumes(0);
     check_placement_and_volumes(1);
     const lpv_settings *r = lpv_engine_settings(lpvt_engine);
-    assert_int_equal(r->far_field, LPV_SWITCH_ON); /* the second run did check the departures */
-    assert_int_equal(r->normal_bins, LPV_SWITCH_ON);
+    assert_int_equal(r->lpv.far_field, LPV_SWITCH_ON); /* the second run did check the departures */
+    assert_int_equal(r->lpv.normal_bins, LPV_SWITCH_ON);
 }
 
 /* E (red) at p facing n from cascade k alone, on the CPU (core/oracle_lookup.c: the same lookup as lookup.glsl's

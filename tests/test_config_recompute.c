@@ -222,7 +222,7 @@ static void test_shading_knob_uploads_and_propagates_nothing(void **state)
     float *before = render();
     const lpv_engine_counters c0 = counters();
 
-    s.damping = 0.5f;
+    s.lpv.damping = 0.5f;
     s.indirect_gain = 2.0f;
     settings(&s);
     const lpv_plan *p = tick();
@@ -290,7 +290,7 @@ static void test_volume_knob_recomputes_without_upload(void **state)
     lpv_settings s = small_settings();
     start(&room, &s);
     const lpv_engine_counters c0 = counters();
-    s.iterations = 6;
+    s.lpv.iterations = 6;
     settings(&s);
     const lpv_plan *p = tick();
     assert_true(p->recompute);

@@ -73,7 +73,7 @@ static lpv_view room_view(void)
 
 static lpv_settings small_settings(void)
 {
-    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 4};
+    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4};
     return set;
 }
 
@@ -228,7 +228,7 @@ static void test_media_removes_energy(void **state)
     lpv_view v = room_view();
     float *rgba = malloc(sizeof(float) * W * H * 4);
     lpv_settings set = small_settings();
-    set.iterations = 12;
+    set.lpv.iterations = 12;
     double last[3], acc[3];
     const float sigma[3] = {0.0f, 0.2f, 1.0f};
     for (int i = 0; i < 3; ++i) {

@@ -63,7 +63,7 @@ static void test_order_values_and_groups(void **state)
     assert_string_equal(log, "pos=a.glb output=x.exr full pos=b.glb n=-3 output=y.exr pos=--not-a-flag ");
     assert_int_equal(s.grid_dims[0], 16);
     assert_int_equal(s.grid_dims[2], 4);
-    assert_int_equal(s.iterations, 7);
+    assert_int_equal(s.lpv.iterations, 7);
     assert_int_equal(c.has_eye, 1);
     assert_true(c.eye[2] == 3.0f);
     assert_memory_equal(argv, args, sizeof args); /* not permuted */

@@ -52,7 +52,7 @@ static int teardown(void **state)
 static lpv_settings paper_unless_set(const lpv_settings *in)
 {
     lpv_settings s = *in;
-    lpv_switch *sw[] = {&s.central_transport, &s.normal_bins, &s.far_field, &s.scene_surfels};
+    lpv_switch *sw[] = {&s.lpv.central_transport, &s.lpv.normal_bins, &s.lpv.far_field, &s.scene_surfels};
     for (size_t i = 0; i < sizeof sw / sizeof sw[0]; ++i)
         if (*sw[i] == LPV_SWITCH_DEFAULT)
             *sw[i] = LPV_SWITCH_OFF;
@@ -101,7 +101,7 @@ static void assert_close(const char *what, const float *gpu, const float *ref, s
 static void test_injection_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 4, .occlusion = LPV_SWITCH_OFF};
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF};
     tick(f, &s, 0);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
@@ -135,7 +135,7 @@ static float *blocking_of(const lpv_gv_point *gv, size_t n)
 static void test_geometry_volume_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 4, .occlusion = LPV_SWITCH_ON};
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_ON};
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t gv_n = lpv_grid_gv_count(g), cells = lpv_grid_cell_count(g);
@@ -193,7 +193,8 @@ static void test_geometry_volume_matches_oracle(void **state)
 
 static void check_propagation(fixture *f, lpv_switch occlusion, int iterations)
 {
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = iterations, .occlusion = occlusion};
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = iterations,
+                      .lpv.occlusion = occlusion};
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
@@ -229,7 +230,7 @@ static void test_propagation_matches_oracle(void **state)
 static void test_lookup_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 8};
+    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 8};
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
@@ -269,8 +270,9 @@ static void test_central_transport_matches_oracle(void **state)
 {
     fixture *f = *state;
     for (int occ = 0; occ < 2; ++occ) {
-        lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .iterations = 6,
-                          .occlusion = occ ? LPV_SWITCH_ON : LPV_SWITCH_OFF, .central_transport = LPV_SWITCH_ON};
+        lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 6,
+                          .lpv.occlusion = occ ? LPV_SWITCH_ON : LPV_SWITCH_OFF,
+                          .lpv.central_transport = LPV_SWITCH_ON};
         tick(f, &s, 1);
         const lpv_grid *g = lpv_engine_grid(f->engine);
         size_t cells = lpv_grid_cell_count(g);
@@ -305,8 +307,9 @@ static void test_central_transport_matches_oracle(void **state)
 static void test_normal_bins_match_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {12, 12, 12}, .rsm_size = 64, .iterations = 5, .occlusion = LPV_SWITCH_ON,
-                      .normal_bins = LPV_SWITCH_ON, .central_transport = LPV_SWITCH_ON};
+    lpv_settings s = {.grid_dims = {12, 12, 12}, .rsm_size = 64, .lpv.iterations = 5,
+                      .lpv.occlusion = LPV_SWITCH_ON,
+                      .lpv.normal_bins = LPV_SWITCH_ON, .lpv.central_transport = LPV_SWITCH_ON};
     tick(f, &s, 1);
     assert_int_equal(lpv_engine_bins(f->engine), LPV_NORMAL_BINS);
     const lpv_grid *g = lpv_engine_grid(f->engine);

@@ -53,7 +53,7 @@ static double tick_checked(const lpv_hard_scene *h, lpv_settings s, int with_vie
     const lpv_scene *scene = &h->scene;
     char err[1024] = "";
     if (paper)
-        s.central_transport = s.normal_bins = s.far_field = s.scene_surfels = LPV_SWITCH_OFF;
+        s.lpv.central_transport = s.lpv.normal_bins = s.lpv.far_field = s.scene_surfels = LPV_SWITCH_OFF;
     if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) != 0 ||
         lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) != 0)
         fail_msg("%s", err);
@@ -65,10 +65,10 @@ static double tick_checked(const lpv_hard_scene *h, lpv_settings s, int with_vie
     const lpv_grid *g = lpv_engine_grid(lpvt_engine);
     const lpv_settings *r = lpv_engine_settings(lpvt_engine);
     if (paper)
-        assert_true(r->far_field == LPV_SWITCH_OFF && r->normal_bins == LPV_SWITCH_OFF);
+        assert_true(r->lpv.far_field == LPV_SWITCH_OFF && r->lpv.normal_bins == LPV_SWITCH_OFF);
     else /* the hard cases leave the departures to the defaults: they are checked here */
-        assert_true(r->far_field == LPV_SWITCH_ON && r->normal_bins == LPV_SWITCH_ON &&
-                    r->central_transport == LPV_SWITCH_ON && r->scene_surfels == LPV_SWITCH_ON);
+        assert_true(r->lpv.far_field == LPV_SWITCH_ON && r->lpv.normal_bins == LPV_SWITCH_ON &&
+                    r->lpv.central_transport == LPV_SWITCH_ON && r->scene_surfels == LPV_SWITCH_ON);
     /* every cascade (far-field level), each the sum of its normal bins */
     size_t cells = lpv_grid_cell_count(g) * (size_t)lpv_engine_cascade_count(lpvt_engine);
     lpv_cell *acc = calloc(cells, sizeof *acc), *last = calloc(cells, sizeof *last);
@@ -99,7 +99,7 @@ static void assert_energy_non_increasing(const lpv_hard_scene *scene, lpv_settin
 {
     double prev = INFINITY;
     for (int k = 1; k <= steps; ++k) {
-        s.iterations = k;
+        s.lpv.iterations = k;
         double e = tick_checked(scene, s, 0);
         assert_true(e <= prev * (1.0 + 1e-6) + 1e-30);
         prev = e;
@@ -171,11 +171,11 @@ static void test_thousand_steps(void **state)
     paper = *(const int *)*state;
     lpv_hard_scene h;
     build("steps_1000", &h);
-    assert_int_equal(h.settings.iterations, 1000);
+    assert_int_equal(h.settings.lpv.iterations, 1000);
     lpv_settings set = h.settings;
-    set.iterations = 1;
+    set.lpv.iterations = 1;
     double first = tick_checked(&h, set, 0);
-    set.iterations = 1000;
+    set.lpv.iterations = 1000;
     double last = tick_checked(&h, set, 1);
     assert_true(first > 0.0);
     assert_true(last <= first * (1.0 + 1e-6));

@@ -121,8 +121,8 @@ static void test_lamp_in_closed_box(void **state)
 {
     (void)state;
     /* the paper's transport on a 32^3 grid: 12 cells of box */
-    lpv_settings fine = {.grid_dims = {32, 32, 32}, .iterations = 8, .central_transport = LPV_SWITCH_OFF,
-                         .far_field = LPV_SWITCH_OFF};
+    lpv_settings fine = {.grid_dims = {32, 32, 32}, .lpv.iterations = 8, .lpv.central_transport = LPV_SWITCH_OFF,
+                         .lpv.far_field = LPV_SWITCH_OFF};
     check(&fine, "32^3, 8 iterations, paper transport, no far field", 1.5f, 0.05);
     lpv_settings departures = {.grid_dims = {32, 32, 32}};
     check(&departures, "32^3, the default departures and iterations", 1.5f, 0.10);
@@ -152,9 +152,9 @@ static void test_scene_surfels_do_not_leak(void **state)
     (void)state;
     const lpv_switch ON = LPV_SWITCH_ON, OFF = LPV_SWITCH_OFF;
     const lpv_settings grids[2] = {
-        {.central_transport = OFF, .normal_bins = OFF, .far_field = OFF, .scene_surfels = OFF},
-        {.grid_dims = {32, 32, 32}, .iterations = 8, .central_transport = OFF, .normal_bins = OFF,
-         .far_field = OFF, .scene_surfels = OFF},
+        {.lpv.central_transport = OFF, .lpv.normal_bins = OFF, .lpv.far_field = OFF, .scene_surfels = OFF},
+        {.grid_dims = {32, 32, 32}, .lpv.iterations = 8, .lpv.central_transport = OFF, .lpv.normal_bins = OFF,
+         .lpv.far_field = OFF, .scene_surfels = OFF},
     };
     for (int k = 0; k < 2; ++k) {
         lpv_settings off = grids[k], on = grids[k];
@@ -177,11 +177,11 @@ static void test_leak_diagnosis(void **state)
         return;
     const lpv_switch ON = LPV_SWITCH_ON, OFF = LPV_SWITCH_OFF;
     lpv_settings v[5] = {
-        {.central_transport = OFF, .normal_bins = OFF, .far_field = OFF, .scene_surfels = OFF},
-        {.central_transport = ON, .normal_bins = OFF, .far_field = OFF, .scene_surfels = OFF},
-        {.central_transport = OFF, .normal_bins = ON, .far_field = OFF, .scene_surfels = OFF},
-        {.central_transport = OFF, .normal_bins = OFF, .far_field = ON, .scene_surfels = OFF},
-        {.central_transport = OFF, .normal_bins = OFF, .far_field = OFF, .scene_surfels = ON},
+        {.lpv.central_transport = OFF, .lpv.normal_bins = OFF, .lpv.far_field = OFF, .scene_surfels = OFF},
+        {.lpv.central_transport = ON, .lpv.normal_bins = OFF, .lpv.far_field = OFF, .scene_surfels = OFF},
+        {.lpv.central_transport = OFF, .lpv.normal_bins = ON, .lpv.far_field = OFF, .scene_surfels = OFF},
+        {.lpv.central_transport = OFF, .lpv.normal_bins = OFF, .lpv.far_field = ON, .scene_surfels = OFF},
+        {.lpv.central_transport = OFF, .lpv.normal_bins = OFF, .lpv.far_field = OFF, .scene_surfels = ON},
     };
     const char *names[5] = {"----", "c---", "-b--", "--f-", "---s"};
     for (int i = 0; i < 5; ++i) {
@@ -199,10 +199,10 @@ static void test_leak_diagnosis(void **state)
         double ind_open, dir_open, leak, dir, leak_paper, leak_near;
         floor_light(&x, 0, 1.5f, &ind_open, &dir_open);
         floor_light(&x, 1, 1.5f, &leak, &dir);
-        x.central_transport = OFF;
+        x.lpv.central_transport = OFF;
         floor_light(&x, 1, 1.5f, &leak_paper, &dir);
-        x.central_transport = ON;
-        x.far_field = OFF;
+        x.lpv.central_transport = ON;
+        x.lpv.far_field = OFF;
         floor_light(&x, 1, 1.5f, &leak_near, &dir);
         printf("defaults on %d^3 (3 m box = %.1f cells): leak %.1f %% of the open floor's direct; central transport "
                "off %.1f %%; far field off %.1f %%\n",

@@ -644,8 +644,8 @@ static void test_settings_ranges(void **state)
     lpv_settings_resolve(&s);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
     assert_int_equal(s.grid_dims[0], LPV_DEFAULT_GRID_DIM);
-    assert_int_equal(s.iterations, LPV_DEFAULT_ITERATIONS);
-    assert_int_equal(s.occlusion, LPV_SWITCH_ON);
+    assert_int_equal(s.lpv.iterations, LPV_DEFAULT_ITERATIONS);
+    assert_int_equal(s.lpv.occlusion, LPV_SWITCH_ON);
     assert_true(s.indirect_gain == 1.0f);
 
     lpv_settings bad;
@@ -659,10 +659,10 @@ static void test_settings_ranges(void **state)
     assert_non_null(strstr(err, "grid_dims[2]"));
     assert_non_null(strstr(err, "1..256"));
     bad = s;
-    bad.iterations = -1;
+    bad.lpv.iterations = -1;
     assert_int_equal(lpv_settings_validate(&bad, err, sizeof err), -1);
     assert_non_null(strstr(err, "iterations"));
-    bad.iterations = 0; /* injection only: valid when set after resolve */
+    bad.lpv.iterations = 0; /* injection only: valid when set after resolve */
     assert_int_equal(lpv_settings_validate(&bad, err, sizeof err), 0);
     bad = s;
     bad.rsm_size = 8;

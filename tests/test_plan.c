@@ -84,7 +84,7 @@ static void test_no_occluders_skips_gv_and_gbuffer(void **state)
     assert_true(p.pass[LPV_PASS_PROPAGATE].run); /* light still propagates, unoccluded */
     /* occlusion off skips them too, with its own reason */
     f.occluder_triangles = 12;
-    p = plan_of((lpv_settings){.occlusion = LPV_SWITCH_OFF}, f);
+    p = plan_of((lpv_settings){.lpv.occlusion = LPV_SWITCH_OFF}, f);
     assert_false(p.pass[LPV_PASS_GV].run);
     assert_false(p.pass[LPV_PASS_GBUFFER].run);
     assert_non_null(strstr(p.pass[LPV_PASS_GV].reason, "occlusion off"));
@@ -179,7 +179,7 @@ static void test_cascade_count(void **state)
     lpv_plan_facts f = baseline();
     /* cascade_size auto (the default): one grid without a camera or with the camera outside the scene, whatever
      * the scene's size (any unit scale); 3 with the camera inside it */
-    assert_true(s.cascade_size == 0.0f);
+    assert_true(s.lpv.cascade_size == 0.0f);
     f.scene_extent = 743.0f;
     assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), 1);
     assert_non_null(strstr(why, "no camera"));
@@ -198,25 +198,26 @@ static void test_cascade_count(void **state)
     assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
     assert_reason(why);
     /* an explicit cascade_size: fits (extent <= cascade_size; equality fits) or not, camera anywhere */
-    lpv_settings eight = resolved((lpv_settings){.cascade_size = 8.0f});
+    lpv_settings eight = resolved((lpv_settings){.lpv.cascade_size = 8.0f});
     f = baseline();
     f.scene_extent = 8.0f;
     assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), 1);
     f.scene_extent = 8.01f;
     assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
     /* the threshold follows cascade_size */
-    lpv_settings small = resolved((lpv_settings){.cascade_size = 2.0f});
+    lpv_settings small = resolved((lpv_settings){.lpv.cascade_size = 2.0f});
     f.scene_extent = 4.0f;
     assert_int_equal(lpv_plan_cascades(&small, &f, why, sizeof why), 3);
     /* explicit wins, both ways */
-    lpv_settings two = resolved((lpv_settings){.cascades = 2});
+    lpv_settings two = resolved((lpv_settings){.lpv.cascades = 2});
     f.scene_extent = 1.0f;
     assert_int_equal(lpv_plan_cascades(&two, &f, why, sizeof why), 2);
-    lpv_settings one = resolved((lpv_settings){.cascades = 1});
+    lpv_settings one = resolved((lpv_settings){.lpv.cascades = 1});
     f.scene_extent = 100.0f;
     assert_int_equal(lpv_plan_cascades(&one, &f, why, sizeof why), 1);
     /* bounds given: one grid over them, even when cascades are asked for */
-    lpv_settings bounds = resolved((lpv_settings){.cascades = 3, .bounds_min = {-1, -1, -1}, .bounds_max = {1, 1, 1}});
+    lpv_settings bounds =
+        resolved((lpv_settings){.lpv.cascades = 3, .bounds_min = {-1, -1, -1}, .bounds_max = {1, 1, 1}});
     f.bounds_given = 1;
     assert_int_equal(lpv_plan_cascades(&bounds, &f, why, sizeof why), 1);
     assert_non_null(strstr(why, "bounds"));
@@ -231,8 +232,8 @@ static void test_cascade_count(void **state)
     lpv_plan p1 = plan_of((lpv_settings){0}, f);
     assert_int_equal(p1.cascades, 1 + LPV_DEFAULT_FAR_FIELD_LEVELS);
     assert_non_null(strstr(p1.cascades_reason, "far field"));
-    assert_int_equal(plan_of((lpv_settings){.far_field = LPV_SWITCH_OFF}, f).cascades, 1);
-    assert_int_equal(plan_of((lpv_settings){.far_field_levels = 2}, f).cascades, 3);
+    assert_int_equal(plan_of((lpv_settings){.lpv.far_field = LPV_SWITCH_OFF}, f).cascades, 1);
+    assert_int_equal(plan_of((lpv_settings){.lpv.far_field_levels = 2}, f).cascades, 3);
 }
 
 static lpv_plan_facts steady(void)
@@ -254,7 +255,7 @@ static void assert_cached(const lpv_plan *p)
 static void test_recompute_rules(void **state)
 {
     (void)state;
-    lpv_settings on = {.bounces = LPV_SWITCH_ON};
+    lpv_settings on = {.lpv.bounces = LPV_SWITCH_ON};
     /* nothing changed: cached, with the reason */
     lpv_plan p = plan_of(on, steady());
     assert_cached(&p);
@@ -272,7 +273,7 @@ static void test_recompute_rules(void **state)
     assert_non_null(strstr(p.recompute_reason, "surfels"));
     assert_true(p.pass[LPV_PASS_GBUFFER].run && p.pass[LPV_PASS_GV].run && p.pass[LPV_PASS_PROPAGATE].run);
     /* 1.5 cells with occlusion off (camera not in the GV): cached */
-    p = plan_of((lpv_settings){.occlusion = LPV_SWITCH_OFF}, f);
+    p = plan_of((lpv_settings){.lpv.occlusion = LPV_SWITCH_OFF}, f);
     assert_cached(&p);
     /* 1.5 cells without occluders (no GV at all): cached */
     f.occluder_triangles = 0;
@@ -280,7 +281,7 @@ static void test_recompute_rules(void **state)
     assert_cached(&p);
     /* placement changed: recompute even with no GV */
     f.placement_changed = 1;
-    p = plan_of((lpv_settings){.occlusion = LPV_SWITCH_OFF}, f);
+    p = plan_of((lpv_settings){.lpv.occlusion = LPV_SWITCH_OFF}, f);
     assert_true(p.recompute);
     assert_non_null(strstr(p.recompute_reason, "cell"));
     /* each kind of change forces a recompute */
@@ -307,12 +308,12 @@ static void test_planner_off_runs_everything(void **state)
     f.occluder_triangles = 0;
     f.glossy_draws = 0;
     f.has_medium = 0;
-    lpv_plan p = plan_of((lpv_settings){.planner = LPV_SWITCH_OFF, .bounces = LPV_SWITCH_ON}, f);
+    lpv_plan p = plan_of((lpv_settings){.planner = LPV_SWITCH_OFF, .lpv.bounces = LPV_SWITCH_ON}, f);
     assert_true(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i)
         assert_true(p.pass[i].run);
     /* planner on, same facts: almost nothing runs */
-    p = plan_of((lpv_settings){.bounces = LPV_SWITCH_ON}, f);
+    p = plan_of((lpv_settings){.lpv.bounces = LPV_SWITCH_ON}, f);
     assert_false(p.recompute);
 }
 
@@ -320,14 +321,14 @@ static void test_bounce_needs_gv(void **state)
 {
     (void)state;
     lpv_plan_facts f = baseline();
-    lpv_settings s = {.bounces = LPV_SWITCH_ON};
+    lpv_settings s = {.lpv.bounces = LPV_SWITCH_ON};
     assert_true(plan_of(s, f).pass[LPV_PASS_BOUNCE].run);
     f.occluder_triangles = 0; /* no GV */
     lpv_plan p = plan_of(s, f);
     assert_false(p.pass[LPV_PASS_BOUNCE].run);
     assert_non_null(strstr(p.pass[LPV_PASS_BOUNCE].reason, "geometry volume"));
     f = baseline();
-    s.occlusion = LPV_SWITCH_OFF;
+    s.lpv.occlusion = LPV_SWITCH_OFF;
     assert_false(plan_of(s, f).pass[LPV_PASS_BOUNCE].run);
     /* bounces off: never */
     assert_false(plan_of((lpv_settings){0}, baseline()).pass[LPV_PASS_BOUNCE].run);
@@ -339,7 +340,8 @@ static void test_bounce_needs_gv(void **state)
  * to one grid over the scene, checked on its own below). */
 static lpv_settings cascade_settings(void)
 {
-    return resolved((lpv_settings){.grid_dims = {16, 16, 16}, .cascade_size = 8.0f, .far_field = LPV_SWITCH_OFF});
+    return resolved(
+        (lpv_settings){.grid_dims = {16, 16, 16}, .lpv.cascade_size = 8.0f, .lpv.far_field = LPV_SWITCH_OFF});
 }
 
 static const float BMIN[3] = {-10, 0, -10}, BMAX[3] = {10, 3, 10};
@@ -359,7 +361,7 @@ static void test_place_snapping_and_nesting(void **state)
         const lpv_grid *g = &set.grid[k];
         assert_memory_equal(g->dims, s.grid_dims, sizeof g->dims);
         if (k > 0) /* nesting: ratio (2) x the previous cell; 1e-6 relative: float rounding of the product */
-            assert_float_equal(g->cell_size, set.grid[k - 1].cell_size * s.cascade_ratio, 1e-6f * g->cell_size);
+            assert_float_equal(g->cell_size, set.grid[k - 1].cell_size * s.lpv.cascade_ratio, 1e-6f * g->cell_size);
         for (int i = 0; i < 3; ++i) {
             float oc = set.origin_cells[k][i];
             assert_float_equal(oc, floorf(oc), 0.0f); /* whole cells, exactly */
@@ -420,11 +422,11 @@ static void test_place_snapping_and_nesting(void **state)
      * coarser levels, each twice the previous cell, its cells unions of 2^3 of the previous level's and its
      * origin dims / 2 of the previous level's cells further out */
     lpv_settings ff = cascade_settings();
-    ff.far_field = LPV_SWITCH_ON;
-    assert_int_equal(resolved((lpv_settings){0}).far_field, LPV_SWITCH_ON);
+    ff.lpv.far_field = LPV_SWITCH_ON;
+    assert_int_equal(resolved((lpv_settings){0}).lpv.far_field, LPV_SWITCH_ON);
     lpv_cascade_set far;
     assert_int_equal(lpv_cascades_place(&ff, 1, BMIN, BMAX, eye, fwd, &far), 0);
-    assert_int_equal(far.count, 1 + ff.far_field_levels);
+    assert_int_equal(far.count, 1 + ff.lpv.far_field_levels);
     assert_false(far.snapped);
     assert_true(far.handoff);
     assert_memory_equal(&far.grid[0], &one.grid[0], sizeof far.grid[0]);

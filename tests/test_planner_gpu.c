@@ -31,7 +31,7 @@ static lpv_settings small_settings(void)
     lpv_settings s = {0};
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
-    s.iterations = 4;
+    s.lpv.iterations = 4;
     /* The emissive-only scene's black lamps must be the LPV's source (VPLs):
      * with area lights on they would light the (absent) surfaces directly and
      * the LPV would stay empty, making the volume comparisons vacuous. The
@@ -198,15 +198,15 @@ static void test_no_occluders_skips_gv(void **state)
         dc += planned[i].r[0];
     assert_true(dc > 0.0);
     /* equals occlusion off */
-    s.occlusion = LPV_SWITCH_OFF;
+    s.lpv.occlusion = LPV_SWITCH_OFF;
     lpv_cell *off = volume_of(&scene, s, &v, &n2);
     assert_int_equal(n, n2);
     assert_same_cells(planned, off, n);
     /* and the GV forced on (planner off, one cascade like the planner chose) without a camera: no surfels, the
      * empty GV transmits exactly 1 */
-    s.occlusion = LPV_SWITCH_ON;
+    s.lpv.occlusion = LPV_SWITCH_ON;
     s.planner = LPV_SWITCH_OFF;
-    s.cascades = 1;
+    s.lpv.cascades = 1;
     lpv_cell *forced = volume_of(&scene, s, NULL, &n3);
     assert_true(plan()->pass[LPV_PASS_GV].run);
     assert_stage_ran("gv");
@@ -246,7 +246,7 @@ static void test_nothing_glossy_no_medium_no_emissive(void **state)
     assert_no_stage("media");
 
     s.planner = LPV_SWITCH_OFF;
-    s.cascades = 1;
+    s.lpv.cascades = 1;
     lpv_cell *forced = volume_of(&scene, s, &v, &n2);
     p = plan();
     assert_true(p->pass[LPV_PASS_GLOSSY].run && p->pass[LPV_PASS_MEDIA].run && p->pass[LPV_PASS_EMISSIVE].run);
@@ -271,7 +271,7 @@ static void test_one_cascade_when_scene_fits(void **state)
     build_lit_room(&scene);
     lpv_view v = room_view(0);
     lpv_settings s = small_settings(); /* cascades auto; the room (2.1 m) fits in 8 m */
-    s.far_field = LPV_SWITCH_OFF;      /* the planner's choice of cascades alone (far field: below) */
+    s.lpv.far_field = LPV_SWITCH_OFF;      /* the planner's choice of cascades alone (far field: below) */
     size_t n, n2;
     lpv_cell *autos = volume_of(&scene, s, &v, &n);
     assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 1);
@@ -279,14 +279,14 @@ static void test_one_cascade_when_scene_fits(void **state)
     assert_int_equal(lpv_engine_last_stats(lpvt_engine)->cascades, 1);
     assert_int_equal(n, (size_t)DIM * DIM * DIM);
     lpv_grid g = *lpv_engine_grid(lpvt_engine);
-    s.cascades = 1;
+    s.lpv.cascades = 1;
     lpv_cell *explicit1 = volume_of(&scene, s, &v, &n2);
     assert_int_equal(n, n2);
     assert_memory_equal(&g, lpv_engine_grid(lpvt_engine), sizeof g);
     assert_same_cells(autos, explicit1, n);
     /* and a small cascade_size makes the same room use 3 */
-    s.cascades = 0;
-    s.cascade_size = 1.0f;
+    s.lpv.cascades = 0;
+    s.lpv.cascade_size = 1.0f;
     set_all(&scene, s, &v);
     tick();
     assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 3);
@@ -296,11 +296,11 @@ static void test_one_cascade_when_scene_fits(void **state)
     set_all(&scene, s, &v);
     tick();
     const lpv_settings *r = lpv_engine_settings(lpvt_engine);
-    assert_int_equal(r->far_field, LPV_SWITCH_ON);
-    assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 1 + r->far_field_levels);
-    assert_int_equal(plan()->cascades, 1 + r->far_field_levels);
+    assert_int_equal(r->lpv.far_field, LPV_SWITCH_ON);
+    assert_int_equal(lpv_engine_cascade_count(lpvt_engine), 1 + r->lpv.far_field_levels);
+    assert_int_equal(plan()->cascades, 1 + r->lpv.far_field_levels);
     assert_non_null(strstr(plan()->cascades_reason, "far field"));
-    assert_int_equal(lpv_engine_last_stats(lpvt_engine)->cascades, 1 + r->far_field_levels);
+    assert_int_equal(lpv_engine_last_stats(lpvt_engine)->cascades, 1 + r->lpv.far_field_levels);
     assert_memory_equal(&g, lpv_engine_cascade(lpvt_engine, 0), sizeof g); /* the finest level: the same grid */
     free(autos);
     free(explicit1);
@@ -378,7 +378,7 @@ static void test_no_occluders_forced_gv_with_camera(void **state)
     lpv_cell *planned = volume_of(&scene, s, &v, &n);
     assert_false(plan()->pass[LPV_PASS_GV].run);
     s.planner = LPV_SWITCH_OFF;
-    s.cascades = 1;
+    s.lpv.cascades = 1;
     lpv_cell *forced = volume_of(&scene, s, &v, &n2);
     assert_true(plan()->pass[LPV_PASS_GBUFFER].run && plan()->pass[LPV_PASS_GV].run);
     assert_int_equal(n, n2);

@@ -38,16 +38,16 @@ static void assert_knobs(const lpv_settings *s, int grid, int iterations, int rs
 {
     for (int i = 0; i < 3; ++i)
         assert_int_equal(s->grid_dims[i], grid);
-    assert_int_equal(s->iterations, iterations);
+    assert_int_equal(s->lpv.iterations, iterations);
     assert_int_equal(s->rsm_size, rsm_size);
-    assert_int_equal(s->occlusion, occlusion);
+    assert_int_equal(s->lpv.occlusion, occlusion);
 }
 
 static void assert_departures(const lpv_settings *s, const expected *e)
 {
-    assert_int_equal(s->central_transport, e->central_transport);
-    assert_int_equal(s->normal_bins, e->normal_bins);
-    assert_int_equal(s->far_field, e->far_field);
+    assert_int_equal(s->lpv.central_transport, e->central_transport);
+    assert_int_equal(s->lpv.normal_bins, e->normal_bins);
+    assert_int_equal(s->lpv.far_field, e->far_field);
     assert_int_equal(s->scene_surfels, e->scene_surfels);
 }
 
@@ -63,7 +63,7 @@ static void test_zero_resolves_to_balanced(void **state)
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
     /* the LPV_DEFAULT_* macros are the balanced preset */
     assert_int_equal(s.grid_dims[0], LPV_DEFAULT_GRID_DIM);
-    assert_int_equal(s.iterations, LPV_DEFAULT_ITERATIONS);
+    assert_int_equal(s.lpv.iterations, LPV_DEFAULT_ITERATIONS);
     assert_int_equal(s.rsm_size, LPV_DEFAULT_RSM_SIZE);
     assert_int_equal(s.emissive_vpls, LPV_DEFAULT_EMISSIVE_VPLS);
     assert_true(s.indirect_gain == 1.0f);
@@ -98,17 +98,17 @@ static void test_each_preset(void **state)
 static void test_explicit_fields_override(void **state)
 {
     (void)state;
-    lpv_settings s = {.preset = LPV_PRESET_FAST, .grid_dims = {64, 64, 64}, .occlusion = LPV_SWITCH_OFF};
+    lpv_settings s = {.preset = LPV_PRESET_FAST, .grid_dims = {64, 64, 64}, .lpv.occlusion = LPV_SWITCH_OFF};
     lpv_settings_resolve(&s);
     assert_int_equal(s.preset, LPV_PRESET_FAST);
     assert_knobs(&s, 64, 4, 128, LPV_SWITCH_OFF); /* iterations and rsm_size from fast */
     assert_int_equal(lpv_preset_match(&s), LPV_PRESET_DEFAULT); /* no preset has these values */
 
-    lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .iterations = 12, .rsm_size = 512, .normal_bins = OFF};
+    lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .lpv.iterations = 12, .rsm_size = 512, .lpv.normal_bins = OFF};
     lpv_settings_resolve(&t);
     assert_knobs(&t, PRESETS[2].grid, 12, 512, LPV_SWITCH_ON);
-    assert_int_equal(t.normal_bins, OFF); /* explicit wins over the preset's on */
-    assert_int_equal(t.far_field, ON);
+    assert_int_equal(t.lpv.normal_bins, OFF); /* explicit wins over the preset's on */
+    assert_int_equal(t.lpv.far_field, ON);
 }
 
 static void test_names_round_trip(void **state)

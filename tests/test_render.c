@@ -30,7 +30,7 @@ static void render(const lpv_scene *scene, lpv_frame_terms terms, lpv_view *view
      * default preset: at balanced's 4 steps light from the green wall barely
      * reaches the floor 2.3 cells away, and the warm spot keeps red ahead
      * of green there (docs/accuracy.md, "Presets"). */
-    lpv_settings s = {.iterations = 8, .rsm_size = 256};
+    lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256};
     lpv_view_from_camera(&scene->cameras[0], W, H, view);
     if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) ||
         lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) ||

@@ -72,7 +72,7 @@ static void test_table_well_formed(void **state)
     assert_null(lpv_field_by_key("grid"));
     assert_null(lpv_field_by_key("no_such_knob"));
     assert_null(lpv_field_by_flag("cascade_size")); /* flags are kebab-case */
-    assert_int_equal(lpv_field_by_key("damping")->offset, offsetof(lpv_settings, damping));
+    assert_int_equal(lpv_field_by_key("damping")->offset, offsetof(lpv_settings, lpv.damping));
     assert_int_equal(lpv_field_by_key("planner")->kind, LPV_FIELD_SWITCH);
     assert_int_equal(lpv_field_by_key("cascades")->kind, LPV_FIELD_INT);
 }
@@ -261,8 +261,8 @@ static void test_cli_flags(void **state)
     lpv_settings_resolve(&s);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
     assert_int_equal(s.preset, LPV_PRESET_FAST);
-    assert_true(s.cascade_size == 12.0f && s.bounces == LPV_SWITCH_ON && s.fog_sigma_s == 0.02f);
-    assert_int_equal(s.iterations, 4); /* the preset's */
+    assert_true(s.lpv.cascade_size == 12.0f && s.lpv.bounces == LPV_SWITCH_ON && s.fog_sigma_s == 0.02f);
+    assert_int_equal(s.lpv.iterations, 4); /* the preset's */
 }
 
 int main(void)

@@ -34,13 +34,13 @@ static lpv_settings temporal_settings(void)
 {
     lpv_settings s = {0};
     if (!departures)
-        s.far_field = s.normal_bins = LPV_SWITCH_OFF;
+        s.lpv.far_field = s.lpv.normal_bins = LPV_SWITCH_OFF;
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
-    s.iterations = ITER;
-    s.cascades = 3;
-    s.cascade_size = DIM * CELL0;
-    s.occlusion = LPV_SWITCH_OFF;
+    s.lpv.iterations = ITER;
+    s.lpv.cascades = 3;
+    s.lpv.cascade_size = DIM * CELL0;
+    s.lpv.occlusion = LPV_SWITCH_OFF;
     s.planner = LPV_SWITCH_OFF;
     return s;
 }
@@ -126,7 +126,7 @@ static void test_subcell_move_is_bit_identical(void **state)
     check_subcell_move_is_bit_identical();
     departures = 1;
     check_subcell_move_is_bit_identical();
-    assert_int_equal(lpv_engine_settings(lpvt_engine)->far_field, LPV_SWITCH_ON);
+    assert_int_equal(lpv_engine_settings(lpvt_engine)->lpv.far_field, LPV_SWITCH_ON);
     departures = 0;
 }
 

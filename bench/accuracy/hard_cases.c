@@ -77,7 +77,7 @@ static int point_light(lpv_scene *s, float x, float y, float z, float intensity)
 /* Room plus one light at the centre; the grid as given. */
 static int centred(lpv_hard_scene *h, float intensity, int gx, int gy, int gz, int iterations)
 {
-    h->settings = (lpv_settings){.grid_dims = {gx, gy, gz}, .rsm_size = 32, .iterations = iterations};
+    h->settings = (lpv_settings){.grid_dims = {gx, gy, gz}, .rsm_size = 32, .lpv.iterations = iterations};
     return make_room(&h->scene, NULL) < 0 ? -1 : point_light(&h->scene, 0.5f, 0.5f, 0.5f, intensity);
 }
 

@@ -77,7 +77,7 @@ typedef struct point {
     int mods;           /* MOD_* bits */
     /* --features (one factor at a time around balanced); all 0 for the classic sweep */
     int feat;           /* 1: a point of the features block */
-    int cascades;       /* settings.cascades (0 = auto) */
+    int cascades;       /* settings.lpv.cascades (0 = auto) */
     float cascade_size; /* m; 0 = default */
     int bounces;        /* 1 = on */
     float damping;      /* 0 = off */
@@ -86,7 +86,7 @@ typedef struct point {
 
 /* --features: the knob varied, around the balanced preset with one grid over
  * the scene (cascades 1), bounces off, damping 0. "cascades 3" uses the
- * scene's cascade size (scene_entry.cascade_size). */
+ * scene's cascade size (scene_entry.lpv.cascade_size). */
 typedef struct feature_def {
     const char *label;
     int cascades, bounces;
@@ -113,12 +113,12 @@ static lpv_switch on_off(int on)
 static lpv_settings point_settings(const point *p)
 {
     return (lpv_settings){.grid_dims = {p->grid, p->grid, p->grid},
-                          .iterations = p->iterations,
+                          .lpv.iterations = p->iterations,
                           .rsm_size = p->rsm,
-                          .occlusion = on_off(p->occlusion),
-                          .central_transport = on_off(p->mods & MOD_CENTRAL),
-                          .normal_bins = on_off(p->mods & MOD_BINS),
-                          .far_field = on_off(p->mods & MOD_FAR),
+                          .lpv.occlusion = on_off(p->occlusion),
+                          .lpv.central_transport = on_off(p->mods & MOD_CENTRAL),
+                          .lpv.normal_bins = on_off(p->mods & MOD_BINS),
+                          .lpv.far_field = on_off(p->mods & MOD_FAR),
                           .scene_surfels = on_off(p->mods & MOD_SURFELS)};
 }
 
@@ -138,8 +138,9 @@ static const char *mod_letters(void)
 
 static int mods_of_settings(const lpv_settings *s)
 {
-    return (s->central_transport == LPV_SWITCH_ON ? MOD_CENTRAL : 0) | (s->normal_bins == LPV_SWITCH_ON ? MOD_BINS : 0) |
-           (s->far_field == LPV_SWITCH_ON ? MOD_FAR : 0) | (s->scene_surfels == LPV_SWITCH_ON ? MOD_SURFELS : 0);
+    return (s->lpv.central_transport == LPV_SWITCH_ON ? MOD_CENTRAL : 0) |
+           (s->lpv.normal_bins == LPV_SWITCH_ON ? MOD_BINS : 0) | (s->lpv.far_field == LPV_SWITCH_ON ? MOD_FAR : 0) |
+           (s->scene_surfels == LPV_SWITCH_ON ? MOD_SURFELS : 0);
 }
 
 /* The named preset the point equals (settings.h), or "" when none: the sweep
@@ -160,7 +161,7 @@ static int preset_points(point *pts)
         lpv_settings s;
         if (lpv_preset_settings(order[i], &s) != 0)
             continue;
-        pts[n++] = (point){s.grid_dims[0], s.iterations, s.rsm_size, s.occlusion == LPV_SWITCH_ON,
+        pts[n++] = (point){s.grid_dims[0], s.lpv.iterations, s.rsm_size, s.lpv.occlusion == LPV_SWITCH_ON,
                            mods_of_settings(&s)};
     }
     return n;
@@ -1266,7 +1267,7 @@ add_features:
         lpv_settings b;
         lpv_preset_settings(LPV_PRESET_BALANCED, &b);
         for (int k = 0; k < NFEATURES && npts < MAX_POINTS; ++k) {
-            point fp = {b.grid_dims[0], b.iterations, b.rsm_size, b.occlusion == LPV_SWITCH_ON};
+            point fp = {b.grid_dims[0], b.lpv.iterations, b.rsm_size, b.lpv.occlusion == LPV_SWITCH_ON};
             fp.feat = 1;
             fp.cascades = FEATURES[k].cascades;
             fp.bounces = FEATURES[k].bounces;
@@ -1459,21 +1460,21 @@ add_features:
             res->p = pts[p];
             lpv_settings st = opt.settings;
             st.grid_dims[0] = st.grid_dims[1] = st.grid_dims[2] = pts[p].grid;
-            st.iterations = pts[p].iterations;
+            st.lpv.iterations = pts[p].iterations;
             st.rsm_size = pts[p].rsm;
-            st.occlusion = pts[p].occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
-            st.central_transport = on_off(pts[p].mods & MOD_CENTRAL);
-            st.normal_bins = on_off(pts[p].mods & MOD_BINS);
-            st.far_field = on_off(pts[p].mods & MOD_FAR);
+            st.lpv.occlusion = pts[p].occlusion ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+            st.lpv.central_transport = on_off(pts[p].mods & MOD_CENTRAL);
+            st.lpv.normal_bins = on_off(pts[p].mods & MOD_BINS);
+            st.lpv.far_field = on_off(pts[p].mods & MOD_FAR);
             st.scene_surfels = on_off(pts[p].mods & MOD_SURFELS);
             if (pts[p].feat) {
-                st.cascades = pts[p].cascades;
+                st.lpv.cascades = pts[p].cascades;
                 if (pts[p].cascades > 1) {
-                    st.cascade_size = se->cascade_size;
+                    st.lpv.cascade_size = se->cascade_size;
                     res->p.cascade_size = se->cascade_size;
                 }
-                st.bounces = pts[p].bounces ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
-                st.damping = pts[p].damping;
+                st.lpv.bounces = pts[p].bounces ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+                st.lpv.damping = pts[p].damping;
             }
             if (lpv_engine_set_settings(engine, &st, err, sizeof err) != 0 ||
                 lpv_engine_set_scene(engine, &scene, err, sizeof err) != 0 ||

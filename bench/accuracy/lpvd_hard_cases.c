@@ -111,8 +111,8 @@ static void describe_settings(const lpv_settings *s, float cell_size, char *out,
         snprintf(grid, sizeof grid, "%d³", s->grid_dims[0]);
     else
         snprintf(grid, sizeof grid, "%dx%dx%d", s->grid_dims[0], s->grid_dims[1], s->grid_dims[2]);
-    snprintf(out, n, "grid %s (cell %.3g m), %d it, RSM %d, occ %s", grid, cell_size, s->iterations, s->rsm_size,
-             s->occlusion == LPV_SWITCH_OFF ? "off" : "on");
+    snprintf(out, n, "grid %s (cell %.3g m), %d it, RSM %d, occ %s", grid, cell_size, s->lpv.iterations, s->rsm_size,
+             s->lpv.occlusion == LPV_SWITCH_OFF ? "off" : "on");
 }
 
 /* lpvd's side: the first step's flux (a tick with 1 iteration), then the
@@ -121,7 +121,7 @@ static int run_lpvd(lpv_engine *e, const lpv_hard_scene *h, const lpv_view *v, f
                     char *err, size_t n)
 {
     lpv_settings one = h->settings;
-    one.iterations = 1;
+    one.lpv.iterations = 1;
     if (tick(e, h, &one, v, err, n) != 0)
         return -1;
     const lpv_grid *g = lpv_engine_grid(e);

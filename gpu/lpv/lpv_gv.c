@@ -52,7 +52,7 @@ void lpv_pass_gv_run(lpv_cascaded *c, const lpv_technique_inputs *in, int bounce
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_TRANSMIT, c->transmit);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_REFLECT, c->reflect);
     glUniform1i(glGetUniformLocation(c->prog_transmit, "u_bounce"), bounce);
-    glUniform1f(glGetUniformLocation(c->prog_transmit, "u_bounce_intensity"), in->settings->bounce_intensity);
+    glUniform1f(glGetUniformLocation(c->prog_transmit, "u_bounce_intensity"), in->settings->lpv.bounce_intensity);
     glDispatchCompute(lpv_div_up((size_t)c->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)c->grid.dims[1], LPV_WG_2D),
                       (GLuint)(c->grid.dims[2] * c->cascades.count));
     lpv_timer_count(timer, 1);

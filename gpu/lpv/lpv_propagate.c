@@ -34,8 +34,8 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
      * level: the accumulation can only grow (an even share per level moved
      * light out of the finer levels later as the count grew, and the Cornell
      * box got worse from 4 to 16 steps). */
-    const int iterations = in->settings->iterations, levels = c->cascades.handoff ? c->cascades.count : 1;
-    const int every = in->settings->far_field_steps > 0 ? in->settings->far_field_steps : 1;
+    const int iterations = in->settings->lpv.iterations, levels = c->cascades.handoff ? c->cascades.count : 1;
+    const int every = in->settings->lpv.far_field_steps > 0 ? in->settings->lpv.far_field_steps : 1;
     GLuint in_view = c->tbo_injected, cur = 0;
     int sig = 0; /* the sigma buffer holding the flux limits of what is read next */
     const GLuint groups[3] = {lpv_div_up((size_t)c->grid.dims[0], LPV_PROP_WG_X),

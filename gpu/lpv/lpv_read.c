@@ -12,7 +12,7 @@
 /* The buffer holding the chosen grid of every LPV volume. */
 static GLuint grid_buffer(const lpv_cascaded *c, const lpv_plan *last, lpv_grid_which which)
 {
-    const int steps = last->pass[LPV_PASS_PROPAGATE].run ? c->settings.iterations : 0;
+    const int steps = last->pass[LPV_PASS_PROPAGATE].run ? c->settings.lpv.iterations : 0;
     if (which == LPV_GRID_INJECTED || (which == LPV_GRID_LAST_STEP && steps == 0))
         return c->lpv_injected;
     if (which == LPV_GRID_LAST_STEP)

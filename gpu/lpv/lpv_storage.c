@@ -72,11 +72,11 @@ int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *rese
     *reset = 0;
     c->cascades = *set;
     c->grid = *g;
-    c->bins = c->settings.normal_bins == LPV_SWITCH_ON ? LPV_NORMAL_BINS : 1;
+    c->bins = c->settings.lpv.normal_bins == LPV_SWITCH_ON ? LPV_NORMAL_BINS : 1;
     struct LpvGridParams params = {
         .dims = {(float)g->dims[0], (float)g->dims[1], (float)g->dims[2], (float)lpv_grid_cell_count(g)},
         .info = {(float)set->count, set->count > 1 && !set->handoff ? 1.0f : 0.0f, (float)c->bins,
-                 c->settings.central_transport == LPV_SWITCH_ON ? (float)LPV_TRANSPORT_CENTRAL
+                 c->settings.lpv.central_transport == LPV_SWITCH_ON ? (float)LPV_TRANSPORT_CENTRAL
                                                                 : (float)LPV_TRANSPORT_PAPER},
     };
     params.mode[0] = set->handoff ? 1.0f : 0.0f;

@@ -143,8 +143,8 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     const lpv_cascaded *c = (const lpv_cascaded *)t;
     s->cascades = c->cascades.count;
     s->cells = lpv_all_cells(c);
-    s->iterations = c->settings.iterations;
-    s->cell_steps = last->pass[LPV_PASS_PROPAGATE].run ? (double)lpv_volume_cells(c) * c->settings.iterations : 0.0;
+    s->iterations = c->settings.lpv.iterations;
+    s->cell_steps = last->pass[LPV_PASS_PROPAGATE].run ? (double)lpv_volume_cells(c) * c->settings.lpv.iterations : 0.0;
     s->occlusion = last->pass[LPV_PASS_GV].run;
 }
 
