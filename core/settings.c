@@ -114,6 +114,34 @@ const char *lpv_preset_names(void)
     return NAME_FAST ", " NAME_BALANCED ", " NAME_ACCURATE; /* the table's names, in its order */
 }
 
+/* The techniques' names, indexed by lpv_technique_id: ONE table. */
+static const char *const TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
+    [LPV_TECHNIQUE_ID_DEFAULT] = NULL, /* not a row: resolves to lpv */
+    [LPV_TECHNIQUE_ID_LPV] = LPV_TECHNIQUE_LPV,
+};
+
+int lpv_technique_from_name(const char *name, lpv_technique_id *out)
+{
+    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; name && t < LPV_TECHNIQUE_ID_COUNT_; ++t)
+        if (strcmp(name, TECHNIQUES[t]) == 0) {
+            *out = (lpv_technique_id)t;
+            return 0;
+        }
+    return -1;
+}
+
+const char *lpv_technique_name(lpv_technique_id t)
+{
+    if (t == LPV_TECHNIQUE_ID_DEFAULT)
+        t = LPV_TECHNIQUE_ID_LPV;
+    return (int)t > (int)LPV_TECHNIQUE_ID_DEFAULT && (int)t < (int)LPV_TECHNIQUE_ID_COUNT_ ? TECHNIQUES[t] : NULL;
+}
+
+const char *lpv_technique_names(void)
+{
+    return LPV_TECHNIQUE_LPV; /* the table's names, in its order, ", " between them */
+}
+
 lpv_preset lpv_preset_match(const lpv_settings *s)
 {
     for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_; ++p) {
@@ -152,6 +180,8 @@ void lpv_settings_resolve(lpv_settings *s)
         if (s->scene_surfels == LPV_SWITCH_DEFAULT)
             s->scene_surfels = p.scene_surfels;
     }
+    if (s->technique == LPV_TECHNIQUE_ID_DEFAULT)
+        s->technique = LPV_TECHNIQUE_ID_LPV;
     if (s->shadow_size == 0)
         s->shadow_size = LPV_DEFAULT_SHADOW_SIZE;
     if (s->indirect_gain == 0.0f)
@@ -230,6 +260,9 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->preset != LPV_PRESET_DEFAULT && !preset_row_of(s->preset))
         return fail(err, err_size, "preset = %d is out of range (allowed 0 = default, 1 = fast, 2 = balanced, "
                     "3 = accurate)", (int)s->preset);
+    if (s->technique != LPV_TECHNIQUE_ID_DEFAULT && !lpv_technique_name(s->technique))
+        return fail(err, err_size, "technique = %d is out of range (allowed: %s)", (int)s->technique,
+                    lpv_technique_names());
     for (int i = 0; i < 3; i++) {
         if (s->grid_dims[i] < 1 || s->grid_dims[i] > LPV_MAX_GRID_DIM)
             return fail(err, err_size, "grid_dims[%d] = %d is out of range (allowed 1..%d)", i, s->grid_dims[i],

@@ -6,8 +6,16 @@
 #define LPV_SETTINGS_H
 
 /* The GI techniques' names (gpu/technique.h's class names; the wire's and the
- * knob description's "technique"). */
+ * knob description's "technique"; --technique and CONFIG's "technique"). */
 #define LPV_TECHNIQUE_LPV "lpv" /* cascaded light propagation volumes (gpu/lpv/) */
+
+/* Which technique computes the volume; 0 means "the default" (lpv). The
+ * names are core/settings.c's technique table, the classes gpu/technique.c's. */
+typedef enum lpv_technique_id {
+    LPV_TECHNIQUE_ID_DEFAULT = 0,
+    LPV_TECHNIQUE_ID_LPV = 1,
+    LPV_TECHNIQUE_ID_COUNT_ /* one past the last; not a technique */
+} lpv_technique_id;
 
 /* Tri-state switch: 0 means "the default". */
 typedef enum lpv_switch {
@@ -86,6 +94,7 @@ typedef struct lpv_settings {
     float indirect_gain;    /* artistic factor on the indirect term; default 1 (0 = default) */
     int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
     lpv_preset preset;      /* supplies the defaults marked "the preset's"; default balanced */
+    lpv_technique_id technique; /* the GI technique; default lpv */
 
     /* Effects read at render time (docs/effects.md). */
     lpv_switch glossy;      /* glossy reflections by marching the volume; default on (run
@@ -151,6 +160,14 @@ int lpv_preset_settings(lpv_preset p, lpv_settings *out);
 /* "fast", "balanced" or "accurate" -> *out. Returns 0, or -1 for any other
  * name (out untouched). */
 int lpv_preset_from_name(const char *name, lpv_preset *out);
+
+/* "lpv" (LPV_TECHNIQUE_LPV, ...) -> *out. Returns 0, or -1 for any other
+ * name (out untouched). */
+int lpv_technique_from_name(const char *name, lpv_technique_id *out);
+/* The technique's name ("lpv" for DEFAULT), or NULL for an unknown value. */
+const char *lpv_technique_name(lpv_technique_id t);
+/* The technique names, comma separated, for help and errors. */
+const char *lpv_technique_names(void);
 
 /* The preset's name ("balanced" for DEFAULT), or NULL for an unknown value. */
 const char *lpv_preset_name(lpv_preset p);

@@ -276,6 +276,10 @@ unsigned lpv_settings_touches(const lpv_settings *a, const lpv_settings *b, char
         touches |= LPV_TOUCH_VOLUME;
         note_first(first, first_size, "preset");
     }
+    if (a->technique != b->technique) { /* another technique: everything anew */
+        touches |= LPV_TOUCH_VOLUME | LPV_TOUCH_SAMPLES | LPV_TOUCH_SHADOWS | LPV_TOUCH_SHADING;
+        note_first(first, first_size, "technique");
+    }
     for (size_t i = 0; i < sizeof FIELDS / sizeof FIELDS[0]; ++i) {
         if (!field_differs(a, b, &FIELDS[i]))
             continue;

@@ -11,6 +11,7 @@
 
 /* The flags with their own syntax; the knobs follow from the field table. */
 static const lpv_flag OWN_SYNTAX[] = {
+    {"technique", 0, "NAME", "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV, the default)"},
     {"preset", 0, "NAME", "quality preset (default balanced; docs/accuracy.md):"},
     {"grid", 0, "N | NxMxK", "LPV cells per axis (default: the preset's)"},
     {"bounds", 0, "x0,y0,z0,x1,y1,z1", "grid bounds in m (default: the scene's bounds)"},
@@ -54,7 +55,12 @@ int lpv_settings_flag_parse(lpv_settings *s, const char *name, const char *v, ch
 {
     if (!v)
         v = "";
-    if (strcmp(name, "preset") == 0) {
+    if (strcmp(name, "technique") == 0) {
+        if (lpv_technique_from_name(v, &s->technique) != 0) {
+            snprintf(err, n, "--technique %s: unknown technique (allowed: %s)", v, lpv_technique_names());
+            return -1;
+        }
+    } else if (strcmp(name, "preset") == 0) {
         if (lpv_preset_from_name(v, &s->preset) != 0) {
             snprintf(err, n, "--preset %s: unknown preset (allowed: %s)", v, lpv_preset_names());
             return -1;

@@ -39,26 +39,62 @@ static int includes(const char **out, size_t cap, const char *const *own, const 
     return 0;
 }
 
+/* Makes technique id the engine's: creates its instance and builds the
+ * passes that read its volume (shading, query, glossy, media) with its
+ * lookup includes (technique.h). On failure the current technique stays. */
+static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t err_size)
+{
+    const lpv_technique_class *cls = lpv_technique_class_of(id);
+    if (!cls)
+        return lpv_error(err, err_size, "technique %d has no implementation", (int)id);
+    const char *const *lookup = cls->lookup_includes;
+    const char *inc_shade[16], *inc_media[16], *inc_lookup[16];
+    if (includes(inc_shade, 16, INC_SHADE, lookup) || includes(inc_media, 16, INC_MEDIA, lookup) ||
+        includes(inc_lookup, 16, NULL, lookup))
+        return lpv_error(err, err_size, "technique %s names too many lookup includes", cls->name);
+    struct {
+        GLuint *prog;
+        const char *a, *b;
+        const char *const *inc;
+    } progs[] = {
+        {&e->prog_shade, "fullscreen.vert", "shade.frag", inc_shade},
+        {&e->prog_query, "query.comp", NULL, inc_lookup},
+        {&e->prog_glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
+        {&e->prog_media, "fullscreen.vert", "media.frag", inc_media},
+    };
+    enum { N = sizeof progs / sizeof progs[0] };
+    GLuint built[N] = {0};
+    for (size_t i = 0; i < N; ++i) {
+        built[i] = lpv_program_build(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
+        if (!built[i]) {
+            for (size_t k = 0; k < i; ++k)
+                glDeleteProgram(built[k]);
+            return -1;
+        }
+    }
+    lpv_technique *t = cls->create(err, err_size);
+    if (!t) {
+        for (size_t k = 0; k < N; ++k)
+            glDeleteProgram(built[k]);
+        return -1;
+    }
+    for (size_t i = 0; i < N; ++i) {
+        if (*progs[i].prog)
+            glDeleteProgram(*progs[i].prog);
+        *progs[i].prog = built[i];
+    }
+    if (e->tech)
+        e->tech->cls->destroy(e->tech);
+    e->tech = t;
+    e->tech_id = id;
+    return 0;
+}
+
 lpv_engine *lpv_engine_create(char *err, size_t err_size)
 {
     lpv_engine *e = calloc(1, sizeof *e);
     if (!e) {
         lpv_error(err, err_size, "out of memory");
-        return NULL;
-    }
-    e->tech = lpv_technique_cascaded_lpv.create(err, err_size);
-    if (!e->tech) {
-        free(e);
-        return NULL;
-    }
-    /* the shading, glossy, media and query passes read the technique's
-     * volume through its lookup includes (technique.h) */
-    const char *const *lookup = e->tech->cls->lookup_includes;
-    const char *inc_shade[16], *inc_media[16], *inc_lookup[16];
-    if (includes(inc_shade, 16, INC_SHADE, lookup) || includes(inc_media, 16, INC_MEDIA, lookup) ||
-        includes(inc_lookup, 16, NULL, lookup)) {
-        lpv_error(err, err_size, "technique %s names too many lookup includes", e->tech->cls->name);
-        lpv_engine_destroy(e);
         return NULL;
     }
     struct {
@@ -70,10 +106,6 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_vpl_extract, "vpl_extract.comp", NULL, NULL},
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, NULL},
-        {&e->prog_shade, "fullscreen.vert", "shade.frag", inc_shade},
-        {&e->prog_query, "query.comp", NULL, inc_lookup},
-        {&e->prog_glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
-        {&e->prog_media, "fullscreen.vert", "media.frag", inc_media},
         {&e->prog_shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
@@ -82,6 +114,10 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
             lpv_engine_destroy(e);
             return NULL;
         }
+    }
+    if (use_technique(e, LPV_TECHNIQUE_ID_LPV, err, err_size) != 0) {
+        lpv_engine_destroy(e);
+        return NULL;
     }
     GLint max_block = 0;
     glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
@@ -171,6 +207,11 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     const unsigned touches = lpv_settings_touches(&e->settings, &s, knob, sizeof knob);
     if (!touches)
         return 0;
+    if (s.technique != e->tech_id) { /* nothing of the old volume carries over */
+        if (use_technique(e, s.technique, err, err_size) != 0)
+            return -1;
+        e->computed = 0;
+    }
     e->settings = s;
     e->tech->cls->configure(e->tech, &e->settings);
     e->ticked = 0; /* a render or read-back follows a tick under the new settings */

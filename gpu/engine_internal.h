@@ -43,6 +43,7 @@ typedef struct lpv_gpu_draw {
 struct lpv_engine {
     lpv_settings settings;
     lpv_technique *tech;      /* the GI technique (gpu/technique.h) */
+    lpv_technique_id tech_id; /* which (settings.technique, resolved) */
     lpv_volume_desc desc;     /* its volume after the last commit */
     int has_scene;
 

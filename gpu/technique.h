@@ -130,4 +130,8 @@ struct lpv_technique_class {
 /* The cascaded light propagation volume (gpu/lpv/). */
 extern const lpv_technique_class lpv_technique_cascaded_lpv;
 
+/* The class of a technique (core/settings.h's ids; technique.c's table), or
+ * NULL for an id without one. */
+const lpv_technique_class *lpv_technique_class_of(lpv_technique_id id);
+
 #endif /* LPV_TECHNIQUE_H */

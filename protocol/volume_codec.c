@@ -574,7 +574,7 @@ static int same_real(double a, double b)
     return fabs(a - b) <= 1e-9 * (fabs(a) > fabs(b) ? fabs(a) : fabs(b)) + 1e-12;
 }
 
-/* "cascades" (R5.6) into vi->cascades; the grid fields are already read.
+/* "cascades" (R5.6) into vi->lpv.cascades; the grid fields are already read.
  * Absent: one cascade equal to the grid (a server before cascades). */
 static int parse_cascades(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n)
 {
@@ -716,7 +716,7 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
     snprintf(l->technique, sizeof l->technique, "%s", json_string_value(v));
     v = json_object_get(d, "far_field");
     if (!json_is_boolean(v)) {
-        lpvp_set_error(err, err_n, "%s.far_field: expected true or false", K);
+        lpvp_set_error(err, err_n, "%s.lpv.far_field: expected true or false", K);
         return -1;
     }
     l->far_field = json_is_true(v);

@@ -204,6 +204,20 @@ static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_setting
     return LPVP_FIELD_OK;
 }
 
+/* CONFIG's "technique": one of core's technique table's names (R4.14).
+ * Returns LPVP_FIELD_OK, _ABSENT or _BAD (message in err). */
+static int config_technique(const json_t *j, lpv_settings *st, char *err, size_t n)
+{
+    const char *names[LPV_TECHNIQUE_ID_COUNT_];
+    int count = 0, idx = 0;
+    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; t < LPV_TECHNIQUE_ID_COUNT_; ++t)
+        names[count++] = lpv_technique_name((lpv_technique_id)t);
+    int rc = lpvp_get_enum(j, "technique", 0, names, (size_t)count, &idx, err, n);
+    if (rc == LPVP_FIELD_OK)
+        st->technique = (lpv_technique_id)(LPV_TECHNIQUE_ID_DEFAULT + 1 + idx);
+    return rc;
+}
+
 /* CONFIG's scalar knobs, one per entry of the field table (core/settings_fields.h):
  * ints as JSON integers, floats as JSON numbers, switches as JSON booleans, each
  * within the table's range. Returns 0, or -1 with a message naming the key. */
@@ -249,6 +263,8 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
         goto bad;
     if (pst < 0)
         return; /* over a limit: already answered */
+    if (config_technique(j, &st, err, sizeof err) == LPVP_FIELD_BAD)
+        goto bad;
     const json_t *gj = json_object_get(j, "grid");
     if (gj && json_is_integer(gj)) { /* a single N is accepted as NxNxN */
         gst = lpvp_get_int(j, "grid", 1, 1, INT32_MAX, &grid[0], err, sizeof err);
@@ -341,8 +357,10 @@ json_t *sv_config_json(sv_conn *c)
                            (double)s.bounds_max[0], (double)s.bounds_max[1], (double)s.bounds_max[2]);
     }
     const char *preset = lpv_preset_name(s.preset); /* CONFIG validated it, so never NULL */
-    json_t *o = json_pack("{s:s, s:[i,i,i], s:o, s:b}", "preset", preset ? preset : "", "grid", s.grid_dims[0],
-                          s.grid_dims[1], s.grid_dims[2], "bounds", bounds, "bounds_auto", auto_bounds);
+    const char *technique = lpv_technique_name(s.technique);
+    json_t *o = json_pack("{s:s, s:s, s:[i,i,i], s:o, s:b}", "technique", technique ? technique : "", "preset",
+                          preset ? preset : "", "grid", s.grid_dims[0], s.grid_dims[1], s.grid_dims[2], "bounds",
+                          bounds, "bounds_auto", auto_bounds);
     /* every knob of the field table (core/settings_fields.h), resolved: iterations, rsm_size, occlusion, ... */
     size_t nf;
     const lpv_field *fields = lpv_fields(&nf);

@@ -67,9 +67,11 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);
-    /* R4.12: CONFIG's knobs and presets, described from core's tables so no client keeps a copy */
+    /* R4.12, R4.14: CONFIG's knobs, presets and techniques, described from core's tables so no client keeps a
+     * copy */
     if (b && (json_object_set_new(b, "knobs", lpvd_knobs_json(&s->cfg.settings, s->cfg.max_texture)) != 0 ||
-              json_object_set_new(b, "presets", lpvd_presets_json()) != 0)) {
+              json_object_set_new(b, "presets", lpvd_presets_json()) != 0 ||
+              json_object_set_new(b, "techniques", lpvd_techniques_json()) != 0)) {
         json_decref(b);
         b = NULL;
     }

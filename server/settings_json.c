@@ -69,6 +69,17 @@ json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture)
     return a;
 }
 
+json_t *lpvd_techniques_json(void)
+{
+    json_t *a = json_array();
+    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; a && t < LPV_TECHNIQUE_ID_COUNT_; ++t)
+        if (json_array_append_new(a, json_string(lpv_technique_name((lpv_technique_id)t))) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    return a;
+}
+
 json_t *lpvd_presets_json(void)
 {
     json_t *a = json_array();

@@ -21,5 +21,7 @@ json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture);
 
 /* The preset names of core's preset table, in its order: ["fast", ...]. */
 json_t *lpvd_presets_json(void);
+/* The technique names CONFIG "technique" accepts (R4.14), core's table in its order. */
+json_t *lpvd_techniques_json(void);
 
 #endif

@@ -130,15 +130,16 @@ static void test_tables(void **state)
     assert_int_equal(lpv_flags_begin(&p, 1, argv, twice, 2, 0), -1);
     assert_non_null(strstr(p.err, "--output"));
 
-    /* the settings group: preset, grid, bounds, then exactly the field table */
+    /* the settings group: technique, preset, grid, bounds, then exactly the field table */
     size_t nf, ng;
     const lpv_field *fields = lpv_fields(&nf);
     const lpv_flag *flags = lpv_settings_flags(&ng);
-    assert_int_equal(ng, nf + 3);
-    assert_string_equal(flags[0].name, "preset");
+    assert_int_equal(ng, nf + 4);
+    assert_string_equal(flags[0].name, "technique");
+    assert_string_equal(flags[1].name, "preset");
     for (size_t i = 0; i < nf; ++i) {
-        assert_string_equal(flags[3 + i].name, fields[i].flag);
-        assert_non_null(flags[3 + i].metavar);
+        assert_string_equal(flags[4 + i].name, fields[i].flag);
+        assert_non_null(flags[4 + i].metavar);
         char line[96];
         snprintf(line, sizeof line, "default %s)", fields[i].deflt);
         if (!strstr(lpv_settings_flags_help(), line))

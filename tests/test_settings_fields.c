@@ -250,6 +250,10 @@ static void test_cli_flags(void **state)
     assert_int_equal(lpvd_option_parse(&o, "bounds", "0,0,0,1,2,3", err, sizeof err), 1);
     assert_true(o.settings.bounds_max[2] == 3.0f);
     assert_int_equal(lpvd_option_parse(&o, "preset", "fast", err, sizeof err), 1);
+    assert_int_equal(lpvd_option_parse(&o, "technique", "photon-map", err, sizeof err), -1);
+    assert_non_null(strstr(err, "--technique photon-map: unknown technique (allowed: lpv"));
+    assert_int_equal(o.settings.technique, LPV_TECHNIQUE_ID_DEFAULT); /* unchanged */
+    assert_int_equal(lpvd_option_parse(&o, "technique", LPV_TECHNIQUE_LPV, err, sizeof err), 1);
     assert_int_equal(lpvd_option_parse(&o, "cascade-size", "12", err, sizeof err), 1);
     assert_int_equal(lpvd_option_parse(&o, "bounces", "on", err, sizeof err), 1);
     assert_int_equal(lpvd_option_parse(&o, "fog-sigma-s", "0.02", err, sizeof err), 1);
@@ -261,8 +265,35 @@ static void test_cli_flags(void **state)
     lpv_settings_resolve(&s);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
     assert_int_equal(s.preset, LPV_PRESET_FAST);
+    assert_int_equal(s.technique, LPV_TECHNIQUE_ID_LPV);
     assert_true(s.lpv.cascade_size == 12.0f && s.lpv.bounces == LPV_SWITCH_ON && s.fog_sigma_s == 0.02f);
     assert_int_equal(s.lpv.iterations, 4); /* the preset's */
+}
+
+/* The technique table: every id has a name that maps back to it; an unset
+ * technique resolves to lpv; an id outside the table is refused by name. */
+static void test_techniques(void **state)
+{
+    (void)state;
+    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; t < LPV_TECHNIQUE_ID_COUNT_; ++t) {
+        const char *name = lpv_technique_name((lpv_technique_id)t);
+        assert_non_null(name);
+        assert_non_null(strstr(lpv_technique_names(), name));
+        lpv_technique_id back = LPV_TECHNIQUE_ID_DEFAULT;
+        assert_int_equal(lpv_technique_from_name(name, &back), 0);
+        assert_int_equal(back, t);
+    }
+    lpv_technique_id keep = LPV_TECHNIQUE_ID_LPV;
+    assert_int_equal(lpv_technique_from_name("LPV", &keep), -1);
+    assert_int_equal(lpv_technique_from_name(NULL, &keep), -1);
+    assert_null(lpv_technique_name(LPV_TECHNIQUE_ID_COUNT_));
+    lpv_settings s = {0};
+    lpv_settings_resolve(&s);
+    assert_int_equal(s.technique, LPV_TECHNIQUE_ID_LPV);
+    char err[256];
+    s.technique = LPV_TECHNIQUE_ID_COUNT_;
+    assert_int_equal(lpv_settings_validate(&s, err, sizeof err), -1);
+    assert_non_null(strstr(err, "technique"));
 }
 
 int main(void)
@@ -273,6 +304,7 @@ int main(void)
         cmocka_unit_test(test_ranges_agree_with_validate),
         cmocka_unit_test(test_bad_strings),
         cmocka_unit_test(test_cli_flags),
+        cmocka_unit_test(test_techniques),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

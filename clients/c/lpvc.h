@@ -147,6 +147,8 @@ size_t lpvc_knobs(const lpvc *c, const lpvc_knob **knobs);
 const lpvc_knob *lpvc_knob_find(const lpvc *c, const char *name);
 /* The preset names the server offers (HELLO "presets"), *count of them. */
 const char *const *lpvc_presets(const lpvc *c, size_t *count);
+/* The GI techniques the server offers (HELLO "techniques", R4.14). */
+const char *const *lpvc_techniques(const lpvc *c, size_t *count);
 
 /* The allowed values in words: "an integer in 1..4096", "a number > 0 and <= 1",
  * "on or off". Returns buf. */
@@ -168,6 +170,7 @@ typedef struct lpvc_config {
     int grid[3];               /* all 0: not sent */
     const float *bounds;       /* [6] x0 y0 z0 x1 y1 z1, or NULL */
     float tick_rate_hz;        /* 0: not sent */
+    const char *technique;     /* one of lpvc_techniques(), or NULL: not sent (R4.14) */
     const char *preset;        /* one of lpvc_presets(), or NULL: not sent. The server applies it
                                   first; the knobs that are sent override its values */
     const lpvc_setting *settings; /* knobs of the description, each checked against it before sending

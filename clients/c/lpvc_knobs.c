@@ -29,6 +29,24 @@ static int number_of(const json_t *v, double *out)
     return 0;
 }
 
+/* The strings of hello's array `key` (absent: none) into *out, pointing into
+ * hello; -1 out of memory. */
+static int names_of(const json_t *hello, const char *key, const char ***out, size_t *count)
+{
+    const json_t *a = json_object_get(hello, key);
+    size_t n = json_is_array(a) ? json_array_size(a) : 0;
+    *out = calloc(n ? n : 1, sizeof **out);
+    *count = 0;
+    if (!*out)
+        return -1;
+    for (size_t i = 0; i < n; ++i) {
+        const char *name = json_string_value(json_array_get(a, i));
+        if (name)
+            (*out)[(*count)++] = name;
+    }
+    return 0;
+}
+
 int lpvc_knobset_read(lpvc_knobset *ks, json_t *hello, char *err, size_t n)
 {
     memset(ks, 0, sizeof *ks);
@@ -36,10 +54,8 @@ int lpvc_knobset_read(lpvc_knobset *ks, json_t *hello, char *err, size_t n)
     const json_t *arr = json_object_get(hello, "knobs");
     size_t count = json_is_array(arr) ? json_array_size(arr) : 0;
     ks->knobs = calloc(count ? count : 1, sizeof *ks->knobs);
-    const json_t *pr = json_object_get(hello, "presets");
-    size_t np = json_is_array(pr) ? json_array_size(pr) : 0;
-    ks->presets = calloc(np ? np : 1, sizeof *ks->presets);
-    if (!ks->knobs || !ks->presets) {
+    if (!ks->knobs || names_of(hello, "presets", &ks->presets, &ks->preset_count) != 0 ||
+        names_of(hello, "techniques", &ks->techniques, &ks->technique_count) != 0) {
         snprintf(err, n, "out of memory");
         return -1;
     }
@@ -78,11 +94,6 @@ int lpvc_knobset_read(lpvc_knobset *ks, json_t *hello, char *err, size_t n)
         k->help = str_or_empty(o, "help");
     }
     ks->count = count;
-    for (size_t i = 0; i < np; ++i) {
-        const char *name = json_string_value(json_array_get(pr, i));
-        if (name)
-            ks->presets[ks->preset_count++] = name;
-    }
     return 0;
 }
 
@@ -90,6 +101,7 @@ void lpvc_knobset_free(lpvc_knobset *ks)
 {
     free(ks->knobs);
     free(ks->presets);
+    free(ks->techniques);
     json_decref(ks->hello);
     memset(ks, 0, sizeof *ks);
 }

@@ -17,9 +17,11 @@ typedef struct lpvc_knobset {
     size_t count;
     const char **presets;
     size_t preset_count;
+    const char **techniques;
+    size_t technique_count;
 } lpvc_knobset;
 
-/* Reads hello's "knobs" and "presets" (absent: none) into *ks, keeping a
+/* Reads hello's "knobs", "presets" and "techniques" (absent: none) into *ks, keeping a
  * reference to hello. Returns 0, or -1 with a message in err when the
  * description breaks R4.12 (a knob without a name or type, a range that is
  * not numbers). */

@@ -29,6 +29,13 @@ const char *const *lpvc_presets(const lpvc *c, size_t *count)
     return c ? c->knobs.presets : NULL;
 }
 
+const char *const *lpvc_techniques(const lpvc *c, size_t *count)
+{
+    if (count)
+        *count = c ? c->knobs.technique_count : 0;
+    return c ? c->knobs.techniques : NULL;
+}
+
 /* ---- requests -------------------------------------------------------------- */
 
 static json_t *vec(const float *v, int n)
@@ -148,6 +155,8 @@ int lpvc_config_set(lpvc *c, const lpvc_config *cfg)
     if (!cfg)
         cfg = &z;
     json_t *o = json_object();
+    if (cfg->technique)
+        json_object_set_new(o, "technique", json_string(cfg->technique));
     if (cfg->preset)
         json_object_set_new(o, "preset", json_string(cfg->preset));
     if (cfg->grid[0] || cfg->grid[1] || cfg->grid[2])

@@ -1364,6 +1364,37 @@ def c_config_preset_bad(ctx):
     return "6 CONFIGs with a bad preset (or a bad field next to a good one) refused, config unchanged"
 
 
+@case("R4.14 R4.6 R2.9", "CONFIG technique takes each technique HELLO lists, reports it, and refuses any other "
+      "naming technique")
+def c_config_technique(ctx):
+    techniques = ctx.hello_reply.get("techniques")
+    check(isinstance(techniques, list) and techniques and all(isinstance(t, str) and t for t in techniques),
+          "R4.14: HELLO reply has no non-empty \"techniques\" array of names: %r" % (techniques,))
+    c, _, _ = ctx.scene_session(light=unique_light("tech"))
+    cfg0 = _preset_config(c, {})
+    check(cfg0.get("technique") in techniques,
+          "R4.14: the effective config's technique %r is not one of %r" % (cfg0.get("technique"), techniques))
+    said = []
+    for t in techniques:
+        cfg = _preset_config(c, {"technique": t})
+        check(cfg.get("technique") == t, "CONFIG technique %r: effective config says %r" % (t, cfg.get("technique")))
+        tk = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+        v = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+        made_by = (v.body.get("volume") or {}).get("technique")
+        check(made_by == t, "R4.14/R5.9: after CONFIG technique %r the volume says technique %r" % (t, made_by))
+        said.append("%s (tick %s)" % (t, tk.body.get("tick")))
+    cfg1 = _preset_config(c, {})
+    for body in ({"technique": "photon_mapping"}, {"technique": ""}, {"technique": 1}, {"technique": None},
+                 {"technique": techniques[0].upper() + "_"}):
+        rid = c.send(CONFIG, body)
+        try:
+            expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "technique")
+        except Fail as e:
+            raise Fail("CONFIG %s: %s" % (json.dumps(body), e))
+    check(_preset_config(c, {}) == cfg1, "a refused technique changed the config")
+    return "chosen and ticked: %s; 5 bad names refused" % ", ".join(said)
+
+
 # R4.12: the knobs are the server's own description (HELLO "knobs"), not a
 # list kept here; these cases check that the description is true: what it
 # says CONFIG accepts, CONFIG accepts, and what it says is out of range or of

@@ -41,7 +41,7 @@ static const char *g_usage =
     "            [--position X,Y,Z] [--direction X,Y,Z] [--range R] [--inner-cone RAD] [--outer-cone RAD]\n"
     "  light-remove ID\n"
     "  camera --eye X,Y,Z --target X,Y,Z [--up X,Y,Z] [--fov DEG] [--size WxH] | camera --scene NAME|INDEX\n"
-    "  config [--preset NAME] [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1] [--tick-rate HZ]\n"
+    "  config [--technique NAME] [--preset NAME] [--grid N|NxMxK] [--bounds x0,y0,z0,x1,y1,z1] [--tick-rate HZ]\n"
     "         [--KNOB VALUE]...     every knob the daemon describes in HELLO (SPEC R4.12), e.g.\n"
     "                               --damping 0.5 --normal-bins off; values are checked against its ranges\n"
     "         | config --json JSON   (the other flags override the preset's values)\n"
@@ -400,6 +400,11 @@ static int cmd_knobs(int argc, char **argv)
     printf("presets:");
     for (size_t i = 0; i < np; ++i)
         printf(" %s", presets[i]);
+    size_t nt = 0;
+    const char *const *techniques = lpvc_techniques(g_c, &nt);
+    printf("\ntechniques:");
+    for (size_t i = 0; i < nt; ++i)
+        printf(" %s", techniques[i]);
     printf("\n");
     fflush(stdout);
     return 0;
@@ -423,6 +428,8 @@ static int cmd_config(int argc, char **argv)
             json = v;
         } else if (strcmp(a, "--preset") == 0) {
             cfg.preset = v; /* the server checks the name (BAD_FIELD lists the allowed ones) */
+        } else if (strcmp(a, "--technique") == 0) {
+            cfg.technique = v; /* one of HELLO's techniques; the server checks it */
         } else if (strcmp(a, "--grid") == 0) {
             if (sscanf(v, "%dx%dx%d", &cfg.grid[0], &cfg.grid[1], &cfg.grid[2]) == 3) {
             } else if (parse_int(v, 1, 100000, &n) == 0) {

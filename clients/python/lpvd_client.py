@@ -694,6 +694,11 @@ class Client(object):
         """The preset names the server offers (HELLO "presets")."""
         return list((self.hello_reply or {}).get("presets", []))
 
+    @property
+    def techniques(self):
+        """The GI techniques the server offers (HELLO "techniques", SPEC R4.14)."""
+        return list((self.hello_reply or {}).get("techniques", []))
+
     @staticmethod
     def knob_value(knob, v):
         """v checked against a knob's description and typed for CONFIG:
@@ -717,7 +722,7 @@ class Client(object):
         return int(v) if kind == "int" else v
 
     def config(self, **settings):
-        """CONFIG: preset (one of ``presets``), grid, bounds, tick_rate_hz and
+        """CONFIG: technique (one of ``techniques``), preset (one of ``presets``), grid, bounds, tick_rate_hz and
         any knob the server describes (``knobs``; SPEC R4.12). A knob's value is
         checked against the description before sending. A preset sets grid,
         iterations, rsm_size and occlusion; the other fields given override it.
