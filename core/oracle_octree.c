@@ -159,8 +159,9 @@ int lpv_octree_add_surfels(lpv_octree *o, const lpv_surfel *surfels, size_t n, s
          * closes every level's. The thesis' build downsamples the GV with
          * eq. 11 instead; a wall lies in one plane of GV points, which is
          * one of two fine planes a coarse element covers along its normal,
-         * so the mean halves its blocking at every level (1 / 2^i of it on
-         * level i) and a closed wall leaks on the coarse levels. */
+         * so the mean halves its blocking at each level (1 / 2^i of it is
+         * left where the wall is on a plane of level i) and a closed wall
+         * leaks on the coarse levels. */
         size_t took = lpv_oracle_inject_surfels(&lv->grid, surfels, n, buffer);
         if (i == 0 && injected)
             *injected = took;
