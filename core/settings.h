@@ -7,13 +7,15 @@
 
 /* The GI techniques' names (gpu/technique.h's class names; the wire's and the
  * knob description's "technique"; --technique and CONFIG's "technique"). */
-#define LPV_TECHNIQUE_LPV "lpv" /* cascaded light propagation volumes (gpu/lpv/) */
+#define LPV_TECHNIQUE_LPV "lpv"       /* cascaded light propagation volumes (gpu/lpv/) */
+#define LPV_TECHNIQUE_OCTREE "octree" /* octree light propagation volumes (gpu/lpv/technique_octree.c) */
 
 /* Which technique computes the volume; 0 means "the default" (lpv). The
  * names are core/settings.c's technique table, the classes gpu/technique.c's. */
 typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_DEFAULT = 0,
     LPV_TECHNIQUE_ID_LPV = 1,
+    LPV_TECHNIQUE_ID_OCTREE = 2,
     LPV_TECHNIQUE_ID_COUNT_ /* one past the last; not a technique */
 } lpv_technique_id;
 

@@ -207,11 +207,8 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     const unsigned touches = lpv_settings_touches(&e->settings, &s, knob, sizeof knob);
     if (!touches)
         return 0;
-    if (s.technique != e->tech_id) { /* nothing of the old volume carries over */
-        if (use_technique(e, s.technique, err, err_size) != 0)
-            return -1;
-        e->computed = 0;
-    }
+    if (s.technique != e->tech_id && use_technique(e, s.technique, err, err_size) != 0)
+        return -1; /* the technique touches the volume: the next tick computes it anew */
     e->settings = s;
     e->tech->cls->configure(e->tech, &e->settings);
     e->ticked = 0; /* a render or read-back follows a tick under the new settings */

@@ -152,6 +152,11 @@ int lpv_engine_bins(const lpv_engine *e);
  * cascade 0 first. */
 size_t lpv_engine_read_gv(lpv_engine *e, lpv_gv_point *out, size_t max);
 size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_floats);
+/* The octree technique's index volume: per level-0 cell, the level its
+ * merged light comes from (0 for techniques without one). With the octree,
+ * read_grid(ACCUMULATED) is the merged volume and read_volumes every level's
+ * accumulation, level 0 first. */
+size_t lpv_engine_read_index(lpv_engine *e, int32_t *out, size_t max);
 /* RSM VPLs (punctual lights' and area light samples'), then the emissive VPLs
  * when the last tick injected them (area lights off). */
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);

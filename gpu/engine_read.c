@@ -37,6 +37,13 @@ size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_float
     return e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_TRANSMIT, LPV_GRID_ACCUMULATED, out, max_floats);
 }
 
+size_t lpv_engine_read_index(lpv_engine *e, int32_t *out, size_t max)
+{
+    if (!e->ticked)
+        return 0;
+    return e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_INDEX, LPV_GRID_ACCUMULATED, out, max);
+}
+
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 {
     if (!e->ticked)

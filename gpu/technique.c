@@ -6,6 +6,7 @@
 
 static const lpv_technique_class *const CLASSES[LPV_TECHNIQUE_ID_COUNT_] = {
     [LPV_TECHNIQUE_ID_LPV] = &lpv_technique_cascaded_lpv,
+    [LPV_TECHNIQUE_ID_OCTREE] = &lpv_technique_octree,
 };
 
 const lpv_technique_class *lpv_technique_class_of(lpv_technique_id id)

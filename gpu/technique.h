@@ -84,6 +84,7 @@ typedef enum lpv_volume_part {
     LPV_VOLUME_STORED,     /* lpv_cell per cell of every volume, as stored */
     LPV_VOLUME_GEOMETRY,   /* lpv_gv_point per geometry-volume point (0 if none) */
     LPV_VOLUME_TRANSMIT,   /* float per cell and direction (0 if none) */
+    LPV_VOLUME_INDEX,      /* int32 per level-0 cell: the octree level its light comes from (0 if none) */
 } lpv_volume_part;
 
 typedef struct lpv_technique_class lpv_technique_class;
@@ -129,6 +130,8 @@ struct lpv_technique_class {
 
 /* The cascaded light propagation volume (gpu/lpv/). */
 extern const lpv_technique_class lpv_technique_cascaded_lpv;
+/* The octree light propagation volume (gpu/lpv/technique_octree.c). */
+extern const lpv_technique_class lpv_technique_octree;
 
 /* The class of a technique (core/settings.h's ids; technique.c's table), or
  * NULL for an id without one. */

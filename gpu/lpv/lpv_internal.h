@@ -29,6 +29,7 @@ typedef struct lpv_cascaded {
     int bins;                 /* LPV volumes per cascade: 1, or LPV_NORMAL_BINS (normal_bins on) */
 
     GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate, prog_handoff;
+    int borrowed_programs;    /* 1: the programs are another state's (the octree's levels share them) */
     GLuint empty_vao;
 
     GLuint grid_ubo;
@@ -55,9 +56,18 @@ static inline size_t lpv_volume_cells(const lpv_cascaded *c)
     return lpv_grid_cell_count(&c->grid) * (size_t)lpv_volumes(c);
 }
 
+/* A state with its own programs, or sharing owner's (which must outlive it);
+ * delete frees storage, the programs it owns and the state (technique_lpv.c). */
+lpv_cascaded *lpv_cascaded_new(char *err, size_t err_size);
+lpv_cascaded *lpv_cascaded_new_sharing(const lpv_cascaded *owner, char *err, size_t err_size);
+void lpv_cascaded_delete(lpv_cascaded *c);
+
 /* Placement and storage (lpv_storage.c). */
 int lpv_cascaded_place(lpv_cascaded *c, const lpv_technique_where *w, int *moved, char *err, size_t err_size);
 int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *reset, char *err, size_t err_size);
+/* One grid exactly where g says (the octree's coarser levels: level 0's box
+ * in cells 2^i times its size), instead of placing it from the settings. */
+void lpv_cascaded_place_grid(lpv_cascaded *c, const lpv_grid *g, int *moved);
 void lpv_cascaded_free_storage(lpv_cascaded *c);
 void lpv_cascaded_memory_need(const lpv_cascaded *c, lpv_memory_need *n);
 

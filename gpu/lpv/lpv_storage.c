@@ -33,6 +33,17 @@ int lpv_cascaded_place(lpv_cascaded *c, const lpv_technique_where *w, int *moved
     return 0;
 }
 
+void lpv_cascaded_place_grid(lpv_cascaded *c, const lpv_grid *g, int *moved)
+{
+    memset(&c->pending, 0, sizeof c->pending);
+    c->pending.count = 1;
+    c->pending.grid[0] = *g;
+    for (int i = 0; i < 3; ++i)
+        c->pending.origin_cells[0][i] = g->origin[i] / g->cell_size;
+    if (moved)
+        *moved = !lpv_cascades_equal(&c->pending, &c->cascades);
+}
+
 void lpv_cascaded_free_storage(lpv_cascaded *c)
 {
     lpv_atlas_destroy(&c->lpv_atlas);

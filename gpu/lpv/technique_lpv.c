@@ -16,15 +16,14 @@ static const char *const INC_GRID[] = {"grid.glsl", NULL};
 static const char *const INC_PROPAGATE[] = {"grid.glsl", "flux_limit.glsl", "medium.glsl", NULL};
 static const char *const LOOKUP[] = {"grid.glsl", "lookup.glsl", NULL};
 
-static void destroy(lpv_technique *t)
+void lpv_cascaded_delete(lpv_cascaded *c)
 {
-    lpv_cascaded *c = (lpv_cascaded *)t;
     if (!c)
         return;
     lpv_cascaded_free_storage(c);
     GLuint *progs[] = {&c->prog_inject_vpl, &c->prog_inject_gv, &c->prog_pack,   &c->prog_gv_merge,
                        &c->prog_transmit,   &c->prog_propagate, &c->prog_handoff};
-    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
+    for (size_t i = 0; !c->borrowed_programs && i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
     if (c->empty_vao)
@@ -33,7 +32,8 @@ static void destroy(lpv_technique *t)
     free(c);
 }
 
-static lpv_technique *create(char *err, size_t err_size)
+/* The state with an empty VAO and its grid block; programs are the caller's. */
+static lpv_cascaded *cascaded_alloc(char *err, size_t err_size)
 {
     lpv_cascaded *c = calloc(1, sizeof *c);
     if (!c) {
@@ -41,6 +41,19 @@ static lpv_technique *create(char *err, size_t err_size)
         return NULL;
     }
     c->base.cls = &lpv_technique_cascaded_lpv;
+    glGenVertexArrays(1, &c->empty_vao);
+    glGenBuffers(1, &c->grid_ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, c->grid_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
+    lpv_settings_resolve(&c->settings);
+    return c;
+}
+
+lpv_cascaded *lpv_cascaded_new(char *err, size_t err_size)
+{
+    lpv_cascaded *c = cascaded_alloc(err, err_size);
+    if (!c)
+        return NULL;
     struct {
         GLuint *prog;
         const char *a, *b;
@@ -57,16 +70,35 @@ static lpv_technique *create(char *err, size_t err_size)
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog = lpv_program_build(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
         if (!*progs[i].prog) {
-            destroy(&c->base);
+            lpv_cascaded_delete(c);
             return NULL;
         }
     }
-    glGenVertexArrays(1, &c->empty_vao);
-    glGenBuffers(1, &c->grid_ubo);
-    glBindBuffer(GL_UNIFORM_BUFFER, c->grid_ubo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
-    lpv_settings_resolve(&c->settings);
-    return &c->base;
+    return c;
+}
+
+lpv_cascaded *lpv_cascaded_new_sharing(const lpv_cascaded *owner, char *err, size_t err_size)
+{
+    lpv_cascaded *c = cascaded_alloc(err, err_size);
+    if (!c)
+        return NULL;
+    c->borrowed_programs = 1;
+    c->prog_inject_vpl = owner->prog_inject_vpl;
+    c->prog_inject_gv = owner->prog_inject_gv;
+    c->prog_pack = owner->prog_pack;
+    c->prog_gv_merge = owner->prog_gv_merge;
+    c->prog_transmit = owner->prog_transmit;
+    c->prog_propagate = owner->prog_propagate;
+    c->prog_handoff = owner->prog_handoff;
+    return c;
+}
+
+static void destroy(lpv_technique *t) { lpv_cascaded_delete((lpv_cascaded *)t); }
+
+static lpv_technique *create(char *err, size_t err_size)
+{
+    lpv_cascaded *c = lpv_cascaded_new(err, err_size);
+    return c ? &c->base : NULL;
 }
 
 static void configure(lpv_technique *t, const lpv_settings *s) { ((lpv_cascaded *)t)->settings = *s; }
