@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """check_results.py - checks an lpvd-accuracy results.csv (the CI sweep).
 
-  check_results.py RESULTS.csv [--scene NAME --better G:I:R:on|off:MODS --worse G:I:R:on|off:MODS] [--rows N]
+  check_results.py RESULTS.csv [--scene NAME --better G:I:R:on|off:MODS:TECHNIQUE --worse G:I:R:on|off:MODS:TECHNIQUE] [--rows N]
 
 Fails (exit 1) unless every expected column is present and filled with a
 finite value in every row (except preset: empty for a point that equals no
@@ -14,16 +14,17 @@ import csv
 import math
 import sys
 
-COLUMNS = ["scene", "grid", "iterations", "rsm", "occlusion", "mods", "ms_per_tick", "ms_rsm", "ms_vpl_extract",
-           "ms_inject", "ms_gbuffer", "ms_gv", "ms_propagate", "ms_shade", "rel_rmse", "rel_bias", "ref_noise",
-           "rel_rmse_excess", "rel_mae", "pixels", "pareto"]
-NUMERIC = COLUMNS[6:]
+COLUMNS = ["scene", "grid", "iterations", "rsm", "occlusion", "mods", "technique", "ms_per_tick", "ms_rsm",
+           "ms_vpl_extract", "ms_inject", "ms_gbuffer", "ms_gv", "ms_propagate", "ms_shade", "rel_rmse", "rel_bias",
+           "ref_noise", "rel_rmse_excess", "rel_mae", "pixels", "pareto"]
+NUMERIC = COLUMNS[7:]
 # preset: the named preset the point equals; legitimately empty for most points.
 OPTIONAL = {"preset": ("fast", "balanced", "accurate")}
 
 
 def key(row):
-    return "%s:%s:%s:%s:%s" % (row["grid"], row["iterations"], row["rsm"], row["occlusion"], row["mods"])
+    return "%s:%s:%s:%s:%s:%s" % (row["grid"], row["iterations"], row["rsm"], row["occlusion"], row["mods"],
+                                  row["technique"])
 
 
 def main():

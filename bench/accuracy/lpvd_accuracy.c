@@ -34,6 +34,7 @@
 #include "hash.h"
 #include "image_io.h"
 #include "metrics.h"
+#include "oracle_octree.h"
 #include "overall.h"
 #include "options.h"
 #include "scene_load.h"
@@ -54,8 +55,8 @@
 #define MAX_PASS 16
 
 /* The stages lpv_engine_stats reports, in CSV column order. */
-static const char *const STAGES[] = {"rsm",       "vpl_extract", "inject",  "gbuffer", "gv",
-                                     "propagate", "shade",       "emissive", "pack"};
+static const char *const STAGES[] = {"rsm",   "vpl_extract", "inject", "gbuffer",    "gv",   "propagate",
+                                     "shade", "emissive",    "pack",   "downsample", "merge"};
 #define NSTAGES ((int)(sizeof STAGES / sizeof STAGES[0]))
 
 /* The full factorial's default values (--knobs replaces any list). RSM and
@@ -82,6 +83,7 @@ typedef struct point {
     int bounces;        /* 1 = on */
     float damping;      /* 0 = off */
     char label[32];     /* the features block's name of the point */
+    lpv_technique_id technique; /* 0 (DEFAULT): the cascaded LPV */
 } point;
 
 /* --features: the knob varied, around the balanced preset with one grid over
@@ -119,7 +121,21 @@ static lpv_settings point_settings(const point *p)
                           .lpv.central_transport = on_off(p->mods & MOD_CENTRAL),
                           .lpv.normal_bins = on_off(p->mods & MOD_BINS),
                           .lpv.far_field = on_off(p->mods & MOD_FAR),
-                          .scene_surfels = on_off(p->mods & MOD_SURFELS)};
+                          .scene_surfels = on_off(p->mods & MOD_SURFELS),
+                          .technique = p->technique};
+}
+
+/* The point's technique by name: "lpv", "octree". */
+static const char *tech_name(int technique) { return lpv_technique_name((lpv_technique_id)technique); }
+
+/* Whether the technique can run the point: the octree halves a cubic
+ * power-of-two grid, and its levels are single grids (no normal bins, no far
+ * field), so it has no points that differ only in those two switches. */
+static int technique_runs(const point *p)
+{
+    if (p->technique != LPV_TECHNIQUE_ID_OCTREE)
+        return 1;
+    return (p->grid & (p->grid - 1)) == 0 && !(p->mods & (MOD_BINS | MOD_FAR));
 }
 
 /* "cbfs" with '-' for the switches that are off: the point's departures. */
@@ -148,6 +164,8 @@ static int mods_of_settings(const lpv_settings *s)
 static const char *point_preset(const point *p)
 {
     lpv_settings s = point_settings(p);
+    if (p->technique != LPV_TECHNIQUE_ID_DEFAULT && p->technique != LPV_TECHNIQUE_ID_LPV)
+        return ""; /* the presets are the cascaded LPV's */
     lpv_preset m = lpv_preset_match(&s);
     return m == LPV_PRESET_DEFAULT ? "" : lpv_preset_name(m);
 }
@@ -180,7 +198,32 @@ typedef struct result {
     double rel_rmse_multi;      /* vs the multi-bounce reference; NAN when not rendered */
     double black, constant;     /* the baselines' rel_rmse (lpv_acc_baselines) */
     double region_share[LPV_ACC_REGIONS], region_rmse[LPV_ACC_REGIONS], region_ratio[LPV_ACC_REGIONS];
+    lpv_octree_error octree;    /* the octree technique's own metric (thesis 6.2); elements 0 otherwise */
 } result;
+
+/* The thesis' correctness metric (section 6.2) on the octree the GPU
+ * computed: every level's accumulation read back into the oracle's octree,
+ * each level above 0 against the mean of its children (core/oracle_octree.h). */
+static void octree_metric(lpv_engine *engine, lpv_octree_error *out)
+{
+    memset(out, 0, sizeof *out);
+    char err[256];
+    lpv_octree o = {0};
+    if (lpv_octree_create(lpv_engine_grid(engine), 0, &o, err, sizeof err) != 0)
+        return;
+    size_t all = 0;
+    for (int i = 0; i < o.levels; ++i)
+        all += lpv_grid_cell_count(&o.level[i].grid);
+    lpv_cell *levels = malloc(all * sizeof *levels);
+    if (levels && lpv_engine_read_volumes(engine, LPV_GRID_ACCUMULATED, levels, all) == all) {
+        size_t at = 0;
+        for (int i = 0; i < o.levels; at += lpv_grid_cell_count(&o.level[i].grid), ++i)
+            memcpy(o.level[i].acc, levels + at, lpv_grid_cell_count(&o.level[i].grid) * sizeof *levels);
+        lpv_octree_measure(&o, out);
+    }
+    free(levels);
+    lpv_octree_free(&o);
+}
 
 /* Each pixel's region (metrics.h) from the reference's primary rays. */
 static uint8_t *region_map(const lpv_scene *scene, const lpv_view *view)
@@ -259,7 +302,7 @@ static const lpv_flag FLAGS[A_COUNT] = {
 };
 
 /* The shared flags this program refuses: the sweep sets them per point. */
-static const char *const SWEPT[] = {"grid", "iterations", "rsm-size", "occlusion", "preset", "central-transport",
+static const char *const SWEPT[] = {"grid", "iterations", "rsm-size", "occlusion", "preset", "technique", "central-transport",
                                     "normal-bins", "far-field", "scene-surfels", NULL};
 
 static int is_swept(const char *name)
@@ -361,6 +404,7 @@ static int in_list(int v, const int *list, int n)
 typedef struct knob_filter {
     int grid[16], ngrid, iter[16], niter, rsm[16], nrsm, occ[2], nocc;
     int sw[4][2], nsw[4]; /* central, bins, far, surfels: off/on */
+    int tech[LPV_TECHNIQUE_ID_COUNT_], ntech; /* lpv_technique_id */
 } knob_filter;
 
 static const char *const MOD_KNOBS[4] = {"central", "bins", "far", "surfels"};
@@ -384,7 +428,18 @@ static int parse_knobs(const char *spec, knob_filter *kf)
             r = kf->nrsm = parse_values(v, kf->rsm, 16, 0);
         else if (strcmp(tok, "occlusion") == 0)
             r = kf->nocc = parse_values(v, kf->occ, 2, 1);
-        else {
+        else if (strcmp(tok, "technique") == 0) {
+            char names[128];
+            snprintf(names, sizeof names, "%s", v);
+            r = kf->ntech = 0;
+            for (char *s2 = NULL, *t = strtok_r(names, "/", &s2); t; t = strtok_r(NULL, "/", &s2)) {
+                lpv_technique_id id;
+                if (kf->ntech >= LPV_TECHNIQUE_ID_COUNT_ || lpv_technique_from_name(t, &id) != 0)
+                    return -1;
+                kf->tech[kf->ntech++] = (int)id;
+            }
+            r = kf->ntech > 0 ? kf->ntech : -1;
+        } else {
             r = -1;
             for (int m = 0; m < 4; ++m)
                 if (strcmp(tok, MOD_KNOBS[m]) == 0)
@@ -404,25 +459,32 @@ static int parse_points(const char *list, point *pts, int max)
     char buf[4096];
     snprintf(buf, sizeof buf, "%s", list);
     for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        char occ[8] = "", mods[8] = "";
+        char occ[8] = "", mods[8] = "", tech[16] = "";
         point p = {0};
-        int got = n < max ? sscanf(tok, "%d:%d:%d:%7[a-z]:%7s", &p.grid, &p.iterations, &p.rsm, occ, mods) : 0;
-        if (got != 4 && got != 5)
+        int got = n < max ? sscanf(tok, "%d:%d:%d:%7[a-z]:%7[-a-z]:%15s", &p.grid, &p.iterations, &p.rsm, occ, mods,
+                                   tech)
+                          : 0;
+        if (got < 4)
             return -1;
+        lpv_technique_id id = LPV_TECHNIQUE_ID_LPV;
+        if (got == 6 && lpv_technique_from_name(tech, &id) != 0)
+            return -1;
+        p.technique = id;
         if (strcmp(occ, "on") == 0)
             p.occlusion = 1;
         else if (strcmp(occ, "off") == 0)
             p.occlusion = 0;
         else
             return -1;
-        for (const char *c = got == 5 ? mods : ""; *c; ++c) { /* letters of cbfs, '-' for off */
+        for (const char *c = got >= 5 ? mods : ""; *c; ++c) { /* letters of cbfs, '-' for off */
             const char *at = strchr(mod_letters(), *c);
             if (*c != '-' && !at)
                 return -1;
             if (*c != '-')
                 p.mods |= 1 << (at - mod_letters());
         }
-        if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192)
+        if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192 ||
+            !technique_runs(&p))
             return -1;
         pts[n++] = p;
     }
@@ -632,17 +694,17 @@ static const char *occ_name(int on)
 
 static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes)
 {
-    fprintf(f, "scene,grid,iterations,rsm,occlusion,mods,ms_per_tick");
+    fprintf(f, "scene,grid,iterations,rsm,occlusion,mods,technique,ms_per_tick");
     for (int k = 0; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
     fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto,preset");
     fprintf(f, ",block,label,cascades,cascade_size,bounces,damping,ref_bounces,rel_rmse_1b,rel_rmse_multi");
     fprintf(f, ",black_rmse,constant_rmse,share_floor,share_ceiling,share_walls,rmse_floor,rmse_ceiling,rmse_walls,"
-               "ratio_floor,ratio_ceiling,ratio_walls\n");
+               "ratio_floor,ratio_ceiling,ratio_walls,octree_e_abs,octree_e_rel,octree_mean_rel\n");
     for (int i = 0; i < n; ++i) {
         char mb[5];
-        fprintf(f, "%s,%d,%d,%d,%s,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
-                occ_name(r[i].p.occlusion), mods_name(r[i].p.mods, mb), r[i].ms_total);
+        fprintf(f, "%s,%d,%d,%d,%s,%s,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
+                occ_name(r[i].p.occlusion), mods_name(r[i].p.mods, mb), tech_name(r[i].p.technique), r[i].ms_total);
         for (int k = 0; k < NSTAGES; ++k)
             fprintf(f, ",%.3f", r[i].stage_ms[k]);
         fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d,%s", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
@@ -660,6 +722,10 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
             fprintf(f, ",%.5f", r[i].region_rmse[g]);
         for (int g = 0; g < LPV_ACC_REGIONS; ++g)
             fprintf(f, ",%.5f", r[i].region_ratio[g]);
+        if (r[i].octree.elements) /* the octree's own metric; empty for the cascaded LPV */
+            fprintf(f, ",%.6g,%.6g,%.6g", r[i].octree.e_abs, r[i].octree.e_rel, r[i].octree.mean_rel);
+        else
+            fprintf(f, ",,,");
         fputc('\n', f);
     }
 }
@@ -737,16 +803,16 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             continue;
         fprintf(f, "## %s\n\n", scenes[s].name);
         fprintf(f, "reference: `%s`%s\n\n", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
-        fprintf(f, "| grid | iterations | RSM | occlusion | mods | preset | ms/tick | propagate ms | gv ms | rel. RMSE "
-                   "| rel. bias | rel. MAE | ref. noise | Pareto |\n");
-        fprintf(f, "|---:|---:|---:|:---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
+        fprintf(f, "| technique | grid | iterations | RSM | occlusion | mods | preset | ms/tick | propagate ms | gv ms "
+                   "| rel. RMSE | rel. bias | rel. MAE | ref. noise | Pareto |\n");
+        fprintf(f, "|:---:|---:|---:|---:|:---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
         for (int i = 0; i < k; ++i) {
             const result *x = rows[i];
             const char *b = x->pareto ? "**" : "";
             fprintf(f,
-                    "| %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f | %s "
-                    "|\n",
-                    b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion),
+                    "| %s | %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f "
+                    "| %s |\n",
+                    tech_name(x->p.technique), b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion),
                     mods_name(x->p.mods, (char[5]){0}), point_preset(&x->p), b,
                     x->ms_total, b,
                     x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
@@ -946,6 +1012,7 @@ static int write_features_plot(const char *out_dir, const result *r, int n, cons
 static const char *key_preset(const int key[LPV_ACC_KEY])
 {
     point p = {key[0], key[1], key[2], key[3], key[4]};
+    p.technique = (lpv_technique_id)key[5];
     return point_preset(&p);
 }
 
@@ -968,7 +1035,8 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     for (int i = 0; i < n; ++i) /* the classic sweep's points only: features share their four knobs */
         if (!r[i].p.feat)
             rows[nrows++] = (lpv_acc_row){r[i].scene,
-                                          {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion, r[i].p.mods},
+                                          {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion, r[i].p.mods,
+                                           (int)r[i].p.technique},
                                           r[i].ms_total, r[i].m.rel_rmse};
     if (nrows == 0) {
         free(rows);
@@ -990,34 +1058,35 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
                     "scenes and normalised RMSE = mean over the scenes of rel. RMSE / the scene's best rel. RMSE "
                     "(1 = the best of this sweep on every scene; docs/accuracy.md). The presets are chosen from "
                     "this front. mods: the departures from the paper switched on, c = central transport, b = "
-                    "normal bins, f = far field, s = scene surfels (docs/propagation.md).\n\n| grid | iterations | "
-                    "RSM | occlusion | mods | preset | mean ms/tick | normalised RMSE |");
-        fprintf(csv, "grid,iterations,rsm,occlusion,mods,mean_ms_per_tick,norm_rmse");
+                    "normal bins, f = far field, s = scene surfels (docs/propagation.md).\n\n| technique | grid | "
+                    "iterations | RSM | occlusion | mods | preset | mean ms/tick | normalised RMSE |");
+        fprintf(csv, "grid,iterations,rsm,occlusion,mods,technique,mean_ms_per_tick,norm_rmse");
         for (int s = 0; s < nscenes; ++s) {
             fprintf(md, " %s rel. RMSE |", scenes[s].name);
             fprintf(csv, ",rel_rmse_%s", scenes[s].name);
         }
-        fprintf(md, " Pareto |\n|---:|---:|---:|:---:|:---:|:---:|---:|---:|");
+        fprintf(md, " Pareto |\n|:---:|---:|---:|---:|:---:|:---:|:---:|---:|---:|");
         fprintf(csv, ",pareto,preset\n");
         for (int s = 0; s < nscenes; ++s)
             fprintf(md, "---:|");
         fprintf(md, ":---:|\n");
-        fprintf(dat, "# mean_ms norm_rmse pareto preset\n");
+        fprintf(dat, "# mean_ms norm_rmse pareto preset technique\n");
         for (size_t j = 0; j < k; ++j) {
             const lpv_acc_overall *x = &o[j];
             const char *b = x->pareto ? "**" : "", *pre = key_preset(x->key);
             char mb[5];
-            fprintf(md, "| %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %s%.3f%s |", b, x->key[0], b, x->key[1],
-                    x->key[2], occ_name(x->key[3]), mods_name(x->key[4], mb), pre, b, x->ms, b, b, x->norm_rmse, b);
-            fprintf(csv, "%d,%d,%d,%s,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), mb, x->ms,
-                    x->norm_rmse);
+            fprintf(md, "| %s | %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %s%.3f%s |", tech_name(x->key[5]), b,
+                    x->key[0], b, x->key[1], x->key[2], occ_name(x->key[3]), mods_name(x->key[4], mb), pre, b, x->ms, b,
+                    b, x->norm_rmse, b);
+            fprintf(csv, "%d,%d,%d,%s,%s,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), mb,
+                    tech_name(x->key[5]), x->ms, x->norm_rmse);
             for (int s = 0; s < nscenes; ++s) {
                 fprintf(md, " %.3f |", x->rel_rmse[s]);
                 fprintf(csv, ",%.5f", x->rel_rmse[s]);
             }
             fprintf(md, " %s |\n", x->pareto ? "**◆**" : "");
             fprintf(csv, ",%d,%s\n", x->pareto, pre);
-            fprintf(dat, "%.4f %.5f %d %s\n", x->ms, x->norm_rmse, x->pareto, *pre ? pre : "-");
+            fprintf(dat, "%.4f %.5f %d %s %s\n", x->ms, x->norm_rmse, x->pareto, *pre ? pre : "-", tech_name(x->key[5]));
         }
         fputc('\n', md);
     }
@@ -1055,7 +1124,10 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     fprintf(f, "set title 'lpvd over all scenes: normalised error vs time (1 = best of the sweep on every scene)'\n");
     fprintf(f, "set xlabel 'GPU ms per tick, mean over the scenes'\nset ylabel 'normalised relative RMSE'\n");
     fprintf(f, "set logscale x\nset grid xtics ytics mxtics\nset key top right\n");
-    fprintf(f, "plot 'plot/overall.dat' using 1:2 with points pt 7 ps 0.8 lc 1 title 'setting', \\\n"
+    fprintf(f, "plot 'plot/overall.dat' using 1:(stringcolumn(5) eq 'lpv' ? $2 : 1/0) with points pt 7 ps 0.8 lc 1 "
+               "title 'lpv (cascaded LPV)', \\\n"
+               "  'plot/overall.dat' using 1:(stringcolumn(5) eq 'octree' ? $2 : 1/0) with points pt 9 ps 1.1 lc 4 "
+               "title 'octree LPV', \\\n"
                "  'plot/overall-pareto.dat' using 1:2 with linespoints pt 6 ps 1.6 lw 2 lc 2 "
                "title 'Pareto front', \\\n"
                "  'plot/overall.dat' using 1:2:(stringcolumn(4) eq '-' ? '' : stringcolumn(4)) with labels left "
@@ -1239,18 +1311,26 @@ int main(int argc, char **argv)
             ni = kf.niter ? kf.niter : (int)(sizeof ITERS / sizeof *ITERS),
             nr = kf.nrsm ? kf.nrsm : (int)(sizeof RSMS / sizeof *RSMS),
             no = kf.nocc ? kf.nocc : (int)(sizeof OCCS / sizeof *OCCS);
-        for (int g = 0; g < ng; ++g)
-            for (int it = 0; it < ni; ++it)
-                for (int r = 0; r < nr; ++r)
-                    for (int o = 0; o < no; ++o)
-                        for (size_t m = 0; m < sizeof MODS / sizeof *MODS && npts < MAX_POINTS; ++m)
-                            pts[npts++] = (point){gl[g], il[it], rl[r], ol[o], MODS[m]};
+        const int lpv_only[] = {LPV_TECHNIQUE_ID_LPV};
+        const int *tl = kf.ntech ? kf.tech : lpv_only, nt = kf.ntech ? kf.ntech : 1;
+        for (int t = 0; t < nt; ++t)
+            for (int g = 0; g < ng; ++g)
+                for (int it = 0; it < ni; ++it)
+                    for (int r = 0; r < nr; ++r)
+                        for (int o = 0; o < no; ++o)
+                            for (size_t m = 0; m < sizeof MODS / sizeof *MODS && npts < MAX_POINTS; ++m) {
+                                point q = {gl[g], il[it], rl[r], ol[o], MODS[m]};
+                                q.technique = (lpv_technique_id)tl[t];
+                                if (technique_runs(&q))
+                                    pts[npts++] = q;
+                            }
     }
     if (knobs) {
         int k = 0;
         for (int i = 0; i < npts; ++i) {
             int keep = in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
-                       in_list(pts[i].rsm, kf.rsm, kf.nrsm) && in_list(pts[i].occlusion, kf.occ, kf.nocc);
+                       in_list(pts[i].rsm, kf.rsm, kf.nrsm) && in_list(pts[i].occlusion, kf.occ, kf.nocc) &&
+                       in_list(pts[i].technique ? (int)pts[i].technique : LPV_TECHNIQUE_ID_LPV, kf.tech, kf.ntech);
             for (int m = 0; m < 4; ++m)
                 keep = keep && in_list((pts[i].mods >> m) & 1, kf.sw[m], kf.nsw[m]);
             if (keep)
@@ -1467,6 +1547,7 @@ add_features:
             st.lpv.normal_bins = on_off(pts[p].mods & MOD_BINS);
             st.lpv.far_field = on_off(pts[p].mods & MOD_FAR);
             st.scene_surfels = on_off(pts[p].mods & MOD_SURFELS);
+            st.technique = pts[p].technique;
             if (pts[p].feat) {
                 st.lpv.cascades = pts[p].cascades;
                 if (pts[p].cascades > 1) {
@@ -1514,6 +1595,8 @@ add_features:
             for (int k = 0; k < NSTAGES; ++k)
                 res->stage_ms[k] = lpv_acc_median(stage[k], (size_t)ticks);
             res->cascades_used = lpv_engine_cascade_count(engine);
+            if (pts[p].technique == LPV_TECHNIQUE_ID_OCTREE)
+                octree_metric(engine, &res->octree);
             if (lpv_acc_compare(rgba, ref, ref_se, view.width, view.height, &res->m) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both, or a black reference\n",
                         se->name);
@@ -1542,8 +1625,10 @@ add_features:
             if (pts[p].feat)
                 snprintf(ep, sizeof ep, "%s/features-%s.png", sub, pts[p].label);
             else
-                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s.png", sub, pts[p].grid, pts[p].iterations,
-                         pts[p].rsm, occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}));
+                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s%s%s.png", sub, pts[p].grid, pts[p].iterations,
+                         pts[p].rsm, occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
+                         pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? "-" : "",
+                         pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? tech_name(pts[p].technique) : "");
             if (lpv_acc_write_error_png(ep, rgba, cmp_ref, view.width, view.height, res->m.mean_ref, err,
                                         sizeof err) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s\n", err);
@@ -1560,10 +1645,10 @@ add_features:
                 }
             }
             fprintf(stderr,
-                    "lpvd-accuracy: %s %d/%d: grid %d, iterations %d, rsm %d, occlusion %s, mods %s: %.2f ms/tick, "
+                    "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s: %.2f ms/tick, "
                     "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
-                    se->name, p + 1, npts, pts[p].grid, pts[p].iterations, pts[p].rsm, occ_name(pts[p].occlusion),
-                    mods_name(pts[p].mods, (char[5]){0}),
+                    se->name, p + 1, npts, tech_name(pts[p].technique), pts[p].grid, pts[p].iterations, pts[p].rsm,
+                    occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
                     res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
                     pts[p].label);
             ++nres;

@@ -17,7 +17,7 @@
 #define LPV_ACC_MAX_SCENES 16
 
 /* One measured (scene, point): the point is identified by key[LPV_ACC_KEY]. */
-#define LPV_ACC_KEY 5
+#define LPV_ACC_KEY 6 /* grid, iterations, rsm, occlusion, mods, technique */
 typedef struct lpv_acc_row {
     int scene; /* 0 .. nscenes-1 */
     int key[LPV_ACC_KEY];
