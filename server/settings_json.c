@@ -69,24 +69,24 @@ json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture)
     return a;
 }
 
-json_t *lpvd_techniques_json(void)
+/* A JSON array of a core table's names, name(first) .. name(end - 1). */
+static json_t *names_json(const char *(*name)(int), int first, int end)
 {
     json_t *a = json_array();
-    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; a && t < LPV_TECHNIQUE_ID_COUNT_; ++t)
-        if (json_array_append_new(a, json_string(lpv_technique_name((lpv_technique_id)t))) != 0) {
+    for (int i = first; a && i < end; ++i)
+        if (json_array_append_new(a, json_string(name(i))) != 0) {
             json_decref(a);
             return NULL;
         }
     return a;
 }
 
-json_t *lpvd_presets_json(void)
+static const char *technique_name(int t) { return lpv_technique_name((lpv_technique_id)t); }
+static const char *preset_name(int p) { return lpv_preset_name((lpv_preset)p); }
+
+json_t *lpvd_techniques_json(void)
 {
-    json_t *a = json_array();
-    for (int p = LPV_PRESET_DEFAULT + 1; a && p < LPV_PRESET_COUNT_; ++p)
-        if (json_array_append_new(a, json_string(lpv_preset_name((lpv_preset)p))) != 0) {
-            json_decref(a);
-            return NULL;
-        }
-    return a;
+    return names_json(technique_name, LPV_TECHNIQUE_ID_DEFAULT + 1, LPV_TECHNIQUE_ID_COUNT_);
 }
+
+json_t *lpvd_presets_json(void) { return names_json(preset_name, LPV_PRESET_DEFAULT + 1, LPV_PRESET_COUNT_); }
