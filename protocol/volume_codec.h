@@ -153,7 +153,7 @@ typedef struct lpvp_cascade_info {
     uint64_t cells;              /* dims[0] x dims[1] x dims[2] */
 } lpvp_cascade_info;
 
-/* ---- Volume description (SPEC R5.9 - R5.12) ------------------------------ */
+/* ---- Volume description (SPEC R5.9 - R5.13) ------------------------------ */
 
 /* The version of the description's layout this library reads and writes
  * (R5.9). New techniques fill the same layout; only an incompatible change
@@ -209,8 +209,9 @@ typedef struct lpvp_index_info {
     uint64_t raw_length;         /* cells x values_per_cell x 4 */
 } lpvp_index_info;
 
-/* What a volume carries (R5.9 - R5.12). The levels' placement is the info's
- * cascades (R5.10 requires the two lists to agree). */
+/* What a volume carries (R5.9 - R5.13). The levels' placement is the info's
+ * cascades (R5.10 requires the two lists to agree), except an octree's
+ * levels (R5.13), which are level_count / level below. */
 typedef struct lpvp_volume_layout {
     int present;                 /* build: send the description; parse: the header had one (0: an
                                     older server, filled from the legacy keys as R5.1 describes) */
@@ -291,7 +292,9 @@ uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi);
 uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k);
 
 /* Builds the header object (new reference; NULL if memory runs out) with
- * every field of section 5 (base_tick only for deltas), the "cascades" array
+ * every field of section 5 (base_tick only for deltas; the description's
+ * levels and index from the layout for content LPVP_CONTENT_LEVELS, R5.13,
+ * the index's raw_offset = lpvp_volume_values_bytes), the "cascades" array
  * (R5.6; one entry from dims/origin/cell_size when cascade_count is 0) plus
  * the fixed "units", "layout" and "sh" strings. */
 json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
@@ -302,8 +305,10 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
  * equal to cascade 0), the description "volume" (R5.9 - R5.12: a layout
  * version this library knows, levels equal to the cascades, roles agreeing
  * with far_field, values naming values_per_cell distinct values, units as the
- * top level's, an index that fits), and that raw_length == the levels'
- * values (+ the index) as described. A header without "cascades" (an older
+ * top level's, an index that fits; or R5.13's octree levels: one cascade,
+ * log2(n) + 1 "octree_level" levels placed as lpvp_octree_level_place says,
+ * far_field false, the index over level 0), and that raw_length == the
+ * levels' values (+ the index) as described. A header without "cascades" (an older
  * server) is read as one cascade equal to the grid; one without "volume" as
  * R5.1's 12 values (layout.present 0). Returns 0, or -1 with
  * "<field>: <what>" in err. */

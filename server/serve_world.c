@@ -311,14 +311,16 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
 static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
 {
     size_t cells0 = lpv_grid_cell_count(&r->grid);
+    int count = lpvp_octree_level_count(r->grid.dims[0]);
+    if (count < 1) /* no octree over this grid */
+        return 0;
     int32_t *index = malloc((cells0 ? cells0 : 1) * sizeof *index);
     if (!index) {
         snprintf(err, n, "out of memory for a %zu-cell index volume", cells0);
         return -1;
     }
     size_t got = lpv_engine_read_index(e, index, cells0);
-    int count = lpvp_octree_level_count(r->grid.dims[0]);
-    if (got == 0 || count < 1) { /* no index volume: no levels to send */
+    if (got == 0) { /* no index volume: no levels to send */
         free(index);
         return 0;
     }

@@ -1474,8 +1474,13 @@ static void test_volume_octree_levels(void **state)
     BAD(json_array_append(json_object_get(b, "cascades"), json_array_get(json_object_get(b, "cascades"), 0)),
         "cascades");
     /* the index: over level 0, one u32 per cell */
-    BAD(json_object_set_new(bd, "index", json_null()), "index");
-    BAD(json_object_set_new(json_object_get(bd, "index"), "values_per_cell", json_integer(2)), "index");
+    BAD(json_object_set_new(bd, "index", json_null()), "need the index volume over level 0");
+    BAD((json_object_set_new(json_object_get(bd, "index"), "values_per_cell", json_integer(2)),
+         json_object_set_new(json_object_get(bd, "index"), "raw_length", json_integer(64 * 2 * 4))),
+        "need the index volume over level 0");
+    BAD((json_object_set_new(json_object_get(bd, "index"), "dims", json_pack("[i,i,i]", 4, 4, 2)),
+         json_object_set_new(json_object_get(bd, "index"), "raw_length", json_integer(32 * 4))),
+        "need the index volume over level 0");
     BAD(json_object_set_new(json_object_get(bd, "index"), "raw_offset", json_integer(0)), "index.raw_offset");
     BAD(json_object_set_new(b, "raw_length", json_integer(73 * 12 * 2)), "raw_length");
     /* a grid with no octree */
