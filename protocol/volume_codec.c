@@ -347,7 +347,10 @@ const char *const lpvp_sh_value_names[LPVP_VALUES_PER_CELL] = {
     "r.Y00", "r.Y1-1", "r.Y10", "r.Y11", "g.Y00", "g.Y1-1", "g.Y10", "g.Y11",
     "b.Y00", "b.Y1-1", "b.Y10", "b.Y11"};
 const char *const lpvp_level_role_names[LPVP_ROLE_COUNT] = {[LPVP_ROLE_CASCADE] = "cascade",
-                                                            [LPVP_ROLE_FAR_FIELD] = "far_field"};
+                                                            [LPVP_ROLE_FAR_FIELD] = "far_field",
+                                                            [LPVP_ROLE_OCTREE_LEVEL] = "octree_level"};
+const char *const lpvp_volume_content_names[LPVP_CONTENT_COUNT] = {[LPVP_CONTENT_MERGED] = "merged",
+                                                                   [LPVP_CONTENT_LEVELS] = "levels"};
 
 void lpvp_volume_layout_sh(lpvp_volume_layout *l, const char *technique, int far_field, int levels)
 {
@@ -356,11 +359,59 @@ void lpvp_volume_layout_sh(lpvp_volume_layout *l, const char *technique, int far
     l->layout_version = LPVP_VOLUME_LAYOUT_VERSION;
     snprintf(l->technique, sizeof l->technique, "%s", technique ? technique : "");
     l->far_field = far_field != 0;
-    for (int k = 0; k < LPVP_MAX_CASCADES; k++)
+    for (int k = 0; k < LPVP_MAX_LEVELS; k++)
         l->role[k] = (l->far_field && k > 0 && k < levels) ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
     l->volumes_per_level = 1;
     l->values_per_cell = LPVP_VALUES_PER_CELL;
     l->sh_values = 1;
+}
+
+int lpvp_octree_level_count(int64_t n)
+{
+    int l = 1;
+    if (n < 1 || (n & (n - 1)) != 0)
+        return -1;
+    while ((n >> (l - 1)) > 1)
+        l++;
+    return l <= LPVP_MAX_LEVELS ? l : -1;
+}
+
+void lpvp_octree_level_place(const lpvp_cascade_info *level0, int i, lpvp_cascade_info *out)
+{
+    *out = *level0;
+    out->cells = 1;
+    for (int a = 0; a < 3; a++) {
+        out->dims[a] = level0->dims[a] >> i;
+        out->cells *= (uint64_t)(out->dims[a] > 0 ? out->dims[a] : 0);
+    }
+    out->cell_size = ldexp(level0->cell_size, i);
+}
+
+int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
+                              char *err, size_t err_n)
+{
+    int count = lpvp_octree_level_count(level0->dims[0]);
+    if (count < 0 || level0->dims[1] != level0->dims[0] || level0->dims[2] != level0->dims[0]) {
+        lpvp_set_error(err, err_n, "a grid of %lldx%lldx%lld cells has no octree of at most %d levels (it needs a cube "
+                       "of a power of two)", (long long)level0->dims[0], (long long)level0->dims[1],
+                       (long long)level0->dims[2], LPVP_MAX_LEVELS);
+        return -1;
+    }
+    lpvp_volume_layout_sh(l, technique, 0, 1);
+    l->content = LPVP_CONTENT_LEVELS;
+    l->level_count = count;
+    for (int i = 0; i < count; i++) {
+        lpvp_octree_level_place(level0, i, &l->level[i]);
+        l->role[i] = LPVP_ROLE_OCTREE_LEVEL;
+    }
+    l->has_index = 1;
+    l->index.level = 0;
+    for (int a = 0; a < 3; a++)
+        l->index.dims[a] = level0->dims[a];
+    l->index.cells = level0->cells;
+    l->index.values_per_cell = 1;
+    l->index.raw_length = level0->cells * LPVP_INDEX_VALUE_SIZE;
+    return 0;
 }
 
 uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi)
@@ -381,6 +432,14 @@ uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi)
 
 int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n)
 {
+    if (l->content == LPVP_CONTENT_LEVELS) {
+        lpvp_set_error(err, err_n,
+                       "volume of content \"%s\" (technique \"%s\": its %d levels and index volume) is not the merged "
+                       "grid R5.7's lookup reads: ask GET_VOLUME with content \"%s\"",
+                       lpvp_volume_content_names[LPVP_CONTENT_LEVELS], l->technique, l->level_count,
+                       lpvp_volume_content_names[LPVP_CONTENT_MERGED]);
+        return -1;
+    }
     if ((l->sh_values || (!l->present && l->values_per_cell == 0)) && l->volumes_per_level <= 1 && !l->has_index)
         return 0;
     lpvp_set_error(err, err_n,
@@ -393,14 +452,28 @@ int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size
 
 /* The description object (R5.9): levels from the cascades, values from the
  * SH names (the only values this library builds). */
+static json_t *placement_json(const lpvp_cascade_info *c);
+static json_t *index_json(const lpvp_volume_info *vi);
+
 static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
 {
     const lpvp_volume_layout *l = &vi->layout;
-    json_t *levels = json_deep_copy(cascades), *values = json_array();
+    json_t *levels = NULL, *values = json_array();
+    if (l->content == LPVP_CONTENT_LEVELS) { /* R5.13: the octree's levels */
+        levels = json_array();
+        for (int k = 0; levels && k < l->level_count && k < LPVP_MAX_LEVELS; k++) {
+            if (json_array_append_new(levels, placement_json(&l->level[k])) != 0) {
+                json_decref(levels);
+                levels = NULL;
+            }
+        }
+    } else {
+        levels = json_deep_copy(cascades);
+    }
     json_t *o = json_object();
     int bad = !levels || !values || !o || !l->sh_values || l->values_per_cell != LPVP_VALUES_PER_CELL;
     for (size_t k = 0; !bad && k < json_array_size(levels); k++) {
-        int r = l->role[k] == LPVP_ROLE_FAR_FIELD ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
+        int r = l->role[k] >= 0 && l->role[k] < LPVP_ROLE_COUNT ? (int)l->role[k] : LPVP_ROLE_CASCADE;
         bad |= json_object_set_new(json_array_get(levels, k), "role", json_string(lpvp_level_role_names[r])) != 0;
     }
     for (int i = 0; !bad && i < LPVP_VALUES_PER_CELL; i++)
@@ -416,8 +489,7 @@ static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
         bad |= json_object_set_new(o, "values", values) != 0;
         values = NULL;
         bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
-        /* this library builds no index volume (R5.12 reserves the key) */
-        bad |= json_object_set_new(o, "index", json_null()) != 0;
+        bad |= json_object_set_new(o, "index", l->has_index ? index_json(vi) : json_null()) != 0;
     }
     json_decref(levels);
     json_decref(values);
@@ -463,10 +535,22 @@ static int cascades_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
     return vi->cascade_count;
 }
 
+/* The levels the raw volume holds: the octree's (R5.13) or the cascades. */
+static int levels_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
+{
+    if (vi->layout.content != LPVP_CONTENT_LEVELS)
+        return cascades_of(vi, out);
+    if (vi->layout.level_count < 1 || vi->layout.level_count > LPVP_MAX_LEVELS)
+        return -1;
+    for (int k = 0; k < vi->layout.level_count; k++)
+        out[k] = vi->layout.level[k];
+    return vi->layout.level_count;
+}
+
 uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi)
 {
-    lpvp_cascade_info c[LPVP_MAX_CASCADES];
-    int n = cascades_of(vi, c);
+    lpvp_cascade_info c[LPVP_MAX_LEVELS];
+    int n = levels_of(vi, c);
     uint64_t total = 0;
     for (int k = 0; k < n; k++)
         total += c[k].cells;
@@ -475,12 +559,31 @@ uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi)
 
 uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k)
 {
-    lpvp_cascade_info c[LPVP_MAX_CASCADES];
-    int n = cascades_of(vi, c);
+    lpvp_cascade_info c[LPVP_MAX_LEVELS];
+    int n = levels_of(vi, c);
     uint64_t first = 0;
     for (int i = 0; i < k && i < n; i++)
         first += c[i].cells;
     return first;
+}
+
+/* One level's (cascade's) placement: dims, origin, cell_size, cells. */
+static json_t *placement_json(const lpvp_cascade_info *c)
+{
+    return json_pack("{s:[I,I,I], s:o, s:f, s:I}", "dims", (json_int_t)c->dims[0], (json_int_t)c->dims[1],
+                     (json_int_t)c->dims[2], "origin", vec_json(c->origin, 3), "cell_size",
+                     isfinite(c->cell_size) ? c->cell_size : 0.0, "cells", (json_int_t)c->cells);
+}
+
+/* The index object (R5.12), right after the levels' values. */
+static json_t *index_json(const lpvp_volume_info *vi)
+{
+    const lpvp_index_info *ix = &vi->layout.index;
+    uint64_t length = ix->cells * (uint64_t)ix->values_per_cell * LPVP_INDEX_VALUE_SIZE;
+    return json_pack("{s:i, s:[I,I,I], s:i, s:s, s:I, s:I}", "level", ix->level, "dims", (json_int_t)ix->dims[0],
+                     (json_int_t)ix->dims[1], (json_int_t)ix->dims[2], "values_per_cell", ix->values_per_cell,
+                     "value_type", LPVP_INDEX_VALUE_TYPE, "raw_offset", (json_int_t)lpvp_volume_values_bytes(vi),
+                     "raw_length", (json_int_t)length);
 }
 
 static json_t *cascades_json(const lpvp_volume_info *vi)
@@ -493,11 +596,7 @@ static json_t *cascades_json(const lpvp_volume_info *vi)
         return NULL;
     }
     for (int k = 0; k < n; k++) {
-        json_t *e = json_pack("{s:[I,I,I], s:o, s:f, s:I}", "dims", (json_int_t)c[k].dims[0],
-                              (json_int_t)c[k].dims[1], (json_int_t)c[k].dims[2], "origin",
-                              vec_json(c[k].origin, 3), "cell_size",
-                              isfinite(c[k].cell_size) ? c[k].cell_size : 0.0, "cells",
-                              (json_int_t)c[k].cells);
+        json_t *e = placement_json(&c[k]);
         if (!e || json_array_append_new(a, e) != 0) {
             json_decref(a);
             return NULL;
@@ -673,6 +772,82 @@ static int parse_cascades(const json_t *obj, lpvp_volume_info *vi, char *err, si
     return 0;
 }
 
+/* 1 when a level object e has ci's dims, origin, cell_size and cells. */
+static int level_matches(const json_t *e, const lpvp_cascade_info *ci)
+{
+    const json_t *dims = json_object_get(e, "dims"), *org = json_object_get(e, "origin"), *v;
+    int same = json_is_array(dims) && json_array_size(dims) == 3 && json_is_array(org) && json_array_size(org) == 3;
+    for (size_t i = 0; same && i < 3; i++) {
+        same = json_is_integer(json_array_get(dims, i)) && json_integer_value(json_array_get(dims, i)) == ci->dims[i] &&
+               json_is_number(json_array_get(org, i)) &&
+               same_real(json_number_value(json_array_get(org, i)), ci->origin[i]);
+    }
+    v = json_object_get(e, "cell_size");
+    same = same && json_is_number(v) && same_real(json_number_value(v), ci->cell_size);
+    v = json_object_get(e, "cells");
+    return same && json_is_integer(v) && (uint64_t)json_integer_value(v) == ci->cells;
+}
+
+/* 1 when levels[0] has the role "octree_level" (R5.13). */
+static int is_octree_levels(const json_t *levels)
+{
+    const json_t *r = json_object_get(json_array_get(levels, 0), "role");
+    return json_is_array(levels) && json_is_string(r) &&
+           strcmp(json_string_value(r), lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL]) == 0;
+}
+
+/* R5.13: an octree's levels over cascades[0] (the only cascade), every one
+ * placed as lpvp_octree_level_place says, far_field false. */
+static int parse_octree_levels(const json_t *d, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    lpvp_volume_layout *l = &vi->layout;
+    const char *K = LPVP_VOLUME_DESC_KEY, *OL = lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL];
+    const json_t *a = json_object_get(d, "levels");
+    const lpvp_cascade_info *c0 = &vi->cascades[0];
+    if (vi->cascade_count != 1) {
+        lpvp_set_error(err, err_n, "cascades: %d entries, but \"%s\" levels need exactly one, level 0", vi->cascade_count,
+                       OL);
+        return -1;
+    }
+    int count = lpvp_octree_level_count(c0->dims[0]);
+    if (count < 0 || c0->dims[1] != c0->dims[0] || c0->dims[2] != c0->dims[0]) {
+        lpvp_set_error(err, err_n, "%s.levels: \"%s\" levels over a %lldx%lldx%lld level 0, which has no octree of at "
+                       "most %d levels (a cube of a power of two)", K, OL, (long long)c0->dims[0], (long long)c0->dims[1],
+                       (long long)c0->dims[2], LPVP_MAX_LEVELS);
+        return -1;
+    }
+    if (json_array_size(a) != (size_t)count) {
+        lpvp_set_error(err, err_n, "%s.levels: %zu \"%s\" levels, but an octree over %lld^3 cells has %d (log2(n) + 1)",
+                       K, json_array_size(a), OL, (long long)c0->dims[0], count);
+        return -1;
+    }
+    if (l->far_field) {
+        lpvp_set_error(err, err_n, "%s.far_field: true with \"%s\" levels (an octree has no far field)", K, OL);
+        return -1;
+    }
+    for (int k = 0; k < count; k++) {
+        const json_t *e = json_array_get(a, (size_t)k), *r = json_object_get(e, "role");
+        lpvp_cascade_info want;
+        lpvp_octree_level_place(c0, k, &want);
+        if (!json_is_object(e) || !level_matches(e, &want)) {
+            lpvp_set_error(err, err_n, "%s.levels[%d]: dims, origin, cell_size and cells differ from octree level %d "
+                           "(level 0's origin, dims n >> %d, cell size 2^%d x level 0's)", K, k, k, k, k);
+            return -1;
+        }
+        if (!json_is_string(r) || strcmp(json_string_value(r), OL) != 0) {
+            lpvp_set_error(err, err_n, "%s.levels[%d].role: expected \"%s\" (level 0's role)", K, k, OL);
+            return -1;
+        }
+        l->level[k] = want;
+        l->role[k] = LPVP_ROLE_OCTREE_LEVEL;
+    }
+    l->content = LPVP_CONTENT_LEVELS;
+    l->level_count = count;
+    return 0;
+}
+
+static int parse_cells(const json_t *obj, const json_t *d, lpvp_volume_info *vi, char *err, size_t err_n);
+
 /* The description (R5.9 - R5.12) into vi->layout; the cascades are already
  * read. Absent: R5.1's 12 values (layout.present 0). Each MUST-reject rule of
  * R5.9 - R5.12 is one check here, its message naming the field. */
@@ -681,7 +856,6 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
     lpvp_volume_layout *l = &vi->layout;
     const json_t *d = json_object_get(obj, LPVP_VOLUME_DESC_KEY), *v, *a;
     const char *K = LPVP_VOLUME_DESC_KEY;
-    long long x;
     char key[96];
     if (!d) {
         lpvp_volume_layout_sh(l, "", 0, vi->cascade_count);
@@ -721,8 +895,10 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
     }
     l->far_field = json_is_true(v);
 
-    /* R5.10: the levels are the cascades, each with a role agreeing with far_field */
     a = json_object_get(d, "levels");
+    if (is_octree_levels(a))
+        return parse_octree_levels(d, vi, err, err_n) != 0 ? -1 : parse_cells(obj, d, vi, err, err_n);
+    /* R5.10: the levels are the cascades, each with a role agreeing with far_field */
     if (!json_is_array(a) || json_array_size(a) != (size_t)vi->cascade_count) {
         lpvp_set_error(err, err_n, "%s.levels: expected an array of %d levels (one per cascade)", K,
                        vi->cascade_count);
@@ -735,20 +911,7 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
             lpvp_set_error(err, err_n, "%s.levels[%d]: expected an object", K, k);
             return -1;
         }
-        const json_t *dims = json_object_get(e, "dims"), *org = json_object_get(e, "origin");
-        int same = json_is_array(dims) && json_array_size(dims) == 3 && json_is_array(org) &&
-                   json_array_size(org) == 3;
-        for (size_t i = 0; same && i < 3; i++) {
-            same = json_is_integer(json_array_get(dims, i)) &&
-                   json_integer_value(json_array_get(dims, i)) == ci->dims[i] &&
-                   json_is_number(json_array_get(org, i)) &&
-                   same_real(json_number_value(json_array_get(org, i)), ci->origin[i]);
-        }
-        v = json_object_get(e, "cell_size");
-        same = same && json_is_number(v) && same_real(json_number_value(v), ci->cell_size);
-        v = json_object_get(e, "cells");
-        same = same && json_is_integer(v) && (uint64_t)json_integer_value(v) == ci->cells;
-        if (!same) {
+        if (!level_matches(e, ci)) {
             lpvp_set_error(err, err_n, "%s.levels[%d]: dims, origin, cell_size and cells differ from cascades[%d]", K,
                            k, k);
             return -1;
@@ -759,8 +922,9 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
             if (strcmp(json_string_value(v), lpvp_level_role_names[r]) == 0)
                 role = r;
         if (role < 0) {
-            lpvp_set_error(err, err_n, "%s.levels[%d].role: expected \"%s\" or \"%s\"", K, k,
-                           lpvp_level_role_names[LPVP_ROLE_CASCADE], lpvp_level_role_names[LPVP_ROLE_FAR_FIELD]);
+            lpvp_set_error(err, err_n, "%s.levels[%d].role: expected \"%s\", \"%s\" or \"%s\"", K, k,
+                           lpvp_level_role_names[LPVP_ROLE_CASCADE], lpvp_level_role_names[LPVP_ROLE_FAR_FIELD],
+                           lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL]);
             return -1;
         }
         int want = (l->far_field && k > 0) ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
@@ -773,6 +937,17 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
         }
         l->role[k] = (lpvp_level_role)role;
     }
+    return parse_cells(obj, d, vi, err, err_n);
+}
+
+/* R5.11, R5.12: what a cell holds, units, the index. */
+static int parse_cells(const json_t *obj, const json_t *d, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    lpvp_volume_layout *l = &vi->layout;
+    const json_t *v, *a;
+    const char *K = LPVP_VOLUME_DESC_KEY;
+    long long x;
+    char key[96];
 
     /* R5.11: what a cell holds */
     snprintf(key, sizeof key, "%s.volumes_per_level", K);
@@ -826,8 +1001,9 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
             return -1;
         }
         snprintf(key, sizeof key, "%s.index.level", K);
-        if (need_int(v, "level", 0, &x, err, err_n) != 0 || x >= vi->cascade_count) {
-            lpvp_set_error(err, err_n, "%s: expected a level in [0, %d]", key, vi->cascade_count - 1);
+        int level_count = l->content == LPVP_CONTENT_LEVELS ? l->level_count : vi->cascade_count;
+        if (need_int(v, "level", 0, &x, err, err_n) != 0 || x >= level_count) {
+            lpvp_set_error(err, err_n, "%s: expected a level in [0, %d]", key, level_count - 1);
             return -1;
         }
         ix->level = (int)x;
@@ -874,6 +1050,16 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
         }
         ix->raw_length = want;
         l->has_index = 1;
+    }
+    if (l->content == LPVP_CONTENT_LEVELS &&
+        (!l->has_index || l->index.level != 0 || l->index.values_per_cell != 1 ||
+         l->index.dims[0] != vi->cascades[0].dims[0] || l->index.dims[1] != vi->cascades[0].dims[1] ||
+         l->index.dims[2] != vi->cascades[0].dims[2])) {
+        lpvp_set_error(err, err_n, "%s.index: \"%s\" levels need the index volume over level 0 (level 0, dims [%lld, "
+                       "%lld, %lld], values_per_cell 1)", K, lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL],
+                       (long long)vi->cascades[0].dims[0], (long long)vi->cascades[0].dims[1],
+                       (long long)vi->cascades[0].dims[2]);
+        return -1;
     }
     return 0;
 }

@@ -143,6 +143,7 @@ int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expe
 /* ---- Volume header JSON (SPEC section 5) ---------------------------------- */
 
 #define LPVP_MAX_CASCADES 4  /* entries of "cascades" (SPEC R5.6) */
+#define LPVP_MAX_LEVELS 9    /* entries of the description's "levels": an octree's (R5.13) */
 
 /* One cascade's placement (SPEC R5.6). */
 typedef struct lpvp_cascade_info {
@@ -152,7 +153,7 @@ typedef struct lpvp_cascade_info {
     uint64_t cells;              /* dims[0] x dims[1] x dims[2] */
 } lpvp_cascade_info;
 
-/* ---- Volume description (SPEC R5.9 - R5.12) ------------------------------ */
+/* ---- Volume description (SPEC R5.9 - R5.13) ------------------------------ */
 
 /* The version of the description's layout this library reads and writes
  * (R5.9). New techniques fill the same layout; only an incompatible change
@@ -174,12 +175,25 @@ extern const char *const lpvp_sh_value_names[LPVP_VALUES_PER_CELL];
 
 /* A level's role (R5.10): "cascade" (levels blended as R5.7 says) or
  * "far_field" (a coarser level carrying on the light of the finer ones; the
- * server sums such levels). */
+ * server sums such levels), or "octree_level" (R5.13: a level of an octree,
+ * level 0's box in cells 2^i times level 0's). */
 typedef enum lpvp_level_role {
     LPVP_ROLE_CASCADE = 0,
     LPVP_ROLE_FAR_FIELD = 1,
-    LPVP_ROLE_COUNT = 2
+    LPVP_ROLE_OCTREE_LEVEL = 2,
+    LPVP_ROLE_COUNT = 3
 } lpvp_level_role;
+
+/* What GET_VOLUME's optional "content" asks for (R5.13): "merged" (the
+ * default: the volume R5.1 - R5.12 describe) or "levels" (a technique's
+ * levels and index volume, e.g. the octree's). */
+#define LPVP_VOLUME_CONTENT_KEY "content"
+typedef enum lpvp_volume_content {
+    LPVP_CONTENT_MERGED = 0,
+    LPVP_CONTENT_LEVELS = 1,
+    LPVP_CONTENT_COUNT = 2
+} lpvp_volume_content;
+extern const char *const lpvp_volume_content_names[LPVP_CONTENT_COUNT];
 extern const char *const lpvp_level_role_names[LPVP_ROLE_COUNT];
 
 /* An index volume (R5.12): value type and its size. */
@@ -195,15 +209,23 @@ typedef struct lpvp_index_info {
     uint64_t raw_length;         /* cells x values_per_cell x 4 */
 } lpvp_index_info;
 
-/* What a volume carries (R5.9 - R5.12). The levels' placement is the info's
- * cascades (R5.10 requires the two lists to agree). */
+/* What a volume carries (R5.9 - R5.13). The levels' placement is the info's
+ * cascades (R5.10 requires the two lists to agree), except an octree's
+ * levels (R5.13), which are level_count / level below. */
 typedef struct lpvp_volume_layout {
     int present;                 /* build: send the description; parse: the header had one (0: an
                                     older server, filled from the legacy keys as R5.1 describes) */
     int layout_version;          /* LPVP_VOLUME_LAYOUT_VERSION (0 when not present) */
     char technique[64];          /* the technique's name, e.g. "cascaded_lpv"; "" when not present */
     int far_field;               /* levels 1.. are far-field levels */
-    lpvp_level_role role[LPVP_MAX_CASCADES];
+    lpvp_level_role role[LPVP_MAX_LEVELS];
+    /* R5.13: content LPVP_CONTENT_LEVELS when the levels are an octree's
+     * (role "octree_level"; the cascades then are level 0 alone): level_count
+     * levels placed as lpvp_octree_level_place says. 0 otherwise: the levels
+     * are the cascades. */
+    lpvp_volume_content content;
+    int level_count;
+    lpvp_cascade_info level[LPVP_MAX_LEVELS];
     int volumes_per_level;       /* >= 1; 1: one (summed) volume per level */
     int values_per_cell;         /* 1..LPVP_MAX_VALUES_PER_CELL */
     int sh_values;               /* the values are lpvp_sh_value_names in order (build: send them) */
@@ -237,6 +259,20 @@ typedef struct lpvp_volume_info {
  * level, no index), roles from far_field; present set. */
 void lpvp_volume_layout_sh(lpvp_volume_layout *l, const char *technique, int far_field, int levels);
 
+/* R5.13's octree: the level count l = log2(n) + 1 of an octree over n^3
+ * cells (n a power of two with l <= LPVP_MAX_LEVELS), else -1; and level i's
+ * placement: level 0's origin, dims >> i, cell size 2^i x level 0's. */
+int lpvp_octree_level_count(int64_t n);
+void lpvp_octree_level_place(const lpvp_cascade_info *level0, int i, lpvp_cascade_info *out);
+
+/* The "levels" layout of R5.13 for technique over level0 (cubic, a power of
+ * two): every octree level of R5.1's 12 values and the index volume (one u32
+ * per level-0 cell, the level its merged light comes from; raw_offset is
+ * filled by lpvp_volume_header_build). Returns 0, or -1 with err set when
+ * level0 has no octree. */
+int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
+                              char *err, size_t err_n);
+
 /* Bytes of the levels' values: all cells x volumes_per_level x
  * values_per_cell x value size (0 on overflow or a bad layout). With
  * layout.present 0 and values_per_cell 0, the legacy 12 values. */
@@ -246,16 +282,19 @@ uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi);
  * level); else -1 with err naming the layout. */
 int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n);
 
-/* Cells of all cascades together (0 if the count is out of range); with
- * cascade_count 0, the cells of dims. */
+/* Cells of all levels together (0 if the count is out of range): the
+ * octree's levels for content LPVP_CONTENT_LEVELS (R5.13), else the
+ * cascades; with cascade_count 0, the cells of dims. */
 uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi);
 
-/* Index of the first cell of cascade k in the raw volume (cascades are
- * concatenated finest first, R5.6): the sum of the cells of cascades 0..k-1. */
+/* Index of the first cell of level (cascade) k in the raw volume (levels are
+ * concatenated finest first, R5.6, R5.11): the sum of the cells of levels 0..k-1. */
 uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k);
 
 /* Builds the header object (new reference; NULL if memory runs out) with
- * every field of section 5 (base_tick only for deltas), the "cascades" array
+ * every field of section 5 (base_tick only for deltas; the description's
+ * levels and index from the layout for content LPVP_CONTENT_LEVELS, R5.13,
+ * the index's raw_offset = lpvp_volume_values_bytes), the "cascades" array
  * (R5.6; one entry from dims/origin/cell_size when cascade_count is 0) plus
  * the fixed "units", "layout" and "sh" strings. */
 json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
@@ -266,8 +305,10 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
  * equal to cascade 0), the description "volume" (R5.9 - R5.12: a layout
  * version this library knows, levels equal to the cascades, roles agreeing
  * with far_field, values naming values_per_cell distinct values, units as the
- * top level's, an index that fits), and that raw_length == the levels'
- * values (+ the index) as described. A header without "cascades" (an older
+ * top level's, an index that fits; or R5.13's octree levels: one cascade,
+ * log2(n) + 1 "octree_level" levels placed as lpvp_octree_level_place says,
+ * far_field false, the index over level 0), and that raw_length == the
+ * levels' values (+ the index) as described. A header without "cascades" (an older
  * server) is read as one cascade equal to the grid; one without "volume" as
  * R5.1's 12 values (layout.present 0). Returns 0, or -1 with
  * "<field>: <what>" in err. */

@@ -111,6 +111,14 @@ typedef struct sv_result {
     lpv_grid cascades[LPVP_MAX_CASCADES]; /* finest first; every cascade has grid.dims */
     float *cells;           /* cells * 12 floats: every cascade's, cascade 0 first */
     size_t cell_count;      /* all cascades' cells */
+    /* GET_VOLUME content "levels" (SPEC R5.13): a technique with an index
+     * volume (the octree) keeps every level's cells (level_cells x 12 floats,
+     * level 0 first, as lpv_engine_read_volumes gives them) and the index (one
+     * per cell of cascade 0); NULL / 0 for a technique without levels. */
+    float *levels;
+    size_t level_cells;
+    uint32_t *index;
+    size_t index_count;
     float *frames[3];       /* rgba float per lpv_frame_terms, NULL if not rendered */
     int width, height;
     lpv_engine_stats stats;
@@ -382,7 +390,7 @@ size_t sv_jobs_queued(sv_server *s);
 /* serve_encode.c */
 /* Volume reply/stream body + attachment. ack: the subscriber (delta source and
  * where the raw is remembered), or NULL. */
-int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
+int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
                      uint8_t **att, size_t *att_len, char *err, size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,

@@ -68,22 +68,21 @@ static void remember_sent(sv_sub *sub, uint64_t tick, const int dims[3], int fp1
     memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
 }
 
-int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
+/* The levels payload (SPEC R5.13): every octree level's 12 values, then the
+ * index volume as little-endian u32 at vi's index offset. */
+static void pack_levels(const sv_result *r, const lpvp_volume_info *vi, uint8_t *raw)
+{
+    lpvp_volume_pack(r->levels, r->level_cells, vi->format, raw);
+    uint8_t *ix = raw + lpvp_volume_values_bytes(vi);
+    for (size_t i = 0; i < r->index_count; ++i)
+        lpvp_put_u32(ix + LPVP_INDEX_VALUE_SIZE * i, r->index[i]);
+}
+
+int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
                      uint8_t **att, size_t *att_len, char *err, size_t n)
 {
     lpvp_volume_format fmt = fp16 ? LPVP_FMT_FP16 : LPVP_FMT_FP32;
-    size_t raw_len = lpvp_volume_raw_size(r->cell_count, fmt);
-    uint8_t *raw = NULL;
-    int fast = r->enc[fp16 ? 1 : 0][zstd ? 1 : 0] && !(sub && sub->delta);
-    if (!fast) {
-        raw = malloc(raw_len ? raw_len : 1);
-        if (!raw) {
-            snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
-            return -1;
-        }
-        lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
-    }
-
+    const int levels = content == LPVP_CONTENT_LEVELS;
     lpvp_volume_info vi;
     memset(&vi, 0, sizeof vi);
     vi.revision = (int64_t)revision;
@@ -97,7 +96,6 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
         vi.origin[i] = r->grid.origin[i];
     }
     vi.cell_size = r->grid.cell_size;
-    vi.raw_length = raw_len; /* all cascades' cells (R5.6) */
     vi.cascade_count = r->cascade_count < 1 ? 1 : r->cascade_count;
     for (int k = 0; k < vi.cascade_count; ++k) {
         const lpv_grid *g = r->cascade_count < 1 ? &r->grid : &r->cascades[k];
@@ -115,12 +113,47 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
      * volume per level whatever its normal bins, R5.1's 12 values a cell. */
     const lpv_volume_desc *d = &r->stats.volume;
     if (!d->technique || d->values_per_cell != LPVP_VALUES_PER_CELL) {
-        free(raw);
         snprintf(err, n, "the tick's volume is described as %d values per cell of technique %s; this encoder sends "
                  "R5.1's %d", d->values_per_cell, d->technique ? d->technique : "(none)", LPVP_VALUES_PER_CELL);
         return -1;
     }
-    lpvp_volume_layout_sh(&vi.layout, d->technique, d->far_field, vi.cascade_count);
+    size_t raw_len;
+    if (levels) { /* R5.13: the octree's levels (cascades: level 0 alone) and its index */
+        vi.cascade_count = 1;
+        if (!r->levels || lpvp_volume_layout_octree(&vi.layout, d->technique, &vi.cascades[0], err, n) != 0) {
+            if (!r->levels)
+                snprintf(err, n, "%s: technique \"%s\" has no levels to send", LPVP_VOLUME_CONTENT_KEY, d->technique);
+            return -1;
+        }
+        raw_len = (size_t)(lpvp_volume_values_bytes(&vi) + vi.layout.index.raw_length);
+        if (lpvp_volume_total_cells(&vi) != r->level_cells || vi.layout.index.cells != r->index_count) {
+            snprintf(err, n, "the tick kept %zu level cells and %zu index entries, its octree has %llu and %llu",
+                     r->level_cells, r->index_count, (unsigned long long)lpvp_volume_total_cells(&vi),
+                     (unsigned long long)vi.layout.index.cells);
+            return -1;
+        }
+    } else {
+        lpvp_volume_layout_sh(&vi.layout, d->technique, d->far_field, vi.cascade_count);
+        raw_len = lpvp_volume_raw_size(r->cell_count, fmt); /* all cascades' cells (R5.6) */
+    }
+    vi.raw_length = raw_len;
+
+    /* the keyframe cache and XOR deltas (R5.3) hold the merged content only */
+    uint8_t *raw = NULL;
+    int fast = !levels && r->enc[fp16 ? 1 : 0][zstd ? 1 : 0] && !(sub && sub->delta);
+    if (levels)
+        sub = NULL;
+    if (!fast) {
+        raw = malloc(raw_len ? raw_len : 1);
+        if (!raw) {
+            snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
+            return -1;
+        }
+        if (levels)
+            pack_levels(r, &vi, raw);
+        else
+            lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
+    }
 
     uint8_t *payload = raw; /* what gets compressed / sent */
     uint8_t *delta = NULL;
@@ -139,8 +172,10 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
             remember_sent(sub, r->tick, r->grid.dims, fp16, raw, raw_len);
     }
 
-    uint8_t **cache = &r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
-    size_t *cache_len = &r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0];
+    uint8_t *no_cache = NULL;
+    size_t no_cache_len = 0;
+    uint8_t **cache = levels ? &no_cache : &r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
+    size_t *cache_len = levels ? &no_cache_len : &r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0];
     if (vi.keyframe && *cache) { /* another subscriber already had this keyframe encoded */
         uint8_t *copy = malloc(*cache_len ? *cache_len : 1);
         if (!copy) {
@@ -173,7 +208,7 @@ int sv_encode_volume(sv_result *r, int fp16, int zstd, sv_sub *sub, uint64_t rev
     }
     free(raw);
     free(delta);
-    if (vi.keyframe && !*cache && *att) {
+    if (vi.keyframe && !levels && !*cache && *att) {
         *cache = malloc(*att_len ? *att_len : 1);
         if (*cache) {
             memcpy(*cache, *att, *att_len);

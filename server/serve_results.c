@@ -76,9 +76,11 @@ int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n)
 void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
-    int fmt = LPVP_FMT_FP16, comp = LPVP_COMP_ZSTD;
+    int fmt = LPVP_FMT_FP16, comp = LPVP_COMP_ZSTD, content = LPVP_CONTENT_MERGED;
     if (lpvp_get_enum(j, "format", 0, lpvp_volume_format_names, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD) {
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, LPVP_VOLUME_CONTENT_KEY, 0, lpvp_volume_content_names, LPVP_CONTENT_COUNT, &content, err,
+                      sizeof err) == LPVP_FIELD_BAD) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
@@ -87,10 +89,20 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
                   "no volume yet for this session's current scene, lights, camera and config: send TICK first");
         return;
     }
+    const sv_result *latest = c->world->latest;
+    if (content == LPVP_CONTENT_LEVELS && !latest->levels) { /* R5.13: only a technique with levels */
+        const char *t = latest->stats.volume.technique;
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                     "%s: \"%s\" needs a technique with levels and an index volume; this session's "
+                     "volume comes from technique \"%s\", whose volume is its merged content \"%s\" only",
+                     LPVP_VOLUME_CONTENT_KEY, lpvp_volume_content_names[LPVP_CONTENT_LEVELS], t ? t : "?",
+                     lpvp_volume_content_names[LPVP_CONTENT_MERGED]);
+        return;
+    }
     json_t *b = NULL;
     uint8_t *att = NULL;
     size_t alen = 0;
-    if (sv_encode_volume(c->world->latest, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD, NULL, c->revision, &b, &att, &alen, err,
+    if (sv_encode_volume(c->world->latest, content, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD, NULL, c->revision, &b, &att, &alen, err,
                          sizeof err) != 0) {
         sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
         return;

@@ -79,7 +79,7 @@ void sv_session_stream(sv_conn *c, sv_result *r)
         json_t *b = NULL;
         uint8_t *att = NULL;
         size_t alen = 0;
-        if (sv_encode_volume(r, vs->fp16, vs->zstd, vs, c->revision, &b, &att, &alen, err, sizeof err) == 0)
+        if (sv_encode_volume(r, LPVP_CONTENT_MERGED, vs->fp16, vs->zstd, vs, c->revision, &b, &att, &alen, err, sizeof err) == 0)
             sv_send(c, LPVP_VOLUME, 0, b, att, alen, SV_STREAM_VOLUME);
         else
             fprintf(stderr, "lpvd serve: client %llu: volume: %s\n", (unsigned long long)c->id, err);

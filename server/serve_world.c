@@ -40,6 +40,8 @@ static void result_free(sv_result *r)
     if (!r)
         return;
     free(r->cells);
+    free(r->levels);
+    free(r->index);
     for (int i = 0; i < 3; ++i)
         free(r->frames[i]);
     for (int i = 0; i < 4; ++i)
@@ -303,6 +305,49 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     return 0;
 }
 
+/* GET_VOLUME content "levels" (SPEC R5.13): with a technique that has an
+ * index volume (the octree), its levels and index, read now on the GL thread.
+ * 0 (nothing kept for a technique without one) or -1 with err. */
+static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
+{
+    size_t cells0 = lpv_grid_cell_count(&r->grid);
+    int count = lpvp_octree_level_count(r->grid.dims[0]);
+    if (count < 1) /* no octree over this grid */
+        return 0;
+    int32_t *index = malloc((cells0 ? cells0 : 1) * sizeof *index);
+    if (!index) {
+        snprintf(err, n, "out of memory for a %zu-cell index volume", cells0);
+        return -1;
+    }
+    size_t got = lpv_engine_read_index(e, index, cells0);
+    if (got == 0) { /* no index volume: no levels to send */
+        free(index);
+        return 0;
+    }
+    lpvp_cascade_info c0 = {.dims = {r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]}, .cells = cells0};
+    size_t total = 0;
+    for (int i = 0; i < count; ++i) {
+        lpvp_cascade_info ci;
+        lpvp_octree_level_place(&c0, i, &ci);
+        total += (size_t)ci.cells;
+    }
+    r->levels = malloc((total ? total : 1) * sizeof(lpv_cell));
+    r->index = malloc((cells0 ? cells0 : 1) * sizeof *r->index);
+    if (!r->levels || !r->index || got != cells0 ||
+        lpv_engine_read_volumes(e, LPV_GRID_ACCUMULATED, (lpv_cell *)r->levels, total) != total) {
+        snprintf(err, n, "%s", !r->levels || !r->index ? "out of memory for the octree's levels"
+                                                       : "the octree's levels or index volume could not be read back");
+        free(index);
+        return -1;
+    }
+    for (size_t i = 0; i < cells0; ++i)
+        r->index[i] = (uint32_t)index[i];
+    free(index);
+    r->level_cells = total;
+    r->index_count = cells0;
+    return 0;
+}
+
 static void gl_tick(sv_server *s, sv_job *j)
 {
     (void)s;
@@ -345,6 +390,11 @@ static void gl_tick(sv_server *s, sv_job *j)
     size_t got = lpv_engine_read_grid(w->engine, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
     if (got < r->cell_count)
         memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
+    if (keep_levels(w->engine, r, j->err, sizeof j->err) != 0) {
+        j->status = LPVP_E_INTERNAL;
+        result_free(r);
+        return;
+    }
     r->width = j->inputs->view.width;
     r->height = j->inputs->view.height;
     for (int t = 0; t < 3; ++t) {

@@ -479,6 +479,94 @@ static void test_tick_volume_query(void **state)
     lpvc_close(c);
 }
 
+/* GET_VOLUME content "levels" (SPEC R5.13): the octree's levels and index
+ * volume, placed as the header says; the merged volume is eq. 10 of them. */
+static void test_octree_levels(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    lpvc_config g8 = {.grid = {8, 8, 8}};
+    OK(c, lpvc_config_set(c, &g8));
+    OK(c, lpvc_config_json(c, "{\"technique\": \"lpv\"}"));
+    OK(c, lpvc_tick(c, NULL));
+    lpvc_volume v;
+    /* a technique without levels: refused, naming "content" */
+    assert_int_equal(lpvc_get_volume(c, &(lpvc_volume_desc){.content = "levels"}, &v), -1);
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+    assert_non_null(strstr(lpvc_error_message(c), "content"));
+    assert_int_equal(lpvc_get_volume(c, &(lpvc_volume_desc){.content = "everything"}, &v), -1);
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+
+    OK(c, lpvc_config_json(c, "{\"technique\": \"octree\"}"));
+    int64_t tick = -1;
+    OK(c, lpvc_tick(c, &tick));
+    lpvc_volume merged, lv, lv16;
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp32", .compression = "none"}, &merged));
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp32", .content = "levels"}, &lv));
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp16", .compression = "none", .content = "levels"}, &lv16));
+    assert_string_equal(merged.content, "merged");
+    assert_string_equal(lv.content, "levels");
+    assert_string_equal(lv.technique, "octree");
+    assert_int_equal(lv.tick, tick);
+    assert_int_equal(merged.level_count, 0);
+    const int n = 8, l = 4;
+    assert_int_equal(lv.level_count, l);
+    assert_int_equal(lv.cascade_count, 1);
+    size_t total = 0;
+    for (int i = 0; i < l; i++) {
+        const lpvc_cascade *lev = &lv.levels[i];
+        for (int a = 0; a < 3; a++) {
+            assert_int_equal(lev->dims[a], n >> i);
+            assert_true(lev->origin[a] == merged.origin[a]);
+        }
+        assert_true(fabsf(lev->cell_size - ldexpf(merged.cell_size, i)) <= 1e-6f * lev->cell_size);
+        assert_int_equal(lev->cells, (size_t)(n >> i) * (size_t)(n >> i) * (size_t)(n >> i));
+        assert_true(lev->data == lv.data + 12 * total);
+        total += lev->cells;
+    }
+    assert_int_equal(lv.total_cells, total);
+    assert_true(lv.cascades[0].data == lv.levels[0].data);
+    assert_int_equal(lv.index_count, (size_t)(n * n * n));
+    assert_int_equal(lv.index_level, 0);
+    assert_int_equal(lv.index_values_per_cell, 1);
+    assert_int_equal(lv16.index_count, lv.index_count);
+    assert_memory_equal(lv16.index, lv.index, lv.index_count * sizeof(uint32_t)); /* u32 whatever the format */
+    /* eq. 10: M(x) = level I(x) at x >> I(x); a level I(x) < l - 1 holds light there */
+    int lit_from_coarser = 0;
+    for (int z = 0; z < n; z++)
+        for (int y = 0; y < n; y++)
+            for (int x = 0; x < n; x++) {
+                size_t cell = (size_t)x + (size_t)n * ((size_t)y + (size_t)n * (size_t)z);
+                uint32_t i = lv.index[cell];
+                assert_true(i < (uint32_t)l);
+                const lpvc_cascade *lev = &lv.levels[i];
+                int m = n >> i;
+                size_t at = (size_t)(x >> i) + (size_t)m * ((size_t)(y >> i) + (size_t)m * (size_t)(z >> i));
+                assert_memory_equal(merged.data + 12 * cell, lev->data + 12 * at, 12 * sizeof(float));
+                float any = 0.0f;
+                for (int k = 0; k < 12; k++)
+                    any = fmaxf(any, fabsf(lev->data[12 * at + k]));
+                if (i + 1 < (uint32_t)l)
+                    assert_true(any > 0.0f);
+                lit_from_coarser += i > 0 && any > 0.0f;
+            }
+    assert_true(max_abs(lv.data, lv.total_cells * 12) > 0.0f);
+    (void)lit_from_coarser;
+    /* R5.7's lookup is for the merged grid: refused on "levels", naming it */
+    char why[256];
+    assert_int_equal(lpvc_volume_lookup_check(&merged, why, sizeof why), 0);
+    assert_int_equal(lpvc_volume_lookup_check(&lv, why, sizeof why), -1);
+    assert_non_null(strstr(why, "\"levels\""));
+    float p[3] = {merged.origin[0] + 0.5f, merged.origin[1] + 0.5f, merged.origin[2] + 0.5f}, nn[3] = {0, 1, 0}, e[3];
+    assert_int_equal(lpvc_volume_irradiance(&lv, p, nn, e), -1);
+    lpvc_volume_free(&merged);
+    lpvc_volume_free(&lv);
+    lpvc_volume_free(&lv16);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
 static void test_frames(void **state)
 {
     (void)state;
@@ -806,6 +894,7 @@ int main(void)
         cmocka_unit_test(test_knob_description),
         cmocka_unit_test(test_errors_keep_the_connection),
         cmocka_unit_test(test_tick_volume_query),
+        cmocka_unit_test(test_octree_levels),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_state_changes_bump_revision),
         cmocka_unit_test(test_config_recomputes_only_what_it_touches),

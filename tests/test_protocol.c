@@ -1385,6 +1385,117 @@ static void expect_refused(json_t *h, const char *what)
     json_decref(h);
 }
 
+/* R5.13: an octree's levels and index volume (GET_VOLUME content "levels"):
+ * built, read back, and every inconsistent placement refused naming it. */
+static void test_volume_octree_levels(void **state)
+{
+    (void)state;
+    char err[256];
+    lpvp_volume_info vi, back;
+    assert_int_equal(lpvp_octree_level_count(1), 1);
+    assert_int_equal(lpvp_octree_level_count(16), 5);
+    assert_int_equal(lpvp_octree_level_count(256), 9);
+    assert_int_equal(lpvp_octree_level_count(512), -1);
+    assert_int_equal(lpvp_octree_level_count(12), -1);
+    assert_int_equal(lpvp_octree_level_count(0), -1);
+
+    memset(&vi, 0, sizeof vi);
+    vi.revision = 3;
+    vi.tick = 7;
+    vi.format = LPVP_FMT_FP16;
+    vi.keyframe = 1;
+    vi.base_tick = -1;
+    vi.cascade_count = 1;
+    lpvp_cascade_info *c0 = &vi.cascades[0];
+    for (int a = 0; a < 3; a++) {
+        vi.dims[a] = c0->dims[a] = 4;
+        vi.origin[a] = c0->origin[a] = -1.0 + 0.25 * a;
+    }
+    vi.cell_size = c0->cell_size = 0.5;
+    c0->cells = 64;
+    lpvp_cascade_info skew = *c0;
+    skew.dims[2] = 2;
+    assert_int_equal(lpvp_volume_layout_octree(&vi.layout, "octree", &skew, err, sizeof err), -1);
+    assert_non_null(strstr(err, "4x4x2"));
+    assert_int_equal(lpvp_volume_layout_octree(&vi.layout, "octree", c0, err, sizeof err), 0);
+    assert_int_equal(vi.layout.content, LPVP_CONTENT_LEVELS);
+    assert_int_equal(vi.layout.level_count, 3);
+    /* levels 4^3 + 2^3 + 1^3 = 73 cells x 12 fp16 values, then 64 u32 */
+    assert_int_equal(lpvp_volume_total_cells(&vi), 73);
+    assert_int_equal(lpvp_volume_values_bytes(&vi), 73 * 12 * 2);
+    assert_int_equal(lpvp_volume_cascade_first_cell(&vi, 2), 72);
+    vi.raw_length = 73 * 12 * 2 + 64 * 4;
+    json_t *h = lpvp_volume_header_build(&vi);
+    assert_non_null(h);
+    json_t *d = json_object_get(h, LPVP_VOLUME_DESC_KEY), *lv = json_object_get(d, "levels");
+    assert_int_equal(json_array_size(lv), 3);
+    assert_int_equal(json_array_size(json_object_get(h, "cascades")), 1);
+    assert_string_equal(json_string_value(json_object_get(json_array_get(lv, 2), "role")), "octree_level");
+    assert_true(json_number_value(json_object_get(json_array_get(lv, 2), "cell_size")) == 2.0);
+    assert_int_equal(json_integer_value(json_object_get(json_array_get(lv, 1), "cells")), 8);
+    json_t *ix = json_object_get(d, "index");
+    assert_int_equal(json_integer_value(json_object_get(ix, "raw_offset")), 73 * 12 * 2);
+    assert_int_equal(json_integer_value(json_object_get(ix, "raw_length")), 64 * 4);
+    assert_string_equal(json_string_value(json_object_get(ix, "value_type")), LPVP_INDEX_VALUE_TYPE);
+
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_int_equal(back.layout.content, LPVP_CONTENT_LEVELS);
+    assert_int_equal(back.layout.level_count, 3);
+    assert_int_equal(back.cascade_count, 1);
+    assert_int_equal(back.layout.level[1].dims[0], 2);
+    assert_true(back.layout.level[2].cell_size == 2.0);
+    assert_true(back.layout.level[2].origin[1] == -0.75);
+    assert_int_equal(back.layout.role[2], LPVP_ROLE_OCTREE_LEVEL);
+    assert_true(back.layout.has_index && back.layout.index.level == 0 && back.layout.index.cells == 64);
+    assert_int_equal(lpvp_volume_total_cells(&back), 73);
+    assert_int_equal(back.raw_length, 73 * 12 * 2 + 64 * 4);
+    assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), -1);
+    assert_non_null(strstr(err, "\"levels\""));
+
+#define BAD(edit, what)                                                                                       \
+    do {                                                                                                      \
+        json_t *b = json_deep_copy(h), *bd = json_object_get(b, LPVP_VOLUME_DESC_KEY);                        \
+        json_t *bl = json_object_get(bd, "levels");                                                           \
+        (void)bl;                                                                                             \
+        edit;                                                                                                 \
+        expect_refused(b, what);                                                                              \
+    } while (0)
+    /* placement: count, dims, origin, cell size, cells, role of every level */
+    BAD(json_array_remove(bl, 2), "levels: 2");
+    BAD(json_array_append(bl, json_array_get(bl, 2)), "levels: 4");
+    BAD(json_object_set_new(json_array_get(bl, 1), "dims", json_pack("[i,i,i]", 2, 2, 1)), "levels[1]");
+    BAD(json_object_set_new(json_array_get(bl, 1), "cells", json_integer(9)), "levels[1]");
+    BAD(json_object_set_new(json_array_get(bl, 2), "cell_size", json_real(1.0)), "levels[2]");
+    BAD(json_object_set_new(json_array_get(bl, 2), "origin", json_pack("[f,f,f]", 0.0, 0.0, 0.0)), "levels[2]");
+    BAD(json_object_set_new(json_array_get(bl, 0), "cell_size", json_real(0.25)), "levels[0]");
+    BAD(json_object_set_new(json_array_get(bl, 1), "role", json_string("cascade")), "levels[1].role");
+    BAD(json_object_set_new(bd, "far_field", json_true()), "far_field");
+    /* the legacy keys describe level 0 alone */
+    BAD(json_array_append(json_object_get(b, "cascades"), json_array_get(json_object_get(b, "cascades"), 0)),
+        "cascades");
+    /* the index: over level 0, one u32 per cell */
+    BAD(json_object_set_new(bd, "index", json_null()), "need the index volume over level 0");
+    BAD((json_object_set_new(json_object_get(bd, "index"), "values_per_cell", json_integer(2)),
+         json_object_set_new(json_object_get(bd, "index"), "raw_length", json_integer(64 * 2 * 4))),
+        "need the index volume over level 0");
+    BAD((json_object_set_new(json_object_get(bd, "index"), "dims", json_pack("[i,i,i]", 4, 4, 2)),
+         json_object_set_new(json_object_get(bd, "index"), "raw_length", json_integer(32 * 4))),
+        "need the index volume over level 0");
+    BAD(json_object_set_new(json_object_get(bd, "index"), "raw_offset", json_integer(0)), "index.raw_offset");
+    BAD(json_object_set_new(b, "raw_length", json_integer(73 * 12 * 2)), "raw_length");
+    /* a grid with no octree */
+    {
+        json_t *b = json_deep_copy(h);
+        json_t *g = json_object_get(b, "grid"), *c = json_array_get(json_object_get(b, "cascades"), 0);
+        json_object_set_new(g, "dims", json_pack("[i,i,i]", 3, 3, 3));
+        json_object_set_new(c, "dims", json_pack("[i,i,i]", 3, 3, 3));
+        json_object_set_new(c, "cells", json_integer(27));
+        expect_refused(b, "3x3x3");
+    }
+#undef BAD
+    json_decref(h);
+}
+
 /* R5.9 - R5.12: the description is built, read back, and every
  * inconsistent variant is refused naming the field. */
 static void test_volume_description(void **state)
@@ -1552,6 +1663,7 @@ int main(void)
         cmocka_unit_test(test_volume_header_and_decode),
         cmocka_unit_test(test_volume_cascades),
         cmocka_unit_test(test_volume_description),
+        cmocka_unit_test(test_volume_octree_levels),
         cmocka_unit_test(test_addresses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

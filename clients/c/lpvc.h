@@ -196,6 +196,7 @@ int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc);
 int lpvc_unsubscribe(lpvc *c, enum lpvc_stream stream);
 
 #define LPVC_MAX_CASCADES 4    /* entries of a volume header's "cascades" (SPEC R5.6) */
+#define LPVC_MAX_LEVELS 9      /* entries of a description's "levels": an octree's (SPEC R5.13) */
 
 /* One cascade of a decoded volume (SPEC R5.6). */
 typedef struct lpvc_cascade {
@@ -243,12 +244,21 @@ typedef struct lpvc_volume {
     int index_level;           /* the level it covers */
     int index_dims[3];
     int index_values_per_cell;
+    /* GET_VOLUME's content (SPEC R5.13): "merged" (the volume above), or
+     * "levels": every octree level (levels[k], level 0 first, each placed as
+     * the header says and pointing into data; cascades[0] is level 0) and the
+     * index volume above (per level-0 cell, the level its merged light comes
+     * from). R5.7's lookup refuses a "levels" volume. */
+    char content[8];
+    int level_count;           /* "levels": 1..LPVC_MAX_LEVELS; "merged": 0 */
+    lpvc_cascade levels[LPVC_MAX_LEVELS];
 } lpvc_volume;
 void lpvc_volume_free(lpvc_volume *v);
 
 typedef struct lpvc_volume_desc {
     const char *format;        /* "fp16" | "fp32"; NULL: "fp32" */
     const char *compression;   /* "zstd" | "none"; NULL: "zstd" */
+    const char *content;       /* "merged" | "levels" (SPEC R5.13); NULL: "merged" */
 } lpvc_volume_desc;
 int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out);
 

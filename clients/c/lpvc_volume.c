@@ -14,6 +14,8 @@
 
 /* ---- volumes --------------------------------------------------------------- */
 
+_Static_assert(LPVC_MAX_LEVELS == LPVP_MAX_LEVELS, "lpvc.h's LPVC_MAX_LEVELS is the protocol's LPVP_MAX_LEVELS");
+
 void lpvc_volume_free(lpvc_volume *v)
 {
     if (!v)
@@ -122,6 +124,18 @@ int lpvci_decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t a
         cs->cells = (size_t)vi.cascades[k].cells;
         cs->data = data + per_cell * (size_t)lpvp_volume_cascade_first_cell(&vi, k);
     }
+    snprintf(out->content, sizeof out->content, "%s", lpvp_volume_content_names[lay->content]);
+    for (int k = 0; lay->content == LPVP_CONTENT_LEVELS && k < lay->level_count && k < LPVC_MAX_LEVELS; k++) {
+        lpvc_cascade *lv = &out->levels[k];
+        for (int a = 0; a < 3; a++) {
+            lv->dims[a] = (int)lay->level[k].dims[a];
+            lv->origin[a] = (float)lay->level[k].origin[a];
+        }
+        lv->cell_size = (float)lay->level[k].cell_size;
+        lv->cells = (size_t)lay->level[k].cells;
+        lv->data = data + per_cell * (size_t)lpvp_volume_cascade_first_cell(&vi, k);
+        out->level_count = k + 1;
+    }
     out->layout_version = lay->layout_version;
     snprintf(out->technique, sizeof out->technique, "%s", lay->technique);
     out->values_per_cell = lay->values_per_cell;
@@ -166,6 +180,12 @@ int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out)
         d = *desc;
     json_t *o = json_pack("{s:s, s:s}", "format", d.format ? d.format : lpvp_volume_format_names[LPVP_FMT_FP32],
                           "compression", d.compression ? d.compression : lpvp_compression_names[LPVP_COMP_ZSTD]);
+    if (o && d.content && json_object_set_new(o, LPVP_VOLUME_CONTENT_KEY, json_string(d.content)) != 0) {
+        json_decref(o);
+        o = NULL;
+    }
+    if (!o)
+        return lpvci_fail(c, LPVC_ERR_IO, "out of memory");
     json_t *reply = NULL;
     uint8_t *att = NULL;
     size_t att_len = 0;
@@ -211,6 +231,9 @@ static lpvp_volume_layout layout_of(const lpvc_volume *v)
     l.volumes_per_level = v->volumes_per_level;
     l.sh_values = v->sh_values;
     l.has_index = v->index != NULL;
+    l.content = strcmp(v->content, lpvp_volume_content_names[LPVP_CONTENT_LEVELS]) == 0 ? LPVP_CONTENT_LEVELS
+                                                                                          : LPVP_CONTENT_MERGED;
+    l.level_count = v->level_count;
     return l;
 }
 

@@ -1682,9 +1682,13 @@ def _description_checks(h):
     check(isinstance(d.get("far_field"), bool), "volume.far_field %r: expected a boolean (R5.10)"
           % (d.get("far_field"),))
     levels, cs = d.get("levels"), h["cascades"]
-    check(isinstance(levels, list) and len(levels) == len(cs), "volume.levels %r: expected %d levels, one per "
-          "cascade (R5.10)" % (levels, len(cs)))
-    for k, (lv, c) in enumerate(zip(levels, cs)):
+    octree = _octree_levels(d)
+    if octree:  # R5.13: content "levels", the octree's levels over cascades[0]
+        _octree_level_checks(d, cs)
+    else:
+        check(isinstance(levels, list) and len(levels) == len(cs), "volume.levels %r: expected %d levels, one "
+              "per cascade (R5.10)" % (levels, len(cs)))
+    for k, (lv, c) in enumerate(zip(levels, cs) if not octree else ()):
         for key in ("dims", "origin", "cell_size", "cells"):
             check(isinstance(lv, dict) and lv.get(key) == c.get(key), "volume.levels[%d].%s %r differs from "
                   "cascades[%d].%s %r (R5.10)" % (k, key, lv.get(key) if isinstance(lv, dict) else lv, k, key,
@@ -1702,7 +1706,7 @@ def _description_checks(h):
     check(all(isinstance(v, str) and v for v in vals) and len(set(vals)) == len(vals),
           "volume.values %r: expected distinct non-empty names (R5.11)" % (vals,))
     size = 2 if h["format"] == "fp16" else 4
-    cells = sum(c["cells"] for c in cs)
+    cells = sum(c["cells"] for c in (levels if octree else cs))
     values_bytes = cells * vpl * vpc * size
     index, index_bytes = d.get("index", None), 0
     check("index" in d, "volume has no \"index\" key (null when there is none, R5.12)")
@@ -1721,6 +1725,43 @@ def _description_checks(h):
               h["raw_length"], cells, vpl, vpc, size, " + index %d" % index_bytes if index_bytes else "",
               values_bytes + index_bytes))
     return d
+
+
+OCTREE_LEVEL_ROLE = "octree_level"  # R5.13: the role of an octree's levels
+
+
+def _octree_levels(d):
+    """Whether a description's levels are an octree's (R5.13)."""
+    levels = d.get("levels")
+    return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+        and levels[0].get("role") == OCTREE_LEVEL_ROLE
+
+
+def _octree_level_checks(d, cs):
+    """R5.13: the cascades are level 0 alone; l = log2(n) + 1 levels, level i
+    at level 0's origin with dims n >> i and cell size 2^i x level 0's; far
+    field false; an index over level 0, one u32 per cell."""
+    levels = d["levels"]
+    check(len(cs) == 1, "octree levels with %d cascades; the legacy keys describe level 0 alone (R5.13)" % len(cs))
+    n = cs[0]["dims"][0]
+    check(cs[0]["dims"] == [n, n, n] and n & (n - 1) == 0, "octree levels over level 0 of dims %r: not a cube of a "
+          "power of two (R5.13)" % (cs[0]["dims"],))
+    check(len(levels) == n.bit_length(), "%d octree levels over %d^3 cells, expected log2(n) + 1 = %d (R5.13)"
+          % (len(levels), n, n.bit_length()))
+    check(d.get("far_field") is False, "volume.far_field %r with octree levels, expected false (R5.13)"
+          % (d.get("far_field"),))
+    for i, lv in enumerate(levels):
+        m, cell = n >> i, cs[0]["cell_size"] * (1 << i)
+        check(isinstance(lv, dict) and lv.get("role") == OCTREE_LEVEL_ROLE and lv.get("dims") == [m, m, m]
+              and lv.get("cells") == m ** 3 and lv.get("origin") == cs[0]["origin"]
+              and abs(lv.get("cell_size", 0) - cell) <= 1e-9 * cell,
+              "volume.levels[%d] %r: expected role %r, dims %r, cells %d, origin %r (level 0's), cell_size %g "
+              "(R5.13)" % (i, lv, OCTREE_LEVEL_ROLE, [m, m, m], m ** 3, cs[0]["origin"], cell))
+    ix = d.get("index")
+    check(isinstance(ix, dict) and ix.get("level") == 0 and ix.get("dims") == [n, n, n]
+          and ix.get("values_per_cell") == 1 and ix.get("value_type") == "u32",
+          "volume.index %r: octree levels need the index over level 0 (level 0, dims %r, values_per_cell 1, u32; "
+          "R5.13)" % (ix, [n, n, n]))
 
 
 def _cascades_checks(h):
@@ -1834,6 +1875,81 @@ def c_volume_description_values(ctx):
         check(chans == [chans[0]] * 4 + [chans[4]] * 4 + [chans[8]] * 4 and len(set(chans)) == 3,
               "values %r are not 4 per channel, channel-major, as the layout %r" % (d["values"], f.body["layout"]))
     return "%d values: %s" % (vpc, ", ".join(d["values"]))
+
+
+@case("R5.13 R5.12", "GET_VOLUME content levels with technique octree: every octree level placed as described, an "
+      "index of one level per cell, and the merged volume is the indexed levels (eq. 10); refused for lpv")
+def c_volume_octree_levels(ctx):
+    ctx.session().close()  # its HELLO reply lists the techniques
+    techniques = (ctx.hello_reply or {}).get("techniques") or []
+    if "octree" not in techniques:  # no technique with levels: "levels" is refused (R5.13)
+        c, cfg, t = ctx.scene_session(light=unique_light("no-octree-levels"))
+        rid = c.send(GET_VOLUME, {"format": "fp32", "content": "levels"})
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+        return "HELLO lists no \"octree\" (%r): content \"levels\" refused naming content" % (techniques,)
+    n = 8
+    # one step: light spreads a cell on level 0, so coarser levels fill the rest (eq. 10 picks them)
+    config = dict(SMALL_CONFIG, grid=[n, n, n], technique="octree", iterations=1)
+    c, cfg, t = ctx.scene_session(config=config, light=unique_light("octree-levels"))
+    for body in ({"content": "everything"}, {"content": 1}):
+        rid = c.send(GET_VOLUME, dict(body, format="fp32"))
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    m = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none", "content": "merged"}),
+                     GET_VOLUME)
+    plain = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    check(m.att == plain.att, "content \"merged\" differs from GET_VOLUME without content (the default)")
+    _vol_header_checks(m.body, "fp32", "none", [n, n, n])
+    check(not _octree_levels(m.body["volume"]), "content \"merged\" describes octree levels")
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none", "content": "levels"}),
+                     GET_VOLUME)
+    _vol_header_checks(f.body, "fp32", "none", [n, n, n])
+    d = f.body["volume"]
+    check(d["technique"] == "octree", "content levels from technique %r" % (d["technique"],))
+    check(_octree_levels(d), "content \"levels\" with technique octree: levels %r are not octree levels"
+          % ([lv.get("role") for lv in d["levels"]],))
+    check(len(f.att) == f.body["raw_length"], "attachment %d bytes, raw_length %d" % (len(f.att),
+                                                                                    f.body["raw_length"]))
+    check(f.body["tick"] == m.body["tick"], "levels of tick %r, merged of tick %r" % (f.body["tick"],
+                                                                                      m.body["tick"]))
+    z = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "zstd", "content": "levels"}),
+                     GET_VOLUME)
+    zs = zstd_frame_content_size(z.att)
+    check(zs[0] and zs[1] == f.body["raw_length"], "zstd levels: content size %r (%s), raw_length %d"
+          % (zs[1], zs[2], f.body["raw_length"]))
+    l = len(d["levels"])
+    ix = d["index"]
+    index = struct.unpack("<%dI" % (n ** 3), f.att[ix["raw_offset"]:ix["raw_offset"] + ix["raw_length"]])
+    vals = f32_list(f.att[:ix["raw_offset"]])
+    check(is_finite_list(vals), "non-finite values in the levels")
+    first, at = [], 0
+    for lv in d["levels"]:
+        first.append(at)
+        at += lv["cells"] * 12
+    merged = f32_list(m.att)
+    used = [0] * l
+    for z_ in range(n):
+        for y in range(n):
+            for x in range(n):
+                cell = x + n * (y + n * z_)
+                i = index[cell]
+                check(0 <= i < l, "index[%d] = %d, not a level in 0..%d" % (cell, i, l - 1))
+                used[i] += 1
+                k = n >> i
+                src = first[i] + 12 * ((x >> i) + k * ((y >> i) + k * (z_ >> i)))
+                got, want = merged[12 * cell:12 * cell + 12], vals[src:src + 12]
+                check(got == want, "merged cell (%d, %d, %d) %r is not level %d's cell at x >> %d %r (eq. 10)"
+                      % (x, y, z_, got[:4], i, i, want[:4]))
+                if i < l - 1:
+                    check(any(v != 0.0 for v in want), "index[%d] = %d names a level with no light there" % (cell, i))
+    check(any(v != 0.0 for v in merged[0::4]), "the merged volume of a lit box is all zero")
+    check(sum(used[1:]) > 0, "after one step every cell's light is level 0's (%r): eq. 10 is not exercised" % (used,))
+    # a technique without levels: content "levels" is refused naming content
+    expect_reply(c.request(CONFIG, {"technique": "lpv"}), CONFIG)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    rid = c.send(GET_VOLUME, {"format": "fp32", "content": "levels"})
+    expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    return "%d levels (%s), %d bytes; cells per index level %r; merged = the indexed levels; lpv refused" % (
+        l, ", ".join("%d^3" % lv["dims"][0] for lv in d["levels"]), len(f.att), used)
 
 
 @case("R5.1", "GET_VOLUME fp32/none: sizes match the grid dims; values finite")

@@ -89,6 +89,7 @@ MAX_CASCADES = 4  # entries of a volume header's "cascades" (SPEC R5.6)
 # The description's layout version this client reads (SPEC R5.9); what a
 # volume carries is read from the description itself.
 VOLUME_LAYOUT_VERSION = 1
+OCTREE_LEVEL_ROLE = "octree_level"  # the role of an octree's levels (SPEC R5.13, GET_VOLUME content "levels")
 # The values, in order, that this client's lookup (Cascade.irradiance: the
 # cosine lobe on SH bands 0-1 per channel) reads; a volume whose description
 # names other values is decoded but not looked up (SPEC R5.11).
@@ -362,11 +363,19 @@ class Volume(Cascade):
             raise ProtocolError("cascades: expected 1 to %d entries" % MAX_CASCADES)
         self.description = self._describe(header, specs)
         desc = self.description
+        # SPEC R5.13: GET_VOLUME content "levels" describes an octree's levels
+        # (the cascades then are level 0 alone); else the levels are the cascades
+        octree = self._octree_levels(desc)
+        self.content = "levels" if octree else "merged"
         vpc, vpl = desc["values_per_cell"], desc["volumes_per_level"]
         self.values_per_cell, self.volumes_per_level = vpc, vpl
         self.technique, self.far_field = desc["technique"], desc["far_field"]
         refusal = None
-        if vpl != 1 or desc["index"] is not None or (
+        if octree:
+            refusal = ("volume of content \"levels\" (technique %r: its %d octree levels and index volume) is not "
+                       "the merged grid the lookup reads (SPEC R5.7, R5.13): ask get_volume(content=\"merged\")" % (
+                           desc["technique"], len(desc["levels"])))
+        elif vpl != 1 or desc["index"] is not None or (
                 desc["values"] is not None and tuple(desc["values"]) != LOOKUP_VALUES):
             refusal = ("volume layout of technique %r (layout_version %d, %d values per cell %s, %d volumes per "
                        "level%s) is not the 12 SH values %s in one volume per level, the only layout this "
@@ -384,7 +393,7 @@ class Volume(Cascade):
             self.index = array.array("I", struct.unpack("<%dI" % (len(ib) // 4), ib))
         self.cascades = []
         first = 0
-        for k, c in enumerate(specs):
+        for k, c in enumerate(desc["levels"] if octree else specs):
             dims = [int(v) for v in c.get("dims", (0, 0, 0))]
             if len(dims) != 3 or min(dims) < 1:
                 raise ProtocolError("cascades[%d].dims: expected 3 integers >= 1" % k)
@@ -403,6 +412,11 @@ class Volume(Cascade):
         if first != len(values):
             raise ProtocolError("volume of %d values (%d bytes of %s) for %d values as described" % (
                 len(values), len(values) * size, self.format, first))
+        # the description's levels: every octree level for content "levels",
+        # else the cascades; the cascades are what the legacy keys describe
+        self.levels = list(self.cascades)
+        if octree:
+            self.cascades = self.cascades[:1]
         c0 = self.cascades[0]
         if grid and (tuple(int(v) for v in grid.get("dims", ())) != c0.dims
                      or abs(float(grid.get("cell_size", 0.0)) - c0.cell_size) > 1e-9 * c0.cell_size):
@@ -434,6 +448,9 @@ class Volume(Cascade):
         if not isinstance(vals, list) or len(vals) != vpc or len(set(vals)) != vpc:
             raise ProtocolError("volume.values: expected %d distinct names (values_per_cell), got %r" % (vpc, vals))
         levels = d.get("levels")
+        if Volume._octree_levels(d):
+            Volume._check_octree_levels(d, specs)
+            return d
         if not isinstance(levels, list) or len(levels) != len(specs):
             raise ProtocolError("volume.levels: expected %d levels (one per cascade)" % len(specs))
         for k, (lv, c) in enumerate(zip(levels, specs)):
@@ -445,6 +462,47 @@ class Volume(Cascade):
                     or not isinstance(ix.get("raw_length"), int):
                 raise ProtocolError("volume.index: expected null or an object with raw_offset and raw_length")
         return d
+    @staticmethod
+    def _octree_levels(d):
+        """Whether description d's levels are an octree's (SPEC R5.13)."""
+        levels = d.get("levels") if isinstance(d, dict) else None
+        return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+            and levels[0].get("role") == OCTREE_LEVEL_ROLE
+
+    @staticmethod
+    def _check_octree_levels(d, specs):
+        """R5.13: one cascade (level 0), l = log2(n) + 1 levels, level i at
+        level 0's origin with dims n >> i and cell size 2^i x level 0's, and
+        the index over level 0 (one u32 per cell)."""
+        levels = d["levels"]
+        if len(specs) != 1:
+            raise ProtocolError("cascades: %d entries, but octree levels need exactly one, level 0" % len(specs))
+        c0 = specs[0]
+        n = c0.get("dims", [0])[0]
+        if list(c0.get("dims", ())) != [n, n, n] or not isinstance(n, int) or n < 1 or n & (n - 1):
+            raise ProtocolError("volume.levels: octree levels over level 0 of dims %r (not a cube of a power of two)"
+                                % (c0.get("dims"),))
+        count = n.bit_length()
+        if len(levels) != count:
+            raise ProtocolError("volume.levels: %d octree levels, an octree over %d^3 cells has %d" % (
+                len(levels), n, count))
+        if d.get("far_field"):
+            raise ProtocolError("volume.far_field: true with octree levels")
+        for i, lv in enumerate(levels):
+            m = n >> i
+            cs = float(c0.get("cell_size", 0.0)) * (1 << i)
+            if not isinstance(lv, dict) or lv.get("role") != OCTREE_LEVEL_ROLE or lv.get("dims") != [m, m, m] \
+                    or lv.get("cells") != m * m * m or lv.get("origin") != c0.get("origin") \
+                    or abs(float(lv.get("cell_size", 0.0)) - cs) > 1e-9 * cs:
+                raise ProtocolError("volume.levels[%d]: not octree level %d (role %r, level 0's origin, dims "
+                                    "n >> %d, cell size 2^%d x level 0's)" % (i, i, OCTREE_LEVEL_ROLE, i, i))
+        ix = d.get("index")
+        if not isinstance(ix, dict) or ix.get("level") != 0 or ix.get("dims") != [n, n, n] \
+                or ix.get("values_per_cell") != 1 or not isinstance(ix.get("raw_offset"), int) \
+                or ix.get("raw_length") != n * n * n * 4:
+            raise ProtocolError("volume.index: octree levels need the index over level 0 (level 0, dims %r, "
+                                "values_per_cell 1, %d bytes)" % ([n, n, n], n * n * n * 4))
+
     def irradiance(self, p, n):
         """E(n) in W/m^2 (r, g, b) at surface point p with normal n, computed
         locally as the server's QUERY_IRRADIANCE (SPEC R5.7): the finest
@@ -757,9 +815,14 @@ class Client(object):
     def unsubscribe(self, stream="volume"):
         return self.request(MSG["UNSUBSCRIBE"], {"stream": stream})[0]
 
-    def get_volume(self, format="fp32", compression=None):
-        """GET_VOLUME, decoded to a ``Volume`` (a keyframe)."""
+    def get_volume(self, format="fp32", compression=None, content=None):
+        """GET_VOLUME, decoded to a ``Volume`` (a keyframe). content: "merged"
+        (None: the server's default, the merged volume) or "levels" (SPEC
+        R5.13: an octree technique's levels, ``Volume.levels``, and its index
+        volume, ``Volume.index``)."""
         body = {"format": format, "compression": compression or _default_compression()}
+        if content is not None:
+            body["content"] = content
         hdr, att = self.request(MSG["GET_VOLUME"], body)
         return self._decode_volume(hdr, att, ack=False)
 
@@ -1024,6 +1087,37 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
         kinds.append("keyframe" if sv.keyframe else "delta/%s" % sv.base_tick)
     c.unsubscribe("volume")
     say("VOLUME stream (fp16, delta) -> %s, each equal to GET_VOLUME of its tick" % ", ".join(kinds))
+    # SPEC R5.13: an octree's levels and index (GET_VOLUME content "levels")
+    try:
+        c.get_volume(content="levels")
+        raise AssertionError("content \"levels\" from technique %r was not refused" % vol.technique)
+    except LpvdError as e:
+        if e.name != "BAD_FIELD" or "content" not in e.message:
+            raise AssertionError("content \"levels\" without levels: %s %s" % (e.name, e.message))
+    if "octree" in (c.hello_reply.get("techniques") or []):
+        c.config(technique="octree", grid=[8, 8, 8])
+        c.tick()
+        merged, lv = c.get_volume(format="fp32"), c.get_volume(format="fp32", content="levels")
+
+        def flat(a):
+            return [float(v) for v in (a.reshape(-1) if hasattr(a, "reshape") else a)]
+        m, n = flat(merged.data), 8
+        if lv.content != "levels" or merged.content != "merged" or len(lv.levels) != 4 or len(lv.cascades) != 1:
+            raise AssertionError("content levels: %r with %d levels, %d cascades" % (
+                lv.content, len(lv.levels), len(lv.cascades)))
+        data = [flat(level.data) for level in lv.levels]
+        for cell, i in enumerate(lv.index):  # eq. 10: merged(x) = level I(x) at x >> I(x)
+            x, y, z, k = cell % n, (cell // n) % n, cell // (n * n), n >> i
+            at = 12 * ((x >> i) + k * ((y >> i) + k * (z >> i)))
+            if m[12 * cell:12 * cell + 12] != data[i][at:at + 12]:
+                raise AssertionError("merged cell %d is not level %d's cell at x >> %d" % (cell, i, i))
+        try:
+            lv.irradiance(lv.origin, (0, 1, 0))
+            raise AssertionError("the lookup read a \"levels\" volume")
+        except LayoutError:
+            pass
+        say("GET_VOLUME content levels (octree) -> %s, index of %d, merged = the indexed levels" % (
+            ", ".join("%d^3" % level.dims[0] for level in lv.levels), len(lv.index)))
     st = c.stats()
     say("STATS -> keys %s" % sorted(st.keys()))
     for line in plan_lines((st.get("plan") or {}).get("plan")):
