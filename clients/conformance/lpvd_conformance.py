@@ -1367,10 +1367,10 @@ def c_config_preset_bad(ctx):
 @case("R4.14 R4.6 R2.9", "CONFIG technique takes each technique HELLO lists, reports it, and refuses any other "
       "naming technique")
 def c_config_technique(ctx):
+    c, _, _ = ctx.scene_session(light=unique_light("tech"))  # its HELLO reply is the one read below
     techniques = ctx.hello_reply.get("techniques")
     check(isinstance(techniques, list) and techniques and all(isinstance(t, str) and t for t in techniques),
           "R4.14: HELLO reply has no non-empty \"techniques\" array of names: %r" % (techniques,))
-    c, _, _ = ctx.scene_session(light=unique_light("tech"))
     cfg0 = _preset_config(c, {})
     check(cfg0.get("technique") in techniques,
           "R4.14: the effective config's technique %r is not one of %r" % (cfg0.get("technique"), techniques))
