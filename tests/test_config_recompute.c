@@ -173,15 +173,7 @@ static const lpv_plan *tick(void)
     return lpv_engine_last_plan(lpvt_engine);
 }
 
-static float *render(void)
-{
-    char err[512] = "";
-    float *rgba = calloc((size_t)IMG * IMG * 4, sizeof *rgba);
-    assert_non_null(rgba);
-    if (lpv_engine_render(lpvt_engine, LPV_TERMS_FULL, rgba, err, sizeof err) != 0)
-        fail_msg("render: %s", err);
-    return rgba;
-}
+static float *render(void) { return lpvt_render(IMG, IMG); }
 
 static int stage_ran(const char *name)
 {

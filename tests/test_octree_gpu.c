@@ -245,15 +245,7 @@ static void test_coarse_levels_reach_further(void **state)
     free(merged);
 }
 
-static float *render(void)
-{
-    char err[512] = "";
-    float *rgba = calloc((size_t)IMG * IMG * 4, sizeof *rgba);
-    assert_non_null(rgba);
-    if (lpv_engine_render(lpvt_engine, LPV_TERMS_FULL, rgba, err, sizeof err) != 0)
-        fail_msg("render: %s", err);
-    return rgba;
-}
+static float *render(void) { return lpvt_render(IMG, IMG); }
 
 /* Switching techniques rebuilds the lookup passes and the volume; going back
  * gives the cascaded LPV's frame bit for bit, and the octree's differs. */

@@ -21,6 +21,7 @@
 #include "lpv_shared.h"
 #include "oracle.h"
 #include "oracle_octree.h"
+#include "test_util.h"
 
 /* Float rounding lets a step's total flux exceed its input by a few ulps
  * (docs/propagation.md section 4); the allowance per step, as in
@@ -31,13 +32,7 @@
 
 static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
 
-static double rnd(double lo, double hi)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return lo + (hi - lo) * (double)(rng_state >> 11) / 9007199254740992.0;
-}
+static double rnd(double lo, double hi) { return lpvt_rand(&rng_state, lo, hi); }
 
 static lpv_grid cube(int n)
 {

@@ -23,6 +23,7 @@
 #include "oracle.h"
 #include "settings.h"
 #include "sh.h"
+#include "test_util.h"
 
 /* Per-step allowance for float rounding in the flux sums (see
  * test_propagation.c and docs/propagation.md). */
@@ -30,13 +31,7 @@
 
 static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
 
-static double rnd(double lo, double hi)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return lo + (hi - lo) * (double)(rng_state >> 11) / 9007199254740992.0;
-}
+static double rnd(double lo, double hi) { return lpvt_rand(&rng_state, lo, hi); }
 
 static void *xcalloc(size_t n, size_t size)
 {

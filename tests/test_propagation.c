@@ -19,6 +19,7 @@
 #include "lpv_shared.h"
 #include "oracle.h"
 #include "sh.h"
+#include "test_util.h"
 
 #define SQRT_4PI 3.5449077018110318
 
@@ -34,13 +35,7 @@ static const int axis_slot[3] = {3, 1, 2};
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 
-static double rnd(double lo, double hi)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return lo + (hi - lo) * (double)(rng_state >> 11) / 9007199254740992.0;
-}
+static double rnd(double lo, double hi) { return lpvt_rand(&rng_state, lo, hi); }
 
 static lpv_grid make_grid(int nx, int ny, int nz)
 {

@@ -136,3 +136,21 @@ void lpvt_patch(const lpv_view *v, const float *rgba, int width, int height, con
     for (int c = 0; c < 3; ++c)
         out[c] /= n;
 }
+
+float *lpvt_render(int width, int height)
+{
+    char err[512] = "";
+    float *rgba = calloc((size_t)width * (size_t)height * 4, sizeof *rgba);
+    assert_non_null(rgba);
+    if (lpv_engine_render(lpvt_engine, LPV_TERMS_FULL, rgba, err, sizeof err) != 0)
+        fail_msg("render: %s", err);
+    return rgba;
+}
+
+double lpvt_rand(uint64_t *state, double lo, double hi)
+{
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    return lo + (hi - lo) * (double)(*state >> 11) / 9007199254740992.0;
+}

@@ -3,6 +3,7 @@
 #define LPV_TEST_UTIL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 /* ../shared next to the checkout (LPVD_SHARED_DIR), or NULL when absent:
  * tests that use it skip cleanly without it. */
@@ -35,6 +36,13 @@ void lpvt_gl_close(struct lpv_gl_context *ctx, struct lpv_engine *engine);
  * lpvt_engine. */
 extern struct lpv_engine *lpvt_engine;
 int lpvt_gl_setup(void **state);
+/* A uniform number in [lo, hi) from the xorshift64 generator *state (a
+ * test's own, so each test's data is reproducible on its own). */
+double lpvt_rand(uint64_t *state, double lo, double hi);
+
+/* The shared engine's full frame at width x height (the view set before),
+ * calloc'd; fails the test with the engine's message on error. */
+float *lpvt_render(int width, int height);
 int lpvt_gl_teardown(void **state);
 
 /* Mean radiance (rgb) over the (2 radius + 1)^2 pixels of a width x height
