@@ -58,6 +58,28 @@ int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], 
     return 0;
 }
 
+int lpv_grid_place_cubic(int resolution, const float bmin[3], const float bmax[3], lpv_grid *out)
+{
+    if (resolution < 1 || resolution > LPV_MAX_GRID_DIM || !bounds_finite(bmin, bmax))
+        return -1;
+    double longest = 0.0;
+    for (int i = 0; i < 3; i++)
+        longest = fmax(longest, (double)bmax[i] - (double)bmin[i]);
+    const double cs = longest > 0.0 ? longest / resolution : 1.0;
+    for (int i = 0; i < 3; i++) {
+        double extent = (double)bmax[i] - (double)bmin[i];
+        int n = (int)ceil(extent / cs - 1e-6) + 2;
+        if (n < 3)
+            n = 3;
+        if (n > LPV_MAX_GRID_DIM)
+            n = LPV_MAX_GRID_DIM;
+        out->dims[i] = n;
+        out->origin[i] = (float)(0.5 * ((double)bmin[i] + (double)bmax[i]) - 0.5 * n * cs);
+    }
+    out->cell_size = (float)cs;
+    return 0;
+}
+
 size_t lpv_grid_cell_count(const lpv_grid *g)
 {
     return (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];

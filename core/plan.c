@@ -16,6 +16,8 @@ static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
     [LPV_PASS_RSM] = "rsm",         [LPV_PASS_EMISSIVE] = "emissive", [LPV_PASS_INJECT] = "inject",
     [LPV_PASS_GBUFFER] = "gbuffer", [LPV_PASS_GV] = "gv",             [LPV_PASS_PROPAGATE] = "propagate",
     [LPV_PASS_BOUNCE] = "bounce",   [LPV_PASS_GLOSSY] = "glossy",     [LPV_PASS_MEDIA] = "media",
+    [LPV_PASS_IV_POINTS] = "iv_points", [LPV_PASS_IV_REPROJECT] = "iv_reproject",
+    [LPV_PASS_IV_GATHER] = "iv_gather", [LPV_PASS_IV_AO] = "iv_ao",
 };
 
 const char *lpv_pass_name(lpv_pass_id id)
@@ -87,7 +89,10 @@ static void decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)
 }
 
 /* Whether the tick must recompute the volume, with the reason. */
-static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, int camera_in_gv, char *why, size_t n)
+/* camera_use: what the camera's view feeds (a recompute when it moves a
+ * cell), NULL when nothing computed depends on it. */
+static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, const char *camera_use, char *why,
+                           size_t n)
 {
     if (s->planner == LPV_SWITCH_OFF)
         return say(why, n, "planner off: every tick recomputes"), 1;
@@ -105,29 +110,17 @@ static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, int c
         return say(why, n, "recompute requested"), 1;
     if (f->placement_changed)
         return say(why, n, "the camera moved a cascade to a new cell"), 1;
-    if (camera_in_gv && f->camera_move_cells >= 1.0f)
-        return say(why, n, "the camera moved %.2f cells and its surfels feed the geometry volume",
-                   (double)f->camera_move_cells), 1;
+    if (camera_use && f->camera_move_cells >= 1.0f)
+        return say(why, n, "the camera moved %.2f cells and %s", (double)f->camera_move_cells, camera_use), 1;
     if (f->camera_move_cells > 0.0f)
         return say(why, n, "only the camera moved (%.2f cells, within a cell of every cascade): cached volume served",
                    (double)f->camera_move_cells), 0;
     return say(why, n, "nothing changed: cached volume served"), 0;
 }
 
-void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+/* Render-time passes: decided first, they do not depend on a recompute. */
+static void render_passes(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p, int all)
 {
-    memset(p, 0, sizeof *p);
-    const int all = s->planner == LPV_SWITCH_OFF;
-    p->cascades = lpv_plan_cascades(s, f, p->cascades_reason, sizeof p->cascades_reason);
-    const int in_use = lpv_cascades_count(s, p->cascades);
-    if (in_use > p->cascades) {
-        size_t len = strlen(p->cascades_reason);
-        say(p->cascades_reason + len, sizeof p->cascades_reason - len, "; far field: %d coarser levels",
-            in_use - p->cascades);
-        p->cascades = in_use;
-    }
-
-    /* Render-time passes are decided first: they do not depend on a recompute. */
     if (all)
         decide(p, LPV_PASS_GLOSSY, 1, "planner off");
     else if (s->glossy == LPV_SWITCH_OFF)
@@ -145,18 +138,13 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
     else
         decide(p, LPV_PASS_MEDIA, 1, "the scene has a participating medium");
 
-    const int occlusion = s->lpv.occlusion == LPV_SWITCH_ON;
-    const int gv = occlusion && (all || f->occluder_triangles > 0);
-    const int camera_in_gv = gv && f->has_view;
-    p->recompute = needs_recompute(s, f, camera_in_gv, p->recompute_reason, sizeof p->recompute_reason);
-    if (!p->recompute) {
-        for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
-            decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
-        return;
-    }
+}
 
-    char area[LPV_PLAN_REASON_MAX];
-    say(area, sizeof area, "area lights: %u emissive surfaces -> %zu samples", f->emissive_surfaces,
+/* The lights' RSMs (the LPV's VPLs and surfels, the imperfect volume's
+ * shadows); area: the area lights' summary, for other reasons. */
+static void rsm_pass(const lpv_plan_facts *f, lpv_plan *p, int all, char *area, size_t area_size)
+{
+    say(area, area_size, "area lights: %u emissive surfaces -> %zu samples", f->emissive_surfaces,
         f->area_light_samples);
     if (f->lights && f->area_light_samples)
         decide(p, LPV_PASS_RSM, 1, "%u punctual lights; %s", f->lights, area);
@@ -166,6 +154,38 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
         decide(p, LPV_PASS_RSM, 1, "%u punctual lights", f->lights);
     else
         decide(p, LPV_PASS_RSM, 0, "no punctual lights");
+}
+
+void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+{
+    memset(p, 0, sizeof *p);
+    const int all = s->planner == LPV_SWITCH_OFF;
+    p->cascades = lpv_plan_cascades(s, f, p->cascades_reason, sizeof p->cascades_reason);
+    const int in_use = lpv_cascades_count(s, p->cascades);
+    if (in_use > p->cascades) {
+        size_t len = strlen(p->cascades_reason);
+        say(p->cascades_reason + len, sizeof p->cascades_reason - len, "; far field: %d coarser levels",
+            in_use - p->cascades);
+        p->cascades = in_use;
+    }
+
+    render_passes(s, f, p, all);
+
+    const int occlusion = s->lpv.occlusion == LPV_SWITCH_ON;
+    const int gv = occlusion && (all || f->occluder_triangles > 0);
+    const int camera_in_gv = gv && f->has_view;
+    p->recompute = needs_recompute(s, f, camera_in_gv ? "its surfels feed the geometry volume" : NULL,
+                                   p->recompute_reason, sizeof p->recompute_reason);
+    for (int i = LPV_PASS_IV_POINTS; i <= LPV_PASS_IV_AO; ++i)
+        decide(p, (lpv_pass_id)i, 0, "the imperfect volume's (technique " LPV_TECHNIQUE_IV ")");
+    if (!p->recompute) {
+        for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
+            decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
+        return;
+    }
+
+    char area[LPV_PLAN_REASON_MAX];
+    rsm_pass(f, p, all, area, sizeof area);
     /* Not a saving but correctness, so also with the planner off: emitters
      * that light the scene directly must not enter the LPV a second time. */
     if (f->area_light_samples)
@@ -213,4 +233,65 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
     p->consumes.emissive_vpls = p->pass[LPV_PASS_EMISSIVE].run;
     p->consumes.surfels = p->pass[LPV_PASS_GV].run;
     p->consumes.camera_surfels = p->pass[LPV_PASS_GV].run && p->pass[LPV_PASS_GBUFFER].run;
+}
+
+void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+{
+    memset(p, 0, sizeof *p);
+    const int all = s->planner == LPV_SWITCH_OFF;
+    p->cascades = 1;
+    say(p->cascades_reason, sizeof p->cascades_reason, "%s: one volume, %d voxels along the scene's longest side",
+        LPV_TECHNIQUE_IV, s->iv.resolution);
+    render_passes(s, f, p, all);
+    const int reproject = s->iv.reprojection == LPV_SWITCH_ON && f->has_view;
+    p->recompute = needs_recompute(s, f, reproject ? "its visible points refine the imperfect volume" : NULL,
+                                   p->recompute_reason, sizeof p->recompute_reason);
+    for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
+        if (i != LPV_PASS_RSM && i != LPV_PASS_GBUFFER)
+            decide(p, (lpv_pass_id)i, 0, "the LPV's (technique " LPV_TECHNIQUE_IV " gathers by ray marching)");
+    if (!p->recompute) {
+        for (int i = 0; i < LPV_PASS_COUNT; ++i)
+            if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA)
+                decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
+        return;
+    }
+    char area[LPV_PLAN_REASON_MAX];
+    rsm_pass(f, p, all, area, sizeof area);
+    if (p->pass[LPV_PASS_RSM].run) {
+        size_t len = strlen(p->pass[LPV_PASS_RSM].reason);
+        say(p->pass[LPV_PASS_RSM].reason + len, sizeof p->pass[LPV_PASS_RSM].reason - len,
+            " (shadows of the points' direct light)");
+    }
+    if (!f->iv_points)
+        decide(p, LPV_PASS_IV_POINTS, 0, "no triangles to sample");
+    else if (f->iv_budget_cut)
+        decide(p, LPV_PASS_IV_POINTS, 1, "%zu points (%d per piece: the %d-point budget cut %d)", f->iv_points,
+               f->iv_points_per_piece, s->iv.max_points, s->iv.points);
+    else
+        decide(p, LPV_PASS_IV_POINTS, 1, "%zu points, %d per triangle piece", f->iv_points, f->iv_points_per_piece);
+    if (s->iv.reprojection == LPV_SWITCH_OFF)
+        decide(p, LPV_PASS_IV_REPROJECT, 0, "reprojection off");
+    else if (!f->has_view)
+        decide(p, LPV_PASS_IV_REPROJECT, 0, "reprojection skipped: no camera");
+    else
+        decide(p, LPV_PASS_IV_REPROJECT, 1, "the camera's visible points refine the volume");
+    if (p->pass[LPV_PASS_IV_REPROJECT].run)
+        decide(p, LPV_PASS_GBUFFER, 1, "the camera's visible points for reprojection");
+    else
+        decide(p, LPV_PASS_GBUFFER, 0, "reprojection does not run (render draws its own)");
+    const int filled = p->pass[LPV_PASS_IV_POINTS].run || p->pass[LPV_PASS_IV_REPROJECT].run;
+    const int lit = all || p->pass[LPV_PASS_RSM].run || (f->emissive_surfaces && !f->area_light_samples);
+    if (!filled)
+        decide(p, LPV_PASS_IV_GATHER, 0, "the volume is empty");
+    else if (!lit)
+        decide(p, LPV_PASS_IV_GATHER, 0, "no light sources");
+    else
+        decide(p, LPV_PASS_IV_GATHER, 1, "%s: %d bounces requested, %d rays per voxel", LPV_TECHNIQUE_IV,
+               s->iv.bounces, s->iv.rays);
+    if (s->iv.ao != LPV_SWITCH_ON)
+        decide(p, LPV_PASS_IV_AO, 0, "ambient occlusion off");
+    else if (!filled)
+        decide(p, LPV_PASS_IV_AO, 0, "the volume is empty");
+    else
+        decide(p, LPV_PASS_IV_AO, 1, "ambient occlusion on, %d rays per voxel", s->iv.rays);
 }

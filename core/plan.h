@@ -26,6 +26,10 @@ typedef enum lpv_pass_id {
     LPV_PASS_BOUNCE,    /* multiple bounces off GV blockers (inside propagation) */
     LPV_PASS_GLOSSY,    /* glossy march at render time */
     LPV_PASS_MEDIA,     /* participating media single scattering at render time */
+    LPV_PASS_IV_POINTS,    /* imperfect volume: the point cloud lit and splatted into the voxels */
+    LPV_PASS_IV_REPROJECT, /* imperfect volume: the camera's visible points refine the voxels */
+    LPV_PASS_IV_GATHER,    /* imperfect volume: radiance gathered per voxel by ray marching, per bounce */
+    LPV_PASS_IV_AO,        /* imperfect volume: ambient occlusion by ray marching */
     LPV_PASS_COUNT
 } lpv_pass_id;
 
@@ -54,6 +58,10 @@ typedef struct lpv_plan_facts {
     int forced;                /* the caller asked for a recompute (lpv_engine_invalidate) */
     int placement_changed;     /* a cascade's snapped placement differs */
     float camera_move_cells;   /* camera travel since the last computed tick, in finest cells */
+    /* the imperfect volume's point cloud (core/iv_points.h), 0 for other techniques */
+    size_t iv_points;
+    int iv_points_per_piece;
+    int iv_budget_cut;         /* the budget lowered the points per piece or coarsened the split */
 } lpv_plan_facts;
 
 typedef struct lpv_plan {
@@ -77,7 +85,8 @@ typedef struct lpv_plan {
 } lpv_plan;
 
 /* "rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce",
- * "glossy", "media"; NULL for an unknown id. */
+ * "glossy", "media", "iv_points", "iv_reproject", "iv_gather", "iv_ao"; NULL
+ * for an unknown id. */
 const char *lpv_pass_name(lpv_pass_id id);
 
 /* Cascades the settings and facts call for (1..LPV_MAX_CASCADES) with the
@@ -88,5 +97,8 @@ int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reas
 
 /* The whole plan for one tick. s must be resolved. */
 void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
+/* The imperfect volume's plan (technique iv): the shared producers it reads
+ * (the RSMs for shadows, the G-buffer for reprojection) and its passes. */
+void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
 
 #endif /* LPV_PLAN_H */

@@ -11,6 +11,7 @@
 #include "cascades.h"
 #include "engine.h"
 #include "error.h"
+#include "iv_points.h"
 #include "gl.h"
 #include "gl_util.h"
 #include "lpv_shared.h"
@@ -78,6 +79,9 @@ struct lpv_engine {
     size_t emissive_vpl_count;
     GLuint scene_surfels;     /* settings.scene_surfel_count over every triangle (GV), 0 = none */
     size_t scene_surfel_count;
+    GLuint iv_points;         /* the imperfect volume's point cloud (technique iv only), 0 = none */
+    size_t iv_point_count;
+    lpv_iv_point_stats iv_point_stats;
     lpv_emitter_list emitters;                          /* emissive triangles (area lights) */
     lpv_area_sample area_samples[LPV_MAX_AREA_LIGHTS];  /* the emitters as area light samples */
     size_t area_sample_count;                           /* 0: area lights off or no emitter */

@@ -13,11 +13,15 @@
 #include "error.h"
 #include "hash.h"
 #include "scene_surfels.h"
+#include "iv_points.h"
 
 static void free_samples(lpv_engine *e)
 {
     lpv_gl_delete_buffer(&e->emissive_vpls);
     lpv_gl_delete_buffer(&e->scene_surfels);
+    lpv_gl_delete_buffer(&e->iv_points);
+    e->iv_point_count = 0;
+    memset(&e->iv_point_stats, 0, sizeof e->iv_point_stats);
     e->emissive_vpl_count = 0;
     e->scene_surfel_count = 0;
 }
@@ -136,12 +140,49 @@ static uint64_t geometry_signature(const lpv_scene *s)
  * its geometry: the emissive surfaces' VPLs (emissive_vpls) and the scene
  * surfels (scene_surfels, scene_surfel_count). Redone by set_settings when
  * one of those knobs changes, without the scene being sent again. */
+/* The imperfect volume's point cloud at its voxel size (core/iv_points.h). */
+static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
+{
+    const lpv_settings *s = &e->settings;
+    const int given = lpv_settings_bounds_given(s);
+    lpv_grid g;
+    if (lpv_grid_place_cubic(s->iv.resolution, given ? s->bounds_min : e->scene_min,
+                             given ? s->bounds_max : e->scene_max, &g) != 0)
+        return lpv_error(err, err_size, "%s: cannot place the imperfect volume over the scene's bounds",
+                         e->geometry.source);
+    lpv_iv_point_params p = {.voxel = g.cell_size,
+                             .points = s->iv.points,
+                             .split = s->iv.split,
+                             .seed = (uint32_t)s->iv.seed,
+                             .max_points = (size_t)s->iv.max_points,
+                             .emission = 1};
+    struct IvPoint *pts = NULL;
+    size_t n = 0;
+    if (lpv_iv_points_make(&e->geometry, &p, &pts, &n, &e->iv_point_stats) != 0)
+        return lpv_error(err, err_size, "out of memory for the imperfect volume's points (iv_max_points %d)",
+                         s->iv.max_points);
+    e->iv_points = lpv_gl_new_ssbo(n * sizeof *pts);
+    if (n)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *pts), pts);
+    e->iv_point_count = n;
+    free(pts);
+    if (glGetError() != GL_NO_ERROR)
+        return lpv_error(err, err_size, "%s: GL error while storing %zu imperfect-volume points", e->geometry.source,
+                         n);
+    return 0;
+}
+
 int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size)
 {
     const lpv_scene *scene = &e->geometry;
     free_samples(e);
     e->counters.scene_samplings++;
 
+    /* The imperfect volume samples its own point cloud; the LPV's samples
+     * (emissive VPLs, scene surfels) would go unused. */
+    const int iv = e->settings.technique == LPV_TECHNIQUE_ID_IV;
+    if (iv)
+        return sample_iv_points(e, err, err_size);
     size_t target = (size_t)e->settings.emissive_vpls;
     lpv_vpl *vpls = target ? calloc(target * 2 + 1024, sizeof *vpls) : NULL;
     size_t n = vpls ? lpv_emissive_sample(scene, target, vpls, target * 2 + 1024) : 0;

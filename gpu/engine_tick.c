@@ -47,6 +47,9 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->settings_changed = e->settings_dirty;
     memcpy(f->settings_knob, e->settings_knob, sizeof f->settings_knob);
     f->forced = e->forced;
+    f->iv_points = e->iv_point_count;
+    f->iv_points_per_piece = e->iv_point_stats.points_per_piece;
+    f->iv_budget_cut = e->iv_point_stats.budget_cut;
     if (e->has_view != e->computed_has_view) {
         f->camera_move_cells = INFINITY;
     } else if (e->has_view) {
@@ -94,6 +97,16 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
     if (e->scene_surfel_count && n < LPV_MAX_SURFEL_SETS)
         in->surfel_sets[n++] = (lpv_surfel_set){e->scene_surfels, 0, e->scene_surfel_count};
     in->surfel_set_count = n;
+    in->light_ubo = e->light_ubo;
+    in->rsm_position = e->rsm_position;
+    in->rsm_albedo = e->rsm_albedo;
+    if (e->plan.pass[LPV_PASS_GBUFFER].run) {
+        memcpy(in->gbuffer, e->gbuf_tex, sizeof in->gbuffer);
+        in->gbuffer_w = e->gbuf_w;
+        in->gbuffer_h = e->gbuf_h;
+    }
+    in->iv_points = e->iv_points;
+    in->iv_point_count = e->iv_point_count;
 }
 
 static void record_stats(lpv_engine *e)

@@ -7,6 +7,7 @@
 static const lpv_technique_class *const CLASSES[LPV_TECHNIQUE_ID_COUNT_] = {
     [LPV_TECHNIQUE_ID_LPV] = &lpv_technique_cascaded_lpv,
     [LPV_TECHNIQUE_ID_OCTREE] = &lpv_technique_octree,
+    [LPV_TECHNIQUE_ID_IV] = &lpv_technique_iv,
 };
 
 const lpv_technique_class *lpv_technique_class_of(lpv_technique_id id)

@@ -73,6 +73,16 @@ typedef struct lpv_technique_inputs {
     size_t surfel_set_count;      /* the surfaces seen this tick, for occlusion */
     lpv_surfel_set surfel_sets[LPV_MAX_SURFEL_SETS];
     const lpv_medium_gpu *medium; /* attenuation during transport */
+    /* For a technique that lights surfaces itself (the imperfect volume):
+     * the lights' block and their RSMs' position and albedo layers as
+     * shadow maps, the camera's G-buffer (0 when it did not run this tick),
+     * and the scene's point cloud (core/iv_points.h). */
+    GLuint light_ubo;
+    GLuint rsm_position, rsm_albedo;        /* 2D array textures (rsm.frag's targets) */
+    GLuint gbuffer[4];                      /* position, normal, albedo, emission (gbuffer.frag) */
+    int gbuffer_w, gbuffer_h;
+    GLuint iv_points;                       /* IvPoint */
+    size_t iv_point_count;
 } lpv_technique_inputs;
 
 /* What the volume is: lpv_volume_desc (engine.h, where the tick's stats
@@ -85,6 +95,8 @@ typedef enum lpv_volume_part {
     LPV_VOLUME_GEOMETRY,   /* lpv_gv_point per geometry-volume point (0 if none) */
     LPV_VOLUME_TRANSMIT,   /* float per cell and direction (0 if none) */
     LPV_VOLUME_INDEX,      /* int32 per level-0 cell: the octree level its light comes from (0 if none) */
+    LPV_VOLUME_IV_VOXELS,  /* lpv_iv_voxel per voxel: the imperfect volume's voxels (0 if none) */
+    LPV_VOLUME_AO,         /* 4 floats per voxel: SH of the visible directions (0 if none) */
 } lpv_volume_part;
 
 typedef struct lpv_technique_class lpv_technique_class;
@@ -132,6 +144,8 @@ struct lpv_technique_class {
 extern const lpv_technique_class lpv_technique_cascaded_lpv;
 /* The octree light propagation volume (gpu/lpv/technique_octree.c). */
 extern const lpv_technique_class lpv_technique_octree;
+/* Imperfect volumes (gpu/iv/). */
+extern const lpv_technique_class lpv_technique_iv;
 
 /* The class of a technique (core/settings.h's ids; technique.c's table), or
  * NULL for an id without one. */

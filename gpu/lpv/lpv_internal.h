@@ -1,24 +1,18 @@
 /*
  * lpv_internal.h - the cascaded LPV technique's state, shared by its files
  * (technique_lpv.c: the lpv_technique_class; lpv_storage.c: placement and
- * buffers; lpv_atlas.c; lpv_inject.c; lpv_gv.c; lpv_propagate.c;
+ * buffers; lpv_inject.c; lpv_gv.c; lpv_propagate.c;
  * lpv_read.c). Not seen outside gpu/lpv/. Each pass takes the state it works
  * on and the tick's inputs, never the engine.
  */
 #ifndef LPV_LPV_INTERNAL_H
 #define LPV_LPV_INTERNAL_H
 
+#include "atlas.h"
 #include "cascades.h"
 #include "gl_util.h"
 #include "technique.h"
 
-/* A 2D atlas of z slices that points are blended into (see grid.glsl). */
-typedef struct lpv_atlas {
-    int tiles_x, width, height;
-    int attachments;
-    GLuint tex[3];
-    GLuint fbo;
-} lpv_atlas;
 
 typedef struct lpv_cascaded {
     lpv_technique base;
@@ -71,19 +65,6 @@ void lpv_cascaded_place_grid(lpv_cascaded *c, const lpv_grid *g, int *moved);
 void lpv_cascaded_free_storage(lpv_cascaded *c);
 void lpv_cascaded_memory_need(const lpv_cascaded *c, lpv_memory_need *n);
 
-/* Atlas (lpv_atlas.c): created per placement, owned by the state. */
-int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size);
-void lpv_atlas_destroy(lpv_atlas *a);
-/* Sets the state for additive point splatting with prog into a, cleared
- * first (begin) or as it is (begin_keep); the grid block and an empty VAO
- * bound. */
-void lpv_atlas_begin(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
-void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
-/* Draws count points of elements [first, first + count) of buffer at binding,
- * once per cascade (instanced: gl_InstanceID is the cascade). */
-void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int cascades,
-                     lpv_timer *timer);
-void lpv_atlas_end(void);
 
 /* The passes; each records its own timer stage. */
 void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rsm_vpls, int emissive_vpls);

@@ -66,6 +66,8 @@ size_t lpv_cascaded_read(lpv_cascaded *c, const lpv_plan *last, lpv_volume_part 
             return 0;
         return lpv_gl_read_buffer(c->transmit, sizeof(float), lpv_all_cells(c) * LPV_DIR_COUNT, out, max);
     case LPV_VOLUME_INDEX: /* one grid per cascade: no index volume */
+    case LPV_VOLUME_IV_VOXELS:
+    case LPV_VOLUME_AO:
         return 0;
     }
     return 0;

@@ -333,6 +333,9 @@ static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part,
             n += lpv_cascaded_read(o->level[i], last, LPV_VOLUME_SUMMED, which, (lpv_cell *)out + n, max - n);
         return n;
     }
+    case LPV_VOLUME_IV_VOXELS:
+    case LPV_VOLUME_AO:
+        return 0;
     case LPV_VOLUME_INDEX:
         return lpv_gl_read_buffer(o->index, sizeof(int32_t), o->merged_cells, out, max);
     case LPV_VOLUME_GEOMETRY:

@@ -1,18 +1,18 @@
 /*
- * lpv_atlas.c - the 2D atlases of z slices that the LPV's injection and its
- * geometry volume blend points into (fp32 render targets, one attachment per
- * colour channel or per half of a point's data): the paper's point
- * splatting, portable because it needs no float atomics and deterministic
- * because blending follows primitive order. The LPV state owns both atlases
- * (lpv_storage.c sizes them with the cascades); the passes get them passed.
+ * atlas.c - the point-splatting atlas (see atlas.h).
  */
 #include <math.h>
 
+#include "atlas.h"
+
 #include "error.h"
-#include "lpv_internal.h"
+#include "lpv_shared.h"
 
 int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err, size_t err_size)
 {
+    if (attachments < 1 || attachments > LPV_ATLAS_MAX_ATTACHMENTS)
+        return lpv_error(err, err_size, "an atlas holds 1..%d attachments, not %d", LPV_ATLAS_MAX_ATTACHMENTS,
+                         attachments);
     a->tiles_x = (int)ceil(sqrt((double)dims[2]));
     int tiles_y = (dims[2] + a->tiles_x - 1) / a->tiles_x;
     a->width = dims[0] * a->tiles_x;
@@ -26,7 +26,7 @@ int lpv_atlas_create(lpv_atlas *a, const int dims[3], int attachments, char *err
     glGenTextures(attachments, a->tex);
     glGenFramebuffers(1, &a->fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
-    GLenum bufs[3];
+    GLenum bufs[LPV_ATLAS_MAX_ATTACHMENTS];
     for (int i = 0; i < attachments; ++i) {
         glBindTexture(GL_TEXTURE_2D, a->tex[i]);
         glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, a->width, a->height);

@@ -1,0 +1,420 @@
+/*
+ * technique_iv.c - imperfect volumes (Mavridis & Papaioannou, the third
+ * seed; docs/imperfect-volumes.md) as an lpv_technique.
+ *
+ * A grid of cubic voxels over the whole scene (core/grid.h,
+ * lpv_grid_place_cubic), rebuilt every computed tick:
+ *
+ *   iv_points     the scene's point cloud (core/iv_points.h, N points per
+ *                 triangle by Turk's formula, made when the geometry or its
+ *                 knobs change) lit by the lights through their RSMs and
+ *                 splatted into the voxels (paper 3.1)
+ *   iv_reproject  the camera's visible pixels, lit the same way, splatted
+ *                 into the same voxels (3.2)
+ *   iv_resolve    the sums into per-voxel means and occupancy bits
+ *   iv_gather     per bounce: every occupied voxel's emission (direct light,
+ *                 plus its albedo times the previous gather's irradiance),
+ *                 then every voxel a lookup reads marches its rays and
+ *                 stores the arriving radiance as SH (3.3), ping-ponging
+ *                 two volumes
+ *   iv_ao         the same march for visibility within a reach (3.5)
+ *
+ * The lookup (iv_volume.glsl, iv_lookup.glsl) reconstructs irradiance at a
+ * surface from the voxels around it (3.4). core/oracle_iv.c is the
+ * reference the tests hold this to.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "atlas.h"
+#include "error.h"
+#include "gl_util.h"
+#include "shader.h"
+#include "technique.h"
+
+/* The atlas's attachments: r, g, b SH sums, normal + count, albedo. */
+#define IV_ATTACHMENTS 5
+
+typedef struct lpv_iv_gpu {
+    lpv_technique base;
+    lpv_settings settings;
+    lpv_grid grid;    /* of the last commit */
+    lpv_grid pending; /* of the last place */
+    GLuint prog_splat, prog_resolve, prog_emit, prog_gather;
+    GLuint empty_vao, grid_ubo;
+    lpv_atlas atlas;
+    GLuint voxels, occupancy, emit, radiance[2], ao;
+    int result;       /* radiance[result] holds the last gather: what the lookup reads */
+    size_t cells;     /* allocated for */
+    int alloc_dims[3];
+    int bounces_run;  /* by the last computed tick */
+} lpv_iv_gpu;
+
+static const char *const INC_SPLAT[] = {"grid.glsl", "lights.glsl", "iv_direct.glsl", NULL};
+static const char *const INC_GRID[] = {"grid.glsl", NULL};
+static const char *const LOOKUP[] = {"grid.glsl", "iv_volume.glsl", "iv_lookup.glsl", NULL};
+
+static void free_storage(lpv_iv_gpu *v)
+{
+    lpv_atlas_destroy(&v->atlas);
+    lpv_gl_delete_buffer(&v->voxels);
+    lpv_gl_delete_buffer(&v->occupancy);
+    lpv_gl_delete_buffer(&v->emit);
+    lpv_gl_delete_buffer(&v->radiance[0]);
+    lpv_gl_delete_buffer(&v->radiance[1]);
+    lpv_gl_delete_buffer(&v->ao);
+    v->cells = 0;
+    memset(v->alloc_dims, 0, sizeof v->alloc_dims);
+}
+
+static void destroy(lpv_technique *t)
+{
+    lpv_iv_gpu *v = (lpv_iv_gpu *)t;
+    if (!v)
+        return;
+    free_storage(v);
+    GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather};
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
+        if (progs[i])
+            glDeleteProgram(progs[i]);
+    lpv_gl_delete_buffer(&v->grid_ubo);
+    if (v->empty_vao)
+        glDeleteVertexArrays(1, &v->empty_vao);
+    free(v);
+}
+
+static lpv_technique *create(char *err, size_t err_size)
+{
+    lpv_iv_gpu *v = calloc(1, sizeof *v);
+    if (!v) {
+        lpv_error(err, err_size, "out of memory");
+        return NULL;
+    }
+    v->base.cls = &lpv_technique_iv;
+    v->prog_splat = lpv_program_build("iv_splat.vert", NULL, "iv_splat.frag", INC_SPLAT, err, err_size);
+    v->prog_resolve = v->prog_splat ? lpv_program_build("iv_resolve.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
+    v->prog_emit = v->prog_resolve ? lpv_program_build("iv_emit.comp", NULL, NULL, LOOKUP, err, err_size) : 0;
+    v->prog_gather = v->prog_emit ? lpv_program_build("iv_gather.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
+    if (!v->prog_gather) {
+        destroy(&v->base);
+        return NULL;
+    }
+    glGenVertexArrays(1, &v->empty_vao);
+    glGenBuffers(1, &v->grid_ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, v->grid_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
+    lpv_settings_resolve(&v->settings);
+    return &v->base;
+}
+
+static void configure(lpv_technique *t, const lpv_settings *s) { ((lpv_iv_gpu *)t)->settings = *s; }
+
+static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, char *err, size_t err_size)
+{
+    lpv_iv_gpu *v = (lpv_iv_gpu *)t;
+    const lpv_settings *s = w->settings;
+    const int given = lpv_settings_bounds_given(s);
+    const float *lo = given ? s->bounds_min : w->bounds_min, *hi = given ? s->bounds_max : w->bounds_max;
+    lpv_grid g;
+    if (lpv_grid_place_cubic(s->iv.resolution, lo, hi, &g) != 0)
+        return lpv_error(err, err_size, "cannot place %d voxels over the bounds (%g %g %g)..(%g %g %g)",
+                         s->iv.resolution, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1],
+                         (double)hi[2]);
+    v->pending = g;
+    if (moved)
+        *moved = memcmp(&g, &v->grid, sizeof g) != 0;
+    return 0;
+}
+
+static void memory_need(const lpv_technique *t, lpv_memory_need *n)
+{
+    const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
+    const lpv_grid *g = v->cells ? &v->grid : &v->pending;
+    /* per voxel: the atlas (5 x 16), IvVoxel (80), emission and two
+     * radiance volumes (3 x 48), AO (16): 320 bytes, within one LPV cell's */
+    n->cells += lpv_grid_cell_count(g);
+    n->cascades = 1;
+    memcpy(n->grid_dims, g->dims, sizeof n->grid_dims);
+}
+
+static void upload_grid(lpv_iv_gpu *v)
+{
+    const lpv_grid *g = &v->grid;
+    struct LpvGridParams params = {
+        .dims = {(float)g->dims[0], (float)g->dims[1], (float)g->dims[2], (float)lpv_grid_cell_count(g)},
+        .info = {1.0f, 0.0f, 1.0f, 0.0f},
+    };
+    for (int i = 0; i < 3; ++i)
+        params.cascade[0][i] = g->origin[i] / g->cell_size;
+    params.cascade[0][3] = g->cell_size;
+    glBindBuffer(GL_UNIFORM_BUFFER, v->grid_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
+}
+
+static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, char *err, size_t err_size)
+{
+    lpv_iv_gpu *v = (lpv_iv_gpu *)t;
+    *reset = 0;
+    v->grid = v->pending;
+    upload_grid(v);
+    if (v->cells && memcmp(v->alloc_dims, v->grid.dims, sizeof v->alloc_dims) == 0)
+        return 0;
+    lpv_memory_need need = w->others;
+    need.cells += lpv_grid_cell_count(&v->grid);
+    need.cascades = 1;
+    memcpy(need.grid_dims, v->grid.dims, sizeof need.grid_dims);
+    if (lpv_memory_check(&need, w->limits, err, err_size) != 0)
+        return -1;
+    free_storage(v);
+    *reset = 1;
+    const size_t cells = lpv_grid_cell_count(&v->grid);
+    if (lpv_atlas_create(&v->atlas, v->grid.dims, IV_ATTACHMENTS, err, err_size) != 0)
+        return -1;
+    v->voxels = lpv_gl_new_ssbo(cells * sizeof(struct IvVoxel));
+    v->occupancy = lpv_gl_new_ssbo((cells + 31) / 32 * sizeof(uint32_t));
+    v->emit = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
+    v->radiance[0] = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
+    v->radiance[1] = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
+    v->ao = lpv_gl_new_ssbo(cells * 4 * sizeof(float));
+    v->cells = cells;
+    memcpy(v->alloc_dims, v->grid.dims, sizeof v->alloc_dims);
+    v->result = 0;
+    if (glGetError() != GL_NO_ERROR) {
+        free_storage(v);
+        return lpv_error(err, err_size, "could not allocate the imperfect volume's %dx%dx%d voxels",
+                         v->grid.dims[0], v->grid.dims[1], v->grid.dims[2]);
+    }
+    return 0;
+}
+
+static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+{
+    (void)t;
+    lpv_plan_make_iv(s, f, p);
+}
+
+static GLuint groups(const lpv_iv_gpu *v) { return lpv_div_up(v->cells, LPV_IV_WG); }
+
+static void clear_buffer(GLuint b)
+{
+    static const float zero = 0.0f;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
+    glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, &zero);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+}
+
+/* iv_points and iv_reproject: the points into the atlas. */
+static void create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
+{
+    const lpv_plan *p = in->plan;
+    GLuint prog = v->prog_splat;
+    lpv_atlas_begin(&v->atlas, prog, v->grid_ubo, v->empty_vao);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
+    glActiveTexture(GL_TEXTURE0 + 5);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
+    glActiveTexture(GL_TEXTURE0 + 6);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
+    glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
+    if (p->pass[LPV_PASS_IV_POINTS].run && in->iv_point_count) {
+        lpv_timer_begin(in->timer, "iv_points");
+        glUniform1i(glGetUniformLocation(prog, "u_source"), 0);
+        lpv_atlas_splat(prog, LPV_SSBO_IV_POINTS, in->iv_points, 0, in->iv_point_count, 1, in->timer);
+        lpv_timer_end(in->timer);
+    }
+    if (p->pass[LPV_PASS_IV_REPROJECT].run && in->gbuffer_w > 0 && in->gbuffer_h > 0) {
+        lpv_timer_begin(in->timer, "iv_reproject");
+        for (int i = 0; i < 4; ++i) {
+            glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+            glBindTexture(GL_TEXTURE_2D, in->gbuffer[i]);
+        }
+        glUniform1i(glGetUniformLocation(prog, "u_source"), 1);
+        glUniform2i(glGetUniformLocation(prog, "u_gbuf_size"), in->gbuffer_w, in->gbuffer_h);
+        glDrawArrays(GL_POINTS, 0, in->gbuffer_w * in->gbuffer_h);
+        lpv_timer_count(in->timer, 1);
+        lpv_timer_end(in->timer);
+    }
+    lpv_atlas_end();
+    glActiveTexture(GL_TEXTURE0);
+
+    lpv_timer_begin(in->timer, "iv_resolve");
+    clear_buffer(v->occupancy); /* all bits 0 */
+    glUseProgram(v->prog_resolve);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    for (int i = 0; i < IV_ATTACHMENTS; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, v->atlas.tex[i]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(glGetUniformLocation(v->prog_resolve, "u_tiles_x"), v->atlas.tiles_x);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_VOXELS, v->voxels);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glDispatchCompute(groups(v), 1, 1);
+    lpv_timer_count(in->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    lpv_timer_end(in->timer);
+}
+
+
+/* One march over the volume: radiance from the emission (ao 0) into out, or
+ * visibility into the AO volume (ao 1). */
+static void march(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int ao, lpv_timer *timer)
+{
+    GLuint prog = v->prog_gather;
+    glUseProgram(prog);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_EMIT, v->emit);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+    glUniform1i(glGetUniformLocation(prog, "u_rays"), s->iv.rays);
+    glUniform1ui(glGetUniformLocation(prog, "u_seed"), (GLuint)s->iv.seed);
+    glUniform1i(glGetUniformLocation(prog, "u_ao"), ao);
+    const float reach = s->iv.ao_distance > 0.0f ? s->iv.ao_distance / v->grid.cell_size : LPV_IV_AO_VOXELS;
+    glUniform1f(glGetUniformLocation(prog, "u_ao_reach"), reach);
+    glDispatchCompute(groups(v), 1, 1);
+    lpv_timer_count(timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+/* Bounces 1..K: emission from the previous gather, then a march. */
+static void gather(lpv_iv_gpu *v, const lpv_technique_inputs *in)
+{
+    const lpv_settings *s = in->settings;
+    lpv_timer_begin(in->timer, "iv_gather");
+    int prev = 0, cur = 0;
+    for (int k = 1; k <= s->iv.bounces; ++k) {
+        cur = k == 1 ? 0 : 1 - prev;
+        glUseProgram(v->prog_emit);
+        glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_VOXELS, v->voxels);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_EMIT, v->emit);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, v->radiance[prev]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+        glUniform1i(glGetUniformLocation(v->prog_emit, "u_bounce"), k);
+        glUniform1i(glGetUniformLocation(v->prog_emit, "u_iv_neighbours"), s->iv.neighbours);
+        glDispatchCompute(groups(v), 1, 1);
+        lpv_timer_count(in->timer, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        march(v, s, v->radiance[cur], 0, in->timer);
+        prev = cur;
+    }
+    v->result = cur;
+    v->bounces_run = s->iv.bounces;
+    lpv_timer_end(in->timer);
+}
+
+static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
+{
+    (void)err;
+    (void)err_size;
+    lpv_iv_gpu *v = (lpv_iv_gpu *)t;
+    const lpv_plan *p = in->plan;
+    create_volume(v, in);
+    if (p->pass[LPV_PASS_IV_GATHER].run) {
+        gather(v, in);
+    } else {
+        v->result = 0;
+        v->bounces_run = 0;
+        clear_buffer(v->radiance[0]);
+    }
+    if (p->pass[LPV_PASS_IV_AO].run) {
+        lpv_timer_begin(in->timer, "iv_ao");
+        march(v, in->settings, v->radiance[1 - v->result], 1, in->timer);
+        lpv_timer_end(in->timer);
+    }
+    glUseProgram(0);
+    return 0;
+}
+
+static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
+{
+    const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
+    glUniform1f(glGetUniformLocation(prog, "u_damping"), damping);
+    glUniform1i(glGetUniformLocation(prog, "u_iv_neighbours"), v->settings.iv.neighbours);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, v->radiance[v->result]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+}
+
+static void describe(const lpv_technique *t, lpv_volume_desc *d)
+{
+    const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
+    memset(d, 0, sizeof *d);
+    d->technique = lpv_technique_iv.name;
+    d->levels = 1;
+    d->level[0] = v->grid;
+    d->volumes_per_level = 1;
+    d->values_per_cell = 12;
+}
+
+/* The voxels' direct light (IvVoxel.r, g, b) as LpvCells. */
+static size_t read_direct(const lpv_iv_gpu *v, lpv_cell *out, size_t max)
+{
+    size_t n = v->cells < max ? v->cells : max;
+    struct IvVoxel *vox = n ? malloc(n * sizeof *vox) : NULL;
+    if (!vox)
+        return 0;
+    n = lpv_gl_read_buffer(v->voxels, sizeof *vox, v->cells, vox, n);
+    for (size_t i = 0; i < n; ++i) {
+        memcpy(out[i].r, vox[i].r, sizeof out[i].r);
+        memcpy(out[i].g, vox[i].g, sizeof out[i].g);
+        memcpy(out[i].b, vox[i].b, sizeof out[i].b);
+    }
+    free(vox);
+    return n;
+}
+
+static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part, lpv_grid_which which, void *out,
+                   size_t max)
+{
+    (void)last;
+    lpv_iv_gpu *v = (lpv_iv_gpu *)t;
+    switch (part) {
+    case LPV_VOLUME_SUMMED:
+    case LPV_VOLUME_STORED:
+        if (which == LPV_GRID_INJECTED)
+            return read_direct(v, out, max);
+        return lpv_gl_read_buffer(v->radiance[v->result], sizeof(lpv_cell), v->cells, out, max);
+    case LPV_VOLUME_IV_VOXELS:
+        return lpv_gl_read_buffer(v->voxels, sizeof(struct IvVoxel), v->cells, out, max);
+    case LPV_VOLUME_AO:
+        return lpv_gl_read_buffer(v->ao, 4 * sizeof(float), v->cells, out, max);
+    case LPV_VOLUME_GEOMETRY:
+    case LPV_VOLUME_TRANSMIT:
+    case LPV_VOLUME_INDEX:
+        return 0;
+    }
+    return 0;
+}
+
+static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats *s)
+{
+    const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
+    s->cascades = 1;
+    s->cells = v->cells;
+    s->iterations = last->pass[LPV_PASS_IV_GATHER].run ? v->bounces_run : 0;
+    s->cell_steps = 0.0;
+    s->occlusion = 1; /* the march stops at occupied voxels */
+}
+
+const lpv_technique_class lpv_technique_iv = {
+    .name = LPV_TECHNIQUE_IV,
+    .lookup_includes = LOOKUP,
+    .create = create,
+    .destroy = destroy,
+    .configure = configure,
+    .place = place,
+    .commit = commit,
+    .plan = plan,
+    .tick = tick,
+    .bind_lookup = bind_lookup,
+    .describe = describe,
+    .read = read,
+    .memory_need = memory_need,
+    .stats = stats,
+};

@@ -1,0 +1,92 @@
+// iv_gather.comp - radiance caching (paper 3.3): every voxel that a lookup
+// can read (one with an occupied voxel among its 27) marches u_rays
+// stratified rays (lpv_iv_ray) through the occupancy, starting
+// LPV_IV_START voxels out and stepping one voxel, until an occupied voxel or
+// the volume's edge. A hit sees what that voxel emits towards the ray's
+// origin; a ray that leaves the volume sees nothing (lpvd has no environment
+// light: the path-traced reference sees black there too). The Monte-Carlo
+// projection 4 pi / N sum L Y stores the arriving radiance as SH of the
+// direction it travels. With u_ao 1 the march returns visibility instead
+// (1 past u_ao_reach metres or out of the volume, 0 at a hit; paper 3.5).
+layout(local_size_x = LPV_IV_WG) in;
+
+layout(std430, binding = LPV_SSBO_IV_OCCUPANCY) readonly buffer Occupancy { uint occupancy[]; };
+layout(std430, binding = LPV_SSBO_IV_EMIT) readonly buffer Emit { LpvCell emit[]; };
+layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell gathered[]; };
+layout(std430, binding = LPV_SSBO_IV_AO) writeonly buffer Ao { vec4 ao[]; };
+
+uniform int u_rays;
+uniform uint u_seed;
+uniform int u_ao;
+uniform float u_ao_reach; // voxels
+
+bool occupied(ivec3 c) { int i = cell_index(c); return (occupancy[i >> 5] & (1u << uint(i & 31))) != 0u; }
+
+bool needed(ivec3 c)
+{
+    for (int z = -1; z <= 1; ++z)
+        for (int y = -1; y <= 1; ++y)
+            for (int x = -1; x <= 1; ++x) {
+                ivec3 q = c + ivec3(x, y, z);
+                if (cell_inside(q) && occupied(q))
+                    return true;
+            }
+    return false;
+}
+
+void main()
+{
+    int i = int(gl_GlobalInvocationID.x);
+    if (i >= grid_cells())
+        return;
+    ivec3 d = grid_dims();
+    ivec3 c = ivec3(i % d.x, (i / d.x) % d.y, i / (d.x * d.y));
+    const float sphere = 4.0 * LPV_PI;
+    if (!needed(c)) {
+        if (u_ao != 0)
+            ao[i] = vec4(sphere * LPV_SH_C0, 0.0, 0.0, 0.0); // open: visibility 1 everywhere
+        else
+            gathered[i] = LpvCell(vec4(0.0), vec4(0.0), vec4(0.0));
+        return;
+    }
+    vec3 centre = vec3(c) + 0.5; // in voxels
+    vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0), vis = vec4(0.0);
+    int max_steps = d.x + d.y + d.z;
+    for (int j = 0; j < u_rays; ++j) {
+        vec3 w;
+        lpv_iv_ray(u_seed, uint(i), uint(j), uint(u_rays), w);
+        vec4 y = sh_basis(-w); // the light arrives travelling along -w
+        int hit = -1;
+        bool out_of_reach = false;
+        for (int s = 0; s < max_steps; ++s) {
+            float t = LPV_IV_START + float(s);
+            if (u_ao != 0 && t > u_ao_reach) {
+                out_of_reach = true;
+                break;
+            }
+            ivec3 q = ivec3(floor(centre + t * w));
+            if (!cell_inside(q))
+                break;
+            if (q == c || !occupied(q))
+                continue;
+            hit = cell_index(q);
+            break;
+        }
+        if (u_ao != 0) {
+            if (hit < 0 || out_of_reach)
+                vis += y;
+            continue;
+        }
+        if (hit < 0)
+            continue;
+        LpvCell e = emit[hit];
+        r += max(dot(e.r, y), 0.0) * y;
+        g += max(dot(e.g, y), 0.0) * y;
+        b += max(dot(e.b, y), 0.0) * y;
+    }
+    float k = sphere / float(u_rays);
+    if (u_ao != 0)
+        ao[i] = vis * k;
+    else
+        gathered[i] = LpvCell(r * k, g * k, b * k);
+}

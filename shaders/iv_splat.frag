@@ -1,0 +1,21 @@
+// iv_splat.frag - writes a point's sums; the atlas blends additively.
+flat in vec4 v_r;
+flat in vec4 v_g;
+flat in vec4 v_b;
+flat in vec4 v_n;
+flat in vec4 v_a;
+
+layout(location = 0) out vec4 o_r;
+layout(location = 1) out vec4 o_g;
+layout(location = 2) out vec4 o_b;
+layout(location = 3) out vec4 o_n;
+layout(location = 4) out vec4 o_a;
+
+void main()
+{
+    o_r = v_r;
+    o_g = v_g;
+    o_b = v_b;
+    o_n = v_n;
+    o_a = v_a;
+}

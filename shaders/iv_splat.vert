@@ -1,0 +1,67 @@
+// iv_splat.vert - one point into the voxel that holds it (paper 3.1 and
+// 3.2): a point of the cloud (u_source 0) or a visible pixel of the camera's
+// G-buffer (u_source 1). Each is lit here (iv_direct.glsl) and carries its
+// outgoing radiance B / pi over its normal's hemisphere as SH (B = albedo x
+// E_direct + pi x emission), its normal, its albedo and a count of 1; the
+// atlas sums them and iv_resolve.comp divides by the count.
+layout(std430, binding = LPV_SSBO_IV_POINTS) readonly buffer Points { IvPoint points[]; };
+layout(binding = 0) uniform sampler2D u_gbuf_position;
+layout(binding = 1) uniform sampler2D u_gbuf_normal;
+layout(binding = 2) uniform sampler2D u_gbuf_albedo;
+layout(binding = 3) uniform sampler2D u_gbuf_emission;
+
+uniform int u_source;      // 0 the cloud, 1 the G-buffer
+uniform int u_first;       // the cloud's first point
+uniform ivec2 u_gbuf_size;
+uniform vec2 u_atlas_size;
+uniform float u_emission;  // 1: emission counts (area lights off); 0: the area lights carry the emitters
+
+flat out vec4 v_r;
+flat out vec4 v_g;
+flat out vec4 v_b;
+flat out vec4 v_n;
+flat out vec4 v_a;
+
+void main()
+{
+    gl_PointSize = 1.0;
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
+    v_r = v_g = v_b = v_n = v_a = vec4(0.0);
+    vec3 p, n, albedo, emission;
+    if (u_source == 0) {
+        IvPoint q = points[u_first + gl_VertexID];
+        if (q.position.w == 0.0)
+            return;
+        p = q.position.xyz;
+        n = q.normal.xyz;
+        albedo = q.albedo.rgb;
+        emission = q.emission.rgb;
+    } else {
+        ivec2 t = ivec2(gl_VertexID % u_gbuf_size.x, gl_VertexID / u_gbuf_size.x);
+        vec4 gn = texelFetch(u_gbuf_normal, t, 0);
+        if (gn.w < 0.5)
+            return; // background
+        p = texelFetch(u_gbuf_position, t, 0).xyz;
+        n = gn.xyz;
+        albedo = texelFetch(u_gbuf_albedo, t, 0).rgb;
+        emission = texelFetch(u_gbuf_emission, t, 0).rgb;
+    }
+    float len = length(n);
+    if (!finite3(p) || !(len > 1e-8) || isinf(len) || !finite3(albedo) || !finite3(emission))
+        return;
+    n /= len;
+    ivec3 c = ivec3(floor(cascade_coords(0, p)));
+    if (!cell_inside(c))
+        return;
+    vec3 radiosity = albedo * iv_direct_irradiance(p, n) + LPV_PI * u_emission * emission;
+    if (!finite3(radiosity))
+        return;
+    vec4 h = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * n.y, LPV_IV_HEMI1 * n.z, LPV_IV_HEMI1 * n.x);
+    v_r = h * radiosity.r;
+    v_g = h * radiosity.g;
+    v_b = h * radiosity.b;
+    v_n = vec4(n, 1.0);
+    v_a = vec4(albedo, 0.0);
+    vec2 texel = vec2(atlas_texel(c, grid_dims().xy)) + 0.5;
+    gl_Position = vec4(texel / u_atlas_size * 2.0 - 1.0, 0.0, 1.0);
+}
