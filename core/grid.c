@@ -67,10 +67,13 @@ int lpv_grid_place_cubic(int resolution, const float bmin[3], const float bmax[3
         longest = fmax(longest, (double)bmax[i] - (double)bmin[i]);
     const double cs = longest > 0.0 ? longest / resolution : 1.0;
     for (int i = 0; i < 3; i++) {
+        /* the bounds on voxel centres: a wall on the bounds (a room's) lies
+         * inside its voxel, not on a face where rounding splits its points */
         double extent = (double)bmax[i] - (double)bmin[i];
-        int n = (int)ceil(extent / cs - 1e-6) + 2;
-        if (n < 3)
-            n = 3;
+        double span = extent / cs;
+        int n = (int)floor(span + 0.5) + 1;
+        if (n < 1)
+            n = 1;
         if (n > LPV_MAX_GRID_DIM)
             n = LPV_MAX_GRID_DIM;
         out->dims[i] = n;

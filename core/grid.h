@@ -27,9 +27,10 @@ typedef struct lpv_grid {
 int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], lpv_grid *out);
 
 /* Places cubic voxels over [bmin, bmax] for the imperfect volume:
- * `resolution` voxels span the longest side, the other axes as many as
- * they need, plus one voxel of margin on every side (so surfaces on the
- * bounds lie inside). Axes are capped at LPV_MAX_GRID_DIM. Returns 0, or -1
+ * `resolution` voxels of side longest / resolution span the longest side,
+ * the other axes as many as they need; one more voxel per axis puts the
+ * bounds on voxel centres, so a surface on the bounds (a room's wall) lies
+ * inside a voxel rather than on a face. Axes are capped at LPV_MAX_GRID_DIM. Returns 0, or -1
  * when a bound is not finite or resolution < 1. */
 int lpv_grid_place_cubic(int resolution, const float bmin[3], const float bmax[3], lpv_grid *out);
 

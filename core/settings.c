@@ -388,8 +388,8 @@ static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_s
     if (!isfinite(iv->split) || iv->split < 0.0f || iv->split > 1e6f)
         return fail(err, err_size, "iv_split = %g is out of range (allowed > 0 and <= 1e6 voxels)",
                     (double)iv->split);
-    if (iv->seed < 0)
-        return fail(err, err_size, "iv_seed = %d is out of range (allowed 1..%d)", iv->seed, 0x7fffffff);
+    if (iv->seed < 0 || iv->seed > LPV_IV_MAX_SEED)
+        return fail(err, err_size, "iv_seed = %d is out of range (allowed 1..%d)", iv->seed, LPV_IV_MAX_SEED);
     if (iv->rays < 0 || iv->rays > LPV_IV_MAX_RAYS)
         return fail(err, err_size, "iv_rays = %d is out of range (allowed 1..%d per voxel)", iv->rays,
                     LPV_IV_MAX_RAYS);

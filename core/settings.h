@@ -179,11 +179,12 @@ typedef struct lpv_settings {
 #define LPV_IV_DEFAULT_BOUNCES 3
 #define LPV_IV_DEFAULT_NEIGHBOURS 8
 #define LPV_IV_AO_VOXELS 4.0f
-#define LPV_IV_DEFAULT_MAX_POINTS (1 << 22)
+#define LPV_IV_DEFAULT_MAX_POINTS (1 << 20)
 #define LPV_IV_MAX_POINTS (1 << 24)
 #define LPV_IV_MAX_POINTS_PER_TRIANGLE 64
 #define LPV_IV_MAX_RAYS 1024
 #define LPV_IV_MAX_BOUNCES 8
+#define LPV_IV_MAX_SEED 99999999
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the

@@ -99,7 +99,7 @@ static const lpv_field FIELDS[] = {
      "random points per triangle (Turk's formula)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
     {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", "1", "",
      "triangles with a longer edge are split before sampling", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, 0x7fffffff, 0, "", "1", "",
+    {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, LPV_IV_MAX_SEED, 0, "", "1", "",
      "random seed of the points and the rays", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
     {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", "64", "",
      "stratified rays marched per voxel", T_VOL, LPV_TECHNIQUE_IV},
@@ -113,7 +113,7 @@ static const lpv_field FIELDS[] = {
      "ambient occlusion volume (the ao frame term)", T_VOL, LPV_TECHNIQUE_IV},
     {"iv_ao_distance", "iv-ao-distance", LPV_FIELD_FLOAT, F(iv.ao_distance), 0, 1e6, 0, "m", "auto",
      "0 = auto: 4 voxels", "reach of the ambient occlusion rays", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_max_points", "iv-max-points", LPV_FIELD_INT, F(iv.max_points), 1, LPV_IV_MAX_POINTS, 0, "", "4194304", "",
+    {"iv_max_points", "iv-max-points", LPV_FIELD_INT, F(iv.max_points), 1, LPV_IV_MAX_POINTS, 0, "", "1048576", "",
      "point cloud budget (more triangles get fewer points each)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
 };
 

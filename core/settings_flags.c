@@ -13,7 +13,7 @@
 static const lpv_flag OWN_SYNTAX[] = {
     {"technique", 0, "NAME",
      "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV, the default), " LPV_TECHNIQUE_OCTREE
-     " (octree LPV: a cubic power-of-two grid) or " LPV_TECHNIQUE_IV " (imperfect volumes: --iv-* knobs)"},
+     " (octree LPV:\na cubic power-of-two grid) or " LPV_TECHNIQUE_IV " (imperfect volumes: the --iv-* knobs)"},
     {"preset", 0, "NAME", "quality preset (default balanced; docs/accuracy.md):"},
     {"grid", 0, "N | NxMxK", "LPV cells per axis (default: the preset's)"},
     {"bounds", 0, "x0,y0,z0,x1,y1,z1", "grid bounds in m (default: the scene's bounds)"},
@@ -116,6 +116,8 @@ static void help_range(const lpv_field *f, char *buf, size_t n)
         snprintf(buf, n, "on|off");
     else if (f->min_exclusive)
         snprintf(buf, n, "> %g, <= %g", f->min, f->max);
+    else if (f->kind == LPV_FIELD_INT)
+        snprintf(buf, n, "%.0f..%.0f", f->min, f->max);
     else
         snprintf(buf, n, "%g..%g", f->min, f->max);
 }
@@ -127,7 +129,7 @@ const char *lpv_settings_flags_help(void)
         return help;
     size_t len = 0, sz = sizeof help;
     lpv_flags_append(help, sz, &len, "Engine settings (--grid and the knobs below win over --preset, in any order):\n");
-    lpv_flags_help(help, sz, &len, &OWN_SYNTAX[0], 1);
+    lpv_flags_help(help, sz, &len, &OWN_SYNTAX[0], 2); /* technique, then preset and its table */
     for (int p = LPV_PRESET_DEFAULT + 1; p < LPV_PRESET_COUNT_; ++p) { /* from the preset table */
         lpv_settings s;
         lpv_preset_settings((lpv_preset)p, &s);
@@ -136,10 +138,10 @@ const char *lpv_settings_flags_help(void)
                          lpv_preset_name((lpv_preset)p), s.grid_dims[0], s.lpv.iterations, s.rsm_size,
                          s.lpv.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&s, letters));
     }
-    lpv_flags_help(help, sz, &len, &OWN_SYNTAX[1], N_OWN - 1);
+    lpv_flags_help(help, sz, &len, &OWN_SYNTAX[2], N_OWN - 2);
     lpv_flags_append(help, sz, &len,
                      "Knobs (docs/propagation.md, docs/shadows.md, docs/cascades.md, docs/effects.md,\n"
-                     "docs/area-lights.md):\n");
+                     "docs/area-lights.md, docs/imperfect-volumes.md):\n");
     size_t count;
     const lpv_field *fields = lpv_fields(&count);
     for (size_t i = 0; i < count; ++i) {
@@ -147,11 +149,13 @@ const char *lpv_settings_flags_help(void)
         char left[64], range[64];
         snprintf(left, sizeof left, "%s %s", f->flag, lpv_field_metavar(f));
         help_range(f, range, sizeof range);
+        /* a flag too long for its column puts the help on the next line */
+        const char *gap = strlen(left) >= 22 ? "\n                          " : "";
         if (f->kind == LPV_FIELD_SWITCH) /* "  --glossy on|off   help\n   (default on)" */
-            lpv_flags_append(help, sz, &len, "  --%-22s%s\n%26s(default %s)\n", left, f->help, "", f->deflt);
+            lpv_flags_append(help, sz, &len, "  --%-22s%s%s\n%26s(default %s)\n", left, gap, f->help, "", f->deflt);
         else /* "  --cascade-size X   help\n   (m; > 0, <= 1e+06; default 8)" */
-            lpv_flags_append(help, sz, &len, "  --%-22s%s\n%26s(%s%s%s%s%s; default %s)\n", left, f->help, "", f->unit,
-                             f->unit[0] ? "; " : "", range, f->note[0] ? ", " : "", f->note, f->deflt);
+            lpv_flags_append(help, sz, &len, "  --%-22s%s%s\n%26s(%s%s%s%s%s; default %s)\n", left, gap, f->help, "",
+                             f->unit, f->unit[0] ? "; " : "", range, f->note[0] ? ", " : "", f->note, f->deflt);
     }
     return help;
 }

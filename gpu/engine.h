@@ -32,6 +32,7 @@ typedef enum lpv_frame_terms {
     LPV_TERMS_FULL = 0,          /* direct + gain * LPV + emission */
     LPV_TERMS_INDIRECT_ONLY = 1, /* gain * LPV only (albedo / pi * E_lpv) */
     LPV_TERMS_DIRECT_ONLY = 2,   /* direct + emission */
+    LPV_TERMS_AO = 3,            /* ambient occlusion, grey, 1 = open (technique iv with iv_ao on) */
 } lpv_frame_terms;
 
 #define LPV_STAGE_MAX 16

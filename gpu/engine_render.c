@@ -17,6 +17,10 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return lpv_error(err, err_size, "render before a tick");
     if (!e->has_view)
         return lpv_error(err, err_size, "render needs a view (camera)");
+    if (terms == LPV_TERMS_AO && !(e->settings.technique == LPV_TECHNIQUE_ID_IV && e->settings.iv.ao == LPV_SWITCH_ON))
+        return lpv_error(err, err_size, "the ao term needs technique %s with iv_ao on (technique %s, iv_ao %s)",
+                         LPV_TECHNIQUE_IV, lpv_technique_name(e->settings.technique),
+                         e->settings.iv.ao == LPV_SWITCH_ON ? "on" : "off");
     if (e->gbuf_stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
         if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
             return -1;
@@ -24,10 +28,10 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     }
     /* Direct light needs the shadow maps (media's in-scattering too, which
      * only a full frame has); they are redrawn only when what they show changed. */
-    if (terms != LPV_TERMS_INDIRECT_ONLY && lpv_pass_shadow_update(e, err, err_size) != 0)
+    if (terms != LPV_TERMS_INDIRECT_ONLY && terms != LPV_TERMS_AO && lpv_pass_shadow_update(e, err, err_size) != 0)
         return -1;
     lpv_pass_shade_run(e, terms);
-    if (e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY)
+    if (e->plan.pass[LPV_PASS_GLOSSY].run && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY))
         lpv_pass_glossy_run(e);
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
         lpv_pass_media_run(e);

@@ -177,6 +177,7 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     b->shading[1] = terms != LPV_TERMS_INDIRECT_ONLY;
     b->shading[2] = terms != LPV_TERMS_DIRECT_ONLY;
     b->shading[3] = terms != LPV_TERMS_INDIRECT_ONLY;
+    b->viewport[3] = terms == LPV_TERMS_AO; /* shade.frag writes the ambient occlusion instead */
     glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
 

@@ -91,7 +91,8 @@ float lpvp_f16_to_f32(uint16_t h)
 const char *const lpvp_volume_format_names[2] = {[LPVP_FMT_FP16] = "fp16", [LPVP_FMT_FP32] = "fp32"};
 const char *const lpvp_compression_names[2] = {[LPVP_COMP_NONE] = "none", [LPVP_COMP_ZSTD] = "zstd"};
 const char *const lpvp_frame_terms_names[LPVP_TERMS_COUNT] = {
-    [LPVP_TERMS_FULL] = "full", [LPVP_TERMS_INDIRECT] = "indirect", [LPVP_TERMS_DIRECT] = "direct"};
+    [LPVP_TERMS_FULL] = "full", [LPVP_TERMS_INDIRECT] = "indirect", [LPVP_TERMS_DIRECT] = "direct",
+    [LPVP_TERMS_AO] = "ao"};
 const char *const lpvp_frame_format_names[LPVP_FRAME_FORMAT_COUNT] = {
     [LPVP_FRAME_RGBA8] = "rgba8", [LPVP_FRAME_PNG] = "png", [LPVP_FRAME_EXR] = "exr"};
 const char *const lpvp_stream_names[LPVP_STREAM_COUNT] = {[LPVP_STREAM_VOLUME] = "volume",

@@ -60,7 +60,8 @@ typedef enum lpvp_frame_terms {
     LPVP_TERMS_FULL = 0,     /* "full" */
     LPVP_TERMS_INDIRECT = 1, /* "indirect" */
     LPVP_TERMS_DIRECT = 2,   /* "direct" */
-    LPVP_TERMS_COUNT = 3
+    LPVP_TERMS_AO = 3,       /* "ao": ambient occlusion (technique iv with iv_ao on) */
+    LPVP_TERMS_COUNT = 4
 } lpvp_frame_terms;
 typedef enum lpvp_frame_format {
     LPVP_FRAME_RGBA8 = 0, /* "rgba8": 8-bit sRGB, zstd or none */

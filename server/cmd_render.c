@@ -3,6 +3,7 @@
  * of the engine on a scene and one frame from its camera, written with
  * OpenImageIO (PNG: tone-mapped 8-bit sRGB; EXR: linear float radiance).
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,13 +17,15 @@
 #include "stats_json.h"
 #include "tonemap.h"
 
-enum { R_OUTPUT, R_INDIRECT, R_DIRECT, R_EXPOSURE, R_BACKGROUND, R_TRANSPARENT, R_STATS, R_HELP, R_COUNT };
+enum { R_OUTPUT, R_INDIRECT, R_DIRECT, R_AO, R_EXPOSURE, R_BACKGROUND, R_TRANSPARENT, R_STATS, R_HELP, R_COUNT };
 
 static const lpv_flag RENDER_FLAGS[R_COUNT] = {
     [R_OUTPUT] = {"output", 'o', "PATH", "image file, .png (8-bit sRGB) or .exr (linear float)\n"
                                          "(default render.png)"},
     [R_INDIRECT] = {"indirect-only", 0, NULL, "only the LPV term: albedo/pi * gain * E_lpv"},
     [R_DIRECT] = {"direct-only", 0, NULL, "only direct light and emission"},
+    [R_AO] = {"ao", 0, "PATH", "also write the ambient occlusion (technique iv; turns iv_ao on), grey\n"
+                               "1 = open, .png (8-bit, linear) or .exr"},
     [R_EXPOSURE] = {"exposure", 0, "auto|EV",
                     "PNG exposure: metered from the frame (auto, default) or\n"
                     "fixed: the PNG shows 683 lm/W x radiance x 2^EV before the\n"
@@ -47,10 +50,35 @@ static void usage(FILE *f)
             help, LPVD_OPTIONS_HELP);
 }
 
+/* The ambient occlusion term into path: linear grey, no exposure or tone
+ * curve (it is a fraction, not light). rgba is scratch of w x h pixels. */
+static int write_ao(lpv_engine *engine, const char *path, float *rgba, int w, int h, char *err, size_t err_size)
+{
+    if (lpv_engine_render(engine, LPV_TERMS_AO, rgba, err, err_size) != 0)
+        return -1;
+    const size_t pixels = (size_t)w * (size_t)h;
+    if (lpv_image_is_float_format(path))
+        return lpv_image_write_f32(path, w, h, 4, rgba, err, err_size);
+    uint8_t *g = malloc(pixels * 4);
+    if (!g)
+        return snprintf(err, err_size, "out of memory for the ao image"), -1;
+    for (size_t i = 0; i < pixels; ++i) {
+        float v = rgba[4 * i];
+        uint8_t b = (uint8_t)lrintf(255.0f * (v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f));
+        g[4 * i] = g[4 * i + 1] = g[4 * i + 2] = b;
+        g[4 * i + 3] = 255;
+    }
+    int rc = lpv_image_write_u8(path, w, h, 4, g, err, err_size);
+    free(g);
+    if (rc == 0)
+        fprintf(stderr, "lpvd render: wrote %s (ambient occlusion)\n", path);
+    return rc;
+}
+
 int lpvd_cmd_render(int argc, char **argv)
 {
     lpvd_options opt = {0};
-    const char *scene_path = NULL, *out_path = "render.png";
+    const char *scene_path = NULL, *out_path = "render.png", *ao_path = NULL;
     lpv_frame_terms terms = LPV_TERMS_FULL;
     lpv_display display;
     lpv_display_default(&display);
@@ -94,6 +122,7 @@ int lpvd_cmd_render(int argc, char **argv)
         case R_OUTPUT: out_path = v; break;
         case R_INDIRECT: terms = LPV_TERMS_INDIRECT_ONLY; break;
         case R_DIRECT: terms = LPV_TERMS_DIRECT_ONLY; break;
+        case R_AO: ao_path = v; break;
         case R_STATS: stats = 1; break;
         case R_TRANSPARENT: display.transparent = 1; break;
         case R_EXPOSURE:
@@ -116,6 +145,14 @@ int lpvd_cmd_render(int argc, char **argv)
         }
     }
 
+    if (ao_path) {
+        if (opt.settings.technique != LPV_TECHNIQUE_ID_IV) {
+            fprintf(stderr, "lpvd render: --ao needs --technique %s (ambient occlusion comes from the imperfect "
+                            "volume)\n", LPV_TECHNIQUE_IV);
+            return 2;
+        }
+        opt.settings.iv.ao = LPV_SWITCH_ON;
+    }
     lpv_scene scene;
     if (lpv_scene_load(scene_path, &scene, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd render: %s\n", err);
@@ -176,6 +213,10 @@ int lpvd_cmd_render(int argc, char **argv)
         }
     }
     fprintf(stderr, "lpvd render: wrote %s (%dx%d) from %s\n", out_path, view.width, view.height, scene.source);
+    if (ao_path && write_ao(engine, ao_path, rgba, view.width, view.height, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd render: %s\n", err);
+        goto done;
+    }
     if (stats) {
         json_t *j = lpvd_stats_json(engine, ctx, scene.source);
         json_dumpf(j, stdout, JSON_INDENT(2));

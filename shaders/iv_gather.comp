@@ -1,8 +1,9 @@
 // iv_gather.comp - radiance caching (paper 3.3): every voxel that a lookup
 // can read (one with an occupied voxel among its 27) marches u_rays
 // stratified rays (lpv_iv_ray) through the occupancy, starting
-// LPV_IV_START voxels out and stepping one voxel, until an occupied voxel or
-// the volume's edge. A hit sees what that voxel emits towards the ray's
+// LPV_IV_START voxels out (occupied voxels; empty ones at their centre) and
+// visiting every voxel the ray crosses, until an occupied voxel or the
+// volume's edge. A hit sees what that voxel emits towards the ray's
 // origin; a ray that leaves the volume sees nothing (lpvd has no environment
 // light: the path-traced reference sees black there too). The Monte-Carlo
 // projection 4 pi / N sum L Y stores the arriving radiance as SH of the
@@ -50,27 +51,45 @@ void main()
         return;
     }
     vec3 centre = vec3(c) + 0.5; // in voxels
+    // The paper starts every ray sqrt(3)/2 voxels out so that it leaves the
+    // surface in its own voxel. An empty voxel has none: skipping would let
+    // its rays start beyond a surface passing close by and see through it,
+    // more so the closer its centre lies to the surface (bands along tilted
+    // walls); its rays start at the centre.
+    const float start = occupied(c) ? LPV_IV_START : 0.0;
     vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0), vis = vec4(0.0);
-    int max_steps = d.x + d.y + d.z;
+    int max_steps = d.x + d.y + d.z + 3;
     for (int j = 0; j < u_rays; ++j) {
         vec3 w;
         lpv_iv_ray(u_seed, uint(i), uint(j), uint(u_rays), w);
         vec4 y = sh_basis(-w); // the light arrives travelling along -w
+        // walk every voxel the ray crosses (Amanatides & Woo), from
+        // LPV_IV_START voxels out: a fixed one-voxel step would skip voxels
+        // the ray only clips and leak through tilted surfaces' staircases
+        vec3 o = centre + start * w;
+        ivec3 q = ivec3(floor(o));
+        ivec3 st = ivec3(sign(w));
+        vec3 inv = vec3(abs(w.x) > 1e-12 ? 1.0 / abs(w.x) : 1e30, abs(w.y) > 1e-12 ? 1.0 / abs(w.y) : 1e30,
+                        abs(w.z) > 1e-12 ? 1.0 / abs(w.z) : 1e30);
+        vec3 cross_at = mix(o - vec3(q), vec3(q) + 1.0 - o, greaterThan(w, vec3(0.0))) * inv; // next faces
+        float t = start; // where the ray enters q
         int hit = -1;
         bool out_of_reach = false;
         for (int s = 0; s < max_steps; ++s) {
-            float t = LPV_IV_START + float(s);
             if (u_ao != 0 && t > u_ao_reach) {
                 out_of_reach = true;
                 break;
             }
-            ivec3 q = ivec3(floor(centre + t * w));
             if (!cell_inside(q))
                 break;
-            if (q == c || !occupied(q))
-                continue;
-            hit = cell_index(q);
-            break;
+            if (q != c && occupied(q)) {
+                hit = cell_index(q);
+                break;
+            }
+            int a = cross_at.x < cross_at.y ? (cross_at.x < cross_at.z ? 0 : 2) : (cross_at.y < cross_at.z ? 1 : 2);
+            t = start + cross_at[a];
+            q[a] += st[a];
+            cross_at[a] += inv[a];
         }
         if (u_ao != 0) {
             if (hit < 0 || out_of_reach)

@@ -50,7 +50,7 @@ void main()
     if (!finite3(p) || !(len > 1e-8) || isinf(len) || !finite3(albedo) || !finite3(emission))
         return;
     n /= len;
-    ivec3 c = ivec3(floor(cascade_coords(0, p)));
+    ivec3 c = iv_cell_of(p, n);
     if (!cell_inside(c))
         return;
     vec3 radiosity = albedo * iv_direct_irradiance(p, n) + LPV_PI * u_emission * emission;

@@ -2,8 +2,16 @@
 // cubic voxels) and the irradiance reconstruction's weights (paper 3.4),
 // shared by the lookup and the bounces. core/oracle_iv.c is the reference.
 uniform int u_iv_neighbours; // the nearest this many of the 8 voxels around the shifted point
+layout(std430, binding = LPV_SSBO_IV_OCCUPANCY) readonly buffer OccupancyLookup { uint iv_occupancy[]; };
 
-ivec3 iv_cell_of(vec3 p) { return ivec3(floor(cascade_coords(0, p))); }
+bool iv_occupied(ivec3 c)
+{
+    int i = cell_index(c);
+    return (iv_occupancy[i >> 5] & (1u << uint(i & 31))) != 0u;
+}
+
+// The voxel a surface point facing n belongs to (LPV_IV_BEHIND).
+ivec3 iv_cell_of(vec3 p, vec3 n) { return ivec3(floor(cascade_coords(0, p) - LPV_IV_BEHIND * n)); }
 vec3 iv_centre(ivec3 c) { return (vec3(c) + 0.5 + cascade_origin_cells(0)) * grid_cell_size(); }
 
 // The reconstruction at a surface point p facing unit n: move half a voxel
@@ -11,11 +19,17 @@ vec3 iv_centre(ivec3 c) { return (vec3(c) + 0.5 + cascade_origin_cells(0)) * gri
 // weights), keep the u_iv_neighbours nearest to q, never the voxel holding p
 // itself (its radiance saw its own surface), and weight each by the cosine
 // between n and the direction from p to its centre (0 behind the surface).
-// Returns the sum of the weights; cell[k], w[k] the voxels and weights.
+// Voxels that hold a surface themselves weigh LPV_IV_HELD_WEIGHT as much:
+// their rays start among the surface's own voxels and see its own light (the
+// paper's "self intersections"), which the cosine alone lets through
+// wherever p lies below its voxel's centre, a pattern at the voxel pitch. A
+// factor rather than a cut keeps the blend continuous where a tilted
+// surface's voxels come and go, and still answers where every neighbour
+// holds a surface (a concave corner). Returns the sum of the weights; cell[k], w[k] the voxels and weights.
 float iv_blend(vec3 p, vec3 n, out ivec3 cell[8], out float w[8])
 {
     vec3 q = p + 0.5 * grid_cell_size() * n;
-    ivec3 own = iv_cell_of(p);
+    ivec3 own = iv_cell_of(p, n);
     vec3 u = cascade_coords(0, q) - 0.5;
     vec3 b = floor(u);
     vec3 f = u - b;
@@ -42,7 +56,8 @@ float iv_blend(vec3 p, vec3 n, out ivec3 cell[8], out float w[8])
         if (cell[k] == own || !cell_inside(cell[k]) || !(len > 0.0))
             w[k] = 0.0;
         else
-            w[k] *= max(0.0, dot(n, dir / len));
+            w[k] *= max(0.0, dot(n, dir / len)) *
+                    (iv_occupied(cell[k]) ? LPV_IV_HELD_WEIGHT : 1.0);
         sum += w[k];
     }
     return sum;

@@ -257,7 +257,7 @@ struct LpvViewBlock {
     mat4 view_proj;       /* world -> clip */
     vec4 eye;             /* xyz world position; w 1 perspective, 0 orthographic */
     vec4 forward;         /* xyz unit view direction; w tan(yfov/2) or ymag (ortho) */
-    vec4 viewport;        /* x width, y height (pixels); z aspect; w unused */
+    vec4 viewport;        /* x width, y height (pixels); z aspect; w 1 = the ambient occlusion term */
     vec4 shading;         /* x indirect gain; y include direct (0/1); z include indirect (0/1);
                              w include emission (0/1) */
 };
@@ -297,7 +297,16 @@ struct IvVoxel {
 /* The march (paper section 3.3): rays start sqrt(3)/2 voxels from the voxel
  * centre (the voxel's bounding sphere) and step one voxel. */
 #define LPV_IV_START 0.86602540378443865f
-#define LPV_IV_WG 64 /* one-dimensional workgroups of the IV's compute passes */
+#define LPV_IV_WG 64
+/* A point belongs to the voxel holding it moved this many voxels against its
+ * normal, so a surface that lies exactly on a voxel face (a wall on a room's
+ * bounds, a box on the lattice) goes wholly to the voxel behind it instead
+ * of splitting between two by rounding; splatting and the lookup's own
+ * voxel agree on it. */
+#define LPV_IV_BEHIND 0.001f
+/* The reconstruction's weight of a voxel that holds a surface, relative to an
+ * empty one (iv_volume.glsl, iv_blend; docs/imperfect-volumes.md). */
+#define LPV_IV_HELD_WEIGHT 0.015625f /* one-dimensional workgroups of the IV's compute passes */
 
 /* Random numbers both sides draw identically: a 32-bit integer hash (Chris
  * Wellons' lowbias32) and a uniform float in [0, 1) from its top 24 bits. */

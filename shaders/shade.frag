@@ -27,6 +27,12 @@ void main()
     }
     vec3 p = pos.xyz;
     vec3 n = nrm.xyz;
+#ifdef LPV_HAS_AO
+    if (V.viewport.w != 0.0) { // the technique's ambient occlusion, 1 = open
+        o_radiance = vec4(vec3(lpv_ao(p, n)), 1.0);
+        return;
+    }
+#endif
     vec3 albedo = texelFetch(u_gbuf_albedo, px, 0).rgb;
     vec3 emission = texelFetch(u_gbuf_emission, px, 0).rgb;
 

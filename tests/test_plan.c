@@ -62,7 +62,8 @@ static void test_baseline_runs_everything_but_bounce(void **state)
     assert_true(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i) {
         assert_reason(p.pass[i].reason);
-        assert_int_equal(p.pass[i].run, i != LPV_PASS_BOUNCE && i != LPV_PASS_GBUFFER); /* no camera: no gbuffer */
+        /* no camera: no gbuffer; the imperfect volume's passes are not the LPV's */
+        assert_int_equal(p.pass[i].run, i != LPV_PASS_BOUNCE && i != LPV_PASS_GBUFFER && i < LPV_PASS_IV_POINTS);
     }
     assert_string_equal(lpv_pass_name(LPV_PASS_GV), "gv");
     assert_null(lpv_pass_name(LPV_PASS_COUNT));
@@ -311,7 +312,7 @@ static void test_planner_off_runs_everything(void **state)
     lpv_plan p = plan_of((lpv_settings){.planner = LPV_SWITCH_OFF, .lpv.bounces = LPV_SWITCH_ON}, f);
     assert_true(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i)
-        assert_true(p.pass[i].run);
+        assert_int_equal(p.pass[i].run, i < LPV_PASS_IV_POINTS); /* every pass of the LPV's */
     /* planner on, same facts: almost nothing runs */
     p = plan_of((lpv_settings){.lpv.bounces = LPV_SWITCH_ON}, f);
     assert_false(p.recompute);
@@ -478,6 +479,88 @@ static void test_place_temporal(void **state)
     assert_false(lpv_cascades_equal(&a, &b));
 }
 
+
+static lpv_plan plan_iv(lpv_settings s, lpv_plan_facts f)
+{
+    lpv_plan p;
+    s.technique = LPV_TECHNIQUE_ID_IV;
+    s = resolved(s);
+    lpv_plan_make_iv(&s, &f, &p);
+    return p;
+}
+
+/* The imperfect volume's plan: its own passes, none of the LPV's, the RSMs
+ * for the points' shadows, the G-buffer only for reprojection, and reasons a
+ * user can read ("iv: 3 bounces requested", "reprojection skipped: no camera"). */
+static void test_iv_plan(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline(); /* no camera */
+    f.iv_points = 1000;
+    f.iv_points_per_piece = 8;
+    lpv_plan p = plan_iv((lpv_settings){0}, f);
+    assert_true(p.recompute);
+    for (int i = 0; i < LPV_PASS_COUNT; ++i)
+        assert_reason(p.pass[i].reason);
+    const lpv_pass_id lpv_only[] = {LPV_PASS_EMISSIVE, LPV_PASS_INJECT, LPV_PASS_GV, LPV_PASS_PROPAGATE,
+                                    LPV_PASS_BOUNCE};
+    for (size_t i = 0; i < sizeof lpv_only / sizeof lpv_only[0]; ++i)
+        assert_false(p.pass[lpv_only[i]].run);
+    assert_true(p.pass[LPV_PASS_RSM].run);
+    assert_true(p.pass[LPV_PASS_IV_POINTS].run);
+    assert_false(p.pass[LPV_PASS_IV_REPROJECT].run);
+    assert_string_equal(p.pass[LPV_PASS_IV_REPROJECT].reason, "reprojection skipped: no camera");
+    assert_false(p.pass[LPV_PASS_GBUFFER].run);
+    assert_true(p.pass[LPV_PASS_IV_GATHER].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_IV_GATHER].reason, "iv: 3 bounces requested"));
+    assert_false(p.pass[LPV_PASS_IV_AO].run);
+    assert_int_equal(p.cascades, 1);
+
+    /* a camera: reprojection and its G-buffer; AO on request */
+    f.has_view = 1;
+    p = plan_iv((lpv_settings){.iv.ao = LPV_SWITCH_ON, .iv.bounces = 1}, f);
+    assert_true(p.pass[LPV_PASS_IV_REPROJECT].run);
+    assert_true(p.pass[LPV_PASS_GBUFFER].run);
+    assert_true(p.pass[LPV_PASS_IV_AO].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_IV_GATHER].reason, "iv: 1 bounces requested"));
+    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
+    assert_false(p.pass[LPV_PASS_IV_REPROJECT].run);
+    assert_string_equal(p.pass[LPV_PASS_IV_REPROJECT].reason, "reprojection off");
+    assert_false(p.pass[LPV_PASS_GBUFFER].run);
+
+    /* nothing lights the volume: no gather; nothing in it: neither */
+    f.lights = 0;
+    f.emissive_surfaces = 0;
+    p = plan_iv((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_IV_GATHER].run);
+    assert_string_equal(p.pass[LPV_PASS_IV_GATHER].reason, "no light sources");
+    f.lights = 1;
+    f.iv_points = 0;
+    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
+    assert_false(p.pass[LPV_PASS_IV_POINTS].run);
+    assert_false(p.pass[LPV_PASS_IV_GATHER].run);
+
+    /* the budget says so */
+    f.iv_points = 500;
+    f.iv_points_per_piece = 2;
+    f.iv_budget_cut = 1;
+    p = plan_iv((lpv_settings){0}, f);
+    assert_non_null(strstr(p.pass[LPV_PASS_IV_POINTS].reason, "budget"));
+
+    /* steady: a camera move of a voxel recomputes only because reprojection feeds the volume */
+    f = steady();
+    f.iv_points = 1000;
+    f.camera_move_cells = 2.0f;
+    p = plan_iv((lpv_settings){0}, f);
+    assert_true(p.recompute);
+    assert_non_null(strstr(p.recompute_reason, "refine the imperfect volume"));
+    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
+    assert_false(p.recompute);
+    for (int i = 0; i < LPV_PASS_COUNT; ++i)
+        if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA)
+            assert_false(p.pass[i].run);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -494,6 +577,7 @@ int main(void)
         cmocka_unit_test(test_bounce_needs_gv),
         cmocka_unit_test(test_place_snapping_and_nesting),
         cmocka_unit_test(test_place_temporal),
+        cmocka_unit_test(test_iv_plan),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

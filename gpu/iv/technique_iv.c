@@ -52,7 +52,7 @@ typedef struct lpv_iv_gpu {
     int bounces_run;  /* by the last computed tick */
 } lpv_iv_gpu;
 
-static const char *const INC_SPLAT[] = {"grid.glsl", "lights.glsl", "iv_direct.glsl", NULL};
+static const char *const INC_SPLAT[] = {"grid.glsl", "lights.glsl", "iv_direct.glsl", "iv_volume.glsl", NULL};
 static const char *const INC_GRID[] = {"grid.glsl", NULL};
 static const char *const LOOKUP[] = {"grid.glsl", "iv_volume.glsl", "iv_lookup.glsl", NULL};
 
@@ -295,6 +295,7 @@ static void gather(lpv_iv_gpu *v, const lpv_technique_inputs *in)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_EMIT, v->emit);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, v->radiance[prev]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
         glUniform1i(glGetUniformLocation(v->prog_emit, "u_bounce"), k);
         glUniform1i(glGetUniformLocation(v->prog_emit, "u_iv_neighbours"), s->iv.neighbours);
         glDispatchCompute(groups(v), 1, 1);
@@ -339,6 +340,7 @@ static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, v->radiance[v->result]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
 }
 
 static void describe(const lpv_technique *t, lpv_volume_desc *d)
