@@ -119,6 +119,7 @@ static const char *const TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
     [LPV_TECHNIQUE_ID_DEFAULT] = NULL, /* not a row: resolves to lpv */
     [LPV_TECHNIQUE_ID_LPV] = LPV_TECHNIQUE_LPV,
     [LPV_TECHNIQUE_ID_OCTREE] = LPV_TECHNIQUE_OCTREE,
+    [LPV_TECHNIQUE_ID_IV] = LPV_TECHNIQUE_IV,
 };
 
 int lpv_technique_from_name(const char *name, lpv_technique_id *out)
@@ -140,7 +141,7 @@ const char *lpv_technique_name(lpv_technique_id t)
 
 const char *lpv_technique_names(void)
 {
-    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE; /* the table's names, in its order */
+    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV; /* the table's names, in its order */
 }
 
 lpv_preset lpv_preset_match(const lpv_settings *s)
@@ -218,7 +219,33 @@ void lpv_settings_resolve(lpv_settings *s)
         s->area_lights = LPV_SWITCH_ON;
     if (s->area_light_samples == 0)
         s->area_light_samples = LPV_DEFAULT_AREA_LIGHT_SAMPLES;
+    lpv_iv_settings *iv = &s->iv;
+    if (iv->resolution == 0)
+        iv->resolution = LPV_IV_DEFAULT_RESOLUTION;
+    if (iv->points == 0)
+        iv->points = LPV_IV_DEFAULT_POINTS;
+    if (iv->split == 0.0f)
+        iv->split = LPV_IV_DEFAULT_SPLIT;
+    if (iv->seed == 0)
+        iv->seed = LPV_IV_DEFAULT_SEED;
+    if (iv->rays == 0)
+        iv->rays = LPV_IV_DEFAULT_RAYS;
+    if (iv->bounces == 0)
+        iv->bounces = LPV_IV_DEFAULT_BOUNCES;
+    if (iv->reprojection == LPV_SWITCH_DEFAULT)
+        iv->reprojection = LPV_SWITCH_ON;
+    if (iv->neighbours == 0)
+        iv->neighbours = LPV_IV_DEFAULT_NEIGHBOURS;
+    if (iv->ao == LPV_SWITCH_DEFAULT)
+        iv->ao = LPV_SWITCH_OFF;
+    /* ao_distance 0 stays 0: auto, LPV_IV_AO_VOXELS voxels */
+    if (iv->max_points == 0)
+        iv->max_points = LPV_IV_DEFAULT_MAX_POINTS;
 }
+
+/* The imperfect volume's knobs (zero = default everywhere but validate sees
+ * resolved settings). */
+static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_size);
 
 /* Writes a formatted message into err (when there is room) and returns -1. */
 static int fail(char *err, unsigned long err_size, const char *fmt, ...)
@@ -322,7 +349,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     } switches[] = {{"bounces", s->lpv.bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
                     {"central_transport", s->lpv.central_transport}, {"normal_bins", s->lpv.normal_bins},
                     {"far_field", s->lpv.far_field}, {"scene_surfels", s->scene_surfels},
-                    {"area_lights", s->area_lights}};
+                    {"area_lights", s->area_lights}, {"iv_reprojection", s->iv.reprojection},
+                    {"iv_ao", s->iv.ao}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
             return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
@@ -344,5 +372,38 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->area_light_samples < 0 || s->area_light_samples > LPV_MAX_AREA_SAMPLES)
         return fail(err, err_size, "area_light_samples = %d is out of range (allowed 1..%d; 0 = the default %d)",
                     s->area_light_samples, LPV_MAX_AREA_SAMPLES, LPV_DEFAULT_AREA_LIGHT_SAMPLES);
+    if (validate_iv(&s->iv, err, err_size) != 0)
+        return -1;
     return validate_bounds(s, err, err_size);
+}
+
+static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_size)
+{
+    if (iv->resolution < 0 || iv->resolution > LPV_MAX_GRID_DIM)
+        return fail(err, err_size, "iv_resolution = %d is out of range (allowed 1..%d voxels; 0 = the default %d)",
+                    iv->resolution, LPV_MAX_GRID_DIM, LPV_IV_DEFAULT_RESOLUTION);
+    if (iv->points < 0 || iv->points > LPV_IV_MAX_POINTS_PER_TRIANGLE)
+        return fail(err, err_size, "iv_points = %d is out of range (allowed 1..%d per triangle)", iv->points,
+                    LPV_IV_MAX_POINTS_PER_TRIANGLE);
+    if (!isfinite(iv->split) || iv->split < 0.0f || iv->split > 1e6f)
+        return fail(err, err_size, "iv_split = %g is out of range (allowed > 0 and <= 1e6 voxels)",
+                    (double)iv->split);
+    if (iv->seed < 0)
+        return fail(err, err_size, "iv_seed = %d is out of range (allowed 1..%d)", iv->seed, 0x7fffffff);
+    if (iv->rays < 0 || iv->rays > LPV_IV_MAX_RAYS)
+        return fail(err, err_size, "iv_rays = %d is out of range (allowed 1..%d per voxel)", iv->rays,
+                    LPV_IV_MAX_RAYS);
+    if (iv->bounces < 0 || iv->bounces > LPV_IV_MAX_BOUNCES)
+        return fail(err, err_size, "iv_bounces = %d is out of range (allowed 1..%d)", iv->bounces,
+                    LPV_IV_MAX_BOUNCES);
+    if (iv->neighbours < 0 || iv->neighbours > 8)
+        return fail(err, err_size, "iv_neighbours = %d is out of range (allowed 1..8 of the 8 voxels around the "
+                    "shifted point)", iv->neighbours);
+    if (!isfinite(iv->ao_distance) || iv->ao_distance < 0.0f || iv->ao_distance > 1e6f)
+        return fail(err, err_size, "iv_ao_distance = %g m is out of range (allowed 0 = auto, or > 0 and <= 1e6)",
+                    (double)iv->ao_distance);
+    if (iv->max_points < 0 || iv->max_points > LPV_IV_MAX_POINTS)
+        return fail(err, err_size, "iv_max_points = %d is out of range (allowed 1..%d)", iv->max_points,
+                    LPV_IV_MAX_POINTS);
+    return 0;
 }

@@ -9,6 +9,7 @@
  * knob description's "technique"; --technique and CONFIG's "technique"). */
 #define LPV_TECHNIQUE_LPV "lpv"       /* cascaded light propagation volumes (gpu/lpv/) */
 #define LPV_TECHNIQUE_OCTREE "octree" /* octree light propagation volumes (gpu/lpv/technique_octree.c) */
+#define LPV_TECHNIQUE_IV "iv"         /* imperfect volumes (gpu/iv/) */
 
 /* Which technique computes the volume; 0 means "the default" (lpv). The
  * names are core/settings.c's technique table, the classes gpu/technique.c's. */
@@ -16,6 +17,7 @@ typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_DEFAULT = 0,
     LPV_TECHNIQUE_ID_LPV = 1,
     LPV_TECHNIQUE_ID_OCTREE = 2,
+    LPV_TECHNIQUE_ID_IV = 3,
     LPV_TECHNIQUE_ID_COUNT_ /* one past the last; not a technique */
 } lpv_technique_id;
 
@@ -86,6 +88,27 @@ typedef struct lpv_lpv_settings {
 /* Everything the engine is told: the volume's resolution and bounds, the
  * shared producers (RSMs, shadow maps, samples of the scene), the shading's
  * effects, the planner, and one nested struct per GI technique. */
+/* Imperfect volumes (Mavridis & Papaioannou, the third seed; docs/imperfect-volumes.md):
+ * a voxel copy of the whole scene from a point cloud, radiance gathered per
+ * voxel by ray marching it. A zero field takes its default. */
+typedef struct lpv_iv_settings {
+    int resolution;         /* voxels along the scene's longest side (voxels are cubes); default 32 */
+    int points;             /* random points per triangle (Turk's formula); default LPV_IV_DEFAULT_POINTS */
+    float split;            /* voxels: a triangle with a longer edge is split before sampling (the
+                               paper's load-time tessellation); default 1 */
+    int seed;               /* the points' and the rays' random seed; default 1 */
+    int rays;               /* stratified rays per voxel; default LPV_IV_DEFAULT_RAYS */
+    int bounces;            /* diffuse bounces (ping-pong passes); default LPV_IV_DEFAULT_BOUNCES */
+    lpv_switch reprojection; /* the camera's visible points refine the volume; default on */
+    int neighbours;         /* the reconstruction blends the nearest this many of the 8 voxels around
+                               the shifted point: 6 (the paper's text) .. 8 (its figure 2);
+                               default LPV_IV_DEFAULT_NEIGHBOURS */
+    lpv_switch ao;          /* ambient occlusion volume; default off */
+    float ao_distance;      /* m, the AO rays' reach; 0 (default) = LPV_IV_AO_VOXELS voxels */
+    int max_points;         /* the point cloud's budget: more triangles x points get fewer points per
+                               triangle (the plan says so); default LPV_IV_DEFAULT_MAX_POINTS */
+} lpv_iv_settings;
+
 typedef struct lpv_settings {
     int grid_dims[3];       /* cells per axis; default: the preset's */
     float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
@@ -124,6 +147,7 @@ typedef struct lpv_settings {
     int area_light_samples; /* samples the emitters are reduced to; default 8 */
 
     lpv_lpv_settings lpv;   /* the cascaded LPV's knobs (LPV_TECHNIQUE_LPV) */
+    lpv_iv_settings iv;     /* the imperfect volume's knobs (LPV_TECHNIQUE_IV) */
 } lpv_settings;
 
 /* The balanced preset's values, i.e. the engine's defaults. They mirror the
@@ -147,6 +171,19 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_FAR_FIELD_STEPS 1
 #define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
+#define LPV_IV_DEFAULT_RESOLUTION 32
+#define LPV_IV_DEFAULT_POINTS 8
+#define LPV_IV_DEFAULT_SPLIT 1.0f
+#define LPV_IV_DEFAULT_SEED 1
+#define LPV_IV_DEFAULT_RAYS 64
+#define LPV_IV_DEFAULT_BOUNCES 3
+#define LPV_IV_DEFAULT_NEIGHBOURS 8
+#define LPV_IV_AO_VOXELS 4.0f
+#define LPV_IV_DEFAULT_MAX_POINTS (1 << 22)
+#define LPV_IV_MAX_POINTS (1 << 24)
+#define LPV_IV_MAX_POINTS_PER_TRIANGLE 64
+#define LPV_IV_MAX_RAYS 1024
+#define LPV_IV_MAX_BOUNCES 8
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / iterations / rsm_size / occlusion take the preset's values, the

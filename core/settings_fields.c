@@ -91,6 +91,30 @@ static const lpv_field FIELDS[] = {
      "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)", T_VOL | T_SHADOWS, ""},
     {"area_light_samples", "area-light-samples", LPV_FIELD_INT, F(area_light_samples), 1, LPV_MAX_AREA_SAMPLES, 0,
      "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)", T_VOL | T_SHADOWS, ""},
+
+    /* Imperfect volumes (docs/imperfect-volumes.md). */
+    {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "32", "",
+     "voxels along the scene's longest side", T_VOL, LPV_TECHNIQUE_IV},
+    {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", "8", "",
+     "random points per triangle (Turk's formula)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
+    {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", "1", "",
+     "triangles with a longer edge are split before sampling", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
+    {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, 0x7fffffff, 0, "", "1", "",
+     "random seed of the points and the rays", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
+    {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", "64", "",
+     "stratified rays marched per voxel", T_VOL, LPV_TECHNIQUE_IV},
+    {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", "3", "",
+     "diffuse bounces (ping-pong passes over two volumes)", T_VOL, LPV_TECHNIQUE_IV},
+    {"iv_reprojection", "iv-reprojection", LPV_FIELD_SWITCH, F(iv.reprojection), 0, 1, 0, "", "on", "",
+     "the camera's visible points refine the volume", T_VOL, LPV_TECHNIQUE_IV},
+    {"iv_neighbours", "iv-neighbours", LPV_FIELD_INT, F(iv.neighbours), 1, 8, 0, "", "8", "the paper's text: 6",
+     "nearest of the 8 voxels around the shifted point the reconstruction blends", T_SHADE, LPV_TECHNIQUE_IV},
+    {"iv_ao", "iv-ao", LPV_FIELD_SWITCH, F(iv.ao), 0, 1, 0, "", "off", "",
+     "ambient occlusion volume (the ao frame term)", T_VOL, LPV_TECHNIQUE_IV},
+    {"iv_ao_distance", "iv-ao-distance", LPV_FIELD_FLOAT, F(iv.ao_distance), 0, 1e6, 0, "m", "auto",
+     "0 = auto: 4 voxels", "reach of the ambient occlusion rays", T_VOL, LPV_TECHNIQUE_IV},
+    {"iv_max_points", "iv-max-points", LPV_FIELD_INT, F(iv.max_points), 1, LPV_IV_MAX_POINTS, 0, "", "4194304", "",
+     "point cloud budget (more triangles get fewer points each)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
 };
 
 #undef F

@@ -12,8 +12,8 @@
 /* The flags with their own syntax; the knobs follow from the field table. */
 static const lpv_flag OWN_SYNTAX[] = {
     {"technique", 0, "NAME",
-     "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV, the default) or " LPV_TECHNIQUE_OCTREE
-     " (octree LPV: a cubic power-of-two grid)"},
+     "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV, the default), " LPV_TECHNIQUE_OCTREE
+     " (octree LPV: a cubic power-of-two grid) or " LPV_TECHNIQUE_IV " (imperfect volumes: --iv-* knobs)"},
     {"preset", 0, "NAME", "quality preset (default balanced; docs/accuracy.md):"},
     {"grid", 0, "N | NxMxK", "LPV cells per axis (default: the preset's)"},
     {"bounds", 0, "x0,y0,z0,x1,y1,z1", "grid bounds in m (default: the scene's bounds)"},

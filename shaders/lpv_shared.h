@@ -262,6 +262,98 @@ struct LpvViewBlock {
                              w include emission (0/1) */
 };
 
+/* ---- Imperfect volumes (gpu/iv/, docs/imperfect-volumes.md) ---------------
+ * The volume is a grid of cubic voxels over the scene (the LpvGridParams UBO
+ * with one cascade). Every SH here is 2-band RGB in LpvCell layout and, as
+ * the LPV's, a function of the direction light TRAVELS: a voxel's outgoing
+ * radiance, and the radiance arriving at a voxel centre (so the lookup's
+ * irradiance is the same lobe(-n) product as the LPV's, without its /cell^2).
+ * Units: radiance W/(m^2 sr), irradiance W/m^2. */
+
+/* A point of the cloud (core/iv_points.c): Turk's uniform points, N per
+ * triangle; the GPU lights it every tick. */
+struct IvPoint {
+    vec4 position; /* xyz world (m); w 1 = a point, 0 = skip */
+    vec4 normal;   /* xyz unit interpolated normal of the triangle's front; w unused */
+    vec4 albedo;   /* rgb diffuse albedo (the material's base colour); a unused */
+    vec4 emission; /* rgb emitted radiance W/(m^2 sr) (0 where area lights carry the emitters); a unused */
+};
+
+/* A voxel after creation: the mean of the points it received. */
+struct IvVoxel {
+    vec4 r;        /* SH of the surfaces' outgoing radiance, W/(m^2 sr): the mean over the  */
+    vec4 g;        /*   points of B / pi over the hemisphere of the point's normal (B = its  */
+    vec4 b;        /*   radiosity, W/m^2), LPV_IV_HEMI0 / LPV_IV_HEMI1 below                 */
+    vec4 normal;   /* xyz the mean of the points' unit normals (not unit); w points, 0 = empty */
+    vec4 albedo;   /* rgb the points' mean albedo (the bounces' reflectance); a unused */
+};
+
+/* The SH of a hemisphere of unit radiance around n, divided by pi:
+ * (HEMI0, HEMI1 n.y, HEMI1 n.z, HEMI1 n.x), so radiosity B x this is the SH
+ * of a Lambertian surface's outgoing radiance B / pi. HEMI0 = 2 C0, HEMI1 = C1. */
+#define LPV_IV_HEMI0 0.56418958354775628f
+#define LPV_IV_HEMI1 0.48860251190291992f
+
+/* The march (paper section 3.3): rays start sqrt(3)/2 voxels from the voxel
+ * centre (the voxel's bounding sphere) and step one voxel. */
+#define LPV_IV_START 0.86602540378443865f
+#define LPV_IV_WG 64 /* one-dimensional workgroups of the IV's compute passes */
+
+/* Random numbers both sides draw identically: a 32-bit integer hash (Chris
+ * Wellons' lowbias32) and a uniform float in [0, 1) from its top 24 bits. */
+#ifdef LPV_GLSL
+#define LPV_U32 uint
+#define LPV_INLINE
+#define LPV_FLOOR floor
+#define LPV_SQRT sqrt
+#define LPV_COS cos
+#define LPV_SIN sin
+#else
+#include <math.h>
+#include <stdint.h>
+#define LPV_U32 uint32_t
+#define LPV_INLINE static inline
+#define LPV_FLOOR floorf
+#define LPV_SQRT sqrtf
+#define LPV_COS cosf
+#define LPV_SIN sinf
+#endif
+
+#ifdef LPV_GLSL
+#define LPV_OUT_VEC3(name) out vec3 name
+#define LPV_VEC3_SET(v, x, y, z) v = vec3(x, y, z)
+#else
+#define LPV_OUT_VEC3(name) float name[3]
+#define LPV_VEC3_SET(v, x, y, z) ((v)[0] = (x), (v)[1] = (y), (v)[2] = (z))
+#endif
+
+LPV_INLINE LPV_U32 lpv_hash_u32(LPV_U32 x)
+{
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+
+LPV_INLINE float lpv_hash_unit(LPV_U32 x) { return (x >> 8u) * (1.0f / 16777216.0f); }
+
+/* Ray j of `rays` from voxel `voxel` under `seed` (paper section 3.3's
+ * stratified directions): rays equal-area bands in z, one jittered ray per
+ * band, azimuths on the golden-ratio sequence rotated per voxel. Writes the
+ * unit direction to d[0..2]. */
+LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays, LPV_OUT_VEC3(d))
+{
+    LPV_U32 h = lpv_hash_u32(seed ^ lpv_hash_u32(voxel + 0x9e3779b9u));
+    float u = (j + lpv_hash_unit(lpv_hash_u32(h + 2u * j))) / rays;
+    float a = j * 0.61803398874989485f + lpv_hash_unit(h);
+    float phi = 6.28318530717958648f * (a - LPV_FLOOR(a));
+    float z = 1.0f - 2.0f * u;
+    float r = LPV_SQRT(z * -z + 1.0f > 0.0f ? z * -z + 1.0f : 0.0f);
+    LPV_VEC3_SET(d, r * LPV_COS(phi), r * LPV_SIN(phi), z);
+}
+
 /* ---- Binding points -------------------------------------------------------- */
 #define LPV_UBO_GRID      0
 #define LPV_UBO_VIEW      1
@@ -276,6 +368,11 @@ struct LpvViewBlock {
 #define LPV_SSBO_GV_TOTAL 7
 #define LPV_SSBO_SIGMA_OUT 8
 #define LPV_SSBO_REFLECT  9
+#define LPV_SSBO_IV_POINTS 10   /* IvPoint */
+#define LPV_SSBO_IV_VOXELS 11   /* IvVoxel per voxel */
+#define LPV_SSBO_IV_OCCUPANCY 12 /* one bit per voxel, 32 to a uint, voxel index order */
+#define LPV_SSBO_IV_EMIT 13     /* LpvCell per voxel: what each occupied voxel sends out this bounce */
+#define LPV_SSBO_IV_AO 14       /* vec4 per voxel: the SH of the visible directions (travel convention) */
 
 /* Texture units of the propagation's inputs (RGBA32F buffer textures). */
 #define LPV_TEX_LPV_IN    0

@@ -1,0 +1,213 @@
+/*
+ * iv_points.c - the imperfect volume's point cloud (see iv_points.h).
+ */
+#include "iv_points.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A piece of a triangle: its corners in the triangle's barycentric
+ * coordinates, so the pieces interpolate the original vertex normals. */
+typedef struct piece {
+    double b[3][3];
+} piece;
+
+typedef struct walk {
+    const lpv_scene *scene;
+    const lpv_vertex *v[3];
+    float front[3];
+    double limit;          /* m: the longest edge a piece may keep */
+    size_t pieces;         /* counted or written so far */
+    /* writing (NULL when counting) */
+    struct IvPoint *out;
+    size_t count, max;
+    int n;
+    uint32_t seed;
+    const lpv_material *m;
+    int emission;
+} walk;
+
+static void world_of(const walk *w, const double b[3], double p[3])
+{
+    for (int i = 0; i < 3; ++i)
+        p[i] = b[0] * w->v[0]->position[i] + b[1] * w->v[1]->position[i] + b[2] * w->v[2]->position[i];
+}
+
+static double dist(const double a[3], const double b[3])
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+static void emit_piece(walk *w, const piece *pc);
+
+/* Splits across the longest edge until every edge is within the limit; the
+ * depth bound keeps a huge triangle (the budget's coarser split catches it)
+ * from recursing without end. */
+static void split(walk *w, const piece *pc, int depth)
+{
+    double p[3][3];
+    for (int i = 0; i < 3; ++i)
+        world_of(w, pc->b[i], p[i]);
+    int longest = 0;
+    double best = -1.0;
+    for (int e = 0; e < 3; ++e) {
+        double d = dist(p[e], p[(e + 1) % 3]);
+        if (d > best) {
+            best = d;
+            longest = e;
+        }
+    }
+    if (!(best > w->limit) || depth >= 40) {
+        if (w->out)
+            emit_piece(w, pc);
+        w->pieces++;
+        return;
+    }
+    const int a = longest, b = (longest + 1) % 3, c = (longest + 2) % 3;
+    double mid[3];
+    for (int i = 0; i < 3; ++i)
+        mid[i] = 0.5 * (pc->b[a][i] + pc->b[b][i]);
+    piece l = *pc, r = *pc;
+    memcpy(l.b[b], mid, sizeof mid); /* (a, mid, c) */
+    memcpy(r.b[a], mid, sizeof mid); /* (mid, b, c) */
+    (void)c;
+    split(w, &l, depth + 1);
+    split(w, &r, depth + 1);
+}
+
+static void turk(uint32_t seed, uint32_t key, int k, double *b0, double *b1, double *b2)
+{
+    uint32_t h = lpv_hash_u32(seed ^ lpv_hash_u32(key * 0x9e3779b1u + (uint32_t)k));
+    double r1 = lpv_hash_unit(h), r2 = lpv_hash_unit(lpv_hash_u32(h ^ 0x85ebca6bu));
+    double s = sqrt(r1);
+    *b0 = 1.0 - s;
+    *b1 = (1.0 - r2) * s;
+    *b2 = r2 * s;
+}
+
+static void emit_piece(walk *w, const piece *pc)
+{
+    for (int k = 0; k < w->n && w->count < w->max; ++k) {
+        double t0, t1, t2;
+        turk(w->seed, (uint32_t)w->pieces, k, &t0, &t1, &t2);
+        double b[3];
+        for (int i = 0; i < 3; ++i)
+            b[i] = t0 * pc->b[0][i] + t1 * pc->b[1][i] + t2 * pc->b[2][i];
+        struct IvPoint *o = &w->out[w->count++];
+        memset(o, 0, sizeof *o);
+        double n[3] = {0, 0, 0}, len2 = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            o->position[i] = (float)(b[0] * w->v[0]->position[i] + b[1] * w->v[1]->position[i] +
+                                     b[2] * w->v[2]->position[i]);
+            n[i] = b[0] * w->v[0]->normal[i] + b[1] * w->v[1]->normal[i] + b[2] * w->v[2]->normal[i];
+            len2 += n[i] * n[i];
+        }
+        /* the file's normals where they are usable and agree with the front
+         * side, else the winding's */
+        double dot = n[0] * w->front[0] + n[1] * w->front[1] + n[2] * w->front[2];
+        const int usable = isfinite(len2) && len2 > 1e-12 && dot > 0.0;
+        for (int i = 0; i < 3; ++i) {
+            o->normal[i] = usable ? (float)(n[i] / sqrt(len2)) : w->front[i];
+            o->albedo[i] = w->m ? w->m->base_color[i] : 1.0f;
+            o->emission[i] = w->emission && w->m ? w->m->emission[i] : 0.0f;
+        }
+        o->position[3] = 1.0f;
+    }
+}
+
+/* Runs the walk over every non-degenerate triangle: counts pieces (w->out
+ * NULL) or writes points. */
+static void walk_scene(walk *w)
+{
+    const lpv_scene *s = w->scene;
+    for (uint32_t d = 0; d < s->draw_count; ++d) {
+        const lpv_draw *dr = &s->draws[d];
+        w->m = dr->material >= 0 && (uint32_t)dr->material < s->material_count ? &s->materials[dr->material] : NULL;
+        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
+            double area;
+            if (dr->first_index + t + 3 > s->index_count ||
+                !lpv_scene_triangle(s, dr->first_index + t, w->v, w->front, &area))
+                continue;
+            piece whole = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+            split(w, &whole, 0);
+        }
+    }
+}
+
+static size_t count_triangles(const lpv_scene *s)
+{
+    size_t n = 0;
+    for (uint32_t d = 0; d < s->draw_count; ++d) {
+        const lpv_draw *dr = &s->draws[d];
+        for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
+            const lpv_vertex *v[3];
+            float f[3];
+            double area;
+            if (dr->first_index + t + 3 <= s->index_count && lpv_scene_triangle(s, dr->first_index + t, v, f, &area))
+                ++n;
+        }
+    }
+    return n;
+}
+
+int lpv_iv_points_make(const lpv_scene *scene, const lpv_iv_point_params *p, struct IvPoint **out, size_t *count,
+                       lpv_iv_point_stats *stats)
+{
+    *out = NULL;
+    *count = 0;
+    lpv_iv_point_stats st = {0};
+    st.triangles = count_triangles(scene);
+    st.split = p->split > 0.0f ? p->split : 1.0f;
+    st.points_per_piece = p->points > 0 ? p->points : 1;
+    const size_t budget = p->max_points > 0 ? p->max_points : 1;
+    /* the pieces at this split; coarser splits until one point each fits */
+    walk w = {.scene = scene};
+    for (;;) {
+        w.limit = (double)st.split * (double)p->voxel;
+        w.pieces = 0;
+        walk_scene(&w);
+        if (w.pieces <= budget || !(w.limit > 0.0) || st.split > 1e6f)
+            break;
+        st.split *= 2.0f;
+        st.budget_cut = 1;
+    }
+    st.pieces = w.pieces;
+    if (st.pieces * (size_t)st.points_per_piece > budget) {
+        st.points_per_piece = (int)(budget / (st.pieces ? st.pieces : 1));
+        if (st.points_per_piece < 1)
+            st.points_per_piece = 1;
+        st.budget_cut = 1;
+    }
+    size_t max = st.pieces * (size_t)st.points_per_piece;
+    if (max > budget)
+        max = budget;
+    if (max > 0) {
+        w.out = malloc(max * sizeof **out);
+        if (!w.out)
+            return -1;
+        w.max = max;
+        w.n = st.points_per_piece;
+        w.seed = p->seed;
+        w.emission = p->emission;
+        w.pieces = 0;
+        walk_scene(&w);
+    }
+    st.points = w.count;
+    *out = w.out;
+    *count = w.count;
+    if (stats)
+        *stats = st;
+    return 0;
+}
+
+void lpv_iv_triangle_points(const float a[3], const float b[3], const float c[3], int n, uint32_t seed, uint32_t key,
+                            float *out)
+{
+    for (int k = 0; k < n; ++k) {
+        double t0, t1, t2;
+        turk(seed, key, k, &t0, &t1, &t2);
+        for (int i = 0; i < 3; ++i)
+            out[3 * k + i] = (float)(t0 * a[i] + t1 * b[i] + t2 * c[i]);
+    }
+}

@@ -1,0 +1,56 @@
+/*
+ * iv_points.h - the point cloud of imperfect volumes (Mavridis &
+ * Papaioannou, section 3.1; docs/imperfect-volumes.md): for every triangle,
+ * N points uniform over its area by Turk's formula
+ *   v = (1 - sqrt(r1)) v1 + (1 - r2) sqrt(r1) v2 + r2 sqrt(r1) v3,
+ * each with the triangle's interpolated normal, its material's albedo and
+ * emission. Triangles with an edge longer than `split` voxels are first cut
+ * in halves across their longest edge (the paper's advice: "tessellate big
+ * triangles at load time"), so N points per piece cover a voxel-sized piece.
+ *
+ * Made on the CPU when the geometry or these knobs change, not per tick: the
+ * engine keeps the geometry and re-samples it then (the planner's SAMPLES
+ * rule), and the GPU lights the points every tick. The paper's geometry
+ * shader generated them per frame; docs/imperfect-volumes.md says why lpvd
+ * does not.
+ */
+#ifndef LPV_IV_POINTS_H
+#define LPV_IV_POINTS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lpv_shared.h"
+#include "scene.h"
+
+typedef struct lpv_iv_point_params {
+    float voxel;       /* m, the volume's voxel side */
+    int points;        /* per triangle (per piece after splitting), >= 1 */
+    float split;       /* voxels; > 0 */
+    uint32_t seed;
+    size_t max_points; /* the budget: fewer points per piece, then coarser splitting, to stay under it */
+    int emission;      /* 1: points carry their material's emission; 0: none (area lights carry it) */
+} lpv_iv_point_params;
+
+typedef struct lpv_iv_point_stats {
+    size_t triangles;  /* non-degenerate triangles sampled */
+    size_t pieces;     /* after splitting */
+    int points_per_piece; /* after the budget */
+    float split;       /* voxels, after the budget */
+    size_t points;     /* written */
+    int budget_cut;    /* 1: the budget lowered points_per_piece or raised split */
+} lpv_iv_point_stats;
+
+/* The cloud for `scene` under p. *out is malloc'ed (free() it), *count its
+ * points. Returns 0, or -1 out of memory (*out NULL, *count 0). Deterministic
+ * for a fixed seed: point k of piece i draws r1, r2 from lpv_hash_u32 of the
+ * seed, i and k. */
+int lpv_iv_points_make(const lpv_scene *scene, const lpv_iv_point_params *p, struct IvPoint **out, size_t *count,
+                       lpv_iv_point_stats *stats);
+
+/* One triangle's points (no splitting), for the voxelization report and the
+ * tests: n points on (a, b, c) from `key`, Turk's formula. Writes 3 floats each. */
+void lpv_iv_triangle_points(const float a[3], const float b[3], const float c[3], int n, uint32_t seed, uint32_t key,
+                            float *out);
+
+#endif /* LPV_IV_POINTS_H */
