@@ -44,14 +44,16 @@ static float centre_of(const lpv_grid *g, int axis, int v)
     return g->origin[axis] + ((float)v + 0.5f) * g->cell_size;
 }
 
-/* floor((x - origin) / s) along one axis, in float; 1 and *cell when it lies
- * in 0..dims-1, 0 otherwise (also for a non-finite x). */
-static int cell_along(const lpv_grid *g, int axis, float x, int *cell)
+/* The range test happens on the float before the int conversion, so no
+ * position (huge, Inf, NaN) can make an out-of-range conversion. */
+int lpv_iv_voxel_of(const lpv_grid *g, const float p[3], int cell[3])
 {
-    float fc = floorf((x - g->origin[axis]) / g->cell_size);
-    if (!(fc >= 0.0f && fc < (float)g->dims[axis]))
-        return 0;
-    *cell = (int)fc;
+    for (int a = 0; a < 3; a++) {
+        float fc = floorf((p[a] - g->origin[a]) / g->cell_size);
+        if (!(fc >= 0.0f && fc < (float)g->dims[a]))
+            return 0;
+        cell[a] = (int)fc;
+    }
     return 1;
 }
 
@@ -97,8 +99,7 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
             !finite3(B))
             continue;
         int v[3];
-        if (!cell_along(g, 0, pt->position[0], &v[0]) || !cell_along(g, 1, pt->position[1], &v[1]) ||
-            !cell_along(g, 2, pt->position[2], &v[2]))
+        if (!lpv_iv_voxel_of(g, pt->position, v))
             continue;
         double *a = &acc[ACC * lpv_grid_index(g, v[0], v[1], v[2])];
         float h[4];
@@ -336,10 +337,10 @@ long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, i
         float t = (LPV_IV_START + (float)i) * s;
         if (t > reach)
             return LPV_IV_BEYOND;
+        const float sample[3] = {c[0] + t * w[0], c[1] + t * w[1], c[2] + t * w[2]};
         int cell[3];
-        for (int a = 0; a < 3; a++)
-            if (!cell_along(g, a, c[a] + t * w[a], &cell[a]))
-                return LPV_IV_ESCAPED;
+        if (!lpv_iv_voxel_of(g, sample, cell))
+            return LPV_IV_ESCAPED;
         if (cell[0] == v[0] && cell[1] == v[1] && cell[2] == v[2])
             continue;
         size_t h = lpv_grid_index(g, cell[0], cell[1], cell[2]);

@@ -38,6 +38,12 @@ typedef struct IvVoxel lpv_iv_voxel;
 #define LPV_IV_ESCAPED (-1L) /* the ray left the grid: no light (lpvd has no environment) */
 #define LPV_IV_BEYOND (-2L)  /* AO only: the ray went past its reach (visible) */
 
+/* The voxel of point p: floor((p - origin) / s) per axis, in float (not
+ * grid.glsl's p / s - origin / s). Returns 1 and cell when it lies in the
+ * grid, 0 otherwise (also for a non-finite p). Creation, the march and
+ * core/iv_voxelize.c all find voxels with it. */
+int lpv_iv_voxel_of(const lpv_grid *g, const float p[3], int cell[3]);
+
 /* A voxel is occupied when at least one point landed in it. */
 static inline int lpv_iv_occupied(const lpv_iv_voxel *v) { return v->normal[3] > 0.0f; }
 
