@@ -28,10 +28,19 @@ typedef struct walk {
     int emission;
 } walk;
 
-static void world_of(const walk *w, const double b[3], double p[3])
+/* One triangle's splitting (lpv_iv_split_triangle). */
+typedef struct splitter {
+    const float *p[3];     /* the triangle's corners, world */
+    double limit;
+    lpv_iv_piece_fn fn;
+    void *user;
+    size_t pieces;
+} splitter;
+
+static void world_of(const splitter *sp, const double b[3], double p[3])
 {
     for (int i = 0; i < 3; ++i)
-        p[i] = b[0] * w->v[0]->position[i] + b[1] * w->v[1]->position[i] + b[2] * w->v[2]->position[i];
+        p[i] = b[0] * sp->p[0][i] + b[1] * sp->p[1][i] + b[2] * sp->p[2][i];
 }
 
 static double dist(const double a[3], const double b[3])
@@ -39,16 +48,14 @@ static double dist(const double a[3], const double b[3])
     return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-static void emit_piece(walk *w, const piece *pc);
-
 /* Splits across the longest edge until every edge is within the limit; the
  * depth bound keeps a huge triangle (the budget's coarser split catches it)
  * from recursing without end. */
-static void split(walk *w, const piece *pc, int depth)
+static void split(splitter *sp, const piece *pc, int depth)
 {
     double p[3][3];
     for (int i = 0; i < 3; ++i)
-        world_of(w, pc->b[i], p[i]);
+        world_of(sp, pc->b[i], p[i]);
     int longest = 0;
     double best = -1.0;
     for (int e = 0; e < 3; ++e) {
@@ -58,10 +65,10 @@ static void split(walk *w, const piece *pc, int depth)
             longest = e;
         }
     }
-    if (!(best > w->limit) || depth >= 40) {
-        if (w->out)
-            emit_piece(w, pc);
-        w->pieces++;
+    if (!(best > sp->limit) || depth >= 40) {
+        if (sp->fn)
+            sp->fn(pc->b, sp->user);
+        sp->pieces++;
         return;
     }
     const int a = longest, b = (longest + 1) % 3, c = (longest + 2) % 3;
@@ -72,8 +79,17 @@ static void split(walk *w, const piece *pc, int depth)
     memcpy(l.b[b], mid, sizeof mid); /* (a, mid, c) */
     memcpy(r.b[a], mid, sizeof mid); /* (mid, b, c) */
     (void)c;
-    split(w, &l, depth + 1);
-    split(w, &r, depth + 1);
+    split(sp, &l, depth + 1);
+    split(sp, &r, depth + 1);
+}
+
+size_t lpv_iv_split_triangle(const float a[3], const float b[3], const float c[3], double limit, lpv_iv_piece_fn fn,
+                             void *user)
+{
+    splitter sp = {{a, b, c}, limit, fn, user, 0};
+    piece whole = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+    split(&sp, &whole, 0);
+    return sp.pieces;
 }
 
 static void turk(uint32_t seed, uint32_t key, int k, double *b0, double *b1, double *b2)
@@ -86,14 +102,14 @@ static void turk(uint32_t seed, uint32_t key, int k, double *b0, double *b1, dou
     *b2 = r2 * s;
 }
 
-static void emit_piece(walk *w, const piece *pc)
+static void emit_piece(walk *w, const double pb[3][3])
 {
     for (int k = 0; k < w->n && w->count < w->max; ++k) {
         double t0, t1, t2;
         turk(w->seed, (uint32_t)w->pieces, k, &t0, &t1, &t2);
         double b[3];
         for (int i = 0; i < 3; ++i)
-            b[i] = t0 * pc->b[0][i] + t1 * pc->b[1][i] + t2 * pc->b[2][i];
+            b[i] = t0 * pb[0][i] + t1 * pb[1][i] + t2 * pb[2][i];
         struct IvPoint *o = &w->out[w->count++];
         memset(o, 0, sizeof *o);
         double n[3] = {0, 0, 0}, len2 = 0.0;
@@ -116,6 +132,16 @@ static void emit_piece(walk *w, const piece *pc)
     }
 }
 
+/* A piece of the walk's triangle: its points (when writing), then the count
+ * that keys the next piece's points. */
+static void walk_piece(const double b[3][3], void *user)
+{
+    walk *w = user;
+    if (w->out)
+        emit_piece(w, b);
+    w->pieces++;
+}
+
 /* Runs the walk over every non-degenerate triangle: counts pieces (w->out
  * NULL) or writes points. */
 static void walk_scene(walk *w)
@@ -129,8 +155,7 @@ static void walk_scene(walk *w)
             if (dr->first_index + t + 3 > s->index_count ||
                 !lpv_scene_triangle(s, dr->first_index + t, w->v, w->front, &area))
                 continue;
-            piece whole = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-            split(w, &whole, 0);
+            lpv_iv_split_triangle(w->v[0]->position, w->v[1]->position, w->v[2]->position, w->limit, walk_piece, w);
         }
     }
 }

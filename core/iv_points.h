@@ -48,6 +48,16 @@ typedef struct lpv_iv_point_stats {
 int lpv_iv_points_make(const lpv_scene *scene, const lpv_iv_point_params *p, struct IvPoint **out, size_t *count,
                        lpv_iv_point_stats *stats);
 
+/* The splitting lpv_iv_points_make does to each triangle (a, b, c): cut in
+ * halves across the longest edge until every edge is <= limit (m; at most
+ * 40 cuts deep). fn (may be NULL) gets each piece's corners in (a, b, c)'s
+ * barycentric coordinates, in the order lpv_iv_points_make numbers the
+ * pieces (piece i of the scene keys its points with i). Returns the number
+ * of pieces. */
+typedef void (*lpv_iv_piece_fn)(const double bary[3][3], void *user);
+size_t lpv_iv_split_triangle(const float a[3], const float b[3], const float c[3], double limit, lpv_iv_piece_fn fn,
+                             void *user);
+
 /* One triangle's points (no splitting), for the voxelization report and the
  * tests: n points on (a, b, c) from `key`, Turk's formula. Writes 3 floats each. */
 void lpv_iv_triangle_points(const float a[3], const float b[3], const float c[3], int n, uint32_t seed, uint32_t key,

@@ -1,0 +1,525 @@
+/*
+ * oracle_iv.c - reference imperfect volumes (see oracle_iv.h): literal loops
+ * over voxels, rays and corners, sums in double.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "oracle_iv.h"
+#include "sh.h"
+
+#define IV_PI 3.14159265358979323846
+
+/* ---- small helpers --------------------------------------------------------- */
+
+static void basis(const float d[3], float y[4])
+{
+    y[0] = LPV_SH_C0;
+    y[1] = LPV_SH_C1 * d[1];
+    y[2] = LPV_SH_C1 * d[2];
+    y[3] = LPV_SH_C1 * d[0];
+}
+
+static void hemi(const float n[3], float h[4])
+{
+    h[0] = LPV_IV_HEMI0;
+    h[1] = LPV_IV_HEMI1 * n[1];
+    h[2] = LPV_IV_HEMI1 * n[2];
+    h[3] = LPV_IV_HEMI1 * n[0];
+}
+
+static float *channel(lpv_cell *c, int ch) { return ch == 0 ? c->r : ch == 1 ? c->g : c->b; }
+
+static const float *cchannel(const lpv_cell *c, int ch) { return ch == 0 ? c->r : ch == 1 ? c->g : c->b; }
+
+static float dot4(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+
+static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+/* The centre of voxel v along one axis, in float. */
+static float centre_of(const lpv_grid *g, int axis, int v)
+{
+    return g->origin[axis] + ((float)v + 0.5f) * g->cell_size;
+}
+
+/* The range test happens on the float before the int conversion, so no
+ * position (huge, Inf, NaN) can make an out-of-range conversion. */
+int lpv_iv_voxel_of(const lpv_grid *g, const float p[3], int cell[3])
+{
+    for (int a = 0; a < 3; a++) {
+        float fc = floorf((p[a] - g->origin[a]) / g->cell_size);
+        if (!(fc >= 0.0f && fc < (float)g->dims[a]))
+            return 0;
+        cell[a] = (int)fc;
+    }
+    return 1;
+}
+
+int lpv_iv_surface_voxel_of(const lpv_grid *g, const float p[3], const float n[3], int cell[3])
+{
+    float nh[3] = {0.0f, 0.0f, 0.0f};
+    if (!lpv_unit_direction(n, nh))
+        nh[0] = nh[1] = nh[2] = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        float fc = floorf((p[a] - g->origin[a]) / g->cell_size - LPV_IV_BEHIND * nh[a]);
+        if (!(fc >= 0.0f && fc < (float)g->dims[a]))
+            return 0;
+        cell[a] = (int)fc;
+    }
+    return 1;
+}
+
+/* 1 when any voxel of the 3x3x3 block around (x, y, z), itself included and
+ * clipped to the grid, is occupied. */
+static int near_occupied(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
+{
+    for (int dz = -1; dz <= 1; dz++) {
+        for (int dy = -1; dy <= 1; dy++) {
+            for (int dx = -1; dx <= 1; dx++) {
+                int a = x + dx, b = y + dy, c = z + dz;
+                if (a < 0 || b < 0 || c < 0 || a >= g->dims[0] || b >= g->dims[1] || c >= g->dims[2])
+                    continue;
+                if (lpv_iv_occupied(&voxels[lpv_grid_index(g, a, b, c)]))
+                    return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* ---- Creation (3.1) -------------------------------------------------------- */
+
+/* Accumulators per voxel: 12 SH, 3 normal, 3 albedo, 1 count. */
+#define ACC 19
+
+int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*radiosity)[3], size_t n,
+                  lpv_iv_voxel *voxels, size_t *taken)
+{
+    size_t cells = lpv_grid_cell_count(g);
+    memset(voxels, 0, cells * sizeof *voxels);
+    if (taken)
+        *taken = 0;
+    double *acc = calloc(cells, ACC * sizeof *acc);
+    if (!acc)
+        return -1;
+    size_t used = 0;
+    for (size_t i = 0; i < n; i++) {
+        const lpv_iv_point *pt = &points[i];
+        const float zero[3] = {0.0f, 0.0f, 0.0f};
+        const float *B = radiosity ? radiosity[i] : zero;
+        if (pt->position[3] == 0.0f || !finite3(pt->position) || !finite3(pt->normal) || !finite3(pt->albedo) ||
+            !finite3(B))
+            continue;
+        int v[3];
+        if (!lpv_iv_surface_voxel_of(g, pt->position, pt->normal, v))
+            continue;
+        double *a = &acc[ACC * lpv_grid_index(g, v[0], v[1], v[2])];
+        float h[4];
+        hemi(pt->normal, h);
+        for (int ch = 0; ch < 3; ch++)
+            for (int k = 0; k < 4; k++)
+                a[4 * ch + k] += (double)B[ch] * (double)h[k];
+        for (int k = 0; k < 3; k++) {
+            a[12 + k] += pt->normal[k];
+            a[15 + k] += pt->albedo[k];
+        }
+        a[18] += 1.0;
+        used++;
+    }
+    for (size_t c = 0; c < cells; c++) {
+        const double *a = &acc[ACC * c];
+        if (a[18] == 0.0)
+            continue;
+        lpv_iv_voxel *o = &voxels[c];
+        for (int k = 0; k < 4; k++) {
+            o->r[k] = (float)(a[k] / a[18]);
+            o->g[k] = (float)(a[4 + k] / a[18]);
+            o->b[k] = (float)(a[8 + k] / a[18]);
+        }
+        for (int k = 0; k < 3; k++) {
+            o->normal[k] = (float)(a[12 + k] / a[18]);
+            o->albedo[k] = (float)(a[15 + k] / a[18]);
+        }
+        o->normal[3] = (float)a[18];
+    }
+    free(acc);
+    if (taken)
+        *taken = used;
+    return 0;
+}
+
+/* ---- Reconstruction (3.4) -------------------------------------------------- */
+
+/* The corners reconstruction blends at p for n, and their weights w_c (not
+ * yet divided by the sum). Returns how many were written to index[] and
+ * weight[] (at most 8); 0 when nothing contributes. */
+static int corners(const lpv_grid *g, const lpv_iv_voxel *voxels, const float p[3], const float n[3], int neighbours,
+                   size_t index[8], double weight[8])
+{
+    float nh[3];
+    if (!finite3(p) || !lpv_unit_direction(n, nh))
+        return 0;
+    const float s = g->cell_size;
+    float f[3];
+    int base[3], own[3];
+    for (int a = 0; a < 3; a++) {
+        float q = p[a] + 0.5f * s * nh[a];
+        float u = (q - g->origin[a]) / s - 0.5f;
+        /* base and base + 1 both outside the grid (or u not finite): nothing */
+        if (!(u >= -1.0f && u < (float)g->dims[a]))
+            return 0;
+        float b = floorf(u);
+        base[a] = (int)b;
+        f[a] = u - b;
+        float fo = floorf((p[a] - g->origin[a]) / s - LPV_IV_BEHIND * nh[a]); /* as creation files p */
+        own[a] = fo >= -1.0f && fo <= (float)g->dims[a] ? (int)fo : -2; /* -2 matches no corner in the grid */
+    }
+    /* the corners by distance to q, then index (insertion sort, stable) */
+    int order[8];
+    float d2[8];
+    for (int c = 0; c < 8; c++) {
+        d2[c] = 0.0f;
+        for (int a = 0; a < 3; a++) {
+            float e = f[a] - (float)((c >> a) & 1);
+            d2[c] += e * e;
+        }
+        int k = c;
+        while (k > 0 && d2[order[k - 1]] > d2[c]) {
+            order[k] = order[k - 1];
+            k--;
+        }
+        order[k] = c;
+    }
+    if (neighbours < 1)
+        neighbours = 1;
+    if (neighbours > 8)
+        neighbours = 8;
+    int m = 0;
+    for (int r = 0; r < neighbours; r++) {
+        const int c = order[r];
+        int v[3], is_own = 1, inside = 1;
+        for (int a = 0; a < 3; a++) {
+            v[a] = base[a] + ((c >> a) & 1);
+            is_own &= v[a] == own[a];
+            inside &= v[a] >= 0 && v[a] < g->dims[a];
+        }
+        if (is_own || !inside)
+            continue;
+        float t = 1.0f;
+        for (int a = 0; a < 3; a++)
+            t *= (c >> a) & 1 ? f[a] : 1.0f - f[a];
+        float d[3];
+        for (int a = 0; a < 3; a++)
+            d[a] = centre_of(g, a, v[a]) - p[a];
+        float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        float cosine = 0.0f;
+        if (len > 0.0f)
+            cosine = nh[0] * (d[0] / len) + nh[1] * (d[1] / len) + nh[2] * (d[2] / len);
+        float w = t * (cosine > 0.0f ? cosine : 0.0f);
+        const size_t vi = lpv_grid_index(g, v[0], v[1], v[2]);
+        if (voxels && lpv_iv_occupied(&voxels[vi]))
+            w *= LPV_IV_HELD_WEIGHT;
+        if (!(w > 0.0f))
+            continue;
+        index[m] = vi;
+        weight[m] = w;
+        m++;
+    }
+    return m;
+}
+
+void lpv_iv_reconstruct(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
+                        const float n[3], int neighbours, lpv_cell *out)
+{
+    memset(out, 0, sizeof *out);
+    size_t index[8];
+    double weight[8], sum = 0.0, acc[3][4] = {{0.0}};
+    int m = corners(g, voxels, p, n, neighbours, index, weight);
+    for (int i = 0; i < m; i++) {
+        sum += weight[i];
+        for (int ch = 0; ch < 3; ch++)
+            for (int k = 0; k < 4; k++)
+                acc[ch][k] += weight[i] * cchannel(&vol[index[i]], ch)[k];
+    }
+    if (!(sum > 0.0))
+        return;
+    for (int ch = 0; ch < 3; ch++)
+        for (int k = 0; k < 4; k++)
+            channel(out, ch)[k] = (float)(acc[ch][k] / sum);
+}
+
+/* lobe(-n^) for a unit-able n; 0 and a zero lobe otherwise. */
+static int lobe_minus(const float n[3], float lobe[4])
+{
+    float nh[3], m[3];
+    if (!lpv_unit_direction(n, nh)) {
+        memset(lobe, 0, 4 * sizeof *lobe);
+        return 0;
+    }
+    m[0] = -nh[0];
+    m[1] = -nh[1];
+    m[2] = -nh[2];
+    lpv_sh_cosine_lobe(m, lobe);
+    return 1;
+}
+
+void lpv_iv_irradiance(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
+                       const float n[3], int neighbours, float rgb[3])
+{
+    lpv_cell L;
+    float lobe[4];
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!lobe_minus(n, lobe))
+        return;
+    lpv_iv_reconstruct(g, voxels, vol, p, n, neighbours, &L);
+    for (int ch = 0; ch < 3; ch++) {
+        float e = dot4(cchannel(&L, ch), lobe);
+        rgb[ch] = e > 0.0f ? e : 0.0f;
+    }
+}
+
+float lpv_iv_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, const vec4 *ao, const float p[3], const float n[3],
+                int neighbours)
+{
+    float lobe[4];
+    if (!lobe_minus(n, lobe))
+        return 1.0f;
+    size_t index[8];
+    double weight[8], sum = 0.0, acc[4] = {0.0};
+    int m = corners(g, voxels, p, n, neighbours, index, weight);
+    for (int i = 0; i < m; i++) {
+        sum += weight[i];
+        for (int k = 0; k < 4; k++)
+            acc[k] += weight[i] * ao[index[i]][k];
+    }
+    if (!(sum > 0.0))
+        return 1.0f; /* nothing to blend: open, as the GPU lookup answers */
+    float L[4];
+    for (int k = 0; k < 4; k++)
+        L[k] = (float)(acc[k] / sum);
+    float a = dot4(L, lobe) / LPV_PI;
+    return a > 1.0f ? 1.0f : a > 0.0f ? a : 0.0f;
+}
+
+/* ---- Emission per bounce --------------------------------------------------- */
+
+void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *incoming, int bounce, int neighbours,
+                 lpv_cell *emit)
+{
+    for (int z = 0; z < g->dims[2]; z++) {
+        for (int y = 0; y < g->dims[1]; y++) {
+            for (int x = 0; x < g->dims[0]; x++) {
+                size_t i = lpv_grid_index(g, x, y, z);
+                const lpv_iv_voxel *h = &voxels[i];
+                lpv_cell *e = &emit[i];
+                memset(e, 0, sizeof *e);
+                if (!lpv_iv_occupied(h))
+                    continue;
+                memcpy(e->r, h->r, sizeof e->r);
+                memcpy(e->g, h->g, sizeof e->g);
+                memcpy(e->b, h->b, sizeof e->b);
+                if (bounce <= 1 || !incoming)
+                    continue;
+                const float *m = h->normal;
+                if (!(sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) > 1e-3f))
+                    continue;
+                /* the irradiance normalises m itself: n^ = m / |m| */
+                const float p[3] = {centre_of(g, 0, x), centre_of(g, 1, y), centre_of(g, 2, z)};
+                float E[3], hm[4];
+                lpv_iv_irradiance(g, voxels, incoming, p, m, neighbours, E);
+                hemi(m, hm); /* m not normalised: a voxel of mixed normals re-emits less directionally */
+                for (int ch = 0; ch < 3; ch++) {
+                    float a = h->albedo[ch] * E[ch];
+                    float *c = channel(e, ch);
+                    for (int k = 0; k < 4; k++)
+                        c[k] += a * hm[k];
+                }
+            }
+        }
+    }
+}
+
+/* ---- The march (3.3, 3.5) -------------------------------------------------- */
+
+long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z, const float w[3], float reach)
+{
+    const float s = g->cell_size;
+    const int v[3] = {x, y, z};
+    /* in voxels: occupied voxels start LPV_IV_START out (their own surface),
+     * empty ones at the centre; then every voxel the ray crosses
+     * (Amanatides & Woo), as iv_gather.comp walks them */
+    const float start = lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]) ? LPV_IV_START : 0.0f;
+    float o[3], inv[3], cross[3];
+    int q[3], st[3];
+    for (int a = 0; a < 3; a++) {
+        o[a] = (float)v[a] + 0.5f + start * w[a];
+        q[a] = (int)floorf(o[a]);
+        st[a] = w[a] > 0.0f ? 1 : w[a] < 0.0f ? -1 : 0;
+        inv[a] = fabsf(w[a]) > 1e-12f ? 1.0f / fabsf(w[a]) : 1e30f;
+        cross[a] = (w[a] > 0.0f ? (float)q[a] + 1.0f - o[a] : o[a] - (float)q[a]) * inv[a];
+    }
+    const float reach_voxels = reach / s;
+    float t = start;
+    const long max_steps = (long)g->dims[0] + g->dims[1] + g->dims[2] + 3;
+    for (long i = 0; i < max_steps; i++) {
+        if (t > reach_voxels)
+            return LPV_IV_BEYOND;
+        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= g->dims[0] || q[1] >= g->dims[1] || q[2] >= g->dims[2])
+            return LPV_IV_ESCAPED;
+        size_t h = lpv_grid_index(g, q[0], q[1], q[2]);
+        if (!(q[0] == v[0] && q[1] == v[1] && q[2] == v[2]) && lpv_iv_occupied(&voxels[h]))
+            return (long)h;
+        int a = cross[0] < cross[1] ? (cross[0] < cross[2] ? 0 : 2) : (cross[1] < cross[2] ? 1 : 2);
+        t = start + cross[a];
+        q[a] += st[a];
+        cross[a] += inv[a];
+    }
+    return LPV_IV_ESCAPED;
+}
+
+/* Y(-w) of ray j of voxel (x, y, z); w to dir. */
+static void ray(const lpv_grid *g, uint32_t seed, int x, int y, int z, int j, int rays, float dir[3], float y4[4])
+{
+    lpv_iv_ray(seed, (uint32_t)lpv_grid_index(g, x, y, z), (uint32_t)j, (uint32_t)rays, dir);
+    const float back[3] = {-dir[0], -dir[1], -dir[2]};
+    basis(back, y4);
+}
+
+void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *emit, uint32_t seed, int rays,
+                   lpv_cell *incoming)
+{
+    const double scale = 4.0 * IV_PI / (double)rays;
+    for (int z = 0; z < g->dims[2]; z++) {
+        for (int y = 0; y < g->dims[1]; y++) {
+            for (int x = 0; x < g->dims[0]; x++) {
+                lpv_cell *out = &incoming[lpv_grid_index(g, x, y, z)];
+                memset(out, 0, sizeof *out);
+                if (!near_occupied(g, voxels, x, y, z))
+                    continue;
+                double acc[3][4] = {{0.0}};
+                for (int j = 0; j < rays; j++) {
+                    float w[3], yb[4];
+                    ray(g, seed, x, y, z, j, rays, w, yb);
+                    long h = lpv_iv_march(g, voxels, x, y, z, w, INFINITY);
+                    if (h < 0)
+                        continue; /* escaped: no light */
+                    for (int ch = 0; ch < 3; ch++) {
+                        float L = dot4(cchannel(&emit[h], ch), yb);
+                        if (!(L > 0.0f))
+                            continue;
+                        for (int k = 0; k < 4; k++)
+                            acc[ch][k] += (double)(L * yb[k]);
+                    }
+                }
+                for (int ch = 0; ch < 3; ch++)
+                    for (int k = 0; k < 4; k++)
+                        channel(out, ch)[k] = (float)(acc[ch][k] * scale);
+            }
+        }
+    }
+}
+
+void lpv_iv_gather_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, uint32_t seed, int rays, float reach, vec4 *ao)
+{
+    const double scale = 4.0 * IV_PI / (double)rays;
+    for (int z = 0; z < g->dims[2]; z++) {
+        for (int y = 0; y < g->dims[1]; y++) {
+            for (int x = 0; x < g->dims[0]; x++) {
+                float *out = ao[lpv_grid_index(g, x, y, z)];
+                if (!near_occupied(g, voxels, x, y, z)) {
+                    /* all visible: the projection of the constant 1 */
+                    out[0] = 4.0f * LPV_PI * LPV_SH_C0;
+                    out[1] = out[2] = out[3] = 0.0f;
+                    continue;
+                }
+                double acc[4] = {0.0};
+                for (int j = 0; j < rays; j++) {
+                    float w[3], yb[4];
+                    ray(g, seed, x, y, z, j, rays, w, yb);
+                    if (lpv_iv_march(g, voxels, x, y, z, w, reach) >= 0)
+                        continue; /* hit: V = 0 */
+                    for (int k = 0; k < 4; k++)
+                        acc[k] += yb[k];
+                }
+                for (int k = 0; k < 4; k++)
+                    out[k] = (float)(acc[k] * scale);
+            }
+        }
+    }
+}
+
+/* ---- Entry points ------------------------------------------------------------ */
+
+static int check(const lpv_iv_desc *d, int need_bounces, char *err, size_t err_size)
+{
+    const lpv_grid *g = &d->grid;
+    for (int a = 0; a < 3; a++)
+        if (g->dims[a] < 1 || g->dims[a] > LPV_MAX_GRID_DIM)
+            return lpv_error(err, err_size, "iv: grid dims %d x %d x %d outside 1..%d", g->dims[0], g->dims[1],
+                             g->dims[2], LPV_MAX_GRID_DIM);
+    if (!finite3(g->origin) || !isfinite(g->cell_size) || !(g->cell_size > 0.0f))
+        return lpv_error(err, err_size, "iv: the grid's origin and cell size must be finite (cell size > 0)");
+    if (d->point_count > 0 && !d->points)
+        return lpv_error(err, err_size, "iv: %zu points but no point array", d->point_count);
+    if (d->rays < 1)
+        return lpv_error(err, err_size, "iv: rays = %d, need >= 1", d->rays);
+    if (need_bounces && d->bounces < 1)
+        return lpv_error(err, err_size, "iv: bounces = %d, need >= 1", d->bounces);
+    if (need_bounces && (d->neighbours < 1 || d->neighbours > 8))
+        return lpv_error(err, err_size, "iv: neighbours = %d, need 1..8", d->neighbours);
+    return 0;
+}
+
+int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, char *err, size_t err_size)
+{
+    if (check(d, 1, err, err_size) != 0)
+        return -1;
+    const lpv_grid *g = &d->grid;
+    size_t cells = lpv_grid_cell_count(g);
+    lpv_iv_voxel *own = voxels ? NULL : malloc(cells * sizeof *own);
+    lpv_cell *emit = malloc(cells * sizeof *emit);
+    lpv_cell *prev = malloc(cells * sizeof *prev);
+    int rc = -1;
+    if ((!voxels && !own) || !emit || !prev) {
+        lpv_error(err, err_size, "iv: out of memory for %zu voxels", cells);
+        goto done;
+    }
+    lpv_iv_voxel *vox = voxels ? voxels : own;
+    if (lpv_iv_create(g, d->points, d->radiosity, d->point_count, vox, NULL) != 0) {
+        lpv_error(err, err_size, "iv: out of memory creating the volume");
+        goto done;
+    }
+    memset(incoming, 0, cells * sizeof *incoming); /* I_0 */
+    for (int k = 1; k <= d->bounces; k++) {
+        memcpy(prev, incoming, cells * sizeof *prev);
+        lpv_iv_emit(g, vox, prev, k, d->neighbours, emit);
+        lpv_iv_gather(g, vox, emit, d->seed, d->rays, incoming);
+    }
+    rc = 0;
+done:
+    free(own);
+    free(emit);
+    free(prev);
+    return rc;
+}
+
+int lpv_iv_run_ao(const lpv_iv_desc *d, float reach, lpv_iv_voxel *voxels, vec4 *ao, char *err, size_t err_size)
+{
+    if (check(d, 0, err, err_size) != 0)
+        return -1;
+    const lpv_grid *g = &d->grid;
+    size_t cells = lpv_grid_cell_count(g);
+    lpv_iv_voxel *own = voxels ? NULL : malloc(cells * sizeof *own);
+    lpv_iv_voxel *vox = voxels ? voxels : own;
+    if (!vox)
+        return lpv_error(err, err_size, "iv: out of memory for %zu voxels", cells);
+    int rc = lpv_iv_create(g, d->points, d->radiosity, d->point_count, vox, NULL);
+    if (rc != 0)
+        lpv_error(err, err_size, "iv: out of memory creating the volume");
+    else
+        lpv_iv_gather_ao(g, vox, d->seed, d->rays, reach, ao);
+    free(own);
+    return rc;
+}
