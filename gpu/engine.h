@@ -158,6 +158,12 @@ size_t lpv_engine_read_transmittance(lpv_engine *e, float *out, size_t max_float
  * read_grid(ACCUMULATED) is the merged volume and read_volumes every level's
  * accumulation, level 0 first. */
 size_t lpv_engine_read_index(lpv_engine *e, int32_t *out, size_t max);
+/* The imperfect volume's voxels after creation (struct IvVoxel per voxel,
+ * lpv_shared.h) and its ambient occlusion (4 floats of SH per voxel); 0 for
+ * the other techniques. read_grid(ACCUMULATED) is its gathered radiance
+ * (W/(m^2 sr)), read_grid(INJECTED) its voxels' direct light. */
+size_t lpv_engine_read_iv_voxels(lpv_engine *e, struct IvVoxel *out, size_t max);
+size_t lpv_engine_read_ao(lpv_engine *e, float *out, size_t max_floats);
 /* RSM VPLs (punctual lights' and area light samples'), then the emissive VPLs
  * when the last tick injected them (area lights off). */
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);

@@ -44,6 +44,20 @@ size_t lpv_engine_read_index(lpv_engine *e, int32_t *out, size_t max)
     return e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_INDEX, LPV_GRID_ACCUMULATED, out, max);
 }
 
+size_t lpv_engine_read_iv_voxels(lpv_engine *e, struct IvVoxel *out, size_t max)
+{
+    if (!e->ticked)
+        return 0;
+    return e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_IV_VOXELS, LPV_GRID_ACCUMULATED, out, max);
+}
+
+size_t lpv_engine_read_ao(lpv_engine *e, float *out, size_t max_floats)
+{
+    if (!e->ticked)
+        return 0;
+    return 4 * e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_AO, LPV_GRID_ACCUMULATED, out, max_floats / 4);
+}
+
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 {
     if (!e->ticked)
