@@ -295,3 +295,27 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *
     else
         decide(p, LPV_PASS_IV_AO, 1, "ambient occlusion on, %d rays per voxel", s->iv.rays);
 }
+
+lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_facts *f, char *why, size_t n)
+{
+    if (s->technique != LPV_TECHNIQUE_ID_AUTO) {
+        const lpv_technique_id t = s->technique == LPV_TECHNIQUE_ID_DEFAULT ? LPV_TECHNIQUE_ID_LPV : s->technique;
+        say(why, n, "requested");
+        return t;
+    }
+    /* The rules follow the three-technique front of the accuracy sweep
+     * (docs/accuracy.md, "Three techniques"): the imperfect volume is the
+     * more accurate on every scene measured, the cascaded LPV the cheaper. */
+    if (s->preset == LPV_PRESET_FAST) {
+        say(why, n, "auto: preset fast asks for the cheapest technique, the cascaded LPV");
+        return LPV_TECHNIQUE_ID_LPV;
+    }
+    if (f && f->occluder_triangles > LPV_AUTO_IV_MAX_TRIANGLES) {
+        say(why, n, "auto: %zu triangles (over %d): the cascaded LPV; the imperfect volume's cloud takes seconds",
+            f->occluder_triangles, LPV_AUTO_IV_MAX_TRIANGLES);
+        return LPV_TECHNIQUE_ID_LPV;
+    }
+    say(why, n, "auto: the imperfect volume, the most accurate technique on every scene of the sweep (preset %s)",
+        lpv_preset_name(s->preset));
+    return LPV_TECHNIQUE_ID_IV;
+}

@@ -64,7 +64,12 @@ typedef struct lpv_plan_facts {
     int iv_budget_cut;         /* the budget lowered the points per piece or coarsened the split */
 } lpv_plan_facts;
 
+/* Technique auto (LPV_TECHNIQUE_ID_AUTO): what the planner runs instead. */
+#define LPV_AUTO_IV_MAX_TRIANGLES 1000000 /* above: the imperfect volume's point cloud costs seconds per change */
+
 typedef struct lpv_plan {
+    char technique[16];                     /* the technique that computed the volume (its class's name) */
+    char technique_reason[LPV_PLAN_REASON_MAX]; /* why: the request, or auto's choice and its reason */
     int cascades;                           /* grids in use: lpv_plan_cascades' count, with the far
                                                field's levels added to one grid (lpv_cascades_count) */
     char cascades_reason[LPV_PLAN_REASON_MAX];
@@ -97,6 +102,11 @@ int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reas
 
 /* The whole plan for one tick. s must be resolved. */
 void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
+/* The technique for technique auto, from the preset and the scene's facts
+ * (never LPV_TECHNIQUE_ID_AUTO), with the reason in why. Any other request
+ * is returned as it is ("requested"). */
+lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_facts *f, char *why, size_t why_size);
+
 /* The imperfect volume's plan (technique iv): the shared producers it reads
  * (the RSMs for shadows, the G-buffer for reprojection) and its passes. */
 void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);

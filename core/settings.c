@@ -120,6 +120,7 @@ static const char *const TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
     [LPV_TECHNIQUE_ID_LPV] = LPV_TECHNIQUE_LPV,
     [LPV_TECHNIQUE_ID_OCTREE] = LPV_TECHNIQUE_OCTREE,
     [LPV_TECHNIQUE_ID_IV] = LPV_TECHNIQUE_IV,
+    [LPV_TECHNIQUE_ID_AUTO] = LPV_TECHNIQUE_AUTO,
 };
 
 int lpv_technique_from_name(const char *name, lpv_technique_id *out)
@@ -141,7 +142,7 @@ const char *lpv_technique_name(lpv_technique_id t)
 
 const char *lpv_technique_names(void)
 {
-    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV; /* the table's names, in its order */
+    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV ", " LPV_TECHNIQUE_AUTO; /* the table's names, in its order */
 }
 
 lpv_preset lpv_preset_match(const lpv_settings *s)

@@ -10,6 +10,7 @@
 #define LPV_TECHNIQUE_LPV "lpv"       /* cascaded light propagation volumes (gpu/lpv/) */
 #define LPV_TECHNIQUE_OCTREE "octree" /* octree light propagation volumes (gpu/lpv/technique_octree.c) */
 #define LPV_TECHNIQUE_IV "iv"         /* imperfect volumes (gpu/iv/) */
+#define LPV_TECHNIQUE_AUTO "auto"     /* the planner chooses from the scene and the preset (core/plan.c) */
 
 /* Which technique computes the volume; 0 means "the default" (lpv). The
  * names are core/settings.c's technique table, the classes gpu/technique.c's. */
@@ -18,6 +19,7 @@ typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_LPV = 1,
     LPV_TECHNIQUE_ID_OCTREE = 2,
     LPV_TECHNIQUE_ID_IV = 3,
+    LPV_TECHNIQUE_ID_AUTO = 4, /* not a class: the engine resolves it (lpv_technique_choose) */
     LPV_TECHNIQUE_ID_COUNT_ /* one past the last; not a technique */
 } lpv_technique_id;
 

@@ -90,6 +90,19 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
     return 0;
 }
 
+int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err, size_t err_size)
+{
+    lpv_plan_facts facts;
+    lpv_engine_gather_facts(e, &facts);
+    char why[sizeof e->tech_reason];
+    const lpv_technique_id id = lpv_technique_choose(s, e->has_scene ? &facts : NULL, why, sizeof why);
+    if (id != e->tech_id && use_technique(e, id, err, err_size) != 0)
+        return -1;
+    e->tech->cls->configure(e->tech, s);
+    memcpy(e->tech_reason, why, sizeof why);
+    return 0;
+}
+
 lpv_engine *lpv_engine_create(char *err, size_t err_size)
 {
     lpv_engine *e = calloc(1, sizeof *e);
@@ -119,6 +132,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         lpv_engine_destroy(e);
         return NULL;
     }
+    snprintf(e->tech_reason, sizeof e->tech_reason, "requested");
     GLint max_block = 0;
     glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
     if ((size_t)max_block < sizeof(struct LpvLightBlock) || (size_t)max_block < sizeof(struct LpvShadowBlock)) {
@@ -207,7 +221,7 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     const unsigned touches = lpv_settings_touches(&e->settings, &s, knob, sizeof knob);
     if (!touches)
         return 0;
-    if (s.technique != e->tech_id && use_technique(e, s.technique, err, err_size) != 0)
+    if (lpv_engine_resolve_technique(e, &s, err, err_size) != 0)
         return -1; /* the technique touches the volume: the next tick computes it anew */
     e->settings = s;
     e->tech->cls->configure(e->tech, &e->settings);

@@ -44,7 +44,8 @@ typedef struct lpv_gpu_draw {
 struct lpv_engine {
     lpv_settings settings;
     lpv_technique *tech;      /* the GI technique (gpu/technique.h) */
-    lpv_technique_id tech_id; /* which (settings.technique, resolved) */
+    lpv_technique_id tech_id; /* which (settings.technique, resolved; auto: lpv_technique_choose's) */
+    char tech_reason[LPV_PLAN_REASON_MAX]; /* why */
     lpv_volume_desc desc;     /* its volume after the last commit */
     int has_scene;
 
@@ -184,6 +185,9 @@ int lpv_engine_memory_check(const lpv_engine *e, char *err, size_t err_size);
 void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f);
 /* Where the technique's volume must go now, under facts f. */
 void lpv_engine_where(const lpv_engine *e, const lpv_plan_facts *f, lpv_technique_where *w);
+/* Switches to the technique settings s call for (technique auto: chosen from
+ * the scene's facts, lpv_technique_choose) and configures it with s. */
+int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err, size_t err_size);
 /* Places and commits the technique's volume for the current inputs without a
  * tick, so lpv_engine_grid() answers right after set_scene/set_settings. */
 int lpv_engine_place_volume(lpv_engine *e, char *err, size_t err_size);

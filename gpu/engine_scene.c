@@ -180,7 +180,7 @@ int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size)
 
     /* The imperfect volume samples its own point cloud; the LPV's samples
      * (emissive VPLs, scene surfels) would go unused. */
-    const int iv = e->settings.technique == LPV_TECHNIQUE_ID_IV;
+    const int iv = e->tech_id == LPV_TECHNIQUE_ID_IV;
     if (iv)
         return sample_iv_points(e, err, err_size);
     size_t target = (size_t)e->settings.emissive_vpls;
@@ -307,7 +307,8 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     lpv_engine_update_area_samples(e);
     if (lpv_scene_copy_geometry(&e->geometry, scene) != 0)
         return lpv_error(err, err_size, "%s: out of memory for the engine's copy of the geometry", scene->source);
-    if (lpv_engine_sample_scene(e, err, err_size) != 0)
+    e->has_scene = 1; /* auto's choice reads the scene's facts */
+    if (lpv_engine_resolve_technique(e, &e->settings, err, err_size) != 0 || lpv_engine_sample_scene(e, err, err_size))
         return -1;
 
     if (glGetError() != GL_NO_ERROR)

@@ -154,6 +154,8 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
         return -1;
     facts.placement_changed = e->computed && moved;
     t->plan(e->tech, &e->settings, &facts, &e->plan);
+    snprintf(e->plan.technique, sizeof e->plan.technique, "%s", t->name);
+    snprintf(e->plan.technique_reason, sizeof e->plan.technique_reason, "%s", e->tech_reason);
     const lpv_plan *p = &e->plan;
     if (!p->recompute) {
         /* The cached volume stands: no pass runs, no stage is recorded. */

@@ -43,7 +43,9 @@ json_t *lpvd_plan_json(const lpv_plan *p)
     }
     if (!passes)
         return NULL;
-    return json_pack("{s:i, s:s#, s:b, s:s#, s:o}", "cascades", p->cascades, "cascades_reason", p->cascades_reason,
+    return json_pack("{s:s, s:s#, s:i, s:s#, s:b, s:s#, s:o}", "technique", p->technique, "technique_reason",
+                     p->technique_reason, reason_len(p->technique_reason), "cascades", p->cascades, "cascades_reason",
+                     p->cascades_reason,
                      reason_len(p->cascades_reason), "recompute", p->recompute != 0,
                      "recompute_reason", p->recompute_reason,
                      reason_len(p->recompute_reason), "passes", passes);

@@ -561,6 +561,30 @@ static void test_iv_plan(void **state)
             assert_false(p.pass[i].run);
 }
 
+/* Technique auto: the planner's choice, with its reason; any other request is kept. */
+static void test_technique_choose(void **state)
+{
+    (void)state;
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_plan_facts f = baseline();
+    lpv_settings s = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_AUTO});
+    assert_int_equal(lpv_technique_choose(&s, &f, why, sizeof why), LPV_TECHNIQUE_ID_IV);
+    assert_non_null(strstr(why, "auto: the imperfect volume"));
+    s = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_AUTO, .preset = LPV_PRESET_FAST});
+    assert_int_equal(lpv_technique_choose(&s, &f, why, sizeof why), LPV_TECHNIQUE_ID_LPV);
+    assert_non_null(strstr(why, "preset fast"));
+    s = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_AUTO});
+    f.occluder_triangles = LPV_AUTO_IV_MAX_TRIANGLES + 1;
+    assert_int_equal(lpv_technique_choose(&s, &f, why, sizeof why), LPV_TECHNIQUE_ID_LPV);
+    assert_non_null(strstr(why, "triangles"));
+    assert_true(strlen(why) < sizeof why - 1); /* not cut */
+    for (int t = LPV_TECHNIQUE_ID_LPV; t <= LPV_TECHNIQUE_ID_IV; ++t) {
+        s = resolved((lpv_settings){.technique = (lpv_technique_id)t});
+        assert_int_equal(lpv_technique_choose(&s, &f, why, sizeof why), t);
+        assert_string_equal(why, "requested");
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -578,6 +602,7 @@ int main(void)
         cmocka_unit_test(test_place_snapping_and_nesting),
         cmocka_unit_test(test_place_temporal),
         cmocka_unit_test(test_iv_plan),
+        cmocka_unit_test(test_technique_choose),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
