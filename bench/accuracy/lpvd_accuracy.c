@@ -34,6 +34,7 @@
 #include "hash.h"
 #include "image_io.h"
 #include "iv_knobs.h"
+#include "iv_tables.h"
 #include "metrics.h"
 #include "oracle_octree.h"
 #include "overall.h"
@@ -277,7 +278,7 @@ typedef struct scene_entry {
 
 enum {
     A_OUT, A_REF_SPP, A_SCENES, A_QUICK, A_PRESETS, A_FEATURES, A_MULTI_BOUNCES, A_KNOBS, A_POINTS,
-    A_TICKS, A_WARMUP, A_REFERENCE, A_NO_PLOT, A_EMISSIVE, A_HELP, A_COUNT
+    A_TICKS, A_WARMUP, A_REFERENCE, A_NO_PLOT, A_EMISSIVE, A_IV_TABLES, A_HELP, A_COUNT
 };
 
 static const lpv_flag FLAGS[A_COUNT] = {
@@ -320,6 +321,11 @@ static const lpv_flag FLAGS[A_COUNT] = {
     [A_EMISSIVE] = {"emissive", 0, NULL, "only the emissive-lit scenes: lpvd's FULL frame vs the reference's\n"
                                          "full frame, area lights off and on with 1..64 samples\n"
                                          "(emissive.csv, emissive.md; docs/area-lights.md)"},
+    [A_IV_TABLES] = {"iv-tables", 0, NULL, "the imperfect volumes paper's tables 1 and 2 instead of a sweep:\n"
+                                          "creation ms (CPU point cloud + GPU iv_points) for 3/7/12/19 points\n"
+                                          "per triangle, reprojection ms, AO and GI march ms, shade ms (scenes\n"
+                                          "default cornell,courtyard,blinds,engine; --size default 512x512;\n"
+                                          "--iv-* set the other knobs); iv-tables.md"},
     [A_HELP] = {"help", 'h', NULL, "this text"},
 };
 
@@ -343,7 +349,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick] [--presets]\n"
             "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
-            "                     [--reference PATH] [--no-plot] [lpvd flags: --backend, --camera, ...]\n"
+            "                     [--reference PATH] [--no-plot] [--iv-tables] [lpvd flags: --backend, --camera, ...]\n"
             "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
             "%s(--quick: %d points; --size: default 128x128 here)\n"
             "lpvd flags (all but the swept knobs: --preset, --grid, --iterations, --rsm-size, --occlusion,\n"
@@ -1491,12 +1497,82 @@ static int parse_scenes(const char *list, scene_entry *scenes, char (*paths)[102
     return nscenes;
 }
 
+/* The CPU's model name (/proc/cpuinfo) and core count, for the tables' header. */
+static void cpu_name(char *out, size_t n)
+{
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    char line[512];
+    snprintf(out, n, "unknown CPU");
+    while (f && fgets(line, sizeof line, f)) {
+        char *colon = strchr(line, ':');
+        if (strncmp(line, "model name", 10) == 0 && colon) {
+            line[strcspn(line, "\n")] = '\0';
+            snprintf(out, n, "%s", colon + 2);
+            break;
+        }
+    }
+    if (f)
+        fclose(f);
+    size_t len = strlen(out);
+    snprintf(out + len, n - len, ", %ld cores", sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+/* --iv-tables (iv_tables.h): the paper's tables 1 and 2 on the scenes. */
+static int run_iv_tables(const lpvd_options *opt, const char *out_dir, const char *scene_list, int ticks, int warmup,
+                         int has_points, int argc, char **argv)
+{
+    if (has_points) {
+        fprintf(stderr, "lpvd-accuracy: --iv-tables measures fixed settings: no --knobs, --points, --quick, "
+                        "--presets or --features with it (set knobs with --iv-*)\n");
+        return 2;
+    }
+    static scene_entry scenes[MAX_SCENES];
+    static char paths[MAX_SCENES][1024];
+    int n = parse_scenes(scene_list, scenes, paths);
+    if (n <= 0)
+        return 2;
+    lpv_acc_iv_scene is[MAX_SCENES];
+    for (int i = 0; i < n; ++i) {
+        is[i] = (lpv_acc_iv_scene){.name = scenes[i].name, .path = scenes[i].path, .has_cam = scenes[i].has_cam,
+                                   .fov = scenes[i].fov};
+        memcpy(is[i].eye, scenes[i].eye, sizeof is[i].eye);
+        memcpy(is[i].target, scenes[i].target, sizeof is[i].target);
+    }
+    char err[1024];
+    lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt->backend}, err, sizeof err);
+    if (!ctx) {
+        fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+        return 1;
+    }
+    lpv_engine *engine = lpv_engine_create(err, sizeof err);
+    int rc = 1;
+    if (!engine) {
+        fprintf(stderr, "lpvd-accuracy: %s\n", err);
+    } else {
+        char machine[1024], cpu[256], command[4096];
+        cpu_name(cpu, sizeof cpu);
+        snprintf(machine, sizeof machine, "backend %s, GL_RENDERER %s; CPU %s",
+                 lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), cpu);
+        size_t len = 0;
+        command[0] = '\0';
+        for (int i = 0; i < argc && len < sizeof command; ++i)
+            len += (size_t)snprintf(command + len, sizeof command - len, "%s%s", i ? " " : "", argv[i]);
+        fprintf(stderr, "lpvd-accuracy: --iv-tables: %s\n", machine);
+        lpv_acc_iv_tables_desc d = {.out_dir = out_dir, .opt = opt, .scenes = is, .nscenes = n, .ticks = ticks,
+                                    .warmup = warmup, .machine = machine, .command = command};
+        rc = lpv_acc_iv_tables_run(engine, &d);
+    }
+    lpv_engine_destroy(engine);
+    lpv_gl_context_destroy(ctx);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
     const char *knobs = NULL, *points_arg = NULL;
     int spp = 256, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
-    int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0;
+    int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0, iv_tables = 0;
     int iv_flag_given[LPV_ACC_IV_KNOBS] = {0}; /* --iv-resolution, ...: refused when the knob is swept */
     lpvd_options opt = {0};
     char *cam_args[MAX_PASS];
@@ -1560,6 +1636,7 @@ int main(int argc, char **argv)
         case A_PRESETS: presets = 1; break;
         case A_FEATURES: features = 1; break;
         case A_EMISSIVE: emissive = 1; break;
+        case A_IV_TABLES: iv_tables = 1; break;
         case A_NO_PLOT: no_plot = 1; break;
         case A_OUT: out_dir = v; break;
         case A_SCENES:
@@ -1598,8 +1675,8 @@ int main(int argc, char **argv)
         }
         }
     }
-    if (!size_given)
-        opt.cam.width = opt.cam.height = 128;
+    if (!size_given) /* the paper's table 1 reprojects 512^2 points */
+        opt.cam.width = opt.cam.height = iv_tables ? 512 : 128;
     if (opt.cam.height == 0) {
         fprintf(stderr, "lpvd-accuracy: --size needs WxH\n");
         return 2;
@@ -1628,6 +1705,10 @@ int main(int argc, char **argv)
         lpv_gl_context_destroy(ctx);
         return rc;
     }
+
+    if (iv_tables)
+        return run_iv_tables(&opt, out_dir, scenes_given ? scene_list : "cornell,courtyard,blinds,engine", ticks,
+                             warmup, knobs || points_arg || quick || presets || features, argc, argv);
 
     /* The point set. */
     static point pts[MAX_POINTS];
