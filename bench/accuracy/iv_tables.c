@@ -157,7 +157,8 @@ static void print_tables(FILE *f, const lpv_acc_iv_tables_desc *d, const lpv_set
         fprintf(f, " %.1f |\n", lpv_acc_median(rp, IV_NS));
     }
     fprintf(f, "\nThe clouds (points made; pieces after splitting triangles longer than the split; * = the budget "
-               "lowered the points per piece):\n\n| scene |");
+               "(--iv-max-points) lowered the points per piece to the number given, so T_N measured fewer):\n\n"
+               "| scene |");
     for (int j = 0; j < IV_NS; ++j)
         fprintf(f, " N = %d |", POINTS_N[j]);
     fprintf(f, "\n|:---|");
@@ -167,8 +168,11 @@ static void print_tables(FILE *f, const lpv_acc_iv_tables_desc *d, const lpv_set
     for (int i = 0; i < n; ++i) {
         fprintf(f, "| %s |", rows[i].name);
         for (int j = 0; j < IV_NS; ++j)
-            fprintf(f, " %zu points, %zu pieces%s |", rows[i].cloud[j].points, rows[i].cloud[j].pieces,
-                    rows[i].cloud[j].budget_cut ? " *" : "");
+            if (rows[i].cloud[j].budget_cut)
+                fprintf(f, " %zu points, %zu pieces * (%d per piece) |", rows[i].cloud[j].points,
+                        rows[i].cloud[j].pieces, rows[i].cloud[j].points_per_piece);
+            else
+                fprintf(f, " %zu points, %zu pieces |", rows[i].cloud[j].points, rows[i].cloud[j].pieces);
         fputc('\n', f);
     }
     fprintf(f, "\n## Table 2: marching and reconstruction (ms), iv_ao on, %d points per triangle\n\n", iv->points);
