@@ -1,13 +1,19 @@
 #!/usr/bin/env python3
 """check_results.py - checks an lpvd-accuracy results.csv (the CI sweep).
 
-  check_results.py RESULTS.csv [--scene NAME --better G:I:R:on|off:MODS:TECHNIQUE --worse G:I:R:on|off:MODS:TECHNIQUE] [--rows N]
+  check_results.py RESULTS.csv [--scene NAME --better POINT --worse POINT] [--rows N]
+
+POINT is G:I:R:on|off:MODS:TECHNIQUE for an LPV point, or
+iv:RES:POINTS:RAYS:BOUNCES:on|off:NEIGHBOURS for an imperfect-volume one.
 
 Fails (exit 1) unless every expected column is present and filled with a
 finite value in every row (except preset: empty for a point that equals no
-named preset, else the preset's name), pareto is 0 or 1, at least one row per
-scene is on the front, and (with --better/--worse) the "better" point of --scene has a
-lower rel_rmse than the "worse" one. No timing is asserted. Standard library only.
+named preset, else the preset's name; and for technique iv the LPV's own knobs
+grid, iterations, occlusion and mods, which are empty, while its iv_* columns,
+empty on LPV rows, are filled and its ref_bounces equals its iv_bounces),
+pareto is 0 or 1, at least one row per scene is on the front, and (with
+--better/--worse) the "better" point of --scene has a lower rel_rmse than the
+"worse" one. No timing is asserted. Standard library only.
 """
 import argparse
 import csv
@@ -18,11 +24,18 @@ COLUMNS = ["scene", "grid", "iterations", "rsm", "occlusion", "mods", "technique
            "ms_vpl_extract", "ms_inject", "ms_gbuffer", "ms_gv", "ms_propagate", "ms_shade", "rel_rmse", "rel_bias",
            "ref_noise", "rel_rmse_excess", "rel_mae", "pixels", "pareto"]
 NUMERIC = COLUMNS[7:]
+# The imperfect volume's (technique iv) knobs and stages, after the LPV's columns.
+IV_KNOBS = ["iv_resolution", "iv_points", "iv_rays", "iv_bounces", "iv_reprojection", "iv_neighbours"]
+IV_COLUMNS = IV_KNOBS + ["ms_iv_points", "ms_iv_reproject", "ms_iv_resolve", "ms_iv_gather", "ms_iv_ao",
+                         "ref_bounces", "rel_rmse_1b"]
+LPV_ONLY = {"grid", "iterations", "occlusion", "mods"}  # empty on iv rows
 # preset: the named preset the point equals; legitimately empty for most points.
 OPTIONAL = {"preset": ("fast", "balanced", "accurate")}
 
 
 def key(row):
+    if row["technique"] == "iv":
+        return "iv:" + ":".join(row[c] for c in IV_KNOBS)
     return "%s:%s:%s:%s:%s:%s" % (row["grid"], row["iterations"], row["rsm"], row["occlusion"], row["mods"],
                                   row["technique"])
 
@@ -38,7 +51,7 @@ def main():
     problems = []
     with open(a.csv, newline="") as f:
         reader = csv.DictReader(f)
-        missing = [c for c in COLUMNS + list(OPTIONAL) if c not in (reader.fieldnames or [])]
+        missing = [c for c in COLUMNS + list(OPTIONAL) + IV_COLUMNS if c not in (reader.fieldnames or [])]
         if missing:
             sys.exit("FAIL: %s: missing columns %s" % (a.csv, ", ".join(missing)))
         rows = list(reader)
@@ -47,8 +60,17 @@ def main():
     if not rows:
         problems.append("no rows")
     for n, row in enumerate(rows, start=2):
-        for c in COLUMNS:
+        iv = row.get("technique") == "iv"
+        for c in COLUMNS + (IV_COLUMNS if iv else []):
             v = (row.get(c) or "").strip()
+            if iv and c in LPV_ONLY:
+                if v:
+                    problems.append("line %d: iv row has %s=%r (the LPV's knob; empty expected)" % (n, c, v))
+                continue
+            if c == "iv_reprojection":
+                if v not in ("on", "off"):
+                    problems.append("line %d: iv_reprojection=%r" % (n, v))
+                continue
             if not v:
                 problems.append("line %d: column %s is empty" % (n, c))
             elif c in NUMERIC:
@@ -59,6 +81,11 @@ def main():
                     continue
                 if not math.isfinite(x):
                     problems.append("line %d: %s=%s is not finite" % (n, c, v))
+        if iv and (row.get("ref_bounces") or "").strip() != (row.get("iv_bounces") or "").strip():
+            problems.append("line %d: iv point with iv_bounces=%s compared with a %s-bounce reference"
+                            % (n, row.get("iv_bounces"), row.get("ref_bounces")))
+        if not iv and any((row.get(c) or "").strip() for c in IV_KNOBS):
+            problems.append("line %d: %s row has iv_* knobs filled" % (n, row.get("technique")))
         for c, names in OPTIONAL.items():
             v = (row.get(c) or "").strip()
             if v and v not in names:

@@ -33,6 +33,8 @@
 #include "engine.h"
 #include "hash.h"
 #include "image_io.h"
+#include "iv_knobs.h"
+#include "iv_tables.h"
 #include "metrics.h"
 #include "oracle_octree.h"
 #include "overall.h"
@@ -54,10 +56,14 @@
 #define MAX_TICKS 1000
 #define MAX_PASS 16
 
-/* The stages lpv_engine_stats reports, in CSV column order. */
+/* The stages lpv_engine_stats reports, in CSV column order: the first
+ * NSTAGES_LPV in their old place, the imperfect volume's at the row's end. */
 static const char *const STAGES[] = {"rsm",   "vpl_extract", "inject", "gbuffer",    "gv",   "propagate",
-                                     "shade", "emissive",    "pack",   "downsample", "merge"};
+                                     "shade", "emissive",    "pack",   "downsample", "merge",
+                                     "iv_points", "iv_reproject", "iv_resolve", "iv_gather", "iv_ao"};
 #define NSTAGES ((int)(sizeof STAGES / sizeof STAGES[0]))
+#define NSTAGES_LPV 11
+enum { ST_GV = 4, ST_PROPAGATE = 5, ST_SHADE = 6, ST_IV_POINTS = 11, ST_IV_REPROJECT, ST_IV_RESOLVE, ST_IV_GATHER };
 
 /* The full factorial's default values (--knobs replaces any list). RSM and
  * occlusion stay at 128^2 / on by default: the first sweep (docs/accuracy.md,
@@ -84,7 +90,12 @@ typedef struct point {
     float damping;      /* 0 = off */
     char label[32];     /* the features block's name of the point */
     lpv_technique_id technique; /* 0 (DEFAULT): the cascaded LPV */
+    /* technique iv: its knobs (0 = --iv-* or the engine's default); of the
+     * LPV's knobs only rsm applies (the lights' shadow maps) */
+    lpv_acc_iv_knobs iv;
 } point;
+
+static int is_iv(const point *p) { return p->technique == LPV_TECHNIQUE_ID_IV; }
 
 /* --features: the knob varied, around the balanced preset with one grid over
  * the scene (cascades 1), bounces off, damping 0. "cascades 3" uses the
@@ -189,7 +200,7 @@ typedef struct result {
     int scene;
     point p;
     double ms_total;
-    double stage_ms[12];
+    double stage_ms[NSTAGES];
     lpv_acc_metrics m;
     int pareto;
     int cascades_used;          /* lpv_engine_cascade_count after the point's ticks */
@@ -199,6 +210,7 @@ typedef struct result {
     double black, constant;     /* the baselines' rel_rmse (lpv_acc_baselines) */
     double region_share[LPV_ACC_REGIONS], region_rmse[LPV_ACC_REGIONS], region_ratio[LPV_ACC_REGIONS];
     lpv_octree_error octree;    /* the octree technique's own metric (thesis 6.2); elements 0 otherwise */
+    lpv_acc_iv_knobs iv;        /* technique iv: the knobs it ran with (resolved) */
 } result;
 
 /* The thesis' correctness metric (section 6.2) on the octree the GPU
@@ -259,11 +271,14 @@ typedef struct scene_entry {
     float eye[3], target[3], fov;
     float cascade_size; /* m, for --features' "cascades-3" (0: auto) */
     int scale_free;     /* a real scene in its own units (engine: millimetres) */
+    int nxref;          /* the iv points' B-bounce references (B > 1), for results.md */
+    int xref_bounces[LPV_IV_MAX_BOUNCES];
+    char xref_exr[LPV_IV_MAX_BOUNCES][1024];
 } scene_entry;
 
 enum {
     A_OUT, A_REF_SPP, A_SCENES, A_QUICK, A_PRESETS, A_FEATURES, A_MULTI_BOUNCES, A_KNOBS, A_POINTS,
-    A_TICKS, A_WARMUP, A_REFERENCE, A_NO_PLOT, A_EMISSIVE, A_HELP, A_COUNT
+    A_TICKS, A_WARMUP, A_REFERENCE, A_NO_PLOT, A_EMISSIVE, A_IV_TABLES, A_HELP, A_COUNT
 };
 
 static const lpv_flag FLAGS[A_COUNT] = {
@@ -287,8 +302,16 @@ static const lpv_flag FLAGS[A_COUNT] = {
     [A_KNOBS] = {"knobs", 0, "SPEC", "the factorial's values per knob (any given list replaces the default), e.g.\n"
                                      "grid=16/32,iterations=8,rsm=256,occlusion=on,central=on,bins=off/on,\n"
                                      "far=on,surfels=on (mods: central transport, normal bins, far field,\n"
-                                     "scene surfels)"},
-    [A_POINTS] = {"points", 0, "LIST", "explicit points GRID:ITER:RSM:on|off[:MODS], MODS letters of cbfs"},
+                                     "scene surfels), technique=lpv/octree/iv; the imperfect volume's\n"
+                                     "iv_resolution=16/32,iv_points=1/8,iv_rays=32/64,iv_bounces=1/3,\n"
+                                     "iv_reprojection=on/off,iv_neighbours=6/8 make a factorial of iv points\n"
+                                     "(unnamed iv knobs: --iv-* or the engine's default; rsm applies to every\n"
+                                     "technique, the other LPV knobs only to lpv/octree points); iv knobs\n"
+                                     "alone imply technique=iv"},
+    [A_POINTS] = {"points", 0, "LIST", "explicit points GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]] (MODS letters\n"
+                                       "of cbfs) or iv[:RES:POINTS:RAYS:BOUNCES:REPROJ:NEIGHBOURS], e.g.\n"
+                                       "iv:32:8:64:3:on:8 or iv:16:-:100 (a field left out or '-': --iv-* or\n"
+                                       "the default; RSM 128)"},
     [A_TICKS] = {"ticks", 0, "N", "timed ticks per point, median reported (default 5)"},
     [A_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 2)"},
     [A_REFERENCE] = {"reference", 0, "PATH", "run this reference command (lpvd-reference's CLI) instead of the\n"
@@ -298,6 +321,11 @@ static const lpv_flag FLAGS[A_COUNT] = {
     [A_EMISSIVE] = {"emissive", 0, NULL, "only the emissive-lit scenes: lpvd's FULL frame vs the reference's\n"
                                          "full frame, area lights off and on with 1..64 samples\n"
                                          "(emissive.csv, emissive.md; docs/area-lights.md)"},
+    [A_IV_TABLES] = {"iv-tables", 0, NULL, "the imperfect volumes paper's tables 1 and 2 instead of a sweep:\n"
+                                          "creation ms (CPU point cloud + GPU iv_points) for 3/7/12/19 points\n"
+                                          "per triangle, reprojection ms, AO and GI march ms, shade ms (scenes\n"
+                                          "default cornell,courtyard,blinds,engine; --size default 512x512;\n"
+                                          "--iv-* set the other knobs); iv-tables.md"},
     [A_HELP] = {"help", 'h', NULL, "this text"},
 };
 
@@ -321,11 +349,12 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick] [--presets]\n"
             "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
-            "                     [--reference PATH] [--no-plot] [lpvd flags: --backend, --camera, ...]\n"
+            "                     [--reference PATH] [--no-plot] [--iv-tables] [lpvd flags: --backend, --camera, ...]\n"
             "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
             "%s(--quick: %d points; --size: default 128x128 here)\n"
             "lpvd flags (all but the swept knobs: --preset, --grid, --iterations, --rsm-size, --occlusion,\n"
-            "--central-transport, --normal-bins, --far-field, --scene-surfels):\n%s",
+            "--central-transport, --normal-bins, --far-field, --scene-surfels; an --iv-* knob only while\n"
+            "--knobs or --points does not sweep it):\n%s",
             help, (int)(sizeof QUICK / sizeof QUICK[0]), LPVD_OPTIONS_HELP);
 }
 
@@ -405,7 +434,23 @@ typedef struct knob_filter {
     int grid[16], ngrid, iter[16], niter, rsm[16], nrsm, occ[2], nocc;
     int sw[4][2], nsw[4]; /* central, bins, far, surfels: off/on */
     int tech[LPV_TECHNIQUE_ID_COUNT_], ntech; /* lpv_technique_id */
+    int iv[LPV_ACC_IV_KNOBS][16], niv[LPV_ACC_IV_KNOBS]; /* technique iv's knobs (iv_knobs.h) */
 } knob_filter;
+
+/* Whether the filter names one of the LPV's own knobs (not rsm: the imperfect
+ * volume's shadow maps are RSMs too), or one of the imperfect volume's. */
+static int names_lpv_knob(const knob_filter *kf)
+{
+    return kf->ngrid || kf->niter || kf->nocc || kf->nsw[0] || kf->nsw[1] || kf->nsw[2] || kf->nsw[3];
+}
+
+static int names_iv_knob(const knob_filter *kf)
+{
+    for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k)
+        if (kf->niv[k])
+            return 1;
+    return 0;
+}
 
 static const char *const MOD_KNOBS[4] = {"central", "bins", "far", "surfels"};
 
@@ -439,6 +484,9 @@ static int parse_knobs(const char *spec, knob_filter *kf)
                 kf->tech[kf->ntech++] = (int)id;
             }
             r = kf->ntech > 0 ? kf->ntech : -1;
+        } else if (lpv_acc_iv_knob_from_name(tok) >= 0) {
+            const int ik = lpv_acc_iv_knob_from_name(tok);
+            r = kf->niv[ik] = lpv_acc_iv_parse_list(ik, v, kf->iv[ik], 16);
         } else {
             r = -1;
             for (int m = 0; m < 4; ++m)
@@ -453,7 +501,10 @@ static int parse_knobs(const char *spec, knob_filter *kf)
     return 0;
 }
 
-static int parse_points(const char *list, point *pts, int max)
+/* --points: "GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]]" or the imperfect
+ * volume's "iv[:RES:POINTS:RAYS:BOUNCES:REPROJ:NEIGHBOURS]" (iv_knobs.h),
+ * comma-separated. Returns the count, or -1 with err set. */
+static int parse_points(const char *list, point *pts, int max, char *err, size_t err_size)
 {
     int n = 0;
     char buf[4096];
@@ -461,9 +512,22 @@ static int parse_points(const char *list, point *pts, int max)
     for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         char occ[8] = "", mods[8] = "", tech[16] = "";
         point p = {0};
-        int got = n < max ? sscanf(tok, "%d:%d:%d:%7[a-z]:%7[-a-z]:%15s", &p.grid, &p.iterations, &p.rsm, occ, mods,
-                                   tech)
-                          : 0;
+        if (n >= max) {
+            snprintf(err, err_size, "at most %d points", max);
+            return -1;
+        }
+        int iv = lpv_acc_iv_parse_point(tok, &p.iv, err, err_size);
+        if (iv < 0)
+            return -1;
+        if (iv > 0) { /* RSM as the sweep's default (RSMS) */
+            p.technique = LPV_TECHNIQUE_ID_IV;
+            p.rsm = RSMS[0];
+            pts[n++] = p;
+            continue;
+        }
+        snprintf(err, err_size, "%s: expected GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]] or "
+                                "iv[:RES:POINTS:RAYS:BOUNCES:REPROJ:NEIGHBOURS]", tok);
+        int got = sscanf(tok, "%d:%d:%d:%7[a-z]:%7[-a-z]:%15s", &p.grid, &p.iterations, &p.rsm, occ, mods, tech);
         if (got < 4)
             return -1;
         lpv_technique_id id = LPV_TECHNIQUE_ID_LPV;
@@ -486,8 +550,12 @@ static int parse_points(const char *list, point *pts, int max)
         if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192 ||
             !technique_runs(&p))
             return -1;
+        if (is_iv(&p)) /* the old form with technique iv: its RSM, the iv knobs' defaults */
+            p = (point){.rsm = p.rsm, .technique = LPV_TECHNIQUE_ID_IV};
         pts[n++] = p;
     }
+    if (n == 0)
+        snprintf(err, err_size, "--points is empty");
     return n > 0 ? n : -1;
 }
 
@@ -692,27 +760,104 @@ static const char *occ_name(int on)
     return on ? "on" : "off";
 }
 
+/* A tone-mapped preview next to a reference EXR (PATH.exr -> PATH.png). */
+static void write_preview(const char *exr, const float *img, int w, int h)
+{
+    size_t np = (size_t)w * (size_t)h;
+    uint8_t *px = malloc(np * 4);
+    char prev[1100], err[512];
+    snprintf(prev, sizeof prev, "%.*s.png", (int)strlen(exr) - 4, exr);
+    if (px) {
+        lpv_tonemap_rgba8(img, np, 1.0f, px);
+        if (lpv_image_write_u8(prev, w, h, 4, px, err, sizeof err) != 0)
+            fprintf(stderr, "lpvd-accuracy: %s\n", err);
+        free(px);
+    }
+}
+
+/* What a reference is rendered with, beside the scene and the view. */
+typedef struct ref_source {
+    const char *out_dir, *cmd; /* cmd NULL: the linked library */
+    int spp, area_lights, ncam;
+    char *const *cam_args;
+} ref_source;
+
+/* The B-bounce reference (B > 1) an imperfect-volume point with B bounces is
+ * compared with: rendered once per scene and bounce count and cached under
+ * OUT/ref like the multi-bounce one (ensure_reference), read into *img and
+ * *se_img (NULL when it has none) on first use. Returns *img, NULL when it
+ * cannot be had. */
+static const float *bounce_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view,
+                                     const ref_source *src, int bounces, float **img, float **se_img)
+{
+    if (*img)
+        return *img;
+    char err[1024];
+    int w = 0, h = 0;
+    if (ensure_reference(e, scene, view, src->out_dir, src->spp, src->cmd, src->cam_args, src->ncam, bounces,
+                         src->area_lights) != 0 ||
+        lpv_image_read_f32(e->mref_exr, 4, &w, &h, img, err, sizeof err) != 0 || w != view->width ||
+        h != view->height) {
+        fprintf(stderr, "lpvd-accuracy: %s: no %d-bounce reference\n", e->name, bounces);
+        free(*img);
+        *img = NULL;
+        return NULL;
+    }
+    if (e->have_mse &&
+        (lpv_image_read_f32(e->mref_se, 4, &w, &h, se_img, err, sizeof err) != 0 || w != view->width ||
+         h != view->height)) {
+        free(*se_img);
+        *se_img = NULL;
+    }
+    write_preview(e->mref_exr, *img, w, h);
+    if (e->nxref < LPV_IV_MAX_BOUNCES) {
+        e->xref_bounces[e->nxref] = bounces;
+        snprintf(e->xref_exr[e->nxref++], sizeof e->xref_exr[0], "%s", e->mref_exr);
+    }
+    return *img;
+}
+
+/* "on"/"off" of an lpv_switch value (iv_reprojection). */
+static const char *switch_name(int v)
+{
+    return v == LPV_SWITCH_ON ? "on" : v == LPV_SWITCH_OFF ? "off" : "default";
+}
+
+/* The CSV: the LPV's columns in their old order (an iv point leaves the
+ * LPV's own knobs, grid to mods and bounces, empty), then the imperfect
+ * volume's knobs and stages (empty and 0 for LPV points). */
 static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes)
 {
     fprintf(f, "scene,grid,iterations,rsm,occlusion,mods,technique,ms_per_tick");
-    for (int k = 0; k < NSTAGES; ++k)
+    for (int k = 0; k < NSTAGES_LPV; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
     fprintf(f, ",rel_rmse,rel_bias,ref_noise,rel_rmse_excess,rel_mae,pixels,pareto,preset");
     fprintf(f, ",block,label,cascades,cascade_size,bounces,damping,ref_bounces,rel_rmse_1b,rel_rmse_multi");
     fprintf(f, ",black_rmse,constant_rmse,share_floor,share_ceiling,share_walls,rmse_floor,rmse_ceiling,rmse_walls,"
-               "ratio_floor,ratio_ceiling,ratio_walls,octree_e_abs,octree_e_rel,octree_mean_rel\n");
+               "ratio_floor,ratio_ceiling,ratio_walls,octree_e_abs,octree_e_rel,octree_mean_rel");
+    for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k)
+        fprintf(f, ",%s", lpv_acc_iv_knob_name(k));
+    for (int k = NSTAGES_LPV; k < NSTAGES; ++k)
+        fprintf(f, ",ms_%s", STAGES[k]);
+    fputc('\n', f);
     for (int i = 0; i < n; ++i) {
         char mb[5];
-        fprintf(f, "%s,%d,%d,%d,%s,%s,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations, r[i].p.rsm,
-                occ_name(r[i].p.occlusion), mods_name(r[i].p.mods, mb), tech_name(r[i].p.technique), r[i].ms_total);
-        for (int k = 0; k < NSTAGES; ++k)
+        const int iv = is_iv(&r[i].p);
+        if (iv)
+            fprintf(f, "%s,,,%d,,,%s,%.3f", scenes[r[i].scene].name, r[i].p.rsm, tech_name(r[i].p.technique),
+                    r[i].ms_total);
+        else
+            fprintf(f, "%s,%d,%d,%d,%s,%s,%s,%.3f", scenes[r[i].scene].name, r[i].p.grid, r[i].p.iterations,
+                    r[i].p.rsm, occ_name(r[i].p.occlusion), mods_name(r[i].p.mods, mb), tech_name(r[i].p.technique),
+                    r[i].ms_total);
+        for (int k = 0; k < NSTAGES_LPV; ++k)
             fprintf(f, ",%.3f", r[i].stage_ms[k]);
         fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%zu,%d,%s", r[i].m.rel_rmse, r[i].m.rel_bias, r[i].m.ref_noise,
                 r[i].m.rel_rmse_excess, r[i].m.rel_mae, r[i].m.pixels, r[i].pareto,
                 r[i].p.feat ? "" : point_preset(&r[i].p));
         fprintf(f, ",%s,%s,%d,%g,%s,%g,%d,%.5f,", r[i].p.feat ? "features" : "sweep", r[i].p.label,
-                r[i].cascades_used, (double)r[i].p.cascade_size, occ_name(r[i].p.bounces), (double)r[i].p.damping,
-                r[i].ref_bounces, r[i].rel_rmse_1b);
+                r[i].cascades_used, (double)r[i].p.cascade_size, iv ? "" : occ_name(r[i].p.bounces),
+                (double)r[i].p.damping, r[i].ref_bounces, r[i].rel_rmse_1b);
         if (isfinite(r[i].rel_rmse_multi))
             fprintf(f, "%.5f", r[i].rel_rmse_multi);
         fprintf(f, ",%.5f,%.5f", r[i].black, r[i].constant);
@@ -726,6 +871,16 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
             fprintf(f, ",%.6g,%.6g,%.6g", r[i].octree.e_abs, r[i].octree.e_rel, r[i].octree.mean_rel);
         else
             fprintf(f, ",,,");
+        for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k) {
+            if (!iv)
+                fputc(',', f);
+            else if (k == LPV_ACC_IV_REPROJECTION)
+                fprintf(f, ",%s", switch_name(r[i].iv.v[k]));
+            else
+                fprintf(f, ",%d", r[i].iv.v[k]);
+        }
+        for (int k = NSTAGES_LPV; k < NSTAGES; ++k)
+            fprintf(f, ",%.3f", r[i].stage_ms[k]);
         fputc('\n', f);
     }
 }
@@ -747,13 +902,92 @@ static int scene_rows(const result *r, int n, int scene, const result **rows)
     return k;
 }
 
+/* A "-" for a knob or stage the row's technique does not have. */
+static void md_cell_int(FILE *f, int have, int v, const char *b)
+{
+    if (have)
+        fprintf(f, " %s%d%s |", b, v, b);
+    else
+        fprintf(f, " - |");
+}
+
+static void md_cell_ms(FILE *f, int have, double v)
+{
+    if (have)
+        fprintf(f, " %.2f |", v);
+    else
+        fprintf(f, " - |");
+}
+
+/* One scene's table when it has imperfect-volume rows: the LPV's columns
+ * ("-" on iv rows) only when LPV rows are there too, then the iv knobs and
+ * stages ("-" on LPV rows), the reference's bounces and the error against
+ * the 1-bounce reference. */
+static void write_md_iv_table(FILE *f, const result *const *rows, int k)
+{
+    int has_lpv = 0;
+    for (int i = 0; i < k; ++i)
+        has_lpv |= !is_iv(&rows[i]->p);
+    fprintf(f, "| technique |%s RSM |%s iv res. | points | rays | bounces | reproj. | nbrs | ms/tick |%s points ms "
+               "| reproject ms | resolve ms | gather ms | shade ms | ref. bounces | rel. RMSE | vs 1-bounce ref "
+               "| rel. bias | rel. MAE | ref. noise | Pareto |\n",
+            has_lpv ? " grid | iterations |" : "", has_lpv ? " occlusion | mods | preset |" : "",
+            has_lpv ? " propagate ms | gv ms |" : "");
+    fprintf(f, "|:---:|%s---:|%s---:|---:|---:|---:|:---:|---:|---:|%s---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+               "---:|---:|:---:|\n",
+            has_lpv ? "---:|---:|" : "", has_lpv ? ":---:|:---:|:---:|" : "", has_lpv ? "---:|---:|" : "");
+    for (int i = 0; i < k; ++i) {
+        const result *x = rows[i];
+        const int iv = is_iv(&x->p);
+        const char *b = x->pareto ? "**" : "";
+        fprintf(f, "| %s |", tech_name(x->p.technique));
+        if (has_lpv) {
+            if (iv)
+                fprintf(f, " - | - |");
+            else
+                fprintf(f, " %s%d³%s | %d |", b, x->p.grid, b, x->p.iterations);
+        }
+        fprintf(f, " %d² |", x->p.rsm);
+        if (has_lpv) {
+            if (iv)
+                fprintf(f, " - | - | |");
+            else
+                fprintf(f, " %s | `%s` | %s |", occ_name(x->p.occlusion), mods_name(x->p.mods, (char[5]){0}),
+                        point_preset(&x->p));
+        }
+        if (iv)
+            fprintf(f, " %s%d³%s |", b, x->iv.v[LPV_ACC_IV_RESOLUTION], b);
+        else
+            fprintf(f, " - |");
+        md_cell_int(f, iv, x->iv.v[LPV_ACC_IV_POINTS], "");
+        md_cell_int(f, iv, x->iv.v[LPV_ACC_IV_RAYS], "");
+        md_cell_int(f, iv, x->iv.v[LPV_ACC_IV_BOUNCES], "");
+        fprintf(f, " %s |", iv ? switch_name(x->iv.v[LPV_ACC_IV_REPROJECTION]) : "-");
+        md_cell_int(f, iv, x->iv.v[LPV_ACC_IV_NEIGHBOURS], "");
+        fprintf(f, " %s%.2f%s |", b, x->ms_total, b);
+        if (has_lpv) {
+            md_cell_ms(f, !iv, x->stage_ms[ST_PROPAGATE]);
+            md_cell_ms(f, !iv, x->stage_ms[ST_GV]);
+        }
+        for (int st = ST_IV_POINTS; st <= ST_IV_GATHER; ++st)
+            md_cell_ms(f, iv, x->stage_ms[st]);
+        fprintf(f, " %.2f | %d | %s%.3f%s | %.3f | %+.3f | %.3f | %.3f | %s |\n", x->stage_ms[ST_SHADE], x->ref_bounces,
+                b, x->m.rel_rmse, b, x->rel_rmse_1b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
+                x->pareto ? "**◆**" : "");
+    }
+    fputc('\n', f);
+}
+
 static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes, int nscenes, const char *header)
 {
     fprintf(f, "# lpvd accuracy sweep\n\n%s\n", header);
     fprintf(f, "Error metrics: docs/accuracy.md. ms/tick: median GPU ms of one tick + the indirect-only render "
                "(sum of the stages). Pareto: no other point of the scene is both faster and more accurate "
                "(rel. RMSE). Rows sorted by ms/tick; Pareto rows marked **◆**; preset: the named preset "
-               "(`--preset`) the point equals.\n\n");
+               "(`--preset`) the point equals. Imperfect-volume (iv) points: rel. RMSE against the reference with "
+               "as many bounces as the point's iv_bounces (ref. bounces), and against the 1-bounce one beside it; "
+               "stage ms are the medians of iv_points, iv_reproject, iv_resolve, iv_gather (all bounces) and "
+               "shade.\n\n");
     const result **rows = malloc((size_t)n * sizeof *rows);
     if (!rows)
         return;
@@ -802,7 +1036,18 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
         if (k == 0)
             continue;
         fprintf(f, "## %s\n\n", scenes[s].name);
-        fprintf(f, "reference: `%s`%s\n\n", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
+        fprintf(f, "reference: `%s`%s", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
+        for (int j = 0; j < scenes[s].nxref; ++j)
+            fprintf(f, "; %d bounces (iv points with %d bounces): `%s`", scenes[s].xref_bounces[j],
+                    scenes[s].xref_bounces[j], scenes[s].xref_exr[j]);
+        fprintf(f, "\n\n");
+        int has_iv = 0;
+        for (int i = 0; i < k; ++i)
+            has_iv |= is_iv(&rows[i]->p);
+        if (has_iv) {
+            write_md_iv_table(f, rows, k);
+            continue;
+        }
         fprintf(f, "| technique | grid | iterations | RSM | occlusion | mods | preset | ms/tick | propagate ms | gv ms "
                    "| rel. RMSE | rel. bias | rel. MAE | ref. noise | Pareto |\n");
         fprintf(f, "|:---:|---:|---:|---:|:---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
@@ -1032,12 +1277,25 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         return -1;
     }
     size_t nrows = 0;
-    for (int i = 0; i < n; ++i) /* the classic sweep's points only: features share their four knobs */
-        if (!r[i].p.feat)
-            rows[nrows++] = (lpv_acc_row){r[i].scene,
-                                          {r[i].p.grid, r[i].p.iterations, r[i].p.rsm, r[i].p.occlusion, r[i].p.mods,
-                                           (int)r[i].p.technique},
-                                          r[i].ms_total, r[i].m.rel_rmse};
+    int has_iv = 0, has_lpv = 0;
+    for (int i = 0; i < n; ++i) { /* the classic sweep's points only: features share their four knobs */
+        if (r[i].p.feat)
+            continue;
+        lpv_acc_row row = {r[i].scene, {0}, r[i].ms_total, r[i].m.rel_rmse};
+        row.key[2] = r[i].p.rsm;
+        row.key[LPV_ACC_KEY_TECHNIQUE] = (int)r[i].p.technique;
+        if (is_iv(&r[i].p)) {
+            memcpy(row.key + LPV_ACC_KEY_IV, r[i].iv.v, sizeof r[i].iv.v);
+            has_iv = 1;
+        } else {
+            row.key[0] = r[i].p.grid;
+            row.key[1] = r[i].p.iterations;
+            row.key[3] = r[i].p.occlusion;
+            row.key[4] = r[i].p.mods;
+            has_lpv = 1;
+        }
+        rows[nrows++] = row;
+    }
     if (nrows == 0) {
         free(rows);
         free(o);
@@ -1058,15 +1316,27 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
                     "scenes and normalised RMSE = mean over the scenes of rel. RMSE / the scene's best rel. RMSE "
                     "(1 = the best of this sweep on every scene; docs/accuracy.md). The presets are chosen from "
                     "this front. mods: the departures from the paper switched on, c = central transport, b = "
-                    "normal bins, f = far field, s = scene surfels (docs/propagation.md).\n\n| technique | grid | "
-                    "iterations | RSM | occlusion | mods | preset | mean ms/tick | normalised RMSE |");
+                    "normal bins, f = far field, s = scene surfels (docs/propagation.md).%s\n\n| technique |",
+                has_iv ? " iv: the imperfect volume (resolution, points per triangle, rays per voxel, bounces, "
+                         "reprojection, neighbours), its rel. RMSE against the reference with its bounces." : "");
+        if (has_lpv)
+            fprintf(md, " grid | iterations | RSM | occlusion | mods | preset |");
+        else
+            fprintf(md, " RSM |");
+        if (has_iv)
+            fprintf(md, " iv res. | points | rays | bounces | reproj. | nbrs |");
+        fprintf(md, " mean ms/tick | normalised RMSE |");
         fprintf(csv, "grid,iterations,rsm,occlusion,mods,technique,mean_ms_per_tick,norm_rmse");
         for (int s = 0; s < nscenes; ++s) {
             fprintf(md, " %s rel. RMSE |", scenes[s].name);
             fprintf(csv, ",rel_rmse_%s", scenes[s].name);
         }
-        fprintf(md, " Pareto |\n|:---:|---:|---:|---:|:---:|:---:|:---:|---:|---:|");
-        fprintf(csv, ",pareto,preset\n");
+        fprintf(md, " Pareto |\n|:---:|%s%s---:|---:|", has_lpv ? "---:|---:|---:|:---:|:---:|:---:|" : "---:|",
+                has_iv ? "---:|---:|---:|---:|:---:|---:|" : "");
+        fprintf(csv, ",pareto,preset");
+        for (int j = 0; j < LPV_ACC_IV_KNOBS; ++j)
+            fprintf(csv, ",%s", lpv_acc_iv_knob_name(j));
+        fputc('\n', csv);
         for (int s = 0; s < nscenes; ++s)
             fprintf(md, "---:|");
         fprintf(md, ":---:|\n");
@@ -1074,19 +1344,49 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         for (size_t j = 0; j < k; ++j) {
             const lpv_acc_overall *x = &o[j];
             const char *b = x->pareto ? "**" : "", *pre = key_preset(x->key);
-            char mb[5];
-            fprintf(md, "| %s | %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %s%.3f%s |", tech_name(x->key[5]), b,
-                    x->key[0], b, x->key[1], x->key[2], occ_name(x->key[3]), mods_name(x->key[4], mb), pre, b, x->ms, b,
-                    b, x->norm_rmse, b);
-            fprintf(csv, "%d,%d,%d,%s,%s,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), mb,
-                    tech_name(x->key[5]), x->ms, x->norm_rmse);
+            const int iv = x->key[LPV_ACC_KEY_TECHNIQUE] == LPV_TECHNIQUE_ID_IV;
+            const int *ivk = x->key + LPV_ACC_KEY_IV;
+            char mb[5] = "";
+            if (!iv)
+                mods_name(x->key[4], mb);
+            fprintf(md, "| %s |", tech_name(x->key[LPV_ACC_KEY_TECHNIQUE]));
+            if (has_lpv && iv)
+                fprintf(md, " - | - | %d² | - | - | |", x->key[2]);
+            else if (has_lpv)
+                fprintf(md, " %s%d³%s | %d | %d² | %s | `%s` | %s |", b, x->key[0], b, x->key[1], x->key[2],
+                        occ_name(x->key[3]), mb, pre);
+            else
+                fprintf(md, " %d² |", x->key[2]);
+            if (has_iv && iv)
+                fprintf(md, " %s%d³%s | %d | %d | %d | %s | %d |", b, ivk[LPV_ACC_IV_RESOLUTION], b,
+                        ivk[LPV_ACC_IV_POINTS], ivk[LPV_ACC_IV_RAYS], ivk[LPV_ACC_IV_BOUNCES],
+                        switch_name(ivk[LPV_ACC_IV_REPROJECTION]), ivk[LPV_ACC_IV_NEIGHBOURS]);
+            else if (has_iv)
+                fprintf(md, " - | - | - | - | - | - |");
+            fprintf(md, " %s%.2f%s | %s%.3f%s |", b, x->ms, b, b, x->norm_rmse, b);
+            if (iv)
+                fprintf(csv, ",,%d,,,%s,%.4f,%.5f", x->key[2], tech_name(x->key[LPV_ACC_KEY_TECHNIQUE]), x->ms,
+                        x->norm_rmse);
+            else
+                fprintf(csv, "%d,%d,%d,%s,%s,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), mb,
+                        tech_name(x->key[LPV_ACC_KEY_TECHNIQUE]), x->ms, x->norm_rmse);
             for (int s = 0; s < nscenes; ++s) {
                 fprintf(md, " %.3f |", x->rel_rmse[s]);
                 fprintf(csv, ",%.5f", x->rel_rmse[s]);
             }
             fprintf(md, " %s |\n", x->pareto ? "**◆**" : "");
-            fprintf(csv, ",%d,%s\n", x->pareto, pre);
-            fprintf(dat, "%.4f %.5f %d %s %s\n", x->ms, x->norm_rmse, x->pareto, *pre ? pre : "-", tech_name(x->key[5]));
+            fprintf(csv, ",%d,%s", x->pareto, pre);
+            for (int q = 0; q < LPV_ACC_IV_KNOBS; ++q) {
+                if (!iv)
+                    fputc(',', csv);
+                else if (q == LPV_ACC_IV_REPROJECTION)
+                    fprintf(csv, ",%s", switch_name(ivk[q]));
+                else
+                    fprintf(csv, ",%d", ivk[q]);
+            }
+            fputc('\n', csv);
+            fprintf(dat, "%.4f %.5f %d %s %s\n", x->ms, x->norm_rmse, x->pareto, *pre ? pre : "-",
+                    tech_name(x->key[LPV_ACC_KEY_TECHNIQUE]));
         }
         fputc('\n', md);
     }
@@ -1128,6 +1428,8 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
                "title 'lpv (cascaded LPV)', \\\n"
                "  'plot/overall.dat' using 1:(stringcolumn(5) eq 'octree' ? $2 : 1/0) with points pt 9 ps 1.1 lc 4 "
                "title 'octree LPV', \\\n"
+               "  'plot/overall.dat' using 1:(stringcolumn(5) eq 'iv' ? $2 : 1/0) with points pt 5 ps 0.9 lc 7 "
+               "title 'imperfect volumes (iv)', \\\n"
                "  'plot/overall-pareto.dat' using 1:2 with linespoints pt 6 ps 1.6 lw 2 lc 2 "
                "title 'Pareto front', \\\n"
                "  'plot/overall.dat' using 1:2:(stringcolumn(4) eq '-' ? '' : stringcolumn(4)) with labels left "
@@ -1138,12 +1440,140 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     return run_gnuplot(out_dir, "overall");
 }
 
+/* The scenes of a --scenes list (names or paths) into scenes[] (paths[]
+ * holds their files). Returns the count, or -1 after saying why. */
+static int parse_scenes(const char *list, scene_entry *scenes, char (*paths)[1024])
+{
+    int nscenes = 0;
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", list);
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (nscenes >= MAX_SCENES) {
+            fprintf(stderr, "lpvd-accuracy: at most %d scenes\n", MAX_SCENES);
+            return -1;
+        }
+        scene_entry *e = &scenes[nscenes];
+        const char *base = strrchr(tok, '/') ? strrchr(tok, '/') + 1 : tok;
+        snprintf(e->name, sizeof e->name, "%s", base);
+        char *dot = strrchr(e->name, '.');
+        int is_file = strchr(tok, '/') || (dot && (strcmp(dot, ".glb") == 0 || strcmp(dot, ".gltf") == 0));
+        if (dot)
+            *dot = '\0';
+        for (char *c = e->name; *c; ++c)
+            if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+                  *c == '-' || *c == '_'))
+                *c = '_';
+        if (is_file) {
+            snprintf(paths[nscenes], sizeof paths[nscenes], "%s", tok);
+            e->path = paths[nscenes];
+        } else if (strcmp(tok, "cornell") == 0) {
+            e->path = NULL;
+        } else if (strcmp(tok, "engine") == 0 || strcmp(tok, "clearcoat") == 0) {
+            /* real scenes the project did not write (scripts/install-deps.sh installs them) */
+            snprintf(paths[nscenes], sizeof paths[nscenes], "%s/%s", ASSIMP_GLTF2_DIR,
+                     strcmp(tok, "engine") == 0 ? "2CylinderEngine-glTF-Binary/2CylinderEngine.glb"
+                                                : "ClearCoat-glTF/ClearCoatTest.gltf");
+            e->path = paths[nscenes];
+            e->scale_free = 1;
+        } else if (strcmp(tok, "cornell-inside") == 0) {
+            /* the built-in box seen from inside its opening: the box's own
+             * camera stands 2.9 m in front of it, and camera-following
+             * cascades of 1 m would then hold no geometry */
+            e->path = NULL;
+            e->has_cam = 1;
+            e->eye[0] = 0.0f, e->eye[1] = 1.0f, e->eye[2] = 0.9f;
+            e->target[0] = 0.0f, e->target[1] = 1.0f, e->target[2] = -1.0f;
+            e->fov = 70.0f;
+        } else {
+            snprintf(paths[nscenes], sizeof paths[nscenes], "%s/%s.glb", LPVD_ACCURACY_SCENES_DIR,
+                     tok);
+            e->path = paths[nscenes];
+        }
+        /* "cascades-3" of --features: a finest cascade well inside the scene */
+        e->cascade_size = e->scale_free ? 0.0f /* auto: a quarter of the scene */
+                          : e->path == NULL ? 1.0f : strcmp(e->name, "blinds") == 0 ? 4.0f : 8.0f;
+        ++nscenes;
+    }
+    return nscenes;
+}
+
+/* The CPU's model name (/proc/cpuinfo) and core count, for the tables' header. */
+static void cpu_name(char *out, size_t n)
+{
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    char line[512];
+    snprintf(out, n, "unknown CPU");
+    while (f && fgets(line, sizeof line, f)) {
+        char *colon = strchr(line, ':');
+        if (strncmp(line, "model name", 10) == 0 && colon) {
+            line[strcspn(line, "\n")] = '\0';
+            snprintf(out, n, "%s", colon + 2);
+            break;
+        }
+    }
+    if (f)
+        fclose(f);
+    size_t len = strlen(out);
+    snprintf(out + len, n - len, ", %ld cores", sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+/* --iv-tables (iv_tables.h): the paper's tables 1 and 2 on the scenes. */
+static int run_iv_tables(const lpvd_options *opt, const char *out_dir, const char *scene_list, int ticks, int warmup,
+                         int has_points, int argc, char **argv)
+{
+    if (has_points) {
+        fprintf(stderr, "lpvd-accuracy: --iv-tables measures fixed settings: no --knobs, --points, --quick, "
+                        "--presets or --features with it (set knobs with --iv-*)\n");
+        return 2;
+    }
+    static scene_entry scenes[MAX_SCENES];
+    static char paths[MAX_SCENES][1024];
+    int n = parse_scenes(scene_list, scenes, paths);
+    if (n <= 0)
+        return 2;
+    lpv_acc_iv_scene is[MAX_SCENES];
+    for (int i = 0; i < n; ++i) {
+        is[i] = (lpv_acc_iv_scene){.name = scenes[i].name, .path = scenes[i].path, .has_cam = scenes[i].has_cam,
+                                   .fov = scenes[i].fov};
+        memcpy(is[i].eye, scenes[i].eye, sizeof is[i].eye);
+        memcpy(is[i].target, scenes[i].target, sizeof is[i].target);
+    }
+    char err[1024];
+    lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt->backend}, err, sizeof err);
+    if (!ctx) {
+        fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+        return 1;
+    }
+    lpv_engine *engine = lpv_engine_create(err, sizeof err);
+    int rc = 1;
+    if (!engine) {
+        fprintf(stderr, "lpvd-accuracy: %s\n", err);
+    } else {
+        char machine[1024], cpu[256], command[4096];
+        cpu_name(cpu, sizeof cpu);
+        snprintf(machine, sizeof machine, "backend %s, GL_RENDERER %s; CPU %s",
+                 lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), cpu);
+        size_t len = 0;
+        command[0] = '\0';
+        for (int i = 0; i < argc && len < sizeof command; ++i)
+            len += (size_t)snprintf(command + len, sizeof command - len, "%s%s", i ? " " : "", argv[i]);
+        fprintf(stderr, "lpvd-accuracy: --iv-tables: %s\n", machine);
+        lpv_acc_iv_tables_desc d = {.out_dir = out_dir, .opt = opt, .scenes = is, .nscenes = n, .ticks = ticks,
+                                    .warmup = warmup, .machine = machine, .command = command};
+        rc = lpv_acc_iv_tables_run(engine, &d);
+    }
+    lpv_engine_destroy(engine);
+    lpv_gl_context_destroy(ctx);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
     const char *knobs = NULL, *points_arg = NULL;
     int spp = 256, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
-    int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0;
+    int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0, iv_tables = 0;
+    int iv_flag_given[LPV_ACC_IV_KNOBS] = {0}; /* --iv-resolution, ...: refused when the knob is swept */
     lpvd_options opt = {0};
     char *cam_args[MAX_PASS];
     char cam_flags[MAX_PASS / 2][16];
@@ -1181,6 +1611,11 @@ int main(int argc, char **argv)
                 fprintf(stderr, "lpvd-accuracy: %s\n", err);
                 return 2;
             }
+            for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k) { /* "iv-rays" is the flag of "iv_rays" */
+                const char *kn = lpv_acc_iv_knob_name(k);
+                if (strncmp(fl->name, "iv-", 3) == 0 && strcmp(fl->name + 3, kn + 3) == 0)
+                    iv_flag_given[k] = 1;
+            }
             if (strcmp(fl->name, "size") == 0)
                 size_given = 1;
             /* the camera choice goes to the reference command too */
@@ -1201,6 +1636,7 @@ int main(int argc, char **argv)
         case A_PRESETS: presets = 1; break;
         case A_FEATURES: features = 1; break;
         case A_EMISSIVE: emissive = 1; break;
+        case A_IV_TABLES: iv_tables = 1; break;
         case A_NO_PLOT: no_plot = 1; break;
         case A_OUT: out_dir = v; break;
         case A_SCENES:
@@ -1239,8 +1675,8 @@ int main(int argc, char **argv)
         }
         }
     }
-    if (!size_given)
-        opt.cam.width = opt.cam.height = 128;
+    if (!size_given) /* the paper's table 1 reprojects 512^2 points */
+        opt.cam.width = opt.cam.height = iv_tables ? 512 : 128;
     if (opt.cam.height == 0) {
         fprintf(stderr, "lpvd-accuracy: --size needs WxH\n");
         return 2;
@@ -1270,6 +1706,10 @@ int main(int argc, char **argv)
         return rc;
     }
 
+    if (iv_tables)
+        return run_iv_tables(&opt, out_dir, scenes_given ? scene_list : "cornell,courtyard,blinds,engine", ticks,
+                             warmup, knobs || points_arg || quick || presets || features, argc, argv);
+
     /* The point set. */
     static point pts[MAX_POINTS];
     int npts = 0;
@@ -1286,9 +1726,9 @@ int main(int argc, char **argv)
         return 2;
     }
     if (points_arg) {
-        npts = parse_points(points_arg, pts, MAX_POINTS);
+        npts = parse_points(points_arg, pts, MAX_POINTS, err, sizeof err);
         if (npts < 0) {
-            fprintf(stderr, "lpvd-accuracy: --points expects GRID:ITER:RSM:on|off[,...]\n");
+            fprintf(stderr, "lpvd-accuracy: --points: %s\n", err);
             return 2;
         }
     } else if (presets) {
@@ -1300,7 +1740,8 @@ int main(int argc, char **argv)
     knob_filter kf = {0};
     if (knobs && parse_knobs(knobs, &kf) != 0) {
         fprintf(stderr, "lpvd-accuracy: --knobs expects e.g. grid=16/32,iterations=8,rsm=256,occlusion=on,"
-                        "central=on,bins=off/on,far=on,surfels=on\n");
+                        "central=on,bins=off/on,far=on,surfels=on,technique=lpv/iv,iv_resolution=16/32,iv_points=8,"
+                        "iv_rays=32/64,iv_bounces=1/3,iv_reprojection=on/off,iv_neighbours=6/8 (see --help)\n");
         return 2;
     }
     if (!points_arg && !presets && !quick) {
@@ -1311,9 +1752,42 @@ int main(int argc, char **argv)
             ni = kf.niter ? kf.niter : (int)(sizeof ITERS / sizeof *ITERS),
             nr = kf.nrsm ? kf.nrsm : (int)(sizeof RSMS / sizeof *RSMS),
             no = kf.nocc ? kf.nocc : (int)(sizeof OCCS / sizeof *OCCS);
-        const int lpv_only[] = {LPV_TECHNIQUE_ID_LPV};
-        const int *tl = kf.ntech ? kf.tech : lpv_only, nt = kf.ntech ? kf.ntech : 1;
+        /* the techniques: --knobs technique=..., else lpv, or iv when only iv knobs are named */
+        const int lpv_only[] = {LPV_TECHNIQUE_ID_LPV}, iv_only[] = {LPV_TECHNIQUE_ID_IV};
+        const int implied_iv = !kf.ntech && names_iv_knob(&kf);
+        const int *tl = kf.ntech ? kf.tech : implied_iv ? iv_only : lpv_only, nt = kf.ntech ? kf.ntech : 1;
+        int tech_lpv = 0, tech_iv = 0;
         for (int t = 0; t < nt; ++t)
+            *(tl[t] == LPV_TECHNIQUE_ID_IV ? &tech_iv : &tech_lpv) = 1;
+        if (implied_iv && names_lpv_knob(&kf)) {
+            fprintf(stderr, "lpvd-accuracy: --knobs names LPV and iv knobs: say which techniques (technique=lpv/iv)\n");
+            return 2;
+        }
+        if (names_iv_knob(&kf) && !tech_iv) {
+            fprintf(stderr, "lpvd-accuracy: --knobs names iv knobs but technique= has no iv\n");
+            return 2;
+        }
+        if (names_lpv_knob(&kf) && !tech_lpv) {
+            fprintf(stderr, "lpvd-accuracy: --knobs names LPV knobs (grid, iterations, occlusion, central, bins, "
+                            "far, surfels) but technique= has neither lpv nor octree\n");
+            return 2;
+        }
+        for (int t = 0; t < nt; ++t) {
+            if (tl[t] == LPV_TECHNIQUE_ID_IV) { /* the iv knobs' factorial (unnamed: not set) x rsm */
+                int idx[LPV_ACC_IV_KNOBS] = {0};
+                for (int r = 0; r < nr; ++r)
+                    for (int done = 0; !done && npts < MAX_POINTS;) {
+                        point q = {.rsm = rl[r], .technique = LPV_TECHNIQUE_ID_IV};
+                        for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k)
+                            q.iv.v[k] = kf.niv[k] ? kf.iv[k][idx[k]] : 0;
+                        pts[npts++] = q;
+                        int k = LPV_ACC_IV_KNOBS - 1; /* the next combination, the last knob fastest */
+                        while (k >= 0 && ++idx[k] >= (kf.niv[k] ? kf.niv[k] : 1))
+                            idx[k--] = 0;
+                        done = k < 0;
+                    }
+                continue;
+            }
             for (int g = 0; g < ng; ++g)
                 for (int it = 0; it < ni; ++it)
                     for (int r = 0; r < nr; ++r)
@@ -1324,13 +1798,23 @@ int main(int argc, char **argv)
                                 if (technique_runs(&q))
                                     pts[npts++] = q;
                             }
+        }
     }
     if (knobs) {
         int k = 0;
         for (int i = 0; i < npts; ++i) {
-            int keep = in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
-                       in_list(pts[i].rsm, kf.rsm, kf.nrsm) && in_list(pts[i].occlusion, kf.occ, kf.nocc) &&
+            int keep = in_list(pts[i].rsm, kf.rsm, kf.nrsm) &&
                        in_list(pts[i].technique ? (int)pts[i].technique : LPV_TECHNIQUE_ID_LPV, kf.tech, kf.ntech);
+            if (is_iv(&pts[i])) { /* its iv knobs as it will run them; the LPV's do not apply */
+                for (int q = 0; q < LPV_ACC_IV_KNOBS; ++q)
+                    keep = keep && in_list(pts[i].iv.v[q] ? pts[i].iv.v[q] : lpv_acc_iv_get(&resolved.iv, q),
+                                           kf.iv[q], kf.niv[q]);
+                if (keep)
+                    pts[k++] = pts[i];
+                continue;
+            }
+            keep = keep && in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
+                   in_list(pts[i].occlusion, kf.occ, kf.nocc);
             for (int m = 0; m < 4; ++m)
                 keep = keep && in_list((pts[i].mods >> m) & 1, kf.sw[m], kf.nsw[m]);
             if (keep)
@@ -1339,6 +1823,16 @@ int main(int argc, char **argv)
         npts = k;
         if (npts == 0) {
             fprintf(stderr, "lpvd-accuracy: --knobs %s leaves no point\n", knobs);
+            return 2;
+        }
+    }
+    for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k) { /* a swept iv knob is not also a flag */
+        int swept = kf.niv[k] > 0;
+        for (int i = 0; i < npts; ++i)
+            swept |= is_iv(&pts[i]) && pts[i].iv.v[k];
+        if (swept && iv_flag_given[k]) {
+            fprintf(stderr, "lpvd-accuracy: %s is swept by --knobs/--points; drop --iv-%s\n", lpv_acc_iv_knob_name(k),
+                    lpv_acc_iv_knob_name(k) + 3);
             return 2;
         }
     }
@@ -1360,58 +1854,9 @@ add_features:
     /* The scenes. */
     static scene_entry scenes[MAX_SCENES];
     static char scene_paths[MAX_SCENES][1024];
-    int nscenes = 0;
-    {
-        char buf[4096];
-        snprintf(buf, sizeof buf, "%s", scene_list);
-        for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-            if (nscenes >= MAX_SCENES) {
-                fprintf(stderr, "lpvd-accuracy: at most %d scenes\n", MAX_SCENES);
-                return 2;
-            }
-            scene_entry *e = &scenes[nscenes];
-            const char *base = strrchr(tok, '/') ? strrchr(tok, '/') + 1 : tok;
-            snprintf(e->name, sizeof e->name, "%s", base);
-            char *dot = strrchr(e->name, '.');
-            int is_file = strchr(tok, '/') || (dot && (strcmp(dot, ".glb") == 0 || strcmp(dot, ".gltf") == 0));
-            if (dot)
-                *dot = '\0';
-            for (char *c = e->name; *c; ++c)
-                if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
-                      *c == '-' || *c == '_'))
-                    *c = '_';
-            if (is_file) {
-                snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s", tok);
-                e->path = scene_paths[nscenes];
-            } else if (strcmp(tok, "cornell") == 0) {
-                e->path = NULL;
-            } else if (strcmp(tok, "engine") == 0 || strcmp(tok, "clearcoat") == 0) {
-                /* real scenes the project did not write (scripts/install-deps.sh installs them) */
-                snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s/%s", ASSIMP_GLTF2_DIR,
-                         strcmp(tok, "engine") == 0 ? "2CylinderEngine-glTF-Binary/2CylinderEngine.glb"
-                                                    : "ClearCoat-glTF/ClearCoatTest.gltf");
-                e->path = scene_paths[nscenes];
-                e->scale_free = 1;
-            } else if (strcmp(tok, "cornell-inside") == 0) {
-                /* the built-in box seen from inside its opening: the box's own
-                 * camera stands 2.9 m in front of it, and camera-following
-                 * cascades of 1 m would then hold no geometry */
-                e->path = NULL;
-                e->has_cam = 1;
-                e->eye[0] = 0.0f, e->eye[1] = 1.0f, e->eye[2] = 0.9f;
-                e->target[0] = 0.0f, e->target[1] = 1.0f, e->target[2] = -1.0f;
-                e->fov = 70.0f;
-            } else {
-                snprintf(scene_paths[nscenes], sizeof scene_paths[nscenes], "%s/%s.glb", LPVD_ACCURACY_SCENES_DIR,
-                         tok);
-                e->path = scene_paths[nscenes];
-            }
-            /* "cascades-3" of --features: a finest cascade well inside the scene */
-            e->cascade_size = e->scale_free ? 0.0f /* auto: a quarter of the scene */
-                              : e->path == NULL ? 1.0f : strcmp(e->name, "blinds") == 0 ? 4.0f : 8.0f;
-            ++nscenes;
-        }
-    }
+    int nscenes = parse_scenes(scene_list, scenes, scene_paths);
+    if (nscenes < 0)
+        return 2;
     if (nscenes == 0) {
         fprintf(stderr, "lpvd-accuracy: --scenes is empty\n");
         return 2;
@@ -1457,6 +1902,10 @@ add_features:
         }
         lpv_view view;
         float *ref = NULL, *ref_se = NULL, *rgba = NULL;
+        /* the iv points' B-bounce references (B > 1), by B, read on first use */
+        float *bref[LPV_IV_MAX_BOUNCES + 1] = {0}, *bref_se[LPV_IV_MAX_BOUNCES + 1] = {0};
+        const ref_source rsrc = {out_dir, ref_is_cmd ? ref_cmd : NULL, spp, area_lights, se->has_cam ? 0 : ncam,
+                                 cam_args};
         uint8_t *regions = NULL;
         int rw = 0, rh = 0;
         lpv_view_choice cam = opt.cam;
@@ -1515,18 +1964,7 @@ add_features:
                 se->have_se = 0;
             }
         }
-        { /* a tone-mapped preview of the reference next to it */
-            size_t np = (size_t)rw * (size_t)rh;
-            uint8_t *px = malloc(np * 4);
-            char prev[1100];
-            snprintf(prev, sizeof prev, "%.*s.png", (int)strlen(se->ref_exr) - 4, se->ref_exr);
-            if (px) {
-                lpv_tonemap_rgba8(ref, np, 1.0f, px);
-                if (lpv_image_write_u8(prev, rw, rh, 4, px, err, sizeof err) != 0)
-                    fprintf(stderr, "lpvd-accuracy: %s\n", err);
-                free(px);
-            }
-        }
+        write_preview(se->ref_exr, ref, rw, rh); /* a tone-mapped preview of the reference next to it */
         if (snprintf(sub, sizeof sub, "%s/err/%s", out_dir, se->name) >= (int)sizeof sub || mkdir_p(sub) != 0) {
             fprintf(stderr, "lpvd-accuracy: cannot create %s/err/%s\n", out_dir, se->name);
             rc = 1;
@@ -1539,6 +1977,12 @@ add_features:
             res->scene = s;
             res->p = pts[p];
             lpv_settings st = opt.settings;
+            if (is_iv(&pts[p])) { /* its knobs over --iv-* and the defaults; the LPV's knobs do not apply */
+                st.technique = LPV_TECHNIQUE_ID_IV;
+                st.rsm_size = pts[p].rsm;
+                lpv_acc_iv_apply(&pts[p].iv, &st.iv);
+                goto settings_made;
+            }
             st.grid_dims[0] = st.grid_dims[1] = st.grid_dims[2] = pts[p].grid;
             st.lpv.iterations = pts[p].iterations;
             st.rsm_size = pts[p].rsm;
@@ -1557,6 +2001,7 @@ add_features:
                 st.lpv.bounces = pts[p].bounces ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
                 st.lpv.damping = pts[p].damping;
             }
+        settings_made:
             if (lpv_engine_set_settings(engine, &st, err, sizeof err) != 0 ||
                 lpv_engine_set_scene(engine, &scene, err, sizeof err) != 0 ||
                 lpv_engine_set_view(engine, &view, err, sizeof err) != 0) {
@@ -1564,7 +2009,12 @@ add_features:
                 rc = 1;
                 break;
             }
-            static double totals[MAX_TICKS], stage[12][MAX_TICKS];
+            {
+                lpv_settings rs = st;
+                lpv_settings_resolve(&rs);
+                res->iv = lpv_acc_iv_of_settings(&rs.iv);
+            }
+            static double totals[MAX_TICKS], stage[NSTAGES][MAX_TICKS];
             for (int t = 0; t < warmup + ticks; ++t) {
                 /* With the planner on, a tick on an unchanged scene serves the
                  * cached volume and runs no stage: every timed tick is a full one. */
@@ -1600,12 +2050,6 @@ add_features:
             if (lpv_acc_compare(rgba, ref, ref_se, view.width, view.height, &res->m) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both, or a black reference\n",
                         se->name);
-            lpv_acc_baselines(rgba, ref, view.width, view.height, &res->black, &res->constant);
-            for (int g = 0; g < LPV_ACC_REGIONS; ++g)
-                res->region_share[g] = res->region_rmse[g] = res->region_ratio[g] = NAN;
-            if (regions)
-                lpv_acc_region_errors(rgba, ref, regions, view.width, view.height, res->region_share, res->region_rmse,
-                                      res->region_ratio);
             res->rel_rmse_1b = res->m.rel_rmse;
             res->ref_bounces = 1;
             res->rel_rmse_multi = NAN;
@@ -1621,9 +2065,36 @@ add_features:
                     }
                 }
             }
+            const int ivb = res->iv.v[LPV_ACC_IV_BOUNCES];
+            if (is_iv(&pts[p]) && ivb > 1 && ivb <= LPV_IV_MAX_BOUNCES) { /* its own bounces' reference */
+                const float *bimg = bounce_reference(se, &scene, &view, &rsrc, ivb, &bref[ivb], &bref_se[ivb]);
+                lpv_acc_metrics mb;
+                if (!bimg) {
+                    rc = 1;
+                    break;
+                }
+                if (lpv_acc_compare(rgba, bimg, bref_se[ivb], view.width, view.height, &mb) != 0)
+                    fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both the %d-bounce reference and "
+                                    "lpvd\n", se->name, ivb);
+                res->m = mb;
+                res->ref_bounces = ivb;
+                cmp_ref = bimg;
+            }
+            /* the baselines and regions: over the point's own reference for
+             * iv points, the 1-bounce one for the LPV's (as before) */
+            const float *base_ref = is_iv(&pts[p]) ? cmp_ref : ref;
+            lpv_acc_baselines(rgba, base_ref, view.width, view.height, &res->black, &res->constant);
+            for (int g = 0; g < LPV_ACC_REGIONS; ++g)
+                res->region_share[g] = res->region_rmse[g] = res->region_ratio[g] = NAN;
+            if (regions)
+                lpv_acc_region_errors(rgba, base_ref, regions, view.width, view.height, res->region_share,
+                                      res->region_rmse, res->region_ratio);
             char ep[1400];
             if (pts[p].feat)
                 snprintf(ep, sizeof ep, "%s/features-%s.png", sub, pts[p].label);
+            else if (is_iv(&pts[p]))
+                snprintf(ep, sizeof ep, "%s/iv-%s-r%d.png", sub, lpv_acc_iv_label(&res->iv, (char[96]){0}, 96),
+                         pts[p].rsm);
             else
                 snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s%s%s.png", sub, pts[p].grid, pts[p].iterations,
                          pts[p].rsm, occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
@@ -1644,18 +2115,33 @@ add_features:
                     free(px);
                 }
             }
-            fprintf(stderr,
-                    "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s: %.2f ms/tick, "
-                    "rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
-                    se->name, p + 1, npts, tech_name(pts[p].technique), pts[p].grid, pts[p].iterations, pts[p].rsm,
-                    occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
-                    res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
-                    pts[p].label);
+            if (is_iv(&pts[p]))
+                fprintf(stderr,
+                        "lpvd-accuracy: %s %d/%d: iv, resolution %d, points %d, rays %d, bounces %d, reprojection %s, "
+                        "neighbours %d, rsm %d: %.2f ms/tick (iv_points %.2f, iv_reproject %.2f, iv_resolve %.2f, "
+                        "iv_gather %.2f, shade %.2f), rel_rmse %.4f vs %d bounce(s) (%.4f vs 1), rel_bias %+.4f\n",
+                        se->name, p + 1, npts, res->iv.v[0], res->iv.v[1], res->iv.v[2], res->iv.v[3],
+                        switch_name(res->iv.v[4]), res->iv.v[5], pts[p].rsm, res->ms_total,
+                        res->stage_ms[ST_IV_POINTS], res->stage_ms[ST_IV_REPROJECT], res->stage_ms[ST_IV_RESOLVE],
+                        res->stage_ms[ST_IV_GATHER], res->stage_ms[ST_SHADE], res->m.rel_rmse, res->ref_bounces,
+                        res->rel_rmse_1b, res->m.rel_bias);
+            else
+                fprintf(stderr,
+                        "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s: "
+                        "%.2f ms/tick, rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
+                        se->name, p + 1, npts, tech_name(pts[p].technique), pts[p].grid, pts[p].iterations, pts[p].rsm,
+                        occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
+                        res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
+                        pts[p].label);
             ++nres;
         }
         free(mref);
         free(mref_se);
     next_scene:
+        for (int b = 0; b <= LPV_IV_MAX_BOUNCES; ++b) {
+            free(bref[b]);
+            free(bref_se[b]);
+        }
         free(regions);
         free(rgba);
         free(ref);

@@ -17,7 +17,13 @@
 #define LPV_ACC_MAX_SCENES 16
 
 /* One measured (scene, point): the point is identified by key[LPV_ACC_KEY]. */
-#define LPV_ACC_KEY 6 /* grid, iterations, rsm, occlusion, mods, technique */
+/* grid, iterations, rsm, occlusion, mods, technique, then the imperfect
+ * volume's knobs (iv_knobs.h's order: resolution, points, rays, bounces,
+ * reprojection, neighbours; 0 for the LPV's points, whose iv knobs do not
+ * apply, as grid..mods but rsm are 0 for iv points) */
+#define LPV_ACC_KEY 12
+#define LPV_ACC_KEY_TECHNIQUE 5
+#define LPV_ACC_KEY_IV 6
 typedef struct lpv_acc_row {
     int scene; /* 0 .. nscenes-1 */
     int key[LPV_ACC_KEY];
