@@ -94,7 +94,8 @@ typedef struct lpv_lpv_settings {
  * a voxel copy of the whole scene from a point cloud, radiance gathered per
  * voxel by ray marching it. A zero field takes its default. */
 typedef struct lpv_iv_settings {
-    int resolution;         /* voxels along the scene's longest side (voxels are cubes); default 32 */
+    int resolution;         /* voxels along the scene's longest side (voxels are cubes); default
+                               LPV_IV_DEFAULT_RESOLUTION */
     int points;             /* random points per triangle (Turk's formula); default LPV_IV_DEFAULT_POINTS */
     float split;            /* voxels: a triangle with a longer edge is split before sampling (the
                                paper's load-time tessellation); default 1 */
@@ -173,11 +174,11 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_FAR_FIELD_STEPS 1
 #define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
-#define LPV_IV_DEFAULT_RESOLUTION 32
-#define LPV_IV_DEFAULT_POINTS 8
+#define LPV_IV_DEFAULT_RESOLUTION 16
+#define LPV_IV_DEFAULT_POINTS 4
 #define LPV_IV_DEFAULT_SPLIT 1.0f
 #define LPV_IV_DEFAULT_SEED 1
-#define LPV_IV_DEFAULT_RAYS 64
+#define LPV_IV_DEFAULT_RAYS 128
 #define LPV_IV_DEFAULT_BOUNCES 3
 #define LPV_IV_DEFAULT_NEIGHBOURS 8
 #define LPV_IV_AO_VOXELS 4.0f

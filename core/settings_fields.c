@@ -93,15 +93,15 @@ static const lpv_field FIELDS[] = {
      "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)", T_VOL | T_SHADOWS, ""},
 
     /* Imperfect volumes (docs/imperfect-volumes.md). */
-    {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "32", "",
+    {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "16", "",
      "voxels along the scene's longest side", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", "8", "",
+    {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", "4", "",
      "random points per triangle (Turk's formula)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
     {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", "1", "",
      "triangles with a longer edge are split before sampling", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
     {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, LPV_IV_MAX_SEED, 0, "", "1", "",
      "random seed of the points and the rays", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", "64", "",
+    {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", "128", "",
      "stratified rays marched per voxel", T_VOL, LPV_TECHNIQUE_IV},
     {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", "3", "",
      "diffuse bounces (ping-pong passes over two volumes)", T_VOL, LPV_TECHNIQUE_IV},

@@ -53,7 +53,8 @@ float lpv_ao(vec3 p, vec3 n_in)
 }
 
 // The radiance at x dotted with v (trilinear over voxel centres), for the
-// glossy march and the media: the volume holds radiance, so no / cell^2.
+// glossy march and the media: the volume holds radiance, so no / cell^2;
+// never negative.
 vec3 lpv_project(vec3 x, vec4 v)
 {
     vec3 u = cascade_coords(0, x) - 0.5;
@@ -68,7 +69,7 @@ vec3 lpv_project(vec3 x, vec4 v)
         LpvCell l = lpv[cell_index(c)];
         e += t.x * t.y * t.z * vec3(dot(l.r, v), dot(l.g, v), dot(l.b, v));
     }
-    return e;
+    return max(e, 0.0); // radiance: the 2-band SH's ringing below zero is not light
 }
 
 float lpv_cell_at(vec3 x) { return grid_cell_size(); }

@@ -13,6 +13,7 @@ layout(binding = 3) uniform sampler2D u_gbuf_emission;
 uniform int u_source;      // 0 the cloud, 1 the G-buffer
 uniform int u_first;       // the cloud's first point
 uniform ivec2 u_gbuf_size;
+uniform int u_stride;      // every u_stride-th pixel in x and y
 uniform vec2 u_atlas_size;
 uniform float u_emission;  // 1: emission counts (area lights off); 0: the area lights carry the emitters
 
@@ -37,7 +38,8 @@ void main()
         albedo = q.albedo.rgb;
         emission = q.emission.rgb;
     } else {
-        ivec2 t = ivec2(gl_VertexID % u_gbuf_size.x, gl_VertexID / u_gbuf_size.x);
+        int cols = (u_gbuf_size.x + u_stride - 1) / u_stride;
+        ivec2 t = ivec2(gl_VertexID % cols, gl_VertexID / cols) * u_stride;
         vec4 gn = texelFetch(u_gbuf_normal, t, 0);
         if (gn.w < 0.5)
             return; // background

@@ -298,6 +298,12 @@ struct IvVoxel {
  * centre (the voxel's bounding sphere) and step one voxel. */
 #define LPV_IV_START 0.86602540378443865f
 #define LPV_IV_WG 64
+/* Reprojection takes at most about this many of the G-buffer's pixels, a
+ * regular subset (every k-th pixel in x and y): a voxel seen by the camera
+ * still gets many, and a 512x512 view costs a quarter (paper 3.2: "the
+ * number of the visible points ... is considerably larger than the number of
+ * the visible voxels"). */
+#define LPV_IV_REPROJECT_POINTS 65536
 /* A point belongs to the voxel holding it moved this many voxels against its
  * normal, so a surface that lies exactly on a voxel face (a wall on a room's
  * bounds, a box on the lattice) goes wholly to the voxel behind it instead

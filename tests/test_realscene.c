@@ -69,9 +69,11 @@ static float lum(const float *p)
     return 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
 }
 
+static lpv_technique_id technique = LPV_TECHNIQUE_ID_LPV; /* the pass over the models */
+
 static void render(const lpv_scene *s, const lpv_view *v, lpv_frame_terms terms, float *rgba)
 {
-    lpv_settings st = {.grid_dims = {16, 16, 16}, .rsm_size = 64};
+    lpv_settings st = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .technique = technique, .iv.ao = LPV_SWITCH_ON};
     char err[1024] = "";
     if (lpv_engine_set_settings(lpvt_engine, &st, err, sizeof err) != 0 ||
         lpv_engine_set_scene(lpvt_engine, s, err, sizeof err) != 0 ||
@@ -167,7 +169,11 @@ static void check_model(const model *m)
     assert_true((double)agree_lit >= m->min_agree * (double)both);
     /* visible after automatic exposure, with indirect light */
     assert_true((double)bright >= m->min_lit_share * (double)covered);
-    assert_true((double)with_ind >= m->min_indirect * (double)covered);
+    /* the LPV lights every surface a little (its self-illumination); the
+     * imperfect volume, like the path tracer, gives a lone convex object
+     * (the cubes) almost none: its pass checks only that the term is sound */
+    if (technique != LPV_TECHNIQUE_ID_IV)
+        assert_true((double)with_ind >= m->min_indirect * (double)covered);
     free(full);
     free(direct);
     free(ind);
@@ -180,14 +186,52 @@ static void check_model(const model *m)
 static void test_assimp_models(void **state)
 {
     (void)state;
+    technique = LPV_TECHNIQUE_ID_LPV;
     for (size_t i = 0; i < sizeof MODELS / sizeof MODELS[0]; ++i)
         check_model(&MODELS[i]);
+}
+
+/* The same models through the imperfect volume (docs/imperfect-volumes.md),
+ * with its ambient occlusion: every check above, and an AO frame in [0, 1]
+ * that is not all open on the covered pixels. */
+static void test_assimp_models_iv(void **state)
+{
+    (void)state;
+    technique = LPV_TECHNIQUE_ID_IV;
+    for (size_t i = 0; i < sizeof MODELS / sizeof MODELS[0]; ++i) {
+        check_model(&MODELS[i]);
+        char path[1024], err[1024];
+        snprintf(path, sizeof path, "%s/%s", models_dir(), MODELS[i].path);
+        lpv_scene s;
+        if (lpv_scene_load(path, &s, err, sizeof err) != 0)
+            fail_msg("%s", err);
+        lpv_view v;
+        lpv_view_from_camera(&s.cameras[0], W, H, &v);
+        float *ao = malloc((size_t)W * H * 4 * sizeof *ao);
+        assert_non_null(ao);
+        render(&s, &v, LPV_TERMS_AO, ao);
+        double sum = 0.0;
+        size_t covered = 0;
+        for (size_t p = 0; p < (size_t)W * H; ++p) {
+            assert_true(ao[4 * p] >= 0.0f && ao[4 * p] <= 1.0f);
+            if (ao[4 * p + 3] > 0.5f) {
+                sum += ao[4 * p];
+                ++covered;
+            }
+        }
+        print_message("%s: mean ambient occlusion %.3f over %zu covered pixels\n", MODELS[i].path,
+                      covered ? sum / (double)covered : 0.0, covered);
+        assert_true(covered > 0 && sum < (double)covered && sum > 0.0);
+        free(ao);
+        lpv_scene_free(&s);
+    }
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_assimp_models),
+        cmocka_unit_test(test_assimp_models_iv),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

@@ -233,7 +233,12 @@ static void create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
         }
         glUniform1i(glGetUniformLocation(prog, "u_source"), 1);
         glUniform2i(glGetUniformLocation(prog, "u_gbuf_size"), in->gbuffer_w, in->gbuffer_h);
-        glDrawArrays(GL_POINTS, 0, in->gbuffer_w * in->gbuffer_h);
+        int stride = 1;
+        while ((size_t)((in->gbuffer_w + stride - 1) / stride) * (size_t)((in->gbuffer_h + stride - 1) / stride) >
+               LPV_IV_REPROJECT_POINTS)
+            ++stride;
+        glUniform1i(glGetUniformLocation(prog, "u_stride"), stride);
+        glDrawArrays(GL_POINTS, 0, ((in->gbuffer_w + stride - 1) / stride) * ((in->gbuffer_h + stride - 1) / stride));
         lpv_timer_count(in->timer, 1);
         lpv_timer_end(in->timer);
     }
