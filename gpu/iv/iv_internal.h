@@ -1,0 +1,45 @@
+/*
+ * iv_internal.h - the imperfect volume's state, shared by its files
+ * (technique_iv.c: the lpv_technique_class, placement and storage;
+ * iv_passes.c: the tick's passes). Not seen outside gpu/iv/; like the LPV's
+ * passes, these take the technique's state and the tick's inputs, never the
+ * engine.
+ */
+#ifndef LPV_IV_INTERNAL_H
+#define LPV_IV_INTERNAL_H
+
+#include "atlas.h"
+#include "gl_util.h"
+#include "technique.h"
+
+/* The atlas's attachments: r, g, b SH sums, normal + count, albedo. */
+#define IV_ATTACHMENTS 5
+
+typedef struct lpv_iv_gpu {
+    lpv_technique base;
+    lpv_settings settings;
+    lpv_grid grid;    /* of the last commit */
+    lpv_grid pending; /* of the last place */
+    GLuint prog_splat, prog_resolve, prog_emit, prog_gather;
+    GLuint empty_vao, grid_ubo;
+    lpv_atlas atlas;
+    GLuint voxels, occupancy, emit, radiance[2], ao;
+    int result;       /* radiance[result] holds the last gather: what the lookup reads */
+    size_t cells;     /* allocated for */
+    int alloc_dims[3];
+    int bounces_run;  /* by the last computed tick */
+} lpv_iv_gpu;
+
+/* Zeroes a buffer (floats or bits alike). */
+void lpv_iv_clear_buffer(GLuint b);
+/* iv_points, iv_reproject and iv_resolve: the points into the atlas, then
+ * into voxel means and occupancy bits. */
+void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in);
+/* One march over the volume: radiance from the emission (ao 0) into out, or
+ * visibility into the AO volume (ao 1). */
+void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int ao, lpv_timer *timer);
+/* iv_gather: bounces 1..K, each an emission pass and a march; the result in
+ * v->radiance[v->result]. */
+void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in);
+
+#endif /* LPV_IV_INTERNAL_H */

@@ -1,0 +1,125 @@
+/*
+ * iv_passes.c - the imperfect volume's passes on one tick's inputs
+ * (technique_iv.c's header lists them; docs/imperfect-volumes.md).
+ */
+#include <stdint.h>
+
+#include "iv_internal.h"
+
+static GLuint groups(const lpv_iv_gpu *v) { return lpv_div_up(v->cells, LPV_IV_WG); }
+
+void lpv_iv_clear_buffer(GLuint b)
+{
+    static const float zero = 0.0f;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
+    glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, &zero);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+}
+
+/* iv_points and iv_reproject: the points into the atlas. */
+void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
+{
+    const lpv_plan *p = in->plan;
+    GLuint prog = v->prog_splat;
+    lpv_atlas_begin(&v->atlas, prog, v->grid_ubo, v->empty_vao);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
+    glActiveTexture(GL_TEXTURE0 + 5);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
+    glActiveTexture(GL_TEXTURE0 + 6);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
+    glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
+    if (p->pass[LPV_PASS_IV_POINTS].run && in->iv_point_count) {
+        lpv_timer_begin(in->timer, "iv_points");
+        glUniform1i(glGetUniformLocation(prog, "u_source"), 0);
+        lpv_atlas_splat(prog, LPV_SSBO_IV_POINTS, in->iv_points, 0, in->iv_point_count, 1, in->timer);
+        lpv_timer_end(in->timer);
+    }
+    if (p->pass[LPV_PASS_IV_REPROJECT].run && in->gbuffer_w > 0 && in->gbuffer_h > 0) {
+        lpv_timer_begin(in->timer, "iv_reproject");
+        for (int i = 0; i < 4; ++i) {
+            glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+            glBindTexture(GL_TEXTURE_2D, in->gbuffer[i]);
+        }
+        glUniform1i(glGetUniformLocation(prog, "u_source"), 1);
+        glUniform2i(glGetUniformLocation(prog, "u_gbuf_size"), in->gbuffer_w, in->gbuffer_h);
+        int stride = 1;
+        while ((size_t)((in->gbuffer_w + stride - 1) / stride) * (size_t)((in->gbuffer_h + stride - 1) / stride) >
+               LPV_IV_REPROJECT_POINTS)
+            ++stride;
+        glUniform1i(glGetUniformLocation(prog, "u_stride"), stride);
+        glDrawArrays(GL_POINTS, 0, ((in->gbuffer_w + stride - 1) / stride) * ((in->gbuffer_h + stride - 1) / stride));
+        lpv_timer_count(in->timer, 1);
+        lpv_timer_end(in->timer);
+    }
+    lpv_atlas_end();
+    glActiveTexture(GL_TEXTURE0);
+
+    lpv_timer_begin(in->timer, "iv_resolve");
+    lpv_iv_clear_buffer(v->occupancy); /* all bits 0 */
+    glUseProgram(v->prog_resolve);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    for (int i = 0; i < IV_ATTACHMENTS; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, v->atlas.tex[i]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(glGetUniformLocation(v->prog_resolve, "u_tiles_x"), v->atlas.tiles_x);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_VOXELS, v->voxels);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glDispatchCompute(groups(v), 1, 1);
+    lpv_timer_count(in->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    lpv_timer_end(in->timer);
+}
+
+
+/* One march over the volume: radiance from the emission (ao 0) into out, or
+ * visibility into the AO volume (ao 1). */
+void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int ao, lpv_timer *timer)
+{
+    GLuint prog = v->prog_gather;
+    glUseProgram(prog);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_EMIT, v->emit);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+    glUniform1i(glGetUniformLocation(prog, "u_rays"), s->iv.rays);
+    glUniform1ui(glGetUniformLocation(prog, "u_seed"), (GLuint)s->iv.seed);
+    glUniform1i(glGetUniformLocation(prog, "u_ao"), ao);
+    const float reach = s->iv.ao_distance > 0.0f ? s->iv.ao_distance / v->grid.cell_size : LPV_IV_AO_VOXELS;
+    glUniform1f(glGetUniformLocation(prog, "u_ao_reach"), reach);
+    glDispatchCompute(groups(v), 1, 1);
+    lpv_timer_count(timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+/* Bounces 1..K: emission from the previous gather, then a march. */
+void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
+{
+    const lpv_settings *s = in->settings;
+    lpv_timer_begin(in->timer, "iv_gather");
+    int prev = 0, cur = 0;
+    for (int k = 1; k <= s->iv.bounces; ++k) {
+        cur = k == 1 ? 0 : 1 - prev;
+        glUseProgram(v->prog_emit);
+        glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_VOXELS, v->voxels);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_EMIT, v->emit);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, v->radiance[prev]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+        glUniform1i(glGetUniformLocation(v->prog_emit, "u_bounce"), k);
+        glUniform1i(glGetUniformLocation(v->prog_emit, "u_iv_neighbours"), s->iv.neighbours);
+        glDispatchCompute(groups(v), 1, 1);
+        lpv_timer_count(in->timer, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        lpv_iv_march_volume(v, s, v->radiance[cur], 0, in->timer);
+        prev = cur;
+    }
+    v->result = cur;
+    v->bounces_run = s->iv.bounces;
+    lpv_timer_end(in->timer);
+}
+
