@@ -236,3 +236,19 @@ void lpv_iv_triangle_points(const float a[3], const float b[3], const float c[3]
             out[3 * k + i] = (float)(t0 * a[i] + t1 * b[i] + t2 * c[i]);
     }
 }
+
+int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], lpv_grid *out)
+{
+    const int given = lpv_settings_bounds_given(s);
+    return lpv_grid_place_cubic(s->iv.resolution, given ? s->bounds_min : smin, given ? s->bounds_max : smax, out);
+}
+
+lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, float voxel)
+{
+    return (lpv_iv_point_params){.voxel = voxel,
+                                 .points = s->iv.points,
+                                 .split = s->iv.split,
+                                 .seed = (uint32_t)s->iv.seed,
+                                 .max_points = (size_t)s->iv.max_points,
+                                 .emission = 1};
+}

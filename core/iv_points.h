@@ -20,8 +20,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "grid.h"
 #include "lpv_shared.h"
 #include "scene.h"
+#include "settings.h"
 
 typedef struct lpv_iv_point_params {
     float voxel;       /* m, the volume's voxel side */
@@ -40,6 +42,17 @@ typedef struct lpv_iv_point_stats {
     size_t points;     /* written */
     int budget_cut;    /* 1: the budget lowered points_per_piece or raised split */
 } lpv_iv_point_stats;
+
+/* The imperfect volume's voxels for settings s over a scene's bounds
+ * [smin, smax] (the settings' bounds when given): lpv_grid_place_cubic at
+ * s->iv.resolution. The engine's cloud and the technique's volume both
+ * place it here. Returns 0 or -1 (lpv_grid_place_cubic's). */
+int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], lpv_grid *out);
+
+/* The cloud's parameters under settings s for voxels of side `voxel` m
+ * (emission always carried: the GPU drops it while area lights carry the
+ * emitters). */
+lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, float voxel);
 
 /* The cloud for `scene` under p. *out is malloc'ed (free() it), *count its
  * points. Returns 0, or -1 out of memory (*out NULL, *count 0). Deterministic

@@ -136,26 +136,15 @@ static uint64_t geometry_signature(const lpv_scene *s)
     return h;
 }
 
-/* The scene's samples under the current settings, from the engine's copy of
- * its geometry: the emissive surfaces' VPLs (emissive_vpls) and the scene
- * surfels (scene_surfels, scene_surfel_count). Redone by set_settings when
- * one of those knobs changes, without the scene being sent again. */
 /* The imperfect volume's point cloud at its voxel size (core/iv_points.h). */
 static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
 {
     const lpv_settings *s = &e->settings;
-    const int given = lpv_settings_bounds_given(s);
     lpv_grid g;
-    if (lpv_grid_place_cubic(s->iv.resolution, given ? s->bounds_min : e->scene_min,
-                             given ? s->bounds_max : e->scene_max, &g) != 0)
+    if (lpv_iv_place(s, e->scene_min, e->scene_max, &g) != 0)
         return lpv_error(err, err_size, "%s: cannot place the imperfect volume over the scene's bounds",
                          e->geometry.source);
-    lpv_iv_point_params p = {.voxel = g.cell_size,
-                             .points = s->iv.points,
-                             .split = s->iv.split,
-                             .seed = (uint32_t)s->iv.seed,
-                             .max_points = (size_t)s->iv.max_points,
-                             .emission = 1};
+    const lpv_iv_point_params p = lpv_iv_point_params_of(s, g.cell_size);
     struct IvPoint *pts = NULL;
     size_t n = 0;
     if (lpv_iv_points_make(&e->geometry, &p, &pts, &n, &e->iv_point_stats) != 0)
@@ -172,6 +161,10 @@ static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
     return 0;
 }
 
+/* The scene's samples under the current settings, from the engine's copy of
+ * its geometry: the emissive surfaces' VPLs (emissive_vpls) and the scene
+ * surfels (scene_surfels, scene_surfel_count). Redone by set_settings when
+ * one of those knobs changes, without the scene being sent again. */
 int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size)
 {
     const lpv_scene *scene = &e->geometry;

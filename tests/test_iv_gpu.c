@@ -90,12 +90,7 @@ static void test_creation_matches_oracle(void **state)
     tick(&scene, &s, NULL);
     const lpv_grid *g = lpv_engine_grid(lpvt_engine);
     const lpv_settings *r = lpv_engine_settings(lpvt_engine);
-    lpv_iv_point_params pp = {.voxel = g->cell_size,
-                              .points = r->iv.points,
-                              .split = r->iv.split,
-                              .seed = (uint32_t)r->iv.seed,
-                              .max_points = (size_t)r->iv.max_points,
-                              .emission = 1};
+    const lpv_iv_point_params pp = lpv_iv_point_params_of(r, g->cell_size);
     struct IvPoint *pts = NULL;
     size_t n = 0;
     assert_int_equal(lpv_iv_points_make(&scene, &pp, &pts, &n, NULL), 0);

@@ -1518,6 +1518,25 @@ static void cpu_name(char *out, size_t n)
 }
 
 /* --iv-tables (iv_tables.h): the paper's tables 1 and 2 on the scenes. */
+/* A GL context and an engine on it, or 1 with the reason on stderr. */
+static int open_gl(lpv_backend backend, lpv_gl_context **ctx, lpv_engine **engine)
+{
+    char err[1024];
+    *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = backend}, err, sizeof err);
+    if (!*ctx) {
+        fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+        return 1;
+    }
+    *engine = lpv_engine_create(err, sizeof err);
+    if (!*engine) {
+        fprintf(stderr, "lpvd-accuracy: %s\n", err);
+        lpv_gl_context_destroy(*ctx);
+        *ctx = NULL;
+        return 1;
+    }
+    return 0;
+}
+
 static int run_iv_tables(const lpvd_options *opt, const char *out_dir, const char *scene_list, int ticks, int warmup,
                          int has_points, int argc, char **argv)
 {
@@ -1538,17 +1557,12 @@ static int run_iv_tables(const lpvd_options *opt, const char *out_dir, const cha
         memcpy(is[i].eye, scenes[i].eye, sizeof is[i].eye);
         memcpy(is[i].target, scenes[i].target, sizeof is[i].target);
     }
-    char err[1024];
-    lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt->backend}, err, sizeof err);
-    if (!ctx) {
-        fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+    lpv_gl_context *ctx = NULL;
+    lpv_engine *engine = NULL;
+    if (open_gl(opt->backend, &ctx, &engine) != 0)
         return 1;
-    }
-    lpv_engine *engine = lpv_engine_create(err, sizeof err);
     int rc = 1;
-    if (!engine) {
-        fprintf(stderr, "lpvd-accuracy: %s\n", err);
-    } else {
+    {
         char machine[1024], cpu[256], command[4096];
         cpu_name(cpu, sizeof cpu);
         snprintf(machine, sizeof machine, "backend %s, GL_RENDERER %s; CPU %s",
@@ -1685,16 +1699,12 @@ int main(int argc, char **argv)
     lpv_settings_resolve(&resolved);
     const int area_lights = resolved.area_lights == LPV_SWITCH_ON;
     if (emissive) {
-        lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt.backend}, err, sizeof err);
-        if (!ctx) {
-            fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+        lpv_gl_context *ctx = NULL;
+        lpv_engine *engine = NULL;
+        if (open_gl(opt.backend, &ctx, &engine) != 0)
             return 1;
-        }
-        lpv_engine *engine = lpv_engine_create(err, sizeof err);
         int rc = 1;
-        if (!engine) {
-            fprintf(stderr, "lpvd-accuracy: %s\n", err);
-        } else {
+        {
             fprintf(stderr, "lpvd-accuracy: backend %s, GL_RENDERER %s\n",
                     lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx));
             lpv_acc_emissive_desc d = {.out_dir = out_dir, .scenes_dir = LPVD_ACCURACY_SCENES_DIR, .opt = &opt,
@@ -1871,17 +1881,10 @@ add_features:
         return 1;
     }
 
-    lpv_gl_context *ctx = lpv_gl_context_create(&(lpv_gl_context_desc){.backend = opt.backend}, err, sizeof err);
-    if (!ctx) {
-        fprintf(stderr, "lpvd-accuracy: no OpenGL 4.5 context: %s\n", err);
+    lpv_gl_context *ctx = NULL;
+    lpv_engine *engine = NULL;
+    if (open_gl(opt.backend, &ctx, &engine) != 0)
         return 1;
-    }
-    lpv_engine *engine = lpv_engine_create(err, sizeof err);
-    if (!engine) {
-        fprintf(stderr, "lpvd-accuracy: %s\n", err);
-        lpv_gl_context_destroy(ctx);
-        return 1;
-    }
     char header[2048];
     snprintf(header, sizeof header,
              "backend %s, GL_RENDERER %s; image %dx%d; reference `%s` at %d spp; median of %d ticks after %d "

@@ -28,6 +28,7 @@
 
 #include "error.h"
 #include "iv_internal.h"
+#include "iv_points.h"
 #include "shader.h"
 
 
@@ -98,7 +99,7 @@ static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, cha
     const int given = lpv_settings_bounds_given(s);
     const float *lo = given ? s->bounds_min : w->bounds_min, *hi = given ? s->bounds_max : w->bounds_max;
     lpv_grid g;
-    if (lpv_grid_place_cubic(s->iv.resolution, lo, hi, &g) != 0)
+    if (lpv_iv_place(s, w->bounds_min, w->bounds_max, &g) != 0)
         return lpv_error(err, err_size, "cannot place %d voxels over the bounds (%g %g %g)..(%g %g %g)",
                          s->iv.resolution, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1],
                          (double)hi[2]);
