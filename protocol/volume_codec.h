@@ -73,6 +73,8 @@ typedef enum lpvp_frame_format {
     LPVP_FRAME_FORMAT_COUNT = 3
 } lpvp_frame_format;
 extern const char *const lpvp_frame_terms_names[LPVP_TERMS_COUNT];
+/* The units of an "ao" frame (a fraction, 1 = open) in every format. */
+#define LPVP_FRAME_AO_UNITS "1"
 extern const char *const lpvp_frame_format_names[LPVP_FRAME_FORMAT_COUNT];
 
 /* The streams of SUBSCRIBE / UNSUBSCRIBE / ACK (R5.5): "volume", "frame". */
