@@ -152,10 +152,23 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
 
 /* ---- Reconstruction (3.4) -------------------------------------------------- */
 
+/* Which voxels hold a surface: the created voxels (lpv_iv_occupied) or one
+ * flag per voxel (non-zero: holds one, as a volume's index on the wire, SPEC
+ * R5.14); neither: none does. */
+typedef struct held_by {
+    const lpv_iv_voxel *voxels;
+    const uint32_t *flags;
+} held_by;
+
+static int holds(const held_by *h, size_t i)
+{
+    return h->voxels ? lpv_iv_occupied(&h->voxels[i]) : h->flags ? h->flags[i] != 0 : 0;
+}
+
 /* The corners reconstruction blends at p for n, and their weights w_c (not
  * yet divided by the sum). Returns how many were written to index[] and
  * weight[] (at most 8); 0 when nothing contributes. */
-static int corners(const lpv_grid *g, const lpv_iv_voxel *voxels, const float p[3], const float n[3], int neighbours,
+static int corners(const lpv_grid *g, const held_by *held, const float p[3], const float n[3], int neighbours,
                    size_t index[8], double weight[8])
 {
     float nh[3];
@@ -219,7 +232,7 @@ static int corners(const lpv_grid *g, const lpv_iv_voxel *voxels, const float p[
             cosine = nh[0] * (d[0] / len) + nh[1] * (d[1] / len) + nh[2] * (d[2] / len);
         float w = t * (cosine > 0.0f ? cosine : 0.0f);
         const size_t vi = lpv_grid_index(g, v[0], v[1], v[2]);
-        if (voxels && lpv_iv_occupied(&voxels[vi]))
+        if (holds(held, vi))
             w *= LPV_IV_HELD_WEIGHT;
         if (!(w > 0.0f))
             continue;
@@ -230,13 +243,13 @@ static int corners(const lpv_grid *g, const lpv_iv_voxel *voxels, const float p[
     return m;
 }
 
-void lpv_iv_reconstruct(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
-                        const float n[3], int neighbours, lpv_cell *out)
+static void reconstruct(const lpv_grid *g, const held_by *held, const lpv_cell *vol, const float p[3], const float n[3],
+                        int neighbours, lpv_cell *out)
 {
     memset(out, 0, sizeof *out);
     size_t index[8];
     double weight[8], sum = 0.0, acc[3][4] = {{0.0}};
-    int m = corners(g, voxels, p, n, neighbours, index, weight);
+    int m = corners(g, held, p, n, neighbours, index, weight);
     for (int i = 0; i < m; i++) {
         sum += weight[i];
         for (int ch = 0; ch < 3; ch++)
@@ -265,19 +278,47 @@ static int lobe_minus(const float n[3], float lobe[4])
     return 1;
 }
 
-void lpv_iv_irradiance(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
-                       const float n[3], int neighbours, float rgb[3])
+static void irradiance(const lpv_grid *g, const held_by *held, const lpv_cell *vol, const float p[3], const float n[3],
+                       int neighbours, float rgb[3])
 {
     lpv_cell L;
     float lobe[4];
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
     if (!lobe_minus(n, lobe))
         return;
-    lpv_iv_reconstruct(g, voxels, vol, p, n, neighbours, &L);
+    reconstruct(g, held, vol, p, n, neighbours, &L);
     for (int ch = 0; ch < 3; ch++) {
         float e = dot4(cchannel(&L, ch), lobe);
         rgb[ch] = e > 0.0f ? e : 0.0f;
     }
+}
+
+void lpv_iv_reconstruct(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
+                        const float n[3], int neighbours, lpv_cell *out)
+{
+    const held_by held = {.voxels = voxels};
+    reconstruct(g, &held, vol, p, n, neighbours, out);
+}
+
+void lpv_iv_reconstruct_held(const lpv_grid *g, const uint32_t *held, const lpv_cell *vol, const float p[3],
+                             const float n[3], int neighbours, lpv_cell *out)
+{
+    const held_by by = {.flags = held};
+    reconstruct(g, &by, vol, p, n, neighbours, out);
+}
+
+void lpv_iv_irradiance(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
+                       const float n[3], int neighbours, float rgb[3])
+{
+    const held_by held = {.voxels = voxels};
+    irradiance(g, &held, vol, p, n, neighbours, rgb);
+}
+
+void lpv_iv_irradiance_held(const lpv_grid *g, const uint32_t *held, const lpv_cell *vol, const float p[3],
+                            const float n[3], int neighbours, float rgb[3])
+{
+    const held_by by = {.flags = held};
+    irradiance(g, &by, vol, p, n, neighbours, rgb);
 }
 
 float lpv_iv_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, const vec4 *ao, const float p[3], const float n[3],
@@ -288,7 +329,8 @@ float lpv_iv_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, const vec4 *ao, c
         return 1.0f;
     size_t index[8];
     double weight[8], sum = 0.0, acc[4] = {0.0};
-    int m = corners(g, voxels, p, n, neighbours, index, weight);
+    const held_by held = {.voxels = voxels};
+    int m = corners(g, &held, p, n, neighbours, index, weight);
     for (int i = 0; i < m; i++) {
         sum += weight[i];
         for (int k = 0; k < 4; k++)

@@ -92,6 +92,17 @@ void lpv_iv_reconstruct(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv
 void lpv_iv_irradiance(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
                        const float n[3], int neighbours, float rgb[3]);
 
+/* The same two with the surface-holding voxels given as one flag per voxel
+ * (lpv_grid_index order; non-zero: holds a surface, as the index of an iv
+ * volume on the wire, SPEC R5.14; NULL: none does) instead of the created
+ * voxels: held[i] != 0 where those test lpv_iv_occupied, the rest is the
+ * same code. For clients that have the volume and its flags, not the voxels
+ * (protocol/volume_lookup.h). */
+void lpv_iv_reconstruct_held(const lpv_grid *g, const uint32_t *held, const lpv_cell *vol, const float p[3],
+                             const float n[3], int neighbours, lpv_cell *out);
+void lpv_iv_irradiance_held(const lpv_grid *g, const uint32_t *held, const lpv_cell *vol, const float p[3],
+                            const float n[3], int neighbours, float rgb[3]);
+
 /* Emission at bounce k >= 1 from I_{k-1} (incoming; NULL or k == 1: none).
  * Empty voxels emit 0. An occupied voxel h emits its direct SH and, for
  * k > 1 when |m| > 1e-3 (m its mean normal, |m| in float), also

@@ -39,6 +39,17 @@ typedef enum lpv_frame_terms {
 
 /* What the last tick and render did: GPU milliseconds per stage (timer
  * queries), dispatches and draws per stage, and counts. */
+/* What a volume's levels are, for a reader that has only the volume (the
+ * daemon's description, SPEC R5.10 - R5.14). */
+typedef enum lpv_levels_kind {
+    LPV_LEVELS_CASCADES = 0,  /* an LPV's cascades (or far-field levels): radiant intensity per cell, W/sr,
+                                 read by the trilinear lookup / cell_size^2 (R5.7) */
+    LPV_LEVELS_IV_VOXELS = 1, /* technique iv's one level of voxels: the radiance arriving at each voxel centre,
+                                 W/(m^2 sr), read by the imperfect volume's reconstruction (core/oracle_iv.h
+                                 lpv_iv_irradiance, R5.14), which also needs which voxels hold a surface
+                                 (lpv_engine_read_iv_voxels) and iv_neighbours below */
+} lpv_levels_kind;
+
 /* What the volume is: its levels (cascades) and what a cell holds, as the
  * technique describes it (lpv_technique_class.describe, technique.h). */
 typedef struct lpv_volume_desc {
@@ -48,6 +59,9 @@ typedef struct lpv_volume_desc {
     int far_field;                /* level k + 1 carries on the light of level k */
     int volumes_per_level;        /* 1, or the normal bins */
     int values_per_cell;          /* floats: 12 = SH bands 0-1 of r, g, b */
+    lpv_levels_kind kind;         /* what the levels are and how they are looked up */
+    const char *units;            /* of the values (static): "W/sr" (cascades), "W/(m^2 sr)" (iv voxels) */
+    int iv_neighbours;            /* LPV_LEVELS_IV_VOXELS: the lookup's voxels (settings iv.neighbours); else 0 */
 } lpv_volume_desc;
 
 typedef struct lpv_engine_stats {
@@ -68,6 +82,21 @@ typedef struct lpv_engine_stats {
     double cell_steps;
     int occlusion;
     unsigned long scene_uploads, scene_samplings; /* lpv_engine_counters, as of this tick */
+    /* technique iv (all 0 for the others): what the tick's imperfect volume
+     * was made of */
+    struct {
+        int on;                /* the volume is an imperfect volume (volume.kind LPV_LEVELS_IV_VOXELS) */
+        size_t points;         /* the scene's point cloud (core/iv_points.h) */
+        int points_per_piece;  /* points per triangle piece (below iv_points when the budget cut it) */
+        size_t voxels;         /* of the grid */
+        long long occupied;    /* voxels holding a surface; -1: not counted (the engine reads no voxels back for
+                                  its stats; the daemon counts them from the index it sends, SPEC R5.14) */
+        int bounces;           /* gathered (0 when iv_gather did not run) */
+        int bounces_requested; /* settings iv.bounces */
+        int rays;              /* marched per voxel and bounce */
+        int reprojected;       /* iv_reproject ran (the camera's pixels refined the volume) */
+        int ao;                /* iv_ao ran (the ao frame term has a volume) */
+    } iv;
     /* the volume these stats' tick computed: a copy, so a reader on another
      * thread (the daemon's encoder) gets it with the tick's cells */
     lpv_volume_desc volume;

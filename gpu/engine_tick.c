@@ -138,6 +138,18 @@ static void record_stats(lpv_engine *e)
     s->scene_samplings = e->counters.scene_samplings;
     e->tech->cls->stats(e->tech, &e->plan, s);
     s->volume = e->desc;
+    if (e->desc.kind == LPV_LEVELS_IV_VOXELS) {
+        s->iv.on = 1;
+        s->iv.points = e->iv_point_count;
+        s->iv.points_per_piece = e->iv_point_stats.points_per_piece;
+        s->iv.voxels = s->cells;
+        s->iv.occupied = -1;
+        s->iv.bounces = e->plan.pass[LPV_PASS_IV_GATHER].run ? s->iterations : 0;
+        s->iv.bounces_requested = e->settings.iv.bounces;
+        s->iv.rays = e->settings.iv.rays;
+        s->iv.reprojected = e->plan.pass[LPV_PASS_IV_REPROJECT].run;
+        s->iv.ao = e->plan.pass[LPV_PASS_IV_AO].run;
+    }
 }
 
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
@@ -163,6 +175,9 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
         e->stats.stage_count = 0;
         e->stats.scene_uploads = e->counters.scene_uploads;
         e->stats.scene_samplings = e->counters.scene_samplings;
+        /* the same volume, but a knob of its lookup (iv_neighbours) may have changed */
+        e->tech->cls->describe(e->tech, &e->desc);
+        e->stats.volume = e->desc;
         e->ticked = 1;
         return 0;
     }

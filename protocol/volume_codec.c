@@ -349,7 +349,8 @@ const char *const lpvp_sh_value_names[LPVP_VALUES_PER_CELL] = {
     "b.Y00", "b.Y1-1", "b.Y10", "b.Y11"};
 const char *const lpvp_level_role_names[LPVP_ROLE_COUNT] = {[LPVP_ROLE_CASCADE] = "cascade",
                                                             [LPVP_ROLE_FAR_FIELD] = "far_field",
-                                                            [LPVP_ROLE_OCTREE_LEVEL] = "octree_level"};
+                                                            [LPVP_ROLE_OCTREE_LEVEL] = "octree_level",
+                                                            [LPVP_ROLE_IV_VOXELS] = "iv_voxels"};
 const char *const lpvp_volume_content_names[LPVP_CONTENT_COUNT] = {[LPVP_CONTENT_MERGED] = "merged",
                                                                    [LPVP_CONTENT_LEVELS] = "levels"};
 
@@ -415,6 +416,38 @@ int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, cons
     return 0;
 }
 
+int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
+                          int neighbours, char *err, size_t err_n)
+{
+    if (neighbours < LPVP_IV_NEIGHBOURS_MIN || neighbours > LPVP_IV_NEIGHBOURS_MAX) {
+        lpvp_set_error(err, err_n, "%s %d is outside %d..%d", LPVP_IV_NEIGHBOURS_KEY, neighbours,
+                       LPVP_IV_NEIGHBOURS_MIN, LPVP_IV_NEIGHBOURS_MAX);
+        return -1;
+    }
+    lpvp_volume_layout_sh(l, technique, 0, 1);
+    l->role[0] = LPVP_ROLE_IV_VOXELS;
+    snprintf(l->units, sizeof l->units, "%s", LPVP_VOLUME_UNITS_RADIANCE);
+    l->has_index = 1;
+    l->index.level = 0;
+    for (int a = 0; a < 3; a++)
+        l->index.dims[a] = level0->dims[a];
+    l->index.cells = level0->cells;
+    l->index.values_per_cell = 1;
+    l->index.raw_length = level0->cells * LPVP_INDEX_VALUE_SIZE;
+    l->iv_neighbours = neighbours;
+    return 0;
+}
+
+int lpvp_volume_layout_is_iv(const lpvp_volume_layout *l)
+{
+    return l->present && l->content == LPVP_CONTENT_MERGED && l->role[0] == LPVP_ROLE_IV_VOXELS;
+}
+
+const char *lpvp_volume_layout_units(const lpvp_volume_layout *l)
+{
+    return l->units[0] ? l->units : LPVP_VOLUME_UNITS;
+}
+
 uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi)
 {
     uint64_t vpc = vi->layout.values_per_cell, vpl = vi->layout.volumes_per_level;
@@ -433,6 +466,13 @@ uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi)
 
 int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n)
 {
+    if (lpvp_volume_layout_is_iv(l)) {
+        lpvp_set_error(err, err_n,
+                       "volume of technique \"%s\" is %s voxels holding radiance (%s) with an index of the voxels "
+                       "that hold a surface, not R5.1's cascades R5.7's lookup reads: use R5.14's lookup",
+                       l->technique, lpvp_level_role_names[LPVP_ROLE_IV_VOXELS], lpvp_volume_layout_units(l));
+        return -1;
+    }
     if (l->content == LPVP_CONTENT_LEVELS) {
         lpvp_set_error(err, err_n,
                        "volume of content \"%s\" (technique \"%s\": its %d levels and index volume) is not the merged "
@@ -441,13 +481,30 @@ int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size
                        lpvp_volume_content_names[LPVP_CONTENT_MERGED]);
         return -1;
     }
-    if ((l->sh_values || (!l->present && l->values_per_cell == 0)) && l->volumes_per_level <= 1 && !l->has_index)
+    if ((l->sh_values || (!l->present && l->values_per_cell == 0)) && l->volumes_per_level <= 1 && !l->has_index &&
+        strcmp(lpvp_volume_layout_units(l), LPVP_VOLUME_UNITS) == 0)
         return 0;
     lpvp_set_error(err, err_n,
                    "volume layout of technique \"%s\" (layout_version %d, %d values per cell%s, %d volumes per "
-                   "level%s) is not R5.1's 12 SH values in one volume per level, the only layout R5.7's lookup reads",
-                   l->technique, l->layout_version, l->values_per_cell, l->sh_values ? ", the SH values" : "",
-                   l->volumes_per_level, l->has_index ? ", with an index volume" : "");
+                   "level%s, units %s) is not R5.1's 12 SH values in one volume per level, the only layout R5.7's "
+                   "lookup reads", l->technique, l->layout_version, l->values_per_cell,
+                   l->sh_values ? ", the SH values" : "", l->volumes_per_level,
+                   l->has_index ? ", with an index volume" : "", lpvp_volume_layout_units(l));
+    return -1;
+}
+
+int lpvp_volume_layout_iv_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n)
+{
+    if (lpvp_volume_layout_is_iv(l) && l->sh_values && l->volumes_per_level == 1 && l->has_index &&
+        l->index.level == 0 && l->index.values_per_cell == 1 && l->iv_neighbours >= LPVP_IV_NEIGHBOURS_MIN &&
+        l->iv_neighbours <= LPVP_IV_NEIGHBOURS_MAX)
+        return 0;
+    lpvp_set_error(err, err_n,
+                   "volume layout of technique \"%s\" (%s, %d values per cell, %d volumes per level%s) is not "
+                   "R5.14's %s voxels, the only layout R5.14's lookup reads", l->technique[0] ? l->technique : "?",
+                   l->content == LPVP_CONTENT_LEVELS ? "content \"levels\"" : "content \"merged\"",
+                   l->values_per_cell, l->volumes_per_level, l->has_index ? ", with an index" : ", no index",
+                   lpvp_level_role_names[LPVP_ROLE_IV_VOXELS]);
     return -1;
 }
 
@@ -489,8 +546,10 @@ static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
         bad |= json_object_set_new(o, "values_per_cell", json_integer(l->values_per_cell)) != 0;
         bad |= json_object_set_new(o, "values", values) != 0;
         values = NULL;
-        bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
+        bad |= json_object_set_new(o, "units", json_string(lpvp_volume_layout_units(l))) != 0;
         bad |= json_object_set_new(o, "index", l->has_index ? index_json(vi) : json_null()) != 0;
+        if (lpvp_volume_layout_is_iv(l)) /* R5.14 */
+            bad |= json_object_set_new(o, LPVP_IV_NEIGHBOURS_KEY, json_integer(l->iv_neighbours)) != 0;
     }
     json_decref(levels);
     json_decref(values);
@@ -635,7 +694,7 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
         grid = NULL;
         json_t *cascades = cascades_json(vi);
         bad |= json_object_set_new(o, "cascades", cascades) != 0;
-        bad |= json_object_set_new(o, "units", json_string(LPVP_VOLUME_UNITS)) != 0;
+        bad |= json_object_set_new(o, "units", json_string(lpvp_volume_layout_units(&vi->layout))) != 0;
         bad |= json_object_set_new(o, "layout", json_string(LPVP_VOLUME_LAYOUT)) != 0;
         bad |= json_object_set_new(o, "sh", json_string(LPVP_VOLUME_SH)) != 0;
         bad |= json_object_set_new(o, "raw_length", json_integer((json_int_t)vi->raw_length)) != 0;
@@ -847,6 +906,74 @@ static int parse_octree_levels(const json_t *d, lpvp_volume_info *vi, char *err,
     return 0;
 }
 
+/* 1 when levels[0] has the role "iv_voxels" (R5.14). */
+static int is_iv_levels(const json_t *levels)
+{
+    const json_t *r = json_object_get(json_array_get(levels, 0), "role");
+    return json_is_array(levels) && json_is_string(r) &&
+           strcmp(json_string_value(r), lpvp_level_role_names[LPVP_ROLE_IV_VOXELS]) == 0;
+}
+
+/* R5.14: technique iv's one level of voxels, equal to cascades[0] (the only
+ * cascade), far_field false, and its lookup's iv_neighbours. The cells, units
+ * and index are checked after parse_cells (iv_checks). */
+static int parse_iv_levels(const json_t *d, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    lpvp_volume_layout *l = &vi->layout;
+    const char *K = LPVP_VOLUME_DESC_KEY, *IV = lpvp_level_role_names[LPVP_ROLE_IV_VOXELS];
+    const json_t *a = json_object_get(d, "levels"), *v;
+    if (vi->cascade_count != 1 || json_array_size(a) != 1) {
+        lpvp_set_error(err, err_n, "%s.levels: %zu levels over %d cascades, but \"%s\" is exactly one level over "
+                       "one cascade (R5.14)", K, json_array_size(a), vi->cascade_count, IV);
+        return -1;
+    }
+    if (!json_is_object(json_array_get(a, 0)) || !level_matches(json_array_get(a, 0), &vi->cascades[0])) {
+        lpvp_set_error(err, err_n, "%s.levels[0]: dims, origin, cell_size and cells differ from cascades[0]", K);
+        return -1;
+    }
+    if (l->far_field) {
+        lpvp_set_error(err, err_n, "%s.far_field: true with \"%s\" levels (an iv volume has no far field)", K, IV);
+        return -1;
+    }
+    v = json_object_get(d, LPVP_IV_NEIGHBOURS_KEY);
+    if (!json_is_integer(v) || json_integer_value(v) < LPVP_IV_NEIGHBOURS_MIN ||
+        json_integer_value(v) > LPVP_IV_NEIGHBOURS_MAX) {
+        lpvp_set_error(err, err_n, "%s.%s: expected an integer in [%d, %d] with \"%s\" levels (R5.14)", K,
+                       LPVP_IV_NEIGHBOURS_KEY, LPVP_IV_NEIGHBOURS_MIN, LPVP_IV_NEIGHBOURS_MAX, IV);
+        return -1;
+    }
+    l->iv_neighbours = (int)json_integer_value(v);
+    l->role[0] = LPVP_ROLE_IV_VOXELS;
+    return 0;
+}
+
+/* R5.14 after parse_cells: the 12 SH values in one volume, radiance units,
+ * the index over level 0 with one value per voxel. */
+static int iv_checks(lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    const lpvp_volume_layout *l = &vi->layout;
+    const lpvp_cascade_info *c0 = &vi->cascades[0];
+    const char *K = LPVP_VOLUME_DESC_KEY, *IV = lpvp_level_role_names[LPVP_ROLE_IV_VOXELS];
+    if (!l->sh_values || l->volumes_per_level != 1) {
+        lpvp_set_error(err, err_n, "%s.values: \"%s\" levels hold R5.1's 12 SH values in one volume per level "
+                       "(got %d values, %d volumes; R5.14)", K, IV, l->values_per_cell, l->volumes_per_level);
+        return -1;
+    }
+    if (strcmp(lpvp_volume_layout_units(l), LPVP_VOLUME_UNITS_RADIANCE) != 0) {
+        lpvp_set_error(err, err_n, "%s.units: \"%s\" with \"%s\" levels, expected \"%s\" (radiance; R5.14)", K,
+                       lpvp_volume_layout_units(l), IV, LPVP_VOLUME_UNITS_RADIANCE);
+        return -1;
+    }
+    if (!l->has_index || l->index.level != 0 || l->index.values_per_cell != 1 || l->index.dims[0] != c0->dims[0] ||
+        l->index.dims[1] != c0->dims[1] || l->index.dims[2] != c0->dims[2]) {
+        lpvp_set_error(err, err_n, "%s.index: \"%s\" levels need the index over level 0 (level 0, dims [%lld, "
+                       "%lld, %lld], values_per_cell 1: which voxels hold a surface; R5.14)", K, IV,
+                       (long long)c0->dims[0], (long long)c0->dims[1], (long long)c0->dims[2]);
+        return -1;
+    }
+    return 0;
+}
+
 static int parse_cells(const json_t *obj, const json_t *d, lpvp_volume_info *vi, char *err, size_t err_n);
 
 /* The description (R5.9 - R5.12) into vi->layout; the cascades are already
@@ -899,6 +1026,10 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
     a = json_object_get(d, "levels");
     if (is_octree_levels(a))
         return parse_octree_levels(d, vi, err, err_n) != 0 ? -1 : parse_cells(obj, d, vi, err, err_n);
+    if (is_iv_levels(a))
+        return parse_iv_levels(d, vi, err, err_n) != 0 || parse_cells(obj, d, vi, err, err_n) != 0
+                   ? -1
+                   : iv_checks(vi, err, err_n);
     /* R5.10: the levels are the cascades, each with a role agreeing with far_field */
     if (!json_is_array(a) || json_array_size(a) != (size_t)vi->cascade_count) {
         lpvp_set_error(err, err_n, "%s.levels: expected an array of %d levels (one per cascade)", K,
@@ -923,9 +1054,9 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
             if (strcmp(json_string_value(v), lpvp_level_role_names[r]) == 0)
                 role = r;
         if (role < 0) {
-            lpvp_set_error(err, err_n, "%s.levels[%d].role: expected \"%s\", \"%s\" or \"%s\"", K, k,
+            lpvp_set_error(err, err_n, "%s.levels[%d].role: expected \"%s\", \"%s\", \"%s\" or \"%s\"", K, k,
                            lpvp_level_role_names[LPVP_ROLE_CASCADE], lpvp_level_role_names[LPVP_ROLE_FAR_FIELD],
-                           lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL]);
+                           lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL], lpvp_level_role_names[LPVP_ROLE_IV_VOXELS]);
             return -1;
         }
         int want = (l->far_field && k > 0) ? LPVP_ROLE_FAR_FIELD : LPVP_ROLE_CASCADE;
@@ -992,6 +1123,12 @@ static int parse_cells(const json_t *obj, const json_t *d, lpvp_volume_info *vi,
         lpvp_set_error(err, err_n, "%s.units: expected a string equal to the header's \"units\"", K);
         return -1;
     }
+    if (json_string_length(v) >= sizeof l->units) {
+        lpvp_set_error(err, err_n, "%s.units: \"%s\" is longer than the units this client knows", K,
+                       json_string_value(v));
+        return -1;
+    }
+    snprintf(l->units, sizeof l->units, "%s", json_string_value(v));
 
     /* R5.12: an index volume after the levels' values */
     v = json_object_get(d, "index");

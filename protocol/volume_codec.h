@@ -34,8 +34,11 @@ float lpvp_f16_to_f32(uint16_t h);
 
 #define LPVP_VALUES_PER_CELL 12  /* r0 r1 r2 r3 g0 g1 g2 g3 b0 b1 b2 b3 */
 
-/* The SPEC strings of the volume header (section 5). */
+/* The SPEC strings of the volume header (section 5). LPVP_VOLUME_UNITS is
+ * an LPV's (radiant intensity per cell); an iv volume's voxels hold radiance
+ * (R5.14). */
 #define LPVP_VOLUME_UNITS "W/sr"
+#define LPVP_VOLUME_UNITS_RADIANCE "W/(m^2 sr)"
 #define LPVP_VOLUME_LAYOUT "cell-major, x fastest; per cell r0 r1 r2 r3 g0 g1 g2 g3 b0 b1 b2 b3"
 #define LPVP_VOLUME_SH "Y00, Y1-1 (y), Y10 (z), Y11 (x), no Condon-Shortley phase"
 
@@ -70,6 +73,8 @@ typedef enum lpvp_frame_format {
     LPVP_FRAME_FORMAT_COUNT = 3
 } lpvp_frame_format;
 extern const char *const lpvp_frame_terms_names[LPVP_TERMS_COUNT];
+/* The units of an "ao" frame (a fraction, 1 = open) in every format. */
+#define LPVP_FRAME_AO_UNITS "1"
 extern const char *const lpvp_frame_format_names[LPVP_FRAME_FORMAT_COUNT];
 
 /* The streams of SUBSCRIBE / UNSUBSCRIBE / ACK (R5.5): "volume", "frame". */
@@ -177,13 +182,22 @@ extern const char *const lpvp_sh_value_names[LPVP_VALUES_PER_CELL];
 /* A level's role (R5.10): "cascade" (levels blended as R5.7 says) or
  * "far_field" (a coarser level carrying on the light of the finer ones; the
  * server sums such levels), or "octree_level" (R5.13: a level of an octree,
- * level 0's box in cells 2^i times level 0's). */
+ * level 0's box in cells 2^i times level 0's), or "iv_voxels" (R5.14: the
+ * one level of technique iv, cubic voxels holding the radiance arriving at
+ * their centres, looked up by R5.14's reconstruction). */
 typedef enum lpvp_level_role {
     LPVP_ROLE_CASCADE = 0,
     LPVP_ROLE_FAR_FIELD = 1,
     LPVP_ROLE_OCTREE_LEVEL = 2,
-    LPVP_ROLE_COUNT = 3
+    LPVP_ROLE_IV_VOXELS = 3,
+    LPVP_ROLE_COUNT = 4
 } lpvp_level_role;
+
+/* R5.14: the description key of an iv volume's lookup parameter (the
+ * session's effective iv_neighbours) and its range. */
+#define LPVP_IV_NEIGHBOURS_KEY "iv_neighbours"
+#define LPVP_IV_NEIGHBOURS_MIN 1
+#define LPVP_IV_NEIGHBOURS_MAX 8
 
 /* What GET_VOLUME's optional "content" asks for (R5.13): "merged" (the
  * default: the volume R5.1 - R5.12 describe) or "levels" (a technique's
@@ -230,8 +244,11 @@ typedef struct lpvp_volume_layout {
     int volumes_per_level;       /* >= 1; 1: one (summed) volume per level */
     int values_per_cell;         /* 1..LPVP_MAX_VALUES_PER_CELL */
     int sh_values;               /* the values are lpvp_sh_value_names in order (build: send them) */
+    char units[32];              /* the description's (and header's) units; "" = LPVP_VOLUME_UNITS */
     int has_index;
     lpvp_index_info index;       /* when has_index */
+    /* R5.14 (role[0] LPVP_ROLE_IV_VOXELS): the reconstruction's voxels, 1..8 */
+    int iv_neighbours;
 } lpvp_volume_layout;
 
 typedef struct lpvp_volume_info {
@@ -274,14 +291,33 @@ void lpvp_octree_level_place(const lpvp_cascade_info *level0, int i, lpvp_cascad
 int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
                               char *err, size_t err_n);
 
+/* R5.14's layout for technique iv over level0 (its one level of voxels):
+ * role "iv_voxels", far_field false, the 12 SH values in one volume, units
+ * LPVP_VOLUME_UNITS_RADIANCE, the index over level 0 (one u32 per voxel: 1 =
+ * it holds a surface; raw_offset is filled by lpvp_volume_header_build) and
+ * iv_neighbours. Returns 0, or -1 with err set for neighbours outside 1..8. */
+int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
+                          int neighbours, char *err, size_t err_n);
+
+/* 1 when the layout is R5.14's (level 0 has the role "iv_voxels"). */
+int lpvp_volume_layout_is_iv(const lpvp_volume_layout *l);
+
+/* The layout's units: l->units, or LPVP_VOLUME_UNITS when that is empty. */
+const char *lpvp_volume_layout_units(const lpvp_volume_layout *l);
+
 /* Bytes of the levels' values: all cells x volumes_per_level x
  * values_per_cell x value size (0 on overflow or a bad layout). With
  * layout.present 0 and values_per_cell 0, the legacy 12 values. */
 uint64_t lpvp_volume_values_bytes(const lpvp_volume_info *vi);
 
-/* 0 when R5.7's lookup reads this layout (the SH values, one volume per
- * level); else -1 with err naming the layout. */
+/* 0 when R5.7's lookup reads this layout (the SH values in W/sr, one volume
+ * per level, no index); else -1 with err naming the layout (an iv volume's:
+ * use R5.14's lookup, lpvp_volume_layout_iv_lookup_check). */
 int lpvp_volume_layout_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n);
+
+/* 0 when R5.14's lookup reads this layout (lpvp_volume_layout_is_iv, with
+ * its index and iv_neighbours); else -1 with err naming the layout. */
+int lpvp_volume_layout_iv_lookup_check(const lpvp_volume_layout *l, char *err, size_t err_n);
 
 /* Cells of all levels together (0 if the count is out of range): the
  * octree's levels for content LPVP_CONTENT_LEVELS (R5.13), else the
@@ -308,7 +344,10 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi);
  * with far_field, values naming values_per_cell distinct values, units as the
  * top level's, an index that fits; or R5.13's octree levels: one cascade,
  * log2(n) + 1 "octree_level" levels placed as lpvp_octree_level_place says,
- * far_field false, the index over level 0), and that raw_length == the
+ * far_field false, the index over level 0; or R5.14's iv voxels: one
+ * cascade and one "iv_voxels" level equal to it, far_field false, the 12 SH
+ * values in one volume, units "W/(m^2 sr)", the index over level 0 with one
+ * value per voxel, iv_neighbours in 1..8), and that raw_length == the
  * levels' values (+ the index) as described. A header without "cascades" (an older
  * server) is read as one cascade equal to the grid; one without "volume" as
  * R5.1's 12 values (layout.present 0). Returns 0, or -1 with

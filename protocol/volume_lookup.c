@@ -1,6 +1,7 @@
 /*
- * volume_lookup.c - SPEC R5.7 on a decoded volume (see volume_lookup.h): the
- * cascade choice and border blend here, the SH lookup from core's oracle.
+ * volume_lookup.c - SPEC R5.7 and R5.14 on a decoded volume (see
+ * volume_lookup.h): the cascade choice and border blend here, the SH lookup
+ * and the imperfect volume's reconstruction from core's oracles.
  */
 #include "volume_lookup.h"
 
@@ -9,6 +10,7 @@
 #include <stdint.h>
 
 #include "oracle.h"
+#include "oracle_iv.h"
 
 /* The wire's 12 values per cell are core's lpv_cell, r g b vec4 each (R5.1). */
 _Static_assert(sizeof(lpv_cell) == 12 * sizeof(float), "lpv_cell is the wire's 12 floats");
@@ -70,5 +72,23 @@ int lpvp_volume_irradiance(const lpvp_lookup_cascade *cs, int count, const float
     lpvp_cascade_irradiance(&cs[k + 1], p, n, coarse);
     for (int ch = 0; ch < 3; ch++)
         rgb[ch] = w * rgb[ch] + (1.0f - w) * coarse[ch];
+    return 0;
+}
+
+int lpvp_iv_irradiance(const lpvp_lookup_iv *v, const float p[3], const float n[3], float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!v || !v->held || v->neighbours < 1 || v->neighbours > 8)
+        return -1;
+    const lpvp_lookup_cascade cs = {.dims = {v->dims[0], v->dims[1], v->dims[2]},
+                                    .origin = {v->origin[0], v->origin[1], v->origin[2]},
+                                    .cell_size = v->cell_size,
+                                    .cells = v->cells};
+    if (!usable(&cs))
+        return -1;
+    lpv_grid g = {.dims = {v->dims[0], v->dims[1], v->dims[2]},
+                  .origin = {v->origin[0], v->origin[1], v->origin[2]},
+                  .cell_size = v->cell_size};
+    lpv_iv_irradiance_held(&g, v->held, (const lpv_cell *)(const void *)v->cells, p, n, v->neighbours, rgb);
     return 0;
 }

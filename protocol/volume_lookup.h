@@ -1,15 +1,24 @@
 /*
- * volume_lookup.h - irradiance from a decoded volume (SPEC R5.7), for
- * clients: the cascade to read at a point and the blend across cascade
- * borders. The SH lookup inside one cascade is core's reference lookup
- * (core/oracle.h lpv_oracle_irradiance: the half-cell offset, trilinear
- * filtering clamped at the edge, the cosine lobe, / cell_size^2), so the
- * client's answer and the oracle tests' are the same code; this file adds only
- * what the SPEC defines on top of it. Part of the lpv_protocol library, which
- * therefore links lpv_core (protocol -> core; core never includes protocol).
+ * volume_lookup.h - irradiance from a decoded volume, for clients.
+ *
+ * R5.7 (the LPV's cascades): the cascade to read at a point and the blend
+ * across cascade borders. The SH lookup inside one cascade is core's
+ * reference lookup (core/oracle.h lpv_oracle_irradiance: the half-cell
+ * offset, trilinear filtering clamped at the edge, the cosine lobe, /
+ * cell_size^2), so the client's answer and the oracle tests' are the same
+ * code; this file adds only what the SPEC defines on top of it.
+ *
+ * R5.14 (technique iv's voxels): the imperfect volume's reconstruction, core's
+ * reference (core/oracle_iv.h lpv_iv_irradiance_held) on the volume and its
+ * index of surface-holding voxels.
+ *
+ * Part of the lpv_protocol library, which therefore links lpv_core
+ * (protocol -> core; core never includes protocol).
  */
 #ifndef LPVP_VOLUME_LOOKUP_H
 #define LPVP_VOLUME_LOOKUP_H
+
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -36,6 +45,24 @@ int lpvp_cascade_irradiance(const lpvp_lookup_cascade *cs, const float p[3], con
  * the border in the finer cascade's cells. Returns 0, or -1 as above. */
 int lpvp_volume_irradiance(const lpvp_lookup_cascade *cs, int count, const float p[3], const float n[3],
                            float rgb[3]);
+
+/* An iv volume (SPEC R5.14): one level of cubic voxels, the radiance
+ * arriving at each voxel's centre (W/(m^2 sr)) as 12 SH values, and which
+ * voxels hold a surface. */
+typedef struct lpvp_lookup_iv {
+    int dims[3];           /* voxels per axis, each >= 1 */
+    float origin[3];       /* m, lower corner */
+    float cell_size;       /* m, > 0: the voxels' side */
+    const float *cells;    /* dims' product x 12 floats in the wire order (R5.1), 16-byte aligned */
+    const uint32_t *held;  /* dims' product flags, the description's index: non-zero = holds a surface */
+    int neighbours;        /* 1..8: the description's iv_neighbours */
+} lpvp_lookup_iv;
+
+/* Irradiance (W/m^2, rgb) at p for a surface with normal n by R5.14's
+ * reconstruction (lpv_iv_irradiance_held). Returns 0, or -1 (rgb zero) for a
+ * volume that is not usable: no cells or flags, misaligned cells, dims < 1, a
+ * cell size <= 0, neighbours outside 1..8. */
+int lpvp_iv_irradiance(const lpvp_lookup_iv *v, const float p[3], const float n[3], float rgb[3]);
 
 #ifdef __cplusplus
 }

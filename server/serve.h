@@ -119,7 +119,12 @@ typedef struct sv_result {
     size_t level_cells;
     uint32_t *index;
     size_t index_count;
-    float *frames[3];       /* rgba float per lpv_frame_terms, NULL if not rendered */
+    /* Technique iv (SPEC R5.14): per voxel of the grid, 1 when it holds a
+     * surface (IvVoxel.normal[3] > 0), the index every iv volume carries;
+     * NULL / 0 for the other techniques. */
+    uint32_t *iv_held;
+    size_t iv_held_count;
+    float *frames[LPVP_TERMS_COUNT]; /* rgba float per lpv_frame_terms, NULL if not rendered */
     int width, height;
     lpv_engine_stats stats;
     lpv_plan plan;          /* the plan of this tick, snapshotted with stats */

@@ -2,12 +2,14 @@
  * serve_encode.c - the payloads of VOLUME / GET_VOLUME (SPEC section 5) and
  * FRAME / GET_FRAME (section 6), through protocol/volume_codec.h: fp16/fp32
  * packing, XOR deltas against the last volume a subscriber ACKed, zstd; and
- * frames as tone-mapped rgba8, PNG or EXR (in-memory, image/image_io.h).
- * A volume carries every cascade (R5.6, cascade 0 first) and both headers
- * the tick's "plan" (lpvd_plan_json).
+ * frames as tone-mapped rgba8, PNG or EXR (in-memory, image/image_io.h), the
+ * ao term as a linear fraction. A volume carries every cascade (R5.6,
+ * cascade 0 first), or technique iv's voxels and their index (R5.14), and
+ * both headers the tick's "plan" (lpvd_plan_json).
  */
 #include "serve.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,14 +70,22 @@ static void remember_sent(sv_sub *sub, uint64_t tick, const int dims[3], int fp1
     memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
 }
 
+_Static_assert((int)LPVP_TERMS_AO == (int)LPV_TERMS_AO && (int)LPVP_TERMS_DIRECT == (int)LPV_TERMS_DIRECT_ONLY,
+               "the protocol's frame terms are the engine's");
+
+/* An index volume (R5.12) as little-endian u32 at ix. */
+static void pack_index(uint8_t *ix, const uint32_t *index, size_t count)
+{
+    for (size_t i = 0; i < count; ++i)
+        lpvp_put_u32(ix + LPVP_INDEX_VALUE_SIZE * i, index[i]);
+}
+
 /* The levels payload (SPEC R5.13): every octree level's 12 values, then the
  * index volume as little-endian u32 at vi's index offset. */
 static void pack_levels(const sv_result *r, const lpvp_volume_info *vi, uint8_t *raw)
 {
     lpvp_volume_pack(r->levels, r->level_cells, vi->format, raw);
-    uint8_t *ix = raw + lpvp_volume_values_bytes(vi);
-    for (size_t i = 0; i < r->index_count; ++i)
-        lpvp_put_u32(ix + LPVP_INDEX_VALUE_SIZE * i, r->index[i]);
+    pack_index(raw + lpvp_volume_values_bytes(vi), r->index, r->index_count);
 }
 
 int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
@@ -132,6 +142,15 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub,
                      (unsigned long long)vi.layout.index.cells);
             return -1;
         }
+    } else if (d->kind == LPV_LEVELS_IV_VOXELS) { /* R5.14: the voxels' radiance, then which hold a surface */
+        if (vi.cascade_count != 1 || !r->iv_held || r->iv_held_count != r->cell_count) {
+            snprintf(err, n, "technique \"%s\": the tick kept %zu of the %zu voxels' occupancy over %d levels",
+                     d->technique, r->iv_held_count, r->cell_count, vi.cascade_count);
+            return -1;
+        }
+        if (lpvp_volume_layout_iv(&vi.layout, d->technique, &vi.cascades[0], d->iv_neighbours, err, n) != 0)
+            return -1;
+        raw_len = (size_t)(lpvp_volume_values_bytes(&vi) + vi.layout.index.raw_length);
     } else {
         lpvp_volume_layout_sh(&vi.layout, d->technique, d->far_field, vi.cascade_count);
         raw_len = lpvp_volume_raw_size(r->cell_count, fmt); /* all cascades' cells (R5.6) */
@@ -149,10 +168,13 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub,
             snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
             return -1;
         }
-        if (levels)
+        if (levels) {
             pack_levels(r, &vi, raw);
-        else
+        } else {
             lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
+            if (vi.layout.has_index) /* R5.14 */
+                pack_index(raw + lpvp_volume_values_bytes(&vi), r->iv_held, r->iv_held_count);
+        }
     }
 
     uint8_t *payload = raw; /* what gets compressed / sent */
@@ -229,6 +251,25 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub,
     return 0;
 }
 
+/* The ao term for display (rgba8, png; SPEC section 6): a fraction, not
+ * light, so no exposure, tone or sRGB curve: each channel 255 x the value
+ * clamped to 0..1; pixels without geometry get the display's background (or
+ * alpha 0 when transparent) as R6.4's. */
+static void fraction_rgba8(const float *rgba, size_t n, const lpv_display *d, uint8_t *out)
+{
+    for (size_t i = 0; i < n; ++i) {
+        float a = rgba[i * 4 + 3];
+        a = isfinite(a) ? fminf(fmaxf(a, 0.0f), 1.0f) : 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            float v = rgba[i * 4 + (size_t)c];
+            v = isfinite(v) ? fminf(fmaxf(v, 0.0f), 1.0f) : 0.0f;
+            float x = d->transparent ? v : a * v + (1.0f - a) * fminf(fmaxf(d->background[c], 0.0f), 1.0f);
+            out[i * 4 + (size_t)c] = (uint8_t)lrintf(255.0f * x);
+        }
+        out[i * 4 + 3] = d->transparent ? (uint8_t)lrintf(255.0f * a) : 255;
+    }
+}
+
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
                     uint64_t revision, uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
 {
@@ -246,7 +287,10 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
             snprintf(err, n, "out of memory for a %dx%d frame", w, h);
             return -1;
         }
-        ev = lpv_display_rgba8(rgba, px, display, rgba8);
+        if (terms == LPVP_TERMS_AO)
+            fraction_rgba8(rgba, px, display, rgba8);
+        else
+            ev = lpv_display_rgba8(rgba, px, display, rgba8);
         if (fmt == LPVP_FRAME_PNG) {
             int rc = lpv_image_encode_u8("png", w, h, 4, rgba8, &data, &len, err, n);
             free(rgba8);
@@ -275,9 +319,15 @@ int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int term
     *body = json_pack("{s:I, s:I, s:s, s:s, s:i, s:i, s:s, s:s, s:I}", "revision", (json_int_t)revision, "tick",
                       (json_int_t)tick, "format", lpvp_frame_format_names[fmt], "compression",
                       lpvp_compression_name(zstd ? LPVP_COMP_ZSTD : LPVP_COMP_NONE), "width", w,
-                      "height", h, "terms", lpvp_frame_terms_names[terms], "units", fmt == LPVP_FRAME_EXR ? "W/(m^2 sr)" : "sRGB",
+                      "height", h, "terms", lpvp_frame_terms_names[terms], "units",
+                      terms == LPVP_TERMS_AO ? LPVP_FRAME_AO_UNITS : fmt == LPVP_FRAME_EXR ? "W/(m^2 sr)" : "sRGB",
                       "raw_length", (json_int_t)raw_len);
-    if (*body && fmt != LPVP_FRAME_EXR &&
+    if (*body && fmt != LPVP_FRAME_EXR && terms == LPVP_TERMS_AO &&
+        json_object_set_new(*body, "transparent", json_boolean(display->transparent)) != 0) {
+        json_decref(*body);
+        *body = NULL;
+    }
+    if (*body && fmt != LPVP_FRAME_EXR && terms != LPVP_TERMS_AO &&
         (json_object_set_new(*body, "exposure_ev", json_real(ev)) != 0 ||
          json_object_set_new(*body, "exposure", json_string(display->exposure_auto ? "auto" : "fixed")) != 0 ||
          json_object_set_new(*body, "transparent", json_boolean(display->transparent)) != 0)) {

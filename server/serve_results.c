@@ -73,6 +73,21 @@ int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n)
                                                                                          : LPVP_FIELD_OK;
 }
 
+int sv_terms_check(const sv_conn *c, int terms, char *err, size_t n)
+{
+    if (terms != LPVP_TERMS_AO)
+        return 0;
+    lpv_settings s = c->settings;
+    lpv_settings_resolve(&s);
+    if (s.technique == LPV_TECHNIQUE_ID_IV && s.iv.ao == LPV_SWITCH_ON)
+        return 0;
+    const char *t = lpv_technique_name(s.technique);
+    snprintf(err, n, "terms: \"%s\" (ambient occlusion) needs technique \"%s\" with iv_ao on; this session has "
+             "technique \"%s\" and iv_ao %s (CONFIG them first)", lpvp_frame_terms_names[LPVP_TERMS_AO],
+             LPV_TECHNIQUE_IV, t ? t : "?", s.iv.ao == LPV_SWITCH_ON ? "on" : "off");
+    return -1;
+}
+
 void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
@@ -136,7 +151,7 @@ void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     if (lpvp_get_enum(j, "format", 0, lpvp_frame_format_names, LPVP_FRAME_FORMAT_COUNT, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD ||
-        sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) {
+        sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD || sv_terms_check(c, terms, err, sizeof err)) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }

@@ -49,6 +49,10 @@ json_t *sv_config_json(sv_conn *c); /* CONFIG and STATS "config" (serve_controls
 /* GET_FRAME's and SUBSCRIBE frame's "exposure" and "transparent"
  * (serve_results.c) */
 int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n);
+/* GET_FRAME's and SUBSCRIBE frame's "terms": 0 when the session's settings
+ * render them; -1 with a message naming "terms" for "ao" without technique iv
+ * and iv_ao on (SPEC section 6, BAD_FIELD). */
+int sv_terms_check(const sv_conn *c, int terms, char *err, size_t n);
 
 /* ---- what the world reports, through sv_world_listener (serve.h) ---- */
 void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id); /* serve_results.c */

@@ -31,7 +31,8 @@ void sv_do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
         lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_bool(j, "delta", 0, &delta, err, sizeof err) == LPVP_FIELD_BAD ||
         (stream && lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD) ||
-        (stream && sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD))
+        (stream && sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) ||
+        (stream && sv_terms_check(c, terms, err, sizeof err) != 0))
         goto bad;
     if (stream && delta) {
         snprintf(err, sizeof err, "delta: only the volume stream has deltas");

@@ -42,7 +42,8 @@ static void result_free(sv_result *r)
     free(r->cells);
     free(r->levels);
     free(r->index);
-    for (int i = 0; i < 3; ++i)
+    free(r->iv_held);
+    for (int i = 0; i < LPVP_TERMS_COUNT; ++i)
         free(r->frames[i]);
     for (int i = 0; i < 4; ++i)
         free(r->enc[i / 2][i % 2]);
@@ -348,6 +349,33 @@ static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
     return 0;
 }
 
+/* An iv volume's index (SPEC R5.14): which voxels hold a surface, read now
+ * on the GL thread from the voxels (IvVoxel.normal[3], the points that landed
+ * in each), and *occupied their count. 0 (nothing kept for a volume that is
+ * not an imperfect volume's) or -1 with err. */
+static int keep_iv_held(lpv_engine *e, sv_result *r, long long *occupied, char *err, size_t n)
+{
+    if (lpv_engine_last_stats(e)->volume.kind != LPV_LEVELS_IV_VOXELS)
+        return 0;
+    size_t cells = lpv_grid_cell_count(&r->grid);
+    struct IvVoxel *vox = malloc((cells ? cells : 1) * sizeof *vox);
+    r->iv_held = malloc((cells ? cells : 1) * sizeof *r->iv_held);
+    if (!vox || !r->iv_held || lpv_engine_read_iv_voxels(e, vox, cells) != cells) {
+        snprintf(err, n, "%s", !vox || !r->iv_held ? "out of memory for the imperfect volume's voxels"
+                                                    : "the imperfect volume's voxels could not be read back");
+        free(vox);
+        return -1;
+    }
+    *occupied = 0;
+    for (size_t i = 0; i < cells; ++i) {
+        r->iv_held[i] = vox[i].normal[3] > 0.0f; /* lpv_iv_occupied */
+        *occupied += r->iv_held[i];
+    }
+    free(vox);
+    r->iv_held_count = cells;
+    return 0;
+}
+
 static void gl_tick(sv_server *s, sv_job *j)
 {
     (void)s;
@@ -390,14 +418,16 @@ static void gl_tick(sv_server *s, sv_job *j)
     size_t got = lpv_engine_read_grid(w->engine, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
     if (got < r->cell_count)
         memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
-    if (keep_levels(w->engine, r, j->err, sizeof j->err) != 0) {
+    long long occupied = -1;
+    if (keep_levels(w->engine, r, j->err, sizeof j->err) != 0 ||
+        keep_iv_held(w->engine, r, &occupied, j->err, sizeof j->err) != 0) {
         j->status = LPVP_E_INTERNAL;
         result_free(r);
         return;
     }
     r->width = j->inputs->view.width;
     r->height = j->inputs->view.height;
-    for (int t = 0; t < 3; ++t) {
+    for (int t = 0; t < LPVP_TERMS_COUNT; ++t) {
         if (!(j->terms_mask & (1u << t)))
             continue;
         size_t px = (size_t)r->width * (size_t)r->height;
@@ -408,6 +438,8 @@ static void gl_tick(sv_server *s, sv_job *j)
         }
     }
     r->stats = *lpv_engine_last_stats(w->engine);
+    if (r->iv_held)
+        r->stats.iv.occupied = occupied; /* counted from the index the volume carries */
     r->plan = *lpv_engine_last_plan(w->engine);
     r->tick = ++w->gl_ticks;
     r->tick_ms = wall_ms() - t0;

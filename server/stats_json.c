@@ -51,6 +51,21 @@ json_t *lpvd_plan_json(const lpv_plan *p)
                      reason_len(p->recompute_reason), "passes", passes);
 }
 
+/* Technique iv's counts (lpv_engine_stats.iv): what the tick's imperfect
+ * volume was made of. */
+static json_t *iv_json(const lpv_engine_stats *st)
+{
+    json_t *o = json_pack("{s:I, s:i, s:I, s:i, s:i, s:i, s:b, s:b}", "points", (json_int_t)st->iv.points,
+                          "points_per_piece", st->iv.points_per_piece, "voxels", (json_int_t)st->iv.voxels, "bounces",
+                          st->iv.bounces, "bounces_requested", st->iv.bounces_requested, "rays", st->iv.rays,
+                          "reprojected", st->iv.reprojected != 0, "ao", st->iv.ao != 0);
+    if (o && st->iv.occupied >= 0 && json_object_set_new(o, "occupied", json_integer(st->iv.occupied)) != 0) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
 json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, const lpv_grid *cascades, int n,
                              double tick_ms)
 {
@@ -73,6 +88,10 @@ json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, c
                           "grid", grid_json(&cascades[0]), "cascades", lpvd_cascades_json(cascades, n), "plan",
                           lpvd_plan_json(plan));
     if (o && tick_ms >= 0.0 && json_object_set_new(o, "tick_ms", json_real(tick_ms)) != 0) {
+        json_decref(o);
+        return NULL;
+    }
+    if (o && st->iv.on && json_object_set_new(o, "iv", iv_json(st)) != 0) {
         json_decref(o);
         return NULL;
     }

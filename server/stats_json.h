@@ -24,7 +24,10 @@ json_t *lpvd_cascades_json(const lpv_grid *cascades, int n);
  *    "counts": {"lights", "area_lights", "rsm_faces", "vpls_rsm",
  *               "vpls_emissive", "surfels_rsm", "surfels_camera", "cells",
  *               "iterations", "cell_steps", "occlusion"},
- *    "grid": cascade 0, "cascades": n placements, "plan": lpvd_plan_json}
+ *    "grid": cascade 0, "cascades": n placements, "plan": lpvd_plan_json,
+ *    "iv" (technique iv only): {"points", "points_per_piece", "voxels",
+ *          "occupied" (when counted), "bounces", "bounces_requested", "rays",
+ *          "reprojected": bool, "ao": bool}}
  * cascades: n >= 1 grids, finest first. A new reference (NULL if memory runs out). */
 json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, const lpv_grid *cascades, int n,
                              double tick_ms);

@@ -567,6 +567,132 @@ static void test_octree_levels(void **state)
     lpvc_close(c);
 }
 
+/* Technique iv (SPEC R5.14): the volume of voxels with its occupancy index
+ * and iv_neighbours, looked up locally (lpvc_volume_irradiance) as the
+ * server's QUERY_IRRADIANCE answers; the "ao" frame term is refused with
+ * BAD_FIELD naming terms unless the session has technique iv with iv_ao on,
+ * and is then a linear fraction (units "1"). */
+static void test_iv_volume(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    float eye[3] = {0, 1, 3.9f}, target[3] = {0, 1, 0};
+    lpvc_camera cam = {.eye = eye, .target = target, .fov_deg = 40, .width = 48, .height = 32};
+    OK(c, lpvc_camera_set(c, &cam));
+    OK(c, lpvc_config_json(c, "{\"technique\": \"lpv\"}"));
+    OK(c, lpvc_tick(c, NULL));
+    lpvc_frame f;
+    const lpvc_frame_desc ao = {.format = "rgba8", .compression = "none", .terms = "ao"};
+    assert_int_equal(lpvc_get_frame(c, &ao, &f), -1);
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+    assert_non_null(strstr(lpvc_error_message(c), "terms"));
+    OK(c, lpvc_config_json(c, "{\"technique\": \"iv\", \"iv_resolution\": 16, \"iv_rays\": 32, \"iv_bounces\": 2, "
+                              "\"iv_neighbours\": 6}"));
+    int64_t tick = -1;
+    OK(c, lpvc_tick(c, &tick));
+    assert_int_equal(lpvc_get_frame(c, &ao, &f), -1); /* iv_ao off */
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+    assert_non_null(strstr(lpvc_error_message(c), "iv_ao"));
+
+    lpvc_volume v, v16;
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp32", .compression = "none"}, &v));
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp16"}, &v16));
+    assert_int_equal(v.tick, tick);
+    assert_string_equal(v.technique, "iv");
+    assert_true(v.iv_voxels);
+    assert_string_equal(v.units, "W/(m^2 sr)");
+    assert_int_equal(v.iv_neighbours, 6);
+    assert_int_equal(v.cascade_count, 1);
+    assert_true(v.sh_values && v.values_per_cell == 12 && v.volumes_per_level == 1);
+    assert_int_equal(v.index_count, v.cells);
+    assert_int_equal(v.index_level, 0);
+    assert_int_equal(v.index_values_per_cell, 1);
+    for (int a = 0; a < 3; a++)
+        assert_int_equal(v.index_dims[a], v.dims[a]);
+    assert_true(v.dims[0] == 17 || v.dims[1] == 17 || v.dims[2] == 17); /* 16 voxels along the longest side + 1 */
+    size_t held = 0;
+    for (size_t i = 0; i < v.index_count; i++) {
+        assert_true(v.index[i] <= 1);
+        held += v.index[i];
+    }
+    assert_true(held > 0 && held < v.cells);
+    assert_memory_equal(v16.index, v.index, v.index_count * sizeof(uint32_t)); /* u32 whatever the format */
+    assert_true(v16.iv_voxels && v16.iv_neighbours == 6);
+    char why[256];
+    assert_int_equal(lpvc_volume_lookup_check(&v, why, sizeof why), 0);
+    {
+        /* without its index the volume is not R5.14's: refused, naming it */
+        lpvc_volume bare = v;
+        bare.index = NULL;
+        bare.index_count = 0;
+        float e[3] = {1, 1, 1};
+        assert_int_equal(lpvc_volume_lookup_check(&bare, why, sizeof why), -1);
+        assert_int_equal(lpvc_volume_irradiance(&bare, eye, target, e), -1);
+        assert_true(e[0] == 0.0f && e[1] == 0.0f && e[2] == 0.0f);
+    }
+
+    /* QUERY_IRRADIANCE = R5.14's lookup on the fp32 volume of the same tick */
+    enum { N = 7 * 64 };
+    float pts[N * 3], nrm[N * 3], rgb[N * 3], local[N * 3];
+    static const float dirs[7][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}};
+    size_t n = 0;
+    for (int i = 0; i < 64; i++)
+        for (int k = 0; k < 7; k++, n++) {
+            int g[3] = {i % 4, (i / 4) % 4, i / 16};
+            for (int a = 0; a < 3; a++) {
+                /* other fractions per axis: no two corners exactly as far from the shifted point (a tie that the
+                 * GPU's float distances may break the other way; R5.14 keeps the lower corner) */
+                static const float at[3] = {0.07f, 0.11f, 0.05f}, step[3] = {0.29f, 0.27f, 0.31f};
+                pts[3 * n + a] = v.origin[a] + (at[a] + step[a] * (float)g[a]) * (float)v.dims[a] * v.cell_size;
+                nrm[3 * n + a] = dirs[k][a];
+            }
+        }
+    OK(c, lpvc_query_irradiance(c, pts, nrm, N, rgb));
+    for (size_t i = 0; i < N; i++)
+        assert_int_equal(lpvc_volume_irradiance(&v, pts + 3 * i, nrm + 3 * i, local + 3 * i), 0);
+    float emax = fmaxf(max_abs(local, N * 3), max_abs(rgb, N * 3));
+    assert_true(emax > 0.0f);
+    size_t lit = 0;
+    for (size_t i = 0; i < N * 3; i++) {
+        assert_true(isfinite(rgb[i]) && rgb[i] >= 0.0f);
+        lit += local[i] > 1e-3f * emax;
+        if (!(fabsf(rgb[i] - local[i]) <= 1e-5f * emax)) { /* measured: 8.5e-7 of the largest */
+            fprintf(stderr, "query %zu: server %g, local %g (max %g)\n", i / 3, (double)rgb[i], (double)local[i],
+                    (double)emax);
+            fail();
+        }
+    }
+    assert_true(lit > N); /* a good share of the probes sees light */
+    lpvc_volume_free(&v);
+    lpvc_volume_free(&v16);
+
+    /* with iv_ao on: the ao frame, grey, a fraction of 255 */
+    OK(c, lpvc_config_json(c, "{\"iv_ao\": true}"));
+    OK(c, lpvc_tick(c, NULL));
+    OK(c, lpvc_get_frame(c, &(lpvc_frame_desc){.format = "rgba8", .compression = "none", .terms = "ao",
+                                               .transparent = true},
+                         &f));
+    assert_string_equal(f.terms, "ao");
+    json_t *hdr = json_loads(f.header_json, 0, NULL);
+    assert_non_null(hdr);
+    assert_string_equal(json_string_value(json_object_get(hdr, "units")), "1");
+    assert_null(json_object_get(hdr, "exposure_ev"));
+    json_decref(hdr);
+    size_t seen = 0, open = 0;
+    for (size_t i = 0; i < f.size; i += 4) {
+        if (f.data[i + 3] == 0)
+            continue;
+        assert_true(f.data[i] == f.data[i + 1] && f.data[i] == f.data[i + 2]);
+        seen++;
+        open += f.data[i] > 128;
+    }
+    assert_true(seen > 0 && open > 0);
+    lpvc_frame_free(&f);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
 static void test_frames(void **state)
 {
     (void)state;
@@ -895,6 +1021,7 @@ int main(void)
         cmocka_unit_test(test_errors_keep_the_connection),
         cmocka_unit_test(test_tick_volume_query),
         cmocka_unit_test(test_octree_levels),
+        cmocka_unit_test(test_iv_volume),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_state_changes_bump_revision),
         cmocka_unit_test(test_config_recomputes_only_what_it_touches),

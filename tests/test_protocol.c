@@ -17,8 +17,10 @@
 #include <string.h>
 #include <zstd.h>
 
+#include "oracle_iv.h"
 #include "proto.h"
 #include "volume_codec.h"
+#include "volume_lookup.h"
 
 /* ---- helpers -------------------------------------------------------------- */
 
@@ -1496,6 +1498,204 @@ static void test_volume_octree_levels(void **state)
     json_decref(h);
 }
 
+/* R5.14: technique iv's volume (one level of voxels, radiance, the index of
+ * the voxels holding a surface, iv_neighbours): built, read back, refused for
+ * R5.7's lookup, and every inconsistent variant refused naming the field. */
+static void test_volume_iv(void **state)
+{
+    (void)state;
+    char err[256];
+    lpvp_volume_info vi, back;
+    memset(&vi, 0, sizeof vi);
+    vi.revision = 2;
+    vi.tick = 5;
+    vi.format = LPVP_FMT_FP32;
+    vi.keyframe = 1;
+    vi.base_tick = -1;
+    vi.cascade_count = 1;
+    lpvp_cascade_info *c0 = &vi.cascades[0];
+    const int dims[3] = {4, 3, 2};
+    for (int a = 0; a < 3; a++) {
+        vi.dims[a] = c0->dims[a] = dims[a];
+        vi.origin[a] = c0->origin[a] = -1.0 + 0.5 * a;
+    }
+    vi.cell_size = c0->cell_size = 0.5;
+    c0->cells = 24;
+    assert_int_equal(lpvp_volume_layout_iv(&vi.layout, "iv", c0, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, LPVP_IV_NEIGHBOURS_KEY));
+    assert_int_equal(lpvp_volume_layout_iv(&vi.layout, "iv", c0, 9, err, sizeof err), -1);
+    assert_int_equal(lpvp_volume_layout_iv(&vi.layout, "iv", c0, 6, err, sizeof err), 0);
+    assert_true(lpvp_volume_layout_is_iv(&vi.layout));
+    assert_string_equal(lpvp_volume_layout_units(&vi.layout), LPVP_VOLUME_UNITS_RADIANCE);
+    /* 24 voxels x 12 fp32 values, then 24 u32 */
+    assert_int_equal(lpvp_volume_values_bytes(&vi), 24 * 12 * 4);
+    vi.raw_length = 24 * 12 * 4 + 24 * 4;
+    json_t *h = lpvp_volume_header_build(&vi);
+    assert_non_null(h);
+    assert_string_equal(json_string_value(json_object_get(h, "units")), "W/(m^2 sr)");
+    json_t *d = json_object_get(h, LPVP_VOLUME_DESC_KEY), *lv = json_object_get(d, "levels");
+    assert_string_equal(json_string_value(json_object_get(d, "units")), "W/(m^2 sr)");
+    assert_string_equal(json_string_value(json_object_get(d, "technique")), "iv");
+    assert_int_equal(json_array_size(lv), 1);
+    assert_string_equal(json_string_value(json_object_get(json_array_get(lv, 0), "role")), "iv_voxels");
+    assert_true(json_is_false(json_object_get(d, "far_field")));
+    assert_int_equal(json_integer_value(json_object_get(d, LPVP_IV_NEIGHBOURS_KEY)), 6);
+    json_t *ix = json_object_get(d, "index");
+    assert_int_equal(json_integer_value(json_object_get(ix, "level")), 0);
+    assert_int_equal(json_integer_value(json_array_get(json_object_get(ix, "dims"), 0)), 4);
+    assert_int_equal(json_integer_value(json_object_get(ix, "values_per_cell")), 1);
+    assert_int_equal(json_integer_value(json_object_get(ix, "raw_offset")), 24 * 12 * 4);
+    assert_int_equal(json_integer_value(json_object_get(ix, "raw_length")), 24 * 4);
+
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_true(lpvp_volume_layout_is_iv(&back.layout));
+    assert_int_equal(back.layout.role[0], LPVP_ROLE_IV_VOXELS);
+    assert_int_equal(back.layout.iv_neighbours, 6);
+    assert_string_equal(back.layout.units, "W/(m^2 sr)");
+    assert_true(back.layout.sh_values && back.layout.has_index && back.layout.index.cells == 24);
+    assert_int_equal(back.raw_length, 24 * 12 * 4 + 24 * 4);
+    /* R5.7's lookup refuses it, R5.14's reads it; and the other way round */
+    assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), -1);
+    assert_non_null(strstr(err, "R5.14"));
+    assert_int_equal(lpvp_volume_layout_iv_lookup_check(&back.layout, err, sizeof err), 0);
+    lpvp_volume_layout sh;
+    lpvp_volume_layout_sh(&sh, "lpv", 0, 1);
+    assert_int_equal(lpvp_volume_layout_iv_lookup_check(&sh, err, sizeof err), -1);
+    assert_non_null(strstr(err, "iv_voxels"));
+    /* W/(m^2 sr) in an LPV's layout is not what R5.7 reads either */
+    snprintf(sh.units, sizeof sh.units, "%s", LPVP_VOLUME_UNITS_RADIANCE);
+    assert_int_equal(lpvp_volume_layout_lookup_check(&sh, err, sizeof err), -1);
+    assert_non_null(strstr(err, "units W/(m^2 sr)"));
+
+#define BAD(edit, what)                                                                                       \
+    do {                                                                                                      \
+        json_t *b = json_deep_copy(h), *bd = json_object_get(b, LPVP_VOLUME_DESC_KEY);                        \
+        json_t *bl = json_object_get(bd, "levels"), *bi = json_object_get(bd, "index");                       \
+        (void)bl;                                                                                             \
+        (void)bi;                                                                                             \
+        edit;                                                                                                 \
+        expect_refused(b, what);                                                                              \
+    } while (0)
+    /* the role and placement: one level equal to the one cascade */
+    {
+        /* as a "cascade" the same header is an LPV-like volume with an index in other units: R5.9 - R5.12
+         * read it, but it is not R5.14's and R5.7's lookup refuses it */
+        json_t *b = json_deep_copy(h);
+        json_object_set_new(json_array_get(json_object_get(json_object_get(b, LPVP_VOLUME_DESC_KEY), "levels"), 0),
+                            "role", json_string("cascade"));
+        assert_int_equal(lpvp_volume_header_parse(b, &back, err, sizeof err), 0);
+        assert_false(lpvp_volume_layout_is_iv(&back.layout));
+        assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), -1);
+        assert_int_equal(lpvp_volume_layout_iv_lookup_check(&back.layout, err, sizeof err), -1);
+        json_decref(b);
+    }
+    BAD(json_object_set_new(json_array_get(bl, 0), "role", json_string("voxels")), "levels[0].role");
+    BAD(json_array_append(bl, json_array_get(bl, 0)), "exactly one level");
+    BAD(json_array_append(json_object_get(b, "cascades"), json_array_get(json_object_get(b, "cascades"), 0)),
+        "cascades");
+    BAD(json_object_set_new(json_array_get(bl, 0), "cell_size", json_real(0.25)), "levels[0]");
+    BAD(json_object_set_new(bd, "far_field", json_true()), "far_field");
+    /* the units: radiance, in the description and the header alike */
+    BAD((json_object_set_new(bd, "units", json_string("W/sr")), json_object_set_new(b, "units", json_string("W/sr"))),
+        "units");
+    BAD(json_object_set_new(bd, "units", json_string("W/sr")), "units");
+    /* the values: the 12 SH values in one volume */
+    BAD(json_array_set_new(json_object_get(bd, "values"), 3, json_string("r.Y2")), "values");
+    BAD((json_object_set_new(bd, "volumes_per_level", json_integer(2)),
+         json_object_set_new(bi, "raw_offset", json_integer(24 * 12 * 4 * 2)),
+         json_object_set_new(b, "raw_length", json_integer(24 * 12 * 4 * 2 + 24 * 4))),
+        "values");
+    /* the index: over level 0, level 0's dims, one u32 per voxel */
+    BAD(json_object_set_new(bd, "index", json_null()), "index");
+    BAD(json_object_del(bd, "index"), "index");
+    BAD((json_object_set_new(bi, "dims", json_pack("[i,i,i]", 4, 3, 1)),
+         json_object_set_new(bi, "raw_length", json_integer(12 * 4)),
+         json_object_set_new(b, "raw_length", json_integer(24 * 12 * 4 + 12 * 4))),
+        "index over level 0");
+    BAD((json_object_set_new(bi, "dims", json_pack("[i,i,i]", 2, 3, 4)))
+        , "index over level 0");
+    BAD((json_object_set_new(bi, "values_per_cell", json_integer(2)),
+         json_object_set_new(bi, "raw_length", json_integer(24 * 2 * 4)),
+         json_object_set_new(b, "raw_length", json_integer(24 * 12 * 4 + 24 * 2 * 4))),
+        "index over level 0");
+    BAD(json_object_set_new(bi, "value_type", json_string("u16")), "index.value_type");
+    BAD(json_object_set_new(bi, "raw_length", json_integer(24 * 2)), "index.raw_length");
+    BAD(json_object_set_new(b, "raw_length", json_integer(24 * 12 * 4)), "raw_length");
+    /* the lookup's parameter */
+    BAD(json_object_del(bd, LPVP_IV_NEIGHBOURS_KEY), LPVP_IV_NEIGHBOURS_KEY);
+    BAD(json_object_set_new(bd, LPVP_IV_NEIGHBOURS_KEY, json_integer(0)), LPVP_IV_NEIGHBOURS_KEY);
+    BAD(json_object_set_new(bd, LPVP_IV_NEIGHBOURS_KEY, json_integer(9)), LPVP_IV_NEIGHBOURS_KEY);
+    BAD(json_object_set_new(bd, LPVP_IV_NEIGHBOURS_KEY, json_real(4.0)), LPVP_IV_NEIGHBOURS_KEY);
+#undef BAD
+    json_decref(h);
+}
+
+/* R5.14's lookup (volume_lookup.h) is core's reconstruction on the flags:
+ * bit for bit what lpv_iv_irradiance gives from the voxels the flags come
+ * from, at random points and normals (inside, on faces, outside the grid). */
+static void test_iv_lookup(void **state)
+{
+    (void)state;
+    const lpv_grid g = {.dims = {5, 4, 6}, .origin = {-1.0f, 0.25f, -0.5f}, .cell_size = 0.4f};
+    const size_t cells = lpv_grid_cell_count(&g);
+    lpv_cell *vol = aligned_alloc(16, cells * sizeof *vol);
+    lpv_iv_voxel *vox = calloc(cells, sizeof *vox);
+    uint32_t *held = calloc(cells, sizeof *held);
+    assert_non_null(vol);
+    assert_non_null(vox);
+    assert_non_null(held);
+    rng_state = 777;
+    for (size_t i = 0; i < cells; i++) {
+        float *c = (float *)&vol[i];
+        for (int k = 0; k < 12; k++)
+            c[k] = (float)(rng() % 2001) / 1000.0f - (k % 4 ? 1.0f : 0.0f);
+        if (rng() % 3 == 0) {
+            vox[i].normal[3] = 1.0f + (float)(rng() % 4);
+            held[i] = 1;
+        }
+    }
+    lpvp_lookup_iv v = {.dims = {g.dims[0], g.dims[1], g.dims[2]},
+                        .origin = {g.origin[0], g.origin[1], g.origin[2]},
+                        .cell_size = g.cell_size,
+                        .cells = (const float *)vol,
+                        .held = held};
+    float rgb[3], want[3];
+    const float p0[3] = {0.0f, 1.0f, 0.5f}, n0[3] = {0.0f, 1.0f, 0.0f};
+    assert_int_equal(lpvp_iv_irradiance(&v, p0, n0, rgb), -1); /* neighbours 0 */
+    v.neighbours = 9;
+    assert_int_equal(lpvp_iv_irradiance(&v, p0, n0, rgb), -1);
+    int nonzero = 0;
+    for (int nb = 1; nb <= 8; nb++) {
+        v.neighbours = nb;
+        for (int t = 0; t < 400; t++) {
+            float p[3], n[3];
+            for (int a = 0; a < 3; a++) {
+                float u = (float)(rng() % 1300) / 1000.0f - 0.15f; /* a little outside too */
+                if (t % 5 == 0)
+                    u = (float)(rng() % 7) / 6.0f; /* on voxel faces and centres */
+                p[a] = g.origin[a] + u * (float)g.dims[a] * g.cell_size;
+                n[a] = (float)(rng() % 2001) / 1000.0f - 1.0f;
+            }
+            if (t % 7 == 0) {
+                n[0] = n[1] = n[2] = 0.0f;
+                n[t % 3] = t % 2 ? 1.0f : -1.0f;
+            }
+            assert_int_equal(lpvp_iv_irradiance(&v, p, n, rgb), 0);
+            lpv_iv_irradiance(&g, vox, vol, p, n, nb, want);
+            assert_memory_equal(rgb, want, sizeof rgb);
+            nonzero += rgb[0] != 0.0f || rgb[1] != 0.0f || rgb[2] != 0.0f;
+        }
+    }
+    assert_true(nonzero > 400);
+    /* flags NULL: refused (a volume without its index is not R5.14's) */
+    v.held = NULL;
+    assert_int_equal(lpvp_iv_irradiance(&v, p0, n0, rgb), -1);
+    assert_true(rgb[0] == 0.0f && rgb[1] == 0.0f && rgb[2] == 0.0f);
+    free(vol);
+    free(vox);
+    free(held);
+}
+
 /* R5.9 - R5.12: the description is built, read back, and every
  * inconsistent variant is refused naming the field. */
 static void test_volume_description(void **state)
@@ -1664,6 +1864,8 @@ int main(void)
         cmocka_unit_test(test_volume_cascades),
         cmocka_unit_test(test_volume_description),
         cmocka_unit_test(test_volume_octree_levels),
+        cmocka_unit_test(test_volume_iv),
+        cmocka_unit_test(test_iv_lookup),
         cmocka_unit_test(test_addresses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

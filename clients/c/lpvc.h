@@ -218,7 +218,7 @@ typedef struct lpvc_volume {
     float cell_size;
     size_t cells;              /* dims[0] * dims[1] * dims[2]: cascade 0's cells */
     float *data;               /* total_cells * volumes_per_level * values_per_cell floats; for R5.1's
-                                  layout (sh_values) per cell r0..r3 g0..g3 b0..b3, x fastest, W/sr */
+                                  layout (sh_values) per cell r0..r3 g0..g3 b0..b3, x fastest, in units */
     char format[8];            /* wire format: "fp16" or "fp32" */
     char compression[8];       /* wire compression */
     bool keyframe;             /* false: was an XOR delta, already undone */
@@ -252,6 +252,14 @@ typedef struct lpvc_volume {
     char content[8];
     int level_count;           /* "levels": 1..LPVC_MAX_LEVELS; "merged": 0 */
     lpvc_cascade levels[LPVC_MAX_LEVELS];
+    /* The values' units ("W/sr": an LPV's intensity per cell; "W/(m^2 sr)":
+     * technique iv's radiance at voxel centres). With iv_voxels (SPEC R5.14)
+     * the volume is technique iv's one level of voxels (cascades[0]), index
+     * says which voxels hold a surface (1) or not (0), and
+     * lpvc_volume_irradiance reconstructs with iv_neighbours of them. */
+    char units[32];
+    bool iv_voxels;
+    int iv_neighbours;         /* 1..8 with iv_voxels, else 0 */
 } lpvc_volume;
 void lpvc_volume_free(lpvc_volume *v);
 
@@ -268,7 +276,7 @@ typedef struct lpvc_frame {
     int64_t revision, tick;
     int width, height;
     char format[8];            /* "rgba8" | "png" | "exr" */
-    char terms[16];            /* "full" | "indirect" | "direct" */
+    char terms[16];            /* "full" | "indirect" | "direct" | "ao" */
     unsigned char *data;
     size_t size;
     char *header_json;
@@ -279,7 +287,8 @@ void lpvc_frame_free(lpvc_frame *f);
 typedef struct lpvc_frame_desc {
     const char *format;        /* "rgba8" | "png" | "exr"; NULL: server default */
     const char *compression;   /* rgba8 only: "zstd" | "none"; NULL: server default */
-    const char *terms;         /* "full" | "indirect" | "direct"; NULL: server default */
+    const char *terms;         /* "full" | "indirect" | "direct" | "ao" (ambient occlusion, 1 = open, linear; only
+                                  with technique iv and iv_ao on, else BAD_FIELD); NULL: server default */
     const char *exposure;      /* rgba8/png: "auto" or an EV such as "-2.5" (sent as a number);
                                   NULL: server default (auto). SPEC R6.4 */
     bool transparent;          /* rgba8/png: background alpha 0 instead of the opaque grey */
@@ -327,17 +336,20 @@ void lpvc_message_free(lpvc_message *m);
  * LPVC_ERR_TIMEOUT. */
 int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
 
-/* ---- Local lookup (SPEC R5.7; protocol/volume_lookup.h over core's oracle) ---- */
+/* ---- Local lookup (SPEC R5.7, R5.14; protocol/volume_lookup.h over core's oracles) ---- */
 
 /* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
  * server's QUERY_IRRADIANCE computes it: with several cascades, the finest
  * containing p, blended to the next coarser within the last 3 cells of its
- * border (SPEC R5.7). Returns 0, or -1 with rgb zero for a volume whose
- * layout the lookup does not read (lpvc_volume_lookup_check says why). */
+ * border (SPEC R5.7); for technique iv's voxels (iv_voxels), R5.14's
+ * reconstruction from the voxels around p and the index. Returns 0, or -1
+ * with rgb zero for a volume whose layout neither lookup reads
+ * (lpvc_volume_lookup_check says why). */
 int lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3]);
 
-/* 0 when lpvc_volume_irradiance reads v's layout (R5.1's 12 SH values, one
- * volume per level); else -1 with a message naming the layout in err. */
+/* 0 when lpvc_volume_irradiance reads v's layout (R5.1's 12 SH values in
+ * W/sr, one volume per level; or R5.14's iv voxels); else -1 with a message
+ * naming the layout in err. */
 int lpvc_volume_lookup_check(const lpvc_volume *v, char *err, size_t n);
 
 /* The same from one cascade alone. */

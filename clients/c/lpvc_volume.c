@@ -2,7 +2,8 @@
  * lpvc_volume.c - the C client's volumes (SPEC section 5): decoding a
  * VOLUME / GET_VOLUME header and attachment (zstd, fp16 and XOR deltas come
  * from protocol/volume_codec.h), the acknowledged volumes kept as delta bases
- * (R5.3), GET_VOLUME, and the local lookup (R5.7, protocol/volume_lookup.h).
+ * (R5.3), GET_VOLUME, and the local lookup (R5.7, or R5.14 for technique iv's
+ * voxels; protocol/volume_lookup.h).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -144,6 +145,9 @@ int lpvci_decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t a
     out->sh_values = lay->sh_values != 0;
     out->index = index;
     out->index_count = index_count;
+    snprintf(out->units, sizeof out->units, "%s", lpvp_volume_layout_units(lay));
+    out->iv_voxels = lpvp_volume_layout_is_iv(lay) != 0;
+    out->iv_neighbours = out->iv_voxels ? lay->iv_neighbours : 0;
     if (ix) {
         out->index_level = ix->level;
         for (int a = 0; a < 3; a++)
@@ -198,7 +202,7 @@ int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out)
     return rc;
 }
 
-/* ---- local lookup: SPEC R5.7, the protocol library's (volume_lookup.h) ----- */
+/* ---- local lookup: SPEC R5.7 and R5.14, the protocol library's (volume_lookup.h) ----- */
 
 static lpvp_lookup_cascade lookup_cascade(const lpvc_cascade *cs)
 {
@@ -234,6 +238,13 @@ static lpvp_volume_layout layout_of(const lpvc_volume *v)
     l.content = strcmp(v->content, lpvp_volume_content_names[LPVP_CONTENT_LEVELS]) == 0 ? LPVP_CONTENT_LEVELS
                                                                                           : LPVP_CONTENT_MERGED;
     l.level_count = v->level_count;
+    snprintf(l.units, sizeof l.units, "%s", v->units);
+    if (v->iv_voxels) { /* R5.14: its one level and the index over it */
+        l.role[0] = LPVP_ROLE_IV_VOXELS;
+        l.iv_neighbours = v->iv_neighbours;
+        l.index.level = v->index_level;
+        l.index.values_per_cell = v->index_values_per_cell;
+    }
     return l;
 }
 
@@ -244,6 +255,16 @@ int lpvc_volume_lookup_check(const lpvc_volume *v, char *err, size_t n)
         return -1;
     }
     lpvp_volume_layout l = layout_of(v);
+    if (lpvp_volume_layout_is_iv(&l)) {
+        if (lpvp_volume_layout_iv_lookup_check(&l, err, n) != 0)
+            return -1;
+        if (v->cascade_count != 1 || v->index_count != v->cascades[0].cells) {
+            snprintf(err, n, "iv volume of %d levels with an index of %zu voxels (R5.14: one level, one per voxel)",
+                     v->cascade_count, v->index_count);
+            return -1;
+        }
+        return 0;
+    }
     return lpvp_volume_layout_lookup_check(&l, err, n);
 }
 
@@ -253,6 +274,16 @@ int lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n
     char err[8];
     if (lpvc_volume_lookup_check(v, err, sizeof err) != 0)
         return -1;
+    if (v->iv_voxels) { /* R5.14 */
+        const lpvc_cascade *cs = &v->cascades[0];
+        const lpvp_lookup_iv iv = {.dims = {cs->dims[0], cs->dims[1], cs->dims[2]},
+                                   .origin = {cs->origin[0], cs->origin[1], cs->origin[2]},
+                                   .cell_size = cs->cell_size,
+                                   .cells = cs->data,
+                                   .held = v->index,
+                                   .neighbours = v->iv_neighbours};
+        return lpvp_iv_irradiance(&iv, p, n, rgb);
+    }
     lpvp_lookup_cascade l[LPVC_MAX_CASCADES];
     int count = v->cascade_count;
     if (count < 1 || count > LPVC_MAX_CASCADES) { /* a volume built by hand: the grid alone */

@@ -1647,7 +1647,8 @@ def _vol_header_checks(h, fmt, comp, dims=None):
         check(k in h, "volume header has no %r: %r" % (k, h))
     check(h["format"] == fmt, "format %r, expected %r" % (h["format"], fmt))
     check(h["compression"] == comp, "compression %r, expected %r" % (h["compression"], comp))
-    check(h["units"] == "W/sr", "units %r, expected W/sr" % h["units"])
+    want_units = IV_UNITS if _iv_levels(h.get("volume") or {}) else "W/sr"  # R5.14: an iv volume holds radiance
+    check(h["units"] == want_units, "units %r, expected %s" % (h["units"], want_units))
     g = h["grid"]
     check(isinstance(g, dict) and isinstance(g.get("dims"), list) and len(g["dims"]) == 3
           and all(isinstance(x, int) and x > 0 for x in g["dims"]), "grid.dims %r" % g)
@@ -1682,13 +1683,15 @@ def _description_checks(h):
     check(isinstance(d.get("far_field"), bool), "volume.far_field %r: expected a boolean (R5.10)"
           % (d.get("far_field"),))
     levels, cs = d.get("levels"), h["cascades"]
-    octree = _octree_levels(d)
+    octree, iv = _octree_levels(d), _iv_levels(d)
     if octree:  # R5.13: content "levels", the octree's levels over cascades[0]
         _octree_level_checks(d, cs)
+    elif iv:  # R5.14: technique iv's one level of voxels
+        _iv_level_checks(d, cs, h)
     else:
         check(isinstance(levels, list) and len(levels) == len(cs), "volume.levels %r: expected %d levels, one "
               "per cascade (R5.10)" % (levels, len(cs)))
-    for k, (lv, c) in enumerate(zip(levels, cs) if not octree else ()):
+    for k, (lv, c) in enumerate(zip(levels, cs) if not (octree or iv) else ()):
         for key in ("dims", "origin", "cell_size", "cells"):
             check(isinstance(lv, dict) and lv.get(key) == c.get(key), "volume.levels[%d].%s %r differs from "
                   "cascades[%d].%s %r (R5.10)" % (k, key, lv.get(key) if isinstance(lv, dict) else lv, k, key,
@@ -1762,6 +1765,126 @@ def _octree_level_checks(d, cs):
           and ix.get("values_per_cell") == 1 and ix.get("value_type") == "u32",
           "volume.index %r: octree levels need the index over level 0 (level 0, dims %r, values_per_cell 1, u32; "
           "R5.13)" % (ix, [n, n, n]))
+
+
+IV_VOXELS_ROLE = "iv_voxels"  # R5.14: the role of technique iv's one level
+IV_UNITS = "W/(m^2 sr)"  # R5.14: its values are radiance
+SH_NAMES = ["%s.%s" % (ch, y) for ch in "rgb" for y in ("Y00", "Y1-1", "Y10", "Y11")]
+
+
+def _iv_levels(d):
+    """Whether a description's levels are technique iv's voxels (R5.14)."""
+    levels = d.get("levels")
+    return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+        and levels[0].get("role") == IV_VOXELS_ROLE
+
+
+def _iv_level_checks(d, cs, h):
+    """R5.14: one cascade and one "iv_voxels" level equal to it, far_field
+    false, the 12 SH values in one volume, units W/(m^2 sr) (header too), the
+    index over level 0 with level 0's dims and one u32 per voxel, and
+    iv_neighbours an integer in 1..8."""
+    levels = d["levels"]
+    check(len(cs) == 1 and len(levels) == 1, "%d levels over %d cascades, R5.14 has one %r level over one cascade"
+          % (len(levels), len(cs), IV_VOXELS_ROLE))
+    for key in ("dims", "origin", "cell_size", "cells"):
+        check(levels[0].get(key) == cs[0].get(key), "volume.levels[0].%s %r differs from cascades[0].%s %r (R5.14)"
+              % (key, levels[0].get(key), key, cs[0].get(key)))
+    check(d.get("far_field") is False, "volume.far_field %r with %r, expected false (R5.14)"
+          % (d.get("far_field"), IV_VOXELS_ROLE))
+    check(d.get("volumes_per_level") == 1 and d.get("values") == SH_NAMES, "volume values %r x %r volumes, R5.14 "
+          "has the 12 SH values %r in one volume" % (d.get("values"), d.get("volumes_per_level"), SH_NAMES))
+    check(d.get("units") == IV_UNITS and h.get("units") == IV_UNITS, "units %r (header %r), R5.14 says %r"
+          % (d.get("units"), h.get("units"), IV_UNITS))
+    ix = d.get("index")
+    check(isinstance(ix, dict) and ix.get("level") == 0 and ix.get("dims") == cs[0]["dims"]
+          and ix.get("values_per_cell") == 1 and ix.get("value_type") == "u32",
+          "volume.index %r: R5.14 has the index over level 0 (level 0, dims %r, values_per_cell 1, u32)"
+          % (ix, cs[0]["dims"]))
+    nb = d.get("iv_neighbours")
+    check(isinstance(nb, int) and not isinstance(nb, bool) and 1 <= nb <= 8,
+          "volume.iv_neighbours %r: expected an integer in 1..8 (R5.14)" % (nb,))
+
+
+_F32 = struct.Struct("<f")
+
+
+def _f32(x):
+    """x rounded to binary32 (R5.14 computes in binary32)."""
+    try:
+        return _F32.unpack(_F32.pack(x))[0]
+    except OverflowError:
+        return math.copysign(float("inf"), x)
+
+
+def _iv_lookup(d, vals, held, p, n):
+    """R5.14's lookup written from the SPEC's seven steps: E (r, g, b) at p
+    with normal n from the voxels (vals: 12 floats per voxel, x fastest; held:
+    the index) of description d's one level."""
+    lv = d["levels"][0]
+    dims, o, s, N = lv["dims"], [_f32(v) for v in lv["origin"]], _f32(lv["cell_size"]), d["iv_neighbours"]
+    f32 = _f32
+    p, n = [f32(v) for v in p], [f32(v) for v in n]
+    # 1
+    if not all(math.isfinite(v) for v in p + n):
+        return [0.0, 0.0, 0.0]
+    ln = f32(math.sqrt(f32(f32(f32(n[0] * n[0]) + f32(n[1] * n[1])) + f32(n[2] * n[2]))))
+    if not (math.isfinite(ln) and ln > f32(1e-8)):
+        return [0.0, 0.0, 0.0]
+    nh = [f32(v / ln) for v in n]
+    b, f, w = [0] * 3, [0.0] * 3, [0] * 3
+    for a in range(3):
+        # 2
+        q = f32(p[a] + f32(f32(0.5 * s) * nh[a]))
+        u = f32(f32(f32(q - o[a]) / s) - 0.5)
+        if not (-1.0 <= u < dims[a]):
+            return [0.0, 0.0, 0.0]
+        b[a] = math.floor(u)
+        f[a] = f32(u - b[a])
+        # 3
+        w[a] = math.floor(f32(f32(f32(p[a] - o[a]) / s) - f32(f32(0.001) * nh[a])))
+    # 4
+    corners = []
+    for c in range(8):
+        bits = [(c >> a) & 1 for a in range(3)]
+        t, dd = 1.0, 0.0
+        for a in range(3):
+            t = f32(t * (f[a] if bits[a] else f32(1.0 - f[a])))
+            e = f32(f[a] - bits[a])
+            dd = f32(dd + f32(e * e))
+        corners.append((dd, c, [b[a] + bits[a] for a in range(3)], t))
+    # 5
+    corners.sort(key=lambda e: (e[0], e[1]))
+    total, acc = 0.0, [0.0] * 12
+    for _, _, v, t in corners[:N]:
+        if v == w or not all(0 <= v[a] < dims[a] for a in range(3)):
+            continue
+        # 6
+        dv = [f32(f32(o[a] + f32(f32(v[a] + 0.5) * s)) - p[a]) for a in range(3)]
+        dl = f32(math.sqrt(f32(f32(f32(dv[0] * dv[0]) + f32(dv[1] * dv[1])) + f32(dv[2] * dv[2]))))
+        cos = 0.0
+        if dl > 0.0:
+            cs = [f32(nh[a] * f32(dv[a] / dl)) for a in range(3)]
+            cos = f32(f32(cs[0] + cs[1]) + cs[2])
+        wc = f32(t * max(0.0, cos))
+        i = v[0] + dims[0] * (v[1] + dims[1] * v[2])
+        if held[i]:
+            wc = f32(wc / 64.0)
+        if not wc > 0.0:
+            continue
+        total += wc
+        for k in range(12):
+            acc[k] += wc * vals[12 * i + k]
+    if not total > 0.0:
+        return [0.0, 0.0, 0.0]
+    # 7
+    lobe = [f32(SH_LOBE0), f32(f32(SH_LOBE1) * -nh[1]), f32(f32(SH_LOBE1) * -nh[2]), f32(f32(SH_LOBE1) * -nh[0])]
+    out = []
+    for ch in range(3):
+        L = [f32(acc[4 * ch + k] / total) for k in range(4)]
+        e = f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3]))
+        out.append(max(0.0, e))
+    return out
 
 
 def _cascades_checks(h):
@@ -1950,6 +2073,97 @@ def c_volume_octree_levels(ctx):
     expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
     return "%d levels (%s), %d bytes; cells per index level %r; merged = the indexed levels; lpv refused" % (
         l, ", ".join("%d^3" % lv["dims"][0] for lv in d["levels"]), len(f.att), used)
+
+
+# technique iv kept small for llvmpipe: ~12 voxels along the box, 16 rays, 2 bounces
+IV_CONFIG = {"technique": "iv", "iv_resolution": 12, "iv_rays": 16, "iv_bounces": 2}
+
+
+def _iv_techniques(ctx):
+    """The techniques HELLO lists (a fresh session's)."""
+    ctx.session().close()
+    return (ctx.hello_reply or {}).get("techniques") or []
+
+
+@case("R5.14 R5.12 R4.7", "technique iv: GET_VOLUME and VOLUME describe one \"iv_voxels\" level in W/(m^2 sr) with "
+      "the occupancy index and the effective iv_neighbours; R5.14's lookup on it agrees with QUERY_IRRADIANCE")
+def c_volume_iv(ctx):
+    if "iv" not in _iv_techniques(ctx):
+        c = ctx.session()
+        rid = c.send(CONFIG, {"technique": "iv"})
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "technique")
+        return "HELLO lists no \"iv\": CONFIG technique iv refused naming technique (R4.14)"
+    c, cfg, t = ctx.scene_session(config=dict(IV_CONFIG, iv_neighbours=6), light=unique_light("iv-volume"))
+    nb = (cfg.body.get("config") or {}).get("iv_neighbours")
+    check(nb == 6, "CONFIG iv_neighbours 6: the effective config says %r" % (nb,))
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    h = f.body
+    _vol_header_checks(h, "fp32", "none")
+    d = h["volume"]
+    check(_iv_levels(d), "technique iv's volume has levels %r, expected one %r level (R5.14)"
+          % ([lv.get("role") for lv in d.get("levels") or []], IV_VOXELS_ROLE))
+    check(d["technique"] == "iv", "volume.technique %r, expected iv" % (d["technique"],))
+    check(d["iv_neighbours"] == nb, "volume.iv_neighbours %r, the effective config's is %r (R5.14)"
+          % (d["iv_neighbours"], nb))
+    cells = h["cascades"][0]["cells"]
+    ix = d["index"]
+    check(ix["raw_offset"] == cells * 12 * 4 and ix["raw_length"] == cells * 4
+          and h["raw_length"] == cells * 12 * 4 + cells * 4 == len(f.att),
+          "raw_length %r, index at %r of %r bytes, attachment %d: expected %d voxels x 48 + %d x 4 (R5.14)"
+          % (h["raw_length"], ix["raw_offset"], ix["raw_length"], len(f.att), cells, cells))
+    vals = f32_list(f.att[:ix["raw_offset"]])
+    held = struct.unpack("<%dI" % cells, f.att[ix["raw_offset"]:])
+    check(is_finite_list(vals), "non-finite values in the iv volume")
+    check(set(held) <= {0, 1}, "index entries %r: R5.14 has 1 (holds a surface) or 0" % (sorted(set(held)),))
+    check(0 < sum(held) < cells, "%d of %d voxels hold a surface in a box" % (sum(held), cells))
+    check(any(v != 0.0 for v in vals[0::4]), "the iv volume of a lit box is all zero")
+    st = (t.body.get("stats") or {}).get("iv")
+    if isinstance(st, dict) and "occupied" in st:  # R4.13 (informative)
+        check(st["occupied"] == sum(held), "TICK stats iv.occupied %r, the index has %d" % (st["occupied"], sum(held)))
+    # the same description and index in fp16, zstd and the stream; no "levels" content
+    z = expect_reply(c.request(GET_VOLUME, {"format": "fp16", "compression": "zstd"}), GET_VOLUME)
+    _vol_header_checks(z.body, "fp16", "zstd")
+    check(z.body["volume"]["levels"] == d["levels"] and z.body["volume"]["iv_neighbours"] == nb,
+          "fp16/zstd describes other levels than fp32")
+    rid = c.send(GET_VOLUME, {"format": "fp32", "content": "levels"})
+    expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    expect_reply(c.request(SUBSCRIBE, {"stream": "volume", "format": "fp32", "compression": "none"}), SUBSCRIBE)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v = c.recv_stream(VOLUME, timeout=ctx.tick_timeout)
+    _vol_header_checks(v.body, "fp32", "none")
+    check(v.body["volume"] == d, "the VOLUME stream describes the iv volume otherwise than GET_VOLUME")
+    check(v.att[ix["raw_offset"]:] == f.att[ix["raw_offset"]:], "the streamed index differs (same inputs)")
+    expect_reply(c.request(UNSUBSCRIBE, {"stream": "volume"}), UNSUBSCRIBE)
+    # R5.14's lookup here against the server's QUERY_IRRADIANCE, at seeded random points (no exact corner ties)
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    vals = f32_list(f.att[:ix["raw_offset"]])
+    held = struct.unpack("<%dI" % cells, f.att[ix["raw_offset"]:])
+    lv = d["levels"][0]
+    rnd = random.Random(14)
+    probes = []
+    for i in range(90):
+        p = [lv["origin"][a] + rnd.uniform(0.03, 0.97) * lv["dims"][a] * lv["cell_size"] for a in range(3)]
+        n = [(0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (-1.0, 0.0, 0.0)][i % 3] if i % 2 else \
+            [rnd.uniform(-1.0, 1.0) for _ in range(3)]
+        probes.append((p, n))
+    att = b"".join(struct.pack("<6f", *(p + list(n))) for p, n in probes)
+    q = expect_reply(c.request(QUERY_IRRADIANCE, {"count": len(probes)}, att), QUERY_IRRADIANCE)
+    check(q.body.get("tick") == f.body.get("tick"), "query tick %r != volume tick %r" % (q.body.get("tick"),
+                                                                                       f.body.get("tick")))
+    got = f32_list(q.att)
+    want = []
+    for p, n in probes:
+        want.extend(_iv_lookup(d, vals, held, p, n))
+    peak = max(max(want), max(got))
+    check(peak > 0.0, "every irradiance is zero (the light does not reach the probes?)")
+    tol = 1e-4 * peak  # R5.14: about 1e-6 of the peak where no two corners tie
+    bad = [(i, a, b) for i, (a, b) in enumerate(zip(want, got)) if abs(a - b) > tol]
+    check(not bad, "%d of %d channel values differ by more than %.3g W/m^2, e.g. probe %d channel %d: R5.14's "
+          "lookup %.6g, QUERY_IRRADIANCE %.6g" % (len(bad), len(want), tol, bad[0][0] // 3, bad[0][0] % 3,
+                                                  bad[0][1], bad[0][2]) if bad else "")
+    worst = max(abs(a - b) for a, b in zip(want, got))
+    return "%s voxels, %d hold a surface, iv_neighbours %d; %d probes agree with QUERY_IRRADIANCE to %.2e of the " \
+        "peak %.4g W/m^2" % ("x".join(str(x) for x in lv["dims"]), sum(held), nb, len(probes), worst / peak, peak)
 
 
 @case("R5.1", "GET_VOLUME fp32/none: sizes match the grid dims; values finite")
@@ -2311,6 +2525,51 @@ def c_plan(ctx):
     return "%d cascade(s); passes run: %s" % (n, ", ".join(run) if run else "none")
 
 
+@case("R8.1 R4.13 R5.14", "technique iv's tick: its passes (iv_points, iv_reproject, iv_gather, iv_ao) after R8.1's "
+      "with their reasons (the bounces asked for, the camera), and the TICK and STATS stats count its volume")
+def c_plan_iv(ctx):
+    if "iv" not in _iv_techniques(ctx):
+        raise Skip("HELLO lists no \"iv\"")
+    c, cfg, t = ctx.scene_session(config=dict(IV_CONFIG, iv_bounces=3), light=unique_light("iv-plan"))
+    plan = (t.body.get("stats") or {}).get("plan")
+    _plan_checks(plan, "TICK reply stats", cascades=1)
+    passes = {p["name"]: p for p in plan["passes"]}
+    names = [p["name"] for p in plan["passes"]]
+    iv_names = ["iv_points", "iv_reproject", "iv_gather", "iv_ao"]
+    check(names[len(PLAN_PASSES):] == iv_names, "passes after R8.1's: %r, expected %r" % (
+        names[len(PLAN_PASSES):], iv_names))
+    g = passes["iv_gather"]
+    check(g["run"] and "iv: 3 bounces requested" in g["reason"], "iv_gather %r: expected it to run, naming "
+          "\"iv: 3 bounces requested\"" % (g,))
+    r = passes["iv_reproject"]
+    # every lpvd session has a camera (the scene's, CAMERA_SET's or one framing the bounds), so reprojection
+    # runs; without one it would be skipped, naming it
+    check(r["run"] or "reprojection skipped: no camera" in r["reason"], "iv_reproject %r: expected it to run with "
+          "the session's camera, or \"reprojection skipped: no camera\"" % (r,))
+    check(not passes["iv_ao"]["run"] and "off" in passes["iv_ao"]["reason"], "iv_ao %r with iv_ao off"
+          % (passes["iv_ao"],))
+    for k in ("propagate", "inject"):
+        check(not passes[k]["run"], "the LPV's pass %r runs for technique iv: %r" % (k, passes[k]))
+    st = (t.body.get("stats") or {}).get("iv")
+    check(isinstance(st, dict), "TICK stats have no \"iv\" object for technique iv (R4.13): %r" % (st,))
+    v = expect_reply(c.request(GET_VOLUME, {"format": "fp16", "compression": "none"}), GET_VOLUME).body
+    cells = v["cascades"][0]["cells"]
+    check(st.get("points", 0) > 0 and st.get("voxels") == cells and st.get("bounces") == 3
+          and st.get("bounces_requested") == 3 and st.get("rays") == IV_CONFIG["iv_rays"]
+          and 0 < st.get("occupied", 0) < cells and st.get("ao") is False,
+          "TICK stats iv %r: expected points > 0, voxels %d, 3 bounces of 3, %d rays, 0 < occupied < voxels, ao "
+          "false" % (st, cells, IV_CONFIG["iv_rays"]))
+    sp = expect_reply(c.request(STATS, {}), STATS).body.get("plan") or {}
+    check(sp.get("iv") == st and sp.get("plan") == plan, "STATS plan differs from the TICK reply's stats for the same "
+          "tick: iv %r vs %r" % (sp.get("iv"), st))
+    expect_reply(c.request(CONFIG, {"iv_reprojection": False}), CONFIG)
+    t2 = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    r2 = {p["name"]: p for p in t2.body["stats"]["plan"]["passes"]}["iv_reproject"]
+    check(not r2["run"] and "reprojection off" in r2["reason"], "iv_reproject %r with iv_reprojection false" % (r2,))
+    return "iv_gather: %s; iv_reproject: %s / %s; stats %s" % (g["reason"], r["reason"], r2["reason"],
+                                                                json.dumps(st, sort_keys=True))
+
+
 @case("R4.8 R3.1", "BYE gets its reply, then the server closes")
 def c_bye(ctx):
     c = ctx.session()
@@ -2507,6 +2766,59 @@ def c_frame_exr(ctx):
     check(e.body.get("terms") == "indirect", "terms %r, expected indirect" % e.body.get("terms"))
     check(e.body.get("compression") in (None, "none"), "exr compression %r (R6.2)" % e.body.get("compression"))
     return "exr %d B" % len(e.att)
+
+
+@case("R6.5 R2.9", "terms ao: GET_FRAME and SUBSCRIBE get BAD_FIELD naming terms for technique lpv and for iv with "
+      "iv_ao off; with iv_ao on a grey frame of fractions in [0, 1], units \"1\", also streamed")
+def c_frame_ao(ctx):
+    c, _, _ = ctx.scene_session(tick=False, config=dict(SMALL_CONFIG, technique="lpv"), light=unique_light("ao"))
+    expect_reply(c.request(CAMERA_SET, {"eye": [0, 1, 3.5], "target": [0, 1, 0], "fov_deg": 40, "width": 40,
+                                        "height": 30}), CAMERA_SET)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+
+    def refused(what):
+        for ftype, body in ((GET_FRAME, {"format": "rgba8", "terms": "ao"}),
+                            (SUBSCRIBE, {"stream": "frame", "format": "rgba8", "terms": "ao"})):
+            rid = c.send(ftype, body)
+            try:
+                expect_error(c.recv_reply(rid, timeout=ctx.tick_timeout), "BAD_FIELD", rid, "terms")
+            except Fail as e:
+                raise Fail("%s %s (%s): %s" % (type_name(ftype), json.dumps(body), what, e))
+    refused("technique lpv")
+    if "iv" not in _iv_techniques(ctx):
+        return "technique lpv: refused naming terms (HELLO lists no \"iv\")"
+    expect_reply(c.request(CONFIG, IV_CONFIG), CONFIG)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    refused("technique iv, iv_ao off")
+    expect_reply(c.request(CONFIG, {"iv_ao": True}), CONFIG)
+    t = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    f = expect_reply(c.request(GET_FRAME, {"format": "rgba8", "compression": "none", "terms": "ao",
+                                           "transparent": True}, timeout=ctx.tick_timeout), GET_FRAME)
+    h = f.body
+    check(h.get("terms") == "ao" and h.get("units") == "1", "ao frame: terms %r, units %r (R6.5: \"ao\", \"1\")"
+          % (h.get("terms"), h.get("units")))
+    check("exposure_ev" not in h and "exposure" not in h, "ao frame header carries an exposure: %r"
+          % ({k: h[k] for k in ("exposure", "exposure_ev") if k in h},))
+    check(h.get("tick") == t.body.get("tick") and len(f.att) == 40 * 30 * 4 == h.get("raw_length"),
+          "ao frame tick %r (TICK %r), %d bytes" % (h.get("tick"), t.body.get("tick"), len(f.att)))
+    seen = [f.att[i] / 255.0 for i in range(0, len(f.att), 4) if f.att[i + 3] == 255]
+    check(all(f.att[i] == f.att[i + 1] == f.att[i + 2] for i in range(0, len(f.att), 4)), "the ao frame is not grey")
+    check(len(seen) > 100, "only %d pixels see geometry" % len(seen))
+    check(all(0.0 <= v <= 1.0 for v in seen), "ao values outside [0, 1]")
+    check(max(seen) > 0.5, "no open surface (ao at most %.3f) in a box seen from its open side" % max(seen))
+    e = expect_reply(c.request(GET_FRAME, {"format": "exr", "terms": "ao"}, timeout=ctx.tick_timeout), GET_FRAME)
+    check(e.att[:4] == b"\x76\x2f\x31\x01" and e.body.get("units") == "1", "ao exr: magic %r, units %r"
+          % (e.att[:4], e.body.get("units")))
+    expect_reply(c.request(SUBSCRIBE, {"stream": "frame", "format": "rgba8", "compression": "none", "terms": "ao"}),
+                 SUBSCRIBE)
+    t2 = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    s = c.recv_stream(FRAME, timeout=ctx.tick_timeout)
+    check(s.body.get("terms") == "ao" and s.body.get("units") == "1" and s.body.get("tick") == t2.body.get("tick"),
+          "streamed ao FRAME: terms %r, units %r, tick %r (TICK %r)" % (s.body.get("terms"), s.body.get("units"),
+                                                                        s.body.get("tick"), t2.body.get("tick")))
+    expect_reply(c.request(UNSUBSCRIBE, {"stream": "frame"}), UNSUBSCRIBE)
+    return "refused for lpv and iv_ao off; ao on: %d pixels in [%.3f, %.3f], mean %.3f; exr and stream" % (
+        len(seen), min(seen), max(seen), sum(seen) / len(seen))
 
 
 @case("R7.1 R7.2 R3.3", "two sessions with identical inputs: own revisions, equal volumes, no leaking updates")

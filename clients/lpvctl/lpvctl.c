@@ -57,7 +57,7 @@ static const char *g_usage =
     "                                          .bin: raw float32 (all cascades' cells x 12, finest first)\n"
     "                                          + FILE.bin.json sidecar (with each cascade's placement);\n"
     "                                          .json: a summary; no -o: summary on stdout\n"
-    "  frame -o OUT.png|OUT.exr|OUT.rgba [--terms full|indirect|direct] [--compression zstd|none]\n"
+    "  frame -o OUT.png|OUT.exr|OUT.rgba [--terms full|indirect|direct|ao] [--compression zstd|none]\n"
     "        [--exposure auto|EV] [--transparent]\n"
     "  query --csv IN.csv -o OUT.csv           CSV px,py,pz,nx,ny,nz -> E_r,E_g,E_b (W/m^2)\n"
     "  query --point X,Y,Z --normal X,Y,Z      one point, printed\n"

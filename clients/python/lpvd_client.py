@@ -20,6 +20,7 @@ check against a running daemon (exit status 0 on success).
 
 import array
 import json
+import math
 import os
 import socket
 import struct
@@ -90,6 +91,9 @@ MAX_CASCADES = 4  # entries of a volume header's "cascades" (SPEC R5.6)
 # volume carries is read from the description itself.
 VOLUME_LAYOUT_VERSION = 1
 OCTREE_LEVEL_ROLE = "octree_level"  # the role of an octree's levels (SPEC R5.13, GET_VOLUME content "levels")
+IV_VOXELS_ROLE = "iv_voxels"  # the role of technique iv's one level of voxels (SPEC R5.14)
+IV_UNITS = "W/(m^2 sr)"  # an iv volume's values: the radiance arriving at each voxel centre (SPEC R5.14)
+LPV_UNITS = "W/sr"  # an LPV's values: radiant intensity per cell, what R5.7's lookup reads
 # The values, in order, that this client's lookup (Cascade.irradiance: the
 # cosine lobe on SH bands 0-1 per channel) reads; a volume whose description
 # names other values is decoded but not looked up (SPEC R5.11).
@@ -197,6 +201,108 @@ def _floats(raw, fmt):
     raise ProtocolError("unknown volume format %r" % fmt)
 
 
+_F32 = struct.Struct("<f")
+
+
+def _f32(x):
+    """x rounded to the nearest binary32 (each step of SPEC R5.14's lookup is
+    a binary32 operation; rounding the double result of one +, -, *, / or
+    sqrt gives the binary32 result exactly)."""
+    try:
+        return _F32.unpack(_F32.pack(x))[0]
+    except OverflowError:  # beyond the largest binary32: what a binary32 operation gives
+        return math.copysign(float("inf"), x)
+
+
+# R5.14's constants as the binary32 values the server and core use
+_IV_BEHIND = _f32(0.001)
+_IV_HELD_WEIGHT = 1.0 / 64.0
+_LOBE0 = _f32(SH_LOBE0)
+_LOBE1 = _f32(SH_LOBE1)
+
+
+def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
+    """SPEC R5.14's lookup: E (W/m^2, r, g, b) at surface point p with normal
+    n from an iv volume: ``dims``, ``origin``, ``cell_size`` its one level,
+    ``cell(x, y, z)`` a voxel's 12 values, ``held(x, y, z)`` its index entry
+    (non-zero: the voxel holds a surface), ``neighbours`` the description's
+    iv_neighbours. Step by step in binary32 as core/oracle_iv.c computes it
+    (lpv_iv_irradiance; the sums of step 7 in double, as there)."""
+    f32 = _f32
+    # 1. a finite p, a unit-able n
+    p = [f32(float(v)) for v in p]
+    n = [f32(float(v)) for v in n]
+    if not all(math.isfinite(v) for v in p + n):
+        return (0.0, 0.0, 0.0)
+    ln = f32(math.sqrt(f32(f32(f32(n[0] * n[0]) + f32(n[1] * n[1])) + f32(n[2] * n[2]))))
+    if not (ln > f32(1e-8)) or ln == float("inf"):
+        return (0.0, 0.0, 0.0)
+    nh = [f32(v / ln) for v in n]
+    s = f32(cell_size)
+    o = [f32(v) for v in origin]
+    # 2. half a voxel in front of the surface, the 8 voxel centres around it
+    base, f, own = [0, 0, 0], [0.0, 0.0, 0.0], [0, 0, 0]
+    for a in range(3):
+        q = f32(p[a] + f32(f32(0.5 * s) * nh[a]))
+        u = f32(f32(f32(q - o[a]) / s) - 0.5)
+        if not (-1.0 <= u < dims[a]):
+            return (0.0, 0.0, 0.0)
+        b = float(int(u // 1))
+        base[a] = int(b)
+        f[a] = f32(u - b)
+        # 3. the point's own voxel, a thousandth of a voxel behind the surface
+        fo = f32(f32(f32(p[a] - o[a]) / s) - f32(_IV_BEHIND * nh[a]))
+        own[a] = int(fo // 1)
+    # 4. + 5. the corners by distance to q (ties: the lower number), the nearest `neighbours`
+    d2 = []
+    for c in range(8):
+        acc = 0.0
+        for a in range(3):
+            e = f32(f[a] - ((c >> a) & 1))
+            acc = f32(acc + f32(e * e))
+        d2.append(acc)
+    order = sorted(range(8), key=lambda c: (d2[c], c))
+    neighbours = min(max(int(neighbours), 1), 8)
+    idx, weight = [], []
+    for c in order[:neighbours]:
+        v = [base[a] + ((c >> a) & 1) for a in range(3)]
+        if v == own or not all(0 <= v[a] < dims[a] for a in range(3)):
+            continue
+        # 6. trilinear weight x the cosine towards the voxel's centre, 1/64 for a voxel holding a surface
+        t = 1.0
+        for a in range(3):
+            t = f32(t * (f[a] if (c >> a) & 1 else f32(1.0 - f[a])))
+        d = [f32(f32(o[a] + f32(f32(v[a] + 0.5) * s)) - p[a]) for a in range(3)]
+        ln2 = f32(math.sqrt(f32(f32(f32(d[0] * d[0]) + f32(d[1] * d[1])) + f32(d[2] * d[2]))))
+        cosine = 0.0
+        if ln2 > 0.0:
+            c = [f32(nh[a] * f32(d[a] / ln2)) for a in range(3)]
+            cosine = f32(f32(c[0] + c[1]) + c[2])
+        w = f32(t * (cosine if cosine > 0.0 else 0.0))
+        if held(v[0], v[1], v[2]):
+            w = f32(w * _IV_HELD_WEIGHT)
+        if not (w > 0.0):
+            continue
+        idx.append(v)
+        weight.append(w)
+    # 7. the blend, then the cosine lobe around -n (radiance: no / s^2)
+    total = sum(weight)
+    if not (total > 0.0):
+        return (0.0, 0.0, 0.0)
+    acc = [0.0] * 12
+    for v, w in zip(idx, weight):
+        vals = cell(v[0], v[1], v[2])
+        for k in range(12):
+            acc[k] += w * float(vals[k])
+    lobe = (_LOBE0, f32(_LOBE1 * -nh[1]), f32(_LOBE1 * -nh[2]), f32(_LOBE1 * -nh[0]))
+    rgb = []
+    for ch in range(3):
+        L = [f32(acc[4 * ch + k] / total) for k in range(4)]
+        e = f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3]))
+        rgb.append(e if e > 0.0 else 0.0)
+    return tuple(rgb)
+
+
 class Cascade(object):
     """One cascade (level) of a volume (SPEC R5.6, R5.10): ``dims``,
     ``origin`` (m, lower corner), ``cell_size`` (m), ``values_per_cell`` and
@@ -206,7 +312,10 @@ class Cascade(object):
     R5.1's layout per cell r0..r3 g0..g3 b0..b3 in radiant intensity W/sr. A
     numpy array of shape (nz, ny, nx, values_per_cell) (one volume) or
     (volumes, nz, ny, nx, values_per_cell) when numpy is available, else a
-    flat ``array('f')``. ``role`` is "cascade" or "far_field".
+    flat ``array('f')``. ``role`` is "cascade" or "far_field" (or
+    "octree_level", R5.13, or "iv_voxels", R5.14: technique iv's voxels,
+    radiance W/(m^2 sr) at their centres, which R5.7's ``irradiance`` and
+    ``total_flux`` refuse; ``Volume.irradiance`` reads them by R5.14).
     """
 
     def __init__(self, dims, origin, cell_size, values, values_per_cell=12, volumes=1, role="cascade",
@@ -261,9 +370,16 @@ class Cascade(object):
         i = (x + self.dims[0] * (y + self.dims[1] * z)) * 12
         return list(self.data[i:i + 12])
 
+    def _check_r57(self):
+        self._check_lookup()
+        if self.role == IV_VOXELS_ROLE:
+            raise LayoutError("technique iv's voxels (role %r) hold radiance (%s) at their centres, not the intensity "
+                              "per cell R5.7's lookup reads: use Volume.irradiance (SPEC R5.14)"
+                              % (IV_VOXELS_ROLE, IV_UNITS))
+
     def total_flux(self):
         """Sum over cells of c0 * sqrt(4 pi) per channel, in W."""
-        self._check_lookup()
+        self._check_r57()
         k = (4.0 * 3.141592653589793) ** 0.5
         if _np is not None:
             d = self.data.reshape(-1, 12)
@@ -316,8 +432,9 @@ class Cascade(object):
         """E(n) in W/m^2 (r, g, b) at surface point p with normal n from this
         cascade alone (propagation.md §6): sample half a cell in front of the
         surface, E = max(0, c . lobe(-n)) / s^2. Raises LayoutError for a
-        volume whose values are not LOOKUP_VALUES in one volume per level."""
-        self._check_lookup()
+        volume whose values are not LOOKUP_VALUES in one volume per level (or
+        are technique iv's voxels, SPEC R5.14)."""
+        self._check_r57()
         ln = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) ** 0.5
         if not (ln > 1e-8) or ln == float("inf") or any(v != v for v in n):
             return (0.0, 0.0, 0.0)
@@ -343,7 +460,13 @@ class Volume(Cascade):
     ``total_flux()`` are cascade 0's (the finest; the whole volume when there
     is one cascade); ``irradiance()`` blends the cascades as R5.7 (and the
     server's QUERY_IRRADIANCE) do. ``plan`` is the tick's plan (SPEC section
-    8) or None.
+    8) or None. ``units`` are the values' units.
+
+    Technique iv's volume (SPEC R5.14; ``iv`` true): one level of voxels
+    holding the radiance arriving at their centres (``units`` W/(m^2 sr)),
+    ``index`` one flag per voxel (1: it holds a surface) and
+    ``iv_neighbours``; ``irradiance()`` is then R5.14's lookup
+    (``iv_irradiance``).
     """
 
     def __init__(self, header, raw):
@@ -366,6 +489,9 @@ class Volume(Cascade):
         # SPEC R5.13: GET_VOLUME content "levels" describes an octree's levels
         # (the cascades then are level 0 alone); else the levels are the cascades
         octree = self._octree_levels(desc)
+        self.iv = self._iv_levels(desc)
+        self.iv_neighbours = desc.get("iv_neighbours") if self.iv else None
+        self.units = desc.get("units") or header.get("units") or LPV_UNITS
         self.content = "levels" if octree else "merged"
         vpc, vpl = desc["values_per_cell"], desc["volumes_per_level"]
         self.values_per_cell, self.volumes_per_level = vpc, vpl
@@ -375,13 +501,16 @@ class Volume(Cascade):
             refusal = ("volume of content \"levels\" (technique %r: its %d octree levels and index volume) is not "
                        "the merged grid the lookup reads (SPEC R5.7, R5.13): ask get_volume(content=\"merged\")" % (
                            desc["technique"], len(desc["levels"])))
-        elif vpl != 1 or desc["index"] is not None or (
+        elif self.iv:
+            pass  # R5.14: read by its own lookup (Volume.irradiance)
+        elif vpl != 1 or desc["index"] is not None or self.units != LPV_UNITS or (
                 desc["values"] is not None and tuple(desc["values"]) != LOOKUP_VALUES):
             refusal = ("volume layout of technique %r (layout_version %d, %d values per cell %s, %d volumes per "
-                       "level%s) is not the 12 SH values %s in one volume per level, the only layout this "
-                       "client's lookup reads (SPEC R5.7, R5.11)" % (
+                       "level%s, units %s) is not the 12 SH values %s in %s in one volume per level, the only layout "
+                       "this client's lookup reads (SPEC R5.7, R5.11)" % (
                            desc["technique"], desc["layout_version"], vpc, desc["values"], vpl,
-                           ", with an index volume" if desc["index"] is not None else "", list(LOOKUP_VALUES)))
+                           ", with an index volume" if desc["index"] is not None else "", self.units,
+                           list(LOOKUP_VALUES), LPV_UNITS))
         self.lookup_refusal = refusal
         size = 2 if self.format == "fp16" else 4
         index = desc["index"]
@@ -422,6 +551,7 @@ class Volume(Cascade):
                      or abs(float(grid.get("cell_size", 0.0)) - c0.cell_size) > 1e-9 * c0.cell_size):
             raise ProtocolError("grid: differs from cascades[0]")
         self.dims, self.origin, self.cell_size, self.data = c0.dims, c0.origin, c0.cell_size, c0.data
+        self.role, self.values_per_cell, self.volumes = c0.role, c0.values_per_cell, c0.volumes
         self._lookup_refusal = refusal
 
     @staticmethod
@@ -451,6 +581,9 @@ class Volume(Cascade):
         if Volume._octree_levels(d):
             Volume._check_octree_levels(d, specs)
             return d
+        if Volume._iv_levels(d):
+            Volume._check_iv_levels(d, specs, header)
+            return d
         if not isinstance(levels, list) or len(levels) != len(specs):
             raise ProtocolError("volume.levels: expected %d levels (one per cascade)" % len(specs))
         for k, (lv, c) in enumerate(zip(levels, specs)):
@@ -468,6 +601,48 @@ class Volume(Cascade):
         levels = d.get("levels") if isinstance(d, dict) else None
         return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
             and levels[0].get("role") == OCTREE_LEVEL_ROLE
+
+    @staticmethod
+    def _iv_levels(d):
+        """Whether description d's levels are technique iv's voxels (SPEC R5.14)."""
+        levels = d.get("levels") if isinstance(d, dict) else None
+        return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+            and levels[0].get("role") == IV_VOXELS_ROLE
+
+    @staticmethod
+    def _check_iv_levels(d, specs, header):
+        """R5.14: one cascade and one "iv_voxels" level equal to it, far field
+        false, the 12 SH values in one volume, radiance units, the index over
+        level 0 (one u32 per voxel) and iv_neighbours in 1..8."""
+        levels = d["levels"]
+        if len(specs) != 1 or len(levels) != 1:
+            raise ProtocolError("volume.levels: %d levels over %d cascades, but %r is exactly one level over one "
+                                "cascade (SPEC R5.14)" % (len(levels), len(specs), IV_VOXELS_ROLE))
+        c0, lv = specs[0], levels[0]
+        if any(lv.get(key) != c0.get(key) for key in ("dims", "origin", "cell_size", "cells")):
+            raise ProtocolError("volume.levels[0]: differs from cascades[0]")
+        if d.get("far_field") is not False:
+            raise ProtocolError("volume.far_field: %r with %r levels, expected false" % (d.get("far_field"),
+                                                                                         IV_VOXELS_ROLE))
+        if d.get("volumes_per_level") != 1 or tuple(d.get("values") or ()) != LOOKUP_VALUES:
+            raise ProtocolError("volume.values: %r levels hold the 12 SH values %s in one volume (got %r, %r "
+                                "volumes)" % (IV_VOXELS_ROLE, list(LOOKUP_VALUES), d.get("values"),
+                                              d.get("volumes_per_level")))
+        if d.get("units") != IV_UNITS or header.get("units") != IV_UNITS:
+            raise ProtocolError("volume.units: %r (header %r) with %r levels, expected %r" % (
+                d.get("units"), header.get("units"), IV_VOXELS_ROLE, IV_UNITS))
+        dims = c0.get("dims")
+        cells = dims[0] * dims[1] * dims[2] if isinstance(dims, list) and len(dims) == 3 else None
+        ix = d.get("index")
+        if not isinstance(ix, dict) or ix.get("level") != 0 or ix.get("dims") != dims \
+                or ix.get("values_per_cell") != 1 or ix.get("value_type") != "u32" \
+                or not isinstance(ix.get("raw_offset"), int) or ix.get("raw_length") != (cells or 0) * 4:
+            raise ProtocolError("volume.index: %r levels need the index over level 0 (level 0, dims %r, "
+                                "values_per_cell 1, u32)" % (IV_VOXELS_ROLE, dims))
+        nb = d.get("iv_neighbours")
+        if not isinstance(nb, int) or isinstance(nb, bool) or not 1 <= nb <= 8:
+            raise ProtocolError("volume.iv_neighbours: %r, expected an integer in [1, 8] with %r levels"
+                                % (nb, IV_VOXELS_ROLE))
 
     @staticmethod
     def _check_octree_levels(d, specs):
@@ -508,9 +683,16 @@ class Volume(Cascade):
         locally as the server's QUERY_IRRADIANCE (SPEC R5.7): the finest
         cascade containing p, blended towards the next coarser one within the
         last 3 cells of its border, w = clamp((d - 1) / 2, 0, 1); each
-        cascade's lookup as propagation.md §6. Raises LayoutError (naming
-        the layout) for a volume this lookup does not read."""
+        cascade's lookup as propagation.md §6. Technique iv's voxels (``iv``):
+        R5.14's lookup instead (``iv_irradiance`` with the index and
+        iv_neighbours). Raises LayoutError (naming the layout) for a volume
+        neither lookup reads."""
         self._check_lookup()
+        if self.iv:
+            nx, ny = self.dims[0], self.dims[1]
+            index = self.index
+            return iv_irradiance(self.dims, self.origin, self.cell_size, self.cell,
+                                 lambda x, y, z: index[x + nx * (y + ny * z)], self.iv_neighbours, p, n)
         cs = self.cascades
         k = next((i for i, c in enumerate(cs) if c.contains(p)), len(cs) - 1)
         fine = Cascade.irradiance(cs[k], p, n)
@@ -819,7 +1001,8 @@ class Client(object):
         """GET_VOLUME, decoded to a ``Volume`` (a keyframe). content: "merged"
         (None: the server's default, the merged volume) or "levels" (SPEC
         R5.13: an octree technique's levels, ``Volume.levels``, and its index
-        volume, ``Volume.index``)."""
+        volume, ``Volume.index``). Technique iv's volume (SPEC R5.14) comes
+        as ``Volume.iv``, its occupancy as ``Volume.index``."""
         body = {"format": format, "compression": compression or _default_compression()}
         if content is not None:
             body["content"] = content
@@ -827,9 +1010,11 @@ class Client(object):
         return self._decode_volume(hdr, att, ack=False)
 
     def get_frame(self, format="rgba8", compression=None, terms="full", exposure=None, transparent=None):
-        """GET_FRAME -> ``Frame`` (rgba8 pixels are decompressed). exposure:
-        "auto" or an EV number (rgba8/png; None: the server's default, auto);
-        transparent: background alpha 0 (SPEC R6.4)."""
+        """GET_FRAME -> ``Frame`` (rgba8 pixels are decompressed). terms:
+        "full", "indirect", "direct" or "ao" (ambient occlusion, a linear
+        fraction, 1 = open; technique iv with iv_ao on only, SPEC R6.5).
+        exposure: "auto" or an EV number (rgba8/png; None: the server's
+        default, auto); transparent: background alpha 0 (SPEC R6.4)."""
         body = {"format": format, "terms": terms}
         if exposure is not None:
             body["exposure"] = exposure
@@ -988,6 +1173,64 @@ def _minimal_glb():
             + struct.pack("<I4s", len(bin_), b"BIN\0") + bin_)
 
 
+def _self_test_iv(c, say):
+    """SPEC R5.14 and R6.5: technique iv's volume decoded, its local lookup
+    (iv_irradiance) against QUERY_IRRADIANCE, and the ao frame term."""
+    try:
+        c.get_frame(format="rgba8", terms="ao")
+        raise AssertionError("terms \"ao\" without technique iv was not refused")
+    except LpvdError as e:
+        if e.name != "BAD_FIELD" or "terms" not in e.message:
+            raise AssertionError("terms \"ao\" without technique iv: %s %s" % (e.name, e.message))
+    c.config(technique="iv", iv_resolution=12, iv_rays=16, iv_bounces=2, iv_neighbours=6)
+    t = c.tick()
+    vol = c.get_volume(format="fp32")
+    if not vol.iv or vol.units != IV_UNITS or vol.iv_neighbours != 6 or len(vol.index) != vol.cells \
+            or vol.lookup_refusal is not None:
+        raise AssertionError("iv volume: iv %r, units %r, iv_neighbours %r, index of %d for %d voxels, refusal %r" % (
+            vol.iv, vol.units, vol.iv_neighbours, len(vol.index or ()), vol.cells, vol.lookup_refusal))
+    held = sum(1 for h in vol.index if h)
+    if not 0 < held < vol.cells:
+        raise AssertionError("iv volume: %d of %d voxels hold a surface" % (held, vol.cells))
+    try:
+        vol.cascades[0].irradiance(vol.origin, (0, 1, 0))
+        raise AssertionError("R5.7's lookup read technique iv's voxels")
+    except LayoutError:
+        pass
+    # random points (a seeded generator: no two corners exactly as far from the
+    # shifted point, a tie the server may break the other way, R5.14)
+    import random
+    rnd = random.Random(5)
+    points, normals = [], []
+    for i in range(120):
+        points.append([vol.origin[a] + rnd.uniform(0.02, 0.98) * vol.dims[a] * vol.cell_size for a in range(3)])
+        normals.append([(0.0, 1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0)][i % 3] if i % 2 else
+                       [rnd.uniform(-1.0, 1.0) for _ in range(3)])
+    e = c.query_irradiance(points, normals)
+    peak = max(max(float(v) for v in row) for row in e)
+    worst = 0.0
+    for p, n, row in zip(points, normals, e):
+        for a, b in zip(vol.irradiance(p, n), row):
+            worst = max(worst, abs(a - float(b)))
+    if not peak > 0.0 or worst > 1e-4 * peak:
+        raise AssertionError("iv: local lookup differs from QUERY_IRRADIANCE by %.3g of the peak %.4g W/m^2"
+                             % (worst / max(peak, 1e-30), peak))
+    st = t.get("stats", {}).get("iv") or {}
+    say("GET_VOLUME technique iv -> %s voxels of %.4g m, %d hold a surface (stats: %s), iv_neighbours %d; local "
+        "R5.14 lookup at %d points differs from QUERY_IRRADIANCE by %.2e of the peak %.4g W/m^2" % (
+            "x".join(str(d) for d in vol.dims), vol.cell_size, held, st.get("occupied"), vol.iv_neighbours,
+            len(points), worst / peak, peak))
+    c.config(iv_ao=True)
+    c.tick()
+    fr = c.get_frame(format="rgba8", compression="none", terms="ao")
+    if fr.header.get("units") != "1" or fr.header.get("terms") != "ao":
+        raise AssertionError("ao frame header %r" % ({k: v for k, v in fr.header.items() if k != "plan"},))
+    grey = all(fr.data[i] == fr.data[i + 1] == fr.data[i + 2] for i in range(0, len(fr.data), 4))
+    if not grey:
+        raise AssertionError("the ao frame is not grey")
+    say("GET_FRAME terms ao -> %dx%d grey, units %s" % (fr.width, fr.height, fr.header.get("units")))
+
+
 def self_test(address, token=None, glb=None, out=sys.stdout):
     """hello, (scene), tick, get_volume, query, stats, bye. Returns 0 on success."""
     def say(msg):
@@ -1118,6 +1361,8 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
             pass
         say("GET_VOLUME content levels (octree) -> %s, index of %d, merged = the indexed levels" % (
             ", ".join("%d^3" % level.dims[0] for level in lv.levels), len(lv.index)))
+    if "iv" in (c.hello_reply.get("techniques") or []):
+        _self_test_iv(c, say)
     st = c.stats()
     say("STATS -> keys %s" % sorted(st.keys()))
     for line in plan_lines((st.get("plan") or {}).get("plan")):

@@ -220,6 +220,9 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     d->level[0] = v->grid;
     d->volumes_per_level = 1;
     d->values_per_cell = 12;
+    d->kind = LPV_LEVELS_IV_VOXELS; /* radiance at the voxel centres, looked up by iv_blend (SPEC R5.14) */
+    d->units = "W/(m^2 sr)";
+    d->iv_neighbours = v->settings.iv.neighbours;
 }
 
 /* The voxels' direct light (IvVoxel.r, g, b) as LpvCells. */

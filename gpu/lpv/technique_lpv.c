@@ -157,6 +157,8 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     d->far_field = c->cascades.handoff;
     d->volumes_per_level = c->bins > 1 ? c->bins : 1;
     d->values_per_cell = 12;
+    d->kind = LPV_LEVELS_CASCADES;
+    d->units = "W/sr";
 }
 
 static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part, lpv_grid_which which, void *out,
