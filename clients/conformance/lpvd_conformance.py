@@ -1381,7 +1381,16 @@ def c_config_technique(ctx):
         tk = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
         v = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
         made_by = (v.body.get("volume") or {}).get("technique")
-        check(made_by == t, "R4.14/R5.9: after CONFIG technique %r the volume says technique %r" % (t, made_by))
+        if t == "auto":  # R4.14: the server chooses one of the others and the plan says why
+            plan = v.body.get("plan") or {}
+            check(made_by in techniques and made_by != "auto",
+                  "R4.14/R5.9: after CONFIG technique auto the volume says technique %r" % (made_by,))
+            check(plan.get("technique") == made_by and isinstance(plan.get("technique_reason"), str)
+                  and plan["technique_reason"].startswith("auto"),
+                  "R4.14/R8.1: technique auto: the plan says %r / %r" % (plan.get("technique"),
+                                                                      plan.get("technique_reason")))
+        else:
+            check(made_by == t, "R4.14/R5.9: after CONFIG technique %r the volume says technique %r" % (t, made_by))
         said.append("%s (tick %s)" % (t, tk.body.get("tick")))
     cfg1 = _preset_config(c, {})
     for body in ({"technique": "photon_mapping"}, {"technique": ""}, {"technique": 1}, {"technique": None},
