@@ -367,16 +367,23 @@ void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *
                 const float *m = h->normal;
                 if (!(sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) > 1e-3f))
                     continue;
-                /* the irradiance normalises m itself: n^ = m / |m| */
+                /* two sides: the points facing n^ = m / |m| (a share (1 + |m|) / 2 of them, if every
+                 * normal is +-n^) re-emit what arrives on that side, the rest what arrives on the other */
+                const float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+                const float nh[3] = {m[0] / len, m[1] / len, m[2] / len}, nb[3] = {-nh[0], -nh[1], -nh[2]};
+                const float front = 0.5f * (1.0f + (len < 1.0f ? len : 1.0f)), back = 1.0f - front;
                 const float p[3] = {centre_of(g, 0, x), centre_of(g, 1, y), centre_of(g, 2, z)};
-                float E[3], hm[4];
-                lpv_iv_irradiance(g, voxels, incoming, p, m, neighbours, E);
-                hemi(m, hm); /* m not normalised: a voxel of mixed normals re-emits less directionally */
+                float Ef[3], Eb[3] = {0.0f, 0.0f, 0.0f}, hf[4], hb[4];
+                lpv_iv_irradiance(g, voxels, incoming, p, nh, neighbours, Ef);
+                if (back > 0.0f)
+                    lpv_iv_irradiance(g, voxels, incoming, p, nb, neighbours, Eb);
+                hemi(nh, hf);
+                hemi(nb, hb);
                 for (int ch = 0; ch < 3; ch++) {
-                    float a = h->albedo[ch] * E[ch];
+                    float af = h->albedo[ch] * Ef[ch] * front, ab = h->albedo[ch] * Eb[ch] * back;
                     float *c = channel(e, ch);
                     for (int k = 0; k < 4; k++)
-                        c[k] += a * hm[k];
+                        c[k] += af * hf[k] + ab * hb[k];
                 }
             }
         }

@@ -105,9 +105,13 @@ void lpv_iv_irradiance_held(const lpv_grid *g, const uint32_t *held, const lpv_c
 
 /* Emission at bounce k >= 1 from I_{k-1} (incoming; NULL or k == 1: none).
  * Empty voxels emit 0. An occupied voxel h emits its direct SH and, for
- * k > 1 when |m| > 1e-3 (m its mean normal, |m| in float), also
- * albedo_h * E per channel times hemi(m) with m NOT normalised, where
- * E = lpv_iv_irradiance(I_{k-1}, centre of h, m / |m|, neighbours).
+ * k > 1 when |m| > 1e-3 (m its mean normal, |m| in float), also both
+ * sides' bounce light: with n^ = m / |m|, front = (1 + min(|m|, 1)) / 2 and
+ * back = 1 - front (the shares of its points facing +-n^, if every normal
+ * is one of the two), albedo_h * (front E(n^) hemi(n^) + back E(-n^)
+ * hemi(-n^)) per channel, E(n) = lpv_iv_irradiance(I_{k-1}, centre of h,
+ * n, neighbours): a thin wall's voxel re-emits each side's light on its
+ * own side.
  * emit has lpv_grid_cell_count entries and is overwritten. */
 void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *incoming, int bounce, int neighbours,
                  lpv_cell *emit);

@@ -1,8 +1,10 @@
 // iv_emit.comp - what every occupied voxel sends out in bounce u_bounce:
 // its direct light, plus from the second bounce on its albedo times the
-// irradiance the previous gather reconstructs at its centre (facing its mean
-// normal) over the hemisphere of that normal (paper 3.3: the two volumes
-// alternate). Empty voxels send nothing.
+// irradiance the previous gather reconstructs at its centre over the
+// hemisphere it arrives on, for each side of its mean normal in proportion
+// to the points facing that way (a thin wall's voxel holds both sides;
+// core/oracle_iv.h, lpv_iv_emit). The two volumes alternate (paper 3.3).
+// Empty voxels send nothing.
 layout(local_size_x = LPV_IV_WG) in;
 
 layout(std430, binding = LPV_SSBO_IV_VOXELS) readonly buffer Voxels { IvVoxel voxels[]; };
@@ -26,11 +28,15 @@ void main()
         if (u_bounce > 1 && len > 1e-3) {
             ivec3 d = grid_dims();
             ivec3 c = ivec3(i % d.x, (i / d.x) % d.y, i / (d.x * d.y));
-            vec3 e = lpv_irradiance(iv_centre(c), m / len) * v.albedo.rgb;
-            vec4 h = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * m.y, LPV_IV_HEMI1 * m.z, LPV_IV_HEMI1 * m.x);
-            o.r += e.r * h;
-            o.g += e.g * h;
-            o.b += e.b * h;
+            vec3 nh = m / len;
+            float front = 0.5 * (1.0 + min(len, 1.0)), back = 1.0 - front;
+            vec3 ef = lpv_irradiance(iv_centre(c), nh) * v.albedo.rgb * front;
+            vec3 eb = back > 0.0 ? lpv_irradiance(iv_centre(c), -nh) * v.albedo.rgb * back : vec3(0.0);
+            vec4 hf = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * nh.y, LPV_IV_HEMI1 * nh.z, LPV_IV_HEMI1 * nh.x);
+            vec4 hb = vec4(LPV_IV_HEMI0, -hf.yzw);
+            o.r += ef.r * hf + eb.r * hb;
+            o.g += ef.g * hf + eb.g * hb;
+            o.b += ef.b * hf + eb.b * hb;
         }
     }
     emit[i] = o;

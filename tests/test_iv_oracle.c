@@ -238,7 +238,7 @@ static void test_furnace(void **state)
 
 /* Albedo 1, K = 8: nothing is NaN or Inf, the total emitted at the last
  * bounce stays <= K B0 per voxel on average (the furnace's exact value;
- * measured 0.973 K B0: the 2-band losses above, compounded), the irradiance
+ * measured 0.947 K B0: the 2-band losses above, compounded), the irradiance
  * on the walls <= K B0 within the furnace's local +5 % (measured max 1.055:
  * wall voxels holding the surface weigh 1/64 in the reconstruction, so the
  * corners of the box read more of the grazing walls),
