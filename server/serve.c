@@ -248,6 +248,7 @@ static void begin_shutdown(sv_server *s, int signum)
     uv_close((uv_handle_t *)&s->idle_timer, NULL);
     uv_close((uv_handle_t *)&s->sigterm, NULL);
     uv_close((uv_handle_t *)&s->sigint, NULL);
+    uv_close((uv_handle_t *)&s->sighup, NULL);
     for (sv_world *w = s->worlds; w; w = w->next)
         if (w->timer_init)
             uv_timer_stop(&w->timer);
@@ -273,6 +274,20 @@ static void begin_shutdown(sv_server *s, int signum)
 static void signal_cb(uv_signal_t *h, int signum)
 {
     begin_shutdown(h->data, signum);
+}
+
+/* SIGHUP (a closed terminal, or a supervisor's "reload"): lpvd logs to
+ * stderr, so there is no log file to reopen, and its settings come from the
+ * command line; it notes the signal and serves on (docs/server.md,
+ * "Signals"). Without a handler SIGHUP's default action would kill the
+ * daemon without BYE and leave its socket file behind. */
+static void sighup_cb(uv_signal_t *h, int signum)
+{
+    (void)signum;
+    const sv_server *s = h->data;
+    fprintf(stderr, "lpvd serve: SIGHUP: nothing to reload (logs go to stderr, settings come from the command "
+                    "line); serving on with %d client(s)\n",
+            s->conn_count);
 }
 
 static void close_walk(uv_handle_t *h, void *arg)
@@ -471,9 +486,11 @@ int lpvd_cmd_serve(int argc, char **argv)
     uv_timer_start(&s->idle_timer, idle_cb, 1000, 1000);
     uv_signal_init(s->loop, &s->sigterm);
     uv_signal_init(s->loop, &s->sigint);
-    s->sigterm.data = s->sigint.data = s;
+    uv_signal_init(s->loop, &s->sighup);
+    s->sigterm.data = s->sigint.data = s->sighup.data = s;
     uv_signal_start(&s->sigterm, signal_cb, SIGTERM);
     uv_signal_start(&s->sigint, signal_cb, SIGINT);
+    uv_signal_start(&s->sighup, sighup_cb, SIGHUP);
 
     fprintf(stderr, "lpvd serve: lpvd %s, backend %s, GL_RENDERER %s\n", LPVD_VERSION, s->gl_backend,
             s->gl_renderer);

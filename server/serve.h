@@ -314,7 +314,7 @@ struct sv_server {
     uv_pipe_t unix_listener;
     uv_tcp_t tcp_listener;
     int unix_on, tcp_on;
-    uv_signal_t sigterm, sigint;
+    uv_signal_t sigterm, sigint, sighup;
     uv_timer_t idle_timer;
     uv_timer_t stop_timer;
     uv_async_t done_async;
