@@ -534,21 +534,15 @@ static int lookup(const json_t *obj, const char *key, int required, json_t **v, 
     return LPVP_FIELD_ABSENT;
 }
 
-/* Integer value of v (integer, or real with an integral value within
- * int64); 0 ok, -1 not an integer. */
+/* Integer value of v: a JSON integer only (R4.11: "Integers MUST be JSON
+ * integers"; 4.0 and 4e0 are JSON numbers with a fraction or an exponent,
+ * which a reader in another language may not take as integers);
+ * 0 ok, -1 not an integer. */
 static int int_value(const json_t *v, int64_t *out)
 {
     if (json_is_integer(v)) {
         *out = (int64_t)json_integer_value(v);
         return 0;
-    }
-    if (json_is_real(v)) {
-        double d = json_real_value(v);
-        if (isfinite(d) && d == floor(d) && d >= -9223372036854775808.0 &&
-            d < 9223372036854775808.0) {
-            *out = (int64_t)d;
-            return 0;
-        }
     }
     return -1;
 }
@@ -559,8 +553,8 @@ static int check_int(const json_t *v, const char *key, const char *idx, int64_t 
     int64_t x;
     if (int_value(v, &x) != 0) {
         if (json_is_real(v))
-            lpvp_set_error(err, err_n, "%s%s: expected an integer, got %.17g", key, idx,
-                    json_real_value(v));
+            lpvp_set_error(err, err_n, "%s%s: expected an integer, got the number %.17g written with a fraction "
+                           "or an exponent (write integers as integers)", key, idx, json_real_value(v));
         else
             lpvp_set_error(err, err_n, "%s%s: expected an integer, got %s", key, idx, type_word(v));
         return LPVP_FIELD_BAD;

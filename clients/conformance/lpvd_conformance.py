@@ -1466,7 +1466,8 @@ def _out_of_range(k):
     return [hi + 0.5 * max(1.0, abs(hi))] + ([lo] if k["min_exclusive"] else [lo - 0.5 * max(1.0, abs(lo))])
 
 
-WRONG_TYPES = {"int": (1.5, "1", True), "number": ("1", True, [1]), "bool": (1, "on", None)}
+WRONG_TYPES = {"int": (1.5, 2.0, "1", True),  # 2.0: a JSON number, not a JSON integer (R4.11)
+               "number": ("1", True, [1]), "bool": (1, "on", None)}
 
 
 def _same(kind, got, want):
