@@ -140,7 +140,9 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
             *err += "refused or missing";
         return false;
     }
-    int fd = open(resolved.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    /* O_NONBLOCK: opening a FIFO would otherwise wait for a writer forever;
+     * fstat below refuses anything but a regular file */
+    int fd = open(resolved.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
     if (fd < 0) {
         if (ctx->missing.empty())
             ctx->missing = "external file " + show(path) + " cannot be opened: " + strerror(errno);
@@ -194,7 +196,7 @@ void set_fs_callbacks(tinygltf::TinyGLTF &loader, Ctx *ctx)
 
 std::string read_main_file(const char *path, std::vector<unsigned char> *data)
 {
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK); /* a FIFO must not block the load: fstat refuses it */
     if (fd < 0)
         return std::string("cannot open: ") + strerror(errno);
     struct stat st;

@@ -38,6 +38,7 @@ typedef struct load_work {
     uint16_t type;
     /* in */
     char *path;            /* resolved real path, or NULL */
+    char *sent;            /* the path as the client sent it: the only one messages name (never the root) */
     uint8_t *glb;          /* attachment or the session scene's bytes (owned copy) */
     size_t glb_size;
     char *base_dir;
@@ -80,10 +81,12 @@ static void load_run(uv_work_t *req)
 {
     load_work *w = req->data;
     if (w->path) {
-        int fd = open(w->path, O_RDONLY | O_CLOEXEC);
+        /* O_NONBLOCK: a FIFO would otherwise wait for a writer forever (and
+         * hold this worker and the daemon's exit); fstat refuses it */
+        int fd = open(w->path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
         struct stat st;
         if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-            snprintf(w->err, sizeof w->err, "%s: %s", w->path, fd < 0 ? strerror(errno) : "not a regular file");
+            snprintf(w->err, sizeof w->err, "path %s: %s", w->sent, fd < 0 ? strerror(errno) : "not a regular file");
             if (fd >= 0)
                 close(fd);
             w->status = LPVP_E_SCENE_INVALID;
@@ -102,7 +105,7 @@ static void load_run(uv_work_t *req)
         }
         close(fd);
         if (!w->glb || got != w->glb_size) {
-            snprintf(w->err, sizeof w->err, "%s: cannot read", w->path);
+            snprintf(w->err, sizeof w->err, "path %s: cannot read", w->sent);
             w->status = LPVP_E_SCENE_INVALID;
             return;
         }
@@ -114,7 +117,7 @@ static void load_run(uv_work_t *req)
         snprintf(w->err, sizeof w->err, "out of memory");
         return;
     }
-    const char *label = w->path ? w->path : "attachment";
+    const char *label = w->sent ? w->sent : "attachment";
     int rc = lpv_gltf_load_memory_w(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
                                     &w->warnings, w->err, sizeof w->err);
     if (rc != 0) {
@@ -264,6 +267,7 @@ static void load_done(uv_work_t *req, int status)
     if (w->scene)
         free_sv_scene_unlisted(w->scene);
     free(w->path);
+    free(w->sent);
     free(w->glb);
     free(w->base_dir);
     free(w->nodes);
@@ -357,9 +361,15 @@ void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
             return;
         }
         int rc = resolve_scene_path(c->srv, path, &w->path, err, sizeof err);
+        if (rc == 0 && !(w->sent = strdup(path))) {
+            free(w->path);
+            rc = -2;
+            snprintf(err, sizeof err, "out of memory");
+        }
         if (rc != 0) {
             free(w);
-            sv_reply_err(c, r->request_id, rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
+            sv_reply_err(c, r->request_id,
+                         rc == -2 ? LPVP_E_INTERNAL : rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
             return;
         }
     } else {
@@ -376,6 +386,7 @@ void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
     }
     if (start_load(c, w) != 0) {
         free(w->path);
+        free(w->sent);
         free(w->glb);
         free(w);
         sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "cannot queue the scene load");
