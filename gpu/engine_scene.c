@@ -304,9 +304,10 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     if (lpv_engine_resolve_technique(e, &e->settings, err, err_size) != 0 || lpv_engine_sample_scene(e, err, err_size))
         return -1;
 
-    if (glGetError() != GL_NO_ERROR)
+    if (glGetError() != GL_NO_ERROR) {
+        e->has_scene = 0;
         return lpv_error(err, err_size, "%s: GL error while uploading the scene", scene->source);
-    e->has_scene = 1;
+    }
     return lpv_engine_place_volume(e, err, err_size);
 }
 

@@ -138,6 +138,11 @@ void lpv_pass_rsm_run(lpv_engine *e)
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     lpv_timer_end(&e->timer);
 
+    /* VPLs and surfels only for a technique whose passes read them (the
+     * LPVs' injection and geometry volume); the imperfect volume reads the
+     * RSM textures themselves, as shadow maps */
+    if (!e->plan.pass[LPV_PASS_INJECT].run && !e->plan.pass[LPV_PASS_GV].run)
+        return;
     lpv_timer_begin(&e->timer, "vpl_extract");
     if (e->rsm_layers > 0) {
         glUseProgram(e->prog_vpl_extract);

@@ -848,12 +848,11 @@ static int level_matches(const json_t *e, const lpvp_cascade_info *ci)
     return same && json_is_integer(v) && (uint64_t)json_integer_value(v) == ci->cells;
 }
 
-/* 1 when levels[0] has the role "octree_level" (R5.13). */
-static int is_octree_levels(const json_t *levels)
+/* 1 when levels[0] has the role `role` ("octree_level": R5.13, "iv_voxels": R5.14). */
+static int levels_have_role(const json_t *levels, int role)
 {
     const json_t *r = json_object_get(json_array_get(levels, 0), "role");
-    return json_is_array(levels) && json_is_string(r) &&
-           strcmp(json_string_value(r), lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL]) == 0;
+    return json_is_array(levels) && json_is_string(r) && strcmp(json_string_value(r), lpvp_level_role_names[role]) == 0;
 }
 
 /* R5.13: an octree's levels over cascades[0] (the only cascade), every one
@@ -904,14 +903,6 @@ static int parse_octree_levels(const json_t *d, lpvp_volume_info *vi, char *err,
     l->content = LPVP_CONTENT_LEVELS;
     l->level_count = count;
     return 0;
-}
-
-/* 1 when levels[0] has the role "iv_voxels" (R5.14). */
-static int is_iv_levels(const json_t *levels)
-{
-    const json_t *r = json_object_get(json_array_get(levels, 0), "role");
-    return json_is_array(levels) && json_is_string(r) &&
-           strcmp(json_string_value(r), lpvp_level_role_names[LPVP_ROLE_IV_VOXELS]) == 0;
 }
 
 /* R5.14: technique iv's one level of voxels, equal to cascades[0] (the only
@@ -1024,9 +1015,9 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
     l->far_field = json_is_true(v);
 
     a = json_object_get(d, "levels");
-    if (is_octree_levels(a))
+    if (levels_have_role(a, LPVP_ROLE_OCTREE_LEVEL))
         return parse_octree_levels(d, vi, err, err_n) != 0 ? -1 : parse_cells(obj, d, vi, err, err_n);
-    if (is_iv_levels(a))
+    if (levels_have_role(a, LPVP_ROLE_IV_VOXELS))
         return parse_iv_levels(d, vi, err, err_n) != 0 || parse_cells(obj, d, vi, err, err_n) != 0
                    ? -1
                    : iv_checks(vi, err, err_n);

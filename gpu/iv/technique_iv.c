@@ -96,13 +96,10 @@ static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, cha
 {
     lpv_iv_gpu *v = (lpv_iv_gpu *)t;
     const lpv_settings *s = w->settings;
-    const int given = lpv_settings_bounds_given(s);
-    const float *lo = given ? s->bounds_min : w->bounds_min, *hi = given ? s->bounds_max : w->bounds_max;
     lpv_grid g;
     if (lpv_iv_place(s, w->bounds_min, w->bounds_max, &g) != 0)
-        return lpv_error(err, err_size, "cannot place %d voxels over the bounds (%g %g %g)..(%g %g %g)",
-                         s->iv.resolution, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1],
-                         (double)hi[2]);
+        return lpv_error(err, err_size, "cannot place %d voxels over the %s bounds (not finite)", s->iv.resolution,
+                         lpv_settings_bounds_given(s) ? "settings'" : "scene's");
     v->pending = g;
     if (moved)
         *moved = memcmp(&g, &v->grid, sizeof g) != 0;
