@@ -4,6 +4,7 @@
 #include "cascades.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "lpv_shared.h"
@@ -88,7 +89,7 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
             else
                 centre = fmin(fmax(centre, bmin[i] + 0.5 * extent), bmax[i] - 0.5 * extent);
             double o = floor(centre / cell) - (double)(g->dims[i] / 2);
-            if (!isfinite(o) || fabs(o) > 1e7)
+            if (!isfinite(o) || fabs(o) > LPV_CASCADE_MAX_ORIGIN_CELLS)
                 return -1;
             out->origin_cells[k][i] = (float)o;
             g->origin[i] = (float)(o * cell);
@@ -97,6 +98,26 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     out->count = count;
     out->snapped = 1;
     out->handoff = s->lpv.far_field == LPV_SWITCH_ON && s->lpv.cascade_ratio == 2.0f;
+    return 0;
+}
+
+int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], char *why, size_t n)
+{
+    int longest = 1;
+    double reach = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        longest = s->grid_dims[i] > longest ? s->grid_dims[i] : longest;
+        reach = fmax(reach, fmax(fabs((double)bmin[i]), fabs((double)bmax[i])));
+    }
+    const double cell = (double)lpv_cascade_finest_size(s, bmin, bmax) / longest;
+    /* lpv_cascades_place: the anchor lies in the bounds, the origin half a grid below it */
+    const double room = LPV_CASCADE_MAX_ORIGIN_CELLS - longest / 2 - 1;
+    if (isfinite(reach) && cell > 0.0 && reach / cell + 1.0 <= room)
+        return 1;
+    if (why)
+        snprintf(why, n, "cascade cells of %g m cannot be counted %g m from the origin in 32-bit floats "
+                 "(at most %g cells); cascade_size %g m or more would fit", cell, reach, LPV_CASCADE_MAX_ORIGIN_CELLS,
+                 reach / (room - 1.0) * longest * 1.001);
     return 0;
 }
 

@@ -48,6 +48,18 @@ typedef struct lpv_cascade_set {
 int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
                        const float *forward, lpv_cascade_set *out);
 
+/* A snapped cascade's origin is a whole number of its cells held in a float:
+ * exact up to 2^24, and 1e7 leaves room for the grid's own cells. */
+#define LPV_CASCADE_MAX_ORIGIN_CELLS 1e7
+
+/* 1 when snapped cascades of settings s (more than one; their finest cell:
+ * lpv_cascade_finest_size / the longest grid side) can be placed wherever
+ * the camera stands over the scene bounds [bmin, bmax]: the finest cascade's
+ * origin, counted in its cells, stays within LPV_CASCADE_MAX_ORIGIN_CELLS.
+ * Else 0, with the reason in why: the cell size, how far from the origin
+ * the scene reaches, and the smallest cascade_size that fits. */
+int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], char *why, size_t n);
+
 /* How many grids lpv_cascades_place(s, count, ...) places: count, or for one
  * grid over the bounds with the far field on 1 + far_field_levels (at most
  * LPV_MAX_CASCADES). */

@@ -7,10 +7,6 @@
 
 #include "lpv_shared.h"
 
-/* Cell sizes outside this range are treated as degenerate (cell size 1):
- * the oracle divides by cell_size^2, which must stay a normal, finite float. */
-#define LPV_MIN_CELL_SIZE 1e-18
-#define LPV_MAX_CELL_SIZE 1e18
 
 static int bounds_finite(const float bmin[3], const float bmax[3])
 {
@@ -21,10 +17,7 @@ static int bounds_finite(const float bmin[3], const float bmax[3])
     return 1;
 }
 
-/* max_i extent_i / max(dims_i - 1, 1): every axis keeps at least half a cell
- * of margin on each side. Computed in double so that huge finite bounds do
- * not overflow before the division. */
-static double cell_size_for(const int dims[3], const float bmin[3], const float bmax[3])
+double lpv_grid_cell_size_over(const int dims[3], const float bmin[3], const float bmax[3])
 {
     double size = 0.0;
     for (int i = 0; i < 3; i++) {
@@ -34,6 +27,12 @@ static double cell_size_for(const int dims[3], const float bmin[3], const float 
         if (s > size)
             size = s;
     }
+    return size;
+}
+
+static double cell_size_for(const int dims[3], const float bmin[3], const float bmax[3])
+{
+    double size = lpv_grid_cell_size_over(dims, bmin, bmax);
     if (!(size >= LPV_MIN_CELL_SIZE && size <= LPV_MAX_CELL_SIZE))
         return 1.0;
     return size;

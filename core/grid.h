@@ -21,6 +21,19 @@ typedef struct lpv_grid {
     float cell_size;  /* m */
 } lpv_grid;
 
+/* Cell sizes a grid may have (m): the oracle divides by cell_size^2, which must
+ * stay a normal, finite float. A grid over bounds whose cells would fall
+ * outside (a scene collapsed to a point) gets cells of 1 m instead; bounds a
+ * user gives are refused instead (lpv_settings_validate). */
+#define LPV_MIN_CELL_SIZE 1e-18
+#define LPV_MAX_CELL_SIZE 1e18
+
+/* The cell size lpv_grid_place gives dims cells over [bmin, bmax] before that
+ * fallback: the longest extent_i / max(dims_i - 1, 1), so every axis keeps at
+ * least half a cell of margin on each side. In double, so that huge finite
+ * bounds do not overflow before the division. */
+double lpv_grid_cell_size_over(const int dims[3], const float bmin[3], const float bmax[3]);
+
 /* Places a grid of dims cells over [bmin, bmax]. Returns 0, or -1 when a bound
  * is not finite or when a
  * dimension is outside 1..LPV_MAX_GRID_DIM. */

@@ -33,7 +33,20 @@ static void say(char *dst, size_t n, const char *fmt, ...)
     va_end(ap);
 }
 
+static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t n);
+
 int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t n)
+{
+    int count = plan_cascades_wanted(s, f, reason, n);
+    if (count > 1 && f->cascades_unfit) { /* the tick must still run: one grid, and the plan says why */
+        say(reason, n, "%d cascades cannot be placed %.3g m from the origin (cells too fine for 32-bit floats): "
+            "one grid", count, (double)f->scene_reach);
+        return 1;
+    }
+    return count;
+}
+
+static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t n)
 {
     if (f->bounds_given) {
         say(reason, n, "the settings fix the grid bounds: one grid over them");

@@ -49,6 +49,8 @@ typedef struct lpv_plan_facts {
     float scene_extent;        /* m, the scene bounds' longest axis */
     float scene_shortest;      /* m, the scene bounds' shortest axis */
     int bounds_given;          /* the settings fix the grid bounds */
+    int cascades_unfit;        /* snapped cascades cannot be placed over the scene (lpv_cascades_fit) */
+    float scene_reach;         /* m, the scene bounds' largest |coordinate| */
     /* what changed since the last computed tick */
     int first_tick;            /* nothing computed yet */
     int scene_changed;         /* geometry or materials */

@@ -2,6 +2,7 @@
 #include "scene.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -53,6 +54,51 @@ int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src)
     memcpy(dst->bounds_min, src->bounds_min, sizeof dst->bounds_min);
     memcpy(dst->bounds_max, src->bounds_max, sizeof dst->bounds_max);
     memcpy(dst->source, src->source, sizeof dst->source);
+    return 0;
+}
+
+int lpv_light_check_intensity(const lpv_light *l, char *err, size_t err_size)
+{
+    double c = fmax(fmax((double)l->color[0], (double)l->color[1]), (double)l->color[2]);
+    double product = (double)l->intensity * c;
+    if (isfinite(product) && product <= (double)(float)LPV_MAX_LIGHT_INTENSITY) /* 1e30 itself is allowed */
+        return 0;
+    snprintf(err, err_size, "intensity x color = %g %s is over the largest lpvd computes with, %g %s", product,
+             l->type == LPV_LIGHT_DIRECTIONAL ? "W/m^2" : "W/sr", LPV_MAX_LIGHT_INTENSITY,
+             l->type == LPV_LIGHT_DIRECTIONAL ? "W/m^2" : "W/sr");
+    return -1;
+}
+
+int lpv_scene_check_ranges(const lpv_scene *scene, char *err, size_t err_size)
+{
+    for (uint32_t i = 0; scene->vertices && i < scene->vertex_count; ++i) {
+        const float *p = scene->vertices[i].position;
+        for (int k = 0; k < 3; ++k)
+            if (!(fabsf(p[k]) <= LPV_MAX_COORD)) {
+                snprintf(err, err_size, "vertex %u lies at %g m, beyond the largest coordinate lpvd computes with "
+                         "(+-%g m)", i, (double)p[k], LPV_MAX_COORD);
+                return -1;
+            }
+    }
+    for (uint32_t i = 0; i < scene->light_count; ++i) {
+        const lpv_light *l = &scene->lights[i];
+        char why[160];
+        for (int k = 0; k < 3; ++k)
+            if (!(fabsf(l->position[k]) <= LPV_MAX_COORD)) {
+                snprintf(err, err_size, "light %u lies at %g m, beyond +-%g m", i, (double)l->position[k],
+                         LPV_MAX_COORD);
+                return -1;
+            }
+        if (!(l->range >= 0.0f && l->range <= LPV_MAX_COORD)) {
+            snprintf(err, err_size, "light %u: range %g m is out of range (0..%g)", i, (double)l->range,
+                     LPV_MAX_COORD);
+            return -1;
+        }
+        if (lpv_light_check_intensity(l, why, sizeof why) != 0) {
+            snprintf(err, err_size, "light %u: %s", i, why);
+            return -1;
+        }
+    }
     return 0;
 }
 

@@ -17,6 +17,18 @@
 #define LPV_NAME_MAX 64
 #define LPV_LUMENS_PER_WATT 683.0f /* photometric -> radiometric, docs/units.md */
 
+/* The largest |coordinate| (m) lpvd computes with: scene vertices after node
+ * transforms, lights' positions and ranges, the camera's eye and target,
+ * CONFIG bounds. Positions are 32-bit floats: at 1e9 m one ulp is 64 m, and
+ * squared distances (at most ~1.2e19) stay far below FLT_MAX, where 2e19 m
+ * between eye and target overflowed. 1e9 m is 2.6 times the distance to the
+ * Moon. Larger values are refused, naming the field (SPEC R4.15). */
+#define LPV_MAX_COORD 1e9
+/* The largest intensity x colour of a light: W/sr (point, spot) or W/m^2
+ * (directional). The GPU hard cases tick at 1e30 (tests/test_gpu_stability.c);
+ * intensity 1e30 with colour 1e30 overflowed float and lit nothing. */
+#define LPV_MAX_LIGHT_INTENSITY 1e30
+
 typedef enum lpv_light_type {
     LPV_LIGHT_DIRECTIONAL = 0,
     LPV_LIGHT_POINT = 1,
@@ -157,6 +169,16 @@ int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src);
 
 /* Recomputes bounds_min/max from the vertices. */
 void lpv_scene_compute_bounds(lpv_scene *scene);
+
+/* 0 when every vertex position is finite and within +-LPV_MAX_COORD and every
+ * light's position, range and intensity x colour are within the limits
+ * above; else -1 with a message naming the first value out of range (a
+ * vertex or light by index, never data of the file beyond the number). */
+int lpv_scene_check_ranges(const lpv_scene *scene, char *err, size_t err_size);
+
+/* 0 when intensity x the largest colour channel is finite and at most
+ * LPV_MAX_LIGHT_INTENSITY; else -1 with a message ("... = %g W/sr ..."). */
+int lpv_light_check_intensity(const lpv_light *light, char *err, size_t err_size);
 
 /* The alpha below which a material's surface is cut away (alpha_mode, the
  * cutoff, LPV_ALPHA_BLEND_THRESHOLD for BLEND); 0 (nothing is cut) for OPAQUE. */

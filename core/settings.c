@@ -15,6 +15,8 @@
 #include <string.h>
 
 #include "area_lights.h"
+#include "grid.h"
+#include "scene.h"
 #include "lpv_shared.h"
 
 #define LPV_MIN_RSM_SIZE 16
@@ -275,12 +277,17 @@ static int validate_bounds(const lpv_settings *s, char *err, unsigned long err_s
         return 0; /* all zero: the scene's bounds */
     for (int i = 0; i < 3; i++) {
         float lo = s->bounds_min[i], hi = s->bounds_max[i];
-        if (!isfinite(lo) || !isfinite(hi) || !(hi >= lo))
+        if (!(fabsf(lo) <= LPV_MAX_COORD) || !(fabsf(hi) <= LPV_MAX_COORD) || !(hi >= lo))
             return fail(err, err_size,
                         "bounds_min[%d] = %g, bounds_max[%d] = %g are out of range "
-                        "(allowed finite with bounds_max >= bounds_min, or all six zero)",
-                        i, (double)lo, i, (double)hi);
+                        "(allowed within +-%g m with bounds_max >= bounds_min, or all six zero)",
+                        i, (double)lo, i, (double)hi, LPV_MAX_COORD);
     }
+    /* the grid would otherwise replace them (lpv_grid_place's fallback) */
+    double cell = lpv_grid_cell_size_over(s->grid_dims, s->bounds_min, s->bounds_max);
+    if (!(cell >= LPV_MIN_CELL_SIZE))
+        return fail(err, err_size, "bounds: over %dx%dx%d cells this box gives cells of %g m, under the smallest "
+                    "cell size %g m", s->grid_dims[0], s->grid_dims[1], s->grid_dims[2], cell, LPV_MIN_CELL_SIZE);
     return 0;
 }
 

@@ -33,13 +33,22 @@ void lpv_view_from_camera(const lpv_camera *cam, int width, int height, lpv_view
 int lpv_view_look_at(const float eye[3], const float target[3], float yfov, int width, int height, lpv_view *out)
 {
     memset(out, 0, sizeof *out);
-    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
-    float len = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    if (!(len > 1e-9f) || !isfinite(len) || !(yfov > 0.0f && yfov < 3.1f))
-        return -1;
+    if (!(yfov > 0.0f && yfov < (float)M_PI))
+        return LPV_VIEW_BAD_FOV;
+    /* in double: eye and target 2e19 m apart squared overflow float */
+    double f[3], len = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        if (!isfinite(eye[i]) || !isfinite(target[i]))
+            return LPV_VIEW_NOT_FINITE;
+        f[i] = (double)target[i] - (double)eye[i];
+        len += f[i] * f[i];
+    }
+    len = sqrt(len);
+    if (!(len > 1e-9))
+        return LPV_VIEW_EYE_IS_TARGET;
     for (int i = 0; i < 3; ++i) {
         out->eye[i] = eye[i];
-        out->forward[i] = f[i] / len;
+        out->forward[i] = (float)(f[i] / len);
     }
     if (fabsf(out->forward[1]) > 0.999f) {
         out->up[2] = -1.0f;

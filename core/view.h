@@ -22,9 +22,16 @@ typedef struct lpv_view {
 /* From a scene camera. width/height are taken as given. */
 void lpv_view_from_camera(const lpv_camera *cam, int width, int height, lpv_view *out);
 
-/* Looking from eye at target with vertical field of view yfov (rad); up is
- * world +Y unless the view is vertical, then -Z. Returns -1 if eye == target
- * or a value is not finite. */
+/* What lpv_view_look_at refuses (negative, so != 0 tests still work). */
+enum {
+    LPV_VIEW_BAD_FOV = -1,       /* yfov not in (0, pi) */
+    LPV_VIEW_NOT_FINITE = -2,    /* eye or target not finite */
+    LPV_VIEW_EYE_IS_TARGET = -3, /* |target - eye| <= 1e-9 m */
+};
+
+/* Looking from eye at target with vertical field of view yfov (rad, strictly
+ * between 0 and pi); up is world +Y unless the view is vertical, then -Z.
+ * Returns 0 or one of the LPV_VIEW_* codes above. */
 int lpv_view_look_at(const float eye[3], const float target[3], float yfov, int width, int height, lpv_view *out);
 
 /* A 45-degree view along -Z that frames the scene's bounds. */

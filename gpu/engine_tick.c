@@ -41,6 +41,9 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->scene_shortest = fminf(e->scene_max[0] - e->scene_min[0],
                               fminf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
     f->bounds_given = lpv_settings_bounds_given(&e->settings);
+    f->cascades_unfit = !lpv_cascades_fit(&e->settings, e->scene_min, e->scene_max, NULL, 0);
+    for (int i = 0; i < 3; ++i)
+        f->scene_reach = fmaxf(f->scene_reach, fmaxf(fabsf(e->scene_min[i]), fabsf(e->scene_max[i])));
     f->first_tick = !e->computed;
     f->scene_changed = e->scene_dirty;
     f->lights_changed = e->lights_dirty;

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cascades.h"
 #include "settings_fields.h"
 
 #define SV_MAX_LIGHTS 256
@@ -35,9 +36,10 @@ void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j)
         lpvp_get_enum(j, "type", 1, TYPES, 3, &type, err, sizeof err) != LPVP_FIELD_OK ||
         lpvp_get_floats(j, "color", 0, 3, 0.0, 1e30, l.color, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_float(j, "intensity", 1, 0.0, 1e30, &l.intensity, err, sizeof err) != LPVP_FIELD_OK ||
-        lpvp_get_floats(j, "position", 0, 3, -1e30, 1e30, l.position, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_floats(j, "position", 0, 3, -LPV_MAX_COORD, LPV_MAX_COORD, l.position, err, sizeof err) ==
+            LPVP_FIELD_BAD ||
         lpvp_get_floats(j, "direction", 0, 3, -1e30, 1e30, l.direction, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_float(j, "range", 0, 0.0, 1e30, &l.range, err, sizeof err) == LPVP_FIELD_BAD ||
+        lpvp_get_float(j, "range", 0, 0.0, LPV_MAX_COORD, &l.range, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_float(j, "inner_cone", 0, 0.0, M_PI / 2.0, &l.inner_cone, err, sizeof err) == LPVP_FIELD_BAD ||
         lpvp_get_float(j, "outer_cone", 0, 0.0, M_PI / 2.0, &l.outer_cone, err, sizeof err) == LPVP_FIELD_BAD) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
@@ -47,14 +49,15 @@ void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j)
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: must not be empty");
         return;
     }
-    float dl = sqrtf(l.direction[0] * l.direction[0] + l.direction[1] * l.direction[1] +
-                     l.direction[2] * l.direction[2]);
-    if (!(dl > 1e-12f) || !isfinite(dl)) {
+    /* in double: components up to 1e30 square beyond float */
+    double dl = sqrt((double)l.direction[0] * l.direction[0] + (double)l.direction[1] * l.direction[1] +
+                     (double)l.direction[2] * l.direction[2]);
+    if (!(dl > 1e-12)) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "direction: must be a non-zero vector");
         return;
     }
     for (int i = 0; i < 3; ++i)
-        l.direction[i] /= dl;
+        l.direction[i] = (float)(l.direction[i] / dl);
     if (type == LPV_LIGHT_SPOT && l.inner_cone > l.outer_cone) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "inner_cone: must not exceed outer_cone");
         return;
@@ -62,6 +65,10 @@ void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j)
     if (type != LPV_LIGHT_SPOT)
         l.inner_cone = l.outer_cone = 0.0f;
     l.type = (lpv_light_type)type;
+    if (lpv_light_check_intensity(&l, err, sizeof err) != 0) { /* 1e30 x 1e30 overflowed and lit nothing */
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "intensity: %s", err);
+        return;
+    }
     memcpy(l.name, id, idlen);
     uint32_t i = 0;
     while (i < c->light_count && strcmp(c->lights[i].name, l.name) != 0)
@@ -139,27 +146,41 @@ void sv_do_camera_set(sv_conn *c, sv_request *r, json_t *j)
     } else {
         float eye[3], target[3], up[3] = {0, 1, 0}, fov = 45.0f;
         int has_up;
-        if (lpvp_get_floats(j, "eye", 1, 3, -1e30, 1e30, eye, err, sizeof err) != LPVP_FIELD_OK ||
-            lpvp_get_floats(j, "target", 1, 3, -1e30, 1e30, target, err, sizeof err) != LPVP_FIELD_OK ||
+        if (lpvp_get_floats(j, "eye", 1, 3, -LPV_MAX_COORD, LPV_MAX_COORD, eye, err, sizeof err) != LPVP_FIELD_OK ||
+            lpvp_get_floats(j, "target", 1, 3, -LPV_MAX_COORD, LPV_MAX_COORD, target, err, sizeof err) !=
+                LPVP_FIELD_OK ||
             (has_up = lpvp_get_floats(j, "up", 0, 3, -1e30, 1e30, up, err, sizeof err)) == LPVP_FIELD_BAD ||
             lpvp_get_float(j, "fov_deg", 0, 0.01, 179.0, &fov, err, sizeof err) == LPVP_FIELD_BAD) {
             sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
             return;
         }
-        if (lpv_view_look_at(eye, target, fov * (float)(M_PI / 180.0), (int)w, (int)h, &v) != 0) {
-            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "target: must differ from eye");
+        int look = lpv_view_look_at(eye, target, fov * (float)(M_PI / 180.0), (int)w, (int)h, &v);
+        if (look != 0) { /* the ranges above leave only eye == target (the other codes: a defect here) */
+            sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s",
+                         look == LPV_VIEW_EYE_IS_TARGET ? "target: must differ from eye (by more than 1e-9 m)"
+                         : look == LPV_VIEW_BAD_FOV     ? "fov_deg: must be above 0 and below 180"
+                                                        : "eye, target: must be finite");
             return;
         }
         if (has_up == LPVP_FIELD_OK) { /* up, made orthogonal to forward */
-            float d = up[0] * v.forward[0] + up[1] * v.forward[1] + up[2] * v.forward[2];
-            float u[3] = {up[0] - d * v.forward[0], up[1] - d * v.forward[1], up[2] - d * v.forward[2]};
-            float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            if (!(ul > 1e-6f) || !isfinite(ul)) {
-                sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "up: must not be parallel to target - eye");
+            /* in double, relative to |up|: components up to 1e30 square beyond float */
+            double d = 0.0, u[3], ul = 0.0, upl = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                d += (double)up[i] * v.forward[i];
+                upl += (double)up[i] * up[i];
+            }
+            for (int i = 0; i < 3; ++i) {
+                u[i] = up[i] - d * v.forward[i];
+                ul += u[i] * u[i];
+            }
+            ul = sqrt(ul);
+            if (!(ul > 1e-6 * sqrt(upl))) {
+                sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                             "up: must be non-zero and not parallel to target - eye");
                 return;
             }
             for (int i = 0; i < 3; ++i)
-                v.up[i] = u[i] / ul;
+                v.up[i] = (float)(u[i] / ul);
         }
         c->view_explicit = 1;
         c->view_camera = -1;
@@ -285,7 +306,7 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
         for (int i = 0; i < 3; ++i)
             st.grid_dims[i] = (int)grid[i];
     }
-    int bst = lpvp_get_floats(j, "bounds", 0, 6, -1e30, 1e30, bounds, err, sizeof err);
+    int bst = lpvp_get_floats(j, "bounds", 0, 6, -LPV_MAX_COORD, LPV_MAX_COORD, bounds, err, sizeof err);
     if (bst == LPVP_FIELD_BAD)
         goto bad;
     if (bst == LPVP_FIELD_OK) {
@@ -326,6 +347,15 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
     lpv_settings_resolve(&chk);
     if (lpv_settings_validate(&chk, err, sizeof err) != 0)
         goto bad;
+    /* explicit cascades must be placeable over the scene (the planner falls
+     * back to one grid for its own choice, and says so in the plan) */
+    char why[320];
+    const lpv_scene *sc = &c->scene->scene;
+    if (chk.lpv.cascades > 1 && !lpv_settings_bounds_given(&chk) &&
+        !lpv_cascades_fit(&chk, sc->bounds_min, sc->bounds_max, why, sizeof why)) {
+        snprintf(err, sizeof err, "cascade_size: %s", why);
+        goto bad;
+    }
     c->settings = st;
     c->tick_rate = rate;
     sv_session_changed(c);

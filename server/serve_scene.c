@@ -120,6 +120,14 @@ static void load_run(uv_work_t *req)
     const char *label = w->sent ? w->sent : "attachment";
     int rc = lpv_gltf_load_memory_w(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
                                     &w->warnings, w->err, sizeof w->err);
+    char why[256];
+    if (rc == 0 && lpv_scene_check_ranges(&sc->scene, why, sizeof why) != 0) {
+        /* a file, or node transforms (SCENE_UPDATE: BAD_FIELD "nodes: ..."),
+         * that puts the scene where float math breaks: refused, not ticked */
+        snprintf(w->err, sizeof w->err, "%s: %s", label, why);
+        lpv_scene_free(&sc->scene);
+        rc = -1;
+    }
     if (rc != 0) {
         free(sc);
         w->status = LPVP_E_SCENE_INVALID;

@@ -1567,6 +1567,38 @@ def c_config_knobs_bad(ctx):
     return "%d bad values refused, config unchanged" % n
 
 
+@case("R4.15", "every value accepted can be ticked with: values where float math breaks are refused naming the "
+      "field, values inside the ranges tick")
+def c_value_ranges(ctx):
+    light = {"id": "r", "type": "point", "position": [0.1, 0.6, 0.2], "intensity": 5}
+    c, _, _ = ctx.scene_session(light=light)
+    refused = [  # (type, body, field the message must name)
+        (CAMERA_SET, {"eye": [0, 0, 1e19], "target": [0, 0, -1e19]}, "eye"),
+        (CAMERA_SET, {"eye": [0, 0, 3], "target": [0, 0, 3]}, "target"),
+        (LIGHT_SET, dict(light, intensity=1e30, color=[1e30, 1e30, 1e30]), "intensity"),
+        (LIGHT_SET, dict(light, position=[1e30, 0, 0]), "position"),
+        (CONFIG, {"bounds": [-1e30, -1e30, -1e30, 1e30, 1e30, 1e30]}, "bounds"),
+        (CONFIG, {"cascades": 3, "cascade_size": 1e-30}, "cascade_size"),
+        (SCENE_UPDATE, {"nodes": [{"node": 0, "scale": [1e30, 1e30, 1e30]}]}, "nodes"),
+    ]
+    for t, body, field in refused:
+        f = c.request(t, body, timeout=ctx.tick_timeout)
+        expect_error(f, "BAD_FIELD", field=field)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK, what="TICK after the refusals")
+    accepted = [
+        (CAMERA_SET, {"eye": [0, 0.5, 3], "target": [0, 0.5, 0], "fov_deg": 179}),
+        (LIGHT_SET, dict(light, intensity=1e30)),
+        (CONFIG, {"cascades": 3, "cascade_size": 0.5}),
+        (CONFIG, {"cascades": 0, "cascade_size": 1e-30}),  # the planner's choice: one grid when it must
+        (CONFIG, {"bounds": [-1e9, -1e9, -1e9, 1e9, 1e9, 1e9]}),  # last: given bounds stay
+    ]
+    for t, body in accepted:
+        expect_reply(c.request(t, body, timeout=ctx.tick_timeout), t, what="%s %s" % (type_name(t), json.dumps(body)))
+        expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK,
+                     what="TICK after %s %s" % (type_name(t), json.dumps(body)))
+    return "%d values refused naming the field, %d accepted and ticked" % (len(refused), len(accepted))
+
+
 # ---------------------------------------------------------------------------
 # Cases: irradiance queries
 
