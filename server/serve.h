@@ -66,11 +66,27 @@ typedef struct sv_config {
     int max_texture;
     int max_grid;
     double max_tick_rate;
-    double idle_timeout;     /* seconds */
+    double idle_timeout;     /* seconds since the last complete frame (R4.9) */
+    /* Before HELLO (R2.5a, R4.1a): a connection that has not yet said HELLO
+     * (with the token where one is required) may send frames of at most
+     * max_preauth_body bytes of JSON and no attachment, must say HELLO within
+     * handshake_timeout seconds, and is one of at most max_preauth such
+     * connections; only HELLO makes it count against max_clients. */
+    uint64_t max_preauth_body;
+    double handshake_timeout; /* 0 = no deadline */
+    int max_preauth;
     lpv_backend backend;
     lpv_settings settings;   /* default CONFIG */
     double tick_rate;        /* default tick_rate_hz */
 } sv_config;
+
+#define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
+#define SV_DEFAULT_HANDSHAKE_TIMEOUT 10.0
+#define SV_DEFAULT_MAX_PREAUTH 16
+/* Reply bytes a connection may have queued before HELLO: its replies are a
+ * few ERRORs of ~100 bytes each, so a peer that sends small frames and never
+ * reads is dropped here instead of at --max-queue (R2.5a). */
+#define SV_PREAUTH_MAX_QUEUE (64u << 10)
 
 /* ---- scenes: parsed glTF, shared by every session that loaded the same bytes */
 typedef struct sv_scene {
@@ -279,7 +295,8 @@ struct sv_conn {
     sv_request *pending_head, *pending_tail;
     size_t pending_count, pending_bytes;
     int busy;               /* a request is being processed asynchronously */
-    uint64_t last_rx_ms;
+    uint64_t last_rx_ms;    /* when the last complete frame arrived (R4.9) */
+    uint64_t accepted_ms;   /* when the connection was accepted (--handshake-timeout) */
     /* writing */
     size_t wq_bytes;        /* bytes handed to uv_write, not yet completed */
     size_t wq_count;
@@ -366,6 +383,10 @@ void sv_conn_close(sv_conn *c);
 void sv_conn_close_after_write(sv_conn *c);
 void sv_conn_unref(sv_conn *c);
 void sv_net_resume_reading(sv_conn *c);
+/* A HELLO that passed the version and token checks: admits c as one of
+ * --max-clients sessions (0), or sends ERROR LIMIT for request_id, closes c
+ * and returns -1 (R4.1a). */
+int sv_net_admit_session(sv_conn *c, uint32_t request_id);
 
 /* serve_session.c */
 void sv_session_init(sv_conn *c);
