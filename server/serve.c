@@ -251,6 +251,34 @@ static void close_all_cb(uv_timer_t *t)
     uv_close((uv_handle_t *)t, NULL);
 }
 
+/* How long SIGTERM waits, after the tick in flight, for requests running on
+ * libuv workers (scene loads) before the process exits without them. */
+#define SV_SHUTDOWN_WAIT_MS 5000
+
+/* The shutdown deadline passed and a scene load is still running on a worker
+ * thread (a huge file being parsed; a load cannot be cancelled). By now every
+ * client has had its replies or SHUTTING_DOWN and BYE, connections and
+ * listeners are closed, the socket file is removed, and the GL thread has
+ * destroyed every engine and been joined. A load only reads files and builds
+ * a private in-memory scene: it writes no file, owns nothing outside the
+ * process and holds no lock anything else waits for, so ending the process
+ * under it loses only memory the kernel takes back. _exit, not exit: exit's
+ * atexit handlers and C++ static destructors would tear down the loader's
+ * libraries while the worker is still in them. */
+static void exit_deadline_cb(uv_timer_t *t)
+{
+    const sv_server *s = t->data;
+    if (s->works_inflight <= 0)
+        return;
+    fprintf(stderr, "lpvd serve: %d scene load(s) still running %d ms after the shutdown; exiting without them "
+                    "(their clients were answered SHUTTING_DOWN)\n",
+            s->works_inflight, SV_SHUTDOWN_WAIT_MS);
+    fprintf(stderr, "lpvd serve: stopped (%llu ticks, %llu bytes sent)\n", (unsigned long long)s->ticks,
+            (unsigned long long)s->bytes_sent);
+    fflush(stderr);
+    _exit(0);
+}
+
 static void begin_shutdown(sv_server *s, int signum)
 {
     if (s->stopping)
@@ -271,13 +299,15 @@ static void begin_shutdown(sv_server *s, int signum)
     for (sv_conn *c = s->conns; c; c = c->next)
         sv_world_detach(c);
     sv_gl_stop(s); /* finishes the tick in flight and delivers its reply */
-    for (sv_conn *c = s->conns; c; c = c->next) {
-        if (c->closing)
-            continue;
-        sv_send(c, LPVP_BYE_REPLY, 0, json_object(), NULL, 0, SV_STREAM_NONE);
-        sv_conn_close_after_write(c);
-    }
+    /* the rest (a load on a worker, requests queued behind it) get SHUTTING_DOWN, then BYE (R3.1, R7.4) */
+    for (sv_conn *c = s->conns; c; c = c->next)
+        sv_session_shutdown(c);
     uv_close((uv_handle_t *)&s->done_async, NULL);
+    if (uv_timer_init(s->loop, &s->exit_timer) == 0) { /* unref'd: only matters while a worker holds the loop */
+        s->exit_timer.data = s;
+        uv_timer_start(&s->exit_timer, exit_deadline_cb, SV_SHUTDOWN_WAIT_MS, 0);
+        uv_unref((uv_handle_t *)&s->exit_timer);
+    }
     /* clients that do not read get 2 s, then are closed */
     if (uv_timer_init(s->loop, &s->stop_timer) == 0) {
         s->stop_timer.data = s;

@@ -295,6 +295,8 @@ struct sv_conn {
     sv_request *pending_head, *pending_tail;
     size_t pending_count, pending_bytes;
     int busy;               /* a request is being processed asynchronously */
+    int work_inflight;      /* that request runs on a libuv worker (a scene load): it cannot be cancelled */
+    uint32_t work_request_id;
     uint64_t last_rx_ms;    /* when the last complete frame arrived (R4.9) */
     uint64_t accepted_ms;   /* when the connection was accepted (--handshake-timeout) */
     /* writing */
@@ -336,6 +338,8 @@ struct sv_server {
     uv_timer_t stop_timer;
     uv_async_t done_async;
     int stopping;
+    uv_timer_t exit_timer;  /* SIGTERM: the most it waits for worker threads (SV_SHUTDOWN_WAIT_MS) */
+    int works_inflight;     /* requests running on libuv workers, all sessions */
     sv_conn *conns;
     int conn_count;
     uint64_t next_conn_id;
@@ -392,6 +396,13 @@ int sv_net_admit_session(sv_conn *c, uint32_t request_id);
 void sv_session_init(sv_conn *c);
 void sv_session_free(sv_conn *c);        /* on close: detach, free state */
 void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
+/* A request of c (request_id) starts / ends running on a libuv worker. */
+void sv_session_work_begin(sv_conn *c, uint32_t request_id);
+void sv_session_work_end(sv_conn *c);
+/* SIGTERM, after the GL thread has answered its jobs: every request of c not
+ * yet answered gets ERROR SHUTTING_DOWN in order, then BYE; c closes once
+ * that is written (R3.1, R7.4). */
+void sv_session_shutdown(sv_conn *c);
 
 /* serve_world.c */
 int sv_gl_start(sv_server *s, char *err, size_t n);
