@@ -90,6 +90,7 @@ void lpvp_limits_default(lpvp_limits *lim)
 {
     lim->max_body = LPVP_DEFAULT_MAX_BODY;
     lim->max_message = LPVP_DEFAULT_MAX_MESSAGE;
+    lim->no_attachment = 0;
 }
 
 static lpvp_limits limits_or_default(const lpvp_limits *lim)
@@ -165,6 +166,11 @@ int lpvp_header_check(const uint8_t in[LPVP_HEADER_SIZE], const lpvp_limits *lim
                 "json_length %u + attachment_length %u exceeds the message limit %llu",
                 (unsigned)h->json_length, (unsigned)h->attachment_length,
                 (unsigned long long)l.max_message);
+        return LPVP_E_TOO_LARGE;
+    }
+    if (l.no_attachment && h->attachment_length) { /* R2.5a */
+        lpvp_set_error(err, err_n, "attachment_length %u: this frame may carry no attachment",
+                (unsigned)h->attachment_length);
         return LPVP_E_TOO_LARGE;
     }
     return LPVP_E_NONE;

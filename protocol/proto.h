@@ -120,6 +120,8 @@ int lpvp_error_closes(int code);
 typedef struct lpvp_limits {
     uint32_t max_body;     /* max json_length (default 1 MiB) */
     uint64_t max_message;  /* max json_length + attachment_length (default 256 MiB) */
+    int no_attachment;     /* 1: any attachment_length > 0 is TOO_LARGE (a server before HELLO, R2.5a);
+                              0 (default): only max_message bounds it */
 } lpvp_limits;
 
 /* Fills the defaults above. Every function taking a const lpvp_limits *
@@ -150,6 +152,7 @@ void lpvp_header_encode(const lpvp_header *h, uint8_t out[LPVP_HEADER_SIZE]);
  *   json_length < 2                         -> LPVP_E_BAD_FRAME   (R2.1)
  *   json_length > max_body, or
  *   json_length + attachment_length > max_message -> LPVP_E_TOO_LARGE (R2.5)
+ *   attachment_length > 0 with no_attachment -> LPVP_E_TOO_LARGE (R2.5a)
  * checked in that order. *h is filled in every case, except that on BAD_MAGIC
  * h->request_id is set to 0 (R2.2: the reply carries request_id 0); on every
  * other error h->request_id is the one to echo. error_code may be NULL; it is

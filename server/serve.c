@@ -51,11 +51,17 @@ static void usage(FILE *f)
             "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
-            "  --idle-timeout S        a silent session is sent BYE and closed (default 300)\n"
+            "  --idle-timeout S        a session with no complete frame for S s is sent BYE and closed\n"
+            "                          (default 300)\n"
+            "Before HELLO (a connection that has not yet said HELLO with the token):\n"
+            "  --max-preauth-body BYTES  JSON of a frame; any attachment is refused (default %u)\n"
+            "  --handshake-timeout S   no HELLO within S s of connecting: ERROR LIMIT, closed (default %g;\n"
+            "                          0 = none)\n"
+            "  --max-preauth N         such connections at once, apart from --max-clients (default %d)\n"
             "Default CONFIG of every session:\n"
             "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
             "%s",
-            LPVD_OPTIONS_HELP);
+            SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT, SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
 }
 
 static int parse_u64(const char *v, uint64_t lo, uint64_t hi, uint64_t *out)
@@ -211,12 +217,21 @@ static void idle_cb(uv_timer_t *t)
     sv_server *s = t->data;
     uint64_t now = sv_now_ms();
     uint64_t limit = (uint64_t)(s->cfg.idle_timeout * 1000.0);
+    uint64_t handshake = (uint64_t)(s->cfg.handshake_timeout * 1000.0);
     for (sv_conn *c = s->conns; c; c = c->next) {
         if (c->closing)
             continue;
         if (c->close_after_write) {
             if (now > c->close_deadline_ms) /* it never read what we wrote */
                 sv_conn_close(c);
+            continue;
+        }
+        if (!c->hello && handshake && now - c->accepted_ms > handshake) { /* R4.1a */
+            fprintf(stderr, "lpvd serve: client %llu (%s) said no HELLO within %g s: closing it\n",
+                    (unsigned long long)c->id, c->peer, s->cfg.handshake_timeout);
+            sv_send_error(c, 0, LPVP_E_LIMIT, "no HELLO within %g s of connecting (--handshake-timeout %g)",
+                          s->cfg.handshake_timeout, s->cfg.handshake_timeout);
+            sv_conn_close_after_write(c);
             continue;
         }
         if (limit && now - c->last_rx_ms > limit && !c->busy) {
@@ -234,6 +249,34 @@ static void close_all_cb(uv_timer_t *t)
     for (sv_conn *c = s->conns; c; c = c->next)
         sv_conn_close(c);
     uv_close((uv_handle_t *)t, NULL);
+}
+
+/* How long SIGTERM waits, after the tick in flight, for requests running on
+ * libuv workers (scene loads) before the process exits without them. */
+#define SV_SHUTDOWN_WAIT_MS 5000
+
+/* The shutdown deadline passed and a scene load is still running on a worker
+ * thread (a huge file being parsed; a load cannot be cancelled). By now every
+ * client has had its replies or SHUTTING_DOWN and BYE, connections and
+ * listeners are closed, the socket file is removed, and the GL thread has
+ * destroyed every engine and been joined. A load only reads files and builds
+ * a private in-memory scene: it writes no file, owns nothing outside the
+ * process and holds no lock anything else waits for, so ending the process
+ * under it loses only memory the kernel takes back. _exit, not exit: exit's
+ * atexit handlers and C++ static destructors would tear down the loader's
+ * libraries while the worker is still in them. */
+static void exit_deadline_cb(uv_timer_t *t)
+{
+    const sv_server *s = t->data;
+    if (s->works_inflight <= 0)
+        return;
+    fprintf(stderr, "lpvd serve: %d scene load(s) still running %d ms after the shutdown; exiting without them "
+                    "(their clients were answered SHUTTING_DOWN)\n",
+            s->works_inflight, SV_SHUTDOWN_WAIT_MS);
+    fprintf(stderr, "lpvd serve: stopped (%llu ticks, %llu bytes sent)\n", (unsigned long long)s->ticks,
+            (unsigned long long)s->bytes_sent);
+    fflush(stderr);
+    _exit(0);
 }
 
 static void begin_shutdown(sv_server *s, int signum)
@@ -256,13 +299,15 @@ static void begin_shutdown(sv_server *s, int signum)
     for (sv_conn *c = s->conns; c; c = c->next)
         sv_world_detach(c);
     sv_gl_stop(s); /* finishes the tick in flight and delivers its reply */
-    for (sv_conn *c = s->conns; c; c = c->next) {
-        if (c->closing)
-            continue;
-        sv_send(c, LPVP_BYE_REPLY, 0, json_object(), NULL, 0, SV_STREAM_NONE);
-        sv_conn_close_after_write(c);
-    }
+    /* the rest (a load on a worker, requests queued behind it) get SHUTTING_DOWN, then BYE (R3.1, R7.4) */
+    for (sv_conn *c = s->conns; c; c = c->next)
+        sv_session_shutdown(c);
     uv_close((uv_handle_t *)&s->done_async, NULL);
+    if (uv_timer_init(s->loop, &s->exit_timer) == 0) { /* unref'd: only matters while a worker holds the loop */
+        s->exit_timer.data = s;
+        uv_timer_start(&s->exit_timer, exit_deadline_cb, SV_SHUTDOWN_WAIT_MS, 0);
+        uv_unref((uv_handle_t *)&s->exit_timer);
+    }
     /* clients that do not read get 2 s, then are closed */
     if (uv_timer_init(s->loop, &s->stop_timer) == 0) {
         s->stop_timer.data = s;
@@ -299,7 +344,8 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", NULL};
+    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", "max-preauth-body",
+    "handshake-timeout", "max-preauth", NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
 {
@@ -316,6 +362,9 @@ int lpvd_cmd_serve(int argc, char **argv)
     cfg->max_grid = 128;
     cfg->max_tick_rate = 60.0;
     cfg->idle_timeout = 300.0;
+    cfg->max_preauth_body = SV_DEFAULT_MAX_PREAUTH_BODY;
+    cfg->handshake_timeout = SV_DEFAULT_HANDSHAKE_TIMEOUT;
+    cfg->max_preauth = SV_DEFAULT_MAX_PREAUTH;
     lpvd_options opt;
     memset(&opt, 0, sizeof opt);
     char err[2048] = "";
@@ -415,6 +464,15 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "idle-timeout")) {
             bad = parse_num(v, 0.0, 1e9, &d);
             cfg->idle_timeout = d;
+        } else if (!strcmp(name, "max-preauth-body")) {
+            bad = parse_u64(v, 64, UINT32_MAX, &u);
+            cfg->max_preauth_body = u;
+        } else if (!strcmp(name, "handshake-timeout")) {
+            bad = parse_num(v, 0.0, 1e9, &d);
+            cfg->handshake_timeout = d;
+        } else if (!strcmp(name, "max-preauth")) {
+            bad = parse_u64(v, 1, 100000, &u);
+            cfg->max_preauth = (int)u;
         } else if (!strcmp(name, "tick-rate")) {
             bad = parse_num(v, 0.0, 10000.0, &d);
             cfg->tick_rate = d;

@@ -66,11 +66,27 @@ typedef struct sv_config {
     int max_texture;
     int max_grid;
     double max_tick_rate;
-    double idle_timeout;     /* seconds */
+    double idle_timeout;     /* seconds since the last complete frame (R4.9) */
+    /* Before HELLO (R2.5a, R4.1a): a connection that has not yet said HELLO
+     * (with the token where one is required) may send frames of at most
+     * max_preauth_body bytes of JSON and no attachment, must say HELLO within
+     * handshake_timeout seconds, and is one of at most max_preauth such
+     * connections; only HELLO makes it count against max_clients. */
+    uint64_t max_preauth_body;
+    double handshake_timeout; /* 0 = no deadline */
+    int max_preauth;
     lpv_backend backend;
     lpv_settings settings;   /* default CONFIG */
     double tick_rate;        /* default tick_rate_hz */
 } sv_config;
+
+#define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
+#define SV_DEFAULT_HANDSHAKE_TIMEOUT 10.0
+#define SV_DEFAULT_MAX_PREAUTH 16
+/* Reply bytes a connection may have queued before HELLO: its replies are a
+ * few ERRORs of ~100 bytes each, so a peer that sends small frames and never
+ * reads is dropped here instead of at --max-queue (R2.5a). */
+#define SV_PREAUTH_MAX_QUEUE (64u << 10)
 
 /* ---- scenes: parsed glTF, shared by every session that loaded the same bytes */
 typedef struct sv_scene {
@@ -279,7 +295,10 @@ struct sv_conn {
     sv_request *pending_head, *pending_tail;
     size_t pending_count, pending_bytes;
     int busy;               /* a request is being processed asynchronously */
-    uint64_t last_rx_ms;
+    int work_inflight;      /* that request runs on a libuv worker (a scene load): it cannot be cancelled */
+    uint32_t work_request_id;
+    uint64_t last_rx_ms;    /* when the last complete frame arrived (R4.9) */
+    uint64_t accepted_ms;   /* when the connection was accepted (--handshake-timeout) */
     /* writing */
     size_t wq_bytes;        /* bytes handed to uv_write, not yet completed */
     size_t wq_count;
@@ -319,6 +338,8 @@ struct sv_server {
     uv_timer_t stop_timer;
     uv_async_t done_async;
     int stopping;
+    uv_timer_t exit_timer;  /* SIGTERM: the most it waits for worker threads (SV_SHUTDOWN_WAIT_MS) */
+    int works_inflight;     /* requests running on libuv workers, all sessions */
     sv_conn *conns;
     int conn_count;
     uint64_t next_conn_id;
@@ -366,11 +387,22 @@ void sv_conn_close(sv_conn *c);
 void sv_conn_close_after_write(sv_conn *c);
 void sv_conn_unref(sv_conn *c);
 void sv_net_resume_reading(sv_conn *c);
+/* A HELLO that passed the version and token checks: admits c as one of
+ * --max-clients sessions (0), or sends ERROR LIMIT for request_id, closes c
+ * and returns -1 (R4.1a). */
+int sv_net_admit_session(sv_conn *c, uint32_t request_id);
 
 /* serve_session.c */
 void sv_session_init(sv_conn *c);
 void sv_session_free(sv_conn *c);        /* on close: detach, free state */
 void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
+/* A request of c (request_id) starts / ends running on a libuv worker. */
+void sv_session_work_begin(sv_conn *c, uint32_t request_id);
+void sv_session_work_end(sv_conn *c);
+/* SIGTERM, after the GL thread has answered its jobs: every request of c not
+ * yet answered gets ERROR SHUTTING_DOWN in order, then BYE; c closes once
+ * that is written (R3.1, R7.4). */
+void sv_session_shutdown(sv_conn *c);
 
 /* serve_world.c */
 int sv_gl_start(sv_server *s, char *err, size_t n);

@@ -3,7 +3,8 @@
  * version (SPEC R4.1), the --token check (R4.2), and the reply that tells the
  * client the server's limits, knobs and presets (R4.12). Until it succeeds,
  * dispatch (serve_session.c) answers every other request with
- * HELLO_REQUIRED.
+ * HELLO_REQUIRED. A HELLO that passes the token check takes one of the
+ * --max-clients slots, or gets LIMIT and the connection closes (R4.1a).
  */
 #include "serve_session_internal.h"
 
@@ -56,14 +57,18 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
+    if (sv_net_admit_session(c, r->request_id) != 0)
+        return;
     c->hello = 1;
     char server[64];
     snprintf(server, sizeof server, "lpvd %s", LPVD_VERSION);
-    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I}", "max_body", (json_int_t)s->cfg.max_body,
-                            "max_message", (json_int_t)s->cfg.max_message, "max_clients", s->cfg.max_clients,
-                            "max_triangles", (json_int_t)s->cfg.max_triangles, "max_texture", s->cfg.max_texture,
-                            "max_grid", s->cfg.max_grid, "max_tick_rate", s->cfg.max_tick_rate, "idle_timeout",
-                            s->cfg.idle_timeout, "max_queue", (json_int_t)s->cfg.max_queue);
+    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I, s:I, s:f, s:i}", "max_body",
+                            (json_int_t)s->cfg.max_body, "max_message", (json_int_t)s->cfg.max_message,
+                            "max_clients", s->cfg.max_clients, "max_triangles", (json_int_t)s->cfg.max_triangles,
+                            "max_texture", s->cfg.max_texture, "max_grid", s->cfg.max_grid, "max_tick_rate",
+                            s->cfg.max_tick_rate, "idle_timeout", s->cfg.idle_timeout, "max_queue",
+                            (json_int_t)s->cfg.max_queue, "max_preauth_body", (json_int_t)s->cfg.max_preauth_body,
+                            "handshake_timeout", s->cfg.handshake_timeout, "max_preauth", s->cfg.max_preauth);
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);

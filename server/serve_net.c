@@ -9,6 +9,14 @@
  * message) and a client over it is disconnected; stream messages (VOLUME,
  * FRAME) keep at most one frame in flight and one unsent per stream, a newer
  * one replacing the unsent older one (SPEC R5.5).
+ *
+ * Before HELLO (SPEC R2.5a, R4.1a) a connection is held to the pre-auth
+ * limits: frames of at most --max-preauth-body bytes of JSON and no
+ * attachment (refused from the header, before the body is read), each frame
+ * dispatched before the next header is looked at (so the limits change the
+ * moment HELLO succeeds, even for frames pipelined behind it), replies capped
+ * at SV_PREAUTH_MAX_QUEUE, and at most --max-preauth such connections; only a
+ * HELLO that passes the token check takes one of the --max-clients slots.
  */
 #include "serve.h"
 
@@ -208,10 +216,12 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
         return c->closing ? -1 : 0;
     }
     size_t len = w->head_len + w->att_len;
-    if (c->wq_bytes > 0 && c->wq_bytes + len > c->srv->cfg.max_queue) {
-        fprintf(stderr, "lpvd serve: client %llu (%s) is not reading: %zu bytes queued, over the %llu-byte cap; "
+    uint64_t cap = c->hello ? c->srv->cfg.max_queue : SV_PREAUTH_MAX_QUEUE;
+    if (c->wq_bytes > 0 && c->wq_bytes + len > cap) {
+        fprintf(stderr, "lpvd serve: client %llu (%s) is not reading: %zu bytes queued, over the %llu-byte cap%s; "
                         "disconnecting it\n",
-                (unsigned long long)c->id, c->peer, c->wq_bytes, (unsigned long long)c->srv->cfg.max_queue);
+                (unsigned long long)c->id, c->peer, c->wq_bytes, (unsigned long long)cap,
+                c->hello ? "" : " before HELLO");
         wreq_free(w);
         sv_conn_close(c);
         return -1;
@@ -235,6 +245,32 @@ int sv_send_error(sv_conn *c, uint32_t request_id, int code, const char *fmt, ..
 }
 
 /* ---- reading ------------------------------------------------------------ */
+/* The frame limits of a connection: the configured ones once it has said
+ * HELLO, the pre-auth ones before (R2.5a). */
+static lpvp_limits conn_limits(const sv_server *s, int authenticated)
+{
+    lpvp_limits lim = {.max_body = (uint32_t)s->cfg.max_body, .max_message = s->cfg.max_message};
+    if (!authenticated) {
+        if (s->cfg.max_preauth_body < lim.max_body)
+            lim.max_body = (uint32_t)s->cfg.max_preauth_body;
+        lim.max_message = lim.max_body;
+        lim.no_attachment = 1;
+    }
+    return lim;
+}
+
+/* The ERROR for a frame refused before HELLO names the pre-auth limit and
+ * the header's values rather than the configured limits. */
+static void preauth_refusal(sv_conn *c, char *msg, size_t n)
+{
+    const lpvp_header *h = &c->parser.header;
+    snprintf(msg, n,
+             "before HELLO the server accepts frames of at most %llu bytes of JSON and no attachment "
+             "(--max-preauth-body %llu); this one declared json_length %u and attachment_length %u",
+             (unsigned long long)c->parser.limits.max_body, (unsigned long long)c->srv->cfg.max_preauth_body,
+             (unsigned)h->json_length, (unsigned)h->attachment_length);
+}
+
 static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
 {
     (void)suggested;
@@ -283,7 +319,6 @@ static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
     }
     if (nread == 0)
         return;
-    c->last_rx_ms = sv_now_ms();
     size_t off = 0, len = (size_t)nread;
     c->refs++;
     while (off < len && !c->closing && !c->close_after_write) {
@@ -292,13 +327,29 @@ static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
         int stt = lpvp_parser_feed(&c->parser, buf->base + off, len - off, &used, &f);
         off += used;
         if (stt == LPVP_PARSE_FRAME) {
+            c->last_rx_ms = sv_now_ms(); /* R4.9: idle counts from the last complete frame */
             if (enqueue_frame(c, &f) != 0) {
                 sv_send_error(c, f.header.request_id, LPVP_E_INTERNAL, "out of memory for the request");
                 sv_conn_close_after_write(c);
                 break;
             }
+            if (!c->hello) {
+                /* Answer it before reading the next header: after a HELLO
+                 * that succeeds the configured limits apply (R2.5a). Before
+                 * HELLO nothing makes a session busy, so this empties the
+                 * queue. */
+                sv_session_pump(c);
+                if (c->hello && !c->closing)
+                    c->parser.limits = conn_limits(c->srv, 1);
+            }
         } else if (stt == LPVP_PARSE_ERROR) {
-            json_t *b = lpvp_error_body(c->parser.error_code, "%s", c->parser.error_message);
+            char pre[320];
+            const char *why = c->parser.error_message;
+            if (!c->hello && c->parser.error_code == LPVP_E_TOO_LARGE) {
+                preauth_refusal(c, pre, sizeof pre);
+                why = pre;
+            }
+            json_t *b = lpvp_error_body(c->parser.error_code, "%s", why);
             sv_send(c, LPVP_ERROR, c->parser.error_request_id, b, NULL, 0, SV_STREAM_NONE);
             sv_conn_close_after_write(c);
             break;
@@ -325,15 +376,16 @@ void sv_net_resume_reading(sv_conn *c)
 }
 
 /* ---- accepting ---------------------------------------------------------- */
-/* Connections that still count against --max-clients. Before refusing a
- * newcomer, connections whose peer has already gone (EOF or reset waiting,
- * not yet seen by the loop) are closed, so a slot freed by a client that just
- * disconnected is reusable at once. */
-static int active_clients(sv_server *s, const sv_conn *except)
+/* Open connections (not closing) that have said HELLO (authenticated = 1:
+ * they count against --max-clients) or not yet (0: against --max-preauth).
+ * Before refusing a newcomer, connections whose peer has already gone (EOF
+ * or reset waiting, not yet seen by the loop) are closed, so a slot freed by
+ * a client that just disconnected is reusable at once. */
+static int active_clients(sv_server *s, const sv_conn *except, int authenticated)
 {
     int n = 0;
     for (sv_conn *c = s->conns; c; c = c->next)
-        if (c != except && !c->closing && !c->close_after_write)
+        if (c != except && !c->closing && !c->close_after_write && !c->hello == !authenticated)
             n++;
     return n;
 }
@@ -374,7 +426,7 @@ static void on_connection(uv_stream_t *server, int status)
     c->next = s->conns;
     s->conns = c;
     s->conn_count++;
-    lpvp_limits lim = {.max_body = (uint32_t)s->cfg.max_body, .max_message = s->cfg.max_message};
+    lpvp_limits lim = conn_limits(s, 0);
     lpvp_parser_init(&c->parser, &lim);
     if (uv_accept(server, &c->h.stream) != 0) {
         sv_conn_close(c);
@@ -395,13 +447,16 @@ static void on_connection(uv_stream_t *server, int status)
     } else {
         snprintf(c->peer, sizeof c->peer, "unix");
     }
-    c->last_rx_ms = sv_now_ms();
+    c->last_rx_ms = c->accepted_ms = sv_now_ms();
     sv_session_init(c);
-    if (active_clients(s, c) >= s->cfg.max_clients)
+    /* R4.1a: connections that have not said HELLO have their own small
+     * quota and never take a --max-clients slot */
+    if (active_clients(s, c, 0) >= s->cfg.max_preauth)
         reap_gone(s, c);
-    if (active_clients(s, c) >= s->cfg.max_clients) {
-        sv_send_error(c, 0, LPVP_E_LIMIT, "too many clients: the server accepts at most %d (--max-clients)",
-                      s->cfg.max_clients);
+    if (active_clients(s, c, 0) >= s->cfg.max_preauth) {
+        sv_send_error(c, 0, LPVP_E_LIMIT,
+                      "too many connections waiting for HELLO: the server accepts at most %d (--max-preauth)",
+                      s->cfg.max_preauth);
         sv_conn_close_after_write(c);
         return;
     }
@@ -409,6 +464,19 @@ static void on_connection(uv_stream_t *server, int status)
         c->reading = 1;
     else
         sv_conn_close(c);
+}
+
+int sv_net_admit_session(sv_conn *c, uint32_t request_id)
+{
+    sv_server *s = c->srv;
+    if (active_clients(s, c, 1) >= s->cfg.max_clients)
+        reap_gone(s, c);
+    if (active_clients(s, c, 1) < s->cfg.max_clients)
+        return 0;
+    sv_send_error(c, request_id, LPVP_E_LIMIT, "too many clients: the server accepts at most %d (--max-clients)",
+                  s->cfg.max_clients);
+    sv_conn_close_after_write(c);
+    return -1;
 }
 
 /* ---- listeners ---------------------------------------------------------- */

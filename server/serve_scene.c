@@ -280,6 +280,7 @@ static void load_done(uv_work_t *req, int status)
     free(w->base_dir);
     free(w->nodes);
     c->busy = 0;
+    sv_session_work_end(c);
     free(w);
     sv_session_pump(c);
     sv_conn_unref(c);
@@ -296,6 +297,7 @@ static int start_load(sv_conn *c, load_work *w)
         c->refs--;
         return -1;
     }
+    sv_session_work_begin(c, w->request_id);
     return 0;
 }
 

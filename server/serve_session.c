@@ -25,7 +25,9 @@ void sv_reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *f
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     sv_send(c, LPVP_ERROR, rid, lpvp_error_body(code, "%s", msg), NULL, 0, SV_STREAM_NONE);
-    if (!noclose && lpvp_error_closes(code))
+    /* SHUTTING_DOWN closes, but not yet: the requests queued behind this one
+     * get their own, then BYE (sv_session_shutdown closes, R7.4) */
+    if (!noclose && lpvp_error_closes(code) && code != LPVP_E_SHUTTING_DOWN)
         sv_conn_close_after_write(c);
 }
 
@@ -164,6 +166,35 @@ void sv_session_free(sv_conn *c)
     c->lights = NULL;
     for (int i = 0; i < 2; ++i)
         sv_sub_clear(&c->subs[i]);
+}
+
+/* ---- requests on worker threads, and shutdown ------------------------------ */
+void sv_session_work_begin(sv_conn *c, uint32_t request_id)
+{
+    c->work_inflight = 1;
+    c->work_request_id = request_id;
+    c->srv->works_inflight++;
+}
+
+void sv_session_work_end(sv_conn *c)
+{
+    c->work_inflight = 0;
+    c->srv->works_inflight--;
+}
+
+void sv_session_shutdown(sv_conn *c)
+{
+    if (c->closing || c->close_after_write)
+        return;
+    /* A load on a worker cannot be stopped: it is answered now and its
+     * result dropped when it ends (the connection is closing by then). */
+    if (c->work_inflight)
+        sv_reply_err(c, c->work_request_id, LPVP_E_SHUTTING_DOWN, 1, "the server is stopping");
+    for (sv_request *r = c->pending_head; r; r = r->next)
+        if (lpvp_type_has_reply(r->type))
+            sv_reply_err(c, r->request_id, LPVP_E_SHUTTING_DOWN, 1, "the server is stopping");
+    sv_send(c, LPVP_BYE_REPLY, 0, json_object(), NULL, 0, SV_STREAM_NONE);
+    sv_conn_close_after_write(c);
 }
 
 /* ---- dispatch ---------------------------------------------------------------- */

@@ -7,7 +7,8 @@
 # temporary Unix socket through tests/reliability/harness.py, which also
 # guarantees the daemon is stopped and its files removed. `conformance` adds
 # TCP on 127.0.0.1 (a free port) with a token file, a scene root, a 4 s idle
-# timeout and --max-triangles 2000 (so R4.5 can aim just above it), and writes JUnit XML to <build>/tests/conformance.xml.
+# timeout, a 3 s handshake deadline (R4.1a) and --max-triangles 2000 (so R4.5
+# can aim just above it), and writes JUnit XML to <build>/tests/conformance.xml.
 # Pure Python 3 standard library; no network beyond loopback.
 
 if(NOT LPVD_SERVE_TESTS_PYTHON)
@@ -28,13 +29,14 @@ add_test(NAME conformance
   COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_harness}"
           --lpvd "$<TARGET_FILE:lpvd>" --tcp --token --scene-root --idle-timeout 4
           --daemon-arg=--max-triangles --daemon-arg=2000
+          --daemon-arg=--handshake-timeout --daemon-arg=3
           --
           "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_conformance}"
           --unix "{unix}" --tcp "{tcp}" --token "{token}" --scene-root "{scene_root}" --idle-timeout 4
           --junit "${CMAKE_CURRENT_BINARY_DIR}/conformance.xml")
 
 set(_lpvd_serve_tests conformance)
-foreach(_name midmessage slow_reader churn sigterm sighup fifo)
+foreach(_name midmessage slow_reader churn sigterm sighup fifo preauth sigterm_load)
   add_test(NAME reliability_${_name}
     COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_serve_dir}/reliability/${_name}.py" --lpvd "$<TARGET_FILE:lpvd>")
   list(APPEND _lpvd_serve_tests reliability_${_name})
@@ -43,5 +45,7 @@ endforeach()
 set_tests_properties(${_lpvd_serve_tests} PROPERTIES
   TIMEOUT 300
   ENVIRONMENT "LPVD_SHARED_DIR=${_lpvd_serve_root}/../shared;LPVD_SOURCE_DIR=${_lpvd_serve_root};PYTHONDONTWRITEBYTECODE=1")
-# Latency and memory bounds: do not share the two cores with other tests.
-set_tests_properties(reliability_slow_reader reliability_churn PROPERTIES RUN_SERIAL TRUE)
+# Latency and memory bounds: do not share the two cores with other tests
+# (sigterm_load's daemon parses a 144 MB scene).
+set_tests_properties(reliability_slow_reader reliability_churn reliability_preauth reliability_sigterm_load
+  PROPERTIES RUN_SERIAL TRUE)

@@ -150,7 +150,7 @@ static void test_header_errors(void **state)
     uint8_t b[24];
     lpvp_header h;
     int code = -1;
-    lpvp_limits lim = {100, 1000};
+    lpvp_limits lim = {100, 1000, 0};
 
     make_header(b, "LPVX", 1, 1, 7, 0, 2, 0);
     expect_header_error(b, NULL, LPVP_E_BAD_MAGIC, 0); /* R2.2: request_id 0 */
@@ -510,11 +510,32 @@ static void test_parser_hostile(void **state)
 
     /* Custom limits reach the parser. */
     {
-        lpvp_limits lim = {16, 64};
+        lpvp_limits lim = {16, 64, 0};
         make_header(b, "LPVD", 1, 3, 5, 0, 17, 0);
         lpvp_parser_init(&p, &lim);
         assert_int_equal(lpvp_parser_feed(&p, b, 24, &used, &f), LPVP_PARSE_ERROR);
         assert_int_equal(p.error_code, LPVP_E_TOO_LARGE);
+        lpvp_parser_free(&p);
+    }
+
+    /* R2.5a: with no_attachment (a server before HELLO) any attachment is
+     * refused from the header alone, however small; a frame without one
+     * passes. */
+    {
+        lpvp_limits lim = {4096, 4096, 1};
+        make_header(b, "LPVD", 1, 1, 6, 0, 2, 1);
+        lpvp_parser_init(&p, &lim);
+        assert_int_equal(lpvp_parser_feed(&p, b, 24, &used, &f), LPVP_PARSE_ERROR);
+        assert_int_equal(used, 24);
+        assert_int_equal(p.error_code, LPVP_E_TOO_LARGE);
+        assert_int_equal(p.error_request_id, 6);
+        assert_non_null(strstr(p.error_message, "attachment_length 1"));
+        lpvp_parser_free(&p);
+        uint8_t fr[26];
+        make_header(fr, "LPVD", 1, 1, 7, 0, 2, 0);
+        memcpy(fr + 24, "{}", 2);
+        lpvp_parser_init(&p, &lim);
+        assert_int_equal(lpvp_parser_feed(&p, fr, sizeof fr, &used, &f), LPVP_PARSE_FRAME);
         lpvp_parser_free(&p);
     }
 

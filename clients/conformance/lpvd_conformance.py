@@ -840,6 +840,29 @@ def c_too_large_message(ctx):
     return "TOO_LARGE, closed"
 
 
+@case("R2.5a", "before HELLO a frame with any attachment, or JSON over limits.max_preauth_body, gets TOO_LARGE "
+      "from the header alone, then close")
+def c_preauth_too_large(ctx):
+    lim = (ctx.limits or {}).get("max_preauth_body")
+    if not isinstance(lim, int):
+        raise Skip("HELLO limits advertise no max_preauth_body (R2.5a is a MAY)")
+    for jl, al, what in ((2, 1, "a 1-byte attachment"), (2, 0xFFFFFFF0, "attachment_length 0xFFFFFFF0"),
+                         (lim + 1, 0, "json_length %d" % (lim + 1))):
+        c = ctx.connect()
+        c.send_raw(HEADER.pack(MAGIC, VERSION, HELLO, 56, 0, jl, al))  # the header alone
+        try:
+            f = c.recv_reply(timeout=5)
+        except socket.timeout:
+            raise Fail("%s before HELLO: no reply within 5 s of the header alone" % what)
+        except Closed:
+            raise Fail("%s before HELLO: closed without ERROR TOO_LARGE" % what)
+        expect_error(f, "TOO_LARGE", 56)
+        check(str(lim) in f.body.get("message", ""), "%s: the message names no limit %d: %r"
+              % (what, lim, f.body.get("message")))
+        check(c.expect_closed(), "%s: connection not closed after TOO_LARGE" % what)
+    return "refused at the header (max_preauth_body %d)" % lim
+
+
 @case("R2.6", "connections closing mid-frame are dropped; the server keeps serving")
 def c_truncated(ctx):
     cuts = [
@@ -2639,6 +2662,56 @@ def c_idle(ctx):
     check(dt >= ctx.args.idle_timeout * 0.8, "BYE after %.1f s, before the idle timeout %g s" % (dt, ctx.args.idle_timeout))
     check(c.expect_closed(), "connection not closed after the idle BYE")
     return "BYE after %.1f s, closed" % dt
+
+
+@case("R4.9", "bytes of a frame never completed do not keep a session alive: BYE after the idle timeout")
+def c_idle_partial_frame(ctx):
+    if not ctx.args.idle_timeout:
+        raise Skip("no --idle-timeout given")
+    c = ctx.session()
+    data = encode_frame(STATS, 3, {"pad": "p" * 200})
+    t0 = time.monotonic()
+    bound = ctx.args.idle_timeout * 3 + 5
+    f = None
+    for i in range(len(data) - 1):  # never the last byte
+        if time.monotonic() - t0 > bound:
+            break
+        c.send_raw(data[i:i + 1])
+        try:
+            f = c.recv_reply(timeout=0.25)
+            break
+        except socket.timeout:
+            continue
+        except Closed:
+            raise Fail("closed without BYE after %.1f s" % (time.monotonic() - t0))
+    dt = time.monotonic() - t0
+    if f is None:
+        raise Fail("no BYE within %.0f s while trickling a frame (idle timeout %g s)" % (dt, ctx.args.idle_timeout))
+    check(f.type == BYE_REPLY and f.rid == 0, "expected BYE 0x800F request_id 0, got %r" % f)
+    check(c.expect_closed(), "connection not closed after the idle BYE")
+    return "BYE after %.1f s of trickling" % dt
+
+
+@case("R4.1a", "a connection that says no HELLO gets ERROR LIMIT when limits.handshake_timeout passes, then close")
+def c_handshake_deadline(ctx):
+    t = (ctx.limits or {}).get("handshake_timeout")
+    if not isinstance(t, (int, float)) or t <= 0:
+        raise Skip("HELLO limits advertise no handshake_timeout")
+    if t > 15:
+        raise Skip("handshake_timeout %g s is too long to wait for here" % t)
+    c = ctx.connect()
+    t0 = time.monotonic()
+    try:
+        f = c.recv_reply(timeout=t * 3 + 5)
+    except socket.timeout:
+        raise Fail("still open %.0f s after connecting (handshake_timeout %g s)" % (time.monotonic() - t0, t))
+    except Closed:
+        raise Fail("closed without ERROR LIMIT")
+    dt = time.monotonic() - t0
+    expect_error(f, "LIMIT", 0)
+    check(dt >= t * 0.8, "LIMIT after %.1f s, before the handshake_timeout %g s" % (dt, t))
+    check(c.expect_closed(), "connection not closed after the handshake LIMIT")
+    return "LIMIT after %.1f s (handshake_timeout %g s), closed" % (dt, t)
 
 
 @case("R4.5", "a scene over the triangle limit gets LIMIT; one at the limit loads")

@@ -91,7 +91,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     uint8_t chunks[8] = {0};
     size_t nc = size < 8 ? size : 8, off, k = 0;
     lpvp_parser p;
-    lpvp_limits lim = {4096, 1 << 16}; /* small limits to reach TOO_LARGE too */
+    lpvp_limits lim = {4096, 1 << 16, 0}; /* small limits to reach TOO_LARGE too */
 
     memcpy(chunks, data, nc);
     data += nc;
