@@ -219,6 +219,11 @@ static size_t payload_len(const lpvp_header *h)
     return (size_t)h->json_length + (size_t)h->attachment_length;
 }
 
+uint64_t lpvp_parser_frame_payload(const lpvp_parser *p)
+{
+    return !p->failed && p->hdr_have == LPVP_HEADER_SIZE ? payload_len(&p->header) : 0;
+}
+
 static void fill_frame(lpvp_frame *f, const lpvp_header *h, const uint8_t *payload)
 {
     f->header = *h;
@@ -258,6 +263,14 @@ int lpvp_parser_feed(lpvp_parser *p, const void *data, size_t len, size_t *consu
     *consumed = 0;
     if (p->failed)
         return LPVP_PARSE_ERROR;
+    /* Between frames a connection holds no more than 1 MiB: a buffer that
+     * assembled a 256 MiB upload is not kept (the frame it backed was valid
+     * only until this call). */
+    if (p->hdr_have == 0 && p->buf_cap > ((size_t)1 << 20)) {
+        free(p->buf);
+        p->buf = NULL;
+        p->buf_cap = 0;
+    }
 
     while (used < len) { /* a payload is never empty (json_length >= 2) */
         if (p->hdr_have < LPVP_HEADER_SIZE) {

@@ -253,6 +253,11 @@ int lpvp_parser_feed(lpvp_parser *p, const void *data, size_t len, size_t *consu
  * would be closing mid-frame, R2.6). */
 int lpvp_parser_mid_frame(const lpvp_parser *p);
 
+/* The payload bytes (json + attachment) its header declared, of the frame
+ * whose header was accepted and whose payload has not all arrived yet; 0
+ * between frames. A server can reserve memory for it before reading on. */
+uint64_t lpvp_parser_frame_payload(const lpvp_parser *p);
+
 /* Frees the buffer; the parser may be lpvp_parser_init'ed again. */
 void lpvp_parser_free(lpvp_parser *p);
 

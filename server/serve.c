@@ -47,6 +47,8 @@ static void usage(FILE *f)
             "  --max-message BYTES     json + attachment of one message (default 268435456)\n"
             "  --max-body BYTES        json of one message (default 1048576)\n"
             "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
+            "  --max-request-memory BYTES  request bytes held for all clients together; a frame that does not\n"
+            "                          fit waits, unread (default %llu, at least --max-message)\n"
             "  --max-triangles N       per scene (default 10000000)\n"
             "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
@@ -61,7 +63,7 @@ static void usage(FILE *f)
             "Default CONFIG of every session:\n"
             "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
             "%s",
-            SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT, SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
+            (unsigned long long)SV_DEFAULT_MAX_REQUEST_MEMORY, SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT, SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
 }
 
 static int parse_u64(const char *v, uint64_t lo, uint64_t hi, uint64_t *out)
@@ -344,7 +346,7 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", "max-preauth-body",
+    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory",
     "handshake-timeout", "max-preauth", NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
@@ -356,6 +358,7 @@ int lpvd_cmd_serve(int argc, char **argv)
     cfg->max_body = LPVP_DEFAULT_MAX_BODY;
     cfg->max_message = LPVP_DEFAULT_MAX_MESSAGE;
     cfg->max_queue = 64u << 20;
+    cfg->max_request_memory = SV_DEFAULT_MAX_REQUEST_MEMORY;
     cfg->max_clients = 64;
     cfg->max_triangles = 10000000;
     cfg->max_texture = 8192;
@@ -470,6 +473,9 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "handshake-timeout")) {
             bad = parse_num(v, 0.0, 1e9, &d);
             cfg->handshake_timeout = d;
+        } else if (!strcmp(name, "max-request-memory")) {
+            bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
+            cfg->max_request_memory = u;
         } else if (!strcmp(name, "max-preauth")) {
             bad = parse_u64(v, 1, 100000, &u);
             cfg->max_preauth = (int)u;
@@ -484,6 +490,11 @@ int lpvd_cmd_serve(int argc, char **argv)
     }
     if (cfg->max_body > cfg->max_message)
         cfg->max_body = cfg->max_message;
+    if (cfg->max_request_memory < cfg->max_message) { /* else the largest message could never be read */
+        fprintf(stderr, "lpvd serve: --max-request-memory %llu is under --max-message %llu\n",
+                (unsigned long long)cfg->max_request_memory, (unsigned long long)cfg->max_message);
+        return 2;
+    }
     if (cfg->tick_rate > cfg->max_tick_rate) {
         fprintf(stderr, "lpvd serve: --tick-rate %g is over --max-tick-rate %g\n", cfg->tick_rate,
                 cfg->max_tick_rate);

@@ -61,6 +61,7 @@ typedef struct sv_config {
     uint64_t max_body;       /* bytes of JSON, default 1 MiB */
     uint64_t max_message;    /* json + attachment, default 256 MiB */
     uint64_t max_queue;      /* bytes queued for writing per connection */
+    uint64_t max_request_memory; /* request bytes held, all connections (R7.5); >= max_message */
     int max_clients;
     uint64_t max_triangles;
     int max_texture;
@@ -81,6 +82,7 @@ typedef struct sv_config {
 } sv_config;
 
 #define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
+#define SV_DEFAULT_MAX_REQUEST_MEMORY ((uint64_t)1 << 30)
 #define SV_DEFAULT_HANDSHAKE_TIMEOUT 10.0
 #define SV_DEFAULT_MAX_PREAUTH 16
 /* Reply bytes a connection may have queued before HELLO: its replies are a
@@ -294,6 +296,8 @@ struct sv_conn {
     uint64_t close_deadline_ms;
     sv_request *pending_head, *pending_tail;
     size_t pending_count, pending_bytes;
+    uint64_t reserved;      /* payload of the frame being read, held against --max-request-memory */
+    uint64_t wait_memory;   /* reading stopped until that reservation fits (R7.5): its turn, 0 = not waiting */
     int busy;               /* a request is being processed asynchronously */
     int work_inflight;      /* that request runs on a libuv worker (a scene load): it cannot be cancelled */
     uint32_t work_request_id;
@@ -342,6 +346,8 @@ struct sv_server {
     int works_inflight;     /* requests running on libuv workers, all sessions */
     sv_conn *conns;
     int conn_count;
+    uint64_t request_bytes; /* reserved + pending request bytes of every connection (R7.5) */
+    uint64_t memory_waits;  /* turns handed out to connections waiting for request memory */
     uint64_t next_conn_id;
     sv_world *worlds;
     int world_count;
@@ -387,6 +393,9 @@ void sv_conn_close(sv_conn *c);
 void sv_conn_close_after_write(sv_conn *c);
 void sv_conn_unref(sv_conn *c);
 void sv_net_resume_reading(sv_conn *c);
+/* A pending request of c (bytes = json + attachment) is taken to be handled:
+ * its bytes leave --max-request-memory and waiting connections may go on. */
+void sv_net_request_handled(sv_conn *c, uint64_t bytes);
 /* A HELLO that passed the version and token checks: admits c as one of
  * --max-clients sessions (0), or sends ERROR LIMIT for request_id, closes c
  * and returns -1 (R4.1a). */

@@ -10,6 +10,14 @@
  * FRAME) keep at most one frame in flight and one unsent per stream, a newer
  * one replacing the unsent older one (SPEC R5.5).
  *
+ * Memory (SPEC R7.5): every connection's requests together hold at most
+ * --max-request-memory bytes. A frame's payload is reserved once its header
+ * is in; a connection whose frame does not fit stops being read (it holds
+ * the header and at most one read buffer) until handled requests free
+ * enough. A reserved frame is always read to its end, so reservations never
+ * wait on each other: memory is freed by requests being handled, or by
+ * connections closing (a trickling one at --idle-timeout).
+ *
  * Before HELLO (SPEC R2.5a, R4.1a) a connection is held to the pre-auth
  * limits: frames of at most --max-preauth-body bytes of JSON and no
  * attachment (refused from the header, before the body is read), each frame
@@ -62,6 +70,10 @@ void sv_conn_unref(sv_conn *c)
     free(c);
 }
 
+/* Requests of c handled or dropped: their bytes leave the budget, and
+ * connections waiting for memory are reserved for and resumed in order. */
+static void release_request_bytes(sv_conn *c, uint64_t bytes);
+
 static void free_pending_requests(sv_conn *c)
 {
     sv_request *r = c->pending_head;
@@ -74,7 +86,11 @@ static void free_pending_requests(sv_conn *c)
     }
     c->pending_head = c->pending_tail = NULL;
     c->pending_count = 0;
+    uint64_t held = c->pending_bytes + c->reserved;
     c->pending_bytes = 0;
+    c->reserved = 0;
+    c->wait_memory = 0;
+    release_request_bytes(c, held);
 }
 
 static void on_closed(uv_handle_t *h)
@@ -306,7 +322,49 @@ static int enqueue_frame(sv_conn *c, const lpvp_frame *f)
     c->pending_tail = r;
     c->pending_count++;
     c->pending_bytes += r->json_len + r->att_len;
+    /* the reservation, if the frame had one, becomes the pending request */
+    c->srv->request_bytes += r->json_len + r->att_len - c->reserved;
+    c->reserved = 0;
     return 0;
+}
+
+/* Reserves the payload of the frame whose header has just been accepted
+ * (R7.5). Returns 0 when c may read on, 1 when it must wait for memory. */
+static int reserve_frame(sv_conn *c)
+{
+    sv_server *s = c->srv;
+    uint64_t need = lpvp_parser_frame_payload(&c->parser);
+    if (need == 0 || c->reserved)
+        return 0;
+    if (s->request_bytes + need > s->cfg.max_request_memory)
+        return 1;
+    c->reserved = need;
+    s->request_bytes += need;
+    return 0;
+}
+
+static void release_request_bytes(sv_conn *c, uint64_t bytes)
+{
+    sv_server *s = c->srv;
+    s->request_bytes -= bytes < s->request_bytes ? bytes : s->request_bytes;
+    /* first come, first served: a big frame waiting is not overtaken by smaller ones behind it */
+    for (;;) {
+        sv_conn *first = NULL;
+        for (sv_conn *w = s->conns; w; w = w->next)
+            if (w->wait_memory && !w->closing && !w->close_after_write &&
+                (!first || w->wait_memory < first->wait_memory))
+                first = w;
+        if (!first || reserve_frame(first) != 0)
+            return;
+        first->wait_memory = 0;
+        sv_net_resume_reading(first);
+    }
+}
+
+void sv_net_request_handled(sv_conn *c, uint64_t bytes)
+{
+    c->pending_bytes -= bytes;
+    release_request_bytes(c, bytes);
 }
 
 static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
@@ -326,6 +384,8 @@ static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
         lpvp_frame f;
         int stt = lpvp_parser_feed(&c->parser, buf->base + off, len - off, &used, &f);
         off += used;
+        if (stt == LPVP_PARSE_NEED_MORE && reserve_frame(c) != 0)
+            c->wait_memory = ++c->srv->memory_waits; /* all of this read is in the parser: stop reading below */
         if (stt == LPVP_PARSE_FRAME) {
             c->last_rx_ms = sv_now_ms(); /* R4.9: idle counts from the last complete frame */
             if (enqueue_frame(c, &f) != 0) {
@@ -356,7 +416,7 @@ static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
         }
     }
     if (!c->closing && !c->close_after_write) {
-        if (c->pending_count >= SV_MAX_PENDING || c->pending_bytes >= SV_MAX_PENDING_BYTES) {
+        if (c->wait_memory || c->pending_count >= SV_MAX_PENDING || c->pending_bytes >= SV_MAX_PENDING_BYTES) {
             uv_read_stop(&c->h.stream);
             c->reading = 0;
         }
@@ -367,7 +427,7 @@ static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
 
 void sv_net_resume_reading(sv_conn *c)
 {
-    if (c->closing || c->close_after_write || c->reading || c->srv->stopping)
+    if (c->closing || c->close_after_write || c->reading || c->srv->stopping || c->wait_memory)
         return;
     if (c->pending_count < SV_MAX_PENDING / 2 && c->pending_bytes < SV_MAX_PENDING_BYTES / 2) {
         if (uv_read_start(&c->h.stream, on_alloc, on_read) == 0)

@@ -261,6 +261,8 @@ void sv_do_stats(sv_conn *c, sv_request *r)
         (json_int_t)c->bytes_sent, "ticks", (json_int_t)s->ticks, "world_ticks",
         (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
         "revision", (json_int_t)c->revision);
+    /* R7.5: request bytes held for all connections, against --max-request-memory */
+    json_object_set_new(json_object_get(b, "queues"), "request_bytes", json_integer((json_int_t)s->request_bytes));
     /* tick coalescing (R7.2): computed ticks vs TICK requests answered by a tick queued for another */
     json_object_set_new(b, "ticks_computed", json_integer((json_int_t)s->ticks));
     json_object_set_new(b, "ticks_coalesced", json_integer((json_int_t)s->ticks_coalesced));

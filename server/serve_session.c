@@ -258,7 +258,7 @@ void sv_session_pump(sv_conn *c)
         if (!c->pending_head)
             c->pending_tail = NULL;
         c->pending_count--;
-        c->pending_bytes -= r->json_len + r->att_len;
+        sv_net_request_handled(c, r->json_len + r->att_len);
         dispatch(c, r);
         free(r->json);
         free(r->att);

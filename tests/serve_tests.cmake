@@ -36,7 +36,7 @@ add_test(NAME conformance
           --junit "${CMAKE_CURRENT_BINARY_DIR}/conformance.xml")
 
 set(_lpvd_serve_tests conformance)
-foreach(_name midmessage slow_reader churn sigterm sighup fifo preauth sigterm_load)
+foreach(_name midmessage slow_reader churn sigterm sighup fifo preauth sigterm_load request_memory)
   add_test(NAME reliability_${_name}
     COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_serve_dir}/reliability/${_name}.py" --lpvd "$<TARGET_FILE:lpvd>")
   list(APPEND _lpvd_serve_tests reliability_${_name})
@@ -47,5 +47,5 @@ set_tests_properties(${_lpvd_serve_tests} PROPERTIES
   ENVIRONMENT "LPVD_SHARED_DIR=${_lpvd_serve_root}/../shared;LPVD_SOURCE_DIR=${_lpvd_serve_root};PYTHONDONTWRITEBYTECODE=1")
 # Latency and memory bounds: do not share the two cores with other tests
 # (sigterm_load's daemon parses a 144 MB scene).
-set_tests_properties(reliability_slow_reader reliability_churn reliability_preauth reliability_sigterm_load
+set_tests_properties(reliability_slow_reader reliability_churn reliability_preauth reliability_sigterm_load reliability_request_memory
   PROPERTIES RUN_SERIAL TRUE)
