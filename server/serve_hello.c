@@ -64,6 +64,10 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
                             "max_triangles", (json_int_t)s->cfg.max_triangles, "max_texture", s->cfg.max_texture,
                             "max_grid", s->cfg.max_grid, "max_tick_rate", s->cfg.max_tick_rate, "idle_timeout",
                             s->cfg.idle_timeout, "max_queue", (json_int_t)s->cfg.max_queue);
+    if (lim) { /* the per-scene budgets (R4.5) */
+        json_object_set_new(lim, "max_scene_texels", json_integer((json_int_t)s->cfg.max_scene_texels));
+        json_object_set_new(lim, "max_scene_bytes", json_integer((json_int_t)s->cfg.max_scene_bytes));
+    }
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);
