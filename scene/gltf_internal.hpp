@@ -122,9 +122,14 @@ bool check_container(const unsigned char *data, size_t size, size_t *json_off, s
  * its JSON rewritten (a .glb's BIN chunk kept) and true is returned. */
 bool tinygltf_compat_file(const unsigned char *data, size_t size, bool is_glb, size_t json_off, size_t json_len,
                           std::vector<unsigned char> *rewritten);
-/* tinygltf's image callback (user data: the Ctx). */
+/* tinygltf's image callback (user data: the Ctx): sizes from the headers,
+ * counted against the budgets; the bytes are kept encoded (component 0). */
 bool image_loader(tinygltf::Image *image, const int image_idx, std::string *err, std::string *warn, int req_width,
                   int req_height, const unsigned char *bytes, int size, void *user);
+/* Decodes every image image_loader kept to RGBA8; an undecodable one fails. */
+void decode_images(tinygltf::Model &model);
+/* tinygltf's messages as one line, without the names it quotes from the file. */
+std::string tinygltf_text(const std::string &s);
 
 /* ---- transforms (gltf_transform.cpp; column-major, like glTF) --------------- */
 struct Mat4 {

@@ -115,7 +115,7 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     if (!ctx.image_error.empty())
         fail("%s", ctx.image_error.c_str());
     if (!ok) {
-        std::string t = one_line(terr);
+        std::string t = tinygltf_text(terr);
         if (!ctx.missing.empty())
             fail("%s (missing buffer or image; tinygltf: %s)", ctx.missing.c_str(), t.c_str());
         fail("glTF rejected by tinygltf: %s", t.empty() ? "unknown error" : t.c_str());
@@ -123,9 +123,10 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     if (!ctx.missing.empty())
         ctx.warn(ctx.missing + "; that image is ignored");
     if (!terr.empty())
-        ctx.warn("tinygltf: " + one_line(terr));
+        ctx.warn("tinygltf: " + tinygltf_text(terr));
     if (!twarn.empty())
-        ctx.warn("tinygltf: " + one_line(twarn));
+        ctx.warn("tinygltf: " + tinygltf_text(twarn));
+    decode_images(model); /* every image counted and within the budgets: now decoded */
 
     apply_node_overrides(model, ctx.overrides, ctx.override_count);
 

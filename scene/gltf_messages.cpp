@@ -91,6 +91,27 @@ std::string show(const std::string &s)
     return ident ? "\"" + s + "\"" : strf("(a %zu-byte name that is not an identifier, not shown)", s.size());
 }
 
+std::string tinygltf_text(const std::string &s)
+{
+    std::string out, line;
+    auto flush = [&]() {
+        size_t cut = line.find(" name = "); /* tinygltf quotes an object's name from the file there */
+        if (cut != std::string::npos)
+            line.resize(cut);
+        if (!line.empty())
+            out += (out.empty() ? "" : "; ") + line;
+        line.clear();
+    };
+    for (char c : s) {
+        if (c == '\n' || c == '\r')
+            flush();
+        else
+            line += c;
+    }
+    flush();
+    return out;
+}
+
 void Ctx::warn(const std::string &w)
 {
     if (std::find(warnings.begin(), warnings.end(), w) != warnings.end())
