@@ -356,18 +356,18 @@ static int start_load(sv_conn *c, load_work *w)
     return 0;
 }
 
-/* R4.3, the checks that need no file system: a root, a path, relative, no
+/* R4.3, the checks that need no file system: a path, a root, relative, no
  * ".." (the open itself refuses links: read_scene_file). 0, or the error
  * code with its message. */
 static int check_scene_path(sv_server *s, const char *p, char *err, size_t n)
 {
-    if (s->root_fd < 0) {
-        snprintf(err, n, "path %s: this server has no --scene-root; send the .glb as an attachment", p);
-        return LPVP_E_PATH_REFUSED;
-    }
     if (!p[0]) {
         snprintf(err, n, "path: empty; give a file's path relative to the scene root");
         return LPVP_E_BAD_FIELD;
+    }
+    if (s->root_fd < 0) {
+        snprintf(err, n, "path %s: this server has no --scene-root; send the .glb as an attachment", p);
+        return LPVP_E_PATH_REFUSED;
     }
     if (p[0] == '/') {
         snprintf(err, n, "path %s: absolute paths are refused; give a path relative to the scene root", p);
