@@ -161,8 +161,8 @@ static void load_run(uv_work_t *req)
                   : w->base_dir[0] == '/' ? open(w->base_dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC)
                                           : lpv_open_beneath(w->root_fd, w->base_dir, O_RDONLY | O_DIRECTORY);
     if (w->base_dir && base_fd < 0) {
-        snprintf(w->err, sizeof w->err, "the scene's folder %s under the scene root: %s", w->base_dir,
-                 strerror(errno));
+        /* not named: for the operator's --scene it is an absolute path of the machine */
+        snprintf(w->err, sizeof w->err, "the scene's folder (for its external files): %s", strerror(errno));
         w->status = LPVP_E_SCENE_INVALID;
         return;
     }
