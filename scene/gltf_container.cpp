@@ -53,7 +53,12 @@ struct JsonScan : nlohmann::json_sax<nlohmann::json> {
     }
     bool parse_error(std::size_t, const std::string &, const nlohmann::detail::exception &ex) override
     {
+        /* nlohmann's message ends with "; last read: '<the file's bytes>'...":
+         * cut there, so that no message quotes the file */
         error = ex.what();
+        size_t cut = error.find("; last read:");
+        if (cut != std::string::npos)
+            error.resize(cut);
         return false;
     }
 };
@@ -137,8 +142,7 @@ bool check_container(const unsigned char *data, size_t size, size_t *json_off, s
     if (!is_glb && !is_json) {
         if (size < 4 && memcmp(data, "glTF", size) == 0)
             fail("truncated .glb: %zu bytes, shorter than the 12-byte header", size);
-        fail("wrong magic: neither a .glb ('glTF' header) nor a JSON .gltf (first bytes %02x %02x %02x %02x)",
-             data[0], size > 1 ? data[1] : 0, size > 2 ? data[2] : 0, size > 3 ? data[3] : 0);
+        fail("wrong magic: neither a .glb (a 'glTF' header) nor a JSON .gltf (a '{' first)");
     }
 
     *json_off = 0;

@@ -1,10 +1,15 @@
 /*
  * gltf_files.cpp - every file a glTF load reads (gltf_internal.hpp): the main
  * file, and the external URIs tinygltf asks for through our FsCallbacks, which
- * refuse ".." components, absolute paths and anything whose realpath leaves
- * the scene's folder before a single byte is read.
+ * refuse ".." components and absolute paths, and open the rest beneath the
+ * scene's folder descriptor with no symbolic link on the way, in one step
+ * (core/open_beneath.h): nothing outside the folder is ever opened.
  */
 #include "gltf_internal.hpp"
+
+extern "C" {
+#include "open_beneath.h"
+}
 
 #include <cerrno>
 #include <cstdlib>
@@ -36,29 +41,22 @@ size_t read_fully(int fd, unsigned char *p, size_t size, int *read_errno)
     return got;
 }
 
-bool inside_root(const std::string &root, const std::string &p)
-{
-    if (root == "/")
-        return p.size() > 1 && p[0] == '/';
-    return p.size() > root.size() + 1 && p.compare(0, root.size(), root) == 0 && p[root.size()] == '/';
-}
-
 enum PathCheck { PATH_OK, PATH_REFUSED, PATH_MISSING };
 
-/* Decides whether tinygltf may touch `candidate` (= base_dir joined with the
- * URI, already percent-decoded) and resolves it. Nothing is opened here. */
-PathCheck check_external(Ctx *ctx, const std::string &candidate, std::string *resolved)
+/* Decides whether tinygltf may touch `candidate` (= kBaseTag joined with the
+ * URI, already percent-decoded) and opens it beneath the scene's folder in
+ * the same step (no window for a swap): *fd is the open regular file. */
+PathCheck open_external(Ctx *ctx, const std::string &candidate, int *fd)
 {
+    *fd = -1;
     if (!ctx->allow_external) {
         if (ctx->refusal.empty())
-            ctx->refusal = "external URI " + show(candidate) +
+            ctx->refusal = "external URI " + show_uri(candidate) +
                            " refused: data loaded from memory without a base folder may only use "
                            "data: URIs and the GLB BIN chunk (anything else would be outside)";
         return PATH_REFUSED;
     }
-    std::string prefix = ctx->base_dir;
-    if (prefix.empty() || prefix.back() != '/')
-        prefix += '/';
+    const std::string prefix = std::string(kBaseTag) + "/";
     if (candidate.compare(0, prefix.size(), prefix) != 0) {
         /* tinygltf's second search path, the working directory: never used,
          * and not worth a message (the first path, the folder, has one). */
@@ -72,51 +70,44 @@ PathCheck check_external(Ctx *ctx, const std::string &candidate, std::string *re
     }
     if (rel.find('\0') != std::string::npos) {
         if (ctx->refusal.empty())
-            ctx->refusal = "external URI " + show(rel) + " contains a NUL byte (refused)";
+            ctx->refusal = "external URI " + show_uri(rel) + " contains a NUL byte (refused)";
         return PATH_REFUSED;
     }
     if (rel[0] == '/') {
         if (ctx->refusal.empty())
-            ctx->refusal = "external URI " + show(rel) +
+            ctx->refusal = "external URI " + show_uri(rel) +
                            " is an absolute path, outside the scene's folder (refused)";
         return PATH_REFUSED;
     }
-    size_t start = 0;
-    while (start <= rel.size()) {
-        size_t end = rel.find('/', start);
-        if (end == std::string::npos)
-            end = rel.size();
-        if (rel.compare(start, end - start, "..") == 0 && end - start == 2) {
-            if (ctx->refusal.empty())
-                ctx->refusal = "external URI " + show(rel) +
-                               " leaves the scene's folder through \"..\" (outside; refused)";
-            return PATH_REFUSED;
-        }
-        start = end + 1;
-    }
-    char *real = realpath(candidate.c_str(), nullptr);
-    if (!real) {
-        int e = errno;
-        if (ctx->missing.empty())
-            ctx->missing = "external file " + show(rel) +
-                           (e == ENOENT ? std::string(" not found") : " cannot be resolved: " + std::string(strerror(e)));
-        return PATH_MISSING;
-    }
-    std::string r(real);
-    free(real);
-    if (!inside_root(ctx->root_real, r)) {
+    if (lpv_path_stays_beneath(rel.c_str()) != 0) {
         if (ctx->refusal.empty())
-            ctx->refusal = "external URI " + show(rel) + " resolves to " + show(r) +
-                           ", outside the scene's folder (symbolic link?; refused)";
+            ctx->refusal = "external URI " + show_uri(rel) +
+                           " leaves the scene's folder through \"..\" (outside; refused)";
         return PATH_REFUSED;
     }
-    struct stat st;
-    if (stat(r.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+    int f = lpv_open_beneath(ctx->dir_fd, rel.c_str(), O_RDONLY);
+    if (f < 0) {
+        int e = errno;
+        if (e == ELOOP || e == EXDEV) {
+            if (ctx->refusal.empty())
+                ctx->refusal = "external URI " + show_uri(rel) +
+                               " goes through a symbolic link (refused: links could lead outside the scene's "
+                               "folder)";
+            return PATH_REFUSED;
+        }
         if (ctx->missing.empty())
-            ctx->missing = "external file " + show(rel) + " is not a regular file";
+            ctx->missing = "external file " + show_uri(rel) +
+                           (e == ENOENT ? std::string(" not found") : " cannot be opened: " + std::string(strerror(e)));
         return PATH_MISSING;
     }
-    *resolved = r;
+    struct stat st;
+    if (fstat(f, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(f);
+        if (ctx->missing.empty())
+            ctx->missing = "external file " + show_uri(rel) + " is not a regular file";
+        return PATH_MISSING;
+    }
+    *fd = f;
     return PATH_OK;
 }
 
@@ -127,33 +118,35 @@ std::string fs_expand(const std::string &path, void *)
 
 bool fs_exists(const std::string &path, void *user)
 {
-    std::string resolved;
-    return check_external(static_cast<Ctx *>(user), path, &resolved) == PATH_OK;
+    int fd = -1;
+    if (open_external(static_cast<Ctx *>(user), path, &fd) != PATH_OK)
+        return false;
+    close(fd);
+    return true;
 }
 
 bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
     Ctx *ctx = static_cast<Ctx *>(user);
-    std::string resolved;
-    if (check_external(ctx, path, &resolved) != PATH_OK) {
+    int fd = -1;
+    if (open_external(ctx, path, &fd) != PATH_OK) {
         if (err)
             *err += "refused or missing";
         return false;
     }
-    /* O_NONBLOCK: opening a FIFO would otherwise wait for a writer forever;
-     * fstat below refuses anything but a regular file */
-    int fd = open(resolved.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
-    if (fd < 0) {
-        if (ctx->missing.empty())
-            ctx->missing = "external file " + show(path) + " cannot be opened: " + strerror(errno);
-        return false;
-    }
+    const std::string rel = path.substr(std::string(kBaseTag).size() + 1);
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || uint64_t(st.st_size) > kMaxFileBytes) {
+    if (fstat(fd, &st) != 0 || uint64_t(st.st_size) > kMaxFileBytes) {
         close(fd);
         if (ctx->missing.empty())
-            ctx->missing = "external file " + show(path) + " is not a regular file or larger than " +
-                           std::to_string(kMaxFileBytes) + " bytes";
+            ctx->missing = "external file " + show_uri(rel) + " is larger than " + std::to_string(kMaxFileBytes) +
+                           " bytes";
+        return false;
+    }
+    if (!take_bytes(*ctx, uint64_t(st.st_size))) { /* over the RAM budget: not read (the load fails with LIMIT) */
+        close(fd);
+        if (err)
+            *err += "over the scene's memory budget";
         return false;
     }
     try {
@@ -167,7 +160,7 @@ bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::strin
     close(fd);
     if (got != out->size()) {
         if (ctx->missing.empty())
-            ctx->missing = "external file " + show(path) + " could not be read completely";
+            ctx->missing = "external file " + show_uri(rel) + " could not be read completely";
         out->clear();
         return false;
     }
@@ -182,6 +175,16 @@ bool fs_write(std::string *err, const std::string &, const std::vector<unsigned 
 }
 
 } // namespace
+
+const char *const kBaseTag = "."; /* files show as "./uri" in tinygltf's messages */
+
+bool take_bytes(Ctx &ctx, uint64_t n)
+{
+    ctx.bytes += n;
+    if (ctx.bytes > ctx.max_bytes && !ctx.over)
+        ctx.over = LPV_GLTF_OVER_BYTES;
+    return !ctx.over_budget();
+}
 
 void set_fs_callbacks(tinygltf::TinyGLTF &loader, Ctx *ctx)
 {

@@ -1,8 +1,9 @@
 /*
  * gltf_images.cpp - the images of a glTF file (gltf_internal.hpp): tinygltf's
  * image callback, which checks an image's bufferView range (tinygltf 2.7 does
- * not), reads PNG and JPEG sizes from their headers and refuses absurd ones
- * before decoding, then decodes to RGBA8 with stb, as tinygltf itself would.
+ * not), reads PNG and JPEG sizes from their headers and counts them against
+ * the load's budgets, and only once every image of the file is counted and
+ * within them decodes to RGBA8 with stb (decode_images), as tinygltf would.
  */
 #include "gltf_internal.hpp"
 
@@ -76,15 +77,31 @@ bool refuse(Ctx *ctx, std::string *err, const std::string &problem)
 
 std::string too_large(int image_idx, int w, int h)
 {
-    return strf("image %d is %dx%d texels, over the %dx%d texture limit (absurd size)", image_idx, w, h,
-                kMaxTextureSize, kMaxTextureSize);
+    return strf("image %d is %dx%d texels", image_idx, w, h);
+}
+
+/* The image's size from its header, against the budgets, before anything is
+ * decoded: false when it must not be decoded (over a budget: the load fails
+ * with LIMIT once tinygltf is done, the later images' sizes still summed). */
+bool within_budgets(Ctx *ctx, int image_idx, int w, int h)
+{
+    if ((w > ctx->max_side || h > ctx->max_side) && !ctx->over) {
+        ctx->over = LPV_GLTF_OVER_TEXTURE;
+        ctx->over_what = too_large(image_idx, w, h);
+    }
+    const uint64_t texels = uint64_t(w) * uint64_t(h);
+    ctx->texels += texels;
+    if (ctx->texels > ctx->max_texels && !ctx->over)
+        ctx->over = LPV_GLTF_OVER_TEXELS;
+    return take_bytes(*ctx, 4 * texels);
 }
 
 } // namespace
 
-/* Decodes an image to RGBA8 with stb after checking its size, and checks an
- * image's bufferView range, which tinygltf 2.7 does not. Undecodable images
- * are kept without pixels (a warning; the texture is then ignored). */
+/* Reads an image's size from its header and counts it against the budgets
+ * (Ctx), keeping the encoded bytes for decode_images; checks an image's
+ * bufferView range, which tinygltf 2.7 does not. An image that cannot be read
+ * is a defect of the file (SPEC R4.4), named by its index. */
 bool image_loader(tinygltf::Image *image, const int image_idx, std::string *err, std::string *,
                   int, int, const unsigned char *bytes, int size, void *user)
 {
@@ -113,43 +130,51 @@ bool image_loader(tinygltf::Image *image, const int image_idx, std::string *err,
     int w = 0, h = 0, comp = 0;
     /* Our own reading of PNG and JPEG headers first: stb refuses some large
      * images itself and would make them look merely corrupt. */
-    if (image_header_size(bytes, size_t(size), &w, &h) &&
-        (w < 1 || h < 1 || w > kMaxTextureSize || h > kMaxTextureSize))
-        return refuse(ctx, err, too_large(image_idx, w, h));
-    if (!stbi_info_from_memory(bytes, size, &w, &h, &comp)) {
-        ctx->warn(strf("image %d: unsupported or corrupt image data (%s); texture ignored", image_idx,
-                         stbi_failure_reason() ? stbi_failure_reason() : "unknown"));
-        return true;
-    }
-    if (w < 1 || h < 1 || w > kMaxTextureSize || h > kMaxTextureSize)
-        return refuse(ctx, err, too_large(image_idx, w, h));
-    if (ctx->texels + uint64_t(w) * uint64_t(h) > kMaxTotalTexels)
+    if (!image_header_size(bytes, size_t(size), &w, &h) && !stbi_info_from_memory(bytes, size, &w, &h, &comp))
         return refuse(ctx, err,
-                      strf("image %d: the textures together exceed %llu texels (absurd size)", image_idx,
-                           (unsigned long long)kMaxTotalTexels));
-    int w2 = 0, h2 = 0, comp2 = 0;
-    unsigned char *px = stbi_load_from_memory(bytes, size, &w2, &h2, &comp2, 4);
-    if (!px || w2 != w || h2 != h) {
-        if (px)
-            stbi_image_free(px);
-        ctx->warn(strf("image %d could not be decoded (%s); texture ignored", image_idx,
-                         stbi_failure_reason() ? stbi_failure_reason() : "size changed"));
-        return true;
-    }
-    try {
-        image->image.assign(px, px + size_t(w) * size_t(h) * 4);
-    } catch (...) {
-        stbi_image_free(px);
-        throw;
-    }
-    stbi_image_free(px);
+                      strf("image %d: not a PNG or JPEG that can be read (%s)", image_idx,
+                           stbi_failure_reason() ? stbi_failure_reason() : "unknown format"));
+    if (w < 1 || h < 1)
+        return refuse(ctx, err, strf("image %d: its header gives an empty size %dx%d", image_idx, w, h));
+    if (!within_budgets(ctx, image_idx, w, h))
+        return true; /* the load fails on the budget after tinygltf */
+    /* Kept encoded (component 0) until every image's header has been counted:
+     * decode_images runs only when the whole scene is within its budgets. */
+    image->image.assign(bytes, bytes + size);
     image->width = w;
     image->height = h;
-    image->component = 4;
-    image->bits = 8;
-    image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
-    ctx->texels += uint64_t(w) * uint64_t(h);
+    image->component = 0;
+    image->bits = 0;
     return true;
+}
+
+void decode_images(tinygltf::Model &model)
+{
+    for (size_t i = 0; i < model.images.size(); i++) {
+        tinygltf::Image &img = model.images[i];
+        if (img.component != 0 || img.image.empty())
+            continue; /* no data (a warning already) */
+        int w = 0, h = 0, comp = 0;
+        unsigned char *px =
+            stbi_load_from_memory(img.image.data(), int(img.image.size()), &w, &h, &comp, 4);
+        if (!px || w != img.width || h != img.height) {
+            const char *why = px ? "its size differs from its header's"
+                                 : stbi_failure_reason() ? stbi_failure_reason() : "corrupt data";
+            if (px)
+                stbi_image_free(px);
+            fail("image %zu could not be decoded (%s)", i, why);
+        }
+        try {
+            img.image.assign(px, px + size_t(w) * size_t(h) * 4);
+        } catch (...) {
+            stbi_image_free(px);
+            throw;
+        }
+        stbi_image_free(px);
+        img.component = 4;
+        img.bits = 8;
+        img.pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    }
 }
 
 } // namespace lpv_gltf

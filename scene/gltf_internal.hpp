@@ -48,6 +48,7 @@ constexpr uint64_t kMaxAccessorCount = 3 * kMaxTriangles; /* elements of one acc
 constexpr int kMaxTextureSize = 16384;                    /* texels per side */
 constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 29;   /* 2 GiB of RGBA8 */
 constexpr uint64_t kMaxFileBytes = uint64_t(1) << 30;     /* main file and each external file */
+constexpr uint64_t kMaxSceneBytes = uint64_t(1) << 34;    /* RAM of one load (lpv_gltf_limits.max_bytes) */
 constexpr int kMaxJsonDepth = 256;
 constexpr int kMaxNodeDepth = 64;
 constexpr size_t kMaxWarnings = LPV_GLTF_WARNINGS_MAX;
@@ -55,6 +56,7 @@ constexpr size_t kMaxWarnings = LPV_GLTF_WARNINGS_MAX;
 /* ---- messages (gltf_messages.cpp) ------------------------------------------ */
 struct Failure {
     std::string msg;
+    int code = LPV_GLTF_DEFECT; /* or the LPV_GLTF_OVER_* of the limit that refused the file */
 };
 
 std::string strf(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
@@ -62,20 +64,34 @@ std::string strf(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 [[noreturn]] void fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 /* tinygltf's multi-line messages as one line. */
 std::string one_line(const std::string &s);
-/* Shortens a value taken from the file for a message (and keeps it printable). */
+/* A name taken from the file (an extension, attribute or type name) for a
+ * message: shown only when it is an identifier (letters, digits, '_', at most
+ * 64), else described, so that no message echoes arbitrary file contents. */
 std::string show(const std::string &s);
+/* An external URI as the file gives it, shortened and kept printable: the
+ * one string from the file that messages quote (it names the file at fault). */
+std::string show_uri(const std::string &s);
 
 /* ---- load context, shared with tinygltf's callbacks ------------------------- */
 struct Ctx {
     std::string label;
-    bool allow_external = false; /* false for memory loads without base_dir */
-    std::string base_dir;        /* as handed to tinygltf */
-    std::string root_real;       /* realpath(base_dir) */
+    bool allow_external = false; /* false for memory loads without a base folder */
+    int dir_fd = -1;             /* the scene's folder: external URIs open beneath it (open_beneath.h) */
     std::string refusal;         /* first security refusal: always fatal */
     std::string missing;         /* first external file that could not be read */
-    std::string image_error;     /* fatal image problem (size cap, bad range) */
+    std::string image_error;     /* fatal image problem (undecodable, bad range) */
     const tinygltf::Model *model = nullptr;
-    uint64_t texels = 0;
+    /* Budgets (lpv_gltf_limits, 0 fields replaced by the caps above) and what
+     * the file needs of them so far; once over one, nothing more is read or
+     * decoded but the sizes from the headers are still summed for the message. */
+    int max_side = kMaxTextureSize;
+    uint64_t max_texels = kMaxTotalTexels;
+    uint64_t max_bytes = kMaxSceneBytes;
+    uint64_t texels = 0; /* decoded texels of every image, from their headers */
+    uint64_t bytes = 0;  /* the file, external files and RGBA8 texels */
+    int over = 0;        /* the first LPV_GLTF_OVER_* hit, 0 none */
+    std::string over_what; /* for OVER_TEXTURE: "image 3 is 16384x16384 texels" */
+    bool over_budget() const { return over != 0; }
     std::vector<std::string> warnings; /* each line once */
     size_t warnings_dropped = 0;       /* past kMaxWarnings */
     const lpv_gltf_node_override *overrides = nullptr; /* lpv_gltf_load_memory_ex */
@@ -89,6 +105,11 @@ struct Ctx {
 /* Routes every file access of tinygltf through checks that keep it inside
  * ctx's folder (or refuse it for memory loads without one). */
 void set_fs_callbacks(tinygltf::TinyGLTF &loader, Ctx *ctx);
+/* The folder tinygltf is told external URIs lie in: a tag, never a real path,
+ * so that none of its messages can name one (the files open beneath dir_fd). */
+extern const char *const kBaseTag;
+/* Counts n more bytes of RAM against the budget; false once over it. */
+bool take_bytes(Ctx &ctx, uint64_t n);
 /* The main file's bytes into *data; "" or the problem (for "<path>: ..."). */
 std::string read_main_file(const char *path, std::vector<unsigned char> *data);
 
@@ -101,9 +122,14 @@ bool check_container(const unsigned char *data, size_t size, size_t *json_off, s
  * its JSON rewritten (a .glb's BIN chunk kept) and true is returned. */
 bool tinygltf_compat_file(const unsigned char *data, size_t size, bool is_glb, size_t json_off, size_t json_len,
                           std::vector<unsigned char> *rewritten);
-/* tinygltf's image callback (user data: the Ctx). */
+/* tinygltf's image callback (user data: the Ctx): sizes from the headers,
+ * counted against the budgets; the bytes are kept encoded (component 0). */
 bool image_loader(tinygltf::Image *image, const int image_idx, std::string *err, std::string *warn, int req_width,
                   int req_height, const unsigned char *bytes, int size, void *user);
+/* Decodes every image image_loader kept to RGBA8; an undecodable one fails. */
+void decode_images(tinygltf::Model &model);
+/* tinygltf's messages as one line, without the names it quotes from the file. */
+std::string tinygltf_text(const std::string &s);
 
 /* ---- transforms (gltf_transform.cpp; column-major, like glTF) --------------- */
 struct Mat4 {

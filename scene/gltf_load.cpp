@@ -7,15 +7,16 @@
  * lists its files):
  *   - the .glb container is validated completely and the JSON pre-scanned for
  *     syntax and depth before tinygltf sees them (gltf_container.cpp);
- *   - every file access goes through our FsCallbacks, which keep it inside
- *     the scene's folder (gltf_files.cpp);
+ *   - every file access goes through our FsCallbacks, which open it beneath
+ *     the scene's folder descriptor (gltf_files.cpp);
  *   - images are decoded by our own loader callback after the size cap and
  *     the bufferView range are checked (gltf_images.cpp);
  *   - accessors, buffer views, sparse data, indices, node graphs and limits
  *     are checked by the Builder, never trusted (gltf_build.cpp and the files
  *     it names).
  * Errors travel as a C++ exception (Failure) inside the adapter and leave it
- * here as "<path or label>: <problem>" and -1; nothing is thrown into C.
+ * here as "<path or label>: <problem>" and -1 (or the LPV_GLTF_OVER_* of the
+ * budget that refused it); nothing is thrown into C.
  * Units: glTF's photometric values are divided by LPV_LUMENS_PER_WATT
  * (docs/units.md).
  */
@@ -25,7 +26,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fcntl.h>
 #include <new>
+#include <unistd.h>
 
 using namespace lpv_gltf;
 
@@ -48,8 +51,38 @@ void set_error(char *err, size_t err_size, const std::string &label, const std::
         snprintf(err, err_size, "%s: %s", label.c_str(), msg.c_str());
 }
 
+/* The message of a load refused by a budget (ctx.over), with what the file
+ * needs of it: the texels of all images (summed from their headers) or the
+ * bytes counted until the load stopped. */
+[[noreturn]] void fail_budget(const Ctx &ctx)
+{
+    Failure f;
+    f.code = ctx.over;
+    if (ctx.over == LPV_GLTF_OVER_TEXTURE)
+        f.msg = strf("%s, over the texture limit of %d texels per side", ctx.over_what.c_str(), ctx.max_side);
+    else if (ctx.over == LPV_GLTF_OVER_TEXELS)
+        f.msg = strf("the images need %llu decoded texels, over the budget of %llu texels per scene",
+                     (unsigned long long)ctx.texels, (unsigned long long)ctx.max_texels);
+    else
+        f.msg = strf("the scene needs at least %llu bytes of memory (file, buffers, RGBA8 texels, model), over "
+                     "the budget of %llu bytes per scene",
+                     (unsigned long long)ctx.bytes, (unsigned long long)ctx.max_bytes);
+    throw f;
+}
+
+/* The scene model's arrays, counted against the RAM budget before they are copied out. */
+uint64_t model_bytes(const Builder &b, size_t density_count)
+{
+    return uint64_t(b.vertices.size()) * sizeof(lpv_vertex) + uint64_t(b.indices.size()) * sizeof(uint32_t) +
+           uint64_t(b.draws.size()) * sizeof(lpv_draw) + uint64_t(b.materials.size()) * sizeof(lpv_material) +
+           uint64_t(b.lights.size()) * sizeof(lpv_light) + uint64_t(b.cameras.size()) * sizeof(lpv_camera) +
+           uint64_t(b.textures.size()) * sizeof(lpv_texture) + uint64_t(density_count) * sizeof(float);
+}
+
 void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
 {
+    if (!take_bytes(ctx, size))
+        fail_budget(ctx);
     size_t json_off = 0, json_len = size;
     const bool is_glb = check_container(data, size, &json_off, &json_len);
 
@@ -67,7 +100,7 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     tinygltf::Model model;
     ctx.model = &model;
     std::string terr, twarn;
-    const std::string base = ctx.allow_external ? ctx.base_dir : std::string();
+    const std::string base = ctx.allow_external ? std::string(kBaseTag) : std::string();
     bool ok;
     if (is_glb)
         ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, data, unsigned(size), base);
@@ -77,10 +110,12 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     ctx.model = nullptr;
     if (!ctx.refusal.empty())
         fail("%s", ctx.refusal.c_str());
+    if (ctx.over_budget())
+        fail_budget(ctx);
     if (!ctx.image_error.empty())
         fail("%s", ctx.image_error.c_str());
     if (!ok) {
-        std::string t = one_line(terr);
+        std::string t = tinygltf_text(terr);
         if (!ctx.missing.empty())
             fail("%s (missing buffer or image; tinygltf: %s)", ctx.missing.c_str(), t.c_str());
         fail("glTF rejected by tinygltf: %s", t.empty() ? "unknown error" : t.c_str());
@@ -88,9 +123,10 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     if (!ctx.missing.empty())
         ctx.warn(ctx.missing + "; that image is ignored");
     if (!terr.empty())
-        ctx.warn("tinygltf: " + one_line(terr));
+        ctx.warn("tinygltf: " + tinygltf_text(terr));
     if (!twarn.empty())
-        ctx.warn("tinygltf: " + one_line(twarn));
+        ctx.warn("tinygltf: " + tinygltf_text(twarn));
+    decode_images(model); /* every image counted and within the budgets: now decoded */
 
     apply_node_overrides(model, ctx.overrides, ctx.override_count);
 
@@ -102,6 +138,8 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
 
     if (b.vertices.size() > UINT32_MAX || b.indices.size() > UINT32_MAX)
         fail("scene too large (absurd size)");
+    if (!take_bytes(ctx, model_bytes(b, density.size())))
+        fail_budget(ctx);
     /* Hand everything over as malloc'd C arrays; lpv_scene_free releases it. */
     out->vertices = c_array(b.vertices);
     out->vertex_count = uint32_t(b.vertices.size());
@@ -146,6 +184,8 @@ int run_load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out, c
         return 0;
     } catch (const Failure &f) {
         set_error(err, err_size, ctx.label, f.msg);
+        lpv_scene_free(out);
+        return f.code;
     } catch (const std::bad_alloc &) {
         set_error(err, err_size, ctx.label, "out of memory");
     } catch (const std::exception &e) {
@@ -214,8 +254,8 @@ extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_w
         ctx.sink = warnings;
         std::string p(path);
         size_t slash = p.find_last_of('/');
-        ctx.base_dir = slash == std::string::npos ? std::string(".")
-                                                  : (slash == 0 ? std::string("/") : p.substr(0, slash));
+        std::string dir = slash == std::string::npos ? std::string(".")
+                                                     : (slash == 0 ? std::string("/") : p.substr(0, slash));
 
         std::vector<unsigned char> data;
         std::string problem = read_main_file(path, &data);
@@ -223,14 +263,13 @@ extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_w
             set_error(err, err_size, ctx.label, problem);
             return -1;
         }
-
-        char *real = realpath(ctx.base_dir.c_str(), nullptr);
-        if (real) {
-            ctx.root_real = real;
-            free(real);
-            ctx.allow_external = true;
-        }
-        return run_load(data.data(), data.size(), ctx, out, err, err_size);
+        /* the folder the user named (links and all); URIs open beneath it */
+        ctx.dir_fd = open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        ctx.allow_external = ctx.dir_fd >= 0;
+        int rc = run_load(data.data(), data.size(), ctx, out, err, err_size);
+        if (ctx.dir_fd >= 0)
+            close(ctx.dir_fd);
+        return rc < 0 ? -1 : rc;
     });
 }
 
@@ -252,12 +291,35 @@ extern "C" int lpv_gltf_load_memory_w(const void *data, size_t size, const char 
                                       lpv_gltf_warnings *warnings, char *err, size_t err_size)
 {
     const char *name = label && label[0] ? label : "<memory>";
+    int fd = -1;
+    if (base_dir) {
+        fd = open(base_dir[0] ? base_dir : ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (fd < 0) {
+            int e = errno;
+            if (!begin_load(name, out, warnings, err, err_size))
+                return -1;
+            if (err && err_size)
+                snprintf(err, err_size, "%s: base folder: %s", name, strerror(e));
+            return -1;
+        }
+    }
+    int rc = lpv_gltf_load_at(data, size, fd, label, nodes, node_count, nullptr, out, warnings, err, err_size);
+    if (fd >= 0)
+        close(fd);
+    return rc < 0 ? -1 : rc;
+}
+
+extern "C" int lpv_gltf_load_at(const void *data, size_t size, int base_fd, const char *label,
+                                const lpv_gltf_node_override *nodes, size_t node_count, const lpv_gltf_limits *limits,
+                                lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size)
+{
+    const char *name = label && label[0] ? label : "<memory>";
     if (!begin_load(name, out, warnings, err, err_size))
-        return -1;
+        return LPV_GLTF_DEFECT;
     if (!data && size > 0) {
         if (err && err_size)
             snprintf(err, err_size, "%s: no data", name);
-        return -1;
+        return LPV_GLTF_DEFECT;
     }
     return guarded(name, out, err, err_size, [&]() {
         Ctx ctx;
@@ -265,20 +327,17 @@ extern "C" int lpv_gltf_load_memory_w(const void *data, size_t size, const char 
         ctx.sink = warnings;
         ctx.overrides = nodes;
         ctx.override_count = nodes ? node_count : 0;
-        if (base_dir) {
-            char *real = realpath(base_dir, nullptr);
-            if (!real) {
-                set_error(err, err_size, ctx.label,
-                          strf("base folder %s: %s", show(base_dir).c_str(), strerror(errno)));
-                return -1;
-            }
-            ctx.root_real = real;
-            free(real);
-            ctx.base_dir = base_dir[0] ? base_dir : ".";
-            ctx.allow_external = true;
+        ctx.dir_fd = base_fd;
+        ctx.allow_external = base_fd >= 0;
+        if (limits) {
+            if (limits->max_texture > 0 && limits->max_texture < ctx.max_side)
+                ctx.max_side = limits->max_texture;
+            if (limits->max_texels > 0 && limits->max_texels < ctx.max_texels)
+                ctx.max_texels = limits->max_texels;
+            if (limits->max_bytes > 0 && limits->max_bytes < ctx.max_bytes)
+                ctx.max_bytes = limits->max_bytes;
         }
         static const unsigned char empty = 0;
         return run_load(size ? static_cast<const unsigned char *>(data) : &empty, size, ctx, out, err, err_size);
     });
 }
-

@@ -18,9 +18,11 @@
  * Refused with a message naming the file and the problem, never a crash:
  * truncated or mis-sized .glb, wrong magic, invalid JSON, accessors or
  * buffer views out of range, indices past the vertex count, NaN or infinite
- * positions, missing buffers, external URIs that leave the scene's folder
- * (refused before anything is read), and extensionsRequired that lpvd does not
- * implement (named).
+ * positions, missing buffers, images that cannot be decoded, external URIs
+ * that leave the scene's folder (absolute, "..", or through any symbolic
+ * link: refused by the same step that opens them, core/open_beneath.h), and
+ * extensionsRequired that lpvd does not implement (named). Messages never
+ * quote the file's bytes: only indices, sizes, URIs and identifier names.
  *
  * Everything else in the file that lpvd does not use (extensions it does not
  * implement, occlusion/emissive/metallic-roughness textures, vertex colours,
@@ -78,6 +80,33 @@ typedef struct lpv_gltf_node_override {
 int lpv_gltf_load_memory_ex(const void *data, size_t size, const char *base_dir, const char *label,
                             const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out, char *err,
                             size_t err_size);
+
+/* What one load may take (the daemon's per-scene budgets). A 0 field means
+ * the loader's own absurd-size cap. Sizes come from the images' headers
+ * before anything is decoded. */
+typedef struct lpv_gltf_limits {
+    int max_texture;     /* texels per image side */
+    uint64_t max_texels; /* decoded texels of all images together */
+    uint64_t max_bytes;  /* RAM: the file, its external files, RGBA8 texels and the scene model */
+} lpv_gltf_limits;
+
+/* lpv_gltf_load_at's results: a defect, or the limit that refused the file
+ * (its message names the limit's value and what the file would need). */
+enum {
+    LPV_GLTF_OK = 0,
+    LPV_GLTF_DEFECT = -1,
+    LPV_GLTF_OVER_TEXTURE = -2, /* lpv_gltf_limits.max_texture */
+    LPV_GLTF_OVER_TEXELS = -3,  /* max_texels */
+    LPV_GLTF_OVER_BYTES = -4    /* max_bytes */
+};
+
+/* The daemon's entry: glb or glTF bytes whose external URIs open beneath the
+ * folder descriptor base_fd (-1: external URIs refused; the descriptor is only
+ * used during the call), within limits (NULL: the caps). Returns LPV_GLTF_OK
+ * or one of the codes above with "<label>: <problem>" in err. */
+int lpv_gltf_load_at(const void *data, size_t size, int base_fd, const char *label,
+                     const lpv_gltf_node_override *nodes, size_t node_count, const lpv_gltf_limits *limits,
+                     lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size);
 
 /* The loaders above with the warnings stored in *warnings (zeroed first)
  * instead of printed on stderr; warnings NULL prints them as above. */

@@ -1,7 +1,7 @@
 /*
  * gltf_messages.cpp - how the glTF adapter words its problems (gltf_internal.hpp):
- * printf-style formatting, the Failure that refuses a file, values from the
- * file shortened for a message, and the warnings, each line once.
+ * printf-style formatting, the Failure that refuses a file, names and URIs
+ * from the file for a message (never other file contents), and the warnings, each line once.
  */
 #include "gltf_internal.hpp"
 
@@ -65,7 +65,7 @@ std::string one_line(const std::string &s)
     return out;
 }
 
-std::string show(const std::string &s)
+std::string show_uri(const std::string &s)
 {
     std::string out = "\"";
     size_t n = 0;
@@ -80,6 +80,35 @@ std::string show(const std::string &s)
             out += char(c);
     }
     out += "\"";
+    return out;
+}
+
+std::string show(const std::string &s)
+{
+    bool ident = !s.empty() && s.size() <= 64;
+    for (unsigned char c : s)
+        ident = ident && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_');
+    return ident ? "\"" + s + "\"" : strf("(a %zu-byte name that is not an identifier, not shown)", s.size());
+}
+
+std::string tinygltf_text(const std::string &s)
+{
+    std::string out, line;
+    auto flush = [&]() {
+        size_t cut = line.find(" name = "); /* tinygltf quotes an object's name from the file there */
+        if (cut != std::string::npos)
+            line.resize(cut);
+        if (!line.empty())
+            out += (out.empty() ? "" : "; ") + line;
+        line.clear();
+    };
+    for (char c : s) {
+        if (c == '\n' || c == '\r')
+            flush();
+        else
+            line += c;
+    }
+    flush();
     return out;
 }
 

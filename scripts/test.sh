@@ -2,7 +2,8 @@
 # Every test on a fresh Debian 12 machine: install, build, run the whole
 # suite (GL tests on Mesa's llvmpipe when there is no GPU; the daemon's
 # conformance and reliability suites against fresh daemons), fuzz the wire
-# protocol for a bounded minute, then build again with AddressSanitizer +
+# protocol for a bounded minute and the glTF loader and its images for 30 s
+# each, then build again with AddressSanitizer +
 # UndefinedBehaviorSanitizer and run the whole suite again. Warnings are
 # errors in every build.
 set -eu
@@ -17,11 +18,18 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 # Fuzz the wire protocol (frame parser, bodies, field getters, zstd) for a
 # bounded minute with libFuzzer + ASan + UBSan (clang); new inputs go to
 # build-fuzz/corpus, the seeds in tests/fuzz/corpus are only read.
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DLPVD_FUZZ=ON
-cmake --build build-fuzz --target fuzz_frame -j "$jobs"
-mkdir -p build-fuzz/corpus
+cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
+  -DCMAKE_CXX_COMPILER=clang++ -DLPVD_FUZZ=ON
+cmake --build build-fuzz --target fuzz_frame fuzz_gltf fuzz_image -j "$jobs"
+mkdir -p build-fuzz/corpus build-fuzz/corpus-gltf build-fuzz/corpus-image
 ./build-fuzz/fuzz/fuzz_frame -max_total_time=60 -rss_limit_mb=2048 -max_len=65536 \
   -print_final_stats=1 build-fuzz/corpus tests/fuzz/corpus
+# The glTF loader and its image path (bytes to the scene model through the
+# daemon's entry), 30 s each; scripts/fuzz-long.sh runs them for hours.
+./build-fuzz/fuzz/fuzz_gltf -max_total_time=30 -rss_limit_mb=2048 -max_len=1048576 -timeout=30 \
+  -print_final_stats=1 build-fuzz/corpus-gltf tests/fuzz/corpus_gltf
+./build-fuzz/fuzz/fuzz_image -max_total_time=30 -rss_limit_mb=2048 -max_len=1048576 -timeout=30 \
+  -print_final_stats=1 build-fuzz/corpus-image tests/fuzz/corpus_image
 
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DLPVD_SANITIZE=ON
 cmake --build build-asan -j "$jobs"

@@ -51,6 +51,8 @@ static void usage(FILE *f)
             "                          fit waits, unread (default %llu, at least --max-message)\n"
             "  --max-triangles N       per scene (default 10000000)\n"
             "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
+            "  --max-scene-texels N    decoded texels of one scene's images, from their headers (default %llu)\n"
+            "  --max-scene-bytes BYTES memory one parsed scene may take: file, buffers, texels, model (default %llu)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
             "  --idle-timeout S        a session with no complete frame for S s is sent BYE and closed\n"
@@ -63,7 +65,9 @@ static void usage(FILE *f)
             "Default CONFIG of every session:\n"
             "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
             "%s",
-            (unsigned long long)SV_DEFAULT_MAX_REQUEST_MEMORY, SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT, SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
+            (unsigned long long)SV_DEFAULT_MAX_REQUEST_MEMORY, (unsigned long long)SV_DEFAULT_MAX_SCENE_TEXELS,
+            (unsigned long long)SV_DEFAULT_MAX_SCENE_BYTES, SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT,
+            SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
 }
 
 static int parse_u64(const char *v, uint64_t lo, uint64_t hi, uint64_t *out)
@@ -346,8 +350,8 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory",
-    "handshake-timeout", "max-preauth", NULL};
+    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-grid", "max-tick-rate", "idle-timeout",
+    "tick-rate", "max-preauth-body", "max-request-memory", "handshake-timeout", "max-preauth", NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
 {
@@ -362,6 +366,9 @@ int lpvd_cmd_serve(int argc, char **argv)
     cfg->max_clients = 64;
     cfg->max_triangles = 10000000;
     cfg->max_texture = 8192;
+    cfg->max_scene_texels = SV_DEFAULT_MAX_SCENE_TEXELS;
+    cfg->max_scene_bytes = SV_DEFAULT_MAX_SCENE_BYTES;
+    s->root_fd = -1;
     cfg->max_grid = 128;
     cfg->max_tick_rate = 60.0;
     cfg->idle_timeout = 300.0;
@@ -458,6 +465,12 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "max-texture")) {
             bad = parse_u64(v, 16, 1 << 20, &u);
             cfg->max_texture = (int)u;
+        } else if (!strcmp(name, "max-scene-texels")) {
+            bad = parse_u64(v, 1, (uint64_t)1 << 40, &u);
+            cfg->max_scene_texels = u;
+        } else if (!strcmp(name, "max-scene-bytes")) {
+            bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
+            cfg->max_scene_bytes = u;
         } else if (!strcmp(name, "max-grid")) {
             bad = parse_u64(v, 1, LPV_MAX_GRID_DIM, &u);
             cfg->max_grid = (int)u;
@@ -524,6 +537,13 @@ int lpvd_cmd_serve(int argc, char **argv)
         cfg->want_unix = 1;
         if (!have_socket)
             lpvp_default_socket_path(cfg->socket_path, sizeof cfg->socket_path);
+    }
+    /* the root is opened once: every SCENE_LOAD path opens beneath this
+     * descriptor (core/open_beneath.h), so renaming or relinking the root's
+     * own path later changes nothing */
+    if (cfg->scene_root[0] && (s->root_fd = open(cfg->scene_root, O_RDONLY | O_DIRECTORY | O_CLOEXEC)) < 0) {
+        fprintf(stderr, "lpvd serve: --scene-root %s: %s\n", cfg->scene_root, strerror(errno));
+        return 2;
     }
     signal(SIGPIPE, SIG_IGN);
 
@@ -592,6 +612,8 @@ out:
     }
     uv_loop_close(s->loop);
     free(s->loop);
+    if (s->root_fd >= 0)
+        close(s->root_fd);
     pthread_mutex_destroy(&s->mu);
     pthread_cond_destroy(&s->cv);
     return rc;

@@ -49,6 +49,13 @@ typedef struct sv_world sv_world;
 typedef struct sv_job sv_job;
 
 /* ---- configuration ------------------------------------------------------ */
+/* Per-scene budgets (docs/server.md, "Limits"): 64 Mi texels is 256 MiB of
+ * RGBA8, eight 4096² or one 8192² texture; 2 GiB of RAM holds a scene at the
+ * other defaults (a 256 MiB file, 256 MiB of texels and the model of
+ * 10 M indexed triangles, ~1 GB), with room to spare. */
+#define SV_DEFAULT_MAX_SCENE_TEXELS ((uint64_t)64 << 20)
+#define SV_DEFAULT_MAX_SCENE_BYTES ((uint64_t)2 << 30)
+
 typedef struct sv_config {
     char socket_path[256];   /* "" = no Unix socket */
     int want_unix;
@@ -65,6 +72,8 @@ typedef struct sv_config {
     int max_clients;
     uint64_t max_triangles;
     int max_texture;
+    uint64_t max_scene_texels; /* decoded texels of one scene's images, from their headers */
+    uint64_t max_scene_bytes;  /* RAM one parsed scene may take (file, buffers, RGBA8 texels, model) */
     int max_grid;
     double max_tick_rate;
     double idle_timeout;     /* seconds since the last complete frame (R4.9) */
@@ -97,7 +106,7 @@ typedef struct sv_scene {
     lpv_scene scene;        /* parsed, default light ensured */
     uint8_t *glb;           /* the bytes (NULL for the built-in scene) */
     size_t glb_size;
-    char *base_dir;         /* folder for external URIs (path loads), or NULL */
+    char *base_dir;         /* folder for external URIs, relative to the scene root (path loads), or NULL */
     lpv_gltf_node_override *nodes; /* SCENE_UPDATE node transforms applied at load */
     size_t node_count;
     struct sv_scene *next;  /* server's list of live scenes */
@@ -354,6 +363,7 @@ struct sv_server {
     uint64_t next_world_id;
     sv_scene *scenes;
     sv_scene *builtin;      /* the default scene */
+    int root_fd;            /* --scene-root, opened once at start: paths open beneath it (-1: none) */
     /* GL thread */
     pthread_t gl_thread;
     int gl_started;

@@ -71,6 +71,10 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
                             "handshake_timeout", s->cfg.handshake_timeout, "max_preauth", s->cfg.max_preauth);
     if (lim)
         json_object_set_new(lim, "max_request_memory", json_integer((json_int_t)s->cfg.max_request_memory));
+    if (lim) { /* the per-scene budgets (R4.5) */
+        json_object_set_new(lim, "max_scene_texels", json_integer((json_int_t)s->cfg.max_scene_texels));
+        json_object_set_new(lim, "max_scene_bytes", json_integer((json_int_t)s->cfg.max_scene_bytes));
+    }
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "gltf_load.h"
+#include "open_beneath.h"
 #include "scene_defaults.h"
 
 /* The SCENE_LOAD reply's "scene". */
@@ -37,11 +38,15 @@ typedef struct load_work {
     uint32_t request_id;
     uint16_t type;
     /* in */
-    char *path;            /* resolved real path, or NULL */
-    char *sent;            /* the path as the client sent it: the only one messages name (never the root) */
+    char *sent;            /* the path as the client sent it (relative to the root), or NULL for an attachment:
+                              the only path messages name (never the root's) */
+    int root_fd;           /* the server's root descriptor (not owned) */
+    uint64_t max_file;     /* --max-message: a path load reads no more than an attachment may carry */
+    lpv_gltf_limits limits; /* the per-scene budgets */
     uint8_t *glb;          /* attachment or the session scene's bytes (owned copy) */
     size_t glb_size;
-    char *base_dir;
+    char *base_dir;        /* the scene's folder (external URIs) relative to the root, absolute only for
+                              the operator's --scene; or NULL */
     lpv_gltf_node_override *nodes;
     size_t node_count;
     uint64_t base_hash;
@@ -77,21 +82,46 @@ static int contains(const uint8_t *hay, size_t n, const char *needle)
     return 0;
 }
 
-static void load_run(uv_work_t *req)
+/* Why a path could not be opened beneath the root, as the client's error. */
+static void path_error(load_work *w, int e)
 {
-    load_work *w = req->data;
-    if (w->path) {
-        /* O_NONBLOCK: a FIFO would otherwise wait for a writer forever (and
-         * hold this worker and the daemon's exit); fstat refuses it */
-        int fd = open(w->path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-        struct stat st;
-        if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-            snprintf(w->err, sizeof w->err, "path %s: %s", w->sent, fd < 0 ? strerror(errno) : "not a regular file");
-            if (fd >= 0)
-                close(fd);
-            w->status = LPVP_E_SCENE_INVALID;
-            return;
-        }
+    w->status = LPVP_E_SCENE_INVALID;
+    if (e == ELOOP || e == EXDEV) {
+        w->status = LPVP_E_PATH_REFUSED;
+        snprintf(w->err, sizeof w->err,
+                 "path %s: goes through a symbolic link (refused: only files and folders under the scene root "
+                 "are opened, never links)", w->sent);
+    } else if (e == ENOENT) {
+        snprintf(w->err, sizeof w->err, "path %s: no such file under the scene root", w->sent);
+    } else if (e == ENOTDIR) {
+        snprintf(w->err, sizeof w->err, "path %s: one of its folders is not a folder", w->sent);
+    } else {
+        snprintf(w->err, sizeof w->err, "path %s: %s", w->sent, strerror(e));
+    }
+}
+
+/* Reads the scene file w->sent, opened beneath the root in one step (no
+ * window between the check and the open: a file swapped for a link is never
+ * followed), only a regular file, at most max_file bytes. 0, or -1 with
+ * w->status and w->err set. */
+static int read_scene_file(load_work *w)
+{
+    int fd = lpv_open_beneath(w->root_fd, w->sent, O_RDONLY);
+    if (fd < 0) {
+        path_error(w, errno);
+        return -1;
+    }
+    struct stat st;
+    w->status = LPVP_E_SCENE_INVALID;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        snprintf(w->err, sizeof w->err, "path %s: %s", w->sent,
+                 S_ISDIR(st.st_mode) ? "is a folder, not a scene file" : "not a regular file");
+    } else if ((uint64_t)st.st_size > w->max_file) {
+        w->status = LPVP_E_LIMIT;
+        snprintf(w->err, sizeof w->err,
+                 "path %s: %llu bytes, over the server's limit of %llu bytes per message (--max-message)", w->sent,
+                 (unsigned long long)st.st_size, (unsigned long long)w->max_file);
+    } else {
         w->glb_size = (size_t)st.st_size;
         w->glb = malloc(w->glb_size ? w->glb_size : 1);
         size_t got = 0;
@@ -103,13 +133,38 @@ static void load_run(uv_work_t *req)
                 break;
             got += (size_t)n;
         }
-        close(fd);
-        if (!w->glb || got != w->glb_size) {
+        if (w->glb && got == w->glb_size && (w->base_dir = dir_of(w->sent)))
+            w->status = 0;
+        else
             snprintf(w->err, sizeof w->err, "path %s: cannot read", w->sent);
-            w->status = LPVP_E_SCENE_INVALID;
-            return;
-        }
-        w->base_dir = dir_of(w->path);
+    }
+    close(fd);
+    return w->status ? -1 : 0;
+}
+
+/* The flag of the budget a loader code names (lpv_gltf_load_at). */
+static const char *budget_flag(int rc)
+{
+    return rc == LPV_GLTF_OVER_TEXTURE ? "--max-texture"
+           : rc == LPV_GLTF_OVER_TEXELS ? "--max-scene-texels"
+                                        : "--max-scene-bytes";
+}
+
+static void load_run(uv_work_t *req)
+{
+    load_work *w = req->data;
+    if (w->sent && read_scene_file(w) != 0)
+        return;
+    /* an absolute folder is only ever the operator's --scene (serve.c); a
+     * client's scene folder is relative to the root and opens beneath it */
+    int base_fd = !w->base_dir ? -1
+                  : w->base_dir[0] == '/' ? open(w->base_dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC)
+                                          : lpv_open_beneath(w->root_fd, w->base_dir, O_RDONLY | O_DIRECTORY);
+    if (w->base_dir && base_fd < 0) {
+        /* not named: for the operator's --scene it is an absolute path of the machine */
+        snprintf(w->err, sizeof w->err, "the scene's folder (for its external files): %s", strerror(errno));
+        w->status = LPVP_E_SCENE_INVALID;
+        return;
     }
     sv_scene *sc = calloc(1, sizeof *sc);
     if (!sc) {
@@ -118,19 +173,25 @@ static void load_run(uv_work_t *req)
         return;
     }
     const char *label = w->sent ? w->sent : "attachment";
-    int rc = lpv_gltf_load_memory_w(w->glb, w->glb_size, w->base_dir, label, w->nodes, w->node_count, &sc->scene,
-                                    &w->warnings, w->err, sizeof w->err);
+    int rc = lpv_gltf_load_at(w->glb, w->glb_size, base_fd, label, w->nodes, w->node_count, &w->limits, &sc->scene,
+                              &w->warnings, w->err, sizeof w->err);
+    if (base_fd >= 0)
+        close(base_fd);
     char why[256];
-    if (rc == 0 && lpv_scene_check_ranges(&sc->scene, why, sizeof why) != 0) {
+    if (rc == LPV_GLTF_OK && lpv_scene_check_ranges(&sc->scene, why, sizeof why) != 0) {
         /* a file, or node transforms (SCENE_UPDATE: BAD_FIELD "nodes: ..."),
          * that puts the scene where float math breaks: refused, not ticked */
         snprintf(w->err, sizeof w->err, "%s: %s", label, why);
         lpv_scene_free(&sc->scene);
-        rc = -1;
+        rc = LPV_GLTF_DEFECT;
     }
-    if (rc != 0) {
+    if (rc != LPV_GLTF_OK) {
         free(sc);
-        w->status = LPVP_E_SCENE_INVALID;
+        w->status = rc == LPV_GLTF_DEFECT ? LPVP_E_SCENE_INVALID : LPVP_E_LIMIT;
+        if (rc != LPV_GLTF_DEFECT) {
+            size_t n = strlen(w->err);
+            snprintf(w->err + n, sizeof w->err - n, " (%s)", budget_flag(rc));
+        }
         return;
     }
     if (lpv_scene_add_defaults(&sc->scene, w->err, sizeof w->err) != 0) {
@@ -274,7 +335,6 @@ static void load_done(uv_work_t *req, int status)
     }
     if (w->scene)
         free_sv_scene_unlisted(w->scene);
-    free(w->path);
     free(w->sent);
     free(w->glb);
     free(w->base_dir);
@@ -290,6 +350,11 @@ static int start_load(sv_conn *c, load_work *w)
 {
     w->req.data = w;
     w->c = c;
+    w->root_fd = c->srv->root_fd;
+    w->max_file = c->srv->cfg.max_message;
+    w->limits.max_texture = c->srv->cfg.max_texture;
+    w->limits.max_texels = c->srv->cfg.max_scene_texels;
+    w->limits.max_bytes = c->srv->cfg.max_scene_bytes;
     c->refs++;
     c->busy = 1;
     if (uv_queue_work(c->srv->loop, &w->req, load_run, load_done) != 0) {
@@ -301,49 +366,27 @@ static int start_load(sv_conn *c, load_work *w)
     return 0;
 }
 
-/* R4.3: relative, no "..", resolved (symlinks too) inside the root. */
-static int resolve_scene_path(sv_server *s, const char *p, char **out, char *err, size_t n)
+/* R4.3, the checks that need no file system: a path, a root, relative, no
+ * ".." (the open itself refuses links: read_scene_file). 0, or the error
+ * code with its message. */
+static int check_scene_path(sv_server *s, const char *p, char *err, size_t n)
 {
-    if (!s->cfg.scene_root[0]) {
+    if (!p[0]) {
+        snprintf(err, n, "path: empty; give a file's path relative to the scene root");
+        return LPVP_E_BAD_FIELD;
+    }
+    if (s->root_fd < 0) {
         snprintf(err, n, "path %s: this server has no --scene-root; send the .glb as an attachment", p);
-        return -1;
+        return LPVP_E_PATH_REFUSED;
     }
-    if (!p[0] || p[0] == '/') {
+    if (p[0] == '/') {
         snprintf(err, n, "path %s: absolute paths are refused; give a path relative to the scene root", p);
-        return -1;
+        return LPVP_E_PATH_REFUSED;
     }
-    const char *q = p;
-    while (*q) {
-        const char *e = strchr(q, '/');
-        size_t len = e ? (size_t)(e - q) : strlen(q);
-        if (len == 2 && q[0] == '.' && q[1] == '.') {
-            snprintf(err, n, "path %s: \"..\" components are refused", p);
-            return -1;
-        }
-        q += len;
-        if (*q == '/')
-            q++;
+    if (lpv_path_stays_beneath(p) != 0) {
+        snprintf(err, n, "path %s: \"..\" components are refused", p);
+        return LPVP_E_PATH_REFUSED;
     }
-    size_t need = strlen(s->cfg.scene_root) + strlen(p) + 2;
-    char *joined = malloc(need);
-    if (!joined) {
-        snprintf(err, n, "out of memory");
-        return -1;
-    }
-    snprintf(joined, need, "%s/%s", s->cfg.scene_root, p);
-    char *real = realpath(joined, NULL);
-    free(joined);
-    if (!real) {
-        snprintf(err, n, "path %s: %s under the scene root", p, strerror(errno));
-        return 1; /* not a refusal: the file does not exist */
-    }
-    size_t rl = strlen(s->cfg.scene_root);
-    if (strncmp(real, s->cfg.scene_root, rl) != 0 || (real[rl] != '/' && !(rl == 1 && s->cfg.scene_root[0] == '/'))) {
-        snprintf(err, n, "path %s: leaves the scene root (through a symbolic link)", p);
-        free(real);
-        return -1;
-    }
-    *out = real;
     return 0;
 }
 
@@ -370,16 +413,14 @@ void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
                       "path: give either \"path\" or a .glb attachment, not both");
             return;
         }
-        int rc = resolve_scene_path(c->srv, path, &w->path, err, sizeof err);
-        if (rc == 0 && !(w->sent = strdup(path))) {
-            free(w->path);
-            rc = -2;
+        int code = check_scene_path(c->srv, path, err, sizeof err);
+        if (code == 0 && !(w->sent = strdup(path))) {
+            code = LPVP_E_INTERNAL;
             snprintf(err, sizeof err, "out of memory");
         }
-        if (rc != 0) {
+        if (code != 0) {
             free(w);
-            sv_reply_err(c, r->request_id,
-                         rc == -2 ? LPVP_E_INTERNAL : rc < 0 ? LPVP_E_PATH_REFUSED : LPVP_E_SCENE_INVALID, 0, "%s", err);
+            sv_reply_err(c, r->request_id, code, 0, "%s", err);
             return;
         }
     } else {
@@ -395,7 +436,6 @@ void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
         r->att_len = 0;
     }
     if (start_load(c, w) != 0) {
-        free(w->path);
         free(w->sent);
         free(w->glb);
         free(w);

@@ -1165,6 +1165,16 @@ def c_path_refused(ctx):
     return "%d paths refused" % len(paths)
 
 
+@case("R4.3b", "an empty scene path gets BAD_FIELD saying it is empty")
+def c_path_empty(ctx):
+    c = ctx.session()
+    rid = c.send(SCENE_LOAD, {"path": ""})
+    f = c.recv_reply(rid, timeout=ctx.tick_timeout)
+    expect_error(f, "BAD_FIELD", rid, field="empty")
+    ctx.ping(c)
+    return "\"\" refused as empty"
+
+
 @case("R4.3", "a symlink inside the root pointing outside gets PATH_REFUSED; a file inside loads",
       needs=("scene_root",))
 def c_path_symlink(ctx):
@@ -1231,6 +1241,81 @@ def c_scene_attachment(ctx):
     want = [-1, 0, -1, 1, 2, 1]
     check(all(abs(x - y) < 1e-4 for x, y in zip(b, want)), "bounds %r, expected %r" % (b, want))
     return "10 triangles, 3 materials, 1 light, the default camera"
+
+
+def grey_png(width, height, rows=True):
+    """An all-zero 8-bit grey PNG; rows=False: its header and an empty IDAT only (a header that lies)."""
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    z = zlib.compressobj(9)
+    row = b"\0" * (width + 1)
+    data = b"".join(z.compress(row) for _ in range(height if rows else 0)) + z.flush()
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)) +
+            chunk(b"IDAT", data) + chunk(b"IEND", b""))
+
+
+def textured_triangle_glb(images):
+    """One triangle whose material uses image 0; every image (PNG bytes) in the BIN chunk."""
+    binb = bytearray(struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<6f", 0, 0, 1, 0, 0, 1))
+    views = [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}]
+    for im in images:
+        views.append({"buffer": 0, "byteOffset": len(binb), "byteLength": len(im)})
+        binb += im + b"\0" * (-len(im) % 4)
+    gltf = {"asset": {"version": "2.0"}, "buffers": [{"byteLength": len(binb)}], "bufferViews": views,
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]},
+                          {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
+            "images": [{"bufferView": 2 + i, "mimeType": "image/png"} for i in range(len(images))],
+            "textures": [{"source": i} for i in range(len(images))],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+            "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
+    return make_glb(gltf, bytes(binb))
+
+
+@case("R4.5b", "an image that cannot be decoded, or whose header is over max_texture, refuses the scene")
+def c_scene_bad_images(ctx):
+    c = ctx.session()
+    lim = (ctx.limits or {}).get("max_texture")
+    cases = [("garbage declared as a PNG", textured_triangle_glb([b"\x89PNG\r\n\x1a\n" + b"not a png" * 8]),
+              "SCENE_INVALID"),
+             ("a truncated PNG", textured_triangle_glb([grey_png(32, 32)[:50]]), "SCENE_INVALID")]
+    if isinstance(lim, int) and lim < (1 << 24):
+        cases.append(("a PNG header claiming %dx%d" % (lim + 1, lim + 1),
+                      textured_triangle_glb([grey_png(lim + 1, lim + 1, rows=False)]), "LIMIT"))
+    for what, glb, code in cases:
+        rid = c.send(SCENE_LOAD, {}, glb)
+        f = c.recv_reply(rid, timeout=ctx.tick_timeout)
+        try:
+            expect_error(f, code, rid, field="image 0")
+        except Fail as e:
+            raise Fail("%s: %s" % (what, e))
+    expect_reply(c.request(SCENE_LOAD, {}, textured_triangle_glb([grey_png(16, 16)]), timeout=ctx.tick_timeout),
+                 SCENE_LOAD, what="a good 16x16 PNG")
+    return "%d bad images refused, a good one loads" % len(cases)
+
+
+@case("R4.5a", "images over max_scene_texels together get LIMIT before decoding")
+def c_scene_texel_budget(ctx):
+    c = ctx.session()
+    lim = ctx.limits or {}
+    budget, side = lim.get("max_scene_texels"), lim.get("max_texture")
+    if not isinstance(budget, int) or not isinstance(side, int):
+        raise Skip("HELLO limits advertise no max_scene_texels / max_texture")
+    side = min(side, 8192)
+    n = budget // (side * side) + 1
+    if n > 16:
+        raise Skip("max_scene_texels %d needs more than 16 images of %d^2" % (budget, side))
+    im = grey_png(side, side)
+    rid = c.send(SCENE_LOAD, {}, textured_triangle_glb([im] * n))
+    f = c.recv_reply(rid, timeout=ctx.tick_timeout)
+    expect_error(f, "LIMIT", rid, field="max-scene-texels")
+    check(str(n * side * side) in f.body["message"], "the message %r does not say the %d texels needed"
+          % (f.body["message"], n * side * side))
+    ctx.ping(c)
+    return "%d images of %d^2 (%d KB each) refused" % (n, side, len(im) // 1024)
 
 
 @case("R4.4", "glb files that lie about their sizes get SCENE_INVALID; the session keeps its scene")
