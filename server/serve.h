@@ -7,8 +7,10 @@
  *                    handlers are in serve_hello.c, serve_scene.c,
  *                    serve_controls.c, serve_results.c and serve_streams.c
  *                    (serve_session_internal.h)
- *   serve_world.c    worlds (shared computations) and the GL thread; they
- *                    report to sessions through sv_world_listener
+ *   serve_world.c    worlds (shared computations) and the completions of
+ *                    their jobs; they report to sessions through
+ *                    sv_world_listener
+ *   serve_gl.c       the GL thread and its job queue
  *   serve_encode.c   VOLUME / FRAME payloads (fp16, XOR delta, zstd, PNG, EXR)
  *
  * Threads: the libuv loop runs on the main thread and owns every structure
@@ -372,14 +374,20 @@ void sv_session_init(sv_conn *c);
 void sv_session_free(sv_conn *c);        /* on close: detach, free state */
 void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
 
-/* serve_world.c */
+/* serve_gl.c */
 int sv_gl_start(sv_server *s, char *err, size_t n);
 void sv_gl_stop(sv_server *s);
 void sv_job_submit(sv_server *s, sv_job *j);
 sv_job *sv_job_new(sv_job_kind kind, sv_world *w);
 void sv_job_free(sv_job *j);
+size_t sv_jobs_queued(sv_server *s);
+
+/* serve_world.c */
 sv_inputs *sv_inputs_build(sv_conn *c);
 void sv_inputs_unref(sv_inputs *in);
+void sv_inputs_release(sv_server *s, sv_inputs *in); /* unref; the scene too with the last ref */
+void sv_job_reply_all(sv_job *j);        /* the job's request and every one that joined it */
+void sv_world_jobs_done(uv_async_t *a);  /* done_async: finished jobs, on the loop */
 void sv_world_attach(sv_conn *c, sv_inputs *in); /* consumes in */
 void sv_world_detach(sv_conn *c);
 void sv_world_unref(sv_world *w);
@@ -390,7 +398,6 @@ sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
 unsigned sv_world_terms_mask(sv_world *w);
 void sv_world_update_timer(sv_world *w);
 int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: joined a queued tick */
-size_t sv_jobs_queued(sv_server *s);
 
 /* serve_encode.c */
 /* Volume reply/stream body + attachment. ack: the subscriber (delta source and
