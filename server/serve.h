@@ -15,8 +15,9 @@
  *
  * Threads: the libuv loop runs on the main thread and owns every structure
  * here except the fields marked "GL thread". One GL thread owns the GL context
- * and every lpv_engine; it takes sv_job's from a mutex-protected FIFO and
- * hands them back through a second FIFO and a uv_async_t. Reference counts are
+ * and every lpv_engine; it takes sv_job's from a mutex-protected queue (worlds
+ * take turns, serve_gl.c) and hands them back through a FIFO and a
+ * uv_async_t. Reference counts are
  * only ever touched on the main thread. docs/server.md has the full picture.
  */
 #ifndef LPVD_SERVE_H
@@ -192,6 +193,8 @@ struct sv_job {
     uint32_t request_id;
     int periodic;
     int started;            /* taken by the GL thread; under srv->mu */
+    int cancelled;          /* no request, subscriber or timer wants it: the GL thread skips it (under
+                               srv->mu; sv_gl_cancel) */
     sv_waiter *joined;      /* tick: more requests answered by this job, in order */
     unsigned terms_mask;    /* tick: which frames to render (1 << terms); under srv->mu until started */
     int terms;              /* render */
@@ -336,6 +339,7 @@ struct sv_server {
     pthread_cond_t cv;
     sv_job *jobs_head, *jobs_tail;
     size_t jobs_queued;
+    uint64_t gl_last_world; /* id of the world whose job the GL thread took last (fair turns) */
     sv_job *done_head, *done_tail;
     int gl_ready;           /* 1 ok, -1 failed */
     char gl_err[1024];
@@ -346,6 +350,7 @@ struct sv_server {
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */
     uint64_t ticks_coalesced; /* TICK requests answered by another request's tick */
+    uint64_t ticks_cancelled; /* queued ticks skipped because every requester had gone */
     uint64_t requests;
     int exit_code;
 };
@@ -381,6 +386,10 @@ void sv_job_submit(sv_server *s, sv_job *j);
 sv_job *sv_job_new(sv_job_kind kind, sv_world *w);
 void sv_job_free(sv_job *j);
 size_t sv_jobs_queued(sv_server *s);
+/* Marks w's jobs that have not started and that wanted(j, arg) says nobody
+ * wants any more: the GL thread skips them (no GL time) and they complete
+ * with no result. Destroy jobs are never cancelled. Loop thread. */
+void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void *arg), void *arg);
 
 /* serve_world.c */
 sv_inputs *sv_inputs_build(sv_conn *c);

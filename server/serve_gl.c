@@ -77,6 +77,53 @@ void sv_job_submit(sv_server *s, sv_job *j)
     pthread_mutex_unlock(&s->mu);
 }
 
+/* Fair GL time: which queued job runs next, unlinked from the queue. Worlds
+ * take turns: the oldest job of the first world after the one served last
+ * (by id, wrapping round) that has a job queued. So a world's jobs still run
+ * in the order they were queued (its destroy job last), and a world with many
+ * jobs (sessions sharing it, each with a request) delays another world by at
+ * most the job running now, never by its whole backlog. A job without a
+ * world (QUIT) goes when no world has a job left. Call with s->mu held and
+ * the queue not empty. */
+static sv_job *take_next_locked(sv_server *s)
+{
+    sv_job **best = NULL;
+    uint64_t best_d = 0;
+    for (sv_job **p = &s->jobs_head; *p; p = &(*p)->next) {
+        if (!(*p)->world) {
+            if (!best)
+                best = p;
+            continue;
+        }
+        uint64_t d = (*p)->world->id - s->gl_last_world - 1; /* turns until this world's, wrapping */
+        if (!best || !(*best)->world || d < best_d) {
+            best = p;
+            best_d = d;
+        }
+    }
+    sv_job *j = *best;
+    *best = j->next;
+    if (s->jobs_tail == j) {
+        s->jobs_tail = NULL;
+        for (sv_job *q = s->jobs_head; q; q = q->next)
+            s->jobs_tail = q;
+    }
+    j->next = NULL;
+    s->jobs_queued--;
+    if (j->world)
+        s->gl_last_world = j->world->id;
+    return j;
+}
+
+void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void *arg), void *arg)
+{
+    pthread_mutex_lock(&s->mu);
+    for (sv_job *j = s->jobs_head; j; j = j->next)
+        if (j->world == w && !j->started && !j->cancelled && j->kind != SV_JOB_DESTROY && !wanted(j, arg))
+            j->cancelled = 1;
+    pthread_mutex_unlock(&s->mu);
+}
+
 size_t sv_jobs_queued(sv_server *s)
 {
     pthread_mutex_lock(&s->mu);
@@ -359,16 +406,16 @@ static void *gl_main(void *arg)
     for (;;) {
         while (!s->jobs_head)
             pthread_cond_wait(&s->cv, &s->mu);
-        sv_job *j = s->jobs_head;
-        s->jobs_head = j->next;
-        if (!s->jobs_head)
-            s->jobs_tail = NULL;
-        s->jobs_queued--;
+        sv_job *j = take_next_locked(s);
         j->started = 1; /* from now on no request joins it (sv_world_join_tick) */
+        int cancelled = j->cancelled;
         pthread_mutex_unlock(&s->mu);
 
         int quit = 0;
-        switch (j->kind) {
+        if (cancelled) { /* nobody wants it any more (sv_gl_cancel): no GL time */
+            j->status = LPVP_E_INTERNAL;
+            snprintf(j->err, sizeof j->err, "cancelled: every request for it is gone");
+        } else switch (j->kind) {
         case SV_JOB_TICK: gl_tick(s, j); break;
         case SV_JOB_RENDER: gl_render(j); break;
         case SV_JOB_QUERY: gl_query(j); break;

@@ -264,6 +264,8 @@ void sv_do_stats(sv_conn *c, sv_request *r)
     /* tick coalescing (R7.2): computed ticks vs TICK requests answered by a tick queued for another */
     json_object_set_new(b, "ticks_computed", json_integer((json_int_t)s->ticks));
     json_object_set_new(b, "ticks_coalesced", json_integer((json_int_t)s->ticks_coalesced));
+    /* fair GL time: queued ticks skipped because every request for them had gone */
+    json_object_set_new(b, "ticks_cancelled", json_integer((json_int_t)s->ticks_cancelled));
     json_object_set_new(b, "world_ticks_computed", json_integer((json_int_t)(c->world ? c->world->ticks_computed : 0)));
     json_object_set_new(b, "world_ticks_coalesced",
                         json_integer((json_int_t)(c->world ? c->world->ticks_coalesced : 0)));

@@ -221,6 +221,8 @@ static void tick_done(sv_server *s, sv_job *j)
             sv_result_unref(w->latest);
             w->latest = sv_result_ref(j->result);
         }
+    } else if (j->cancelled) {
+        s->ticks_cancelled++;
     } else if (j->periodic && j->status) {
         fprintf(stderr, "lpvd serve: world %llu: tick failed: %s\n", (unsigned long long)w->id, j->err);
     }
@@ -401,10 +403,43 @@ void sv_world_unref(sv_world *w)
     }
 }
 
+static int conn_listens(const sv_conn *c)
+{
+    return c && !c->closing && !c->close_after_write;
+}
+
+/* Whether anyone still wants queued job j of a world that keeps
+ * (arg != NULL) or loses (arg == NULL) its last session: a request's session
+ * that is still open, the world's tick timer (a periodic tick), or for a tick
+ * a session of the world subscribed to a stream. */
+static int job_wanted(const sv_job *j, void *arg)
+{
+    const sv_world *w = arg;
+    if (!w)
+        return 0;
+    if (conn_listens(j->conn))
+        return 1;
+    for (const sv_waiter *wt = j->joined; wt; wt = wt->next)
+        if (conn_listens(wt->conn))
+            return 1;
+    if (j->kind != SV_JOB_TICK)
+        return 0;
+    if (j->periodic)
+        return 1;
+    for (const sv_conn *c = w->srv->conns; c; c = c->next)
+        if (c->world == w && conn_listens(c) && (c->subs[SV_STREAM_VOLUME].on || c->subs[SV_STREAM_FRAME].on))
+            return 1;
+    return 0;
+}
+
 void sv_world_detach(sv_conn *c)
 {
     sv_world *w = c->world;
     c->world = NULL;
+    /* a session that closes leaves its queued requests behind: nobody may
+     * want them now (a tick of 20 s for a client that has gone) */
+    if (w && c->closing && w->srv->gl_started)
+        sv_gl_cancel(w->srv, w, job_wanted, w->refs > 1 ? w : NULL);
     sv_world_unref(w);
 }
 
