@@ -51,6 +51,8 @@ static void usage(FILE *f)
             "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
+            "  --max-tick-cost N       cell-steps one tick may cost: CONFIG over it gets LIMIT (default "
+            SV_STR(SV_DEFAULT_MAX_TICK_COST) ")\n"
             "  --idle-timeout S        a silent session is sent BYE and closed (default 300)\n"
             "Default CONFIG of every session:\n"
             "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
@@ -299,7 +301,7 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "idle-timeout", "tick-rate", NULL};
+    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate", NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
 {
@@ -315,6 +317,7 @@ int lpvd_cmd_serve(int argc, char **argv)
     cfg->max_texture = 8192;
     cfg->max_grid = 128;
     cfg->max_tick_rate = 60.0;
+    cfg->max_tick_cost = SV_DEFAULT_MAX_TICK_COST;
     cfg->idle_timeout = 300.0;
     lpvd_options opt;
     memset(&opt, 0, sizeof opt);
@@ -412,6 +415,9 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "max-tick-rate")) {
             bad = parse_num(v, 0.0, 10000.0, &d);
             cfg->max_tick_rate = d;
+        } else if (!strcmp(name, "max-tick-cost")) {
+            bad = parse_u64(v, 1, (uint64_t)1 << 50, &u);
+            cfg->max_tick_cost = u;
         } else if (!strcmp(name, "idle-timeout")) {
             bad = parse_num(v, 0.0, 1e9, &d);
             cfg->idle_timeout = d;
@@ -447,6 +453,12 @@ int lpvd_cmd_serve(int argc, char **argv)
         }
     cfg->settings = opt.settings;
     cfg->backend = opt.backend;
+    lpv_settings resolved = cfg->settings;
+    lpv_settings_resolve(&resolved);
+    if (sv_tick_cost_check(cfg, &resolved, err, sizeof err) != 0) { /* every session starts with it */
+        fprintf(stderr, "lpvd serve: the default CONFIG: %s\n", err);
+        return 2;
+    }
     if (token_file && read_token(token_file, cfg, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd serve: %s\n", err);
         return 2;

@@ -52,6 +52,12 @@ typedef struct sv_world sv_world;
 typedef struct sv_job sv_job;
 
 /* ---- configuration ------------------------------------------------------ */
+/* --max-tick-cost's default, in cell-steps (core/tick_cost.h): about 4 s of
+ * propagation on llvmpipe with 2 cores (25,165,824 cell-steps took 2 s). */
+#define SV_DEFAULT_MAX_TICK_COST 40000000
+#define SV_STR_(x) #x
+#define SV_STR(x) SV_STR_(x)
+
 typedef struct sv_config {
     char socket_path[256];   /* "" = no Unix socket */
     int want_unix;
@@ -69,6 +75,7 @@ typedef struct sv_config {
     int max_texture;
     int max_grid;
     double max_tick_rate;
+    uint64_t max_tick_cost;  /* cell-steps one tick may cost (core/tick_cost.h) */
     double idle_timeout;     /* seconds */
     lpv_backend backend;
     lpv_settings settings;   /* default CONFIG */
@@ -407,6 +414,11 @@ sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
 unsigned sv_world_terms_mask(sv_world *w);
 void sv_world_update_timer(sv_world *w);
 int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: joined a queued tick */
+
+/* serve_controls.c: 0 when resolved settings s cost at most --max-tick-cost
+ * a tick, else -1 with a message naming the cost, the budget and what to
+ * lower (CONFIG's LIMIT, and the default CONFIG at start). */
+int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, size_t n);
 
 /* serve_encode.c */
 /* Volume reply/stream body + attachment. ack: the subscriber (delta source and
