@@ -12,6 +12,7 @@
  *                    sv_world_listener
  *   serve_gl.c       the GL thread and its job queue
  *   serve_encode.c   VOLUME / FRAME payloads (fp16, XOR delta, zstd, PNG, EXR)
+ *   serve_encode_work.c  runs them on libuv's work threads, sends on the loop
  *
  * Threads: the libuv loop runs on the main thread and owns every structure
  * here except the fields marked "GL thread". One GL thread owns the GL context
@@ -249,7 +250,8 @@ typedef struct sv_sub {
     int terms;              /* frame terms */
     lpv_display display;    /* frame: exposure and background of rgba8/png */
     sv_sent sent[SV_SENT_KEEP];
-    sv_sent acked;          /* raw == NULL: none */
+    sv_sent acked;          /* raw == NULL: none (or lent to the encoding in flight) */
+    uint32_t epoch;         /* bumped by sv_sub_clear: a lent base is no longer this subscription's */
 } sv_sub;
 
 struct sv_wreq; /* one frame being written (serve_net.c) */
@@ -299,6 +301,10 @@ struct sv_conn {
     struct sv_wreq *stream_pending[2]; /* newest unsent stream message */
     uint64_t bytes_sent;
     uint64_t stream_dropped;
+    /* encoding on the work threads (serve_encode_work.c), per stream: one in
+     * flight, and the newest result waiting for it (a newer replaces it) */
+    int enc_busy[2];
+    sv_result *enc_next[2]; /* ref */
     /* session */
     const sv_world_listener *listener; /* how its world reports to it */
     int hello;
@@ -420,17 +426,21 @@ int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: join
  * lower (CONFIG's LIMIT, and the default CONFIG at start). */
 int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, size_t n);
 
-/* serve_encode.c */
-/* Volume reply/stream body + attachment. ack: the subscriber (delta source and
- * where the raw is remembered), or NULL. */
-int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
-                     uint8_t **att, size_t *att_len, char *err, size_t n);
+/* serve_encode.c: thread-safe, run on libuv's work threads */
+/* Volume reply/stream body + attachment. A delta subscriber's encoding passes
+ * keep_raw: it gets the raw volume (for sv_sub_remember), and a delta against
+ * base (its ACKed volume) when base fits; else keep_raw and base are NULL. */
+int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
+                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
+                     size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
                     uint64_t revision,
                     uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len,
                     char *err, size_t n);
+/* the loop's side of a subscription */
 void sv_sub_clear(sv_sub *sub);
 void sv_sub_ack(sv_sub *sub, uint64_t tick);
+void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len);
 
 #endif

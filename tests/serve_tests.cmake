@@ -34,7 +34,7 @@ add_test(NAME conformance
           --junit "${CMAKE_CURRENT_BINARY_DIR}/conformance.xml")
 
 set(_lpvd_serve_tests conformance)
-foreach(_name midmessage slow_reader churn sigterm sighup fifo fair_gl)
+foreach(_name midmessage slow_reader churn sigterm sighup fifo fair_gl encode_offloop)
   add_test(NAME reliability_${_name}
     COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_serve_dir}/reliability/${_name}.py" --lpvd "$<TARGET_FILE:lpvd>")
   list(APPEND _lpvd_serve_tests reliability_${_name})
