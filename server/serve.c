@@ -301,7 +301,8 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate", NULL};
+    "max-triangles", "max-texture", "max-grid", "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate",
+    NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
 {

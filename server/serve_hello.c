@@ -59,7 +59,8 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
     c->hello = 1;
     char server[64];
     snprintf(server, sizeof server, "lpvd %s", LPVD_VERSION);
-    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I, s:I}", "max_body", (json_int_t)s->cfg.max_body,
+    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I, s:I}", "max_body",
+                            (json_int_t)s->cfg.max_body,
                             "max_message", (json_int_t)s->cfg.max_message, "max_clients", s->cfg.max_clients,
                             "max_triangles", (json_int_t)s->cfg.max_triangles, "max_texture", s->cfg.max_texture,
                             "max_grid", s->cfg.max_grid, "max_tick_rate", s->cfg.max_tick_rate, "idle_timeout",
