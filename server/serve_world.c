@@ -280,13 +280,14 @@ unsigned sv_world_terms_mask(sv_world *w)
     return m;
 }
 
-/* The world's tick job that the GL thread has not started yet and that was
- * queued for the world's current inputs, or NULL. Call with srv->mu held: the
+/* The world's tick job that the GL thread has not started yet, that was
+ * queued for the world's current inputs and that is not cancelled (its
+ * requesters left: sv_gl_cancel), or NULL. Call with srv->mu held: the
  * GL thread sets `started` under it. */
 static sv_job *joinable_tick_locked(sv_world *w)
 {
     sv_job *q = w->queued_tick;
-    return q && !q->started && q->gen == w->gen ? q : NULL;
+    return q && !q->started && !q->cancelled && q->gen == w->gen ? q : NULL;
 }
 
 /* Tick coalescing (R7.2): a TICK for a world whose tick is still queued for

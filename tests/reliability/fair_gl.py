@@ -121,6 +121,30 @@ def cancelled(rep, ep):
     cheap.close()
 
 
+def cancelled_shared(rep, ep):
+    """A tick cancelled when its session left is never joined: a session of the same world that sends TICK
+    afterwards gets a tick of its own, not the cancelled one's error."""
+    h = scene_session(ep, config=dict(HEAVY, iterations=64))
+    shared = dict(lc.SMALL_CONFIG, iterations=5)
+    a = scene_session(ep, config=shared)
+    b = scene_session(ep, config=shared)
+    s0 = stats(b)
+    rh = h.send(lc.TICK, {})
+    a.send(lc.TICK, {})
+    q = wait_gl_jobs(b, 1)
+    a.close()
+    t_end = time.monotonic() + 30
+    while stats(b).get("clients", 0) >= s0.get("clients", 0) and time.monotonic() < t_end:
+        time.sleep(0.02)
+    f = b.request(lc.TICK, {}, timeout=600)
+    rep.check(f.type == (lc.TICK | lc.REPLY), "a TICK of the same world after its queued tick was cancelled is "
+              "answered by a tick, not by the cancelled one's error",
+              "gl_jobs %d; %s" % (q, f.body if f.type == lc.ERROR else "type 0x%04x" % f.type))
+    ok(h.recv_reply(rh, timeout=600), lc.TICK, "heavy TICK")
+    for c in (h, b):
+        c.close()
+
+
 def main():
     ap = harness.common_args(__doc__.split("\n")[0])
     args = ap.parse_args()
@@ -131,6 +155,7 @@ def main():
         ep = ("unix", d.unix)
         fairness(rep, ep)
         cancelled(rep, ep)
+        cancelled_shared(rep, ep)
         return rep.finish(d)
     finally:
         d.kill()
