@@ -146,7 +146,8 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
 
 /* Irradiance (W/m^2, rgb) from the last tick's accumulated LPV at n points
  * (xyz triples) for surfaces with the given normals (xyz triples), the lookup
- * the shading uses. rgb receives 3n floats. */
+ * the shading uses. rgb receives 3n floats. Any n: the GPU work goes in
+ * chunks of 2^20 points (one dispatch reaches 4,194,240). */
 int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
                           size_t err_size);
 

@@ -68,48 +68,24 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     return 0;
 }
 
-int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
-                          size_t err_size)
+/* Points per dispatch of the irradiance query: the GL guarantees 65535 work
+ * groups per dimension (GL_MAX_COMPUTE_WORK_GROUP_COUNT, llvmpipe's too), so
+ * one dispatch of 64-point groups reaches 4,194,240 points; a larger query
+ * failed with GL_INVALID_VALUE (issue 14, item 7). Chunks of 2^20 points also
+ * keep the two query buffers at 48 MiB whatever the count. */
+#define QUERY_CHUNK ((size_t)1 << 20)
+#define QUERY_GROUP 64 /* shaders/query.comp's local_size_x */
+
+/* One chunk of n <= QUERY_CHUNK points through the query buffers. */
+static void irradiance_chunk(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb,
+                             float *in, float *out)
 {
-    if (!e->ticked)
-        return lpv_error(err, err_size, "irradiance query before a tick");
-    if (n == 0)
-        return 0;
-    if (n > (size_t)1 << 26)
-        return lpv_error(err, err_size, "%zu query points, at most %zu per call", n, (size_t)1 << 26);
-    float *in = malloc(n * 8 * sizeof(float));
-    float *out = malloc(n * 4 * sizeof(float));
-    if (!in || !out) {
-        free(in);
-        free(out);
-        return lpv_error(err, err_size, "out of memory for %zu query points", n);
-    }
     for (size_t i = 0; i < n; ++i) {
         for (int k = 0; k < 3; ++k) {
             in[i * 8 + (size_t)k] = points[i * 3 + (size_t)k];
             in[i * 8 + 4 + (size_t)k] = normals[i * 3 + (size_t)k];
         }
         in[i * 8 + 3] = in[i * 8 + 7] = 0.0f;
-    }
-    if (e->query_capacity < n) {
-        lpv_gl_delete_buffer(&e->query_in);
-        lpv_gl_delete_buffer(&e->query_out);
-        for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
-        }
-        e->query_in = lpv_gl_new_ssbo(n * 8 * sizeof(float));
-        e->query_out = lpv_gl_new_ssbo(n * 4 * sizeof(float));
-        GLenum alloc_err = glGetError();
-        if (alloc_err != GL_NO_ERROR) {
-            lpv_gl_delete_buffer(&e->query_in);
-            lpv_gl_delete_buffer(&e->query_out);
-            e->query_capacity = 0;
-            free(in);
-            free(out);
-            return lpv_error(err, err_size,
-                             "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)", n,
-                             (double)n * 48.0 / 1e9, alloc_err);
-        }
-        e->query_capacity = n;
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_in);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
@@ -118,13 +94,54 @@ int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *norma
     e->tech->cls->bind_lookup(e->tech, e->prog_query, e->settings.lpv.damping);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
-    glDispatchCompute(lpv_div_up(n, 64), 1, 1);
+    glDispatchCompute(lpv_div_up(n, QUERY_GROUP), 1, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_out);
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 4 * sizeof(float)), out);
     for (size_t i = 0; i < n; ++i)
         for (int k = 0; k < 3; ++k)
             rgb[i * 3 + (size_t)k] = out[i * 4 + (size_t)k];
+}
+
+int lpv_engine_irradiance(lpv_engine *e, const float *points, const float *normals, size_t n, float *rgb, char *err,
+                          size_t err_size)
+{
+    if (!e->ticked)
+        return lpv_error(err, err_size, "irradiance query before a tick");
+    if (n == 0)
+        return 0;
+    const size_t cap = n < QUERY_CHUNK ? n : QUERY_CHUNK;
+    float *in = malloc(cap * 8 * sizeof(float));
+    float *out = malloc(cap * 4 * sizeof(float));
+    if (!in || !out) {
+        free(in);
+        free(out);
+        return lpv_error(err, err_size, "out of memory for %zu query points", cap);
+    }
+    if (e->query_capacity < cap) {
+        lpv_gl_delete_buffer(&e->query_in);
+        lpv_gl_delete_buffer(&e->query_out);
+        for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
+        }
+        e->query_in = lpv_gl_new_ssbo(cap * 8 * sizeof(float));
+        e->query_out = lpv_gl_new_ssbo(cap * 4 * sizeof(float));
+        GLenum alloc_err = glGetError();
+        if (alloc_err != GL_NO_ERROR) {
+            lpv_gl_delete_buffer(&e->query_in);
+            lpv_gl_delete_buffer(&e->query_out);
+            e->query_capacity = 0;
+            free(in);
+            free(out);
+            return lpv_error(err, err_size,
+                             "could not allocate buffers for %zu query points (%.2f GB; GL error 0x%04x)", cap,
+                             (double)cap * 48.0 / 1e9, alloc_err);
+        }
+        e->query_capacity = cap;
+    }
+    for (size_t at = 0; at < n; at += cap) {
+        size_t m = n - at < cap ? n - at : cap;
+        irradiance_chunk(e, points + at * 3, normals + at * 3, m, rgb + at * 3, in, out);
+    }
     free(in);
     free(out);
     GLenum gl_err = glGetError();

@@ -55,6 +55,8 @@ static void usage(FILE *f)
             "  --max-scene-bytes BYTES memory one parsed scene may take: file, buffers, texels, model (default %llu)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
+            "  --max-tick-cost N       cell-steps one tick may cost: CONFIG over it gets LIMIT (default "
+            SV_STR(SV_DEFAULT_MAX_TICK_COST) ")\n"
             "  --idle-timeout S        a session with no complete frame for S s is sent BYE and closed\n"
             "                          (default 300)\n"
             "Before HELLO (a connection that has not yet said HELLO with the token):\n"
@@ -350,8 +352,8 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-grid", "max-tick-rate", "idle-timeout",
-    "tick-rate", "max-preauth-body", "max-request-memory", "handshake-timeout", "max-preauth", NULL};
+    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-grid", "max-tick-rate", "max-tick-cost",
+    "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory", "handshake-timeout", "max-preauth", NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
 {
@@ -371,6 +373,7 @@ int lpvd_cmd_serve(int argc, char **argv)
     s->root_fd = -1;
     cfg->max_grid = 128;
     cfg->max_tick_rate = 60.0;
+    cfg->max_tick_cost = SV_DEFAULT_MAX_TICK_COST;
     cfg->idle_timeout = 300.0;
     cfg->max_preauth_body = SV_DEFAULT_MAX_PREAUTH_BODY;
     cfg->handshake_timeout = SV_DEFAULT_HANDSHAKE_TIMEOUT;
@@ -477,6 +480,9 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "max-tick-rate")) {
             bad = parse_num(v, 0.0, 10000.0, &d);
             cfg->max_tick_rate = d;
+        } else if (!strcmp(name, "max-tick-cost")) {
+            bad = parse_u64(v, 1, (uint64_t)1 << 50, &u);
+            cfg->max_tick_cost = u;
         } else if (!strcmp(name, "idle-timeout")) {
             bad = parse_num(v, 0.0, 1e9, &d);
             cfg->idle_timeout = d;
@@ -529,6 +535,12 @@ int lpvd_cmd_serve(int argc, char **argv)
         }
     cfg->settings = opt.settings;
     cfg->backend = opt.backend;
+    lpv_settings resolved = cfg->settings;
+    lpv_settings_resolve(&resolved);
+    if (sv_tick_cost_check(cfg, &resolved, err, sizeof err) != 0) { /* every session starts with it */
+        fprintf(stderr, "lpvd serve: the default CONFIG: %s\n", err);
+        return 2;
+    }
     if (token_file && read_token(token_file, cfg, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd serve: %s\n", err);
         return 2;

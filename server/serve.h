@@ -7,14 +7,18 @@
  *                    handlers are in serve_hello.c, serve_scene.c,
  *                    serve_controls.c, serve_results.c and serve_streams.c
  *                    (serve_session_internal.h)
- *   serve_world.c    worlds (shared computations) and the GL thread; they
- *                    report to sessions through sv_world_listener
+ *   serve_world.c    worlds (shared computations) and the completions of
+ *                    their jobs; they report to sessions through
+ *                    sv_world_listener
+ *   serve_gl.c       the GL thread and its job queue
  *   serve_encode.c   VOLUME / FRAME payloads (fp16, XOR delta, zstd, PNG, EXR)
+ *   serve_encode_work.c  runs them on libuv's work threads, sends on the loop
  *
  * Threads: the libuv loop runs on the main thread and owns every structure
  * here except the fields marked "GL thread". One GL thread owns the GL context
- * and every lpv_engine; it takes sv_job's from a mutex-protected FIFO and
- * hands them back through a second FIFO and a uv_async_t. Reference counts are
+ * and every lpv_engine; it takes sv_job's from a mutex-protected queue (worlds
+ * take turns, serve_gl.c) and hands them back through a FIFO and a
+ * uv_async_t. Reference counts are
  * only ever touched on the main thread. docs/server.md has the full picture.
  */
 #ifndef LPVD_SERVE_H
@@ -55,6 +59,11 @@ typedef struct sv_job sv_job;
  * 10 M indexed triangles, ~1 GB), with room to spare. */
 #define SV_DEFAULT_MAX_SCENE_TEXELS ((uint64_t)64 << 20)
 #define SV_DEFAULT_MAX_SCENE_BYTES ((uint64_t)2 << 30)
+/* --max-tick-cost's default, in cell-steps (core/tick_cost.h): about 4 s of
+ * propagation on llvmpipe with 2 cores (25,165,824 cell-steps took 2 s). */
+#define SV_DEFAULT_MAX_TICK_COST 40000000
+#define SV_STR_(x) #x
+#define SV_STR(x) SV_STR_(x)
 
 typedef struct sv_config {
     char socket_path[256];   /* "" = no Unix socket */
@@ -76,6 +85,7 @@ typedef struct sv_config {
     uint64_t max_scene_bytes;  /* RAM one parsed scene may take (file, buffers, RGBA8 texels, model) */
     int max_grid;
     double max_tick_rate;
+    uint64_t max_tick_cost;  /* cell-steps one tick may cost (core/tick_cost.h) */
     double idle_timeout;     /* seconds since the last complete frame (R4.9) */
     /* Before HELLO (R2.5a, R4.1a): a connection that has not yet said HELLO
      * (with the token where one is required) may send frames of at most
@@ -217,6 +227,8 @@ struct sv_job {
     uint32_t request_id;
     int periodic;
     int started;            /* taken by the GL thread; under srv->mu */
+    int cancelled;          /* no request, subscriber or timer wants it: the GL thread skips it (under
+                               srv->mu; sv_gl_cancel) */
     sv_waiter *joined;      /* tick: more requests answered by this job, in order */
     unsigned terms_mask;    /* tick: which frames to render (1 << terms); under srv->mu until started */
     int terms;              /* render */
@@ -264,7 +276,8 @@ typedef struct sv_sub {
     int terms;              /* frame terms */
     lpv_display display;    /* frame: exposure and background of rgba8/png */
     sv_sent sent[SV_SENT_KEEP];
-    sv_sent acked;          /* raw == NULL: none */
+    sv_sent acked;          /* raw == NULL: none (or lent to the encoding in flight) */
+    uint32_t epoch;         /* bumped by sv_sub_clear: a lent base is no longer this subscription's */
 } sv_sub;
 
 struct sv_wreq; /* one frame being written (serve_net.c) */
@@ -319,6 +332,10 @@ struct sv_conn {
     struct sv_wreq *stream_pending[2]; /* newest unsent stream message */
     uint64_t bytes_sent;
     uint64_t stream_dropped;
+    /* encoding on the work threads (serve_encode_work.c), per stream: one in
+     * flight, and the newest result waiting for it (a newer replaces it) */
+    int enc_busy[2];
+    sv_result *enc_next[2]; /* ref */
     /* session */
     const sv_world_listener *listener; /* how its world reports to it */
     int hello;
@@ -371,6 +388,7 @@ struct sv_server {
     pthread_cond_t cv;
     sv_job *jobs_head, *jobs_tail;
     size_t jobs_queued;
+    uint64_t gl_last_world; /* id of the world whose job the GL thread took last (fair turns) */
     sv_job *done_head, *done_tail;
     int gl_ready;           /* 1 ok, -1 failed */
     char gl_err[1024];
@@ -381,6 +399,7 @@ struct sv_server {
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */
     uint64_t ticks_coalesced; /* TICK requests answered by another request's tick */
+    uint64_t ticks_cancelled; /* queued ticks skipped because every requester had gone */
     uint64_t requests;
     int exit_code;
 };
@@ -423,14 +442,24 @@ void sv_session_work_end(sv_conn *c);
  * that is written (R3.1, R7.4). */
 void sv_session_shutdown(sv_conn *c);
 
-/* serve_world.c */
+/* serve_gl.c */
 int sv_gl_start(sv_server *s, char *err, size_t n);
 void sv_gl_stop(sv_server *s);
 void sv_job_submit(sv_server *s, sv_job *j);
 sv_job *sv_job_new(sv_job_kind kind, sv_world *w);
 void sv_job_free(sv_job *j);
+size_t sv_jobs_queued(sv_server *s);
+/* Marks w's jobs that have not started and that wanted(j, arg) says nobody
+ * wants any more: the GL thread skips them (no GL time) and they complete
+ * with no result. Destroy jobs are never cancelled. Loop thread. */
+void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void *arg), void *arg);
+
+/* serve_world.c */
 sv_inputs *sv_inputs_build(sv_conn *c);
 void sv_inputs_unref(sv_inputs *in);
+void sv_inputs_release(sv_server *s, sv_inputs *in); /* unref; the scene too with the last ref */
+void sv_job_reply_all(sv_job *j);        /* the job's request and every one that joined it */
+void sv_world_jobs_done(uv_async_t *a);  /* done_async: finished jobs, on the loop */
 void sv_world_attach(sv_conn *c, sv_inputs *in); /* consumes in */
 void sv_world_detach(sv_conn *c);
 void sv_world_unref(sv_world *w);
@@ -441,19 +470,27 @@ sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
 unsigned sv_world_terms_mask(sv_world *w);
 void sv_world_update_timer(sv_world *w);
 int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: joined a queued tick */
-size_t sv_jobs_queued(sv_server *s);
 
-/* serve_encode.c */
-/* Volume reply/stream body + attachment. ack: the subscriber (delta source and
- * where the raw is remembered), or NULL. */
-int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
-                     uint8_t **att, size_t *att_len, char *err, size_t n);
+/* serve_controls.c: 0 when resolved settings s cost at most --max-tick-cost
+ * a tick, else -1 with a message naming the cost, the budget and what to
+ * lower (CONFIG's LIMIT, and the default CONFIG at start). */
+int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, size_t n);
+
+/* serve_encode.c: thread-safe, run on libuv's work threads */
+/* Volume reply/stream body + attachment. A delta subscriber's encoding passes
+ * keep_raw: it gets the raw volume (for sv_sub_remember), and a delta against
+ * base (its ACKed volume) when base fits; else keep_raw and base are NULL. */
+int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
+                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
+                     size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
                     uint64_t revision,
                     uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len,
                     char *err, size_t n);
+/* the loop's side of a subscription */
 void sv_sub_clear(sv_sub *sub);
 void sv_sub_ack(sv_sub *sub, uint64_t tick);
+void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len);
 
 #endif

@@ -16,6 +16,7 @@
 
 #include "cascades.h"
 #include "settings_fields.h"
+#include "tick_cost.h"
 
 #define SV_MAX_LIGHTS 256
 #define SV_MAX_VIEW_SIDE 4096
@@ -356,6 +357,10 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
         snprintf(err, sizeof err, "cascade_size: %s", why);
         goto bad;
     }
+    if (sv_tick_cost_check(&s->cfg, &chk, err, sizeof err) != 0) { /* R4.6a: the settings as a whole */
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "%s", err);
+        return;
+    }
     c->settings = st;
     c->tick_rate = rate;
     sv_session_changed(c);
@@ -365,6 +370,17 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
     return;
 bad:
     sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+}
+
+int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, size_t n)
+{
+    lpv_tick_cost tc;
+    lpv_tick_cost_estimate(s, &tc);
+    if (tc.cell_steps <= (double)cfg->max_tick_cost)
+        return 0;
+    snprintf(err, n, "tick cost: %s = %.0f cell-steps, over the server's budget of %llu a tick (--max-tick-cost); "
+             "lower %s", tc.terms, tc.cell_steps, (unsigned long long)cfg->max_tick_cost, tc.lower);
+    return -1;
 }
 
 /* CONFIG's reply and STATS' "config": the session's settings, resolved. */

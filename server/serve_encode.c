@@ -6,10 +6,17 @@
  * ao term as a linear fraction. A volume carries every cascade (R5.6,
  * cascade 0 first), or technique iv's voxels and their index (R5.14), and
  * both headers the tick's "plan" (lpvd_plan_json).
+ *
+ * The encoders run on libuv's work threads (serve_encode_work.c): they read
+ * only immutable results and what they are given, and the one shared thing
+ * they write, a result's keyframe cache, is under enc_mu. A subscriber's
+ * state (its ACKed base, the volumes it may ACK) is the loop's: the caller
+ * hands the base in and remembers the raw volume that comes out.
  */
 #include "serve.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,8 +26,13 @@
 #include "tonemap.h"
 #include "volume_codec.h"
 
+/* Guards every sv_result's enc / enc_len (the keyframe cache): encoders of
+ * one result run on several work threads at once. */
+static pthread_mutex_t enc_mu = PTHREAD_MUTEX_INITIALIZER;
+
 void sv_sub_clear(sv_sub *sub)
 {
+    sub->epoch++; /* an encoding in flight no longer hands its base back (sv_sub_restore_base) */
     for (int i = 0; i < SV_SENT_KEEP; ++i) {
         free(sub->sent[i].raw);
         sub->sent[i].raw = NULL;
@@ -47,7 +59,8 @@ void sv_sub_ack(sv_sub *sub, uint64_t tick)
     }
 }
 
-static void remember_sent(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, const uint8_t *raw, size_t len)
+/* Keeps raw (taken, not copied) as a volume sent to sub that it may ACK. */
+void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len)
 {
     int slot = 0;
     for (int i = 0; i < SV_SENT_KEEP; ++i) {
@@ -58,12 +71,8 @@ static void remember_sent(sv_sub *sub, uint64_t tick, const int dims[3], int fp1
         if (sub->sent[i].tick < sub->sent[slot].tick)
             slot = i;
     }
-    uint8_t *copy = malloc(len ? len : 1);
-    if (!copy)
-        return;
-    memcpy(copy, raw, len);
     free(sub->sent[slot].raw);
-    sub->sent[slot].raw = copy;
+    sub->sent[slot].raw = raw;
     sub->sent[slot].raw_len = len;
     sub->sent[slot].tick = tick;
     sub->sent[slot].fp16 = fp16;
@@ -88,9 +97,48 @@ static void pack_levels(const sv_result *r, const lpvp_volume_info *vi, uint8_t 
     pack_index(raw + lpvp_volume_values_bytes(vi), r->index, r->index_count);
 }
 
-int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub, uint64_t revision, json_t **body,
-                     uint8_t **att, size_t *att_len, char *err, size_t n)
+/* A copy of r's cached keyframe attachment [fp16][zstd] in *att, or 0
+ * when none is cached (or no memory for the copy). */
+static int cache_copy(sv_result *r, int fp16, int zstd, uint8_t **att, size_t *att_len)
 {
+    int got = 0;
+    pthread_mutex_lock(&enc_mu);
+    const uint8_t *c = r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
+    size_t len = r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0];
+    if (c) {
+        *att = malloc(len ? len : 1);
+        if (*att) {
+            memcpy(*att, c, len);
+            *att_len = len;
+            got = 1;
+        }
+    }
+    pthread_mutex_unlock(&enc_mu);
+    return got;
+}
+
+/* Caches a copy of att as r's keyframe [fp16][zstd], unless another encoder
+ * got there first. */
+static void cache_put(sv_result *r, int fp16, int zstd, const uint8_t *att, size_t len)
+{
+    pthread_mutex_lock(&enc_mu);
+    uint8_t **c = &r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
+    if (!*c) {
+        *c = malloc(len ? len : 1);
+        if (*c) {
+            memcpy(*c, att, len);
+            r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0] = len;
+        }
+    }
+    pthread_mutex_unlock(&enc_mu);
+}
+
+int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
+                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
+                     size_t n)
+{
+    if (keep_raw)
+        *keep_raw = NULL;
     lpvp_volume_format fmt = fp16 ? LPVP_FMT_FP16 : LPVP_FMT_FP32;
     const int levels = content == LPVP_CONTENT_LEVELS;
     lpvp_volume_info vi;
@@ -158,57 +206,37 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub,
     vi.raw_length = raw_len;
 
     /* the keyframe cache and XOR deltas (R5.3) hold the merged content only */
-    uint8_t *raw = NULL;
-    int fast = !levels && r->enc[fp16 ? 1 : 0][zstd ? 1 : 0] && !(sub && sub->delta);
     if (levels)
-        sub = NULL;
-    if (!fast) {
-        raw = malloc(raw_len ? raw_len : 1);
-        if (!raw) {
-            snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
-            return -1;
-        }
-        if (levels) {
-            pack_levels(r, &vi, raw);
-        } else {
-            lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
-            if (vi.layout.has_index) /* R5.14 */
-                pack_index(raw + lpvp_volume_values_bytes(&vi), r->iv_held, r->iv_held_count);
-        }
+        keep_raw = NULL;
+    if (!levels && !keep_raw && cache_copy(r, fp16, zstd, att, att_len)) /* another session had it encoded */
+        goto header;
+    uint8_t *raw = malloc(raw_len ? raw_len : 1);
+    if (!raw) {
+        snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
+        return -1;
+    }
+    if (levels) {
+        pack_levels(r, &vi, raw);
+    } else {
+        lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
+        if (vi.layout.has_index) /* R5.14 */
+            pack_index(raw + lpvp_volume_values_bytes(&vi), r->iv_held, r->iv_held_count);
     }
 
     uint8_t *payload = raw; /* what gets compressed / sent */
     uint8_t *delta = NULL;
-    if (sub && !fast) {
-        if (sub->delta && sub->acked.raw && sub->acked.fp16 == fp16 && sub->acked.raw_len == raw_len &&
-            memcmp(sub->acked.dims, r->grid.dims, sizeof sub->acked.dims) == 0 && sub->acked.tick < r->tick) {
-            delta = malloc(raw_len ? raw_len : 1);
-            if (delta) {
-                lpvp_xor(delta, raw, sub->acked.raw, raw_len);
-                payload = delta;
-                vi.keyframe = 0;
-                vi.base_tick = (int64_t)sub->acked.tick;
-            }
+    if (keep_raw && base && base->raw && base->fp16 == fp16 && base->raw_len == raw_len &&
+        memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick < r->tick) {
+        delta = malloc(raw_len ? raw_len : 1);
+        if (delta) {
+            lpvp_xor(delta, raw, base->raw, raw_len);
+            payload = delta;
+            vi.keyframe = 0;
+            vi.base_tick = (int64_t)base->tick;
         }
-        if (sub->delta)
-            remember_sent(sub, r->tick, r->grid.dims, fp16, raw, raw_len);
     }
-
-    uint8_t *no_cache = NULL;
-    size_t no_cache_len = 0;
-    uint8_t **cache = levels ? &no_cache : &r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
-    size_t *cache_len = levels ? &no_cache_len : &r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0];
-    if (vi.keyframe && *cache) { /* another subscriber already had this keyframe encoded */
-        uint8_t *copy = malloc(*cache_len ? *cache_len : 1);
-        if (!copy) {
-            free(raw);
-            free(delta);
-            snprintf(err, n, "out of memory");
-            return -1;
-        }
-        memcpy(copy, *cache, *cache_len);
-        *att = copy;
-        *att_len = *cache_len;
+    if (vi.keyframe && !levels && cache_copy(r, fp16, zstd, att, att_len)) {
+        /* cached meanwhile */
     } else if (zstd) {
         uint8_t *z = NULL;
         size_t zlen = 0;
@@ -219,24 +247,34 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, sv_sub *sub,
         }
         *att = z;
         *att_len = zlen;
-    } else if (payload == raw) {
-        *att = raw;
-        raw = NULL;
-        *att_len = raw_len;
-    } else {
+    } else if (payload == delta) {
         *att = delta;
         delta = NULL;
         *att_len = raw_len;
-    }
-    free(raw);
-    free(delta);
-    if (vi.keyframe && !levels && !*cache && *att) {
-        *cache = malloc(*att_len ? *att_len : 1);
-        if (*cache) {
-            memcpy(*cache, *att, *att_len);
-            *cache_len = *att_len;
+    } else if (!keep_raw) {
+        *att = raw;
+        raw = NULL;
+        *att_len = raw_len;
+    } else { /* sent and remembered: two copies */
+        *att = malloc(raw_len ? raw_len : 1);
+        if (!*att) {
+            free(raw);
+            snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
+            return -1;
         }
+        memcpy(*att, raw, raw_len);
+        *att_len = raw_len;
     }
+    free(delta);
+    if (keep_raw) { /* the subscriber remembers it (sv_sub_remember) */
+        *keep_raw = raw;
+        *keep_len = raw_len;
+    } else {
+        free(raw);
+    }
+    if (vi.keyframe && !levels && *att)
+        cache_put(r, fp16, zstd, *att, *att_len);
+header:
     *body = lpvp_volume_header_build(&vi);
     if (*body && json_object_set_new(*body, "plan", lpvd_plan_json(&r->plan)) != 0) {
         json_decref(*body);

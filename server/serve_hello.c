@@ -75,6 +75,8 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
         json_object_set_new(lim, "max_scene_texels", json_integer((json_int_t)s->cfg.max_scene_texels));
         json_object_set_new(lim, "max_scene_bytes", json_integer((json_int_t)s->cfg.max_scene_bytes));
     }
+    if (lim)
+        json_object_set_new(lim, "max_tick_cost", json_integer((json_int_t)s->cfg.max_tick_cost));
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);

@@ -114,33 +114,8 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
                      lpvp_volume_content_names[LPVP_CONTENT_MERGED]);
         return;
     }
-    json_t *b = NULL;
-    uint8_t *att = NULL;
-    size_t alen = 0;
-    if (sv_encode_volume(c->world->latest, content, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD, NULL, c->revision, &b, &att, &alen, err,
-                         sizeof err) != 0) {
-        sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "%s", err);
-        return;
-    }
-    sv_send(c, LPVP_REPLY(LPVP_GET_VOLUME), r->request_id, b, att, alen, SV_STREAM_NONE);
-}
-
-static void send_frame_reply(sv_conn *c, uint32_t rid, const float *rgba, int w, int h, int fmt, int zstd, int terms,
-                             const lpv_display *display, uint64_t tick)
-{
-    /* the plan of the tick shown, when it is still the world's latest */
-    const lpv_plan *plan = c->world && c->world->latest && c->world->latest->tick == tick ? &c->world->latest->plan
-                                                                                          : NULL;
-    char err[512];
-    json_t *b = NULL;
-    uint8_t *att = NULL;
-    size_t alen = 0;
-    if (sv_encode_frame(rgba, w, h, fmt, zstd, terms, display, c->revision, tick, plan, &b, &att, &alen, err,
-                        sizeof err) != 0) {
-        sv_reply_err(c, rid, LPVP_E_INTERNAL, 0, "%s", err);
-        return;
-    }
-    sv_send(c, LPVP_REPLY(LPVP_GET_FRAME), rid, b, att, alen, SV_STREAM_NONE);
+    /* packed and compressed on a work thread; the session is busy until the reply is queued */
+    sv_reply_volume(c, r->request_id, c->world->latest, content, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD);
 }
 
 void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
@@ -160,10 +135,10 @@ void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
                   "no tick yet for this session's current scene, lights, camera and config: send TICK first");
         return;
     }
-    const sv_result *res = c->world->latest;
-    if (res->frames[terms]) { /* rendered with the tick already */
-        send_frame_reply(c, r->request_id, res->frames[terms], res->width, res->height, fmt, comp == LPVP_COMP_ZSTD, terms,
-                         &display, res->tick);
+    sv_result *res = c->world->latest;
+    if (res->frames[terms]) { /* rendered with the tick already: encoded on a work thread */
+        sv_reply_frame(c, r->request_id, res, NULL, res->width, res->height, fmt, comp == LPVP_COMP_ZSTD, terms,
+                       &display, res->tick);
         return;
     }
     sv_job *jb = sv_job_new(SV_JOB_RENDER, c->world);
@@ -266,6 +241,8 @@ void sv_do_stats(sv_conn *c, sv_request *r)
     /* tick coalescing (R7.2): computed ticks vs TICK requests answered by a tick queued for another */
     json_object_set_new(b, "ticks_computed", json_integer((json_int_t)s->ticks));
     json_object_set_new(b, "ticks_coalesced", json_integer((json_int_t)s->ticks_coalesced));
+    /* fair GL time: queued ticks skipped because every request for them had gone */
+    json_object_set_new(b, "ticks_cancelled", json_integer((json_int_t)s->ticks_cancelled));
     json_object_set_new(b, "world_ticks_computed", json_integer((json_int_t)(c->world ? c->world->ticks_computed : 0)));
     json_object_set_new(b, "world_ticks_coalesced",
                         json_integer((json_int_t)(c->world ? c->world->ticks_coalesced : 0)));
@@ -285,23 +262,15 @@ void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
         json_object_set_new(b, "tick", json_integer((json_int_t)j->result->tick));
         json_object_set_new(b, "stats", tick_stats(j->result));
         sv_reply(c, LPVP_TICK, request_id, b);
-    } else if (j->kind == SV_JOB_RENDER) {
-        send_frame_reply(c, request_id, j->rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
-                         j->terms, &j->display, j->tick);
-    } else if (j->kind == SV_JOB_QUERY) {
-        uint8_t *att = malloc(j->count ? j->count * 12 : 1);
-        if (!att) {
-            sv_reply_err(c, request_id, LPVP_E_INTERNAL, 0, "out of memory");
-        } else {
-            for (size_t i = 0; i < j->count * 3; ++i) {
-                uint32_t u;
-                memcpy(&u, &j->out[i], 4);
-                lpvp_put_u32(att + i * 4, u);
-            }
-            json_t *b = json_pack("{s:I, s:I, s:I}", "revision", (json_int_t)c->revision, "tick", (json_int_t)j->tick,
-                                  "count", (json_int_t)j->count);
-            sv_send(c, LPVP_REPLY(LPVP_QUERY_IRRADIANCE), request_id, b, att, j->count * 12, SV_STREAM_NONE);
-        }
+    } else if (j->kind == SV_JOB_RENDER) { /* the frame passes to the encoding on a work thread */
+        float *rgba = j->rgba;
+        j->rgba = NULL;
+        sv_reply_frame(c, request_id, NULL, rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
+                       j->terms, &j->display, j->tick);
+    } else if (j->kind == SV_JOB_QUERY) { /* so do the answers, packed there */
+        float *out = j->out;
+        j->out = NULL;
+        sv_reply_query(c, request_id, out, j->count, j->tick);
     }
-    sv_session_pump(c);
+    sv_session_pump(c); /* a reply encoding keeps the session busy: nothing is taken before it is queued */
 }

@@ -10,6 +10,7 @@
  *                     and the replies of GL jobs
  *   serve_streams.c   SUBSCRIBE, UNSUBSCRIBE, ACK and the VOLUME / FRAME
  *                     streams after each tick
+ *   serve_encode_work.c  their payloads encoded on libuv's work threads
  *
  * Everything here runs on the loop thread. Each sv_do_* handles one request
  * type for dispatch (serve_session.c): it either replies before it returns or
@@ -53,6 +54,19 @@ int sv_get_display(const json_t *j, lpv_display *d, char *err, size_t n);
  * render them; -1 with a message naming "terms" for "ao" without technique iv
  * and iv_ao on (SPEC section 6, BAD_FIELD). */
 int sv_terms_check(const sv_conn *c, int terms, char *err, size_t n);
+
+/* ---- encoding on libuv's work threads, sending on the loop (serve_encode_work.c) ----
+ * A reply keeps the session busy until it is queued (R3.2) and carries the
+ * revision of when the request was handled (R3.3); a frame over --max-queue
+ * is not sent: ERROR LIMIT instead (R3.5). */
+void sv_reply_volume(sv_conn *c, uint32_t rid, sv_result *r, int content, int fp16, int zstd);
+/* rgba_owned: a rendered frame, taken; NULL: r's frames[terms], r referenced */
+void sv_reply_frame(sv_conn *c, uint32_t rid, sv_result *r, float *rgba_owned, int w, int h, int fmt, int zstd,
+                    int terms, const lpv_display *display, uint64_t tick);
+void sv_reply_query(sv_conn *c, uint32_t rid, float *out_owned, size_t count, uint64_t tick); /* out: taken */
+/* The stream's message of tick result r, after the one in flight (a newer
+ * result replaces one still waiting, R5.5). */
+void sv_stream_result(sv_conn *c, int stream, sv_result *r);
 
 /* ---- what the world reports, through sv_world_listener (serve.h) ---- */
 void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id); /* serve_results.c */

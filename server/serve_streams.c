@@ -70,31 +70,15 @@ void sv_do_ack(sv_conn *c, sv_request *r, json_t *j)
 }
 
 /* ---- streams ---------------------------------------------------------------- */
+/* After every reply of a tick of c's world: the subscribed messages, encoded
+ * on a work thread (serve_encode_work.c), newest first when it falls behind. */
 void sv_session_stream(sv_conn *c, sv_result *r)
 {
     if (!c->hello || c->close_after_write || c->world_gen != r->gen)
         return;
-    char err[512];
-    sv_sub *vs = &c->subs[SV_STREAM_VOLUME];
-    if (vs->on) {
-        json_t *b = NULL;
-        uint8_t *att = NULL;
-        size_t alen = 0;
-        if (sv_encode_volume(r, LPVP_CONTENT_MERGED, vs->fp16, vs->zstd, vs, c->revision, &b, &att, &alen, err, sizeof err) == 0)
-            sv_send(c, LPVP_VOLUME, 0, b, att, alen, SV_STREAM_VOLUME);
-        else
-            fprintf(stderr, "lpvd serve: client %llu: volume: %s\n", (unsigned long long)c->id, err);
-    }
+    if (c->subs[SV_STREAM_VOLUME].on)
+        sv_stream_result(c, SV_STREAM_VOLUME, r);
     sv_sub *fs = &c->subs[SV_STREAM_FRAME];
-    if (fs->on && r->frames[fs->terms] && !c->closing) {
-        json_t *b = NULL;
-        uint8_t *att = NULL;
-        size_t alen = 0;
-        if (sv_encode_frame(r->frames[fs->terms], r->width, r->height, fs->fmt, fs->zstd, fs->terms, &fs->display,
-                            c->revision,
-                            r->tick, &r->plan, &b, &att, &alen, err, sizeof err) == 0)
-            sv_send(c, LPVP_FRAME, 0, b, att, alen, SV_STREAM_FRAME);
-        else
-            fprintf(stderr, "lpvd serve: client %llu: frame: %s\n", (unsigned long long)c->id, err);
-    }
+    if (fs->on && r->frames[fs->terms] && !c->closing)
+        sv_stream_result(c, SV_STREAM_FRAME, r);
 }

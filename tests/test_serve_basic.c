@@ -238,11 +238,13 @@ static int start_daemon(void **state)
     fflush(NULL);
     child = fork();
     if (child == 0) {
+        /* --max-tick-cost: test_sharing_coalesces' blocker is a long tick on purpose */
         char *argv[] = {"lpvd", "serve", "--socket", sock_path, "--scene-root", root_dir, "--grid", "8",
-                        "--iterations", "2", "--rsm-size", "64", "--emissive-vpls", "64", NULL};
+                        "--iterations", "2", "--rsm-size", "64", "--emissive-vpls", "64", "--max-tick-cost",
+                        "1000000000", NULL};
         if (have_exe)
             execv(exe, argv);
-        int rc = lpvd_cmd_serve(14, argv + 1);
+        int rc = lpvd_cmd_serve(16, argv + 1);
         fflush(NULL);
         _exit(rc);
     }

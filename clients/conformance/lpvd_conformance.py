@@ -1381,6 +1381,30 @@ def c_limit_tick_rate(ctx):
     return "1e6 Hz refused"
 
 
+@case("R4.6a", "CONFIG whose tick would cost over the tick budget gets LIMIT naming it; nothing changes")
+def c_limit_tick_cost(ctx):
+    c = ctx.session()
+    budget = (ctx.limits or {}).get("max_tick_cost")
+    if not isinstance(budget, int) or budget < 1:
+        raise Fail("HELLO limits advertise no integer max_tick_cost (R4.6a)")
+    knobs = {k.get("name"): k for k in (ctx.hello_reply or {}).get("knobs", []) if isinstance(k, dict)}
+    it_max = knobs.get("iterations", {}).get("max")
+    mg = ctx.max_grid() or 32
+    g = min(mg, 64)
+    if not isinstance(it_max, int) or g ** 3 * it_max <= budget:
+        raise Skip("grid %d and the largest iterations (%r) stay within max_tick_cost %d" % (g, it_max, budget))
+    before = expect_reply(c.request(CONFIG, {"iterations": 3}), CONFIG).body.get("config", {})
+    rid = c.send(CONFIG, {"grid": [g, g, g], "iterations": it_max})
+    f = c.recv_reply(rid)
+    expect_error(f, "LIMIT", rid)
+    msg = f.body.get("message", "")
+    check(str(budget) in msg, "the LIMIT message does not name the budget %d: %r" % (budget, msg))
+    after = expect_reply(c.request(CONFIG, {}), CONFIG).body.get("config", {})
+    check(after.get("grid") == before.get("grid") and after.get("iterations") == 3,
+          "the refused CONFIG changed the effective config: %r -> %r" % (before, after))
+    return "grid %d x %d iterations refused against %d: %s" % (g, it_max, budget, msg)
+
+
 @case("R4.6 R2.9", "invalid CONFIG values get BAD_FIELD")
 def c_config_invalid(ctx):
     c = ctx.session()

@@ -1,0 +1,512 @@
+/*
+ * serve_gl.c - the GL thread of `lpvd serve` and its job queue. The GL thread
+ * is the only thread that touches GL: it creates the context, owns every
+ * world's engine, and runs jobs (tick, render, query, destroy) one at a time;
+ * finished jobs go back to the loop through done_async, where the world layer
+ * (serve_world.c, sv_world_jobs_done) replies and streams.
+ */
+#include "serve.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double wall_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+/* ---- jobs --------------------------------------------------------------- */
+sv_job *sv_job_new(sv_job_kind kind, sv_world *w)
+{
+    sv_job *j = calloc(1, sizeof *j);
+    if (!j)
+        return NULL;
+    j->kind = kind;
+    j->world = w;
+    if (w) {
+        j->inputs = w->inputs;
+        if (j->inputs)
+            j->inputs->refs++;
+        j->gen = w->gen;
+        w->jobs++;
+    }
+    return j;
+}
+
+void sv_job_free(sv_job *j)
+{
+    if (!j)
+        return;
+    if (j->world) {
+        j->world->jobs--;
+        if (j->world->queued_tick == j)
+            j->world->queued_tick = NULL;
+        sv_inputs_release(j->world->srv, j->inputs);
+    }
+    if (j->conn)
+        sv_conn_unref(j->conn);
+    while (j->joined) {
+        sv_waiter *wt = j->joined;
+        j->joined = wt->next;
+        sv_conn_unref(wt->conn);
+        free(wt);
+    }
+    sv_result_unref(j->result);
+    free(j->points);
+    free(j->rgba);
+    free(j->out);
+    free(j);
+}
+
+void sv_job_submit(sv_server *s, sv_job *j)
+{
+    pthread_mutex_lock(&s->mu);
+    j->next = NULL;
+    if (s->jobs_tail)
+        s->jobs_tail->next = j;
+    else
+        s->jobs_head = j;
+    s->jobs_tail = j;
+    s->jobs_queued++;
+    pthread_cond_signal(&s->cv);
+    pthread_mutex_unlock(&s->mu);
+}
+
+/* Fair GL time: which queued job runs next, unlinked from the queue. Worlds
+ * take turns: the oldest job of the first world after the one served last
+ * (by id, wrapping round) that has a job queued. So a world's jobs still run
+ * in the order they were queued (its destroy job last), and a world with many
+ * jobs (sessions sharing it, each with a request) delays another world by at
+ * most the job running now, never by its whole backlog. A job without a
+ * world (QUIT) goes when no world has a job left. Call with s->mu held and
+ * the queue not empty. */
+static sv_job *take_next_locked(sv_server *s)
+{
+    sv_job **best = NULL;
+    uint64_t best_d = 0;
+    for (sv_job **p = &s->jobs_head; *p; p = &(*p)->next) {
+        if (!(*p)->world) {
+            if (!best)
+                best = p;
+            continue;
+        }
+        uint64_t d = (*p)->world->id - s->gl_last_world - 1; /* turns until this world's, wrapping */
+        if (!best || !(*best)->world || d < best_d) {
+            best = p;
+            best_d = d;
+        }
+    }
+    sv_job *j = *best;
+    *best = j->next;
+    if (s->jobs_tail == j) {
+        s->jobs_tail = NULL;
+        for (sv_job *q = s->jobs_head; q; q = q->next)
+            s->jobs_tail = q;
+    }
+    j->next = NULL;
+    s->jobs_queued--;
+    if (j->world)
+        s->gl_last_world = j->world->id;
+    return j;
+}
+
+void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void *arg), void *arg)
+{
+    pthread_mutex_lock(&s->mu);
+    for (sv_job *j = s->jobs_head; j; j = j->next)
+        if (j->world == w && !j->started && !j->cancelled && j->kind != SV_JOB_DESTROY && !wanted(j, arg))
+            j->cancelled = 1;
+    pthread_mutex_unlock(&s->mu);
+}
+
+size_t sv_jobs_queued(sv_server *s)
+{
+    pthread_mutex_lock(&s->mu);
+    size_t n = s->jobs_queued;
+    pthread_mutex_unlock(&s->mu);
+    return n;
+}
+
+/* ---- GL thread ---------------------------------------------------------- */
+static uint64_t scene_sig(const sv_inputs *in)
+{
+    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, &in->scene, sizeof in->scene);
+    if (in->material_count)
+        h = lpv_hash_bytes(h, in->materials, sizeof(lpv_material) * in->material_count);
+    h = lpv_hash_bytes(h, &in->material_count, sizeof in->material_count);
+    if (in->light_count)
+        h = lpv_hash_bytes(h, in->lights, sizeof(lpv_light) * in->light_count);
+    h = lpv_hash_bytes(h, &in->light_count, sizeof in->light_count);
+    return h;
+}
+
+/* Brings the world's engine to the job's inputs. */
+static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, size_t n)
+{
+    if (!w->engine) {
+        w->engine = lpv_engine_create(err, n);
+        if (!w->engine)
+            return -1;
+        w->gl_has_applied = 0;
+    }
+    if (w->gl_has_applied && w->gl_applied_gen == gen)
+        return 0;
+    uint64_t sig = scene_sig(in);
+    int settings_changed = !w->gl_has_applied || memcmp(&w->gl_settings, &in->settings, sizeof in->settings) != 0;
+    int scene_changed = !w->gl_has_applied || w->gl_scene_sig != sig;
+    int view_changed = !w->gl_has_applied || memcmp(&w->gl_view, &in->view, sizeof in->view) != 0;
+    w->gl_has_applied = 0;
+    if (settings_changed && lpv_engine_set_settings(w->engine, &in->settings, err, n) != 0)
+        return -1;
+    /* the engine re-samples the scene itself when a knob needs it: a CONFIG
+     * sends no geometry again (lpv_engine_set_settings) */
+    if (scene_changed) {
+        lpv_scene sc = in->scene->scene;
+        sc.materials = in->materials;
+        sc.material_count = in->material_count;
+        sc.lights = in->lights;
+        sc.light_count = in->light_count;
+        if (lpv_engine_set_scene(w->engine, &sc, err, n) != 0)
+            return -1;
+    }
+    if (view_changed && lpv_engine_set_view(w->engine, &in->view, err, n) != 0)
+        return -1;
+    w->gl_settings = in->settings;
+    w->gl_view = in->view;
+    w->gl_scene_sig = sig;
+    w->gl_applied_gen = gen;
+    w->gl_has_applied = 1;
+    w->gl_ticked = 0;
+    return 0;
+}
+
+/* GET_VOLUME content "levels" (SPEC R5.13): with a technique that has an
+ * index volume (the octree), its levels and index, read now on the GL thread.
+ * 0 (nothing kept for a technique without one) or -1 with err. */
+static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
+{
+    size_t cells0 = lpv_grid_cell_count(&r->grid);
+    int count = lpvp_octree_level_count(r->grid.dims[0]);
+    if (count < 1) /* no octree over this grid */
+        return 0;
+    int32_t *index = malloc((cells0 ? cells0 : 1) * sizeof *index);
+    if (!index) {
+        snprintf(err, n, "out of memory for a %zu-cell index volume", cells0);
+        return -1;
+    }
+    size_t got = lpv_engine_read_index(e, index, cells0);
+    if (got == 0) { /* no index volume: no levels to send */
+        free(index);
+        return 0;
+    }
+    lpvp_cascade_info c0 = {.dims = {r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]}, .cells = cells0};
+    size_t total = 0;
+    for (int i = 0; i < count; ++i) {
+        lpvp_cascade_info ci;
+        lpvp_octree_level_place(&c0, i, &ci);
+        total += (size_t)ci.cells;
+    }
+    r->levels = malloc((total ? total : 1) * sizeof(lpv_cell));
+    r->index = malloc((cells0 ? cells0 : 1) * sizeof *r->index);
+    if (!r->levels || !r->index || got != cells0 ||
+        lpv_engine_read_volumes(e, LPV_GRID_ACCUMULATED, (lpv_cell *)r->levels, total) != total) {
+        snprintf(err, n, "%s", !r->levels || !r->index ? "out of memory for the octree's levels"
+                                                       : "the octree's levels or index volume could not be read back");
+        free(index);
+        return -1;
+    }
+    for (size_t i = 0; i < cells0; ++i)
+        r->index[i] = (uint32_t)index[i];
+    free(index);
+    r->level_cells = total;
+    r->index_count = cells0;
+    return 0;
+}
+
+/* An iv volume's index (SPEC R5.14): which voxels hold a surface, read now
+ * on the GL thread from the voxels (IvVoxel.normal[3], the points that landed
+ * in each), and *occupied their count. 0 (nothing kept for a volume that is
+ * not an imperfect volume's) or -1 with err. */
+static int keep_iv_held(lpv_engine *e, sv_result *r, long long *occupied, char *err, size_t n)
+{
+    if (lpv_engine_last_stats(e)->volume.kind != LPV_LEVELS_IV_VOXELS)
+        return 0;
+    size_t cells = lpv_grid_cell_count(&r->grid);
+    struct IvVoxel *vox = malloc((cells ? cells : 1) * sizeof *vox);
+    r->iv_held = malloc((cells ? cells : 1) * sizeof *r->iv_held);
+    if (!vox || !r->iv_held || lpv_engine_read_iv_voxels(e, vox, cells) != cells) {
+        snprintf(err, n, "%s", !vox || !r->iv_held ? "out of memory for the imperfect volume's voxels"
+                                                    : "the imperfect volume's voxels could not be read back");
+        free(vox);
+        return -1;
+    }
+    *occupied = 0;
+    for (size_t i = 0; i < cells; ++i) {
+        r->iv_held[i] = vox[i].normal[3] > 0.0f; /* lpv_iv_occupied */
+        *occupied += r->iv_held[i];
+    }
+    free(vox);
+    r->iv_held_count = cells;
+    return 0;
+}
+
+static void gl_tick(sv_server *s, sv_job *j)
+{
+    (void)s;
+    sv_world *w = j->world;
+    double t0 = wall_ms();
+    if (gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err) != 0 ||
+        lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
+        j->status = LPVP_E_INTERNAL;
+        return;
+    }
+    w->gl_ticked = 1;
+    w->gl_ticked_gen = j->gen;
+    sv_result *r = calloc(1, sizeof *r);
+    if (!r) {
+        j->status = LPVP_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory");
+        return;
+    }
+    r->refs = 1;
+    r->gen = j->gen;
+    r->grid = *lpv_engine_grid(w->engine);
+    r->cascade_count = lpv_engine_cascade_count(w->engine);
+    if (r->cascade_count < 1)
+        r->cascade_count = 1;
+    if (r->cascade_count > LPVP_MAX_CASCADES)
+        r->cascade_count = LPVP_MAX_CASCADES;
+    r->cell_count = 0;
+    for (int k = 0; k < r->cascade_count; ++k) {
+        const lpv_grid *g = lpv_engine_cascade(w->engine, k);
+        r->cascades[k] = g ? *g : r->grid;
+        r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
+    }
+    r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
+    if (!r->cells) {
+        j->status = LPVP_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory for %zu cells", r->cell_count);
+        sv_result_unref(r);
+        return;
+    }
+    size_t got = lpv_engine_read_grid(w->engine, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
+    if (got < r->cell_count)
+        memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
+    long long occupied = -1;
+    if (keep_levels(w->engine, r, j->err, sizeof j->err) != 0 ||
+        keep_iv_held(w->engine, r, &occupied, j->err, sizeof j->err) != 0) {
+        j->status = LPVP_E_INTERNAL;
+        sv_result_unref(r);
+        return;
+    }
+    r->width = j->inputs->view.width;
+    r->height = j->inputs->view.height;
+    for (int t = 0; t < LPVP_TERMS_COUNT; ++t) {
+        if (!(j->terms_mask & (1u << t)))
+            continue;
+        size_t px = (size_t)r->width * (size_t)r->height;
+        r->frames[t] = malloc(px * 4 * sizeof(float));
+        if (!r->frames[t] || lpv_engine_render(w->engine, (lpv_frame_terms)t, r->frames[t], j->err, sizeof j->err)) {
+            free(r->frames[t]);
+            r->frames[t] = NULL;
+        }
+    }
+    r->stats = *lpv_engine_last_stats(w->engine);
+    if (r->iv_held)
+        r->stats.iv.occupied = occupied; /* counted from the index the volume carries */
+    r->plan = *lpv_engine_last_plan(w->engine);
+    r->tick = ++w->gl_ticks;
+    r->tick_ms = wall_ms() - t0;
+    j->result = r;
+}
+
+static int gl_ready_for(sv_world *w, sv_job *j)
+{
+    if (!w->engine || !w->gl_ticked || w->gl_ticked_gen != j->gen || w->gl_applied_gen != j->gen) {
+        j->status = LPVP_E_NOT_READY;
+        snprintf(j->err, sizeof j->err, "no tick since the last change of this session's scene, lights, camera or "
+                                        "config: send TICK first");
+        return 0;
+    }
+    return 1;
+}
+
+static void gl_render(sv_job *j)
+{
+    sv_world *w = j->world;
+    if (!gl_ready_for(w, j))
+        return;
+    j->width = j->inputs->view.width;
+    j->height = j->inputs->view.height;
+    j->rgba = malloc((size_t)j->width * (size_t)j->height * 4 * sizeof(float));
+    if (!j->rgba) {
+        j->status = LPVP_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory for a %dx%d frame", j->width, j->height);
+        return;
+    }
+    if (lpv_engine_render(w->engine, (lpv_frame_terms)j->terms, j->rgba, j->err, sizeof j->err) != 0)
+        j->status = LPVP_E_INTERNAL;
+    j->tick = w->gl_ticks;
+}
+
+static void gl_query(sv_job *j)
+{
+    sv_world *w = j->world;
+    if (!gl_ready_for(w, j))
+        return;
+    size_t n = j->count;
+    j->out = calloc(n ? n * 3 : 1, sizeof(float));
+    float *p = malloc((n ? n : 1) * 3 * sizeof(float)), *nr = malloc((n ? n : 1) * 3 * sizeof(float));
+    if (!j->out || !p || !nr) {
+        free(p);
+        free(nr);
+        j->status = LPVP_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "out of memory for %zu points", n);
+        return;
+    }
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            p[i * 3 + k] = j->points[i * 6 + k];
+            nr[i * 3 + k] = j->points[i * 6 + 3 + k];
+        }
+    if (n && lpv_engine_irradiance(w->engine, p, nr, n, j->out, j->err, sizeof j->err) != 0)
+        j->status = LPVP_E_INTERNAL;
+    for (size_t i = 0; i < n * 3; ++i)
+        if (!isfinite(j->out[i]))
+            j->out[i] = 0.0f;
+    free(p);
+    free(nr);
+    j->tick = w->gl_ticks;
+}
+
+static void *gl_main(void *arg)
+{
+    sv_server *s = arg;
+    lpv_gl_context_desc desc = {.backend = s->cfg.backend};
+    char err[1024] = "";
+    lpv_gl_context *ctx = lpv_gl_context_create(&desc, err, sizeof err);
+    pthread_mutex_lock(&s->mu);
+    if (!ctx) {
+        snprintf(s->gl_err, sizeof s->gl_err, "%s", err);
+        s->gl_ready = -1;
+        pthread_cond_broadcast(&s->cv);
+        pthread_mutex_unlock(&s->mu);
+        return NULL;
+    }
+    s->gl_ctx = ctx;
+    snprintf(s->gl_backend, sizeof s->gl_backend, "%s", lpv_backend_name(lpv_gl_context_backend(ctx)));
+    snprintf(s->gl_renderer, sizeof s->gl_renderer, "%s", lpv_gl_context_renderer(ctx));
+    s->gl_ready = 1;
+    pthread_cond_broadcast(&s->cv);
+    for (;;) {
+        while (!s->jobs_head)
+            pthread_cond_wait(&s->cv, &s->mu);
+        sv_job *j = take_next_locked(s);
+        j->started = 1; /* from now on no request joins it (sv_world_join_tick) */
+        int cancelled = j->cancelled;
+        pthread_mutex_unlock(&s->mu);
+
+        int quit = 0;
+        if (cancelled) { /* nobody wants it any more (sv_gl_cancel): no GL time */
+            j->status = LPVP_E_INTERNAL;
+            snprintf(j->err, sizeof j->err, "cancelled: every request for it is gone");
+        } else switch (j->kind) {
+        case SV_JOB_TICK: gl_tick(s, j); break;
+        case SV_JOB_RENDER: gl_render(j); break;
+        case SV_JOB_QUERY: gl_query(j); break;
+        case SV_JOB_DESTROY:
+            lpv_engine_destroy(j->world->engine);
+            j->world->engine = NULL;
+            break;
+        case SV_JOB_QUIT: quit = 1; break;
+        }
+
+        pthread_mutex_lock(&s->mu);
+        if (quit) {
+            free(j);
+            break;
+        }
+        j->next = NULL;
+        if (s->done_tail)
+            s->done_tail->next = j;
+        else
+            s->done_head = j;
+        s->done_tail = j;
+        pthread_mutex_unlock(&s->mu);
+        uv_async_send(&s->done_async);
+        pthread_mutex_lock(&s->mu);
+    }
+    pthread_mutex_unlock(&s->mu);
+    lpv_gl_context_destroy(ctx);
+    return NULL;
+}
+
+
+int sv_gl_start(sv_server *s, char *err, size_t n)
+{
+    if (uv_async_init(s->loop, &s->done_async, sv_world_jobs_done) != 0) {
+        snprintf(err, n, "uv_async_init failed");
+        return -1;
+    }
+    s->done_async.data = s;
+    if (pthread_create(&s->gl_thread, NULL, gl_main, s) != 0) {
+        snprintf(err, n, "cannot start the GL thread");
+        return -1;
+    }
+    s->gl_started = 1;
+    pthread_mutex_lock(&s->mu);
+    while (s->gl_ready == 0)
+        pthread_cond_wait(&s->cv, &s->mu);
+    pthread_mutex_unlock(&s->mu);
+    if (s->gl_ready < 0) {
+        pthread_join(s->gl_thread, NULL);
+        s->gl_started = 0;
+        snprintf(err, n, "no OpenGL 4.5 context: %s", s->gl_err);
+        return -1;
+    }
+    return 0;
+}
+
+/* Drops the jobs not started yet (their requests get ERROR SHUTTING_DOWN),
+ * lets the running one finish, runs the engines' destroy jobs, stops the GL
+ * thread and runs every completion. The caller has detached every session
+ * from its world first, so every world has a destroy job queued. */
+void sv_gl_stop(sv_server *s)
+{
+    if (!s->gl_started)
+        return;
+    pthread_mutex_lock(&s->mu);
+    sv_job *dropped = s->jobs_head;
+    s->jobs_head = s->jobs_tail = NULL;
+    s->jobs_queued = 0;
+    pthread_mutex_unlock(&s->mu);
+    while (dropped) {
+        sv_job *next = dropped->next;
+        dropped->next = NULL;
+        if (dropped->kind == SV_JOB_DESTROY) {
+            sv_job_submit(s, dropped); /* engines must still be destroyed on the GL thread */
+        } else {
+            if (dropped->periodic && dropped->world)
+                dropped->world->periodic_pending = 0;
+            dropped->status = LPVP_E_SHUTTING_DOWN;
+            snprintf(dropped->err, sizeof dropped->err, "the server is stopping");
+            sv_job_reply_all(dropped);
+            sv_job_free(dropped);
+        }
+        dropped = next;
+    }
+    sv_job *q = calloc(1, sizeof *q);
+    if (q) {
+        q->kind = SV_JOB_QUIT;
+        sv_job_submit(s, q);
+        pthread_join(s->gl_thread, NULL);
+    }
+    s->gl_started = 0;
+    sv_world_jobs_done(&s->done_async);
+}
+
