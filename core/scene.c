@@ -57,6 +57,19 @@ int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src)
     return 0;
 }
 
+uint64_t lpv_scene_bytes(const lpv_scene *s)
+{
+    uint64_t b = (uint64_t)s->vertex_count * sizeof *s->vertices + (uint64_t)s->index_count * sizeof *s->indices +
+                 (uint64_t)s->draw_count * sizeof *s->draws + (uint64_t)s->material_count * sizeof *s->materials +
+                 (uint64_t)s->light_count * sizeof *s->lights + (uint64_t)s->camera_count * sizeof *s->cameras +
+                 (uint64_t)s->texture_count * sizeof *s->textures;
+    for (uint32_t i = 0; i < s->texture_count; ++i)
+        b += (uint64_t)s->textures[i].width * (uint64_t)s->textures[i].height * 4u;
+    if (s->medium.density)
+        b += (uint64_t)s->medium.dims[0] * s->medium.dims[1] * s->medium.dims[2] * sizeof *s->medium.density;
+    return b;
+}
+
 int lpv_light_check_intensity(const lpv_light *l, char *err, size_t err_size)
 {
     double c = fmax(fmax((double)l->color[0], (double)l->color[1]), (double)l->color[2]);

@@ -170,6 +170,10 @@ int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src);
 /* Recomputes bounds_min/max from the vertices. */
 void lpv_scene_compute_bounds(lpv_scene *scene);
 
+/* Bytes the scene's arrays take in memory: vertices, indices, draws,
+ * materials, texture texels, lights, cameras and the medium's density. */
+uint64_t lpv_scene_bytes(const lpv_scene *scene);
+
 /* 0 when every vertex position is finite and within +-LPV_MAX_COORD and every
  * light's position, range and intensity x colour are within the limits
  * above; else -1 with a message naming the first value out of range (a

@@ -115,6 +115,12 @@ lpv_engine_counters lpv_engine_get_counters(const lpv_engine *e);
 lpv_engine *lpv_engine_create(char *err, size_t err_size);
 void lpv_engine_destroy(lpv_engine *e);
 
+/* Lowers the memory the engine may allocate (its budget starts at half of
+ * the video memory or RAM, gpu/memory_limits.c) to bytes; source says where
+ * the cap comes from in refusals (e.g. "--max-world-memory"). A cap above
+ * the current budget changes nothing. */
+void lpv_engine_cap_memory(lpv_engine *e, uint64_t bytes, const char *source);
+
 /* Uploads the scene (geometry, materials, textures, lights) and samples its
  * emissive surfaces into VPLs and keeps them for the area light samples. The
  * scene may be freed afterwards (the engine keeps a copy of its geometry to

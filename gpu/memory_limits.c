@@ -89,6 +89,14 @@ void lpv_engine_memory_need(const lpv_engine *e, lpv_memory_need *n)
     }
 }
 
+void lpv_engine_cap_memory(lpv_engine *e, uint64_t bytes, const char *source)
+{
+    if (bytes == 0 || bytes >= e->mem_limits.budget)
+        return;
+    e->mem_limits.budget = bytes;
+    snprintf(e->mem_limits.budget_source, sizeof e->mem_limits.budget_source, "%s", source);
+}
+
 int lpv_engine_memory_check(const lpv_engine *e, char *err, size_t err_size)
 {
     lpv_memory_need need;

@@ -17,8 +17,10 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 
 # Fuzz the wire protocol (frame parser, bodies, field getters, zstd) for a
 # bounded minute with libFuzzer + ASan + UBSan (clang); new inputs go to
-# build-fuzz/corpus, the seeds in tests/fuzz/corpus are only read.
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
+# build-fuzz/corpus, the seeds in tests/fuzz/corpus are only read. --fresh:
+# a build-fuzz configured with other compilers would otherwise drop these
+# -D options when CMake resets its cache for the compiler change.
+cmake --fresh -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
   -DCMAKE_CXX_COMPILER=clang++ -DLPVD_FUZZ=ON
 cmake --build build-fuzz --target fuzz_frame fuzz_gltf fuzz_image -j "$jobs"
 mkdir -p build-fuzz/corpus build-fuzz/corpus-gltf build-fuzz/corpus-image

@@ -47,12 +47,15 @@ static void usage(FILE *f)
             "  --max-message BYTES     json + attachment of one message (default 268435456)\n"
             "  --max-body BYTES        json of one message (default 1048576)\n"
             "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
+            "  --max-world-memory BYTES  GPU storage one world (one computation) may take (default %llu)\n"
             "  --max-request-memory BYTES  request bytes held for all clients together; a frame that does not\n"
             "                          fit waits, unread (default %llu, at least --max-message)\n"
             "  --max-triangles N       per scene (default 10000000)\n"
             "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
             "  --max-scene-texels N    decoded texels of one scene's images, from their headers (default %llu)\n"
             "  --max-scene-bytes BYTES memory one parsed scene may take: file, buffers, texels, model (default %llu)\n"
+            "  --max-scenes-memory BYTES  all live scenes together, each counted once (default %llu, at least\n"
+            "                          --max-scene-bytes)\n"
             "  --max-grid N            LPV cells per axis (default 128, at most 256)\n"
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
             "  --max-tick-cost N       cell-steps one tick may cost: CONFIG over it gets LIMIT (default "
@@ -67,8 +70,9 @@ static void usage(FILE *f)
             "Default CONFIG of every session:\n"
             "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
             "%s",
-            (unsigned long long)SV_DEFAULT_MAX_REQUEST_MEMORY, (unsigned long long)SV_DEFAULT_MAX_SCENE_TEXELS,
-            (unsigned long long)SV_DEFAULT_MAX_SCENE_BYTES, SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT,
+            (unsigned long long)SV_DEFAULT_MAX_WORLD_MEMORY, (unsigned long long)SV_DEFAULT_MAX_REQUEST_MEMORY, (unsigned long long)SV_DEFAULT_MAX_SCENE_TEXELS,
+            (unsigned long long)SV_DEFAULT_MAX_SCENE_BYTES, (unsigned long long)SV_DEFAULT_MAX_SCENES_MEMORY,
+            SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT,
             SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
 }
 
@@ -352,8 +356,9 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-grid", "max-tick-rate", "max-tick-cost",
-    "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory", "handshake-timeout", "max-preauth", NULL};
+    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-scenes-memory", "max-world-memory", "max-grid",
+    "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory",
+    "handshake-timeout", "max-preauth", NULL};
 
 int lpvd_cmd_serve(int argc, char **argv)
 {
@@ -365,6 +370,8 @@ int lpvd_cmd_serve(int argc, char **argv)
     cfg->max_message = LPVP_DEFAULT_MAX_MESSAGE;
     cfg->max_queue = 64u << 20;
     cfg->max_request_memory = SV_DEFAULT_MAX_REQUEST_MEMORY;
+    cfg->max_scenes_memory = SV_DEFAULT_MAX_SCENES_MEMORY;
+    cfg->max_world_memory = SV_DEFAULT_MAX_WORLD_MEMORY;
     cfg->max_clients = 64;
     cfg->max_triangles = 10000000;
     cfg->max_texture = 8192;
@@ -492,6 +499,12 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "handshake-timeout")) {
             bad = parse_num(v, 0.0, 1e9, &d);
             cfg->handshake_timeout = d;
+        } else if (!strcmp(name, "max-world-memory")) {
+            bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 44, &u);
+            cfg->max_world_memory = u;
+        } else if (!strcmp(name, "max-scenes-memory")) {
+            bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
+            cfg->max_scenes_memory = u;
         } else if (!strcmp(name, "max-request-memory")) {
             bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
             cfg->max_request_memory = u;
@@ -509,6 +522,11 @@ int lpvd_cmd_serve(int argc, char **argv)
     }
     if (cfg->max_body > cfg->max_message)
         cfg->max_body = cfg->max_message;
+    if (cfg->max_scenes_memory < cfg->max_scene_bytes) { /* else the largest scene could never load */
+        fprintf(stderr, "lpvd serve: --max-scenes-memory %llu is under --max-scene-bytes %llu\n",
+                (unsigned long long)cfg->max_scenes_memory, (unsigned long long)cfg->max_scene_bytes);
+        return 2;
+    }
     if (cfg->max_request_memory < cfg->max_message) { /* else the largest message could never be read */
         fprintf(stderr, "lpvd serve: --max-request-memory %llu is under --max-message %llu\n",
                 (unsigned long long)cfg->max_request_memory, (unsigned long long)cfg->max_message);

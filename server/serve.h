@@ -78,6 +78,8 @@ typedef struct sv_config {
     uint64_t max_message;    /* json + attachment, default 256 MiB */
     uint64_t max_queue;      /* bytes queued for writing per connection */
     uint64_t max_request_memory; /* request bytes held, all connections (R7.5); >= max_message */
+    uint64_t max_scenes_memory;  /* bytes of all live scenes together (R4.5c); >= max_scene_bytes */
+    uint64_t max_world_memory;   /* GPU storage of one world's engine (R7.6) */
     int max_clients;
     uint64_t max_triangles;
     int max_texture;
@@ -102,6 +104,8 @@ typedef struct sv_config {
 
 #define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
 #define SV_DEFAULT_MAX_REQUEST_MEMORY ((uint64_t)1 << 30)
+#define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)
+#define SV_DEFAULT_MAX_WORLD_MEMORY ((uint64_t)1 << 30)
 #define SV_DEFAULT_HANDSHAKE_TIMEOUT 10.0
 #define SV_DEFAULT_MAX_PREAUTH 16
 /* Reply bytes a connection may have queued before HELLO: its replies are a
@@ -119,6 +123,7 @@ typedef struct sv_scene {
     char *base_dir;         /* folder for external URIs, relative to the scene root (path loads), or NULL */
     lpv_gltf_node_override *nodes; /* SCENE_UPDATE node transforms applied at load */
     size_t node_count;
+    uint64_t bytes;         /* the file + lpv_scene_bytes: what it counts against --max-scenes-memory */
     struct sv_scene *next;  /* server's list of live scenes */
 } sv_scene;
 
@@ -374,6 +379,7 @@ struct sv_server {
     int conn_count;
     uint64_t request_bytes; /* reserved + pending request bytes of every connection (R7.5) */
     uint64_t memory_waits;  /* turns handed out to connections waiting for request memory */
+    uint64_t scenes_bytes;  /* sv_scene.bytes of every live scene, once each (--max-scenes-memory) */
     uint64_t next_conn_id;
     sv_world *worlds;
     int world_count;
@@ -467,6 +473,9 @@ void sv_result_unref(sv_result *r);
 sv_result *sv_result_ref(sv_result *r);
 void sv_scene_unref(sv_server *s, sv_scene *sc);
 sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
+/* 1 when sc is already live or fits in --max-scenes-memory next to the live
+ * scenes; else 0 with the LIMIT message in err. */
+int sv_scene_fits(sv_server *s, const sv_scene *sc, char *err, size_t n);
 unsigned sv_world_terms_mask(sv_world *w);
 void sv_world_update_timer(sv_world *w);
 int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: joined a queued tick */

@@ -152,6 +152,9 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
         w->engine = lpv_engine_create(err, n);
         if (!w->engine)
             return -1;
+        char cap[64]; /* bounds the daemon's GPU memory: worlds x this (docs/server.md, "Worst-case memory") */
+        snprintf(cap, sizeof cap, "--max-world-memory %llu", (unsigned long long)w->srv->cfg.max_world_memory);
+        lpv_engine_cap_memory(w->engine, w->srv->cfg.max_world_memory, cap);
         w->gl_has_applied = 0;
     }
     if (w->gl_has_applied && w->gl_applied_gen == gen)
@@ -262,7 +265,9 @@ static void gl_tick(sv_server *s, sv_job *j)
     double t0 = wall_ms();
     if (gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err) != 0 ||
         lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
-        j->status = LPVP_E_INTERNAL;
+        /* the engine's memory refusals name their budget's source: the cap
+         * gl_apply set is the server's limit, so LIMIT (R7.6), not a fault */
+        j->status = strstr(j->err, "--max-world-memory") ? LPVP_E_LIMIT : LPVP_E_INTERNAL;
         return;
     }
     w->gl_ticked = 1;

@@ -74,6 +74,8 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
     if (lim) { /* the per-scene budgets (R4.5) */
         json_object_set_new(lim, "max_scene_texels", json_integer((json_int_t)s->cfg.max_scene_texels));
         json_object_set_new(lim, "max_scene_bytes", json_integer((json_int_t)s->cfg.max_scene_bytes));
+        json_object_set_new(lim, "max_scenes_memory", json_integer((json_int_t)s->cfg.max_scenes_memory));
+        json_object_set_new(lim, "max_world_memory", json_integer((json_int_t)s->cfg.max_world_memory));
     }
     if (lim)
         json_object_set_new(lim, "max_tick_cost", json_integer((json_int_t)s->cfg.max_tick_cost));

@@ -212,6 +212,7 @@ static void load_run(uv_work_t *req)
     if (w->node_count)
         h = lpv_hash_bytes(h, w->nodes, sizeof *w->nodes * w->node_count);
     sc->hash = h ? h : 1;
+    sc->bytes = lpv_scene_bytes(&sc->scene) + w->glb_size;
     sc->glb = w->glb;
     sc->glb_size = w->glb_size;
     sc->base_dir = w->base_dir;
@@ -263,7 +264,8 @@ static void load_done(uv_work_t *req, int status)
             sv_reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "nodes: %s", w->err);
         } else if (w->status) {
             sv_reply_err(c, w->request_id, w->status, 0, "%s", w->err);
-        } else if (scene_over_limits(s, &w->scene->scene, err, sizeof err)) {
+        } else if (scene_over_limits(s, &w->scene->scene, err, sizeof err) ||
+                   !sv_scene_fits(s, w->scene, err, sizeof err)) {
             free_sv_scene_unlisted(w->scene);
             w->scene = NULL;
             sv_reply_err(c, w->request_id, LPVP_E_LIMIT, 0, "%s", err);

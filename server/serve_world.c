@@ -59,6 +59,7 @@ void sv_scene_unref(sv_server *s, sv_scene *sc)
         }
     if (s->builtin == sc)
         s->builtin = NULL;
+    s->scenes_bytes -= sc->bytes;
     lpv_scene_free(&sc->scene);
     free(sc->glb);
     free(sc->base_dir);
@@ -66,29 +67,47 @@ void sv_scene_unref(sv_server *s, sv_scene *sc)
     free(sc);
 }
 
-sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc)
+/* The live scene equal to sc (same bytes, folder and node overrides), or NULL. */
+static sv_scene *scene_equal(sv_server *s, const sv_scene *sc)
 {
-    for (sv_scene *o = s->scenes; o; o = o->next) {
+    for (sv_scene *o = s->scenes; o; o = o->next)
         if (o->hash == sc->hash && o->glb_size == sc->glb_size &&
             (o->glb_size == 0 || (o->glb && sc->glb && memcmp(o->glb, sc->glb, o->glb_size) == 0)) &&
             ((!o->base_dir && !sc->base_dir) || (o->base_dir && sc->base_dir && !strcmp(o->base_dir, sc->base_dir))) &&
             o->node_count == sc->node_count &&
-            (!o->node_count || memcmp(o->nodes, sc->nodes, sizeof *o->nodes * o->node_count) == 0)) {
-            o->refs++;
-            sc->refs = 1;
-            sc->next = NULL;
-            /* sc was never listed: free it directly */
-            lpv_scene_free(&sc->scene);
-            free(sc->glb);
-            free(sc->base_dir);
-            free(sc->nodes);
-            free(sc);
+            (!o->node_count || memcmp(o->nodes, sc->nodes, sizeof *o->nodes * o->node_count) == 0))
             return o;
-        }
+    return NULL;
+}
+
+int sv_scene_fits(sv_server *s, const sv_scene *sc, char *err, size_t n)
+{
+    if (scene_equal(s, sc) || s->scenes_bytes + sc->bytes <= s->cfg.max_scenes_memory)
+        return 1;
+    snprintf(err, n, "the scene needs %llu bytes; the server's scenes take %llu of the %llu bytes all scenes may "
+             "take together (--max-scenes-memory): try again when sessions have let theirs go",
+             (unsigned long long)sc->bytes, (unsigned long long)s->scenes_bytes,
+             (unsigned long long)s->cfg.max_scenes_memory);
+    return 0;
+}
+
+sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc)
+{
+    sv_scene *o = scene_equal(s, sc);
+    if (o) {
+        o->refs++;
+        /* sc was never listed: free it directly */
+        lpv_scene_free(&sc->scene);
+        free(sc->glb);
+        free(sc->base_dir);
+        free(sc->nodes);
+        free(sc);
+        return o;
     }
     sc->refs = 1;
     sc->next = s->scenes;
     s->scenes = sc;
+    s->scenes_bytes += sc->bytes;
     return sc;
 }
 
