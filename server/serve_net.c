@@ -510,15 +510,24 @@ static void on_connection(uv_stream_t *server, int status)
     c->last_rx_ms = c->accepted_ms = sv_now_ms();
     sv_session_init(c);
     /* R4.1a: connections that have not said HELLO have their own small
-     * quota and never take a --max-clients slot */
+     * quota and never take a --max-clients slot. When it is full the oldest
+     * of them goes, not the newcomer: refusing newcomers would let anyone
+     * who keeps --max-preauth connections open shut every client out, while
+     * a client that says HELLO at once is through long before it is the
+     * oldest. */
     if (active_clients(s, c, 0) >= s->cfg.max_preauth)
         reap_gone(s, c);
     if (active_clients(s, c, 0) >= s->cfg.max_preauth) {
-        sv_send_error(c, 0, LPVP_E_LIMIT,
-                      "too many connections waiting for HELLO: the server accepts at most %d (--max-preauth)",
-                      s->cfg.max_preauth);
-        sv_conn_close_after_write(c);
-        return;
+        sv_conn *oldest = NULL;
+        for (sv_conn *o = s->conns; o; o = o->next)
+            if (o != c && !o->hello && !o->closing && !o->close_after_write && (!oldest || o->id < oldest->id))
+                oldest = o;
+        if (oldest) {
+            sv_send_error(oldest, 0, LPVP_E_LIMIT,
+                          "closed to let a newer connection in: at most %d connections may wait for HELLO "
+                          "(--max-preauth), and this was the oldest", s->cfg.max_preauth);
+            sv_conn_close_after_write(oldest);
+        }
     }
     if (uv_read_start(&c->h.stream, on_alloc, on_read) == 0)
         c->reading = 1;

@@ -15,7 +15,9 @@ Hostile clients that never authenticate, against a TCP listener with a token:
    instead of getting all 20000 HELLO_REQUIRED errors queued.
 3. slots: with --max-clients 4, 8 connections trickling one byte every 2 s
    (never a whole frame) do not keep a client with the right token out; a
-   connection over --max-preauth gets ERROR LIMIT naming it and is closed;
+   connection over --max-preauth is let in and the oldest connection waiting
+   for HELLO gets ERROR LIMIT naming it and is closed (before: the newcomer
+   was refused, so 16 connections held open kept every client out);
    with 4 sessions open a fifth right HELLO gets LIMIT (naming --max-clients,
    the HELLO's request_id) and is closed.
 4. deadline: a silent connection, and one trickling bytes, are sent ERROR
@@ -185,17 +187,24 @@ def case_slots(rep, lpvd):
         except Exception as e:
             rep.check(False, "8 trickling unauthenticated connections (max-clients 4): a right HELLO gets in",
                       repr(e))
-        # fill the pre-auth quota (8 tricklers + 2), then one more
+        # fill the pre-auth quota (8 tricklers + 2), then one more: the oldest trickler makes room
         waiting = [lc.Conn(ep, timeout=10) for _ in range(2)]
         time.sleep(0.3)
         over = lc.Conn(ep, timeout=10)
         try:
-            f = over.recv_reply(timeout=5)
+            hello(over, d.token)
+            sessions.append(over)
+            rep.check(True, "connection 11 while 10 wait for HELLO (--max-preauth 10) is let in and says HELLO")
+        except Exception as e:
+            rep.check(False, "connection 11 while 10 wait for HELLO (--max-preauth 10) is let in and says HELLO",
+                      repr(e))
+        try:
+            f = tricklers[0].recv_reply(timeout=5)
             msg = f.body.get("message", "")
-            good = f.err_name == "LIMIT" and "--max-preauth" in msg and over.expect_closed(5)
+            good = f.err_name == "LIMIT" and "--max-preauth" in msg and tricklers[0].expect_closed(5)
         except (socket.timeout, lc.Closed) as e:
             good, msg = False, repr(e)
-        rep.check(good, "connection 11 waiting for HELLO (--max-preauth 10): ERROR LIMIT naming it, closed", msg)
+        rep.check(good, "the oldest connection waiting for HELLO got ERROR LIMIT naming --max-preauth, closed", msg)
         for w in waiting:
             w.close()
         time.sleep(0.3)
