@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 secs="${1:-3600}"
 [ $# -gt 0 ] && shift
 targets="${*:-fuzz_frame fuzz_gltf fuzz_image}"
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
+cmake --fresh -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang \
   -DCMAKE_CXX_COMPILER=clang++ -DLPVD_FUZZ=ON >/dev/null
 # shellcheck disable=SC2086
 cmake --build build-fuzz --target $targets -j "$(nproc)" >/dev/null

@@ -467,7 +467,9 @@ int lpvd_cmd_serve(int argc, char **argv)
             bad = parse_u64(v, 64, UINT32_MAX, &u);
             cfg->max_body = u;
         } else if (!strcmp(name, "max-queue")) {
-            bad = parse_u64(v, 1024, (uint64_t)1 << 40, &u);
+            /* at least 64 KiB: no reply over it is sent (R3.5), and HELLO's,
+             * which describes every knob, takes ~15 KiB */
+            bad = parse_u64(v, 65536, (uint64_t)1 << 40, &u);
             cfg->max_queue = u;
         } else if (!strcmp(name, "max-triangles")) {
             bad = parse_u64(v, 1, (uint64_t)1 << 40, &u);

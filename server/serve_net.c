@@ -233,6 +233,15 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
     }
     size_t len = w->head_len + w->att_len;
     uint64_t cap = c->hello ? c->srv->cfg.max_queue : SV_PREAUTH_MAX_QUEUE;
+    if (len > cap && type != LPVP_ERROR && type != LPVP_BYE_REPLY) {
+        /* R3.5 for every reply, the small ones too (a STATS under a tiny
+         * --max-queue): never sent, an ERROR instead, the connection stays */
+        wreq_free(w);
+        return sv_send_error(c, request_id, LPVP_E_LIMIT,
+                             "the %s reply is %zu bytes, over this server's per-client queue limit of %llu bytes "
+                             "(--max-queue): not sent", lpvp_type_name((uint16_t)(type & ~LPVP_REPLY_BIT)), len,
+                             (unsigned long long)cap);
+    }
     if (c->wq_bytes > 0 && c->wq_bytes + len > cap) {
         fprintf(stderr, "lpvd serve: client %llu (%s) is not reading: %zu bytes queued, over the %llu-byte cap%s; "
                         "disconnecting it\n",
