@@ -30,7 +30,7 @@ mkdir -p build-fuzz/corpus build-fuzz/corpus-gltf build-fuzz/corpus-image
 # daemon's entry), 30 s each; scripts/fuzz-long.sh runs them for hours.
 ./build-fuzz/fuzz/fuzz_gltf -max_total_time=30 -rss_limit_mb=2048 -max_len=1048576 -timeout=30 \
   -print_final_stats=1 build-fuzz/corpus-gltf tests/fuzz/corpus_gltf
-./build-fuzz/fuzz/fuzz_image -max_total_time=30 -rss_limit_mb=2048 -max_len=1048576 -timeout=30 \
+./build-fuzz/fuzz/fuzz_image -max_total_time=30 -rss_limit_mb=2048 -malloc_limit_mb=4096 -max_len=1048576 -timeout=30 \
   -print_final_stats=1 build-fuzz/corpus-image tests/fuzz/corpus_image
 
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DLPVD_SANITIZE=ON

@@ -19,6 +19,7 @@ And with --max-scene-bytes 1048576: a .glb with a 2 MiB buffer gets LIMIT naming
 """
 
 import json
+import os
 import struct
 import sys
 import zlib
@@ -114,6 +115,17 @@ def main():
         expect(rep, c, textured_glb([b"\x89PNG\r\n\x1a\n" + b"garbage, not a PNG at all" * 4]), "SCENE_INVALID",
                ["image 0"], "garbage declared as a PNG")
         expect(rep, c, textured_glb([png(64, 64)[:60]]), "SCENE_INVALID", ["image 0"], "a truncated PNG")
+        # fuzz_image's finding (docs/fuzzing.md): stb reserves 2 GiB of address space for this 90-byte PNG's
+        # bogus zlib stored block and touches none of it
+        seed = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fuzz", "corpus_image",
+                            "png-stored-block-2gib")
+        with open(seed, "rb") as fh:
+            bogus = fh.read()
+        before = peak_kib(d)
+        expect(rep, c, textured_glb([bogus]), "SCENE_INVALID", ["image 0"], "a 1x8 PNG whose zlib block claims 2 GiB")
+        rise_mb = (peak_kib(d) - before) / 1024.0
+        bound = 512 if harness.is_asan(lpvd) else 64  # ASan writes shadow for the freed 2 GiB: 256 MB
+        rep.check(rise_mb < bound, "and the peak RSS rose %.1f MB (< %d)" % (rise_mb, bound))
         ok = c.request(lc.SCENE_LOAD, {}, textured_glb([png(64, 64)]), timeout=120)
         rep.check(ok.type == (lc.SCENE_LOAD | lc.REPLY), "a good 64x64 PNG still loads", json.dumps(ok.body))
     finally:
