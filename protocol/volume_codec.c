@@ -389,6 +389,18 @@ void lpvp_octree_level_place(const lpvp_cascade_info *level0, int i, lpvp_cascad
     out->cell_size = ldexp(level0->cell_size, i);
 }
 
+/* The one-value-per-cell index volume (SPEC R5.13, R5.14) over level 0. */
+static void layout_index_over(lpvp_volume_layout *l, const lpvp_cascade_info *level0)
+{
+    l->has_index = 1;
+    l->index.level = 0;
+    for (int a = 0; a < 3; a++)
+        l->index.dims[a] = level0->dims[a];
+    l->index.cells = level0->cells;
+    l->index.values_per_cell = 1;
+    l->index.raw_length = level0->cells * LPVP_INDEX_VALUE_SIZE;
+}
+
 int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
                               char *err, size_t err_n)
 {
@@ -406,13 +418,7 @@ int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, cons
         lpvp_octree_level_place(level0, i, &l->level[i]);
         l->role[i] = LPVP_ROLE_OCTREE_LEVEL;
     }
-    l->has_index = 1;
-    l->index.level = 0;
-    for (int a = 0; a < 3; a++)
-        l->index.dims[a] = level0->dims[a];
-    l->index.cells = level0->cells;
-    l->index.values_per_cell = 1;
-    l->index.raw_length = level0->cells * LPVP_INDEX_VALUE_SIZE;
+    layout_index_over(l, level0);
     return 0;
 }
 
@@ -427,13 +433,7 @@ int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lp
     lpvp_volume_layout_sh(l, technique, 0, 1);
     l->role[0] = LPVP_ROLE_IV_VOXELS;
     snprintf(l->units, sizeof l->units, "%s", LPVP_VOLUME_UNITS_RADIANCE);
-    l->has_index = 1;
-    l->index.level = 0;
-    for (int a = 0; a < 3; a++)
-        l->index.dims[a] = level0->dims[a];
-    l->index.cells = level0->cells;
-    l->index.values_per_cell = 1;
-    l->index.raw_length = level0->cells * LPVP_INDEX_VALUE_SIZE;
+    layout_index_over(l, level0);
     l->iv_neighbours = neighbours;
     return 0;
 }
