@@ -16,6 +16,7 @@
 
 #include "cascades.h"
 #include "settings_fields.h"
+#include "settings_json.h"
 #include "tick_cost.h"
 
 #define SV_MAX_LIGHTS 256
@@ -194,145 +195,22 @@ void sv_do_camera_set(sv_conn *c, sv_request *r, json_t *j)
 }
 
 
-/* CONFIG's "preset": resets grid / iterations / rsm_size / occlusion to the
- * preset's (by clearing them, so resolve fills them in), before the message's
- * other fields override them. Returns LPVP_FIELD_OK or _ABSENT, LPVP_FIELD_BAD
- * (message in err), or -2 when the preset is over a server limit (ERROR LIMIT
- * already sent: --max-grid and --max-texture bound presets as well). */
-static int config_preset(sv_conn *c, sv_request *r, const json_t *j, lpv_settings *st, char *err, size_t n)
-{
-    /* the choices are core's preset table (lpv_preset_name), in its order */
-    const char *names[LPV_PRESET_COUNT_];
-    int count = 0, idx = 0;
-    for (int q = LPV_PRESET_DEFAULT + 1; q < LPV_PRESET_COUNT_; ++q)
-        names[count++] = lpv_preset_name((lpv_preset)q);
-    int rc = lpvp_get_enum(j, "preset", 0, names, (size_t)count, &idx, err, n);
-    if (rc != LPVP_FIELD_OK)
-        return rc;
-    lpv_settings p;
-    lpv_preset_settings((lpv_preset)(LPV_PRESET_DEFAULT + 1 + idx), &p);
-    const sv_server *s = c->srv;
-    if (p.grid_dims[0] > s->cfg.max_grid || p.rsm_size > s->cfg.max_texture) {
-        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
-                  "preset: %s (grid %d, rsm_size %d) is over the server's limits (--max-grid %d, --max-texture %d)",
-                  names[idx], p.grid_dims[0], p.rsm_size, s->cfg.max_grid, s->cfg.max_texture);
-        return -2;
-    }
-    st->preset = p.preset;
-    memset(st->grid_dims, 0, sizeof st->grid_dims);
-    st->lpv.iterations = 0;
-    st->rsm_size = 0;
-    st->lpv.occlusion = LPV_SWITCH_DEFAULT;
-    return LPVP_FIELD_OK;
-}
-
-/* CONFIG's "technique": one of core's technique table's names (R4.14).
- * Returns LPVP_FIELD_OK, _ABSENT or _BAD (message in err). */
-static int config_technique(const json_t *j, lpv_settings *st, char *err, size_t n)
-{
-    const char *names[LPV_TECHNIQUE_ID_COUNT_];
-    int count = 0, idx = 0;
-    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; t < LPV_TECHNIQUE_ID_COUNT_; ++t)
-        names[count++] = lpv_technique_name((lpv_technique_id)t);
-    int rc = lpvp_get_enum(j, "technique", 0, names, (size_t)count, &idx, err, n);
-    if (rc == LPVP_FIELD_OK)
-        st->technique = (lpv_technique_id)(LPV_TECHNIQUE_ID_DEFAULT + 1 + idx);
-    return rc;
-}
-
-/* CONFIG's scalar knobs, one per entry of the field table (core/settings_fields.h):
- * ints as JSON integers, floats as JSON numbers, switches as JSON booleans, each
- * within the table's range. Returns 0, or -1 with a message naming the key. */
-static int config_fields(const json_t *j, lpv_settings *st, char *err, size_t n)
-{
-    size_t nf;
-    const lpv_field *fields = lpv_fields(&nf);
-    for (size_t i = 0; i < nf; ++i) {
-        const lpv_field *f = &fields[i];
-        int64_t iv;
-        double dv;
-        int bv, rc;
-        char why[160];
-        if (f->kind == LPV_FIELD_SWITCH) {
-            if ((rc = lpvp_get_bool(j, f->key, 0, &bv, err, n)) == LPVP_FIELD_OK)
-                lpv_field_set_bool(st, f, bv);
-        } else if (f->kind == LPV_FIELD_INT) {
-            if ((rc = lpvp_get_int(j, f->key, 0, (int64_t)f->min, (int64_t)f->max, &iv, err, n)) == LPVP_FIELD_OK)
-                lpv_field_set_number(st, f, (double)iv, NULL, 0);
-        } else if ((rc = lpvp_get_number(j, f->key, 0, f->min, f->max, &dv, err, n)) == LPVP_FIELD_OK &&
-                   lpv_field_set_number(st, f, dv, why, sizeof why) != 0) { /* an exclusive minimum */
-            snprintf(err, n, "%s: %s", f->key, why);
-            return -1;
-        }
-        if (rc == LPVP_FIELD_BAD)
-            return -1;
-    }
-    return 0;
-}
-
 void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
 {
     sv_server *s = c->srv;
     char err[512];
     lpv_settings st = c->settings;
     double rate = c->tick_rate;
-    int64_t grid[3];
-    float bounds[6];
-    int gst;
     double lim_rate = s->cfg.max_tick_rate;
-    int pst = config_preset(c, r, j, &st, err, sizeof err);
-    if (pst == LPVP_FIELD_BAD)
-        goto bad;
-    if (pst < 0)
-        return; /* over a limit: already answered */
-    if (config_technique(j, &st, err, sizeof err) == LPVP_FIELD_BAD)
-        goto bad;
-    const json_t *gj = json_object_get(j, "grid");
-    if (gj && json_is_integer(gj)) { /* a single N is accepted as NxNxN */
-        gst = lpvp_get_int(j, "grid", 1, 1, INT32_MAX, &grid[0], err, sizeof err);
-        grid[1] = grid[2] = grid[0];
-    } else {
-        gst = lpvp_get_ints(j, "grid", 0, 3, 1, INT32_MAX, grid, err, sizeof err);
+    const lpvd_settings_limits lim = {s->cfg.max_grid, s->cfg.max_texture};
+    int sst = lpvd_settings_apply_json(j, &st, &lim, err, sizeof err);
+    if (sst == LPVD_SETTINGS_LIMIT) {
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "%s", err);
+        return;
     }
-    if (gst == LPVP_FIELD_BAD)
+    if (sst != 0)
         goto bad;
-    if (gst == LPVP_FIELD_OK) {
-        for (int i = 0; i < 3; ++i)
-            if (grid[i] > s->cfg.max_grid) {
-                sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
-                          "grid: %lld cells on an axis is over the server's limit of %d (--max-grid)",
-                          (long long)grid[i], s->cfg.max_grid);
-                return;
-            }
-        for (int i = 0; i < 3; ++i)
-            st.grid_dims[i] = (int)grid[i];
-    }
-    int bst = lpvp_get_floats(j, "bounds", 0, 6, -LPV_MAX_COORD, LPV_MAX_COORD, bounds, err, sizeof err);
-    if (bst == LPVP_FIELD_BAD)
-        goto bad;
-    if (bst == LPVP_FIELD_OK) {
-        if (!(bounds[3] > bounds[0] && bounds[4] > bounds[1] && bounds[5] > bounds[2])) {
-            snprintf(err, sizeof err, "bounds: expected [x0, y0, z0, x1, y1, z1] with max > min");
-            goto bad;
-        }
-        memcpy(st.bounds_min, bounds, sizeof st.bounds_min);
-        memcpy(st.bounds_max, bounds + 3, sizeof st.bounds_max);
-    }
     int ist;
-    if (config_fields(j, &st, err, sizeof err) != 0) /* iterations, rsm_size, occlusion, ..., planner */
-        goto bad;
-    if (json_object_get(j, "rsm_size") && st.rsm_size > s->cfg.max_texture) {
-        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
-                  "rsm_size: %d is over the server's texture limit of %d (--max-texture)", st.rsm_size,
-                  s->cfg.max_texture);
-        return;
-    }
-    if (json_object_get(j, "shadow_size") && st.shadow_size > s->cfg.max_texture) {
-        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
-                  "shadow_size: %d is over the server's texture limit of %d (--max-texture)", st.shadow_size,
-                  s->cfg.max_texture);
-        return;
-    }
     double rv;
     if ((ist = lpvp_get_number(j, "tick_rate_hz", 0, 0.0, 1e9, &rv, err, sizeof err)) == LPVP_FIELD_BAD)
         goto bad;
