@@ -16,6 +16,7 @@
 
 #include "cascades.h"
 #include "settings_fields.h"
+#include "light_json.h"
 #include "settings_json.h"
 #include "tick_cost.h"
 
@@ -24,54 +25,12 @@
 
 void sv_do_light_set(sv_conn *c, sv_request *r, json_t *j)
 {
-    static const char *const TYPES[] = {"directional", "point", "spot"}; /* = lpv_light_type */
     char err[512];
-    const char *id = NULL;
-    size_t idlen = 0;
-    int type = 0;
     lpv_light l;
-    memset(&l, 0, sizeof l);
-    l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    l.direction[1] = -1.0f;
-    l.outer_cone = (float)(M_PI / 4.0);
-    if (lpvp_get_string(j, "id", 1, LPV_NAME_MAX - 1, &id, &idlen, err, sizeof err) != LPVP_FIELD_OK ||
-        lpvp_get_enum(j, "type", 1, TYPES, 3, &type, err, sizeof err) != LPVP_FIELD_OK ||
-        lpvp_get_floats(j, "color", 0, 3, 0.0, 1e30, l.color, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_float(j, "intensity", 1, 0.0, 1e30, &l.intensity, err, sizeof err) != LPVP_FIELD_OK ||
-        lpvp_get_floats(j, "position", 0, 3, -LPV_MAX_COORD, LPV_MAX_COORD, l.position, err, sizeof err) ==
-            LPVP_FIELD_BAD ||
-        lpvp_get_floats(j, "direction", 0, 3, -1e30, 1e30, l.direction, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_float(j, "range", 0, 0.0, LPV_MAX_COORD, &l.range, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_float(j, "inner_cone", 0, 0.0, M_PI / 2.0, &l.inner_cone, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_float(j, "outer_cone", 0, 0.0, M_PI / 2.0, &l.outer_cone, err, sizeof err) == LPVP_FIELD_BAD) {
+    if (lpvd_light_from_json(j, &l, err, sizeof err) != 0) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
-    if (idlen == 0) {
-        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "id: must not be empty");
-        return;
-    }
-    /* in double: components up to 1e30 square beyond float */
-    double dl = sqrt((double)l.direction[0] * l.direction[0] + (double)l.direction[1] * l.direction[1] +
-                     (double)l.direction[2] * l.direction[2]);
-    if (!(dl > 1e-12)) {
-        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "direction: must be a non-zero vector");
-        return;
-    }
-    for (int i = 0; i < 3; ++i)
-        l.direction[i] = (float)(l.direction[i] / dl);
-    if (type == LPV_LIGHT_SPOT && l.inner_cone > l.outer_cone) {
-        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "inner_cone: must not exceed outer_cone");
-        return;
-    }
-    if (type != LPV_LIGHT_SPOT)
-        l.inner_cone = l.outer_cone = 0.0f;
-    l.type = (lpv_light_type)type;
-    if (lpv_light_check_intensity(&l, err, sizeof err) != 0) { /* 1e30 x 1e30 overflowed and lit nothing */
-        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "intensity: %s", err);
-        return;
-    }
-    memcpy(l.name, id, idlen);
     uint32_t i = 0;
     while (i < c->light_count && strcmp(c->lights[i].name, l.name) != 0)
         ++i;
