@@ -225,7 +225,9 @@ void Builder::read_indices(int index, std::vector<uint32_t> &out)
         out[i] = uint32_t(tmp[i]);
 }
 
-/* The mesh builder's instance (gltf_mesh.cpp); read_indices uses <double>. */
+/* The mesh builder's instance (gltf_mesh.cpp); read_indices and the
+ * animations (gltf_animation.cpp) use <double>. */
 template void Builder::read_accessor<float>(int, int, const char *, std::vector<float> &);
+template void Builder::read_accessor<double>(int, int, const char *, std::vector<double> &);
 
 } // namespace lpv_gltf

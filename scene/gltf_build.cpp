@@ -169,7 +169,7 @@ void Builder::build()
     const Mat4 id = identity();
     for (int r : roots)
         visit(r, id, 1);
-    for (const std::string &w : unused_features(m_, scene))
+    for (const std::string &w : unused_features(m_, scene, ctx_.played))
         ctx_.warn(w);
 }
 

@@ -80,7 +80,7 @@ std::string what_instead(const std::string &name)
     if (name == "EXT_mesh_gpu_instancing")
         return "not supported; each mesh is drawn once at its node, without the instances";
     if (name == "KHR_animation_pointer")
-        return "not supported; nothing is animated";
+        return "not supported; its animation channels are ignored";
     return "not supported by lpvd; ignored";
 }
 
@@ -94,7 +94,7 @@ bool extension_supported(const std::string &name)
     return false;
 }
 
-std::vector<std::string> unused_features(const tinygltf::Model &m, int scene)
+std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, const std::vector<int> &played)
 {
     std::vector<std::string> out;
 
@@ -130,6 +130,11 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene)
         note_extensions(ext, m.buffers[i].extensions, "buffer", int(i));
     for (size_t i = 0; i < m.scenes.size(); i++)
         note_extensions(ext, m.scenes[i].extensions, "scene", int(i));
+    for (size_t i = 0; i < m.animations.size(); i++)
+        for (const tinygltf::AnimationChannel &c : m.animations[i].channels) {
+            note_extensions(ext, c.extensions, "animation", int(i));
+            note_extensions(ext, c.target_extensions, "animation", int(i));
+        }
     for (const auto &kv : ext) {
         if (extension_supported(kv.first))
             continue;
@@ -224,9 +229,20 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene)
     if (!m.skins.empty())
         out.push_back(std::to_string(m.skins.size()) + (m.skins.size() == 1 ? " skin" : " skins") +
                       ": not applied; skinned meshes are drawn in their bind pose");
-    if (!m.animations.empty())
+    if (played.empty() && !m.animations.empty())
         out.push_back(std::to_string(m.animations.size()) + (m.animations.size() == 1 ? " animation" : " animations") +
                       ": not played; the file's static pose is drawn");
+    if (!played.empty()) {
+        /* The played animations' channels lpvd cannot apply (gltf_animation.cpp skips them). */
+        Uses weights;
+        for (int a : played)
+            for (size_t c = 0; c < m.animations[size_t(a)].channels.size(); c++)
+                if (m.animations[size_t(a)].channels[c].target_path == "weights")
+                    weights.add(("animation " + std::to_string(a) + " channel").c_str(), int(c));
+        if (weights.total)
+            out.push_back("morph target weights channels (" + weights.describe() +
+                          "): not applied; the base shape is drawn");
+    }
     if (m.scenes.size() > 1)
         out.push_back("the file holds " + std::to_string(m.scenes.size()) + " scenes: only scene " +
                       std::to_string(scene < 0 ? 0 : scene) + " is loaded");

@@ -8,6 +8,7 @@
  *   gltf_container.cpp  .glb container and JSON pre-scan, before tinygltf
  *   gltf_images.cpp     image size caps and decoding, tinygltf's callback
  *   gltf_build.cpp      the Builder: the node forest walked into draws
+ *   gltf_animation.cpp  animations sampled at a time into node overrides
  *   gltf_transform.cpp  node transforms and the caller's node overrides
  *   gltf_accessor.cpp   buffer views and accessors, every range checked
  *   gltf_mesh.cpp       primitives into world-space triangles
@@ -96,6 +97,9 @@ struct Ctx {
     size_t warnings_dropped = 0;       /* past kMaxWarnings */
     const lpv_gltf_node_override *overrides = nullptr; /* lpv_gltf_load_memory_ex */
     size_t override_count = 0;
+    const lpv_gltf_animation_time *animation = nullptr; /* lpv_gltf_load_file_animated: the pose to sample */
+    lpv_gltf_animation_list *animation_list = nullptr;   /* lpv_gltf_animations: list them, build nothing */
+    std::vector<int> played;                             /* the animations applied (for the warnings) */
     lpv_gltf_warnings *sink = nullptr; /* NULL: warnings go to stderr */
 
     void warn(const std::string &w); /* gltf_messages.cpp */
@@ -166,6 +170,13 @@ class Builder {
 
     void build(); /* gltf_build.cpp */
 
+    /* gltf_animation.cpp: the node overrides that pose the model at `at`
+     * (every channel the chosen animations play checked first; the indices
+     * of those animations go to ctx.played), and the file's animations, each
+     * checked the same way. */
+    std::vector<lpv_gltf_node_override> sample_animations(const lpv_gltf_animation_time &at);
+    void list_animations(lpv_gltf_animation_list &out);
+
     std::vector<lpv_vertex> vertices;
     std::vector<uint32_t> indices;
     std::vector<lpv_draw> draws;
@@ -199,6 +210,11 @@ class Builder {
     template <class T> void read_accessor(int index, int want_ncomp, const char *what, std::vector<T> &out);
     void read_indices(int index, std::vector<uint32_t> &out);
     void check_buffer_views();
+    /* gltf_animation.cpp: one animation's channels and samplers, read and
+     * checked (defined there). */
+    struct Animation;
+    void read_animation(size_t index, Animation &out);
+    void read_animation_parts(size_t index, Animation &out);
     /* gltf_build.cpp */
     void check_node_graph();
     void visit(int node, const Mat4 &parent, int depth);

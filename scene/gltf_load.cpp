@@ -126,11 +126,20 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
         ctx.warn("tinygltf: " + tinygltf_text(terr));
     if (!twarn.empty())
         ctx.warn("tinygltf: " + tinygltf_text(twarn));
+    Builder b(model, ctx);
+    if (ctx.animation_list) { /* lpv_gltf_animations: no images, no scene */
+        b.list_animations(*ctx.animation_list);
+        return;
+    }
     decode_images(model); /* every image counted and within the budgets: now decoded */
 
+    /* The animation's pose first, then the caller's overrides (which win). */
+    if (ctx.animation) {
+        std::vector<lpv_gltf_node_override> pose = b.sample_animations(*ctx.animation);
+        apply_node_overrides(model, pose.data(), pose.size());
+    }
     apply_node_overrides(model, ctx.overrides, ctx.override_count);
 
-    Builder b(model, ctx);
     b.build();
     lpv_medium medium;
     std::vector<float> density;
@@ -170,7 +179,9 @@ int run_load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out, c
 {
     try {
         load(data, size, ctx, out);
-        if (ctx.sink) {
+        if (ctx.animation_list) {
+            /* a list, not a load: its warnings are the load's to give */
+        } else if (ctx.sink) {
             for (const std::string &w : ctx.warnings)
                 snprintf(ctx.sink->line[ctx.sink->count++], LPV_GLTF_WARNING_LEN, "%s", w.c_str());
             ctx.sink->dropped = int(ctx.warnings_dropped);
@@ -231,15 +242,10 @@ template <class F> int guarded(const char *name, lpv_scene *out, char *err, size
     return -1;
 }
 
-} // namespace
-
-extern "C" int lpv_gltf_load_file(const char *path, lpv_scene *out, char *err, size_t err_size)
-{
-    return lpv_gltf_load_file_w(path, out, nullptr, err, err_size);
-}
-
-extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_warnings *warnings, char *err,
-                                    size_t err_size)
+/* A file's load: the scene (posed by animation when it is given), or with
+ * list the file's animations only (out then stays zeroed). */
+int load_file(const char *path, const lpv_gltf_animation_time *animation, lpv_gltf_animation_list *list,
+              lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size)
 {
     if (!begin_load(path ? path : "(null)", out, warnings, err, err_size))
         return -1;
@@ -252,6 +258,8 @@ extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_w
         Ctx ctx;
         ctx.label = path;
         ctx.sink = warnings;
+        ctx.animation = animation;
+        ctx.animation_list = list;
         std::string p(path);
         size_t slash = p.find_last_of('/');
         std::string dir = slash == std::string::npos ? std::string(".")
@@ -271,6 +279,46 @@ extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_w
             close(ctx.dir_fd);
         return rc < 0 ? -1 : rc;
     });
+}
+
+} // namespace
+
+extern "C" int lpv_gltf_load_file(const char *path, lpv_scene *out, char *err, size_t err_size)
+{
+    return load_file(path, nullptr, nullptr, out, nullptr, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_warnings *warnings, char *err,
+                                    size_t err_size)
+{
+    return load_file(path, nullptr, nullptr, out, warnings, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_file_animated(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out,
+                                           char *err, size_t err_size)
+{
+    return load_file(path, at, nullptr, out, nullptr, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_file_animated_w(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out,
+                                             lpv_gltf_warnings *warnings, char *err, size_t err_size)
+{
+    return load_file(path, at, nullptr, out, warnings, err, err_size);
+}
+
+extern "C" int lpv_gltf_animations(const char *path, lpv_gltf_animation_list *out, char *err, size_t err_size)
+{
+    if (!out) {
+        if (err && err_size)
+            snprintf(err, err_size, "%s: no animation list to fill", path ? path : "(null)");
+        return -1;
+    }
+    memset(out, 0, sizeof *out);
+    lpv_scene unused; /* zeroed by begin_load, never filled */
+    int rc = load_file(path, nullptr, out, &unused, nullptr, err, err_size);
+    if (rc != 0)
+        memset(out, 0, sizeof *out);
+    return rc;
 }
 
 extern "C" int lpv_gltf_load_memory(const void *data, size_t size, const char *base_dir, const char *label,

@@ -10,10 +10,12 @@
  * KHR_draco_mesh_compression (libdraco) and EXT_meshopt_compression
  * (libmeshoptimizer) (docs/scenes.md, "Materials", "Compressed meshes"),
  * KHR_lights_punctual (directional, point, spot with cone angles and range),
- * cameras, and lpvd's participating medium from the loaded scene's extras
- * (scenes[scene].extras.lpvd_medium, else the document's extras.lpvd_medium;
- * docs/scenes.md, "Media"), every field checked and named when refused. Photometric values are converted to radiometric ones with
- * LPV_LUMENS_PER_WATT (docs/units.md).
+ * cameras, node translation / rotation / scale animations sampled at a
+ * given time (lpv_gltf_load_file_animated, below), and lpvd's participating
+ * medium from the loaded scene's extras (scenes[scene].extras.lpvd_medium,
+ * else the document's extras.lpvd_medium; docs/scenes.md, "Media"), every
+ * field checked and named when refused. Photometric values are converted to
+ * radiometric ones with LPV_LUMENS_PER_WATT (docs/units.md).
  *
  * Refused with a message naming the file and the problem, never a crash:
  * truncated or mis-sized .glb, wrong magic, invalid JSON, accessors or
@@ -26,7 +28,8 @@
  *
  * Everything else in the file that lpvd does not use (extensions it does not
  * implement, occlusion/emissive/metallic-roughness textures, vertex colours,
- * skins, morph targets, animations, ...) is a warning, one line per feature
+ * skins, morph targets, animations unless played (below), ...) is a
+ * warning, one line per feature
  * (docs/scenes.md, "Supported and warned"): printed on stderr as
  * "lpvd: <file>: warning: <line>", or handed to the caller through the _w
  * functions below.
@@ -80,6 +83,56 @@ typedef struct lpv_gltf_node_override {
 int lpv_gltf_load_memory_ex(const void *data, size_t size, const char *base_dir, const char *label,
                             const lpv_gltf_node_override *nodes, size_t node_count, lpv_scene *out, char *err,
                             size_t err_size);
+
+/* ---- animations (docs/scenes.md, "Animations") -----------------------------
+ * Node translation / rotation / scale channels of the file's animations,
+ * sampled at a time (LINEAR, with rotations slerped along the shortest path;
+ * STEP; CUBICSPLINE), become node overrides (above) before the scene is
+ * flattened, so meshes, cameras and lights below an animated node move with
+ * it. Times before an animation's first keyframe take the first value, after
+ * its last the last. Morph-target "weights" channels and KHR_animation_pointer
+ * are not supported: warned, ignored. Defects (an unknown animation, a
+ * negative or non-finite time, sampler times not finite or not increasing,
+ * an output count that does not fit the interpolation, a target node out of
+ * range or given as a matrix, an accessor of the wrong type) refuse the
+ * file with "<path>: animation 2 ("Walk"): <problem>". */
+
+/* Which animation, and when. */
+typedef struct lpv_gltf_animation_time {
+    /* The animation's name, else its index as a decimal string (a name is
+     * looked up first); NULL or "" plays every animation of the file at
+     * once (a later animation wins where two animate the same property). */
+    const char *animation;
+    double time; /* seconds from the animation's start, finite, >= 0 */
+} lpv_gltf_animation_time;
+
+/* lpv_gltf_load_file with the nodes posed by *at; at NULL loads the file's
+ * static pose exactly like lpv_gltf_load_file. A file without animations is
+ * refused when at is given. */
+int lpv_gltf_load_file_animated(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out, char *err,
+                                size_t err_size);
+/* The same with the warnings stored in *warnings, like lpv_gltf_load_file_w. */
+int lpv_gltf_load_file_animated_w(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out,
+                                  lpv_gltf_warnings *warnings, char *err, size_t err_size);
+
+#define LPV_GLTF_ANIMATIONS_MAX 64
+#define LPV_GLTF_ANIMATION_NAME_LEN 64
+typedef struct lpv_gltf_animation_info {
+    char name[LPV_GLTF_ANIMATION_NAME_LEN]; /* the file's name, cut to fit (whole UTF-8 characters); "" if none */
+    double duration;                        /* seconds: the largest input time of its samplers */
+    int channels;                           /* node translation / rotation / scale channels it plays */
+} lpv_gltf_animation_info;
+
+typedef struct lpv_gltf_animation_list {
+    int count; /* the file's animations, possibly more than LPV_GLTF_ANIMATIONS_MAX */
+    lpv_gltf_animation_info animation[LPV_GLTF_ANIMATIONS_MAX]; /* the first min(count, MAX), by index */
+} lpv_gltf_animation_list;
+
+/* The animations of a .gltf or .glb file, each checked as if it were played
+ * (a defect in any refuses the call like a load would). Images are not
+ * decoded and no scene is built; no warnings are printed. Returns 0, or -1
+ * with "<path>: <problem>" in err and *out zeroed. */
+int lpv_gltf_animations(const char *path, lpv_gltf_animation_list *out, char *err, size_t err_size);
 
 /* What one load may take (the daemon's per-scene budgets). A 0 field means
  * the loader's own absurd-size cap. Sizes come from the images' headers

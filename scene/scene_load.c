@@ -4,15 +4,28 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "gltf_load.h"
 #include "scene_defaults.h"
 
 int lpv_scene_load(const char *path, lpv_scene *out, char *err, size_t err_size)
 {
+    return lpv_scene_load_animated(path, NULL, out, err, err_size);
+}
+
+int lpv_scene_load_animated(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out, char *err,
+                            size_t err_size)
+{
     memset(out, 0, sizeof *out);
-    int rc = (path && path[0]) ? lpv_gltf_load_file(path, out, err, err_size) : lpv_scene_builtin_cornell(out);
+    const int builtin = !(path && path[0]);
+    if (builtin && at) {
+        snprintf(err, err_size,
+                 "built-in scene: it has no animations (an animation was requested at %g s; give a glTF file "
+                 "that has one)",
+                 at->time);
+        return -1;
+    }
+    int rc = builtin ? lpv_scene_builtin_cornell(out) : lpv_gltf_load_file_animated(path, at, out, err, err_size);
     if (rc != 0) {
-        if (!(path && path[0]))
+        if (builtin)
             snprintf(err, err_size, "built-in scene: out of memory");
         lpv_scene_free(out);
         return -1;

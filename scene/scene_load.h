@@ -7,8 +7,16 @@
 #define LPV_SCENE_LOAD_H
 
 #include <stddef.h>
+#include "gltf_load.h"
 #include "scene.h"
 
 int lpv_scene_load(const char *path, lpv_scene *out, char *err, size_t err_size);
+
+/* lpv_scene_load with the file's nodes posed by one of its animations at a
+ * time (lpv_gltf_load_file_animated; docs/scenes.md, "Animations"); at NULL
+ * is lpv_scene_load. The built-in scene (path NULL or "") has no animations:
+ * a request for one is refused. The defaults are placed for the posed scene. */
+int lpv_scene_load_animated(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out, char *err,
+                            size_t err_size);
 
 #endif

@@ -1,8 +1,9 @@
 /*
  * test_gltf.c - the glTF loader (scene/gltf_load.h): hand-made .glb and .gltf
  * files built here, every malformed or hostile case refused with a message
- * naming the file and the problem, and ../shared/scenes/cornell-box.glb
- * against the built-in Cornell box.
+ * naming the file and the problem, ../shared/scenes/cornell-box.glb
+ * against the built-in Cornell box, and node animations posed at a time
+ * (lpv_gltf_load_file_animated) against hand-computed positions.
  *
  * JSON in this file is written with single quotes; J() turns them into
  * double quotes.
@@ -23,6 +24,7 @@
 
 #include "gltf_load.h"
 #include "scene.h"
+#include "scene_load.h"
 #include "test_util.h"
 
 #define S45 0.70710678118654752f
@@ -1284,6 +1286,606 @@ static void test_cornell_glb_matches_builtin(void **state)
     lpv_scene_free(&b);
 }
 
+/* ---- (d) animations ---------------------------------------------------------- */
+
+/* An animated file: TRI_JSON's triangle (accessor 0, bufferView 0) and the
+ * keyframe data appended as accessors 1, 2, ... in bufferView 1. */
+typedef struct anim_file {
+    bin b;
+    char accessors[4096];
+    size_t len;
+    int next;
+} anim_file;
+
+static void anim_init(anim_file *f)
+{
+    tri_bin(&f->b);
+    f->accessors[0] = '\0';
+    f->len = 0;
+    f->next = 1;
+}
+
+/* An accessor given as JSON (with '); returns its index. */
+static int anim_acc_json(anim_file *f, const char *json)
+{
+    int n = snprintf(f->accessors + f->len, sizeof f->accessors - f->len, ",%s", json);
+    assert_true(n > 0 && (size_t)n < sizeof f->accessors - f->len);
+    f->len += (size_t)n;
+    return f->next++;
+}
+
+/* count float elements of type SCALAR, VEC3 or VEC4 from v; returns the accessor index. */
+static int anim_acc(anim_file *f, const char *type, int count, const float *v)
+{
+    int ncomp = strcmp(type, "SCALAR") == 0 ? 1 : strcmp(type, "VEC3") == 0 ? 3 : 4;
+    size_t off = f->b.n - 36;
+    for (int i = 0; i < count * ncomp; i++)
+        put_f32(&f->b, v[i]);
+    char json[160];
+    snprintf(json, sizeof json, "{'bufferView':1,'byteOffset':%zu,'componentType':5126,'count':%d,'type':'%s'}", off,
+             count, type);
+    return anim_acc_json(f, json);
+}
+
+/* The file with the given nodes, scene roots and animations (JSON with ' ;
+ * animations NULL: none), written as name into path. */
+static void anim_write(char *path, const char *name, const anim_file *f, const char *nodes, const char *roots,
+                       const char *animations)
+{
+    char anims[4096] = "";
+    if (animations)
+        snprintf(anims, sizeof anims, ",'animations':%s", animations);
+    const char *json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':%zu}],"
+                         "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':%zu}],"
+                         "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}%s],"
+                         "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                         "'nodes':%s,'scenes':[{'nodes':%s}],'scene':0%s}",
+                         f->b.n, f->b.n - 36, f->accessors, nodes, roots, anims);
+    write_glb(path, name, json, &f->b);
+}
+
+/* One animation named name of one channel (node 0, path) with one sampler. */
+static const char *one_channel(const char *name, const char *path, int input, int output, const char *interp)
+{
+    static char json[512];
+    snprintf(json, sizeof json,
+             "[{'name':'%s','channels':[{'sampler':0,'target':{'node':0,'path':'%s'}}],"
+             "'samplers':[{'input':%d,'output':%d,'interpolation':'%s'}]}]",
+             name, path, input, output, interp);
+    return json;
+}
+
+static void load_at(const char *path, const char *animation, double t, lpv_scene *s)
+{
+    lpv_gltf_animation_time at = {animation, t};
+    char err[768] = "";
+    memset(s, 0x5a, sizeof *s);
+    if (lpv_gltf_load_file_animated(path, &at, s, err, sizeof err) != 0)
+        fail_msg("loading %s at %g s failed: %s", path, t, err);
+    assert_string_equal(s->source, path);
+}
+
+/* Vertex `v` of the flattened scene posed at t must be (x, y, z). */
+static void vertex_at(const char *path, const char *animation, double t, uint32_t v, float x, float y, float z)
+{
+    lpv_scene s;
+    load_at(path, animation, t, &s);
+    assert_true(v < s.vertex_count);
+    print_message("    t = %-6g vertex %u (%g, %g, %g)\n", t, v, s.vertices[v].position[0], s.vertices[v].position[1],
+                  s.vertices[v].position[2]);
+    assert_vec3(s.vertices[v].position, x, y, z, 1e-5f);
+    lpv_scene_free(&s);
+}
+
+/* Posing must fail, name the file and say each of the words (NULL ends them
+ * early); the scene stays zeroed. */
+static void expect_anim_fail(const char *path, const char *animation, double t, const char *w1, const char *w2)
+{
+    lpv_gltf_animation_time at = {animation, t};
+    lpv_scene s;
+    char err[768] = "";
+    memset(&s, 0x5a, sizeof s);
+    int rc = lpv_gltf_load_file_animated(path, &at, &s, err, sizeof err);
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    print_message("    %-28s -> %s\n", base, err);
+    if (rc != -1)
+        fail_msg("%s posed at %g s but should have failed with '%s'", path, t, w1);
+    if (!strstr(err, base))
+        fail_msg("error '%s' does not name the file '%s'", err, base);
+    if (!strstr(err, w1) || (w2 && !strstr(err, w2)))
+        fail_msg("error '%s' does not mention '%s' and '%s'", err, w1, w2 ? w2 : "");
+    assert_true(scene_is_zero(&s));
+    lpv_scene_free(&s);
+}
+
+/* A file defect: refused when posed and when its animations are listed. */
+static void expect_anim_defect(const char *path, const char *w1, const char *w2)
+{
+    expect_anim_fail(path, "Walk", 0.5, w1, w2);
+    expect_anim_fail(path, "0", 0.5, w1, w2);
+    lpv_gltf_animation_list list;
+    char err[768] = "";
+    memset(&list, 0x5a, sizeof list);
+    assert_int_equal(lpv_gltf_animations(path, &list, err, sizeof err), -1);
+    assert_non_null(strstr(err, w1));
+    assert_int_equal(list.count, 0);
+}
+
+static const float T01[] = {0, 1};
+static const float T13[] = {1, 3};
+
+static void test_animation_linear_translation(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    const float v[] = {0, 0, 0, 4, 2, 0};
+    int in = anim_acc(&f, "SCALAR", 2, T13), out = anim_acc(&f, "VEC3", 2, v);
+    char anims[512];
+    /* no "interpolation": LINEAR is glTF's default */
+    snprintf(anims, sizeof anims,
+             "[{'name':'Slide','channels':[{'sampler':0,'target':{'node':0,'path':'translation'}}],"
+             "'samplers':[{'input':%d,'output':%d}]}]",
+             in, out);
+    char path[512];
+    anim_write(path, "anim-linear.glb", &f, "[{'mesh':0,'translation':[7,0,0]}]", "[0]", anims);
+
+    /* the static pose, also for at NULL */
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_vec3(s.vertices[0].position, 7, 0, 0, 1e-6f);
+    lpv_scene_free(&s);
+    char err[512] = "";
+    assert_int_equal(lpv_gltf_load_file_animated(path, NULL, &s, err, sizeof err), 0);
+    assert_vec3(s.vertices[0].position, 7, 0, 0, 1e-6f);
+    lpv_scene_free(&s);
+
+    vertex_at(path, "Slide", 1.0, 0, 0, 0, 0);     /* the first keyframe */
+    vertex_at(path, "Slide", 2.0, 0, 2, 1, 0);     /* half-way */
+    vertex_at(path, "Slide", 1.5, 0, 1, 0.5f, 0);  /* a quarter */
+    vertex_at(path, "Slide", 3.0, 0, 4, 2, 0);     /* the last */
+    vertex_at(path, "Slide", 0.0, 0, 0, 0, 0);     /* before the first: clamped */
+    vertex_at(path, "Slide", 100.0, 0, 4, 2, 0);   /* after the last: clamped */
+    vertex_at(path, "Slide", 2.0, 1, 3, 1, 0);     /* the whole triangle moves */
+    load_at(path, "Slide", 2.0, &s);
+    assert_vec3(s.bounds_min, 2, 1, 0, 1e-6f);
+    assert_vec3(s.bounds_max, 3, 2, 0, 1e-6f);
+    lpv_scene_free(&s);
+}
+
+static void test_animation_step(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    const float t[] = {0, 1, 2}, v[] = {0, 0, 0, 5, 0, 0, 10, 0, 0};
+    int in = anim_acc(&f, "SCALAR", 3, t), out = anim_acc(&f, "VEC3", 3, v);
+    char path[512];
+    anim_write(path, "anim-step.glb", &f, "[{'mesh':0}]", "[0]", one_channel("Hop", "translation", in, out, "STEP"));
+    vertex_at(path, "Hop", 0.0, 0, 0, 0, 0);
+    vertex_at(path, "Hop", 0.5, 0, 0, 0, 0);
+    vertex_at(path, "Hop", 0.999, 0, 0, 0, 0);
+    vertex_at(path, "Hop", 1.0, 0, 5, 0, 0);
+    vertex_at(path, "Hop", 1.5, 0, 5, 0, 0);
+    vertex_at(path, "Hop", 2.0, 0, 10, 0, 0);
+    vertex_at(path, "Hop", 9.0, 0, 10, 0, 0);
+}
+
+static void test_animation_cubicspline(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    /* keyframes at 0 and 2 s (td = 2), each (in-tangent a, value v, out-tangent b):
+     * v0 = (0,0,0), b0 = (1,0,3); a1 = (0,-1,2), v1 = (4,2,0); a0 and b1 unused (9s). */
+    const float t[] = {0, 2};
+    const float v[] = {9, 9, 9, 0, 0, 0, 1, 0, 3, /**/ 0, -1, 2, 4, 2, 0, 9, 9, 9};
+    int in = anim_acc(&f, "SCALAR", 2, t), out = anim_acc(&f, "VEC3", 6, v);
+    char path[512];
+    anim_write(path, "anim-cubic.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Curve", "translation", in, out, "CUBICSPLINE"));
+    /* p(u) = h00 v0 + h10 td b0 + h01 v1 + h11 td a1 with
+     * h00 = 2u^3 - 3u^2 + 1, h10 = u^3 - 2u^2 + u, h01 = -2u^3 + 3u^2, h11 = u^3 - u^2.
+     * t = 0.5: u = 1/4, h = (0.84375, 0.140625, 0.15625, -0.046875):
+     *   x = 0.140625*2*1 + 0.15625*4 = 0.90625
+     *   y = 0.15625*2 - 0.046875*2*(-1) = 0.40625
+     *   z = 0.140625*2*3 - 0.046875*2*2 = 0.65625
+     * t = 1: u = 1/2, h = (0.5, 0.125, 0.5, -0.125): (2.25, 1.25, 0.25). */
+    vertex_at(path, "Curve", 0.5, 0, 0.90625f, 0.40625f, 0.65625f);
+    vertex_at(path, "Curve", 1.0, 0, 2.25f, 1.25f, 0.25f);
+    /* the keyframes and past them: the values, never the tangents */
+    vertex_at(path, "Curve", 0.0, 0, 0, 0, 0);
+    vertex_at(path, "Curve", 2.0, 0, 4, 2, 0);
+    vertex_at(path, "Curve", 7.0, 0, 4, 2, 0);
+
+    /* a CUBICSPLINE rotation with zero tangents, identity -> 90 deg about y:
+     * half-way the Hermite blend (0, 0.354, 0, 0.854) normalised is 45 deg */
+    anim_init(&f);
+    const float q[] = {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, /**/ 0, 0, 0, 0, 0, S45, 0, S45, 0, 0, 0, 0};
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC4", 6, q);
+    anim_write(path, "anim-cubic-rotation.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Turn", "rotation", in, out, "CUBICSPLINE"));
+    vertex_at(path, "Turn", 0.5, 1, S45, 0, -S45);
+    vertex_at(path, "Turn", 1.0, 1, 0, 0, -1);
+}
+
+static void test_animation_rotation_slerp(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    /* identity -> 90 deg about y, and the same end as -q (the same rotation) */
+    const float q[] = {0, 0, 0, 1, 0, S45, 0, S45};
+    const float qn[] = {0, 0, 0, 1, 0, -S45, 0, -S45};
+    int in = anim_acc(&f, "SCALAR", 2, T01), out = anim_acc(&f, "VEC4", 2, q), outn = anim_acc(&f, "VEC4", 2, qn);
+    char anims[1024];
+    snprintf(anims, sizeof anims,
+             "[{'name':'Turn','channels':[{'sampler':0,'target':{'node':0,'path':'rotation'}}],"
+             "'samplers':[{'input':%d,'output':%d,'interpolation':'LINEAR'}]},"
+             " {'name':'TurnNegated','channels':[{'sampler':0,'target':{'node':0,'path':'rotation'}}],"
+             "'samplers':[{'input':%d,'output':%d,'interpolation':'LINEAR'}]}]",
+             in, out, in, outn);
+    char path[512];
+    anim_write(path, "anim-slerp.glb", &f, "[{'mesh':0}]", "[0]", anims);
+    /* vertex 1 is (1,0,0): R_y(a) takes it to (cos a, 0, -sin a) */
+    vertex_at(path, "Turn", 0.5, 1, S45, 0, -S45);                       /* 45 deg */
+    vertex_at(path, "Turn", 0.25, 1, 0.92387953f, 0, -0.38268343f);      /* 22.5 deg (a lerp gives 21.6) */
+    vertex_at(path, "Turn", 1.0, 1, 0, 0, -1);                           /* 90 deg */
+    vertex_at(path, "Turn", 0.5, 2, 0, 1, 0);                            /* (0,1,0) stays */
+    /* -q: the shortest path is the same 45 deg, not 135 deg the other way */
+    vertex_at(path, "TurnNegated", 0.5, 1, S45, 0, -S45);
+    vertex_at(path, "TurnNegated", 0.25, 1, 0.92387953f, 0, -0.38268343f);
+}
+
+static void test_animation_hierarchy(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    /* parent 0: translation (0,0,0) -> (2,0,0) over 1 s and one rotation
+     * keyframe, 90 deg about z; child 1 (the mesh) at (0,1,0) below it */
+    const float t0[] = {0}, rz[] = {0, 0, S45, S45}, v[] = {0, 0, 0, 2, 0, 0};
+    int in = anim_acc(&f, "SCALAR", 2, T01), out = anim_acc(&f, "VEC3", 2, v);
+    int in1 = anim_acc(&f, "SCALAR", 1, t0), out1 = anim_acc(&f, "VEC4", 1, rz);
+    char anims[1024];
+    snprintf(anims, sizeof anims,
+             "[{'name':'Carry','channels':[{'sampler':0,'target':{'node':0,'path':'translation'}},"
+             "{'sampler':1,'target':{'node':0,'path':'rotation'}}],"
+             "'samplers':[{'input':%d,'output':%d},{'input':%d,'output':%d,'interpolation':'STEP'}]}]",
+             in, out, in1, out1);
+    char path[512];
+    anim_write(path, "anim-hierarchy.glb", &f,
+               "[{'translation':[0,0,5],'children':[1]},{'mesh':0,'translation':[0,1,0]}]", "[0]", anims);
+    /* static: (0,0,5) + (0,1,0) */
+    lpv_scene s;
+    load_ok(path, &s);
+    assert_vec3(s.vertices[0].position, 0, 1, 5, 1e-6f);
+    lpv_scene_free(&s);
+    /* t = 0.5: parent at (1,0,0) turned 90 deg about z: the child's (0,1,0) -> (-1,0,0) */
+    vertex_at(path, "Carry", 0.5, 0, 0, 0, 0);
+    vertex_at(path, "Carry", 0.5, 1, 0, 1, 0); /* (1,1,0) local -> (-1,1,0) + (1,0,0) */
+    vertex_at(path, "Carry", 1.0, 0, 1, 0, 0);
+}
+
+static void test_animation_choice_and_list(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    const float t2[] = {0, 2}, t4[] = {0, 4};
+    const float left[] = {0, 0, 0, -2, 0, 0}, up[] = {0, 0, 1, 0, 4, 1};
+    int in0 = anim_acc(&f, "SCALAR", 2, t2), out0 = anim_acc(&f, "VEC3", 2, left);
+    int in1 = anim_acc(&f, "SCALAR", 2, t4), out1 = anim_acc(&f, "VEC3", 2, up);
+    char anims[1024];
+    snprintf(anims, sizeof anims,
+             "[{'name':'Left','channels':[{'sampler':0,'target':{'node':0,'path':'translation'}}],"
+             "'samplers':[{'input':%d,'output':%d}]},"
+             " {'name':'Up','channels':[{'sampler':0,'target':{'node':1,'path':'translation'}}],"
+             "'samplers':[{'input':%d,'output':%d}]}]",
+             in0, out0, in1, out1);
+    char path[512];
+    anim_write(path, "anim-choice.glb", &f, "[{'mesh':0},{'mesh':0,'translation':[0,0,1]}]", "[0,1]", anims);
+    /* node 0 draws vertices 0-2, node 1 vertices 3-5 */
+    vertex_at(path, "Left", 1.0, 0, -1, 0, 0);
+    vertex_at(path, "Left", 1.0, 3, 0, 0, 1);
+    vertex_at(path, "0", 1.0, 0, -1, 0, 0);
+    vertex_at(path, "0", 1.0, 3, 0, 0, 1);
+    vertex_at(path, "Up", 1.0, 0, 0, 0, 0);
+    vertex_at(path, "Up", 1.0, 3, 0, 1, 1);
+    vertex_at(path, "1", 1.0, 0, 0, 0, 0);
+    vertex_at(path, "1", 1.0, 3, 0, 1, 1);
+    /* every animation at once */
+    vertex_at(path, "", 1.0, 0, -1, 0, 0);
+    vertex_at(path, "", 1.0, 3, 0, 1, 1);
+    vertex_at(path, NULL, 3.0, 0, -2, 0, 0);
+    vertex_at(path, NULL, 3.0, 3, 0, 3, 1);
+
+    lpv_gltf_animation_list list;
+    char err[512] = "";
+    memset(&list, 0x5a, sizeof list);
+    if (lpv_gltf_animations(path, &list, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    assert_int_equal(list.count, 2);
+    assert_string_equal(list.animation[0].name, "Left");
+    assert_string_equal(list.animation[1].name, "Up");
+    assert_true(list.animation[0].duration == 2.0);
+    assert_true(list.animation[1].duration == 4.0);
+    assert_int_equal(list.animation[0].channels, 1);
+    assert_int_equal(list.animation[1].channels, 1);
+    assert_int_equal(list.animation[2].channels, 0); /* the rest zeroed */
+
+    /* a file without animations lists none */
+    anim_write(path, "anim-none.glb", &f, "[{'mesh':0}]", "[0]", NULL);
+    assert_int_equal(lpv_gltf_animations(path, &list, err, sizeof err), 0);
+    assert_int_equal(list.count, 0);
+}
+
+static int warned(const lpv_gltf_warnings *w, const char *word)
+{
+    for (int i = 0; i < w->count; i++)
+        if (strstr(w->line[i], word))
+            return 1;
+    return 0;
+}
+
+static void test_animation_warnings(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    const float v[] = {0, 0, 0, 4, 0, 0}, wts[] = {0, 1};
+    int in = anim_acc(&f, "SCALAR", 2, T01), out = anim_acc(&f, "VEC3", 2, v);
+    int wout = anim_acc(&f, "SCALAR", 2, wts);
+    /* channel 1 animates morph weights; channel 2 is KHR_animation_pointer's
+     * (no target node: tinygltf drops it, with a warning) */
+    char anims[1024];
+    snprintf(anims, sizeof anims,
+             "[{'name':'Walk','channels':[{'sampler':0,'target':{'node':0,'path':'translation'}},"
+             "{'sampler':1,'target':{'node':0,'path':'weights'}},"
+             "{'sampler':1,'target':{'path':'pointer','extensions':{'KHR_animation_pointer':"
+             "{'pointer':'/nodes/0/scale'}}}}],"
+             "'samplers':[{'input':%d,'output':%d},{'input':%d,'output':%d}]}]",
+             in, out, in, wout);
+    char path[512];
+    anim_write(path, "anim-warnings.glb", &f, "[{'mesh':0}]", "[0]", anims);
+    lpv_scene s;
+    lpv_gltf_warnings w;
+    char err[512] = "";
+
+    /* static: the animation is not played */
+    if (lpv_gltf_load_file_w(path, &s, &w, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    for (int i = 0; i < w.count; i++)
+        print_message("    static: %s\n", w.line[i]);
+    assert_true(warned(&w, "1 animation: not played"));
+    assert_false(warned(&w, "weights"));
+    assert_vec3(s.vertices[0].position, 0, 0, 0, 1e-6f);
+    lpv_scene_free(&s);
+
+    /* played: the translation is applied, the weights channel warned, and no
+     * line says the animation is not played */
+    lpv_gltf_animation_time at = {"Walk", 0.5};
+    if (lpv_gltf_load_file_animated_w(path, &at, &s, &w, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    for (int i = 0; i < w.count; i++)
+        print_message("    played: %s\n", w.line[i]);
+    assert_vec3(s.vertices[0].position, 2, 0, 0, 1e-6f);
+    assert_true(warned(&w, "morph target weights channels (animation 0 channel 1): not applied"));
+    assert_false(warned(&w, "not played"));
+    lpv_scene_free(&s);
+
+    /* KHR_animation_pointer in extensionsUsed: one line, its channels ignored */
+    const char *ptr_json =
+        J("{'asset':{'version':'2.0'},'extensionsUsed':['KHR_animation_pointer'],'buffers':[{'byteLength':%zu}],"
+          "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':%zu}],"
+          "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}%s],"
+          "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+          "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}],'scene':0,'animations':%s}",
+          f.b.n, f.b.n - 36, f.accessors, anims);
+    write_glb(path, "anim-pointer.glb", ptr_json, &f.b);
+    if (lpv_gltf_load_file_animated_w(path, &at, &s, &w, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    for (int i = 0; i < w.count; i++)
+        print_message("    pointer: %s\n", w.line[i]);
+    assert_vec3(s.vertices[0].position, 2, 0, 0, 1e-6f);
+    assert_true(warned(&w, "KHR_animation_pointer"));
+    assert_true(warned(&w, "channels are ignored"));
+    assert_false(warned(&w, "nothing is animated"));
+    lpv_scene_free(&s);
+}
+
+static void test_animation_defects(void **state)
+{
+    (void)state;
+    char path[512];
+    anim_file f;
+    const float v2[] = {0, 0, 0, 1, 1, 1}, v3[] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
+    const float t3[] = {0, 1, 1}, tnan[] = {0, NAN};
+    const float q2[] = {0, 0, 0, 1, 0, 0, 0, 1}, qzero[] = {0, 0, 0, 0, 0, 0, 0, 1};
+
+    /* the good file, asked wrongly */
+    anim_init(&f);
+    int in = anim_acc(&f, "SCALAR", 2, T01), out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-good.glb", &f, "[{'mesh':0}]", "[0]", one_channel("Walk", "translation", in, out, "LINEAR"));
+    vertex_at(path, "Walk", 0.5, 0, 0.5f, 0.5f, 0.5f);
+    expect_anim_fail(path, "Run", 0.5, "animation \"Run\" does not exist", "1 animation (0 \"Walk\")");
+    expect_anim_fail(path, "3", 0.5, "animation \"3\" does not exist", "1 animation");
+    expect_anim_fail(path, "-1", 0.5, "does not exist", "1 animation");
+    expect_anim_fail(path, "Walk", NAN, "time nan s is not finite", "\"Walk\"");
+    expect_anim_fail(path, "Walk", INFINITY, "not finite", NULL);
+    expect_anim_fail(path, "Walk", -0.25, "time -0.25 s is negative", "\"Walk\"");
+    expect_anim_fail(path, NULL, -1.0, "every animation: time -1 s is negative", NULL);
+
+    /* a file without animations */
+    anim_write(path, "anim-none-asked.glb", &f, "[{'mesh':0}]", "[0]", NULL);
+    expect_anim_fail(path, NULL, 1.0, "the file has no animations", NULL);
+    expect_anim_fail(path, "Walk", 1.0, "the file has no animations", NULL);
+
+    /* sampler input: not increasing, not finite, not SCALAR FLOAT, out of range */
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 3, t3);
+    out = anim_acc(&f, "VEC3", 3, v3);
+    anim_write(path, "anim-not-increasing.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: keyframe times are not increasing",
+                       "keyframe 2 at 1 s follows one at 1 s");
+
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, tnan);
+    out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-time-nan.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: keyframe time 1 is not finite", NULL);
+
+    anim_init(&f);
+    in = anim_acc(&f, "VEC3", 2, v2);
+    out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-input-vec3.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: input accessor 1 must be SCALAR FLOAT", NULL);
+
+    anim_init(&f);
+    put_u8(&f.b, 0);
+    put_u8(&f.b, 1);
+    pad4(&f.b);
+    in = anim_acc_json(&f, "{'bufferView':1,'byteOffset':0,'componentType':5121,'count':2,'type':'SCALAR'}");
+    out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-input-ubyte.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: input accessor 1 must be SCALAR FLOAT", NULL);
+
+    anim_init(&f);
+    out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-input-range.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", 9, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: input accessor 9 does not exist", NULL);
+
+    /* outputs: the count the interpolation needs, the type the path needs */
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC3", 3, v3);
+    anim_write(path, "anim-linear-count.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: output accessor 2 holds 3 elements",
+                       "LINEAR with 2 keyframes needs 2");
+    anim_write(path, "anim-step-count.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "STEP"));
+    expect_anim_defect(path, "STEP with 2 keyframes needs 2", "\"Walk\"");
+
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-cubic-count.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "CUBICSPLINE"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: output accessor 2 holds 2 elements",
+                       "CUBICSPLINE with 2 keyframes needs 6");
+
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC4", 2, q2);
+    anim_write(path, "anim-translation-vec4.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): channel 0 (translation): output accessor 2", "must be VEC3");
+    anim_write(path, "anim-scale-vec4.glb", &f, "[{'mesh':0}]", "[0]", one_channel("Walk", "scale", in, out, "LINEAR"));
+    expect_anim_defect(path, "channel 0 (scale)", "must be VEC3");
+
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC3", 2, v2);
+    anim_write(path, "anim-rotation-vec3.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "rotation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): channel 0 (rotation): output accessor 2", "must be VEC4");
+
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC4", 2, qzero);
+    anim_write(path, "anim-rotation-zero.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "rotation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: rotation 0 is not a unit quaternion", NULL);
+
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    const float vnan[] = {0, 0, 0, 1, INFINITY, 1};
+    out = anim_acc(&f, "VEC3", 2, vnan);
+    anim_write(path, "anim-output-inf.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: output element 1 is not finite", NULL);
+
+    /* channels and samplers */
+    anim_init(&f);
+    in = anim_acc(&f, "SCALAR", 2, T01);
+    out = anim_acc(&f, "VEC3", 2, v2);
+    char anims[512];
+    snprintf(anims, sizeof anims,
+             "[{'name':'Walk','channels':[{'sampler':0,'target':{'node':7,'path':'translation'}}],"
+             "'samplers':[{'input':%d,'output':%d}]}]",
+             in, out);
+    anim_write(path, "anim-node-range.glb", &f, "[{'mesh':0}]", "[0]", anims);
+    expect_anim_defect(path, "animation 0 (\"Walk\"): channel 0: target node 7 does not exist", "1 node)");
+    snprintf(anims, sizeof anims,
+             "[{'name':'Walk','channels':[{'sampler':4,'target':{'node':0,'path':'translation'}}],"
+             "'samplers':[{'input':%d,'output':%d}]}]",
+             in, out);
+    anim_write(path, "anim-sampler-range.glb", &f, "[{'mesh':0}]", "[0]", anims);
+    expect_anim_defect(path, "animation 0 (\"Walk\"): channel 0: sampler 4 does not exist", NULL);
+    anim_write(path, "anim-interpolation.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "BEZIER"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): sampler 0: interpolation \"BEZIER\" is not LINEAR", NULL);
+    anim_write(path, "anim-path.glb", &f, "[{'mesh':0}]", "[0]", one_channel("Walk", "colour", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): channel 0: target path \"colour\"", NULL);
+    anim_write(path, "anim-matrix-node.glb", &f, "[{'mesh':0,'matrix':[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    expect_anim_defect(path, "animation 0 (\"Walk\"): channel 0: target node 0 is given as a matrix", NULL);
+
+    /* a name that is not an identifier is not quoted: the index names it */
+    anim_write(path, "anim-odd-name.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk.001", "translation", in, out, "BEZIER"));
+    expect_anim_fail(path, "Walk.001", 0.5, "animation 0: sampler 0: interpolation", NULL);
+    expect_anim_fail(path, "Walk", 0.5, "animation \"Walk\" does not exist", "1 animation (0)");
+}
+
+static void test_animation_scene_load(void **state)
+{
+    (void)state;
+    lpv_gltf_animation_time at = {"Walk", 0.5};
+    lpv_scene s;
+    char err[512] = "";
+    /* the built-in scene has no animations */
+    memset(&s, 0x5a, sizeof s);
+    assert_int_equal(lpv_scene_load_animated(NULL, &at, &s, err, sizeof err), -1);
+    print_message("    built-in -> %s\n", err);
+    assert_non_null(strstr(err, "built-in scene"));
+    assert_non_null(strstr(err, "no animations"));
+    assert_true(scene_is_zero(&s));
+    assert_int_equal(lpv_scene_load_animated("", &at, &s, err, sizeof err), -1);
+    assert_non_null(strstr(err, "built-in scene"));
+    /* without a request it is the built-in scene */
+    assert_int_equal(lpv_scene_load_animated(NULL, NULL, &s, err, sizeof err), 0);
+    assert_true(s.vertex_count > 0);
+    lpv_scene_free(&s);
+
+    /* a file: posed, then given the default camera and light */
+    anim_file f;
+    anim_init(&f);
+    const float v2[] = {0, 0, 0, 2, 0, 0};
+    int in = anim_acc(&f, "SCALAR", 2, T01), out = anim_acc(&f, "VEC3", 2, v2);
+    char path[512];
+    anim_write(path, "anim-scene.glb", &f, "[{'mesh':0}]", "[0]",
+               one_channel("Walk", "translation", in, out, "LINEAR"));
+    if (lpv_scene_load_animated(path, &at, &s, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    assert_vec3(s.vertices[0].position, 1, 0, 0, 1e-6f);
+    assert_int_equal(s.default_camera_added, 1);
+    assert_true(s.camera_count >= 1);
+    lpv_scene_free(&s);
+    /* and its defects reach the caller */
+    at.animation = "Run";
+    assert_int_equal(lpv_scene_load_animated(path, &at, &s, err, sizeof err), -1);
+    assert_non_null(strstr(err, "animation \"Run\" does not exist"));
+    assert_true(scene_is_zero(&s));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1308,6 +1910,15 @@ int main(void)
         cmocka_unit_test(test_node_graphs),
         cmocka_unit_test(test_absurd_sizes),
         cmocka_unit_test(test_cornell_glb_matches_builtin),
+        cmocka_unit_test(test_animation_linear_translation),
+        cmocka_unit_test(test_animation_step),
+        cmocka_unit_test(test_animation_cubicspline),
+        cmocka_unit_test(test_animation_rotation_slerp),
+        cmocka_unit_test(test_animation_hierarchy),
+        cmocka_unit_test(test_animation_choice_and_list),
+        cmocka_unit_test(test_animation_warnings),
+        cmocka_unit_test(test_animation_defects),
+        cmocka_unit_test(test_animation_scene_load),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
