@@ -82,12 +82,16 @@ bool check_size(const char *path, int width, int height, int channels, const voi
 // and EXR frames are encoded exactly like `lpvd render`'s files: 8-bit sRGB,
 // or linear float for the formats lpv_image_is_float_format names. Our alpha
 // is straight (unassociated), as PNG stores it: OIIO must not un-premultiply;
-// EXR is written as is.
+// EXR is written as is. The same pixels give the same bytes: OpenImageIO's
+// EXR writer stamps the current time into a "DateTime" attribute unless the
+// spec has one, so the spec names none (empty), and a batch job's shards, a
+// re-run or the daemon's frame cache get byte-identical files.
 ImageSpec output_spec(const char *name, int width, int height, int channels)
 {
     const bool is_float = lpv_image_is_float_format(name) != 0;
     ImageSpec spec(width, height, channels, is_float ? TypeDesc::FLOAT : TypeDesc::UINT8);
     spec.attribute("oiio:ColorSpace", is_float ? "Linear" : "sRGB");
+    spec.attribute("DateTime", "");
     if (!is_float)
         spec.attribute("oiio:UnassociatedAlpha", 1);
     if (channels == 2)

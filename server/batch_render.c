@@ -1,0 +1,438 @@
+/* batch_render.c - see batch_render.h. */
+#include "batch_render.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "engine.h"
+#include "image_io.h"
+#include "report.h"
+#include "scene_load.h"
+#include "stats_json.h"
+#include "tonemap.h"
+
+struct lpvd_batch_renderer {
+    const lpvd_batch_job *job;
+    char out[PATH_MAX];
+    char root[PATH_MAX]; /* the job folder, resolved: scenes and points stay inside */
+    lpv_gl_context *ctx;
+    lpv_engine *engine;
+    lpv_scene scene; /* the loaded one */
+    int scene_index, scene_time; /* which (-1: none) */
+    int engine_scene, engine_lights; /* what the engine was last given (-1: nothing) */
+    float *points;   /* LPVD_OUT_POINTS: 6 floats each */
+    size_t point_count;
+    float *rgba;
+    uint8_t *rgba8;
+};
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+static json_t *wall_time(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_REALTIME, &t);
+    struct tm tm;
+    gmtime_r(&t.tv_sec, &tm);
+    char buf[64], out[80];
+    strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+    snprintf(out, sizeof out, "%s.%03ldZ", buf, t.tv_nsec / 1000000L);
+    return json_string(out);
+}
+
+static int fail(char *err, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, n, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* dir/rel, resolved, must lie inside root (no symbolic link out of it either). */
+static int inside(const char *root, const char *dir, const char *rel, char out[PATH_MAX], char *err, size_t n)
+{
+    char joined[2 * PATH_MAX];
+    snprintf(joined, sizeof joined, "%s/%s", dir, rel);
+    if (!realpath(joined, out))
+        return fail(err, n, "%s: %s", rel, strerror(errno));
+    size_t len = strlen(root);
+    if (strncmp(out, root, len) != 0 || (out[len] != '/' && out[len] != '\0'))
+        return fail(err, n, "%s: leaves the job file's folder", rel);
+    return 0;
+}
+
+/* The points file: px,py,pz,nx,ny,nz per line ('#' lines and blank lines skipped). */
+static int load_points(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return fail(err, n, "points %s: %s", r->job->points_path, strerror(errno));
+    char line[1024];
+    size_t cap = 0, lineno = 0;
+    int rc = 0;
+    while (rc == 0 && fgets(line, sizeof line, f)) {
+        ++lineno;
+        if (line[0] == '#' || line[strspn(line, " \t\r\n")] == '\0')
+            continue;
+        float v[6];
+        if (sscanf(line, "%f,%f,%f,%f,%f,%f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) != 6) {
+            rc = fail(err, n, "points %s:%zu: expected px,py,pz,nx,ny,nz", r->job->points_path, lineno);
+            break;
+        }
+        for (int i = 0; i < 6; ++i)
+            if (!isfinite(v[i]) || fabsf(v[i]) > LPV_MAX_COORD)
+                rc = fail(err, n, "points %s:%zu: values must be finite, within 1e9", r->job->points_path, lineno);
+        if (r->point_count == cap) {
+            cap = cap ? 2 * cap : 1024;
+            if (cap > (size_t)1 << 24) {
+                rc = fail(err, n, "points %s: more than 16777216 points", r->job->points_path);
+                break;
+            }
+            float *np = realloc(r->points, cap * 6 * sizeof *np);
+            if (!np) {
+                rc = fail(err, n, "out of memory");
+                break;
+            }
+            r->points = np;
+        }
+        memcpy(&r->points[6 * r->point_count++], v, sizeof v);
+    }
+    fclose(f);
+    return rc;
+}
+
+lpvd_batch_renderer *lpvd_batch_renderer_create(const lpvd_batch_job *job, lpv_backend backend, const char *out_dir,
+                                                char *err, size_t n)
+{
+    lpvd_batch_renderer *r = calloc(1, sizeof *r);
+    if (!r) {
+        fail(err, n, "out of memory");
+        return NULL;
+    }
+    r->job = job;
+    r->scene_index = r->scene_time = r->engine_scene = r->engine_lights = -1;
+    snprintf(r->out, sizeof r->out, "%s", out_dir);
+    if (!realpath(job->dir, r->root)) {
+        fail(err, n, "%s: %s", job->dir, strerror(errno));
+        goto bad;
+    }
+    if (job->outputs & LPVD_OUT_POINTS) {
+        char path[PATH_MAX];
+        if (inside(r->root, job->dir, job->points_path, path, err, n) != 0 || load_points(r, path, err, n) != 0)
+            goto bad;
+    }
+    size_t pixels = (size_t)job->width * (size_t)job->height;
+    r->rgba = malloc(pixels * 4 * sizeof *r->rgba);
+    r->rgba8 = malloc(pixels * 4);
+    if (!r->rgba || !r->rgba8) {
+        fail(err, n, "out of memory for %dx%d images", job->width, job->height);
+        goto bad;
+    }
+    lpv_gl_context_desc desc = {.backend = backend};
+    r->ctx = lpv_gl_context_create(&desc, err, n);
+    if (!r->ctx)
+        goto bad;
+    fprintf(stderr, "lpvd batch: backend %s, GL_RENDERER %s\n", lpv_backend_name(lpv_gl_context_backend(r->ctx)),
+            lpv_gl_context_renderer(r->ctx));
+    r->engine = lpv_engine_create(err, n);
+    if (!r->engine)
+        goto bad;
+    return r;
+bad:
+    lpvd_batch_renderer_destroy(r);
+    return NULL;
+}
+
+void lpvd_batch_renderer_destroy(lpvd_batch_renderer *r)
+{
+    if (!r)
+        return;
+    lpv_engine_destroy(r->engine);
+    lpv_gl_context_destroy(r->ctx);
+    lpv_scene_free(&r->scene);
+    free(r->points);
+    free(r->rgba);
+    free(r->rgba8);
+    free(r);
+}
+
+/* The item's scene at its time, loaded unless it already is. */
+static int use_scene(lpvd_batch_renderer *r, const lpvd_batch_item *it, char *err, size_t n)
+{
+    if (r->scene_index == it->scene && r->scene_time == it->time)
+        return 0;
+    lpv_scene_free(&r->scene);
+    r->scene_index = r->scene_time = r->engine_scene = -1;
+    const lpvd_batch_scene *s = &r->job->scenes[it->scene];
+    if (!s->path)
+        return lpv_scene_load(NULL, &r->scene, err, n);
+    char path[PATH_MAX];
+    if (inside(r->root, r->job->dir, s->path, path, err, n) != 0)
+        return -1;
+    int rc;
+    if (it->time >= 0) {
+        lpv_gltf_animation_time at = {.animation = s->animation, .time = s->times[it->time]};
+        rc = lpv_scene_load_animated(path, &at, &r->scene, err, n);
+    } else {
+        rc = lpv_scene_load(path, &r->scene, err, n);
+    }
+    if (rc != 0)
+        return -1;
+    r->scene_index = it->scene;
+    r->scene_time = it->time;
+    return 0;
+}
+
+/* View k of an orbit of n around the scene's bounds. */
+static int orbit_view(const lpvd_batch_camera *c, const lpv_scene *s, int w, int h, lpv_view *v)
+{
+    float centre[3], radius = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+        centre[i] = 0.5f * (s->bounds_min[i] + s->bounds_max[i]);
+        float e = 0.5f * (s->bounds_max[i] - s->bounds_min[i]);
+        radius += e * e;
+    }
+    radius = sqrtf(radius);
+    float fov = c->orbit_fov_deg * (float)(M_PI / 180.0);
+    float d = c->orbit_distance > 0.0f ? c->orbit_distance : 1.05f * radius / sinf(0.5f * fov);
+    if (!(d > 0.0f))
+        d = 1.0f;
+    double az = 2.0 * M_PI * c->orbit_k / c->orbit_n, el = c->orbit_elevation_deg * M_PI / 180.0;
+    float eye[3] = {centre[0] + d * (float)(cos(el) * sin(az)), centre[1] + d * (float)sin(el),
+                    centre[2] + d * (float)(cos(el) * cos(az))};
+    return lpv_view_look_at(eye, centre, fov, w, h, v);
+}
+
+/* path = out/rel; written by fn to a temporary name in the same folder with
+ * the same extension, then renamed. */
+typedef int (*writer)(lpvd_batch_renderer *r, const char *path, char *err, size_t n);
+
+static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json_t *outputs, const char *kind,
+                        char *err, size_t n)
+{
+    char path[PATH_MAX], tmp[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", r->out, rel);
+    char *slash = strrchr(path, '/');
+    for (char *p = path + strlen(r->out) + 1; p <= slash; ++p) /* the id's folders */
+        if (*p == '/') {
+            *p = '\0';
+            int made = mkdir(path, 0777) == 0 || errno == EEXIST;
+            *p = '/';
+            if (!made)
+                return fail(err, n, "%s: %s", path, strerror(errno));
+        }
+    const char *ext = strrchr(slash, '.');
+    snprintf(tmp, sizeof tmp, "%.*s.tmp-%ld%s", (int)(ext - path), path, (long)getpid(), ext);
+    if (fn(r, tmp, err, n) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    if (rename(tmp, path) != 0) {
+        int e = errno;
+        unlink(tmp);
+        return fail(err, n, "%s: %s", path, strerror(e));
+    }
+    json_array_append_new(outputs, json_pack("{s:s, s:s}", "kind", kind, "path", rel));
+    return 0;
+}
+
+static int w_png(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    size_t pixels = (size_t)r->job->width * (size_t)r->job->height;
+    lpv_display_rgba8(r->rgba, pixels, &r->job->display, r->rgba8);
+    return lpv_image_write_u8(path, r->job->width, r->job->height, 4, r->rgba8, err, n);
+}
+
+static int w_exr(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    return lpv_image_write_f32(path, r->job->width, r->job->height, 4, r->rgba, err, n);
+}
+
+static int w_ao(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    if (lpv_engine_render(r->engine, LPV_TERMS_AO, r->rgba, err, n) != 0)
+        return -1;
+    size_t pixels = (size_t)r->job->width * (size_t)r->job->height;
+    for (size_t i = 0; i < pixels; ++i) { /* linear grey, 1 = open (as lpvd render --ao) */
+        float v = r->rgba[4 * i];
+        uint8_t b = (uint8_t)lrintf(255.0f * (v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f));
+        r->rgba8[4 * i] = r->rgba8[4 * i + 1] = r->rgba8[4 * i + 2] = b;
+        r->rgba8[4 * i + 3] = 255;
+    }
+    return lpv_image_write_u8(path, r->job->width, r->job->height, 4, r->rgba8, err, n);
+}
+
+static int w_points(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    size_t np = r->point_count;
+    float *pos = malloc((np ? np : 1) * 3 * sizeof *pos), *nor = malloc((np ? np : 1) * 3 * sizeof *nor);
+    float *rgb = malloc((np ? np : 1) * 3 * sizeof *rgb);
+    int rc = -1;
+    FILE *f = NULL;
+    if (!pos || !nor || !rgb) {
+        fail(err, n, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < np; ++i)
+        for (int k = 0; k < 3; ++k) {
+            pos[3 * i + k] = r->points[6 * i + k];
+            nor[3 * i + k] = r->points[6 * i + 3 + k];
+        }
+    if (np && lpv_engine_irradiance(r->engine, pos, nor, np, rgb, err, n) != 0)
+        goto done;
+    if (!(f = fopen(path, "w"))) {
+        fail(err, n, "%s: %s", path, strerror(errno));
+        goto done;
+    }
+    fprintf(f, "# irradiance E (W/m^2) of the indirect light at each point of %s\nE_r,E_g,E_b\n", r->job->points_path);
+    for (size_t i = 0; i < np; ++i)
+        fprintf(f, "%.9g,%.9g,%.9g\n", (double)rgb[3 * i], (double)rgb[3 * i + 1], (double)rgb[3 * i + 2]);
+    rc = fclose(f) == 0 ? 0 : fail(err, n, "%s: %s", path, strerror(errno));
+    f = NULL;
+done:
+    if (f)
+        fclose(f);
+    free(pos);
+    free(nor);
+    free(rgb);
+    return rc;
+}
+
+/* The stats' stages as {name: gpu_ms} and its plan, into e. */
+static void add_stats(lpvd_batch_renderer *r, json_t *e)
+{
+    json_t *st = lpvd_stats_json(r->engine, r->ctx, r->scene.source);
+    json_t *stages = json_object();
+    size_t i;
+    json_t *s;
+    json_array_foreach(json_object_get(st, "stages"), i, s)
+    {
+        json_object_set(stages, json_string_value(json_object_get(s, "name")), json_object_get(s, "gpu_ms"));
+    }
+    json_object_set_new(e, "stages", stages);
+    json_object_set(e, "plan", json_object_get(st, "plan") ? json_object_get(st, "plan") : json_null());
+    json_decref(st);
+}
+
+json_t *lpvd_batch_render_item(lpvd_batch_renderer *r, const lpvd_batch_item *it)
+{
+    const lpvd_batch_job *job = r->job;
+    const lpvd_batch_scene *sc = &job->scenes[it->scene];
+    const lpvd_batch_camera *cam = &job->cameras[it->scene][it->camera];
+    const lpvd_batch_lights *li = &job->lights[it->lights];
+    const lpvd_batch_settings *se = &job->settings[it->settings];
+    json_t *e = json_pack("{s:s, s:i, s:s, s:s, s:s, s:O}", "id", it->id, "index", it->index, "scene",
+                          sc->path ? sc->path : "built-in:cornell-box", "camera", cam->name, "lights", li->name,
+                          "settings", se->json ? se->json : json_object());
+    if (!e)
+        return NULL;
+    json_object_set_new(e, "settings_name", json_string(se->name));
+    json_object_set_new(e, "time", it->time >= 0 ? json_real(sc->times[it->time]) : json_null());
+    json_object_set_new(e, "started", wall_time());
+    json_t *outputs = json_array();
+    json_object_set_new(e, "outputs", outputs);
+    char err[1024] = "";
+    double t0 = now_ms(), t_load = 0.0, t_tick = 0.0, t_render = 0.0, t_write = 0.0;
+    int ok = 0;
+    lpv_settings s = se->settings;
+    if ((job->outputs & LPVD_OUT_AO) && s.technique != LPV_TECHNIQUE_ID_IV) {
+        snprintf(err, sizeof err, "the ao output needs technique iv (settings \"%s\")", se->name);
+        goto done;
+    }
+    if (job->outputs & LPVD_OUT_AO)
+        s.iv.ao = LPV_SWITCH_ON;
+    if (use_scene(r, it, err, sizeof err) != 0)
+        goto done;
+    t_load = now_ms() - t0;
+    lpv_view view;
+    if (cam->orbit_n) {
+        if (orbit_view(cam, &r->scene, job->width, job->height, &view) != 0) {
+            snprintf(err, sizeof err, "camera %s: the scene's bounds give no orbit view", cam->name);
+            goto done;
+        }
+    } else {
+        lpv_view_choice choice = cam->choice;
+        choice.camera = cam->camera_name[0] ? cam->camera_name : NULL;
+        choice.width = job->width;
+        choice.height = job->height;
+        if (lpv_view_resolve(&choice, &r->scene, &view, err, sizeof err) != 0)
+            goto done;
+        view.width = job->width; /* the job's size, whatever the camera's aspect */
+        view.height = job->height;
+    }
+    double t1 = now_ms();
+    if (r->engine_scene != it->scene || r->engine_lights != it->lights) {
+        lpv_scene given = r->scene; /* shallow: the lights replaced for this item */
+        if (!li->use_file) {
+            given.lights = li->lights;
+            given.light_count = (uint32_t)li->count;
+        }
+        if (lpv_engine_set_scene(r->engine, &given, err, sizeof err) != 0)
+            goto done;
+        r->engine_scene = it->scene;
+        r->engine_lights = it->lights;
+    }
+    if (lpv_engine_set_settings(r->engine, &s, err, sizeof err) != 0 ||
+        lpv_engine_set_view(r->engine, &view, err, sizeof err) != 0 || lpv_engine_tick(r->engine, err, sizeof err) != 0)
+        goto done;
+    double t2 = now_ms();
+    t_tick = t2 - t1;
+    if ((job->outputs & (LPVD_OUT_PNG | LPVD_OUT_EXR)) &&
+        lpv_engine_render(r->engine, (lpv_frame_terms)job->terms, r->rgba, err, sizeof err) != 0)
+        goto done;
+    double t3 = now_ms();
+    t_render = t3 - t2;
+    char rel[PATH_MAX];
+    if (job->outputs & LPVD_OUT_PNG) {
+        snprintf(rel, sizeof rel, "%s.png", it->id);
+        if (write_atomic(r, rel, w_png, outputs, "image", err, sizeof err) != 0)
+            goto done;
+    }
+    if (job->outputs & LPVD_OUT_EXR) {
+        snprintf(rel, sizeof rel, "%s.exr", it->id);
+        if (write_atomic(r, rel, w_exr, outputs, "exr", err, sizeof err) != 0)
+            goto done;
+    }
+    if (job->outputs & LPVD_OUT_AO) {
+        snprintf(rel, sizeof rel, "%s-ao.png", it->id);
+        if (write_atomic(r, rel, w_ao, outputs, "ao", err, sizeof err) != 0)
+            goto done;
+    }
+    if (job->outputs & LPVD_OUT_POINTS) {
+        snprintf(rel, sizeof rel, "%s-points.csv", it->id);
+        if (write_atomic(r, rel, w_points, outputs, "points", err, sizeof err) != 0)
+            goto done;
+    }
+    t_write = now_ms() - t3;
+    add_stats(r, e);
+    ok = 1;
+done:
+    json_object_set_new(e, "status", json_string(ok ? "ok" : "failed"));
+    if (!ok) {
+        json_object_set_new(e, "error", json_string(err));
+        r->engine_scene = -1; /* a failed item may have left the engine half set */
+    }
+    json_object_set_new(e, "ms", json_pack("{s:f, s:f, s:f, s:f, s:f}", "load", t_load, "tick", t_tick, "render",
+                                           t_render, "write", t_write, "total", now_ms() - t0));
+    json_object_set_new(e, "finished", wall_time());
+    return e;
+}
+
+int lpvd_batch_write_report(const char *out_dir, char *err, size_t err_size)
+{
+    return lpv_batch_report(out_dir, err, err_size);
+}

@@ -1,0 +1,310 @@
+#!/usr/bin/env python3
+"""batch_cli.py - `lpvd batch` from the outside (docs/batch.md), one case per run:
+
+  shards   N shards as N concurrent processes render exactly the job's items,
+           each once, byte-identical to a single-process run; the Indexed
+           Job's environment (JOB_COMPLETION_INDEX, LPVD_SHARDS) picks the
+           same shard as --shard; --merge combines the manifests
+  resume   SIGTERM after the first item: the item in flight finishes, no
+           temporary file is left, exit 3; the re-run renders only the rest
+           (no item twice) and a third run renders nothing
+  failures a missing scene and a torn manifest line: the bad item is recorded
+           with an error naming the file, the others are rendered, exit 1
+  errors   bad job files are refused with exit 2 and a message naming the key
+  schema   the example job (scenes/batch-example.json) is valid against
+           docs/batch.schema.json and `lpvd batch --list` expands it; job files
+           the schema refuses, lpvd refuses too
+
+usage: batch_cli.py --lpvd PATH --source DIR CASE
+"""
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+FAILS = []
+
+
+def check(cond, what):
+    if not cond:
+        FAILS.append(what)
+        print("FAIL:", what)
+    return cond
+
+
+def run(lpvd, *args, env=None, timeout=600):
+    p = subprocess.run([lpvd, "batch", *args], capture_output=True, text=True, env=env, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+def manifest_lines(out):
+    lines = []
+    for name in sorted(os.listdir(out)):
+        if name.startswith("manifest-") and name.endswith(".jsonl"):
+            with open(os.path.join(out, name)) as f:
+                lines += [json.loads(line) for line in f if line.strip()]
+    return lines
+
+
+def digests(out):
+    """Every output file under out (not manifests, not the report) -> sha256."""
+    d = {}
+    for root, _, files in os.walk(out):
+        for f in files:
+            if f.startswith("manifest") or f in ("report.html", "contact.png") or "/thumbs" in root:
+                continue
+            p = os.path.join(root, f)
+            with open(p, "rb") as fh:
+                d[os.path.relpath(p, out)] = hashlib.sha256(fh.read()).hexdigest()
+    return d
+
+
+def small_job(tmp, source, extra_scene=None):
+    """A 12-item job over the built-in box and the courtyard at 48x48."""
+    shutil.copy(os.path.join(source, "scenes", "courtyard.glb"), tmp)
+    scenes = [{"name": "cornell"}, {"path": "courtyard.glb"}]
+    if extra_scene:
+        scenes.append(extra_scene)
+    job = {
+        "lpvd_batch": 1,
+        "size": [48, 48],
+        "scenes": scenes,
+        "cameras": [{"name": "file"}, {"name": "orbit", "orbit": {"views": 2, "elevation_deg": 20}}],
+        "settings": [{"name": "fast", "preset": "fast"}, {"name": "iv", "technique": "iv", "iv_rays": 32}],
+        "outputs": ["png", "exr"],
+    }
+    path = os.path.join(tmp, "job.json")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    return path
+
+
+def listed(lpvd, job, *extra):
+    rc, out, err = run(lpvd, job, "--list", *extra)
+    check(rc == 0, "--list exits 0: " + err)
+    return [line.split("\t") for line in out.splitlines()]
+
+
+def case_shards(lpvd, source, tmp):
+    job = small_job(tmp, source)
+    items = listed(lpvd, job)
+    ids = [i[1] for i in items]
+    check(len(ids) == 12 and len(set(ids)) == 12, "the job expands to 12 distinct items: %r" % ids)
+    one = os.path.join(tmp, "one")
+    rc, _, err = run(lpvd, job, "--out", one, "--progress", "lines")
+    check(rc == 0, "single run exits 0: " + err[-2000:])
+    n = 3
+    sharded = os.path.join(tmp, "sharded")
+    procs = [subprocess.Popen([lpvd, "batch", job, "--out", sharded, "--shard", "%d/%d" % (i, n), "--progress", "off"],
+                              stderr=subprocess.PIPE, text=True) for i in range(n)]
+    for i, p in enumerate(procs):
+        _, err = p.communicate(timeout=600)
+        check(p.returncode == 0, "shard %d/%d exits 0: %s" % (i, n, err[-2000:]))
+    lines = manifest_lines(sharded)
+    got = [e["id"] for e in lines]
+    check(sorted(got) == sorted(ids), "the shards rendered exactly the job's items, each once")
+    per_shard = [len([e for e in lines if e["shard"] == [i, n]]) for i in range(n)]
+    check(all(c > 0 for c in per_shard), "every shard got work: %r" % per_shard)
+    a, b = digests(one), digests(sharded)
+    check(len(a) == 24, "two outputs per item in the single run: %d" % len(a))
+    check(a == b, "sharded outputs byte-identical to the single run: differ in %r" %
+          sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))[:5])
+    # the listed shard of every item is the shard that rendered it
+    shard_of = {i[1]: i[2] for i in listed(lpvd, job, "--shard", "0/3")}
+    for i in range(1, n):
+        shard_of.update({x[1]: x[2] for x in listed(lpvd, job, "--shard", "%d/%d" % (i, n))})
+    check(all(shard_of[e["id"]] == "%d/%d" % tuple(e["shard"]) for e in lines), "--list names each item's shard")
+    # Kubernetes Indexed Job environment = --shard
+    env = dict(os.environ, JOB_COMPLETION_INDEX="1", LPVD_SHARDS="3")
+    rc, out, err = run(lpvd, job, "--list", env=env)
+    check(rc == 0 and out == subprocess.run([lpvd, "batch", job, "--list", "--shard", "1/3"], capture_output=True,
+                                            text=True).stdout, "JOB_COMPLETION_INDEX=1 LPVD_SHARDS=3 lists shard 1/3")
+    env = dict(os.environ, JOB_COMPLETION_INDEX="1")
+    rc, _, err = run(lpvd, job, "--out", os.path.join(tmp, "x"), env=env)
+    check(rc == 2 and "LPVD_SHARDS" in err, "JOB_COMPLETION_INDEX without LPVD_SHARDS is refused: " + err)
+    rc, _, err = run(lpvd, job, "--out", sharded, "--merge")
+    with open(os.path.join(sharded, "manifest.jsonl")) as f:
+        merged = [json.loads(line) for line in f]
+    check(rc == 0 and [e["id"] for e in merged] == ids, "--merge writes every item once, in the job's order")
+    rc, _, err = run(lpvd, job, "--out", sharded, "--progress", "lines")
+    check(rc == 0 and "12 already done" in err, "a run after the shards renders nothing: " + err[-500:])
+
+
+def case_resume(lpvd, source, tmp):
+    job = small_job(tmp, source)
+    out = os.path.join(tmp, "out")
+    p = subprocess.Popen([lpvd, "batch", job, "--out", out, "--progress", "lines"], stderr=subprocess.PIPE,
+                         text=True)
+    deadline = time.time() + 300
+    man = os.path.join(out, "manifest-0-of-1.jsonl")
+    while time.time() < deadline:  # wait for the first item's manifest line
+        if os.path.exists(man) and open(man).read().count("\n") >= 1:
+            break
+        time.sleep(0.02)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=300)
+    first = manifest_lines(out)
+    check(p.returncode == 3, "SIGTERM mid-job exits 3 (resumable): %d %s" % (p.returncode, err[-1000:]))
+    check(0 < len(first) < 12, "stopped after the item in flight: %d of 12 done" % len(first))
+    check("run again to resume" in err, "says how to resume: " + err[-500:])
+    tmps = [f for _, _, fs in os.walk(out) for f in fs if ".tmp-" in f]
+    check(not tmps, "no temporary file left behind: %r" % tmps)
+    check(all(e["status"] == "ok" and e["outputs"] for e in first), "every recorded item is complete")
+    for e in first:
+        for o in e["outputs"]:
+            check(os.path.getsize(os.path.join(out, o["path"])) > 0, "output written: " + o["path"])
+    rc, _, err = run(lpvd, job, "--out", out, "--progress", "lines")
+    check(rc == 0, "the re-run completes the job: " + err[-1000:])
+    ids = [e["id"] for e in manifest_lines(out)]
+    check(len(ids) == 12 and len(set(ids)) == 12, "over both runs every item rendered once: %d lines, %d ids" %
+          (len(ids), len(set(ids))))
+    rc, _, err = run(lpvd, job, "--out", out, "--progress", "lines")
+    check(rc == 0 and "0 done" in err and "12 already done" in err, "a third run renders nothing: " + err[-500:])
+    # an output deleted after the fact is rendered again
+    victim = manifest_lines(out)[0]["outputs"][0]["path"]
+    os.remove(os.path.join(out, victim))
+    rc, _, err = run(lpvd, job, "--out", out, "--progress", "lines")
+    check(rc == 0 and "1 done" in err and os.path.exists(os.path.join(out, victim)),
+          "an item whose output vanished is rendered again: " + err[-500:])
+
+
+def case_failures(lpvd, source, tmp):
+    job = small_job(tmp, source, extra_scene={"name": "ghost", "path": "missing.glb"})
+    out = os.path.join(tmp, "out")
+    os.makedirs(out)
+    with open(os.path.join(out, "manifest-0-of-1.jsonl"), "w") as f:
+        f.write('{"id": "cornell/file/file/fast", "status": "ok", "outp')  # torn by a crash
+    rc, _, err = run(lpvd, job, "--out", out, "--progress", "lines")
+    lines = manifest_lines_tolerant(out)
+    bad = [e for e in lines if e["status"] == "failed"]
+    good = [e for e in lines if e["status"] == "ok"]
+    check(rc == 1, "exit 1 when an item failed: %d" % rc)
+    check("unreadable manifest line" in err, "the torn line is reported: " + err[-800:])
+    check(len(bad) == 6 and all("missing.glb" in e["error"] for e in bad),
+          "the missing scene's 6 items fail naming the file: %r" % [e.get("error") for e in bad][:2])
+    check(len(good) == 12, "the other 12 items are rendered: %d" % len(good))
+    rc, _, err = run(lpvd, job, "--out", out, "--progress", "lines")
+    check(rc == 1 and "6 failed" in err and "12 skipped" in err, "a re-run retries only the failed: " + err[-500:])
+
+
+def manifest_lines_tolerant(out):
+    lines = []
+    for name in sorted(os.listdir(out)):
+        if name.startswith("manifest-"):
+            for line in open(os.path.join(out, name)):
+                try:
+                    e = json.loads(line)
+                except ValueError:
+                    continue
+                lines.append(e)
+    return lines
+
+
+def case_errors(lpvd, source, tmp):
+    outside = os.path.join(os.path.dirname(tmp.rstrip("/")), "outside-%d.glb" % os.getpid())
+    shutil.copy(os.path.join(source, "scenes", "courtyard.glb"), outside)
+    os.symlink(outside, os.path.join(tmp, "link.glb"))
+    cases = [
+        ("[1, 2]", "expected a JSON object"),
+        ('{"scenes": []}', "lpvd_batch"),
+        ('{"lpvd_batch": 2}', "lpvd_batch"),
+        ('{"lpvd_batch": 1, "scene": []}', 'unknown key "scene"'),
+        ('{"lpvd_batch": 1, "scenes": [{"path": "../x.glb"}]}', "scenes[0].path"),
+        ('{"lpvd_batch": 1, "scenes": [{"path": "/etc/passwd"}]}', "scenes[0].path"),
+        ('{"lpvd_batch": 1, "scenes": [{"name": "a/b"}]}', "scenes[0].name"),
+        ('{"lpvd_batch": 1, "scenes": [{}, {}]}', 'two entries are named "cornell"'),
+        ('{"lpvd_batch": 1, "settings": [{"grid": 0}]}', "settings[0].grid"),
+        ('{"lpvd_batch": 1, "settings": [{"iterations": 2.5}]}', "settings[0].iterations"),
+        ('{"lpvd_batch": 1, "settings": [{"colour": 1}]}', 'unknown key "colour"'),
+        ('{"lpvd_batch": 1, "settings": [{"technique": "rtx"}]}', "settings[0].technique"),
+        ('{"lpvd_batch": 1, "cameras": [{"eye": [0, 0, 1]}]}', "cameras[0].target"),
+        ('{"lpvd_batch": 1, "cameras": [{"fov_deg": 180}]}', "cameras[0].fov_deg"),
+        ('{"lpvd_batch": 1, "cameras": [{"orbit": {"views": 0}}]}', "cameras[0].orbit"),
+        ('{"lpvd_batch": 1, "lights": [{"lights": [{"id": "a", "type": "laser", "intensity": 1}]}]}',
+         "lights[0].lights[0].type"),
+        ('{"lpvd_batch": 1, "scenes": [{"times": [0]}]}', "scenes[0].times"),
+        ('{"lpvd_batch": 1, "scenes": [{"path": "a.glb", "times": [1, 1]}]}', "scenes[0].times[1]"),
+        ('{"lpvd_batch": 1, "outputs": ["gif"]}', "outputs[0]"),
+        ('{"lpvd_batch": 1, "size": [0, 10]}', "size"),
+        ('{"lpvd_batch": 1, "cameras": [{"orbit": {"views": 3600}}], "settings": [' +
+         ",".join('{"name": "s%d"}' % i for i in range(300)) + "]}", "more than 1000000 items"),
+    ]
+    for i, (text, want) in enumerate(cases):
+        path = os.path.join(tmp, "bad%d.json" % i)
+        with open(path, "w") as f:
+            f.write(text)
+        rc, _, err = run(lpvd, path, "--list")
+        check(rc == 2 and want in err, "bad job %d refused naming %r: rc %d, %s" % (i, want, rc, err.strip()))
+    # a symbolic link out of the job's folder: refused when the item runs
+    path = os.path.join(tmp, "link.json")
+    with open(path, "w") as f:
+        json.dump({"lpvd_batch": 1, "size": [16, 16], "scenes": [{"path": "link.glb"}]}, f)
+    rc, _, err = run(lpvd, path, "--out", os.path.join(tmp, "o"), "--progress", "lines")
+    lines = manifest_lines(os.path.join(tmp, "o"))
+    check(rc == 1 and lines and "leaves the job file's folder" in lines[0].get("error", ""),
+          "a scene linked from outside the job's folder is refused: %s" % err[-500:])
+    os.remove(outside)
+    rc, _, err = run(lpvd, os.path.join(tmp, "none.json"), "--list")
+    check(rc == 2 and "none.json" in err, "a missing job file is named: " + err)
+    rc, _, err = run(lpvd, path, "--shard", "3/3", "--list")
+    check(rc == 2 and "3/3" in err, "--shard 3/3 is refused: " + err)
+
+
+def case_schema(lpvd, source, tmp):
+    import jsonschema  # python3-jsonschema (scripts/install-deps.sh)
+    with open(os.path.join(source, "docs", "batch.schema.json")) as f:
+        schema = json.load(f)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    v = jsonschema.Draft202012Validator(schema)
+    example = os.path.join(source, "scenes", "batch-example.json")
+    with open(example) as f:
+        ex = json.load(f)
+    errors = [e.message for e in v.iter_errors(ex)]
+    check(not errors, "the example job is valid against the schema: %r" % errors)
+    items = listed(lpvd, example)
+    check(len(items) == 20, "the example job expands to 20 items: %d" % len(items))
+    # what the schema refuses, lpvd refuses
+    bad = [
+        {"lpvd_batch": 1, "scenes": [{"path": "../up.glb"}]},
+        {"lpvd_batch": 1, "scenes": [{"name": ".hidden"}]},
+        {"lpvd_batch": 1, "cameras": [{"camera": 0, "eye": [0, 0, 0], "target": [0, 0, 1]}]},
+        {"lpvd_batch": 1, "outputs": []},
+        {"lpvd_batch": 1, "size": [10]},
+        {"lpvd_batch": 1, "extra": 1},
+        {"lpvd_batch": 1, "scenes": [{"path": "a.glb", "animation": "walk"}]},
+    ]
+    for i, j in enumerate(bad):
+        check(not v.is_valid(j), "schema refuses bad job %d" % i)
+        path = os.path.join(tmp, "schema-bad%d.json" % i)
+        with open(path, "w") as f:
+            json.dump(j, f)
+        rc, _, err = run(lpvd, path, "--list")
+        check(rc == 2, "lpvd refuses bad job %d too: %s" % (i, err.strip()))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--lpvd", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("case", choices=["shards", "resume", "failures", "errors", "schema"])
+    a = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="lpvd-batch-")
+    try:
+        globals()["case_" + a.case](os.path.abspath(a.lpvd), os.path.abspath(a.source), tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    if FAILS:
+        print("%d check(s) failed" % len(FAILS))
+        return 1
+    print("ok")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
