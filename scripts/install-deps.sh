@@ -11,11 +11,13 @@ PACKAGES="
   libopenimageio-dev
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev
-  python3 gnuplot-nox
+  python3 python3-jsonschema gnuplot-nox
   assimp-testmodels
 "
 # khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
 # into gpu/gl_api.h at build time (docs/gl-backends.md).
+# python3-jsonschema: tests/batch/batch_cli.py checks job files against
+# docs/batch.schema.json.
 # assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
 # tests/test_realscene.c and the accuracy sweep render as scenes the project
 # did not write.

@@ -11,6 +11,7 @@
 #include "engine.h"
 #include "light_json.h"
 #include "proto.h"
+#include "settings_fields.h"
 #include "settings_json.h"
 #include "tick_cost.h"
 
@@ -209,7 +210,10 @@ static int expand_cameras(const json_t *c, const char *where, lpvd_batch_camera 
             *d = one;
             if (one.orbit_n) {
                 d->orbit_k = k;
-                snprintf(d->name, sizeof d->name, "%.*s-%d", LPVD_BATCH_NAME_MAX - 8, one.name, k);
+                char named[LPVD_BATCH_NAME_MAX + 16]; /* a name of <= 57 characters + "-3599" */
+                snprintf(named, sizeof named, "%.57s-%d", one.name, k);
+                memcpy(d->name, named, LPVD_BATCH_NAME_MAX - 1);
+                d->name[LPVD_BATCH_NAME_MAX - 1] = '\0';
             }
             for (int j = 0; j < *count - 1; ++j)
                 if (strcmp((*out)[j].name, d->name) == 0) {

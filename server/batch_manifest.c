@@ -95,9 +95,17 @@ FILE *lpvd_manifest_open(const char *dir, int shard, int shards, char *err, size
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/manifest-%d-of-%d.jsonl", dir, shard, shards);
-    FILE *f = fopen(path, "a");
-    if (!f)
+    FILE *f = fopen(path, "a+");
+    if (!f) {
         snprintf(err, err_size, "%s: %s", path, strerror(errno));
+        return NULL;
+    }
+    /* a line torn by a crash has no newline: the next entry starts its own line */
+    if (fseek(f, -1, SEEK_END) == 0 && fgetc(f) != '\n' && (fputc('\n', f) == EOF || fflush(f) != 0)) {
+        snprintf(err, err_size, "%s: %s", path, strerror(errno));
+        fclose(f);
+        return NULL;
+    }
     return f;
 }
 

@@ -14,7 +14,7 @@
 
 #include "engine.h"
 #include "image_io.h"
-#include "report.h"
+
 #include "scene_load.h"
 #include "stats_json.h"
 #include "tonemap.h"
@@ -224,8 +224,9 @@ typedef int (*writer)(lpvd_batch_renderer *r, const char *path, char *err, size_
 static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json_t *outputs, const char *kind,
                         char *err, size_t n)
 {
-    char path[PATH_MAX], tmp[PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/%s", r->out, rel);
+    char path[2 * PATH_MAX], tmp[2 * PATH_MAX + 64];
+    if ((size_t)snprintf(path, sizeof path, "%s/%s", r->out, rel) >= sizeof path)
+        return fail(err, n, "%s/%s: path too long", r->out, rel);
     char *slash = strrchr(path, '/');
     for (char *p = path + strlen(r->out) + 1; p <= slash; ++p) /* the id's folders */
         if (*p == '/') {
@@ -430,9 +431,4 @@ done:
                                            t_render, "write", t_write, "total", now_ms() - t0));
     json_object_set_new(e, "finished", wall_time());
     return e;
-}
-
-int lpvd_batch_write_report(const char *out_dir, char *err, size_t err_size)
-{
-    return lpv_batch_report(out_dir, err, err_size);
 }

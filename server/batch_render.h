@@ -30,7 +30,4 @@ void lpvd_batch_renderer_destroy(lpvd_batch_renderer *r);
  * memory. */
 json_t *lpvd_batch_render_item(lpvd_batch_renderer *r, const lpvd_batch_item *item);
 
-/* The job's report (batch/report.h) from out_dir's manifests. */
-int lpvd_batch_write_report(const char *out_dir, char *err, size_t err_size);
-
 #endif

@@ -26,7 +26,7 @@
 #include "commands.h"
 #include "options.h"
 
-enum { B_OUT, B_SHARD, B_LIST, B_MERGE, B_REPORT, B_PROGRESS, B_HELP, B_COUNT };
+enum { B_OUT, B_SHARD, B_LIST, B_MERGE, B_PROGRESS, B_HELP, B_COUNT };
 
 static const lpv_flag BATCH_FLAGS[B_COUNT] = {
     [B_OUT] = {"out", 'o', "DIR", "the output folder: images, manifests, report (required but for --list)"},
@@ -34,7 +34,6 @@ static const lpv_flag BATCH_FLAGS[B_COUNT] = {
                                    "LPVD_SHARDS from the environment (a Kubernetes Indexed Job), else 0/1"},
     [B_LIST] = {"list", 0, NULL, "print the job's items (index, id, shard) and exit"},
     [B_MERGE] = {"merge", 0, NULL, "combine DIR's shard manifests into DIR/manifest.jsonl and exit"},
-    [B_REPORT] = {"report", 0, NULL, "write DIR/report.html and DIR/contact.png from the manifests and exit"},
     [B_PROGRESS] = {"progress", 0, "auto|bar|lines|off", "progress on stderr (auto: a bar on a terminal, else lines)"},
     [B_HELP] = {"help", 'h', NULL, "this text"},
 };
@@ -172,7 +171,7 @@ int lpvd_cmd_batch(int argc, char **argv)
 {
     lpvd_options opt = {0};
     const char *job_path = NULL, *out = NULL, *shard_flag = NULL, *progress_mode = "auto";
-    int list = 0, merge = 0, report = 0;
+    int list = 0, merge = 0;
     char err[1024] = "";
     lpv_flag_group groups[2] = {{BATCH_FLAGS, B_COUNT, NULL, NULL}};
     int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_BACKEND, 1, groups + 1);
@@ -205,7 +204,6 @@ int lpvd_cmd_batch(int argc, char **argv)
         case B_SHARD: shard_flag = v; break;
         case B_LIST: list = 1; break;
         case B_MERGE: merge = 1; break;
-        case B_REPORT: report = 1; break;
         case B_PROGRESS: progress_mode = v; break;
         }
     }
@@ -218,25 +216,19 @@ int lpvd_cmd_batch(int argc, char **argv)
         fprintf(stderr, "lpvd batch: --progress %s: expected auto, bar, lines or off\n", progress_mode);
         return 2;
     }
-    if (!out && (merge || report || !list)) {
+    if (!out && (merge || !list)) {
         fprintf(stderr, "lpvd batch: --out DIR is required\n");
         return 2;
     }
-    if (merge || report) {
+    if (merge) {
         int skipped = 0;
-        if (merge) {
-            int n = lpvd_manifest_merge(out, &skipped, err, sizeof err);
-            if (n < 0) {
-                fprintf(stderr, "lpvd batch: --merge: %s\n", err);
-                return 1;
-            }
-            fprintf(stderr, "lpvd batch: merged %d items into %s/manifest.jsonl%s\n", n, out,
-                    skipped ? " (unreadable lines skipped)" : "");
-        }
-        if (report && lpvd_batch_write_report(out, err, sizeof err) != 0) {
-            fprintf(stderr, "lpvd batch: --report: %s\n", err);
+        int n = lpvd_manifest_merge(out, &skipped, err, sizeof err);
+        if (n < 0) {
+            fprintf(stderr, "lpvd batch: --merge: %s\n", err);
             return 1;
         }
+        fprintf(stderr, "lpvd batch: merged %d items into %s/manifest.jsonl%s\n", n, out,
+                skipped ? " (unreadable lines skipped)" : "");
         return 0;
     }
     if (!job_path) {

@@ -4,6 +4,7 @@
 #define LPVD_COMMANDS_H
 
 int lpvd_cmd_render(int argc, char **argv);
+int lpvd_cmd_batch(int argc, char **argv);  /* batch jobs, cmd_batch.c */
 int lpvd_cmd_serve(int argc, char **argv); /* the daemon, serve.c */
 
 #endif

@@ -1,6 +1,7 @@
 /*
  * main.c - the lpvd program: a dispatcher over subcommands.
  *   lpvd render ...   one frame of a scene to an image (offline, batch jobs)
+ *   lpvd batch ...    many items of a job file in one process (docs/batch.md)
  *   lpvd serve ...    the daemon: clients over a Unix socket or TCP (docs/server.md)
  */
 #include <stdio.h>
@@ -14,6 +15,7 @@ static void usage(FILE *f)
             "usage: lpvd <command> [args]\n"
             "commands:\n"
             "  render [SCENE] -o OUT.png|OUT.exr   render a glTF scene (default: built-in Cornell box)\n"
+            "  batch JOB.json --out DIR            render every item of a job file, resumable (docs/batch.md)\n"
             "  serve [flags]                       run the daemon (Unix socket / TCP, protocol/SPEC.md)\n"
             "  version                             print the version\n"
             "Run 'lpvd <command> --help' for a command's flags.\n");
@@ -28,6 +30,8 @@ int main(int argc, char **argv)
     const char *cmd = argv[1];
     if (strcmp(cmd, "render") == 0)
         return lpvd_cmd_render(argc - 1, argv + 1);
+    if (strcmp(cmd, "batch") == 0)
+        return lpvd_cmd_batch(argc - 1, argv + 1);
     if (strcmp(cmd, "serve") == 0)
         return lpvd_cmd_serve(argc - 1, argv + 1);
     if (strcmp(cmd, "version") == 0 || strcmp(cmd, "--version") == 0) {

@@ -268,7 +268,7 @@ def case_schema(lpvd, source, tmp):
     errors = [e.message for e in v.iter_errors(ex)]
     check(not errors, "the example job is valid against the schema: %r" % errors)
     items = listed(lpvd, example)
-    check(len(items) == 20, "the example job expands to 20 items: %d" % len(items))
+    check(len(items) == 16, "the example job expands to 16 items: %d" % len(items))
     # what the schema refuses, lpvd refuses
     bad = [
         {"lpvd_batch": 1, "scenes": [{"path": "../up.glb"}]},
