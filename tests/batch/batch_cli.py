@@ -11,6 +11,8 @@
   failures a missing scene and a torn manifest line: the bad item is recorded
            with an error naming the file, the others are rendered, exit 1
   errors   bad job files are refused with exit 2 and a message naming the key
+  features animation times (the frame at t equals the file posed there),
+           light overrides, irradiance at points, ambient occlusion
   schema   the example job (scenes/batch-example.json) is valid against
            docs/batch.schema.json and `lpvd batch --list` expands it; job files
            the schema refuses, lpvd refuses too
@@ -288,11 +290,118 @@ def case_schema(lpvd, source, tmp):
         check(rc == 2, "lpvd refuses bad job %d too: %s" % (i, err.strip()))
 
 
+def gltf_box(path, translation=None, animate_to=None):
+    """A 1 m box (12 triangles) on a node over a 6 m floor, lit by a point
+    light; the box's node at `translation`, or animated from x = -1.5 to
+    animate_to over 1 s (LINEAR)."""
+    import base64
+    import struct
+    def box(lo, hi):
+        (x0, y0, z0), (x1, y1, z1) = lo, hi
+        c = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0), (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+        faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (3, 7, 6, 2), (0, 4, 7, 3), (1, 2, 6, 5)]
+        v = []
+        for f in faces:  # counter-clockwise seen from outside
+            for t in ((f[0], f[1], f[2]), (f[0], f[2], f[3])):
+                v += [c[i] for i in t]
+        return v
+    meshes = [box((-3, -0.1, -3), (3, 0, 3)), box((-0.5, 0, -0.5), (0.5, 1, 0.5))]
+    blob = b""
+    accessors, views, gmeshes = [], [], []
+    for m in meshes:
+        data = b"".join(struct.pack("<3f", *p) for p in m)
+        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": len(m), "type": "VEC3",
+                          "min": [min(p[i] for p in m) for i in range(3)], "max": [max(p[i] for p in m) for i in range(3)]})
+        gmeshes.append({"primitives": [{"attributes": {"POSITION": len(accessors) - 1}, "material": len(gmeshes)}]})
+        blob += data
+    doc = {"asset": {"version": "2.0"}, "scene": 0,
+           "scenes": [{"nodes": [0, 1, 2, 3]}],
+           "nodes": [{"mesh": 0}, {"mesh": 1, "translation": translation or [-1.5, 0, 0]},
+                     {"camera": 0, "translation": [0, 3, 7], "rotation": [-0.2164, 0, 0, 0.9763]},
+                     {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1, 4, 1]}],
+           "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1, "aspectRatio": 1.0}}],
+           "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}},
+                         {"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.2, 0.1, 1], "metallicFactor": 0}}],
+           "meshes": gmeshes, "accessors": accessors, "bufferViews": views,
+           "extensionsUsed": ["KHR_lights_punctual"],
+           "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 3000.0}]}}}
+    if animate_to is not None:
+        keys = struct.pack("<2f", 0.0, 1.0) + struct.pack("<6f", -1.5, 0, 0, *animate_to)
+        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": 8})
+        views.append({"buffer": 0, "byteOffset": len(blob) + 8, "byteLength": 24})
+        accessors.append({"bufferView": len(views) - 2, "componentType": 5126, "count": 2, "type": "SCALAR",
+                          "min": [0.0], "max": [1.0]})
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": 2, "type": "VEC3"})
+        doc["animations"] = [{"name": "slide", "samplers": [{"input": len(accessors) - 2, "output": len(accessors) - 1}],
+                              "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}]
+        blob += keys
+    doc["buffers"] = [{"byteLength": len(blob),
+                       "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}]
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def case_features(lpvd, source, tmp):
+    gltf_box(os.path.join(tmp, "anim.gltf"), animate_to=[1.5, 0, 0])
+    gltf_box(os.path.join(tmp, "posed.gltf"), translation=[0.75, 0, 0])
+    with open(os.path.join(tmp, "pts.csv"), "w") as f:
+        f.write("# px,py,pz,nx,ny,nz\n0,0.01,2,0,1,0\n2,0.01,-2,0,1,0\n0.5,0.5,0.51,0,0,1\n")
+    job = {"lpvd_batch": 1, "size": [64, 64],
+           "scenes": [{"path": "anim.gltf", "animation": "slide", "times": [0, 0.75, 2]}, {"path": "posed.gltf"}],
+           "lights": [{"name": "file"},
+                      {"name": "blue", "lights": [{"id": "b", "type": "point", "intensity": 500.0,
+                                                   "color": [0.2, 0.4, 1.0], "position": [-1, 3, 2]}]}],
+           "settings": [{"name": "iv", "technique": "iv", "iv_rays": 32}],
+           "outputs": ["png", "ao", {"points": "pts.csv"}]}
+    path = os.path.join(tmp, "job.json")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    out = os.path.join(tmp, "out")
+    rc, _, err = run(lpvd, path, "--out", out, "--progress", "lines")
+    check(rc == 0, "the features job runs: " + err[-1500:])
+    d = digests(out)
+    def h(rel):
+        return d.get(rel)
+    check(h("anim@0.75/default/file/iv.png") == h("posed/default/file/iv.png") is not None,
+          "the frame at t = 0.75 s is the file posed there, byte for byte")
+    check(h("anim@0/default/file/iv.png") != h("anim@0.75/default/file/iv.png"), "the box moved between 0 and 0.75 s")
+    check(h("anim@2/default/file/iv.png") != h("anim@0.75/default/file/iv.png"), "and again by 2 s (clamped at 1 s)")
+    check(h("posed/default/blue/iv.png") != h("posed/default/file/iv.png"), "the light override changes the image")
+    entries = {e["id"]: e for e in manifest_lines(out)}
+    check(len(entries) == 8 and all(e["status"] == "ok" for e in entries.values()), "8 items ok")
+    e = entries.get("anim@0.75/default/file/iv", {})
+    check(e.get("time") == 0.75 and {o["kind"] for o in e.get("outputs", [])} == {"image", "ao", "points"},
+          "the manifest names the time and the three outputs: %r" % e)
+    with open(os.path.join(out, "posed/default/file/iv-points.csv")) as f:
+        rows = [line.strip().split(",") for line in f if line.strip() and not line.startswith(("#", "E_"))]
+    vals = [float(v) for r in rows for v in r]
+    check(len(rows) == 3 and all(v >= 0 and v == v and v < 1e6 for v in vals) and sum(vals) > 0,
+          "irradiance at the 3 points, finite, some light: %r" % rows)
+    # ao without the imperfect volume is refused per item, naming why
+    job["settings"] = [{"name": "lpv", "technique": "lpv"}]
+    with open(path, "w") as f:
+        json.dump(job, f)
+    rc, _, err = run(lpvd, path, "--out", os.path.join(tmp, "o2"), "--progress", "lines")
+    lines = manifest_lines(os.path.join(tmp, "o2"))
+    check(rc == 1 and lines and all("ao output needs technique iv" in e.get("error", "") for e in lines),
+          "the ao output with technique lpv fails each item, saying why")
+    # an animation the file does not have
+    job["settings"] = [{"name": "iv", "technique": "iv"}]
+    job["scenes"] = [{"path": "anim.gltf", "animation": "walk", "times": [0]}]
+    with open(path, "w") as f:
+        json.dump(job, f)
+    rc, _, err = run(lpvd, path, "--out", os.path.join(tmp, "o3"), "--progress", "lines")
+    lines = manifest_lines(os.path.join(tmp, "o3"))
+    check(rc == 1 and lines and "walk" in lines[0].get("error", ""), "an unknown animation is named: %r" %
+          [e.get("error") for e in lines][:1])
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lpvd", required=True)
     ap.add_argument("--source", required=True)
-    ap.add_argument("case", choices=["shards", "resume", "failures", "errors", "schema"])
+    ap.add_argument("case", choices=["shards", "resume", "failures", "errors", "features", "schema"])
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="lpvd-batch-")
     try:
