@@ -373,8 +373,11 @@ static int parse_outputs(const json_t *o, lpvd_batch_job *job, char *err, size_t
             job->outputs |= LPVD_OUT_EXR;
         else if (strcmp(s, "ao") == 0)
             job->outputs |= LPVD_OUT_AO;
+        else if (strcmp(s, "volume") == 0)
+            job->outputs |= LPVD_OUT_VOLUME;
         else
-            return fail(err, n, "outputs[%zu]: expected \"png\", \"exr\", \"ao\" or {\"points\": PATH}", i);
+            return fail(err, n, "outputs[%zu]: expected \"png\", \"exr\", \"ao\", \"volume\" or {\"points\": PATH}",
+                        i);
     }
     return 0;
 }

@@ -26,6 +26,7 @@ enum {
     LPVD_OUT_EXR = 2,    /* linear float radiance */
     LPVD_OUT_AO = 4,     /* ambient occlusion, grey PNG (technique iv) */
     LPVD_OUT_POINTS = 8, /* irradiance at the job's points, CSV */
+    LPVD_OUT_VOLUME = 16, /* the SH volume: GET_VOLUME's body (JSON) and raw fp32 attachment */
 };
 
 typedef struct lpvd_batch_scene {

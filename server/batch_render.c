@@ -16,8 +16,16 @@
 #include "image_io.h"
 
 #include "scene_load.h"
+#include "serve.h"
 #include "stats_json.h"
 #include "tonemap.h"
+
+/* The volume as GET_VOLUME would send it, between its two files' writers. */
+typedef struct volume_out {
+    json_t *body;
+    uint8_t *att;
+    size_t att_len;
+} volume_out;
 
 struct lpvd_batch_renderer {
     const lpvd_batch_job *job;
@@ -32,6 +40,7 @@ struct lpvd_batch_renderer {
     size_t point_count;
     float *rgba;
     uint8_t *rgba8;
+    volume_out vol;
 };
 
 static double now_ms(void)
@@ -313,6 +322,51 @@ done:
     return rc;
 }
 
+/* The volume as GET_VOLUME would send it (SPEC section 5: the body as JSON,
+ * the attachment raw fp32, keyframe, uncompressed), read back now. */
+
+static int w_volume_json(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    return json_dump_file(r->vol.body, path, JSON_INDENT(1) | JSON_SORT_KEYS) == 0
+               ? 0
+               : fail(err, n, "%s: cannot write", path);
+}
+
+static int w_volume_bin(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return fail(err, n, "%s: %s", path, strerror(errno));
+    int ok = fwrite(r->vol.att, 1, r->vol.att_len, f) == r->vol.att_len;
+    if (fclose(f) != 0 || !ok)
+        return fail(err, n, "%s: cannot write", path);
+    return 0;
+}
+
+static int write_volume(lpvd_batch_renderer *r, const char *id, json_t *outputs, char *err, size_t n)
+{
+    sv_result *res = sv_result_take(r->engine, r->job->width, r->job->height, 0, err, n);
+    if (!res)
+        return -1;
+    memset(&r->vol, 0, sizeof r->vol);
+    int rc = sv_encode_volume(res, LPVP_CONTENT_MERGED, 0, 0, NULL, NULL, NULL, 0, &r->vol.body, &r->vol.att,
+                              &r->vol.att_len, err, n);
+    sv_result_unref(res);
+    char rel[PATH_MAX];
+    if (rc == 0) {
+        snprintf(rel, sizeof rel, "%s-volume.bin", id);
+        rc = write_atomic(r, rel, w_volume_bin, outputs, "volume", err, n);
+    }
+    if (rc == 0) {
+        snprintf(rel, sizeof rel, "%s-volume.json", id);
+        rc = write_atomic(r, rel, w_volume_json, outputs, "volume_header", err, n);
+    }
+    json_decref(r->vol.body);
+    free(r->vol.att);
+    memset(&r->vol, 0, sizeof r->vol);
+    return rc;
+}
+
 /* The stats' stages as {name: gpu_ms} and its plan, into e. */
 static void add_stats(lpvd_batch_renderer *r, json_t *e)
 {
@@ -418,6 +472,8 @@ json_t *lpvd_batch_render_item(lpvd_batch_renderer *r, const lpvd_batch_item *it
         if (write_atomic(r, rel, w_points, outputs, "points", err, sizeof err) != 0)
             goto done;
     }
+    if ((job->outputs & LPVD_OUT_VOLUME) && write_volume(r, it->id, outputs, err, sizeof err) != 0)
+        goto done;
     t_write = now_ms() - t3;
     add_stats(r, e);
     ok = 1;

@@ -470,6 +470,13 @@ void sv_world_attach(sv_conn *c, sv_inputs *in); /* consumes in */
 void sv_world_detach(sv_conn *c);
 void sv_world_unref(sv_world *w);
 void sv_result_unref(sv_result *r);
+/* The engine's last tick read back (serve_tick_result.c): every cascade's
+ * accumulated volume, the octree's levels and index or the imperfect
+ * volume's occupancy when the technique has them, the frames of terms_mask
+ * (bit t: lpv_frame_terms t) at width x height, stats and plan; refs 1, tick
+ * and gen 0 (the caller's). NULL with a message in err. On the GL context's
+ * thread. */
+sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n);
 sv_result *sv_result_ref(sv_result *r);
 void sv_scene_unref(sv_server *s, sv_scene *sc);
 sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */

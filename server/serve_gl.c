@@ -188,76 +188,6 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     return 0;
 }
 
-/* GET_VOLUME content "levels" (SPEC R5.13): with a technique that has an
- * index volume (the octree), its levels and index, read now on the GL thread.
- * 0 (nothing kept for a technique without one) or -1 with err. */
-static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
-{
-    size_t cells0 = lpv_grid_cell_count(&r->grid);
-    int count = lpvp_octree_level_count(r->grid.dims[0]);
-    if (count < 1) /* no octree over this grid */
-        return 0;
-    int32_t *index = malloc((cells0 ? cells0 : 1) * sizeof *index);
-    if (!index) {
-        snprintf(err, n, "out of memory for a %zu-cell index volume", cells0);
-        return -1;
-    }
-    size_t got = lpv_engine_read_index(e, index, cells0);
-    if (got == 0) { /* no index volume: no levels to send */
-        free(index);
-        return 0;
-    }
-    lpvp_cascade_info c0 = {.dims = {r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]}, .cells = cells0};
-    size_t total = 0;
-    for (int i = 0; i < count; ++i) {
-        lpvp_cascade_info ci;
-        lpvp_octree_level_place(&c0, i, &ci);
-        total += (size_t)ci.cells;
-    }
-    r->levels = malloc((total ? total : 1) * sizeof(lpv_cell));
-    r->index = malloc((cells0 ? cells0 : 1) * sizeof *r->index);
-    if (!r->levels || !r->index || got != cells0 ||
-        lpv_engine_read_volumes(e, LPV_GRID_ACCUMULATED, (lpv_cell *)r->levels, total) != total) {
-        snprintf(err, n, "%s", !r->levels || !r->index ? "out of memory for the octree's levels"
-                                                       : "the octree's levels or index volume could not be read back");
-        free(index);
-        return -1;
-    }
-    for (size_t i = 0; i < cells0; ++i)
-        r->index[i] = (uint32_t)index[i];
-    free(index);
-    r->level_cells = total;
-    r->index_count = cells0;
-    return 0;
-}
-
-/* An iv volume's index (SPEC R5.14): which voxels hold a surface, read now
- * on the GL thread from the voxels (IvVoxel.normal[3], the points that landed
- * in each), and *occupied their count. 0 (nothing kept for a volume that is
- * not an imperfect volume's) or -1 with err. */
-static int keep_iv_held(lpv_engine *e, sv_result *r, long long *occupied, char *err, size_t n)
-{
-    if (lpv_engine_last_stats(e)->volume.kind != LPV_LEVELS_IV_VOXELS)
-        return 0;
-    size_t cells = lpv_grid_cell_count(&r->grid);
-    struct IvVoxel *vox = malloc((cells ? cells : 1) * sizeof *vox);
-    r->iv_held = malloc((cells ? cells : 1) * sizeof *r->iv_held);
-    if (!vox || !r->iv_held || lpv_engine_read_iv_voxels(e, vox, cells) != cells) {
-        snprintf(err, n, "%s", !vox || !r->iv_held ? "out of memory for the imperfect volume's voxels"
-                                                    : "the imperfect volume's voxels could not be read back");
-        free(vox);
-        return -1;
-    }
-    *occupied = 0;
-    for (size_t i = 0; i < cells; ++i) {
-        r->iv_held[i] = vox[i].normal[3] > 0.0f; /* lpv_iv_occupied */
-        *occupied += r->iv_held[i];
-    }
-    free(vox);
-    r->iv_held_count = cells;
-    return 0;
-}
-
 static void gl_tick(sv_server *s, sv_job *j)
 {
     (void)s;
@@ -272,59 +202,13 @@ static void gl_tick(sv_server *s, sv_job *j)
     }
     w->gl_ticked = 1;
     w->gl_ticked_gen = j->gen;
-    sv_result *r = calloc(1, sizeof *r);
+    sv_result *r = sv_result_take(w->engine, j->inputs->view.width, j->inputs->view.height, j->terms_mask, j->err,
+                                  sizeof j->err);
     if (!r) {
         j->status = LPVP_E_INTERNAL;
-        snprintf(j->err, sizeof j->err, "out of memory");
         return;
     }
-    r->refs = 1;
     r->gen = j->gen;
-    r->grid = *lpv_engine_grid(w->engine);
-    r->cascade_count = lpv_engine_cascade_count(w->engine);
-    if (r->cascade_count < 1)
-        r->cascade_count = 1;
-    if (r->cascade_count > LPVP_MAX_CASCADES)
-        r->cascade_count = LPVP_MAX_CASCADES;
-    r->cell_count = 0;
-    for (int k = 0; k < r->cascade_count; ++k) {
-        const lpv_grid *g = lpv_engine_cascade(w->engine, k);
-        r->cascades[k] = g ? *g : r->grid;
-        r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
-    }
-    r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
-    if (!r->cells) {
-        j->status = LPVP_E_INTERNAL;
-        snprintf(j->err, sizeof j->err, "out of memory for %zu cells", r->cell_count);
-        sv_result_unref(r);
-        return;
-    }
-    size_t got = lpv_engine_read_grid(w->engine, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
-    if (got < r->cell_count)
-        memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
-    long long occupied = -1;
-    if (keep_levels(w->engine, r, j->err, sizeof j->err) != 0 ||
-        keep_iv_held(w->engine, r, &occupied, j->err, sizeof j->err) != 0) {
-        j->status = LPVP_E_INTERNAL;
-        sv_result_unref(r);
-        return;
-    }
-    r->width = j->inputs->view.width;
-    r->height = j->inputs->view.height;
-    for (int t = 0; t < LPVP_TERMS_COUNT; ++t) {
-        if (!(j->terms_mask & (1u << t)))
-            continue;
-        size_t px = (size_t)r->width * (size_t)r->height;
-        r->frames[t] = malloc(px * 4 * sizeof(float));
-        if (!r->frames[t] || lpv_engine_render(w->engine, (lpv_frame_terms)t, r->frames[t], j->err, sizeof j->err)) {
-            free(r->frames[t]);
-            r->frames[t] = NULL;
-        }
-    }
-    r->stats = *lpv_engine_last_stats(w->engine);
-    if (r->iv_held)
-        r->stats.iv.occupied = occupied; /* counted from the index the volume carries */
-    r->plan = *lpv_engine_last_plan(w->engine);
     r->tick = ++w->gl_ticks;
     r->tick_ms = wall_ms() - t0;
     j->result = r;

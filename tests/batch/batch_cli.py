@@ -353,7 +353,7 @@ def case_features(lpvd, source, tmp):
                       {"name": "blue", "lights": [{"id": "b", "type": "point", "intensity": 500.0,
                                                    "color": [0.2, 0.4, 1.0], "position": [-1, 3, 2]}]}],
            "settings": [{"name": "iv", "technique": "iv", "iv_rays": 32}],
-           "outputs": ["png", "ao", {"points": "pts.csv"}]}
+           "outputs": ["png", "ao", "volume", {"points": "pts.csv"}]}
     path = os.path.join(tmp, "job.json")
     with open(path, "w") as f:
         json.dump(job, f)
@@ -371,13 +371,26 @@ def case_features(lpvd, source, tmp):
     entries = {e["id"]: e for e in manifest_lines(out)}
     check(len(entries) == 8 and all(e["status"] == "ok" for e in entries.values()), "8 items ok")
     e = entries.get("anim@0.75/default/file/iv", {})
-    check(e.get("time") == 0.75 and {o["kind"] for o in e.get("outputs", [])} == {"image", "ao", "points"},
-          "the manifest names the time and the three outputs: %r" % e)
+    check(e.get("time") == 0.75 and {o["kind"] for o in e.get("outputs", [])} ==
+          {"image", "ao", "points", "volume", "volume_header"}, "the manifest names the time and the outputs: %r" % e)
     with open(os.path.join(out, "posed/default/file/iv-points.csv")) as f:
         rows = [line.strip().split(",") for line in f if line.strip() and not line.startswith(("#", "E_"))]
     vals = [float(v) for r in rows for v in r]
     check(len(rows) == 3 and all(v >= 0 and v == v and v < 1e6 for v in vals) and sum(vals) > 0,
           "irradiance at the 3 points, finite, some light: %r" % rows)
+    # the volume file decodes with the Python client and its SPEC lookup gives the engine's irradiance
+    sys.path.insert(0, os.path.join(source, "clients", "python"))
+    import lpvd_client
+    with open(os.path.join(out, "posed/default/file/iv-volume.json")) as f:
+        header = json.load(f)
+    with open(os.path.join(out, "posed/default/file/iv-volume.bin"), "rb") as f:
+        vol = lpvd_client.Volume(header, f.read())
+    pts = [((0, 0.01, 2), (0, 1, 0)), ((2, 0.01, -2), (0, 1, 0)), ((0.5, 0.5, 0.51), (0, 0, 1))]
+    for (p, nrm), row in zip(pts, rows):
+        want = [float(v) for v in row]
+        got = vol.irradiance(p, nrm)
+        check(all(abs(g - w) <= 1e-4 * max(1.0, abs(w)) + 1e-3 * max(want) for g, w in zip(got, want)),
+              "the volume's lookup at %r gives the engine's irradiance: %r vs %r" % (p, got, want))
     # ao without the imperfect volume is refused per item, naming why
     job["settings"] = [{"name": "lpv", "technique": "lpv"}]
     with open(path, "w") as f:

@@ -1,0 +1,135 @@
+/*
+ * serve_tick_result.c - a tick's result read back from the engine on the GL
+ * thread (sv_result: the accumulated volume of every cascade, the octree's
+ * levels and index, the imperfect volume's occupancy, the frames asked for,
+ * the stats and plan), what GET_VOLUME, GET_FRAME and the streams encode.
+ * The daemon's GL thread and lpvd batch's volume output take it here.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "serve.h"
+
+/* GET_VOLUME content "levels" (SPEC R5.13): with a technique that has an
+ * index volume (the octree), its levels and index, read now on the GL thread.
+ * 0 (nothing kept for a technique without one) or -1 with err. */
+static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
+{
+    size_t cells0 = lpv_grid_cell_count(&r->grid);
+    int count = lpvp_octree_level_count(r->grid.dims[0]);
+    if (count < 1) /* no octree over this grid */
+        return 0;
+    int32_t *index = malloc((cells0 ? cells0 : 1) * sizeof *index);
+    if (!index) {
+        snprintf(err, n, "out of memory for a %zu-cell index volume", cells0);
+        return -1;
+    }
+    size_t got = lpv_engine_read_index(e, index, cells0);
+    if (got == 0) { /* no index volume: no levels to send */
+        free(index);
+        return 0;
+    }
+    lpvp_cascade_info c0 = {.dims = {r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]}, .cells = cells0};
+    size_t total = 0;
+    for (int i = 0; i < count; ++i) {
+        lpvp_cascade_info ci;
+        lpvp_octree_level_place(&c0, i, &ci);
+        total += (size_t)ci.cells;
+    }
+    r->levels = malloc((total ? total : 1) * sizeof(lpv_cell));
+    r->index = malloc((cells0 ? cells0 : 1) * sizeof *r->index);
+    if (!r->levels || !r->index || got != cells0 ||
+        lpv_engine_read_volumes(e, LPV_GRID_ACCUMULATED, (lpv_cell *)r->levels, total) != total) {
+        snprintf(err, n, "%s", !r->levels || !r->index ? "out of memory for the octree's levels"
+                                                       : "the octree's levels or index volume could not be read back");
+        free(index);
+        return -1;
+    }
+    for (size_t i = 0; i < cells0; ++i)
+        r->index[i] = (uint32_t)index[i];
+    free(index);
+    r->level_cells = total;
+    r->index_count = cells0;
+    return 0;
+}
+
+/* An iv volume's index (SPEC R5.14): which voxels hold a surface, read now
+ * on the GL thread from the voxels (IvVoxel.normal[3], the points that landed
+ * in each), and *occupied their count. 0 (nothing kept for a volume that is
+ * not an imperfect volume's) or -1 with err. */
+static int keep_iv_held(lpv_engine *e, sv_result *r, long long *occupied, char *err, size_t n)
+{
+    if (lpv_engine_last_stats(e)->volume.kind != LPV_LEVELS_IV_VOXELS)
+        return 0;
+    size_t cells = lpv_grid_cell_count(&r->grid);
+    struct IvVoxel *vox = malloc((cells ? cells : 1) * sizeof *vox);
+    r->iv_held = malloc((cells ? cells : 1) * sizeof *r->iv_held);
+    if (!vox || !r->iv_held || lpv_engine_read_iv_voxels(e, vox, cells) != cells) {
+        snprintf(err, n, "%s", !vox || !r->iv_held ? "out of memory for the imperfect volume's voxels"
+                                                    : "the imperfect volume's voxels could not be read back");
+        free(vox);
+        return -1;
+    }
+    *occupied = 0;
+    for (size_t i = 0; i < cells; ++i) {
+        r->iv_held[i] = vox[i].normal[3] > 0.0f; /* lpv_iv_occupied */
+        *occupied += r->iv_held[i];
+    }
+    free(vox);
+    r->iv_held_count = cells;
+    return 0;
+}
+
+sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n)
+{
+    sv_result *r = calloc(1, sizeof *r);
+    if (!r) {
+        snprintf(err, n, "out of memory");
+        return NULL;
+    }
+    r->refs = 1;
+    r->grid = *lpv_engine_grid(e);
+    r->cascade_count = lpv_engine_cascade_count(e);
+    if (r->cascade_count < 1)
+        r->cascade_count = 1;
+    if (r->cascade_count > LPVP_MAX_CASCADES)
+        r->cascade_count = LPVP_MAX_CASCADES;
+    r->cell_count = 0;
+    for (int k = 0; k < r->cascade_count; ++k) {
+        const lpv_grid *g = lpv_engine_cascade(e, k);
+        r->cascades[k] = g ? *g : r->grid;
+        r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
+    }
+    r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
+    if (!r->cells) {
+        snprintf(err, n, "out of memory for %zu cells", r->cell_count);
+        sv_result_unref(r);
+        return NULL;
+    }
+    size_t got = lpv_engine_read_grid(e, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
+    if (got < r->cell_count)
+        memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
+    long long occupied = -1;
+    if (keep_levels(e, r, err, n) != 0 || keep_iv_held(e, r, &occupied, err, n) != 0) {
+        sv_result_unref(r);
+        return NULL;
+    }
+    r->width = width;
+    r->height = height;
+    for (int t = 0; t < LPVP_TERMS_COUNT; ++t) {
+        if (!(terms_mask & (1u << t)))
+            continue;
+        size_t px = (size_t)r->width * (size_t)r->height;
+        r->frames[t] = malloc(px * 4 * sizeof(float));
+        if (!r->frames[t] || lpv_engine_render(e, (lpv_frame_terms)t, r->frames[t], err, n)) {
+            free(r->frames[t]);
+            r->frames[t] = NULL;
+        }
+    }
+    r->stats = *lpv_engine_last_stats(e);
+    if (r->iv_held)
+        r->stats.iv.occupied = occupied; /* counted from the index the volume carries */
+    r->plan = *lpv_engine_last_plan(e);
+    return r;
+}
