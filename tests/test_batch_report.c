@@ -1,7 +1,7 @@
 /* test_batch_report.c - the report of a batch job (batch/report.h): manifests
  * with a superseded and a torn line, escaping, totals, thumbnails and the
- * contact sheet; the merged manifest first; items without a thumbnail; no
- * items; clean failures; the manifests' times. */
+ * contact sheet; the merged manifest first; one id in two shards; items
+ * without a thumbnail; no items; clean failures; the manifests' times. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -233,6 +233,34 @@ static void test_merged_first(void **state)
     free(html);
 }
 
+/* The same id in two shard files: the line that finished later counts,
+ * whichever file is read first. */
+static void test_across_shards(void **state)
+{
+    (void)state;
+    const char *dir = job_dir("across");
+    write_manifest(dir, "manifest-0-of-2.jsonl",
+                   "{\"id\": \"x\", \"status\": \"ok\", \"finished\": \"2026-11-25T10:00:05Z\"}\n"
+                   "{\"id\": \"y\", \"status\": \"ok\", \"finished\": \"2026-11-25T10:00:01Z\"}\n");
+    write_manifest(dir, "manifest-1-of-2.jsonl",
+                   "{\"id\": \"x\", \"status\": \"failed\", \"error\": \"older-x\", "
+                   "\"finished\": \"2026-11-25T10:00:01Z\"}\n"
+                   "{\"id\": \"y\", \"status\": \"failed\", \"error\": \"newer-y\", "
+                   "\"finished\": \"2026-11-25T10:00:09Z\"}\n");
+    char err[1024] = "";
+    lpv_batch_report_summary s;
+    if (lpv_batch_report(dir, &s, NULL, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    assert_int_equal(s.items, 2);
+    assert_int_equal(s.superseded, 2);
+    assert_int_equal(s.ok, 1);
+    assert_int_equal(s.failed, 1);
+    char *html = read_text(dir, "report.html");
+    assert_null(strstr(html, "older-x"));
+    assert_contains(html, "newer-y");
+    free(html);
+}
+
 /* An ok item whose image is missing or that has none: the report is still
  * written, the row says why, and each gets a warning. */
 static void test_missing_image(void **state)
@@ -336,8 +364,9 @@ static void test_times(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_fixture),   cmocka_unit_test(test_merged_first), cmocka_unit_test(test_missing_image),
-        cmocka_unit_test(test_no_items),  cmocka_unit_test(test_errors),       cmocka_unit_test(test_times),
+        cmocka_unit_test(test_fixture),       cmocka_unit_test(test_merged_first), cmocka_unit_test(test_across_shards),
+        cmocka_unit_test(test_missing_image), cmocka_unit_test(test_no_items),     cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_times),
     };
     return cmocka_run_group_tests_name("batch_report", tests, NULL, NULL);
 }
