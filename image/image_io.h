@@ -34,6 +34,15 @@ int lpv_image_encode_u8(const char *ext, int width, int height, int channels, co
 int lpv_image_encode_f32(const char *ext, int width, int height, int channels, const float *pixels,
                          uint8_t **out, size_t *out_len, char *err, size_t err_size);
 
+/* Resizes width x height pixels of `channels` floats (1..4) to dst_width x
+ * dst_height through OpenImageIO's resize with a box filter one destination
+ * pixel wide: each destination pixel is the average of the source area under
+ * it, so values stay within the source's range (no ringing: HDR radiance
+ * stays non-negative). Every channel, alpha included, is averaged on its own.
+ * *out is malloc'd; free() it. Returns 0, or -1 with a message in err. */
+int lpv_image_resize_f32(const float *pixels, int width, int height, int channels, int dst_width, int dst_height,
+                         float **out, char *err, size_t err_size);
+
 /* 1 if the path's extension is one lpv writes as float (".exr"), else 0. */
 int lpv_image_is_float_format(const char *path);
 

@@ -21,6 +21,8 @@
 #include "image_io.h"
 
 #include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cctype>
@@ -325,4 +327,48 @@ extern "C" int lpv_image_encode_f32(const char *ext, int width, int height, int 
                                     uint8_t **out, size_t *out_len, char *err, size_t err_size)
 {
     return encode_image(ext, width, height, channels, TypeDesc::FLOAT, pixels, out, out_len, err, err_size);
+}
+
+// ---- resizing (the batch report's thumbnails) --------------------------------
+
+extern "C" int lpv_image_resize_f32(const float *pixels, int width, int height, int channels, int dst_width,
+                                    int dst_height, float **out, char *err, size_t err_size)
+{
+    if (out)
+        *out = nullptr;
+    if (!out) {
+        set_err(err, err_size, "resize: no output buffer");
+        return -1;
+    }
+    if (!check_size("resize source", width, height, channels, pixels, err, err_size) ||
+        !check_size("resize destination", dst_width, dst_height, channels, pixels, err, err_size))
+        return -1;
+    try {
+        ImageSpec src_spec(width, height, channels, TypeDesc::FLOAT);
+        // Wraps the caller's pixels without copying; resize only reads them.
+        OIIO::ImageBuf src(src_spec, const_cast<float *>(pixels));
+        OIIO::ImageBuf dst(ImageSpec(dst_width, dst_height, channels, TypeDesc::FLOAT));
+        if (!OIIO::ImageBufAlgo::resize(dst, src, "box", 1.0f)) {
+            set_err(err, err_size, "resize: " + one_line(dst.geterror()));
+            return -1;
+        }
+        const size_t n = (size_t)dst_width * (size_t)dst_height * (size_t)channels;
+        float *p = static_cast<float *>(std::malloc(n * sizeof(float)));
+        if (!p) {
+            set_err(err, err_size, "resize: out of memory");
+            return -1;
+        }
+        if (!dst.get_pixels(dst.roi(), TypeDesc::FLOAT, p)) {
+            std::free(p);
+            set_err(err, err_size, "resize: " + one_line(dst.geterror()));
+            return -1;
+        }
+        *out = p;
+        return 0;
+    } catch (const std::exception &e) {
+        set_err(err, err_size, std::string("resize: ") + e.what());
+    } catch (...) {
+        set_err(err, err_size, "resize: unknown error");
+    }
+    return -1;
 }

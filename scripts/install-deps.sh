@@ -13,6 +13,7 @@ PACKAGES="
   libcmocka-dev
   python3 python3-jsonschema gnuplot-nox
   assimp-testmodels
+  chromium
 "
 # khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
 # into gpu/gl_api.h at build time (docs/gl-backends.md).
@@ -21,6 +22,9 @@ PACKAGES="
 # assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
 # tests/test_realscene.c and the accuracy sweep render as scenes the project
 # did not write.
+# chromium: the batch report test (tests/report_browser.py) opens report.html
+# in it, headless, to check the page's thumbnails load and its script logs no
+# error; the test fails without it.
 
 if [ "$(id -u)" -eq 0 ]; then
   SUDO=""

@@ -1,5 +1,5 @@
 /* test_image.c - image_io.h through OpenImageIO: PNG (8-bit) and EXR (float)
- * round trips, channel conversion on read, and clean failures. */
+ * round trips, channel conversion on read, resizing, and clean failures. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -251,12 +251,53 @@ static void test_read_errors(void **state)
     assert_int_equal(lpv_image_read_f32(NULL, 4, &w, &h, &rd, err, sizeof err), -1);
 }
 
+/* Resizing is an area average: a 1-pixel checkerboard halved in each
+ * direction is flat grey, a ramp shrunk by 3 gives the means of its thirds,
+ * and HDR values next to black never ring below 0. */
+static void test_resize(void **state)
+{
+    (void)state;
+    enum { W = 12, H = 8 };
+    float src[W * H * 2];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            src[(y * W + x) * 2] = (float)((x + y) & 1);         /* checkerboard */
+            src[(y * W + x) * 2 + 1] = x < W / 2 ? 0.0f : 1000.0f; /* a hard HDR edge */
+        }
+    char err[512] = "";
+    float *out = NULL;
+    if (lpv_image_resize_f32(src, W, H, 2, W / 2, H / 2, &out, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    for (int i = 0; i < (W / 2) * (H / 2); i++) {
+        assert_true(fabsf(out[2 * i] - 0.5f) < 1e-5f);
+        assert_true(out[2 * i + 1] >= 0.0f && out[2 * i + 1] <= 1000.0f);
+    }
+    free(out);
+
+    float ramp[9];
+    for (int x = 0; x < 9; x++)
+        ramp[x] = (float)x;
+    out = NULL;
+    assert_int_equal(lpv_image_resize_f32(ramp, 9, 1, 1, 3, 1, &out, err, sizeof err), 0);
+    assert_true(fabsf(out[0] - 1.0f) < 1e-5f);
+    assert_true(fabsf(out[1] - 4.0f) < 1e-5f);
+    assert_true(fabsf(out[2] - 7.0f) < 1e-5f);
+    free(out);
+
+    out = NULL;
+    assert_int_equal(lpv_image_resize_f32(ramp, 9, 1, 1, 0, 1, &out, err, sizeof err), -1);
+    assert_null(out);
+    assert_int_equal(lpv_image_resize_f32(ramp, 9, 1, 5, 3, 1, &out, err, sizeof err), -1);
+    assert_int_equal(lpv_image_resize_f32(NULL, 9, 1, 1, 3, 1, &out, err, sizeof err), -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_png_roundtrip),  cmocka_unit_test(test_png_rgb_read_rgba),
         cmocka_unit_test(test_exr_roundtrip),  cmocka_unit_test(test_float_format),
         cmocka_unit_test(test_write_errors),   cmocka_unit_test(test_read_errors),
+        cmocka_unit_test(test_resize),
     };
     return cmocka_run_group_tests_name("image", tests, NULL, NULL);
 }
