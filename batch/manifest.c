@@ -65,6 +65,8 @@ static int shard_cmp(const void *a, const void *b)
     return strcmp(x->name, y->name);
 }
 
+#define NO_MANIFEST (-2)
+
 /* The file names to read into m->files: the merged manifest first (when
  * there is one), then the shards' own, which may hold newer lines (a shard
  * run again after a merge). */
@@ -75,8 +77,10 @@ static int find_files(const char *dir, lpv_manifest *m, char *err, size_t err_si
     snprintf(path, sizeof path, "%s/manifest.jsonl", dir);
     const int merged = stat(path, &st) == 0 && S_ISREG(st.st_mode);
     DIR *d = opendir(dir);
-    if (!d)
-        return set_err(err, err_size, "%s: %s", dir, strerror(errno));
+    if (!d) {
+        set_err(err, err_size, "%s: %s", dir, strerror(errno));
+        return errno == ENOENT ? NO_MANIFEST : -1;
+    }
     shard_file *list = NULL;
     size_t n = 0, cap = 0;
     int rc = 0;
@@ -121,8 +125,10 @@ static int find_files(const char *dir, lpv_manifest *m, char *err, size_t err_si
     if (rc != 0)
         return set_err(err, err_size, "%s%s: out of memory", dir, "");
     m->nfiles = n + (size_t)merged;
-    if (m->nfiles == 0)
-        return set_err(err, err_size, "%s: no manifest (manifest.jsonl or manifest-I-of-N.jsonl)%s", dir, "");
+    if (m->nfiles == 0) {
+        set_err(err, err_size, "%s: no manifest (manifest.jsonl or manifest-I-of-N.jsonl)%s", dir, "");
+        return NO_MANIFEST;
+    }
     return 0;
 }
 
@@ -251,14 +257,30 @@ static int item_cmp(const void *a, const void *b)
     return x->seq < y->seq ? -1 : x->seq > y->seq;
 }
 
+static int read_manifests(const char *dir, lpv_manifest *m, int none_ok, FILE *warnings, char *err,
+                          size_t err_size);
+
 int lpv_manifest_read(const char *dir, lpv_manifest *m, FILE *warnings, char *err, size_t err_size)
+{
+    return read_manifests(dir, m, 0, warnings, err, err_size);
+}
+
+int lpv_manifest_read_any(const char *dir, lpv_manifest *m, FILE *warnings, char *err, size_t err_size)
+{
+    return read_manifests(dir, m, 1, warnings, err, err_size);
+}
+
+static int read_manifests(const char *dir, lpv_manifest *m, int none_ok, FILE *warnings, char *err, size_t err_size)
 {
     memset(m, 0, sizeof *m);
     m->first_started = NAN;
     m->last_finished = NAN;
     if (!dir || !dir[0])
         return set_err(err, err_size, "no folder given%s%s", "", "");
-    if (find_files(dir, m, err, err_size) != 0)
+    int found = find_files(dir, m, err, err_size);
+    if (found == NO_MANIFEST && none_ok)
+        return 0;
+    if (found != 0)
         return -1;
     json_t *by_id = json_object();
     if (!by_id)

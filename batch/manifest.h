@@ -46,6 +46,9 @@ typedef struct lpv_manifest {
  * Returns 0, or -1 with a message in err: no manifest in DIR, a file that
  * cannot be read, out of memory. lpv_manifest_free(m) in both cases. */
 int lpv_manifest_read(const char *dir, lpv_manifest *m, FILE *warnings, char *err, size_t err_size);
+/* The same, but a folder with no manifest (or no folder) is no error: 0 and
+ * no items (a job's first run). */
+int lpv_manifest_read_any(const char *dir, lpv_manifest *m, FILE *warnings, char *err, size_t err_size);
 void lpv_manifest_free(lpv_manifest *m);
 
 /* 1 when the item's "status" is "ok"; anything else counts as failed. */

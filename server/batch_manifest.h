@@ -1,10 +1,9 @@
 /*
- * batch_manifest.h - lpvd batch's manifests (docs/batch.md): JSON Lines,
- * one object per finished item, appended by each shard to
+ * batch_manifest.h - writing lpvd batch's manifests (docs/batch.md): JSON
+ * Lines, one object per finished item, appended by each shard to
  * OUT/manifest-I-of-N.jsonl and combined by --merge into OUT/manifest.jsonl.
- * A later line of the same id supersedes an earlier one; a line that is not
- * a JSON object with a string "id" (a torn last line after a crash) is
- * skipped and counted.
+ * Reading them (which line of an id counts, torn lines) is batch/manifest.h's,
+ * shared with the report.
  */
 #ifndef LPVD_BATCH_MANIFEST_H
 #define LPVD_BATCH_MANIFEST_H
@@ -14,13 +13,6 @@
 
 #include <jansson.h>
 
-/* Every entry of the folder's manifests (manifest.jsonl and each
- * manifest-*-of-*.jsonl, in name order, lines in file order), the last per
- * id kept: a JSON object mapping id -> entry. *skipped gets the number of
- * unreadable lines. NULL with a message in err if the folder cannot be
- * read (no manifest at all is an empty object). */
-json_t *lpvd_manifest_load(const char *dir, int *skipped, char *err, size_t err_size);
-
 /* Opens (creates) OUT/manifest-I-of-N.jsonl for appending. */
 FILE *lpvd_manifest_open(const char *dir, int shard, int shards, char *err, size_t err_size);
 
@@ -29,7 +21,7 @@ FILE *lpvd_manifest_open(const char *dir, int shard, int shards, char *err, size
  * Returns 0 or -1. */
 int lpvd_manifest_append(FILE *f, const json_t *entry);
 
-/* --merge: every entry of the folder (lpvd_manifest_load) written to
+/* --merge: every entry of the folder (lpv_manifest_read) written to
  * OUT/manifest.jsonl in the items' "index" order, replacing it atomically.
  * Returns the number of entries, or -1 with a message in err. */
 int lpvd_manifest_merge(const char *dir, int *skipped, char *err, size_t err_size);

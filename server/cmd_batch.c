@@ -24,9 +24,11 @@
 #include "batch_manifest.h"
 #include "batch_render.h"
 #include "commands.h"
+#include "manifest.h"
+#include "report.h"
 #include "options.h"
 
-enum { B_OUT, B_SHARD, B_LIST, B_MERGE, B_PROGRESS, B_HELP, B_COUNT };
+enum { B_OUT, B_SHARD, B_LIST, B_MERGE, B_REPORT, B_PROGRESS, B_HELP, B_COUNT };
 
 static const lpv_flag BATCH_FLAGS[B_COUNT] = {
     [B_OUT] = {"out", 'o', "DIR", "the output folder: images, manifests, report (required but for --list)"},
@@ -34,6 +36,9 @@ static const lpv_flag BATCH_FLAGS[B_COUNT] = {
                                    "LPVD_SHARDS from the environment (a Kubernetes Indexed Job), else 0/1"},
     [B_LIST] = {"list", 0, NULL, "print the job's items (index, id, shard) and exit"},
     [B_MERGE] = {"merge", 0, NULL, "combine DIR's shard manifests into DIR/manifest.jsonl and exit"},
+    [B_REPORT] = {"report", 0, NULL, "write DIR/report.html, DIR/contact.png and DIR/thumbs/ from DIR's\n"
+                                    "manifests and exit (with --merge: after merging); a run of the\n"
+                                    "whole job (shard 0/1) writes them at its end"},
     [B_PROGRESS] = {"progress", 0, "auto|bar|lines|off", "progress on stderr (auto: a bar on a terminal, else lines)"},
     [B_HELP] = {"help", 'h', NULL, "this text"},
 };
@@ -150,6 +155,20 @@ static int entry_done(const char *dir, const json_t *e)
     return json_array_size(outs) > 0;
 }
 
+/* The report of DIR's manifests (batch/report.h). */
+static int write_report(const char *dir)
+{
+    char err[1024];
+    lpv_batch_report_summary s;
+    if (lpv_batch_report(dir, &s, stderr, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd batch: report: %s\n", err);
+        return -1;
+    }
+    fprintf(stderr, "lpvd batch: report: %s/report.html (%ld ok, %ld failed)%s\n", dir, s.ok, s.failed,
+            s.contact_tiles ? ", contact.png" : "");
+    return 0;
+}
+
 static int do_list(const lpvd_batch_job *job, int shard, int shards, int shard_given)
 {
     unsigned char *mine = malloc((size_t)job->item_count + 1);
@@ -171,7 +190,7 @@ int lpvd_cmd_batch(int argc, char **argv)
 {
     lpvd_options opt = {0};
     const char *job_path = NULL, *out = NULL, *shard_flag = NULL, *progress_mode = "auto";
-    int list = 0, merge = 0;
+    int list = 0, merge = 0, report = 0;
     char err[1024] = "";
     lpv_flag_group groups[2] = {{BATCH_FLAGS, B_COUNT, NULL, NULL}};
     int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_BACKEND, 1, groups + 1);
@@ -204,6 +223,7 @@ int lpvd_cmd_batch(int argc, char **argv)
         case B_SHARD: shard_flag = v; break;
         case B_LIST: list = 1; break;
         case B_MERGE: merge = 1; break;
+        case B_REPORT: report = 1; break;
         case B_PROGRESS: progress_mode = v; break;
         }
     }
@@ -216,20 +236,21 @@ int lpvd_cmd_batch(int argc, char **argv)
         fprintf(stderr, "lpvd batch: --progress %s: expected auto, bar, lines or off\n", progress_mode);
         return 2;
     }
-    if (!out && (merge || !list)) {
+    if (!out && (merge || report || !list)) {
         fprintf(stderr, "lpvd batch: --out DIR is required\n");
         return 2;
     }
-    if (merge) {
+    if (merge || report) {
         int skipped = 0;
-        int n = lpvd_manifest_merge(out, &skipped, err, sizeof err);
+        int n = merge ? lpvd_manifest_merge(out, &skipped, err, sizeof err) : 0;
         if (n < 0) {
             fprintf(stderr, "lpvd batch: --merge: %s\n", err);
             return 1;
         }
-        fprintf(stderr, "lpvd batch: merged %d items into %s/manifest.jsonl%s\n", n, out,
-                skipped ? " (unreadable lines skipped)" : "");
-        return 0;
+        if (merge)
+            fprintf(stderr, "lpvd batch: merged %d items into %s/manifest.jsonl%s\n", n, out,
+                    skipped ? " (unreadable lines skipped)" : "");
+        return report && write_report(out) != 0 ? 1 : 0;
     }
     if (!job_path) {
         fprintf(stderr, "lpvd batch: no job file given (see lpvd batch --help)\n");
@@ -252,28 +273,36 @@ int lpvd_cmd_batch(int argc, char **argv)
     }
     int rc = 1;
     unsigned char *mine = malloc((size_t)job.item_count + 1);
-    json_t *done = NULL;
+    lpv_manifest done;
+    memset(&done, 0, sizeof done);
     FILE *manifest = NULL;
     lpvd_batch_renderer *r = NULL;
     if (!mine || mkdirs(out) != 0) {
         fprintf(stderr, "lpvd batch: %s: %s\n", out, mine ? strerror(errno) : "out of memory");
         goto end;
     }
-    int count = lpvd_batch_shard(&job, shard, shards, mine), skipped_lines = 0;
-    done = lpvd_manifest_load(out, &skipped_lines, err, sizeof err);
-    if (!done || !(manifest = lpvd_manifest_open(out, shard, shards, err, sizeof err))) {
+    int count = lpvd_batch_shard(&job, shard, shards, mine);
+    if (lpv_manifest_read_any(out, &done, stderr, err, sizeof err) != 0 ||
+        !(manifest = lpvd_manifest_open(out, shard, shards, err, sizeof err))) {
         fprintf(stderr, "lpvd batch: %s\n", err);
         goto end;
     }
-    if (skipped_lines)
-        fprintf(stderr, "lpvd batch: %d unreadable manifest line(s) skipped (their items run again)\n",
-                skipped_lines);
+    if (done.skipped)
+        fprintf(stderr, "lpvd batch: %ld unreadable manifest line(s) skipped (their items run again)\n",
+                done.skipped);
     progress pr = {.mode = pmode, .total = count, .start = now_s()};
-    for (int k = 0; k < job.item_count; ++k)
-        if (mine[k] && entry_done(out, json_object_get(done, job.items[k].id))) {
+    json_t *by_id = json_object(); /* the job's items by id: a manifest line names its item by id */
+    for (int k = 0; by_id && k < job.item_count; ++k)
+        json_object_set_new(by_id, job.items[k].id, json_integer(k));
+    for (size_t i = 0; by_id && i < done.count; ++i) {
+        const json_t *pos = json_object_get(by_id, done.items[i].id);
+        json_int_t k = pos ? json_integer_value(pos) : -1;
+        if (k >= 0 && mine[k] && entry_done(out, done.items[i].line)) {
             mine[k] = 0;
             pr.skipped++;
         }
+    }
+    json_decref(by_id);
     fprintf(stderr, "lpvd batch: %s: %d items, shard %d/%d has %d, %d already done\n", job_path, job.item_count,
             shard, shards, count, pr.skipped);
     struct sigaction sa;
@@ -320,12 +349,14 @@ int lpvd_cmd_batch(int argc, char **argv)
         fprintf(stderr, "lpvd batch: shard %d/%d: %d done, %d failed, %d skipped (done before)\n", shard, shards,
                 pr.done, pr.failed, pr.skipped);
         rc = failed ? 1 : 0;
+        if (shards == 1 && pr.done + pr.failed > 0 && write_report(out) != 0)
+            rc = 1;
     }
 end:
     lpvd_batch_renderer_destroy(r);
     if (manifest)
         fclose(manifest);
-    json_decref(done);
+    lpv_manifest_free(&done);
     free(mine);
     lpvd_batch_job_free(&job);
     return rc;
