@@ -11,11 +11,14 @@ PACKAGES="
   libopenimageio-dev
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev
-  python3 gnuplot-nox
+  python3 python3-yaml gnuplot-nox
   assimp-testmodels
 "
 # khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
 # into gpu/gl_api.h at build time (docs/gl-backends.md).
+# python3-yaml: PyYAML, with which tests/test_k8s_manifests.py parses the
+# Kubernetes manifests of docker/k8s/ (every other Python script of the
+# project uses the standard library only).
 # assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
 # tests/test_realscene.c and the accuracy sweep render as scenes the project
 # did not write.
