@@ -11,7 +11,7 @@ PACKAGES="
   libopenimageio-dev
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev
-  python3 python3-jsonschema gnuplot-nox
+  python3 python3-jsonschema python3-yaml gnuplot-nox
   assimp-testmodels
   chromium
 "
@@ -19,6 +19,8 @@ PACKAGES="
 # into gpu/gl_api.h at build time (docs/gl-backends.md).
 # python3-jsonschema: tests/batch/batch_cli.py checks job files against
 # docs/batch.schema.json.
+# python3-yaml: PyYAML, with which tests/test_k8s_manifests.py parses the
+# Kubernetes manifests of docker/k8s/.
 # assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
 # tests/test_realscene.c and the accuracy sweep render as scenes the project
 # did not write.
