@@ -130,6 +130,19 @@ def case_shards(lpvd, source, tmp):
     env = dict(os.environ, JOB_COMPLETION_INDEX="1")
     rc, _, err = run(lpvd, job, "--out", os.path.join(tmp, "x"), env=env)
     check(rc == 2 and "LPVD_SHARDS" in err, "JOB_COMPLETION_INDEX without LPVD_SHARDS is refused: " + err)
+    # an item's image does not depend on the item before it: a camera that
+    # moves less than a cell would get the daemon's cached volume
+    for name, cams in (("pair", [40, 50]), ("alone", [50])):
+        j = {"lpvd_batch": 1, "size": [48, 48], "scenes": [{"path": "courtyard.glb"}],
+             "cameras": [{"name": "fov%d" % f, "camera": 0, "fov_deg": f} for f in cams],
+             "settings": [{"name": "fast", "preset": "fast"}], "outputs": ["exr"]}
+        with open(os.path.join(tmp, name + ".json"), "w") as f:
+            json.dump(j, f)
+        rc, _, err = run(lpvd, os.path.join(tmp, name + ".json"), "--out", os.path.join(tmp, name), "--progress", "off")
+        check(rc == 0, name + " runs: " + err[-500:])
+    check(digests(os.path.join(tmp, "pair")).get("courtyard/fov50/file/fast.exr") ==
+          digests(os.path.join(tmp, "alone")).get("courtyard/fov50/file/fast.exr") is not None,
+          "the fov 50 image is the same after the fov 40 one as alone")
     rc, _, err = run(lpvd, job, "--out", sharded, "--merge")
     with open(os.path.join(sharded, "manifest.jsonl")) as f:
         merged = [json.loads(line) for line in f]
