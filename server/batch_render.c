@@ -2,6 +2,7 @@
 #include "batch_render.h"
 
 #include <errno.h>
+#include <glob.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -248,6 +249,15 @@ static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json
                 return fail(err, n, "%s: %s", path, strerror(errno));
         }
     const char *ext = strrchr(slash, '.');
+    /* what a process killed while writing this item left (SIGKILL, a lost
+     * node): never an output, since only the manifest says what is done;
+     * removed here, as no other process renders this item at the same time */
+    glob_t g;
+    snprintf(tmp, sizeof tmp, "%.*s.tmp-*%s", (int)(ext - path), path, ext);
+    if (glob(tmp, GLOB_NOSORT | GLOB_NOESCAPE, NULL, &g) == 0)
+        for (size_t i = 0; i < g.gl_pathc; ++i)
+            unlink(g.gl_pathv[i]);
+    globfree(&g);
     snprintf(tmp, sizeof tmp, "%.*s.tmp-%ld%s", (int)(ext - path), path, (long)getpid(), ext);
     if (fn(r, tmp, err, n) != 0) {
         unlink(tmp);

@@ -181,6 +181,33 @@ def case_resume(lpvd, source, tmp):
           (len(ids), len(set(ids))))
     rc, _, err = run(lpvd, job, "--out", out, "--progress", "lines")
     check(rc == 0 and "0 done" in err and "12 already done" in err, "a third run renders nothing: " + err[-500:])
+    # SIGKILL in the middle of an item: nothing to finish it; the re-run
+    # renders what has no ok line (the killed item included) and removes
+    # what the killed process was writing
+    out2 = os.path.join(tmp, "killed")
+    p = subprocess.Popen([lpvd, "batch", job, "--out", out2, "--progress", "off"], stderr=subprocess.DEVNULL)
+    man2 = os.path.join(out2, "manifest-0-of-1.jsonl")
+    deadline = time.time() + 300
+    while time.time() < deadline and not (os.path.exists(man2) and open(man2).read().count("\n") >= 2):
+        time.sleep(0.005)
+    p.kill()
+    p.wait()
+    before = len(manifest_lines(out2))
+    # what a process killed while writing leaves: a temporary of an item not yet done
+    pending = [i[1] for i in listed(lpvd, job) if i[1] not in {e["id"] for e in manifest_lines(out2)}]
+    check(len(pending) > 0, "items were left by the kill")
+    leftover = os.path.join(out2, pending[-1] + ".tmp-999999.png")
+    os.makedirs(os.path.dirname(leftover), exist_ok=True)
+    with open(leftover, "wb") as f:
+        f.write(b"half a PNG")
+    rc, _, err = run(lpvd, job, "--out", out2, "--progress", "lines")
+    lines = manifest_lines(out2)
+    ids = [e["id"] for e in lines if e["status"] == "ok"]
+    check(rc == 0 and 0 < before < 12 and len(ids) == 12 and len(set(ids)) == 12,
+          "after SIGKILL (%d done) the re-run completes the job, every item once: rc %d, %d ok lines" %
+          (before, rc, len(ids)))
+    tmps = [f for _, _, fs in os.walk(out2) for f in fs if ".tmp-" in f]
+    check(not tmps, "the killed process's temporary files are gone: %r" % tmps)
     # an output deleted after the fact is rendered again
     victim = manifest_lines(out)[0]["outputs"][0]["path"]
     os.remove(os.path.join(out, victim))
