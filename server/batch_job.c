@@ -3,26 +3,17 @@
 
 #include <limits.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "engine.h"
+#include "error.h"
 #include "light_json.h"
 #include "proto.h"
 #include "settings_fields.h"
 #include "settings_json.h"
 #include "tick_cost.h"
-
-static int fail(char *err, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, n, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 static char *dup_str(const char *s)
 {
@@ -42,19 +33,19 @@ static int take_name(const json_t *o, const char *where, const char *deflt, char
     const char *s = deflt;
     if (v) {
         if (!json_is_string(v))
-            return fail(err, n, "%s.name: expected a string", where);
+            return lpv_error(err, n, "%s.name: expected a string", where);
         s = json_string_value(v);
     }
     if (!s)
-        return fail(err, n, "%s.name: required", where);
+        return lpv_error(err, n, "%s.name: required", where);
     size_t len = strlen(s);
     if (len == 0 || len >= LPVD_BATCH_NAME_MAX || s[0] == '.')
-        return fail(err, n, "%s.name: must be 1..%d characters, not starting with '.'", where, LPVD_BATCH_NAME_MAX - 1);
+        return lpv_error(err, n, "%s.name: must be 1..%d characters, not starting with '.'", where, LPVD_BATCH_NAME_MAX - 1);
     for (size_t i = 0; i < len; ++i) {
         char c = s[i];
         if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
               c == '-'))
-            return fail(err, n, "%s.name: \"%s\" may hold only letters, digits, '.', '_' and '-' (it names files)",
+            return lpv_error(err, n, "%s.name: \"%s\" may hold only letters, digits, '.', '_' and '-' (it names files)",
                         where, s);
     }
     memcpy(out, s, len + 1);
@@ -65,19 +56,19 @@ static int take_name(const json_t *o, const char *where, const char *deflt, char
 static int take_path(const json_t *v, const char *where, char **out, char *err, size_t n)
 {
     if (!json_is_string(v))
-        return fail(err, n, "%s: expected a string path", where);
+        return lpv_error(err, n, "%s: expected a string path", where);
     const char *s = json_string_value(v);
     if (s[0] == '\0' || s[0] == '/')
-        return fail(err, n, "%s: must be a path relative to the job file's folder", where);
+        return lpv_error(err, n, "%s: must be a path relative to the job file's folder", where);
     for (const char *p = s; *p;) {
         const char *e = strchr(p, '/');
         size_t len = e ? (size_t)(e - p) : strlen(p);
         if (len == 0 || (len == 2 && p[0] == '.' && p[1] == '.'))
-            return fail(err, n, "%s: \"%s\" leaves the job file's folder or has an empty part", where, s);
+            return lpv_error(err, n, "%s: \"%s\" leaves the job file's folder or has an empty part", where, s);
         p += len + (e ? 1 : 0);
     }
     *out = dup_str(s);
-    return *out ? 0 : fail(err, n, "out of memory");
+    return *out ? 0 : lpv_error(err, n, "out of memory");
 }
 
 /* Checks that o has only the keys in allowed (NULL-terminated). */
@@ -92,7 +83,7 @@ static int only_keys(const json_t *o, const char *where, const char *const *allo
         for (const char *const *a = allowed; *a && !ok; ++a)
             ok = strcmp(*a, key) == 0;
         if (!ok)
-            return fail(err, n, "%s: unknown key \"%s\"", where, key);
+            return lpv_error(err, n, "%s: unknown key \"%s\"", where, key);
     }
     return 0;
 }
@@ -101,7 +92,7 @@ static int take_floats(const json_t *o, const char *key, const char *where, int 
 {
     char why[256];
     int rc = lpvp_get_floats(o, key, 1, (size_t)count, -LPV_MAX_COORD, LPV_MAX_COORD, out, why, sizeof why);
-    return rc == LPVP_FIELD_OK ? 0 : fail(err, n, "%s.%s", where, why);
+    return rc == LPVP_FIELD_OK ? 0 : lpv_error(err, n, "%s.%s", where, why);
 }
 
 /* ---- cameras ----------------------------------------------------------------- */
@@ -112,16 +103,16 @@ static int parse_camera(const json_t *c, const char *where, lpvd_batch_camera *o
     memset(out, 0, sizeof *out);
     *views = 1;
     if (!json_is_object(c))
-        return fail(err, n, "%s: expected an object", where);
+        return lpv_error(err, n, "%s: expected an object", where);
     if (only_keys(c, where, KEYS, err, n) != 0 || take_name(c, where, "default", out->name, err, n) != 0)
         return -1;
     const json_t *cam = json_object_get(c, "camera"), *orbit = json_object_get(c, "orbit");
     const json_t *eye = json_object_get(c, "eye"), *fov = json_object_get(c, "fov_deg");
     if (!!cam + !!orbit + !!eye > 1)
-        return fail(err, n, "%s: give one of camera, eye/target and orbit", where);
+        return lpv_error(err, n, "%s: give one of camera, eye/target and orbit", where);
     if (fov) {
         if (!json_is_number(fov) || !(json_number_value(fov) > 0.0 && json_number_value(fov) < 180.0))
-            return fail(err, n, "%s.fov_deg: expected a number in (0, 180)", where);
+            return lpv_error(err, n, "%s.fov_deg: expected a number in (0, 180)", where);
         out->choice.has_fov = 1;
         out->choice.fov_deg = (float)json_number_value(fov);
     }
@@ -135,7 +126,7 @@ static int parse_camera(const json_t *c, const char *where, lpvd_batch_camera *o
                    json_string_length(cam) < LPVD_BATCH_NAME_MAX) {
             s = json_string_value(cam);
         } else {
-            return fail(err, n, "%s.camera: expected the file's camera index or name", where);
+            return lpv_error(err, n, "%s.camera: expected the file's camera index or name", where);
         }
         snprintf(out->camera_name, sizeof out->camera_name, "%s", s);
     } else if (eye) {
@@ -144,20 +135,20 @@ static int parse_camera(const json_t *c, const char *where, lpvd_batch_camera *o
             return -1;
         out->choice.has_eye = out->choice.has_target = 1;
     } else if (json_object_get(c, "target")) {
-        return fail(err, n, "%s.target: needs eye", where);
+        return lpv_error(err, n, "%s.target: needs eye", where);
     } else if (orbit) {
         static const char *const OKEYS[] = {"views", "elevation_deg", "distance", NULL};
         char w[160];
         snprintf(w, sizeof w, "%s.orbit", where);
         if (!json_is_object(orbit) || only_keys(orbit, w, OKEYS, err, n) != 0)
-            return json_is_object(orbit) ? -1 : fail(err, n, "%s: expected an object", w);
+            return json_is_object(orbit) ? -1 : lpv_error(err, n, "%s: expected an object", w);
         int64_t v = 8;
         double el = 25.0, dist = 0.0;
         char why[256];
         if (lpvp_get_int(orbit, "views", 0, 1, 3600, &v, why, sizeof why) == LPVP_FIELD_BAD ||
             lpvp_get_number(orbit, "elevation_deg", 0, -89.0, 89.0, &el, why, sizeof why) == LPVP_FIELD_BAD ||
             lpvp_get_number(orbit, "distance", 0, 0.0, LPV_MAX_COORD, &dist, why, sizeof why) == LPVP_FIELD_BAD)
-            return fail(err, n, "%s.%s", w, why);
+            return lpv_error(err, n, "%s.%s", w, why);
         out->orbit_n = (int)v;
         out->orbit_elevation_deg = (float)el;
         out->orbit_distance = (float)dist;
@@ -180,7 +171,7 @@ static int expand_cameras(const json_t *c, const char *where, lpvd_batch_camera 
     }
     int rc = -1;
     if (!json_is_array(c) || json_array_size(c) == 0) {
-        fail(err, n, "%s: expected a non-empty array", where);
+        lpv_error(err, n, "%s: expected a non-empty array", where);
         goto done;
     }
     size_t total = 0;
@@ -194,12 +185,12 @@ static int expand_cameras(const json_t *c, const char *where, lpvd_batch_camera 
         total += (size_t)views;
     }
     if (total > LPVD_BATCH_MAX_ITEMS) {
-        fail(err, n, "%s: %zu views, more than %d", where, total, LPVD_BATCH_MAX_ITEMS);
+        lpv_error(err, n, "%s: %zu views, more than %d", where, total, LPVD_BATCH_MAX_ITEMS);
         goto done;
     }
     *out = calloc(total, sizeof **out);
     if (!*out) {
-        fail(err, n, "out of memory");
+        lpv_error(err, n, "out of memory");
         goto done;
     }
     for (size_t i = 0; i < json_array_size(c); ++i) {
@@ -217,7 +208,7 @@ static int expand_cameras(const json_t *c, const char *where, lpvd_batch_camera 
             }
             for (int j = 0; j < *count - 1; ++j)
                 if (strcmp((*out)[j].name, d->name) == 0) {
-                    fail(err, n, "%s: two cameras are named \"%s\"", where, d->name);
+                    lpv_error(err, n, "%s: two cameras are named \"%s\"", where, d->name);
                     goto done;
                 }
         }
@@ -239,7 +230,7 @@ static int parse_scene(const json_t *s, const char *where, lpvd_batch_scene *out
 {
     static const char *const KEYS[] = {"name", "path", "cameras", "animation", "times", NULL};
     if (!json_is_object(s))
-        return fail(err, n, "%s: expected an object", where);
+        return lpv_error(err, n, "%s: expected an object", where);
     if (only_keys(s, where, KEYS, err, n) != 0)
         return -1;
     const json_t *path = json_object_get(s, "path");
@@ -261,27 +252,27 @@ static int parse_scene(const json_t *s, const char *where, lpvd_batch_scene *out
         if (json_is_integer(anim) && json_integer_value(anim) >= 0 && json_integer_value(anim) < INT_MAX)
             snprintf(buf, sizeof buf, "%lld", (long long)json_integer_value(anim));
         else if (!json_is_string(anim) || json_string_length(anim) == 0)
-            return fail(err, n, "%s.animation: expected the animation's index or name", where);
+            return lpv_error(err, n, "%s.animation: expected the animation's index or name", where);
         out->animation = dup_str(json_is_string(anim) ? json_string_value(anim) : buf);
         if (!times)
-            return fail(err, n, "%s.animation: needs times", where);
+            return lpv_error(err, n, "%s.animation: needs times", where);
     }
     if (times) {
         if (!out->path)
-            return fail(err, n, "%s.times: the built-in scene has no animations", where);
+            return lpv_error(err, n, "%s.times: the built-in scene has no animations", where);
         if (!json_is_array(times) || json_array_size(times) == 0 || json_array_size(times) > 100000)
-            return fail(err, n, "%s.times: expected a non-empty array of seconds", where);
+            return lpv_error(err, n, "%s.times: expected a non-empty array of seconds", where);
         out->time_count = (int)json_array_size(times);
         out->times = calloc((size_t)out->time_count, sizeof *out->times);
         if (!out->times)
-            return fail(err, n, "out of memory");
+            return lpv_error(err, n, "out of memory");
         for (int i = 0; i < out->time_count; ++i) {
             const json_t *t = json_array_get(times, (size_t)i);
             double v = json_is_number(t) ? json_number_value(t) : -1.0;
             if (!(v >= 0.0 && v <= 1e9))
-                return fail(err, n, "%s.times[%d]: expected seconds, 0..1e9", where, i);
+                return lpv_error(err, n, "%s.times[%d]: expected seconds, 0..1e9", where, i);
             if (i > 0 && !(v > out->times[i - 1]))
-                return fail(err, n, "%s.times[%d]: times must increase (each names its items)", where, i);
+                return lpv_error(err, n, "%s.times[%d]: times must increase (each names its items)", where, i);
             out->times[i] = v;
         }
     }
@@ -295,7 +286,7 @@ static int parse_lights(const json_t *l, const char *where, lpvd_batch_lights *o
 {
     static const char *const KEYS[] = {"name", "lights", NULL};
     if (!json_is_object(l))
-        return fail(err, n, "%s: expected an object", where);
+        return lpv_error(err, n, "%s: expected an object", where);
     if (only_keys(l, where, KEYS, err, n) != 0 || take_name(l, where, "file", out->name, err, n) != 0)
         return -1;
     const json_t *list = json_object_get(l, "lights");
@@ -304,15 +295,15 @@ static int parse_lights(const json_t *l, const char *where, lpvd_batch_lights *o
         return 0;
     }
     if (!json_is_array(list) || json_array_size(list) > 256)
-        return fail(err, n, "%s.lights: expected an array of at most 256 lights (LIGHT_SET bodies)", where);
+        return lpv_error(err, n, "%s.lights: expected an array of at most 256 lights (LIGHT_SET bodies)", where);
     out->count = (int)json_array_size(list);
     out->lights = calloc((size_t)out->count + 1, sizeof *out->lights);
     if (!out->lights)
-        return fail(err, n, "out of memory");
+        return lpv_error(err, n, "out of memory");
     for (int i = 0; i < out->count; ++i) {
         char why[512];
         if (lpvd_light_from_json(json_array_get(list, (size_t)i), &out->lights[i], why, sizeof why) != 0)
-            return fail(err, n, "%s.lights[%d].%s", where, i, why);
+            return lpv_error(err, n, "%s.lights[%d].%s", where, i, why);
     }
     return 0;
 }
@@ -320,7 +311,7 @@ static int parse_lights(const json_t *l, const char *where, lpvd_batch_lights *o
 static int parse_settings(const json_t *s, const char *where, lpvd_batch_settings *out, char *err, size_t n)
 {
     if (!json_is_object(s))
-        return fail(err, n, "%s: expected an object", where);
+        return lpv_error(err, n, "%s: expected an object", where);
     if (take_name(s, where, "default", out->name, err, n) != 0)
         return -1;
     const char *key;
@@ -330,17 +321,17 @@ static int parse_settings(const json_t *s, const char *where, lpvd_batch_setting
         (void)v;
         if (strcmp(key, "name") != 0 && strcmp(key, "preset") != 0 && strcmp(key, "technique") != 0 &&
             strcmp(key, "grid") != 0 && strcmp(key, "bounds") != 0 && !lpv_field_by_key(key))
-            return fail(err, n, "%s: unknown key \"%s\" (the settings are CONFIG's, docs/protocol.md)", where, key);
+            return lpv_error(err, n, "%s: unknown key \"%s\" (the settings are CONFIG's, docs/protocol.md)", where, key);
     }
     const lpvd_settings_limits none = {INT_MAX, INT_MAX};
     char why[512];
     memset(&out->settings, 0, sizeof out->settings);
     if (lpvd_settings_apply_json(s, &out->settings, &none, why, sizeof why) != LPVD_SETTINGS_OK)
-        return fail(err, n, "%s.%s", where, why);
+        return lpv_error(err, n, "%s.%s", where, why);
     lpv_settings chk = out->settings;
     lpv_settings_resolve(&chk);
     if (lpv_settings_validate(&chk, why, sizeof why) != 0)
-        return fail(err, n, "%s: %s", where, why);
+        return lpv_error(err, n, "%s: %s", where, why);
     out->json = json_deep_copy(s);
     json_object_del(out->json, "name");
     return 0;
@@ -353,7 +344,7 @@ static int parse_outputs(const json_t *o, lpvd_batch_job *job, char *err, size_t
         return 0;
     }
     if (!json_is_array(o) || json_array_size(o) == 0)
-        return fail(err, n, "outputs: expected a non-empty array");
+        return lpv_error(err, n, "outputs: expected a non-empty array");
     for (size_t i = 0; i < json_array_size(o); ++i) {
         const json_t *v = json_array_get(o, i);
         if (json_is_object(v) && json_object_size(v) == 1 && json_object_get(v, "points")) {
@@ -376,7 +367,7 @@ static int parse_outputs(const json_t *o, lpvd_batch_job *job, char *err, size_t
         else if (strcmp(s, "volume") == 0)
             job->outputs |= LPVD_OUT_VOLUME;
         else
-            return fail(err, n, "outputs[%zu]: expected \"png\", \"exr\", \"ao\", \"volume\" or {\"points\": PATH}",
+            return lpv_error(err, n, "outputs[%zu]: expected \"png\", \"exr\", \"ao\", \"volume\" or {\"points\": PATH}",
                         i);
     }
     return 0;
@@ -395,13 +386,13 @@ static int parse_list(const json_t *root, const char *key, size_t elem, void **o
     }
     int rc = -1;
     if (!json_is_array(a) || json_array_size(a) == 0 || json_array_size(a) > 100000) {
-        fail(err, n, "%s: expected a non-empty array", key);
+        lpv_error(err, n, "%s: expected a non-empty array", key);
         goto done;
     }
     *count = (int)json_array_size(a);
     *out = calloc((size_t)*count, elem);
     if (!*out) {
-        fail(err, n, "out of memory");
+        lpv_error(err, n, "out of memory");
         goto done;
     }
     for (int i = 0; i < *count; ++i) {
@@ -411,7 +402,7 @@ static int parse_list(const json_t *root, const char *key, size_t elem, void **o
             goto done;
         for (int j = 0; j < i; ++j) /* every kind starts with its name */
             if (strcmp((char *)*out + (size_t)j * elem, (char *)*out + (size_t)i * elem) == 0) {
-                fail(err, n, "%s: two entries are named \"%s\"", key, (char *)*out + (size_t)i * elem);
+                lpv_error(err, n, "%s: two entries are named \"%s\"", key, (char *)*out + (size_t)i * elem);
                 goto done;
             }
     }
@@ -435,11 +426,11 @@ static int expand(lpvd_batch_job *job, char *err, size_t n)
         int times = job->scenes[s].time_count ? job->scenes[s].time_count : 1;
         total += (size_t)times * (size_t)job->camera_count[s] * (size_t)job->lights_count * (size_t)job->settings_count;
         if (total > LPVD_BATCH_MAX_ITEMS)
-            return fail(err, n, "the job expands to more than %d items", LPVD_BATCH_MAX_ITEMS);
+            return lpv_error(err, n, "the job expands to more than %d items", LPVD_BATCH_MAX_ITEMS);
     }
     job->items = calloc(total ? total : 1, sizeof *job->items);
     if (!job->items)
-        return fail(err, n, "out of memory");
+        return lpv_error(err, n, "out of memory");
     double pixels = (double)job->width * job->height;
     for (int s = 0; s < job->scene_count; ++s) {
         const lpvd_batch_scene *sc = &job->scenes[s];
@@ -480,23 +471,23 @@ int lpvd_batch_job_load(const char *path, lpvd_batch_job *job, char *err, size_t
     json_error_t je;
     json_t *root = json_load_file(path, JSON_REJECT_DUPLICATES, &je);
     if (!root)
-        return fail(err, n, "%s:%d: %s", path, je.line, je.text);
+        return lpv_error(err, n, "%s:%d: %s", path, je.line, je.text);
     int rc = -1;
     char why[512];
     const char *slash = strrchr(path, '/');
     job->dir = slash ? strndup(path, (size_t)(slash - path) + (slash == path)) : dup_str(".");
     if (!json_is_object(root)) {
-        fail(err, n, "%s: expected a JSON object", path);
+        lpv_error(err, n, "%s: expected a JSON object", path);
         goto done;
     }
     if (only_keys(root, "job", KEYS, why, sizeof why) != 0) {
-        fail(err, n, "%s: %s", path, why);
+        lpv_error(err, n, "%s: %s", path, why);
         goto done;
     }
     int64_t version = 0, size[2] = {512, 512};
     if (lpvp_get_int(root, "lpvd_batch", 1, 1, 1, &version, why, sizeof why) != LPVP_FIELD_OK ||
         lpvp_get_ints(root, "size", 0, 2, 1, 8192, size, why, sizeof why) == LPVP_FIELD_BAD) {
-        fail(err, n, "%s: %s", path, why);
+        lpv_error(err, n, "%s: %s", path, why);
         goto done;
     }
     job->width = (int)size[0];
@@ -504,7 +495,7 @@ int lpvd_batch_job_load(const char *path, lpvd_batch_job *job, char *err, size_t
     static const char *const TERMS[] = {"full", "indirect", "direct"};
     int terms = 0;
     if (lpvp_get_enum(root, "terms", 0, TERMS, 3, &terms, why, sizeof why) == LPVP_FIELD_BAD) {
-        fail(err, n, "%s: %s", path, why);
+        lpv_error(err, n, "%s: %s", path, why);
         goto done;
     }
     job->terms = terms == 0 ? LPV_TERMS_FULL : terms == 1 ? LPV_TERMS_INDIRECT_ONLY : LPV_TERMS_DIRECT_ONLY;
@@ -516,7 +507,7 @@ int lpvd_batch_job_load(const char *path, lpvd_batch_job *job, char *err, size_t
         else
             snprintf(buf, sizeof buf, "%s", json_is_string(ex) ? json_string_value(ex) : "?");
         if (lpv_exposure_parse(buf, &job->display, why, sizeof why) != 0) {
-            fail(err, n, "%s: exposure: %s", path, why);
+            lpv_error(err, n, "%s: exposure: %s", path, why);
             goto done;
         }
     }
@@ -529,13 +520,13 @@ int lpvd_batch_job_load(const char *path, lpvd_batch_job *job, char *err, size_t
                    sizeof why, lights_fn, "[{}]") != 0 ||
         parse_list(root, "settings", sizeof(lpvd_batch_settings), (void **)&job->settings, &job->settings_count, why,
                    sizeof why, settings_fn, "[{}]") != 0) {
-        fail(err, n, "%s: %s", path, why);
+        lpv_error(err, n, "%s: %s", path, why);
         goto done;
     }
     job->cameras = calloc((size_t)job->scene_count, sizeof *job->cameras);
     job->camera_count = calloc((size_t)job->scene_count, sizeof *job->camera_count);
     if (!job->cameras || !job->camera_count) {
-        fail(err, n, "out of memory");
+        lpv_error(err, n, "out of memory");
         goto done;
     }
     for (int s = 0; s < job->scene_count; ++s) {
@@ -544,12 +535,12 @@ int lpvd_batch_job_load(const char *path, lpvd_batch_job *job, char *err, size_t
         snprintf(w, sizeof w, own ? "scenes[%d].cameras" : "cameras", s);
         if (expand_cameras(own ? own : json_object_get(root, "cameras"), w, &job->cameras[s], &job->camera_count[s],
                            why, sizeof why) != 0) {
-            fail(err, n, "%s: %s", path, why);
+            lpv_error(err, n, "%s: %s", path, why);
             goto done;
         }
     }
     if (expand(job, why, sizeof why) != 0) {
-        fail(err, n, "%s: %s", path, why);
+        lpv_error(err, n, "%s: %s", path, why);
         goto done;
     }
     rc = 0;
@@ -591,7 +582,7 @@ int lpvd_batch_parse_shard(const char *text, int *i, int *n, char *err, size_t e
 {
     char tail;
     if (sscanf(text, "%d/%d%c", i, n, &tail) != 2 || !(*n >= 1 && *n <= 100000 && *i >= 0 && *i < *n))
-        return fail(err, err_size, "shard \"%s\": expected I/N with 0 <= I < N <= 100000", text);
+        return lpv_error(err, err_size, "shard \"%s\": expected I/N with 0 <= I < N <= 100000", text);
     return 0;
 }
 

@@ -5,7 +5,6 @@
 #include <glob.h>
 #include <limits.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +13,7 @@
 #include <unistd.h>
 
 #include "engine.h"
+#include "error.h"
 #include "image_io.h"
 
 #include "scene_load.h"
@@ -65,25 +65,16 @@ static json_t *wall_time(void)
     return json_string(out);
 }
 
-static int fail(char *err, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, n, fmt, ap);
-    va_end(ap);
-    return -1;
-}
-
 /* dir/rel, resolved, must lie inside root (no symbolic link out of it either). */
 static int inside(const char *root, const char *dir, const char *rel, char out[PATH_MAX], char *err, size_t n)
 {
     char joined[2 * PATH_MAX];
     snprintf(joined, sizeof joined, "%s/%s", dir, rel);
     if (!realpath(joined, out))
-        return fail(err, n, "%s: %s", rel, strerror(errno));
+        return lpv_error(err, n, "%s: %s", rel, strerror(errno));
     size_t len = strlen(root);
     if (strncmp(out, root, len) != 0 || (out[len] != '/' && out[len] != '\0'))
-        return fail(err, n, "%s: leaves the job file's folder", rel);
+        return lpv_error(err, n, "%s: leaves the job file's folder", rel);
     return 0;
 }
 
@@ -92,7 +83,7 @@ static int load_points(lpvd_batch_renderer *r, const char *path, char *err, size
 {
     FILE *f = fopen(path, "r");
     if (!f)
-        return fail(err, n, "points %s: %s", r->job->points_path, strerror(errno));
+        return lpv_error(err, n, "points %s: %s", r->job->points_path, strerror(errno));
     char line[1024];
     size_t cap = 0, lineno = 0;
     int rc = 0;
@@ -102,21 +93,21 @@ static int load_points(lpvd_batch_renderer *r, const char *path, char *err, size
             continue;
         float v[6];
         if (sscanf(line, "%f,%f,%f,%f,%f,%f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) != 6) {
-            rc = fail(err, n, "points %s:%zu: expected px,py,pz,nx,ny,nz", r->job->points_path, lineno);
+            rc = lpv_error(err, n, "points %s:%zu: expected px,py,pz,nx,ny,nz", r->job->points_path, lineno);
             break;
         }
         for (int i = 0; i < 6; ++i)
             if (!isfinite(v[i]) || fabsf(v[i]) > LPV_MAX_COORD)
-                rc = fail(err, n, "points %s:%zu: values must be finite, within 1e9", r->job->points_path, lineno);
+                rc = lpv_error(err, n, "points %s:%zu: values must be finite, within 1e9", r->job->points_path, lineno);
         if (r->point_count == cap) {
             cap = cap ? 2 * cap : 1024;
             if (cap > (size_t)1 << 24) {
-                rc = fail(err, n, "points %s: more than 16777216 points", r->job->points_path);
+                rc = lpv_error(err, n, "points %s: more than 16777216 points", r->job->points_path);
                 break;
             }
             float *np = realloc(r->points, cap * 6 * sizeof *np);
             if (!np) {
-                rc = fail(err, n, "out of memory");
+                rc = lpv_error(err, n, "out of memory");
                 break;
             }
             r->points = np;
@@ -132,14 +123,14 @@ lpvd_batch_renderer *lpvd_batch_renderer_create(const lpvd_batch_job *job, lpv_b
 {
     lpvd_batch_renderer *r = calloc(1, sizeof *r);
     if (!r) {
-        fail(err, n, "out of memory");
+        lpv_error(err, n, "out of memory");
         return NULL;
     }
     r->job = job;
     r->scene_index = r->scene_time = r->engine_scene = r->engine_lights = -1;
     snprintf(r->out, sizeof r->out, "%s", out_dir);
     if (!realpath(job->dir, r->root)) {
-        fail(err, n, "%s: %s", job->dir, strerror(errno));
+        lpv_error(err, n, "%s: %s", job->dir, strerror(errno));
         goto bad;
     }
     if (job->outputs & LPVD_OUT_POINTS) {
@@ -151,7 +142,7 @@ lpvd_batch_renderer *lpvd_batch_renderer_create(const lpvd_batch_job *job, lpv_b
     r->rgba = malloc(pixels * 4 * sizeof *r->rgba);
     r->rgba8 = malloc(pixels * 4);
     if (!r->rgba || !r->rgba8) {
-        fail(err, n, "out of memory for %dx%d images", job->width, job->height);
+        lpv_error(err, n, "out of memory for %dx%d images", job->width, job->height);
         goto bad;
     }
     lpv_gl_context_desc desc = {.backend = backend};
@@ -238,7 +229,7 @@ static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json
 {
     char path[2 * PATH_MAX], tmp[2 * PATH_MAX + 64];
     if ((size_t)snprintf(path, sizeof path, "%s/%s", r->out, rel) >= sizeof path)
-        return fail(err, n, "%s/%s: path too long", r->out, rel);
+        return lpv_error(err, n, "%s/%s: path too long", r->out, rel);
     char *slash = strrchr(path, '/');
     for (char *p = path + strlen(r->out) + 1; p <= slash; ++p) /* the id's folders */
         if (*p == '/') {
@@ -246,7 +237,7 @@ static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json
             int made = mkdir(path, 0777) == 0 || errno == EEXIST;
             *p = '/';
             if (!made)
-                return fail(err, n, "%s: %s", path, strerror(errno));
+                return lpv_error(err, n, "%s: %s", path, strerror(errno));
         }
     const char *ext = strrchr(slash, '.');
     /* what a process killed while writing this item left (SIGKILL, a lost
@@ -266,7 +257,7 @@ static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json
     if (rename(tmp, path) != 0) {
         int e = errno;
         unlink(tmp);
-        return fail(err, n, "%s: %s", path, strerror(e));
+        return lpv_error(err, n, "%s: %s", path, strerror(e));
     }
     json_array_append_new(outputs, json_pack("{s:s, s:s}", "kind", kind, "path", rel));
     return 0;
@@ -306,7 +297,7 @@ static int w_points(lpvd_batch_renderer *r, const char *path, char *err, size_t 
     int rc = -1;
     FILE *f = NULL;
     if (!pos || !nor || !rgb) {
-        fail(err, n, "out of memory");
+        lpv_error(err, n, "out of memory");
         goto done;
     }
     for (size_t i = 0; i < np; ++i)
@@ -317,13 +308,13 @@ static int w_points(lpvd_batch_renderer *r, const char *path, char *err, size_t 
     if (np && lpv_engine_irradiance(r->engine, pos, nor, np, rgb, err, n) != 0)
         goto done;
     if (!(f = fopen(path, "w"))) {
-        fail(err, n, "%s: %s", path, strerror(errno));
+        lpv_error(err, n, "%s: %s", path, strerror(errno));
         goto done;
     }
     fprintf(f, "# irradiance E (W/m^2) of the indirect light at each point of %s\nE_r,E_g,E_b\n", r->job->points_path);
     for (size_t i = 0; i < np; ++i)
         fprintf(f, "%.9g,%.9g,%.9g\n", (double)rgb[3 * i], (double)rgb[3 * i + 1], (double)rgb[3 * i + 2]);
-    rc = fclose(f) == 0 ? 0 : fail(err, n, "%s: %s", path, strerror(errno));
+    rc = fclose(f) == 0 ? 0 : lpv_error(err, n, "%s: %s", path, strerror(errno));
     f = NULL;
 done:
     if (f)
@@ -341,17 +332,17 @@ static int w_volume_json(lpvd_batch_renderer *r, const char *path, char *err, si
 {
     return json_dump_file(r->vol.body, path, JSON_INDENT(1) | JSON_SORT_KEYS) == 0
                ? 0
-               : fail(err, n, "%s: cannot write", path);
+               : lpv_error(err, n, "%s: cannot write", path);
 }
 
 static int w_volume_bin(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
 {
     FILE *f = fopen(path, "wb");
     if (!f)
-        return fail(err, n, "%s: %s", path, strerror(errno));
+        return lpv_error(err, n, "%s: %s", path, strerror(errno));
     int ok = fwrite(r->vol.att, 1, r->vol.att_len, f) == r->vol.att_len;
     if (fclose(f) != 0 || !ok)
-        return fail(err, n, "%s: cannot write", path);
+        return lpv_error(err, n, "%s: cannot write", path);
     return 0;
 }
 
