@@ -60,7 +60,7 @@ typedef struct lpvd_batch_settings {
 } lpvd_batch_settings;
 
 typedef struct lpvd_batch_item {
-    char id[4 * LPVD_BATCH_NAME_MAX + 32];
+    char id[4 * LPVD_BATCH_NAME_MAX + 64]; /* four names, a time and the slashes */
     int index;          /* in the job's expansion */
     int scene, time, camera, lights, settings; /* indices; time -1 = none; camera into the scene's list */
     double cost;        /* expected cost, arbitrary units (cell-steps + pixels), for sharding */

@@ -181,13 +181,13 @@ static int use_scene(lpvd_batch_renderer *r, const lpvd_batch_item *it, char *er
     lpv_scene_free(&r->scene);
     r->scene_index = r->scene_time = r->engine_scene = -1;
     const lpvd_batch_scene *s = &r->job->scenes[it->scene];
-    if (!s->path)
-        return lpv_scene_load(NULL, &r->scene, err, n);
     char path[PATH_MAX];
-    if (inside(r->root, r->job->dir, s->path, path, err, n) != 0)
+    if (s->path && inside(r->root, r->job->dir, s->path, path, err, n) != 0)
         return -1;
     int rc;
-    if (it->time >= 0) {
+    if (!s->path) {
+        rc = lpv_scene_load(NULL, &r->scene, err, n); /* the built-in Cornell box */
+    } else if (it->time >= 0) {
         lpv_gltf_animation_time at = {.animation = s->animation, .time = s->times[it->time]};
         rc = lpv_scene_load_animated(path, &at, &r->scene, err, n);
     } else {
