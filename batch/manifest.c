@@ -110,7 +110,8 @@ static int find_files(const char *dir, lpv_manifest *m, char *err, size_t err_si
     }
     closedir(d);
     if (rc == 0 && n + merged > 0) {
-        qsort(list, n, sizeof *list, shard_cmp);
+        if (n > 1)
+            qsort(list, n, sizeof *list, shard_cmp);
         m->files = calloc(n + (size_t)merged, sizeof *m->files);
         if (!m->files || (merged && !(m->files[0] = strdup("manifest.jsonl"))))
             rc = -1;
