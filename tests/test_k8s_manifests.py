@@ -9,26 +9,41 @@ Static checks, always:
     NAME` builds (the one place that name is decided);
   - docker/Dockerfile's ENTRYPOINT is the lpvd binary of its own build, and
     the manifests run that binary (and lpvctl from the same build);
-  - each Indexed Job runs `lpvd batch` with LPVD_SHARDS = spec.completions,
-    its failure policy ignores the exit status its SIGTERM wrapper uses, and
+  - each Indexed Job runs `lpvd batch` directly as the image's ENTRYPOINT (no
+    command, no shell around it, so lpvd's exit status is the container's),
+    with LPVD_SHARDS = spec.completions, its job file and --out on claims that
+    the toolbox pod mounts at the same paths; its podFailurePolicy, evaluated
+    as Kubernetes does, ignores exit status 3 (stopped by SIGTERM, resumable)
+    and the DisruptionTarget condition, fails the Job on 2 (bad job file) and
+    counts 1 (an item failed) and 137 against backoffLimitPerIndex (>= 1);
     a GPU Job asks for the NVIDIA graphics capability (EGL);
   - the daemon's workload runs `lpvd serve`, has readiness and liveness
     probes, and its token, port and headless Service agree.
 
-Behaviour, always (needs only /bin/sh): each Job's SIGTERM wrapper, run around
-a fake lpvd, passes exit statuses 0, 1 and 2 through, and on SIGTERM passes
-the signal on, waits for the item in flight and exits 143.
-
-Behaviour, when LPVD_BINARY and LPVCTL_BINARY are set (ctest sets them):
-`lpvd serve` starts with the manifest's own args and the probes' commands
-pass against it, the readiness probe fails with a wrong token while liveness
-holds, and both fail once it has stopped.
+Behaviour, when LPVD_BINARY (and, for the daemon, LPVCTL_BINARY) is set
+(ctest sets both):
+  - each Job's container argv is run with the built lpvd, its mount paths
+    (/scenes, /out) moved to temporary folders, and the environment the
+    manifest sets (LPVD_SHARDS; LP_NUM_THREADS from limits.cpu; a GPU Job's
+    LPVD_GL_BACKEND=egl-device left out, the test having no GPU node) plus
+    JOB_COMPLETION_INDEX = 0 .. completions-1 in turn, on a two-item job:
+    every index exits 0 (most shards are empty), the shards' manifests
+    together hold each item once, and the toolbox's end-of-job command
+    (the same argv + --merge --report, no shard) merges and reports them;
+  - one index of a larger job (4 items per shard) gets SIGTERM as soon as its
+    first manifest line is written: it exits 3, a status the failure policy
+    ignores, with some but not all of its items recorded, and run again it
+    resumes and exits 0 with each of its items recorded once;
+  - `lpvd serve` starts with the manifest's own args and the probes' commands
+    pass against it, the readiness probe fails with a wrong token while
+    liveness holds, and both fail once it has stopped.
 
 Needs PyYAML (Debian: python3-yaml, in scripts/install-deps.sh). Exit 0 when
 every check passes, 1 otherwise (each failure printed).
 """
 import glob
 import json
+import math
 import os
 import re
 import shlex
@@ -184,25 +199,12 @@ def env_value(c, name):
     return None
 
 
-def wrapper_script(c):
-    """The script of `command: [/bin/sh, -c, SCRIPT, NAME]`, else None."""
-    cmd = c.get("command") or []
-    if len(cmd) >= 3 and cmd[0] in ("/bin/sh", "sh", "/bin/bash", "bash") and cmd[1] == "-c":
-        return cmd[2]
-    return None
-
-
 def effective_argv(c, entry):
-    """What the container runs as lpvd's argv: ENTRYPOINT + args, command + args,
-    or a sh -c wrapper's "$@" (its args)."""
+    """What the container runs: ENTRYPOINT + args without a command, else
+    command + args."""
     cmd = c.get("command")
     args = list(c.get("args") or [])
-    if not cmd:
-        return [entry] + args
-    script = wrapper_script(c)
-    if script is not None:
-        return args if '"$@"' in script else None
-    return list(cmd) + args
+    return [entry] + args if not cmd else list(cmd) + args
 
 
 def check_images(docs, name):
@@ -218,12 +220,40 @@ def check_images(docs, name):
                   f"not {name!r} (docker/README.md's docker build -t)")
 
 
+def policy_action(rules, container, exit_code, conditions=()):
+    """The action a Job's podFailurePolicy takes for a failed pod whose
+    container `container` exited with `exit_code` and which has the pod
+    conditions `conditions` (types, status True), as Kubernetes decides it:
+    the first rule that matches, else Count."""
+    for r in rules:
+        on_exit = r.get("onExitCodes")
+        on_cond = r.get("onPodConditions")
+        match = False
+        if on_exit:
+            name = on_exit.get("containerName")
+            values = on_exit.get("values") or []
+            if name is None or name == container:
+                if on_exit.get("operator") == "In":
+                    match = exit_code in values
+                elif on_exit.get("operator") == "NotIn":
+                    match = exit_code != 0 and exit_code not in values
+        elif on_cond:
+            match = any(p.get("type") in conditions and str(p.get("status", "True")) == "True" for p in on_cond)
+        if match:
+            return r.get("action")
+    return "Count"
+
+
 def check_jobs(docs, entry):
+    """The static checks of each Indexed Job; returns [(where, job, container,
+    argv)] of the Jobs running `lpvd batch`, for check_batch_live."""
     jobs = [(w, d) for w, d in docs if d.get("kind") == "Job"]
     indexed = [(w, d) for w, d in jobs if (d.get("spec") or {}).get("completionMode") == "Indexed"]
     check(indexed, "docker/k8s: no Indexed Job (completionMode: Indexed)")
-    scripts = {}
+    toolbox = [(w, d) for w, d in docs if d.get("kind") == "Pod"]
+    check(toolbox, "docker/k8s: no Pod (the toolbox of docs/deploy.md)")
     policies = {}
+    found = []
     for where, d in indexed:
         spec = d["spec"]
         tmpl = pod_spec(d)
@@ -234,95 +264,249 @@ def check_jobs(docs, entry):
               f"{where}: parallelism {par!r} outside 1..completions")
         check(tmpl.get("restartPolicy") == "Never",
               f"{where}: restartPolicy must be Never (backoffLimitPerIndex, podFailurePolicy)")
+        check(spec.get("podReplacementPolicy") == "Failed",
+              f"{where}: podReplacementPolicy must be Failed: two pods of one index would append to one manifest")
         grace = tmpl.get("terminationGracePeriodSeconds")
         check(isinstance(grace, int) and grace >= 60,
               f"{where}: terminationGracePeriodSeconds {grace!r}: must let the item in flight finish (>= 60)")
         batch = []
         for c in tmpl.get("containers") or []:
             argv = effective_argv(c, entry)
-            if argv and len(argv) >= 2 and argv[1] == "batch":
+            if "batch" in argv:
                 batch.append((c, argv))
         if not check(len(batch) == 1, f"{where}: expected one container running `lpvd batch`, found {len(batch)}"):
             continue
         c, argv = batch[0]
-        check(argv[0] == entry, f"{where}: runs {argv[0]}, not the image's lpvd ({entry})")
+        # lpvd itself, not a shell around it: its exit status (3 on SIGTERM
+        # with items left) is then the container's, and SIGTERM reaches it
+        check(not c.get("command") or list(c["command"]) == [entry],
+              f"{where}: container {c.get('name')} has command {c.get('command')}: run the image's ENTRYPOINT "
+              f"({entry}) directly, so that lpvd's exit status is the container's")
+        if not check(argv[0] == entry and argv[1:2] == ["batch"],
+                     f"{where}: runs {argv[:2]}, not the image's lpvd ({entry}) with `batch`"):
+            continue
         shards = env_value(c, "LPVD_SHARDS")
         check(shards is not None and str(shards) == str(completions),
               f"{where}: LPVD_SHARDS {shards!r} != spec.completions {completions!r}")
         check("--shard" not in argv, f"{where}: --shard on the command line overrides JOB_COMPLETION_INDEX")
-        check("--out" in argv, f"{where}: lpvd batch without --out")
+        if not check("--out" in argv[:-1], f"{where}: lpvd batch without --out DIR"):
+            continue
+        positional = [a for i, a in enumerate(argv[2:], 2) if not a.startswith("-") and argv[i - 1] != "--out"]
+        if not check(len(positional) == 1, f"{where}: expected one job file after `batch`, got {positional}"):
+            continue
+        # the job file and --out on the claims, and the toolbox pod (where
+        # docs/deploy.md runs --list, --merge and --report) sees them at the
+        # same paths
+        claims = {v.get("name"): (v.get("persistentVolumeClaim") or {}).get("claimName") for v in tmpl.get("volumes") or []}
+        mounts = c.get("volumeMounts") or []
+
+        def mount_of(path, ms):
+            ms = [m for m in ms if path.startswith(m.get("mountPath", "").rstrip("/") + "/")]
+            return max(ms, key=lambda m: len(m["mountPath"])) if ms else None
+
+        for what, path, writable in (("the job file", positional[0], False),
+                                     ("--out", argv[argv.index("--out") + 1], True)):
+            m = mount_of(path, mounts)
+            if not check(m and claims.get(m.get("name")), f"{where}: {what} {path} is not on a mounted claim"):
+                continue
+            if writable:
+                check(not m.get("readOnly"), f"{where}: --out {path} is on a read-only mount")
+            for twhere, td in toolbox:
+                ts = pod_spec(td)
+                tclaims = {v.get("name"): (v.get("persistentVolumeClaim") or {}).get("claimName")
+                           for v in ts.get("volumes") or []}
+                tm = [mount_of(path, tc.get("volumeMounts") or []) for tc in ts.get("containers") or []]
+                check(any(x and x["mountPath"] == m["mountPath"] and tclaims.get(x.get("name")) == claims[m["name"]]
+                          for x in tm),
+                      f"{twhere}: does not mount claim {claims[m['name']]} at {m['mountPath']} as {where} does "
+                      f"(docs/deploy.md reaches {path} there)")
+        # the failure policy, evaluated as Kubernetes does
         rules = (spec.get("podFailurePolicy") or {}).get("rules") or []
+        name = c.get("name")
         for r in rules:
             cn = (r.get("onExitCodes") or {}).get("containerName")
-            check(cn is None or cn == c.get("name"),
-                  f"{where}: podFailurePolicy names container {cn!r}, the batch container is {c.get('name')!r}")
-        script = wrapper_script(c)
-        if script is not None:
-            scripts[where] = script
-            for code in sorted(set(re.findall(r"\bexit (\d+)\b", script))):
-                ignored = any(r.get("action") == "Ignore" and int(code) in ((r.get("onExitCodes") or {}).get("values") or [])
-                              for r in rules)
-                check(ignored, f"{where}: the wrapper exits {code} on SIGTERM but podFailurePolicy does not Ignore it")
+            check(cn is None or cn == name,
+                  f"{where}: podFailurePolicy names container {cn!r}, the batch container is {name!r}")
+        want = [(3, (), "Ignore", "3 (stopped by SIGTERM with items left: the index runs again and resumes)"),
+                (2, (), "FailJob", "2 (a bad command line or job file: every retry fails the same way)"),
+                (1, (), "Count", "1 (an item failed: counted against backoffLimitPerIndex, the index retried)"),
+                (137, (), "Count", "137 (killed: out of memory, or past the grace period)")]
+        want += [(code, ("DisruptionTarget",), "Ignore", f"{code} with condition DisruptionTarget (pre-empted, evicted)")
+                 for code in (1, 3, 137, 143)]
+        for code, conds, action, what in want:
+            got = policy_action(rules, name, code, conds)
+            check(got == action, f"{where}: podFailurePolicy takes {got} for exit status {what}, not {action}")
+        limit = spec.get("backoffLimitPerIndex")
+        check(isinstance(limit, int) and limit >= 1,
+              f"{where}: backoffLimitPerIndex {limit!r}: an index whose items failed (exit 1) must be retried")
         policies[where] = rules
         limits = (c.get("resources") or {}).get("limits") or {}
         if "nvidia.com/gpu" in limits:
             caps = env_value(c, "NVIDIA_DRIVER_CAPABILITIES") or ""
             check("graphics" in caps.split(",") or caps == "all",
                   f"{where}: a GPU Job without graphics in NVIDIA_DRIVER_CAPABILITIES gets no NVIDIA EGL")
-        check_wrapper(where, c, argv)
-    check(len(set(scripts.values())) <= 1, f"the Jobs' SIGTERM wrappers differ: {sorted(scripts)}")
+        found.append((where, d, c, argv))
     check(len({json.dumps(p, sort_keys=True) for p in policies.values()}) <= 1,
           f"the Jobs' podFailurePolicy rules differ: {sorted(policies)}")
+    return found
 
 
-FAKE_LPVD = """#!/bin/sh
-# a fake `lpvd batch`: items of 0.1 s; on SIGTERM it finishes the item in
-# flight and exits 0, as the real one does when nothing failed
-echo "argv $*" >> "$FAKE_LOG"
-trap 'echo term >> "$FAKE_LOG"; sleep 0.3; echo item-finished >> "$FAKE_LOG"; exit 0' TERM
-i=0
-while [ "$i" -lt "$FAKE_ITEMS" ]; do sleep 0.1; i=$((i + 1)); done
-exit "$FAKE_RC"
-"""
+# --- lpvd batch, live ---------------------------------------------------------
+
+SMALL_JOB = {"lpvd_batch": 1, "size": [32, 32],
+             "settings": [{"name": "a", "preset": "fast"}, {"name": "b", "preset": "fast", "iterations": 2}]}
 
 
-def check_wrapper(where, c, argv):
-    """Runs the container's command around a fake lpvd (no Kubernetes needed)."""
-    if wrapper_script(c) is None:
-        return
-    with tempfile.TemporaryDirectory() as tmp:
-        fake = os.path.join(tmp, "lpvd")
-        with open(fake, "w") as f:
-            f.write(FAKE_LPVD)
-        os.chmod(fake, 0o755)
-        log = os.path.join(tmp, "log")
-        cmd = list(c["command"]) + [fake] + argv[1:]
-        env = dict(os.environ, FAKE_LOG=log, FAKE_ITEMS="2")
-        for rc in (0, 1, 2):
-            env["FAKE_RC"] = str(rc)
-            got = subprocess.run(cmd, env=env, timeout=30).returncode
-            check(got == rc, f"{where}: the wrapper turned lpvd's exit status {rc} into {got}")
-        with open(log) as f:
-            check(f.readline().strip() == "argv " + " ".join(argv[1:]),
-                  f"{where}: the wrapper did not pass lpvd its arguments")
-        os.unlink(log)
-        env.update(FAKE_ITEMS="300", FAKE_RC="0")
-        p = subprocess.Popen(cmd, env=env)
-        deadline = time.time() + 10
-        while not (os.path.exists(log) and open(log).read()) and time.time() < deadline:
-            time.sleep(0.05)
-        time.sleep(0.2)  # let the wrapper reach its wait
-        p.send_signal(signal.SIGTERM)
-        try:
-            got = p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            got = None
-        with open(log) as f:
-            lines = f.read().split()
-        check(got == 143, f"{where}: on SIGTERM the wrapper exited {got}, not 143 (a 0 would complete the index)")
-        check("term" in lines, f"{where}: the wrapper did not pass SIGTERM on to lpvd")
-        check("item-finished" in lines, f"{where}: the wrapper exited before lpvd finished its item")
+class Pod:
+    """A Job's batch container run here: its argv with the mounts' paths
+    rewritten to folders of `tmp`, the ENTRYPOINT replaced by the built lpvd,
+    and the environment the manifest sets (plus what Kubernetes adds)."""
+
+    def __init__(self, where, job, c, argv, lpvd, tmp):
+        self.where = where
+        self.lpvd = lpvd
+        self.shards = job["spec"]["completions"]
+        roots = {m["mountPath"].rstrip("/"): os.path.join(tmp, m["name"]) for m in c.get("volumeMounts") or []}
+        for r in roots.values():
+            os.makedirs(r, exist_ok=True)
+
+        def local(a):
+            for mp in sorted(roots, key=len, reverse=True):
+                if a == mp or a.startswith(mp + "/"):
+                    return roots[mp] + a[len(mp):]
+            return a
+
+        self.args = [local(a) for a in argv[1:]]
+        self.out = self.args[self.args.index("--out") + 1]
+        self.job_file = [a for i, a in enumerate(self.args[1:], 1)
+                         if not a.startswith("-") and self.args[i - 1] != "--out"][0]
+        # the environment: this process's, less what would pick the shard or
+        # the backend, then the manifest's env
+        self.base = {k: v for k, v in os.environ.items()
+                     if k not in ("JOB_COMPLETION_INDEX", "LPVD_SHARDS", "LPVD_GL_BACKEND")}
+        self.env = dict(self.base)
+        gpu = "nvidia.com/gpu" in ((c.get("resources") or {}).get("limits") or {})
+        for e in c.get("env") or []:
+            if gpu and e.get("name") == "LPVD_GL_BACKEND":
+                continue  # egl-device needs the GPU node; the shards and statuses are the same on llvmpipe
+            if "value" in e:
+                self.env[e["name"]] = str(e["value"])
+            ref = (e.get("valueFrom") or {}).get("resourceFieldRef") or {}
+            if ref.get("resource") == "limits.cpu":  # whole CPUs, rounded up (divisor 1)
+                cpu = str(((c.get("resources") or {}).get("limits") or {}).get("cpu", "1"))
+                self.env[e["name"]] = str(math.ceil(int(cpu[:-1]) / 1000 if cpu.endswith("m") else float(cpu)))
+
+    def write_job(self, job):
+        os.makedirs(os.path.dirname(self.job_file), exist_ok=True)
+        with open(self.job_file, "w") as f:
+            json.dump(job, f)
+
+    def index_env(self, i):
+        return dict(self.env, JOB_COMPLETION_INDEX=str(i))
+
+    def run(self, i, extra=(), env=None):
+        r = subprocess.run([self.lpvd] + self.args + list(extra), env=env or self.index_env(i),
+                           capture_output=True, text=True, timeout=120)
+        return r.returncode, (r.stdout + r.stderr).strip()
+
+    def ids(self, env):
+        """The items `--list` prints for `env`: [id]."""
+        r = subprocess.run([self.lpvd, "batch", self.job_file, "--list"], env=env,
+                           capture_output=True, text=True, timeout=60)
+        check(r.returncode == 0, f"{self.where}: lpvd batch --list exited {r.returncode}: {r.stderr.strip()}")
+        return [line.split("\t")[1] for line in r.stdout.splitlines() if line.count("\t") == 2]
+
+    def manifest(self, i):
+        return os.path.join(self.out, f"manifest-{i}-of-{self.shards}.jsonl")
+
+    def lines(self, paths):
+        out = []
+        for p in paths:
+            if os.path.exists(p):
+                with open(p) as f:
+                    out += [json.loads(line) for line in f if line.strip()]
+        return out
+
+
+def check_batch_live(found, lpvd):
+    for where, job, c, argv in found:
+        rules = (job["spec"].get("podFailurePolicy") or {}).get("rules") or []
+        # every index of the Job, one after the other, on a two-item job:
+        # with more shards than items most shards are empty, and exit 0 too
+        with tempfile.TemporaryDirectory() as tmp:
+            pod = Pod(where, job, c, argv, lpvd, tmp)
+            pod.write_job(SMALL_JOB)
+            items = pod.ids(pod.base)
+            check(len(items) == 2, f"{where}: the two-item job lists {items}")
+            for i in range(pod.shards):
+                rc, log = pod.run(i)
+                check(rc == 0, f"{where}: index {i} of {pod.shards} exited {rc}, not 0: {log[-2000:]}")
+            names = sorted(os.path.basename(p) for p in glob.glob(os.path.join(pod.out, "manifest*.jsonl")))
+            check(names == sorted(os.path.basename(pod.manifest(i)) for i in range(pod.shards)),
+                  f"{where}: the indexes wrote {names}, not manifest-I-of-{pod.shards}.jsonl for I = 0..{pod.shards - 1}")
+            lines = pod.lines(glob.glob(os.path.join(pod.out, "manifest*.jsonl")))
+            got = sorted(e.get("id") for e in lines)
+            check(got == sorted(items), f"{where}: the shards' manifests hold {got}, not each of {items} once")
+            check(all(e.get("status") == "ok" for e in lines), f"{where}: an item failed: {lines}")
+            for e in lines:
+                for o in e.get("outputs") or []:
+                    check(os.path.isfile(os.path.join(pod.out, o.get("path", ""))),
+                          f"{where}: {e.get('id')}: output {o.get('path')} missing")
+            # the end of the job, as docs/deploy.md runs it in the toolbox pod
+            rc, log = pod.run(0, ["--merge", "--report"], env=pod.base)
+            check(rc == 0, f"{where}: --merge --report exited {rc}: {log[-2000:]}")
+            merged = pod.lines([os.path.join(pod.out, "manifest.jsonl")])
+            check(sorted(e.get("id") for e in merged) == sorted(items),
+                  f"{where}: --merge wrote {[e.get('id') for e in merged]}, not {items}")
+            for f in ("report.html", "contact.png"):
+                check(os.path.isfile(os.path.join(pod.out, f)), f"{where}: --report wrote no {f}")
+        # SIGTERM to one index of a larger job once its first item is
+        # recorded: the item in flight finishes, exit 3, which the failure
+        # policy ignores; the index run again resumes and exits 0
+        with tempfile.TemporaryDirectory() as tmp:
+            pod = Pod(where, job, c, argv, lpvd, tmp)
+            pod.write_job({"lpvd_batch": 1, "size": [32, 32],
+                           "cameras": [{"name": "o", "orbit": {"views": 4 * pod.shards}}],
+                           "settings": [{"name": "fast", "preset": "fast"}]})
+            per = [pod.ids(pod.index_env(i)) for i in range(pod.shards)]
+            i = max(range(pod.shards), key=lambda k: len(per[k]))
+            mine = per[i]
+            if not check(len(mine) >= 3, f"{where}: the SIGTERM test needs an index with 3 items or more: {per}"):
+                continue
+            log = open(os.path.join(tmp, "stderr"), "w+")
+            p = subprocess.Popen([lpvd] + pod.args, env=pod.index_env(i), stderr=log)
+            deadline = time.time() + 60
+            first = False
+            while p.poll() is None and time.time() < deadline and not first:
+                if os.path.exists(pod.manifest(i)):
+                    with open(pod.manifest(i)) as f:
+                        first = f.read().endswith("\n")
+                time.sleep(0.01)
+            p.send_signal(signal.SIGTERM)
+            try:
+                rc = p.wait(timeout=120)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                rc = p.wait()
+            log.seek(0)
+            text = log.read().strip()
+            log.close()
+            done = [e.get("id") for e in pod.lines([pod.manifest(i)])]
+            check(first, f"{where}: index {i}: no manifest line before SIGTERM: {text[-2000:]}")
+            check(rc == 3, f"{where}: index {i}: exited {rc} on SIGTERM with items left, not 3: {text[-2000:]}")
+            check(policy_action(rules, c.get("name"), rc) == "Ignore",
+                  f"{where}: podFailurePolicy does not ignore {rc}, the status lpvd batch exits with on SIGTERM")
+            check(1 <= len(done) < len(mine), f"{where}: index {i}: {len(done)} of {len(mine)} items recorded "
+                                              f"after SIGTERM; expected some, not all")
+            rc, text = pod.run(i)
+            check(rc == 0, f"{where}: index {i} run again after SIGTERM exited {rc}, not 0: {text[-2000:]}")
+            lines = pod.lines([pod.manifest(i)])
+            got = sorted(e.get("id") for e in lines)
+            check(got == sorted(mine), f"{where}: index {i} after resuming holds {got}, not each of {mine} once")
+            check(all(e.get("status") == "ok" for e in lines), f"{where}: index {i}: an item failed: {lines}")
+            print(f"test_k8s_manifests: {where}: {pod.shards} indexes of a 2-item job; index {i} of a "
+                  f"{4 * pod.shards}-item job: SIGTERM after its first item, {len(done)} of {len(mine)} items "
+                  f"recorded, exit 3; run again: exit {rc}, {len(got)} items")
 
 
 def check_serve(docs, entry, lpvctl):
@@ -482,11 +666,16 @@ def main():
     if name:
         check_images(docs, name)
     serve = []
+    batch = []
     if entry:
-        check_jobs(docs, entry)
+        batch = check_jobs(docs, entry)
         serve = check_serve(docs, entry, lpvctl)
     lpvd_bin = os.environ.get("LPVD_BINARY")
     lpvctl_bin = os.environ.get("LPVCTL_BINARY")
+    if lpvd_bin and os.path.exists(lpvd_bin):
+        check_batch_live(batch, lpvd_bin)
+    elif batch:
+        print("test_k8s_manifests: LPVD_BINARY not set: the Jobs' lpvd batch was not run")
     if serve and lpvd_bin and lpvctl_bin and os.path.exists(lpvd_bin) and os.path.exists(lpvctl_bin):
         check_serve_live(serve, build_dir, lpvd_bin, lpvctl_bin)
     elif serve:
