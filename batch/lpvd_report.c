@@ -11,7 +11,7 @@ int main(int argc, char **argv)
         FILE *f = argc == 2 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0) ? stdout : stderr;
         fprintf(f, "usage: lpvd-report DIR\n"
                    "Writes DIR/report.html, DIR/contact.png and DIR/thumbs/ from the manifests of the\n"
-                   "batch job in DIR (DIR/manifest.jsonl, else every DIR/manifest-I-of-N.jsonl).\n");
+                   "batch job in DIR (DIR/manifest.jsonl, then every DIR/manifest-I-of-N.jsonl).\n");
         return f == stdout ? 0 : 2;
     }
     char err[1024] = "";

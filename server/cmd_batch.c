@@ -188,6 +188,14 @@ static int do_list(const lpvd_batch_job *job, int shard, int shards, int shard_g
 
 int lpvd_cmd_batch(int argc, char **argv)
 {
+    /* first of all: in a container lpvd is PID 1, and the kernel drops a
+     * SIGTERM sent to a PID 1 that has no handler, so one arriving while the
+     * job file is read would be lost */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGINT, &sa, NULL);
     lpvd_options opt = {0};
     const char *job_path = NULL, *out = NULL, *shard_flag = NULL, *progress_mode = "auto";
     int list = 0, merge = 0, report = 0;
@@ -305,11 +313,6 @@ int lpvd_cmd_batch(int argc, char **argv)
     json_decref(by_id);
     fprintf(stderr, "lpvd batch: %s: %d items, shard %d/%d has %d, %d already done\n", job_path, job.item_count,
             shard, shards, count, pr.skipped);
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigaction(SIGTERM, &sa, NULL);
-    sigaction(SIGINT, &sa, NULL);
     if (pr.skipped < count) {
         r = lpvd_batch_renderer_create(&job, opt.backend, out, err, sizeof err);
         if (!r) {
