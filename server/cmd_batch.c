@@ -43,18 +43,19 @@ static const lpv_flag BATCH_FLAGS[B_COUNT] = {
     [B_HELP] = {"help", 'h', NULL, "this text"},
 };
 
-static void usage(FILE *f)
+static void usage(FILE *f, const lpv_flag_group *backend)
 {
-    char help[4096];
-    size_t len = 0;
+    char help[4096], gl[1024];
+    size_t len = 0, glen = 0;
     lpv_flags_help(help, sizeof help, &len, BATCH_FLAGS, B_COUNT);
+    lpv_flags_help(gl, sizeof gl, &glen, backend->flags, backend->count); /* options.c's table */
     fprintf(f,
             "usage: lpvd batch JOB.json --out DIR [flags]\n"
             "Renders every item of a job file (docs/batch.md); re-running resumes.\n"
             "Exit status: 0 every item of the shard done, 1 an item failed, 2 a bad command line\n"
             "or job file, 3 stopped by a signal before the shard was done (run again to resume).\n%s"
-            "GL backend (docs/gl-backends.md):\n  --backend NAME          auto (default), egl-device, egl-surfaceless, osmesa\n",
-            help);
+            "GL:\n%s",
+            help, gl);
 }
 
 /* The shard from the command line, else the Indexed Job's environment. */
@@ -226,7 +227,7 @@ int lpvd_cmd_batch(int argc, char **argv)
             continue;
         }
         switch (fl - BATCH_FLAGS) {
-        case B_HELP: usage(stdout); return 0;
+        case B_HELP: usage(stdout, &groups[1]); return 0;
         case B_OUT: out = v; break;
         case B_SHARD: shard_flag = v; break;
         case B_LIST: list = 1; break;
