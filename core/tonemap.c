@@ -128,3 +128,13 @@ float lpv_display_rgba8(const float *rgba, size_t n, const lpv_display *d, uint8
     }
     return ev;
 }
+
+void lpv_fraction_gray8(const float *rgba, size_t n, uint8_t *out)
+{
+    for (size_t i = 0; i < n; ++i) {
+        float v = rgba[4 * i];
+        uint8_t b = (uint8_t)lrintf(255.0f * (v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f));
+        out[4 * i] = out[4 * i + 1] = out[4 * i + 2] = b;
+        out[4 * i + 3] = 255;
+    }
+}

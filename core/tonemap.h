@@ -51,6 +51,12 @@ float lpv_exposure_meter_ev(const float *rgba, size_t n);
  * Non-finite values become 0. Returns the EV used. */
 float lpv_display_rgba8(const float *rgba, size_t n, const lpv_display *d, uint8_t *out);
 
+/* A fraction (the ambient occlusion, 1 = open) as a grey picture: each
+ * channel 255 x the pixel's red value clamped to 0..1 (NaN: 0), alpha 255; no
+ * exposure, tone or sRGB curve (it is not light). What `lpvd render --ao` and
+ * lpvd batch's ao output write. */
+void lpv_fraction_gray8(const float *rgba, size_t n, uint8_t *out);
+
 /* Lower level, for tools comparing images at one explicit linear factor:
  * scale by `factor` (no 683), Reinhard, sRGB; alpha copied, clamped to 0..1. */
 void lpv_tonemap_rgba8(const float *rgba, size_t n, float factor, uint8_t *out);

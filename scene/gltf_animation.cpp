@@ -17,6 +17,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <glm/gtc/quaternion.hpp>
+
 namespace lpv_gltf {
 
 namespace {
@@ -59,24 +61,17 @@ void normalize4(double q[4])
             q[i] /= l;
 }
 
-/* Spherical interpolation of unit quaternions a -> b along the shortest arc. */
-void slerp(const double a[4], const double b_in[4], double u, double out[4])
+/* Spherical interpolation of unit quaternions a -> b (glTF order x, y, z, w)
+ * along the shortest arc: GLM's slerp (q and -q are the same rotation; nearly
+ * equal keys fall back to a linear blend), renormalised. */
+void slerp(const double a[4], const double b[4], double u, double out[4])
 {
-    double b[4], d = 0.0;
-    for (int i = 0; i < 4; i++)
-        d += a[i] * b_in[i];
-    const double sign = d < 0.0 ? -1.0 : 1.0; /* q and -q are the same rotation: take the nearer */
-    for (int i = 0; i < 4; i++)
-        b[i] = sign * b_in[i];
-    d = std::min(std::fabs(d), 1.0);
-    double wa = 1.0 - u, wb = u;
-    if (d < 0.9995) { /* else nearly equal: a normalised lerp is exact enough and stable */
-        const double th = std::acos(d), s = std::sin(th);
-        wa = std::sin((1.0 - u) * th) / s;
-        wb = std::sin(u * th) / s;
-    }
-    for (int i = 0; i < 4; i++)
-        out[i] = wa * a[i] + wb * b[i];
+    const glm::dquat qa(a[3], a[0], a[1], a[2]), qb(b[3], b[0], b[1], b[2]); /* w first */
+    const glm::dquat q = glm::slerp(qa, qb, u);
+    out[0] = q.x;
+    out[1] = q.y;
+    out[2] = q.z;
+    out[3] = q.w;
     normalize4(out);
 }
 

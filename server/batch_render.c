@@ -15,6 +15,7 @@
 #include "engine.h"
 #include "error.h"
 #include "image_io.h"
+#include "points_csv.h"
 
 #include "scene_load.h"
 #include "serve.h"
@@ -37,7 +38,7 @@ struct lpvd_batch_renderer {
     lpv_scene scene; /* the loaded one */
     int scene_index, scene_time; /* which (-1: none) */
     int engine_scene, engine_lights; /* what the engine was last given (-1: nothing) */
-    float *points;   /* LPVD_OUT_POINTS: 6 floats each */
+    float *points, *normals; /* LPVD_OUT_POINTS: 3 floats each */
     size_t point_count;
     float *rgba;
     uint8_t *rgba8;
@@ -78,44 +79,24 @@ static int inside(const char *root, const char *dir, const char *rel, char out[P
     return 0;
 }
 
-/* The points file: px,py,pz,nx,ny,nz per line ('#' lines and blank lines skipped). */
+/* The points file (core/points_csv.h), read once for every item; values
+ * must be finite and within LPV_MAX_COORD. */
 static int load_points(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
 {
     FILE *f = fopen(path, "r");
     if (!f)
         return lpv_error(err, n, "points %s: %s", r->job->points_path, strerror(errno));
-    char line[1024];
-    size_t cap = 0, lineno = 0;
-    int rc = 0;
-    while (rc == 0 && fgets(line, sizeof line, f)) {
-        ++lineno;
-        if (line[0] == '#' || line[strspn(line, " \t\r\n")] == '\0')
-            continue;
-        float v[6];
-        if (sscanf(line, "%f,%f,%f,%f,%f,%f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) != 6) {
-            rc = lpv_error(err, n, "points %s:%zu: expected px,py,pz,nx,ny,nz", r->job->points_path, lineno);
-            break;
-        }
-        for (int i = 0; i < 6; ++i)
-            if (!isfinite(v[i]) || fabsf(v[i]) > LPV_MAX_COORD)
-                rc = lpv_error(err, n, "points %s:%zu: values must be finite, within 1e9", r->job->points_path, lineno);
-        if (r->point_count == cap) {
-            cap = cap ? 2 * cap : 1024;
-            if (cap > (size_t)1 << 24) {
-                rc = lpv_error(err, n, "points %s: more than 16777216 points", r->job->points_path);
-                break;
-            }
-            float *np = realloc(r->points, cap * 6 * sizeof *np);
-            if (!np) {
-                rc = lpv_error(err, n, "out of memory");
-                break;
-            }
-            r->points = np;
-        }
-        memcpy(&r->points[6 * r->point_count++], v, sizeof v);
-    }
+    long got = lpv_points_csv_read(f, r->job->points_path, &r->points, &r->normals, err, n);
     fclose(f);
-    return rc;
+    if (got < 0)
+        return -1;
+    r->point_count = (size_t)got;
+    for (size_t i = 0; i < 3 * r->point_count; ++i)
+        if (!isfinite(r->points[i]) || fabsf(r->points[i]) > LPV_MAX_COORD || !isfinite(r->normals[i]) ||
+            fabsf(r->normals[i]) > LPV_MAX_COORD)
+            return lpv_error(err, n, "points %s: point %zu: values must be finite, within 1e9", r->job->points_path,
+                             i / 3 + 1);
+    return 0;
 }
 
 lpvd_batch_renderer *lpvd_batch_renderer_create(const lpvd_batch_job *job, lpv_backend backend, const char *out_dir,
@@ -168,6 +149,7 @@ void lpvd_batch_renderer_destroy(lpvd_batch_renderer *r)
     lpv_gl_context_destroy(r->ctx);
     lpv_scene_free(&r->scene);
     free(r->points);
+    free(r->normals);
     free(r->rgba);
     free(r->rgba8);
     free(r);
@@ -280,32 +262,21 @@ static int w_ao(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
     if (lpv_engine_render(r->engine, LPV_TERMS_AO, r->rgba, err, n) != 0)
         return -1;
     size_t pixels = (size_t)r->job->width * (size_t)r->job->height;
-    for (size_t i = 0; i < pixels; ++i) { /* linear grey, 1 = open (as lpvd render --ao) */
-        float v = r->rgba[4 * i];
-        uint8_t b = (uint8_t)lrintf(255.0f * (v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f));
-        r->rgba8[4 * i] = r->rgba8[4 * i + 1] = r->rgba8[4 * i + 2] = b;
-        r->rgba8[4 * i + 3] = 255;
-    }
+    lpv_fraction_gray8(r->rgba, pixels, r->rgba8); /* as lpvd render --ao */
     return lpv_image_write_u8(path, r->job->width, r->job->height, 4, r->rgba8, err, n);
 }
 
 static int w_points(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
 {
     size_t np = r->point_count;
-    float *pos = malloc((np ? np : 1) * 3 * sizeof *pos), *nor = malloc((np ? np : 1) * 3 * sizeof *nor);
     float *rgb = malloc((np ? np : 1) * 3 * sizeof *rgb);
     int rc = -1;
     FILE *f = NULL;
-    if (!pos || !nor || !rgb) {
+    if (!rgb) {
         lpv_error(err, n, "out of memory");
         goto done;
     }
-    for (size_t i = 0; i < np; ++i)
-        for (int k = 0; k < 3; ++k) {
-            pos[3 * i + k] = r->points[6 * i + k];
-            nor[3 * i + k] = r->points[6 * i + 3 + k];
-        }
-    if (np && lpv_engine_irradiance(r->engine, pos, nor, np, rgb, err, n) != 0)
+    if (np && lpv_engine_irradiance(r->engine, r->points, r->normals, np, rgb, err, n) != 0)
         goto done;
     if (!(f = fopen(path, "w"))) {
         lpv_error(err, n, "%s: %s", path, strerror(errno));
@@ -319,8 +290,6 @@ static int w_points(lpvd_batch_renderer *r, const char *path, char *err, size_t 
 done:
     if (f)
         fclose(f);
-    free(pos);
-    free(nor);
     free(rgb);
     return rc;
 }

@@ -62,12 +62,7 @@ static int write_ao(lpv_engine *engine, const char *path, float *rgba, int w, in
     uint8_t *g = malloc(pixels * 4);
     if (!g)
         return snprintf(err, err_size, "out of memory for the ao image"), -1;
-    for (size_t i = 0; i < pixels; ++i) {
-        float v = rgba[4 * i];
-        uint8_t b = (uint8_t)lrintf(255.0f * (v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f));
-        g[4 * i] = g[4 * i + 1] = g[4 * i + 2] = b;
-        g[4 * i + 3] = 255;
-    }
+    lpv_fraction_gray8(rgba, pixels, g);
     int rc = lpv_image_write_u8(path, w, h, 4, g, err, err_size);
     free(g);
     if (rc == 0)

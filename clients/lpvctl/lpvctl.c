@@ -21,6 +21,7 @@
 #include <jansson.h>
 
 #include "lpvc.h"
+#include "points_csv.h"
 
 #define MAX_ARGS 64
 
@@ -739,21 +740,6 @@ static int cmd_frame(int argc, char **argv)
     return rc;
 }
 
-/* Splits a CSV line into up to n numbers; returns how many were numbers. */
-static int csv_numbers(char *line, float *out, int n)
-{
-    int k = 0;
-    char *save = NULL;
-    for (char *tok = strtok_r(line, ",; \t\r\n", &save); tok && k < n; tok = strtok_r(NULL, ",; \t\r\n", &save)) {
-        char *end;
-        double v = strtod(tok, &end);
-        if (end == tok || *end != '\0')
-            return -1;
-        out[k++] = (float)v;
-    }
-    return k;
-}
-
 static int cmd_query(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL;
@@ -798,43 +784,13 @@ static int cmd_query(int argc, char **argv)
         fprintf(stderr, "lpvctl: query: cannot read %s: %s\n", in, strerror(errno));
         return 1;
     }
-    size_t n = 0, cap = 256;
-    float *pts = malloc(cap * 3 * sizeof(float)), *nrm = malloc(cap * 3 * sizeof(float));
-    char line[4096];
-    size_t lineno = 0;
-    int rc = 0;
-    while (pts && nrm && fgets(line, sizeof line, f)) {
-        lineno++;
-        char copy[4096];
-        snprintf(copy, sizeof copy, "%s", line);
-        float v[6];
-        int k = csv_numbers(copy, v, 6);
-        if (k == 0)
-            continue; /* blank line */
-        if (k < 0 && n == 0 && lineno == 1)
-            continue; /* header */
-        if (k != 6) {
-            fprintf(stderr, "lpvctl: query: %s:%zu: expected 6 numbers px,py,pz,nx,ny,nz\n", in, lineno);
-            rc = 2;
-            break;
-        }
-        if (n == cap) {
-            cap *= 2;
-            float *p2 = realloc(pts, cap * 3 * sizeof(float));
-            if (p2)
-                pts = p2;
-            float *n2 = realloc(nrm, cap * 3 * sizeof(float));
-            if (n2)
-                nrm = n2;
-            if (!p2 || !n2) {
-                rc = 1;
-                break;
-            }
-        }
-        memcpy(pts + 3 * n, v, 3 * sizeof(float));
-        memcpy(nrm + 3 * n, v + 3, 3 * sizeof(float));
-        n++;
-    }
+    float *pts = NULL, *nrm = NULL;
+    char why[512];
+    long got = lpv_points_csv_read(f, in, &pts, &nrm, why, sizeof why);
+    size_t n = got > 0 ? (size_t)got : 0;
+    int rc = got >= 0 ? 0 : got == LPV_POINTS_BAD_LINE ? 2 : 1;
+    if (rc != 0)
+        fprintf(stderr, "lpvctl: query: %s\n", why);
     if (f != stdin)
         fclose(f);
     float *rgb = rc == 0 && pts && nrm ? malloc((n ? n : 1) * 3 * sizeof(float)) : NULL;
