@@ -388,7 +388,7 @@ def case_features(lpvd, source, tmp):
     with open(os.path.join(tmp, "pts.csv"), "w") as f:
         f.write("# px,py,pz,nx,ny,nz\n0,0.01,2,0,1,0\n2,0.01,-2,0,1,0\n0.5,0.5,0.51,0,0,1\n")
     job = {"lpvd_batch": 1, "size": [64, 64],
-           "scenes": [{"path": "anim.gltf", "animation": "slide", "times": [0, 0.75, 2]}, {"path": "posed.gltf"}],
+           "scenes": [{"path": "anim.gltf", "animation": "slide", "times": [0, 0.75, 1, 2]}, {"path": "posed.gltf"}],
            "lights": [{"name": "file"},
                       {"name": "blue", "lights": [{"id": "b", "type": "point", "intensity": 500.0,
                                                    "color": [0.2, 0.4, 1.0], "position": [-1, 3, 2]}]}],
@@ -406,10 +406,12 @@ def case_features(lpvd, source, tmp):
     check(h("anim@0.75/default/file/iv.png") == h("posed/default/file/iv.png") is not None,
           "the frame at t = 0.75 s is the file posed there, byte for byte")
     check(h("anim@0/default/file/iv.png") != h("anim@0.75/default/file/iv.png"), "the box moved between 0 and 0.75 s")
-    check(h("anim@2/default/file/iv.png") != h("anim@0.75/default/file/iv.png"), "and again by 2 s (clamped at 1 s)")
+    check(h("anim@1/default/file/iv.png") != h("anim@0.75/default/file/iv.png"), "and again by 1 s")
+    check(h("anim@2/default/file/iv.png") == h("anim@1/default/file/iv.png") is not None,
+          "after the last keyframe (1 s) the pose stays: 2 s renders as 1 s")
     check(h("posed/default/blue/iv.png") != h("posed/default/file/iv.png"), "the light override changes the image")
     entries = {e["id"]: e for e in manifest_lines(out)}
-    check(len(entries) == 8 and all(e["status"] == "ok" for e in entries.values()), "8 items ok")
+    check(len(entries) == 10 and all(e["status"] == "ok" for e in entries.values()), "10 items ok")
     e = entries.get("anim@0.75/default/file/iv", {})
     check(e.get("time") == 0.75 and {o["kind"] for o in e.get("outputs", [])} ==
           {"image", "ao", "points", "volume", "volume_header"}, "the manifest names the time and the outputs: %r" % e)
