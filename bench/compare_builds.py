@@ -8,12 +8,14 @@ B ..., with the same arguments, and for every configuration and stage prints
 the median of the per-round ratios new/old (below 1: the new build is
 faster) beside both medians.
 
-    python3 bench/compare_builds.py --old ../old/build/bench/lpvd-bench \\
+    python3 bench/compare_builds.py --baseline ../old/build/bench/lpvd-bench \\
         --new build/bench/lpvd-bench --rounds 5 -- --repeat 5 --warmup 2
 
-An earlier build: `git worktree add ../old REV && cmake -S ../old -B
-../old/build -DCMAKE_BUILD_TYPE=RelWithDebInfo && cmake --build ../old/build
---target lpvd-bench`. Standard library only; prints Markdown.
+An earlier build: `sh bench/build_baseline.sh REV ../old` (a worktree of REV
+with this checkout's bench source, so both print the same configurations).
+Rows: every stage, "total" (the stages' GPU ms) and "wall" (the whole tick
+and frame on the CPU clock); a summary of the speed-ups (old / new) ends the
+output. Standard library only; prints Markdown.
 """
 import argparse
 import re
@@ -48,7 +50,7 @@ def run(binary, args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--old", required=True, help="the earlier build's lpvd-bench")
+    ap.add_argument("--old", "--baseline", dest="old", required=True, help="the earlier build's lpvd-bench")
     ap.add_argument("--new", required=True, help="this build's lpvd-bench")
     ap.add_argument("--rounds", type=int, default=5, help="A/B rounds (default 5)")
     ap.add_argument("bench_args", nargs="*", help="after --: arguments for both benches")
@@ -84,6 +86,24 @@ def main():
             print("| %s | %.2f | %.2f | %s |" % (stage, statistics.median(x for x, _ in pairs),
                                                statistics.median(y for _, y in pairs),
                                                "%.3f" % statistics.median(ratios) if ratios else "–"))
+    summary(olds, news)
+
+
+def summary(olds, news):
+    """Speed-up (old / new, median of the rounds' ratios) of the wall and of
+    each configuration's largest stages, and the propagation throughput."""
+    print("\n## Summary: speed-up old / new (median of per-round ratios)\n")
+    print("| configuration | wall | total | propagate |")
+    print("|---|---:|---:|---:|")
+    for conf in news[0]:
+        if not all(conf in o for o in olds):
+            continue
+        cells = []
+        for stage in ("wall", "total", "propagate"):
+            r = [o[conf][stage] / n[conf][stage] for o, n in zip(olds, news)
+                 if stage in o[conf] and stage in n[conf] and n[conf][stage] > 0]
+            cells.append("%.2fx" % statistics.median(r) if r else "–")
+        print("| %s | %s |" % (conf.split(":")[0] + ": " + conf.split(":")[1].split(",")[0].strip(), " | ".join(cells)))
 
 
 if __name__ == "__main__":

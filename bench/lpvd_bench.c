@@ -7,15 +7,20 @@
  *
  * Configurations: the default preset (balanced), and the paper's pipeline
  * (the four departures of docs/propagation.md off) at 32^3 / 8 iterations /
- * RSM 256^2 and the same at 64^3, the configurations the propagation
- * throughput has been measured on since issue 3. Prints a Markdown table;
- * README.md records it with the machine.
+ * RSM 256^2, the same at 64^3 (the configurations the propagation
+ * throughput has been measured on since issue 3) and with 3 cascades of 32^3.
+ * Prints a Markdown table per configuration: each stage's GPU ms, their sum,
+ * and "wall": the whole tick and frame as the process sees it (CPU clock,
+ * lpv_engine_tick + lpv_engine_render with its read-back). README.md records
+ * it with the machine; bench/compare_builds.py runs two builds' benches
+ * alternately and prints the ratios.
  * Not a test: nothing here asserts a time.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "context.h"
 #include "engine.h"
@@ -25,7 +30,15 @@
 typedef struct config {
     int grid, iterations, rsm; /* 0: the preset's */
     int paper;                 /* 1: the departures off */
+    int cascades;              /* 0: the settings' (auto) */
 } config;
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -120,7 +133,7 @@ int main(int argc, char **argv)
     printf("# lpvd-bench: %s, backend %s, GL_RENDERER %s, image %dx%d, median of %d ticks after %d warm-up\n\n",
            scene.source, lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), view.width,
            view.height, repeat, warmup);
-    const config configs[] = {{0, 0, 0, 0}, {32, 8, 256, 1}, {64, 8, 256, 1}};
+    const config configs[] = {{0, 0, 0, 0, 0}, {32, 8, 256, 1, 0}, {64, 8, 256, 1, 0}, {32, 8, 256, 1, 3}};
     int rc = 0;
     for (size_t c = 0; c < sizeof configs / sizeof configs[0] && rc == 0; ++c) {
         lpv_settings s = opt.settings;
@@ -129,6 +142,8 @@ int main(int argc, char **argv)
             s.lpv.iterations = configs[c].iterations;
             s.rsm_size = configs[c].rsm;
         }
+        if (configs[c].cascades)
+            s.lpv.cascades = configs[c].cascades;
         if (configs[c].paper)
             s.lpv.central_transport = s.lpv.normal_bins = s.lpv.far_field = s.scene_surfels = LPV_SWITCH_OFF;
         lpv_settings_resolve(&s);
@@ -139,21 +154,28 @@ int main(int argc, char **argv)
             break;
         }
         double samples[LPV_STAGE_MAX][1000];
-        double totals[1000];
+        double totals[1000], walls[1000];
         char names[LPV_STAGE_MAX][32];
         int stage_count = 0;
         for (int r = 0; r < warmup + repeat; ++r) {
             /* The planner serves an unchanged scene's cached volume without
              * running a stage: every timed tick is made a full one. */
             lpv_engine_invalidate(e);
-            if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0 || lpv_engine_tick(e, err, sizeof err) != 0 ||
-                lpv_engine_render(e, LPV_TERMS_FULL, rgba, err, sizeof err)) {
+            if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0) {
                 fprintf(stderr, "lpvd-bench: %s\n", err);
                 rc = 1;
                 break;
             }
+            double t0 = now_ms();
+            if (lpv_engine_tick(e, err, sizeof err) != 0 || lpv_engine_render(e, LPV_TERMS_FULL, rgba, err, sizeof err)) {
+                fprintf(stderr, "lpvd-bench: %s\n", err);
+                rc = 1;
+                break;
+            }
+            double wall = now_ms() - t0;
             if (r < warmup)
                 continue;
+            walls[r - warmup] = wall;
             const lpv_engine_stats *st = lpv_engine_last_stats(e);
             stage_count = st->stage_count;
             double total = 0.0;
@@ -169,7 +191,10 @@ int main(int argc, char **argv)
         const lpv_engine_stats *st = lpv_engine_last_stats(e);
         char letters[5];
         printf("## %s: %d^3 cells, %d iterations, RSM %d^2, occlusion %s, departures %s (%d cascades)\n\n",
-               configs[c].grid ? "the paper's pipeline" : lpv_preset_name(s.preset), s.grid_dims[0], s.lpv.iterations,
+               configs[c].cascades ? "cascaded, the paper's pipeline"
+               : configs[c].grid   ? "the paper's pipeline"
+                                   : lpv_preset_name(s.preset),
+               s.grid_dims[0], s.lpv.iterations,
                s.rsm_size, st->occlusion ? "on" : "off", lpv_settings_departures(&s, letters), st->cascades);
         printf("| stage | GPU ms (median) |\n|---|---:|\n");
         double prop_ms = 0.0;
@@ -179,7 +204,8 @@ int main(int argc, char **argv)
                 prop_ms = m;
             printf("| %s | %.2f |\n", names[k], m);
         }
-        printf("| **total** | **%.2f** |\n\n", median(totals, repeat));
+        printf("| **total** | **%.2f** |\n", median(totals, repeat));
+        printf("| **wall** | **%.2f** |\n\n", median(walls, repeat));
         /* every volume's cells (cascades x normal bins) times the steps */
         double cell_steps = st->cell_steps;
         printf("propagation: %.0f cell-steps in %.2f ms = **%.1f M cell-steps/s**\n\n", cell_steps, prop_ms,

@@ -17,6 +17,14 @@ static uint64_t pixels(const lpv_memory_need *n)
     return (uint64_t)(n->image_w > 0 ? n->image_w : 0) * (uint64_t)(n->image_h > 0 ? n->image_h : 0);
 }
 
+uint64_t lpv_memory_camera_surfels(int w, int h)
+{
+    /* blocks of s x s pixels, min(LPV_CAMERA_SLOTS = 8, s^2) surfels each:
+     * s = 1 gives w h, s = 2 at most (w / 2 + 1)(h / 2 + 1) 4, s >= 3 at
+     * most ((w + s - 1) / s)((h + s - 1) / s) 8: all within (w + 2)(h + 2) */
+    return (uint64_t)(w > 0 ? w + 2 : 0) * (uint64_t)(h > 0 ? h + 2 : 0);
+}
+
 uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n)
 {
     return texels(n->rsm_size, n->rsm_faces) * (LPV_MEM_RSM_TEXEL + LPV_MEM_VPL + LPV_MEM_SURFEL);
@@ -34,7 +42,7 @@ uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
 
 uint64_t lpv_memory_image_bytes(const lpv_memory_need *n)
 {
-    return pixels(n) * (LPV_MEM_PIXEL + LPV_MEM_SURFEL);
+    return pixels(n) * LPV_MEM_PIXEL + lpv_memory_camera_surfels(n->image_w, n->image_h) * LPV_MEM_SURFEL;
 }
 
 uint64_t lpv_memory_total_bytes(const lpv_memory_need *n)
@@ -104,7 +112,7 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
                     "most %.2f GB: lower grid or cascades",
                     what, gb(cell_buffer), LPV_MEM_CELL_BUFFER, gb(lim->max_buffer));
     }
-    uint64_t surfels = pixels(n) * LPV_MEM_SURFEL;
+    uint64_t surfels = lpv_memory_camera_surfels(n->image_w, n->image_h) * LPV_MEM_SURFEL;
     if (surfels > lim->max_buffer) {
         part_name(n, 3, what, sizeof what);
         return fail(err, err_size,

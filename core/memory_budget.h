@@ -18,7 +18,7 @@
 #define LPV_MEM_VPL 48u           /* one LpvVpl per RSM texel */
 #define LPV_MEM_SURFEL 48u        /* one LpvSurfel per RSM texel or pixel */
 #define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
-#define LPV_MEM_CELL 392u         /* per cell: 4 LPV buffers (4 x 48), transmittances (24), reflectances
+#define LPV_MEM_CELL 440u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48), transmittances (24), reflectances
                                      (96), flux limits (2 x 16), the injection atlas (3 x RGBA32F) */
 #define LPV_MEM_GV_POINT 80u      /* per geometry-volume point: the total (48, an LpvGvPoint) and atlas
                                      (2 x RGBA32F) */
@@ -48,6 +48,9 @@ typedef struct lpv_memory_need {
 } lpv_memory_need;
 
 /* Bytes of each part, and of all. */
+/* The most camera surfels a w x h view makes at any camera_surfel_step
+ * (camera_surfels.comp): the size of their buffer. */
+uint64_t lpv_memory_camera_surfels(int w, int h);
 uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n);    /* RSM textures + VPL + surfel buffers */
 uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n); /* shadow maps */
 uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n);

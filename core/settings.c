@@ -330,6 +330,9 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->emissive_vpls < 0 || s->emissive_vpls > LPV_MAX_EMISSIVE_VPLS)
         return fail(err, err_size, "emissive_vpls = %d is out of range (allowed 0..%d)", s->emissive_vpls,
                     LPV_MAX_EMISSIVE_VPLS);
+    if (s->camera_surfel_step < 0 || s->camera_surfel_step > LPV_MAX_CAMERA_SURFEL_STEP)
+        return fail(err, err_size, "camera_surfel_step = %d is out of range (allowed 0 = auto, 1..%d)",
+                    s->camera_surfel_step, LPV_MAX_CAMERA_SURFEL_STEP);
     if (s->scene_surfel_count < 1 || s->scene_surfel_count > (1 << 22))
         return fail(err, err_size, "scene_surfel_count = %d is out of range (allowed 1..%d)", s->scene_surfel_count,
                     1 << 22);
@@ -414,4 +417,18 @@ static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_s
         return fail(err, err_size, "iv_max_points = %d is out of range (allowed 1..%d)", iv->max_points,
                     LPV_IV_MAX_POINTS);
     return 0;
+}
+
+int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)
+{
+    if (s->camera_surfel_step > 0)
+        return s->camera_surfel_step;
+    int g = s->grid_dims[0];
+    for (int i = 1; i < 3; ++i)
+        if (s->grid_dims[i] > g)
+            g = s->grid_dims[i];
+    int step = g > 0 ? image_h / (LPV_CAMERA_SURFELS_PER_CELL * g) : 1;
+    if (step > LPV_MAX_CAMERA_SURFEL_STEP)
+        step = LPV_MAX_CAMERA_SURFEL_STEP;
+    return step > 1 ? step : 1;
 }

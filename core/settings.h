@@ -142,6 +142,9 @@ typedef struct lpv_settings {
     lpv_switch scene_surfels;     /* surfels sampled over every triangle join the geometry volume, so
                                      walls no view sees still block; default: the preset's */
     int scene_surfel_count;       /* how many; default 65536 */
+    int camera_surfel_step;       /* G-buffer pixels per camera surfel along each axis (a block of
+                                     step x step pixels becomes one surfel); 0 (default) = auto,
+                                     lpv_settings_camera_surfel_step() */
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     lpv_switch area_lights; /* on (default): emitters light the scene directly through
                                area_light_samples shadow-mapped samples and stop injecting
@@ -173,6 +176,11 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_FAR_FIELD_LEVELS 1
 #define LPV_DEFAULT_FAR_FIELD_STEPS 1
 #define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
+/* Auto camera surfel step: this many surfels per finest cell along the
+ * image's height when the grid spans it (seed 000: the camera's buffers are
+ * down-sampled before surfel injection). */
+#define LPV_CAMERA_SURFELS_PER_CELL 4
+#define LPV_MAX_CAMERA_SURFEL_STEP 64
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 #define LPV_IV_DEFAULT_RESOLUTION 16
 #define LPV_IV_DEFAULT_POINTS 4
@@ -237,5 +245,10 @@ int lpv_settings_bounds_given(const lpv_settings *s);
 /* Checks ranges after resolve; on failure writes a message naming the setting
  * into err and returns -1. */
 int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_size);
+
+/* The camera surfel step in effect for an image image_h pixels high:
+ * camera_surfel_step when set, else image_h / (LPV_CAMERA_SURFELS_PER_CELL x
+ * the grid's largest dimension), at least 1. */
+int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h);
 
 #endif /* LPV_SETTINGS_H */

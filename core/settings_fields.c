@@ -86,6 +86,9 @@ static const lpv_field FIELDS[] = {
      "surfels over every triangle join the geometry volume (walls no view sees block)", T_VOL | T_SAMPLES, ""},
     {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",
      "65536", "", "surfels sampled over the scene's triangles", T_VOL | T_SAMPLES, ""},
+    {"camera_surfel_step", "camera-surfel-step", LPV_FIELD_INT, F(camera_surfel_step), 0,
+     LPV_MAX_CAMERA_SURFEL_STEP, 0, "pixels", "auto", "0 = auto: 4 surfels per finest cell along the image's height",
+     "G-buffer pixels per camera surfel along each axis (geometry volume)", T_VOL, ""},
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", "on", "",
      "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)", T_VOL | T_SHADOWS, ""},

@@ -114,6 +114,8 @@ struct lpv_engine {
     GLuint view_ubo;
     struct LpvViewBlock view_block;
     int gbuf_w, gbuf_h;
+    /* the camera's surfels: blocks of camera_surfel_step pixels, camera_surfel_slots surfels each */
+    int camera_surfel_w, camera_surfel_h, camera_surfel_slots;
     GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
 
@@ -193,5 +195,11 @@ int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err
 int lpv_engine_place_volume(lpv_engine *e, char *err, size_t err_size);
 /* After a commit: the volume's description, and what a storage reset drops. */
 void lpv_engine_committed(lpv_engine *e, int reset);
+
+/* The camera's surfels the last G-buffer pass made (pass_camera.c). */
+static inline size_t lpv_engine_camera_surfel_count(const lpv_engine *e)
+{
+    return (size_t)e->camera_surfel_w * (size_t)e->camera_surfel_h * (size_t)e->camera_surfel_slots;
+}
 
 #endif /* LPV_ENGINE_INTERNAL_H */

@@ -96,7 +96,8 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
          n < LPV_MAX_SURFEL_SETS && (lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0); ++b)
         in->surfel_sets[n++] = (lpv_surfel_set){e->surfels, first, count};
     if (e->plan.pass[LPV_PASS_GBUFFER].run && n < LPV_MAX_SURFEL_SETS)
-        in->surfel_sets[n++] = (lpv_surfel_set){e->camera_surfels, 0, (size_t)e->gbuf_w * (size_t)e->gbuf_h};
+        in->surfel_sets[n++] =
+            (lpv_surfel_set){e->camera_surfels, 0, lpv_engine_camera_surfel_count(e)};
     if (e->scene_surfel_count && n < LPV_MAX_SURFEL_SETS)
         in->surfel_sets[n++] = (lpv_surfel_set){e->scene_surfels, 0, e->scene_surfel_count};
     in->surfel_set_count = n;
@@ -136,7 +137,7 @@ static void record_stats(lpv_engine *e)
     s->surfels_rsm = 0;
     for (size_t b = 0, first, count; gv && (lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0); ++b)
         s->surfels_rsm += count;
-    s->surfels_camera = e->plan.consumes.camera_surfels ? (size_t)e->gbuf_w * e->gbuf_h : 0;
+    s->surfels_camera = e->plan.consumes.camera_surfels ? lpv_engine_camera_surfel_count(e) : 0;
     s->scene_uploads = e->counters.scene_uploads;
     s->scene_samplings = e->counters.scene_samplings;
     e->tech->cls->stats(e->tech, &e->plan, s);

@@ -16,33 +16,30 @@
 // grows toward the surface (its directional derivative along n is negative,
 // i.e. it arrives from behind a thin wall), the lookup is damped by
 // 1 - strength * (1 - E(1.5 cells out) / E(0.5 cells out)); strength 0 = off.
-layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer AccLookup { LpvCell lpv[]; };
+// The accumulated volume as three RGBA32F 3D textures (r, g, b; linear
+// filtering), volume v at z-slab v % u_lpv_slabs_z and y-slab
+// v / u_lpv_slabs_z (gpu/lpv/lpv_lookup_volume.c fills them from the LPV
+// buffer after each tick): one filtered fetch per channel is the trilinear
+// interpolation between the 8 cell centres around q.
+layout(binding = LPV_TEX_LOOKUP_R) uniform sampler3D u_lpv_r;
+layout(binding = LPV_TEX_LOOKUP_G) uniform sampler3D u_lpv_g;
+layout(binding = LPV_TEX_LOOKUP_B) uniform sampler3D u_lpv_b;
+uniform int u_lpv_slabs_z;
 
 uniform float u_damping;
 
 // The trilinearly interpolated SH (r, g, b) at continuous cell coordinates q
-// (cell centres at +0.5) of cascade k, clamped at the grid's edge.
+// (cell centres at +0.5) of volume v, clamped at the grid's edge: the clamp
+// keeps the filter inside v's cells, so neighbouring volumes never mix.
 void volume_sh_at(int v, vec3 q, out vec4 r, out vec4 g, out vec4 b)
 {
     ivec3 dims = grid_dims();
-    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) - 0.5;
-    ivec3 c0 = min(ivec3(floor(q)), dims - 1);
-    ivec3 c1 = min(c0 + 1, dims - 1);
-    vec3 f = q - vec3(c0);
-    int base = v * grid_cells();
-    r = vec4(0.0);
-    g = vec4(0.0);
-    b = vec4(0.0);
-    for (int j = 0; j < 8; ++j) {
-        ivec3 sel = ivec3(j & 1, (j >> 1) & 1, (j >> 2) & 1);
-        ivec3 c = mix(c0, c1, bvec3(sel));
-        vec3 w3 = mix(1.0 - f, f, vec3(sel));
-        float w = w3.x * w3.y * w3.z;
-        LpvCell cell = lpv[base + cell_index(c)];
-        r += w * cell.r;
-        g += w * cell.g;
-        b += w * cell.b;
-    }
+    int slabs = max(u_lpv_slabs_z, 1);
+    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) + vec3(0.0, float((v / slabs) * dims.y), float((v % slabs) * dims.z));
+    vec3 t = q / vec3(textureSize(u_lpv_r, 0));
+    r = textureLod(u_lpv_r, t, 0.0);
+    g = textureLod(u_lpv_g, t, 0.0);
+    b = textureLod(u_lpv_b, t, 0.0);
 }
 
 // The SH of cascade k at q summed over its volumes (the physical field).

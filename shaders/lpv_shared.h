@@ -396,11 +396,18 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_TRANSMIT  3
 #define LPV_TEX_REFLECT   4
 #define LPV_TEX_DENSITY   7 /* the medium's 3D density (units 0..6 are the shading's) */
+/* The accumulated LPV as 3D textures for the lookup (lookup.glsl, gpu/lpv/lpv_lookup_volume.c). */
+#define LPV_TEX_LOOKUP_R  8
+#define LPV_TEX_LOOKUP_G  9
+#define LPV_TEX_LOOKUP_B  10
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
 #define LPV_PROP_WG_X 32
 #define LPV_PROP_WG_Y 2
 #define LPV_WG_2D 8
+/* Surfels per block of camera pixels at most (camera_surfels.comp): one per
+ * geometry-volume point the block's pixels snap to. */
+#define LPV_CAMERA_SLOTS 8
 
 /* ---- Limits ---------------------------------------------------------------- */
 #define LPV_MAX_GRID_DIM     256  /* cells per axis */

@@ -9,15 +9,36 @@ layout(std140, binding = LPV_UBO_SHADOW) uniform ShadowUBO { LpvShadowBlock S; }
 // compare), 1 = lit. uv is the face's own (0..1); every tap is kept half a
 // texel inside the face's tile (area light faces share a layer), so the
 // filter never reads a neighbouring face.
+//
+// The same filter in (R + 1)^2 taps instead of (2R + 1)^2: along an axis the
+// 2R + 1 taps weigh the 2R + 2 texels under them (1 - f, 1, ..., 1, f), f the
+// sample's fraction between texel centres. Each pair of neighbouring texels
+// is one bilinear compare placed so that its lerp gives the pair's ratio, with
+// the pair's total as its weight: (1 - f, 1) at 1 / (2 - f) into the pair,
+// weight 2 - f; (1, 1) at 1/2, weight 2; (1, f) at f / (1 + f), weight 1 + f.
 float shadow_pcf(int face, vec2 uv, float depth, int R)
 {
     float texel = S.counts.z;
     vec4 tile = S.faces[face].tile;
     vec2 at = tile.xy + uv * tile.z, lo = tile.xy + 0.5 * texel, hi = tile.xy + tile.z - 0.5 * texel;
+    if (R == 0)
+        return texture(u_shadow, vec4(clamp(at, lo, hi), tile.w, depth));
+    vec2 u = at / texel - 0.5; // texel-centre coordinates
+    vec2 i = floor(u), f = u - i;
     float sum = 0.0;
-    for (int y = -R; y <= R; ++y)
-        for (int x = -R; x <= R; ++x)
-            sum += texture(u_shadow, vec4(clamp(at + vec2(x, y) * texel, lo, hi), tile.w, depth));
+    for (int y = 0; y <= R; ++y) {
+        // pair y along t covers texels i.y - R + 2y and the one after it
+        float wy = y == 0 ? 2.0 - f.y : (y == R ? 1.0 + f.y : 2.0);
+        float oy = y == 0 ? 1.0 / (2.0 - f.y) : (y == R ? f.y / (1.0 + f.y) : 0.5);
+        float ty = i.y - float(R) + 2.0 * float(y) + oy;
+        for (int x = 0; x <= R; ++x) {
+            float wx = x == 0 ? 2.0 - f.x : (x == R ? 1.0 + f.x : 2.0);
+            float ox = x == 0 ? 1.0 / (2.0 - f.x) : (x == R ? f.x / (1.0 + f.x) : 0.5);
+            float tx = i.x - float(R) + 2.0 * float(x) + ox;
+            vec2 c = (vec2(tx, ty) + 0.5) * texel;
+            sum += wx * wy * texture(u_shadow, vec4(clamp(c, lo, hi), tile.w, depth));
+        }
+    }
     return sum / float((2 * R + 1) * (2 * R + 1));
 }
 

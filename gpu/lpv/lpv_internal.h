@@ -11,6 +11,7 @@
 #include "atlas.h"
 #include "cascades.h"
 #include "gl_util.h"
+#include "lpv_lookup_volume.h"
 #include "technique.h"
 
 
@@ -22,7 +23,8 @@ typedef struct lpv_cascaded {
     lpv_cascade_set pending;  /* placement of the last place */
     int bins;                 /* LPV volumes per cascade: 1, or LPV_NORMAL_BINS (normal_bins on) */
 
-    GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate, prog_handoff;
+    GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate, prog_handoff,
+        prog_lookup_pack;
     int borrowed_programs;    /* 1: the programs are another state's (the octree's levels share them) */
     GLuint empty_vao;
 
@@ -30,6 +32,8 @@ typedef struct lpv_cascaded {
     lpv_atlas lpv_atlas, gv_atlas; /* injection's and the geometry volume's */
     GLuint lpv_injected, lpv_ping, lpv_pong, lpv_acc, gv_total, transmit, reflect;
     GLuint lpv_last; /* the buffer the last propagation step (or hand-off) wrote */
+    lpv_lookup_volume lookup; /* lpv_acc as the lookup's 3D textures, when lookup_wanted */
+    int lookup_wanted;        /* 1: the shading reads this state (the octree's levels are read merged) */
     GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
     GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
     size_t grid_alloc_cells; /* cells of all cascades */

@@ -48,6 +48,7 @@ void lpv_cascaded_free_storage(lpv_cascaded *c)
 {
     lpv_atlas_destroy(&c->lpv_atlas);
     lpv_atlas_destroy(&c->gv_atlas);
+    lpv_lookup_volume_free(&c->lookup);
     GLuint *bufs[] = {&c->lpv_injected, &c->lpv_ping, &c->lpv_pong, &c->lpv_acc,  &c->gv_total,
                       &c->transmit,     &c->reflect,  &c->sigma[0], &c->sigma[1]};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i)
@@ -133,6 +134,8 @@ int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *rese
     c->tbo_acc = lpv_gl_buffer_view(c->lpv_acc, GL_RGBA32F);
     c->tbo_transmit = lpv_gl_buffer_view(c->transmit, GL_R32F);
     c->tbo_reflect = lpv_gl_buffer_view(c->reflect, GL_RGBA32F);
+    if (c->lookup_wanted && lpv_lookup_volume_alloc(&c->lookup, g->dims, lpv_volumes(c), err, err_size) != 0)
+        return -1;
     c->grid_alloc_cells = cells;
     memcpy(c->grid_alloc_dims, g->dims, sizeof g->dims);
     c->grid_alloc_cascades = set->count;

@@ -21,8 +21,8 @@ void lpv_cascaded_delete(lpv_cascaded *c)
     if (!c)
         return;
     lpv_cascaded_free_storage(c);
-    GLuint *progs[] = {&c->prog_inject_vpl, &c->prog_inject_gv, &c->prog_pack,   &c->prog_gv_merge,
-                       &c->prog_transmit,   &c->prog_propagate, &c->prog_handoff};
+    GLuint *progs[] = {&c->prog_inject_vpl, &c->prog_inject_gv, &c->prog_pack,    &c->prog_gv_merge,
+                       &c->prog_transmit,   &c->prog_propagate, &c->prog_handoff, &c->prog_lookup_pack};
     for (size_t i = 0; !c->borrowed_programs && i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -66,6 +66,7 @@ lpv_cascaded *lpv_cascaded_new(char *err, size_t err_size)
         {&c->prog_transmit, "transmit.comp", NULL, INC_GRID},
         {&c->prog_propagate, "propagate.comp", NULL, INC_PROPAGATE},
         {&c->prog_handoff, "lpv_handoff.comp", NULL, INC_PROPAGATE},
+        {&c->prog_lookup_pack, "lpv_lookup_pack.comp", NULL, NULL},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog = lpv_program_build(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
@@ -90,6 +91,7 @@ lpv_cascaded *lpv_cascaded_new_sharing(const lpv_cascaded *owner, char *err, siz
     c->prog_transmit = owner->prog_transmit;
     c->prog_propagate = owner->prog_propagate;
     c->prog_handoff = owner->prog_handoff;
+    c->prog_lookup_pack = owner->prog_lookup_pack;
     return c;
 }
 
@@ -98,6 +100,8 @@ static void destroy(lpv_technique *t) { lpv_cascaded_delete((lpv_cascaded *)t); 
 static lpv_technique *create(char *err, size_t err_size)
 {
     lpv_cascaded *c = lpv_cascaded_new(err, err_size);
+    if (c)
+        c->lookup_wanted = 1;
     return c ? &c->base : NULL;
 }
 
@@ -135,6 +139,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         lpv_pass_gv_run(c, in, p->pass[LPV_PASS_BOUNCE].run);
     if (p->pass[LPV_PASS_PROPAGATE].run)
         lpv_pass_propagate_run(c, in, p->pass[LPV_PASS_GV].run, p->pass[LPV_PASS_BOUNCE].run);
+    lpv_lookup_volume_fill(&c->lookup, c->prog_lookup_pack, c->lpv_acc, in->timer);
     return 0;
 }
 
@@ -143,7 +148,7 @@ static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
     const lpv_cascaded *c = (const lpv_cascaded *)t;
     glUniform1f(glGetUniformLocation(prog, "u_damping"), damping);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, c->grid_ubo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, c->lpv_acc);
+    lpv_lookup_volume_bind(&c->lookup, prog);
 }
 
 static void describe(const lpv_technique *t, lpv_volume_desc *d)

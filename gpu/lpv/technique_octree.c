@@ -43,6 +43,7 @@ typedef struct lpv_octree_gpu {
     GLuint prog_downsample, prog_merge;
     GLuint merged;                           /* LpvCell per level-0 cell: what the lookup reads */
     GLuint index;                            /* int per level-0 cell: I(x) */
+    lpv_lookup_volume lookup;                /* merged as the lookup's 3D textures */
     size_t merged_cells;
 } lpv_octree_gpu;
 
@@ -62,6 +63,7 @@ static void free_merged(lpv_octree_gpu *o)
 {
     lpv_gl_delete_buffer(&o->merged);
     lpv_gl_delete_buffer(&o->index);
+    lpv_lookup_volume_free(&o->lookup);
     o->merged_cells = 0;
 }
 
@@ -206,6 +208,8 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
         *reset = 1;
         if (glGetError() != GL_NO_ERROR)
             return lpv_error(err, err_size, "could not allocate the octree's merged %zu-cell volume", cells);
+        if (lpv_lookup_volume_alloc(&o->lookup, o->level[0]->grid.dims, 1, err, err_size) != 0)
+            return -1;
     }
     return 0;
 }
@@ -295,6 +299,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
     lpv_timer_begin(in->timer, "merge");
     merge(o, in->timer);
     lpv_timer_end(in->timer);
+    lpv_lookup_volume_fill(&o->lookup, o->level[0]->prog_lookup_pack, o->merged, in->timer);
     return 0;
 }
 
@@ -303,7 +308,7 @@ static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
     const lpv_octree_gpu *o = (const lpv_octree_gpu *)t;
     glUniform1f(glGetUniformLocation(prog, "u_damping"), damping);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, o->level[0]->grid_ubo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, o->merged);
+    lpv_lookup_volume_bind(&o->lookup, prog);
 }
 
 static void describe(const lpv_technique *t, lpv_volume_desc *d)
