@@ -17,17 +17,24 @@ static uint64_t pixels(const lpv_memory_need *n)
     return (uint64_t)(n->image_w > 0 ? n->image_w : 0) * (uint64_t)(n->image_h > 0 ? n->image_h : 0);
 }
 
-uint64_t lpv_memory_camera_surfels(int w, int h)
+uint64_t lpv_memory_block_samples(int w, int h)
 {
-    /* blocks of s x s pixels, min(LPV_CAMERA_SLOTS = 8, s^2) surfels each:
+    /* blocks of s x s pixels, min(LPV_BLOCK_SLOTS = 8, s^2) surfels each:
      * s = 1 gives w h, s = 2 at most (w / 2 + 1)(h / 2 + 1) 4, s >= 3 at
      * most ((w + s - 1) / s)((h + s - 1) / s) 8: all within (w + 2)(h + 2) */
     return (uint64_t)(w > 0 ? w + 2 : 0) * (uint64_t)(h > 0 ? h + 2 : 0);
 }
 
+/* The RSMs' VPLs (and as many surfels): at most lpv_memory_block_samples
+ * per layer, whatever rsm_vpl_step down-samples them to. */
+static uint64_t rsm_samples(const lpv_memory_need *n)
+{
+    return lpv_memory_block_samples(n->rsm_size, n->rsm_size) * (uint64_t)(n->rsm_faces > 0 ? n->rsm_faces : 0);
+}
+
 uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n)
 {
-    return texels(n->rsm_size, n->rsm_faces) * (LPV_MEM_RSM_TEXEL + LPV_MEM_VPL + LPV_MEM_SURFEL);
+    return texels(n->rsm_size, n->rsm_faces) * LPV_MEM_RSM_TEXEL + rsm_samples(n) * (LPV_MEM_VPL + LPV_MEM_SURFEL);
 }
 
 uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n)
@@ -42,7 +49,7 @@ uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
 
 uint64_t lpv_memory_image_bytes(const lpv_memory_need *n)
 {
-    return pixels(n) * LPV_MEM_PIXEL + lpv_memory_camera_surfels(n->image_w, n->image_h) * LPV_MEM_SURFEL;
+    return pixels(n) * LPV_MEM_PIXEL + lpv_memory_block_samples(n->image_w, n->image_h) * LPV_MEM_SURFEL;
 }
 
 uint64_t lpv_memory_total_bytes(const lpv_memory_need *n)
@@ -96,11 +103,11 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
                     n->rsm_faces, n->shadow_faces, lim->max_layers);
 
     /* Single buffers a shader must address. */
-    uint64_t vpl = texels(n->rsm_size, n->rsm_faces) * LPV_MEM_VPL;
+    uint64_t vpl = rsm_samples(n) * LPV_MEM_VPL;
     if (vpl > lim->max_buffer) {
         part_name(n, 0, what, sizeof what);
         return fail(err, err_size,
-                    "%s needs %.2f GB for one VPL buffer (%u B per texel); one shader storage buffer may hold "
+                    "%s needs %.2f GB for one VPL buffer (%u B per VPL); one shader storage buffer may hold "
                     "at most %.2f GB: lower rsm_size or use fewer lights",
                     what, gb(vpl), LPV_MEM_VPL, gb(lim->max_buffer));
     }
@@ -112,7 +119,7 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
                     "most %.2f GB: lower grid or cascades",
                     what, gb(cell_buffer), LPV_MEM_CELL_BUFFER, gb(lim->max_buffer));
     }
-    uint64_t surfels = lpv_memory_camera_surfels(n->image_w, n->image_h) * LPV_MEM_SURFEL;
+    uint64_t surfels = lpv_memory_block_samples(n->image_w, n->image_h) * LPV_MEM_SURFEL;
     if (surfels > lim->max_buffer) {
         part_name(n, 3, what, sizeof what);
         return fail(err, err_size,

@@ -48,9 +48,10 @@ typedef struct lpv_memory_need {
 } lpv_memory_need;
 
 /* Bytes of each part, and of all. */
-/* The most camera surfels a w x h view makes at any camera_surfel_step
- * (camera_surfels.comp): the size of their buffer. */
-uint64_t lpv_memory_camera_surfels(int w, int h);
+/* The most samples a w x h buffer down-sampled in blocks makes at any step
+ * (block_groups.glsl: camera surfels, RSM VPLs and surfels per layer): the
+ * size of their buffers. */
+uint64_t lpv_memory_block_samples(int w, int h);
 uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n);    /* RSM textures + VPL + surfel buffers */
 uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n); /* shadow maps */
 uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n);

@@ -28,7 +28,7 @@ static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
     int cell[3];
     if (v->position[3] == 0.0f || !finite3(v->position) || !finite3(v->flux))
         return 0;
-    if (!lpv_unit_direction(v->normal, n))
+    if (!lpv_mean_direction(v->normal, n))
         return 0;
     for (int i = 0; i < 3; i++)
         p[i] = v->position[i] + 0.5f * g->cell_size * n[i];
@@ -58,7 +58,7 @@ size_t lpv_oracle_inject_vpls_binned(const lpv_grid *g, const lpv_vpl *vpls, siz
     size_t injected = 0, count = lpv_grid_cell_count(g);
     for (size_t i = 0; i < n; i++) {
         float un[3];
-        if (!lpv_unit_direction(vpls[i].normal, un))
+        if (!lpv_mean_direction(vpls[i].normal, un))
             continue;
         injected += (size_t)inject_vpl(g, &vpls[i], cells + (size_t)lpv_oracle_normal_bin(un) * count);
     }
@@ -82,7 +82,7 @@ static int inject_surfel(const lpv_grid *g, const lpv_surfel *s, vec4 *gv)
     float area = s->position[3];
     if (!(area > 0.0f) || !isfinite(area) || !finite3(s->position))
         return 0;
-    if (!lpv_unit_direction(s->normal, n))
+    if (!lpv_mean_direction(s->normal, n))
         return 0;
     if (!lpv_grid_gv_point_of(g, s->position, pt))
         return 0;

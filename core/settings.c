@@ -333,6 +333,9 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->camera_surfel_step < 0 || s->camera_surfel_step > LPV_MAX_CAMERA_SURFEL_STEP)
         return fail(err, err_size, "camera_surfel_step = %d is out of range (allowed 0 = auto, 1..%d)",
                     s->camera_surfel_step, LPV_MAX_CAMERA_SURFEL_STEP);
+    if (s->rsm_vpl_step < 0 || s->rsm_vpl_step > LPV_MAX_RSM_VPL_STEP)
+        return fail(err, err_size, "rsm_vpl_step = %d is out of range (allowed 0 = auto, 1..%d)", s->rsm_vpl_step,
+                    LPV_MAX_RSM_VPL_STEP);
     if (s->scene_surfel_count < 1 || s->scene_surfel_count > (1 << 22))
         return fail(err, err_size, "scene_surfel_count = %d is out of range (allowed 1..%d)", s->scene_surfel_count,
                     1 << 22);
@@ -419,16 +422,31 @@ static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_s
     return 0;
 }
 
-int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)
+/* side / (per_cell x the grid's largest dimension), within 1..max. */
+static int auto_step(const lpv_settings *s, int side, int per_cell, int max)
 {
-    if (s->camera_surfel_step > 0)
-        return s->camera_surfel_step;
     int g = s->grid_dims[0];
     for (int i = 1; i < 3; ++i)
         if (s->grid_dims[i] > g)
             g = s->grid_dims[i];
-    int step = g > 0 ? image_h / (LPV_CAMERA_SURFELS_PER_CELL * g) : 1;
-    if (step > LPV_MAX_CAMERA_SURFEL_STEP)
-        step = LPV_MAX_CAMERA_SURFEL_STEP;
+    int step = g > 0 ? side / (per_cell * g) : 1;
+    if (step > max)
+        step = max;
     return step > 1 ? step : 1;
+}
+
+int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)
+{
+    if (s->camera_surfel_step > 0)
+        return s->camera_surfel_step;
+    return auto_step(s, image_h, LPV_CAMERA_SURFELS_PER_CELL, LPV_MAX_CAMERA_SURFEL_STEP);
+}
+
+int lpv_settings_rsm_vpl_step(const lpv_settings *s, int size, int tile)
+{
+    int want = s->rsm_vpl_step > 0 ? s->rsm_vpl_step : auto_step(s, size, LPV_RSM_VPLS_PER_CELL, LPV_MAX_RSM_VPL_STEP);
+    int step = 1;
+    while (step * 2 <= want && tile > 0 && tile % (step * 2) == 0)
+        step *= 2;
+    return step;
 }

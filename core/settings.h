@@ -145,6 +145,9 @@ typedef struct lpv_settings {
     int camera_surfel_step;       /* G-buffer pixels per camera surfel along each axis (a block of
                                      step x step pixels becomes one surfel); 0 (default) = auto,
                                      lpv_settings_camera_surfel_step() */
+    int rsm_vpl_step;             /* RSM texels per VPL and surfel block along each axis (each block
+                                     gives one VPL per cell it reaches, block_groups.glsl); 0
+                                     (default) = auto, lpv_settings_rsm_vpl_step() */
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     lpv_switch area_lights; /* on (default): emitters light the scene directly through
                                area_light_samples shadow-mapped samples and stop injecting
@@ -181,6 +184,10 @@ typedef struct lpv_settings {
  * down-sampled before surfel injection). */
 #define LPV_CAMERA_SURFELS_PER_CELL 4
 #define LPV_MAX_CAMERA_SURFEL_STEP 64
+/* Auto RSM VPL step: this many VPL blocks per finest cell along a light
+ * face's side when the grid spans it. */
+#define LPV_RSM_VPLS_PER_CELL 4
+#define LPV_MAX_RSM_VPL_STEP 64
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 #define LPV_IV_DEFAULT_RESOLUTION 16
 #define LPV_IV_DEFAULT_POINTS 4
@@ -250,5 +257,11 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
  * camera_surfel_step when set, else image_h / (LPV_CAMERA_SURFELS_PER_CELL x
  * the grid's largest dimension), at least 1. */
 int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h);
+/* The RSM VPL step in effect for RSM layers of size x size texels whose
+ * faces are tiles of `tile` texels (size itself, or an area light face's
+ * tile side): rsm_vpl_step when set, else size / (LPV_RSM_VPLS_PER_CELL x
+ * the grid's largest dimension); then the largest power of two not above it
+ * that divides tile, at least 1, so blocks never straddle two faces. */
+int lpv_settings_rsm_vpl_step(const lpv_settings *s, int size, int tile);
 
 #endif /* LPV_SETTINGS_H */

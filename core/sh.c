@@ -52,6 +52,19 @@ float lpv_sh_dot(const float a[4], const float b[4])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
 }
 
+int lpv_mean_direction(const float in[3], float out[3])
+{
+    if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
+        return 0;
+    float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
+    if (!(len > 1e-8f) || !isfinite(len))
+        return 0;
+    float d = len > 1.0f ? len : 1.0f;
+    for (int i = 0; i < 3; i++)
+        out[i] = in[i] / d;
+    return 1;
+}
+
 int lpv_unit_direction(const float in[3], float out[3])
 {
     if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))

@@ -24,5 +24,12 @@ float lpv_sh_dot(const float a[4], const float b[4]);
  * computed in float, as in the shaders, so one whose length overflows is
  * rejected too); then out = in / |in| and 1 is returned, else 0. */
 int lpv_unit_direction(const float in[3], float out[3]);
+/* A VPL's or surfel's normal (docs/propagation.md section 3c): a unit
+ * normal, or the weighted mean of the unit normals of the samples a
+ * down-sampled VPL or surfel stands for (length <= 1, shorter where they
+ * differ, so the lobe it injects is the sum of theirs). Longer vectors are
+ * normalised. 0 for a non-finite or (nearly) zero vector, as
+ * lpv_unit_direction. */
+int lpv_mean_direction(const float in[3], float out[3]);
 
 #endif /* LPV_SH_H */

@@ -61,7 +61,7 @@ struct lpv_engine {
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
+    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
         prog_media, prog_shadow;
 
     /* scene */
@@ -95,8 +95,9 @@ struct lpv_engine {
     int rsm_layers;       /* layers in use: punctual faces + those the area faces' tiles fill */
     int area_face_side;   /* texels of an area light face's tile */
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
-    GLuint vpls, surfels; /* one per RSM texel */
-    size_t rsm_texels;    /* rsm_layers * rsm_size^2 */
+    GLuint vpls, surfels; /* blocks of RSM texels, up to LPV_BLOCK_SLOTS each (vpl_extract.comp) */
+    size_t rsm_per_layer; /* VPLs (and surfels) per layer: blocks^2 x slots */
+    size_t rsm_vpl_count; /* rsm_layers * rsm_per_layer */
 
     /* shadow maps of direct light (pass_shadow.c), rendered at render time */
     struct LpvShadowBlock shadow_block; /* the faces the maps hold */
@@ -195,6 +196,11 @@ int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err
 int lpv_engine_place_volume(lpv_engine *e, char *err, size_t err_size);
 /* After a commit: the volume's description, and what a storage reset drops. */
 void lpv_engine_committed(lpv_engine *e, int reset);
+
+/* Sets prog's (in use) block_groups.glsl uniforms: the volume's cascades
+ * after the last commit (none for a technique without cascades: one group
+ * per block). block_groups.c. */
+void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog);
 
 /* The camera's surfels the last G-buffer pass made (pass_camera.c). */
 static inline size_t lpv_engine_camera_surfel_count(const lpv_engine *e)

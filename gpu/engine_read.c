@@ -62,7 +62,7 @@ size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 {
     if (!e->ticked)
         return 0;
-    size_t n = lpv_gl_read_buffer(e->vpls, sizeof(lpv_vpl), e->rsm_texels, out, max);
+    size_t n = lpv_gl_read_buffer(e->vpls, sizeof(lpv_vpl), e->rsm_vpl_count, out, max);
     if (n < max && e->plan.consumes.emissive_vpls) /* what the technique got */
         n += lpv_gl_read_buffer(e->emissive_vpls, sizeof(lpv_vpl), e->emissive_vpl_count, out + n, max - n);
     return n;
@@ -84,7 +84,7 @@ size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
 
 void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *first, size_t *count)
 {
-    const size_t per_layer = (size_t)e->rsm_size * (size_t)e->rsm_size;
+    const size_t per_layer = e->rsm_per_layer;
     const size_t lights = (size_t)e->light_block.counts[2];
     *first = *count = 0;
     if (buffer < lights) {

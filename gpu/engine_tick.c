@@ -87,7 +87,7 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
     in->plan = &e->plan;
     in->timer = &e->timer;
     in->rsm_vpls = e->vpls;
-    in->rsm_vpl_count = e->rsm_texels;
+    in->rsm_vpl_count = e->rsm_vpl_count;
     in->emissive_vpls = e->emissive_vpls;
     in->emissive_vpl_count = e->emissive_vpl_count;
     in->medium = &e->medium;
@@ -131,7 +131,7 @@ static void record_stats(lpv_engine *e)
     s->area_lights = (unsigned)(e->light_block.counts[0] - e->light_block.counts[2]);
     s->rsm_faces = (unsigned)e->face_count;
     s->rsm_size = (unsigned)e->settings.rsm_size;
-    s->vpls_rsm = e->rsm_texels;
+    s->vpls_rsm = e->rsm_vpl_count;
     s->vpls_emissive = e->plan.consumes.emissive_vpls ? e->emissive_vpl_count : 0;
     const int gv = e->plan.consumes.surfels;
     s->surfels_rsm = 0;

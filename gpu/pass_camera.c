@@ -71,7 +71,7 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
 
     glGenBuffers(1, &e->camera_surfels);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->camera_surfels);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lpv_memory_camera_surfels(w, h) * sizeof(lpv_surfel)), NULL,
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lpv_memory_block_samples(w, h) * sizeof(lpv_surfel)), NULL,
                  GL_DYNAMIC_COPY);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
@@ -164,27 +164,13 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     const int step = lpv_settings_camera_surfel_step(&e->settings, v->height);
     e->camera_surfel_w = (v->width + step - 1) / step;
     e->camera_surfel_h = (v->height + step - 1) / step;
-    e->camera_surfel_slots = step * step < LPV_CAMERA_SLOTS ? step * step : LPV_CAMERA_SLOTS;
-    /* the cascades the geometry volume splats to: the blocks group their
-     * pixels by the points they snap to (describe() ran at the commit before
-     * this pass; other techniques read no camera surfels' grid: one slot) */
-    float grids[LPV_MAX_CASCADES][4] = {{0}};
-    int levels = e->desc.kind == LPV_LEVELS_CASCADES ? e->desc.levels : 0;
-    for (int k = 0; k < levels && k < LPV_MAX_CASCADES; ++k) {
-        const lpv_grid *g = &e->desc.level[k];
-        if (!(g->cell_size > 0.0f))
-            levels = 0;
-        for (int i = 0; i < 3; ++i)
-            grids[k][i] = g->origin[i];
-        grids[k][3] = g->cell_size;
-    }
+    e->camera_surfel_slots = step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
     GLuint cs = e->prog_camera_surfels;
     glUniform2i(glGetUniformLocation(cs, "u_size"), v->width, v->height);
     glUniform1i(glGetUniformLocation(cs, "u_step"), step);
     glUniform2i(glGetUniformLocation(cs, "u_out_size"), e->camera_surfel_w, e->camera_surfel_h);
     glUniform1i(glGetUniformLocation(cs, "u_slots"), e->camera_surfel_slots);
-    glUniform4fv(glGetUniformLocation(cs, "u_gv_grid"), LPV_MAX_CASCADES, &grids[0][0]);
-    glUniform1i(glGetUniformLocation(cs, "u_gv_levels"), levels);
+    lpv_engine_bind_block_groups(e, cs);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->camera_surfels);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glDispatchCompute(lpv_div_up((size_t)e->camera_surfel_w, LPV_WG_2D), lpv_div_up((size_t)e->camera_surfel_h, LPV_WG_2D),

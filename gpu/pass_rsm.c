@@ -50,11 +50,10 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     const int layers = e->rsm_layers > 0 ? e->rsm_layers : 1;
     if (e->rsm_alloc_size == size && e->rsm_alloc_faces == layers) {
         e->rsm_size = size;
-        e->rsm_texels = (size_t)e->rsm_layers * (size_t)size * (size_t)size;
         return 0;
     }
     e->rsm_size = 0;
-    e->rsm_texels = 0;
+    e->rsm_vpl_count = 0;
     /* Estimate before allocating: past what the device holds, drivers fail
      * in ways that crash (llvmpipe segfaults on shader storage past 2 GiB). */
     lpv_memory_need need;
@@ -72,7 +71,8 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     e->rsm_depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
     glGenFramebuffers(1, &e->rsm_fbo);
 
-    size_t texels = (size_t)layers * (size_t)size * (size_t)size;
+    /* the most VPLs (and surfels) any step makes: see lpv_memory_block_samples */
+    size_t texels = (size_t)layers * (size_t)lpv_memory_block_samples(size, size);
     glGenBuffers(1, &e->vpls);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_vpl)), NULL, GL_DYNAMIC_COPY);
@@ -88,7 +88,7 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     e->rsm_alloc_size = size;
     e->rsm_alloc_faces = layers;
     e->rsm_size = size;
-    e->rsm_texels = (size_t)e->rsm_layers * (size_t)size * (size_t)size;
+    e->rsm_vpl_count = 0;
     return 0;
 }
 
@@ -145,17 +145,37 @@ void lpv_pass_rsm_run(lpv_engine *e)
         return;
     lpv_timer_begin(&e->timer, "vpl_extract");
     if (e->rsm_layers > 0) {
-        glUseProgram(e->prog_vpl_extract);
+        /* blocks of step x step texels, grouped by the cells (VPLs) and GV
+         * points (surfels) of the cascades they reach (block_groups.glsl);
+         * the step divides an area light face's tile side */
+        const int tile = e->area_sample_count > 0 && e->area_face_side > 0 ? e->area_face_side : size;
+        const int step = lpv_settings_rsm_vpl_step(&e->settings, size, tile);
+        const int blocks = (size + step - 1) / step;
+        const int slots = step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
+        e->rsm_per_layer = (size_t)blocks * (size_t)blocks * (size_t)slots;
+        e->rsm_vpl_count = (size_t)e->rsm_layers * e->rsm_per_layer;
+        /* step 1: a VPL per texel (a program without the grouping: llvmpipe
+         * would run its code for every texel even where it is not needed) */
+        const GLuint prog = step > 1 ? e->prog_vpl_blocks : e->prog_vpl_extract;
+        glUseProgram(prog);
+        if (step > 1) {
+            lpv_engine_bind_block_groups(e, prog);
+            glUniform1i(glGetUniformLocation(prog, "u_step"), step);
+            glUniform1i(glGetUniformLocation(prog, "u_blocks"), blocks);
+            glUniform1i(glGetUniformLocation(prog, "u_slots"), slots);
+            glUniform1i(glGetUniformLocation(prog, "u_bins"),
+                        e->desc.volumes_per_level > 1 ? e->desc.volumes_per_level : 1);
+        }
         GLuint tex[4] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo};
         for (int i = 0; i < 4; ++i) {
             glActiveTexture(GL_TEXTURE0 + (GLenum)i);
             glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
         }
-        glUniform1i(glGetUniformLocation(e->prog_vpl_extract, "u_size"), size);
+        glUniform1i(glGetUniformLocation(prog, "u_size"), size);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->vpls);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->surfels);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-        glDispatchCompute(lpv_div_up((size_t)size, LPV_WG_2D), lpv_div_up((size_t)size, LPV_WG_2D),
+        glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D),
                           (GLuint)e->rsm_layers);
         lpv_timer_count(&e->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

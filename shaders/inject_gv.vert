@@ -25,7 +25,7 @@ void main()
     float w = cascade_object_weight(k, s.normal.w);
     if (!(w > 0.0))
         return;
-    vec3 n = s.normal.xyz / len;
+    vec3 n = s.normal.xyz / max(len, 1.0); // unit, or a down-sampled surfel's mean normal (core/sh.h lpv_mean_direction)
     float cell = cascade_cell(k);
     ivec3 p = ivec3(floor(cascade_coords(k, s.position.xyz) + 0.5));
     ivec3 gv_dims = grid_dims() + 1;

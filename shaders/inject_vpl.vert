@@ -23,7 +23,7 @@ void main()
     float len = length(v.normal.xyz);
     if (v.position.w == 0.0 || !finite3(v.position.xyz) || !finite3(v.flux.rgb) || !(len > 1e-8) || isinf(len))
         return;
-    vec3 n = v.normal.xyz / len;
+    vec3 n = v.normal.xyz / max(len, 1.0); // unit, or a down-sampled VPL's mean normal (core/sh.h lpv_mean_direction)
     float w = cascade_object_weight(k, v.normal.w);
     if (!(w > 0.0))
         return;

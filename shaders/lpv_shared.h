@@ -405,9 +405,10 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_PROP_WG_X 32
 #define LPV_PROP_WG_Y 2
 #define LPV_WG_2D 8
-/* Surfels per block of camera pixels at most (camera_surfels.comp): one per
- * geometry-volume point the block's pixels snap to. */
-#define LPV_CAMERA_SLOTS 8
+/* Samples per block of a down-sampled buffer at most (block_groups.glsl:
+ * camera surfels, RSM VPLs and surfels): one per cell or geometry-volume
+ * point the block's samples reach. */
+#define LPV_BLOCK_SLOTS 8
 
 /* ---- Limits ---------------------------------------------------------------- */
 #define LPV_MAX_GRID_DIM     256  /* cells per axis */

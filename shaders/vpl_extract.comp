@@ -1,5 +1,6 @@
 // vpl_extract.comp - turns every RSM texel of every face into one VPL and one
-// surfel (position.w = 0 / area 0 where the texel saw nothing).
+// surfel (position.w = 0 / area 0 where the texel saw nothing): the
+// extraction at rsm_vpl_step 1; vpl_blocks.comp down-samples.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = 0) uniform sampler2DArray u_rsm_position;

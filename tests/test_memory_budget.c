@@ -4,7 +4,7 @@
  * core/memory_budget.c, docs/shadows.md "Memory"):
  *  1. the estimate and the check on their own, against given limits;
  *  2. through GL: a scene with 8 point lights (48 light faces) and
- *     rsm_size 2048 (a 9.66 GB VPL buffer, which crashed llvmpipe) is
+ *     rsm_size 2048 (a 9.68 GB VPL buffer, which crashed llvmpipe) is
  *     refused, and the same engine then works at a sane size;
  *  3. under LPVD_MEMORY_BUDGET_MB a shadow_size whose maps do not fit is
  *     refused at render time, naming shadow_size and the budget, and
@@ -60,14 +60,16 @@ static void test_estimates_and_check(void **state)
     char err[512] = "";
     assert_int_equal(lpv_memory_check(&n, &LIMITS, err, sizeof err), 0);
     /* the parts, by their formats */
-    assert_int_equal(lpv_memory_rsm_bytes(&n), 128ull * 128 * 48 * (56 + 48 + 48));
+    /* textures per texel; VPLs and surfels per slot of the down-sampling's
+     * blocks, at most (128 + 2)^2 a layer at any step */
+    assert_int_equal(lpv_memory_rsm_bytes(&n), 128ull * 128 * 48 * 56 + 130ull * 130 * 48 * (48 + 48));
     assert_int_equal(lpv_memory_shadow_bytes(&n), 1024ull * 1024 * 48 * 4);
     assert_int_equal(lpv_memory_total_bytes(&n), lpv_memory_rsm_bytes(&n) + lpv_memory_shadow_bytes(&n) +
                                                      lpv_memory_grid_bytes(&n) + lpv_memory_image_bytes(&n));
 
     n = sane();
-    n.rsm_size = 2048; /* 48 x 2048^2 x 48 B = 9.66 GB in one buffer */
-    expect_refused(&n, "rsm_size 2048 x 48 light faces needs 9.66 GB for one VPL buffer", "2.15 GB");
+    n.rsm_size = 2048; /* 48 x (2048 + 2)^2 x 48 B = 9.68 GB in one buffer */
+    expect_refused(&n, "rsm_size 2048 x 48 light faces needs 9.68 GB for one VPL buffer", "2.15 GB");
     n = sane();
     n.rsm_size = 512; /* one VPL buffer of 0.60 GB fits; all RSM storage (1.91 GB) and 8192^2 shadows do not */
     n.shadow_size = 4096; /* 48 x 4096^2 x 4 B = 3.22 GB, the largest part */
@@ -121,7 +123,7 @@ static void test_rsm_size_that_crashed_is_refused(void **state)
     lpv_settings big = {.grid_dims = {8, 8, 8}, .rsm_size = 2048};
     assert_int_equal(run_engine(lpvt_engine, &s, &big, &v, rgba, err, sizeof err), -1);
     printf("refused: %s\n", err);
-    assert_non_null(strstr(err, "rsm_size 2048 x 48 light faces needs 9.66 GB"));
+    assert_non_null(strstr(err, "rsm_size 2048 x 48 light faces needs 9.68 GB"));
     /* nothing was left half made: the engine works at a size that fits */
     lpv_settings ok = {.grid_dims = {8, 8, 8}, .rsm_size = 32, .shadow_size = 64};
     if (run_engine(lpvt_engine, &s, &ok, &v, rgba, err, sizeof err) != 0)
