@@ -74,22 +74,31 @@ void main()
     int ti = k * grid_cells() + cell_index(c); // this cell in the per-cascade buffers
     LpvCell sum;
     sum.r = sum.g = sum.b = vec4(0.0);
-    for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
-        int axis = dir / 2;
-        float s = (dir & 1) == 0 ? 1.0 : -1.0;
-        ivec3 src = c;
-        src[axis] -= int(s);
-        if (!cell_inside(src))
-            continue;
-        int slot = axis == 0 ? 3 : axis; // x lives in slot 3, y in 1, z in 2
-        float t = u_occlusion != 0 ? texelFetch(u_transmit, ti * LPV_DIR_COUNT + dir).x : 1.0;
-        int j = base + cell_index(src);
-        LpvCell n = fetch_cell(u_in, j);
-        vec4 sigma = texelFetch(u_sigma_in, j);
-        sum.r += t * transfer(n.r, sigma.r, slot, s);
-        sum.g += t * transfer(n.g, sigma.g, slot, s);
-        sum.b += t * transfer(n.b, sigma.b, slot, s);
+    // the six directions written out (GATHER), so that the axis, the sign
+    // and the SH slot are constants: llvmpipe would otherwise index vectors
+    // and branch per lane
+#define GATHER(dir, axis, s, slot)                                                               \
+    {                                                                                            \
+        ivec3 src = c;                                                                           \
+        src[axis] -= int(s);                                                                     \
+        if (src[axis] >= 0 && src[axis] < grid_dims()[axis]) {                                   \
+            float t = u_occlusion != 0 ? texelFetch(u_transmit, ti * LPV_DIR_COUNT + dir).x : 1.0; \
+            int j = base + cell_index(src);                                                      \
+            LpvCell n = fetch_cell(u_in, j);                                                     \
+            vec4 sigma = texelFetch(u_sigma_in, j);                                              \
+            sum.r += t * transfer(n.r, sigma.r, slot, s);                                        \
+            sum.g += t * transfer(n.g, sigma.g, slot, s);                                        \
+            sum.b += t * transfer(n.b, sigma.b, slot, s);                                        \
+        }                                                                                        \
     }
+    // direction order +x -x +y -y +z -z; x lives in SH slot 3, y in 1, z in 2
+    GATHER(0, 0, 1.0, 3)
+    GATHER(1, 0, -1.0, 3)
+    GATHER(2, 1, 1.0, 1)
+    GATHER(3, 1, -1.0, 1)
+    GATHER(4, 2, 1.0, 2)
+    GATHER(5, 2, -1.0, 2)
+#undef GATHER
     if (u_bounce != 0 && u_occlusion != 0) {
         LpvCell self = fetch_cell(u_in, i);
         vec4 sigma = texelFetch(u_sigma_in, i);
