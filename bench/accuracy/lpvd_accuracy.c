@@ -93,7 +93,27 @@ typedef struct point {
     /* technique iv: its knobs (0 = --iv-* or the engine's default); of the
      * LPV's knobs only rsm applies (the lights' shadow maps) */
     lpv_acc_iv_knobs iv;
+    /* the down-sampling of the camera's surfels and the RSMs' VPLs
+     * (settings.camera_surfel_step, rsm_vpl_step): 0 = not swept (the
+     * flags' value, else auto), -1 = auto, N = every N texels */
+    int cstep, rstep;
 } point;
+
+/* The setting a swept step stands for (0 = auto), or the base's. */
+static int step_setting(int swept, int base) { return swept == 0 ? base : swept < 0 ? 0 : swept; }
+
+/* " cam 4, vpl auto" when the point sweeps the steps, else "". */
+static const char *steps_name(const point *p, char buf[48])
+{
+    buf[0] = '\0';
+    if (p->cstep || p->rstep) {
+        char c[12], r[12];
+        snprintf(c, sizeof c, p->cstep > 0 ? "%d" : "auto", p->cstep);
+        snprintf(r, sizeof r, p->rstep > 0 ? "%d" : "auto", p->rstep);
+        snprintf(buf, 48, " cam %s, vpl %s", p->cstep ? c : "-", p->rstep ? r : "-");
+    }
+    return buf;
+}
 
 static int is_iv(const point *p) { return p->technique == LPV_TECHNIQUE_ID_IV; }
 
@@ -177,6 +197,8 @@ static const char *point_preset(const point *p)
     lpv_settings s = point_settings(p);
     if (p->technique != LPV_TECHNIQUE_ID_DEFAULT && p->technique != LPV_TECHNIQUE_ID_LPV)
         return ""; /* the presets are the cascaded LPV's */
+    if (p->cstep > 0 || p->rstep > 0)
+        return ""; /* a preset down-samples automatically */
     lpv_preset m = lpv_preset_match(&s);
     return m == LPV_PRESET_DEFAULT ? "" : lpv_preset_name(m);
 }
@@ -307,11 +329,14 @@ static const lpv_flag FLAGS[A_COUNT] = {
                                      "iv_reprojection=on/off,iv_neighbours=6/8 make a factorial of iv points\n"
                                      "(unnamed iv knobs: --iv-* or the engine's default; rsm applies to every\n"
                                      "technique, the other LPV knobs only to lpv/octree points); iv knobs\n"
-                                     "alone imply technique=iv"},
+                                     "alone imply technique=iv; camera_step=auto/1/4, rsm_step=auto/1/4\n"
+                                     "sweep the down-sampling of the camera's surfels and the RSMs' VPLs\n"
+                                     "(--camera-surfel-step, --rsm-vpl-step; auto = the engine's default)"},
     [A_POINTS] = {"points", 0, "LIST", "explicit points GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]] (MODS letters\n"
                                        "of cbfs) or iv[:RES:POINTS:RAYS:BOUNCES:REPROJ:NEIGHBOURS], e.g.\n"
                                        "iv:32:8:64:3:on:8 or iv:16:-:100 (a field left out or '-': --iv-* or\n"
-                                       "the default; RSM 128)"},
+                                       "the default; RSM 128); @CAM/VPL after a point sets its steps (a\n"
+                                       "number or auto), e.g. 8:8:128:on:cbfs@1/1"},
     [A_TICKS] = {"ticks", 0, "N", "timed ticks per point, median reported (default 5)"},
     [A_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 2)"},
     [A_REFERENCE] = {"reference", 0, "PATH", "run this reference command (lpvd-reference's CLI) instead of the\n"
@@ -435,7 +460,24 @@ typedef struct knob_filter {
     int sw[4][2], nsw[4]; /* central, bins, far, surfels: off/on */
     int tech[LPV_TECHNIQUE_ID_COUNT_], ntech; /* lpv_technique_id */
     int iv[LPV_ACC_IV_KNOBS][16], niv[LPV_ACC_IV_KNOBS]; /* technique iv's knobs (iv_knobs.h) */
+    int cs[16], ncs, rs[16], nrs; /* camera_step, rsm_step: -1 = auto (point.cstep, rstep) */
 } knob_filter;
+
+/* "auto/1/4": the steps' list, auto as -1. */
+static int parse_steps(const char *v, int *out, int max)
+{
+    char buf[128];
+    snprintf(buf, sizeof buf, "%s", v);
+    int n = 0;
+    for (char *save = NULL, *t = strtok_r(buf, "/", &save); t; t = strtok_r(NULL, "/", &save)) {
+        char *end;
+        long x = strcmp(t, "auto") == 0 ? -1 : strtol(t, &end, 10);
+        if (n >= max || (x != -1 && (*end || x < 1 || x > LPV_MAX_CAMERA_SURFEL_STEP)))
+            return -1;
+        out[n++] = (int)x;
+    }
+    return n > 0 ? n : -1;
+}
 
 /* Whether the filter names one of the LPV's own knobs (not rsm: the imperfect
  * volume's shadow maps are RSMs too), or one of the imperfect volume's. */
@@ -473,6 +515,10 @@ static int parse_knobs(const char *spec, knob_filter *kf)
             r = kf->nrsm = parse_values(v, kf->rsm, 16, 0);
         else if (strcmp(tok, "occlusion") == 0)
             r = kf->nocc = parse_values(v, kf->occ, 2, 1);
+        else if (strcmp(tok, "camera_step") == 0)
+            r = kf->ncs = parse_steps(v, kf->cs, 16);
+        else if (strcmp(tok, "rsm_step") == 0)
+            r = kf->nrs = parse_steps(v, kf->rs, 16);
         else if (strcmp(tok, "technique") == 0) {
             char names[128];
             snprintf(names, sizeof names, "%s", v);
@@ -501,7 +547,8 @@ static int parse_knobs(const char *spec, knob_filter *kf)
     return 0;
 }
 
-/* --points: "GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]]" or the imperfect
+/* --points: "GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]][@CAM/VPL]" (the steps,
+ * a number or auto) or the imperfect
  * volume's "iv[:RES:POINTS:RAYS:BOUNCES:REPROJ:NEIGHBOURS]" (iv_knobs.h),
  * comma-separated. Returns the count, or -1 with err set. */
 static int parse_points(const char *list, point *pts, int max, char *err, size_t err_size)
@@ -512,6 +559,17 @@ static int parse_points(const char *list, point *pts, int max, char *err, size_t
     for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         char occ[8] = "", mods[8] = "", tech[16] = "";
         point p = {0};
+        char *steps = strchr(tok, '@'); /* the steps */
+        if (steps) {
+            int st[2];
+            *steps = '\0';
+            if (parse_steps(steps + 1, st, 2) != 2) {
+                snprintf(err, err_size, "%s: @CAM/VPL expects two steps, each a number or auto", steps + 1);
+                return -1;
+            }
+            p.cstep = st[0];
+            p.rstep = st[1];
+        }
         if (n >= max) {
             snprintf(err, err_size, "at most %d points", max);
             return -1;
@@ -551,7 +609,7 @@ static int parse_points(const char *list, point *pts, int max, char *err, size_t
             !technique_runs(&p))
             return -1;
         if (is_iv(&p)) /* the old form with technique iv: its RSM, the iv knobs' defaults */
-            p = (point){.rsm = p.rsm, .technique = LPV_TECHNIQUE_ID_IV};
+            p = (point){.rsm = p.rsm, .technique = LPV_TECHNIQUE_ID_IV, .cstep = p.cstep, .rstep = p.rstep};
         pts[n++] = p;
     }
     if (n == 0)
@@ -839,6 +897,7 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
         fprintf(f, ",%s", lpv_acc_iv_knob_name(k));
     for (int k = NSTAGES_LPV; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
+    fprintf(f, ",camera_surfel_step,rsm_vpl_step"); /* the settings, 0 = auto; empty: not swept */
     fputc('\n', f);
     for (int i = 0; i < n; ++i) {
         char mb[5];
@@ -881,6 +940,14 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
         }
         for (int k = NSTAGES_LPV; k < NSTAGES; ++k)
             fprintf(f, ",%.3f", r[i].stage_ms[k]);
+        if (r[i].p.cstep)
+            fprintf(f, ",%d", step_setting(r[i].p.cstep, 0));
+        else
+            fputc(',', f);
+        if (r[i].p.rstep)
+            fprintf(f, ",%d", step_setting(r[i].p.rstep, 0));
+        else
+            fputc(',', f);
         fputc('\n', f);
     }
 }
@@ -1055,10 +1122,10 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             const result *x = rows[i];
             const char *b = x->pareto ? "**" : "";
             fprintf(f,
-                    "| %s | %s%d³%s | %d | %d² | %s | `%s` | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f "
+                    "| %s | %s%d³%s | %d | %d² | %s | `%s`%s | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f "
                     "| %s |\n",
                     tech_name(x->p.technique), b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion),
-                    mods_name(x->p.mods, (char[5]){0}), point_preset(&x->p), b,
+                    mods_name(x->p.mods, (char[5]){0}), steps_name(&x->p, (char[48]){0}), point_preset(&x->p), b,
                     x->ms_total, b,
                     x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
                     x->pareto ? "**◆**" : "");
@@ -1258,6 +1325,8 @@ static const char *key_preset(const int key[LPV_ACC_KEY])
 {
     point p = {key[0], key[1], key[2], key[3], key[4]};
     p.technique = (lpv_technique_id)key[5];
+    p.cstep = key[LPV_ACC_KEY_STEPS];
+    p.rstep = key[LPV_ACC_KEY_STEPS + 1];
     return point_preset(&p);
 }
 
@@ -1284,6 +1353,8 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         lpv_acc_row row = {r[i].scene, {0}, r[i].ms_total, r[i].m.rel_rmse};
         row.key[2] = r[i].p.rsm;
         row.key[LPV_ACC_KEY_TECHNIQUE] = (int)r[i].p.technique;
+        row.key[LPV_ACC_KEY_STEPS] = r[i].p.cstep;
+        row.key[LPV_ACC_KEY_STEPS + 1] = r[i].p.rstep;
         if (is_iv(&r[i].p)) {
             memcpy(row.key + LPV_ACC_KEY_IV, r[i].iv.v, sizeof r[i].iv.v);
             has_iv = 1;
@@ -1353,8 +1424,12 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
             if (has_lpv && iv)
                 fprintf(md, " - | - | %d² | - | - | |", x->key[2]);
             else if (has_lpv)
-                fprintf(md, " %s%d³%s | %d | %d² | %s | `%s` | %s |", b, x->key[0], b, x->key[1], x->key[2],
-                        occ_name(x->key[3]), mb, pre);
+                fprintf(md, " %s%d³%s | %d | %d² | %s | `%s`%s | %s |", b, x->key[0], b, x->key[1], x->key[2],
+                        occ_name(x->key[3]), mb,
+                        steps_name(&(point){.cstep = x->key[LPV_ACC_KEY_STEPS],
+                                            .rstep = x->key[LPV_ACC_KEY_STEPS + 1]},
+                                   (char[48]){0}),
+                        pre);
             else
                 fprintf(md, " %d² |", x->key[2]);
             if (has_iv && iv)
@@ -1751,7 +1826,8 @@ int main(int argc, char **argv)
     if (knobs && parse_knobs(knobs, &kf) != 0) {
         fprintf(stderr, "lpvd-accuracy: --knobs expects e.g. grid=16/32,iterations=8,rsm=256,occlusion=on,"
                         "central=on,bins=off/on,far=on,surfels=on,technique=lpv/iv,iv_resolution=16/32,iv_points=8,"
-                        "iv_rays=32/64,iv_bounces=1/3,iv_reprojection=on/off,iv_neighbours=6/8 (see --help)\n");
+                        "iv_rays=32/64,iv_bounces=1/3,iv_reprojection=on/off,iv_neighbours=6/8,camera_step=auto/1,"
+                        "rsm_step=auto/1 (see --help)\n");
         return 2;
     }
     if (!points_arg && !presets && !quick) {
@@ -1805,8 +1881,14 @@ int main(int argc, char **argv)
                             for (size_t m = 0; m < sizeof MODS / sizeof *MODS && npts < MAX_POINTS; ++m) {
                                 point q = {gl[g], il[it], rl[r], ol[o], MODS[m]};
                                 q.technique = (lpv_technique_id)tl[t];
-                                if (technique_runs(&q))
-                                    pts[npts++] = q;
+                                if (!technique_runs(&q))
+                                    continue;
+                                for (int c = 0; c < (kf.ncs ? kf.ncs : 1); ++c) /* the steps, when swept */
+                                    for (int e = 0; e < (kf.nrs ? kf.nrs : 1) && npts < MAX_POINTS; ++e) {
+                                        q.cstep = kf.ncs ? kf.cs[c] : 0;
+                                        q.rstep = kf.nrs ? kf.rs[e] : 0;
+                                        pts[npts++] = q;
+                                    }
                             }
         }
     }
@@ -1824,7 +1906,8 @@ int main(int argc, char **argv)
                 continue;
             }
             keep = keep && in_list(pts[i].grid, kf.grid, kf.ngrid) && in_list(pts[i].iterations, kf.iter, kf.niter) &&
-                   in_list(pts[i].occlusion, kf.occ, kf.nocc);
+                   in_list(pts[i].occlusion, kf.occ, kf.nocc) && in_list(pts[i].cstep, kf.cs, kf.ncs) &&
+                   in_list(pts[i].rstep, kf.rs, kf.nrs);
             for (int m = 0; m < 4; ++m)
                 keep = keep && in_list((pts[i].mods >> m) & 1, kf.sw[m], kf.nsw[m]);
             if (keep)
@@ -1995,6 +2078,8 @@ add_features:
             st.lpv.far_field = on_off(pts[p].mods & MOD_FAR);
             st.scene_surfels = on_off(pts[p].mods & MOD_SURFELS);
             st.technique = pts[p].technique;
+            st.camera_surfel_step = step_setting(pts[p].cstep, st.camera_surfel_step);
+            st.rsm_vpl_step = step_setting(pts[p].rstep, st.rsm_vpl_step);
             if (pts[p].feat) {
                 st.lpv.cascades = pts[p].cascades;
                 if (pts[p].cascades > 1) {
@@ -2130,10 +2215,11 @@ add_features:
                         res->rel_rmse_1b, res->m.rel_bias);
             else
                 fprintf(stderr,
-                        "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s: "
+                        "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s%s: "
                         "%.2f ms/tick, rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
                         se->name, p + 1, npts, tech_name(pts[p].technique), pts[p].grid, pts[p].iterations, pts[p].rsm,
                         occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
+                        steps_name(&pts[p], (char[48]){0}),
                         res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
                         pts[p].label);
             ++nres;
