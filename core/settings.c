@@ -442,9 +442,9 @@ int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)
     return auto_step(s, image_h, LPV_CAMERA_SURFELS_PER_CELL, LPV_MAX_CAMERA_SURFEL_STEP);
 }
 
-int lpv_settings_rsm_vpl_step(const lpv_settings *s, int size, int tile)
+int lpv_settings_rsm_vpl_step(const lpv_settings *s, int tile)
 {
-    int want = s->rsm_vpl_step > 0 ? s->rsm_vpl_step : auto_step(s, size, LPV_RSM_VPLS_PER_CELL, LPV_MAX_RSM_VPL_STEP);
+    int want = s->rsm_vpl_step > 0 ? s->rsm_vpl_step : LPV_RSM_AUTO_STEP;
     int step = 1;
     while (step * 2 <= want && tile > 0 && tile % (step * 2) == 0)
         step *= 2;

@@ -184,9 +184,13 @@ typedef struct lpv_settings {
  * down-sampled before surfel injection). */
 #define LPV_CAMERA_SURFELS_PER_CELL 4
 #define LPV_MAX_CAMERA_SURFEL_STEP 64
-/* Auto RSM VPL step: this many VPL blocks per finest cell along a light
- * face's side when the grid spans it. */
-#define LPV_RSM_VPLS_PER_CELL 4
+/* Auto RSM VPL step: LPV_RSM_AUTO_STEP. A block of 2 x 2 texels never has
+ * more groups than its slots (LPV_BLOCK_SLOTS), so the auto step changes no
+ * cell's light at any grid (each block already gives one VPL per cell it
+ * reaches: the VPL count follows what the grid resolves); a larger explicit
+ * step can merge groups past the slots (an RSM texel of a light near a
+ * corner sees several cells and both walls). */
+#define LPV_RSM_AUTO_STEP 2
 #define LPV_MAX_RSM_VPL_STEP 64
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 #define LPV_IV_DEFAULT_RESOLUTION 16
@@ -257,11 +261,10 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
  * camera_surfel_step when set, else image_h / (LPV_CAMERA_SURFELS_PER_CELL x
  * the grid's largest dimension), at least 1. */
 int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h);
-/* The RSM VPL step in effect for RSM layers of size x size texels whose
- * faces are tiles of `tile` texels (size itself, or an area light face's
- * tile side): rsm_vpl_step when set, else size / (LPV_RSM_VPLS_PER_CELL x
- * the grid's largest dimension); then the largest power of two not above it
- * that divides tile, at least 1, so blocks never straddle two faces. */
-int lpv_settings_rsm_vpl_step(const lpv_settings *s, int size, int tile);
+/* The RSM VPL step in effect for RSM faces of `tile` texels a side:
+ * rsm_vpl_step when set, else LPV_RSM_AUTO_STEP; then the largest power of
+ * two not above it that divides tile, at least 1, so blocks never straddle
+ * two faces. */
+int lpv_settings_rsm_vpl_step(const lpv_settings *s, int tile);
 
 #endif /* LPV_SETTINGS_H */

@@ -18,7 +18,7 @@ void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog)
         if (!(g->cell_size > 0.0f))
             levels = 0;
         for (int i = 0; i < 3; ++i) /* in cells, as the technique's grid block holds it */
-            grids[k][i] = g->origin[i] / g->cell_size;
+            grids[k][i] = e->desc.origin_cells[k][i];
         grids[k][3] = g->cell_size;
     }
     glUniform4fv(glGetUniformLocation(prog, "u_group_grid"), LPV_MAX_CASCADES, &grids[0][0]);

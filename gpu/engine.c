@@ -19,6 +19,7 @@ static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
 static const char *const INC_RSM[] = {"material.glsl", "lights.glsl", NULL};
 static const char *const INC_SHADE[] = {"lights.glsl", "shadow.glsl", NULL};
 static const char *const INC_MEDIA[] = {"lights.glsl", "shadow.glsl", "medium.glsl", NULL};
+static const char *const INC_BLOCKS[] = {"grid.glsl", "block_groups.glsl", NULL};
 static const char *const INC_BLOCKS8[] = {"grid.glsl", "block_slots8.glsl", "block_groups.glsl", NULL};
 
 /* out = the technique's lookup includes, then the pass's own (both
@@ -118,7 +119,8 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     } progs[] = {
         {&e->prog_rsm, "scene.vert", "rsm.frag", INC_RSM},
         {&e->prog_vpl_extract, "vpl_extract.comp", NULL, NULL},
-        {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_BLOCKS8},
+        {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_BLOCKS},
+        {&e->prog_vpl_blocks8, "vpl_blocks.comp", NULL, INC_BLOCKS8},
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, INC_BLOCKS8},
         {&e->prog_shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
@@ -198,7 +200,7 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_gl_delete_buffer(&e->query_out);
     if (e->tech)
         e->tech->cls->destroy(e->tech);
-    GLuint *progs[] = {&e->prog_rsm,    &e->prog_vpl_extract, &e->prog_vpl_blocks, &e->prog_gbuffer, &e->prog_camera_surfels,
+    GLuint *progs[] = {&e->prog_rsm,    &e->prog_vpl_extract, &e->prog_vpl_blocks, &e->prog_vpl_blocks8, &e->prog_gbuffer, &e->prog_camera_surfels,
                        &e->prog_shade,  &e->prog_query,       &e->prog_glossy,  &e->prog_media,
                        &e->prog_shadow};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)

@@ -56,6 +56,8 @@ typedef struct lpv_volume_desc {
     const char *technique;        /* the class's name (static) */
     int levels;                   /* 1..LPV_MAX_CASCADES */
     lpv_grid level[LPV_MAX_CASCADES];
+    float origin_cells[LPV_MAX_CASCADES][3]; /* each level's lower corner in its cells, exactly as the shaders
+                                                place it (grid.glsl cascade_coords) */
     int far_field;                /* level k + 1 carries on the light of level k */
     int volumes_per_level;        /* 1, or the normal bins */
     int values_per_cell;          /* floats: 12 = SH bands 0-1 of r, g, b */

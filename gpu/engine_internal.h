@@ -61,7 +61,7 @@ struct lpv_engine {
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
+    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
         prog_media, prog_shadow;
 
     /* scene */
@@ -78,8 +78,12 @@ struct lpv_engine {
     lpv_scene geometry;       /* the CPU copy the samples below are drawn from (lpv_scene_copy_geometry) */
     GLuint emissive_vpls;
     size_t emissive_vpl_count;
-    GLuint scene_surfels;     /* settings.scene_surfel_count over every triangle (GV), 0 = none */
-    size_t scene_surfel_count;
+    GLuint scene_surfels;     /* settings.scene_surfel_count over every triangle (GV), 0 = none, grouped by
+                                 the GV points of the volume's cascades (core/surfel_groups.h) */
+    size_t scene_surfel_count; /* in the buffer: the groups */
+    lpv_surfel *scene_surfel_samples; /* the samples themselves, regrouped when the cascades move */
+    size_t scene_surfel_sample_count;
+    uint64_t scene_surfel_grid_sig; /* the cascades the buffer's groups are for; 0 = none yet */
     GLuint iv_points;         /* the imperfect volume's point cloud (technique iv only), 0 = none */
     size_t iv_point_count;
     lpv_iv_point_stats iv_point_stats;
@@ -96,7 +100,7 @@ struct lpv_engine {
     int area_face_side;   /* texels of an area light face's tile */
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* blocks of RSM texels, up to LPV_BLOCK_SLOTS each (vpl_extract.comp) */
-    size_t rsm_per_layer; /* VPLs (and surfels) per layer: blocks^2 x slots */
+    size_t rsm_per_layer[2]; /* VPLs (and surfels) per layer, punctual and area lights': blocks^2 x slots */
     size_t rsm_vpl_count; /* rsm_layers * rsm_per_layer */
 
     /* shadow maps of direct light (pass_shadow.c), rendered at render time */
@@ -196,6 +200,10 @@ int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err
 int lpv_engine_place_volume(lpv_engine *e, char *err, size_t err_size);
 /* After a commit: the volume's description, and what a storage reset drops. */
 void lpv_engine_committed(lpv_engine *e, int reset);
+
+/* Groups the scene surfels by the GV points of the cascades committed last,
+ * unless they already are (engine_scene.c). */
+void lpv_engine_group_scene_surfels(lpv_engine *e);
 
 /* Sets prog's (in use) block_groups.glsl uniforms: the volume's cascades
  * after the last commit (none for a technique without cascades: one group

@@ -84,7 +84,7 @@ size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
 
 void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *first, size_t *count)
 {
-    const size_t per_layer = e->rsm_per_layer;
+    const size_t per_layer = e->rsm_per_layer[0], per_area_layer = e->rsm_per_layer[1];
     const size_t lights = (size_t)e->light_block.counts[2];
     *first = *count = 0;
     if (buffer < lights) {
@@ -100,7 +100,7 @@ void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *firs
         if (layers > e->rsm_layers - e->punctual_faces)
             layers = e->rsm_layers - e->punctual_faces;
         *first = (size_t)e->punctual_faces * per_layer;
-        *count = (size_t)layers * per_layer;
+        *count = (size_t)layers * per_area_layer;
     }
 }
 

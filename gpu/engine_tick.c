@@ -190,6 +190,7 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
     lpv_engine_committed(e, reset);
     if (rc != 0)
         return -1;
+    lpv_engine_group_scene_surfels(e);
     if (lpv_pass_rsm_prepare(e, err, err_size) != 0)
         return -1;
     if (p->pass[LPV_PASS_RSM].run)

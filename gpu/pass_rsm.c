@@ -92,6 +92,46 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     return 0;
 }
 
+/* Layers [first, first + count) of the RSMs, whose faces are `side` texels
+ * (a whole layer, or an area light's tile), into VPLs and surfels from
+ * element `base` on: blocks of step x step texels, grouped by the cells
+ * (VPLs) and GV points (surfels) of the cascades they reach
+ * (block_groups.glsl), the step dividing side. Returns the elements per layer. */
+static size_t extract_layers(lpv_engine *e, int first, int count, int side, size_t base)
+{
+    const int size = e->rsm_size;
+    const int step = lpv_settings_rsm_vpl_step(&e->settings, side);
+    const int blocks = (size + step - 1) / step;
+    const int slots = step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
+    if (count <= 0)
+        return (size_t)blocks * (size_t)blocks * (size_t)slots;
+    /* step 1: a VPL per texel (a program without the grouping: llvmpipe
+     * would run its code for every texel even where it is not needed);
+     * step 2: four slots (block_groups.glsl), as many as texels; larger: 8 */
+    const GLuint prog = step == 1 ? e->prog_vpl_extract : step == 2 ? e->prog_vpl_blocks : e->prog_vpl_blocks8;
+    glUseProgram(prog);
+    if (step > 1) {
+        lpv_engine_bind_block_groups(e, prog);
+        glUniform1i(glGetUniformLocation(prog, "u_step"), step);
+        glUniform1i(glGetUniformLocation(prog, "u_blocks"), blocks);
+        glUniform1i(glGetUniformLocation(prog, "u_slots"), slots);
+    }
+    GLuint tex[4] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo};
+    for (int i = 0; i < 4; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
+    }
+    glUniform1i(glGetUniformLocation(prog, "u_size"), size);
+    glUniform1i(glGetUniformLocation(prog, "u_layer0"), first);
+    glUniform1i(glGetUniformLocation(prog, "u_base"), (GLint)base);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->vpls);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->surfels);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D), (GLuint)count);
+    lpv_timer_count(&e->timer, 1);
+    return (size_t)blocks * (size_t)blocks * (size_t)slots;
+}
+
 void lpv_pass_rsm_run(lpv_engine *e)
 {
     const int size = e->rsm_size;
@@ -144,41 +184,15 @@ void lpv_pass_rsm_run(lpv_engine *e)
     if (!e->plan.pass[LPV_PASS_INJECT].run && !e->plan.pass[LPV_PASS_GV].run)
         return;
     lpv_timer_begin(&e->timer, "vpl_extract");
-    if (e->rsm_layers > 0) {
-        /* blocks of step x step texels, grouped by the cells (VPLs) and GV
-         * points (surfels) of the cascades they reach (block_groups.glsl);
-         * the step divides an area light face's tile side */
-        const int tile = e->area_sample_count > 0 && e->area_face_side > 0 ? e->area_face_side : size;
-        const int step = lpv_settings_rsm_vpl_step(&e->settings, size, tile);
-        const int blocks = (size + step - 1) / step;
-        const int slots = step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
-        e->rsm_per_layer = (size_t)blocks * (size_t)blocks * (size_t)slots;
-        e->rsm_vpl_count = (size_t)e->rsm_layers * e->rsm_per_layer;
-        /* step 1: a VPL per texel (a program without the grouping: llvmpipe
-         * would run its code for every texel even where it is not needed) */
-        const GLuint prog = step > 1 ? e->prog_vpl_blocks : e->prog_vpl_extract;
-        glUseProgram(prog);
-        if (step > 1) {
-            lpv_engine_bind_block_groups(e, prog);
-            glUniform1i(glGetUniformLocation(prog, "u_step"), step);
-            glUniform1i(glGetUniformLocation(prog, "u_blocks"), blocks);
-            glUniform1i(glGetUniformLocation(prog, "u_slots"), slots);
-            glUniform1i(glGetUniformLocation(prog, "u_bins"),
-                        e->desc.volumes_per_level > 1 ? e->desc.volumes_per_level : 1);
-        }
-        GLuint tex[4] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo};
-        for (int i = 0; i < 4; ++i) {
-            glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-            glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
-        }
-        glUniform1i(glGetUniformLocation(prog, "u_size"), size);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->vpls);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->surfels);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-        glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D),
-                          (GLuint)e->rsm_layers);
-        lpv_timer_count(&e->timer, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    }
+    /* the punctual lights' layers (one face a layer), then the area lights'
+     * (faces tiled four to a layer), each kind at the step of its faces'
+     * side: its VPLs after the punctual ones' */
+    const int punctual = e->punctual_faces < e->rsm_layers ? e->punctual_faces : e->rsm_layers;
+    const int area_side = e->area_face_side > 0 ? e->area_face_side : size;
+    e->rsm_per_layer[0] = extract_layers(e, 0, punctual, size, 0);
+    e->rsm_per_layer[1] = extract_layers(e, punctual, e->rsm_layers - punctual, area_side,
+                                         (size_t)punctual * e->rsm_per_layer[0]);
+    e->rsm_vpl_count = (size_t)punctual * e->rsm_per_layer[0] + (size_t)(e->rsm_layers - punctual) * e->rsm_per_layer[1];
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     lpv_timer_end(&e->timer);
 }

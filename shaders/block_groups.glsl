@@ -1,7 +1,8 @@
 // block_groups.glsl - down-sampling a buffer's samples (camera pixels, RSM
 // texels) in blocks without moving their light or blocking between cells:
 // each block's samples are grouped by the cell (VPLs) or geometry-volume
-// point (surfels) they land in, in every cascade (and by normal bin), and
+// point (surfels) they land in, in every cascade, and by normal bin (so the
+// two faces of a thin wall, whose normals would cancel, stay apart), and
 // one sample per group carries the group's sum at its weighted centroid
 // (camera_surfels.comp, vpl_blocks.comp). Since a centroid of points in one
 // cell lies in that cell, every cell or point receives what the samples gave

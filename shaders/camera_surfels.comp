@@ -55,7 +55,7 @@ void main()
             vec3 x = p.xyz, n = nt.xyz;
             float w = p.w, tag = em.a; // tag: object size
             vec3 val = p.w * texelFetch(u_gbuf_albedo, t, 0).rgb;
-            uvec4 g = group_key(x, n, true, -1);
+            uvec4 g = group_key(x, n, true, normal_bin(n)); // the bin: opposite faces never cancel
             BG_STEP
         }
     int base = (s.x + u_out_size.x * s.y) * u_slots;

@@ -6,9 +6,9 @@
 // centroid with its flux-weighted mean normal, and as many surfels, one per
 // set of geometry-volume points, carrying the summed area at the
 // area-weighted centroid. Every cell and point so receives what the texels
-// gave it one by one (exactly on a plane). Sample i of block b of layer l is
-// [(l * u_blocks^2 + b) * u_slots + i]; unused slots have position.w = 0
-// (VPL) / area 0 (surfel).
+// gave it one by one (exactly on a plane). Sample i of block b of layer
+// u_layer0 + l is [u_base + (l * u_blocks^2 + b) * u_slots + i]; unused
+// slots have position.w = 0 (VPL) / area 0 (surfel).
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = 0) uniform sampler2DArray u_rsm_position;
@@ -23,7 +23,8 @@ uniform int u_size;   // texels per layer side
 uniform int u_step;   // texels per block side
 uniform int u_blocks; // blocks per layer side: ceil(u_size / u_step)
 uniform int u_slots;  // samples per block: min(LPV_BLOCK_SLOTS, u_step^2)
-uniform int u_bins;   // the technique's normal bins (1: none)
+uniform int u_layer0; // the first layer of this dispatch
+uniform int u_base;   // its first element
 
 bool g_vpls; // what block_emit writes: VPLs, else surfels
 
@@ -63,7 +64,8 @@ void block_vpls(ivec2 lo, ivec2 hi, int layer, int base)
                 continue;
             vec3 x = p.xyz, n = nt.xyz / len, val = f.rgb;
             float tag = f.a; // object size
-            uvec4 g = group_key(x, n, false, u_bins > 1 ? normal_bin(n) : -1);
+            // the bin always: VPLs of opposite faces never cancel in one mean
+            uvec4 g = group_key(x, n, false, normal_bin(n));
             BG_STEP
         }
     BG_EMIT_ALL
@@ -87,7 +89,7 @@ void block_surfels(ivec2 lo, ivec2 hi, int layer, int base)
                 continue;
             vec3 x = p.xyz, n = nt.xyz, val = p.w * albedo.rgb;
             float w = p.w, tag = texelFetch(u_rsm_flux, t, 0).a;
-            uvec4 g = group_key(x, n, true, -1);
+            uvec4 g = group_key(x, n, true, normal_bin(n));
             BG_STEP
         }
     BG_EMIT_ALL
@@ -99,7 +101,7 @@ void main()
     if (b.x >= u_blocks || b.y >= u_blocks)
         return;
     ivec2 lo = b.xy * u_step, hi = min(lo + u_step, ivec2(u_size));
-    int base = ((b.z * u_blocks + b.y) * u_blocks + b.x) * u_slots;
-    block_vpls(lo, hi, b.z, base);
-    block_surfels(lo, hi, b.z, base);
+    int base = u_base + ((b.z * u_blocks + b.y) * u_blocks + b.x) * u_slots;
+    block_vpls(lo, hi, b.z + u_layer0, base);
+    block_surfels(lo, hi, b.z + u_layer0, base);
 }

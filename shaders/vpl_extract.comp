@@ -12,13 +12,16 @@ layout(std430, binding = LPV_SSBO_VPLS) writeonly buffer Vpls { LpvVpl vpls[]; }
 layout(std430, binding = LPV_SSBO_SURFELS) writeonly buffer Surfels { LpvSurfel surfels[]; };
 
 uniform int u_size;
+uniform int u_layer0; // the first layer of this dispatch
+uniform int u_base;   // its first element
 
 void main()
 {
     ivec3 t = ivec3(gl_GlobalInvocationID);
     if (t.x >= u_size || t.y >= u_size)
         return;
-    uint i = uint(t.x + u_size * (t.y + u_size * t.z));
+    uint i = uint(u_base + t.x + u_size * (t.y + u_size * t.z));
+    t.z += u_layer0;
     vec4 p = texelFetch(u_rsm_position, t, 0);
     vec4 n = texelFetch(u_rsm_normal, t, 0);
     vec4 f = texelFetch(u_rsm_flux, t, 0);

@@ -157,8 +157,12 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     memset(d, 0, sizeof *d);
     d->technique = lpv_technique_cascaded_lpv.name;
     d->levels = c->cascades.count > 0 ? c->cascades.count : 1;
-    for (int k = 0; k < d->levels; ++k)
+    for (int k = 0; k < d->levels; ++k) {
         d->level[k] = (k < c->cascades.count) ? c->cascades.grid[k] : c->grid;
+        for (int i = 0; i < 3; ++i)
+            d->origin_cells[k][i] = k < c->cascades.count ? c->cascades.origin_cells[k][i]
+                                                          : c->grid.origin[i] / c->grid.cell_size;
+    }
     d->far_field = c->cascades.handoff;
     d->volumes_per_level = c->bins > 1 ? c->bins : 1;
     d->values_per_cell = 12;

@@ -318,6 +318,8 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     d->technique = lpv_technique_octree.name;
     d->levels = 1; /* the merged volume: one grid, level 0's */
     d->level[0] = o->level[0]->grid;
+    for (int i = 0; i < 3; ++i)
+        d->origin_cells[0][i] = o->level[0]->cascades.origin_cells[0][i];
     d->far_field = 0;
     d->volumes_per_level = 1;
     d->values_per_cell = 12;
