@@ -206,6 +206,29 @@ int main(int argc, char **argv)
         }
         printf("| **total** | **%.2f** |\n", median(totals, repeat));
         printf("| **wall** | **%.2f** |\n\n", median(walls, repeat));
+        /* The shading's parts: the same frame with only direct light, then
+         * only the LPV term (a tick that finds nothing changed runs no pass,
+         * so each render's stages are the last stats'). */
+        double split[2][1000];
+        const lpv_frame_terms split_terms[2] = {LPV_TERMS_DIRECT_ONLY, LPV_TERMS_INDIRECT_ONLY};
+        for (int t = 0; t < 2 && rc == 0; ++t)
+            for (int r = 0; r < repeat; ++r) {
+                if (lpv_engine_tick(e, err, sizeof err) != 0 ||
+                    lpv_engine_render(e, split_terms[t], rgba, err, sizeof err) != 0) {
+                    fprintf(stderr, "lpvd-bench: %s\n", err);
+                    rc = 1;
+                    break;
+                }
+                const lpv_engine_stats *ss = lpv_engine_last_stats(e);
+                split[t][r] = 0.0;
+                for (int k = 0; k < ss->stage_count; ++k)
+                    if (strcmp(ss->stages[k].name, "shade") == 0)
+                        split[t][r] = ss->stages[k].gpu_ms;
+            }
+        if (rc)
+            break;
+        printf("shade: direct light only %.2f ms, indirect (the lookup) only %.2f ms\n\n", median(split[0], repeat),
+               median(split[1], repeat));
         /* every volume's cells (cascades x normal bins) times the steps */
         double cell_steps = st->cell_steps;
         printf("propagation: %.0f cell-steps in %.2f ms = **%.1f M cell-steps/s**\n\n", cell_steps, prop_ms,
