@@ -44,17 +44,19 @@ ivec3 group_unpack(uint k) { return ivec3(int(k & 511u), int((k >> 9) & 511u), i
 // sample on a cell's border falls on the same side.
 uint group_code(int c, vec3 x, vec3 n, bool points, int bin)
 {
-    if (c >= u_group_levels)
-        return 0u;
     vec4 g = u_group_grid[c];
     ivec3 q = points ? ivec3(floor(x / g.w - g.xyz + 0.5)) : ivec3(floor((x + 0.5 * g.w * n) / g.w - g.xyz));
     return group_pack(q, max(bin, 0));
 }
 
+// A loop to the cascades in use (llvmpipe computes every branch of an
+// unrolled one).
 uvec4 group_key(vec3 x, vec3 n, bool points, int bin)
 {
-    return uvec4(group_code(0, x, n, points, bin), group_code(1, x, n, points, bin), group_code(2, x, n, points, bin),
-                 group_code(3, x, n, points, bin));
+    uvec4 key = uvec4(0u);
+    for (int c = 0; c < u_group_levels; ++c)
+        key[c] = group_code(c, x, n, points, bin);
+    return key;
 }
 
 #define BG_DECL(k) uvec4 bg_key##k = uvec4(0u); float bg_w##k = 0.0, bg_tag##k = 0.0; \
