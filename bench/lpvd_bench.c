@@ -3,7 +3,7 @@
  * repeated ticks, after warm-up ticks that absorb shader compilation) and
  * the propagation throughput in cell-steps per second.
  *
- *   lpvd-bench [--repeat N] [--warmup N] [lpvd flags: --size WxH, --backend NAME, ...] [SCENE]
+ *   lpvd-bench [--repeat N] [--warmup N] [--config NAME] [lpvd flags: --size WxH, --backend NAME, ...] [SCENE]
  *
  * Configurations: the default preset (balanced), and the paper's pipeline
  * (the four departures of docs/propagation.md off) at 32^3 / 8 iterations /
@@ -28,6 +28,7 @@
 #include "scene_load.h"
 
 typedef struct config {
+    const char *name;          /* --config */
     int grid, iterations, rsm; /* 0: the preset's */
     int paper;                 /* 1: the departures off */
     int cascades;              /* 0: the settings' (auto) */
@@ -52,11 +53,12 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-enum { B_REPEAT, B_WARMUP, B_HELP, B_COUNT };
+enum { B_REPEAT, B_WARMUP, B_CONFIG, B_HELP, B_COUNT };
 
 static const lpv_flag FLAGS[B_COUNT] = {
     [B_REPEAT] = {"repeat", 0, "N", "timed ticks per configuration, 1..1000 (default 15)"},
     [B_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 3)"},
+    [B_CONFIG] = {"config", 0, "NAME", "only this configuration: balanced, paper32, paper64 or cascades3 (default all)"},
     [B_HELP] = {"help", 'h', NULL, "this text"},
 };
 
@@ -65,12 +67,13 @@ static void usage(FILE *f)
     char help[2048];
     size_t len = 0;
     lpv_flags_help(help, sizeof help, &len, FLAGS, B_COUNT);
-    fprintf(f, "usage: lpvd-bench [--repeat N] [--warmup N] [lpvd flags] [SCENE]\n%s%s", help, LPVD_OPTIONS_HELP);
+    fprintf(f, "usage: lpvd-bench [--repeat N] [--warmup N] [--config NAME] [lpvd flags] [SCENE]\n%s%s", help, LPVD_OPTIONS_HELP);
 }
 
 int main(int argc, char **argv)
 {
     int repeat = 15, warmup = 3;
+    const char *only = NULL;
     const char *scene_path = NULL;
     lpvd_options opt = {0};
     char err[1024];
@@ -101,10 +104,23 @@ int main(int argc, char **argv)
             repeat = atoi(v);
         } else if (fl == &FLAGS[B_WARMUP]) {
             warmup = atoi(v);
+        } else if (fl == &FLAGS[B_CONFIG]) {
+            only = v;
         }
     }
     if (repeat < 1 || repeat > 1000 || warmup < 0) {
         fprintf(stderr, "lpvd-bench: --repeat 1..1000, --warmup >= 0\n");
+        return 2;
+    }
+    const config configs[] = {{"balanced", 0, 0, 0, 0, 0},
+                              {"paper32", 32, 8, 256, 1, 0},
+                              {"paper64", 64, 8, 256, 1, 0},
+                              {"cascades3", 32, 8, 256, 1, 3}};
+    int known = !only;
+    for (size_t c = 0; c < sizeof configs / sizeof configs[0]; ++c)
+        known |= only && strcmp(only, configs[c].name) == 0;
+    if (!known) {
+        fprintf(stderr, "lpvd-bench: --config %s: expected balanced, paper32, paper64 or cascades3\n", only);
         return 2;
     }
 
@@ -133,9 +149,10 @@ int main(int argc, char **argv)
     printf("# lpvd-bench: %s, backend %s, GL_RENDERER %s, image %dx%d, median of %d ticks after %d warm-up\n\n",
            scene.source, lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), view.width,
            view.height, repeat, warmup);
-    const config configs[] = {{0, 0, 0, 0, 0}, {32, 8, 256, 1, 0}, {64, 8, 256, 1, 0}, {32, 8, 256, 1, 3}};
     int rc = 0;
     for (size_t c = 0; c < sizeof configs / sizeof configs[0] && rc == 0; ++c) {
+        if (only && strcmp(only, configs[c].name) != 0)
+            continue;
         lpv_settings s = opt.settings;
         if (configs[c].grid) {
             s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = configs[c].grid;
