@@ -52,27 +52,21 @@ float lpv_sh_dot(const float a[4], const float b[4])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
 }
 
-int lpv_mean_direction(const float in[3], float out[3])
+/* in / len, or in / max(len, 1) (keep_short): 0 for a non-finite or nearly
+ * zero vector. */
+static int direction(const float in[3], float out[3], int keep_short)
 {
     if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
         return 0;
     float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
     if (!(len > 1e-8f) || !isfinite(len))
         return 0;
-    float d = len > 1.0f ? len : 1.0f;
+    float d = keep_short && len < 1.0f ? 1.0f : len;
     for (int i = 0; i < 3; i++)
         out[i] = in[i] / d;
     return 1;
 }
 
-int lpv_unit_direction(const float in[3], float out[3])
-{
-    if (!isfinite(in[0]) || !isfinite(in[1]) || !isfinite(in[2]))
-        return 0;
-    float len = sqrtf(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
-    if (!(len > 1e-8f) || !isfinite(len))
-        return 0;
-    for (int i = 0; i < 3; i++)
-        out[i] = in[i] / len;
-    return 1;
-}
+int lpv_mean_direction(const float in[3], float out[3]) { return direction(in, out, 1); }
+
+int lpv_unit_direction(const float in[3], float out[3]) { return direction(in, out, 0); }
