@@ -422,24 +422,18 @@ static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_s
     return 0;
 }
 
-/* side / (per_cell x the grid's largest dimension), within 1..max. */
-static int auto_step(const lpv_settings *s, int side, int per_cell, int max)
-{
-    int g = s->grid_dims[0];
-    for (int i = 1; i < 3; ++i)
-        if (s->grid_dims[i] > g)
-            g = s->grid_dims[i];
-    int step = g > 0 ? side / (per_cell * g) : 1;
-    if (step > max)
-        step = max;
-    return step > 1 ? step : 1;
-}
-
 int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)
 {
     if (s->camera_surfel_step > 0)
         return s->camera_surfel_step;
-    return auto_step(s, image_h, LPV_CAMERA_SURFELS_PER_CELL, LPV_MAX_CAMERA_SURFEL_STEP);
+    int g = s->grid_dims[0];
+    for (int i = 1; i < 3; ++i)
+        if (s->grid_dims[i] > g)
+            g = s->grid_dims[i];
+    int step = g > 0 ? image_h / (LPV_CAMERA_SURFELS_PER_CELL * g) : 1;
+    if (step > LPV_MAX_CAMERA_SURFEL_STEP)
+        step = LPV_MAX_CAMERA_SURFEL_STEP;
+    return step > 1 ? step : 1;
 }
 
 int lpv_settings_rsm_vpl_step(const lpv_settings *s, int tile)

@@ -4,22 +4,40 @@
  * (pass_rsm.c) are down-sampled in blocks grouped by the cells and
  * geometry-volume points of the volume's cascades.
  */
+#include <string.h>
+
 #include "engine_internal.h"
 
-void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog)
+int lpv_engine_group_grids(const lpv_engine *e, lpv_group_grid g[LPV_MAX_CASCADES])
 {
     /* describe() ran at the commit before the producers of this tick */
-    float grids[LPV_MAX_CASCADES][4] = {{0}};
+    memset(g, 0, LPV_MAX_CASCADES * sizeof *g);
     int levels = e->desc.kind == LPV_LEVELS_CASCADES ? e->desc.levels : 0;
     if (levels > LPV_MAX_CASCADES)
         levels = LPV_MAX_CASCADES;
     for (int k = 0; k < levels; ++k) {
-        const lpv_grid *g = &e->desc.level[k];
-        if (!(g->cell_size > 0.0f))
-            levels = 0;
-        for (int i = 0; i < 3; ++i) /* in cells, as the technique's grid block holds it */
-            grids[k][i] = e->desc.origin_cells[k][i];
-        grids[k][3] = g->cell_size;
+        /* in cells, as the technique's grid block holds it */
+        memcpy(g[k].origin_cells, e->desc.origin_cells[k], sizeof g[k].origin_cells);
+        g[k].cell_size = e->desc.level[k].cell_size;
+        if (!(g[k].cell_size > 0.0f))
+            return 0;
+    }
+    return levels;
+}
+
+int lpv_block_slots(int step)
+{
+    return step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
+}
+
+void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog)
+{
+    lpv_group_grid g[LPV_MAX_CASCADES];
+    const int levels = lpv_engine_group_grids(e, g);
+    float grids[LPV_MAX_CASCADES][4];
+    for (int k = 0; k < LPV_MAX_CASCADES; ++k) {
+        memcpy(grids[k], g[k].origin_cells, sizeof g[k].origin_cells);
+        grids[k][3] = g[k].cell_size;
     }
     glUniform4fv(glGetUniformLocation(prog, "u_group_grid"), LPV_MAX_CASCADES, &grids[0][0]);
     glUniform1i(glGetUniformLocation(prog, "u_group_levels"), levels);

@@ -200,9 +200,9 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_gl_delete_buffer(&e->query_out);
     if (e->tech)
         e->tech->cls->destroy(e->tech);
-    GLuint *progs[] = {&e->prog_rsm,    &e->prog_vpl_extract, &e->prog_vpl_blocks, &e->prog_vpl_blocks8, &e->prog_gbuffer, &e->prog_camera_surfels,
-                       &e->prog_shade,  &e->prog_query,       &e->prog_glossy,  &e->prog_media,
-                       &e->prog_shadow};
+    GLuint *progs[] = {&e->prog_rsm,     &e->prog_vpl_extract, &e->prog_vpl_blocks, &e->prog_vpl_blocks8,
+                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade,    &e->prog_query,
+                       &e->prog_glossy,  &e->prog_media,          &e->prog_shadow};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

@@ -17,6 +17,7 @@
 #include "lpv_shared.h"
 #include "medium.h"
 #include "memory_budget.h"
+#include "surfel_groups.h"
 #include "technique.h"
 #include "timer.h"
 
@@ -61,8 +62,8 @@ struct lpv_engine {
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels, prog_shade, prog_query, prog_glossy,
-        prog_media, prog_shadow;
+    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
+        prog_shade, prog_query, prog_glossy, prog_media, prog_shadow;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -99,9 +100,9 @@ struct lpv_engine {
     int rsm_layers;       /* layers in use: punctual faces + those the area faces' tiles fill */
     int area_face_side;   /* texels of an area light face's tile */
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
-    GLuint vpls, surfels; /* blocks of RSM texels, up to LPV_BLOCK_SLOTS each (vpl_extract.comp) */
+    GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
     size_t rsm_per_layer[2]; /* VPLs (and surfels) per layer, punctual and area lights': blocks^2 x slots */
-    size_t rsm_vpl_count; /* rsm_layers * rsm_per_layer */
+    size_t rsm_vpl_count; /* punctual layers x rsm_per_layer[0] + area layers x rsm_per_layer[1] */
 
     /* shadow maps of direct light (pass_shadow.c), rendered at render time */
     struct LpvShadowBlock shadow_block; /* the faces the maps hold */
@@ -205,10 +206,14 @@ void lpv_engine_committed(lpv_engine *e, int reset);
  * unless they already are (engine_scene.c). */
 void lpv_engine_group_scene_surfels(lpv_engine *e);
 
-/* Sets prog's (in use) block_groups.glsl uniforms: the volume's cascades
- * after the last commit (none for a technique without cascades: one group
- * per block). block_groups.c. */
+/* The volume's cascades after the last commit as the groups' keys see them
+ * (block_groups.glsl, core/surfel_groups.h): fills g and returns how many
+ * (0 for a technique without cascades: one group per block). block_groups.c. */
+int lpv_engine_group_grids(const lpv_engine *e, lpv_group_grid g[LPV_MAX_CASCADES]);
+/* Sets prog's (in use) block_groups.glsl uniforms from those cascades. */
 void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog);
+/* Samples a block of step x step keeps: min(step^2, LPV_BLOCK_SLOTS). */
+int lpv_block_slots(int step);
 
 /* The camera's surfels the last G-buffer pass made (pass_camera.c). */
 static inline size_t lpv_engine_camera_surfel_count(const lpv_engine *e)

@@ -13,8 +13,6 @@
 #include "error.h"
 #include "hash.h"
 #include "scene_surfels.h"
-#include "surfel_groups.h"
-#include "hash.h"
 #include "iv_points.h"
 
 static void free_samples(lpv_engine *e)
@@ -196,15 +194,13 @@ int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size)
     if (want && !surfels)
         return lpv_error(err, err_size, "out of memory for %zu scene surfels", want);
     size_t ns = surfels ? lpv_scene_surfels(scene, want, surfels, want + 1) : 0;
-    /* the buffer holds at most one group per sample; filled by
-     * lpv_engine_group_scene_surfels once the cascades are placed */
+    /* the buffer holds at most one group per sample; the next tick fills it
+     * (lpv_engine_group_scene_surfels, once the cascades are committed) */
     e->scene_surfels = lpv_gl_new_ssbo(ns * sizeof(lpv_surfel));
     e->scene_surfel_samples = surfels;
     e->scene_surfel_sample_count = ns;
     e->scene_surfel_count = 0;
     e->scene_surfel_grid_sig = 0;
-    if (ns)
-        lpv_engine_group_scene_surfels(e);
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "%s: GL error while storing the scene's samples", scene->source);
     return 0;
@@ -216,22 +212,13 @@ void lpv_engine_group_scene_surfels(lpv_engine *e)
     if (!n || !e->scene_surfels)
         return;
     lpv_group_grid g[LPV_MAX_CASCADES];
-    memset(g, 0, sizeof g);
-    int levels = e->desc.kind == LPV_LEVELS_CASCADES ? e->desc.levels : 0;
-    if (levels > LPV_MAX_CASCADES)
-        levels = LPV_MAX_CASCADES;
-    for (int k = 0; k < levels; ++k) {
-        memcpy(g[k].origin_cells, e->desc.origin_cells[k], sizeof g[k].origin_cells);
-        g[k].cell_size = e->desc.level[k].cell_size;
-        if (!(g[k].cell_size > 0.0f))
-            levels = 0;
-    }
+    const int levels = lpv_engine_group_grids(e, g);
     uint64_t sig = lpv_hash_bytes(lpv_hash_bytes(LPV_HASH_INIT, &levels, sizeof levels), g, sizeof g);
     if (sig == 0)
         sig = 1;
     if (sig == e->scene_surfel_grid_sig)
         return;
-    /* no cascades yet (before the first commit): the samples as they are */
+    /* a technique without cascades: the samples as they are */
     lpv_surfel *grouped = levels ? malloc(n * sizeof *grouped) : NULL;
     size_t m = grouped ? lpv_surfels_group(e->scene_surfel_samples, n, g, levels, grouped) : 0;
     const lpv_surfel *src = m ? grouped : e->scene_surfel_samples;

@@ -164,7 +164,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     const int step = lpv_settings_camera_surfel_step(&e->settings, v->height);
     e->camera_surfel_w = (v->width + step - 1) / step;
     e->camera_surfel_h = (v->height + step - 1) / step;
-    e->camera_surfel_slots = step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
+    e->camera_surfel_slots = lpv_block_slots(step);
     GLuint cs = e->prog_camera_surfels;
     glUniform2i(glGetUniformLocation(cs, "u_size"), v->width, v->height);
     glUniform1i(glGetUniformLocation(cs, "u_step"), step);

@@ -102,7 +102,7 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
     const int size = e->rsm_size;
     const int step = lpv_settings_rsm_vpl_step(&e->settings, side);
     const int blocks = (size + step - 1) / step;
-    const int slots = step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
+    const int slots = lpv_block_slots(step);
     if (count <= 0)
         return (size_t)blocks * (size_t)blocks * (size_t)slots;
     /* step 1: a VPL per texel (a program without the grouping: llvmpipe

@@ -59,6 +59,35 @@ uvec4 group_key(vec3 x, vec3 n, bool points, int bin)
     return key;
 }
 
+// A group (block_emit's arguments) as the surfel or VPL it becomes. The mean
+// normal stays unnormalised: its lobe is the sum of the members' lobes
+// (lpv_mean_direction). An empty or broken group gives area 0 / position.w
+// 0, which the splats skip.
+bool group_ok(float w, vec3 pos, vec3 nrm)
+{
+    return w > 0.0 && !isinf(w) && finite3(pos) && finite3(nrm) && length(nrm) > 1e-8;
+}
+
+LpvSurfel group_surfel(float area, vec3 pos, vec3 nrm, vec3 albedo_sum, float size)
+{
+    bool ok = group_ok(area, pos, nrm);
+    LpvSurfel s;
+    s.position = vec4(ok ? pos : vec3(0.0), ok ? area : 0.0);
+    s.normal = vec4(ok ? nrm : vec3(0.0, 0.0, 1.0), size);
+    s.albedo = vec4(ok ? albedo_sum / area : vec3(0.0), 0.0);
+    return s;
+}
+
+LpvVpl group_vpl(float w, vec3 pos, vec3 nrm, vec3 flux, float size)
+{
+    bool ok = group_ok(w, pos, nrm);
+    LpvVpl v;
+    v.position = vec4(ok ? pos : vec3(0.0), ok ? 1.0 : 0.0);
+    v.normal = vec4(ok ? nrm : vec3(0.0, 0.0, 1.0), size); // w: object size
+    v.flux = vec4(ok ? flux : vec3(0.0), 0.0);
+    return v;
+}
+
 #define BG_DECL(k) uvec4 bg_key##k = uvec4(0u); float bg_w##k = 0.0, bg_tag##k = 0.0; \
     vec3 bg_x0##k = vec3(0.0), bg_n0##k = vec3(0.0), bg_pos##k = vec3(0.0), bg_nrm##k = vec3(0.0), bg_val##k = vec3(0.0);
 #define BG_MATCH(k) if (bg_slot < 0 && bg_used > k && bg_key##k == g && bg_tag##k == tag) bg_slot = k;

@@ -21,16 +21,9 @@ uniform int u_step;       // pixels per block along each axis
 uniform ivec2 u_out_size; // blocks: ceil(u_size / u_step)
 uniform int u_slots;      // surfels per block: min(LPV_BLOCK_SLOTS, u_step^2)
 
-vec3 g_at; // where an empty slot stands
-
 void block_emit(int i, float area, vec3 pos_mean, vec3 nrm_mean, vec3 albedo_sum, float size)
 {
-    // the area-weighted mean normal, not normalised: its lobe is the sum of
-    // the pixels' lobes (lpv_mean_direction)
-    bool ok = area > 0.0 && !isinf(area) && finite3(pos_mean) && finite3(nrm_mean) && length(nrm_mean) > 1e-8;
-    surfels[i].position = vec4(ok ? pos_mean : g_at, ok ? area : 0.0);
-    surfels[i].normal = vec4(ok ? nrm_mean : vec3(0.0, 0.0, 1.0), size);
-    surfels[i].albedo = vec4(ok ? albedo_sum / area : vec3(0.0), 0.0);
+    surfels[i] = group_surfel(area, pos_mean, nrm_mean, albedo_sum, size);
 }
 
 void main()
@@ -39,7 +32,6 @@ void main()
     if (s.x >= u_out_size.x || s.y >= u_out_size.y)
         return;
     ivec2 lo = s * u_step, hi = min(lo + u_step, u_size);
-    g_at = texelFetch(u_gbuf_position, lo, 0).xyz;
     BG_DECL_ALL
     for (int py = lo.y; py < hi.y; ++py)
         for (int px = lo.x; px < hi.x; ++px) {

@@ -30,20 +30,10 @@ bool g_vpls; // what block_emit writes: VPLs, else surfels
 
 void block_emit(int i, float w, vec3 pos_mean, vec3 nrm_mean, vec3 val, float size)
 {
-    // the weighted mean normal, not normalised: its lobe is the sum of the
-    // texels' lobes (lpv_mean_direction)
-    bool ok = w > 0.0 && !isinf(w) && finite3(pos_mean) && finite3(nrm_mean) && length(nrm_mean) > 1e-8;
-    vec3 pos = ok ? pos_mean : vec3(0.0);
-    vec3 nrm = ok ? nrm_mean : vec3(0.0, 0.0, 1.0);
-    if (g_vpls) {
-        vpls[i].position = vec4(pos, ok ? 1.0 : 0.0);
-        vpls[i].normal = vec4(nrm, size); // w: object size
-        vpls[i].flux = vec4(ok ? val : vec3(0.0), 0.0);
-    } else {
-        surfels[i].position = vec4(pos, ok ? w : 0.0);
-        surfels[i].normal = vec4(nrm, size);
-        surfels[i].albedo = vec4(ok ? val / w : vec3(0.0), 0.0);
-    }
+    if (g_vpls)
+        vpls[i] = group_vpl(w, pos_mean, nrm_mean, val, size);
+    else
+        surfels[i] = group_surfel(w, pos_mean, nrm_mean, val, size);
 }
 
 // The block's texels as VPLs: grouped by injection cell and normal bin,
