@@ -3,7 +3,7 @@
  * repeated ticks, after warm-up ticks that absorb shader compilation) and
  * the propagation throughput in cell-steps per second.
  *
- *   lpvd-bench [--repeat N] [--warmup N] [--config NAME] [lpvd flags: --size WxH, --backend NAME, ...] [SCENE]
+ *   lpvd-bench [--repeat N] [--warmup N] [--config NAME] [--frame-out DIR] [lpvd flags: --size WxH, --backend NAME, ...] [SCENE]
  *
  * Configurations: the default preset (balanced), and the paper's pipeline
  * (the four departures of docs/propagation.md off) at 32^3 / 8 iterations /
@@ -13,7 +13,11 @@
  * and "wall": the whole tick and frame as the process sees it (CPU clock,
  * lpv_engine_tick + lpv_engine_render with its read-back). README.md records
  * it with the machine; bench/compare_builds.py runs two builds' benches
- * alternately and prints the ratios.
+ * alternately and prints the ratios. Each configuration's last frame is
+ * summarised (mean radiance of the covered pixels, non-finite values) so a
+ * run on another GPU or driver can be checked against llvmpipe's figures;
+ * --frame-out writes it as raw RGBA8 (display-encoded as `lpvd render` does)
+ * for a look where the machine has no image library.
  * Not a test: nothing here asserts a time.
  */
 #include <math.h>
@@ -26,6 +30,7 @@
 #include "engine.h"
 #include "options.h"
 #include "scene_load.h"
+#include "tonemap.h"
 
 typedef struct config {
     const char *name;          /* --config */
@@ -53,12 +58,54 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-enum { B_REPEAT, B_WARMUP, B_CONFIG, B_HELP, B_COUNT };
+/* The frame's check figures: mean RGB radiance (W/(sr m^2)) of the pixels
+ * that see geometry (alpha > 0.5) and the count of non-finite values; with
+ * dir, the frame display-encoded (automatic exposure) as raw RGBA8. */
+static int frame_report(const char *dir, const char *name, const float *rgba, int w, int h)
+{
+    size_t n = (size_t)w * h, covered = 0, bad = 0;
+    double sum[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; ++i) {
+        const float *p = rgba + 4 * i;
+        for (int c = 0; c < 4; ++c)
+            bad += !isfinite(p[c]);
+        if (p[3] > 0.5f && isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
+            ++covered;
+            for (int c = 0; c < 3; ++c)
+                sum[c] += p[c];
+        }
+    }
+    double k = covered ? 1.0 / (double)covered : 0.0;
+    printf("frame: %zu of %zu pixels covered, mean radiance %.6g %.6g %.6g W/(sr m^2), %zu non-finite values\n", covered,
+           n, sum[0] * k, sum[1] * k, sum[2] * k, bad);
+    if (!dir)
+        return 0;
+    uint8_t *px = malloc(n * 4);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s-%dx%d.rgba", dir, name, w, h);
+    FILE *f = px ? fopen(path, "wb") : NULL;
+    int ok = f != NULL;
+    if (ok) {
+        lpv_display d;
+        lpv_display_default(&d);
+        lpv_display_rgba8(rgba, n, &d, px);
+        ok = fwrite(px, 4, n, f) == n;
+    }
+    if (f)
+        ok &= fclose(f) == 0;
+    free(px);
+    if (!ok)
+        fprintf(stderr, "lpvd-bench: --frame-out: cannot write %s\n", path);
+    return ok ? 0 : -1;
+}
+
+enum { B_REPEAT, B_WARMUP, B_CONFIG, B_FRAME_OUT, B_HELP, B_COUNT };
 
 static const lpv_flag FLAGS[B_COUNT] = {
     [B_REPEAT] = {"repeat", 0, "N", "timed ticks per configuration, 1..1000 (default 15)"},
     [B_WARMUP] = {"warmup", 0, "N", "untimed ticks first (default 3)"},
     [B_CONFIG] = {"config", 0, "NAME", "only this configuration: balanced, paper32, paper64 or cascades3 (default all)"},
+    [B_FRAME_OUT] = {"frame-out", 0, "DIR", "write each configuration's last frame to DIR/CONFIG-WxH.rgba (raw RGBA8, sRGB)"},
     [B_HELP] = {"help", 'h', NULL, "this text"},
 };
 
@@ -67,13 +114,13 @@ static void usage(FILE *f)
     char help[2048];
     size_t len = 0;
     lpv_flags_help(help, sizeof help, &len, FLAGS, B_COUNT);
-    fprintf(f, "usage: lpvd-bench [--repeat N] [--warmup N] [--config NAME] [lpvd flags] [SCENE]\n%s%s", help, LPVD_OPTIONS_HELP);
+    fprintf(f, "usage: lpvd-bench [--repeat N] [--warmup N] [--config NAME] [--frame-out DIR] [lpvd flags] [SCENE]\n%s%s", help, LPVD_OPTIONS_HELP);
 }
 
 int main(int argc, char **argv)
 {
     int repeat = 15, warmup = 3;
-    const char *only = NULL;
+    const char *only = NULL, *frame_dir = NULL;
     const char *scene_path = NULL;
     lpvd_options opt = {0};
     char err[1024];
@@ -106,6 +153,8 @@ int main(int argc, char **argv)
             warmup = atoi(v);
         } else if (fl == &FLAGS[B_CONFIG]) {
             only = v;
+        } else if (fl == &FLAGS[B_FRAME_OUT]) {
+            frame_dir = v;
         }
     }
     if (repeat < 1 || repeat > 1000 || warmup < 0) {
@@ -223,6 +272,10 @@ int main(int argc, char **argv)
         }
         printf("| **total** | **%.2f** |\n", median(totals, repeat));
         printf("| **wall** | **%.2f** |\n\n", median(walls, repeat));
+        if (frame_report(frame_dir, configs[c].name, rgba, view.width, view.height) != 0) {
+            rc = 1;
+            break;
+        }
         /* The shading's parts: the same frame with only direct light, then
          * only the LPV term (a tick that finds nothing changed runs no pass,
          * so each render's stages are the last stats'). */
