@@ -31,7 +31,7 @@ static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
     if (!lpv_mean_direction(v->normal, n))
         return 0;
     for (int i = 0; i < 3; i++)
-        p[i] = v->position[i] + 0.5f * g->cell_size * n[i];
+        p[i] = v->position[i] + LPV_VPL_SHIFT_CELLS * g->cell_size * n[i];
     if (!lpv_grid_cell_of(g, p, cell))
         return 0;
 
@@ -84,7 +84,10 @@ static int inject_surfel(const lpv_grid *g, const lpv_surfel *s, vec4 *gv)
         return 0;
     if (!lpv_mean_direction(s->normal, n))
         return 0;
-    if (!lpv_grid_gv_point_of(g, s->position, pt))
+    float p[3];
+    for (int i = 0; i < 3; i++)
+        p[i] = s->position[i] + LPV_TIE_CELLS * g->cell_size * n[i]; /* as grid.glsl's gv_point_at */
+    if (!lpv_grid_gv_point_of(g, p, pt))
         return 0;
 
     float lobe[4];

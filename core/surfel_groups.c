@@ -55,8 +55,9 @@ size_t lpv_surfels_group(const lpv_surfel *in, size_t n, const lpv_group_grid *g
         keyed *e = &k[m++];
         for (int c = 0; c < levels; ++c)
             for (int a = 0; a < 3; ++a) {
-                /* as inject_gv.vert: floor(cascade_coords + 0.5), in float */
-                float q = floorf(s->position[a] / grids[c].cell_size - grids[c].origin_cells[a] + 0.5f);
+                /* as grid.glsl's gv_point_at, in float */
+                float x = s->position[a] + LPV_TIE_CELLS * grids[c].cell_size * dir[a];
+                float q = floorf(x / grids[c].cell_size - grids[c].origin_cells[a] + 0.5f);
                 e->point[c][a] = q > 1e9f ? 1000000000 : q < -1e9f ? -1000000000 : (int32_t)q;
             }
         e->bin = lpv_oracle_normal_bin(dir);

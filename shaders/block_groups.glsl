@@ -45,7 +45,7 @@ ivec3 group_unpack(uint k) { return ivec3(int(k & 511u), int((k >> 9) & 511u), i
 uint group_code(int c, vec3 x, vec3 n, bool points, int bin)
 {
     vec4 g = u_group_grid[c];
-    ivec3 q = points ? ivec3(floor(x / g.w - g.xyz + 0.5)) : ivec3(floor((x + 0.5 * g.w * n) / g.w - g.xyz));
+    ivec3 q = points ? gv_point_at(x, n, g.w, g.xyz) : vpl_cell_at(x, n, g.w, g.xyz);
     return group_pack(q, max(bin, 0));
 }
 

@@ -30,6 +30,21 @@ bool cell_inside(ivec3 c)
 // shift every point by exactly whole cells.
 vec3 cascade_coords(int k, vec3 p) { return p / cascade_cell(k) - cascade_origin_cells(k); }
 
+// The cell of a VPL at x with normal n and the GV point of a surfel there, in
+// a grid of `cell` m with its lower corner at origin_cells (lpv_shared.h,
+// LPV_VPL_SHIFT_CELLS and LPV_TIE_CELLS); the cascade's, and the down-sampling
+// keys' (block_groups.glsl), are these.
+ivec3 vpl_cell_at(vec3 x, vec3 n, float cell, vec3 origin_cells)
+{
+    return ivec3(floor((x + LPV_VPL_SHIFT_CELLS * cell * n) / cell - origin_cells));
+}
+ivec3 gv_point_at(vec3 x, vec3 n, float cell, vec3 origin_cells)
+{
+    return ivec3(floor((x + LPV_TIE_CELLS * cell * n) / cell - origin_cells + 0.5));
+}
+ivec3 cascade_vpl_cell(int k, vec3 x, vec3 n) { return vpl_cell_at(x, n, cascade_cell(k), cascade_origin_cells(k)); }
+ivec3 cascade_gv_point(int k, vec3 x, vec3 n) { return gv_point_at(x, n, cascade_cell(k), cascade_origin_cells(k)); }
+
 // A compute invocation over every cascade: z runs over dims.z * cascades.
 // Returns the cascade and sets c to the cell within it.
 int cascade_of_invocation(ivec3 id, out ivec3 c)

@@ -27,7 +27,7 @@ void main()
         return;
     vec3 n = s.normal.xyz / max(len, 1.0); // unit, or a down-sampled surfel's mean normal (core/sh.h lpv_mean_direction)
     float cell = cascade_cell(k);
-    ivec3 p = ivec3(floor(cascade_coords(k, s.position.xyz) + 0.5));
+    ivec3 p = cascade_gv_point(k, s.position.xyz, n);
     ivec3 gv_dims = grid_dims() + 1;
     if (any(lessThan(p, ivec3(0))) || any(greaterThanEqual(p, gv_dims)))
         return;

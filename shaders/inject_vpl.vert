@@ -27,13 +27,13 @@ void main()
     float w = cascade_object_weight(k, v.normal.w);
     if (!(w > 0.0))
         return;
-    ivec3 c = ivec3(floor(cascade_coords(k, v.position.xyz + 0.5 * cascade_cell(k) * n)));
+    ivec3 c = cascade_vpl_cell(k, v.position.xyz, n);
     if (!cell_inside(c))
         return;
     // far field: a VPL lives in the finest cascade holding it; coarser ones
     // receive its light through the hand-off
     if (far_field() && k > 0 &&
-        cell_inside(ivec3(floor(cascade_coords(k - 1, v.position.xyz + 0.5 * cascade_cell(k - 1) * n)))))
+        cell_inside(cascade_vpl_cell(k - 1, v.position.xyz, n)))
         return;
 
     vec4 lobe = sh_lobe(n) * (w / LPV_PI);

@@ -297,6 +297,22 @@ struct IvVoxel {
 /* The march (paper section 3.3): rays start sqrt(3)/2 voxels from the voxel
  * centre (the voxel's bounding sphere) and step one voxel. */
 #define LPV_IV_START 0.86602540378443865f
+/* Where a sample lands in the LPV (docs/propagation.md §2): a VPL in the cell
+ * holding its position moved LPV_VPL_SHIFT_CELLS cells along its normal, a
+ * surfel on the geometry-volume point nearest its position moved
+ * LPV_TIE_CELLS cells along its normal. The half cell keeps a surface's light
+ * in the cell in front of it (paper, section 5); LPV_TIE_CELLS settles the
+ * surfaces that lie exactly where rounding would split them (the default
+ * grid pads the scene's bounds by half a cell, so its walls sit on cell
+ * centres: their VPLs on cell faces, their surfels halfway between two GV
+ * points) on the side in front of the surface, on every GPU and in the CPU
+ * oracle alike, not by the last bit of a division (an H100 and llvmpipe put
+ * the Cornell box's back-wall VPLs in different cells without it). Both are
+ * linear in the normal, so a down-sampled group (mean normal, centroid) lands
+ * where its members do. */
+#define LPV_TIE_CELLS 0.00390625f
+#define LPV_VPL_SHIFT_CELLS (0.5f + LPV_TIE_CELLS)
+
 #define LPV_IV_WG 64
 /* Reprojection takes at most about this many of the G-buffer's pixels, a
  * regular subset (every k-th pixel in x and y): a voxel seen by the camera

@@ -281,10 +281,23 @@ static void test_vpl_on_cell_corner_and_face(void **state)
     check_lands(&g, vpl(3, 4, 5, 0, 0, -1, 2, 0, 0), 3, 4, 4);
     check_lands(&g, vpl(2, 2, 2, 1, 1, 1, 2, 0, 0), 2, 2, 2);
     check_lands(&g, vpl(2, 2, 2, -1, -1, -1, 2, 0, 0), 1, 1, 1);
-    /* Shifted position exactly on a face (x = 6) and on an edge. */
+    /* Half a cell would put these exactly on a face (x = 6): the tie goes to
+     * the cell in front of the surface whichever way it faces
+     * (LPV_TIE_CELLS), not to the upper cell by floor's rounding. */
     check_lands(&g, vpl(5.5f, 2.5f, 2.5f, 1, 0, 0, 2, 0, 0), 6, 2, 2);
-    check_lands(&g, vpl(6.5f, 2.5f, 2.5f, -1, 0, 0, 2, 0, 0), 6, 2, 2);
+    check_lands(&g, vpl(6.5f, 2.5f, 2.5f, -1, 0, 0, 2, 0, 0), 5, 2, 2);
+    /* ... and on an edge. */
     check_lands(&g, vpl(5.5f, 2, 2.5f, 1, 0, 0, 2, 0, 0), 6, 2, 2);
+
+    /* A surfel exactly halfway between two GV points (x = 2.5) goes to the one
+     * in front of it, whichever way it faces. */
+    for (int side = 0; side < 2; ++side) {
+        vec4 *tie = xcalloc(lpv_grid_gv_count(&g), sizeof(vec4));
+        lpv_surfel t = surfel(2.5f, 2.2f, 2.2f, 1, side ? -1.0f : 1.0f, 0, 0);
+        assert_int_equal(lpv_oracle_inject_surfels(&g, &t, 1, tie), 1);
+        assert_true(tie[lpv_grid_gv_index(&g, side ? 2 : 3, 2, 2)][0] > 0.0f);
+        free(tie);
+    }
 
     /* Through the pipeline, lights on corners and faces give finite light. */
     lpv_vpl v[] = {vpl(3, 4, 5, 0, 0, 1, 1, 1, 1), vpl(6, 2.5f, 2.5f, 1, 0, 0, 1, 1, 1),
