@@ -11,6 +11,8 @@
 #include <math.h>
 #include <string.h>
 
+#include <cglm/cglm.h>
+
 #include "engine_internal.h"
 
 void lpv_pass_shadow_free(lpv_engine *e)
@@ -64,6 +66,99 @@ static int allocate(lpv_engine *e, int size, int layers, char *err, size_t err_s
     return 0;
 }
 
+/* The cone of directions light l sends light into: a spot's outer cone, an
+ * area light sample's hemisphere (cosine emission); 0 for lights that light
+ * every direction (points, directional cascades). */
+static int light_cone(const lpv_engine *e, int l, vec3 apex, vec3 axis, float *half_angle)
+{
+    const struct LpvLightGpu *g = &e->light_block.lights[l];
+    const int type = (int)g->position_type[3];
+    if (type != LPV_LIGHT_TYPE_SPOT && type != LPV_LIGHT_TYPE_AREA)
+        return 0;
+    glm_vec3_copy((float *)g->position_type, apex);
+    glm_vec3_copy((float *)g->direction_range, axis);
+    if (!(glm_vec3_norm(axis) > 1e-8f))
+        return 0;
+    glm_vec3_normalize(axis);
+    *half_angle = type == LPV_LIGHT_TYPE_AREA ? (float)(M_PI / 2.0) : acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
+    return *half_angle < (float)M_PI;
+}
+
+/* The part of shadow face f (its tile at x, y, side texels) that can be read
+ * with a non-zero weight: a spot lights only its outer cone and an area
+ * light sample only the half-space its normal faces, and the shading's
+ * irradiance outside them is 0 (lights.glsl), so depth there is never
+ * needed. A spot wider than 45 degrees gets a cube of six faces (one behind
+ * it, four mostly outside its cone), an area light sample five (half of each
+ * side face behind the emitter). The rectangle bounds the cone's footprint
+ * on the face: the face's border points inside the cone and the cone's rim
+ * (sampled at 256 azimuths, opened by 0.02 rad) projected into the face,
+ * plus a margin for the PCF kernel and the receiver offsets (shadow.glsl).
+ * Returns 0 when no direction of the face is lit (the face is not drawn). */
+#define RIM_SAMPLES 256
+#define EDGE_SAMPLES 64
+static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int rect[4])
+{
+    const struct LpvShadowFaceGpu *F = &e->shadow_block.faces[f];
+    rect[0] = x, rect[1] = y, rect[2] = side, rect[3] = side;
+    vec3 apex, axis;
+    float half;
+    if (F->info[1] != 1.0f || !light_cone(e, (int)F->info[2], apex, axis, &half))
+        return 1;
+    const float open = half + 0.02f, cos_open = cosf(open);
+    float lo[2] = {2.0f, 2.0f}, hi[2] = {-2.0f, -2.0f};
+    mat4 inv;
+    glm_mat4_inv((vec4 *)F->view_proj, inv);
+    /* the face's border: the NDC square's edge points whose direction is in the cone */
+    for (int i = 0; i < 4 * EDGE_SAMPLES; ++i) {
+        const float t = -1.0f + 2.0f * (float)(i % EDGE_SAMPLES) / (float)(EDGE_SAMPLES - 1);
+        const int edge = i / EDGE_SAMPLES;
+        const float u = edge < 2 ? t : (edge == 2 ? -1.0f : 1.0f), v = edge < 2 ? (edge == 0 ? -1.0f : 1.0f) : t;
+        vec4 ndc = {u, v, 0.0f, 1.0f}, w;
+        glm_mat4_mulv(inv, ndc, w);
+        if (!(fabsf(w[3]) > 1e-20f))
+            continue;
+        vec3 d = {w[0] / w[3] - apex[0], w[1] / w[3] - apex[1], w[2] / w[3] - apex[2]};
+        if (glm_vec3_dot(d, axis) >= cos_open * glm_vec3_norm(d)) {
+            lo[0] = fminf(lo[0], u), hi[0] = fmaxf(hi[0], u);
+            lo[1] = fminf(lo[1], v), hi[1] = fmaxf(hi[1], v);
+        }
+    }
+    /* the cone's rim, where it crosses the face */
+    vec3 t1, t2, up = {0.0f, 1.0f, 0.0f};
+    if (fabsf(axis[1]) > 0.9f)
+        glm_vec3_copy((vec3){1.0f, 0.0f, 0.0f}, up);
+    glm_vec3_cross(axis, up, t1);
+    glm_vec3_normalize(t1);
+    glm_vec3_cross(axis, t1, t2);
+    for (int i = 0; i < RIM_SAMPLES; ++i) {
+        const float a = 2.0f * (float)M_PI * (float)i / (float)RIM_SAMPLES;
+        const float c = cosf(open), sn = sinf(open);
+        vec4 p = {apex[0], apex[1], apex[2], 1.0f}, clip;
+        for (int k = 0; k < 3; ++k)
+            p[k] += c * axis[k] + sn * (cosf(a) * t1[k] + sinf(a) * t2[k]);
+        glm_mat4_mulv((vec4 *)F->view_proj, p, clip);
+        if (!(clip[3] > 0.0f))
+            continue;
+        const float u = clip[0] / clip[3], v = clip[1] / clip[3];
+        if (fabsf(u) > 1.0f || fabsf(v) > 1.0f)
+            continue;
+        lo[0] = fminf(lo[0], u), hi[0] = fmaxf(hi[0], u);
+        lo[1] = fminf(lo[1], v), hi[1] = fmaxf(hi[1], v);
+    }
+    if (lo[0] > hi[0] || lo[1] > hi[1])
+        return 0;
+    const float margin = LPV_SHADOW_BORDER_TEXELS + 2.0f * (float)(LPV_SHADOW_PCF_RADIUS + 1);
+    int r[4];
+    for (int k = 0; k < 2; ++k) {
+        float a = floorf((lo[k] * 0.5f + 0.5f) * (float)side - margin), b = ceilf((hi[k] * 0.5f + 0.5f) * (float)side + margin);
+        a = fmaxf(a, 0.0f), b = fminf(b, (float)side);
+        r[k] = (int)a, r[k + 2] = (int)b - (int)a;
+    }
+    rect[0] = x + r[0], rect[1] = y + r[1], rect[2] = r[2], rect[3] = r[3];
+    return r[2] > 0 && r[3] > 0;
+}
+
 static void draw(lpv_engine *e)
 {
     const int size = e->shadow_alloc_size, faces = (int)e->shadow_block.counts[0];
@@ -77,21 +172,30 @@ static void draw(lpv_engine *e)
     glDepthMask(GL_TRUE);
     glUseProgram(e->prog_shadow);
     GLint loc_vp = glGetUniformLocation(e->prog_shadow, "u_view_proj");
+    const float far_depth = 1.0f;
+    glEnable(GL_SCISSOR_TEST);
     for (int f = 0; f < faces; ++f) {
-        /* A face fills its layer, or (area light samples) one tile of it: a
-         * layer is attached and cleared once, before its first face draws. */
+        /* A face fills its layer, or (area light samples) one tile of it, or
+         * the lit half of that tile: only what it draws is cleared (the
+         * clear costs as much as the drawing on llvmpipe). */
         const float *tile = e->shadow_block.faces[f].tile;
         const int layer = (int)tile[3];
         if (layer != bound_layer) {
             glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, layer);
-            glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
             bound_layer = layer;
         }
         const int side = (int)lroundf(tile[2] * (float)size);
-        glViewport((int)lroundf(tile[0] * (float)size), (int)lroundf(tile[1] * (float)size), side, side);
+        const int x = (int)lroundf(tile[0] * (float)size), y = (int)lroundf(tile[1] * (float)size);
+        int rect[4];
+        if (!face_lit_rect(e, f, x, y, side, rect))
+            continue;
+        glScissor(rect[0], rect[1], rect[2], rect[3]);
+        glClearBufferfv(GL_DEPTH, 0, &far_depth);
+        glViewport(x, y, side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->shadow_block.faces[f].view_proj);
         lpv_engine_draw_scene(e, e->prog_shadow, 0); /* lights see both sides */
     }
+    glDisable(GL_SCISSOR_TEST);
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     lpv_timer_end(&e->timer);

@@ -44,7 +44,9 @@ void main()
             vec3 to_light;
             vec3 e = light_irradiance_normal(li, p, to_light);
             float cos_i = dot(n, to_light);
-            if (cos_i <= 0.0)
+            // outside a spot's cone or behind an area light sample the
+            // irradiance is 0: no shadow taps (pass_shadow.c draws no depth there)
+            if (cos_i <= 0.0 || !any(greaterThan(e, vec3(0.0))))
                 continue;
             e_direct += e * cos_i * shadow_visibility(l, p, n);
         }

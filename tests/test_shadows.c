@@ -15,6 +15,12 @@
  *     (the path tracer's shadow-ray test decides every pixel), no lit pixel
  *     anywhere on the plane is darkened (no acne at grazing incidence), with
  *     the cascades' texels (core/shadow_cascades.c) as the tolerance.
+ *  3. A spot wider than 45 degrees (a cube of shadow-map faces, of which
+ *     pass_shadow.c draws only what the cone reaches: not the face behind
+ *     it, a band of each side face) over a plane, with a small box on each
+ *     side near the cone's rim and one under the light: every box's shadow
+ *     is there and nothing lit is darkened, against the path tracer's direct
+ *     irradiance (its spot falloff too).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -297,11 +303,118 @@ static void test_small_box_under_a_low_sun(void **state)
     lpv_scene_free(&s);
 }
 
+/* ---- 3. a wide spot: boxes near its rim ----------------------------------- */
+
+#define SPOT_I 20.0f /* W/sr on the axis */
+#define SPOT_H 2.0f  /* m */
+#define SPOT_SIZE 512 /* texels per cube face */
+
+static void test_wide_spot_rim_shadows(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){ALBEDO, ALBEDO, ALBEDO}, NULL);
+    const float plane[4][3] = {{-8, 0, 8}, {8, 0, 8}, {8, 0, -8}, {-8, 0, -8}};
+    assert_true(lpv_scene_add_quad(&s, grey, plane, NULL) >= 0);
+    /* four boxes 2.3 m out along +-x and +-z (their shadows 50-58 degrees off
+     * the axis, in the cube's side faces, inside the 62-degree cone) and one
+     * under the light (the face below) */
+    enum { BOXES = 5 };
+    const float centre[BOXES][2] = {{2.3f, 0.0f}, {-2.3f, 0.0f}, {0.0f, 2.3f}, {0.0f, -2.3f}, {0.6f, 0.4f}};
+    float lo[BOXES][3], hi[BOXES][3];
+    for (int b = 0; b < BOXES; ++b) {
+        const float r = 0.25f, h = b < 4 ? 0.3f : 1.0f;
+        lo[b][0] = centre[b][0] - r, lo[b][1] = 0.0f, lo[b][2] = centre[b][1] - r;
+        hi[b][0] = centre[b][0] + r, hi[b][1] = h, hi[b][2] = centre[b][1] + r;
+        assert_true(lpv_scene_add_box(&s, grey, lo[b], hi[b]) >= 0);
+    }
+    lpv_light *spot = lpv_scene_add_point_light(&s, (float[3]){0, SPOT_H, 0}, SPOT_I);
+    assert_non_null(spot);
+    spot->type = LPV_LIGHT_SPOT;
+    spot->direction[0] = spot->direction[2] = 0.0f, spot->direction[1] = -1.0f;
+    spot->inner_cone = 40.0f * (float)M_PI / 180.0f;
+    spot->outer_cone = 62.0f * (float)M_PI / 180.0f;
+    lpv_scene_compute_bounds(&s);
+
+    enum { W = 192, H = 192 };
+    lpv_view view;
+    assert_int_equal(lpv_view_look_at((float[3]){0.0f, 9.0f, 0.01f}, (float[3]){0.0f, 0.0f, 0.0f},
+                                      50.0f * (float)M_PI / 180.0f, W, H, &view),
+                     0);
+    lpv_settings set = {.grid_dims = {16, 16, 16}, .shadow_size = SPOT_SIZE};
+    float *rgba = render_direct(&s, &set, &view);
+    lpv_ref *ref = NULL;
+    char err[512] = "";
+    if (lpv_ref_create(&s, NULL, &ref, err, sizeof err) != 0)
+        fail_msg("reference: %s", err);
+
+    /* Tolerance around the shadows' edges: three texels of a cube face at the
+     * rim's distance, spread along the floor at the rim's incidence. */
+    const float rim = SPOT_H / cosf(spot->outer_cone);
+    const float tol = 3.0f * 2.0f * rim / (float)SPOT_SIZE / cosf(spot->outer_cone);
+    const float up[3] = {0.0f, 1.0f, 0.0f};
+    int lit = 0, acne = 0, dark[BOXES] = {0}, leak = 0;
+    for (int y = 0; y < H; ++y) {
+        for (int x = 0; x < W; ++x) {
+            float p[3];
+            const float *px = &rgba[4 * ((size_t)y * W + (size_t)x)];
+            if (floor_point(&view, x, y, p) != 0 || px[3] < 0.5f)
+                continue;
+            int on_box = 0, near_edge = 0, shadowed = -1;
+            for (int b = 0; b < BOXES; ++b) {
+                /* the box's footprint and the contact around it, where the
+                 * receiver offsets let light in (docs/shadows.md) */
+                on_box |= p[0] > lo[b][0] - tol && p[0] < hi[b][0] + tol && p[2] > lo[b][2] - tol &&
+                          p[2] < hi[b][2] + tol;
+                int in = 0;
+                for (int k = 0; k < 9; ++k) { /* p and eight points around it at the tolerance */
+                    float q[3] = {p[0], 0.0f, p[2]};
+                    if (k < 8) {
+                        q[0] += tol * cosf((float)k * (float)M_PI / 4.0f);
+                        q[2] += tol * sinf((float)k * (float)M_PI / 4.0f);
+                    }
+                    float d[3] = {q[0], q[1] - SPOT_H, q[2]}; /* travelling from the light */
+                    in += box_blocks(q, d, lo[b], hi[b]);
+                }
+                near_edge |= in > 0 && in < 9;
+                if (in == 9)
+                    shadowed = b;
+            }
+            if (on_box || near_edge)
+                continue;
+            float e[3];
+            lpv_ref_direct_irradiance(ref, (float[3]){p[0], 1e-4f, p[2]}, up, e);
+            const double want = ALBEDO / M_PI * (double)e[1];
+            if (shadowed >= 0) {
+                ++dark[shadowed];
+                if (px[1] > 1e-3 * ALBEDO / M_PI * SPOT_I / (SPOT_H * SPOT_H))
+                    ++leak;
+            } else if (e[1] > 0.05f * SPOT_I / (SPOT_H * SPOT_H)) {
+                ++lit;
+                if (fabs(px[1] / want - 1.0) > 0.02)
+                    ++acne;
+            }
+        }
+    }
+    printf("wide spot: %d lit plane pixels (%d off by more than 2 %%), shadows of the boxes %d %d %d %d %d pixels "
+           "(%d lit)\n",
+           lit, acne, dark[0], dark[1], dark[2], dark[3], dark[4], leak);
+    assert_true(lit > 2000);
+    for (int b = 0; b < BOXES; ++b)
+        assert_true(dark[b] > 10); /* every box casts its shadow, the rim's too */
+    assert_int_equal(acne, 0);
+    assert_int_equal(leak, 0);
+    lpv_ref_destroy(ref);
+    free(rgba);
+    lpv_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_shadow_edge),
         cmocka_unit_test(test_small_box_under_a_low_sun),
+        cmocka_unit_test(test_wide_spot_rim_shadows),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
