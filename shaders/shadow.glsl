@@ -53,9 +53,14 @@ int shadow_face(int l, vec3 x)
     if (info.z == 2.0) { // area light sample: the face whose axis is nearest x's direction
         vec3 d = x - L.lights[l].position_type.xyz;
         int best = first;
-        for (int k = 1; k < count; ++k)
-            if (dot(d, S.faces[first + k].axis.xyz) > dot(d, S.faces[best].axis.xyz))
+        float best_dot = dot(d, S.faces[first].axis.xyz);
+        for (int k = 1; k < count; ++k) {
+            float dk = dot(d, S.faces[first + k].axis.xyz);
+            if (dk > best_dot) {
                 best = first + k;
+                best_dot = dk;
+            }
+        }
         return best;
     }
     if (count == 6) {
