@@ -17,7 +17,7 @@
 
 static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
 static const char *const INC_RSM[] = {"material.glsl", "lights.glsl", NULL};
-static const char *const INC_SHADE[] = {"lights.glsl", "shadow.glsl", NULL};
+static const char *const INC_SHADE[] = {"lights.glsl", "shadow.glsl", "shading.glsl", NULL};
 static const char *const INC_MEDIA[] = {"lights.glsl", "shadow.glsl", "medium.glsl", NULL};
 static const char *const INC_BLOCKS[] = {"grid.glsl", "block_groups.glsl", NULL};
 static const char *const INC_BLOCKS8[] = {"grid.glsl", "block_slots8.glsl", "block_groups.glsl", NULL};
@@ -59,7 +59,7 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
         const char *a, *b;
         const char *const *inc;
     } progs[] = {
-        {&e->prog_shade, "fullscreen.vert", "shade.frag", inc_shade},
+        {&e->prog_shade, "shade.comp", NULL, inc_shade},
         {&e->prog_query, "query.comp", NULL, inc_lookup},
         {&e->prog_glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
         {&e->prog_media, "fullscreen.vert", "media.frag", inc_media},

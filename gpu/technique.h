@@ -17,7 +17,7 @@
  *               float lpv_cell_at(vec3 x)             the volume's scale at x (m)
  *               uniform float u_damping;              0 = off
  *             and whatever they bind (bind_lookup binds it). The engine
- *             pastes them into shade.frag, glossy.frag, media.frag and
+ *             pastes them into shade.comp, glossy.frag, media.frag and
  *             query.comp when it builds those programs.
  *
  * A technique sees none of the engine: what it needs comes in the structs

@@ -4,7 +4,7 @@
 // direction r over GLOSSY_STEPS cells and average the radiance travelling back
 // toward the surface, I(-r) / cell^2, weighted by the inverse squared
 // distance. Added (blending ONE, ONE) to the shaded frame as F0 x that
-// radiance, F0 = mix(0.04, albedo, metallic); shade.frag lowered the diffuse
+// radiance, F0 = mix(0.04, albedo, metallic); shading.glsl lowered the diffuse
 // part of the same pixels by kd, so the pixel does not gain energy.
 in vec2 v_uv;
 

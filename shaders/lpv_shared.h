@@ -417,6 +417,9 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_LOOKUP_G  9
 #define LPV_TEX_LOOKUP_B  10
 
+/* Image unit of the frame that shade.comp writes (pass_camera.c). */
+#define LPV_IMG_FRAME 0
+
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
 #define LPV_PROP_WG_X 32
 #define LPV_PROP_WG_Y 2

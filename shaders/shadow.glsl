@@ -135,7 +135,7 @@ float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
     return shadow_pcf(f, uvz.xy, uvz.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
 }
 
-// The filtered visibility for surfaces (shade.frag).
+// The filtered visibility for surfaces (shading.glsl).
 float shadow_visibility(int l, vec3 p, vec3 n)
 {
     return shadow_visibility_taps(l, p, n, 0);

@@ -1,10 +1,10 @@
-// shade.frag - the final frame in linear radiance, W/(m^2 sr):
+// shading.glsl - the final frame in linear radiance, W/(m^2 sr):
 //   L = albedo / pi * (E_direct + gain * E_lpv) + emission
 // with E_direct from the lights through their shadow maps and E_lpv the
 // irradiance looked up in the accumulated LPV. Switches in the view block
 // select the terms (e.g. --indirect-only keeps only the LPV term).
-in vec2 v_uv;
-
+// shade_pixel(px) is one pixel of it, from the G-buffer; shade.comp runs it
+// for every pixel (pass_camera.c, lpv_pass_shade_run).
 layout(binding = 0) uniform sampler2D u_gbuf_position;
 layout(binding = 1) uniform sampler2D u_gbuf_normal;
 layout(binding = 2) uniform sampler2D u_gbuf_albedo;
@@ -12,26 +12,19 @@ layout(binding = 3) uniform sampler2D u_gbuf_emission;
 
 layout(std140, binding = LPV_UBO_VIEW) uniform ViewUBO { LpvViewBlock V; };
 
-layout(location = 0) out vec4 o_radiance;
-
 uniform float u_glossy_roughness; // materials below it are glossy; 0 when the glossy pass does not run
 
-void main()
+vec4 shade_pixel(ivec2 px)
 {
-    ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 pos = texelFetch(u_gbuf_position, px, 0);
     vec4 nrm = texelFetch(u_gbuf_normal, px, 0);
-    if (nrm.w < 0.5) {
-        o_radiance = vec4(0.0, 0.0, 0.0, 0.0);
-        return;
-    }
+    if (nrm.w < 0.5)
+        return vec4(0.0);
     vec3 p = pos.xyz;
     vec3 n = nrm.xyz;
 #ifdef LPV_HAS_AO
-    if (V.viewport.w != 0.0) { // the technique's ambient occlusion, 1 = open
-        o_radiance = vec4(vec3(lpv_ao(p, n)), 1.0);
-        return;
-    }
+    if (V.viewport.w != 0.0) // the technique's ambient occlusion, 1 = open
+        return vec4(vec3(lpv_ao(p, n)), 1.0);
 #endif
     vec3 albedo = texelFetch(u_gbuf_albedo, px, 0).rgb;
     vec3 emission = texelFetch(u_gbuf_emission, px, 0).rgb;
@@ -61,5 +54,5 @@ void main()
     vec3 radiance = kd * albedo / LPV_PI * (e_direct + e_indirect);
     if (V.shading.w != 0.0)
         radiance += emission;
-    o_radiance = vec4(radiance, 1.0);
+    return vec4(radiance, 1.0);
 }

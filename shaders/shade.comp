@@ -1,0 +1,13 @@
+// shade.comp - the final frame (shading.glsl), one invocation per pixel,
+// written into the frame texture.
+layout(local_size_x = LPV_WG_2D, local_size_y = LPV_WG_2D) in;
+
+layout(binding = LPV_IMG_FRAME, rgba32f) writeonly uniform image2D u_frame;
+
+void main()
+{
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, imageSize(u_frame))))
+        return;
+    imageStore(u_frame, px, shade_pixel(px));
+}
