@@ -18,8 +18,8 @@
 #define LPV_MEM_VPL 48u           /* one LpvVpl per RSM texel */
 #define LPV_MEM_SURFEL 48u        /* one LpvSurfel per RSM texel or pixel */
 #define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
-#define LPV_MEM_CELL 440u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48), transmittances (24), reflectances
-                                     (96), flux limits (2 x 16), the injection atlas (3 x RGBA32F) */
+#define LPV_MEM_CELL 504u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48), transmittances (24), reflectances
+                                     (96), what the cells send (2 x 48), the injection atlas (3 x RGBA32F) */
 #define LPV_MEM_GV_POINT 80u      /* per geometry-volume point: the total (48, an LpvGvPoint) and atlas
                                      (2 x RGBA32F) */
 #define LPV_MEM_CELL_BUFFER 48u   /* the largest single grid buffer (one LpvCell per cell) */

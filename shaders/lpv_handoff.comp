@@ -6,12 +6,13 @@
 // coarse step carries it twice the distance, so what a surface accumulates
 // from a passing wave stays the same). The finest cascade is left empty, the
 // coarsest keeps its own light as well. Nothing is accumulated here: the
-// light only changes the grid it lives in. Writes the new flux limits.
+// light only changes the grid it lives in. Writes what the cells send next
+// (flux_limit.glsl, limited).
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = LPV_TEX_LPV_IN) uniform samplerBuffer u_in; // LpvCell as 3 texels
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell cout[]; };
-layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 sigma_out[]; };
+layout(std430, binding = LPV_SSBO_SENT_OUT) writeonly buffer SentOut { LpvCell sent_out[]; };
 
 void add_cell(inout LpvCell o, int j)
 {
@@ -43,5 +44,5 @@ void main()
     }
     int i = v * grid_cells() + cell_index(c);
     cout[i] = o;
-    sigma_out[i] = vec4(flux_limit(o.r), flux_limit(o.g), flux_limit(o.b), 0.0);
+    sent_out[i] = limited(o);
 }

@@ -1,7 +1,7 @@
 // lpv_pack.comp - copies the injection atlas into the LPV buffer layout
 // (LpvCell per cell, x fastest, volumes - cascades x normal bins - one after
 // another) as both the injected grid and the initial accumulation, with the
-// cells' flux limits for the first step.
+// what the cells send on the first step (flux_limit.glsl, limited).
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = 0) uniform sampler2D u_atlas_r;
@@ -10,7 +10,7 @@ layout(binding = 2) uniform sampler2D u_atlas_b;
 
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Injected { LpvCell injected[]; };
 layout(std430, binding = LPV_SSBO_LPV_ACC) writeonly buffer Acc { LpvCell acc[]; };
-layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 sigma_out[]; };
+layout(std430, binding = LPV_SSBO_SENT_OUT) writeonly buffer SentOut { LpvCell sent_out[]; };
 
 void main()
 {
@@ -27,5 +27,5 @@ void main()
     int i = k * grid_cells() + cell_index(c);
     injected[i] = cell;
     acc[i] = cell;
-    sigma_out[i] = vec4(flux_limit(cell.r), flux_limit(cell.g), flux_limit(cell.b), 0.0);
+    sent_out[i] = limited(cell);
 }

@@ -397,7 +397,7 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_VPLS     5
 #define LPV_SSBO_SURFELS  6
 #define LPV_SSBO_GV_TOTAL 7
-#define LPV_SSBO_SIGMA_OUT 8
+#define LPV_SSBO_SENT_OUT 8 /* LpvCell per cell: what it sends, its coefficients times its flux limits */
 #define LPV_SSBO_REFLECT  9
 #define LPV_SSBO_IV_POINTS 10   /* IvPoint */
 #define LPV_SSBO_IV_VOXELS 11   /* IvVoxel per voxel */
@@ -407,7 +407,7 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 
 /* Texture units of the propagation's inputs (RGBA32F buffer textures). */
 #define LPV_TEX_LPV_IN    0
-#define LPV_TEX_SIGMA_IN  1
+#define LPV_TEX_SENT_IN   1
 #define LPV_TEX_ACC_IN    2
 #define LPV_TEX_TRANSMIT  3
 #define LPV_TEX_REFLECT   4

@@ -1,7 +1,7 @@
 // octree_downsample.comp - the octree's downsampling step (Olovsson's thesis,
 // section 4.2, eq. 11): each cell of level i is the mean of its eight
 // children in level i - 1, written as the level's injected grid and initial
-// accumulation, with its flux limits for the first propagation step (as
+// accumulation, with what its cells send on the first step (as
 // lpv_pack.comp does for level 0). The grid block is level i's; u_fine_dims
 // are level i - 1's. core/oracle_octree.c is the reference.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -9,7 +9,7 @@ layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Fine { LpvCell fine[]; };
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Injected { LpvCell injected[]; };
 layout(std430, binding = LPV_SSBO_LPV_ACC) writeonly buffer Acc { LpvCell acc[]; };
-layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 sigma_out[]; };
+layout(std430, binding = LPV_SSBO_SENT_OUT) writeonly buffer SentOut { LpvCell sent_out[]; };
 
 uniform ivec3 u_fine_dims;
 
@@ -35,5 +35,5 @@ void main()
     int i = cell_index(c);
     injected[i] = m;
     acc[i] = m;
-    sigma_out[i] = vec4(flux_limit(m.r), flux_limit(m.g), flux_limit(m.b), 0.0);
+    sent_out[i] = limited(m);
 }

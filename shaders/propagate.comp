@@ -1,9 +1,10 @@
 // propagate.comp - one propagation step in every cascade, gathered per
 // destination cell (docs/propagation.md). Light from the neighbour at
 // cell - dir, travelling along dir, is the sparse matrix of lpv_shared.h
-// applied to the neighbour's coefficients, scaled by the neighbour's flux
-// limit sigma (computed when the neighbour was written: by lpv_pack.comp or
-// the previous step) and by the face's transmittance. Cascades never exchange
+// applied to the neighbour's coefficients times its flux limit sigma (what
+// it sends, flux_limit.glsl limited(): written with the neighbour by
+// lpv_pack.comp, the hand-off or the previous step), scaled by the face's
+// transmittance. Cascades never exchange
 // light: each is its own volume. The step's output is also added to the
 // accumulated volume.
 //
@@ -14,40 +15,40 @@
 // exceeds what was sent, so the energy stays bounded for albedo <= 1.
 layout(local_size_x = LPV_PROP_WG_X, local_size_y = LPV_PROP_WG_Y, local_size_z = 1) in;
 
-layout(binding = LPV_TEX_LPV_IN) uniform samplerBuffer u_in;       // LpvCell as 3 texels
+layout(binding = LPV_TEX_SENT_IN) uniform samplerBuffer u_sent;    // LpvCell as 3 texels: coefficients x sigma
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell cout[]; };
 layout(std430, binding = LPV_SSBO_LPV_ACC) writeonly buffer Acc { LpvCell acc[]; };
 layout(binding = LPV_TEX_ACC_IN) uniform samplerBuffer u_acc;           // LpvCell as 3 texels
 layout(binding = LPV_TEX_TRANSMIT) uniform samplerBuffer u_transmit;    // 6 per cell
-layout(binding = LPV_TEX_SIGMA_IN) uniform samplerBuffer u_sigma_in; // rgb flux limits
 layout(binding = LPV_TEX_REFLECT) uniform samplerBuffer u_reflect;   // rgb reflectance, 6 per cell
-layout(std430, binding = LPV_SSBO_SIGMA_OUT) writeonly buffer SigmaOut { vec4 sigma_out[]; };
+layout(std430, binding = LPV_SSBO_SENT_OUT) writeonly buffer SentOut { LpvCell sent_out[]; };
 
 uniform int u_occlusion; // 0 on the first step and when occlusion is off
 uniform int u_bounce;    // 1: reflect blocked light (only with u_occlusion)
 
-// The term one source channel c, with flux limit sigma (flux_limit.glsl),
-// sends along +-axis (slot 1 = y, 2 = z, 3 = x).
+// The term one source channel c (already times its flux limit) sends along
+// +-axis (slot 1 = y, 2 = z, 3 = x).
 // The band-1 rows of the transfer (E, F, G of lpv_shared.h) depend on the
 // transport; row 0 (A, B) does not.
 vec3 prop_efg;
 
-vec4 transfer(vec4 c, float sigma, int slot, float s)
+vec4 transfer(vec4 c, int slot, float s)
 {
     float f = LPV_PROP_A * c.x + s * LPV_PROP_B * c[slot];
-    if (!(f > 0.0) || !(sigma > 0.0))
+    if (!(f > 0.0))
         return vec4(0.0);
     vec4 o = prop_efg.z * c;
     o.x = f;
     o[slot] = s * prop_efg.x * c.x + prop_efg.y * c[slot];
-    return o * sigma;
+    return o;
 }
 
-// DC of what channel c sends along +-axis: the flux it sends / sqrt(4 pi).
-float sent_dc(vec4 c, float sigma, int slot, float s)
+// DC of what channel c (times its flux limit) sends along +-axis: the flux
+// it sends / sqrt(4 pi).
+float sent_dc(vec4 c, int slot, float s)
 {
     float f = LPV_PROP_A * c.x + s * LPV_PROP_B * c[slot];
-    return (f > 0.0 && sigma > 0.0) ? f * sigma : 0.0;
+    return f > 0.0 ? f : 0.0;
 }
 
 LpvCell fetch_cell(samplerBuffer b, int j)
@@ -84,11 +85,10 @@ void main()
         if (src[axis] >= 0 && src[axis] < grid_dims()[axis]) {                                   \
             float t = u_occlusion != 0 ? texelFetch(u_transmit, ti * LPV_DIR_COUNT + dir).x : 1.0; \
             int j = base + cell_index(src);                                                      \
-            LpvCell n = fetch_cell(u_in, j);                                                     \
-            vec4 sigma = texelFetch(u_sigma_in, j);                                              \
-            sum.r += t * transfer(n.r, sigma.r, slot, s);                                        \
-            sum.g += t * transfer(n.g, sigma.g, slot, s);                                        \
-            sum.b += t * transfer(n.b, sigma.b, slot, s);                                        \
+            LpvCell n = fetch_cell(u_sent, j);                                                   \
+            sum.r += t * transfer(n.r, slot, s);                                                 \
+            sum.g += t * transfer(n.g, slot, s);                                                 \
+            sum.b += t * transfer(n.b, slot, s);                                                 \
         }                                                                                        \
     }
     // direction order +x -x +y -y +z -z; x lives in SH slot 3, y in 1, z in 2
@@ -100,8 +100,7 @@ void main()
     GATHER(5, 2, -1.0, 2)
 #undef GATHER
     if (u_bounce != 0 && u_occlusion != 0) {
-        LpvCell self = fetch_cell(u_in, i);
-        vec4 sigma = texelFetch(u_sigma_in, i);
+        LpvCell self = fetch_cell(u_sent, i);
         for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
             int axis = dir / 2;
             float s = (dir & 1) == 0 ? 1.0 : -1.0;
@@ -116,9 +115,9 @@ void main()
             vec3 back = vec3(0.0);
             back[axis] = -s;
             vec4 lobe = sh_lobe(back) / LPV_SH_LOBE0; // DC 1: the reflected DC is refl x sent DC
-            sum.r += lobe * (refl.r * sent_dc(self.r, sigma.r, slot, s));
-            sum.g += lobe * (refl.g * sent_dc(self.g, sigma.g, slot, s));
-            sum.b += lobe * (refl.b * sent_dc(self.b, sigma.b, slot, s));
+            sum.r += lobe * (refl.r * sent_dc(self.r, slot, s));
+            sum.g += lobe * (refl.g * sent_dc(self.g, slot, s));
+            sum.b += lobe * (refl.b * sent_dc(self.b, slot, s));
         }
     }
     if ((u_medium & 1) != 0) {
@@ -131,9 +130,10 @@ void main()
         sum.b *= att.b;
     }
     cout[i] = sum;
-    // The next step needs each source's flux limit; computing it here, once
-    // per cell, saves recomputing it for each of the six destinations.
-    sigma_out[i] = vec4(flux_limit(sum.r), flux_limit(sum.g), flux_limit(sum.b), 0.0);
+    // The next step gathers what each source sends; computing it here, once
+    // per cell, saves recomputing the flux limit for each of the six
+    // destinations, and the neighbours read 12 values instead of 16.
+    sent_out[i] = limited(sum);
     LpvCell a = fetch_cell(u_acc, i);
     a.r += sum.r;
     a.g += sum.g;

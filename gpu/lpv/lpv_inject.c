@@ -41,7 +41,7 @@ void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rs
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, c->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, c->lpv_injected);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, c->lpv_acc);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, c->sigma[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SENT_OUT, c->sent[0]);
     glDispatchCompute(lpv_div_up((size_t)c->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)c->grid.dims[1], LPV_WG_2D),
                       (GLuint)(c->grid.dims[2] * lpv_volumes(c)));
     lpv_timer_count(timer, 1);

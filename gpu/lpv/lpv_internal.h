@@ -34,8 +34,8 @@ typedef struct lpv_cascaded {
     GLuint lpv_last; /* the buffer the last propagation step (or hand-off) wrote */
     lpv_lookup_volume lookup; /* lpv_acc as the lookup's 3D textures, when lookup_wanted */
     int lookup_wanted;        /* 1: the shading reads this state (the octree's levels are read merged) */
-    GLuint sigma[2]; /* flux limits of the cells a step reads / writes */
-    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sigma[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
+    GLuint sent[2]; /* what the cells a step reads / writes send: LpvCell x flux limits (flux_limit.glsl) */
+    GLuint tbo_injected, tbo_ping, tbo_pong, tbo_sent[2], tbo_acc, tbo_transmit, tbo_reflect; /* buffer-texture views */
     size_t grid_alloc_cells; /* cells of all cascades */
     int grid_alloc_dims[3], grid_alloc_cascades, grid_alloc_bins;
 } lpv_cascaded;

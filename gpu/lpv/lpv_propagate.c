@@ -37,40 +37,38 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
     const int iterations = in->settings->lpv.iterations, levels = c->cascades.handoff ? c->cascades.count : 1;
     const int every = in->settings->lpv.far_field_steps > 0 ? in->settings->lpv.far_field_steps : 1;
     GLuint in_view = c->tbo_injected, cur = 0;
-    int sig = 0; /* the sigma buffer holding the flux limits of what is read next */
+    int sent = 0; /* the buffer holding what the cells read next send (flux_limit.glsl, limited) */
     const GLuint groups[3] = {lpv_div_up((size_t)c->grid.dims[0], LPV_PROP_WG_X),
                               lpv_div_up((size_t)c->grid.dims[1], LPV_PROP_WG_Y),
                               (GLuint)(c->grid.dims[2] * lpv_volumes(c))};
     for (int i = 0; i < iterations; ++i) {
         GLuint out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
         glUseProgram(c->prog_propagate);
-        glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
-        glBindTexture(GL_TEXTURE_BUFFER, in_view);
-        glActiveTexture(GL_TEXTURE0 + LPV_TEX_SIGMA_IN);
-        glBindTexture(GL_TEXTURE_BUFFER, c->tbo_sigma[sig]);
+        glActiveTexture(GL_TEXTURE0 + LPV_TEX_SENT_IN);
+        glBindTexture(GL_TEXTURE_BUFFER, c->tbo_sent[sent]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, c->sigma[sig ^ 1]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SENT_OUT, c->sent[sent ^ 1]);
         glUniform1i(loc_occ, occlusion && i > 0);
         glDispatchCompute(groups[0], groups[1], groups[2]);
         lpv_timer_count(timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         cur = out;
         in_view = out == c->lpv_ping ? c->tbo_ping : c->tbo_pong;
-        sig ^= 1;
+        sent ^= 1;
         if ((i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations) {
             out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
             glUseProgram(c->prog_handoff);
             glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
             glBindTexture(GL_TEXTURE_BUFFER, in_view);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, c->sigma[sig ^ 1]);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SENT_OUT, c->sent[sent ^ 1]);
             glDispatchCompute(lpv_div_up((size_t)c->grid.dims[0], LPV_WG_2D),
                               lpv_div_up((size_t)c->grid.dims[1], LPV_WG_2D), groups[2]);
             lpv_timer_count(timer, 1);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             cur = out;
             in_view = out == c->lpv_ping ? c->tbo_ping : c->tbo_pong;
-            sig ^= 1;
+            sent ^= 1;
         }
     }
     c->lpv_last = cur ? cur : c->lpv_injected;

@@ -50,10 +50,10 @@ void lpv_cascaded_free_storage(lpv_cascaded *c)
     lpv_atlas_destroy(&c->gv_atlas);
     lpv_lookup_volume_free(&c->lookup);
     GLuint *bufs[] = {&c->lpv_injected, &c->lpv_ping, &c->lpv_pong, &c->lpv_acc,  &c->gv_total,
-                      &c->transmit,     &c->reflect,  &c->sigma[0], &c->sigma[1]};
+                      &c->transmit,     &c->reflect,  &c->sent[0], &c->sent[1]};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i)
         lpv_gl_delete_buffer(bufs[i]);
-    GLuint *views[] = {&c->tbo_injected, &c->tbo_ping, &c->tbo_pong, &c->tbo_sigma[0], &c->tbo_sigma[1],
+    GLuint *views[] = {&c->tbo_injected, &c->tbo_ping, &c->tbo_pong, &c->tbo_sent[0], &c->tbo_sent[1],
                        &c->tbo_acc, &c->tbo_transmit, &c->tbo_reflect};
     for (size_t i = 0; i < sizeof views / sizeof views[0]; ++i)
         lpv_gl_delete_texture(views[i]);
@@ -124,13 +124,13 @@ int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *rese
     c->gv_total = lpv_gl_new_ssbo(gv * sizeof(lpv_gv_point));
     c->transmit = lpv_gl_new_ssbo(cells * LPV_DIR_COUNT * sizeof(float));
     c->reflect = lpv_gl_new_ssbo(cells * LPV_DIR_COUNT * 4 * sizeof(float));
-    c->sigma[0] = lpv_gl_new_ssbo(vcells * 4 * sizeof(float));
-    c->sigma[1] = lpv_gl_new_ssbo(vcells * 4 * sizeof(float));
+    c->sent[0] = lpv_gl_new_ssbo(vcells * sizeof(lpv_cell));
+    c->sent[1] = lpv_gl_new_ssbo(vcells * sizeof(lpv_cell));
     c->tbo_injected = lpv_gl_buffer_view(c->lpv_injected, GL_RGBA32F);
     c->tbo_ping = lpv_gl_buffer_view(c->lpv_ping, GL_RGBA32F);
     c->tbo_pong = lpv_gl_buffer_view(c->lpv_pong, GL_RGBA32F);
-    c->tbo_sigma[0] = lpv_gl_buffer_view(c->sigma[0], GL_RGBA32F);
-    c->tbo_sigma[1] = lpv_gl_buffer_view(c->sigma[1], GL_RGBA32F);
+    c->tbo_sent[0] = lpv_gl_buffer_view(c->sent[0], GL_RGBA32F);
+    c->tbo_sent[1] = lpv_gl_buffer_view(c->sent[1], GL_RGBA32F);
     c->tbo_acc = lpv_gl_buffer_view(c->lpv_acc, GL_RGBA32F);
     c->tbo_transmit = lpv_gl_buffer_view(c->transmit, GL_R32F);
     c->tbo_reflect = lpv_gl_buffer_view(c->reflect, GL_RGBA32F);

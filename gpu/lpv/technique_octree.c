@@ -245,7 +245,7 @@ static void downsample(lpv_octree_gpu *o, int i, lpv_timer *timer)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, fine->lpv_injected);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, c->lpv_injected);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, c->lpv_acc);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SIGMA_OUT, c->sigma[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SENT_OUT, c->sent[0]);
     glUniform3i(glGetUniformLocation(o->prog_downsample, "u_fine_dims"), fine->grid.dims[0], fine->grid.dims[1],
                 fine->grid.dims[2]);
     glDispatchCompute(lpv_div_up((size_t)c->grid.dims[0], LPV_WG_2D), lpv_div_up((size_t)c->grid.dims[1], LPV_WG_2D),
