@@ -80,7 +80,8 @@ static int light_cone(const lpv_engine *e, int l, vec3 apex, vec3 axis, float *h
     if (!(glm_vec3_norm(axis) > 1e-8f))
         return 0;
     glm_vec3_normalize(axis);
-    *half_angle = type == LPV_LIGHT_TYPE_AREA ? (float)(M_PI / 2.0) : acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
+    *half_angle = type == LPV_LIGHT_TYPE_AREA ? (float)(M_PI / 2.0)
+                                              : acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
     return *half_angle < (float)M_PI;
 }
 
@@ -151,7 +152,8 @@ static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int
     const float margin = LPV_SHADOW_BORDER_TEXELS + 2.0f * (float)(LPV_SHADOW_PCF_RADIUS + 1);
     int r[4];
     for (int k = 0; k < 2; ++k) {
-        float a = floorf((lo[k] * 0.5f + 0.5f) * (float)side - margin), b = ceilf((hi[k] * 0.5f + 0.5f) * (float)side + margin);
+        float a = floorf((lo[k] * 0.5f + 0.5f) * (float)side - margin);
+        float b = ceilf((hi[k] * 0.5f + 0.5f) * (float)side + margin);
         a = fmaxf(a, 0.0f), b = fminf(b, (float)side);
         r[k] = (int)a, r[k + 2] = (int)b - (int)a;
     }
