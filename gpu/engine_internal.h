@@ -169,6 +169,10 @@ void lpv_light_faces_build(lpv_engine *e);
  * faces are tiles, four to a layer. */
 void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers);
 
+/* A spot's outer cone half angle (rad) from its GPU record (cos stored in
+ * cone_faces[1]): what its shadow faces cover and what it lights. */
+float lpv_spot_outer_angle(const struct LpvLightGpu *g);
+
 /* The shadow-map faces for e->light_block's lights (punctual lights and area
  * light samples) at shadow_size, the directional cascades fitted to e->view.
  * Returns 0 or -1 with err. */

@@ -296,6 +296,11 @@ void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_lay
     *shadow_layers = shadows + area_layers(e->settings.shadow_size, area_faces);
 }
 
+float lpv_spot_outer_angle(const struct LpvLightGpu *g)
+{
+    return acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
+}
+
 static void shadow_perspective_face(struct LpvShadowFaceGpu *f, const vec3 eye, const vec3 dir, float tan_half,
                                     float near_z, float far_z, int light, int size)
 {
@@ -364,11 +369,10 @@ int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *
                 f->info[3] = (float)k;
                 glm_vec3_copy(dir, f->axis);
             }
-        } else if (type == LPV_LIGHT_TYPE_SPOT &&
-                   acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f)) <= LPV_SHADOW_SPOT_MAX_SINGLE_FACE) {
+        } else if (type == LPV_LIGHT_TYPE_SPOT && lpv_spot_outer_angle(g) <= LPV_SHADOW_SPOT_MAX_SINGLE_FACE) {
             if (faces + 1 > LPV_MAX_SHADOW_FACES)
                 return lpv_error(err, err_size, "too many shadow-map faces");
-            float outer = acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
+            float outer = lpv_spot_outer_angle(g);
             float half = outer > 1e-3f ? outer : 1e-3f;
             shadow_perspective_face(&b->faces[faces++], pos, dir, tanf(half), near_z, far_from(e, pos), l, size);
         } else {

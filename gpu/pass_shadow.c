@@ -80,8 +80,7 @@ static int light_cone(const lpv_engine *e, int l, vec3 apex, vec3 axis, float *h
     if (!(glm_vec3_norm(axis) > 1e-8f))
         return 0;
     glm_vec3_normalize(axis);
-    *half_angle = type == LPV_LIGHT_TYPE_AREA ? (float)(M_PI / 2.0)
-                                              : acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
+    *half_angle = type == LPV_LIGHT_TYPE_AREA ? (float)(M_PI / 2.0) : lpv_spot_outer_angle(g);
     return *half_angle < (float)M_PI;
 }
 
@@ -106,7 +105,7 @@ static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int
     float half;
     if (F->info[1] != 1.0f || !light_cone(e, (int)F->info[2], apex, axis, &half))
         return 1;
-    const float open = half + 0.02f, cos_open = cosf(open);
+    const float open = half + 0.02f, cos_open = cosf(open), sin_open = sinf(open);
     float lo[2] = {2.0f, 2.0f}, hi[2] = {-2.0f, -2.0f};
     mat4 inv;
     glm_mat4_inv((vec4 *)F->view_proj, inv);
@@ -133,11 +132,10 @@ static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int
     glm_vec3_normalize(t1);
     glm_vec3_cross(axis, t1, t2);
     for (int i = 0; i < RIM_SAMPLES; ++i) {
-        const float a = 2.0f * (float)M_PI * (float)i / (float)RIM_SAMPLES;
-        const float c = cosf(open), sn = sinf(open);
+        const float a = 2.0f * (float)M_PI * (float)i / (float)RIM_SAMPLES, ca = cosf(a), sa = sinf(a);
         vec4 p = {apex[0], apex[1], apex[2], 1.0f}, clip;
         for (int k = 0; k < 3; ++k)
-            p[k] += c * axis[k] + sn * (cosf(a) * t1[k] + sinf(a) * t2[k]);
+            p[k] += cos_open * axis[k] + sin_open * (ca * t1[k] + sa * t2[k]);
         glm_mat4_mulv((vec4 *)F->view_proj, p, clip);
         if (!(clip[3] > 0.0f))
             continue;

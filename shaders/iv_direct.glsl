@@ -51,12 +51,9 @@ vec3 iv_direct_irradiance(vec3 p, vec3 n)
     int count = int(L.counts.x);
     for (int l = 0; l < count; ++l) {
         LpvLightGpu li = L.lights[l];
-        vec3 to_light;
-        vec3 e_perp = light_irradiance_normal(li, p, to_light);
-        float cos_i = dot(n, to_light);
-        if (!(cos_i > 0.0) || !any(greaterThan(e_perp, vec3(0.0))))
-            continue;
-        e += e_perp * cos_i * iv_rsm_visibility(light_face_for(li, p), p, n, to_light);
+        vec3 e_cos, to_light;
+        if (light_arrives(li, p, n, e_cos, to_light))
+            e += e_cos * iv_rsm_visibility(light_face_for(li, p), p, n, to_light);
     }
     return e;
 }

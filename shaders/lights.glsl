@@ -42,6 +42,19 @@ vec3 light_irradiance_normal(LpvLightGpu li, vec3 p, out vec3 to_light)
     return li.intensity.rgb * spot_factor(li, -to_light) * range_window(li, dist) / dist2;
 }
 
+// Whether light li reaches a surface at p facing n, before any shadowing:
+// false behind the surface, outside a spot's cone, behind an area light
+// sample (no shadow lookup is needed there; pass_shadow.c draws no depth
+// for it). When true, e_cos is the unshadowed irradiance (W/m^2, rgb) on the
+// surface and to_light the unit direction towards the light.
+bool light_arrives(LpvLightGpu li, vec3 p, vec3 n, out vec3 e_cos, out vec3 to_light)
+{
+    vec3 e = light_irradiance_normal(li, p, to_light);
+    float cos_i = dot(n, to_light);
+    e_cos = e * cos_i;
+    return cos_i > 0.0 && any(greaterThan(e, vec3(0.0)));
+}
+
 // The face of light `li` whose shadow map covers p: the single face, or the
 // cube face of the major axis of p - light (faces ordered +x -x +y -y +z -z).
 int light_face_for(LpvLightGpu li, vec3 p)

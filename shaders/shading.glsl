@@ -33,15 +33,9 @@ vec4 shade_pixel(ivec2 px)
     if (V.shading.y != 0.0) {
         int count = int(L.counts.x);
         for (int l = 0; l < count; ++l) {
-            LpvLightGpu li = L.lights[l];
-            vec3 to_light;
-            vec3 e = light_irradiance_normal(li, p, to_light);
-            float cos_i = dot(n, to_light);
-            // outside a spot's cone or behind an area light sample the
-            // irradiance is 0: no shadow taps (pass_shadow.c draws no depth there)
-            if (cos_i <= 0.0 || !any(greaterThan(e, vec3(0.0))))
-                continue;
-            e_direct += e * cos_i * shadow_visibility(l, p, n);
+            vec3 e, to_light;
+            if (light_arrives(L.lights[l], p, n, e, to_light))
+                e_direct += e * shadow_visibility(l, p, n);
         }
     }
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);
