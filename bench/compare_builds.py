@@ -4,7 +4,7 @@ one machine in one run, as per-stage ratios.
 
 Machines drift (other jobs, turbo, thermal state), so absolute times from
 different days do not compare. This runs the two benches alternately, A B A
-B ..., with the same arguments, and for every configuration and stage prints
+A ..., with the same arguments, and for every configuration and stage prints
 the median of the per-round ratios new/old (below 1: the new build is
 faster) beside both medians.
 
@@ -59,12 +59,18 @@ def main():
         ap.error("--rounds must be at least 1")
     olds, news, head = [], [], ""
     for i in range(a.rounds):
-        o, _ = run(a.old, a.bench_args)
-        n, head = run(a.new, a.bench_args)
+        # the order swaps every round (A B, B A, ...): whichever runs second
+        # in a pair has measured up to 10 % slower on the bench machine
+        if i % 2 == 0:
+            o, _ = run(a.old, a.bench_args)
+            n, head = run(a.new, a.bench_args)
+        else:
+            n, head = run(a.new, a.bench_args)
+            o, _ = run(a.old, a.bench_args)
         olds.append(o)
         news.append(n)
         print("compare_builds: round %d/%d done" % (i + 1, a.rounds), file=sys.stderr)
-    print("# new / old, %d alternating rounds, medians of per-round ratios" % a.rounds)
+    print("# new / old, %d rounds in alternating order, medians of per-round ratios" % a.rounds)
     print()
     print("new: `%s`, old: `%s`, arguments `%s`" % (a.new, a.old, " ".join(a.bench_args)))
     print()

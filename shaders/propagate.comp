@@ -25,6 +25,7 @@ layout(std430, binding = LPV_SSBO_SENT_OUT) writeonly buffer SentOut { LpvCell s
 
 uniform int u_occlusion; // 0 on the first step and when occlusion is off
 uniform int u_bounce;    // 1: reflect blocked light (only with u_occlusion)
+uniform int u_write_coeffs; // 1: also write the coefficients (cout): the last step and before a hand-off
 
 // The term one source channel c (already times its flux limit) sends along
 // +-axis (slot 1 = y, 2 = z, 3 = x).
@@ -129,7 +130,11 @@ void main()
         sum.g *= att.g;
         sum.b *= att.b;
     }
-    cout[i] = sum;
+    // Only the hand-off and the read-back of the last step read the
+    // coefficients themselves (the next step gathers what is sent): other
+    // steps skip the store, a third of what a cell-step writes.
+    if (u_write_coeffs != 0)
+        cout[i] = sum;
     // The next step gathers what each source sends; computing it here, once
     // per cell, saves recomputing the flux limit for each of the six
     // destinations, and the neighbours read 12 values instead of 16.

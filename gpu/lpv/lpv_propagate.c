@@ -12,6 +12,7 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
     lpv_timer_begin(timer, "propagate");
     glUseProgram(c->prog_propagate);
     GLint loc_occ = glGetUniformLocation(c->prog_propagate, "u_occlusion");
+    GLint loc_write = glGetUniformLocation(c->prog_propagate, "u_write_coeffs");
     glUniform1i(glGetUniformLocation(c->prog_propagate, "u_bounce"), bounce);
     lpv_medium_bind(in->medium, in->settings, c->prog_propagate, in->plan->pass[LPV_PASS_MEDIA].run);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_REFLECT);
@@ -45,19 +46,23 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
                               (GLuint)(c->grid.dims[2] * lpv_volumes(c))};
     for (int i = 0; i < iterations; ++i) {
         GLuint out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
+        const int handoff_next = (i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations;
         glUseProgram(c->prog_propagate);
         glActiveTexture(GL_TEXTURE0 + LPV_TEX_SENT_IN);
         glBindTexture(GL_TEXTURE_BUFFER, c->tbo_sent[sent]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SENT_OUT, c->sent[sent ^ 1]);
         glUniform1i(loc_occ, occlusion && i > 0);
+        /* the coefficients are read only by a hand-off and by the read-back
+         * of the last step (LPV_GRID_LAST_STEP) */
+        glUniform1i(loc_write, handoff_next || i + 1 == iterations);
         glDispatchCompute(groups[0], groups[1], groups[2]);
         lpv_timer_count(timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         cur = out;
         in_view = out == c->lpv_ping ? c->tbo_ping : c->tbo_pong;
         sent ^= 1;
-        if ((i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations) {
+        if (handoff_next) {
             out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
             glUseProgram(c->prog_handoff);
             glActiveTexture(GL_TEXTURE0 + LPV_TEX_LPV_IN);
