@@ -19,7 +19,7 @@ layout(binding = LPV_TEX_SENT_IN) uniform samplerBuffer u_sent;    // LpvCell as
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell cout[]; };
 layout(std430, binding = LPV_SSBO_LPV_ACC) writeonly buffer Acc { LpvCell acc[]; };
 layout(binding = LPV_TEX_ACC_IN) uniform samplerBuffer u_acc;           // LpvCell as 3 texels
-layout(binding = LPV_TEX_TRANSMIT) uniform samplerBuffer u_transmit;    // 6 per cell
+layout(binding = LPV_TEX_TRANSMIT) uniform samplerBuffer u_transmit;    // 6 per cell, as 3 RG texels (+-x, +-y, +-z)
 layout(binding = LPV_TEX_REFLECT) uniform samplerBuffer u_reflect;   // rgb reflectance, 6 per cell
 layout(std430, binding = LPV_SSBO_SENT_OUT) writeonly buffer SentOut { LpvCell sent_out[]; };
 
@@ -76,21 +76,29 @@ void main()
     int ti = k * grid_cells() + cell_index(c); // this cell in the per-cascade buffers
     LpvCell sum;
     sum.r = sum.g = sum.b = vec4(0.0);
+    // the transmittances of the six faces, a pair (+axis, -axis) per fetch
+    vec2 trans[3] = vec2[3](vec2(1.0), vec2(1.0), vec2(1.0));
+    if (u_occlusion != 0)
+        for (int axis = 0; axis < 3; ++axis)
+            trans[axis] = texelFetch(u_transmit, ti * 3 + axis).xy;
     // the six directions written out (GATHER), so that the axis, the sign
     // and the SH slot are constants: llvmpipe would otherwise index vectors
-    // and branch per lane
+    // and branch per lane. A neighbour outside the grid is read clamped
+    // (the cell itself) and weighted 0, without a branch: llvmpipe runs
+    // a branch that differs between lanes under masks, which costs more than
+    // the fetch it would save at the border.
 #define GATHER(dir, axis, s, slot)                                                               \
     {                                                                                            \
         ivec3 src = c;                                                                           \
         src[axis] -= int(s);                                                                     \
-        if (src[axis] >= 0 && src[axis] < grid_dims()[axis]) {                                   \
-            float t = u_occlusion != 0 ? texelFetch(u_transmit, ti * LPV_DIR_COUNT + dir).x : 1.0; \
-            int j = base + cell_index(src);                                                      \
-            LpvCell n = fetch_cell(u_sent, j);                                                   \
-            sum.r += t * transfer(n.r, slot, s);                                                 \
-            sum.g += t * transfer(n.g, slot, s);                                                 \
-            sum.b += t * transfer(n.b, slot, s);                                                 \
-        }                                                                                        \
+        bool inside = src[axis] >= 0 && src[axis] < grid_dims()[axis];                          \
+        float t = inside ? trans[axis][dir & 1] : 0.0;                                           \
+        src[axis] = clamp(src[axis], 0, grid_dims()[axis] - 1);                                  \
+        int j = base + cell_index(src);                                                          \
+        LpvCell n = fetch_cell(u_sent, j);                                                       \
+        sum.r += t * transfer(n.r, slot, s);                                                     \
+        sum.g += t * transfer(n.g, slot, s);                                                     \
+        sum.b += t * transfer(n.b, slot, s);                                                     \
     }
     // direction order +x -x +y -y +z -z; x lives in SH slot 3, y in 1, z in 2
     GATHER(0, 0, 1.0, 3)

@@ -132,7 +132,7 @@ int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *rese
     c->tbo_sent[0] = lpv_gl_buffer_view(c->sent[0], GL_RGBA32F);
     c->tbo_sent[1] = lpv_gl_buffer_view(c->sent[1], GL_RGBA32F);
     c->tbo_acc = lpv_gl_buffer_view(c->lpv_acc, GL_RGBA32F);
-    c->tbo_transmit = lpv_gl_buffer_view(c->transmit, GL_R32F);
+    c->tbo_transmit = lpv_gl_buffer_view(c->transmit, GL_RG32F); /* a face pair per texel */
     c->tbo_reflect = lpv_gl_buffer_view(c->reflect, GL_RGBA32F);
     if (c->lookup_wanted && lpv_lookup_volume_alloc(&c->lookup, g->dims, lpv_volumes(c), err, err_size) != 0)
         return -1;
