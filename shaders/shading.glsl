@@ -31,11 +31,18 @@ vec4 shade_pixel(ivec2 px)
 
     vec3 e_direct = vec3(0.0);
     if (V.shading.y != 0.0) {
-        int count = int(L.counts.x);
-        for (int l = 0; l < count; ++l) {
+        // the punctual lights, then the area light samples (lights.glsl):
+        // apart, so that each loop holds only its kind's shadow lookup
+        int punctual = int(L.counts.z), count = int(L.counts.x);
+        for (int l = 0; l < punctual; ++l) {
             vec3 e, to_light;
             if (light_arrives(L.lights[l], p, n, e, to_light))
-                e_direct += e * shadow_visibility(l, p, n);
+                e_direct += e * shadow_visibility(l, p, n, SHADOW_PUNCTUAL);
+        }
+        for (int l = punctual; l < count; ++l) {
+            vec3 e, to_light;
+            if (light_arrives(L.lights[l], p, n, e, to_light))
+                e_direct += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
         }
     }
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);

@@ -42,19 +42,33 @@ float shadow_pcf(int face, vec2 uv, float depth, int R)
     return sum / float((2 * R + 1) * (2 * R + 1));
 }
 
+// Which lights a caller passes (a constant, so that after inlining the
+// compiler drops the code of the other kinds): llvmpipe runs both sides of
+// every branch under lane masks, so a loop over all lights pays for every
+// kind's face selection with each light; the shading loops over the
+// punctual lights and the area light samples apart (shading.glsl).
+const int SHADOW_ANY_LIGHT = 0;
+const int SHADOW_PUNCTUAL = 1;    // lights [0, L.counts.z)
+const int SHADOW_AREA_SAMPLE = 2; // lights [L.counts.z, L.counts.x)
+
 // The shadow-map face of light l that holds x: the cube face of the major
 // axis of x - light, the area light face whose axis is nearest x - light, the
 // single face of a spot, or the finest cascade whose
 // square holds x with LPV_SHADOW_BORDER_TEXELS to spare; -1 if none does.
-int shadow_face(int l, vec3 x)
+// kind: which lights l can be (SHADOW_ANY_LIGHT when unknown).
+int shadow_face_of(int l, vec3 x, const int kind)
 {
     vec4 info = S.lights[l];
     int first = int(info.x), count = int(info.y);
-    if (info.z == 2.0) { // area light sample: the face whose axis is nearest x's direction
+    if (kind == SHADOW_AREA_SAMPLE || (kind == SHADOW_ANY_LIGHT && info.z == 2.0)) {
+        // area light sample: the face whose axis is nearest x's direction
         vec3 d = x - L.lights[l].position_type.xyz;
         int best = first;
         float best_dot = dot(d, S.faces[first].axis.xyz);
-        for (int k = 1; k < count; ++k) {
+        // every sample has LPV_AREA_FACES faces (gpu/light_faces.c): a
+        // constant bound that the compiler unrolls (llvmpipe runs a loop
+        // with a mask and an any-lane test per trip)
+        for (int k = 1; k < LPV_AREA_FACES; ++k) {
             float dk = dot(d, S.faces[first + k].axis.xyz);
             if (dk > best_dot) {
                 best = first + k;
@@ -93,6 +107,7 @@ float shadow_texel(int f, vec3 x, vec3 light_pos)
 }
 
 // Visibility (0..1) of light l from a receiver at p with unit normal n,
+// a light of the given kind (SHADOW_ANY_LIGHT when unknown),
 // filtered over the kernel (taps = 1: one bilinear compare, for callers that
 // average many lookups themselves, such as the media's ray march). The
 // receiver bias is in texels of the map at p (texel size T), so it does not
@@ -101,7 +116,7 @@ float shadow_texel(int f, vec3 x, vec3 light_pos)
 // the kernel, then (LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan(theta))
 // * T towards the light (the slope-scaled depth bias; moving along the ray to
 // the light keeps the texel the same).
-float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
+float shadow_visibility_of(int l, vec3 p, vec3 n, int taps, const int kind)
 {
     LpvLightGpu li = L.lights[l];
     if (int(S.lights[l].y) == 0)
@@ -112,13 +127,13 @@ float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
     float c = clamp(dot(n, to_light), 0.0, 1.0);
     float s = sqrt(max(1.0 - c * c, 0.0));
     float tan_t = min(s / max(c, 1e-4), LPV_SHADOW_MAX_SLOPE);
-    int f = shadow_face(l, p);
+    int f = shadow_face_of(l, p, kind);
     vec3 q = p;
     for (int pass = 0; pass < 2 && f >= 0; ++pass) {
         float T = shadow_texel(f, p, lp);
         q = p + n * (LPV_SHADOW_NORMAL_OFFSET * T * s) +
             to_light * ((LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan_t) * T);
-        int g = shadow_face(l, q); // the offset may cross into a neighbouring face or cascade
+        int g = shadow_face_of(l, q, kind); // the offset may cross into a neighbouring face or cascade
         if (g == f)
             break;
         f = g;
@@ -135,8 +150,14 @@ float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
     return shadow_pcf(f, uvz.xy, uvz.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
 }
 
-// The filtered visibility for surfaces (shading.glsl).
-float shadow_visibility(int l, vec3 p, vec3 n)
+float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
 {
-    return shadow_visibility_taps(l, p, n, 0);
+    return shadow_visibility_of(l, p, n, taps, SHADOW_ANY_LIGHT);
+}
+
+// The filtered visibility for surfaces (shading.glsl), of a light of the
+// given kind.
+float shadow_visibility(int l, vec3 p, vec3 n, const int kind)
+{
+    return shadow_visibility_of(l, p, n, 0, kind);
 }
