@@ -41,6 +41,11 @@ int lpv_medium_upload(lpv_medium_gpu *g, const lpv_scene *scene, char *err, size
     return 0;
 }
 
+int lpv_medium_active(const lpv_medium_gpu *g, const lpv_settings *s, int on)
+{
+    return on && (s->fog_sigma_s > 0.0f || s->fog_sigma_a > 0.0f || g->medium.present);
+}
+
 void lpv_medium_bind(const lpv_medium_gpu *g, const lpv_settings *s, GLuint prog, int on)
 {
     int flags = 0;

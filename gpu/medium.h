@@ -25,5 +25,7 @@ void lpv_medium_free(lpv_medium_gpu *m);
 /* Sets medium.glsl's uniforms of prog (in use): the fog settings win over the
  * scene's medium; on = 0 binds "no medium". */
 void lpv_medium_bind(const lpv_medium_gpu *m, const lpv_settings *s, GLuint prog, int on);
+/* Whether lpv_medium_bind(m, s, prog, on) binds a medium (u_medium != 0). */
+int lpv_medium_active(const lpv_medium_gpu *m, const lpv_settings *s, int on);
 
 #endif /* LPV_MEDIUM_H */

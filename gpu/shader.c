@@ -214,10 +214,16 @@ GLuint lpv_program_graphics(const char *vert, const char *geom, const char *frag
 GLuint lpv_program_build(const char *first, const char *geom, const char *frag, const char *const *includes,
                          char *err, size_t err_size)
 {
+    return lpv_program_build_defines(first, geom, frag, NULL, includes, err, err_size);
+}
+
+GLuint lpv_program_build_defines(const char *first, const char *geom, const char *frag, const char *defines,
+                                 const char *const *includes, char *err, size_t err_size)
+{
     /* The includes use the shared header's types, so it goes first; its
      * include guard makes the copy shader.c adds afterwards a no-op. */
     const char *shared = lpv_shader_text("lpv_shared.h");
-    size_t len = strlen(shared) + 2;
+    size_t len = strlen(shared) + 2 + (defines ? strlen(defines) + 1 : 0);
     for (const char *const *i = includes; i && *i; ++i) {
         const char *t = lpv_shader_text(*i);
         if (!t) {
@@ -231,7 +237,12 @@ GLuint lpv_program_build(const char *first, const char *geom, const char *frag, 
         lpv_error(err, err_size, "out of memory building %s", first);
         return 0;
     }
-    strcpy(prelude, shared);
+    prelude[0] = '\0';
+    if (defines) {
+        strcat(prelude, defines);
+        strcat(prelude, "\n");
+    }
+    strcat(prelude, shared);
     strcat(prelude, "\n");
     for (const char *const *i = includes; i && *i; ++i) {
         strcat(prelude, lpv_shader_text(*i));

@@ -28,5 +28,9 @@ GLuint lpv_program_graphics(const char *vert, const char *geom, const char *frag
  * builds a compute program from first. Returns 0 with err on failure. */
 GLuint lpv_program_build(const char *first, const char *geom, const char *frag, const char *const *includes,
                          char *err, size_t err_size);
+/* The same with "#define ..." lines (or NULL) ahead of everything: one source
+ * compiled into variants whose unused code the compiler drops. */
+GLuint lpv_program_build_defines(const char *first, const char *geom, const char *frag, const char *defines,
+                                 const char *const *includes, char *err, size_t err_size);
 
 #endif /* LPV_SHADER_H */

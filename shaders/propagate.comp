@@ -108,6 +108,11 @@ void main()
     GATHER(4, 2, 1.0, 2)
     GATHER(5, 2, -1.0, 2)
 #undef GATHER
+#if LPV_PROPAGATE_EFFECTS
+    // Compiled only into the variant the engine uses when a bounce or a
+    // medium is on (gpu/lpv/lpv_propagate.c): llvmpipe runs a branch's code
+    // under lane masks even when no lane takes it, and these two blocks cost
+    // the plain step 15 %.
     if (u_bounce != 0 && u_occlusion != 0) {
         LpvCell self = fetch_cell(u_sent, i);
         for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
@@ -138,6 +143,7 @@ void main()
         sum.g *= att.g;
         sum.b *= att.b;
     }
+#endif
     // Only the hand-off and the read-back of the last step read the
     // coefficients themselves (the next step gathers what is sent): other
     // steps skip the store, a third of what a cell-step writes.

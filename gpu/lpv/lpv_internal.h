@@ -23,8 +23,10 @@ typedef struct lpv_cascaded {
     lpv_cascade_set pending;  /* placement of the last place */
     int bins;                 /* LPV volumes per cascade: 1, or LPV_NORMAL_BINS (normal_bins on) */
 
-    GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate, prog_handoff,
-        prog_lookup_pack;
+    /* prog_propagate without the bounce and medium terms, prog_propagate_effects
+     * with them (propagate.comp, LPV_PROPAGATE_EFFECTS) */
+    GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate,
+        prog_propagate_effects, prog_handoff, prog_lookup_pack;
     int borrowed_programs;    /* 1: the programs are another state's (the octree's levels share them) */
     GLuint empty_vao;
 

@@ -10,11 +10,15 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
 {
     lpv_timer *timer = in->timer;
     lpv_timer_begin(timer, "propagate");
-    glUseProgram(c->prog_propagate);
-    GLint loc_occ = glGetUniformLocation(c->prog_propagate, "u_occlusion");
-    GLint loc_write = glGetUniformLocation(c->prog_propagate, "u_write_coeffs");
-    glUniform1i(glGetUniformLocation(c->prog_propagate, "u_bounce"), bounce);
-    lpv_medium_bind(in->medium, in->settings, c->prog_propagate, in->plan->pass[LPV_PASS_MEDIA].run);
+    /* the variant without the bounce and medium terms unless one is on */
+    const int media = in->plan->pass[LPV_PASS_MEDIA].run;
+    const GLuint prog = bounce || lpv_medium_active(in->medium, in->settings, media) ? c->prog_propagate_effects
+                                                                                     : c->prog_propagate;
+    glUseProgram(prog);
+    GLint loc_occ = glGetUniformLocation(prog, "u_occlusion");
+    GLint loc_write = glGetUniformLocation(prog, "u_write_coeffs");
+    glUniform1i(glGetUniformLocation(prog, "u_bounce"), bounce);
+    lpv_medium_bind(in->medium, in->settings, prog, media);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_REFLECT);
     glBindTexture(GL_TEXTURE_BUFFER, c->tbo_reflect);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, c->grid_ubo);
@@ -47,7 +51,7 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
     for (int i = 0; i < iterations; ++i) {
         GLuint out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
         const int handoff_next = (i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations;
-        glUseProgram(c->prog_propagate);
+        glUseProgram(prog);
         glActiveTexture(GL_TEXTURE0 + LPV_TEX_SENT_IN);
         glBindTexture(GL_TEXTURE_BUFFER, c->tbo_sent[sent]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);

@@ -22,7 +22,8 @@ void lpv_cascaded_delete(lpv_cascaded *c)
         return;
     lpv_cascaded_free_storage(c);
     GLuint *progs[] = {&c->prog_inject_vpl, &c->prog_inject_gv, &c->prog_pack,    &c->prog_gv_merge,
-                       &c->prog_transmit,   &c->prog_propagate, &c->prog_handoff, &c->prog_lookup_pack};
+                       &c->prog_transmit,   &c->prog_propagate, &c->prog_propagate_effects,
+                       &c->prog_handoff,    &c->prog_lookup_pack};
     for (size_t i = 0; !c->borrowed_programs && i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -58,18 +59,21 @@ lpv_cascaded *lpv_cascaded_new(char *err, size_t err_size)
         GLuint *prog;
         const char *a, *b;
         const char *const *inc;
+        const char *defines;
     } progs[] = {
         {&c->prog_inject_vpl, "inject_vpl.vert", "inject_vpl.frag", INC_GRID},
         {&c->prog_inject_gv, "inject_gv.vert", "inject_gv.frag", INC_GRID},
         {&c->prog_pack, "lpv_pack.comp", NULL, INC_PROPAGATE},
         {&c->prog_gv_merge, "gv_merge.comp", NULL, INC_GRID},
         {&c->prog_transmit, "transmit.comp", NULL, INC_GRID},
-        {&c->prog_propagate, "propagate.comp", NULL, INC_PROPAGATE},
+        {&c->prog_propagate, "propagate.comp", NULL, INC_PROPAGATE, "#define LPV_PROPAGATE_EFFECTS 0"},
+        {&c->prog_propagate_effects, "propagate.comp", NULL, INC_PROPAGATE, "#define LPV_PROPAGATE_EFFECTS 1"},
         {&c->prog_handoff, "lpv_handoff.comp", NULL, INC_PROPAGATE},
         {&c->prog_lookup_pack, "lpv_lookup_pack.comp", NULL, NULL},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
-        *progs[i].prog = lpv_program_build(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
+        *progs[i].prog =
+            lpv_program_build_defines(progs[i].a, NULL, progs[i].b, progs[i].defines, progs[i].inc, err, err_size);
         if (!*progs[i].prog) {
             lpv_cascaded_delete(c);
             return NULL;
@@ -90,6 +94,7 @@ lpv_cascaded *lpv_cascaded_new_sharing(const lpv_cascaded *owner, char *err, siz
     c->prog_gv_merge = owner->prog_gv_merge;
     c->prog_transmit = owner->prog_transmit;
     c->prog_propagate = owner->prog_propagate;
+    c->prog_propagate_effects = owner->prog_propagate_effects;
     c->prog_handoff = owner->prog_handoff;
     c->prog_lookup_pack = owner->prog_lookup_pack;
     return c;
