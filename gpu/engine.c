@@ -58,8 +58,12 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
         GLuint *prog;
         const char *a, *b;
         const char *const *inc;
+        const char *defines;
     } progs[] = {
-        {&e->prog_shade, "shade.comp", NULL, inc_shade},
+        /* the frame without the damping's second lookup, and with it (the
+         * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING) */
+        {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, NULL},
         {&e->prog_query, "query.comp", NULL, inc_lookup},
         {&e->prog_glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
         {&e->prog_media, "fullscreen.vert", "media.frag", inc_media},
@@ -67,7 +71,8 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
     enum { N = sizeof progs / sizeof progs[0] };
     GLuint built[N] = {0};
     for (size_t i = 0; i < N; ++i) {
-        built[i] = lpv_program_build(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
+        built[i] = lpv_program_build_defines(progs[i].a, NULL, progs[i].b, progs[i].defines, progs[i].inc, err,
+                                             err_size);
         if (!built[i]) {
             for (size_t k = 0; k < i; ++k)
                 glDeleteProgram(built[k]);
@@ -200,9 +205,9 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_gl_delete_buffer(&e->query_out);
     if (e->tech)
         e->tech->cls->destroy(e->tech);
-    GLuint *progs[] = {&e->prog_rsm,     &e->prog_vpl_extract, &e->prog_vpl_blocks, &e->prog_vpl_blocks8,
-                       &e->prog_gbuffer, &e->prog_camera_surfels, &e->prog_shade,    &e->prog_query,
-                       &e->prog_glossy,  &e->prog_media,          &e->prog_shadow};
+    GLuint *progs[] = {&e->prog_rsm,          &e->prog_vpl_extract,  &e->prog_vpl_blocks, &e->prog_vpl_blocks8,
+                       &e->prog_gbuffer,      &e->prog_camera_surfels, &e->prog_shade,     &e->prog_shade_damped,
+                       &e->prog_query,        &e->prog_glossy,       &e->prog_media,       &e->prog_shadow};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

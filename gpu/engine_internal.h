@@ -63,7 +63,7 @@ struct lpv_engine {
 
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
-        prog_shade, prog_query, prog_glossy, prog_media, prog_shadow;
+        prog_shade, prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;

@@ -198,9 +198,10 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
 
-    glUseProgram(e->prog_shade);
-    e->tech->cls->bind_lookup(e->tech, e->prog_shade, e->settings.lpv.damping);
-    glUniform1f(glGetUniformLocation(e->prog_shade, "u_glossy_roughness"),
+    const GLuint prog = e->settings.lpv.damping > 0.0f ? e->prog_shade_damped : e->prog_shade;
+    glUseProgram(prog);
+    e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
+    glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),
                 e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
                                                                                   : 0.0f);
     for (int i = 0; i < 4; ++i) {
