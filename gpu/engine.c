@@ -110,6 +110,9 @@ int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err
     return 0;
 }
 
+/* The scene passes' programs for scenes of plain materials (material.glsl). */
+#define PLAIN "#define LPV_MATERIAL_PLAIN 1"
+
 lpv_engine *lpv_engine_create(char *err, size_t err_size)
 {
     lpv_engine *e = calloc(1, sizeof *e);
@@ -121,17 +124,22 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         GLuint *prog;
         const char *a, *b;
         const char *const *inc;
+        const char *defines;
     } progs[] = {
         {&e->prog_rsm, "scene.vert", "rsm.frag", INC_RSM},
+        {&e->prog_rsm_plain, "scene.vert", "rsm.frag", INC_RSM, PLAIN},
         {&e->prog_vpl_extract, "vpl_extract.comp", NULL, NULL},
         {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_BLOCKS},
         {&e->prog_vpl_blocks8, "vpl_blocks.comp", NULL, INC_BLOCKS8},
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
+        {&e->prog_gbuffer_plain, "scene.vert", "gbuffer.frag", INC_MATERIAL, PLAIN},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, INC_BLOCKS8},
         {&e->prog_shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
+        {&e->prog_shadow_plain, "scene.vert", "shadow_depth.frag", INC_MATERIAL, PLAIN},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
-        *progs[i].prog = lpv_program_build(progs[i].a, NULL, progs[i].b, progs[i].inc, err, err_size);
+        *progs[i].prog =
+            lpv_program_build_defines(progs[i].a, NULL, progs[i].b, progs[i].defines, progs[i].inc, err, err_size);
         if (!*progs[i].prog) {
             lpv_engine_destroy(e);
             return NULL;
@@ -205,9 +213,10 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_gl_delete_buffer(&e->query_out);
     if (e->tech)
         e->tech->cls->destroy(e->tech);
-    GLuint *progs[] = {&e->prog_rsm,          &e->prog_vpl_extract,  &e->prog_vpl_blocks, &e->prog_vpl_blocks8,
-                       &e->prog_gbuffer,      &e->prog_camera_surfels, &e->prog_shade,     &e->prog_shade_damped,
-                       &e->prog_query,        &e->prog_glossy,       &e->prog_media,       &e->prog_shadow};
+    GLuint *progs[] = {&e->prog_rsm,        &e->prog_rsm_plain,     &e->prog_vpl_extract,    &e->prog_vpl_blocks,
+                       &e->prog_vpl_blocks8, &e->prog_gbuffer,       &e->prog_gbuffer_plain,  &e->prog_camera_surfels,
+                       &e->prog_shade,       &e->prog_shade_damped,  &e->prog_query,          &e->prog_glossy,
+                       &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

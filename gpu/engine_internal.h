@@ -64,6 +64,9 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
         prog_shade, prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
+    /* the scene passes' programs without textures, normal maps and alpha cuts
+     * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
+    GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -71,6 +74,7 @@ struct lpv_engine {
     uint32_t draw_count;
     lpv_gpu_material *materials;
     uint32_t material_count;
+    int materials_plain;      /* 1: no material has a texture, a normal map or an alpha cut */
     GLuint *textures;
     uint32_t texture_count;
     lpv_light lights[LPV_MAX_LIGHTS];
@@ -138,6 +142,9 @@ struct lpv_engine {
  * back faces of materials that are not double-sided are culled (the camera's
  * view, as glTF says; light views pass 0 and see both sides). */
 void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided);
+/* The program a scene pass draws with: plain (built with LPV_MATERIAL_PLAIN)
+ * when the scene's materials are all plain, else full. */
+GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plain);
 
 /* The scene's GPU objects (engine_scene.c): freed, and the emitters as area
  * light samples under the current settings (none when area lights are off). */

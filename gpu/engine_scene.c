@@ -293,6 +293,12 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         lpv_uv_transform_matrix(&m->normal_uv, g->normal_uv);
     }
     e->material_count = scene->material_count;
+    e->materials_plain = 1;
+    for (uint32_t i = 0; i < e->material_count; ++i) {
+        const lpv_gpu_material *g = &e->materials[i];
+        if (g->texture >= 0 || g->normal_texture >= 0 || g->alpha_cutoff > 0.0f)
+            e->materials_plain = 0;
+    }
     if (upload_textures(e, scene, err, err_size) != 0)
         return -1;
 
@@ -338,6 +344,11 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         return lpv_error(err, err_size, "%s: GL error while uploading the scene", scene->source);
     }
     return lpv_engine_place_volume(e, err, err_size);
+}
+
+GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plain)
+{
+    return e->materials_plain ? plain : full;
 }
 
 void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)

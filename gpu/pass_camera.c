@@ -140,7 +140,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    GLuint p = e->prog_gbuffer;
+    GLuint p = lpv_engine_material_program(e, e->prog_gbuffer, e->prog_gbuffer_plain);
     glUseProgram(p);
     glUniformMatrix4fv(glGetUniformLocation(p, "u_view_proj"), 1, GL_FALSE, (const float *)e->view_block.view_proj);
     glUniform3fv(glGetUniformLocation(p, "u_eye"), 1, e->view_block.eye);

@@ -146,10 +146,11 @@ void lpv_pass_rsm_run(lpv_engine *e)
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    glUseProgram(e->prog_rsm);
+    const GLuint prog = lpv_engine_material_program(e, e->prog_rsm, e->prog_rsm_plain);
+    glUseProgram(prog);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
-    GLint loc_vp = glGetUniformLocation(e->prog_rsm, "u_view_proj");
-    GLint loc_face = glGetUniformLocation(e->prog_rsm, "u_face");
+    GLint loc_vp = glGetUniformLocation(prog, "u_view_proj");
+    GLint loc_face = glGetUniformLocation(prog, "u_face");
     int bound_layer = -1;
     for (int f = 0; f < e->face_count; ++f) {
         /* A face fills its layer, or (area lights) one tile of it: a layer is
@@ -172,7 +173,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
         glViewport((int)lroundf(tile[0] * (float)size), (int)lroundf(tile[1] * (float)size), side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
         glUniform1i(loc_face, f);
-        lpv_engine_draw_scene(e, e->prog_rsm, 0); /* lights see both sides */
+        lpv_engine_draw_scene(e, prog, 0); /* lights see both sides */
     }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

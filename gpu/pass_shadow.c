@@ -170,8 +170,9 @@ static void draw(lpv_engine *e)
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    glUseProgram(e->prog_shadow);
-    GLint loc_vp = glGetUniformLocation(e->prog_shadow, "u_view_proj");
+    const GLuint prog = lpv_engine_material_program(e, e->prog_shadow, e->prog_shadow_plain);
+    glUseProgram(prog);
+    GLint loc_vp = glGetUniformLocation(prog, "u_view_proj");
     const float far_depth = 1.0f;
     glEnable(GL_SCISSOR_TEST);
     for (int f = 0; f < faces; ++f) {
@@ -193,7 +194,7 @@ static void draw(lpv_engine *e)
         glClearBufferfv(GL_DEPTH, 0, &far_depth);
         glViewport(x, y, side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->shadow_block.faces[f].view_proj);
-        lpv_engine_draw_scene(e, e->prog_shadow, 0); /* lights see both sides */
+        lpv_engine_draw_scene(e, prog, 0); /* lights see both sides */
     }
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_DEPTH_TEST);

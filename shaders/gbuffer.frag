@@ -26,7 +26,7 @@ void main()
     vec3 n = surface_normal(v_normal, p, to_eye, side);
     // the surfel's area from the geometric facing (before the normal map)
     float cos_s = max(abs(dot(n, to_eye)), 0.05);
-    if (u_has_normal_texture != 0) {
+    if (LPV_MATERIAL_PLAIN == 0 && u_has_normal_texture != 0) {
         vec2 uvn = texture_uv(u_normal_uv_set, u_normal_uv_row0, u_normal_uv_row1, v_uv, v_uv1);
         // mapped on the front side, then turned with the side seen (glTF)
         n = side * normal_mapped(side * n, p, v_tangent, uvn);
@@ -43,7 +43,7 @@ void main()
         area = u_pixel_area / cos_s;
     }
     // after every derivative: cut-away texels leave no pixel (and no depth)
-    if (base.a < u_alpha_cutoff)
+    if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff)
         discard;
     o_position = vec4(p, area);
     o_normal = vec4(n, 1.0 + clamp(u_metallic, 0.0, 1.0)); // w >= 1: covered; w - 1: metallic

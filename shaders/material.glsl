@@ -1,5 +1,14 @@
 // material.glsl - the per-draw material and the surface normal, shared by the
 // RSM and G-buffer fragment shaders (docs/scenes.md, "Materials").
+// LPV_MATERIAL_PLAIN 1 compiles a scene pass's program for scenes whose
+// materials all have no base colour texture, no normal map and no alpha
+// cut (gpu/engine_scene.c, lpv_engine_material_program): llvmpipe runs the
+// code of a branch under lane masks even when no lane takes it, so the
+// texture fetches and the normal map's frame cost every pixel, and a
+// discard keeps the depth-only shadow faces from its fast path.
+#ifndef LPV_MATERIAL_PLAIN
+#define LPV_MATERIAL_PLAIN 0
+#endif
 uniform vec4 u_base_color;      // linear RGBA factor
 uniform int u_has_texture;      // base colour texture bound to unit 0 (sRGB, decoded by GL)
 uniform vec3 u_emission;        // W/(m^2 sr)
@@ -29,7 +38,7 @@ vec2 texture_uv(int set, vec3 row0, vec3 row1, vec2 uv0, vec2 uv1)
 vec4 material_albedo(vec2 uv0, vec2 uv1)
 {
     vec4 c = u_base_color;
-    if (u_has_texture != 0)
+    if (LPV_MATERIAL_PLAIN == 0 && u_has_texture != 0)
         c *= texture(u_base_texture, texture_uv(u_base_uv_set, u_base_uv_row0, u_base_uv_row1, uv0, uv1));
     return c;
 }

@@ -51,7 +51,7 @@ void main()
     vec3 power = e_perp * texel_area_perp;
     vec4 base = material_albedo(v_uv, v_uv1);
     vec3 albedo = base.rgb;
-    if (base.a < u_alpha_cutoff) // after every derivative
+    if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff) // after every derivative
         discard;
 
     o_position = vec4(p, texel_area_perp / cos_s);

@@ -9,6 +9,6 @@ in vec4 v_tangent;
 
 void main()
 {
-    if (u_alpha_cutoff > 0.0 && material_albedo(v_uv, v_uv1).a < u_alpha_cutoff)
+    if (LPV_MATERIAL_PLAIN == 0 && u_alpha_cutoff > 0.0 && material_albedo(v_uv, v_uv1).a < u_alpha_cutoff)
         discard;
 }
