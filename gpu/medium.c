@@ -50,13 +50,15 @@ void lpv_medium_bind(const lpv_medium_gpu *g, const lpv_settings *s, GLuint prog
 {
     int flags = 0;
     float sigma_s[3] = {0, 0, 0}, sigma_a[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-    if (on && (s->fog_sigma_s > 0.0f || s->fog_sigma_a > 0.0f)) { /* the fog settings win */
+    if (!lpv_medium_active(g, s, on)) {
+        /* no medium: flags 0 */
+    } else if (s->fog_sigma_s > 0.0f || s->fog_sigma_a > 0.0f) { /* the fog settings win */
         flags = 1;
         for (int i = 0; i < 3; ++i) {
             sigma_s[i] = s->fog_sigma_s;
             sigma_a[i] = s->fog_sigma_a;
         }
-    } else if (on && g->medium.present) {
+    } else { /* the scene's medium */
         const lpv_medium *m = &g->medium;
         flags = 1 | (m->has_box ? 2 : 0) | (g->density ? 4 : 0);
         memcpy(sigma_s, m->sigma_s, sizeof sigma_s);

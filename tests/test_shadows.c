@@ -57,6 +57,26 @@ static float *render_direct(const lpv_scene *s, const lpv_settings *set, const l
     return rgba;
 }
 
+/* A grey material and the square floor y = 0 of half side `half` (m);
+ * returns the material for the test's other geometry. */
+static int grey_floor(lpv_scene *s, float half)
+{
+    int grey = lpv_scene_add_material(s, "grey", (float[3]){ALBEDO, ALBEDO, ALBEDO}, NULL);
+    const float plane[4][3] = {{-half, 0, half}, {half, 0, half}, {half, 0, -half}, {-half, 0, -half}};
+    assert_true(lpv_scene_add_quad(s, grey, plane, NULL) >= 0);
+    return grey;
+}
+
+/* The path tracer's view of s, for its direct irradiance. */
+static lpv_ref *reference_of(const lpv_scene *s)
+{
+    lpv_ref *ref = NULL;
+    char err[512] = "";
+    if (lpv_ref_create(s, NULL, &ref, err, sizeof err) != 0)
+        fail_msg("reference: %s", err);
+    return ref;
+}
+
 /* The point where pixel (x, y)'s ray meets the plane y = 0, or -1. */
 static int floor_point(const lpv_view *v, int x, int y, float p[3])
 {
@@ -91,9 +111,7 @@ static void test_point_light_shadow_edge(void **state)
 {
     (void)state;
     lpv_scene s = {0};
-    int grey = lpv_scene_add_material(&s, "grey", (float[3]){ALBEDO, ALBEDO, ALBEDO}, NULL);
-    const float plane[4][3] = {{-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4}};
-    assert_true(lpv_scene_add_quad(&s, grey, plane, NULL) >= 0);
+    int grey = grey_floor(&s, 4.0f);
     const float h = 0.5f * LIGHT_H, a = SQUARE;
     const float square[4][3] = {{-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}};
     assert_true(lpv_scene_add_quad(&s, grey, square, NULL) >= 0);
@@ -204,9 +222,7 @@ static void test_small_box_under_a_low_sun(void **state)
 {
     (void)state;
     lpv_scene s = {0};
-    int grey = lpv_scene_add_material(&s, "grey", (float[3]){ALBEDO, ALBEDO, ALBEDO}, NULL);
-    const float plane[4][3] = {{-32, 0, 32}, {32, 0, 32}, {32, 0, -32}, {-32, 0, -32}};
-    assert_true(lpv_scene_add_quad(&s, grey, plane, NULL) >= 0);
+    int grey = grey_floor(&s, 32.0f);
     const float lo[3] = {-0.1f, 0.0f, -0.1f}, hi[3] = {0.1f, 0.2f, 0.1f};
     assert_true(lpv_scene_add_box(&s, grey, lo, hi) >= 0);
     float d[3] = {-1.0f, -0.3f, -0.2f}; /* travelling; about 16 degrees above the horizon */
@@ -241,10 +257,7 @@ static void test_small_box_under_a_low_sun(void **state)
     float ul = sqrtf(u[0] * u[0] + u[1] * u[1]);
     u[0] /= ul;
     u[1] /= ul;
-    lpv_ref *ref = NULL;
-    char err[512] = "";
-    if (lpv_ref_create(&s, NULL, &ref, err, sizeof err) != 0)
-        fail_msg("reference: %s", err);
+    lpv_ref *ref = reference_of(&s);
 
     const double unshadowed = ALBEDO / M_PI * SUN_E * (double)-d[1];
     int lit = 0, acne = 0, dark = 0, leak = 0, far_lit = 0;
@@ -313,9 +326,7 @@ static void test_wide_spot_rim_shadows(void **state)
 {
     (void)state;
     lpv_scene s = {0};
-    int grey = lpv_scene_add_material(&s, "grey", (float[3]){ALBEDO, ALBEDO, ALBEDO}, NULL);
-    const float plane[4][3] = {{-8, 0, 8}, {8, 0, 8}, {8, 0, -8}, {-8, 0, -8}};
-    assert_true(lpv_scene_add_quad(&s, grey, plane, NULL) >= 0);
+    int grey = grey_floor(&s, 8.0f);
     /* four boxes 2.3 m out along +-x and +-z (their shadows 50-58 degrees off
      * the axis, in the cube's side faces, inside the 62-degree cone) and one
      * under the light (the face below) */
@@ -343,10 +354,7 @@ static void test_wide_spot_rim_shadows(void **state)
                      0);
     lpv_settings set = {.grid_dims = {16, 16, 16}, .shadow_size = SPOT_SIZE};
     float *rgba = render_direct(&s, &set, &view);
-    lpv_ref *ref = NULL;
-    char err[512] = "";
-    if (lpv_ref_create(&s, NULL, &ref, err, sizeof err) != 0)
-        fail_msg("reference: %s", err);
+    lpv_ref *ref = reference_of(&s);
 
     /* Tolerance around the shadows' edges: three texels of a cube face at the
      * rim's distance, spread along the floor at the rim's incidence. */

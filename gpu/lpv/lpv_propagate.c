@@ -32,7 +32,8 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
      * gather far faster than SSBO loads) what the cells step i - 1 wrote
      * send (sent[], their coefficients times their flux limits), written by
      * lpv_pack.comp first, then by each step and hand-off in turn; the
-     * coefficients themselves go to ping and pong, which the hand-off reads. With the
+     * coefficients themselves go to ping and pong only where they are read
+     * (by a hand-off, and the last step's by LPV_GRID_LAST_STEP). With the
      * far field on, each level but the coarsest takes far_field_steps steps,
      * then a hand-off moves the light in flight on to the next coarser
      * cascade (lpv_handoff.comp), as one more turn of the ping-pong; the
