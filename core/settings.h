@@ -154,6 +154,10 @@ typedef struct lpv_settings {
                                their own VPLs; off: emitters reach the scene only as
                                emissive_vpls VPLs in the volume */
     int area_light_samples; /* samples the emitters are reduced to; default 8 */
+    /* The frame's irradiance lookup (docs/accuracy.md, "The lookup step"). */
+    int lookup_step;        /* pixels per lookup of the technique's irradiance along each axis: 1
+                               (default) every pixel; N > 1 once per N x N block, spread to the
+                               block's pixels by a plane- and normal-aware upsampling */
 
     lpv_lpv_settings lpv;   /* the cascaded LPV's knobs (LPV_TECHNIQUE_LPV) */
     lpv_iv_settings iv;     /* the imperfect volume's knobs (LPV_TECHNIQUE_IV) */
@@ -193,6 +197,8 @@ typedef struct lpv_settings {
 #define LPV_RSM_AUTO_STEP 2
 #define LPV_MAX_RSM_VPL_STEP 64
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
+#define LPV_DEFAULT_LOOKUP_STEP 1
+#define LPV_MAX_LOOKUP_STEP 4
 #define LPV_IV_DEFAULT_RESOLUTION 16
 #define LPV_IV_DEFAULT_POINTS 4
 #define LPV_IV_DEFAULT_SPLIT 1.0f

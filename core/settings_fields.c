@@ -97,6 +97,9 @@ static const lpv_field FIELDS[] = {
      "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)", T_VOL | T_SHADOWS, ""},
     {"area_light_samples", "area-light-samples", LPV_FIELD_INT, F(area_light_samples), 1, LPV_MAX_AREA_SAMPLES, 0,
      "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)", T_VOL | T_SHADOWS, ""},
+    {"lookup_step", "lookup-step", LPV_FIELD_INT, F(lookup_step), 1, LPV_MAX_LOOKUP_STEP, 0, "pixels", "1", "",
+     "pixels per irradiance lookup along each axis in the frame (N > 1: once per N x N block, upsampled "
+     "along planes; accuracy vs time)", T_SHADE, ""},
 
     /* Imperfect volumes (docs/imperfect-volumes.md). */
     {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "16", "",

@@ -64,6 +64,9 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
          * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING) */
         {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
         {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, NULL},
+        {&e->prog_shade_blocks, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1"},
+        {&e->prog_lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->prog_lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
         {&e->prog_query, "query.comp", NULL, inc_lookup},
         {&e->prog_glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
         {&e->prog_media, "fullscreen.vert", "media.frag", inc_media},
@@ -198,6 +201,9 @@ static void free_camera(lpv_engine *e)
     lpv_gl_delete_framebuffer(&e->frame_fbo);
     lpv_gl_delete_buffer(&e->camera_surfels);
     e->gbuf_w = e->gbuf_h = 0;
+    for (int i = 0; i < 2; ++i)
+        lpv_gl_delete_texture(&e->block_tex[i]);
+    e->block_w = e->block_h = e->block_step = 0;
 }
 
 void lpv_engine_destroy(lpv_engine *e)
@@ -216,7 +222,8 @@ void lpv_engine_destroy(lpv_engine *e)
     GLuint *progs[] = {&e->prog_rsm,        &e->prog_rsm_plain,     &e->prog_vpl_extract,    &e->prog_vpl_blocks,
                        &e->prog_vpl_blocks8, &e->prog_gbuffer,       &e->prog_gbuffer_plain,  &e->prog_camera_surfels,
                        &e->prog_shade,       &e->prog_shade_damped,  &e->prog_query,          &e->prog_glossy,
-                       &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain};
+                       &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain,
+                       &e->prog_shade_blocks, &e->prog_lookup_blocks,   &e->prog_lookup_blocks_damped};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

@@ -67,6 +67,10 @@ struct lpv_engine {
     /* the scene passes' programs without textures, normal maps and alpha cuts
      * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
     GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
+    /* the lookup step (settings.lookup_step > 1): the frame reading the
+     * blocks' irradiance, and the blocks' lookup without and with damping
+     * (shading.glsl, lookup_blocks.comp) */
+    GLuint prog_shade_blocks, prog_lookup_blocks, prog_lookup_blocks_damped;
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -128,6 +132,10 @@ struct lpv_engine {
     int camera_surfel_w, camera_surfel_h, camera_surfel_slots;
     GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
+    /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp),
+     * block_w x block_h blocks of block_step pixels; 0 until a step above 1 */
+    GLuint block_tex[2];
+    int block_w, block_h, block_step;
 
     GLuint query_in, query_out; /* irradiance queries */
     size_t query_capacity;

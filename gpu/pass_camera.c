@@ -181,6 +181,44 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     return 0;
 }
 
+/* The blocks' irradiance and planes at lookup step `step` for the frame's
+ * size (lookup_blocks.comp); kept while neither changes. */
+static void ensure_blocks(lpv_engine *e, int step)
+{
+    const int w = (e->gbuf_w + step - 1) / step, h = (e->gbuf_h + step - 1) / step;
+    if (e->block_step == step && e->block_w == w && e->block_h == h)
+        return;
+    for (int i = 0; i < 2; ++i) {
+        lpv_gl_delete_texture(&e->block_tex[i]);
+        e->block_tex[i] = texture_2d(GL_RGBA32F, w, h);
+    }
+    e->block_w = w;
+    e->block_h = h;
+    e->block_step = step;
+}
+
+/* The lookup step (settings.lookup_step > 1): the technique's irradiance
+ * once per block of step x step pixels, bound for the frame that reads it
+ * (shading.glsl, lookup_upsampled). Needs ensure_blocks, the G-buffer and
+ * the view block bound. */
+static void lookup_blocks_run(lpv_engine *e)
+{
+    const int step = e->block_step;
+    const float damping = e->settings.lpv.damping;
+    const GLuint prog = damping > 0.0f ? e->prog_lookup_blocks_damped : e->prog_lookup_blocks;
+    glUseProgram(prog);
+    e->tech->cls->bind_lookup(e->tech, prog, damping);
+    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
+    glBindImageTexture(LPV_IMG_BLOCK_IRRADIANCE, e->block_tex[0], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(LPV_IMG_BLOCK_PLANE, e->block_tex[1], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(lpv_div_up((size_t)e->block_w, LPV_WG_2D), lpv_div_up((size_t)e->block_h, LPV_WG_2D), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_BLOCK_IRRADIANCE);
+    glBindTexture(GL_TEXTURE_2D, e->block_tex[0]);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_BLOCK_PLANE);
+    glBindTexture(GL_TEXTURE_2D, e->block_tex[1]);
+}
+
 /* The frame (shading.glsl) as a compute pass writing the frame texture: on
  * llvmpipe it costs what the full-screen triangle did, and on a GPU whose
  * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
@@ -198,16 +236,29 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
 
-    const GLuint prog = e->settings.lpv.damping > 0.0f ? e->prog_shade_damped : e->prog_shade;
-    glUseProgram(prog);
-    e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
-    glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),
-                e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
-                                                                                  : 0.0f);
+    /* the lookup step looks the irradiance up per block first; frames
+     * without the term (direct light, ambient occlusion) need none. The
+     * blocks' textures are (re)made before the G-buffer is bound: making a
+     * texture binds it to the active unit. */
+    const int step = e->settings.lookup_step;
+    const int blocks = step > 1 && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY);
+    if (blocks)
+        ensure_blocks(e, step);
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
     }
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
+    if (blocks)
+        lookup_blocks_run(e);
+    const GLuint prog =
+        blocks ? e->prog_shade_blocks : (e->settings.lpv.damping > 0.0f ? e->prog_shade_damped : e->prog_shade);
+    glUseProgram(prog);
+    e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
+    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
+    glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),
+                e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
+                                                                                  : 0.0f);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);

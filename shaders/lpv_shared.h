@@ -417,8 +417,23 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_LOOKUP_G  9
 #define LPV_TEX_LOOKUP_B  10
 
-/* Image unit of the frame that shade.comp writes (pass_camera.c). */
+/* The frame's irradiance looked up once per lookup_step^2 block
+ * (lookup_blocks.comp, shading.glsl's lookup_upsampled): per block the
+ * irradiance (rgb, a 1 = the block saw a surface) and the plane it was
+ * looked up on (xyz unit normal, w its distance along it from the origin). */
+#define LPV_TEX_BLOCK_IRRADIANCE 11
+#define LPV_TEX_BLOCK_PLANE      12
+
+/* Image units of the frame that shade.comp writes (pass_camera.c) and of the
+ * blocks' irradiance and planes that lookup_blocks.comp writes. */
 #define LPV_IMG_FRAME 0
+#define LPV_IMG_BLOCK_IRRADIANCE 1
+#define LPV_IMG_BLOCK_PLANE 2
+/* Two points lie on one plane for the lookup step when their normals are
+ * within LPV_BLOCK_NORMAL_COS and the plane of one passes within
+ * LPV_BLOCK_PLANE_PIXELS block widths (at the point's depth) of the other. */
+#define LPV_BLOCK_NORMAL_COS 0.999
+#define LPV_BLOCK_PLANE_PIXELS 4.0
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
 #define LPV_PROP_WG_X 32

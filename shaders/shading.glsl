@@ -14,6 +14,73 @@ layout(std140, binding = LPV_UBO_VIEW) uniform ViewUBO { LpvViewBlock V; };
 
 uniform float u_glossy_roughness; // materials below it are glossy; 0 when the glossy pass does not run
 
+// The lookup step (docs/accuracy.md, "The lookup step"): with lookup_step N >
+// 1 the technique's irradiance is looked up once per N x N block of pixels
+// (lookup_blocks.comp) and each pixel takes it from the blocks around it that
+// lie on its own plane. LPV_LOOKUP_BLOCKS 1 is the frame that reads the
+// blocks (the engine's prog_shade_blocks), 0 the one that looks up every
+// pixel itself.
+#ifndef LPV_LOOKUP_BLOCKS
+#define LPV_LOOKUP_BLOCKS 0
+#endif
+uniform int u_lookup_step;
+
+// The width (m) of a block of u_lookup_step pixels at p: 2 tan(yfov / 2)
+// times the depth per image height (orthographic: 2 ymag).
+float block_width_at(vec3 p)
+{
+    float depth = V.eye.w != 0.0 ? max(dot(p - V.eye.xyz, V.forward.xyz), 0.0) : 1.0;
+    return 2.0 * V.forward.w * depth / V.viewport.y * float(u_lookup_step);
+}
+
+// How alike point p with unit normal n is to a block's plane (xyz unit
+// normal, w distance from the origin), 0..1: 1 on the plane facing its way,
+// falling with cos^8 of the angle between the normals and to 0 at
+// LPV_BLOCK_PLANE_PIXELS block widths off the plane (another surface).
+float plane_likeness(vec4 plane, vec3 p, vec3 n)
+{
+    float wn = max(dot(n, plane.xyz), 0.0);
+    wn *= wn;
+    wn *= wn;
+    wn *= wn;
+    float off = abs(dot(plane.xyz, p) - plane.w) / (LPV_BLOCK_PLANE_PIXELS * block_width_at(p));
+    return wn * clamp(1.0 - off, 0.0, 1.0);
+}
+
+#if LPV_LOOKUP_BLOCKS
+layout(binding = LPV_TEX_BLOCK_IRRADIANCE) uniform sampler2D u_block_irradiance;
+layout(binding = LPV_TEX_BLOCK_PLANE) uniform sampler2D u_block_plane;
+
+// The irradiance at pixel px (point p, normal n) from the four blocks around
+// it: bilinear between the blocks' centres, each weighted by how alike its
+// plane is (plane_likeness), so light never crosses an edge between surfaces;
+// where no block around is alike, the most alike one's.
+vec3 lookup_upsampled(vec3 p, vec3 n_in, ivec2 px)
+{
+    float len = length(n_in);
+    vec3 n = len > 1e-8 ? n_in / len : vec3(0.0);
+    vec2 u = (vec2(px) + 0.5) / float(u_lookup_step) - 0.5; // block centres at integers
+    ivec2 i0 = ivec2(floor(u));
+    vec2 f = u - vec2(i0);
+    ivec2 last = textureSize(u_block_irradiance, 0) - 1;
+    vec3 sum = vec3(0.0), most_alike = vec3(0.0);
+    float weights = 0.0, best = -1.0;
+    for (int j = 0; j < 4; ++j) {
+        ivec2 b = clamp(i0 + ivec2(j & 1, j >> 1), ivec2(0), last);
+        vec4 e = texelFetch(u_block_irradiance, b, 0);
+        float like = e.a * plane_likeness(texelFetch(u_block_plane, b, 0), p, n);
+        float w = ((j & 1) != 0 ? f.x : 1.0 - f.x) * ((j >> 1) != 0 ? f.y : 1.0 - f.y) * like;
+        sum += w * e.rgb;
+        weights += w;
+        if (like > best) {
+            best = like;
+            most_alike = e.rgb;
+        }
+    }
+    return weights > 0.0 ? sum / weights : most_alike;
+}
+#endif
+
 vec4 shade_pixel(ivec2 px)
 {
     vec4 pos = texelFetch(u_gbuf_position, px, 0);
@@ -45,7 +112,11 @@ vec4 shade_pixel(ivec2 px)
                 e_direct += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
         }
     }
+#if LPV_LOOKUP_BLOCKS
+    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lookup_upsampled(p, n, px) : vec3(0.0);
+#else
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);
+#endif
     // With the glossy pass on, a glossy surface's diffuse part gives way to
     // its specular part (glossy.frag adds F0 x the LPV's radiance along the
     // reflection): kd = (1 - metallic)(1 - 0.04).
