@@ -2,6 +2,7 @@
 """check_results.py - checks an lpvd-accuracy results.csv (the CI sweep).
 
   check_results.py RESULTS.csv [--scene NAME --better POINT --worse POINT] [--rows N]
+                   [--lookup-steps LIST]
 
 POINT is G:I:R:on|off:MODS:TECHNIQUE for an LPV point, or
 iv:RES:POINTS:RAYS:BOUNCES:on|off:NEIGHBOURS for an imperfect-volume one.
@@ -13,7 +14,9 @@ grid, iterations, occlusion and mods, which are empty, while its iv_* columns,
 empty on LPV rows, are filled and its ref_bounces equals its iv_bounces),
 pareto is 0 or 1, at least one row per scene is on the front, and (with
 --better/--worse) the "better" point of --scene has a lower rel_rmse than the
-"worse" one. No timing is asserted. Standard library only.
+"worse" one, and (with --lookup-steps 1,2) every point ran at each listed
+lookup step (the lookup_step column). No timing is asserted. Standard
+library only.
 """
 import argparse
 import csv
@@ -47,6 +50,7 @@ def main():
     ap.add_argument("--better")
     ap.add_argument("--worse")
     ap.add_argument("--rows", type=int)
+    ap.add_argument("--lookup-steps")
     a = ap.parse_args()
     problems = []
     with open(a.csv, newline="") as f:
@@ -105,6 +109,14 @@ def main():
             if not b < w:
                 problems.append("scene %s: %s (rel_rmse %.4f) is not more accurate than %s (%.4f)"
                                 % (a.scene, a.better, b, a.worse, w))
+    if a.lookup_steps:
+        want = sorted(a.lookup_steps.split(","))
+        by_point = {}
+        for r in rows:
+            by_point.setdefault((r["scene"], key(r)), []).append((r.get("lookup_step") or "").strip())
+        for (scene, k), got in sorted(by_point.items()):
+            if sorted(got) != want:
+                problems.append("scene %s point %s: lookup steps %s, expected %s" % (scene, k, got, want))
     if problems:
         print("FAIL: " + a.csv)
         for p in problems:

@@ -97,21 +97,28 @@ typedef struct point {
      * (settings.camera_surfel_step, rsm_vpl_step): 0 = not swept (the
      * flags' value, else auto), -1 = auto, N = every N texels */
     int cstep, rstep;
+    /* the frame's lookup step (settings.lookup_step): 0 = not swept (the
+     * flag's value), N = once per N x N pixels */
+    int lstep;
 } point;
 
 /* The setting a swept step stands for (0 = auto), or the base's. */
 static int step_setting(int swept, int base) { return swept == 0 ? base : swept < 0 ? 0 : swept; }
 
-/* " cam 4, vpl auto" when the point sweeps the steps, else "". */
+/* " cam 4, vpl auto" when the point sweeps the steps, " lookup 2" when it
+ * sweeps the lookup step, else "". */
 static const char *steps_name(const point *p, char buf[48])
 {
     buf[0] = '\0';
+    size_t at = 0;
     if (p->cstep || p->rstep) {
         char c[12], r[12];
         snprintf(c, sizeof c, p->cstep > 0 ? "%d" : "auto", p->cstep);
         snprintf(r, sizeof r, p->rstep > 0 ? "%d" : "auto", p->rstep);
-        snprintf(buf, 48, " cam %s, vpl %s", p->cstep ? c : "-", p->rstep ? r : "-");
+        at = (size_t)snprintf(buf, 48, " cam %s, vpl %s", p->cstep ? c : "-", p->rstep ? r : "-");
     }
+    if (p->lstep && at < 48)
+        snprintf(buf + at, 48 - at, " lookup %d", p->lstep);
     return buf;
 }
 
@@ -197,8 +204,8 @@ static const char *point_preset(const point *p)
     lpv_settings s = point_settings(p);
     if (p->technique != LPV_TECHNIQUE_ID_DEFAULT && p->technique != LPV_TECHNIQUE_ID_LPV)
         return ""; /* the presets are the cascaded LPV's */
-    if (p->cstep > 0 || p->rstep > 0)
-        return ""; /* a preset down-samples automatically */
+    if (p->cstep > 0 || p->rstep > 0 || p->lstep > 1)
+        return ""; /* a preset down-samples automatically and looks every pixel up */
     lpv_preset m = lpv_preset_match(&s);
     return m == LPV_PRESET_DEFAULT ? "" : lpv_preset_name(m);
 }
@@ -331,7 +338,8 @@ static const lpv_flag FLAGS[A_COUNT] = {
                                      "technique, the other LPV knobs only to lpv/octree points); iv knobs\n"
                                      "alone imply technique=iv; camera_step=auto/1/4, rsm_step=auto/1/4\n"
                                      "sweep the down-sampling of the camera's surfels and the RSMs' VPLs\n"
-                                     "(--camera-surfel-step, --rsm-vpl-step; auto = the engine's default)"},
+                                     "(--camera-surfel-step, --rsm-vpl-step; auto = the engine's default);\n"
+                                     "lookup_step=1/2 runs every point at each lookup step (--lookup-step)"},
     [A_POINTS] = {"points", 0, "LIST", "explicit points GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]] (MODS letters\n"
                                        "of cbfs) or iv[:RES:POINTS:RAYS:BOUNCES:REPROJ:NEIGHBOURS], e.g.\n"
                                        "iv:32:8:64:3:on:8 or iv:16:-:100 (a field left out or '-': --iv-* or\n"
@@ -461,6 +469,7 @@ typedef struct knob_filter {
     int tech[LPV_TECHNIQUE_ID_COUNT_], ntech; /* lpv_technique_id */
     int iv[LPV_ACC_IV_KNOBS][16], niv[LPV_ACC_IV_KNOBS]; /* technique iv's knobs (iv_knobs.h) */
     int cs[16], ncs, rs[16], nrs; /* camera_step, rsm_step: -1 = auto (point.cstep, rstep) */
+    int ls[16], nls;              /* lookup_step: every point at each (point.lstep) */
 } knob_filter;
 
 /* "auto/1/4": the steps' list, auto as -1. */
@@ -519,6 +528,12 @@ static int parse_knobs(const char *spec, knob_filter *kf)
             r = kf->ncs = parse_steps(v, kf->cs, 16);
         else if (strcmp(tok, "rsm_step") == 0)
             r = kf->nrs = parse_steps(v, kf->rs, 16);
+        else if (strcmp(tok, "lookup_step") == 0) {
+            r = kf->nls = parse_values(v, kf->ls, 16, 0);
+            for (int i = 0; i < kf->nls; ++i)
+                if (kf->ls[i] < 1 || kf->ls[i] > LPV_MAX_LOOKUP_STEP)
+                    r = -1;
+        }
         else if (strcmp(tok, "technique") == 0) {
             char names[128];
             snprintf(names, sizeof names, "%s", v);
@@ -897,7 +912,7 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
         fprintf(f, ",%s", lpv_acc_iv_knob_name(k));
     for (int k = NSTAGES_LPV; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
-    fprintf(f, ",camera_surfel_step,rsm_vpl_step"); /* the settings, 0 = auto; empty: not swept */
+    fprintf(f, ",camera_surfel_step,rsm_vpl_step,lookup_step"); /* the settings, 0 = auto; empty: not swept */
     fputc('\n', f);
     for (int i = 0; i < n; ++i) {
         char mb[5];
@@ -946,6 +961,10 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
             fputc(',', f);
         if (r[i].p.rstep)
             fprintf(f, ",%d", step_setting(r[i].p.rstep, 0));
+        else
+            fputc(',', f);
+        if (r[i].p.lstep)
+            fprintf(f, ",%d", r[i].p.lstep);
         else
             fputc(',', f);
         fputc('\n', f);
@@ -1327,6 +1346,7 @@ static const char *key_preset(const int key[LPV_ACC_KEY])
     p.technique = (lpv_technique_id)key[5];
     p.cstep = key[LPV_ACC_KEY_STEPS];
     p.rstep = key[LPV_ACC_KEY_STEPS + 1];
+    p.lstep = key[LPV_ACC_KEY_STEPS + 2];
     return point_preset(&p);
 }
 
@@ -1355,6 +1375,7 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
         row.key[LPV_ACC_KEY_TECHNIQUE] = (int)r[i].p.technique;
         row.key[LPV_ACC_KEY_STEPS] = r[i].p.cstep;
         row.key[LPV_ACC_KEY_STEPS + 1] = r[i].p.rstep;
+        row.key[LPV_ACC_KEY_STEPS + 2] = r[i].p.lstep;
         if (is_iv(&r[i].p)) {
             memcpy(row.key + LPV_ACC_KEY_IV, r[i].iv.v, sizeof r[i].iv.v);
             has_iv = 1;
@@ -1427,7 +1448,8 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
                 fprintf(md, " %s%d³%s | %d | %d² | %s | `%s`%s | %s |", b, x->key[0], b, x->key[1], x->key[2],
                         occ_name(x->key[3]), mb,
                         steps_name(&(point){.cstep = x->key[LPV_ACC_KEY_STEPS],
-                                            .rstep = x->key[LPV_ACC_KEY_STEPS + 1]},
+                                            .rstep = x->key[LPV_ACC_KEY_STEPS + 1],
+                                            .lstep = x->key[LPV_ACC_KEY_STEPS + 2]},
                                    (char[48]){0}),
                         pre);
             else
@@ -1827,7 +1849,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "lpvd-accuracy: --knobs expects e.g. grid=16/32,iterations=8,rsm=256,occlusion=on,"
                         "central=on,bins=off/on,far=on,surfels=on,technique=lpv/iv,iv_resolution=16/32,iv_points=8,"
                         "iv_rays=32/64,iv_bounces=1/3,iv_reprojection=on/off,iv_neighbours=6/8,camera_step=auto/1,"
-                        "rsm_step=auto/1 (see --help)\n");
+                        "rsm_step=auto/1,lookup_step=1/2 (see --help)\n");
         return 2;
     }
     if (!points_arg && !presets && !quick) {
@@ -1918,6 +1940,17 @@ int main(int argc, char **argv)
             fprintf(stderr, "lpvd-accuracy: --knobs %s leaves no point\n", knobs);
             return 2;
         }
+    }
+    if (kf.nls) { /* the lookup step: every point (of any point set) at each swept step */
+        static point base[MAX_POINTS];
+        memcpy(base, pts, (size_t)npts * sizeof *pts);
+        const int nbase = npts;
+        npts = 0;
+        for (int i = 0; i < nbase; ++i)
+            for (int l = 0; l < kf.nls && npts < MAX_POINTS; ++l) {
+                pts[npts] = base[i];
+                pts[npts++].lstep = kf.ls[l];
+            }
     }
     for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k) { /* a swept iv knob is not also a flag */
         int swept = kf.niv[k] > 0;
@@ -2080,6 +2113,8 @@ add_features:
             st.technique = pts[p].technique;
             st.camera_surfel_step = step_setting(pts[p].cstep, st.camera_surfel_step);
             st.rsm_vpl_step = step_setting(pts[p].rstep, st.rsm_vpl_step);
+            if (pts[p].lstep)
+                st.lookup_step = pts[p].lstep;
             if (pts[p].feat) {
                 st.lpv.cascades = pts[p].cascades;
                 if (pts[p].cascades > 1) {

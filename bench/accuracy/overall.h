@@ -21,10 +21,10 @@
  * volume's knobs (iv_knobs.h's order: resolution, points, rays, bounces,
  * reprojection, neighbours; 0 for the LPV's points, whose iv knobs do not
  * apply, as grid..mods but rsm are 0 for iv points) */
-#define LPV_ACC_KEY 14
+#define LPV_ACC_KEY 15
 #define LPV_ACC_KEY_TECHNIQUE 5
 #define LPV_ACC_KEY_IV 6 /* .. 11 */
-#define LPV_ACC_KEY_STEPS 12 /* camera surfel step, RSM VPL step (lpvd_accuracy.c point.cstep, rstep) */
+#define LPV_ACC_KEY_STEPS 12 /* camera surfel step, RSM VPL step, lookup step (lpvd_accuracy.c point.cstep, rstep, lstep) */
 typedef struct lpv_acc_row {
     int scene; /* 0 .. nscenes-1 */
     int key[LPV_ACC_KEY];
