@@ -17,20 +17,10 @@ void main()
         return;
     int step = u_lookup_step, count = step * step;
     ivec2 first = b * step, size = textureSize(u_gbuf_normal, 0);
-    // the first covered pixel: scanned backwards, so the earliest one wins
-    vec3 p0 = vec3(0.0), n0 = vec3(0.0);
+    // one pass in raster order: the first covered pixel fixes the plane, and
+    // it and every later pixel on that plane join the mean
+    vec4 plane = vec4(0.0);
     bool seen = false;
-    for (int k = count - 1; k >= 0; --k) {
-        ivec2 px = first + ivec2(k % step, k / step);
-        vec4 nrm = texelFetch(u_gbuf_normal, min(px, size - 1), 0);
-        if (nrm.w >= 0.5 && all(lessThan(px, size))) {
-            p0 = texelFetch(u_gbuf_position, px, 0).xyz;
-            n0 = nrm.xyz;
-            seen = true;
-        }
-    }
-    vec3 n = length(n0) > 1e-8 ? normalize(n0) : vec3(0.0);
-    vec4 plane = vec4(n, dot(n, p0));
     vec3 p_sum = vec3(0.0), n_sum = vec3(0.0);
     float on = 0.0;
     for (int k = 0; k < count; ++k) {
@@ -38,14 +28,18 @@ void main()
         ivec2 at = min(px, size - 1);
         vec4 nrm = texelFetch(u_gbuf_normal, at, 0);
         vec3 p = texelFetch(u_gbuf_position, at, 0).xyz;
-        vec3 nk = length(nrm.xyz) > 1e-8 ? normalize(nrm.xyz) : vec3(0.0);
-        bool same = nrm.w >= 0.5 && all(lessThan(px, size)) && dot(nk, n) >= LPV_BLOCK_NORMAL_COS &&
-                    abs(dot(n, p) - plane.w) < LPV_BLOCK_PLANE_PIXELS * block_width_at(p);
+        vec3 nk = unit_or_zero(nrm.xyz);
+        bool covered = nrm.w >= 0.5 && all(lessThan(px, size));
+        if (covered && !seen) {
+            plane = vec4(nk, dot(nk, p));
+            seen = true;
+        }
+        bool same = covered && dot(nk, plane.xyz) >= LPV_BLOCK_NORMAL_COS && plane_offset(plane, p) < 1.0;
         p_sum += same ? p : vec3(0.0);
         n_sum += same ? nrm.xyz : vec3(0.0);
         on += same ? 1.0 : 0.0;
     }
     vec3 e = seen ? lpv_irradiance(p_sum / max(on, 1.0), n_sum) : vec3(0.0);
     imageStore(u_block_irradiance_out, b, vec4(e, seen ? 1.0 : 0.0));
-    imageStore(u_block_plane_out, b, seen ? plane : vec4(0.0));
+    imageStore(u_block_plane_out, b, plane);
 }

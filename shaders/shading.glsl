@@ -33,18 +33,31 @@ float block_width_at(vec3 p)
     return 2.0 * V.forward.w * depth / V.viewport.y * float(u_lookup_step);
 }
 
-// How alike point p with unit normal n is to a block's plane (xyz unit
-// normal, w distance from the origin), 0..1: 1 on the plane facing its way,
-// falling with cos^8 of the angle between the normals and to 0 at
-// LPV_BLOCK_PLANE_PIXELS block widths off the plane (another surface).
+// v / |v|, or 0 for a zero normal (a pixel no surface covers).
+vec3 unit_or_zero(vec3 v)
+{
+    float len = length(v);
+    return len > 1e-8 ? v / len : vec3(0.0);
+}
+
+// How far p lies off a block's plane (xyz unit normal, w distance from the
+// origin), in LPV_BLOCK_PLANE_PIXELS block widths at p: below 1, the same
+// surface.
+float plane_offset(vec4 plane, vec3 p)
+{
+    return abs(dot(plane.xyz, p) - plane.w) / (LPV_BLOCK_PLANE_PIXELS * block_width_at(p));
+}
+
+// How alike point p with unit normal n is to a block's plane, 0..1: 1 on the
+// plane facing its way, falling with cos^8 of the angle between the normals
+// and to 0 at plane_offset 1 (another surface).
 float plane_likeness(vec4 plane, vec3 p, vec3 n)
 {
     float wn = max(dot(n, plane.xyz), 0.0);
     wn *= wn;
     wn *= wn;
     wn *= wn;
-    float off = abs(dot(plane.xyz, p) - plane.w) / (LPV_BLOCK_PLANE_PIXELS * block_width_at(p));
-    return wn * clamp(1.0 - off, 0.0, 1.0);
+    return wn * clamp(1.0 - plane_offset(plane, p), 0.0, 1.0);
 }
 
 #if LPV_LOOKUP_BLOCKS
@@ -57,8 +70,7 @@ layout(binding = LPV_TEX_BLOCK_PLANE) uniform sampler2D u_block_plane;
 // where no block around is alike, the most alike one's.
 vec3 lookup_upsampled(vec3 p, vec3 n_in, ivec2 px)
 {
-    float len = length(n_in);
-    vec3 n = len > 1e-8 ? n_in / len : vec3(0.0);
+    vec3 n = unit_or_zero(n_in);
     vec2 u = (vec2(px) + 0.5) / float(u_lookup_step) - 0.5; // block centres at integers
     ivec2 i0 = ivec2(floor(u));
     vec2 f = u - vec2(i0);

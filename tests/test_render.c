@@ -23,20 +23,27 @@
 
 enum { W = 96, H = 96 };
 
-static void render_damped(const lpv_scene *scene, lpv_frame_terms terms, float damping, lpv_view *view, float *rgba)
+/* The frame `terms` of the scene's first camera at w x h with settings s. */
+static void render_with(const lpv_scene *scene, const lpv_settings *s, lpv_frame_terms terms, int w, int h,
+                        lpv_view *view, float *rgba)
 {
     char err[1024] = "";
-    /* Issue 2's configuration (32^3, 8 iterations, RSM 256^2), not the
-     * default preset: at balanced's 4 steps light from the green wall barely
-     * reaches the floor 2.3 cells away, and the warm spot keeps red ahead
-     * of green there (docs/accuracy.md, "Presets"). */
-    lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256, .lpv.damping = damping};
-    lpv_view_from_camera(&scene->cameras[0], W, H, view);
-    if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) ||
+    lpv_view_from_camera(&scene->cameras[0], w, h, view);
+    if (lpv_engine_set_settings(lpvt_engine, s, err, sizeof err) ||
         lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) ||
         lpv_engine_set_view(lpvt_engine, view, err, sizeof err) || lpv_engine_tick(lpvt_engine, err, sizeof err) ||
         lpv_engine_render(lpvt_engine, terms, rgba, err, sizeof err))
         fail_msg("%s", err);
+}
+
+static void render_damped(const lpv_scene *scene, lpv_frame_terms terms, float damping, lpv_view *view, float *rgba)
+{
+    /* Issue 2's configuration (32^3, 8 iterations, RSM 256^2), not the
+     * default preset: at balanced's 4 steps light from the green wall barely
+     * reaches the floor 2.3 cells away, and the warm spot keeps red ahead
+     * of green there (docs/accuracy.md, "Presets"). */
+    const lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256, .lpv.damping = damping};
+    render_with(scene, &s, terms, W, H, view, rgba);
 }
 
 static void render(const lpv_scene *scene, lpv_frame_terms terms, lpv_view *view, float *rgba)
@@ -119,15 +126,9 @@ static void test_damping_only_darkens(void **state)
 /* The Cornell box's indirect-only frame at lookup step `step`, w x h. */
 static void render_step(const lpv_scene *scene, int step, int w, int h, float *rgba)
 {
-    char err[1024] = "";
-    lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256, .lookup_step = step};
+    const lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256, .lookup_step = step};
     lpv_view view;
-    lpv_view_from_camera(&scene->cameras[0], w, h, &view);
-    if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) ||
-        lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) ||
-        lpv_engine_set_view(lpvt_engine, &view, err, sizeof err) || lpv_engine_tick(lpvt_engine, err, sizeof err) ||
-        lpv_engine_render(lpvt_engine, LPV_TERMS_INDIRECT_ONLY, rgba, err, sizeof err))
-        fail_msg("%s", err);
+    render_with(scene, &s, LPV_TERMS_INDIRECT_ONLY, w, h, &view, rgba);
 }
 
 /* The lookup step (shading.glsl, lookup_blocks.comp): looking the

@@ -105,9 +105,11 @@ typedef struct point {
 /* The setting a swept step stands for (0 = auto), or the base's. */
 static int step_setting(int swept, int base) { return swept == 0 ? base : swept < 0 ? 0 : swept; }
 
-/* " cam 4, vpl auto" when the point sweeps the steps, " lookup 2" when it
- * sweeps the lookup step, else "". */
-static const char *steps_name(const point *p, char buf[48])
+/* The swept steps of a point, "" when it sweeps none: for a label
+ * (file = 0) " cam 4, vpl auto lookup 2", for an image's file name (file =
+ * 1) "-cam4-vplauto-lookup2", so points that differ only in their steps do
+ * not overwrite each other's images. */
+static const char *steps_text(const point *p, int file, char buf[48])
 {
     buf[0] = '\0';
     size_t at = 0;
@@ -115,12 +117,15 @@ static const char *steps_name(const point *p, char buf[48])
         char c[12], r[12];
         snprintf(c, sizeof c, p->cstep > 0 ? "%d" : "auto", p->cstep);
         snprintf(r, sizeof r, p->rstep > 0 ? "%d" : "auto", p->rstep);
-        at = (size_t)snprintf(buf, 48, " cam %s, vpl %s", p->cstep ? c : "-", p->rstep ? r : "-");
+        at = (size_t)snprintf(buf, 48, file ? "-cam%s-vpl%s" : " cam %s, vpl %s", p->cstep ? c : "-",
+                              p->rstep ? r : "-");
     }
     if (p->lstep && at < 48)
-        snprintf(buf + at, 48 - at, " lookup %d", p->lstep);
+        snprintf(buf + at, 48 - at, file ? "-lookup%d" : " lookup %d", p->lstep);
     return buf;
 }
+
+
 
 static int is_iv(const point *p) { return p->technique == LPV_TECHNIQUE_ID_IV; }
 
@@ -1144,7 +1149,7 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
                     "| %s | %s%d³%s | %d | %d² | %s | `%s`%s | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f "
                     "| %s |\n",
                     tech_name(x->p.technique), b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion),
-                    mods_name(x->p.mods, (char[5]){0}), steps_name(&x->p, (char[48]){0}), point_preset(&x->p), b,
+                    mods_name(x->p.mods, (char[5]){0}), steps_text(&x->p, 0, (char[48]){0}), point_preset(&x->p), b,
                     x->ms_total, b,
                     x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
                     x->pareto ? "**◆**" : "");
@@ -1447,10 +1452,10 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
             else if (has_lpv)
                 fprintf(md, " %s%d³%s | %d | %d² | %s | `%s`%s | %s |", b, x->key[0], b, x->key[1], x->key[2],
                         occ_name(x->key[3]), mb,
-                        steps_name(&(point){.cstep = x->key[LPV_ACC_KEY_STEPS],
+                        steps_text(&(point){.cstep = x->key[LPV_ACC_KEY_STEPS],
                                             .rstep = x->key[LPV_ACC_KEY_STEPS + 1],
                                             .lstep = x->key[LPV_ACC_KEY_STEPS + 2]},
-                                   (char[48]){0}),
+                                   0, (char[48]){0}),
                         pre);
             else
                 fprintf(md, " %d² |", x->key[2]);
@@ -2219,10 +2224,11 @@ add_features:
                 snprintf(ep, sizeof ep, "%s/iv-%s-r%d.png", sub, lpv_acc_iv_label(&res->iv, (char[96]){0}, 96),
                          pts[p].rsm);
             else
-                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s%s%s.png", sub, pts[p].grid, pts[p].iterations,
+                snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s%s%s%s.png", sub, pts[p].grid, pts[p].iterations,
                          pts[p].rsm, occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
                          pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? "-" : "",
-                         pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? tech_name(pts[p].technique) : "");
+                         pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? tech_name(pts[p].technique) : "",
+                         steps_text(&pts[p], 1, (char[48]){0}));
             if (lpv_acc_write_error_png(ep, rgba, cmp_ref, view.width, view.height, res->m.mean_ref, err,
                                         sizeof err) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s\n", err);
@@ -2254,7 +2260,7 @@ add_features:
                         "%.2f ms/tick, rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
                         se->name, p + 1, npts, tech_name(pts[p].technique), pts[p].grid, pts[p].iterations, pts[p].rsm,
                         occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
-                        steps_name(&pts[p], (char[48]){0}),
+                        steps_text(&pts[p], 0, (char[48]){0}),
                         res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
                         pts[p].label);
             ++nres;
