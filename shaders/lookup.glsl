@@ -25,6 +25,11 @@ layout(binding = LPV_TEX_LOOKUP_R) uniform sampler3D u_lpv_r;
 layout(binding = LPV_TEX_LOOKUP_G) uniform sampler3D u_lpv_g;
 layout(binding = LPV_TEX_LOOKUP_B) uniform sampler3D u_lpv_b;
 uniform int u_lpv_slabs_z;
+// Each cascade's irradiance (before the 1 / cell^2 and the clamp at 0) on
+// the six axis normals, axis a of cascade k as volume k * LPV_LOOKUP_AXES + a
+// in the same slab layout (lpv_axis_pack.comp fills it from the LPV buffer).
+layout(binding = LPV_TEX_LOOKUP_AXES) uniform sampler3D u_lpv_axes;
+uniform int u_lpv_axes_slabs_z;
 
 uniform float u_damping;
 // 0 compiles the damping out (the engine's frame without damping): llvmpipe
@@ -34,15 +39,43 @@ uniform float u_damping;
 #define LPV_LOOKUP_DAMPING 1
 #endif
 
+// Volume v's texture coordinates at continuous cell coordinates q in a
+// texture of `size` texels with `slabs` volumes along z per y-slab, clamped
+// half a cell inside v so that neighbouring volumes never mix.
+vec3 volume_texcoord(int v, vec3 q, int slabs, vec3 size)
+{
+    ivec3 dims = grid_dims();
+    slabs = max(slabs, 1);
+    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) + vec3(0.0, float((v / slabs) * dims.y), float((v % slabs) * dims.z));
+    return q / size;
+}
+
+// Axis normal a: +x -x +y -y +z -z.
+vec3 lookup_axis(int a)
+{
+    vec3 n = vec3(0.0);
+    n[a >> 1] = (a & 1) == 0 ? 1.0 : -1.0;
+    return n;
+}
+
+// The axis normal n is exactly (two components zero), else -1.
+int lookup_axis_of(vec3 n)
+{
+    if (n.y == 0.0 && n.z == 0.0)
+        return n.x > 0.0 ? 0 : 1;
+    if (n.x == 0.0 && n.z == 0.0)
+        return n.y > 0.0 ? 2 : 3;
+    if (n.x == 0.0 && n.y == 0.0)
+        return n.z > 0.0 ? 4 : 5;
+    return -1;
+}
+
 // The trilinearly interpolated SH (r, g, b) at continuous cell coordinates q
 // (cell centres at +0.5) of volume v, clamped at the grid's edge: the clamp
 // keeps the filter inside v's cells, so neighbouring volumes never mix.
 void volume_sh_at(int v, vec3 q, out vec4 r, out vec4 g, out vec4 b)
 {
-    ivec3 dims = grid_dims();
-    int slabs = max(u_lpv_slabs_z, 1);
-    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) + vec3(0.0, float((v / slabs) * dims.y), float((v % slabs) * dims.z));
-    vec3 t = q / vec3(textureSize(u_lpv_r, 0));
+    vec3 t = volume_texcoord(v, q, u_lpv_slabs_z, vec3(textureSize(u_lpv_r, 0)));
     r = textureLod(u_lpv_r, t, 0.0);
     g = textureLod(u_lpv_g, t, 0.0);
     b = textureLod(u_lpv_b, t, 0.0);
@@ -107,15 +140,34 @@ vec4 bin_irradiance_weights(int b, vec3 n)
 // cascades in use, not LPV_MAX_CASCADES: on llvmpipe a return in the middle
 // and a constant-bound loop both cost code that does not apply (the lookup
 // took 92 ms of a 512^2 frame at the balanced preset, now 55).
+// The weights of volume `bin` of a cascade with `bins` volumes for a surface
+// facing unit n: E = sum over the volumes of dot(c, weights) / cell^2.
+vec4 volume_irradiance_weights(int bins, int bin, vec3 n)
+{
+    return bins == 1 ? sh_lobe(-n) : bin_irradiance_weights(bin, n);
+}
+
+// Walls, floors and boxes aligned with the axes read the sum over the
+// volumes made once per cell for their normal (u_lpv_axes): one fetch
+// instead of three per volume. Trilinear filtering and the sum are both
+// linear, so the two ways give the same E up to rounding; the full sum
+// runs only where some pixel of a SIMD group is not axis-aligned (llvmpipe
+// skips an if that no lane takes).
 vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
 {
     const int bins = bin_count();
     vec3 e = vec3(0.0);
-    for (int bin = 0; bin < bins; ++bin) {
-        vec4 w = bins == 1 ? sh_lobe(-n) : bin_irradiance_weights(bin, n);
-        vec4 r, g, b;
-        volume_sh_at(k * bins + bin, q, r, g, b);
-        e += vec3(dot(r, w), dot(g, w), dot(b, w));
+    int a = lookup_axis_of(n);
+    if (a >= 0) {
+        vec3 t = volume_texcoord(k * LPV_LOOKUP_AXES + a, q, u_lpv_axes_slabs_z, vec3(textureSize(u_lpv_axes, 0)));
+        e = textureLod(u_lpv_axes, t, 0.0).rgb;
+    } else {
+        for (int bin = 0; bin < bins; ++bin) {
+            vec4 w = volume_irradiance_weights(bins, bin, n);
+            vec4 r, g, b;
+            volume_sh_at(k * bins + bin, q, r, g, b);
+            e += vec3(dot(r, w), dot(g, w), dot(b, w));
+        }
     }
     float cell = cascade_cell(k);
     return max(e / (cell * cell), 0.0);

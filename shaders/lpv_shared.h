@@ -416,6 +416,12 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_LOOKUP_R  8
 #define LPV_TEX_LOOKUP_G  9
 #define LPV_TEX_LOOKUP_B  10
+/* The same volume's irradiance on the six axis-aligned normals (+x -x +y -y
+ * +z -z), summed over the normal bins, per cascade (lpv_axis_pack.comp): a
+ * surface whose normal is exactly an axis reads it with one fetch per
+ * cascade instead of three per volume (lookup.glsl, cascade_irradiance_at). */
+#define LPV_TEX_LOOKUP_AXES 13
+#define LPV_LOOKUP_AXES 6
 
 /* The frame's irradiance looked up once per lookup_step^2 block
  * (lookup_blocks.comp, shading.glsl's lookup_upsampled): per block the

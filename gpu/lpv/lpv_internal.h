@@ -26,7 +26,8 @@ typedef struct lpv_cascaded {
     /* prog_propagate without the bounce and medium terms, prog_propagate_effects
      * with them (propagate.comp, LPV_PROPAGATE_EFFECTS) */
     GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate,
-        prog_propagate_effects, prog_handoff, prog_lookup_pack;
+        prog_propagate_effects, prog_handoff, prog_lookup_pack,
+        prog_axis_pack;
     int borrowed_programs;    /* 1: the programs are another state's (the octree's levels share them) */
     GLuint empty_vao;
 
@@ -50,10 +51,17 @@ static inline size_t lpv_all_cells(const lpv_cascaded *c)
 }
 /* LPV volumes (cascades x normal bins) and their cells: the size of the LPV
  * buffers; the geometry volume and transmittances stay per cascade. */
-static inline int lpv_volumes(const lpv_cascaded *c) { return c->cascades.count * (c->bins > 1 ? c->bins : 1); }
+static inline int lpv_cascade_volumes(const lpv_cascaded *c) { return c->bins > 1 ? c->bins : 1; }
+static inline int lpv_volumes(const lpv_cascaded *c) { return c->cascades.count * lpv_cascade_volumes(c); }
 static inline size_t lpv_volume_cells(const lpv_cascaded *c)
 {
     return lpv_grid_cell_count(&c->grid) * (size_t)lpv_volumes(c);
+}
+
+/* The programs that fill a lookup volume from this state's kind of buffer. */
+static inline lpv_lookup_programs lpv_cascaded_lookup_programs(const lpv_cascaded *c)
+{
+    return (lpv_lookup_programs){c->prog_lookup_pack, c->prog_axis_pack};
 }
 
 /* A state with its own programs, or sharing owner's (which must outlive it);

@@ -7,7 +7,9 @@
  * what read-backs (GET_VOLUME) read.
  *
  * Volumes (cascades x normal bins) are stacked along z, and along y when z
- * would pass GL_MAX_3D_TEXTURE_SIZE.
+ * would pass GL_MAX_3D_TEXTURE_SIZE. A fourth texture holds each cascade's
+ * irradiance on the six axis normals, summed over its bins
+ * (lpv_axis_pack.comp), for surfaces aligned with the axes.
  */
 #ifndef LPV_LOOKUP_VOLUME_H
 #define LPV_LOOKUP_VOLUME_H
@@ -18,19 +20,29 @@
 #include "timer.h"
 
 typedef struct lpv_lookup_volume {
-    GLuint tex[3];   /* r, g, b */
-    int dims[3];     /* one volume's cells */
-    int volumes;
-    int slabs_z;     /* volumes stacked along z before the next y-slab */
+    GLuint tex[3];     /* r, g, b */
+    GLuint axes;       /* rgb irradiance per cascade and axis normal */
+    int dims[3];       /* one volume's cells */
+    int cascades, bins; /* volumes = cascades x bins */
+    int slabs_z;       /* volumes stacked along z before the next y-slab */
+    int axes_slabs_z;  /* the same for the axis volumes (cascades x LPV_LOOKUP_AXES) */
 } lpv_lookup_volume;
 
-/* (Re)allocates for `volumes` volumes of dims cells; keeps what fits. */
-int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int volumes, char *err, size_t err_size);
+/* The programs that fill it. */
+typedef struct lpv_lookup_programs {
+    GLuint pack; /* lpv_lookup_pack.comp */
+    GLuint axes; /* lpv_axis_pack.comp */
+} lpv_lookup_programs;
+
+/* (Re)allocates for cascades x bins volumes of dims cells; keeps what fits. */
+int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascades, int bins, char *err,
+                            size_t err_size);
 void lpv_lookup_volume_free(lpv_lookup_volume *l);
-/* Copies src (LpvCell per cell, volumes one after another) with prog
- * (lpv_lookup_pack.comp), as the timer stage "lookup_pack". */
-void lpv_lookup_volume_fill(const lpv_lookup_volume *l, GLuint prog, GLuint src, lpv_timer *timer);
-/* Binds the textures to LPV_TEX_LOOKUP_R/G/B and sets prog's (in use) u_lpv_slabs_z. */
+/* Copies src (LpvCell per cell, volumes one after another) and sums it on
+ * the axis normals, as the timer stage "lookup_pack". */
+void lpv_lookup_volume_fill(const lpv_lookup_volume *l, lpv_lookup_programs progs, GLuint src, lpv_timer *timer);
+/* Binds the textures to LPV_TEX_LOOKUP_R/G/B/AXES and sets prog's (in use)
+ * u_lpv_slabs_z and u_lpv_axes_slabs_z. */
 void lpv_lookup_volume_bind(const lpv_lookup_volume *l, GLuint prog);
 
 #endif /* LPV_LOOKUP_VOLUME_H */

@@ -23,7 +23,7 @@ void lpv_cascaded_delete(lpv_cascaded *c)
     lpv_cascaded_free_storage(c);
     GLuint *progs[] = {&c->prog_inject_vpl, &c->prog_inject_gv, &c->prog_pack,    &c->prog_gv_merge,
                        &c->prog_transmit,   &c->prog_propagate, &c->prog_propagate_effects,
-                       &c->prog_handoff,    &c->prog_lookup_pack};
+                       &c->prog_handoff,    &c->prog_lookup_pack, &c->prog_axis_pack};
     for (size_t i = 0; !c->borrowed_programs && i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -70,6 +70,7 @@ lpv_cascaded *lpv_cascaded_new(char *err, size_t err_size)
         {&c->prog_propagate_effects, "propagate.comp", NULL, INC_PROPAGATE, "#define LPV_PROPAGATE_EFFECTS 1"},
         {&c->prog_handoff, "lpv_handoff.comp", NULL, INC_PROPAGATE},
         {&c->prog_lookup_pack, "lpv_lookup_pack.comp", NULL, NULL},
+        {&c->prog_axis_pack, "lpv_axis_pack.comp", NULL, LOOKUP},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog =
@@ -97,6 +98,7 @@ lpv_cascaded *lpv_cascaded_new_sharing(const lpv_cascaded *owner, char *err, siz
     c->prog_propagate_effects = owner->prog_propagate_effects;
     c->prog_handoff = owner->prog_handoff;
     c->prog_lookup_pack = owner->prog_lookup_pack;
+    c->prog_axis_pack = owner->prog_axis_pack;
     return c;
 }
 
@@ -144,7 +146,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         lpv_pass_gv_run(c, in, p->pass[LPV_PASS_BOUNCE].run);
     if (p->pass[LPV_PASS_PROPAGATE].run)
         lpv_pass_propagate_run(c, in, p->pass[LPV_PASS_GV].run, p->pass[LPV_PASS_BOUNCE].run);
-    lpv_lookup_volume_fill(&c->lookup, c->prog_lookup_pack, c->lpv_acc, in->timer);
+    lpv_lookup_volume_fill(&c->lookup, lpv_cascaded_lookup_programs(c), c->lpv_acc, in->timer);
     return 0;
 }
 

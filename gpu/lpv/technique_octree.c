@@ -208,7 +208,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
         *reset = 1;
         if (glGetError() != GL_NO_ERROR)
             return lpv_error(err, err_size, "could not allocate the octree's merged %zu-cell volume", cells);
-        if (lpv_lookup_volume_alloc(&o->lookup, o->level[0]->grid.dims, 1, err, err_size) != 0)
+        if (lpv_lookup_volume_alloc(&o->lookup, o->level[0]->grid.dims, 1, 1, err, err_size) != 0)
             return -1;
     }
     return 0;
@@ -299,7 +299,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
     lpv_timer_begin(in->timer, "merge");
     merge(o, in->timer);
     lpv_timer_end(in->timer);
-    lpv_lookup_volume_fill(&o->lookup, o->level[0]->prog_lookup_pack, o->merged, in->timer);
+    lpv_lookup_volume_fill(&o->lookup, lpv_cascaded_lookup_programs(o->level[0]), o->merged, in->timer);
     return 0;
 }
 
