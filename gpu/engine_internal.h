@@ -95,6 +95,9 @@ struct lpv_engine {
     uint64_t scene_surfel_grid_sig; /* the cascades the buffer's groups are for; 0 = none yet */
     GLuint iv_points;         /* the imperfect volume's point cloud (technique iv only), 0 = none */
     size_t iv_point_count;
+    /* the scene's flat surfaces' normals for the lookup (core/scene_planes.h) */
+    float lookup_planes[LPV_MAX_LOOKUP_PLANES][3];
+    int lookup_plane_count;
     lpv_iv_point_stats iv_point_stats;
     lpv_emitter_list emitters;                          /* emissive triangles (area lights) */
     lpv_area_sample area_samples[LPV_MAX_AREA_LIGHTS];  /* the emitters as area light samples */

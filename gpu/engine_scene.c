@@ -12,6 +12,7 @@
 #include "engine_internal.h"
 #include "error.h"
 #include "hash.h"
+#include "scene_planes.h"
 #include "scene_surfels.h"
 #include "iv_points.h"
 
@@ -330,6 +331,11 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     memcpy(e->scene_min, scene->bounds_min, sizeof e->scene_min);
     memcpy(e->scene_max, scene->bounds_max, sizeof e->scene_max);
 
+    e->lookup_plane_count = lpv_scene_plane_normals(scene, e->lookup_planes, LPV_MAX_LOOKUP_PLANES);
+    if (e->lookup_plane_count < 0) {
+        e->lookup_plane_count = 0;
+        return lpv_error(err, err_size, "%s: out of memory for the flat surfaces' normals", scene->source);
+    }
     if (lpv_emitters_collect(scene, &e->emitters) != 0)
         return lpv_error(err, err_size, "%s: out of memory for the emissive triangles", scene->source);
     lpv_engine_update_area_samples(e);

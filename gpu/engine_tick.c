@@ -111,6 +111,8 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
     }
     in->iv_points = e->iv_points;
     in->iv_point_count = e->iv_point_count;
+    in->lookup_planes = (const float (*)[3])e->lookup_planes;
+    in->lookup_plane_count = e->lookup_plane_count;
 }
 
 static void record_stats(lpv_engine *e)

@@ -83,6 +83,10 @@ typedef struct lpv_technique_inputs {
     int gbuffer_w, gbuffer_h;
     GLuint iv_points;                       /* IvPoint */
     size_t iv_point_count;
+    /* The normals of the scene's largest flat surfaces (core/scene_planes.h),
+     * for a lookup that keeps their irradiance per cell. */
+    const float (*lookup_planes)[3];
+    int lookup_plane_count;
 } lpv_technique_inputs;
 
 /* What the volume is: lpv_volume_desc (engine.h, where the tick's stats

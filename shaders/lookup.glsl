@@ -26,10 +26,15 @@ layout(binding = LPV_TEX_LOOKUP_G) uniform sampler3D u_lpv_g;
 layout(binding = LPV_TEX_LOOKUP_B) uniform sampler3D u_lpv_b;
 uniform int u_lpv_slabs_z;
 // Each cascade's irradiance (before the 1 / cell^2 and the clamp at 0) on
-// the six axis normals, axis a of cascade k as volume k * LPV_LOOKUP_AXES + a
-// in the same slab layout (lpv_axis_pack.comp fills it from the LPV buffer).
+// the six axis normals and then the scene's plane normals (u_lpv_planes,
+// u_lpv_plane_count of them in use): normal a of cascade k as volume
+// k * u_lpv_lookup_normals + a in the same slab layout (lpv_axis_pack.comp
+// fills it from the LPV buffer).
 layout(binding = LPV_TEX_LOOKUP_AXES) uniform sampler3D u_lpv_axes;
 uniform int u_lpv_axes_slabs_z;
+uniform int u_lpv_lookup_normals; // LPV_LOOKUP_AXES + the planes' room
+uniform int u_lpv_plane_count;
+uniform vec3 u_lpv_planes[LPV_MAX_LOOKUP_PLANES];
 
 uniform float u_damping;
 // 0 compiles the damping out (the engine's frame without damping): llvmpipe
@@ -58,16 +63,28 @@ vec3 lookup_axis(int a)
     return n;
 }
 
-// The axis normal n is exactly (two components zero), else -1.
-int lookup_axis_of(vec3 n)
+// The lookup's normal a: an axis, then the planes.
+vec3 lookup_normal(int a)
 {
+    return a < LPV_LOOKUP_AXES ? lookup_axis(a) : u_lpv_planes[a - LPV_LOOKUP_AXES];
+}
+
+// Which of the lookup's normals unit n is: the axis it is exactly (two
+// components zero), or a plane's normal it is within the tolerance of; -1
+// if none.
+int lookup_normal_of(vec3 n)
+{
+    int a = -1;
     if (n.y == 0.0 && n.z == 0.0)
-        return n.x > 0.0 ? 0 : 1;
-    if (n.x == 0.0 && n.z == 0.0)
-        return n.y > 0.0 ? 2 : 3;
-    if (n.x == 0.0 && n.y == 0.0)
-        return n.z > 0.0 ? 4 : 5;
-    return -1;
+        a = n.x > 0.0 ? 0 : 1;
+    else if (n.x == 0.0 && n.z == 0.0)
+        a = n.y > 0.0 ? 2 : 3;
+    else if (n.x == 0.0 && n.y == 0.0)
+        a = n.z > 0.0 ? 4 : 5;
+    for (int j = 0; j < u_lpv_plane_count; ++j)
+        if (all(lessThanEqual(abs(n - u_lpv_planes[j]), vec3(LPV_LOOKUP_PLANE_TOLERANCE))))
+            a = LPV_LOOKUP_AXES + j;
+    return a;
 }
 
 // The trilinearly interpolated SH (r, g, b) at continuous cell coordinates q
@@ -147,19 +164,21 @@ vec4 volume_irradiance_weights(int bins, int bin, vec3 n)
     return bins == 1 ? sh_lobe(-n) : bin_irradiance_weights(bin, n);
 }
 
-// Walls, floors and boxes aligned with the axes read the sum over the
-// volumes made once per cell for their normal (u_lpv_axes): one fetch
-// instead of three per volume. Trilinear filtering and the sum are both
-// linear, so the two ways give the same E up to rounding; the full sum
-// runs only where some pixel of a SIMD group is not axis-aligned (llvmpipe
-// skips an if that no lane takes).
-vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
+// Surfaces facing an axis or one of the scene's plane normals read the sum
+// over the volumes made once per cell for that normal (u_lpv_axes): one
+// fetch instead of three per volume. Trilinear filtering and the sum are
+// both linear, so the two ways give the same E up to rounding (and, for a
+// plane, the normal's rounding); the full sum's fetches run only where some
+// pixel of a SIMD group has another normal (llvmpipe fetches nothing for a
+// group whose lanes are all masked off).
+// a: lookup_normal_of(n), found once per pixel (the search is arithmetic
+// that every lane runs).
+vec3 cascade_irradiance_at(int k, vec3 q, vec3 n, int a)
 {
     const int bins = bin_count();
     vec3 e = vec3(0.0);
-    int a = lookup_axis_of(n);
     if (a >= 0) {
-        vec3 t = volume_texcoord(k * LPV_LOOKUP_AXES + a, q, u_lpv_axes_slabs_z, vec3(textureSize(u_lpv_axes, 0)));
+        vec3 t = volume_texcoord(k * u_lpv_lookup_normals + a, q, u_lpv_axes_slabs_z, vec3(textureSize(u_lpv_axes, 0)));
         e = textureLod(u_lpv_axes, t, 0.0).rgb;
     } else {
         for (int bin = 0; bin < bins; ++bin) {
@@ -173,13 +192,13 @@ vec3 cascade_irradiance_at(int k, vec3 q, vec3 n)
     return max(e / (cell * cell), 0.0);
 }
 
-vec3 cascade_irradiance(int k, vec3 p, vec3 n)
+vec3 cascade_irradiance(int k, vec3 p, vec3 n, int a)
 {
     // half a cell in front of the surface, mirroring the injection offset
     vec3 q = cascade_coords(k, p + 0.5 * cascade_cell(k) * n);
-    vec3 e = cascade_irradiance_at(k, q, n);
+    vec3 e = cascade_irradiance_at(k, q, n, a);
     if (LPV_LOOKUP_DAMPING != 0 && u_damping > 0.0) {
-        vec3 far = cascade_irradiance_at(k, q + n, n);
+        vec3 far = cascade_irradiance_at(k, q + n, n, a);
         float near_l = dot(e, vec3(0.2126, 0.7152, 0.0722));
         float far_l = dot(far, vec3(0.2126, 0.7152, 0.0722));
         float ratio = near_l > 0.0 ? clamp(far_l / near_l, 0.0, 1.0) : 1.0;
@@ -235,12 +254,13 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
     if (!(len > 1e-8) || isinf(len) || !finite3(p))
         return vec3(0.0);
     vec3 n = n_in / len;
+    int a = lookup_normal_of(n);
     float share[LPV_MAX_CASCADES];
     cascade_shares(p, share);
     vec3 e = vec3(0.0);
     for (int k = 0; k < cascade_count(); ++k) // not LPV_MAX_CASCADES: see cascade_irradiance_at
         if (share[k] > 0.0)
-            e += share[k] * cascade_irradiance(k, p, n);
+            e += share[k] * cascade_irradiance(k, p, n, a);
     return e;
 }
 

@@ -1,9 +1,11 @@
-// lpv_axis_pack.comp - the irradiance of each cascade on the six axis normals
-// (lookup.glsl's u_lpv_axes): per cell and axis a, the sum over the cascade's
-// volumes of dot(c, volume_irradiance_weights(bins, bin, axis a)) per
-// channel, before the 1 / cell^2 and the clamp at 0, which the lookup applies
-// after its trilinear filter as on the full sum. Axis volume k * 6 + a sits
-// at z-slab v % u_slabs_z and y-slab v / u_slabs_z (gpu/lpv/lpv_lookup_volume.c).
+// lpv_axis_pack.comp - the irradiance of each cascade on the lookup's normals
+// (lookup.glsl's u_lpv_axes: the six axes, then the scene's plane normals):
+// per cell and normal a, the sum over the cascade's volumes of
+// dot(c, volume_irradiance_weights(bins, bin, lookup_normal(a))) per
+// channel, before the 1 / cell^2 and the clamp at 0, which the lookup
+// applies after its trilinear filter as on the full sum. Volume
+// v = k * u_lpv_lookup_normals + a sits at z-slab v % u_slabs_z and y-slab
+// v / u_slabs_z (gpu/lpv/lpv_lookup_volume.c).
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer Src { LpvCell src[]; };
@@ -17,10 +19,10 @@ void main()
 {
     ivec3 id = ivec3(gl_GlobalInvocationID);
     int v = id.z / u_dims.z, z = id.z % u_dims.z;
-    if (id.x >= u_dims.x || id.y >= u_dims.y || v >= u_dims.w * LPV_LOOKUP_AXES)
+    int k = v / u_lpv_lookup_normals, a = v % u_lpv_lookup_normals;
+    if (id.x >= u_dims.x || id.y >= u_dims.y || k >= u_dims.w || a >= LPV_LOOKUP_AXES + u_lpv_plane_count)
         return;
-    int k = v / LPV_LOOKUP_AXES;
-    vec3 n = lookup_axis(v % LPV_LOOKUP_AXES);
+    vec3 n = lookup_normal(a);
     int cells = u_dims.x * u_dims.y * u_dims.z;
     int cell = id.x + u_dims.x * (id.y + u_dims.y * z);
     vec3 e = vec3(0.0);

@@ -20,6 +20,7 @@
 #include "context.h"
 #include "engine.h"
 #include "oracle.h"
+#include "scene_planes.h"
 #include "scene.h"
 #include "test_util.h"
 
@@ -349,6 +350,11 @@ static void test_normal_bins_match_oracle(void **state)
             assert_true(fabs(sum[i].r[k] - want) <= 1e-5 * (fabs(want) + 1e-3));
         }
 
+    /* the box's slanted walls and block sides: the lookup's plane normals
+     * (core/scene_planes.h), read from their own irradiance volumes */
+    float planes[LPV_MAX_LOOKUP_PLANES][3];
+    const int plane_count = lpv_scene_plane_normals(&f->scene, planes, LPV_MAX_LOOKUP_PLANES);
+    assert_int_equal(plane_count, 14);
     enum { N = 400 };
     float p[N * 3], n[N * 3], gq[N * 3], rq[N * 3];
     unsigned seed = 777;
@@ -363,6 +369,8 @@ static void test_normal_bins_match_oracle(void **state)
             n[i * 3] = n[i * 3 + 1] = n[i * 3 + 2] = 0.0f;
             n[i * 3 + (i / 5) % 3] = (i % 10 == 0) ? 1.0f : -1.0f;
         }
+        if (i % 5 == 1)
+            memcpy(&n[i * 3], planes[(i / 5) % plane_count], sizeof planes[0]);
     }
     char err[256];
     assert_int_equal(lpv_engine_irradiance(f->engine, p, n, N, gq, err, sizeof err), 0);

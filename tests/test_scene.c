@@ -15,6 +15,7 @@
 
 #include "scene.h"
 #include "scene_defaults.h"
+#include "scene_planes.h"
 
 static void assert_vec3(const float *v, float x, float y, float z, float tol)
 {
@@ -309,6 +310,42 @@ static void test_bounds_ignore_non_finite(void **state)
     lpv_scene_free(&s);
 }
 
+/* The lookup's plane normals (core/scene_planes.h) of the built-in box: the
+ * normals of its flat surfaces off the axes (the slanted left wall; the
+ * blocks' eight sides, whose opposite sides share a normal up to its sign:
+ * seven in all), each as n and -n, unit, none twice, the largest (the left
+ * wall) first; the room's other walls, floor, ceiling and the blocks' tops
+ * lie on axes. */
+static void test_plane_normals(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    assert_int_equal(lpv_scene_builtin_cornell(&s), 0);
+    float n[LPV_MAX_LOOKUP_PLANES][3];
+    const int count = lpv_scene_plane_normals(&s, n, LPV_MAX_LOOKUP_PLANES);
+    assert_int_equal(count, 14);
+    for (int i = 0; i < count; ++i) {
+        const float len = sqrtf(n[i][0] * n[i][0] + n[i][1] * n[i][1] + n[i][2] * n[i][2]);
+        assert_true(fabsf(len - 1.0f) < 1e-6f);
+        const int zeros = (n[i][0] == 0.0f) + (n[i][1] == 0.0f) + (n[i][2] == 0.0f);
+        assert_true(zeros < 2);
+        if (i % 2 == 1)
+            for (int k = 0; k < 3; ++k)
+                assert_true(n[i][k] == -n[i - 1][k]);
+        for (int j = 0; j < i; ++j) /* all different */
+            assert_true(fabsf(n[i][0] - n[j][0]) > LPV_LOOKUP_PLANE_TOLERANCE ||
+                        fabsf(n[i][1] - n[j][1]) > LPV_LOOKUP_PLANE_TOLERANCE ||
+                        fabsf(n[i][2] - n[j][2]) > LPV_LOOKUP_PLANE_TOLERANCE);
+    }
+    /* the left wall (about 2 x 2 m, facing +x into the room) is the largest */
+    assert_true(fabsf(n[0][0]) > 0.99f);
+    /* room for fewer: the largest pairs, in the same order */
+    float few[5][3];
+    assert_int_equal(lpv_scene_plane_normals(&s, few, 5), 4);
+    assert_memory_equal(few, n, sizeof(float[4][3]));
+    lpv_scene_free(&s);
+}
+
 static void test_free_zeroed_and_null(void **state)
 {
     (void)state;
@@ -340,6 +377,7 @@ int main(void)
         cmocka_unit_test(test_defaults_respect_emission_and_lights),
         cmocka_unit_test(test_defaults_empty),
         cmocka_unit_test(test_bounds_ignore_non_finite),
+        cmocka_unit_test(test_plane_normals),
         cmocka_unit_test(test_free_zeroed_and_null),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

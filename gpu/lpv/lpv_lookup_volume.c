@@ -7,6 +7,8 @@
 #include "gl_util.h"
 #include "lpv_shared.h"
 
+#include <string.h>
+
 void lpv_lookup_volume_free(lpv_lookup_volume *l)
 {
     for (int i = 0; i < 3; ++i)
@@ -50,7 +52,13 @@ int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascade
         l->cascades == cascades && l->bins == bins)
         return 0;
     lpv_lookup_volume_free(l);
-    const int volumes = cascades * bins, axes = cascades * LPV_LOOKUP_AXES;
+    /* planes only with normal bins (without, the full lookup is three
+     * fetches per cascade), within LPV_LOOKUP_PLANE_TEXELS, in pairs (n, -n) */
+    const long long cells = (long long)dims[0] * dims[1] * dims[2] * cascades;
+    long long room = bins > 1 && cells > 0 ? LPV_LOOKUP_PLANE_TEXELS / cells : 0;
+    room = room > LPV_MAX_LOOKUP_PLANES ? LPV_MAX_LOOKUP_PLANES : room;
+    l->plane_room = (int)room & ~1;
+    const int volumes = cascades * bins, axes = cascades * (LPV_LOOKUP_AXES + l->plane_room);
     for (int i = 0; i < 3; ++i)
         l->tex[i] = volume_texture(dims, volumes, &l->slabs_z);
     l->axes = volume_texture(dims, axes, &l->axes_slabs_z);
@@ -73,10 +81,23 @@ int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascade
     return 0;
 }
 
-void lpv_lookup_volume_fill(const lpv_lookup_volume *l, lpv_lookup_programs progs, GLuint src, lpv_timer *timer)
+/* The lookup normals' uniforms of prog (in use). */
+static void set_normals(const lpv_lookup_volume *l, GLuint prog)
+{
+    glUniform1i(glGetUniformLocation(prog, "u_lpv_lookup_normals"), LPV_LOOKUP_AXES + l->plane_room);
+    glUniform1i(glGetUniformLocation(prog, "u_lpv_plane_count"), l->plane_count);
+    if (l->plane_count > 0)
+        glUniform3fv(glGetUniformLocation(prog, "u_lpv_planes"), l->plane_count, &l->planes[0][0]);
+}
+
+void lpv_lookup_volume_fill(lpv_lookup_volume *l, lpv_lookup_programs progs, GLuint src, const float (*planes)[3],
+                            int plane_count, lpv_timer *timer)
 {
     if (!l->tex[0])
         return;
+    l->plane_count = plane_count < l->plane_room ? plane_count : l->plane_room;
+    if (l->plane_count > 0)
+        memcpy(l->planes, planes, (size_t)l->plane_count * sizeof l->planes[0]);
     lpv_timer_begin(timer, "lookup_pack");
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, src);
     glUseProgram(progs.pack);
@@ -91,9 +112,10 @@ void lpv_lookup_volume_fill(const lpv_lookup_volume *l, lpv_lookup_programs prog
     glUniform4i(glGetUniformLocation(progs.axes, "u_dims"), l->dims[0], l->dims[1], l->dims[2], l->cascades);
     glUniform1i(glGetUniformLocation(progs.axes, "u_bins"), l->bins);
     glUniform1i(glGetUniformLocation(progs.axes, "u_slabs_z"), l->axes_slabs_z);
+    set_normals(l, progs.axes);
     glBindImageTexture(0, l->axes, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(lpv_div_up((size_t)l->dims[0], LPV_WG_2D), lpv_div_up((size_t)l->dims[1], LPV_WG_2D),
-                      (GLuint)(l->dims[2] * l->cascades * LPV_LOOKUP_AXES));
+                      (GLuint)(l->dims[2] * l->cascades * (LPV_LOOKUP_AXES + l->plane_room)));
     lpv_timer_count(timer, 2);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     lpv_timer_end(timer);
@@ -111,4 +133,5 @@ void lpv_lookup_volume_bind(const lpv_lookup_volume *l, GLuint prog)
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(glGetUniformLocation(prog, "u_lpv_slabs_z"), l->slabs_z > 0 ? l->slabs_z : 1);
     glUniform1i(glGetUniformLocation(prog, "u_lpv_axes_slabs_z"), l->axes_slabs_z > 0 ? l->axes_slabs_z : 1);
+    set_normals(l, prog);
 }

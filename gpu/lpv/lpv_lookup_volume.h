@@ -8,8 +8,9 @@
  *
  * Volumes (cascades x normal bins) are stacked along z, and along y when z
  * would pass GL_MAX_3D_TEXTURE_SIZE. A fourth texture holds each cascade's
- * irradiance on the six axis normals, summed over its bins
- * (lpv_axis_pack.comp), for surfaces aligned with the axes.
+ * irradiance on the six axis normals and on the scene's plane normals
+ * (core/scene_planes.h), summed over its bins (lpv_axis_pack.comp), for
+ * the surfaces that face them.
  */
 #ifndef LPV_LOOKUP_VOLUME_H
 #define LPV_LOOKUP_VOLUME_H
@@ -17,15 +18,19 @@
 #include <stddef.h>
 
 #include "gl.h"
+#include "lpv_shared.h"
 #include "timer.h"
 
 typedef struct lpv_lookup_volume {
     GLuint tex[3];     /* r, g, b */
-    GLuint axes;       /* rgb irradiance per cascade and axis normal */
+    GLuint axes;       /* rgb irradiance per cascade and lookup normal */
     int dims[3];       /* one volume's cells */
     int cascades, bins; /* volumes = cascades x bins */
     int slabs_z;       /* volumes stacked along z before the next y-slab */
-    int axes_slabs_z;  /* the same for the axis volumes (cascades x LPV_LOOKUP_AXES) */
+    int axes_slabs_z;  /* the same for the normals' volumes (cascades x normals) */
+    int plane_room;    /* plane normals the texture holds (0 without normal bins) */
+    int plane_count;   /* of them filled by the last fill */
+    float planes[LPV_MAX_LOOKUP_PLANES][3];
 } lpv_lookup_volume;
 
 /* The programs that fill it. */
@@ -39,8 +44,10 @@ int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascade
                             size_t err_size);
 void lpv_lookup_volume_free(lpv_lookup_volume *l);
 /* Copies src (LpvCell per cell, volumes one after another) and sums it on
- * the axis normals, as the timer stage "lookup_pack". */
-void lpv_lookup_volume_fill(const lpv_lookup_volume *l, lpv_lookup_programs progs, GLuint src, lpv_timer *timer);
+ * the axis normals and the first plane_count of planes (as many as there is
+ * room for), as the timer stage "lookup_pack". */
+void lpv_lookup_volume_fill(lpv_lookup_volume *l, lpv_lookup_programs progs, GLuint src, const float (*planes)[3],
+                            int plane_count, lpv_timer *timer);
 /* Binds the textures to LPV_TEX_LOOKUP_R/G/B/AXES and sets prog's (in use)
  * u_lpv_slabs_z and u_lpv_axes_slabs_z. */
 void lpv_lookup_volume_bind(const lpv_lookup_volume *l, GLuint prog);

@@ -146,7 +146,8 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         lpv_pass_gv_run(c, in, p->pass[LPV_PASS_BOUNCE].run);
     if (p->pass[LPV_PASS_PROPAGATE].run)
         lpv_pass_propagate_run(c, in, p->pass[LPV_PASS_GV].run, p->pass[LPV_PASS_BOUNCE].run);
-    lpv_lookup_volume_fill(&c->lookup, lpv_cascaded_lookup_programs(c), c->lpv_acc, in->timer);
+    lpv_lookup_volume_fill(&c->lookup, lpv_cascaded_lookup_programs(c), c->lpv_acc, in->lookup_planes,
+                           in->lookup_plane_count, in->timer);
     return 0;
 }
 

@@ -299,7 +299,8 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
     lpv_timer_begin(in->timer, "merge");
     merge(o, in->timer);
     lpv_timer_end(in->timer);
-    lpv_lookup_volume_fill(&o->lookup, lpv_cascaded_lookup_programs(o->level[0]), o->merged, in->timer);
+    lpv_lookup_volume_fill(&o->lookup, lpv_cascaded_lookup_programs(o->level[0]), o->merged, in->lookup_planes,
+                           in->lookup_plane_count, in->timer);
     return 0;
 }
 
