@@ -62,8 +62,11 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
     } progs[] = {
         /* the frame without the damping's second lookup, and with it (the
          * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING) */
-        {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
-        {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, NULL},
+        {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade_rest, "shade_rest.comp", NULL, inc_shade,
+         "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_blocks, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1"},
         {&e->prog_lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
         {&e->prog_lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
@@ -200,6 +203,7 @@ static void free_camera(lpv_engine *e)
     lpv_gl_delete_framebuffer(&e->gbuf_fbo);
     lpv_gl_delete_framebuffer(&e->frame_fbo);
     lpv_gl_delete_buffer(&e->camera_surfels);
+    lpv_gl_delete_buffer(&e->shade_rest);
     e->gbuf_w = e->gbuf_h = 0;
     for (int i = 0; i < 2; ++i)
         lpv_gl_delete_texture(&e->block_tex[i]);
@@ -223,7 +227,8 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_vpl_blocks8, &e->prog_gbuffer,       &e->prog_gbuffer_plain,  &e->prog_camera_surfels,
                        &e->prog_shade,       &e->prog_shade_damped,  &e->prog_query,          &e->prog_glossy,
                        &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain,
-                       &e->prog_shade_blocks, &e->prog_lookup_blocks,   &e->prog_lookup_blocks_damped};
+                       &e->prog_shade_blocks, &e->prog_lookup_blocks,   &e->prog_lookup_blocks_damped,
+                       &e->prog_shade_rest,  &e->prog_shade_rest_damped};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

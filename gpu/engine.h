@@ -84,6 +84,10 @@ typedef struct lpv_engine_stats {
     double cell_steps;
     int occlusion;
     unsigned long scene_uploads, scene_samplings; /* lpv_engine_counters, as of this tick */
+    /* pixels of the last frame whose indirect light took the technique's full
+     * lookup (shade_rest.comp) instead of their normal's own volume
+     * (lookup.glsl; 0 with the lookup step, or before a frame) */
+    size_t frame_full_lookups;
     /* technique iv (all 0 for the others): what the tick's imperfect volume
      * was made of */
     struct {

@@ -64,6 +64,9 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
         prog_shade, prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
+    /* the frame's second pass: the indirect light of the pixels prog_shade
+     * listed (shade_rest.comp; shading.glsl, LPV_LOOKUP_SPLIT) */
+    GLuint prog_shade_rest, prog_shade_rest_damped;
     /* the scene passes' programs without textures, normal maps and alpha cuts
      * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
     GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
@@ -135,6 +138,7 @@ struct lpv_engine {
     int camera_surfel_w, camera_surfel_h, camera_surfel_slots;
     GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
+    GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
     /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp),
      * block_w x block_h blocks of block_step pixels; 0 until a step above 1 */
     GLuint block_tex[2];
@@ -170,6 +174,8 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light fa
 void lpv_pass_rsm_run(lpv_engine *e);
 int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the targets could not be allocated */
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
+/* Pixels of the last frame the second pass looked up in full (shade_rest.comp). */
+size_t lpv_pass_shade_full_lookups(lpv_engine *e);
 void lpv_pass_glossy_run(lpv_engine *e);
 void lpv_pass_media_run(lpv_engine *e);
 

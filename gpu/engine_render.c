@@ -31,6 +31,7 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     if (terms != LPV_TERMS_INDIRECT_ONLY && terms != LPV_TERMS_AO && lpv_pass_shadow_update(e, err, err_size) != 0)
         return -1;
     lpv_pass_shade_run(e, terms);
+    e->stats.frame_full_lookups = lpv_pass_shade_full_lookups(e);
     if (e->plan.pass[LPV_PASS_GLOSSY].run && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY))
         lpv_pass_glossy_run(e);
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)

@@ -33,9 +33,10 @@ static void free_targets(lpv_engine *e)
         glDeleteFramebuffers(1, &e->gbuf_fbo);
         glDeleteFramebuffers(1, &e->frame_fbo);
         glDeleteBuffers(1, &e->camera_surfels);
+        glDeleteBuffers(1, &e->shade_rest);
     }
     memset(e->gbuf_tex, 0, sizeof e->gbuf_tex);
-    e->gbuf_depth = e->frame_tex = e->gbuf_fbo = e->frame_fbo = e->camera_surfels = 0;
+    e->gbuf_depth = e->frame_tex = e->gbuf_fbo = e->frame_fbo = e->camera_surfels = e->shade_rest = 0;
     e->gbuf_w = e->gbuf_h = 0;
     e->camera_surfel_w = e->camera_surfel_h = e->camera_surfel_slots = 0;
 }
@@ -73,6 +74,10 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->camera_surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lpv_memory_block_samples(w, h) * sizeof(lpv_surfel)), NULL,
                  GL_DYNAMIC_COPY);
+    glGenBuffers(1, &e->shade_rest);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(4 * sizeof(GLuint) + (size_t)w * (size_t)h * 2 * sizeof(GLint)),
+                 NULL, GL_DYNAMIC_COPY);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
         free_targets(e);
@@ -224,6 +229,28 @@ static void lookup_blocks_run(lpv_engine *e)
  * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
  * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
  * core. The glossy and media passes then blend into the same texture. */
+/* Makes prog the current program with the shading's uniforms and the
+ * technique's lookup bound. */
+static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms terms, int step)
+{
+    glUseProgram(prog);
+    e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
+    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
+    glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),
+                e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
+                                                                                  : 0.0f);
+}
+
+size_t lpv_pass_shade_full_lookups(lpv_engine *e)
+{
+    if (e->settings.lookup_step > 1 || !e->shade_rest)
+        return 0;
+    GLuint head[4] = {0, 0, 0, 0};
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
+    return head[3];
+}
+
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
 {
     lpv_timer_begin(&e->timer, "shade");
@@ -251,23 +278,33 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
     if (blocks)
         lookup_blocks_run(e);
-    const GLuint prog =
-        blocks ? e->prog_shade_blocks : (e->settings.lpv.damping > 0.0f ? e->prog_shade_damped : e->prog_shade);
-    glUseProgram(prog);
-    e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
-    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
-    glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),
-                e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
-                                                                                  : 0.0f);
+    const int damped = e->settings.lpv.damping > 0.0f;
+    const GLuint prog = blocks ? e->prog_shade_blocks : (damped ? e->prog_shade_damped : e->prog_shade);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
+    if (!blocks) { /* the list of pixels for the second pass starts empty: 0 x 1 x 1 workgroups, 0 pixels */
+        static const GLuint head[4] = {0, 1, 1, 0};
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SHADE_REST, e->shade_rest);
+    }
+    use_shading_program(e, prog, terms, step);
     glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
+    if (!blocks) {
+        /* the listed pixels' indirect light, as many workgroups as the list holds */
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        use_shading_program(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, terms, step);
+        glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, e->shade_rest);
+        glDispatchComputeIndirect(0);
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+    }
     /* the glossy and media passes blend into the frame, which is then read back */
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    lpv_timer_count(&e->timer, 1);
+    lpv_timer_count(&e->timer, blocks ? 1 : 2);
     lpv_timer_end(&e->timer);
 }

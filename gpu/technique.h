@@ -12,6 +12,13 @@
  *   GLSL side the includes named in lookup_includes, which must define
  *               vec3  lpv_irradiance(vec3 p, vec3 n)  irradiance (W/m^2) of a
  *                                                     surface at p facing n
+ *               vec3  lpv_irradiance_listed(vec3 p, vec3 n, out bool done)
+ *                                                     the same where it is
+ *                                                     cheap (done), else done
+ *                                                     = false: the frame then
+ *                                                     calls lpv_irradiance in
+ *                                                     a second pass
+ *                                                     (shade_rest.comp)
  *               vec3  lpv_project(vec3 x, vec4 v)     the SH at x dotted with v
  *                                                     per channel, / cell^2
  *               float lpv_cell_at(vec3 x)             the volume's scale at x (m)

@@ -73,3 +73,10 @@ vec3 lpv_project(vec3 x, vec4 v)
 }
 
 float lpv_cell_at(vec3 x) { return grid_cell_size(); }
+
+// Every normal is cheap here: no second pass (technique.h).
+vec3 lpv_irradiance_listed(vec3 p, vec3 n, out bool done)
+{
+    done = true;
+    return lpv_irradiance(p, n);
+}

@@ -1,7 +1,7 @@
 // The cascaded LPV's side of the technique seam (gpu/technique.h): with
 // grid.glsl it is the "lpv" technique's lookup_includes, and defines what the
-// engine's shade/glossy/media/query shaders call: lpv_irradiance, lpv_project,
-// lpv_cell_at and the u_damping uniform.
+// engine's shade/glossy/media/query shaders call: lpv_irradiance,
+// lpv_irradiance_listed, lpv_project, lpv_cell_at and the u_damping uniform.
 // lookup.glsl - irradiance from the accumulated LPV cascades (core/oracle_lookup.c
 // is the single-grid reference). In one cascade: trilinear interpolation
 // between cell centres, clamped at the grid's edge, at half a cell in front
@@ -153,10 +153,6 @@ vec4 bin_irradiance_weights(int b, vec3 n)
     return vec4(w0, wv.y, wv.z, wv.x); // slot order (1, y, z, x)
 }
 
-// One loop over the volumes, bins or not, and (lpv_irradiance) over the
-// cascades in use, not LPV_MAX_CASCADES: on llvmpipe a return in the middle
-// and a constant-bound loop both cost code that does not apply (the lookup
-// took 92 ms of a 512^2 frame at the balanced preset, now 55).
 // The weights of volume `bin` of a cascade with `bins` volumes for a surface
 // facing unit n: E = sum over the volumes of dot(c, weights) / cell^2.
 vec4 volume_irradiance_weights(int bins, int bin, vec3 n)
@@ -164,6 +160,10 @@ vec4 volume_irradiance_weights(int bins, int bin, vec3 n)
     return bins == 1 ? sh_lobe(-n) : bin_irradiance_weights(bin, n);
 }
 
+// One loop over the volumes, bins or not, and (lpv_irradiance) over the
+// cascades in use, not LPV_MAX_CASCADES: on llvmpipe a return in the middle
+// and a constant-bound loop both cost code that does not apply (the lookup
+// took 92 ms of a 512^2 frame at the balanced preset, then 55).
 // Surfaces facing an axis or one of the scene's plane normals read the sum
 // over the volumes made once per cell for that normal (u_lpv_axes): one
 // fetch instead of three per volume. Trilinear filtering and the sum are
@@ -172,15 +172,17 @@ vec4 volume_irradiance_weights(int bins, int bin, vec3 n)
 // pixel of a SIMD group has another normal (llvmpipe fetches nothing for a
 // group whose lanes are all masked off).
 // a: lookup_normal_of(n), found once per pixel (the search is arithmetic
-// that every lane runs).
-vec3 cascade_irradiance_at(int k, vec3 q, vec3 n, int a)
+// that every lane runs). listed_only (a constant): leave the full sum out of
+// the program (the caller looks up only listed normals; llvmpipe runs an
+// if's arithmetic even where no lane takes it).
+vec3 cascade_irradiance_at(int k, vec3 q, vec3 n, int a, const bool listed_only)
 {
     const int bins = bin_count();
     vec3 e = vec3(0.0);
     if (a >= 0) {
         vec3 t = volume_texcoord(k * u_lpv_lookup_normals + a, q, u_lpv_axes_slabs_z, vec3(textureSize(u_lpv_axes, 0)));
         e = textureLod(u_lpv_axes, t, 0.0).rgb;
-    } else {
+    } else if (!listed_only) {
         for (int bin = 0; bin < bins; ++bin) {
             vec4 w = volume_irradiance_weights(bins, bin, n);
             vec4 r, g, b;
@@ -192,13 +194,13 @@ vec3 cascade_irradiance_at(int k, vec3 q, vec3 n, int a)
     return max(e / (cell * cell), 0.0);
 }
 
-vec3 cascade_irradiance(int k, vec3 p, vec3 n, int a)
+vec3 cascade_irradiance(int k, vec3 p, vec3 n, int a, const bool listed_only)
 {
     // half a cell in front of the surface, mirroring the injection offset
     vec3 q = cascade_coords(k, p + 0.5 * cascade_cell(k) * n);
-    vec3 e = cascade_irradiance_at(k, q, n, a);
+    vec3 e = cascade_irradiance_at(k, q, n, a, listed_only);
     if (LPV_LOOKUP_DAMPING != 0 && u_damping > 0.0) {
-        vec3 far = cascade_irradiance_at(k, q + n, n, a);
+        vec3 far = cascade_irradiance_at(k, q + n, n, a, listed_only);
         float near_l = dot(e, vec3(0.2126, 0.7152, 0.0722));
         float far_l = dot(far, vec3(0.2126, 0.7152, 0.0722));
         float ratio = near_l > 0.0 ? clamp(far_l / near_l, 0.0, 1.0) : 1.0;
@@ -248,20 +250,36 @@ void cascade_shares(vec3 p, out float share[LPV_MAX_CASCADES])
         share[k] = k < cascade_count() ? cascade_holds(k, p) : 0.0;
 }
 
-vec3 lpv_irradiance(vec3 p, vec3 n_in)
+// The irradiance at p facing n_in; with listed_only (a constant) only where
+// n_in is one of the lookup's normals (done true; elsewhere 0 and done
+// false, for lpv_irradiance in a second pass).
+vec3 irradiance_of(vec3 p, vec3 n_in, const bool listed_only, out bool done)
 {
+    done = true;
     float len = length(n_in);
     if (!(len > 1e-8) || isinf(len) || !finite3(p))
         return vec3(0.0);
     vec3 n = n_in / len;
     int a = lookup_normal_of(n);
+    done = !listed_only || a >= 0;
     float share[LPV_MAX_CASCADES];
     cascade_shares(p, share);
     vec3 e = vec3(0.0);
     for (int k = 0; k < cascade_count(); ++k) // not LPV_MAX_CASCADES: see cascade_irradiance_at
         if (share[k] > 0.0)
-            e += share[k] * cascade_irradiance(k, p, n, a);
+            e += share[k] * cascade_irradiance(k, p, n, a, listed_only);
     return e;
+}
+
+vec3 lpv_irradiance(vec3 p, vec3 n_in)
+{
+    bool done;
+    return irradiance_of(p, n_in, false, done);
+}
+
+vec3 lpv_irradiance_listed(vec3 p, vec3 n_in, out bool done)
+{
+    return irradiance_of(p, n_in, true, done);
 }
 
 // (r, g, b) . v / cell^2 at world point x, blended across cascades like

@@ -404,6 +404,7 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_IV_OCCUPANCY 12 /* one bit per voxel, 32 to a uint, voxel index order */
 #define LPV_SSBO_IV_EMIT 13     /* LpvCell per voxel: what each occupied voxel sends out this bounce */
 #define LPV_SSBO_IV_AO 14       /* vec4 per voxel: the SH of the visible directions (travel convention) */
+#define LPV_SSBO_SHADE_REST 15  /* the frame's pixels left for shade_rest.comp (shading.glsl, LPV_LOOKUP_SPLIT) */
 
 /* Texture units of the propagation's inputs (RGBA32F buffer textures). */
 #define LPV_TEX_LPV_IN    0
@@ -451,6 +452,7 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_BLOCK_PLANE_PIXELS 4.0
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
+#define LPV_SHADE_REST_WG 64
 #define LPV_PROP_WG_X 32
 #define LPV_PROP_WG_Y 2
 #define LPV_WG_2D 8

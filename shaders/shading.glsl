@@ -25,6 +25,24 @@ uniform float u_glossy_roughness; // materials below it are glossy; 0 when the g
 #endif
 uniform int u_lookup_step;
 
+// The frame in two passes (LPV_LOOKUP_SPLIT 1, the engine's prog_shade):
+// shade.comp looks up only what the technique finds cheaply
+// (lpv_irradiance_listed: the lookup's own normals) and lists the other
+// pixels; shade_rest.comp then adds their indirect light. On llvmpipe the
+// full lookup's arithmetic would otherwise run for every pixel under lane
+// masks. The list: a dispatch's workgroup counts (x grows by one per
+// LPV_SHADE_REST_WG pixels), the pixel count, then the pixels.
+#ifndef LPV_LOOKUP_SPLIT
+#define LPV_LOOKUP_SPLIT 0
+#endif
+#if LPV_LOOKUP_SPLIT
+layout(std430, binding = LPV_SSBO_SHADE_REST) buffer ShadeRest
+{
+    uvec4 rest_head; // x, y, z workgroups of shade_rest.comp; w pixels listed
+    ivec2 rest_px[];
+};
+#endif
+
 // The width (m) of a block of u_lookup_step pixels at p: 2 tan(yfov / 2)
 // times the depth per image height (orthographic: 2 ymag).
 float block_width_at(vec3 p)
@@ -93,6 +111,18 @@ vec3 lookup_upsampled(vec3 p, vec3 n_in, ivec2 px)
 }
 #endif
 
+// kd x albedo / pi at pixel px (metallic_w: the G-buffer normal's w). With
+// the glossy pass on, a glossy surface's diffuse part gives way to its
+// specular part (glossy.frag adds F0 x the LPV's radiance along the
+// reflection): kd = (1 - metallic)(1 - 0.04).
+vec3 diffuse_reflectance(ivec2 px, float metallic_w)
+{
+    vec4 a = texelFetch(u_gbuf_albedo, px, 0);
+    float metallic = clamp(metallic_w - 1.0, 0.0, 1.0);
+    float kd = a.a < u_glossy_roughness ? (1.0 - metallic) * (1.0 - 0.04) : 1.0;
+    return kd * a.rgb / LPV_PI;
+}
+
 vec4 shade_pixel(ivec2 px)
 {
     vec4 pos = texelFetch(u_gbuf_position, px, 0);
@@ -105,7 +135,6 @@ vec4 shade_pixel(ivec2 px)
     if (V.viewport.w != 0.0) // the technique's ambient occlusion, 1 = open
         return vec4(vec3(lpv_ao(p, n)), 1.0);
 #endif
-    vec3 albedo = texelFetch(u_gbuf_albedo, px, 0).rgb;
     vec3 emission = texelFetch(u_gbuf_emission, px, 0).rgb;
 
     vec3 e_direct = vec3(0.0);
@@ -126,16 +155,22 @@ vec4 shade_pixel(ivec2 px)
     }
 #if LPV_LOOKUP_BLOCKS
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lookup_upsampled(p, n, px) : vec3(0.0);
+#elif LPV_LOOKUP_SPLIT
+    vec3 e_indirect = vec3(0.0);
+    if (V.shading.z != 0.0) {
+        bool done;
+        e_indirect = V.shading.x * lpv_irradiance_listed(p, n, done);
+        if (!done) {
+            uint i = atomicAdd(rest_head.w, 1u);
+            if (i % uint(LPV_SHADE_REST_WG) == 0u)
+                atomicAdd(rest_head.x, 1u);
+            rest_px[i] = px;
+        }
+    }
 #else
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);
 #endif
-    // With the glossy pass on, a glossy surface's diffuse part gives way to
-    // its specular part (glossy.frag adds F0 x the LPV's radiance along the
-    // reflection): kd = (1 - metallic)(1 - 0.04).
-    float roughness = texelFetch(u_gbuf_albedo, px, 0).a;
-    float metallic = clamp(nrm.w - 1.0, 0.0, 1.0);
-    float kd = roughness < u_glossy_roughness ? (1.0 - metallic) * (1.0 - 0.04) : 1.0;
-    vec3 radiance = kd * albedo / LPV_PI * (e_direct + e_indirect);
+    vec3 radiance = diffuse_reflectance(px, nrm.w) * (e_direct + e_indirect);
     if (V.shading.w != 0.0)
         radiance += emission;
     return vec4(radiance, 1.0);
