@@ -4,7 +4,7 @@
  */
 #include "memory_budget.h"
 
-#include "lpv_shared.h" /* LPV_LOOKUP_PLANE_TEXELS */
+#include "lpv_shared.h" /* LPV_LOOKUP_NORMAL_TEXELS */
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -46,9 +46,9 @@ uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n)
 
 uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
 {
-    /* the lookup's plane normals take at most LPV_LOOKUP_PLANE_TEXELS in all */
-    const uint64_t planes = n->cells > 0 ? (uint64_t)LPV_LOOKUP_PLANE_TEXELS * LPV_MEM_LOOKUP_PLANE_TEXEL : 0;
-    return (uint64_t)n->cells * LPV_MEM_CELL + (uint64_t)n->gv_points * LPV_MEM_GV_POINT + planes;
+    /* the lookup's normals take at most LPV_LOOKUP_NORMAL_TEXELS in all */
+    const uint64_t normals = n->cells > 0 ? (uint64_t)LPV_LOOKUP_NORMAL_TEXELS * LPV_MEM_LOOKUP_NORMAL_TEXEL : 0;
+    return (uint64_t)n->cells * LPV_MEM_CELL + (uint64_t)n->gv_points * LPV_MEM_GV_POINT + normals;
 }
 
 uint64_t lpv_memory_image_bytes(const lpv_memory_need *n)

@@ -18,11 +18,10 @@
 #define LPV_MEM_VPL 48u           /* one LpvVpl per RSM texel */
 #define LPV_MEM_SURFEL 48u        /* one LpvSurfel per RSM texel or pixel */
 #define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
-#define LPV_MEM_CELL 600u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48) and its six
-                                     axis-normal irradiances (6 x RGBA32F), transmittances (24), reflectances
+#define LPV_MEM_CELL 504u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48), transmittances (24), reflectances
                                      (96), what the cells send (2 x 48), the injection atlas (3 x RGBA32F) */
-#define LPV_MEM_LOOKUP_PLANE_TEXEL 16u /* RGBA32F per texel of the lookup's plane normals (LPV_LOOKUP_PLANE_TEXELS
-                                         at most) */
+#define LPV_MEM_LOOKUP_NORMAL_TEXEL 16u /* RGBA32F per texel of the lookup's normals (LPV_LOOKUP_NORMAL_TEXELS
+                                          at most) */
 #define LPV_MEM_GV_POINT 80u      /* per geometry-volume point: the total (48, an LpvGvPoint) and atlas
                                      (2 x RGBA32F) */
 #define LPV_MEM_CELL_BUFFER 48u   /* the largest single grid buffer (one LpvCell per cell) */

@@ -62,8 +62,11 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
     } progs[] = {
         /* the frame without the damping's second lookup, and with it (the
          * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING) */
-        {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, NULL},
+        /* the frame in two passes (the technique's lookup_split) */
+        {&e->prog_shade_split, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade_split_damped, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_rest, "shade_rest.comp", NULL, inc_shade,
          "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
@@ -228,7 +231,8 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_shade,       &e->prog_shade_damped,  &e->prog_query,          &e->prog_glossy,
                        &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain,
                        &e->prog_shade_blocks, &e->prog_lookup_blocks,   &e->prog_lookup_blocks_damped,
-                       &e->prog_shade_rest,  &e->prog_shade_rest_damped};
+                       &e->prog_shade_rest,  &e->prog_shade_rest_damped, &e->prog_shade_split,
+                       &e->prog_shade_split_damped};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

@@ -64,9 +64,11 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
         prog_shade, prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
-    /* the frame's second pass: the indirect light of the pixels prog_shade
-     * listed (shade_rest.comp; shading.glsl, LPV_LOOKUP_SPLIT) */
-    GLuint prog_shade_rest, prog_shade_rest_damped;
+    /* the frame in two passes (the technique's lookup_split): the first
+     * looks up the pixels of the lookup's own normals and lists the rest,
+     * the second (shade_rest.comp) adds their indirect light (shading.glsl,
+     * LPV_LOOKUP_SPLIT) */
+    GLuint prog_shade_split, prog_shade_split_damped, prog_shade_rest, prog_shade_rest_damped;
     /* the scene passes' programs without textures, normal maps and alpha cuts
      * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
     GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
@@ -139,6 +141,7 @@ struct lpv_engine {
     GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
     GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
+    int shade_split;   /* the last frame was shaded in two passes */
     /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp),
      * block_w x block_h blocks of block_step pixels; 0 until a step above 1 */
     GLuint block_tex[2];

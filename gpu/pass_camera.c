@@ -243,7 +243,7 @@ static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms term
 
 size_t lpv_pass_shade_full_lookups(lpv_engine *e)
 {
-    if (e->settings.lookup_step > 1 || !e->shade_rest)
+    if (!e->shade_split || !e->shade_rest)
         return 0;
     GLuint head[4] = {0, 0, 0, 0};
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
@@ -279,13 +279,16 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     if (blocks)
         lookup_blocks_run(e);
     const int damped = e->settings.lpv.damping > 0.0f;
-    const GLuint prog = blocks ? e->prog_shade_blocks : (damped ? e->prog_shade_damped : e->prog_shade);
+    const int split = !blocks && e->tech->cls->lookup_split && e->tech->cls->lookup_split(e->tech);
+    const GLuint prog = blocks  ? e->prog_shade_blocks
+                        : split ? (damped ? e->prog_shade_split_damped : e->prog_shade_split)
+                                : (damped ? e->prog_shade_damped : e->prog_shade);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
-    if (!blocks) { /* the list of pixels for the second pass starts empty: 0 x 1 x 1 workgroups, 0 pixels */
+    if (split) { /* the list of pixels for the second pass starts empty: 0 x 1 x 1 workgroups, 0 pixels */
         static const GLuint head[4] = {0, 1, 1, 0};
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
         glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
@@ -294,7 +297,7 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     use_shading_program(e, prog, terms, step);
     glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
-    if (!blocks) {
+    if (split) {
         /* the listed pixels' indirect light, as many workgroups as the list holds */
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         use_shading_program(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, terms, step);
@@ -305,6 +308,7 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     }
     /* the glossy and media passes blend into the frame, which is then read back */
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    lpv_timer_count(&e->timer, blocks ? 1 : 2);
+    lpv_timer_count(&e->timer, split ? 2 : 1);
+    e->shade_split = split;
     lpv_timer_end(&e->timer);
 }

@@ -18,7 +18,8 @@
  *                                                     = false: the frame then
  *                                                     calls lpv_irradiance in
  *                                                     a second pass
- *                                                     (shade_rest.comp)
+ *                                                     (shade_rest.comp) when
+ *                                                     lookup_split says so
  *               vec3  lpv_project(vec3 x, vec4 v)     the SH at x dotted with v
  *                                                     per channel, / cell^2
  *               float lpv_cell_at(vec3 x)             the volume's scale at x (m)
@@ -140,6 +141,10 @@ struct lpv_technique_class {
     int (*tick)(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size);
     /* Binds what lookup_includes read for prog (in use). */
     void (*bind_lookup)(const lpv_technique *t, GLuint prog, float damping);
+    /* Optional: 1 when lpv_irradiance_listed serves most pixels cheaply, so
+     * the frame looks up in two passes (shading.glsl, LPV_LOOKUP_SPLIT);
+     * NULL or 0: one pass of lpv_irradiance. */
+    int (*lookup_split)(const lpv_technique *t);
     void (*describe)(const lpv_technique *t, lpv_volume_desc *d);
     /* Copies a part of the volume computed under plan `last` (which: an
      * lpv_grid_which for the light's parts); returns elements written. */

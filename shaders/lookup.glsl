@@ -32,7 +32,7 @@ uniform int u_lpv_slabs_z;
 // fills it from the LPV buffer).
 layout(binding = LPV_TEX_LOOKUP_AXES) uniform sampler3D u_lpv_axes;
 uniform int u_lpv_axes_slabs_z;
-uniform int u_lpv_lookup_normals; // LPV_LOOKUP_AXES + the planes' room
+uniform int u_lpv_lookup_normals; // LPV_LOOKUP_AXES + the planes' room, or 0: none
 uniform int u_lpv_plane_count;
 uniform vec3 u_lpv_planes[LPV_MAX_LOOKUP_PLANES];
 
@@ -75,6 +75,8 @@ vec3 lookup_normal(int a)
 int lookup_normal_of(vec3 n)
 {
     int a = -1;
+    if (u_lpv_lookup_normals == 0)
+        return a;
     if (n.y == 0.0 && n.z == 0.0)
         a = n.x > 0.0 ? 0 : 1;
     else if (n.x == 0.0 && n.z == 0.0)

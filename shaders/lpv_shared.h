@@ -424,13 +424,15 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_LOOKUP_AXES 13
 #define LPV_LOOKUP_AXES 6
 /* After the axes, the same for up to LPV_MAX_LOOKUP_PLANES normals of the
- * scene's largest flat surfaces (core/scene_planes.c), with normal bins on
- * and as many as fit LPV_LOOKUP_PLANE_TEXELS texels in all: a pixel whose
- * normal is within LPV_LOOKUP_PLANE_TOLERANCE of one per component reads
- * that normal's irradiance (the G-buffer normalises the same vertex normal,
- * so it differs by rounding only). */
+ * scene's largest flat surfaces (core/scene_planes.c): a pixel whose normal
+ * is within LPV_LOOKUP_PLANE_TOLERANCE of one per component reads that
+ * normal's irradiance (the G-buffer normalises the same vertex normal, so
+ * it differs by rounding only). Only with normal bins (without, the full
+ * lookup is three fetches per cascade) and in LPV_LOOKUP_NORMAL_TEXELS
+ * texels in all: the six axes and as many planes as fit, or none when the
+ * axes do not (filling them costs more than it saves at large grids). */
 #define LPV_MAX_LOOKUP_PLANES 24
-#define LPV_LOOKUP_PLANE_TEXELS 524288
+#define LPV_LOOKUP_NORMAL_TEXELS 131072
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6
 
 /* The frame's irradiance looked up once per lookup_step^2 block

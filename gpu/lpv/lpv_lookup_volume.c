@@ -52,17 +52,21 @@ int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascade
         l->cascades == cascades && l->bins == bins)
         return 0;
     lpv_lookup_volume_free(l);
-    /* planes only with normal bins (without, the full lookup is three
-     * fetches per cascade), within LPV_LOOKUP_PLANE_TEXELS, in pairs (n, -n) */
+    /* the lookup's own normals only with normal bins (without, the full
+     * lookup is three fetches per cascade) and within
+     * LPV_LOOKUP_NORMAL_TEXELS: the axes and as many planes as fit, in
+     * pairs (n, -n), or none */
     const long long cells = (long long)dims[0] * dims[1] * dims[2] * cascades;
-    long long room = bins > 1 && cells > 0 ? LPV_LOOKUP_PLANE_TEXELS / cells : 0;
-    room = room > LPV_MAX_LOOKUP_PLANES ? LPV_MAX_LOOKUP_PLANES : room;
-    l->plane_room = (int)room & ~1;
-    const int volumes = cascades * bins, axes = cascades * (LPV_LOOKUP_AXES + l->plane_room);
+    long long fit = bins > 1 && cells > 0 ? LPV_LOOKUP_NORMAL_TEXELS / cells : 0;
+    fit = fit > LPV_LOOKUP_AXES + LPV_MAX_LOOKUP_PLANES ? LPV_LOOKUP_AXES + LPV_MAX_LOOKUP_PLANES : fit;
+    l->normals = fit >= LPV_LOOKUP_AXES ? LPV_LOOKUP_AXES + (((int)fit - LPV_LOOKUP_AXES) & ~1) : 0;
+    l->plane_room = l->normals > 0 ? l->normals - LPV_LOOKUP_AXES : 0;
+    const int volumes = cascades * bins, axes = cascades * l->normals;
     for (int i = 0; i < 3; ++i)
         l->tex[i] = volume_texture(dims, volumes, &l->slabs_z);
-    l->axes = volume_texture(dims, axes, &l->axes_slabs_z);
-    if (!l->tex[0] || !l->axes) {
+    if (axes > 0)
+        l->axes = volume_texture(dims, axes, &l->axes_slabs_z);
+    if (!l->tex[0] || (axes > 0 && !l->axes)) {
         GLint max3d = 0;
         glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
         lpv_lookup_volume_free(l);
@@ -84,7 +88,7 @@ int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascade
 /* The lookup normals' uniforms of prog (in use). */
 static void set_normals(const lpv_lookup_volume *l, GLuint prog)
 {
-    glUniform1i(glGetUniformLocation(prog, "u_lpv_lookup_normals"), LPV_LOOKUP_AXES + l->plane_room);
+    glUniform1i(glGetUniformLocation(prog, "u_lpv_lookup_normals"), l->normals);
     glUniform1i(glGetUniformLocation(prog, "u_lpv_plane_count"), l->plane_count);
     if (l->plane_count > 0)
         glUniform3fv(glGetUniformLocation(prog, "u_lpv_planes"), l->plane_count, &l->planes[0][0]);
@@ -108,15 +112,18 @@ void lpv_lookup_volume_fill(lpv_lookup_volume *l, lpv_lookup_programs progs, GLu
         glBindImageTexture((GLuint)i, l->tex[i], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(lpv_div_up((size_t)l->dims[0], LPV_WG_2D), lpv_div_up((size_t)l->dims[1], LPV_WG_2D),
                       (GLuint)(l->dims[2] * l->cascades * l->bins));
-    glUseProgram(progs.axes);
-    glUniform4i(glGetUniformLocation(progs.axes, "u_dims"), l->dims[0], l->dims[1], l->dims[2], l->cascades);
-    glUniform1i(glGetUniformLocation(progs.axes, "u_bins"), l->bins);
-    glUniform1i(glGetUniformLocation(progs.axes, "u_slabs_z"), l->axes_slabs_z);
-    set_normals(l, progs.axes);
-    glBindImageTexture(0, l->axes, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(lpv_div_up((size_t)l->dims[0], LPV_WG_2D), lpv_div_up((size_t)l->dims[1], LPV_WG_2D),
-                      (GLuint)(l->dims[2] * l->cascades * (LPV_LOOKUP_AXES + l->plane_room)));
-    lpv_timer_count(timer, 2);
+    lpv_timer_count(timer, 1);
+    if (l->normals > 0) {
+        glUseProgram(progs.axes);
+        glUniform4i(glGetUniformLocation(progs.axes, "u_dims"), l->dims[0], l->dims[1], l->dims[2], l->cascades);
+        glUniform1i(glGetUniformLocation(progs.axes, "u_bins"), l->bins);
+        glUniform1i(glGetUniformLocation(progs.axes, "u_slabs_z"), l->axes_slabs_z);
+        set_normals(l, progs.axes);
+        glBindImageTexture(0, l->axes, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glDispatchCompute(lpv_div_up((size_t)l->dims[0], LPV_WG_2D), lpv_div_up((size_t)l->dims[1], LPV_WG_2D),
+                          (GLuint)(l->dims[2] * l->cascades * l->normals));
+        lpv_timer_count(timer, 1);
+    }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     lpv_timer_end(timer);
 }

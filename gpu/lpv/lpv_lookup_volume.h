@@ -28,7 +28,8 @@ typedef struct lpv_lookup_volume {
     int cascades, bins; /* volumes = cascades x bins */
     int slabs_z;       /* volumes stacked along z before the next y-slab */
     int axes_slabs_z;  /* the same for the normals' volumes (cascades x normals) */
-    int plane_room;    /* plane normals the texture holds (0 without normal bins) */
+    int normals;       /* the lookup's own normals: LPV_LOOKUP_AXES + plane_room, or 0 (no fourth texture) */
+    int plane_room;    /* of them plane normals */
     int plane_count;   /* of them filled by the last fill */
     float planes[LPV_MAX_LOOKUP_PLANES][3];
 } lpv_lookup_volume;

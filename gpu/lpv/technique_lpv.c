@@ -159,6 +159,8 @@ static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
     lpv_lookup_volume_bind(&c->lookup, prog);
 }
 
+static int lookup_split(const lpv_technique *t) { return ((const lpv_cascaded *)t)->lookup.normals > 0; }
+
 static void describe(const lpv_technique *t, lpv_volume_desc *d)
 {
     const lpv_cascaded *c = (const lpv_cascaded *)t;
@@ -210,6 +212,7 @@ const lpv_technique_class lpv_technique_cascaded_lpv = {
     .plan = plan,
     .tick = tick,
     .bind_lookup = bind_lookup,
+    .lookup_split = lookup_split,
     .describe = describe,
     .read = read,
     .memory_need = memory_need,
