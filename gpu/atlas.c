@@ -71,14 +71,14 @@ void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLui
 
 /* Draws count points reading elements [first, first + count) of buffer at
  * binding, once per cascade (instanced: gl_InstanceID is the cascade). */
-void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int cascades,
+void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int instances,
                      lpv_timer *timer)
 {
     if (!count)
         return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     glUniform1i(glGetUniformLocation(prog, "u_first"), (GLint)first);
-    glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)count, (GLsizei)cascades);
+    glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)count, (GLsizei)instances);
     lpv_timer_count(timer, 1);
 }
 

@@ -32,8 +32,8 @@ void lpv_atlas_destroy(lpv_atlas *a);
 void lpv_atlas_begin(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
 void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
 /* Draws count points of elements [first, first + count) of buffer at binding,
- * once per cascade (instanced: gl_InstanceID is the cascade). */
-void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int cascades,
+ * `instances` times (gl_InstanceID: the cascade, for splats into every one). */
+void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int instances,
                      lpv_timer *timer);
 void lpv_atlas_end(void);
 

@@ -1,8 +1,12 @@
 // inject_vpl.vert - one point per VPL and cascade (instance) into the LPV
 // atlas (the volume of its normal's bin when normal bins are on), at the cell
 // holding position + half a cell along the normal, carrying lobe(n) * flux / pi
-// per channel. Additive blending sums VPLs in array order: portable, no float
-// atomics, deterministic.
+// per channel. With the far field, one point per VPL (a single instance),
+// into the finest level holding it (docs/propagation.md §5b): llvmpipe runs
+// the vertex stage on one thread, and an instance per level whose points all
+// but one level drop cost the splat a third of its time at the default.
+// Additive blending sums VPLs in array order: portable, no float atomics,
+// deterministic.
 layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Vpls { LpvVpl vpls[]; };
 
 uniform int u_first;
@@ -24,16 +28,22 @@ void main()
     if (v.position.w == 0.0 || !finite3(v.position.xyz) || !finite3(v.flux.rgb) || !(len > 1e-8) || isinf(len))
         return;
     vec3 n = v.normal.xyz / max(len, 1.0); // unit, or a down-sampled VPL's mean normal (core/sh.h lpv_mean_direction)
+    // far field: a VPL lives in the finest level holding it; coarser ones
+    // receive its light through the hand-off (the levels nest: each cell is
+    // 2^3 of the finer level's)
+    if (far_field()) {
+        k = -1;
+        for (int j = cascade_count() - 1; j >= 0; --j)
+            if (cell_inside(cascade_vpl_cell(j, v.position.xyz, n)))
+                k = j;
+        if (k < 0)
+            return;
+    }
     float w = cascade_object_weight(k, v.normal.w);
     if (!(w > 0.0))
         return;
     ivec3 c = cascade_vpl_cell(k, v.position.xyz, n);
     if (!cell_inside(c))
-        return;
-    // far field: a VPL lives in the finest cascade holding it; coarser ones
-    // receive its light through the hand-off
-    if (far_field() && k > 0 &&
-        cell_inside(cascade_vpl_cell(k - 1, v.position.xyz, n)))
         return;
 
     vec4 lobe = sh_lobe(n) * (w / LPV_PI);

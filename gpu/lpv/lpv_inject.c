@@ -12,11 +12,13 @@
 void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rsm_vpls, int emissive_vpls)
 {
     lpv_timer *timer = in->timer;
+    /* a point per VPL and level, or with the far field one per VPL into the
+     * finest level holding it (inject_vpl.vert) */
+    const int instances = c->cascades.handoff ? 1 : c->cascades.count;
     lpv_timer_begin(timer, "inject");
     lpv_atlas_begin(&c->lpv_atlas, c->prog_inject_vpl, c->grid_ubo, c->empty_vao);
     if (rsm_vpls)
-        lpv_atlas_splat(c->prog_inject_vpl, LPV_SSBO_VPLS, in->rsm_vpls, 0, in->rsm_vpl_count, c->cascades.count,
-                        timer);
+        lpv_atlas_splat(c->prog_inject_vpl, LPV_SSBO_VPLS, in->rsm_vpls, 0, in->rsm_vpl_count, instances, timer);
     lpv_atlas_end();
     lpv_timer_end(timer);
     /* Emissive surfaces are their own stage, so the plan's "emissive" pass
@@ -24,8 +26,8 @@ void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rs
     if (emissive_vpls) {
         lpv_timer_begin(timer, "emissive");
         lpv_atlas_begin_keep(&c->lpv_atlas, c->prog_inject_vpl, c->grid_ubo, c->empty_vao);
-        lpv_atlas_splat(c->prog_inject_vpl, LPV_SSBO_VPLS, in->emissive_vpls, 0, in->emissive_vpl_count,
-                        c->cascades.count, timer);
+        lpv_atlas_splat(c->prog_inject_vpl, LPV_SSBO_VPLS, in->emissive_vpls, 0, in->emissive_vpl_count, instances,
+                        timer);
         lpv_atlas_end();
         lpv_timer_end(timer);
     }
