@@ -455,6 +455,9 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 
 /* ---- Compute workgroup sizes (the C side dispatches with the same numbers) - */
 #define LPV_SHADE_REST_WG 64
+/* shade_rest.comp's workgroups at most (GL guarantees 65535 per dimension);
+ * past that many pixels each invocation takes several */
+#define LPV_SHADE_REST_MAX_GROUPS 65535
 #define LPV_PROP_WG_X 32
 #define LPV_PROP_WG_Y 2
 #define LPV_WG_2D 8

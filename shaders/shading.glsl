@@ -31,7 +31,8 @@ uniform int u_lookup_step;
 // pixels; shade_rest.comp then adds their indirect light. On llvmpipe the
 // full lookup's arithmetic would otherwise run for every pixel under lane
 // masks. The list: a dispatch's workgroup counts (x grows by one per
-// LPV_SHADE_REST_WG pixels), the pixel count, then the pixels.
+// LPV_SHADE_REST_WG pixels, up to LPV_SHADE_REST_MAX_GROUPS), the pixel
+// count, then the pixels.
 #ifndef LPV_LOOKUP_SPLIT
 #define LPV_LOOKUP_SPLIT 0
 #endif
@@ -162,7 +163,7 @@ vec4 shade_pixel(ivec2 px)
         e_indirect = V.shading.x * lpv_irradiance_listed(p, n, done);
         if (!done) {
             uint i = atomicAdd(rest_head.w, 1u);
-            if (i % uint(LPV_SHADE_REST_WG) == 0u)
+            if (i % uint(LPV_SHADE_REST_WG) == 0u && i / uint(LPV_SHADE_REST_WG) < uint(LPV_SHADE_REST_MAX_GROUPS))
                 atomicAdd(rest_head.x, 1u);
             rest_px[i] = px;
         }
