@@ -31,7 +31,6 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     if (terms != LPV_TERMS_INDIRECT_ONLY && terms != LPV_TERMS_AO && lpv_pass_shadow_update(e, err, err_size) != 0)
         return -1;
     lpv_pass_shade_run(e, terms);
-    e->stats.frame_full_lookups = lpv_pass_shade_full_lookups(e);
     if (e->plan.pass[LPV_PASS_GLOSSY].run && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY))
         lpv_pass_glossy_run(e);
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
@@ -42,6 +41,8 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    /* read after the frame, which waited for the passes anyway */
+    e->stats.frame_full_lookups = lpv_pass_shade_full_lookups(e);
     /* GL rows run bottom-up; files and callers want the top row first. */
     size_t row = (size_t)w * 4;
     for (int y = 0; y < h / 2; ++y) {

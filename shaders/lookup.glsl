@@ -28,10 +28,10 @@ uniform int u_lpv_slabs_z;
 // Each cascade's irradiance (before the 1 / cell^2 and the clamp at 0) on
 // the six axis normals and then the scene's plane normals (u_lpv_planes,
 // u_lpv_plane_count of them in use): normal a of cascade k as volume
-// k * u_lpv_lookup_normals + a in the same slab layout (lpv_axis_pack.comp
+// k * u_lpv_lookup_normals + a in the same slab layout (lpv_normals_pack.comp
 // fills it from the LPV buffer).
-layout(binding = LPV_TEX_LOOKUP_AXES) uniform sampler3D u_lpv_axes;
-uniform int u_lpv_axes_slabs_z;
+layout(binding = LPV_TEX_LOOKUP_NORMALS) uniform sampler3D u_lpv_normals;
+uniform int u_lpv_normals_slabs_z;
 uniform int u_lpv_lookup_normals; // LPV_LOOKUP_AXES + the planes' room, or 0: none
 uniform int u_lpv_plane_count;
 uniform vec3 u_lpv_planes[LPV_MAX_LOOKUP_PLANES];
@@ -51,7 +51,8 @@ vec3 volume_texcoord(int v, vec3 q, int slabs, vec3 size)
 {
     ivec3 dims = grid_dims();
     slabs = max(slabs, 1);
-    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) + vec3(0.0, float((v / slabs) * dims.y), float((v % slabs) * dims.z));
+    q = clamp(q, vec3(0.5), vec3(dims) - 0.5) +
+        vec3(0.0, float(lpv_slab_y0(v, slabs, dims.y)), float(lpv_slab_z0(v, slabs, dims.z)));
     return q / size;
 }
 
@@ -167,7 +168,7 @@ vec4 volume_irradiance_weights(int bins, int bin, vec3 n)
 // and a constant-bound loop both cost code that does not apply (the lookup
 // took 92 ms of a 512^2 frame at the balanced preset, then 55).
 // Surfaces facing an axis or one of the scene's plane normals read the sum
-// over the volumes made once per cell for that normal (u_lpv_axes): one
+// over the volumes made once per cell for that normal (u_lpv_normals): one
 // fetch instead of three per volume. Trilinear filtering and the sum are
 // both linear, so the two ways give the same E up to rounding (and, for a
 // plane, the normal's rounding); the full sum's fetches run only where some
@@ -182,8 +183,8 @@ vec3 cascade_irradiance_at(int k, vec3 q, vec3 n, int a, const bool listed_only)
     const int bins = bin_count();
     vec3 e = vec3(0.0);
     if (a >= 0) {
-        vec3 t = volume_texcoord(k * u_lpv_lookup_normals + a, q, u_lpv_axes_slabs_z, vec3(textureSize(u_lpv_axes, 0)));
-        e = textureLod(u_lpv_axes, t, 0.0).rgb;
+        vec3 t = volume_texcoord(k * u_lpv_lookup_normals + a, q, u_lpv_normals_slabs_z, vec3(textureSize(u_lpv_normals, 0)));
+        e = textureLod(u_lpv_normals, t, 0.0).rgb;
     } else if (!listed_only) {
         for (int bin = 0; bin < bins; ++bin) {
             vec4 w = volume_irradiance_weights(bins, bin, n);

@@ -20,7 +20,7 @@ void main()
     if (id.x >= u_dims.x || id.y >= u_dims.y || v >= u_dims.w)
         return;
     int i = id.x + u_dims.x * (id.y + u_dims.y * id.z); // volumes follow each other in z
-    ivec3 t = ivec3(id.x, id.y + (v / u_slabs_z) * u_dims.y, z + (v % u_slabs_z) * u_dims.z);
+    ivec3 t = ivec3(id.x, id.y + lpv_slab_y0(v, u_slabs_z, u_dims.y), z + lpv_slab_z0(v, u_slabs_z, u_dims.z));
     LpvCell c = src[i];
     imageStore(u_r, t, c.r);
     imageStore(u_g, t, c.g);

@@ -418,10 +418,10 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_LOOKUP_G  9
 #define LPV_TEX_LOOKUP_B  10
 /* The same volume's irradiance on the six axis-aligned normals (+x -x +y -y
- * +z -z), summed over the normal bins, per cascade (lpv_axis_pack.comp): a
+ * +z -z), summed over the normal bins, per cascade (lpv_normals_pack.comp): a
  * surface whose normal is exactly an axis reads it with one fetch per
  * cascade instead of three per volume (lookup.glsl, cascade_irradiance_at). */
-#define LPV_TEX_LOOKUP_AXES 13
+#define LPV_TEX_LOOKUP_NORMALS 13
 #define LPV_LOOKUP_AXES 6
 /* After the axes, the same for up to LPV_MAX_LOOKUP_PLANES normals of the
  * scene's largest flat surfaces (core/scene_planes.c): a pixel whose normal
@@ -432,6 +432,11 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
  * texels in all: the six axes and as many planes as fit, or none when the
  * axes do not (filling them costs more than it saves at large grids). */
 #define LPV_MAX_LOOKUP_PLANES 24
+/* Where volume v of a lookup texture begins, in cells along y and z:
+ * `slabs` volumes along z, then the next y-slab (lpv_lookup_volume.c sizes
+ * the textures so; lookup.glsl and the packs address them so). */
+LPV_INLINE int lpv_slab_y0(int v, int slabs, int dim_y) { return (v / slabs) * dim_y; }
+LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v % slabs) * dim_z; }
 #define LPV_LOOKUP_NORMAL_TEXELS 131072
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6
 

@@ -248,7 +248,7 @@ static void test_lookup_matches_oracle(void **state)
             seed = seed * 1664525u + 1013904223u;
             n[i * 3 + k] = (float)(seed >> 8) / 8388608.0f - 1.0f;
         }
-        if (i % 7 == 0) { /* the six axis normals (lookup.glsl's u_lpv_axes), some not of unit length */
+        if (i % 7 == 0) { /* the six axis normals (lookup.glsl's u_lpv_normals), some not of unit length */
             n[i * 3] = n[i * 3 + 1] = n[i * 3 + 2] = 0.0f;
             n[i * 3 + (i / 7) % 3] = ((i / 21) % 2 == 0 ? 1.0f : -1.0f) * (i % 4 == 0 ? 2.5f : 1.0f);
         }

@@ -27,7 +27,7 @@ typedef struct lpv_cascaded {
      * with them (propagate.comp, LPV_PROPAGATE_EFFECTS) */
     GLuint prog_inject_vpl, prog_inject_gv, prog_pack, prog_gv_merge, prog_transmit, prog_propagate,
         prog_propagate_effects, prog_handoff, prog_lookup_pack,
-        prog_axis_pack;
+        prog_normals_pack;
     int borrowed_programs;    /* 1: the programs are another state's (the octree's levels share them) */
     GLuint empty_vao;
 
@@ -61,7 +61,7 @@ static inline size_t lpv_volume_cells(const lpv_cascaded *c)
 /* The programs that fill a lookup volume from this state's kind of buffer. */
 static inline lpv_lookup_programs lpv_cascaded_lookup_programs(const lpv_cascaded *c)
 {
-    return (lpv_lookup_programs){c->prog_lookup_pack, c->prog_axis_pack};
+    return (lpv_lookup_programs){c->prog_lookup_pack, c->prog_normals_pack};
 }
 
 /* A state with its own programs, or sharing owner's (which must outlive it);

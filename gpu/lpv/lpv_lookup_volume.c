@@ -13,7 +13,7 @@ void lpv_lookup_volume_free(lpv_lookup_volume *l)
 {
     for (int i = 0; i < 3; ++i)
         lpv_gl_delete_texture(&l->tex[i]);
-    lpv_gl_delete_texture(&l->axes);
+    lpv_gl_delete_texture(&l->normals_tex);
     *l = (lpv_lookup_volume){0};
 }
 
@@ -60,18 +60,17 @@ int lpv_lookup_volume_alloc(lpv_lookup_volume *l, const int dims[3], int cascade
     long long fit = bins > 1 && cells > 0 ? LPV_LOOKUP_NORMAL_TEXELS / cells : 0;
     fit = fit > LPV_LOOKUP_AXES + LPV_MAX_LOOKUP_PLANES ? LPV_LOOKUP_AXES + LPV_MAX_LOOKUP_PLANES : fit;
     l->normals = fit >= LPV_LOOKUP_AXES ? LPV_LOOKUP_AXES + (((int)fit - LPV_LOOKUP_AXES) & ~1) : 0;
-    l->plane_room = l->normals > 0 ? l->normals - LPV_LOOKUP_AXES : 0;
-    const int volumes = cascades * bins, axes = cascades * l->normals;
+    const int volumes = cascades * bins, normal_volumes = cascades * l->normals;
     for (int i = 0; i < 3; ++i)
         l->tex[i] = volume_texture(dims, volumes, &l->slabs_z);
-    if (axes > 0)
-        l->axes = volume_texture(dims, axes, &l->axes_slabs_z);
-    if (!l->tex[0] || (axes > 0 && !l->axes)) {
+    if (normal_volumes > 0)
+        l->normals_tex = volume_texture(dims, normal_volumes, &l->normals_slabs_z);
+    if (!l->tex[0] || (normal_volumes > 0 && !l->normals_tex)) {
         GLint max3d = 0;
         glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
         lpv_lookup_volume_free(l);
         return lpv_error(err, err_size, "%d volumes of %dx%dx%d cells do not fit the lookup's 3D textures (GL allows %d "
-                         "texels a side)", axes > volumes ? axes : volumes, dims[0], dims[1], dims[2], max3d);
+                         "texels a side)", normal_volumes > volumes ? normal_volumes : volumes, dims[0], dims[1], dims[2], max3d);
     }
     for (int i = 0; i < 3; ++i)
         l->dims[i] = dims[i];
@@ -99,7 +98,8 @@ void lpv_lookup_volume_fill(lpv_lookup_volume *l, lpv_lookup_programs progs, GLu
 {
     if (!l->tex[0])
         return;
-    l->plane_count = plane_count < l->plane_room ? plane_count : l->plane_room;
+    const int room = l->normals > 0 ? l->normals - LPV_LOOKUP_AXES : 0;
+    l->plane_count = plane_count < room ? plane_count : room;
     if (l->plane_count > 0)
         memcpy(l->planes, planes, (size_t)l->plane_count * sizeof l->planes[0]);
     lpv_timer_begin(timer, "lookup_pack");
@@ -114,12 +114,12 @@ void lpv_lookup_volume_fill(lpv_lookup_volume *l, lpv_lookup_programs progs, GLu
                       (GLuint)(l->dims[2] * l->cascades * l->bins));
     lpv_timer_count(timer, 1);
     if (l->normals > 0) {
-        glUseProgram(progs.axes);
-        glUniform4i(glGetUniformLocation(progs.axes, "u_dims"), l->dims[0], l->dims[1], l->dims[2], l->cascades);
-        glUniform1i(glGetUniformLocation(progs.axes, "u_bins"), l->bins);
-        glUniform1i(glGetUniformLocation(progs.axes, "u_slabs_z"), l->axes_slabs_z);
-        set_normals(l, progs.axes);
-        glBindImageTexture(0, l->axes, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glUseProgram(progs.normals);
+        glUniform4i(glGetUniformLocation(progs.normals, "u_dims"), l->dims[0], l->dims[1], l->dims[2], l->cascades);
+        glUniform1i(glGetUniformLocation(progs.normals, "u_bins"), l->bins);
+        glUniform1i(glGetUniformLocation(progs.normals, "u_slabs_z"), l->normals_slabs_z);
+        set_normals(l, progs.normals);
+        glBindImageTexture(0, l->normals_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute(lpv_div_up((size_t)l->dims[0], LPV_WG_2D), lpv_div_up((size_t)l->dims[1], LPV_WG_2D),
                           (GLuint)(l->dims[2] * l->cascades * l->normals));
         lpv_timer_count(timer, 1);
@@ -135,10 +135,10 @@ void lpv_lookup_volume_bind(const lpv_lookup_volume *l, GLuint prog)
         glActiveTexture(GL_TEXTURE0 + units[i]);
         glBindTexture(GL_TEXTURE_3D, l->tex[i]);
     }
-    glActiveTexture(GL_TEXTURE0 + LPV_TEX_LOOKUP_AXES);
-    glBindTexture(GL_TEXTURE_3D, l->axes);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_LOOKUP_NORMALS);
+    glBindTexture(GL_TEXTURE_3D, l->normals_tex);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(glGetUniformLocation(prog, "u_lpv_slabs_z"), l->slabs_z > 0 ? l->slabs_z : 1);
-    glUniform1i(glGetUniformLocation(prog, "u_lpv_axes_slabs_z"), l->axes_slabs_z > 0 ? l->axes_slabs_z : 1);
+    glUniform1i(glGetUniformLocation(prog, "u_lpv_normals_slabs_z"), l->normals_slabs_z > 0 ? l->normals_slabs_z : 1);
     set_normals(l, prog);
 }

@@ -9,7 +9,7 @@
  * Volumes (cascades x normal bins) are stacked along z, and along y when z
  * would pass GL_MAX_3D_TEXTURE_SIZE. A fourth texture holds each cascade's
  * irradiance on the six axis normals and on the scene's plane normals
- * (core/scene_planes.h), summed over its bins (lpv_axis_pack.comp), for
+ * (core/scene_planes.h), summed over its bins (lpv_normals_pack.comp), for
  * the surfaces that face them.
  */
 #ifndef LPV_LOOKUP_VOLUME_H
@@ -23,21 +23,20 @@
 
 typedef struct lpv_lookup_volume {
     GLuint tex[3];     /* r, g, b */
-    GLuint axes;       /* rgb irradiance per cascade and lookup normal */
+    GLuint normals_tex; /* rgb irradiance per cascade and lookup normal */
     int dims[3];       /* one volume's cells */
     int cascades, bins; /* volumes = cascades x bins */
     int slabs_z;       /* volumes stacked along z before the next y-slab */
-    int axes_slabs_z;  /* the same for the normals' volumes (cascades x normals) */
-    int normals;       /* the lookup's own normals: LPV_LOOKUP_AXES + plane_room, or 0 (no fourth texture) */
-    int plane_room;    /* of them plane normals */
-    int plane_count;   /* of them filled by the last fill */
+    int normals_slabs_z;  /* the same for the normals' volumes (cascades x normals) */
+    int normals;       /* the lookup's own normals: LPV_LOOKUP_AXES and room for planes, or 0 (no fourth texture) */
+    int plane_count;   /* planes filled by the last fill */
     float planes[LPV_MAX_LOOKUP_PLANES][3];
 } lpv_lookup_volume;
 
 /* The programs that fill it. */
 typedef struct lpv_lookup_programs {
     GLuint pack; /* lpv_lookup_pack.comp */
-    GLuint axes; /* lpv_axis_pack.comp */
+    GLuint normals; /* lpv_normals_pack.comp */
 } lpv_lookup_programs;
 
 /* (Re)allocates for cascades x bins volumes of dims cells; keeps what fits. */
@@ -50,7 +49,7 @@ void lpv_lookup_volume_free(lpv_lookup_volume *l);
 void lpv_lookup_volume_fill(lpv_lookup_volume *l, lpv_lookup_programs progs, GLuint src, const float (*planes)[3],
                             int plane_count, lpv_timer *timer);
 /* Binds the textures to LPV_TEX_LOOKUP_R/G/B/AXES and sets prog's (in use)
- * u_lpv_slabs_z and u_lpv_axes_slabs_z. */
+ * u_lpv_slabs_z and u_lpv_normals_slabs_z. */
 void lpv_lookup_volume_bind(const lpv_lookup_volume *l, GLuint prog);
 
 #endif /* LPV_LOOKUP_VOLUME_H */

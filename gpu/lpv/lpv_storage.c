@@ -134,7 +134,8 @@ int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *rese
     c->tbo_acc = lpv_gl_buffer_view(c->lpv_acc, GL_RGBA32F);
     c->tbo_transmit = lpv_gl_buffer_view(c->transmit, GL_RG32F); /* a face pair per texel */
     c->tbo_reflect = lpv_gl_buffer_view(c->reflect, GL_RGBA32F);
-    if (c->lookup_wanted && lpv_lookup_volume_alloc(&c->lookup, g->dims, c->cascades.count, lpv_cascade_volumes(c), err, err_size) != 0)
+    if (c->lookup_wanted &&
+        lpv_lookup_volume_alloc(&c->lookup, g->dims, c->cascades.count, lpv_cascade_volumes(c), err, err_size) != 0)
         return -1;
     c->grid_alloc_cells = cells;
     memcpy(c->grid_alloc_dims, g->dims, sizeof g->dims);

@@ -23,7 +23,7 @@ void lpv_cascaded_delete(lpv_cascaded *c)
     lpv_cascaded_free_storage(c);
     GLuint *progs[] = {&c->prog_inject_vpl, &c->prog_inject_gv, &c->prog_pack,    &c->prog_gv_merge,
                        &c->prog_transmit,   &c->prog_propagate, &c->prog_propagate_effects,
-                       &c->prog_handoff,    &c->prog_lookup_pack, &c->prog_axis_pack};
+                       &c->prog_handoff,    &c->prog_lookup_pack, &c->prog_normals_pack};
     for (size_t i = 0; !c->borrowed_programs && i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
@@ -70,7 +70,7 @@ lpv_cascaded *lpv_cascaded_new(char *err, size_t err_size)
         {&c->prog_propagate_effects, "propagate.comp", NULL, INC_PROPAGATE, "#define LPV_PROPAGATE_EFFECTS 1"},
         {&c->prog_handoff, "lpv_handoff.comp", NULL, INC_PROPAGATE},
         {&c->prog_lookup_pack, "lpv_lookup_pack.comp", NULL, NULL},
-        {&c->prog_axis_pack, "lpv_axis_pack.comp", NULL, LOOKUP},
+        {&c->prog_normals_pack, "lpv_normals_pack.comp", NULL, LOOKUP},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog =
@@ -98,7 +98,7 @@ lpv_cascaded *lpv_cascaded_new_sharing(const lpv_cascaded *owner, char *err, siz
     c->prog_propagate_effects = owner->prog_propagate_effects;
     c->prog_handoff = owner->prog_handoff;
     c->prog_lookup_pack = owner->prog_lookup_pack;
-    c->prog_axis_pack = owner->prog_axis_pack;
+    c->prog_normals_pack = owner->prog_normals_pack;
     return c;
 }
 

@@ -1,5 +1,5 @@
-// lpv_axis_pack.comp - the irradiance of each cascade on the lookup's normals
-// (lookup.glsl's u_lpv_axes: the six axes, then the scene's plane normals):
+// lpv_normals_pack.comp - the irradiance of each cascade on the lookup's normals
+// (lookup.glsl's u_lpv_normals: the six axes, then the scene's plane normals):
 // per cell and normal a, the sum over the cascade's volumes of
 // dot(c, volume_irradiance_weights(bins, bin, lookup_normal(a))) per
 // channel, before the 1 / cell^2 and the clamp at 0, which the lookup
@@ -9,7 +9,7 @@
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer Src { LpvCell src[]; };
-layout(binding = 0, rgba32f) writeonly uniform image3D u_axes;
+layout(binding = 0, rgba32f) writeonly uniform image3D u_normals;
 
 uniform ivec4 u_dims; // one volume's cells x, y, z; the cascade count
 uniform int u_bins;   // LPV volumes per cascade
@@ -31,6 +31,6 @@ void main()
         vec4 w = volume_irradiance_weights(u_bins, bin, n);
         e += vec3(dot(c.r, w), dot(c.g, w), dot(c.b, w));
     }
-    ivec3 t = ivec3(id.x, id.y + (v / u_slabs_z) * u_dims.y, z + (v % u_slabs_z) * u_dims.z);
-    imageStore(u_axes, t, vec4(e, 0.0));
+    ivec3 t = ivec3(id.x, id.y + lpv_slab_y0(v, u_slabs_z, u_dims.y), z + lpv_slab_z0(v, u_slabs_z, u_dims.z));
+    imageStore(u_normals, t, vec4(e, 0.0));
 }
