@@ -106,6 +106,31 @@ float shadow_texel(int f, vec3 x, vec3 light_pos)
     return F.info.x * max(dot(x - light_pos, F.axis.xyz), 0.0);
 }
 
+// Size (m) of one texel at x of the face of perspective light l (any light
+// but a directional one) that holds x, without finding that face: all of a
+// light's faces have the same texel per metre of depth (info.x), and the face
+// holding x is the one along whose axis x lies deepest (an area sample's or a
+// cube's: the largest dot product with the axes; a spot's single face: its
+// own axis). The face itself is then looked up once, for the offset point.
+float shadow_texel_perspective(int l, vec3 x, const int kind)
+{
+    vec4 info = S.lights[l];
+    int first = int(info.x);
+    vec3 d = x - L.lights[l].position_type.xyz;
+    float depth;
+    if (kind == SHADOW_AREA_SAMPLE || (kind == SHADOW_ANY_LIGHT && info.z == 2.0)) {
+        depth = dot(d, S.faces[first].axis.xyz);
+        for (int k = 1; k < LPV_AREA_FACES; ++k)
+            depth = max(depth, dot(d, S.faces[first + k].axis.xyz));
+    } else if (int(info.y) == 6) {
+        vec3 a = abs(d);
+        depth = max(a.x, max(a.y, a.z));
+    } else {
+        depth = dot(d, S.faces[first].axis.xyz);
+    }
+    return S.faces[first].info.x * max(depth, 0.0);
+}
+
 // Visibility (0..1) of light l from a receiver at p with unit normal n,
 // a light of the given kind (SHADOW_ANY_LIGHT when unknown),
 // filtered over the kernel (taps = 1: one bilinear compare, for callers that
@@ -127,16 +152,29 @@ float shadow_visibility_of(int l, vec3 p, vec3 n, int taps, const int kind)
     float c = clamp(dot(n, to_light), 0.0, 1.0);
     float s = sqrt(max(1.0 - c * c, 0.0));
     float tan_t = min(s / max(c, 1e-4), LPV_SHADOW_MAX_SLOPE);
-    int f = shadow_face_of(l, p, kind);
+    // the offset may cross into a neighbouring face or cascade: the face is
+    // the offset point's
+    int f;
     vec3 q = p;
-    for (int pass = 0; pass < 2 && f >= 0; ++pass) {
-        float T = shadow_texel(f, p, lp);
+    if (kind == SHADOW_AREA_SAMPLE || S.lights[l].z != 1.0) {
+        // perspective faces: T from p's depth, then one face lookup
+        float T = shadow_texel_perspective(l, p, kind);
         q = p + n * (LPV_SHADOW_NORMAL_OFFSET * T * s) +
             to_light * ((LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan_t) * T);
-        int g = shadow_face_of(l, q, kind); // the offset may cross into a neighbouring face or cascade
-        if (g == f)
-            break;
-        f = g;
+        f = shadow_face_of(l, q, kind);
+    } else {
+        // a directional light's cascades: each has its own texel, so a
+        // crossing is offset again by the next cascade's
+        f = shadow_face_of(l, p, kind);
+        for (int pass = 0; pass < 2 && f >= 0; ++pass) {
+            float T = shadow_texel(f, p, lp);
+            q = p + n * (LPV_SHADOW_NORMAL_OFFSET * T * s) +
+                to_light * ((LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan_t) * T);
+            int g = shadow_face_of(l, q, kind);
+            if (g == f)
+                break;
+            f = g;
+        }
     }
     if (f < 0)
         return 1.0; // outside every cascade: no shadow information
