@@ -36,7 +36,7 @@ static uint64_t rsm_samples(const lpv_memory_need *n)
 
 uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n)
 {
-    return texels(n->rsm_size, n->rsm_faces) * LPV_MEM_RSM_TEXEL + rsm_samples(n) * (LPV_MEM_VPL + LPV_MEM_SURFEL);
+    return texels(n->rsm_size, n->rsm_faces) * LPV_MEM_RSM_TEXEL + rsm_samples(n) * (LPV_MEM_VPL + LPV_MEM_VPL_LIVE + LPV_MEM_SURFEL);
 }
 
 uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n)

@@ -16,6 +16,8 @@
 /* Bytes per element of each kind of storage (the GL formats in gpu/). */
 #define LPV_MEM_RSM_TEXEL 56u     /* 3 x RGBA32F + RGBA8 + DEPTH32F per RSM texel */
 #define LPV_MEM_VPL 48u           /* one LpvVpl per RSM texel */
+#define LPV_MEM_VPL_LIVE 49u      /* per RSM texel: the dense copy of the VPLs that carry light (48), and two
+                                     uints per 32 for their live bits and places (gpu/compact.h; rounded up) */
 #define LPV_MEM_SURFEL 48u        /* one LpvSurfel per RSM texel or pixel */
 #define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
 #define LPV_MEM_CELL 504u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48), transmittances (24), reflectances

@@ -82,6 +82,18 @@ void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, s
     lpv_timer_count(timer, 1);
 }
 
+void lpv_atlas_splat_indirect(GLuint prog, GLuint binding, GLuint buffer, GLuint draw, int instances, lpv_timer *timer)
+{
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
+    glUniform1i(glGetUniformLocation(prog, "u_first"), 0);
+    const GLuint n = (GLuint)instances;
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, draw);
+    glBufferSubData(GL_DRAW_INDIRECT_BUFFER, sizeof(GLuint), sizeof n, &n); /* the command's instance count */
+    glDrawArraysIndirect(GL_POINTS, NULL);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    lpv_timer_count(timer, 1);
+}
+
 /* Clears the atlas and sets the state for additive point splatting with prog. */
 void lpv_atlas_begin(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao)
 {

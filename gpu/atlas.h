@@ -35,6 +35,10 @@ void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLui
  * `instances` times (gl_InstanceID: the cascade, for splats into every one). */
 void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int instances,
                      lpv_timer *timer);
+/* The same for the samples compacted into buffer with their count in the
+ * draw command at the start of draw (compact.h): only the live ones are
+ * drawn. */
+void lpv_atlas_splat_indirect(GLuint prog, GLuint binding, GLuint buffer, GLuint draw, int instances, lpv_timer *timer);
 void lpv_atlas_end(void);
 
 #endif /* LPV_ATLAS_H */

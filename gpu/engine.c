@@ -19,8 +19,12 @@ static const char *const INC_MATERIAL[] = {"material.glsl", NULL};
 static const char *const INC_RSM[] = {"material.glsl", "lights.glsl", NULL};
 static const char *const INC_SHADE[] = {"lights.glsl", "shadow.glsl", "shading.glsl", NULL};
 static const char *const INC_MEDIA[] = {"lights.glsl", "shadow.glsl", "medium.glsl", NULL};
-static const char *const INC_BLOCKS[] = {"grid.glsl", "block_groups.glsl", NULL};
 static const char *const INC_BLOCKS8[] = {"grid.glsl", "block_slots8.glsl", "block_groups.glsl", NULL};
+/* the RSMs' VPL producers mark the VPLs that carry light (compact.glsl) */
+static const char *const INC_VPL_BLOCKS[] = {"grid.glsl", "block_groups.glsl", "compact.glsl", NULL};
+static const char *const INC_VPL_BLOCKS8[] = {"grid.glsl", "block_slots8.glsl", "block_groups.glsl", "compact.glsl",
+                                              NULL};
+static const char *const INC_COMPACT[] = {"compact.glsl", NULL};
 
 /* out = the technique's lookup includes, then the pass's own (both
  * NULL-terminated; own may be NULL). Returns -1 when they do not fit. */
@@ -137,14 +141,16 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     } progs[] = {
         {&e->prog_rsm, "scene.vert", "rsm.frag", INC_RSM},
         {&e->prog_rsm_plain, "scene.vert", "rsm.frag", INC_RSM, PLAIN},
-        {&e->prog_vpl_extract, "vpl_extract.comp", NULL, NULL},
-        {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_BLOCKS},
-        {&e->prog_vpl_blocks8, "vpl_blocks.comp", NULL, INC_BLOCKS8},
+        {&e->prog_vpl_extract, "vpl_extract.comp", NULL, INC_COMPACT},
+        {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS},
+        {&e->prog_vpl_blocks8, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8},
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
         {&e->prog_gbuffer_plain, "scene.vert", "gbuffer.frag", INC_MATERIAL, PLAIN},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, INC_BLOCKS8},
         {&e->prog_shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
         {&e->prog_shadow_plain, "scene.vert", "shadow_depth.frag", INC_MATERIAL, PLAIN},
+        {&e->prog_compact[0], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 1"},
+        {&e->prog_compact[1], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 2"},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog =
@@ -232,7 +238,7 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain,
                        &e->prog_shade_blocks, &e->prog_lookup_blocks,   &e->prog_lookup_blocks_damped,
                        &e->prog_shade_rest,  &e->prog_shade_rest_damped, &e->prog_shade_split,
-                       &e->prog_shade_split_damped};
+                       &e->prog_shade_split_damped, &e->prog_compact[0], &e->prog_compact[1]};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

@@ -209,6 +209,10 @@ size_t lpv_engine_read_ao(lpv_engine *e, float *out, size_t max_floats);
 /* RSM VPLs (punctual lights' and area light samples'), then the emissive VPLs
  * when the last tick injected them (area lights off). */
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);
+/* The RSMs' VPLs the injection drew at the last tick: those of
+ * lpv_engine_read_vpls's RSM part that carry light (position[3] != 0), in
+ * their order (gpu/compact.h). Returns how many (at most max copied). */
+size_t lpv_engine_read_injected_vpls(lpv_engine *e, lpv_vpl *out, size_t max);
 /* Surfels of one GV buffer: 0..P-1 = each punctual light's RSM; P = the area
  * light samples' (when there are any); then the camera (with a view); then
  * the scene surfels (settings.scene_surfels on). */

@@ -76,6 +76,7 @@ struct lpv_engine {
      * blocks' irradiance, and the blocks' lookup without and with damping
      * (shading.glsl, lookup_blocks.comp) */
     GLuint prog_shade_blocks, prog_lookup_blocks, prog_lookup_blocks_damped;
+    GLuint prog_compact[2]; /* compact.comp's scan and copy */
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -117,6 +118,9 @@ struct lpv_engine {
     int area_face_side;   /* texels of an area light face's tile */
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
+    /* the VPLs that carry light, in order, and their draw command (compact.h):
+     * the injection draws only them */
+    GLuint vpls_live, vpls_draw;
     size_t rsm_per_layer[2]; /* VPLs (and surfels) per layer, punctual and area lights': blocks^2 x slots */
     size_t rsm_vpl_count; /* punctual layers x rsm_per_layer[0] + area layers x rsm_per_layer[1] */
 

@@ -68,6 +68,16 @@ size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
     return n;
 }
 
+size_t lpv_engine_read_injected_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
+{
+    if (!e->ticked || !e->vpls_draw)
+        return 0;
+    GLuint count = 0;
+    lpv_gl_read_buffer(e->vpls_draw, sizeof count, 1, &count, 1);
+    lpv_gl_read_buffer(e->vpls_live, sizeof(lpv_vpl), count, out, max);
+    return count;
+}
+
 /* GV buffers: each punctual light, then (if any) the area light samples as
  * one (their first sample's faces; rsm.frag leaves the others' out), then the
  * camera. */

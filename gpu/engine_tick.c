@@ -86,7 +86,8 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
     in->settings = &e->settings;
     in->plan = &e->plan;
     in->timer = &e->timer;
-    in->rsm_vpls = e->vpls;
+    in->rsm_vpls = e->vpls_live;
+    in->rsm_vpl_draw = e->vpls_draw;
     in->rsm_vpl_count = e->rsm_vpl_count;
     in->emissive_vpls = e->emissive_vpls;
     in->emissive_vpl_count = e->emissive_vpl_count;

@@ -7,6 +7,7 @@
  */
 #include <math.h>
 
+#include "compact.h"
 #include "engine_internal.h"
 
 static GLuint array_texture(GLenum format, int size, int layers)
@@ -35,6 +36,8 @@ static void free_rsm_storage(lpv_engine *e)
         glDeleteBuffers(1, &e->vpls);
     if (e->surfels)
         glDeleteBuffers(1, &e->surfels);
+    lpv_gl_delete_buffer(&e->vpls_live);
+    lpv_gl_delete_buffer(&e->vpls_draw);
     e->rsm_position = e->rsm_normal = e->rsm_flux = e->rsm_albedo = e->rsm_depth = e->rsm_fbo = 0;
     e->vpls = e->surfels = 0;
     e->rsm_alloc_size = e->rsm_alloc_faces = 0;
@@ -79,6 +82,12 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     glGenBuffers(1, &e->surfels);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
+    glGenBuffers(1, &e->vpls_live);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls_live);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_vpl)), NULL, GL_DYNAMIC_COPY);
+    glGenBuffers(1, &e->vpls_draw);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls_draw);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)lpv_compact_head_bytes(texels), NULL, GL_DYNAMIC_COPY);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
         free_rsm_storage(e);
@@ -185,6 +194,9 @@ void lpv_pass_rsm_run(lpv_engine *e)
     if (!e->plan.pass[LPV_PASS_INJECT].run && !e->plan.pass[LPV_PASS_GV].run)
         return;
     lpv_timer_begin(&e->timer, "vpl_extract");
+    /* the producers mark the VPLs that carry light (compact.h) */
+    lpv_compact_clear(e->vpls_draw);
+    lpv_compact_bind(e->vpls_draw);
     /* the punctual lights' layers (one face a layer), then the area lights'
      * (faces tiled four to a layer), each kind at the step of its faces'
      * side: its VPLs after the punctual ones' */
@@ -195,5 +207,8 @@ void lpv_pass_rsm_run(lpv_engine *e)
                                          (size_t)punctual * e->rsm_per_layer[0]);
     e->rsm_vpl_count = (size_t)punctual * e->rsm_per_layer[0] + (size_t)(e->rsm_layers - punctual) * e->rsm_per_layer[1];
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    /* the injection draws only the VPLs that carry light (most of the
+     * blocks' slots are empty) */
+    lpv_compact_run(e->prog_compact, e->vpls, e->rsm_vpl_count, e->vpls_live, e->vpls_draw);
     lpv_timer_end(&e->timer);
 }

@@ -74,8 +74,9 @@ typedef struct lpv_technique_inputs {
     const lpv_settings *settings;
     const lpv_plan *plan;         /* this tick's, with the technique's passes decided */
     lpv_timer *timer;             /* each pass records its own stage */
-    GLuint rsm_vpls;              /* LpvVpl per RSM texel */
-    size_t rsm_vpl_count;
+    GLuint rsm_vpls;              /* the RSMs' LpvVpls that carry light, in order (compact.h) */
+    GLuint rsm_vpl_draw;          /* their draw command: the count (lpv_atlas_splat_indirect) */
+    size_t rsm_vpl_count;         /* at most this many (the RSMs' blocks x slots) */
     GLuint emissive_vpls;         /* the emissive surfaces' VPLs */
     size_t emissive_vpl_count;
     size_t surfel_set_count;      /* the surfaces seen this tick, for occlusion */

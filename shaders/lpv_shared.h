@@ -405,6 +405,8 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_IV_EMIT 13     /* LpvCell per voxel: what each occupied voxel sends out this bounce */
 #define LPV_SSBO_IV_AO 14       /* vec4 per voxel: the SH of the visible directions (travel convention) */
 #define LPV_SSBO_SHADE_REST 15  /* the frame's pixels left for shade_rest.comp (shading.glsl, LPV_LOOKUP_SPLIT) */
+#define LPV_SSBO_COMPACT_HEAD 0 /* compact.comp: the draw command, then a count per chunk */
+#define LPV_SSBO_COMPACT_DST 4  /* compact.comp: the live samples, in order */
 
 /* Texture units of the propagation's inputs (RGBA32F buffer textures). */
 #define LPV_TEX_LPV_IN    0
@@ -466,6 +468,12 @@ LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v % slabs) * d
 #define LPV_PROP_WG_X 32
 #define LPV_PROP_WG_Y 2
 #define LPV_WG_2D 8
+/* compact.comp: samples per chunk (one invocation each; the bits of a uint,
+ * compact.glsl), chunk invocations per workgroup, and the scan's single
+ * workgroup. */
+#define LPV_COMPACT_CHUNK 32
+#define LPV_COMPACT_WG 64
+#define LPV_COMPACT_SCAN_WG 1024
 /* Samples per block of a down-sampled buffer at most (block_groups.glsl:
  * camera surfels, RSM VPLs and surfels): one per cell or geometry-volume
  * point the block's samples reach. */

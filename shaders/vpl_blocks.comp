@@ -30,9 +30,12 @@ bool g_vpls; // what block_emit writes: VPLs, else surfels
 
 void block_emit(int i, float w, vec3 pos_mean, vec3 nrm_mean, vec3 val, float size)
 {
-    if (g_vpls)
-        vpls[i] = group_vpl(w, pos_mean, nrm_mean, val, size);
-    else
+    if (g_vpls) {
+        LpvVpl v = group_vpl(w, pos_mean, nrm_mean, val, size);
+        vpls[i] = v;
+        if (v.position.w != 0.0)
+            compact_mark_live(i);
+    } else
         surfels[i] = group_surfel(w, pos_mean, nrm_mean, val, size);
 }
 

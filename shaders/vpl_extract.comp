@@ -27,6 +27,8 @@ void main()
     vec4 f = texelFetch(u_rsm_flux, t, 0);
     bool covered = n.w > 0.5;
     vpls[i].position = vec4(p.xyz, covered ? 1.0 : 0.0);
+    if (covered)
+        compact_mark_live(int(i));
     vpls[i].normal = vec4(n.xyz, f.a); // w: object size
     vpls[i].flux = vec4(f.rgb, 0.0);
     vec4 albedo = texelFetch(u_rsm_albedo, t, 0);

@@ -13,7 +13,9 @@
  * ticked at camera_surfel_step = rsm_vpl_step = 1, again at 4 and 2 (a block
  * of 4 texels has no more groups than the 8 slots) and at auto:
  * the injected volumes and the geometry volume read back agree within float
- * rounding (1e-4 of the largest value), with fewer VPLs and camera surfels.
+ * rounding (1e-4 of the largest value), with fewer VPLs and camera surfels;
+ * the VPLs the injection draws are exactly those that carry light, in order
+ * (the compaction of gpu/compact.h).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -173,6 +175,16 @@ static void snap(const lpv_scene *scene, const lpv_view *view, int cam_step, int
     s->vpls = 0; /* the VPLs that carry light (a block's unused slots do not) */
     for (size_t i = 0; i < nv; ++i)
         s->vpls += v[i].position[3] != 0.0f;
+    /* the injection drew exactly those, in their order, to the bit
+     * (gpu/compact.h) */
+    lpv_vpl *live = calloc(max, sizeof *live);
+    assert_non_null(live);
+    size_t nl = lpv_engine_read_injected_vpls(lpvt_engine, live, max);
+    assert_int_equal(nl, s->vpls);
+    for (size_t i = 0, j = 0; i < nv; ++i)
+        if (v[i].position[3] != 0.0f)
+            assert_memory_equal(&v[i], &live[j++], sizeof *v);
+    free(live);
     free(v);
     s->camera = stats->surfels_camera;
     assert_true(s->nvol > 0);

@@ -60,9 +60,10 @@ static void test_estimates_and_check(void **state)
     char err[512] = "";
     assert_int_equal(lpv_memory_check(&n, &LIMITS, err, sizeof err), 0);
     /* the parts, by their formats */
-    /* textures per texel; VPLs and surfels per slot of the down-sampling's
-     * blocks, at most (128 + 2)^2 a layer at any step */
-    assert_int_equal(lpv_memory_rsm_bytes(&n), 128ull * 128 * 48 * 56 + 130ull * 130 * 48 * (48 + 48));
+    /* textures per texel; VPLs (and the dense copy of the live ones with
+     * their bits and places, 48 + 1 rounded up) and surfels per slot of the
+     * down-sampling's blocks, at most (128 + 2)^2 a layer at any step */
+    assert_int_equal(lpv_memory_rsm_bytes(&n), 128ull * 128 * 48 * 56 + 130ull * 130 * 48 * (48 + 49 + 48));
     assert_int_equal(lpv_memory_shadow_bytes(&n), 1024ull * 1024 * 48 * 4);
     assert_int_equal(lpv_memory_total_bytes(&n), lpv_memory_rsm_bytes(&n) + lpv_memory_shadow_bytes(&n) +
                                                      lpv_memory_grid_bytes(&n) + lpv_memory_image_bytes(&n));

@@ -18,7 +18,7 @@ void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rs
     lpv_timer_begin(timer, "inject");
     lpv_atlas_begin(&c->lpv_atlas, c->prog_inject_vpl, c->grid_ubo, c->empty_vao);
     if (rsm_vpls)
-        lpv_atlas_splat(c->prog_inject_vpl, LPV_SSBO_VPLS, in->rsm_vpls, 0, in->rsm_vpl_count, instances, timer);
+        lpv_atlas_splat_indirect(c->prog_inject_vpl, LPV_SSBO_VPLS, in->rsm_vpls, in->rsm_vpl_draw, instances, timer);
     lpv_atlas_end();
     lpv_timer_end(timer);
     /* Emissive surfaces are their own stage, so the plan's "emissive" pass
