@@ -17,6 +17,7 @@
 #include "context.h"
 #include "engine.h"
 #include "image_io.h"
+#include "lpv_shared.h"
 #include "scene.h"
 #include "scene_load.h"
 #include "test_util.h"
@@ -195,9 +196,12 @@ static void test_lookup_step_follows_planes(void **state)
  * vertex normal turned by about a milliradian no pixel does, and the second
  * pass looks up all of them. The two indirect-only frames agree to what the
  * turn changes (measured: worst value 0.25 % apart). */
-static void test_frame_second_pass(void **state)
+/* The frame in two passes at w x h: the built-in box with every vertex
+ * normal turned by a milliradian sends every covered pixel through the
+ * second pass (frame_full_lookups), whose light must be the first pass's
+ * of the flat box. Returns the covered pixels. */
+static size_t check_second_pass(int w, int h)
 {
-    (void)state;
     lpv_scene flat, turned;
     assert_int_equal(lpv_scene_builtin_cornell(&flat), 0);
     assert_int_equal(lpv_scene_builtin_cornell(&turned), 0);
@@ -214,23 +218,29 @@ static void test_frame_second_pass(void **state)
     }
     const lpv_settings s = {0}; /* the default preset: normal bins, two cascades */
     lpv_view view;
-    float *a = calloc((size_t)W * H * 4, sizeof *a), *b = calloc((size_t)W * H * 4, sizeof *b);
-    render_with(&flat, &s, LPV_TERMS_INDIRECT_ONLY, W, H, &view, a);
+    const size_t pixels = (size_t)w * (size_t)h;
+    float *a = calloc(pixels * 4, sizeof *a), *b = calloc(pixels * 4, sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    render_with(&flat, &s, LPV_TERMS_INDIRECT_ONLY, w, h, &view, a);
     assert_int_equal(lpv_engine_last_stats(lpvt_engine)->frame_full_lookups, 0);
-    render_with(&turned, &s, LPV_TERMS_INDIRECT_ONLY, W, H, &view, b);
+    render_with(&turned, &s, LPV_TERMS_INDIRECT_ONLY, w, h, &view, b);
     size_t covered = 0;
     double mean = 0.0;
-    for (size_t i = 0; i < (size_t)W * H; ++i)
+    for (size_t i = 0; i < pixels; ++i)
         if (a[4 * i + 3] > 0.5f) {
             ++covered;
             mean += (a[4 * i] + a[4 * i + 1] + a[4 * i + 2]) / 3.0;
         }
-    assert_true(covered > (size_t)W * H / 2);
+    assert_true(covered > pixels / 2);
     mean /= (double)covered;
     assert_int_equal(lpv_engine_last_stats(lpvt_engine)->frame_full_lookups, covered);
     double worst = 0.0, sum_a = 0.0, sum_b = 0.0;
-    for (size_t i = 0; i < (size_t)W * H; ++i) {
+    size_t unlit = 0; /* covered pixels the second pass left black */
+    for (size_t i = 0; i < pixels; ++i) {
         assert_true(a[4 * i + 3] == b[4 * i + 3]);
+        if (a[4 * i + 3] > 0.5f && a[4 * i] + a[4 * i + 1] + a[4 * i + 2] > 0.0f && b[4 * i] + b[4 * i + 1] + b[4 * i + 2] == 0.0f)
+            ++unlit;
         for (int c = 0; c < 3; ++c) {
             const double x = a[4 * i + (size_t)c], y = b[4 * i + (size_t)c];
             assert_true(isfinite(y) && y >= 0.0);
@@ -239,14 +249,32 @@ static void test_frame_second_pass(void **state)
             sum_b += y;
         }
     }
-    print_message("second pass: %zu pixels, worst value %.4f apart, sums %.6g and %.6g\n", covered, worst, sum_a,
-                  sum_b);
+    print_message("second pass at %dx%d: %zu pixels, %zu left unlit, worst value %.4f apart, sums %.6g and %.6g\n",
+                  w, h, covered, unlit, worst, sum_a, sum_b);
+    assert_int_equal(unlit, 0);
     assert_true(worst < 0.02);
     assert_true(fabs(sum_b - sum_a) < 0.002 * sum_a);
     free(a);
     free(b);
     lpv_scene_free(&flat);
     lpv_scene_free(&turned);
+    return covered;
+}
+
+static void test_frame_second_pass(void **state)
+{
+    (void)state;
+    check_second_pass(W, H);
+}
+
+/* Past LPV_SHADE_REST_MAX_GROUPS workgroups of LPV_SHADE_REST_WG listed
+ * pixels (4 194 240) each invocation of the second pass takes several:
+ * 2200 x 2200 lists about 4.56 M. */
+static void test_frame_second_pass_strided(void **state)
+{
+    (void)state;
+    const size_t covered = check_second_pass(2200, 2200);
+    assert_true(covered > (size_t)LPV_SHADE_REST_WG * LPV_SHADE_REST_MAX_GROUPS);
 }
 
 static void test_shared_glb_matches_builtin(void **state)
@@ -344,6 +372,7 @@ int main(void)
         cmocka_unit_test(test_damping_only_darkens),
         cmocka_unit_test(test_lookup_step_follows_planes),
         cmocka_unit_test(test_frame_second_pass),
+        cmocka_unit_test(test_frame_second_pass_strided),
         cmocka_unit_test(test_shared_glb_matches_builtin),
         cmocka_unit_test(test_render_command_files),
         cmocka_unit_test(test_render_command_rejects_bad_input),
