@@ -224,11 +224,6 @@ static void lookup_blocks_run(lpv_engine *e)
     glBindTexture(GL_TEXTURE_2D, e->block_tex[1]);
 }
 
-/* The frame (shading.glsl) as a compute pass writing the frame texture: on
- * llvmpipe it costs what the full-screen triangle did, and on a GPU whose
- * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
- * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
- * core. The glossy and media passes then blend into the same texture. */
 /* Makes prog the current program with the shading's uniforms and the
  * technique's lookup bound. */
 static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms terms, int step)
@@ -251,6 +246,11 @@ size_t lpv_pass_shade_full_lookups(lpv_engine *e)
     return head[3];
 }
 
+/* The frame (shading.glsl) as a compute pass writing the frame texture: on
+ * llvmpipe it costs what the full-screen triangle did, and on a GPU whose
+ * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
+ * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
+ * core. The glossy and media passes then blend into the same texture. */
 void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
 {
     lpv_timer_begin(&e->timer, "shade");

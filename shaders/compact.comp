@@ -12,13 +12,8 @@
 //   2: each chunk copies its live samples from its first place on.
 layout(local_size_x = LPV_COMPACT_PHASE == 1 ? LPV_COMPACT_SCAN_WG : LPV_COMPACT_WG) in;
 
-struct LpvCompactSample
-{
-    vec4 position, normal, flux;
-};
-
-layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Src { LpvCompactSample src[]; };
-layout(std430, binding = LPV_SSBO_COMPACT_DST) writeonly buffer Dst { LpvCompactSample dst[]; };
+layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Src { LpvVpl src[]; };
+layout(std430, binding = LPV_SSBO_COMPACT_DST) writeonly buffer Dst { LpvVpl dst[]; };
 
 uniform int u_chunks; // chunks of LPV_COMPACT_CHUNK samples
 

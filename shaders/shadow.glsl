@@ -55,14 +55,17 @@ const int SHADOW_AREA_SAMPLE = 2; // lights [L.counts.z, L.counts.x)
 // axis of x - light, the area light face whose axis is nearest x - light, the
 // single face of a spot, or the finest cascade whose
 // square holds x with LPV_SHADOW_BORDER_TEXELS to spare; -1 if none does.
+// depth: x's depth along that face's axis (m) for a perspective face (every
+// light but a directional one), 0 for a cascade.
 // kind: which lights l can be (SHADOW_ANY_LIGHT when unknown).
-int shadow_face_of(int l, vec3 x, const int kind)
+int shadow_face_at(int l, vec3 x, const int kind, out float depth)
 {
     vec4 info = S.lights[l];
     int first = int(info.x), count = int(info.y);
+    vec3 d = x - L.lights[l].position_type.xyz;
+    depth = 0.0;
     if (kind == SHADOW_AREA_SAMPLE || (kind == SHADOW_ANY_LIGHT && info.z == 2.0)) {
         // area light sample: the face whose axis is nearest x's direction
-        vec3 d = x - L.lights[l].position_type.xyz;
         int best = first;
         float best_dot = dot(d, S.faces[first].axis.xyz);
         // every sample has LPV_AREA_FACES faces (gpu/light_faces.c): a
@@ -75,19 +78,22 @@ int shadow_face_of(int l, vec3 x, const int kind)
                 best_dot = dk;
             }
         }
+        depth = best_dot;
         return best;
     }
     if (count == 6) {
-        vec3 d = x - L.lights[l].position_type.xyz;
         vec3 a = abs(d);
+        depth = max(a.x, max(a.y, a.z));
         if (a.x >= a.y && a.x >= a.z)
             return first + (d.x >= 0.0 ? 0 : 1);
         if (a.y >= a.z)
             return first + (d.y >= 0.0 ? 2 : 3);
         return first + (d.z >= 0.0 ? 4 : 5);
     }
-    if (info.z == 0.0)
+    if (info.z == 0.0) {
+        depth = dot(d, S.faces[first].axis.xyz);
         return first;
+    }
     float inner = 1.0 - 2.0 * LPV_SHADOW_BORDER_TEXELS * S.counts.z;
     for (int k = 0; k < count; ++k) {
         vec4 c = S.faces[first + k].view_proj * vec4(x, 1.0); // orthographic: w = 1
@@ -97,6 +103,12 @@ int shadow_face_of(int l, vec3 x, const int kind)
     return -1;
 }
 
+int shadow_face_of(int l, vec3 x, const int kind)
+{
+    float depth;
+    return shadow_face_at(l, x, kind, depth);
+}
+
 // Size (m) of one texel of face f at x.
 float shadow_texel(int f, vec3 x, vec3 light_pos)
 {
@@ -104,31 +116,6 @@ float shadow_texel(int f, vec3 x, vec3 light_pos)
     if (F.info.y == 0.0)
         return F.info.x;
     return F.info.x * max(dot(x - light_pos, F.axis.xyz), 0.0);
-}
-
-// Size (m) of one texel at x of the face of perspective light l (any light
-// but a directional one) that holds x, without finding that face: all of a
-// light's faces have the same texel per metre of depth (info.x), and the face
-// holding x is the one along whose axis x lies deepest (an area sample's or a
-// cube's: the largest dot product with the axes; a spot's single face: its
-// own axis). The face itself is then looked up once, for the offset point.
-float shadow_texel_perspective(int l, vec3 x, const int kind)
-{
-    vec4 info = S.lights[l];
-    int first = int(info.x);
-    vec3 d = x - L.lights[l].position_type.xyz;
-    float depth;
-    if (kind == SHADOW_AREA_SAMPLE || (kind == SHADOW_ANY_LIGHT && info.z == 2.0)) {
-        depth = dot(d, S.faces[first].axis.xyz);
-        for (int k = 1; k < LPV_AREA_FACES; ++k)
-            depth = max(depth, dot(d, S.faces[first + k].axis.xyz));
-    } else if (int(info.y) == 6) {
-        vec3 a = abs(d);
-        depth = max(a.x, max(a.y, a.z));
-    } else {
-        depth = dot(d, S.faces[first].axis.xyz);
-    }
-    return S.faces[first].info.x * max(depth, 0.0);
 }
 
 // Visibility (0..1) of light l from a receiver at p with unit normal n,
@@ -157,8 +144,12 @@ float shadow_visibility_of(int l, vec3 p, vec3 n, int taps, const int kind)
     int f;
     vec3 q = p;
     if (kind == SHADOW_AREA_SAMPLE || S.lights[l].z != 1.0) {
-        // perspective faces: T from p's depth, then one face lookup
-        float T = shadow_texel_perspective(l, p, kind);
+        // perspective faces: all of a light's faces have the same texel per
+        // metre of depth (info.x), so T needs only p's depth along the axis of
+        // the face holding p; the face that is read is the offset point's
+        float depth;
+        shadow_face_at(l, p, kind, depth);
+        float T = S.faces[int(S.lights[l].x)].info.x * max(depth, 0.0);
         q = p + n * (LPV_SHADOW_NORMAL_OFFSET * T * s) +
             to_light * ((LPV_SHADOW_DEPTH_BIAS + LPV_SHADOW_SLOPE_BIAS * tan_t) * T);
         f = shadow_face_of(l, q, kind);
