@@ -441,9 +441,9 @@ int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)
     return step > 1 ? step : 1;
 }
 
-int lpv_settings_rsm_vpl_step(const lpv_settings *s, int tile)
+int lpv_settings_rsm_vpl_step(const lpv_settings *s, int tile, int surfels)
 {
-    int want = s->rsm_vpl_step > 0 ? s->rsm_vpl_step : LPV_RSM_AUTO_STEP;
+    int want = s->rsm_vpl_step > 0 ? s->rsm_vpl_step : surfels ? LPV_RSM_AUTO_STEP : LPV_RSM_AUTO_VPL_STEP;
     int step = 1;
     while (step * 2 <= want && tile > 0 && tile % (step * 2) == 0)
         step *= 2;

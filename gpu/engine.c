@@ -144,6 +144,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_vpl_extract, "vpl_extract.comp", NULL, INC_COMPACT},
         {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS},
         {&e->prog_vpl_blocks8, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8},
+        {&e->prog_vpl_blocks8_vpls, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8, "#define LPV_BLOCKS_VPLS_ONLY 1"},
         {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
         {&e->prog_gbuffer_plain, "scene.vert", "gbuffer.frag", INC_MATERIAL, PLAIN},
         {&e->prog_camera_surfels, "camera_surfels.comp", NULL, INC_BLOCKS8},
@@ -232,13 +233,31 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_gl_delete_buffer(&e->query_out);
     if (e->tech)
         e->tech->cls->destroy(e->tech);
-    GLuint *progs[] = {&e->prog_rsm,        &e->prog_rsm_plain,     &e->prog_vpl_extract,    &e->prog_vpl_blocks,
-                       &e->prog_vpl_blocks8, &e->prog_gbuffer,       &e->prog_gbuffer_plain,  &e->prog_camera_surfels,
-                       &e->prog_shade,       &e->prog_shade_damped,  &e->prog_query,          &e->prog_glossy,
-                       &e->prog_media,       &e->prog_shadow,        &e->prog_shadow_plain,
-                       &e->prog_shade_blocks, &e->prog_lookup_blocks,   &e->prog_lookup_blocks_damped,
-                       &e->prog_shade_rest,  &e->prog_shade_rest_damped, &e->prog_shade_split,
-                       &e->prog_shade_split_damped, &e->prog_compact[0], &e->prog_compact[1]};
+    GLuint *progs[] = {&e->prog_rsm,
+                       &e->prog_rsm_plain,
+                       &e->prog_vpl_extract,
+                       &e->prog_vpl_blocks,
+                       &e->prog_vpl_blocks8,
+                       &e->prog_vpl_blocks8_vpls,
+                       &e->prog_gbuffer,
+                       &e->prog_gbuffer_plain,
+                       &e->prog_camera_surfels,
+                       &e->prog_shade,
+                       &e->prog_shade_damped,
+                       &e->prog_query,
+                       &e->prog_glossy,
+                       &e->prog_media,
+                       &e->prog_shadow,
+                       &e->prog_shadow_plain,
+                       &e->prog_shade_blocks,
+                       &e->prog_lookup_blocks,
+                       &e->prog_lookup_blocks_damped,
+                       &e->prog_shade_rest,
+                       &e->prog_shade_rest_damped,
+                       &e->prog_shade_split,
+                       &e->prog_shade_split_damped,
+                       &e->prog_compact[0],
+                       &e->prog_compact[1]};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

@@ -62,8 +62,9 @@ struct lpv_engine {
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
-        prog_shade, prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
+    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels, prog_shade,
+        prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
+    GLuint prog_vpl_blocks8_vpls; /* vpl_blocks.comp without the surfels (LPV_BLOCKS_VPLS_ONLY) */
     /* the frame in two passes (the technique's lookup_split): the first
      * looks up the pixels of the lookup's own normals and lists the rest,
      * the second (shade_rest.comp) adds their indirect light (shading.glsl,
@@ -121,8 +122,11 @@ struct lpv_engine {
     /* the VPLs that carry light, in order, and their draw command (compact.h):
      * the injection draws only them */
     GLuint vpls_live, vpls_draw;
-    size_t rsm_per_layer[2]; /* VPLs (and surfels) per layer, punctual and area lights': blocks^2 x slots */
-    size_t rsm_vpl_count; /* punctual layers x rsm_per_layer[0] + area layers x rsm_per_layer[1] */
+    /* VPLs (and surfels) per layer, blocks^2 x slots: the punctual lights',
+     * the area lights' layers whose surfels the GV takes
+     * (lpv_engine_area_gv_layers), the other area layers' (pass_rsm.c) */
+    size_t rsm_per_layer[3];
+    size_t rsm_vpl_count; /* the three kinds of layers x their rsm_per_layer */
 
     /* shadow maps of direct light (pass_shadow.c), rendered at render time */
     struct LpvShadowBlock shadow_block; /* the faces the maps hold */
@@ -247,6 +251,10 @@ void lpv_engine_group_scene_surfels(lpv_engine *e);
 int lpv_engine_group_grids(const lpv_engine *e, lpv_group_grid g[LPV_MAX_CASCADES]);
 /* Sets prog's (in use) block_groups.glsl uniforms from those cascades. */
 void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog);
+/* The area lights' RSM layers (after the punctual lights') that hold the
+ * first sample's faces: the only ones whose surfels the geometry volume
+ * takes (rsm.frag); pass_rsm.c. */
+int lpv_engine_area_gv_layers(const lpv_engine *e);
 /* Samples a block of step x step keeps: min(step^2, LPV_BLOCK_SLOTS). */
 int lpv_block_slots(int step);
 

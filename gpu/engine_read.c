@@ -104,11 +104,7 @@ void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *firs
     } else if (buffer == lights && area_gv_buffers(e)) {
         /* only the layers holding the first sample's faces: the other
          * samples' surfels are left out of the GV anyway (rsm.frag) */
-        const int side = e->area_face_side > 0 ? e->area_face_side : e->rsm_size;
-        const int per_row = e->rsm_size / side, faces_per_layer = per_row * per_row;
-        int layers = (LPV_AREA_FACES + faces_per_layer - 1) / faces_per_layer;
-        if (layers > e->rsm_layers - e->punctual_faces)
-            layers = e->rsm_layers - e->punctual_faces;
+        const int layers = lpv_engine_area_gv_layers(e);
         *first = (size_t)e->punctual_faces * per_layer;
         *count = (size_t)layers * per_area_layer;
     }

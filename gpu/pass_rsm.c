@@ -105,19 +105,25 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
  * (a whole layer, or an area light's tile), into VPLs and surfels from
  * element `base` on: blocks of step x step texels, grouped by the cells
  * (VPLs) and GV points (surfels) of the cascades they reach
- * (block_groups.glsl), the step dividing side. Returns the elements per layer. */
-static size_t extract_layers(lpv_engine *e, int first, int count, int side, size_t base)
+ * (block_groups.glsl), the step dividing side; surfels: whether the
+ * geometry volume takes these layers' surfels (the step depends on it,
+ * lpv_settings_rsm_vpl_step). Returns the elements per layer. */
+static size_t extract_layers(lpv_engine *e, int first, int count, int side, size_t base, int surfels)
 {
     const int size = e->rsm_size;
-    const int step = lpv_settings_rsm_vpl_step(&e->settings, side);
+    const int step = lpv_settings_rsm_vpl_step(&e->settings, side, surfels);
     const int blocks = (size + step - 1) / step;
     const int slots = lpv_block_slots(step);
     if (count <= 0)
         return (size_t)blocks * (size_t)blocks * (size_t)slots;
     /* step 1: a VPL per texel (a program without the grouping: llvmpipe
      * would run its code for every texel even where it is not needed);
-     * step 2: four slots (block_groups.glsl), as many as texels; larger: 8 */
-    const GLuint prog = step == 1 ? e->prog_vpl_extract : step == 2 ? e->prog_vpl_blocks : e->prog_vpl_blocks8;
+     * step 2: four slots (block_groups.glsl), as many as texels; larger: 8,
+     * without the surfels' grouping where the GV leaves them out (their
+     * slots are then not written) */
+    const GLuint prog = step == 1   ? e->prog_vpl_extract
+                        : step == 2 ? e->prog_vpl_blocks
+                                    : (surfels ? e->prog_vpl_blocks8 : e->prog_vpl_blocks8_vpls);
     glUseProgram(prog);
     if (step > 1) {
         lpv_engine_bind_block_groups(e, prog);
@@ -139,6 +145,17 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
     glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D), (GLuint)count);
     lpv_timer_count(&e->timer, 1);
     return (size_t)blocks * (size_t)blocks * (size_t)slots;
+}
+
+int lpv_engine_area_gv_layers(const lpv_engine *e)
+{
+    const int area = e->rsm_layers - e->punctual_faces;
+    if (area <= 0 || e->rsm_size <= 0)
+        return 0;
+    const int side = e->area_face_side > 0 ? e->area_face_side : e->rsm_size;
+    const int per_row = e->rsm_size / side, faces_per_layer = per_row * per_row;
+    const int layers = (LPV_AREA_FACES + faces_per_layer - 1) / faces_per_layer;
+    return layers < area ? layers : area;
 }
 
 void lpv_pass_rsm_run(lpv_engine *e)
@@ -198,14 +215,20 @@ void lpv_pass_rsm_run(lpv_engine *e)
     lpv_compact_clear(e->vpls_draw);
     lpv_compact_bind(e->vpls_draw);
     /* the punctual lights' layers (one face a layer), then the area lights'
-     * (faces tiled four to a layer), each kind at the step of its faces'
-     * side: its VPLs after the punctual ones' */
+     * (faces tiled four to a layer): those holding the first sample's faces,
+     * whose surfels the geometry volume takes, then the others, which give
+     * VPLs only (rsm.frag); each at the step of its faces' side, one after
+     * the other in the buffers */
     const int punctual = e->punctual_faces < e->rsm_layers ? e->punctual_faces : e->rsm_layers;
     const int area_side = e->area_face_side > 0 ? e->area_face_side : size;
-    e->rsm_per_layer[0] = extract_layers(e, 0, punctual, size, 0);
-    e->rsm_per_layer[1] = extract_layers(e, punctual, e->rsm_layers - punctual, area_side,
-                                         (size_t)punctual * e->rsm_per_layer[0]);
-    e->rsm_vpl_count = (size_t)punctual * e->rsm_per_layer[0] + (size_t)(e->rsm_layers - punctual) * e->rsm_per_layer[1];
+    const int area = e->rsm_layers - punctual, area_gv = lpv_engine_area_gv_layers(e);
+    size_t base = 0;
+    e->rsm_per_layer[0] = extract_layers(e, 0, punctual, size, base, 1);
+    base += (size_t)punctual * e->rsm_per_layer[0];
+    e->rsm_per_layer[1] = extract_layers(e, punctual, area_gv, area_side, base, 1);
+    base += (size_t)area_gv * e->rsm_per_layer[1];
+    e->rsm_per_layer[2] = extract_layers(e, punctual + area_gv, area - area_gv, area_side, base, 0);
+    e->rsm_vpl_count = base + (size_t)(area - area_gv) * e->rsm_per_layer[2];
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     /* the injection draws only the VPLs that carry light (most of the
      * blocks' slots are empty) */

@@ -26,6 +26,12 @@ uniform int u_slots;  // samples per block: min(LPV_BLOCK_SLOTS, u_step^2)
 uniform int u_layer0; // the first layer of this dispatch
 uniform int u_base;   // its first element
 
+// LPV_BLOCKS_VPLS_ONLY 1: VPLs only, for layers whose surfels the geometry
+// volume leaves out (pass_rsm.c); their surfel slots are not written.
+#ifndef LPV_BLOCKS_VPLS_ONLY
+#define LPV_BLOCKS_VPLS_ONLY 0
+#endif
+
 bool g_vpls; // what block_emit writes: VPLs, else surfels
 
 void block_emit(int i, float w, vec3 pos_mean, vec3 nrm_mean, vec3 val, float size)
@@ -96,5 +102,7 @@ void main()
     ivec2 lo = b.xy * u_step, hi = min(lo + u_step, ivec2(u_size));
     int base = u_base + ((b.z * u_blocks + b.y) * u_blocks + b.x) * u_slots;
     block_vpls(lo, hi, b.z + u_layer0, base);
+#if !LPV_BLOCKS_VPLS_ONLY
     block_surfels(lo, hi, b.z + u_layer0, base);
+#endif
 }

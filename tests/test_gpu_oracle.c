@@ -107,12 +107,15 @@ static void test_injection_matches_oracle(void **state)
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
     /* the spot's RSM layer and the 8 area light samples' 40 faces as 32^2
-     * tiles, 4 to a layer (docs/area-lights.md): 11 layers of 64^2 */
+     * tiles, 4 to a layer (docs/area-lights.md): 11 layers of 64^2; a slot
+     * per texel in the spot's layer and the 2 holding the first sample's
+     * faces (blocks of 2 x 2 texels, 4 slots), half that in the other 8,
+     * which give VPLs only (blocks of 4 x 4, 8 slots: LPV_RSM_AUTO_VPL_STEP) */
     size_t vmax = 64 * 64 * 16;
     lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
     size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
     assert_int_equal(lpv_engine_last_stats(f->engine)->area_lights, 8);
-    assert_int_equal(nv, 64 * 64 * 11);
+    assert_int_equal(nv, 64 * 64 * 3 + 64 * 64 * 8 / 2);
     lpv_cell *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref);
     assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, gpu, cells), cells);
     size_t injected = lpv_oracle_inject_vpls(g, vpls, nv, ref);
