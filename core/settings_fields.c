@@ -90,7 +90,8 @@ static const lpv_field FIELDS[] = {
      LPV_MAX_CAMERA_SURFEL_STEP, 0, "pixels", "auto", "0 = auto: 4 surfels per finest cell along the image's height",
      "G-buffer pixels per camera surfel along each axis (geometry volume)", T_VOL, ""},
     {"rsm_vpl_step", "rsm-vpl-step", LPV_FIELD_INT, F(rsm_vpl_step), 0, LPV_MAX_RSM_VPL_STEP, 0, "texels", "auto",
-     "0 = auto: 2 (exact: a block never has more cells than slots); a power of two dividing the face",
+     "0 = auto: 2 (exact: a block never has more cells than slots), 4 in the layers that give VPLs only (the "
+     "area light samples after the first); a power of two dividing the face",
      "RSM texels per VPL and surfel along each axis (injection, geometry volume)", T_VOL, ""},
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", "on", "",
