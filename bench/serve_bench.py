@@ -17,8 +17,9 @@ Prints Markdown tables:
   4. 64 concurrent clients: HELLO + TICK + GET_VOLUME each, total time and
      per-request latency p50/p99;
   5. sharing: 8 clients with the same scene and config (one shared world,
-     R7.2) vs 1 client vs 8 clients with distinct lights: tick throughput and
-     the server's STATS "worlds".
+     R7.2) vs 1 client vs 8 clients with distinct lights, the lights moved
+     1 cm in lock-step before each TICK so that every round computes: tick
+     throughput and the server's STATS "worlds".
 Pure Python standard library (zstd payloads are measured, not decoded).
 """
 
@@ -285,10 +286,11 @@ class Bench:
         rows = []
         for label, nclients, distinct in (("1 client", 1, False), ("8 clients, same scene + config", 8, False),
                                           ("8 clients, distinct lights", 8, True)):
-            conns = []
+            conns, lights = [], []
             for i in range(nclients):
                 light = {"id": "share", "type": "point", "intensity": 10.0 + (i if distinct else 0),
                          "position": [0, 1.5, 0]}
+                lights.append(light)
                 conns.append(self.scene(light=light))
             for c in conns:  # first tick (world creation, shader warm-up) not timed
                 self.req(c, lc.TICK, timeout=300)
@@ -297,10 +299,19 @@ class Bench:
             lat = []
             errors = []
             lock = threading.Lock()
+            # the clients move their lights 1 cm in lock-step before each
+            # TICK, so every round computes (the planner serves an unchanged
+            # world's cached volume): the shared case's clients move theirs
+            # to the same place and meet again in one world
+            barrier = threading.Barrier(nclients)
 
-            def run(c):
+            def run(c, light):
                 try:
-                    for _ in range(k):
+                    for r in range(k):
+                        light["position"] = [0.01 * ((r + 1) % 2), 1.5, 0]
+                        barrier.wait(300)
+                        self.req(c, lc.LIGHT_SET, light)
+                        barrier.wait(300)
                         t0 = time.monotonic()
                         self.req(c, lc.TICK, timeout=300)
                         with lock:
@@ -308,8 +319,9 @@ class Bench:
                 except Exception as e:
                     with lock:
                         errors.append(str(e))
+                    barrier.abort()
 
-            threads = [threading.Thread(target=run, args=(c,)) for c in conns]
+            threads = [threading.Thread(target=run, args=(c, li)) for c, li in zip(conns, lights)]
             t0 = time.monotonic()
             for t in threads:
                 t.start()
@@ -322,8 +334,8 @@ class Bench:
             for c in conns:
                 c.close()
             rows.append((label, nclients * k, dt, lat, worlds, srv_ticks, errors))
-        self.emit("### 5. Sharing: 8 clients on one scene vs 1 (%d TICKs per client, %d^3, 8 iterations)"
-                  % (k, GRID[0]))
+        self.emit("### 5. Sharing: 8 clients on one scene vs 1 (%d TICKs per client, %d^3, 8 iterations, the lights "
+                  "moved 1 cm in lock-step before each TICK, so each round computes)" % (k, GRID[0]))
         self.emit()
         self.emit("STATS worlds counts every session's world, including the one of the bench's own STATS "
                   "connection (the default scene); server ticks computed = the change in STATS ticks.")
