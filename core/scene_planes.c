@@ -33,15 +33,26 @@ static int on_axis(const float n[3])
     return zeros >= 2;
 }
 
-/* Whether one of the first count normals is t for the lookup (within
- * LPV_LOOKUP_PLANE_TOLERANCE per component): the opposite sides of a block
- * are one plane normal and its negation. */
+static int within_tolerance(const float a[3], const float b[3])
+{
+    return fabsf(a[0] - b[0]) <= LPV_LOOKUP_PLANE_TOLERANCE && fabsf(a[1] - b[1]) <= LPV_LOOKUP_PLANE_TOLERANCE &&
+           fabsf(a[2] - b[2]) <= LPV_LOOKUP_PLANE_TOLERANCE;
+}
+
+/* Whether t is, for the lookup (within LPV_LOOKUP_PLANE_TOLERANCE per
+ * component), an axis or one of the first count normals: the opposite sides
+ * of a block are one plane normal and its negation. So no pixel's normal
+ * matches an axis and a plane, which lookup.glsl's search relies on. */
 static int listed(const float (*out)[3], int count, const float t[3])
 {
+    for (int a = 0; a < 6; ++a) {
+        float axis[3] = {0.0f, 0.0f, 0.0f};
+        axis[a >> 1] = (a & 1) ? -1.0f : 1.0f;
+        if (within_tolerance(axis, t))
+            return 1;
+    }
     for (int i = 0; i < count; ++i)
-        if (fabsf(out[i][0] - t[0]) <= LPV_LOOKUP_PLANE_TOLERANCE &&
-            fabsf(out[i][1] - t[1]) <= LPV_LOOKUP_PLANE_TOLERANCE &&
-            fabsf(out[i][2] - t[2]) <= LPV_LOOKUP_PLANE_TOLERANCE)
+        if (within_tolerance(out[i], t))
             return 1;
     return 0;
 }

@@ -14,9 +14,10 @@
 /* Up to `max` unit normals (xyz, world) of flat triangles (three equal
  * vertex normals), the largest total area first, each with its negation
  * (the G-buffer turns a normal to the camera's side), none listed twice
- * (within LPV_LOOKUP_PLANE_TOLERANCE per component). Normals along an axis
- * are left out (the lookup has those already). Returns the count, or -1
- * when out of memory. */
+ * (within LPV_LOOKUP_PLANE_TOLERANCE per component). Normals along an axis,
+ * or within the tolerance of one, are left out (the lookup has the axes
+ * already, and a pixel must not match both). Returns the count, or -1 when
+ * out of memory. */
 int lpv_scene_plane_normals(const lpv_scene *scene, float (*out)[3], int max);
 
 #endif /* LPV_SCENE_PLANES_H */

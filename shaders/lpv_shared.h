@@ -436,9 +436,17 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_MAX_LOOKUP_PLANES 24
 /* Where volume v of a lookup texture begins, in cells along y and z:
  * `slabs` volumes along z, then the next y-slab (lpv_lookup_volume.c sizes
- * the textures so; lookup.glsl and the packs address them so). */
-LPV_INLINE int lpv_slab_y0(int v, int slabs, int dim_y) { return (v / slabs) * dim_y; }
-LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v % slabs) * dim_z; }
+ * the textures so; lookup.glsl and the packs address them so). GLSL takes
+ * the slab's index in float arithmetic, exact for these small non-negative
+ * values: llvmpipe has no vector integer division and divides lane by lane
+ * (the frame's lookup calls it per pixel; 3 ms of a 512^2 frame). */
+#ifdef LPV_GLSL
+int lpv_slab_index(int v, int slabs) { return int((float(v) + 0.5) / float(slabs)); }
+#else
+LPV_INLINE int lpv_slab_index(int v, int slabs) { return v / slabs; }
+#endif
+LPV_INLINE int lpv_slab_y0(int v, int slabs, int dim_y) { return lpv_slab_index(v, slabs) * dim_y; }
+LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v - lpv_slab_index(v, slabs) * slabs) * dim_z; }
 #define LPV_LOOKUP_NORMAL_TEXELS 131072
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6
 

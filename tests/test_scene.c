@@ -343,6 +343,27 @@ static void test_plane_normals(void **state)
     float few[5][3];
     assert_int_equal(lpv_scene_plane_normals(&s, few, 5), 4);
     assert_memory_equal(few, n, sizeof(float[4][3]));
+    /* a floor whose normal is off +y by less than the tolerance (not along
+     * the axis, so not left out as one) is not listed: the lookup finds its
+     * pixels by the axis, and no pixel may match an axis and a plane
+     * (lookup.glsl's search stops at the first it finds) */
+    const lpv_draw *floor = &s.draws[0];
+    for (uint32_t i = 0; i < floor->index_count; ++i) {
+        lpv_vertex *v = &s.vertices[s.indices[floor->first_index + i]];
+        assert_true(v->normal[1] == 1.0f);
+        v->normal[0] = 5e-7f;
+    }
+    float nudged[LPV_MAX_LOOKUP_PLANES][3];
+    assert_int_equal(lpv_scene_plane_normals(&s, nudged, LPV_MAX_LOOKUP_PLANES), count);
+    assert_memory_equal(nudged, n, sizeof(float[14][3]));
+    for (int i = 0; i < count; ++i)
+        for (int a = 0; a < 6; ++a) {
+            float axis[3] = {0.0f, 0.0f, 0.0f};
+            axis[a >> 1] = (a & 1) ? -1.0f : 1.0f;
+            assert_true(fabsf(nudged[i][0] - axis[0]) > LPV_LOOKUP_PLANE_TOLERANCE ||
+                        fabsf(nudged[i][1] - axis[1]) > LPV_LOOKUP_PLANE_TOLERANCE ||
+                        fabsf(nudged[i][2] - axis[2]) > LPV_LOOKUP_PLANE_TOLERANCE);
+        }
     lpv_scene_free(&s);
 }
 
