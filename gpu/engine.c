@@ -58,6 +58,8 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
     if (includes(inc_shade, 16, INC_SHADE, lookup) || includes(inc_media, 16, INC_MEDIA, lookup) ||
         includes(inc_lookup, 16, NULL, lookup))
         return lpv_error(err, err_size, "technique %s names too many lookup includes", cls->name);
+    /* a frame program for scenes without directional lights */
+#define NO_DIRECTIONAL "#define LPV_SHADE_DIRECTIONAL 0"
     struct {
         GLuint *prog;
         const char *a, *b;
@@ -65,16 +67,24 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
         const char *defines;
     } progs[] = {
         /* the frame without the damping's second lookup, and with it (the
-         * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING) */
-        {&e->prog_shade, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
-        {&e->prog_shade_damped, "shade.comp", NULL, inc_shade, NULL},
+         * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING); each
+         * frame program without the directional lights' loop ([0]) and with
+         * it ([1]: shading.glsl, LPV_SHADE_DIRECTIONAL) */
+        {&e->prog_shade[0], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n" NO_DIRECTIONAL},
+        {&e->prog_shade[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->prog_shade_damped[0], "shade.comp", NULL, inc_shade, NO_DIRECTIONAL},
+        {&e->prog_shade_damped[1], "shade.comp", NULL, inc_shade, NULL},
         /* the frame in two passes (the technique's lookup_split) */
-        {&e->prog_shade_split, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_shade_split_damped, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade_split[0], "shade.comp", NULL, inc_shade,
+         "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1\n" NO_DIRECTIONAL},
+        {&e->prog_shade_split[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
+        {&e->prog_shade_split_damped[0], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1\n" NO_DIRECTIONAL},
+        {&e->prog_shade_split_damped[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_rest, "shade_rest.comp", NULL, inc_shade,
          "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_shade_blocks, "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1"},
+        {&e->prog_shade_blocks[0], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1\n" NO_DIRECTIONAL},
+        {&e->prog_shade_blocks[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1"},
         {&e->prog_lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
         {&e->prog_lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
         {&e->prog_query, "query.comp", NULL, inc_lookup},
@@ -242,20 +252,25 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_gbuffer,
                        &e->prog_gbuffer_plain,
                        &e->prog_camera_surfels,
-                       &e->prog_shade,
-                       &e->prog_shade_damped,
+                       &e->prog_shade[0],
+                       &e->prog_shade[1],
+                       &e->prog_shade_damped[0],
+                       &e->prog_shade_damped[1],
                        &e->prog_query,
                        &e->prog_glossy,
                        &e->prog_media,
                        &e->prog_shadow,
                        &e->prog_shadow_plain,
-                       &e->prog_shade_blocks,
+                       &e->prog_shade_blocks[0],
+                       &e->prog_shade_blocks[1],
                        &e->prog_lookup_blocks,
                        &e->prog_lookup_blocks_damped,
                        &e->prog_shade_rest,
                        &e->prog_shade_rest_damped,
-                       &e->prog_shade_split,
-                       &e->prog_shade_split_damped,
+                       &e->prog_shade_split[0],
+                       &e->prog_shade_split[1],
+                       &e->prog_shade_split_damped[0],
+                       &e->prog_shade_split_damped[1],
                        &e->prog_compact[0],
                        &e->prog_compact[1]};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)

@@ -62,21 +62,24 @@ struct lpv_engine {
     int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels, prog_shade,
-        prog_shade_damped, prog_query, prog_glossy, prog_media, prog_shadow;
+    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
+        prog_query, prog_glossy, prog_media, prog_shadow;
+    /* the frame programs ([0] without the directional lights' loop, [1]
+     * with it: pass_camera.c takes [1] only for scenes that have one) */
+    GLuint prog_shade[2], prog_shade_damped[2];
     GLuint prog_vpl_blocks8_vpls; /* vpl_blocks.comp without the surfels (LPV_BLOCKS_VPLS_ONLY) */
     /* the frame in two passes (the technique's lookup_split): the first
      * looks up the pixels of the lookup's own normals and lists the rest,
      * the second (shade_rest.comp) adds their indirect light (shading.glsl,
      * LPV_LOOKUP_SPLIT) */
-    GLuint prog_shade_split, prog_shade_split_damped, prog_shade_rest, prog_shade_rest_damped;
+    GLuint prog_shade_split[2], prog_shade_split_damped[2], prog_shade_rest, prog_shade_rest_damped;
     /* the scene passes' programs without textures, normal maps and alpha cuts
      * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
     GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
     /* the lookup step (settings.lookup_step > 1): the frame reading the
      * blocks' irradiance, and the blocks' lookup without and with damping
      * (shading.glsl, lookup_blocks.comp) */
-    GLuint prog_shade_blocks, prog_lookup_blocks, prog_lookup_blocks_damped;
+    GLuint prog_shade_blocks[2], prog_lookup_blocks, prog_lookup_blocks_damped;
     GLuint prog_compact[2]; /* compact.comp's scan and copy */
 
     /* scene */

@@ -68,6 +68,24 @@ static float far_from(const lpv_engine *e, const vec3 p)
     return sqrtf(far2) * 1.01f + 1e-3f;
 }
 
+/* The scene's punctual lights in the light block's order: the directional
+ * ones first (as many as counts[3] says), then the others, each kind in
+ * scene order, so that the shading loops over each kind apart
+ * (shading.glsl: llvmpipe runs a loop's code for every kind of light
+ * otherwise). */
+static const lpv_light *punctual_in_order(const lpv_engine *e, uint32_t i)
+{
+    uint32_t directional = 0;
+    for (uint32_t l = 0; l < e->light_count; ++l)
+        directional += e->lights[l].type == LPV_LIGHT_DIRECTIONAL;
+    const int want_directional = i < directional;
+    uint32_t rank = want_directional ? i : i - directional;
+    for (uint32_t l = 0; l < e->light_count; ++l)
+        if ((e->lights[l].type == LPV_LIGHT_DIRECTIONAL) == want_directional && rank-- == 0)
+            return &e->lights[l];
+    return &e->lights[i]; /* not reached */
+}
+
 /* Point lights and spots wider than one face get six cube faces. */
 static int light_is_wide(const lpv_light *src)
 {
@@ -207,12 +225,14 @@ void lpv_light_faces_build(lpv_engine *e)
     const int n = e->settings.rsm_size;
     int faces = 0, lights = 0;
 
-    for (uint32_t l = 0; l < e->light_count && lights < LPV_MAX_LIGHTS; ++l) {
-        const lpv_light *src = &e->lights[l];
+    int directional = 0;
+    for (uint32_t i = 0; i < e->light_count && lights < LPV_MAX_LIGHTS; ++i) {
+        const lpv_light *src = punctual_in_order(e, i);
         int wide = light_is_wide(src);
         int need = wide ? 6 : 1;
         if (faces + need > LPV_MAX_FACES)
             break;
+        directional += src->type == LPV_LIGHT_DIRECTIONAL;
         struct LpvLightGpu *g = &b->lights[lights];
         vec3 dir = {src->direction[0], src->direction[1], src->direction[2]};
         if (!(glm_vec3_norm(dir) > 1e-8f))
@@ -267,6 +287,7 @@ void lpv_light_faces_build(lpv_engine *e)
         ++lights;
     }
     b->counts[2] = (float)lights;
+    b->counts[3] = (float)directional;
     e->punctual_faces = faces;
     const int area = add_area_lights(e, lights, faces, faces, near_z);
     lights += area;
@@ -279,8 +300,8 @@ void lpv_light_faces_build(lpv_engine *e)
 void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers)
 {
     int faces = 0, shadows = 0, lights = 0;
-    for (uint32_t l = 0; l < e->light_count && lights < LPV_MAX_LIGHTS; ++l) {
-        const lpv_light *src = &e->lights[l];
+    for (uint32_t i = 0; i < e->light_count && lights < LPV_MAX_LIGHTS; ++i) {
+        const lpv_light *src = punctual_in_order(e, i);
         int need = light_is_wide(src) ? 6 : 1;
         if (faces + need > LPV_MAX_FACES)
             break;

@@ -280,9 +280,12 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
         lookup_blocks_run(e);
     const int damped = e->settings.lpv.damping > 0.0f;
     const int split = !blocks && e->tech->cls->lookup_split && e->tech->cls->lookup_split(e->tech);
-    const GLuint prog = blocks  ? e->prog_shade_blocks
-                        : split ? (damped ? e->prog_shade_split_damped : e->prog_shade_split)
-                                : (damped ? e->prog_shade_damped : e->prog_shade);
+    /* without the directional lights' loop where there are none: llvmpipe
+     * would run its code once for every pixel even with no light in it */
+    const int dir = e->light_block.counts[3] > 0.0f;
+    const GLuint prog = blocks  ? e->prog_shade_blocks[dir]
+                        : split ? (damped ? e->prog_shade_split_damped[dir] : e->prog_shade_split[dir])
+                                : (damped ? e->prog_shade_damped[dir] : e->prog_shade[dir]);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);

@@ -196,7 +196,8 @@ struct LpvFaceGpu {
 };
 
 struct LpvLightBlock {
-    vec4 counts;          /* x lights (punctual first, then area samples), y faces, z punctual lights */
+    vec4 counts;          /* x lights (punctual first, then area samples), y faces, z punctual lights,
+                             w directional lights (the first of the punctual ones) */
     LPV_STRUCT(LpvLightGpu) lights[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
     LPV_STRUCT(LpvFaceGpu) faces[LPV_MAX_FACES];
 };

@@ -25,6 +25,14 @@ uniform float u_glossy_roughness; // materials below it are glossy; 0 when the g
 #endif
 uniform int u_lookup_step;
 
+// LPV_SHADE_DIRECTIONAL 0: the frame without the directional lights' loop
+// (the engine's programs for scenes without one, gpu/engine.c): llvmpipe
+// runs a loop's code at least once for every pixel, and the cascades'
+// search cost a 512^2 frame 4 ms with no directional light in the scene.
+#ifndef LPV_SHADE_DIRECTIONAL
+#define LPV_SHADE_DIRECTIONAL 1
+#endif
+
 // The frame in two passes (LPV_LOOKUP_SPLIT 1, the engine's prog_shade):
 // shade.comp looks up only what the technique finds cheaply
 // (lpv_irradiance_listed: the lookup's own normals) and lists the other
@@ -140,13 +148,21 @@ vec4 shade_pixel(ivec2 px)
 
     vec3 e_direct = vec3(0.0);
     if (V.shading.y != 0.0) {
-        // the punctual lights, then the area light samples (lights.glsl):
-        // apart, so that each loop holds only its kind's shadow lookup
-        int punctual = int(L.counts.z), count = int(L.counts.x);
-        for (int l = 0; l < punctual; ++l) {
+        // the directional lights, the points and spots, then the area light
+        // samples (lights.glsl, gpu/light_faces.c): apart, so that each loop
+        // holds only its kind's shadow lookup
+        int directional = int(L.counts.w), punctual = int(L.counts.z), count = int(L.counts.x);
+#if LPV_SHADE_DIRECTIONAL
+        for (int l = 0; l < directional; ++l) {
             vec3 e, to_light;
             if (light_arrives(L.lights[l], p, n, e, to_light))
-                e_direct += e * shadow_visibility(l, p, n, SHADOW_PUNCTUAL);
+                e_direct += e * shadow_visibility(l, p, n, SHADOW_DIRECTIONAL);
+        }
+#endif
+        for (int l = directional; l < punctual; ++l) {
+            vec3 e, to_light;
+            if (light_arrives(L.lights[l], p, n, e, to_light))
+                e_direct += e * shadow_visibility(l, p, n, SHADOW_PERSPECTIVE);
         }
         for (int l = punctual; l < count; ++l) {
             vec3 e, to_light;

@@ -45,11 +45,13 @@ float shadow_pcf(int face, vec2 uv, float depth, int R)
 // Which lights a caller passes (a constant, so that after inlining the
 // compiler drops the code of the other kinds): llvmpipe runs both sides of
 // every branch under lane masks, so a loop over all lights pays for every
-// kind's face selection with each light; the shading loops over the
-// punctual lights and the area light samples apart (shading.glsl).
+// kind's face selection with each light (a spot paid 4 ms of a 512^2 frame
+// for the directional lights' cascade search); the shading loops over each
+// kind apart (shading.glsl; gpu/light_faces.c orders the lights so).
 const int SHADOW_ANY_LIGHT = 0;
-const int SHADOW_PUNCTUAL = 1;    // lights [0, L.counts.z)
-const int SHADOW_AREA_SAMPLE = 2; // lights [L.counts.z, L.counts.x)
+const int SHADOW_DIRECTIONAL = 1; // lights [0, L.counts.w): cascades
+const int SHADOW_PERSPECTIVE = 2; // lights [L.counts.w, L.counts.z): points and spots, one face or a cube
+const int SHADOW_AREA_SAMPLE = 3; // lights [L.counts.z, L.counts.x)
 
 // The shadow-map face of light l that holds x: the cube face of the major
 // axis of x - light, the area light face whose axis is nearest x - light, the
@@ -81,7 +83,7 @@ int shadow_face_at(int l, vec3 x, const int kind, out float depth)
         depth = best_dot;
         return best;
     }
-    if (count == 6) {
+    if (kind != SHADOW_DIRECTIONAL && count == 6) {
         vec3 a = abs(d);
         depth = max(a.x, max(a.y, a.z));
         if (a.x >= a.y && a.x >= a.z)
@@ -90,7 +92,7 @@ int shadow_face_at(int l, vec3 x, const int kind, out float depth)
             return first + (d.y >= 0.0 ? 2 : 3);
         return first + (d.z >= 0.0 ? 4 : 5);
     }
-    if (info.z == 0.0) {
+    if (kind == SHADOW_PERSPECTIVE || (kind == SHADOW_ANY_LIGHT && info.z == 0.0)) {
         depth = dot(d, S.faces[first].axis.xyz);
         return first;
     }
@@ -143,7 +145,7 @@ float shadow_visibility_of(int l, vec3 p, vec3 n, int taps, const int kind)
     // the offset point's
     int f;
     vec3 q = p;
-    if (kind == SHADOW_AREA_SAMPLE || S.lights[l].z != 1.0) {
+    if (kind == SHADOW_AREA_SAMPLE || kind == SHADOW_PERSPECTIVE || (kind == SHADOW_ANY_LIGHT && S.lights[l].z != 1.0)) {
         // perspective faces: all of a light's faces have the same texel per
         // metre of depth (info.x), so T needs only p's depth along the axis of
         // the face holding p; the face that is read is the offset point's

@@ -21,6 +21,13 @@
  *     side near the cone's rim and one under the light: every box's shadow
  *     is there and nothing lit is darkened, against the path tracer's direct
  *     irradiance (its spot falloff too).
+ *  4. Lights of every kind in any order: the shading loops over the
+ *     directional lights, the points and spots, and the area light samples
+ *     apart (gpu/light_faces.c puts the directional ones first; a scene
+ *     without one gets a frame program without their loop). A point light,
+ *     a sun and a spot over a plane with a box, declared in two orders, give
+ *     the same frame, and it is the sum of the frames of each light alone
+ *     (each kind's own shadows are tests 1 to 3's).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -417,12 +424,88 @@ static void test_wide_spot_rim_shadows(void **state)
     lpv_scene_free(&s);
 }
 
+/* ---- 4. lights of every kind, in any order ------------------------------- */
+
+/* The plane and box of test 4 with the lights of `which` (bits: 1 point, 2
+ * sun, 4 spot), declared in that order or reversed. */
+static void mixed_scene(lpv_scene *s, int which, int reversed)
+{
+    memset(s, 0, sizeof *s);
+    int grey = grey_floor(s, 4.0f);
+    assert_true(lpv_scene_add_box(s, grey, (float[3]){-0.3f, 0.0f, -0.3f}, (float[3]){0.3f, 0.6f, 0.3f}) >= 0);
+    for (int i = 0; i < 3; ++i) {
+        const int k = reversed ? 2 - i : i;
+        if (!(which & (1 << k)))
+            continue;
+        if (k == 0)
+            assert_non_null(lpv_scene_add_point_light(s, (float[3]){1.0f, 2.0f, 0.5f}, LIGHT_I));
+        else if (k == 1)
+            assert_non_null(lpv_scene_add_directional_light(s, (float[3]){-0.5f, -0.8f, -0.33f}, SUN_E));
+        else {
+            lpv_light *spot = lpv_scene_add_point_light(s, (float[3]){-1.0f, 2.0f, -0.5f}, SPOT_I);
+            assert_non_null(spot);
+            spot->type = LPV_LIGHT_SPOT;
+            spot->direction[0] = 0.3f, spot->direction[1] = -1.0f, spot->direction[2] = 0.2f;
+            spot->inner_cone = 0.4f;
+            spot->outer_cone = 0.6f;
+        }
+    }
+    lpv_scene_compute_bounds(s);
+}
+
+static void test_lights_in_any_order(void **state)
+{
+    (void)state;
+    enum { W = 96, H = 72 };
+    lpv_view view;
+    assert_int_equal(lpv_view_look_at((float[3]){2.5f, 2.5f, 3.0f}, (float[3]){0.0f, 0.0f, 0.0f},
+                                      60.0f * (float)M_PI / 180.0f, W, H, &view),
+                     0);
+    lpv_settings set = {.grid_dims = {8, 8, 8}};
+    lpv_scene s;
+    float *all[2], *alone[3];
+    for (int r = 0; r < 2; ++r) {
+        mixed_scene(&s, 7, r);
+        all[r] = render_direct(&s, &set, &view);
+        lpv_scene_free(&s);
+    }
+    for (int k = 0; k < 3; ++k) {
+        mixed_scene(&s, 1 << k, 0);
+        alone[k] = render_direct(&s, &set, &view);
+        lpv_scene_free(&s);
+    }
+    double peak = 0.0, order = 0.0, sum = 0.0;
+    int lit[3] = {0, 0, 0};
+    for (size_t i = 0; i < (size_t)W * H * 4; ++i) {
+        if (i % 4 == 3)
+            continue;
+        peak = fmax(peak, all[0][i]);
+        order = fmax(order, fabs((double)all[0][i] - all[1][i]));
+        sum = fmax(sum, fabs((double)all[0][i] - alone[0][i] - alone[1][i] - alone[2][i]));
+        for (int k = 0; k < 3; ++k)
+            lit[k] += alone[k][i] > 0.0f;
+    }
+    printf("lights in any order: peak %.4g, the two orders differ by %.3g, the sum of the lights alone by %.3g; "
+           "lit values %d / %d / %d\n",
+           peak, order, sum, lit[0], lit[1], lit[2]);
+    assert_true(peak > 0.0);
+    for (int k = 0; k < 3; ++k)
+        assert_true(lit[k] > 1000); /* every light lights the plane */
+    assert_true(order <= 1e-5 * peak);
+    assert_true(sum <= 1e-5 * peak);
+    for (int k = 0; k < 3; ++k)
+        free(alone[k]);
+    free(all[0]);
+    free(all[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_shadow_edge),
         cmocka_unit_test(test_small_box_under_a_low_sun),
         cmocka_unit_test(test_wide_spot_rim_shadows),
+        cmocka_unit_test(test_lights_in_any_order),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
