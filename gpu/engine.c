@@ -252,30 +252,27 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_gbuffer,
                        &e->prog_gbuffer_plain,
                        &e->prog_camera_surfels,
-                       &e->prog_shade[0],
-                       &e->prog_shade[1],
-                       &e->prog_shade_damped[0],
-                       &e->prog_shade_damped[1],
                        &e->prog_query,
                        &e->prog_glossy,
                        &e->prog_media,
                        &e->prog_shadow,
                        &e->prog_shadow_plain,
-                       &e->prog_shade_blocks[0],
-                       &e->prog_shade_blocks[1],
                        &e->prog_lookup_blocks,
                        &e->prog_lookup_blocks_damped,
                        &e->prog_shade_rest,
                        &e->prog_shade_rest_damped,
-                       &e->prog_shade_split[0],
-                       &e->prog_shade_split[1],
-                       &e->prog_shade_split_damped[0],
-                       &e->prog_shade_split_damped[1],
                        &e->prog_compact[0],
                        &e->prog_compact[1]};
+    /* the frame programs, each without and with the directional lights' loop */
+    GLuint *variants[] = {e->prog_shade, e->prog_shade_damped, e->prog_shade_split, e->prog_shade_split_damped,
+                          e->prog_shade_blocks};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
+    for (size_t i = 0; i < sizeof variants / sizeof variants[0]; ++i)
+        for (int k = 0; k < 2; ++k)
+            if (variants[i][k])
+                glDeleteProgram(variants[i][k]);
     if (e->empty_vao)
         glDeleteVertexArrays(1, &e->empty_vao);
     lpv_gl_delete_buffer(&e->light_ubo);

@@ -68,22 +68,19 @@ static float far_from(const lpv_engine *e, const vec3 p)
     return sqrtf(far2) * 1.01f + 1e-3f;
 }
 
-/* The scene's punctual lights in the light block's order: the directional
- * ones first (as many as counts[3] says), then the others, each kind in
- * scene order, so that the shading loops over each kind apart
- * (shading.glsl: llvmpipe runs a loop's code for every kind of light
- * otherwise). */
-static const lpv_light *punctual_in_order(const lpv_engine *e, uint32_t i)
+/* The first LPV_MAX_LIGHTS of the scene's punctual lights in the light
+ * block's order: the directional ones first (as many as counts[3] says),
+ * then the others, each kind in scene order, so that the shading loops over
+ * each kind apart (shading.glsl: llvmpipe runs a loop's code for every kind
+ * of light otherwise). Returns how many. */
+static int punctual_in_order(const lpv_engine *e, const lpv_light *out[LPV_MAX_LIGHTS])
 {
-    uint32_t directional = 0;
-    for (uint32_t l = 0; l < e->light_count; ++l)
-        directional += e->lights[l].type == LPV_LIGHT_DIRECTIONAL;
-    const int want_directional = i < directional;
-    uint32_t rank = want_directional ? i : i - directional;
-    for (uint32_t l = 0; l < e->light_count; ++l)
-        if ((e->lights[l].type == LPV_LIGHT_DIRECTIONAL) == want_directional && rank-- == 0)
-            return &e->lights[l];
-    return &e->lights[i]; /* not reached */
+    int n = 0;
+    for (int pass = 0; pass < 2; ++pass)
+        for (uint32_t l = 0; l < e->light_count && n < LPV_MAX_LIGHTS; ++l)
+            if ((e->lights[l].type == LPV_LIGHT_DIRECTIONAL) == (pass == 0))
+                out[n++] = &e->lights[l];
+    return n;
 }
 
 /* Point lights and spots wider than one face get six cube faces. */
@@ -225,9 +222,11 @@ void lpv_light_faces_build(lpv_engine *e)
     const int n = e->settings.rsm_size;
     int faces = 0, lights = 0;
 
+    const lpv_light *order[LPV_MAX_LIGHTS];
+    const int ordered = punctual_in_order(e, order);
     int directional = 0;
-    for (uint32_t i = 0; i < e->light_count && lights < LPV_MAX_LIGHTS; ++i) {
-        const lpv_light *src = punctual_in_order(e, i);
+    for (int i = 0; i < ordered; ++i) {
+        const lpv_light *src = order[i];
         int wide = light_is_wide(src);
         int need = wide ? 6 : 1;
         if (faces + need > LPV_MAX_FACES)
@@ -300,8 +299,10 @@ void lpv_light_faces_build(lpv_engine *e)
 void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers)
 {
     int faces = 0, shadows = 0, lights = 0;
-    for (uint32_t i = 0; i < e->light_count && lights < LPV_MAX_LIGHTS; ++i) {
-        const lpv_light *src = punctual_in_order(e, i);
+    const lpv_light *order[LPV_MAX_LIGHTS];
+    const int ordered = punctual_in_order(e, order);
+    for (int i = 0; i < ordered; ++i) {
+        const lpv_light *src = order[i];
         int need = light_is_wide(src) ? 6 : 1;
         if (faces + need > LPV_MAX_FACES)
             break;
