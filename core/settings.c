@@ -224,6 +224,8 @@ void lpv_settings_resolve(lpv_settings *s)
         s->area_light_samples = LPV_DEFAULT_AREA_LIGHT_SAMPLES;
     if (s->lookup_step == 0)
         s->lookup_step = LPV_DEFAULT_LOOKUP_STEP;
+    if (s->area_shadow_step == 0)
+        s->area_shadow_step = LPV_DEFAULT_AREA_SHADOW_STEP;
     lpv_iv_settings *iv = &s->iv;
     if (iv->resolution == 0)
         iv->resolution = LPV_IV_DEFAULT_RESOLUTION;
@@ -391,6 +393,9 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->lookup_step < 0 || s->lookup_step > LPV_MAX_LOOKUP_STEP)
         return fail(err, err_size, "lookup_step = %d is out of range (allowed 1..%d; 0 = the default %d)",
                     s->lookup_step, LPV_MAX_LOOKUP_STEP, LPV_DEFAULT_LOOKUP_STEP);
+    if (s->area_shadow_step < 0 || s->area_shadow_step > LPV_MAX_AREA_SHADOW_STEP)
+        return fail(err, err_size, "area_shadow_step = %d is out of range (allowed 1..%d; 0 = the default %d)",
+                    s->area_shadow_step, LPV_MAX_AREA_SHADOW_STEP, LPV_DEFAULT_AREA_SHADOW_STEP);
     if (validate_iv(&s->iv, err, err_size) != 0)
         return -1;
     return validate_bounds(s, err, err_size);

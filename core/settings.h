@@ -158,6 +158,11 @@ typedef struct lpv_settings {
     int lookup_step;        /* pixels per lookup of the technique's irradiance along each axis: 1
                                (default) every pixel; N > 1 once per N x N block, spread to the
                                block's pixels by a plane- and normal-aware upsampling */
+    /* The area lights' shadows in the frame (docs/area-lights.md, "The area shadow step"). */
+    int area_shadow_step;   /* pixels per evaluation of the area light samples' shadow maps along
+                               each axis: 1 every pixel; N > 1 (default 2) once per N x N block,
+                               as the ratio of shadowed to unshadowed irradiance, spread like the
+                               lookup step's blocks; each pixel keeps its own unshadowed light */
 
     lpv_lpv_settings lpv;   /* the cascaded LPV's knobs (LPV_TECHNIQUE_LPV) */
     lpv_iv_settings iv;     /* the imperfect volume's knobs (LPV_TECHNIQUE_IV) */
@@ -209,6 +214,8 @@ typedef struct lpv_settings {
 #define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
 #define LPV_DEFAULT_LOOKUP_STEP 1
 #define LPV_MAX_LOOKUP_STEP 4
+#define LPV_DEFAULT_AREA_SHADOW_STEP 2
+#define LPV_MAX_AREA_SHADOW_STEP 4
 #define LPV_IV_DEFAULT_RESOLUTION 16
 #define LPV_IV_DEFAULT_POINTS 4
 #define LPV_IV_DEFAULT_SPLIT 1.0f

@@ -101,6 +101,10 @@ static const lpv_field FIELDS[] = {
     {"lookup_step", "lookup-step", LPV_FIELD_INT, F(lookup_step), 1, LPV_MAX_LOOKUP_STEP, 0, "pixels", "1", "",
      "pixels per irradiance lookup along each axis in the frame (N > 1: once per N x N block, upsampled "
      "along planes; accuracy vs time)", T_SHADE, ""},
+    {"area_shadow_step", "area-shadow-step", LPV_FIELD_INT, F(area_shadow_step), 1, LPV_MAX_AREA_SHADOW_STEP, 0,
+     "pixels", "2", "",
+     "pixels per evaluation of the area lights' shadow maps along each axis in the frame (N > 1: once per "
+     "N x N block as a visibility ratio, upsampled along planes; accuracy vs time)", T_SHADE, ""},
 
     /* Imperfect volumes (docs/imperfect-volumes.md). */
     {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "16", "",

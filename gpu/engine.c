@@ -45,6 +45,16 @@ static int includes(const char **out, size_t cap, const char *const *own, const 
     return 0;
 }
 
+/* The frame programs built so far (lpv_engine_frame_program). */
+static void delete_frame_programs(lpv_engine *e)
+{
+    for (int v = 0; v < LPV_FRAME_VARIANTS; ++v)
+        if (e->prog_frame[v]) {
+            glDeleteProgram(e->prog_frame[v]);
+            e->prog_frame[v] = 0;
+        }
+}
+
 /* Makes technique id the engine's: creates its instance and builds the
  * passes that read its volume (shading, query, glossy, media) with its
  * lookup includes (technique.h). On failure the current technique stays. */
@@ -58,33 +68,17 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
     if (includes(inc_shade, 16, INC_SHADE, lookup) || includes(inc_media, 16, INC_MEDIA, lookup) ||
         includes(inc_lookup, 16, NULL, lookup))
         return lpv_error(err, err_size, "technique %s names too many lookup includes", cls->name);
-    /* a frame program for scenes without directional lights */
-#define NO_DIRECTIONAL "#define LPV_SHADE_DIRECTIONAL 0"
     struct {
         GLuint *prog;
         const char *a, *b;
         const char *const *inc;
         const char *defines;
     } progs[] = {
-        /* the frame without the damping's second lookup, and with it (the
-         * setting's default is off; lookup.glsl, LPV_LOOKUP_DAMPING); each
-         * frame program without the directional lights' loop ([0]) and with
-         * it ([1]: shading.glsl, LPV_SHADE_DIRECTIONAL) */
-        {&e->prog_shade[0], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n" NO_DIRECTIONAL},
-        {&e->prog_shade[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
-        {&e->prog_shade_damped[0], "shade.comp", NULL, inc_shade, NO_DIRECTIONAL},
-        {&e->prog_shade_damped[1], "shade.comp", NULL, inc_shade, NULL},
-        /* the frame in two passes (the technique's lookup_split) */
-        {&e->prog_shade_split[0], "shade.comp", NULL, inc_shade,
-         "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1\n" NO_DIRECTIONAL},
-        {&e->prog_shade_split[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_shade_split_damped[0], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1\n" NO_DIRECTIONAL},
-        {&e->prog_shade_split_damped[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
+        /* the frame's programs are built when first used (lpv_engine_frame_program) */
         {&e->prog_shade_rest, "shade_rest.comp", NULL, inc_shade,
          "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_shade_blocks[0], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1\n" NO_DIRECTIONAL},
-        {&e->prog_shade_blocks[1], "shade.comp", NULL, inc_shade, "#define LPV_LOOKUP_BLOCKS 1"},
+        {&e->prog_area_shadow_blocks, "area_shadow_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
         {&e->prog_lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
         {&e->prog_lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
         {&e->prog_query, "query.comp", NULL, inc_lookup},
@@ -117,7 +111,29 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
         e->tech->cls->destroy(e->tech);
     e->tech = t;
     e->tech_id = id;
+    delete_frame_programs(e); /* they hold the previous technique's lookup */
     return 0;
+}
+
+GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size_t err_size)
+{
+    if (variant & LPV_FRAME_BLOCKS) /* the frame reads the blocks' irradiance: it looks nothing up */
+        variant &= ~(unsigned)(LPV_FRAME_DAMPED | LPV_FRAME_SPLIT);
+    if (e->prog_frame[variant])
+        return e->prog_frame[variant];
+    const char *inc_shade[16];
+    if (includes(inc_shade, 16, INC_SHADE, e->tech->cls->lookup_includes)) {
+        lpv_error(err, err_size, "technique %s names too many lookup includes", e->tech->cls->name);
+        return 0;
+    }
+    char defines[256];
+    snprintf(defines, sizeof defines, "%s%s%s%s%s", variant & LPV_FRAME_DIRECTIONAL ? "" : "#define LPV_SHADE_DIRECTIONAL 0\n",
+             variant & LPV_FRAME_DAMPED ? "" : "#define LPV_LOOKUP_DAMPING 0\n",
+             variant & LPV_FRAME_SPLIT ? "#define LPV_LOOKUP_SPLIT 1\n" : "",
+             variant & LPV_FRAME_BLOCKS ? "#define LPV_LOOKUP_BLOCKS 1\n" : "",
+             variant & LPV_FRAME_AREA_BLOCKS ? "#define LPV_AREA_SHADOW_BLOCKS 1\n" : "");
+    e->prog_frame[variant] = lpv_program_build_defines("shade.comp", NULL, NULL, defines, inc_shade, err, err_size);
+    return e->prog_frame[variant];
 }
 
 int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err, size_t err_size)
@@ -225,9 +241,7 @@ static void free_camera(lpv_engine *e)
     lpv_gl_delete_buffer(&e->camera_surfels);
     lpv_gl_delete_buffer(&e->shade_rest);
     e->gbuf_w = e->gbuf_h = 0;
-    for (int i = 0; i < 2; ++i)
-        lpv_gl_delete_texture(&e->block_tex[i]);
-    e->block_w = e->block_h = e->block_step = 0;
+    lpv_frame_blocks_free(e);
 }
 
 void lpv_engine_destroy(lpv_engine *e)
@@ -243,6 +257,7 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_gl_delete_buffer(&e->query_out);
     if (e->tech)
         e->tech->cls->destroy(e->tech);
+    delete_frame_programs(e);
     GLuint *progs[] = {&e->prog_rsm,
                        &e->prog_rsm_plain,
                        &e->prog_vpl_extract,
@@ -261,18 +276,12 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_lookup_blocks_damped,
                        &e->prog_shade_rest,
                        &e->prog_shade_rest_damped,
+                       &e->prog_area_shadow_blocks,
                        &e->prog_compact[0],
                        &e->prog_compact[1]};
-    /* the frame programs, each without and with the directional lights' loop */
-    GLuint *variants[] = {e->prog_shade, e->prog_shade_damped, e->prog_shade_split, e->prog_shade_split_damped,
-                          e->prog_shade_blocks};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);
-    for (size_t i = 0; i < sizeof variants / sizeof variants[0]; ++i)
-        for (int k = 0; k < 2; ++k)
-            if (variants[i][k])
-                glDeleteProgram(variants[i][k]);
     if (e->empty_vao)
         glDeleteVertexArrays(1, &e->empty_vao);
     lpv_gl_delete_buffer(&e->light_ubo);

@@ -42,6 +42,23 @@ typedef struct lpv_gpu_draw {
     float size; /* m, longest side of the draw's bounding box (cascade fading) */
 } lpv_gpu_draw;
 
+/* The frame's variants (shade.comp's defines, shading.glsl), a bit each. */
+enum {
+    LPV_FRAME_DIRECTIONAL = 1, /* the directional lights' loop (scenes that have one) */
+    LPV_FRAME_DAMPED = 2,      /* the lookup's damping (settings.lpv.damping > 0) */
+    LPV_FRAME_SPLIT = 4,       /* the first of two passes (the technique's lookup_split) */
+    LPV_FRAME_BLOCKS = 8,      /* the irradiance from the lookup step's blocks */
+    LPV_FRAME_AREA_BLOCKS = 16, /* the area light samples' visibility from the area shadow step's blocks */
+    LPV_FRAME_VARIANTS = 32
+};
+
+/* Textures of a pass per block of the frame's pixels (frame_blocks.c): a
+ * value and a plane per block, w x h blocks of step x step pixels. */
+typedef struct lpv_frame_blocks {
+    GLuint tex[2];
+    int w, h, step;
+} lpv_frame_blocks;
+
 struct lpv_engine {
     lpv_settings settings;
     lpv_technique *tech;      /* the GI technique (gpu/technique.h) */
@@ -64,22 +81,21 @@ struct lpv_engine {
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
         prog_query, prog_glossy, prog_media, prog_shadow;
-    /* the frame programs ([0] without the directional lights' loop, [1]
-     * with it: pass_camera.c takes [1] only for scenes that have one) */
-    GLuint prog_shade[2], prog_shade_damped[2];
+    /* the frame programs (shade.comp), one per variant (LPV_FRAME_*), built
+     * when first used (lpv_engine_frame_program) */
+    GLuint prog_frame[LPV_FRAME_VARIANTS];
     GLuint prog_vpl_blocks8_vpls; /* vpl_blocks.comp without the surfels (LPV_BLOCKS_VPLS_ONLY) */
-    /* the frame in two passes (the technique's lookup_split): the first
-     * looks up the pixels of the lookup's own normals and lists the rest,
-     * the second (shade_rest.comp) adds their indirect light (shading.glsl,
-     * LPV_LOOKUP_SPLIT) */
-    GLuint prog_shade_split[2], prog_shade_split_damped[2], prog_shade_rest, prog_shade_rest_damped;
+    /* the second pass of a frame in two passes (LPV_FRAME_SPLIT):
+     * shade_rest.comp adds the indirect light of the pixels the first listed */
+    GLuint prog_shade_rest, prog_shade_rest_damped;
     /* the scene passes' programs without textures, normal maps and alpha cuts
      * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
     GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
-    /* the lookup step (settings.lookup_step > 1): the frame reading the
-     * blocks' irradiance, and the blocks' lookup without and with damping
-     * (shading.glsl, lookup_blocks.comp) */
-    GLuint prog_shade_blocks[2], prog_lookup_blocks, prog_lookup_blocks_damped;
+    /* the lookup step (settings.lookup_step > 1): the blocks' lookup without
+     * and with damping (lookup_blocks.comp); the area shadow step
+     * (settings.area_shadow_step > 1): the blocks' area light visibility
+     * (area_shadow_blocks.comp) */
+    GLuint prog_lookup_blocks, prog_lookup_blocks_damped, prog_area_shadow_blocks;
     GLuint prog_compact[2]; /* compact.comp's scan and copy */
 
     /* scene */
@@ -153,10 +169,10 @@ struct lpv_engine {
     GLuint frame_tex, frame_fbo;
     GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
     int shade_split;   /* the last frame was shaded in two passes */
-    /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp),
-     * block_w x block_h blocks of block_step pixels; 0 until a step above 1 */
-    GLuint block_tex[2];
-    int block_w, block_h, block_step;
+    /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp)
+     * and the blocks' area light visibility and planes of the area shadow
+     * step (area_shadow_blocks.comp); empty until a step above 1 */
+    lpv_frame_blocks lookup_blocks, area_shadow_blocks;
 
     GLuint query_in, query_out; /* irradiance queries */
     size_t query_capacity;
@@ -183,11 +199,24 @@ void lpv_engine_update_area_samples(lpv_engine *e);
  * e->geometry (engine_scene.c). */
 int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size);
 
+/* The frame program of a variant (LPV_FRAME_* bits), built on first use and
+ * kept until the technique changes; 0 with err set if it does not build. */
+GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size_t err_size);
+
+/* The frame's passes per block of pixels (frame_blocks.c), each before the
+ * frame that reads its blocks, with the G-buffer and view block bound: the
+ * lookup step's irradiance (settings.lookup_step > 1) and the area shadow
+ * step's visibility (settings.area_shadow_step > 1; scenes with area light
+ * samples, frames with direct light). Each records a timer stage. */
+void lpv_frame_lookup_blocks_run(lpv_engine *e);
+void lpv_frame_area_shadow_blocks_run(lpv_engine *e);
+void lpv_frame_blocks_free(lpv_engine *e);
+
 /* Per-pass set-up and work; each _run records its own timer stage. */
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
 void lpv_pass_rsm_run(lpv_engine *e);
 int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the targets could not be allocated */
-void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms);
+int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size);
 /* Pixels of the last frame the second pass looked up in full (shade_rest.comp). */
 size_t lpv_pass_shade_full_lookups(lpv_engine *e);
 void lpv_pass_glossy_run(lpv_engine *e);

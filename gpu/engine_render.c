@@ -30,7 +30,8 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
      * only a full frame has); they are redrawn only when what they show changed. */
     if (terms != LPV_TERMS_INDIRECT_ONLY && terms != LPV_TERMS_AO && lpv_pass_shadow_update(e, err, err_size) != 0)
         return -1;
-    lpv_pass_shade_run(e, terms);
+    if (lpv_pass_shade_run(e, terms, err, err_size) != 0)
+        return -1;
     if (e->plan.pass[LPV_PASS_GLOSSY].run && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY))
         lpv_pass_glossy_run(e);
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)

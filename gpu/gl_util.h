@@ -17,6 +17,9 @@ GLuint lpv_gl_new_ssbo(size_t bytes);
 /* A buffer texture of the given format over buffer b. */
 GLuint lpv_gl_buffer_view(GLuint b, GLenum format);
 void lpv_gl_delete_buffer(GLuint *b);
+/* A w x h 2D texture of one level in `format`, nearest filtering, clamped
+ * to its edges, left bound to the active unit. */
+GLuint lpv_gl_new_texture_2d(GLenum format, int w, int h);
 void lpv_gl_delete_texture(GLuint *t);
 void lpv_gl_delete_framebuffer(GLuint *f);
 /* Copies min(available, max) elements from the start of buf into out after

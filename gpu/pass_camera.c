@@ -11,19 +11,6 @@
 
 #include "engine_internal.h"
 
-static GLuint texture_2d(GLenum format, int w, int h)
-{
-    GLuint t;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
-}
-
 static void free_targets(lpv_engine *e)
 {
     if (e->gbuf_fbo) {
@@ -56,17 +43,17 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
     GLenum bufs[4];
     for (int i = 0; i < 4; ++i) {
-        e->gbuf_tex[i] = texture_2d(formats[i], w, h);
+        e->gbuf_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf_tex[i], 0);
         bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
     }
-    e->gbuf_depth = texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+    e->gbuf_depth = lpv_gl_new_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf_depth, 0);
     glDrawBuffers(4, bufs);
 
     glGenFramebuffers(1, &e->frame_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->frame_fbo);
-    e->frame_tex = texture_2d(GL_RGBA32F, w, h);
+    e->frame_tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->frame_tex, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
@@ -186,51 +173,14 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     return 0;
 }
 
-/* The blocks' irradiance and planes at lookup step `step` for the frame's
- * size (lookup_blocks.comp); kept while neither changes. */
-static void ensure_blocks(lpv_engine *e, int step)
-{
-    const int w = (e->gbuf_w + step - 1) / step, h = (e->gbuf_h + step - 1) / step;
-    if (e->block_step == step && e->block_w == w && e->block_h == h)
-        return;
-    for (int i = 0; i < 2; ++i) {
-        lpv_gl_delete_texture(&e->block_tex[i]);
-        e->block_tex[i] = texture_2d(GL_RGBA32F, w, h);
-    }
-    e->block_w = w;
-    e->block_h = h;
-    e->block_step = step;
-}
-
-/* The lookup step (settings.lookup_step > 1): the technique's irradiance
- * once per block of step x step pixels, bound for the frame that reads it
- * (shading.glsl, lookup_upsampled). Needs ensure_blocks, the G-buffer and
- * the view block bound. */
-static void lookup_blocks_run(lpv_engine *e)
-{
-    const int step = e->block_step;
-    const float damping = e->settings.lpv.damping;
-    const GLuint prog = damping > 0.0f ? e->prog_lookup_blocks_damped : e->prog_lookup_blocks;
-    glUseProgram(prog);
-    e->tech->cls->bind_lookup(e->tech, prog, damping);
-    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
-    glBindImageTexture(LPV_IMG_BLOCK_IRRADIANCE, e->block_tex[0], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(LPV_IMG_BLOCK_PLANE, e->block_tex[1], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(lpv_div_up((size_t)e->block_w, LPV_WG_2D), lpv_div_up((size_t)e->block_h, LPV_WG_2D), 1);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    glActiveTexture(GL_TEXTURE0 + LPV_TEX_BLOCK_IRRADIANCE);
-    glBindTexture(GL_TEXTURE_2D, e->block_tex[0]);
-    glActiveTexture(GL_TEXTURE0 + LPV_TEX_BLOCK_PLANE);
-    glBindTexture(GL_TEXTURE_2D, e->block_tex[1]);
-}
-
 /* Makes prog the current program with the shading's uniforms and the
  * technique's lookup bound. */
-static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms terms, int step)
+static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms terms)
 {
     glUseProgram(prog);
     e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
-    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
+    glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), e->settings.lookup_step);
+    glUniform1i(glGetUniformLocation(prog, "u_area_shadow_step"), e->settings.area_shadow_step);
     glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),
                 e->plan.pass[LPV_PASS_GLOSSY].run && terms != LPV_TERMS_DIRECT_ONLY ? e->settings.glossy_roughness
                                                                                   : 0.0f);
@@ -251,8 +201,26 @@ size_t lpv_pass_shade_full_lookups(lpv_engine *e)
  * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
  * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
  * core. The glossy and media passes then blend into the same texture. */
-void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
+int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size)
 {
+    /* the frame's variant: the lookup step's blocks (frames with the LPV
+     * term), else the technique's two passes; the area shadow step's blocks
+     * (frames with direct light, scenes with area light samples); without
+     * the directional lights' loop where there are none (llvmpipe would run
+     * its code once for every pixel even with no light in it) */
+    const int indirect = terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY;
+    const int direct = terms == LPV_TERMS_FULL || terms == LPV_TERMS_DIRECT_ONLY;
+    const int blocks = e->settings.lookup_step > 1 && indirect;
+    const int area_blocks = e->settings.area_shadow_step > 1 && direct && e->light_block.counts[0] > e->light_block.counts[2];
+    const int damped = e->settings.lpv.damping > 0.0f;
+    const int split = !blocks && e->tech->cls->lookup_split && e->tech->cls->lookup_split(e->tech);
+    const unsigned variant = (e->light_block.counts[3] > 0.0f ? LPV_FRAME_DIRECTIONAL : 0u) |
+                             (damped ? LPV_FRAME_DAMPED : 0u) | (split ? LPV_FRAME_SPLIT : 0u) |
+                             (blocks ? LPV_FRAME_BLOCKS : 0u) | (area_blocks ? LPV_FRAME_AREA_BLOCKS : 0u);
+    const GLuint prog = lpv_engine_frame_program(e, variant, err, err_size);
+    if (!prog)
+        return -1;
+
     lpv_timer_begin(&e->timer, "shade");
     struct LpvViewBlock *b = &e->view_block;
     b->shading[0] = e->settings.indirect_gain;
@@ -262,48 +230,35 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     b->viewport[3] = terms == LPV_TERMS_AO; /* shading.glsl writes the ambient occlusion instead */
     glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
-
-    /* the lookup step looks the irradiance up per block first; frames
-     * without the term (direct light, ambient occlusion) need none. The
-     * blocks' textures are (re)made before the G-buffer is bound: making a
-     * texture binds it to the active unit. */
-    const int step = e->settings.lookup_step;
-    const int blocks = step > 1 && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY);
-    if (blocks)
-        ensure_blocks(e, step);
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
     }
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
-    if (blocks)
-        lookup_blocks_run(e);
-    const int damped = e->settings.lpv.damping > 0.0f;
-    const int split = !blocks && e->tech->cls->lookup_split && e->tech->cls->lookup_split(e->tech);
-    /* without the directional lights' loop where there are none: llvmpipe
-     * would run its code once for every pixel even with no light in it */
-    const int dir = e->light_block.counts[3] > 0.0f;
-    const GLuint prog = blocks  ? e->prog_shade_blocks[dir]
-                        : split ? (damped ? e->prog_shade_split_damped[dir] : e->prog_shade_split[dir])
-                                : (damped ? e->prog_shade_damped[dir] : e->prog_shade[dir]);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
+    /* the passes per block first (frame_blocks.c) */
+    if (blocks)
+        lpv_frame_lookup_blocks_run(e);
+    if (area_blocks) {
+        lpv_frame_area_shadow_blocks_run(e);
+        lpv_timer_begin(&e->timer, "shade");
+    }
     if (split) { /* the list of pixels for the second pass starts empty: 0 x 1 x 1 workgroups, 0 pixels */
         static const GLuint head[4] = {0, 1, 1, 0};
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
         glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SHADE_REST, e->shade_rest);
     }
-    use_shading_program(e, prog, terms, step);
+    use_shading_program(e, prog, terms);
     glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
     if (split) {
         /* the listed pixels' indirect light, as many workgroups as the list holds */
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        use_shading_program(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, terms, step);
+        use_shading_program(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, terms);
         glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, e->shade_rest);
         glDispatchComputeIndirect(0);
@@ -311,7 +266,8 @@ void lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms)
     }
     /* the glossy and media passes blend into the frame, which is then read back */
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    lpv_timer_count(&e->timer, split ? 2 : 1);
+    lpv_timer_count(&e->timer, (blocks ? 1 : 0) + (split ? 2 : 1));
     e->shade_split = split;
     lpv_timer_end(&e->timer);
+    return 0;
 }

@@ -452,17 +452,26 @@ LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v - lpv_slab_i
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6
 
 /* The frame's irradiance looked up once per lookup_step^2 block
- * (lookup_blocks.comp, shading.glsl's lookup_upsampled): per block the
+ * (lookup_blocks.comp, shading.glsl's blocks_upsampled): per block the
  * irradiance (rgb, a 1 = the block saw a surface) and the plane it was
  * looked up on (xyz unit normal, w its distance along it from the origin). */
 #define LPV_TEX_BLOCK_IRRADIANCE 11
 #define LPV_TEX_BLOCK_PLANE      12
+/* The area light samples' visibility once per area_shadow_step^2 block
+ * (area_shadow_blocks.comp, shading.glsl's area_visibility): per block the
+ * shadowed over the unshadowed irradiance of the samples (rgb, a 1 = the
+ * block saw a surface) and its plane, as for the lookup step. */
+#define LPV_TEX_AREA_SHADOW       14
+#define LPV_TEX_AREA_SHADOW_PLANE 15
 
-/* Image units of the frame that shade.comp writes (pass_camera.c) and of the
- * blocks' irradiance and planes that lookup_blocks.comp writes. */
+/* Image units of the frame that shade.comp writes (pass_camera.c), of the
+ * blocks' irradiance and planes that lookup_blocks.comp writes and of the
+ * blocks' area light visibility that area_shadow_blocks.comp writes. */
 #define LPV_IMG_FRAME 0
 #define LPV_IMG_BLOCK_IRRADIANCE 1
 #define LPV_IMG_BLOCK_PLANE 2
+#define LPV_IMG_AREA_SHADOW 3
+#define LPV_IMG_AREA_SHADOW_PLANE 4
 /* Two points lie on one plane for the lookup step when their normals are
  * within LPV_BLOCK_NORMAL_COS and the plane of one passes within
  * LPV_BLOCK_PLANE_PIXELS block widths (at the point's depth) of the other. */

@@ -52,12 +52,12 @@ layout(std430, binding = LPV_SSBO_SHADE_REST) buffer ShadeRest
 };
 #endif
 
-// The width (m) of a block of u_lookup_step pixels at p: 2 tan(yfov / 2)
-// times the depth per image height (orthographic: 2 ymag).
-float block_width_at(vec3 p)
+// The width (m) of a block of `step` pixels at p: 2 tan(yfov / 2) times the
+// depth per image height (orthographic: 2 ymag).
+float block_width_at(vec3 p, int step)
 {
     float depth = V.eye.w != 0.0 ? max(dot(p - V.eye.xyz, V.forward.xyz), 0.0) : 1.0;
-    return 2.0 * V.forward.w * depth / V.viewport.y * float(u_lookup_step);
+    return 2.0 * V.forward.w * depth / V.viewport.y * float(step);
 }
 
 // v / |v|, or 0 for a zero normal (a pixel no surface covers).
@@ -68,46 +68,77 @@ vec3 unit_or_zero(vec3 v)
 }
 
 // How far p lies off a block's plane (xyz unit normal, w distance from the
-// origin), in LPV_BLOCK_PLANE_PIXELS block widths at p: below 1, the same
-// surface.
-float plane_offset(vec4 plane, vec3 p)
+// origin), in LPV_BLOCK_PLANE_PIXELS widths at p of a block of `step`
+// pixels: below 1, the same surface.
+float plane_offset(vec4 plane, vec3 p, int step)
 {
-    return abs(dot(plane.xyz, p) - plane.w) / (LPV_BLOCK_PLANE_PIXELS * block_width_at(p));
+    return abs(dot(plane.xyz, p) - plane.w) / (LPV_BLOCK_PLANE_PIXELS * block_width_at(p, step));
 }
 
 // How alike point p with unit normal n is to a block's plane, 0..1: 1 on the
 // plane facing its way, falling with cos^8 of the angle between the normals
 // and to 0 at plane_offset 1 (another surface).
-float plane_likeness(vec4 plane, vec3 p, vec3 n)
+float plane_likeness(vec4 plane, vec3 p, vec3 n, int step)
 {
     float wn = max(dot(n, plane.xyz), 0.0);
     wn *= wn;
     wn *= wn;
     wn *= wn;
-    return wn * clamp(1.0 - plane_offset(plane, p), 0.0, 1.0);
+    return wn * clamp(1.0 - plane_offset(plane, p, step), 0.0, 1.0);
 }
 
-#if LPV_LOOKUP_BLOCKS
-layout(binding = LPV_TEX_BLOCK_IRRADIANCE) uniform sampler2D u_block_irradiance;
-layout(binding = LPV_TEX_BLOCK_PLANE) uniform sampler2D u_block_plane;
+// The surface of block b of step x step pixels, for the passes that work per
+// block (lookup_blocks.comp, area_shadow_blocks.comp): the block's first
+// covered pixel in raster order fixes its plane (xyz unit normal, w distance
+// from the origin), and it and every later pixel on that plane join the mean
+// point and the normals' sum. False when no pixel of the block is covered.
+bool block_surface(ivec2 b, int step, out vec4 plane, out vec3 p_mean, out vec3 n_sum)
+{
+    ivec2 first = b * step, size = textureSize(u_gbuf_normal, 0);
+    bool seen = false;
+    vec3 p_sum = vec3(0.0);
+    float on = 0.0;
+    plane = vec4(0.0);
+    n_sum = vec3(0.0);
+    for (int k = 0; k < step * step; ++k) {
+        ivec2 px = first + ivec2(k % step, k / step);
+        ivec2 at = min(px, size - 1);
+        vec4 nrm = texelFetch(u_gbuf_normal, at, 0);
+        vec3 p = texelFetch(u_gbuf_position, at, 0).xyz;
+        vec3 nk = unit_or_zero(nrm.xyz);
+        bool covered = nrm.w >= 0.5 && all(lessThan(px, size));
+        if (covered && !seen) {
+            plane = vec4(nk, dot(nk, p));
+            seen = true;
+        }
+        bool same = covered && dot(nk, plane.xyz) >= LPV_BLOCK_NORMAL_COS && plane_offset(plane, p, step) < 1.0;
+        p_sum += same ? p : vec3(0.0);
+        n_sum += same ? nrm.xyz : vec3(0.0);
+        on += same ? 1.0 : 0.0;
+    }
+    p_mean = p_sum / max(on, 1.0);
+    return seen;
+}
 
-// The irradiance at pixel px (point p, normal n) from the four blocks around
-// it: bilinear between the blocks' centres, each weighted by how alike its
-// plane is (plane_likeness), so light never crosses an edge between surfaces;
-// where no block around is alike, the most alike one's.
-vec3 lookup_upsampled(vec3 p, vec3 n_in, ivec2 px)
+// The value at pixel px (point p, normal n) of the blocks of step x step
+// pixels whose values (rgb; a 1 = the block saw a surface) and planes the two
+// samplers hold: bilinear between the four blocks' centres around px, each
+// weighted by how alike its plane is (plane_likeness), so nothing crosses an
+// edge between surfaces; where no block around is alike, the most alike
+// one's.
+vec3 blocks_upsampled(sampler2D values, sampler2D planes, int step, vec3 p, vec3 n_in, ivec2 px)
 {
     vec3 n = unit_or_zero(n_in);
-    vec2 u = (vec2(px) + 0.5) / float(u_lookup_step) - 0.5; // block centres at integers
+    vec2 u = (vec2(px) + 0.5) / float(step) - 0.5; // block centres at integers
     ivec2 i0 = ivec2(floor(u));
     vec2 f = u - vec2(i0);
-    ivec2 last = textureSize(u_block_irradiance, 0) - 1;
+    ivec2 last = textureSize(values, 0) - 1;
     vec3 sum = vec3(0.0), most_alike = vec3(0.0);
     float weights = 0.0, best = -1.0;
     for (int j = 0; j < 4; ++j) {
         ivec2 b = clamp(i0 + ivec2(j & 1, j >> 1), ivec2(0), last);
-        vec4 e = texelFetch(u_block_irradiance, b, 0);
-        float like = e.a * plane_likeness(texelFetch(u_block_plane, b, 0), p, n);
+        vec4 e = texelFetch(values, b, 0);
+        float like = e.a * plane_likeness(texelFetch(planes, b, 0), p, n, step);
         float w = ((j & 1) != 0 ? f.x : 1.0 - f.x) * ((j >> 1) != 0 ? f.y : 1.0 - f.y) * like;
         sum += w * e.rgb;
         weights += w;
@@ -118,6 +149,42 @@ vec3 lookup_upsampled(vec3 p, vec3 n_in, ivec2 px)
     }
     return weights > 0.0 ? sum / weights : most_alike;
 }
+
+#if LPV_LOOKUP_BLOCKS
+layout(binding = LPV_TEX_BLOCK_IRRADIANCE) uniform sampler2D u_block_irradiance;
+layout(binding = LPV_TEX_BLOCK_PLANE) uniform sampler2D u_block_plane;
+#endif
+
+// The area light samples' visibility at p (unit normal n), per channel: the
+// shadowed over the unshadowed irradiance of all samples, so that the
+// samples weigh by the light each brings; 1 where none arrives.
+// area_shadow_blocks.comp evaluates it once per block of u_area_shadow_step
+// pixels (the area shadow step, docs/area-lights.md); the frame multiplies
+// each pixel's own unshadowed irradiance by it, spread by blocks_upsampled.
+vec3 area_visibility(vec3 p, vec3 n)
+{
+    vec3 lit = vec3(0.0), arrives = vec3(0.0);
+    for (int l = int(L.counts.z); l < int(L.counts.x); ++l) {
+        vec3 e, to_light;
+        if (light_arrives(L.lights[l], p, n, e, to_light)) {
+            arrives += e;
+            lit += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
+        }
+    }
+    return mix(vec3(1.0), lit / max(arrives, vec3(1e-30)), greaterThan(arrives, vec3(0.0)));
+}
+
+// LPV_AREA_SHADOW_BLOCKS 1: the frame that reads the area light samples'
+// visibility from area_shadow_blocks.comp's blocks (the engine's frame
+// variant LPV_FRAME_AREA_BLOCKS); 0 the one that reads every sample's shadow
+// map at every pixel.
+#ifndef LPV_AREA_SHADOW_BLOCKS
+#define LPV_AREA_SHADOW_BLOCKS 0
+#endif
+uniform int u_area_shadow_step;
+#if LPV_AREA_SHADOW_BLOCKS
+layout(binding = LPV_TEX_AREA_SHADOW) uniform sampler2D u_area_shadow;
+layout(binding = LPV_TEX_AREA_SHADOW_PLANE) uniform sampler2D u_area_shadow_plane;
 #endif
 
 // kd x albedo / pi at pixel px (metallic_w: the G-buffer normal's w). With
@@ -164,14 +231,24 @@ vec4 shade_pixel(ivec2 px)
             if (light_arrives(L.lights[l], p, n, e, to_light))
                 e_direct += e * shadow_visibility(l, p, n, SHADOW_PERSPECTIVE);
         }
+#if LPV_AREA_SHADOW_BLOCKS
+        vec3 e_area = vec3(0.0);
+        for (int l = punctual; l < count; ++l) {
+            vec3 e, to_light;
+            if (light_arrives(L.lights[l], p, n, e, to_light))
+                e_area += e;
+        }
+        e_direct += e_area * blocks_upsampled(u_area_shadow, u_area_shadow_plane, u_area_shadow_step, p, n, px);
+#else
         for (int l = punctual; l < count; ++l) {
             vec3 e, to_light;
             if (light_arrives(L.lights[l], p, n, e, to_light))
                 e_direct += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
         }
+#endif
     }
 #if LPV_LOOKUP_BLOCKS
-    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lookup_upsampled(p, n, px) : vec3(0.0);
+    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * blocks_upsampled(u_block_irradiance, u_block_plane, u_lookup_step, p, n, px) : vec3(0.0);
 #elif LPV_LOOKUP_SPLIT
     vec3 e_indirect = vec3(0.0);
     if (V.shading.z != 0.0) {
