@@ -276,8 +276,9 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
-        /* The shading's parts: the same frame with only direct light, then
-         * only the LPV term (a tick that finds nothing changed runs no pass,
+        /* The shading's parts (the frame's own stages, shade and
+         * area_shadow): the same frame with only direct light, then only
+         * the LPV term (a tick that finds nothing changed runs no pass,
          * so each render's stages are the last stats'). */
         double split[2][1000];
         const lpv_frame_terms split_terms[2] = {LPV_TERMS_DIRECT_ONLY, LPV_TERMS_INDIRECT_ONLY};
@@ -292,12 +293,12 @@ int main(int argc, char **argv)
                 const lpv_engine_stats *ss = lpv_engine_last_stats(e);
                 split[t][r] = 0.0;
                 for (int k = 0; k < ss->stage_count; ++k)
-                    if (strcmp(ss->stages[k].name, "shade") == 0)
-                        split[t][r] = ss->stages[k].gpu_ms;
+                    if (strcmp(ss->stages[k].name, "shade") == 0 || strcmp(ss->stages[k].name, "area_shadow") == 0)
+                        split[t][r] += ss->stages[k].gpu_ms;
             }
         if (rc)
             break;
-        printf("shade: direct light only %.2f ms, indirect (the lookup) only %.2f ms\n\n", median(split[0], repeat),
+        printf("shade + area_shadow: direct light only %.2f ms, indirect (the lookup) only %.2f ms\n\n", median(split[0], repeat),
                median(split[1], repeat));
         /* every volume's cells (cascades x normal bins) times the steps */
         double cell_steps = st->cell_steps;
