@@ -27,10 +27,10 @@
 #define LPV_MEM_GV_POINT 80u      /* per geometry-volume point: the total (48, an LpvGvPoint) and atlas
                                      (2 x RGBA32F) */
 #define LPV_MEM_CELL_BUFFER 48u   /* the largest single grid buffer (one LpvCell per cell) */
-#define LPV_MEM_PIXEL 100u        /* G-buffer (RGBA32F x3, RGBA16F), depth, frame (RGBA32F) per pixel, the
+#define LPV_MEM_PIXEL 108u        /* G-buffer (RGBA32F x3, RGBA16F), depth, frame (RGBA32F) per pixel, the
                                      lookup step's and the area shadow step's blocks (2 x RGBA32F each per
-                                     block of >= 2 x 2 pixels) and the frame's second pass (an ivec2 per
-                                     pixel) */
+                                     block of >= 2 x 2 pixels) and the frame's two lists for second passes
+                                     (an ivec2 per pixel each) */
 
 /* What the device allows. */
 typedef struct lpv_memory_limits {

@@ -79,6 +79,8 @@ static int use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t e
          "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
         {&e->prog_area_shadow_blocks, "area_shadow_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->prog_area_shadow_rest, "area_shadow_rest.comp", NULL, inc_shade,
+         "#define LPV_LOOKUP_DAMPING 0\n#define LPV_AREA_SHADOW_BLOCKS 1"},
         {&e->prog_lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
         {&e->prog_lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
         {&e->prog_query, "query.comp", NULL, inc_lookup},
@@ -240,6 +242,7 @@ static void free_camera(lpv_engine *e)
     lpv_gl_delete_framebuffer(&e->frame_fbo);
     lpv_gl_delete_buffer(&e->camera_surfels);
     lpv_gl_delete_buffer(&e->shade_rest);
+    lpv_gl_delete_buffer(&e->area_rest);
     e->gbuf_w = e->gbuf_h = 0;
     lpv_frame_blocks_free(e);
 }
@@ -277,6 +280,7 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_shade_rest,
                        &e->prog_shade_rest_damped,
                        &e->prog_area_shadow_blocks,
+                       &e->prog_area_shadow_rest,
                        &e->prog_compact[0],
                        &e->prog_compact[1]};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)

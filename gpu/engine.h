@@ -88,6 +88,10 @@ typedef struct lpv_engine_stats {
      * lookup (shade_rest.comp) instead of their normal's own volume
      * (lookup.glsl; 0 with the lookup step, or before a frame) */
     size_t frame_full_lookups;
+    /* pixels of the last frame whose area light took every sample's shadow
+     * map (area_shadow_rest.comp) because no block of the area shadow step
+     * around them lies on their surface (0 at step 1, or before a frame) */
+    size_t frame_area_shadow_pixels;
     /* technique iv (all 0 for the others): what the tick's imperfect volume
      * was made of */
     struct {

@@ -96,6 +96,7 @@ struct lpv_engine {
      * (settings.area_shadow_step > 1): the blocks' area light visibility
      * (area_shadow_blocks.comp) */
     GLuint prog_lookup_blocks, prog_lookup_blocks_damped, prog_area_shadow_blocks;
+    GLuint prog_area_shadow_rest; /* the area light of the pixels no block is alike to (area_shadow_rest.comp) */
     GLuint prog_compact[2]; /* compact.comp's scan and copy */
 
     /* scene */
@@ -168,7 +169,9 @@ struct lpv_engine {
     GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
     GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
+    GLuint area_rest;  /* the pixels left for area_shadow_rest.comp (the same layout) */
     int shade_split;   /* the last frame was shaded in two passes */
+    int shade_area_blocks; /* the last frame took the area light's shadows from the area shadow step's blocks */
     /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp)
      * and the blocks' area light visibility and planes of the area shadow
      * step (area_shadow_blocks.comp); empty until a step above 1 */
@@ -219,6 +222,8 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the 
 int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size);
 /* Pixels of the last frame the second pass looked up in full (shade_rest.comp). */
 size_t lpv_pass_shade_full_lookups(lpv_engine *e);
+/* Pixels of the last frame whose area light area_shadow_rest.comp added. */
+size_t lpv_pass_shade_area_rest_pixels(lpv_engine *e);
 void lpv_pass_glossy_run(lpv_engine *e);
 void lpv_pass_media_run(lpv_engine *e);
 

@@ -44,6 +44,7 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     /* read after the frame, which waited for the passes anyway */
     e->stats.frame_full_lookups = lpv_pass_shade_full_lookups(e);
+    e->stats.frame_area_shadow_pixels = lpv_pass_shade_area_rest_pixels(e);
     /* GL rows run bottom-up; files and callers want the top row first. */
     size_t row = (size_t)w * 4;
     for (int y = 0; y < h / 2; ++y) {

@@ -21,9 +21,11 @@ static void free_targets(lpv_engine *e)
         glDeleteFramebuffers(1, &e->frame_fbo);
         glDeleteBuffers(1, &e->camera_surfels);
         glDeleteBuffers(1, &e->shade_rest);
+        glDeleteBuffers(1, &e->area_rest);
     }
     memset(e->gbuf_tex, 0, sizeof e->gbuf_tex);
     e->gbuf_depth = e->frame_tex = e->gbuf_fbo = e->frame_fbo = e->camera_surfels = e->shade_rest = 0;
+    e->area_rest = 0;
     e->gbuf_w = e->gbuf_h = 0;
     e->camera_surfel_w = e->camera_surfel_h = e->camera_surfel_slots = 0;
 }
@@ -61,10 +63,16 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->camera_surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lpv_memory_block_samples(w, h) * sizeof(lpv_surfel)), NULL,
                  GL_DYNAMIC_COPY);
-    glGenBuffers(1, &e->shade_rest);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(4 * sizeof(GLuint) + (size_t)w * (size_t)h * 2 * sizeof(GLint)),
-                 NULL, GL_DYNAMIC_COPY);
+    /* the frame's two lists of pixels for a second pass: the lookup's
+     * (shade_rest.comp) and the area shadow step's (area_shadow_rest.comp) */
+    GLuint *lists[2] = {&e->shade_rest, &e->area_rest};
+    for (int i = 0; i < 2; ++i) {
+        glGenBuffers(1, lists[i]);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, *lists[i]);
+        glBufferData(GL_SHADER_STORAGE_BUFFER,
+                     (GLsizeiptr)(4 * sizeof(GLuint) + (size_t)w * (size_t)h * 2 * sizeof(GLint)), NULL,
+                     GL_DYNAMIC_COPY);
+    }
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
         free_targets(e);
@@ -186,14 +194,46 @@ static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms term
                                                                                   : 0.0f);
 }
 
-size_t lpv_pass_shade_full_lookups(lpv_engine *e)
+/* The pixel count of a list of the frame's (a uvec4 head: w the count). */
+static size_t listed_pixels(GLuint list)
 {
-    if (!e->shade_split || !e->shade_rest)
-        return 0;
     GLuint head[4] = {0, 0, 0, 0};
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, list);
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
     return head[3];
+}
+
+size_t lpv_pass_shade_full_lookups(lpv_engine *e)
+{
+    return e->shade_split && e->shade_rest ? listed_pixels(e->shade_rest) : 0;
+}
+
+size_t lpv_pass_shade_area_rest_pixels(lpv_engine *e)
+{
+    return e->shade_area_blocks && e->area_rest ? listed_pixels(e->area_rest) : 0;
+}
+
+/* Empties a list of the frame's (0 x 1 x 1 workgroups, 0 pixels) and binds
+ * it at SSBO binding `binding`. */
+static void start_list(GLuint list, GLuint binding)
+{
+    static const GLuint head[4] = {0, 1, 1, 0};
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, list);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, list);
+}
+
+/* A second pass over a list of the frame's pixels: prog (made current with
+ * the shading's uniforms) adds to the frame, as many workgroups as the list
+ * holds. */
+static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms terms)
+{
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    use_shading_program(e, prog, terms);
+    glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, list);
+    glDispatchComputeIndirect(0);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
 }
 
 /* The frame (shading.glsl) as a compute pass writing the frame texture: on
@@ -246,28 +286,24 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
         lpv_frame_area_shadow_blocks_run(e);
         lpv_timer_begin(&e->timer, "shade");
     }
-    if (split) { /* the list of pixels for the second pass starts empty: 0 x 1 x 1 workgroups, 0 pixels */
-        static const GLuint head[4] = {0, 1, 1, 0};
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->shade_rest);
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof head, head);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SHADE_REST, e->shade_rest);
-    }
+    /* the lists of pixels for the second passes start empty */
+    if (split)
+        start_list(e->shade_rest, LPV_SSBO_SHADE_REST);
+    if (area_blocks)
+        start_list(e->area_rest, LPV_SSBO_AREA_REST);
     use_shading_program(e, prog, terms);
     glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
-    if (split) {
-        /* the listed pixels' indirect light, as many workgroups as the list holds */
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        use_shading_program(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, terms);
-        glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, e->shade_rest);
-        glDispatchComputeIndirect(0);
-        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
-    }
+    /* the listed pixels' indirect light, then their area light */
+    if (split)
+        run_list(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, e->shade_rest, terms);
+    if (area_blocks)
+        run_list(e, e->prog_area_shadow_rest, e->area_rest, terms);
     /* the glossy and media passes blend into the frame, which is then read back */
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    lpv_timer_count(&e->timer, (blocks ? 1 : 0) + (split ? 2 : 1));
+    lpv_timer_count(&e->timer, (blocks ? 1 : 0) + 1 + (split ? 1 : 0) + (area_blocks ? 1 : 0));
     e->shade_split = split;
+    e->shade_area_blocks = area_blocks;
     lpv_timer_end(&e->timer);
     return 0;
 }

@@ -78,12 +78,13 @@ json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, c
         total += st->stages[i].gpu_ms;
     }
     json_t *counts = json_pack(
-        "{s:i, s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b, s:I, s:I, s:I}", "lights", (int)st->lights, "area_lights",
+        "{s:i, s:i, s:i, s:I, s:I, s:I, s:I, s:I, s:i, s:f, s:b, s:I, s:I, s:I, s:I}", "lights", (int)st->lights, "area_lights",
         (int)st->area_lights, "rsm_faces", (int)st->rsm_faces, "vpls_rsm", (json_int_t)st->vpls_rsm, "vpls_emissive",
         (json_int_t)st->vpls_emissive, "surfels_rsm", (json_int_t)st->surfels_rsm, "surfels_camera",
         (json_int_t)st->surfels_camera, "cells", (json_int_t)st->cells, "iterations", st->iterations, "cell_steps",
         st->cell_steps, "occlusion", st->occlusion != 0, "scene_uploads", (json_int_t)st->scene_uploads,
-        "scene_samplings", (json_int_t)st->scene_samplings, "frame_full_lookups", (json_int_t)st->frame_full_lookups);
+        "scene_samplings", (json_int_t)st->scene_samplings, "frame_full_lookups", (json_int_t)st->frame_full_lookups,
+        "frame_area_shadow_pixels", (json_int_t)st->frame_area_shadow_pixels);
     json_t *o = json_pack("{s:o, s:f, s:o, s:o, s:o, s:o}", "stages", stages, "total_gpu_ms", total, "counts", counts,
                           "grid", grid_json(&cascades[0]), "cascades", lpvd_cascades_json(cascades, n), "plan",
                           lpvd_plan_json(plan));

@@ -408,6 +408,8 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_SHADE_REST 15  /* the frame's pixels left for shade_rest.comp (shading.glsl, LPV_LOOKUP_SPLIT) */
 #define LPV_SSBO_COMPACT_HEAD 0 /* compact.comp: the draw command, then a count per chunk */
 #define LPV_SSBO_COMPACT_DST 4  /* compact.comp: the live samples, in order */
+#define LPV_SSBO_AREA_REST 0    /* the frame's pixels left for area_shadow_rest.comp (shading.glsl,
+                                   LPV_AREA_SHADOW_BLOCKS); no frame program binds 0 otherwise */
 
 /* Texture units of the propagation's inputs (RGBA32F buffer textures). */
 #define LPV_TEX_LPV_IN    0

@@ -52,6 +52,16 @@ layout(std430, binding = LPV_SSBO_SHADE_REST) buffer ShadeRest
 };
 #endif
 
+// Appends pixel px to a list of that layout (head: a uvec4, list: ivec2[]),
+// a workgroup more in head.x per LPV_SHADE_REST_WG pixels.
+#define LPV_LIST_PIXEL(head, list, px)                                                                     \
+    {                                                                                                      \
+        uint listed_ = atomicAdd(head.w, 1u);                                                              \
+        if (listed_ % uint(LPV_SHADE_REST_WG) == 0u && listed_ / uint(LPV_SHADE_REST_WG) < uint(LPV_SHADE_REST_MAX_GROUPS)) \
+            atomicAdd(head.x, 1u);                                                                         \
+        list[listed_] = px;                                                                                \
+    }
+
 // The width (m) of a block of `step` pixels at p: 2 tan(yfov / 2) times the
 // depth per image height (orthographic: 2 ymag).
 float block_width_at(vec3 p, int step)
@@ -124,9 +134,9 @@ bool block_surface(ivec2 b, int step, out vec4 plane, out vec3 p_mean, out vec3 
 // pixels whose values (rgb; a 1 = the block saw a surface) and planes the two
 // samplers hold: bilinear between the four blocks' centres around px, each
 // weighted by how alike its plane is (plane_likeness), so nothing crosses an
-// edge between surfaces; where no block around is alike, the most alike
-// one's.
-vec3 blocks_upsampled(sampler2D values, sampler2D planes, int step, vec3 p, vec3 n_in, ivec2 px)
+// edge between surfaces; where no block around is alike (weights 0: a
+// surface thinner than the blocks), the most alike one's.
+vec3 blocks_upsampled(sampler2D values, sampler2D planes, int step, vec3 p, vec3 n_in, ivec2 px, out float weights)
 {
     vec3 n = unit_or_zero(n_in);
     vec2 u = (vec2(px) + 0.5) / float(step) - 0.5; // block centres at integers
@@ -134,7 +144,8 @@ vec3 blocks_upsampled(sampler2D values, sampler2D planes, int step, vec3 p, vec3
     vec2 f = u - vec2(i0);
     ivec2 last = textureSize(values, 0) - 1;
     vec3 sum = vec3(0.0), most_alike = vec3(0.0);
-    float weights = 0.0, best = -1.0;
+    float best = -1.0;
+    weights = 0.0;
     for (int j = 0; j < 4; ++j) {
         ivec2 b = clamp(i0 + ivec2(j & 1, j >> 1), ivec2(0), last);
         vec4 e = texelFetch(values, b, 0);
@@ -155,6 +166,22 @@ layout(binding = LPV_TEX_BLOCK_IRRADIANCE) uniform sampler2D u_block_irradiance;
 layout(binding = LPV_TEX_BLOCK_PLANE) uniform sampler2D u_block_plane;
 #endif
 
+// The area light samples' irradiance at p (unit normal n) through their
+// shadow maps (W/m^2, rgb); `arrives` the same without the shadows.
+vec3 area_light_shadowed(vec3 p, vec3 n, out vec3 arrives)
+{
+    vec3 lit = vec3(0.0);
+    arrives = vec3(0.0);
+    for (int l = int(L.counts.z); l < int(L.counts.x); ++l) {
+        vec3 e, to_light;
+        if (light_arrives(L.lights[l], p, n, e, to_light)) {
+            arrives += e;
+            lit += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
+        }
+    }
+    return lit;
+}
+
 // The area light samples' visibility at p (unit normal n), per channel: the
 // shadowed over the unshadowed irradiance of all samples, so that the
 // samples weigh by the light each brings; 1 where none arrives.
@@ -163,21 +190,19 @@ layout(binding = LPV_TEX_BLOCK_PLANE) uniform sampler2D u_block_plane;
 // each pixel's own unshadowed irradiance by it, spread by blocks_upsampled.
 vec3 area_visibility(vec3 p, vec3 n)
 {
-    vec3 lit = vec3(0.0), arrives = vec3(0.0);
-    for (int l = int(L.counts.z); l < int(L.counts.x); ++l) {
-        vec3 e, to_light;
-        if (light_arrives(L.lights[l], p, n, e, to_light)) {
-            arrives += e;
-            lit += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
-        }
-    }
+    vec3 arrives;
+    vec3 lit = area_light_shadowed(p, n, arrives);
     return mix(vec3(1.0), lit / max(arrives, vec3(1e-30)), greaterThan(arrives, vec3(0.0)));
 }
 
 // LPV_AREA_SHADOW_BLOCKS 1: the frame that reads the area light samples'
 // visibility from area_shadow_blocks.comp's blocks (the engine's frame
 // variant LPV_FRAME_AREA_BLOCKS); 0 the one that reads every sample's shadow
-// map at every pixel.
+// map at every pixel. A lit pixel that no block around is alike to (a
+// surface thinner than the blocks, seen edge-on or far away) gets no area
+// light from the frame and is listed instead (the layout of ShadeRest):
+// area_shadow_rest.comp adds its area light through every sample's shadow
+// map, as at step 1.
 #ifndef LPV_AREA_SHADOW_BLOCKS
 #define LPV_AREA_SHADOW_BLOCKS 0
 #endif
@@ -185,6 +210,11 @@ uniform int u_area_shadow_step;
 #if LPV_AREA_SHADOW_BLOCKS
 layout(binding = LPV_TEX_AREA_SHADOW) uniform sampler2D u_area_shadow;
 layout(binding = LPV_TEX_AREA_SHADOW_PLANE) uniform sampler2D u_area_shadow_plane;
+layout(std430, binding = LPV_SSBO_AREA_REST) buffer AreaRest
+{
+    uvec4 area_rest_head; // x, y, z workgroups of area_shadow_rest.comp; w pixels listed
+    ivec2 area_rest_px[];
+};
 #endif
 
 // kd x albedo / pi at pixel px (metallic_w: the G-buffer normal's w). With
@@ -238,7 +268,12 @@ vec4 shade_pixel(ivec2 px)
             if (light_arrives(L.lights[l], p, n, e, to_light))
                 e_area += e;
         }
-        e_direct += e_area * blocks_upsampled(u_area_shadow, u_area_shadow_plane, u_area_shadow_step, p, n, px);
+        float alike;
+        vec3 v = blocks_upsampled(u_area_shadow, u_area_shadow_plane, u_area_shadow_step, p, n, px, alike);
+        if (alike > 0.0)
+            e_direct += e_area * v;
+        else if (any(greaterThan(e_area, vec3(0.0))))
+            LPV_LIST_PIXEL(area_rest_head, area_rest_px, px)
 #else
         for (int l = punctual; l < count; ++l) {
             vec3 e, to_light;
@@ -248,18 +283,17 @@ vec4 shade_pixel(ivec2 px)
 #endif
     }
 #if LPV_LOOKUP_BLOCKS
-    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * blocks_upsampled(u_block_irradiance, u_block_plane, u_lookup_step, p, n, px) : vec3(0.0);
+    float alike;
+    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * blocks_upsampled(u_block_irradiance, u_block_plane,
+                                                                           u_lookup_step, p, n, px, alike)
+                                         : vec3(0.0);
 #elif LPV_LOOKUP_SPLIT
     vec3 e_indirect = vec3(0.0);
     if (V.shading.z != 0.0) {
         bool done;
         e_indirect = V.shading.x * lpv_irradiance_listed(p, n, done);
-        if (!done) {
-            uint i = atomicAdd(rest_head.w, 1u);
-            if (i % uint(LPV_SHADE_REST_WG) == 0u && i / uint(LPV_SHADE_REST_WG) < uint(LPV_SHADE_REST_MAX_GROUPS))
-                atomicAdd(rest_head.x, 1u);
-            rest_px[i] = px;
-        }
+        if (!done)
+            LPV_LIST_PIXEL(rest_head, rest_px, px)
     }
 #else
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);

@@ -17,9 +17,16 @@
 
 #define MAX_TICKS 1000
 
-/* The points: area lights off (before issue 10), then on with K samples. */
-static const int SAMPLES[] = {0, 1, 4, 8, 16, 32, 64}; /* 0 = area lights off */
-#define NPOINTS ((int)(sizeof SAMPLES / sizeof SAMPLES[0]))
+/* The points: area lights off (before issue 10), then on with K samples at
+ * the settings' area shadow step (0: the given settings', by default
+ * LPV_DEFAULT_AREA_SHADOW_STEP), and at 4, 8 and 16 samples also at the
+ * steps 1 and 4 (docs/area-lights.md, "The area shadow step"). */
+static const struct {
+    int samples; /* 0 = area lights off */
+    int step;    /* area_shadow_step; 0 = the settings' */
+} POINTS[] = {{0, 0},  {1, 0},  {4, 0}, {4, 1},  {4, 4},  {8, 0},  {8, 1},
+              {8, 4},  {16, 0}, {16, 1}, {16, 4}, {32, 0}, {64, 0}};
+#define NPOINTS ((int)(sizeof POINTS / sizeof POINTS[0]))
 
 /* 1 when p lies on one of the emitters' triangles (within tol of its plane). */
 static int on_emitter(const lpv_emitter_list *l, const float p[3], float tol)
@@ -91,6 +98,7 @@ static int write_png(const char *path, const float *rgba, int w, int h, float ex
 typedef struct row {
     const char *scene;
     int samples; /* 0 = area lights off */
+    int step;    /* the area shadow step it ran at */
     double ms_frame, ms_tick;
     lpv_acc_metrics m;        /* the full frame */
     lpv_acc_metrics m_direct; /* direct light + emission only, against the reference's bounces = 0 */
@@ -179,11 +187,16 @@ static int run_scene(lpv_engine *e, const lpv_acc_emissive_desc *d, const char *
         fprintf(stderr, "lpvd-accuracy: %s\n", err);
     for (int p = 0; p < NPOINTS; ++p) {
         lpv_settings st = d->opt->settings;
-        st.area_lights = SAMPLES[p] ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
-        st.area_light_samples = SAMPLES[p] ? SAMPLES[p] : 0;
+        st.area_lights = POINTS[p].samples ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+        st.area_light_samples = POINTS[p].samples;
+        if (POINTS[p].step)
+            st.area_shadow_step = POINTS[p].step;
+        lpv_settings resolved = st;
+        lpv_settings_resolve(&resolved);
         row *r = &rows[(*nrows)];
         r->scene = name;
-        r->samples = SAMPLES[p];
+        r->samples = POINTS[p].samples;
+        r->step = resolved.area_shadow_step;
         if (lpvd_point(e, scene, &view, st, d->ticks, d->warmup, img, img_d, &r->ms_frame, &r->ms_tick) != 0)
             goto done;
         memcpy(ref_m, ref, n * sizeof *ref);
@@ -206,11 +219,13 @@ static int run_scene(lpv_engine *e, const lpv_acc_emissive_desc *d, const char *
         }
         if (lpv_acc_compare(img, ref_m, se, view.width, view.height, &r->m) != 0)
             fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel to compare\n", name);
-        char label[32];
-        if (SAMPLES[p])
-            snprintf(label, sizeof label, "on-%d", SAMPLES[p]);
-        else
+        char label[48];
+        if (!POINTS[p].samples)
             snprintf(label, sizeof label, "off");
+        else if (POINTS[p].step)
+            snprintf(label, sizeof label, "on-%d-step%d", POINTS[p].samples, POINTS[p].step);
+        else
+            snprintf(label, sizeof label, "on-%d", POINTS[p].samples);
         snprintf(path, sizeof path, "%s/emissive/%s-%s.png", d->out_dir, name, label);
         write_png(path, img, view.width, view.height, (float)(0.25 / fmax(mean, 1e-30)));
         snprintf(path, sizeof path, "%s/emissive/%s-%s-direct-error.png", d->out_dir, name, label);
@@ -280,12 +295,12 @@ int lpv_acc_emissive_run(lpv_engine *e, const lpv_acc_emissive_desc *d)
     FILE *f = fopen(path, "w");
     if (!f)
         return 1;
-    fprintf(f, "scene,area_lights,area_light_samples,ms_frame,ms_tick,pixels,mean_ref,mean_lpv,rel_rmse,rel_bias,"
+    fprintf(f, "scene,area_lights,area_light_samples,area_shadow_step,ms_frame,ms_tick,pixels,mean_ref,mean_lpv,rel_rmse,rel_bias,"
                "ref_noise,rel_rmse_excess,rel_mae,direct_rel_rmse,direct_rel_bias,direct_ref_noise\n");
     for (int i = 0; i < nrows; ++i) {
         const row *r = &rows[i];
-        fprintf(f, "%s,%s,%d,%.3f,%.3f,%zu,%.6g,%.6g,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f\n", r->scene,
-                r->samples ? "on" : "off", r->samples, r->ms_frame, r->ms_tick, r->m.pixels, r->m.mean_ref,
+        fprintf(f, "%s,%s,%d,%d,%.3f,%.3f,%zu,%.6g,%.6g,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f\n", r->scene,
+                r->samples ? "on" : "off", r->samples, r->step, r->ms_frame, r->ms_tick, r->m.pixels, r->m.mean_ref,
                 r->m.mean_lpv, r->m.rel_rmse, r->m.rel_bias, r->m.ref_noise, r->m.rel_rmse_excess, r->m.rel_mae,
                 r->m_direct.rel_rmse, r->m_direct.rel_bias, r->m_direct.ref_noise);
     }
@@ -297,16 +312,18 @@ int lpv_acc_emissive_run(lpv_engine *e, const lpv_acc_emissive_desc *d)
     fprintf(f, "Full frame (emission + direct + LPV) vs the path tracer's full frame (1 bounce, %d spp), "
                "emitter pixels left out; GPU ms per frame = tick + render, median of %d.\n\n",
             d->spp, d->ticks);
-    fprintf(f, "| scene | area lights | samples | ms/frame | ms/tick | rel. RMSE | rel. bias | ref. noise | "
-               "direct only: rel. RMSE | rel. bias |\n");
-    fprintf(f, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    fprintf(f, "| scene | area lights | samples | area shadow step | ms/frame | ms/tick | rel. RMSE | rel. bias | "
+               "ref. noise | direct only: rel. RMSE | rel. bias |\n");
+    fprintf(f, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int i = 0; i < nrows; ++i) {
         const row *r = &rows[i];
-        char k[16] = "–";
-        if (r->samples)
+        char k[16] = "–", st[16] = "–";
+        if (r->samples) {
             snprintf(k, sizeof k, "%d", r->samples);
-        fprintf(f, "| %s | %s | %s | %.1f | %.1f | %.3f | %+.3f | %.3f | %.3f | %+.3f |\n", r->scene,
-                r->samples ? "on" : "off", k, r->ms_frame, r->ms_tick, r->m.rel_rmse, r->m.rel_bias, r->m.ref_noise,
+            snprintf(st, sizeof st, "%d", r->step);
+        }
+        fprintf(f, "| %s | %s | %s | %s | %.1f | %.1f | %.3f | %+.3f | %.3f | %.3f | %+.3f |\n", r->scene,
+                r->samples ? "on" : "off", k, st, r->ms_frame, r->ms_tick, r->m.rel_rmse, r->m.rel_bias, r->m.ref_noise,
                 r->m_direct.rel_rmse, r->m_direct.rel_bias);
     }
     fclose(f);

@@ -3,7 +3,9 @@
  * lpvd's FULL frame (emission + direct + LPV) against the path tracer's full
  * frame (lpv_ref_render_full, one bounce) on scenes lit only by emissive
  * surfaces, for area lights off (the emitters reach the scene only as VPLs in
- * the LPV: the state before issue 10) and on with several sample counts.
+ * the LPV: the state before issue 10) and on with several sample counts, at
+ * 4, 8 and 16 samples also at the area shadow steps 1 and 4 besides the
+ * settings' (docs/area-lights.md, "The area shadow step").
  *
  * Scenes: cornell-emissive (the built-in Cornell box without its spot light:
  * only the ceiling quad lights it) and, when present, scenes/emissive-room.glb.

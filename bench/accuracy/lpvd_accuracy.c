@@ -357,7 +357,8 @@ static const lpv_flag FLAGS[A_COUNT] = {
                                              "library when linked, else reference/lpvd-reference in this build tree)"},
     [A_NO_PLOT] = {"no-plot", 0, NULL, "do not run gnuplot (plot.gp is still written)"},
     [A_EMISSIVE] = {"emissive", 0, NULL, "only the emissive-lit scenes: lpvd's FULL frame vs the reference's\n"
-                                         "full frame, area lights off and on with 1..64 samples\n"
+                                         "full frame, area lights off and on with 1..64 samples, at 4, 8\n"
+                                         "and 16 samples also at area shadow steps 1 and 4\n"
                                          "(emissive.csv, emissive.md; docs/area-lights.md)"},
     [A_IV_TABLES] = {"iv-tables", 0, NULL, "the imperfect volumes paper's tables 1 and 2 instead of a sweep:\n"
                                           "creation ms (CPU point cloud + GPU iv_points) for 3/7/12/19 points\n"
