@@ -129,7 +129,8 @@ GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size
         return 0;
     }
     char defines[256];
-    snprintf(defines, sizeof defines, "%s%s%s%s%s", variant & LPV_FRAME_DIRECTIONAL ? "" : "#define LPV_SHADE_DIRECTIONAL 0\n",
+    snprintf(defines, sizeof defines, "%s%s%s%s%s",
+             variant & LPV_FRAME_DIRECTIONAL ? "" : "#define LPV_SHADE_DIRECTIONAL 0\n",
              variant & LPV_FRAME_DAMPED ? "" : "#define LPV_LOOKUP_DAMPING 0\n",
              variant & LPV_FRAME_SPLIT ? "#define LPV_LOOKUP_SPLIT 1\n" : "",
              variant & LPV_FRAME_BLOCKS ? "#define LPV_LOOKUP_BLOCKS 1\n" : "",

@@ -275,11 +275,8 @@ vec4 shade_pixel(ivec2 px)
         else if (any(greaterThan(e_area, vec3(0.0))))
             LPV_LIST_PIXEL(area_rest_head, area_rest_px, px)
 #else
-        for (int l = punctual; l < count; ++l) {
-            vec3 e, to_light;
-            if (light_arrives(L.lights[l], p, n, e, to_light))
-                e_direct += e * shadow_visibility(l, p, n, SHADOW_AREA_SAMPLE);
-        }
+        vec3 arrives;
+        e_direct += area_light_shadowed(p, n, arrives);
 #endif
     }
 #if LPV_LOOKUP_BLOCKS

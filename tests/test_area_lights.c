@@ -368,16 +368,6 @@ static void test_plan_says_why(void **state)
     lpv_scene_free(&s);
 }
 
-/* Whether the last stats name stage `name`. */
-static int has_stage(const char *name)
-{
-    const lpv_engine_stats *st = lpv_engine_last_stats(lpvt_engine);
-    for (int i = 0; i < st->stage_count; ++i)
-        if (strcmp(st->stages[i].name, name) == 0)
-            return 1;
-    return 0;
-}
-
 /* The frame of `terms` at area shadow step `step` (s, v, set as given). */
 static float *frame_at_step(const lpv_scene *s, lpv_settings set, const lpv_view *v, int step, lpv_frame_terms terms)
 {
@@ -398,10 +388,10 @@ static void test_area_shadow_step_keeps_penumbra(void **state)
     lpv_view v = floor_view(); /* from above: the plate, the floor, the plate's penumbra on it */
     const lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 128};
     float *every = frame_at_step(&s, set, &v, 1, LPV_TERMS_DIRECT_ONLY);
-    assert_false(has_stage("area_shadow"));
+    assert_false(lpvt_stage("area_shadow", NULL, NULL));
     for (int step = 2; step <= 4; step += 2) {
         float *blocks = frame_at_step(&s, set, &v, step, LPV_TERMS_DIRECT_ONLY);
-        assert_true(has_stage("area_shadow"));
+        assert_true(lpvt_stage("area_shadow", NULL, NULL));
         /* over the floor: the frames' difference against the mean; in the
          * penumbra (0.6 to 1.0 m from the foot, where the plate hides part
          * of the emitter) the mean of each, against the unshadowed light */
@@ -442,7 +432,7 @@ static void test_area_shadow_step_keeps_penumbra(void **state)
     lpv_settings off = set;
     off.area_lights = LPV_SWITCH_OFF;
     float *a = frame_at_step(&s, off, &v, 1, LPV_TERMS_FULL), *b = frame_at_step(&s, off, &v, 2, LPV_TERMS_FULL);
-    assert_false(has_stage("area_shadow"));
+    assert_false(lpvt_stage("area_shadow", NULL, NULL));
     assert_memory_equal(a, b, (size_t)W * H * 4 * sizeof *a);
     free(a);
     free(b);

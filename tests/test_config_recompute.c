@@ -177,11 +177,8 @@ static float *render(void) { return lpvt_render(IMG, IMG); }
 
 static int stage_ran(const char *name)
 {
-    const lpv_engine_stats *st = lpv_engine_last_stats(lpvt_engine);
-    for (int i = 0; i < st->stage_count; ++i)
-        if (strcmp(st->stages[i].name, name) == 0 && st->stages[i].calls > 0)
-            return 1;
-    return 0;
+    unsigned calls = 0;
+    return lpvt_stage(name, &calls, NULL) && calls > 0;
 }
 
 static int same_image(const float *a, const float *b)

@@ -97,34 +97,19 @@ static void tick(void)
     }
 }
 
-/* 1 if the last tick's stats hold a stage of that name (with its calls in *calls, its gpu_ms in *ms). */
-static int has_stage(const char *name, unsigned *calls, double *ms)
-{
-    const lpv_engine_stats *st = lpv_engine_last_stats(lpvt_engine);
-    for (int i = 0; i < st->stage_count; ++i)
-        if (strcmp(st->stages[i].name, name) == 0) {
-            if (calls)
-                *calls = st->stages[i].calls;
-            if (ms)
-                *ms = st->stages[i].gpu_ms;
-            return 1;
-        }
-    return 0;
-}
-
 /* The skipped pass left no trace: no stage, or a stage with 0 ms and 0 calls. */
 static void assert_no_stage(const char *name)
 {
     unsigned calls = 0;
     double ms = 0.0;
-    if (has_stage(name, &calls, &ms))
+    if (lpvt_stage(name, &calls, &ms))
         assert_true(calls == 0 && ms == 0.0);
 }
 
 static void assert_stage_ran(const char *name)
 {
     unsigned calls = 0;
-    assert_true(has_stage(name, &calls, NULL));
+    assert_true(lpvt_stage(name, &calls, NULL));
     assert_true(calls > 0);
 }
 
@@ -250,7 +235,7 @@ static void test_nothing_glossy_no_medium_no_emissive(void **state)
     lpv_cell *forced = volume_of(&scene, s, &v, &n2);
     p = plan();
     assert_true(p->pass[LPV_PASS_GLOSSY].run && p->pass[LPV_PASS_MEDIA].run && p->pass[LPV_PASS_EMISSIVE].run);
-    assert_true(has_stage("emissive", NULL, NULL)); /* it ran, over zero emissive VPLs (so 0 calls) */
+    assert_true(lpvt_stage("emissive", NULL, NULL)); /* it ran, over zero emissive VPLs (so 0 calls) */
     float *frame_forced = render();
     assert_stage_ran("glossy"); /* forced: they ran, and changed nothing in a scene with nothing glossy and no fog */
     assert_stage_ran("media");
@@ -404,7 +389,7 @@ static void test_tick_after_media_render(void **state)
     tick();
     assert_true(plan()->pass[LPV_PASS_MEDIA].run);
     float *frame = render();
-    assert_true(has_stage("media", NULL, NULL));
+    assert_true(lpvt_stage("media", NULL, NULL));
     scene.lights[0].position[0] += 0.1f;
     set_all(&scene, s, &v);
     tick(); /* "GL error 0x0502 during the tick" if the media pass leaks its blend function */

@@ -147,6 +147,20 @@ float *lpvt_render(int width, int height)
     return rgba;
 }
 
+int lpvt_stage(const char *name, unsigned *calls, double *ms)
+{
+    const lpv_engine_stats *st = lpv_engine_last_stats(lpvt_engine);
+    for (int i = 0; i < st->stage_count; ++i)
+        if (strcmp(st->stages[i].name, name) == 0) {
+            if (calls)
+                *calls = st->stages[i].calls;
+            if (ms)
+                *ms = st->stages[i].gpu_ms;
+            return 1;
+        }
+    return 0;
+}
+
 double lpvt_rand(uint64_t *state, double lo, double hi)
 {
     *state ^= *state << 13;

@@ -45,6 +45,10 @@ double lpvt_rand(uint64_t *state, double lo, double hi);
 float *lpvt_render(int width, int height);
 int lpvt_gl_teardown(void **state);
 
+/* 1 if the shared engine's last stats hold a stage of that name (its calls
+ * in *calls, its gpu_ms in *ms, either may be NULL), else 0. */
+int lpvt_stage(const char *name, unsigned *calls, double *ms);
+
 /* Mean radiance (rgb) over the (2 radius + 1)^2 pixels of a width x height
  * RGBA float frame where world point p lands in view v; fails the test when
  * the patch leaves the frame or a pixel saw no geometry. */
