@@ -220,6 +220,8 @@ void lpv_settings_resolve(lpv_settings *s)
         s->scene_surfel_count = LPV_DEFAULT_SCENE_SURFEL_COUNT;
     if (s->area_lights == LPV_SWITCH_DEFAULT)
         s->area_lights = LPV_SWITCH_ON;
+    if (s->reach == LPV_SWITCH_DEFAULT)
+        s->reach = LPV_SWITCH_ON;
     if (s->area_light_samples == 0)
         s->area_light_samples = LPV_DEFAULT_AREA_LIGHT_SAMPLES;
     if (s->lookup_step == 0)
@@ -367,7 +369,7 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     } switches[] = {{"bounces", s->lpv.bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
                     {"central_transport", s->lpv.central_transport}, {"normal_bins", s->lpv.normal_bins},
                     {"far_field", s->lpv.far_field}, {"scene_surfels", s->scene_surfels},
-                    {"area_lights", s->area_lights}, {"iv_reprojection", s->iv.reprojection},
+                    {"area_lights", s->area_lights}, {"reach", s->reach}, {"iv_reprojection", s->iv.reprojection},
                     {"iv_ao", s->iv.ao}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)

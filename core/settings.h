@@ -149,6 +149,9 @@ typedef struct lpv_settings {
                                      gives one VPL per cell it reaches, block_groups.glsl); 0
                                      (default) = auto, lpv_settings_rsm_vpl_step() */
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
+    lpv_switch reach;       /* on (default): no technique's light reaches air a closed surface
+                               keeps every light from (core/reach.h, docs/propagation.md
+                               "Enclosed lights"); off: the volume as propagated */
     lpv_switch area_lights; /* on (default): emitters light the scene directly through
                                area_light_samples shadow-mapped samples and stop injecting
                                their own VPLs; off: emitters reach the scene only as

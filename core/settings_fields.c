@@ -93,6 +93,9 @@ static const lpv_field FIELDS[] = {
      "0 = auto: 2 (exact: a block never has more cells than slots), 4 in the layers that give VPLs only (the "
      "area light samples after the first); a power of two dividing the face",
      "RSM texels per VPL and surfel along each axis (injection, geometry volume)", T_VOL, ""},
+    /* Enclosed lights (docs/propagation.md, "Enclosed lights"). */
+    {"reach", "reach", LPV_FIELD_SWITCH, F(reach), 0, 1, 0, "", "on", "",
+     "indirect light only in the air spaces a light reaches (closed walls keep it in)", T_SHADE, ""},
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
     {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", "on", "",
      "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)", T_VOL | T_SHADOWS, ""},

@@ -26,7 +26,8 @@ static const char *const INC_VPL_BLOCKS8[] = {"grid.glsl", "block_slots8.glsl", 
                                               NULL};
 static const char *const INC_COMPACT[] = {"compact.glsl", NULL};
 
-/* out = the technique's lookup includes, then the pass's own (both
+/* out = the technique's lookup includes, reach.glsl (the enclosed-light
+ * mask every reader of the volume multiplies by), then the pass's own (both
  * NULL-terminated; own may be NULL). Returns -1 when they do not fit. */
 static int includes(const char **out, size_t cap, const char *const *own, const char *const *lookup)
 {
@@ -36,6 +37,10 @@ static int includes(const char **out, size_t cap, const char *const *own, const 
             out[n++] = *i;
         else
             return -1;
+    if (n + 1 < cap)
+        out[n++] = "reach.glsl";
+    else
+        return -1;
     for (const char *const *i = own; i && *i; ++i)
         if (n + 1 < cap)
             out[n++] = *i;

@@ -16,6 +16,7 @@
 #include "gl_util.h"
 #include "lpv_shared.h"
 #include "medium.h"
+#include "reach.h"
 #include "memory_budget.h"
 #include "surfel_groups.h"
 #include "technique.h"
@@ -129,6 +130,8 @@ struct lpv_engine {
     lpv_emitter_list emitters;                          /* emissive triangles (area lights) */
     lpv_area_sample area_samples[LPV_MAX_AREA_LIGHTS];  /* the emitters as area light samples */
     size_t area_sample_count;                           /* 0: area lights off or no emitter */
+    lpv_reach reach;          /* where light can reach (core/reach.h), for the scene's geometry */
+    GLuint reach_tex;         /* its mask for reach.glsl (R8UI 3D), 0 = none */
 
     /* lights and RSMs */
     struct LpvLightBlock light_block;
@@ -197,6 +200,15 @@ GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plai
 /* The scene's GPU objects (engine_scene.c): freed, and the emitters as area
  * light samples under the current settings (none when area lights are off). */
 void lpv_engine_free_scene(lpv_engine *e);
+
+/* gpu/reach_volume.c: where light can reach (core/reach.h). build: for the
+ * scene's geometry (lpv_engine_set_scene); light: for the engine's lights
+ * and emitters, uploading the mask; bind: the technique's lookup and the
+ * mask for a program in use that reads the volume (reach.glsl). */
+int lpv_engine_reach_build(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
+void lpv_engine_reach_light(lpv_engine *e);
+void lpv_engine_reach_free(lpv_engine *e);
+void lpv_engine_bind_lookup(const lpv_engine *e, GLuint prog, float damping);
 void lpv_engine_update_area_samples(lpv_engine *e);
 /* The emissive VPLs and scene surfels under the current settings, from
  * e->geometry (engine_scene.c). */

@@ -95,7 +95,7 @@ static void irradiance_chunk(lpv_engine *e, const float *points, const float *no
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
     glUseProgram(e->prog_query);
     glUniform1i(glGetUniformLocation(e->prog_query, "u_count"), (GLint)n);
-    e->tech->cls->bind_lookup(e->tech, e->prog_query, e->settings.lpv.damping);
+    lpv_engine_bind_lookup(e, e->prog_query, e->settings.lpv.damping);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
     glDispatchCompute(lpv_div_up(n, QUERY_GROUP), 1, 1);

@@ -51,6 +51,7 @@ void lpv_engine_free_scene(lpv_engine *e)
     e->texture_count = e->draw_count = e->material_count = 0;
     e->light_count = 0;
     lpv_emitters_free(&e->emitters);
+    lpv_engine_reach_free(e);
     e->area_sample_count = 0;
     e->occluder_triangles = 0;
     e->has_scene = 0;
@@ -235,6 +236,7 @@ static void set_lights(lpv_engine *e, const lpv_scene *scene)
     e->light_count = 0;
     for (uint32_t i = 0; i < scene->light_count && e->light_count < LPV_MAX_LIGHTS; ++i)
         e->lights[e->light_count++] = scene->lights[i];
+    lpv_engine_reach_light(e);
 }
 
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
@@ -325,6 +327,8 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, tangent));
     glBindVertexArray(0);
 
+    if (lpv_engine_reach_build(e, scene, err, err_size) != 0)
+        return -1;
     set_lights(e, scene);
     if (lpv_medium_upload(&e->medium, scene, err, err_size) != 0)
         return -1;

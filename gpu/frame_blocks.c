@@ -49,7 +49,7 @@ void lpv_frame_lookup_blocks_run(lpv_engine *e)
     const float damping = e->settings.lpv.damping;
     const GLuint prog = damping > 0.0f ? e->prog_lookup_blocks_damped : e->prog_lookup_blocks;
     glUseProgram(prog);
-    e->tech->cls->bind_lookup(e->tech, prog, damping);
+    lpv_engine_bind_lookup(e, prog, damping);
     glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
     run_blocks(e, &e->lookup_blocks, step, LPV_IMG_BLOCK_IRRADIANCE, LPV_IMG_BLOCK_PLANE, LPV_TEX_BLOCK_IRRADIANCE,
                LPV_TEX_BLOCK_PLANE);

@@ -186,7 +186,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
 static void use_shading_program(lpv_engine *e, GLuint prog, lpv_frame_terms terms)
 {
     glUseProgram(prog);
-    e->tech->cls->bind_lookup(e->tech, prog, e->settings.lpv.damping);
+    lpv_engine_bind_lookup(e, prog, e->settings.lpv.damping);
     glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), e->settings.lookup_step);
     glUniform1i(glGetUniformLocation(prog, "u_area_shadow_step"), e->settings.area_shadow_step);
     glUniform1f(glGetUniformLocation(prog, "u_glossy_roughness"),

@@ -47,7 +47,7 @@ void lpv_pass_glossy_run(lpv_engine *e)
     glBlendFunc(GL_ONE, GL_ONE);
     glUseProgram(e->prog_glossy);
     glUniform1f(glGetUniformLocation(e->prog_glossy, "u_glossy_roughness"), e->settings.glossy_roughness);
-    e->tech->cls->bind_lookup(e->tech, e->prog_glossy, e->settings.lpv.damping);
+    lpv_engine_bind_lookup(e, e->prog_glossy, e->settings.lpv.damping);
     draw_fullscreen(e);
     lpv_timer_end(&e->timer);
 }
@@ -65,7 +65,7 @@ void lpv_pass_media_run(lpv_engine *e)
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
     lpv_medium_bind(&e->medium, &e->settings, p, 1);
     glUniform1f(glGetUniformLocation(p, "u_media_step"), e->settings.media_step);
-    e->tech->cls->bind_lookup(e->tech, p, 0.0f);
+    lpv_engine_bind_lookup(e, p, 0.0f);
     /* March over the medium's box, or over the scene and the coarsest cascade. */
     float lo[3], hi[3];
     const lpv_grid *g = &e->desc.level[e->desc.levels - 1];

@@ -19,6 +19,18 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  by two emissive surfaces and nothing else: a ceiling panel
                  (one quad facing down) and a wall strip (one quad facing into
                  the room); a table and a block cast their shadows.
+  lamp-box.glb   ENCLOSED LIGHT (issue 30): the room with a closed 0.6 m box
+                 (2 cm walls) on a plinth, a point light inside it and
+                 nothing else: every surface in view must stay black.
+  lamp-box-panel.glb  the same box holding an emissive panel (facing up,
+                 under the box's lid) instead of the point light.
+  lamp-open.glb  the same room, plinth and lamp with the box's lid and walls
+                 left out: the light the enclosed lamp would give if it leaked
+                 (the 1 % target of issue 30 is measured against it).
+  two-rooms.glb  ENCLOSED ROOM: two rooms sharing a closed 10 cm wall, a point
+                 light in the left one, the camera in the right one (dark).
+  two-rooms-lit.glb  the same with the lamp in the camera's room (the 1 %
+                 target of issue 30 is measured against it).
 
 Every object is an axis-aligned box (12 triangles) or a quad (2 triangles, its
 front the side its corners run counter-clockwise around); each material is one
@@ -347,10 +359,67 @@ def emissive_room():
     return s
 
 
+def lamp_box(light="point", enclosed=True):
+    """The room with a 0.6 m box of 2 cm walls on a 0.5 m plinth; inside it a
+    point light (light="point") or an emissive panel facing up (light="panel").
+    enclosed=False leaves out the box's lid and four walls (the lamp and the
+    box's floor stay), so the lamp lights the room."""
+    s = Scene()
+    room(s)
+    grey = s.material("box_grey", (0.60, 0.60, 0.60))
+    plinth = s.material("plinth", (0.50, 0.45, 0.40))
+    s.add_box(plinth, (-0.4, 0.0, -0.9), (0.4, 0.5, -0.1))
+    lo, hi, t = (-0.3, 0.5, -0.8), (0.3, 1.1, -0.2), 0.02
+    s.add_box(grey, (lo[0], lo[1], lo[2]), (hi[0], lo[1] + t, hi[2]))              # box floor
+    if enclosed:
+        s.add_box(grey, (lo[0], hi[1] - t, lo[2]), (hi[0], hi[1], hi[2]))          # lid
+        s.add_box(grey, (lo[0], lo[1], lo[2]), (lo[0] + t, hi[1], hi[2]))          # walls
+        s.add_box(grey, (hi[0] - t, lo[1], lo[2]), (hi[0], hi[1], hi[2]))
+        s.add_box(grey, (lo[0], lo[1], lo[2]), (hi[0], hi[1], lo[2] + t))
+        s.add_box(grey, (lo[0], lo[1], hi[2] - t), (hi[0], hi[1], hi[2]))
+    if light == "point":
+        # 4600 cd = 6.7 W/sr
+        s.light("lamp", {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (0.0, 0.8, -0.5),
+                (0.0, 0.0, -0.5))
+    else:
+        # 20 W/(m^2 sr) (13660 nits): a 0.3 x 0.3 m panel 5 cm under the lid, facing up
+        panel = s.material("lamp_panel", (0.9, 0.9, 0.9), emission=((1.0, 0.95, 0.85), 13660.0))
+        y = hi[1] - t - 0.05
+        s.add_quad(panel, [(-0.15, y, -0.35), (-0.15, y, -0.65), (0.15, y, -0.65), (0.15, y, -0.35)])
+    s.camera("Camera", (1.4, 1.7, 1.9), (-0.3, 0.8, -0.8), 65.0)
+    return s
+
+
+def two_rooms(lit_side=-1):
+    """Two 4 x 3 x 4 m rooms side by side (x in [-4, 0] and [0, 4]) sharing a
+    closed 10 cm wall at x = 0; a point light in the left room (lit_side -1)
+    or in the right one (+1), the camera in the right one looking at the
+    shared wall."""
+    s = Scene()
+    wall = s.material("walls", (0.75, 0.75, 0.72))
+    floor = s.material("floor", (0.45, 0.45, 0.45))
+    t = 0.1
+    s.add_box(floor, (-4 - t, -t, -2 - t), (4 + t, 0, 2 + t))
+    s.add_box(wall, (-4 - t, 3, -2 - t), (4 + t, 3 + t, 2 + t))
+    s.add_box(wall, (-4 - t, 0, -2 - t), (4 + t, 3, -2))             # back
+    s.add_box(wall, (-4 - t, 0, 2), (4 + t, 3, 2 + t))               # front
+    s.add_box(wall, (-4 - t, 0, -2), (-4, 3, 2))                     # left end
+    s.add_box(wall, (4, 0, -2), (4 + t, 3, 2))                       # right end
+    s.add_box(wall, (-t / 2, 0, -2), (t / 2, 3, 2))                  # the shared wall
+    s.light("lamp", {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (2.0 * lit_side, 2.2, 0.0),
+            (2.0 * lit_side, 0.0, 0.0))
+    s.camera("Camera", (3.6, 1.6, 1.6), (0.0, 1.2, -0.6), 70.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
-                        ("smoke", smoke), ("emissive-room", emissive_room)):
+                        ("smoke", smoke), ("emissive-room", emissive_room), ("lamp-box", lamp_box),
+                        ("lamp-box-panel", lambda: lamp_box("panel")),
+                        ("lamp-open", lambda: lamp_box(enclosed=False)),
+                        ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
+                        ("two-rooms-lit", lambda: two_rooms(+1))):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

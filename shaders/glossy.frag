@@ -40,7 +40,7 @@ void main()
     for (int j = 1; j <= GLOSSY_STEPS; ++j) {
         float d = float(j) * cell;
         float w = 1.0 / (d * d);
-        sum += w * lpv_project(start + d * r, toward_surface);
+        sum += w * lpv_reach_point(start + d * r) * lpv_project(start + d * r, toward_surface);
         wsum += w;
     }
     float metallic = clamp(nrm.w - 1.0, 0.0, 1.0);

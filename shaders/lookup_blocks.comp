@@ -18,7 +18,7 @@ void main()
     vec4 plane;
     vec3 p, n_sum;
     bool seen = block_surface(b, u_lookup_step, plane, p, n_sum);
-    vec3 e = seen ? lpv_irradiance(p, n_sum) : vec3(0.0);
+    vec3 e = seen ? lpv_reach(p, normalize(n_sum)) * lpv_irradiance(p, n_sum) : vec3(0.0);
     imageStore(u_block_irradiance_out, b, vec4(e, seen ? 1.0 : 0.0));
     imageStore(u_block_plane_out, b, plane);
 }

@@ -465,6 +465,13 @@ LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v - lpv_slab_i
  * block saw a surface) and its plane, as for the lookup step. */
 #define LPV_TEX_AREA_SHADOW       14
 #define LPV_TEX_AREA_SHADOW_PLANE 15
+/* Where light can reach (core/reach.h, reach.glsl): an R8UI 3D texture of
+ * the scene's voxels, each LPV_REACH_SOLID, _DARK (air no light reaches) or
+ * _LIT; every pass that reads the technique's volume multiplies by it. */
+#define LPV_TEX_REACH 16
+#define LPV_REACH_SOLID 0
+#define LPV_REACH_DARK 1
+#define LPV_REACH_LIT 2
 
 /* Image units of the frame that shade.comp writes (pass_camera.c), of the
  * blocks' irradiance and planes that lookup_blocks.comp writes and of the

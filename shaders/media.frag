@@ -69,7 +69,7 @@ void main()
         float rho = medium_density(x);
         if (rho > 0.0) {
             vec3 sigma_s = u_medium_sigma_s * rho, sigma_t = (u_medium_sigma_s + u_medium_sigma_a) * rho;
-            vec3 source = lpv_project(x, fluence);
+            vec3 source = lpv_reach_point(x) * lpv_project(x, fluence);
             for (int l = 0; l < lights; ++l) {
                 vec3 to_light;
                 vec3 e = light_irradiance_normal(L.lights[l], x, to_light);

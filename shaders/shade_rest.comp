@@ -16,7 +16,7 @@ void main()
         ivec2 px = rest_px[i];
         vec4 pos = texelFetch(u_gbuf_position, px, 0);
         vec4 nrm = texelFetch(u_gbuf_normal, px, 0);
-        vec3 e = V.shading.x * lpv_irradiance(pos.xyz, nrm.xyz);
+        vec3 e = V.shading.x * lpv_reach(pos.xyz, nrm.xyz) * lpv_irradiance(pos.xyz, nrm.xyz);
         vec4 c = imageLoad(u_frame, px);
         imageStore(u_frame, px, vec4(c.rgb + diffuse_reflectance(px, nrm.w) * e, c.a));
     }

@@ -288,12 +288,12 @@ vec4 shade_pixel(ivec2 px)
     vec3 e_indirect = vec3(0.0);
     if (V.shading.z != 0.0) {
         bool done;
-        e_indirect = V.shading.x * lpv_irradiance_listed(p, n, done);
+        e_indirect = V.shading.x * lpv_reach(p, n) * lpv_irradiance_listed(p, n, done);
         if (!done)
             LPV_LIST_PIXEL(rest_head, rest_px, px)
     }
 #else
-    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_irradiance(p, n) : vec3(0.0);
+    vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_reach(p, n) * lpv_irradiance(p, n) : vec3(0.0);
 #endif
     vec3 radiance = diffuse_reflectance(px, nrm.w) * (e_direct + e_indirect);
     if (V.shading.w != 0.0)

@@ -1,0 +1,319 @@
+/*
+ * reach.c - the scene's air spaces and which of them a light reaches
+ * (reach.h). Voxelization by core/iv_voxelize.h's triangle/box test, the
+ * components by a breadth-first flood fill over 6-connected air voxels.
+ */
+#include "reach.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "iv_voxelize.h"
+
+static size_t voxel_index(const lpv_reach *r, int x, int y, int z)
+{
+    return (size_t)x + (size_t)r->dims[0] * ((size_t)y + (size_t)r->dims[1] * (size_t)z);
+}
+
+static size_t voxel_count(const int dims[3]) { return (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2]; }
+
+/* Cubic voxels over the bounds grown by the margin: the smallest side (up to
+ * a few percent) whose grid fits max_voxels and LPV_REACH_MAX_DIM per axis. */
+static int place(lpv_reach *r, const float bmin[3], const float bmax[3], size_t max_voxels)
+{
+    double ext[3], longest = 0.0, volume = 1.0;
+    for (int k = 0; k < 3; ++k) {
+        ext[k] = (double)bmax[k] - (double)bmin[k];
+        if (!isfinite(ext[k]) || ext[k] < 0.0)
+            return -1;
+        longest = fmax(longest, ext[k]);
+    }
+    if (!(longest > 0.0))
+        return -1;
+    for (int k = 0; k < 3; ++k)
+        volume *= fmax(ext[k], longest * 1e-3);
+    double s = fmax(cbrt(volume / (double)max_voxels), longest / (double)(LPV_REACH_MAX_DIM - 2 * LPV_REACH_MARGIN - 1));
+    for (int tries = 0; tries < 200; ++tries, s *= 1.05) {
+        int dims[3];
+        for (int k = 0; k < 3; ++k)
+            dims[k] = (int)floor(ext[k] / s) + 1 + 2 * LPV_REACH_MARGIN;
+        if (dims[0] > LPV_REACH_MAX_DIM || dims[1] > LPV_REACH_MAX_DIM || dims[2] > LPV_REACH_MAX_DIM ||
+            voxel_count(dims) > max_voxels)
+            continue;
+        memcpy(r->dims, dims, sizeof dims);
+        r->voxel = (float)s;
+        for (int k = 0; k < 3; ++k) /* centred: the margin on both sides */
+            r->origin[k] = (float)(0.5 * ((double)bmin[k] + (double)bmax[k]) - 0.5 * dims[k] * s);
+        return 0;
+    }
+    return -1;
+}
+
+/* Marks every voxel triangle (a, b, c) touches as solid (label 0; the
+ * labels start at 1 = air). */
+static void voxelize_triangle(lpv_reach *r, const float *p[3])
+{
+    double tri[3][3];
+    int lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+        for (int i = 0; i < 3; ++i)
+            tri[i][k] = ((double)p[i][k] - (double)r->origin[k]) / (double)r->voxel;
+        double mn = fmin(tri[0][k], fmin(tri[1][k], tri[2][k])) - LPV_IV_VOXELIZE_EPS;
+        double mx = fmax(tri[0][k], fmax(tri[1][k], tri[2][k])) + LPV_IV_VOXELIZE_EPS;
+        if (!(mx >= 0.0 && mn < (double)r->dims[k]))
+            return;
+        lo[k] = mn < 0.0 ? 0 : (int)floor(mn);
+        hi[k] = mx >= (double)r->dims[k] ? r->dims[k] - 1 : (int)floor(mx);
+    }
+    const double half[3] = {0.5 + LPV_IV_VOXELIZE_EPS, 0.5 + LPV_IV_VOXELIZE_EPS, 0.5 + LPV_IV_VOXELIZE_EPS};
+    for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+            for (int x = lo[0]; x <= hi[0]; ++x) {
+                const double centre[3] = {x + 0.5, y + 0.5, z + 0.5};
+                size_t v = voxel_index(r, x, y, z);
+                if (r->label[v] != 0 && lpv_iv_tri_box_overlap(centre, half, tri))
+                    r->label[v] = 0;
+            }
+}
+
+/* Labels the air (label 1 on entry) with components 1..n by flood fill. */
+static int label_components(lpv_reach *r)
+{
+    const size_t n = voxel_count(r->dims);
+    uint32_t *queue = malloc(n * sizeof *queue);
+    if (!queue)
+        return -1;
+    /* air starts as UINT32_MAX (unvisited), solid stays 0 */
+    for (size_t v = 0; v < n; ++v)
+        if (r->label[v])
+            r->label[v] = UINT32_MAX;
+    const size_t sx = 1, sy = (size_t)r->dims[0], sz = (size_t)r->dims[0] * (size_t)r->dims[1];
+    uint32_t next = 0;
+    for (size_t seed = 0; seed < n; ++seed) {
+        if (r->label[seed] != UINT32_MAX)
+            continue;
+        const uint32_t id = ++next;
+        size_t head = 0, tail = 0;
+        r->label[seed] = id;
+        queue[tail++] = (uint32_t)seed;
+        while (head < tail) {
+            const size_t v = queue[head++];
+            const int x = (int)(v % sy), y = (int)((v / sy) % (size_t)r->dims[1]), z = (int)(v / sz);
+            const size_t nb[6] = {v - sx, v + sx, v - sy, v + sy, v - sz, v + sz};
+            const int ok[6] = {x > 0, x + 1 < r->dims[0], y > 0, y + 1 < r->dims[1], z > 0, z + 1 < r->dims[2]};
+            for (int k = 0; k < 6; ++k)
+                if (ok[k] && r->label[nb[k]] == UINT32_MAX) {
+                    r->label[nb[k]] = id;
+                    queue[tail++] = (uint32_t)nb[k];
+                }
+        }
+    }
+    free(queue);
+    r->components = next;
+    return 0;
+}
+
+static int is_emissive(const lpv_material *m)
+{
+    return m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
+}
+
+int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, char *err, size_t err_size)
+{
+    memset(r, 0, sizeof *r);
+    if (!max_voxels)
+        max_voxels = LPV_REACH_DEFAULT_VOXELS;
+    if (place(r, scene->bounds_min, scene->bounds_max, max_voxels) != 0)
+        return lpv_error(err, err_size, "reach: the scene has no finite, non-empty bounds");
+    const size_t n = voxel_count(r->dims);
+    r->label = malloc(n * sizeof *r->label);
+    r->mask = malloc(n);
+    size_t emissive = 0;
+    for (uint32_t d = 0; d < scene->draw_count; ++d) {
+        const lpv_draw *dr = &scene->draws[d];
+        const lpv_material *m =
+            dr->material >= 0 && (uint32_t)dr->material < scene->material_count ? &scene->materials[dr->material] : NULL;
+        if (is_emissive(m))
+            emissive += dr->index_count / 3;
+    }
+    r->emitter_seeds = malloc((2 * emissive + 1) * 6 * sizeof(float));
+    if (!r->label || !r->mask || !r->emitter_seeds)
+        return lpv_error(err, err_size, "reach: out of memory for %zu voxels", n);
+    for (size_t v = 0; v < n; ++v)
+        r->label[v] = 1;
+    for (uint32_t d = 0; d < scene->draw_count; ++d) {
+        const lpv_draw *dr = &scene->draws[d];
+        const lpv_material *m =
+            dr->material >= 0 && (uint32_t)dr->material < scene->material_count ? &scene->materials[dr->material] : NULL;
+        const int opaque = !m || m->alpha_mode == LPV_ALPHA_OPAQUE;
+        const int emits = is_emissive(m);
+        if (!opaque && !emits)
+            continue;
+        for (uint32_t i = 0; i + 2 < dr->index_count; i += 3) {
+            const lpv_vertex *v[3];
+            float front[3];
+            double area;
+            if (!lpv_scene_triangle(scene, dr->first_index + i, v, front, &area))
+                continue;
+            if (opaque) {
+                const float *p[3] = {v[0]->position, v[1]->position, v[2]->position};
+                voxelize_triangle(r, p);
+            }
+            if (emits) /* both sides: a seed only ever adds light, never takes it away */
+                for (int side = -1; side <= 1; side += 2) {
+                    float *s = &r->emitter_seeds[6 * r->emitter_seed_count++];
+                    for (int k = 0; k < 3; ++k) {
+                        s[k] = (v[0]->position[k] + v[1]->position[k] + v[2]->position[k]) / 3.0f;
+                        s[3 + k] = (float)side * front[k];
+                    }
+                }
+        }
+    }
+    if (label_components(r) != 0)
+        return lpv_error(err, err_size, "reach: out of memory for the flood fill of %zu voxels", n);
+    r->unsure = 1; /* until lpv_reach_light sees the lights */
+    for (size_t v = 0; v < n; ++v)
+        r->mask[v] = r->label[v] ? LPV_REACH_LIT : LPV_REACH_SOLID;
+    return 0;
+}
+
+/* The voxel holding p, or -1 outside the grid. */
+static long voxel_at(const lpv_reach *r, const float p[3])
+{
+    int c[3];
+    for (int k = 0; k < 3; ++k) {
+        double q = floor(((double)p[k] - (double)r->origin[k]) / (double)r->voxel);
+        if (!(q >= 0.0 && q < (double)r->dims[k]))
+            return -1;
+        c[k] = (int)q;
+    }
+    return (long)voxel_index(r, c[0], c[1], c[2]);
+}
+
+/* Lights the component of the voxel holding p, or, when that voxel is
+ * solid, the components of the air voxels around it. Returns 0, or -1 when
+ * there is no air there at all. A point outside the grid lights the outside. */
+static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
+{
+    long v = voxel_at(r, p);
+    if (v < 0) {
+        lit[r->label[0]] = 1; /* voxel 0 is in the margin: outside air */
+        return 0;
+    }
+    if (r->label[v]) {
+        lit[r->label[v]] = 1;
+        return 0;
+    }
+    const int x = (int)((size_t)v % (size_t)r->dims[0]), y = (int)(((size_t)v / (size_t)r->dims[0]) % (size_t)r->dims[1]),
+              z = (int)((size_t)v / ((size_t)r->dims[0] * (size_t)r->dims[1]));
+    int found = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                int X = x + dx, Y = y + dy, Z = z + dz;
+                if (X < 0 || Y < 0 || Z < 0 || X >= r->dims[0] || Y >= r->dims[1] || Z >= r->dims[2])
+                    continue;
+                uint32_t l = r->label[voxel_index(r, X, Y, Z)];
+                if (l) {
+                    lit[l] = 1;
+                    found = 1;
+                }
+            }
+    return found ? 0 : -1;
+}
+
+void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
+{
+    const size_t n = voxel_count(r->dims);
+    r->unsure = 0;
+    r->lit_components = 0;
+    r->solid_voxels = r->dark_voxels = r->lit_voxels = 0;
+    unsigned char *lit = calloc((size_t)r->components + 1, 1);
+    if (!lit || !r->label || !r->mask) {
+        free(lit);
+        r->unsure = 1;
+        return;
+    }
+    for (size_t i = 0; i < light_count; ++i) {
+        const lpv_light *l = &lights[i];
+        if (l->type == LPV_LIGHT_DIRECTIONAL)
+            lit[r->label[0]] = 1;
+        else if (light_at(r, l->position, lit) != 0)
+            r->unsure = 1;
+    }
+    /* An emitter lights the air voxels next to its centroid's voxel on each
+     * side (of the 26 around it, those on that side of the triangle). A side
+     * closer to a surface than a voxel (a panel flush on a ceiling) finds
+     * none and lights nothing: its light goes into that surface. */
+    for (size_t i = 0; i < r->emitter_seed_count; ++i) {
+        const float *c = &r->emitter_seeds[6 * i], *dir = c + 3;
+        long v = voxel_at(r, c);
+        if (v < 0)
+            continue;
+        const int x = (int)((size_t)v % (size_t)r->dims[0]),
+                  y = (int)(((size_t)v / (size_t)r->dims[0]) % (size_t)r->dims[1]),
+                  z = (int)((size_t)v / ((size_t)r->dims[0] * (size_t)r->dims[1]));
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int X = x + dx, Y = y + dy, Z = z + dz;
+                    if ((float)dx * dir[0] + (float)dy * dir[1] + (float)dz * dir[2] < 0.5f || X < 0 || Y < 0 ||
+                        Z < 0 || X >= r->dims[0] || Y >= r->dims[1] || Z >= r->dims[2])
+                        continue;
+                    lit[r->label[voxel_index(r, X, Y, Z)]] = 1; /* lit[0], solid, is never read */
+                }
+    }
+    for (uint32_t c = 1; c <= r->components; ++c)
+        r->lit_components += lit[c];
+    for (size_t v = 0; v < n; ++v) {
+        const uint32_t l = r->label[v];
+        r->mask[v] = !l ? LPV_REACH_SOLID : (lit[l] || r->unsure) ? LPV_REACH_LIT : LPV_REACH_DARK;
+        r->solid_voxels += !l;
+        r->dark_voxels += r->mask[v] == LPV_REACH_DARK;
+        r->lit_voxels += r->mask[v] == LPV_REACH_LIT;
+    }
+    free(lit);
+}
+
+float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3])
+{
+    if (!r->mask || r->unsure)
+        return 1.0f;
+    static const float steps[] = {0.75f, 1.5f, 2.5f, 3.5f};
+    for (size_t i = 0; i < sizeof steps / sizeof steps[0]; ++i) {
+        float q[3];
+        for (int k = 0; k < 3; ++k)
+            q[k] = p[k] + n[k] * steps[i] * r->voxel;
+        long v = voxel_at(r, q);
+        if (v < 0)
+            return 1.0f;
+        if (r->mask[v] != LPV_REACH_SOLID)
+            return r->mask[v] == LPV_REACH_LIT ? 1.0f : 0.0f;
+    }
+    /* a corner: the 27 voxels around 2 voxels along n */
+    int c[3];
+    for (int k = 0; k < 3; ++k)
+        c[k] = (int)floor(((double)p[k] + 2.0 * (double)n[k] * (double)r->voxel - (double)r->origin[k]) /
+                          (double)r->voxel);
+    int dark = 0;
+    for (int k = 0; k < 27; ++k) {
+        const int x = c[0] + k % 3 - 1, y = c[1] + (k / 3) % 3 - 1, z = c[2] + k / 9 - 1;
+        if (x < 0 || y < 0 || z < 0 || x >= r->dims[0] || y >= r->dims[1] || z >= r->dims[2])
+            continue;
+        const uint8_t m = r->mask[voxel_index(r, x, y, z)];
+        if (m == LPV_REACH_LIT)
+            return 1.0f;
+        dark |= m == LPV_REACH_DARK;
+    }
+    return dark ? 0.0f : 1.0f;
+}
+
+void lpv_reach_free(lpv_reach *r)
+{
+    free(r->label);
+    free(r->mask);
+    free(r->emitter_seeds);
+    memset(r, 0, sizeof *r);
+}

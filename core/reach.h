@@ -1,0 +1,89 @@
+/*
+ * reach.h - where the scene's light can go: the connected air spaces of the
+ * scene and which of them hold a light (issue 30, docs/propagation.md
+ * "Enclosed lights").
+ *
+ * Every technique carries its light in cells or voxels much larger than a
+ * wall is thick, so light put into a closed box, or into one of two rooms
+ * that share a wall, spreads through the wall: a lamp in a closed 0.6 m box
+ * lit the room outside it at 34 % of the unenclosed lamp's indirect light
+ * (lpv; octree 37 %, iv 2.7 %). The path tracer says 0: no path leaves a
+ * closed surface. This module finds the closed spaces exactly enough to
+ * tell: the scene's opaque triangles are voxelized conservatively (every
+ * voxel a triangle touches is solid, core/iv_voxelize.h's overlap test) on a
+ * fine grid of cubic voxels, the air between them is split into its
+ * 6-connected components, and a component is lit when a light can put light
+ * into it: a point or spot light's voxel, both sides of an emissive
+ * triangle, the air outside the scene for a directional light or a light
+ * outside the bounds. A conservative voxelization of a closed surface
+ * separates 6-connected air, so no component crosses a closed wall.
+ *
+ * The frame, the queries and the glossy and media passes multiply the
+ * technique's irradiance at a surface by lpv_reach_at's answer (reach.glsl
+ * on the GPU): 0 where the air in front of the surface is a component no
+ * light reaches, else 1. The answer is 1 (nothing is removed) wherever it is
+ * unsure: a surface in a gap narrower than the voxels, a light inside a
+ * solid voxel with no air around it. Gaps narrower than a voxel close, so
+ * light through a crack thinner than the voxel size is taken away; the
+ * voxel size is reported with the plan.
+ */
+#ifndef LPV_REACH_H
+#define LPV_REACH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lpv_shared.h" /* LPV_REACH_SOLID, _DARK, _LIT: a voxel's state in mask and on the GPU */
+#include "scene.h"
+
+/* The voxel budget of lpv_reach_build when the caller gives 0, and the most
+ * voxels along one axis (GL's 3D textures are at least 2048 on the
+ * implementations lpvd runs on; 1024 keeps the texture small). */
+#define LPV_REACH_DEFAULT_VOXELS (2u << 20)
+#define LPV_REACH_MAX_DIM 1024
+/* Voxels of air around the scene's bounds: the air outside the scene is one
+ * component however the scene touches its bounds. */
+#define LPV_REACH_MARGIN 2
+
+typedef struct lpv_reach {
+    int dims[3];
+    float origin[3];   /* world position of voxel (0, 0, 0)'s lower corner, m */
+    float voxel;       /* side, m */
+    uint32_t *label;   /* per voxel (x fastest): 0 solid, else its air component 1..components */
+    uint32_t components;
+    uint8_t *mask;     /* per voxel: LPV_REACH_SOLID / DARK / LIT (lpv_reach_light) */
+    /* Emissive triangles' seeds: each triangle's centroid and front
+     * normal, and again with the normal turned round. */
+    float *emitter_seeds; /* 6 floats each: point, direction */
+    size_t emitter_seed_count;
+    /* lpv_reach_light's result: */
+    int unsure;        /* 1: a light's seed had no air around it; every voxel reads lit */
+    size_t solid_voxels, dark_voxels, lit_voxels;
+    uint32_t lit_components;
+} lpv_reach;
+
+/* Voxelizes the scene's opaque triangles (alpha mode OPAQUE; cut-out and
+ * blended surfaces let light through) over its bounds grown by
+ * LPV_REACH_MARGIN voxels, with cubic voxels as small as max_voxels (0 =
+ * LPV_REACH_DEFAULT_VOXELS) and LPV_REACH_MAX_DIM allow, labels the air's
+ * components and records the emitters' seeds. The mask is all lit until
+ * lpv_reach_light. Returns 0, or -1 with a message (out of memory, no
+ * bounds). r is zeroed first; free it with lpv_reach_free either way. */
+int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, char *err, size_t err_size);
+
+/* The mask for these punctual lights and the emitters recorded by build:
+ * the components holding a light are lit, the rest of the air dark. */
+void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count);
+
+/* 1 when light can reach the air in front of a surface at p facing n (unit),
+ * 0 when that air is a component no light reaches: the first non-solid voxel
+ * at 0.75, 1.5, 2.5 and 3.5 voxels along n decides; when all are solid (a
+ * surface in a corner, the steps running along the other surface's voxels)
+ * the 27 voxels around 2 voxels along n do: any lit gives 1, else any dark
+ * 0. A point outside the grid, no air around or an unsure mask give 1. The
+ * GPU's reach.glsl is the same rule. */
+float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3]);
+
+void lpv_reach_free(lpv_reach *r);
+
+#endif /* LPV_REACH_H */

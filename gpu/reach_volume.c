@@ -1,0 +1,60 @@
+/*
+ * reach_volume.c - the engine's side of core/reach.h: the scene's air
+ * spaces built when its geometry arrives, the lit ones found again when the
+ * lights change, and the mask as an R8UI 3D texture that reach.glsl reads
+ * in every pass that looks the technique's volume up (docs/propagation.md,
+ * "Enclosed lights").
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "engine_internal.h"
+
+void lpv_engine_reach_free(lpv_engine *e)
+{
+    lpv_reach_free(&e->reach);
+    if (e->reach_tex)
+        glDeleteTextures(1, &e->reach_tex);
+    e->reach_tex = 0;
+}
+
+int lpv_engine_reach_build(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
+{
+    lpv_engine_reach_free(e);
+    if (lpv_reach_build(&e->reach, scene, 0, err, err_size) != 0) {
+        lpv_reach_free(&e->reach); /* a scene without bounds: everything reads lit */
+        return lpv_error(err, err_size, "%s: %s", scene->source, err);
+    }
+    return 0;
+}
+
+void lpv_engine_reach_light(lpv_engine *e)
+{
+    if (!e->reach.mask)
+        return;
+    lpv_reach_light(&e->reach, e->lights, e->light_count);
+    if (!e->reach_tex) {
+        glGenTextures(1, &e->reach_tex);
+        glBindTexture(GL_TEXTURE_3D, e->reach_tex);
+        glTexStorage3D(GL_TEXTURE_3D, 1, GL_R8UI, e->reach.dims[0], e->reach.dims[1], e->reach.dims[2]);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    } else
+        glBindTexture(GL_TEXTURE_3D, e->reach_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, e->reach.dims[0], e->reach.dims[1], e->reach.dims[2], GL_RED_INTEGER,
+                    GL_UNSIGNED_BYTE, e->reach.mask);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glBindTexture(GL_TEXTURE_3D, 0);
+}
+
+void lpv_engine_bind_lookup(const lpv_engine *e, GLuint prog, float damping)
+{
+    e->tech->cls->bind_lookup(e->tech, prog, damping);
+    const int on = e->reach_tex && !e->reach.unsure && e->settings.reach != LPV_SWITCH_OFF;
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_REACH);
+    glBindTexture(GL_TEXTURE_3D, on ? e->reach_tex : 0);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform4f(glGetUniformLocation(prog, "u_reach_grid"), e->reach.origin[0], e->reach.origin[1],
+                e->reach.origin[2], on ? e->reach.voxel : 0.0f);
+}

@@ -1,0 +1,202 @@
+/*
+ * test_reach.c - the scene's air spaces and which a light reaches
+ * (core/reach.c), pure C: a lamp in a closed box, two rooms sharing a wall,
+ * a doorway, a directional light outside, an emissive panel, a light
+ * inside a thin slab.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "reach.h"
+#include "scene_build.h"
+
+static void add_box(lpv_scene *s, int m, float x0, float y0, float z0, float x1, float y1, float z1)
+{
+    assert_true(lpv_scene_add_box(s, m, (float[3]){x0, y0, z0}, (float[3]){x1, y1, z1}) >= 0);
+}
+
+/* A 4 x 3 x 4 m room of 10 cm walls; inside it a 0.6 m box of 2 cm walls
+ * (closed, or without its lid), a point light inside the box. */
+static void lamp_scene(lpv_scene *s, int closed)
+{
+    memset(s, 0, sizeof *s);
+    int grey = lpv_scene_add_material(s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    assert_true(grey >= 0);
+    add_box(s, grey, -2.1f, -0.1f, -2.1f, 2.1f, 0.0f, 2.1f); /* floor */
+    add_box(s, grey, -2.1f, 3.0f, -2.1f, 2.1f, 3.1f, 2.1f);  /* ceiling */
+    add_box(s, grey, -2.1f, 0.0f, -2.1f, -2.0f, 3.0f, 2.1f);
+    add_box(s, grey, 2.0f, 0.0f, -2.1f, 2.1f, 3.0f, 2.1f);
+    add_box(s, grey, -2.0f, 0.0f, -2.1f, 2.0f, 3.0f, -2.0f);
+    add_box(s, grey, -2.0f, 0.0f, 2.0f, 2.0f, 3.0f, 2.1f);
+    const float lo[3] = {-0.3f, 0.5f, -0.3f}, hi[3] = {0.3f, 1.1f, 0.3f}, t = 0.02f;
+    add_box(s, grey, lo[0], lo[1], lo[2], hi[0], lo[1] + t, hi[2]);
+    if (closed)
+        add_box(s, grey, lo[0], hi[1] - t, lo[2], hi[0], hi[1], hi[2]);
+    add_box(s, grey, lo[0], lo[1], lo[2], lo[0] + t, hi[1], hi[2]);
+    add_box(s, grey, hi[0] - t, lo[1], lo[2], hi[0], hi[1], hi[2]);
+    add_box(s, grey, lo[0], lo[1], lo[2], hi[0], hi[1], lo[2] + t);
+    add_box(s, grey, lo[0], lo[1], hi[2] - t, hi[0], hi[1], hi[2]);
+    assert_non_null(lpv_scene_add_point_light(s, (float[3]){0.0f, 0.8f, 0.0f}, 5.0f));
+    lpv_scene_compute_bounds(s);
+}
+
+static void build_and_light(lpv_reach *r, const lpv_scene *s)
+{
+    char err[256];
+    assert_int_equal(lpv_reach_build(r, s, 0, err, sizeof err), 0);
+    lpv_reach_light(r, s->lights, s->light_count);
+    assert_int_equal(r->unsure, 0);
+}
+
+static const float UP[3] = {0, 1, 0}, DOWN[3] = {0, -1, 0}, PX[3] = {1, 0, 0}, NX[3] = {-1, 0, 0};
+
+static void test_closed_box_keeps_its_light(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    lamp_scene(&s, 1);
+    lpv_reach r;
+    build_and_light(&r, &s);
+    /* inside the box: the floor of the box, facing up, and the inner walls */
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.52f, 0.0f}, UP) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.28f, 0.8f, 0.0f}, NX) == 1.0f);
+    /* outside: the room's floor, walls, ceiling and the box's outer faces */
+    assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 0.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){-2.0f, 1.5f, 0.0f}, PX) == 0.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 3.0f, 0.0f}, DOWN) == 0.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.3f, 0.8f, 0.0f}, PX) == 0.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 1.1f, 0.0f}, UP) == 0.0f);
+    assert_true(r.components >= 3); /* outside, room, box (and the walls' insides) */
+    assert_int_equal(r.lit_components, 1);
+    assert_true(r.voxel < 0.05f); /* finer than the room's walls are thick */
+    lpv_reach_free(&r);
+    lpv_scene_free(&s);
+}
+
+static void test_open_box_lights_the_room(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    lamp_scene(&s, 0);
+    lpv_reach r;
+    build_and_light(&r, &s);
+    assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.3f, 0.8f, 0.0f}, PX) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 3.0f, 0.0f}, DOWN) == 1.0f);
+    /* the outside of the room stays dark: a point light lights only its own space */
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 3.1f, 0.0f}, UP) == 0.0f);
+    lpv_reach_free(&r);
+    lpv_scene_free(&s);
+}
+
+/* A directional light lights the air outside the scene and what opens onto
+ * it; an emitter lights both sides of itself. */
+static void test_directional_and_emitters(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    int lamp = lpv_scene_add_material(&s, "lamp", (float[3]){0.8f, 0.8f, 0.8f}, (float[3]){5.0f, 5.0f, 5.0f});
+    add_box(&s, grey, -5.0f, -0.1f, -5.0f, 5.0f, 0.0f, 5.0f);       /* ground */
+    add_box(&s, grey, 1.0f, 0.0f, 1.0f, 3.0f, 2.0f, 3.0f);          /* a closed block (solid inside) */
+    /* a closed 1 m shell (four walls, floor, lid) holding an emissive quad facing up */
+    add_box(&s, grey, -3.0f, 0.0f, -3.0f, -2.0f, 0.05f, -2.0f);
+    add_box(&s, grey, -3.0f, 0.95f, -3.0f, -2.0f, 1.0f, -2.0f);
+    add_box(&s, grey, -3.0f, 0.0f, -3.0f, -2.95f, 1.0f, -2.0f);
+    add_box(&s, grey, -2.05f, 0.0f, -3.0f, -2.0f, 1.0f, -2.0f);
+    add_box(&s, grey, -3.0f, 0.0f, -3.0f, -2.0f, 1.0f, -2.95f);
+    add_box(&s, grey, -3.0f, 0.0f, -2.05f, -2.0f, 1.0f, -2.0f);
+    const float q[4][3] = {{-2.7f, 0.5f, -2.3f}, {-2.3f, 0.5f, -2.3f}, {-2.3f, 0.5f, -2.7f}, {-2.7f, 0.5f, -2.7f}};
+    assert_true(lpv_scene_add_quad(&s, lamp, q, NULL) >= 0);
+    lpv_scene_compute_bounds(&s);
+    lpv_reach r;
+    char err[256];
+    assert_int_equal(lpv_reach_build(&r, &s, 0, err, sizeof err), 0);
+    /* no lights at all: only the emitter's shell is lit */
+    lpv_reach_light(&r, NULL, 0);
+    assert_int_equal(r.unsure, 0);
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.0f, 0.0f}, UP) == 0.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){-2.5f, 0.05f, -2.5f}, UP) == 1.0f); /* under the panel */
+    assert_true(lpv_reach_at(&r, (float[3]){-2.5f, 0.95f, -2.5f}, DOWN) == 1.0f); /* above its back */
+    /* a sun: the ground and the block's faces are lit, the shell's inside still is */
+    lpv_light sun = {.type = LPV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 1.0f, .direction = {0, -1, 0}};
+    lpv_reach_light(&r, &sun, 1);
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.0f, 0.0f}, UP) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){3.0f, 1.0f, 2.0f}, PX) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){-2.5f, 0.05f, -2.5f}, UP) == 1.0f);
+    lpv_reach_free(&r);
+    lpv_scene_free(&s);
+}
+
+/* Two rooms sharing a 10 cm wall: a lamp in one leaves the other dark; a
+ * 0.8 m doorway in the wall joins them. */
+static void test_two_rooms(void **state)
+{
+    (void)state;
+    for (int door = 0; door <= 1; ++door) {
+        lpv_scene s = {0};
+        int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+        add_box(&s, grey, -4.1f, -0.1f, -2.1f, 4.1f, 0.0f, 2.1f);
+        add_box(&s, grey, -4.1f, 3.0f, -2.1f, 4.1f, 3.1f, 2.1f);
+        add_box(&s, grey, -4.1f, 0.0f, -2.1f, 4.1f, 3.0f, -2.0f);
+        add_box(&s, grey, -4.1f, 0.0f, 2.0f, 4.1f, 3.0f, 2.1f);
+        add_box(&s, grey, -4.1f, 0.0f, -2.0f, -4.0f, 3.0f, 2.0f);
+        add_box(&s, grey, 4.0f, 0.0f, -2.0f, 4.1f, 3.0f, 2.0f);
+        if (door) {
+            add_box(&s, grey, -0.05f, 0.0f, -2.0f, 0.05f, 3.0f, -0.4f);
+            add_box(&s, grey, -0.05f, 0.0f, 0.4f, 0.05f, 3.0f, 2.0f);
+            add_box(&s, grey, -0.05f, 2.1f, -0.4f, 0.05f, 3.0f, 0.4f);
+        } else
+            add_box(&s, grey, -0.05f, 0.0f, -2.0f, 0.05f, 3.0f, 2.0f);
+        assert_non_null(lpv_scene_add_point_light(&s, (float[3]){-2.0f, 2.2f, 0.0f}, 5.0f));
+        lpv_scene_compute_bounds(&s);
+        lpv_reach r;
+        build_and_light(&r, &s);
+        assert_true(lpv_reach_at(&r, (float[3]){-2.0f, 0.0f, 0.0f}, UP) == 1.0f);
+        assert_true(lpv_reach_at(&r, (float[3]){-0.05f, 1.5f, 1.0f}, NX) == 1.0f);
+        const float expect = door ? 1.0f : 0.0f;
+        assert_true(lpv_reach_at(&r, (float[3]){2.0f, 0.0f, 0.0f}, UP) == expect);
+        assert_true(lpv_reach_at(&r, (float[3]){0.05f, 1.5f, 1.0f}, PX) == expect);
+        lpv_reach_free(&r);
+        lpv_scene_free(&s);
+    }
+}
+
+/* A light inside a solid voxel (here in a floor slab thinner than a voxel)
+ * lights the air around that voxel: both sides of the slab. */
+static void test_light_in_thin_slab(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    add_box(&s, grey, -2.0f, -0.005f, -2.0f, 2.0f, 0.0f, 2.0f);
+    add_box(&s, grey, -2.0f, -1.0f, -2.0f, 2.0f, 2.0f, -1.9f); /* a wall, so the bounds have depth */
+    assert_non_null(lpv_scene_add_point_light(&s, (float[3]){0.0f, -0.0025f, 0.0f}, 5.0f));
+    lpv_scene_compute_bounds(&s);
+    lpv_reach r;
+    build_and_light(&r, &s);
+    assert_true(r.voxel > 0.005f);
+    assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){1.0f, -0.005f, 1.0f}, DOWN) == 1.0f);
+    lpv_reach_free(&r);
+    lpv_scene_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_closed_box_keeps_its_light),
+        cmocka_unit_test(test_open_box_lights_the_room),
+        cmocka_unit_test(test_directional_and_emitters),
+        cmocka_unit_test(test_two_rooms),
+        cmocka_unit_test(test_light_in_thin_slab),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
