@@ -12,7 +12,5 @@ void main()
     int i = int(gl_GlobalInvocationID.x);
     if (i >= u_count)
         return;
-    vec3 p = queries[2 * i].xyz, n = queries[2 * i + 1].xyz;
-    float l = length(n);
-    results[i] = vec4(lpv_reach(p, l > 0.0 ? n / l : n) * lpv_irradiance(p, n), 0.0);
+    results[i] = vec4(lpv_irradiance(queries[2 * i].xyz, queries[2 * i + 1].xyz), 0.0);
 }
