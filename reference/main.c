@@ -25,7 +25,7 @@ static const char USAGE_HEAD[] =
     "Without SCENE: the built-in Cornell box.\n"
     "\n";
 
-enum { F_OUT, F_STDERR, F_FULL, F_AREA, F_BOUNCES, F_SPP, F_THREADS, F_SEED, F_POINTS, F_HELP, F_COUNT };
+enum { F_OUT, F_STDERR, F_FULL, F_AREA, F_BOUNCES, F_MAX_BOUNCES, F_SPP, F_THREADS, F_SEED, F_POINTS, F_HELP, F_COUNT };
 
 /* Long-only parsing: "-spp 64" is "--spp 64", as it always was here. */
 static const lpv_flag FLAGS[F_COUNT] = {
@@ -34,7 +34,10 @@ static const lpv_flag FLAGS[F_COUNT] = {
     [F_FULL] = {"full", 0, NULL, "the full frame: emission + direct + bounced light"},
     [F_AREA] = {"area-lights", 0, "on|off", "on (default, as lpvd): emissive surfaces are lights, their\n"
                                             "direct light is not in E_ind; off: it is (lpvd --area-lights off)"},
-    [F_BOUNCES] = {"bounces", 0, "N", "diffuse bounces (default 1 = lpvd's LPV term; --full: 0..64)"},
+    [F_BOUNCES] = {"bounces", 0, "N|converged", "diffuse bounces (default 1 = lpvd's LPV term; --full: 0..64);\n"
+                                               "converged (or all): every bounce until the path's throughput\n"
+                                               "is negligible (Russian roulette), the light a user sees"},
+    [F_MAX_BOUNCES] = {"max-bounces", 0, "N", "the cap on a converged path's bounces (default 64)"},
     [F_SPP] = {"spp", 0, "N", "samples per pixel or point (default 64)"},
     [F_THREADS] = {"threads", 0, "N", "worker threads (default: the number of cores)"},
     [F_SEED] = {"seed", 0, "N", "RNG seed (default 0)"},
@@ -115,6 +118,15 @@ static long read_points(const char *path, float **pts, float **nrm)
     return (long)n;
 }
 
+/* "3 bounce(s)" or "converged bounces". */
+static void bounce_label(int bounces, char *buf, size_t size)
+{
+    if (bounces == LPV_REF_BOUNCES_CONVERGED)
+        snprintf(buf, size, "%s", "converged bounces");
+    else
+        snprintf(buf, size, "%d bounce(s)", bounces);
+}
+
 static int run_points(const lpv_ref *ref, const char *in, const char *out, int bounces, int spp)
 {
     float *pts = NULL, *nrm = NULL;
@@ -154,9 +166,11 @@ static int run_points(const lpv_ref *ref, const char *in, const char *out, int b
         fprintf(stderr, "lpvd-reference: writing %s failed\n", out);
         goto done;
     }
-    printf("lpvd-reference: %ld points, %d spp, %d bounce(s), %d threads, %.3f s, mean relative standard error "
+    char bl[32];
+    bounce_label(bounces, bl, sizeof bl);
+    printf("lpvd-reference: %ld points, %d spp, %s, %d threads, %.3f s, mean relative standard error "
            "%.4g, wrote %s\n",
-           n, spp, bounces, lpv_ref_threads(ref), secs, rel_n ? rel / (double)rel_n : 0.0, out);
+           n, spp, bl, lpv_ref_threads(ref), secs, rel_n ? rel / (double)rel_n : 0.0, out);
     rc = 0;
 done:
     free(pts);
@@ -169,7 +183,7 @@ done:
 int main(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *se_out = NULL, *points = NULL;
-    int bounces = 1, spp = 64, threads = 0, full = 0, area_lights = 1;
+    int bounces = 1, max_bounces = 0, spp = 64, threads = 0, full = 0, area_lights = 1;
     unsigned long long seed = 0;
     lpv_view_choice cam;
     memset(&cam, 0, sizeof cam);
@@ -219,8 +233,17 @@ int main(int argc, char **argv)
             area_lights = strcmp(val, "on") == 0;
             break;
         case F_BOUNCES:
-            if (parse_int(val, 0, 64, &bounces) != 0) {
-                fprintf(stderr, "lpvd-reference: --bounces %s: expected 1..64 (0..64 with --full)\n", val);
+            if (strcmp(val, "converged") == 0 || strcmp(val, "all") == 0) {
+                bounces = LPV_REF_BOUNCES_CONVERGED;
+            } else if (parse_int(val, 0, 64, &bounces) != 0) {
+                fprintf(stderr, "lpvd-reference: --bounces %s: expected 1..64 (0..64 with --full) or converged\n",
+                        val);
+                return 2;
+            }
+            break;
+        case F_MAX_BOUNCES:
+            if (parse_int(val, 1, 1 << 16, &max_bounces) != 0) {
+                fprintf(stderr, "lpvd-reference: --max-bounces %s: expected 1..65536\n", val);
                 return 2;
             }
             break;
@@ -267,7 +290,8 @@ int main(int argc, char **argv)
         return 1;
     }
     lpv_ref *ref = NULL;
-    lpv_ref_desc desc = {.threads = threads, .seed = seed, .emitters_are_lights = area_lights};
+    lpv_ref_desc desc = {
+        .threads = threads, .seed = seed, .emitters_are_lights = area_lights, .max_bounces = max_bounces};
     double t0 = now_s();
     if (lpv_ref_create(&scene, &desc, &ref, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-reference: %s: %s\n", scene.source, err);
@@ -307,12 +331,13 @@ int main(int argc, char **argv)
         (se_out && lpv_image_write_f32(se_out, view.width, view.height, 4, se, err, sizeof err) != 0)) {
         fprintf(stderr, "lpvd-reference: %s\n", err);
     } else {
-        printf("lpvd-reference: %s, %u triangles (build %.3f s), %dx%d, %s, %d spp, %d bounce(s), %d threads, "
+        char bl[32];
+        bounce_label(bounces, bl, sizeof bl);
+        printf("lpvd-reference: %s, %u triangles (build %.3f s), %dx%d, %s, %d spp, %s, %d threads, "
                "%.3f s, mean relative standard error %.4g, wrote %s%s%s\n",
                scene.source, lpv_ref_triangle_count(ref), build_s, view.width, view.height,
                full ? "full frame" : area_lights ? "indirect, area lights on" : "indirect, area lights off", spp,
-               bounces,
-               lpv_ref_threads(ref), secs, rel, out, se_out ? " and " : "", se_out ? se_out : "");
+               bl, lpv_ref_threads(ref), secs, rel, out, se_out ? " and " : "", se_out ? se_out : "");
         rc = 0;
     }
     free(img);

@@ -51,6 +51,7 @@ struct lpv_ref {
     double *emitter_cdf; /* emitter_count + 1 running sums of (L_r + L_g + L_b) A */
     uint32_t emitter_count;
     int emitters_are_lights;
+    int max_bounces; /* converged paths' cap */
     int threads;
     uint64_t seed;
     float eps;
@@ -284,6 +285,7 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
     r->threads = resolve_threads(d.threads);
     r->seed = d.seed;
     r->emitters_are_lights = d.emitters_are_lights != 0;
+    r->max_bounces = d.max_bounces > 0 ? d.max_bounces : LPV_REF_MAX_BOUNCES_DEFAULT;
 
     /* Triangles. */
     size_t cap = 0;
@@ -706,8 +708,18 @@ static void sample_path(const lpv_ref *r, pcg32 *rng, const float p_in[3], const
     memcpy(ns, ns_in, sizeof ns);
     memcpy(ng, ng_in, sizeof ng);
     out[0] = out[1] = out[2] = 0.0;
+    const int converged = bounces == LPV_REF_BOUNCES_CONVERGED;
+    if (converged)
+        bounces = r->max_bounces;
     for (int depth = 1; depth <= bounces; ++depth) {
         float dir[3], org[3];
+        if (converged && depth > LPV_REF_RR_START) {
+            float q = fminf(0.95f, fmaxf(thr[0], fmaxf(thr[1], thr[2])));
+            if (!(pcg32_float(rng) < q))
+                break;
+            for (int i = 0; i < 3; ++i)
+                thr[i] /= q;
+        }
         sample_cosine(rng, ns, dir);
         if (!(dot3(dir, ng) > 0.0f))
             break; /* below the surface itself (shading normal != geometric) */
@@ -751,8 +763,18 @@ static void sample_path_lights(const lpv_ref *r, pcg32 *rng, const float p_in[3]
     out[0] = out[1] = out[2] = 0.0;
     if (with_direct)
         emitter_direct(r, rng, p, ns, ng, out);
+    const int converged = bounces == LPV_REF_BOUNCES_CONVERGED;
+    if (converged)
+        bounces = r->max_bounces;
     for (int depth = 1; depth <= bounces; ++depth) {
         float dir[3], org[3];
+        if (converged && depth > LPV_REF_RR_START) {
+            double q = fmin(0.95, fmax(thr[0], fmax(thr[1], thr[2])));
+            if (!((double)pcg32_float(rng) < q))
+                break;
+            for (int i = 0; i < 3; ++i)
+                thr[i] /= q;
+        }
         sample_cosine(rng, ns, dir);
         if (!(dot3(dir, ng) > 0.0f))
             break;
@@ -884,7 +906,7 @@ static void point_item(job *j, size_t i)
 int lpv_ref_irradiance(const lpv_ref *r, const float *points, const float *normals, size_t n, int bounces,
                        int samples, float *out_rgb, float *out_stderr_rgb)
 {
-    if (!r || (n && (!points || !normals)) || bounces < 1 || samples < 1)
+    if (!r || (n && (!points || !normals)) || (bounces < 1 && bounces != LPV_REF_BOUNCES_CONVERGED) || samples < 1)
         return -1;
     if (!n)
         return 0;
@@ -971,7 +993,8 @@ static void pixel_item(job *j, size_t i)
 
 int lpv_ref_render_indirect(const lpv_ref *r, const lpv_view *view, int bounces, int spp, float *rgba, float *rgba_se)
 {
-    if (!r || !view || !rgba || view->width < 1 || view->height < 1 || bounces < 1 || spp < 1)
+    if (!r || !view || !rgba || view->width < 1 || view->height < 1 ||
+        (bounces < 1 && bounces != LPV_REF_BOUNCES_CONVERGED) || spp < 1)
         return -1;
     job j = {.ref = r, .count = (size_t)view->width * (size_t)view->height, .item = pixel_item, .view = view,
              .rgba = rgba, .rgba_se = rgba_se, .bounces = bounces, .samples = spp};
@@ -981,7 +1004,8 @@ int lpv_ref_render_indirect(const lpv_ref *r, const lpv_view *view, int bounces,
 
 int lpv_ref_render_full(const lpv_ref *r, const lpv_view *view, int bounces, int spp, float *rgba, float *rgba_se)
 {
-    if (!r || !view || !rgba || view->width < 1 || view->height < 1 || bounces < 0 || spp < 1)
+    if (!r || !view || !rgba || view->width < 1 || view->height < 1 ||
+        (bounces < 0 && bounces != LPV_REF_BOUNCES_CONVERGED) || spp < 1)
         return -1;
     job j = {.ref = r, .count = (size_t)view->width * (size_t)view->height, .item = pixel_item, .view = view,
              .rgba = rgba, .rgba_se = rgba_se, .bounces = bounces, .samples = spp, .full = 1};

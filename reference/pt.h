@@ -48,7 +48,21 @@ typedef struct lpv_ref_desc {
     int emitters_are_lights; /* 1: emissive surfaces are lights (their direct light is not in E_ind),
                                 the split lpvd makes with area lights on; 0: emission seen directly
                                 is part of E_ind (area lights off) */
+    int max_bounces;         /* the cap on a converged path's bounces (LPV_REF_BOUNCES_CONVERGED);
+                                0 = LPV_REF_MAX_BOUNCES_DEFAULT; ignored by fixed bounce counts */
 } lpv_ref_desc;
+
+/* `bounces` value: converged light, i.e. every bounce until the path's
+ * throughput is negligible. Paths run unchanged for LPV_REF_RR_START bounces,
+ * then survive each further bounce with probability
+ * q = min(0.95, max channel of the throughput) and divide by q (Russian
+ * roulette: unbiased), up to lpv_ref_desc.max_bounces. Light that needs more
+ * bounces than the cap is the only thing missing (a closed box of albedo a
+ * loses a^cap of it: 0.8^64 = 6e-7). Fixed bounce counts never use roulette
+ * and are bit-identical to what they always were. */
+#define LPV_REF_BOUNCES_CONVERGED (-1)
+#define LPV_REF_MAX_BOUNCES_DEFAULT 64
+#define LPV_REF_RR_START 3
 
 /* Builds the reference for a scene (copied: the scene may be freed after).
  * Triangles with out-of-range indices, non-finite corners or zero area are
@@ -69,7 +83,8 @@ int lpv_ref_threads(const lpv_ref *ref);
  * gives 0. */
 void lpv_ref_direct_irradiance(const lpv_ref *ref, const float p[3], const float n[3], float out_rgb[3]);
 
-/* E_ind at n points (points, normals: 3 floats each), `bounces` >= 1,
+/* E_ind at n points (points, normals: 3 floats each), `bounces` >= 1 or
+ * LPV_REF_BOUNCES_CONVERGED,
  * `samples` >= 1 per point. out_rgb and out_stderr_rgb (either may be NULL)
  * get 3 floats per point: the estimate and its standard error. A point with a
  * non-finite position or degenerate normal gets 0 and 0. Returns 0, or -1 on
@@ -80,6 +95,7 @@ int lpv_ref_irradiance(const lpv_ref *ref, const float *points, const float *nor
 /* The indirect-only image: per pixel (width * height * 4 floats, top row
  * first) albedo/pi * E_ind(bounces) at the first surface the ray through the
  * pixel centre hits (normal turned towards the camera), alpha 1; background 0
+ * (bounces >= 1 or LPV_REF_BOUNCES_CONVERGED)
  * with alpha 0. rgba_stderr (may be NULL) gets the standard error of each
  * channel (alpha: as the image). Returns 0, or -1 on bad arguments. */
 int lpv_ref_render_indirect(const lpv_ref *ref, const lpv_view *view, int bounces, int samples_per_pixel,
@@ -88,7 +104,8 @@ int lpv_ref_render_indirect(const lpv_ref *ref, const lpv_view *view, int bounce
 /* The full image: per pixel L_e (front side) + albedo/pi * (E_direct +
  * E_ind(bounces)) at the first surface, emitters as lights whatever the
  * desc says: bounces = diffuse reflections of direct light, punctual and
- * emitted alike (1 = what lpvd's full frame approximates; 0 = direct only).
+ * emitted alike (1 = what lpvd's full frame approximates; 0 = direct only;
+ * LPV_REF_BOUNCES_CONVERGED = every bounce, what a user sees).
  * Punctual light is exact, the emitters' direct light and the bounces are
  * sampled (samples_per_pixel each); rgba_stderr (may be NULL) as in
  * lpv_ref_render_indirect. Returns 0, or -1 on bad arguments. */

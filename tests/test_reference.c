@@ -3,7 +3,11 @@
  * from punctual lights equals the analytic formula, one bounce off a finite
  * emissive rectangle agrees with its form factor within 3 standard errors,
  * the furnace (closed sphere, uniform albedo and emission) gives
- * pi L_e (1 + rho + ... + rho^(N-1)), the standard error falls like
+ * pi L_e (1 + rho + ... + rho^(N-1)), converged light (Russian roulette,
+ * LPV_REF_BOUNCES_CONVERGED) gives the whole series pi L_e / (1 - rho) in
+ * both estimators and matches 64 fixed bounces in the Cornell box within
+ * noise, a cap at or below the roulette's start is the fixed count bit for
+ * bit, the standard error falls like
  * 1/sqrt(spp), primary rays map back into their pixel through
  * lpv_view_project, the Cornell image is finite, bleeds colour and is
  * bit-identical across runs and thread counts, and hostile input is skipped.
@@ -431,6 +435,186 @@ static void test_furnace_lit(void **state)
     lpv_scene_free(&b.s);
 }
 
+/* ---- 2b. converged light ----------------------------------------------------- */
+
+static lpv_ref *make_ref_desc(const lpv_scene *s, const lpv_ref_desc *d)
+{
+    lpv_ref *ref = NULL;
+    char err[256] = "";
+    int rc = lpv_ref_create(s, d, &ref, err, sizeof err);
+    if (rc != 0)
+        print_error("lpv_ref_create: %s\n", err);
+    assert_int_equal(rc, 0);
+    return ref;
+}
+
+/* 1 + rho + ... + rho^(n-1) */
+static double geo_sum(double rho, int n)
+{
+    double geo = 0.0, pw = 1.0;
+    for (int j = 0; j < n; ++j, pw *= rho)
+        geo += pw;
+    return geo;
+}
+
+/* The lit furnace, converged: every bounce of the series. Emission seen
+ * directly (area lights off): E = (pi L_e + rho E_d) / (1 - rho); emitters as
+ * lights: E = rho (pi L_e + E_d) / (1 - rho), the 1-bounce term times
+ * 1 / (1 - rho). Both up to the default cap's rho^64 (< 1e-6 here). The
+ * roulette gives every sample a different weight: the estimate has a
+ * standard error, and must sit within it of the series sum. */
+static void test_furnace_converged(void **state)
+{
+    (void)state;
+    builder b;
+    b_init(&b);
+    int m = b_material(&b, FURNACE_RHO[0], FURNACE_RHO[1], FURNACE_RHO[2], FURNACE_LE[0], FURNACE_LE[1],
+                       FURNACE_LE[2]);
+    build_icosphere(&b, 3, m);
+    lpv_light *li = b_light(&b, LPV_LIGHT_POINT);
+    li->intensity = 0.4f;
+    const double intensity = li->intensity;
+    for (int lights = 0; lights <= 1; ++lights) {
+        lpv_ref_desc d = {.emitters_are_lights = lights};
+        lpv_ref *ref = make_ref_desc(&b.s, &d);
+        float e[12], se[12], e1[12], se1[12];
+        assert_int_equal(lpv_ref_irradiance(ref, &FURNACE_P[0][0], &FURNACE_N[0][0], 4, LPV_REF_BOUNCES_CONVERGED,
+                                            4096, e, se),
+                         0);
+        assert_int_equal(lpv_ref_irradiance(ref, &FURNACE_P[0][0], &FURNACE_N[0][0], 4, 1, 4096, e1, se1), 0);
+        for (int c = 0; c < 3; ++c) {
+            double rho = FURNACE_RHO[c], geo = geo_sum(rho, LPV_REF_MAX_BOUNCES_DEFAULT);
+            double emit = M_PI * FURNACE_LE[c], lit = rho * intensity;
+            double want = lights ? rho * (emit + intensity) * geo : (emit + lit) * geo;
+            double facets = 0.01 * (lights ? rho * intensity : lit) * geo; /* E_d within ~0.7 % of I / R^2 */
+            for (int i = 0; i < 4; ++i) {
+                double got = e[3 * i + c], err = se[3 * i + c];
+                print_message("furnace converged (%s) point %d ch %d: %.6f want %.6f (se %.2g), 1 bounce %.6f\n",
+                              lights ? "emitters as lights" : "emission seen", i, c, got, want, err, e1[3 * i + c]);
+                assert_true(err > 0.0);
+                assert_true(err < 0.02 * want);
+                assert_true(fabs(got - want) <= 4.0 * err + facets);
+                /* More than the 1-bounce estimate, by far more than both
+                 * standard errors (the missing bounces are rho/(1-rho) of
+                 * it: 1x, 4x and 0.25x). */
+                assert_true(got - e1[3 * i + c] > 4.0 * (err + se1[3 * i + c]));
+            }
+        }
+        lpv_ref_destroy(ref);
+    }
+    lpv_scene_free(&b.s);
+}
+
+/* Image mean (rgb, covered pixels) and the standard error of that mean. */
+static void image_mean(const float *img, const float *se, int w, int h, double mean[3], double mean_se[3])
+{
+    size_t n = 0;
+    double sum[3] = {0, 0, 0}, var[3] = {0, 0, 0};
+    for (size_t i = 0; i < (size_t)w * (size_t)h; ++i) {
+        if (!(img[4 * i + 3] > 0.0f))
+            continue;
+        n++;
+        for (int c = 0; c < 3; ++c) {
+            sum[c] += img[4 * i + (size_t)c];
+            var[c] += (double)se[4 * i + (size_t)c] * se[4 * i + (size_t)c];
+        }
+    }
+    assert_true(n > 0);
+    for (int c = 0; c < 3; ++c) {
+        mean[c] = sum[c] / (double)n;
+        mean_se[c] = sqrt(var[c]) / (double)n;
+    }
+}
+
+/* Russian roulette is unbiased: in the Cornell box (open, coloured, with
+ * an area light) the converged image's mean equals 64 fixed bounces' within
+ * their standard errors, for the indirect image in both emitter modes and the
+ * full frame, and clearly exceeds the 1-bounce image's. */
+static void test_converged_matches_fixed(void **state)
+{
+    (void)state;
+    enum { W = 16, SPPC = 128 };
+    lpv_scene s;
+    assert_int_equal(lpv_scene_builtin_cornell(&s), 0);
+    lpv_view v;
+    lpv_view_from_camera(&s.cameras[0], W, W, &v);
+    size_t n = (size_t)W * W * 4;
+    float *a = malloc(n * sizeof *a), *a_se = malloc(n * sizeof *a_se);
+    float *f = malloc(n * sizeof *f), *f_se = malloc(n * sizeof *f_se);
+    float *o = malloc(n * sizeof *o), *o_se = malloc(n * sizeof *o_se);
+    assert_true(a && a_se && f && f_se && o && o_se);
+    for (int mode = 0; mode < 3; ++mode) { /* indirect lights off, indirect lights on, full */
+        lpv_ref_desc d = {.emitters_are_lights = mode != 0, .seed = 7};
+        lpv_ref *ref = make_ref_desc(&s, &d);
+        if (mode == 2) {
+            assert_int_equal(lpv_ref_render_full(ref, &v, LPV_REF_BOUNCES_CONVERGED, SPPC, a, a_se), 0);
+            assert_int_equal(lpv_ref_render_full(ref, &v, 64, SPPC, f, f_se), 0);
+            assert_int_equal(lpv_ref_render_full(ref, &v, 1, SPPC, o, o_se), 0);
+        } else {
+            assert_int_equal(lpv_ref_render_indirect(ref, &v, LPV_REF_BOUNCES_CONVERGED, SPPC, a, a_se), 0);
+            assert_int_equal(lpv_ref_render_indirect(ref, &v, 64, SPPC, f, f_se), 0);
+            assert_int_equal(lpv_ref_render_indirect(ref, &v, 1, SPPC, o, o_se), 0);
+        }
+        double ma[3], sa[3], mf[3], sf[3], mo[3], so[3];
+        image_mean(a, a_se, W, W, ma, sa);
+        image_mean(f, f_se, W, W, mf, sf);
+        image_mean(o, o_se, W, W, mo, so);
+        for (int c = 0; c < 3; ++c) {
+            double tol = 4.0 * sqrt(sa[c] * sa[c] + sf[c] * sf[c]);
+            print_message("cornell mode %d ch %d: converged %.6f (se %.2g), 64 bounces %.6f (se %.2g), 1 bounce %.6f\n",
+                          mode, c, ma[c], sa[c], mf[c], sf[c], mo[c]);
+            assert_true(fabs(ma[c] - mf[c]) <= tol);
+            assert_true(ma[c] - mo[c] > 4.0 * (sa[c] + so[c]));
+        }
+        lpv_ref_destroy(ref);
+    }
+    free(a);
+    free(a_se);
+    free(f);
+    free(f_se);
+    free(o);
+    free(o_se);
+    lpv_scene_free(&s);
+}
+
+/* The cap: a converged path never rolls the dice before LPV_REF_RR_START
+ * bounces, so a cap at or below it is the fixed bounce count bit for bit
+ * (and the fixed counts are what they always were: no roulette). Bad
+ * bounce values are refused. */
+static void test_converged_cap(void **state)
+{
+    (void)state;
+    enum { W = 8 };
+    lpv_scene s;
+    assert_int_equal(lpv_scene_builtin_cornell(&s), 0);
+    lpv_view v;
+    lpv_view_from_camera(&s.cameras[0], W, W, &v);
+    size_t n = (size_t)W * W * 4;
+    float *a = malloc(n * sizeof *a), *a_se = malloc(n * sizeof *a_se);
+    float *f = malloc(n * sizeof *f), *f_se = malloc(n * sizeof *f_se);
+    assert_true(a && a_se && f && f_se);
+    for (int lights = 0; lights <= 1; ++lights)
+        for (int cap = 1; cap <= LPV_REF_RR_START; ++cap) {
+            lpv_ref_desc d = {.emitters_are_lights = lights, .max_bounces = cap};
+            lpv_ref *ref = make_ref_desc(&s, &d);
+            assert_int_equal(lpv_ref_render_indirect(ref, &v, LPV_REF_BOUNCES_CONVERGED, 8, a, a_se), 0);
+            assert_int_equal(lpv_ref_render_indirect(ref, &v, cap, 8, f, f_se), 0);
+            assert_memory_equal(a, f, n * sizeof *a);
+            assert_memory_equal(a_se, f_se, n * sizeof *a);
+            assert_int_equal(lpv_ref_render_full(ref, &v, LPV_REF_BOUNCES_CONVERGED, 8, a, a_se), 0);
+            assert_int_equal(lpv_ref_render_full(ref, &v, cap, 8, f, f_se), 0);
+            assert_memory_equal(a, f, n * sizeof *a);
+            assert_int_equal(lpv_ref_render_indirect(ref, &v, -2, 8, a, a_se), -1);
+            assert_int_equal(lpv_ref_render_full(ref, &v, -2, 8, a, a_se), -1);
+            lpv_ref_destroy(ref);
+        }
+    free(a);
+    free(a_se);
+    free(f);
+    free(f_se);
+    lpv_scene_free(&s);
+}
+
 /* ---- 3. the Cornell image ------------------------------------------------------ */
 
 static void test_pixel_rays_project_back(void **state)
@@ -680,6 +864,9 @@ int main(void)
         cmocka_unit_test(test_one_bounce_rectangle),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_furnace_lit),
+        cmocka_unit_test(test_furnace_converged),
+        cmocka_unit_test(test_converged_matches_fixed),
+        cmocka_unit_test(test_converged_cap),
         cmocka_unit_test(test_pixel_rays_project_back),
         cmocka_unit_test(test_cornell_image),
         cmocka_unit_test(test_texture_albedo),

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """check_results.py - checks an lpvd-accuracy results.csv (the CI sweep).
 
-  check_results.py RESULTS.csv [--scene NAME --better POINT --worse POINT] [--rows N]
+  check_results.py RESULTS.csv [--scene NAME --better POINT --worse POINT [--metric COLUMN]] [--rows N]
                    [--lookup-steps LIST]
 
 POINT is G:I:R:on|off:MODS:TECHNIQUE for an LPV point, or
@@ -13,10 +13,17 @@ named preset, else the preset's name; and for technique iv the LPV's own knobs
 grid, iterations, occlusion and mods, which are empty, while its iv_* columns,
 empty on LPV rows, are filled and its ref_bounces equals its iv_bounces),
 pareto is 0 or 1, at least one row per scene is on the front, and (with
---better/--worse) the "better" point of --scene has a lower rel_rmse than the
-"worse" one, and (with --lookup-steps 1,2) every point ran at each listed
-lookup step (the lookup_step column). No timing is asserted. Standard
-library only.
+--better/--worse) the "better" point of --scene has a lower --metric (default
+rel_rmse, the error against converged light; rel_rmse_own: against the
+reference with the point's own bounce count) than the "worse" one, and (with
+--lookup-steps 1,2) every point ran at each listed lookup step (the
+lookup_step column). Since issue 30 rel_rmse, rel_bias and rel_mae are against
+converged light and rel_*_own against the own-bounce reference: every row must
+have them all, ref_noise2 > 0, at_ref_noise 0 or 1 and equal to
+rel_rmse < 2 ref_noise2, and rel_bias < rel_bias_own (converged light holds
+more light than any fewer bounces, so a frame is darker against it: a row
+where it is not was scored against the wrong reference). No timing is
+asserted. Standard library only.
 """
 import argparse
 import csv
@@ -31,6 +38,8 @@ NUMERIC = COLUMNS[7:]
 IV_KNOBS = ["iv_resolution", "iv_points", "iv_rays", "iv_bounces", "iv_reprojection", "iv_neighbours"]
 IV_COLUMNS = IV_KNOBS + ["ms_iv_points", "ms_iv_reproject", "ms_iv_resolve", "ms_iv_gather", "ms_iv_ao",
                          "ref_bounces", "rel_rmse_1b"]
+# Issue 30: the score against the own-bounce reference beside the converged one.
+OWN_COLUMNS = ["rel_rmse_own", "rel_bias_own", "rel_mae_own", "ref_noise_own", "ref_noise2", "at_ref_noise"]
 LPV_ONLY = {"grid", "iterations", "occlusion", "mods"}  # empty on iv rows
 # preset: the named preset the point equals; legitimately empty for most points.
 OPTIONAL = {"preset": ("fast", "balanced", "accurate")}
@@ -51,11 +60,13 @@ def main():
     ap.add_argument("--worse")
     ap.add_argument("--rows", type=int)
     ap.add_argument("--lookup-steps")
+    ap.add_argument("--metric", default="rel_rmse", choices=("rel_rmse", "rel_rmse_own"))
     a = ap.parse_args()
     problems = []
     with open(a.csv, newline="") as f:
         reader = csv.DictReader(f)
-        missing = [c for c in COLUMNS + list(OPTIONAL) + IV_COLUMNS if c not in (reader.fieldnames or [])]
+        missing = [c for c in COLUMNS + list(OPTIONAL) + IV_COLUMNS + OWN_COLUMNS
+                   if c not in (reader.fieldnames or [])]
         if missing:
             sys.exit("FAIL: %s: missing columns %s" % (a.csv, ", ".join(missing)))
         rows = list(reader)
@@ -65,7 +76,7 @@ def main():
         problems.append("no rows")
     for n, row in enumerate(rows, start=2):
         iv = row.get("technique") == "iv"
-        for c in COLUMNS + (IV_COLUMNS if iv else []):
+        for c in COLUMNS + OWN_COLUMNS + (IV_COLUMNS if iv else []):
             v = (row.get(c) or "").strip()
             if iv and c in LPV_ONLY:
                 if v:
@@ -77,7 +88,7 @@ def main():
                 continue
             if not v:
                 problems.append("line %d: column %s is empty" % (n, c))
-            elif c in NUMERIC:
+            elif c in NUMERIC or c in OWN_COLUMNS:
                 try:
                     x = float(v)
                 except ValueError:
@@ -85,6 +96,20 @@ def main():
                     continue
                 if not math.isfinite(x):
                     problems.append("line %d: %s=%s is not finite" % (n, c, v))
+        try:
+            rmse, noise2 = float(row["rel_rmse"]), float(row["ref_noise2"])
+            bias, bias_own = float(row["rel_bias"]), float(row["rel_bias_own"])
+            if not noise2 > 0:
+                problems.append("line %d: ref_noise2=%s (the converged reference's noise from two seeds)"
+                                % (n, row["ref_noise2"]))
+            if row["at_ref_noise"] != ("1" if rmse < 2 * noise2 else "0"):
+                problems.append("line %d: at_ref_noise=%s with rel_rmse %s and ref_noise2 %s"
+                                % (n, row["at_ref_noise"], row["rel_rmse"], row["ref_noise2"]))
+            if not bias < bias_own:
+                problems.append("line %d: rel_bias %+.4f vs converged light is not below rel_bias_own %+.4f vs %s "
+                                "bounce(s)" % (n, bias, bias_own, row.get("ref_bounces")))
+        except (KeyError, ValueError):
+            pass  # reported above as empty or not a number
         if iv and (row.get("ref_bounces") or "").strip() != (row.get("iv_bounces") or "").strip():
             problems.append("line %d: iv point with iv_bounces=%s compared with a %s-bounce reference"
                             % (n, row.get("iv_bounces"), row.get("ref_bounces")))
@@ -104,11 +129,12 @@ def main():
         if a.better not in sel or a.worse not in sel:
             problems.append("scene %s: points %s and %s not both in the CSV" % (a.scene, a.better, a.worse))
         else:
-            b, w = float(sel[a.better]["rel_rmse"]), float(sel[a.worse]["rel_rmse"])
-            print("%s: %s rel_rmse %.4f, %s rel_rmse %.4f" % (a.scene, a.better, b, a.worse, w))
+            m = a.metric
+            b, w = float(sel[a.better][m]), float(sel[a.worse][m])
+            print("%s: %s %s %.4f, %s %s %.4f" % (a.scene, a.better, m, b, a.worse, m, w))
             if not b < w:
-                problems.append("scene %s: %s (rel_rmse %.4f) is not more accurate than %s (%.4f)"
-                                % (a.scene, a.better, b, a.worse, w))
+                problems.append("scene %s: %s (%s %.4f) is not more accurate than %s (%.4f)"
+                                % (a.scene, a.better, m, b, a.worse, w))
     if a.lookup_steps:
         want = sorted(a.lookup_steps.split(","))
         by_point = {}

@@ -238,7 +238,9 @@ typedef struct result {
     lpv_acc_metrics m;
     int pareto;
     int cascades_used;          /* lpv_engine_cascade_count after the point's ticks */
-    int ref_bounces;            /* bounces of the reference m compares with */
+    int ref_bounces;            /* bounces of the point's own reference (own) */
+    lpv_acc_metrics own;        /* vs that own-bounce reference (m: vs converged light) */
+    int at_noise;               /* m.rel_rmse < 2 x the scene's ref_noise2: at the reference's noise */
     double rel_rmse_1b;         /* vs the 1-bounce reference */
     double rel_rmse_multi;      /* vs the multi-bounce reference; NAN when not rendered */
     double black, constant;     /* the baselines' rel_rmse (lpv_acc_baselines) */
@@ -305,19 +307,28 @@ typedef struct scene_entry {
     float eye[3], target[3], fov;
     float cascade_size; /* m, for --features' "cascades-3" (0: auto) */
     int scale_free;     /* a real scene in its own units (engine: millimetres) */
+    /* converged light (LPV_REF_BOUNCES_CONVERGED), rendered with two seeds:
+     * their mean is what every point is scored against */
+    char cref_exr[2][1024], cref_se[2][1024];
+    int have_cse[2];
+    int conv_spp;     /* samples per pixel of each seed */
+    double ref_noise2; /* sqrt(mean((R1 - R2)^2)) / 2 / mean(R): the noise of their mean */
     int nxref;          /* the iv points' B-bounce references (B > 1), for results.md */
     int xref_bounces[LPV_IV_MAX_BOUNCES];
     char xref_exr[LPV_IV_MAX_BOUNCES][1024];
 } scene_entry;
 
 enum {
-    A_OUT, A_REF_SPP, A_SCENES, A_QUICK, A_PRESETS, A_FEATURES, A_MULTI_BOUNCES, A_KNOBS, A_POINTS,
+    A_OUT, A_REF_SPP, A_CONV_SPP, A_SCENES, A_QUICK, A_PRESETS, A_FEATURES, A_MULTI_BOUNCES, A_KNOBS, A_POINTS,
     A_TICKS, A_WARMUP, A_REFERENCE, A_NO_PLOT, A_EMISSIVE, A_IV_TABLES, A_HELP, A_COUNT
 };
 
 static const lpv_flag FLAGS[A_COUNT] = {
     [A_OUT] = {"out", 0, "DIR", "output folder (default accuracy-out)"},
     [A_REF_SPP] = {"ref-spp", 0, "N", "reference samples per pixel (default 256)"},
+    [A_CONV_SPP] = {"conv-spp", 0, "N", "samples per pixel of each of the two seeds of the converged\n"
+                                        "reference every point is scored against (default ref-spp / 2:\n"
+                                        "their mean has ref-spp)"},
     [A_SCENES] = {"scenes", 0, "LIST",
                   "comma list: cornell (built-in), courtyard, blinds (scenes/*.glb),\n"
                   "engine, clearcoat (Debian's assimp-testmodels: 2CylinderEngine.glb,\n"
@@ -386,7 +397,7 @@ static void usage(FILE *f)
     size_t len = 0;
     lpv_flags_help(help, sizeof help, &len, FLAGS, A_COUNT);
     fprintf(f,
-            "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--scenes LIST] [--quick] [--presets]\n"
+            "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--conv-spp N] [--scenes LIST] [--quick] [--presets]\n"
             "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
             "                     [--reference PATH] [--no-plot] [--iv-tables] [lpvd flags: --backend, --camera, ...]\n"
             "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
@@ -695,8 +706,9 @@ static int run_command(char *const argv[])
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/* The reference in process (lpv_reference): 1 bounce, spp samples per pixel. */
-static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, int bounces, int spp,
+/* The reference in process (lpv_reference): `bounces` bounces
+ * (LPV_REF_BOUNCES_CONVERGED: converged light), spp samples per pixel. */
+static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, int bounces, int spp, uint64_t seed,
                                 int area_lights, const char *exr, const char *se_exr)
 {
     char err[1024] = "";
@@ -706,8 +718,8 @@ static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, in
     int rc = -1;
     if (!rgba || !se) {
         fprintf(stderr, "lpvd-accuracy: out of memory for the reference\n");
-    } else if (lpv_ref_create(scene, &(lpv_ref_desc){.emitters_are_lights = area_lights}, &ref, err, sizeof err) !=
-               0) {
+    } else if (lpv_ref_create(scene, &(lpv_ref_desc){.emitters_are_lights = area_lights, .seed = seed}, &ref, err,
+                              sizeof err) != 0) {
         fprintf(stderr, "lpvd-accuracy: reference: %s\n", err);
     } else if (lpv_ref_render_indirect(ref, view, bounces, spp, rgba, se) != 0) {
         fprintf(stderr, "lpvd-accuracy: reference: lpv_ref_render_indirect failed\n");
@@ -723,18 +735,19 @@ static int render_reference_lib(const lpv_scene *scene, const lpv_view *view, in
     return rc;
 }
 
-/* Makes sure the scene's reference is cached; fills e->ref_exr / ref_se.
- * ref_cmd NULL: the linked library (lpv_reference, in process). */
-static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const char *out_dir,
-                            int spp, const char *ref_cmd, char *const *cam_args, int ncam, int bounces,
-                            int area_lights)
+/* Makes sure a reference of the scene is cached under OUT/ref; fills
+ * ref_exr / ref_se (1024 bytes each) and *have_se. bounces > 1 or
+ * LPV_REF_BOUNCES_CONVERGED with a seed (0 = the default stream): their own
+ * keys; the 1-bounce key and file names stay as they were, so old caches
+ * still hit. ref_cmd NULL: the linked library (lpv_reference, in process). */
+static int ensure_reference_as(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const char *out_dir,
+                               int spp, const char *ref_cmd, char *const *cam_args, int ncam, int bounces,
+                               uint64_t seed, int area_lights, char *ref_exr, char *ref_se, int *have_se)
 {
-    /* bounces > 1: the multi-bounce reference, into e->mref_* (the 1-bounce
-     * key and file names stay as they were, so old caches still hit) */
-    char *ref_exr = bounces > 1 ? e->mref_exr : e->ref_exr, *ref_se = bounces > 1 ? e->mref_se : e->ref_se;
-    int *have_se = bounces > 1 ? &e->have_mse : &e->have_se;
-    char bsuffix[16] = "";
-    if (bounces > 1)
+    char bsuffix[64] = "";
+    if (bounces == LPV_REF_BOUNCES_CONVERGED)
+        snprintf(bsuffix, sizeof bsuffix, "-conv-s%llu", (unsigned long long)seed);
+    else if (bounces > 1)
         snprintf(bsuffix, sizeof bsuffix, "-b%d", bounces);
     /* lpvd with area lights on keeps the emitters' direct light out of its
      * indirect term, and so does the reference it is compared with */
@@ -745,8 +758,10 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     h = lpv_hash_bytes(h, view, sizeof *view);
     h = lpv_hash_bytes(h, &spp, sizeof spp);
     h = ref_cmd ? lpv_hash_bytes(h, ref_cmd, strlen(ref_cmd)) : lpv_hash_bytes(h, "lib:lpv_reference", 17);
-    if (bounces > 1)
+    if (bounces > 1 || bounces == LPV_REF_BOUNCES_CONVERGED)
         h = lpv_hash_bytes(h, &bounces, sizeof bounces);
+    if (seed)
+        h = lpv_hash_bytes(h, &seed, sizeof seed);
     char key[256];
     if (snprintf(key, sizeof key, "%s-%dx%d-spp%d%s-%016llx", e->name, view->width, view->height, spp, bsuffix,
                  (unsigned long long)h) >= (int)sizeof key ||
@@ -764,9 +779,13 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     snprintf(tmp_exr, sizeof tmp_exr, "%s/ref/%s.tmp%d.exr", out_dir, key, (int)getpid());
     snprintf(tmp_se, sizeof tmp_se, "%s/ref/%s.stderr.tmp%d.exr", out_dir, key, (int)getpid());
     if (!ref_cmd) {
-        fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, %d bounce(s), %d spp)\n",
-                e->name, bounces, spp);
-        if (render_reference_lib(scene, view, bounces, spp, area_lights, tmp_exr, tmp_se) != 0 ||
+        if (bounces == LPV_REF_BOUNCES_CONVERGED)
+            fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, converged, "
+                            "seed %llu, %d spp)\n", e->name, (unsigned long long)seed, spp);
+        else
+            fprintf(stderr, "lpvd-accuracy: %s: rendering the reference in process (lpv_reference, %d bounce(s), "
+                            "%d spp)\n", e->name, bounces, spp);
+        if (render_reference_lib(scene, view, bounces, spp, seed, area_lights, tmp_exr, tmp_se) != 0 ||
             rename(tmp_exr, ref_exr) != 0 ||
             rename(tmp_se, ref_se) != 0) {
             unlink(tmp_exr);
@@ -778,8 +797,12 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     }
     snprintf(spp_s, sizeof spp_s, "%d", spp);
     snprintf(size_s, sizeof size_s, "%dx%d", view->width, view->height);
-    char bounces_s[16];
-    snprintf(bounces_s, sizeof bounces_s, "%d", bounces);
+    char bounces_s[16], seed_s[32];
+    if (bounces == LPV_REF_BOUNCES_CONVERGED)
+        snprintf(bounces_s, sizeof bounces_s, "%s", "converged");
+    else
+        snprintf(bounces_s, sizeof bounces_s, "%d", bounces);
+    snprintf(seed_s, sizeof seed_s, "%llu", (unsigned long long)seed);
     char *argv[32 + MAX_PASS];
     int a = 0;
     argv[a++] = (char *)ref_cmd;
@@ -808,9 +831,13 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
         argv[a++] = "--fov";
         argv[a++] = cam_s[2];
     }
-    if (bounces > 1) {
+    if (bounces > 1 || bounces == LPV_REF_BOUNCES_CONVERGED) {
         argv[a++] = "--bounces";
         argv[a++] = bounces_s;
+    }
+    if (seed) {
+        argv[a++] = "--seed";
+        argv[a++] = seed_s;
     }
     argv[a++] = "--area-lights";
     argv[a++] = area_lights ? "on" : "off";
@@ -832,6 +859,19 @@ static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_vi
     if (!*have_se)
         fprintf(stderr, "lpvd-accuracy: %s: warning: no stderr image; ref_noise will be 0\n", e->name);
     return 0;
+}
+
+/* The 1-bounce reference (into e->ref_*) or, bounces > 1, the multi-bounce
+ * one (e->mref_*), seed 0. */
+static int ensure_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const char *out_dir,
+                            int spp, const char *ref_cmd, char *const *cam_args, int ncam, int bounces,
+                            int area_lights)
+{
+    if (bounces > 1)
+        return ensure_reference_as(e, scene, view, out_dir, spp, ref_cmd, cam_args, ncam, bounces, 0, area_lights,
+                                   e->mref_exr, e->mref_se, &e->have_mse);
+    return ensure_reference_as(e, scene, view, out_dir, spp, ref_cmd, cam_args, ncam, bounces, 0, area_lights,
+                               e->ref_exr, e->ref_se, &e->have_se);
 }
 
 static const char *occ_name(int on)
@@ -896,6 +936,96 @@ static const float *bounce_reference(scene_entry *e, const lpv_scene *scene, con
     return *img;
 }
 
+/* The seeds of the two converged references. */
+static const uint64_t CONV_SEEDS[2] = {1, 2};
+
+/* Converged light, what a user sees: the reference with every bounce
+ * (LPV_REF_BOUNCES_CONVERGED), rendered with two seeds at e->conv_spp each
+ * and cached under OUT/ref like the others. *img gets their mean R, *se_img
+ * its standard error sqrt(S1^2 + S2^2) / 2 (NULL without stderr images), and
+ * e->ref_noise2 = sqrt(mean((R1 - R2)^2)) / 2 / mean(R) over the pixels both
+ * cover: the noise of the mean of two, measured rather than estimated.
+ * Returns 0 or -1. */
+static int converged_reference(scene_entry *e, const lpv_scene *scene, const lpv_view *view, const ref_source *src,
+                               float **img, float **se_img)
+{
+    char err[1024];
+    float *r[2] = {NULL, NULL}, *sd[2] = {NULL, NULL};
+    int rc = -1;
+    *img = *se_img = NULL;
+    e->ref_noise2 = NAN;
+    for (int k = 0; k < 2; ++k) {
+        int w = 0, h = 0;
+        if (ensure_reference_as(e, scene, view, src->out_dir, e->conv_spp, src->cmd, src->cam_args, src->ncam,
+                                LPV_REF_BOUNCES_CONVERGED, CONV_SEEDS[k], src->area_lights, e->cref_exr[k],
+                                e->cref_se[k], &e->have_cse[k]) != 0 ||
+            lpv_image_read_f32(e->cref_exr[k], 4, &w, &h, &r[k], err, sizeof err) != 0 || w != view->width ||
+            h != view->height) {
+            fprintf(stderr, "lpvd-accuracy: %s: no converged reference (seed %llu)\n", e->name,
+                    (unsigned long long)CONV_SEEDS[k]);
+            goto done;
+        }
+        if (e->have_cse[k] && (lpv_image_read_f32(e->cref_se[k], 4, &w, &h, &sd[k], err, sizeof err) != 0 ||
+                               w != view->width || h != view->height)) {
+            free(sd[k]);
+            sd[k] = NULL;
+        }
+    }
+    size_t np = (size_t)view->width * (size_t)view->height;
+    float *m = malloc(np * 4 * sizeof *m), *ms = sd[0] && sd[1] ? malloc(np * 4 * sizeof *ms) : NULL;
+    if (!m) {
+        free(ms);
+        goto done;
+    }
+    double sum = 0.0, d2 = 0.0;
+    size_t cnt = 0;
+    for (size_t i = 0; i < np; ++i) {
+        const int both = r[0][4 * i + 3] > 0.5f && r[1][4 * i + 3] > 0.5f;
+        for (int c = 0; c < 4; ++c) {
+            m[4 * i + (size_t)c] = c == 3 ? (both ? 1.0f : 0.0f) : 0.5f * (r[0][4 * i + (size_t)c] + r[1][4 * i + (size_t)c]);
+            if (ms) {
+                double a = sd[0][4 * i + (size_t)c], b = sd[1][4 * i + (size_t)c];
+                ms[4 * i + (size_t)c] = c == 3 ? 1.0f : (float)(0.5 * sqrt(a * a + b * b));
+            }
+            if (both && c < 3) {
+                double d = (double)r[0][4 * i + (size_t)c] - r[1][4 * i + (size_t)c];
+                sum += m[4 * i + (size_t)c];
+                d2 += d * d;
+                cnt++;
+            }
+        }
+    }
+    if (cnt && sum > 0.0)
+        e->ref_noise2 = sqrt(d2 / (double)cnt) / 2.0 / (sum / (double)cnt);
+    *img = m;
+    *se_img = ms;
+    write_preview(e->cref_exr[0], r[0], view->width, view->height);
+    rc = 0;
+done:
+    for (int k = 0; k < 2; ++k) {
+        free(r[k]);
+        free(sd[k]);
+    }
+    return rc;
+}
+
+/* "at the reference's noise": a rel. RMSE below twice the converged
+ * reference's measured noise tells nothing about the technique. */
+static int at_ref_noise(double rel_rmse, double ref_noise2)
+{
+    return isfinite(rel_rmse) && isfinite(ref_noise2) && rel_rmse < 2.0 * ref_noise2;
+}
+
+/* A Markdown rel. RMSE cell's text: the figure, or "at the reference's noise". */
+static const char *md_rmse(double rel_rmse, int at_noise, char *buf, size_t size)
+{
+    if (at_noise)
+        snprintf(buf, size, "%s", "at the reference's noise");
+    else
+        snprintf(buf, size, "%.3f", rel_rmse);
+    return buf;
+}
+
 /* "on"/"off" of an lpv_switch value (iv_reprojection). */
 static const char *switch_name(int v)
 {
@@ -919,6 +1049,9 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
     for (int k = NSTAGES_LPV; k < NSTAGES; ++k)
         fprintf(f, ",ms_%s", STAGES[k]);
     fprintf(f, ",camera_surfel_step,rsm_vpl_step,lookup_step"); /* the settings, 0 = auto; empty: not swept */
+    /* rel_rmse .. rel_mae above: against converged light; these: against the
+     * reference with the point's own bounces (ref_bounces) */
+    fprintf(f, ",rel_rmse_own,rel_bias_own,rel_mae_own,ref_noise_own,ref_noise2,at_ref_noise");
     fputc('\n', f);
     for (int i = 0; i < n; ++i) {
         char mb[5];
@@ -973,6 +1106,8 @@ static void write_csv(FILE *f, const result *r, int n, const scene_entry *scenes
             fprintf(f, ",%d", r[i].p.lstep);
         else
             fputc(',', f);
+        fprintf(f, ",%.5f,%.5f,%.5f,%.5f,%.5f,%d", r[i].own.rel_rmse, r[i].own.rel_bias, r[i].own.rel_mae,
+                r[i].own.ref_noise, scenes[r[i].scene].ref_noise2, r[i].at_noise);
         fputc('\n', f);
     }
 }
@@ -1013,20 +1148,21 @@ static void md_cell_ms(FILE *f, int have, double v)
 
 /* One scene's table when it has imperfect-volume rows: the LPV's columns
  * ("-" on iv rows) only when LPV rows are there too, then the iv knobs and
- * stages ("-" on LPV rows), the reference's bounces and the error against
- * the 1-bounce reference. */
+ * stages ("-" on LPV rows), the error against converged light, the own
+ * reference's bounces and the error against it and against the 1-bounce
+ * reference. */
 static void write_md_iv_table(FILE *f, const result *const *rows, int k)
 {
     int has_lpv = 0;
     for (int i = 0; i < k; ++i)
         has_lpv |= !is_iv(&rows[i]->p);
     fprintf(f, "| technique |%s RSM |%s iv res. | points | rays | bounces | reproj. | nbrs | ms/tick |%s points ms "
-               "| reproject ms | resolve ms | gather ms | shade ms | ref. bounces | rel. RMSE | vs 1-bounce ref "
-               "| rel. bias | rel. MAE | ref. noise | Pareto |\n",
+               "| reproject ms | resolve ms | gather ms | shade ms | rel. RMSE | rel. bias | rel. MAE | ref. noise "
+               "| ref. bounces | rel. RMSE vs own | rel. bias vs own | vs 1-bounce ref | Pareto |\n",
             has_lpv ? " grid | iterations |" : "", has_lpv ? " occlusion | mods | preset |" : "",
             has_lpv ? " propagate ms | gv ms |" : "");
     fprintf(f, "|:---:|%s---:|%s---:|---:|---:|---:|:---:|---:|---:|%s---:|---:|---:|---:|---:|---:|---:|---:|---:|"
-               "---:|---:|:---:|\n",
+               "---:|---:|---:|---:|:---:|\n",
             has_lpv ? "---:|---:|" : "", has_lpv ? ":---:|:---:|:---:|" : "", has_lpv ? "---:|---:|" : "");
     for (int i = 0; i < k; ++i) {
         const result *x = rows[i];
@@ -1063,8 +1199,10 @@ static void write_md_iv_table(FILE *f, const result *const *rows, int k)
         }
         for (int st = ST_IV_POINTS; st <= ST_IV_GATHER; ++st)
             md_cell_ms(f, iv, x->stage_ms[st]);
-        fprintf(f, " %.2f | %d | %s%.3f%s | %.3f | %+.3f | %.3f | %.3f | %s |\n", x->stage_ms[ST_SHADE], x->ref_bounces,
-                b, x->m.rel_rmse, b, x->rel_rmse_1b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
+        char rm[40];
+        fprintf(f, " %.2f | %s%s%s | %+.3f | %.3f | %.3f | %d | %.3f | %+.3f | %.3f | %s |\n", x->stage_ms[ST_SHADE],
+                b, md_rmse(x->m.rel_rmse, x->at_noise, rm, sizeof rm), b, x->m.rel_bias, x->m.rel_mae,
+                x->m.ref_noise, x->ref_bounces, x->own.rel_rmse, x->own.rel_bias, x->rel_rmse_1b,
                 x->pareto ? "**◆**" : "");
     }
     fputc('\n', f);
@@ -1076,9 +1214,13 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
     fprintf(f, "Error metrics: docs/accuracy.md. ms/tick: median GPU ms of one tick + the indirect-only render "
                "(sum of the stages). Pareto: no other point of the scene is both faster and more accurate "
                "(rel. RMSE). Rows sorted by ms/tick; Pareto rows marked **◆**; preset: the named preset "
-               "(`--preset`) the point equals. Imperfect-volume (iv) points: rel. RMSE against the reference with "
-               "as many bounces as the point's iv_bounces (ref. bounces), and against the 1-bounce one beside it; "
-               "stage ms are the medians of iv_points, iv_reproject, iv_resolve, iv_gather (all bounces) and "
+               "(`--preset`) the point equals. rel. RMSE, rel. bias, rel. MAE, ref. noise, the Pareto front, "
+               "plots and error images: against converged light (`lpvd-reference --bounces converged`, the mean of "
+               "two seeds), the light a user sees; \"at the reference's noise\" where rel. RMSE is below twice "
+               "the converged reference's measured noise (ref_noise2 below). rel. RMSE / bias vs own: against the "
+               "reference with as many bounces as the point computes (ref. bounces: 1 for the LPV and the octree, "
+               "its iv_bounces for an imperfect volume, the multi-bounce count for bounces on). Imperfect-volume "
+               "(iv) stage ms are the medians of iv_points, iv_reproject, iv_resolve, iv_gather (all bounces) and "
                "shade.\n\n");
     const result **rows = malloc((size_t)n * sizeof *rows);
     if (!rows)
@@ -1096,10 +1238,10 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             continue;
         fprintf(f, "## %s: one factor at a time (--features)\n\n", scenes[s].name);
         fprintf(f, "Each row changes one knob of `base` (balanced: 32³, 4 iterations, RSM 128², occlusion on; "
-                   "cascades 1 = one grid over the scene, bounces off, damping 0). rel. RMSE: against the "
-                   "reference with as many bounces as the point models (1 bounce with bounces off, %d with "
-                   "bounces on); the two columns after it compare every point with both references.%s\n\n",
-                base->ref_bounces > 1 ? base->ref_bounces : (scenes[s].have_mref ? 3 : 1),
+                   "cascades 1 = one grid over the scene, bounces off, damping 0). rel. RMSE and bias: against "
+                   "converged light; the two columns after it compare every point with the 1-bounce and the "
+                   "%d-bounce references.%s\n\n",
+                base->ref_bounces > 1 ? base->ref_bounces : 3,
                 scenes[s].has_cam ? " This scene uses its own camera inside the box (see docs), so that 1 m "
                                     "cascades nest in the 2 m box." : "");
         fprintf(f, "| point | cascades (size) | bounces | damping | ms/tick | Δ ms vs base | propagate ms | rel. RMSE "
@@ -1112,9 +1254,10 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             char csz[32] = "";
             if (x->cascades_used > 1)
                 snprintf(csz, sizeof csz, " (%g m)", (double)x->p.cascade_size);
-            fprintf(f, "| %s | %d%s | %s | %g | %.2f | %+.2f | %.2f | %.3f | %.3f | ", x->p.label, x->cascades_used,
+            char rm[40];
+            fprintf(f, "| %s | %d%s | %s | %g | %.2f | %+.2f | %.2f | %s | %.3f | ", x->p.label, x->cascades_used,
                     csz, occ_name(x->p.bounces), (double)x->p.damping, x->ms_total, x->ms_total - base->ms_total,
-                    x->stage_ms[5], x->m.rel_rmse, x->rel_rmse_1b);
+                    x->stage_ms[5], md_rmse(x->m.rel_rmse, x->at_noise, rm, sizeof rm), x->rel_rmse_1b);
             if (isfinite(x->rel_rmse_multi))
                 fprintf(f, "%.3f", x->rel_rmse_multi);
             else
@@ -1128,7 +1271,10 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
         if (k == 0)
             continue;
         fprintf(f, "## %s\n\n", scenes[s].name);
-        fprintf(f, "reference: `%s`%s", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
+        fprintf(f, "converged reference (scored against): the mean of `%s` and `%s` (%d spp each); its noise "
+                   "ref_noise2 = sqrt(mean((R1 - R2)^2)) / 2 / mean(R) = %.4f.\n\n",
+                scenes[s].cref_exr[0], scenes[s].cref_exr[1], scenes[s].conv_spp, scenes[s].ref_noise2);
+        fprintf(f, "1-bounce reference: `%s`%s", scenes[s].ref_exr, scenes[s].have_se ? "" : " (no stderr image)");
         for (int j = 0; j < scenes[s].nxref; ++j)
             fprintf(f, "; %d bounces (iv points with %d bounces): `%s`", scenes[s].xref_bounces[j],
                     scenes[s].xref_bounces[j], scenes[s].xref_exr[j]);
@@ -1141,18 +1287,21 @@ static void write_md(FILE *f, const result *r, int n, const scene_entry *scenes,
             continue;
         }
         fprintf(f, "| technique | grid | iterations | RSM | occlusion | mods | preset | ms/tick | propagate ms | gv ms "
-                   "| rel. RMSE | rel. bias | rel. MAE | ref. noise | Pareto |\n");
-        fprintf(f, "|:---:|---:|---:|---:|:---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
+                   "| rel. RMSE | rel. bias | rel. MAE | ref. noise | ref. bounces | rel. RMSE vs own | rel. bias vs own "
+                   "| Pareto |\n");
+        fprintf(f, "|:---:|---:|---:|---:|:---:|:---:|:---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|:---:|\n");
         for (int i = 0; i < k; ++i) {
             const result *x = rows[i];
             const char *b = x->pareto ? "**" : "";
+            char rm[40];
             fprintf(f,
-                    "| %s | %s%d³%s | %d | %d² | %s | `%s`%s | %s | %s%.2f%s | %.2f | %.2f | %s%.3f%s | %+.3f | %.3f | %.3f "
-                    "| %s |\n",
+                    "| %s | %s%d³%s | %d | %d² | %s | `%s`%s | %s | %s%.2f%s | %.2f | %.2f | %s%s%s | %+.3f | %.3f | %.3f "
+                    "| %d | %.3f | %+.3f | %s |\n",
                     tech_name(x->p.technique), b, x->p.grid, b, x->p.iterations, x->p.rsm, occ_name(x->p.occlusion),
                     mods_name(x->p.mods, (char[5]){0}), steps_text(&x->p, 0, (char[48]){0}), point_preset(&x->p), b,
                     x->ms_total, b,
-                    x->stage_ms[5], x->stage_ms[4], b, x->m.rel_rmse, b, x->m.rel_bias, x->m.rel_mae, x->m.ref_noise,
+                    x->stage_ms[5], x->stage_ms[4], b, md_rmse(x->m.rel_rmse, x->at_noise, rm, sizeof rm), b,
+                    x->m.rel_bias, x->m.rel_mae, x->m.ref_noise, x->ref_bounces, x->own.rel_rmse, x->own.rel_bias,
                     x->pareto ? "**◆**" : "");
         }
         fputc('\n', f);
@@ -1264,7 +1413,7 @@ static int write_plot(const char *out_dir, const result *r, int n, const scene_e
         return -1;
     fprintf(f, "set title 'lpvd indirect light vs path-traced reference: what accuracy costs in time'\n");
     fprintf(f, "set xlabel 'GPU ms per tick (median; tick + indirect-only render)'\n");
-    fprintf(f, "set ylabel 'relative RMSE'\n");
+    fprintf(f, "set ylabel 'relative RMSE vs converged light'\n");
     fprintf(f, "set logscale x\nset grid xtics ytics mxtics\nset key outside right top\nset yrange [0:*]\n");
     fprintf(f, "plot \\\n");
     for (int s = 0; s < nscenes; ++s) {
@@ -1330,7 +1479,7 @@ static int write_features_plot(const char *out_dir, const result *r, int n, cons
                "set boxwidth 0.9\nset grid ytics\nset key top left\nset yrange [0:*]\nset datafile missing 'NaN'\n");
     for (int panel = 0; panel < 2; ++panel) {
         fprintf(f, "set ylabel '%s'\n", panel == 0 ? "GPU ms per tick (median)"
-                                                     : "relative RMSE vs its reference (bounces on: multi-bounce)");
+                                                     : "relative RMSE vs converged light");
         fprintf(f, "plot ");
         for (int s = 0; s < nscenes; ++s)
             fprintf(f, "%s'plot/features.dat' using %d%s title '%s'", s ? ", " : "", 2 + 2 * s + panel,
@@ -1412,11 +1561,11 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
     if (rc == 0) {
         fprintf(md, "## all scenes: the overall front\n\nPoints measured on every scene, by mean ms/tick over the "
                     "scenes and normalised RMSE = mean over the scenes of rel. RMSE / the scene's best rel. RMSE "
-                    "(1 = the best of this sweep on every scene; docs/accuracy.md). The presets are chosen from "
-                    "this front. mods: the departures from the paper switched on, c = central transport, b = "
+                    "(1 = the best of this sweep on every scene; docs/accuracy.md), every rel. RMSE against "
+                    "converged light. The presets are chosen from this front. mods: the departures from the paper switched on, c = central transport, b = "
                     "normal bins, f = far field, s = scene surfels (docs/propagation.md).%s\n\n| technique |",
                 has_iv ? " iv: the imperfect volume (resolution, points per triangle, rays per voxel, bounces, "
-                         "reprojection, neighbours), its rel. RMSE against the reference with its bounces." : "");
+                         "reprojection, neighbours)." : "");
         if (has_lpv)
             fprintf(md, " grid | iterations | RSM | occlusion | mods | preset |");
         else
@@ -1474,7 +1623,9 @@ static int write_overall(const char *out_dir, const result *r, int n, const scen
                 fprintf(csv, "%d,%d,%d,%s,%s,%s,%.4f,%.5f", x->key[0], x->key[1], x->key[2], occ_name(x->key[3]), mb,
                         tech_name(x->key[LPV_ACC_KEY_TECHNIQUE]), x->ms, x->norm_rmse);
             for (int s = 0; s < nscenes; ++s) {
-                fprintf(md, " %.3f |", x->rel_rmse[s]);
+                char rm[40];
+                fprintf(md, " %s |", md_rmse(x->rel_rmse[s], at_ref_noise(x->rel_rmse[s], scenes[s].ref_noise2), rm,
+                                             sizeof rm));
                 fprintf(csv, ",%.5f", x->rel_rmse[s]);
             }
             fprintf(md, " %s |\n", x->pareto ? "**◆**" : "");
@@ -1688,7 +1839,7 @@ int main(int argc, char **argv)
 {
     const char *out_dir = "accuracy-out", *scene_list = "cornell,courtyard,blinds", *ref_given = NULL;
     const char *knobs = NULL, *points_arg = NULL;
-    int spp = 256, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
+    int spp = 256, conv_spp = 0, quick = 0, presets = 0, ticks = 5, warmup = 2, no_plot = 0, size_given = 0;
     int features = 0, multi_bounces = 3, scenes_given = 0, emissive = 0, iv_tables = 0;
     int iv_flag_given[LPV_ACC_IV_KNOBS] = {0}; /* --iv-resolution, ...: refused when the knob is swept */
     lpvd_options opt = {0};
@@ -1774,16 +1925,20 @@ int main(int argc, char **argv)
             break;
         }
         case A_REF_SPP:
+        case A_CONV_SPP:
         case A_TICKS:
         case A_WARMUP: {
             char *end = NULL;
             long x = strtol(v, &end, 10);
-            if (!end || *end || x < (id == A_WARMUP ? 0 : 1) || x > (id == A_REF_SPP ? 1000000 : MAX_TICKS)) {
+            if (!end || *end || x < (id == A_WARMUP ? 0 : 1) ||
+                x > (id == A_REF_SPP || id == A_CONV_SPP ? 1000000 : MAX_TICKS)) {
                 fprintf(stderr, "lpvd-accuracy: bad value for --%s: %s\n", fl->name, v);
                 return 2;
             }
             if (id == A_REF_SPP)
                 spp = (int)x;
+            else if (id == A_CONV_SPP)
+                conv_spp = (int)x;
             else if (id == A_TICKS)
                 ticks = (int)x;
             else
@@ -2009,10 +2164,12 @@ add_features:
         return 1;
     char header[2048];
     snprintf(header, sizeof header,
-             "backend %s, GL_RENDERER %s; image %dx%d; reference `%s` at %d spp; median of %d ticks after %d "
-             "warm-up; %d point(s) per scene.\n",
+             "backend %s, GL_RENDERER %s; image %dx%d; reference `%s`: converged light (every bounce, Russian "
+             "roulette) with 2 seeds at %d spp each, the own-bounce references at %d spp; median of %d ticks after "
+             "%d warm-up; %d point(s) per scene.\n",
              lpv_backend_name(lpv_gl_context_backend(ctx)), lpv_gl_context_renderer(ctx), opt.cam.width,
-             opt.cam.height, ref_cmd, spp, ticks, warmup, npts);
+             opt.cam.height, ref_cmd, conv_spp > 0 ? conv_spp : (spp / 2 > 0 ? spp / 2 : 1), spp, ticks, warmup,
+             npts);
     fprintf(stderr, "lpvd-accuracy: %s", header);
 
     result *results = calloc((size_t)nscenes * (size_t)npts, sizeof *results);
@@ -2050,7 +2207,7 @@ add_features:
             rc = 1;
             goto next_scene;
         }
-        float *mref = NULL, *mref_se = NULL;
+        float *mref = NULL, *mref_se = NULL, *cref = NULL, *cref_se = NULL;
         if (features) { /* the multi-bounce reference: for bounces on, and to compare every point with */
             int mw = 0, mh = 0;
             if (ensure_reference(se, &scene, &view, out_dir, spp, ref_is_cmd ? ref_cmd : NULL, cam_args,
@@ -2090,6 +2247,13 @@ add_features:
             }
         }
         write_preview(se->ref_exr, ref, rw, rh); /* a tone-mapped preview of the reference next to it */
+        se->conv_spp = conv_spp > 0 ? conv_spp : (spp / 2 > 0 ? spp / 2 : 1);
+        if (converged_reference(se, &scene, &view, &rsrc, &cref, &cref_se) != 0) {
+            rc = 1;
+            goto next_scene;
+        }
+        fprintf(stderr, "lpvd-accuracy: %s: converged reference, 2 seeds x %d spp, ref_noise2 %.4f\n", se->name,
+                se->conv_spp, se->ref_noise2);
         if (snprintf(sub, sizeof sub, "%s/err/%s", out_dir, se->name) >= (int)sizeof sub || mkdir_p(sub) != 0) {
             fprintf(stderr, "lpvd-accuracy: cannot create %s/err/%s\n", out_dir, se->name);
             rc = 1;
@@ -2209,9 +2373,16 @@ add_features:
                 res->ref_bounces = ivb;
                 cmp_ref = bimg;
             }
-            /* the baselines and regions: over the point's own reference for
-             * iv points, the 1-bounce one for the LPV's (as before) */
-            const float *base_ref = is_iv(&pts[p]) ? cmp_ref : ref;
+            /* The score: against converged light (what a user sees), the
+             * own-bounce figures beside it; the baselines, regions and
+             * error image against converged light too. */
+            res->own = res->m;
+            if (lpv_acc_compare(rgba, cref, cref_se, view.width, view.height, &res->m) != 0)
+                fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both the converged reference and "
+                                "lpvd\n", se->name);
+            res->at_noise = at_ref_noise(res->m.rel_rmse, se->ref_noise2);
+            cmp_ref = cref;
+            const float *base_ref = cref;
             lpv_acc_baselines(rgba, base_ref, view.width, view.height, &res->black, &res->constant);
             for (int g = 0; g < LPV_ACC_REGIONS; ++g)
                 res->region_share[g] = res->region_rmse[g] = res->region_ratio[g] = NAN;
@@ -2249,25 +2420,32 @@ add_features:
                 fprintf(stderr,
                         "lpvd-accuracy: %s %d/%d: iv, resolution %d, points %d, rays %d, bounces %d, reprojection %s, "
                         "neighbours %d, rsm %d: %.2f ms/tick (iv_points %.2f, iv_reproject %.2f, iv_resolve %.2f, "
-                        "iv_gather %.2f, shade %.2f), rel_rmse %.4f vs %d bounce(s) (%.4f vs 1), rel_bias %+.4f\n",
+                        "iv_gather %.2f, shade %.2f), rel_rmse %.4f rel_bias %+.4f vs converged%s; %.4f %+.4f vs %d "
+                        "bounce(s) (%.4f vs 1)\n",
                         se->name, p + 1, npts, res->iv.v[0], res->iv.v[1], res->iv.v[2], res->iv.v[3],
                         switch_name(res->iv.v[4]), res->iv.v[5], pts[p].rsm, res->ms_total,
                         res->stage_ms[ST_IV_POINTS], res->stage_ms[ST_IV_REPROJECT], res->stage_ms[ST_IV_RESOLVE],
-                        res->stage_ms[ST_IV_GATHER], res->stage_ms[ST_SHADE], res->m.rel_rmse, res->ref_bounces,
-                        res->rel_rmse_1b, res->m.rel_bias);
+                        res->stage_ms[ST_IV_GATHER], res->stage_ms[ST_SHADE], res->m.rel_rmse, res->m.rel_bias,
+                        res->at_noise ? " (at the reference's noise)" : "", res->own.rel_rmse, res->own.rel_bias,
+                        res->ref_bounces, res->rel_rmse_1b);
             else
                 fprintf(stderr,
                         "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s%s: "
-                        "%.2f ms/tick, rel_rmse %.4f, rel_bias %+.4f, ref_noise %.4f%s%s\n",
+                        "%.2f ms/tick, rel_rmse %.4f, rel_bias %+.4f vs converged%s (ref_noise2 %.4f); %.4f %+.4f vs "
+                        "%d bounce(s)%s%s\n",
                         se->name, p + 1, npts, tech_name(pts[p].technique), pts[p].grid, pts[p].iterations, pts[p].rsm,
                         occ_name(pts[p].occlusion), mods_name(pts[p].mods, (char[5]){0}),
                         steps_text(&pts[p], 0, (char[48]){0}),
-                        res->ms_total, res->m.rel_rmse, res->m.rel_bias, res->m.ref_noise, pts[p].feat ? "; " : "",
+                        res->ms_total, res->m.rel_rmse, res->m.rel_bias,
+                        res->at_noise ? " (at the reference's noise)" : "", se->ref_noise2, res->own.rel_rmse,
+                        res->own.rel_bias, res->ref_bounces, pts[p].feat ? "; " : "",
                         pts[p].label);
             ++nres;
         }
         free(mref);
         free(mref_se);
+        free(cref);
+        free(cref_se);
     next_scene:
         for (int b = 0; b <= LPV_IV_MAX_BOUNCES; ++b) {
             free(bref[b]);
