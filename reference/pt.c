@@ -673,10 +673,22 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
     float cos_r = dot3(ns, w), cos_e = -dot3(tr->front, w);
     if (!(cos_r > 0.0f) || !(cos_e > 0.0f) || !(dot3(ng, w) > 0.0f))
         return;
-    float org[3];
-    for (int i = 0; i < 3; ++i)
+    /* The shadow ray leaves eps off the surface and is aimed at q from
+     * there: along w from the offset origin it would meet the emitter's
+     * plane eps (ng . n_e) / cos_e short of q, inside the 2 eps margin only
+     * when cos_e > 1/2, and so shadow itself at grazing angles (14 % of a
+     * large emitter's light lost 1 m under it). */
+    float org[3], to_q[3];
+    for (int i = 0; i < 3; ++i) {
         org[i] = p[i] + r->eps * ng[i];
-    if (occluded(r, org, w, dist - 2.0f * r->eps))
+        to_q[i] = q[i] - org[i];
+    }
+    float len = sqrtf(dot3(to_q, to_q));
+    if (!(len > 2.0f * r->eps))
+        return;
+    for (int i = 0; i < 3; ++i)
+        to_q[i] /= len;
+    if (occluded(r, org, to_q, len - 2.0f * r->eps))
         return;
     /* pdf per unit area of the point: weight(tr) / total */
     double weight = ((double)le[0] + le[1] + le[2]);

@@ -275,6 +275,20 @@ static void test_one_bounce_rectangle(void **state)
         assert_true(se[c] > 0.0f && se[c] < 0.01 * want);
         assert_true(fabs(e[c] - want) <= 3.0 * se[c]);
     }
+    /* Next-event estimation on the emitter agrees: its shadow rays do not
+     * stop on the emitter short of the point they aim at (grazing angles). */
+    lpv_ref *lights = NULL;
+    char err[256] = "";
+    assert_int_equal(lpv_ref_create(&b.s, &(lpv_ref_desc){.emitters_are_lights = 1}, &lights, err, sizeof err), 0);
+    assert_int_equal(lpv_ref_emitter_irradiance(lights, p, n, 1, 65536, e, se), 0);
+    for (int c = 0; c < 3; ++c) {
+        double want = factor * L[c];
+        print_message("rectangle: emitter sampling E[%d] = %.6f +- %.6f, analytic %.6f\n", c, e[c], se[c], want);
+        assert_true(se[c] > 0.0f && se[c] < 0.01 * want);
+        assert_true(fabs(e[c] - want) <= 3.0 * se[c]);
+    }
+    lpv_ref_destroy(lights);
+    assert_int_equal(lpv_ref_irradiance(ref, p, n, 1, 1, 65536, e, se), 0);
     /* Nothing else in the scene: more bounces add nothing (same streams). */
     float e2[3], se2[3];
     assert_int_equal(lpv_ref_irradiance(ref, p, n, 1, 3, 65536, e2, se2), 0);
