@@ -18,6 +18,9 @@
  *     once per 2 x 2 or 4 x 4 block gives the every-pixel frame's penumbra
  *     within a few percent, and changes nothing where there is no area light;
  *     a surface thinner than the blocks takes its light from the second pass.
+ *  6. A double-sided emitter (glTF doubleSided, issue 30) emits from its back
+ *     as from its front, in lpvd (every technique) and the reference; a
+ *     single-sided one leaves what lies behind it dark.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -213,6 +216,112 @@ static void test_reference_agrees(void **state)
     free(full);
     free(fse);
     lpv_ref_destroy(ref);
+    lpv_scene_free(&s);
+}
+
+/* The square turned to face up (its front towards +y, away from the floor);
+ * double_sided as glTF's doubleSided: then its back emits too. */
+static void build_facing_up(lpv_scene *s, int double_sided)
+{
+    memset(s, 0, sizeof *s);
+    int grey = lpv_scene_add_material(s, "floor", (float[3]){RHO, RHO, RHO}, NULL);
+    int lamp = lpv_scene_add_material(s, "lamp", (float[3]){0, 0, 0}, (float[3]){LE, LE, LE});
+    s->materials[lamp].double_sided = double_sided;
+    const float f = FLOOR_HALF, h = HALF, y = HEIGHT;
+    const float floor_q[4][3] = {{-f, 0, f}, {f, 0, f}, {f, 0, -f}, {-f, 0, -f}};
+    const float lamp_q[4][3] = {{-h, y, h}, {h, y, h}, {h, y, -h}, {-h, y, -h}}; /* counter-clockwise from above */
+    assert_true(lpv_scene_add_quad(s, grey, floor_q, NULL) >= 0);
+    assert_true(lpv_scene_add_quad(s, lamp, lamp_q, NULL) >= 0);
+    lpv_scene_compute_bounds(s);
+}
+
+/* The mean of lpvd's direct irradiance over the analytic one (the square's
+ * form factor, as if it faced down) on the floor within 1 m of its foot. */
+static double direct_ratio_facing_up(int double_sided, lpv_technique_id technique)
+{
+    lpv_scene s;
+    build_facing_up(&s, double_sided);
+    lpv_view v = floor_view();
+    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 128, .technique = technique};
+    run(&s, set, &v);
+    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
+    char err[512] = "";
+    if (lpv_engine_render(lpvt_engine, LPV_TERMS_DIRECT_ONLY, rgba, err, sizeof err) != 0)
+        fail_msg("render: %s", err);
+    double got = 0.0, want = 0.0;
+    int n = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            float p[3];
+            const float *px = &rgba[4 * ((size_t)y * W + x)];
+            if (!floor_point(&v, x, y, p) || px[3] < 0.5f || hypotf(p[0], p[2]) > 1.0f)
+                continue;
+            got += px[1] * M_PI / RHO;
+            want += analytic_e(p[0], p[2]);
+            n++;
+        }
+    assert_true(n > 200);
+    free(rgba);
+    lpv_scene_free(&s);
+    return got / want;
+}
+
+/* Issue 30: a double-sided emitter emits from both sides, as glTF viewers
+ * light it. Facing up over the floor, the square lights the floor with its
+ * back as it does facing down (each technique: they share the area light
+ * samples), the reference agrees, and twice the flux goes out; single-sided,
+ * the floor behind it stays dark. */
+static void test_double_sided_emits_both_ways(void **state)
+{
+    (void)state;
+    const lpv_technique_id techs[3] = {LPV_TECHNIQUE_ID_LPV, LPV_TECHNIQUE_ID_OCTREE, LPV_TECHNIQUE_ID_IV};
+    for (int t = 0; t < 3; ++t) {
+        double two = direct_ratio_facing_up(1, techs[t]), one = direct_ratio_facing_up(0, techs[t]);
+        printf("area lights: a square facing up over the floor (technique %d): floor E / form factor %.4f "
+               "double-sided, %.5f single-sided\n",
+               (int)techs[t], two, one);
+        assert_true(fabs(two - 1.0) < 0.03);
+        assert_true(one < 1e-3);
+    }
+    /* the samples: pi L A from each side, half of them facing down */
+    lpv_scene s;
+    build_facing_up(&s, 1);
+    lpv_emitter_list l;
+    assert_int_equal(lpv_emitters_collect(&s, &l), 0);
+    assert_int_equal(l.count, 4);
+    assert_int_equal(l.surfaces, 1);
+    lpv_area_sample smp[LPV_DEFAULT_AREA_LIGHT_SAMPLES];
+    assert_int_equal(lpv_area_lights_sample(&l, LPV_DEFAULT_AREA_LIGHT_SAMPLES, smp), LPV_DEFAULT_AREA_LIGHT_SAMPLES);
+    double up = 0.0, down = 0.0;
+    for (int k = 0; k < LPV_DEFAULT_AREA_LIGHT_SAMPLES; ++k)
+        *(smp[k].normal[1] > 0.99f ? &up : &down) += M_PI * smp[k].intensity[1];
+    const double side_flux = M_PI * LE * 4.0 * HALF * HALF;
+    assert_true(fabs(up - side_flux) < 1e-5 * side_flux);
+    assert_true(fabs(down - side_flux) < 1e-5 * side_flux);
+    lpv_emitters_free(&l);
+    /* the reference: the analytic irradiance below; single-sided none */
+    const float pts[2][3] = {{0, 0, 0}, {0.3f, 0, 0.1f}}, nrm[2][3] = {{0, 1, 0}, {0, 1, 0}};
+    for (int ds = 1; ds >= 0; --ds) {
+        s.materials[1].double_sided = ds;
+        lpv_ref *ref = NULL;
+        char err[512] = "";
+        if (lpv_ref_create(&s, &(lpv_ref_desc){.emitters_are_lights = 1}, &ref, err, sizeof err) != 0)
+            fail_msg("%s", err);
+        float e[6], se[6];
+        assert_int_equal(lpv_ref_emitter_irradiance(ref, &pts[0][0], &nrm[0][0], 2, 16384, e, se), 0);
+        for (int i = 0; i < 2; ++i) {
+            double want = analytic_e(pts[i][0], pts[i][2]);
+            printf("area lights: reference E under a square facing up (%s) at (%.1f, 0, %.1f) = %.5f +- %.5f, "
+                   "analytic from its back %.5f\n",
+                   ds ? "double-sided" : "single-sided", (double)pts[i][0], (double)pts[i][2], (double)e[3 * i + 1],
+                   (double)se[3 * i + 1], want);
+            if (ds)
+                assert_true(fabs(e[3 * i + 1] - want) < 3.0 * se[3 * i + 1] && se[3 * i + 1] < 0.01 * want);
+            else
+                assert_true(e[3 * i + 1] == 0.0f);
+        }
+        lpv_ref_destroy(ref);
+    }
     lpv_scene_free(&s);
 }
 
@@ -507,7 +616,7 @@ int main(void)
         cmocka_unit_test(test_direct_matches_form_factor), cmocka_unit_test(test_reference_agrees),
         cmocka_unit_test(test_occluder_casts_shadow),      cmocka_unit_test(test_energy_no_double_count),
         cmocka_unit_test(test_plan_says_why),              cmocka_unit_test(test_area_shadow_step_keeps_penumbra),
-        cmocka_unit_test(test_area_shadow_step_thin_surfaces),
+        cmocka_unit_test(test_area_shadow_step_thin_surfaces), cmocka_unit_test(test_double_sided_emits_both_ways),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
