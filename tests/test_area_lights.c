@@ -477,6 +477,25 @@ static void test_plan_says_why(void **state)
     lpv_scene_free(&s);
 }
 
+/* Whether pixel (x, y)'s ray meets the box [lo, hi] before the floor. */
+static int ray_hits_box(const lpv_view *v, int x, int y, const float lo[3], const float hi[3])
+{
+    float org[3], dir[3], tmin, tmax;
+    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
+    double t0 = 0.0, t1 = dir[1] < 0.0f ? -org[1] / dir[1] : 1e30;
+    for (int a = 0; a < 3; ++a) {
+        if (fabsf(dir[a]) < 1e-12f) {
+            if (org[a] < lo[a] || org[a] > hi[a])
+                return 0;
+            continue;
+        }
+        double ta = (lo[a] - org[a]) / dir[a], tb = (hi[a] - org[a]) / dir[a];
+        t0 = fmax(t0, fmin(ta, tb));
+        t1 = fmin(t1, fmax(ta, tb));
+    }
+    return t0 < t1;
+}
+
 /* The frame of `terms` at area shadow step `step` (s, v, set as given). */
 static float *frame_at_step(const lpv_scene *s, lpv_settings set, const lpv_view *v, int step, lpv_frame_terms terms)
 {
@@ -496,6 +515,7 @@ static void test_area_shadow_step_keeps_penumbra(void **state)
     build(&s, 1, FLOOR_HALF);
     lpv_view v = floor_view(); /* from above: the plate, the floor, the plate's penumbra on it */
     const lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 128};
+    const float plate_lo[3] = {-0.4f, 0.49f, -0.4f}, plate_hi[3] = {0.4f, 0.51f, 0.4f};
     float *every = frame_at_step(&s, set, &v, 1, LPV_TERMS_DIRECT_ONLY);
     assert_false(lpvt_stage("area_shadow", NULL, NULL));
     for (int step = 2; step <= 4; step += 2) {
@@ -511,8 +531,8 @@ static void test_area_shadow_step_keeps_penumbra(void **state)
                 const size_t i = 4 * ((size_t)y * W + x);
                 assert_true(isfinite(blocks[i]) && isfinite(blocks[i + 1]) && isfinite(blocks[i + 2]));
                 float p[3];
-                if (!floor_point(&v, x, y, p) || every[i + 3] < 0.5f || fmax(fabsf(p[0]), fabsf(p[2])) < 0.41)
-                    continue; /* not the floor, or the plate above it */
+                if (!floor_point(&v, x, y, p) || every[i + 3] < 0.5f || ray_hits_box(&v, x, y, plate_lo, plate_hi))
+                    continue; /* not the floor, or the plate in front of it */
                 const double a = every[i + 1] * M_PI / RHO, b = blocks[i + 1] * M_PI / RHO;
                 diff2 += (a - b) * (a - b);
                 sum += a;
@@ -546,25 +566,6 @@ static void test_area_shadow_step_keeps_penumbra(void **state)
     free(a);
     free(b);
     lpv_scene_free(&s);
-}
-
-/* Whether pixel (x, y)'s ray meets the box [lo, hi] before the floor. */
-static int ray_hits_box(const lpv_view *v, int x, int y, const float lo[3], const float hi[3])
-{
-    float org[3], dir[3], tmin, tmax;
-    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
-    double t0 = 0.0, t1 = dir[1] < 0.0f ? -org[1] / dir[1] : 1e30;
-    for (int a = 0; a < 3; ++a) {
-        if (fabsf(dir[a]) < 1e-12f) {
-            if (org[a] < lo[a] || org[a] > hi[a])
-                return 0;
-            continue;
-        }
-        double ta = (lo[a] - org[a]) / dir[a], tb = (hi[a] - org[a]) / dir[a];
-        t0 = fmax(t0, fmin(ta, tb));
-        t1 = fmin(t1, fmax(ta, tb));
-    }
-    return t0 < t1;
 }
 
 /* A white pole 3 cm thick in the plate's penumbra, about a pixel wide in the
