@@ -2,16 +2,20 @@
  * area_lights.h - emissive surfaces as direct area lights (issue 10,
  * docs/area-lights.md).
  *
- * The scene's emissive triangles (front side, radiance L_e in W/(m^2 sr)) are
+ * The scene's emissive triangles (radiance L_e in W/(m^2 sr) from the front
+ * side, and the same from the back when the material is double-sided, as
+ * glTF's doubleSided means: each side is an emitter of its own here) are
  * reduced to a bounded number K of "area light samples": points on the
- * emitters with a Lambertian (cosine) emission profile over their front
- * hemisphere,
+ * emitters with a Lambertian (cosine) emission profile over the hemisphere
+ * of the side they stand for,
  *
  *     I_k(w) = I_k max(0, <n_k, w>)   W/sr per channel,   I_k = sum of L_e A over the part it stands for,
  *
  * so each sample emits pi I_k W and all K together emit exactly the
- * emitters' flux pi sum(L_e A) per channel. The engine renders every sample
- * through the punctual-light machinery (shadow maps, RSM faces).
+ * emitters' flux pi sum(L_e A) per channel (the sum over emitting sides: a
+ * double-sided emitter has twice the flux of a single-sided one). The engine
+ * renders every sample through the punctual-light machinery (shadow maps,
+ * RSM faces).
  *
  * Placement: the triangles are laid end to end along their emitted power
  * (weight (L_r + L_g + L_b) A) in scene order, and the line is cut into K
@@ -22,8 +26,11 @@
  * patches of equal area. The sample sits at the power-weighted centroid of
  * its patches when they are coplanar (a rectangular lamp of two triangles
  * with K = 1: its centre), else at the centroid of the patch holding the
- * part's midpoint, and faces that patch's front. Neighbouring triangles of a
- * mesh are usually neighbours in space, so a part is a patch of an emitter.
+ * part's midpoint, and faces that patch's emitting side (so a part that
+ * straddles the front and back of a double-sided emitter, as with K = 1 or
+ * an odd K on one such emitter, sends both sides' power the midpoint's
+ * way). Neighbouring triangles of a mesh are usually neighbours in space,
+ * so a part is a patch of an emitter.
  * Deterministic: the same scene and K give the same samples.
  */
 #ifndef LPV_AREA_LIGHTS_H
@@ -37,10 +44,11 @@
 /* Most samples a scene gets (the settings' area_light_samples range). */
 #define LPV_MAX_AREA_SAMPLES LPV_MAX_AREA_LIGHTS
 
-/* One usable emissive triangle (front side emits). */
+/* One emitting side of a usable emissive triangle: its front, and for a
+ * double-sided material also its back (the same corners, the normal turned). */
 typedef struct lpv_emitter_tri {
     float p[3][3];     /* corners, m */
-    float normal[3];   /* unit front normal */
+    float normal[3];   /* unit normal of the emitting side */
     float emission[3]; /* radiance, W/(m^2 sr) */
     double area;       /* m^2 */
 } lpv_emitter_tri;
@@ -52,7 +60,8 @@ typedef struct lpv_emitter_list {
 } lpv_emitter_list;
 
 /* Collects the scene's emissive triangles (draws whose material has finite,
- * positive emission; degenerate triangles skipped). Returns 0, or -1 on
+ * positive emission; degenerate triangles skipped), per draw its triangles'
+ * fronts, then for a double-sided material their backs. Returns 0, or -1 on
  * allocation failure (list left empty). */
 int lpv_emitters_collect(const lpv_scene *scene, lpv_emitter_list *list);
 void lpv_emitters_free(lpv_emitter_list *list);

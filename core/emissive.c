@@ -28,8 +28,10 @@ static double emission_weight(const float e[3])
     return (double)e[0] + e[1] + e[2];
 }
 
-/* Calls fn for every non-degenerate triangle of every emissive draw, in
- * draw order. Returns 0, or the first non-zero value fn returned (stop). */
+/* Calls fn for every emitting side of every non-degenerate triangle of every
+ * emissive draw, in draw order: its front, then (double-sided material, as
+ * glTF's doubleSided means) its back with the normal turned. Returns 0, or
+ * the first non-zero value fn returned (stop). */
 typedef int (*triangle_fn)(void *ud, const float *p[3], const float n[3], double area, const float e[3]);
 
 static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *ud)
@@ -39,15 +41,21 @@ static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *
         if (!material_emits(s, dr->material))
             continue;
         const float *e = s->materials[dr->material].emission;
+        const int sides = s->materials[dr->material].double_sided ? 2 : 1;
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
             const float *p[3];
             float n[3];
             double area;
             if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, p, n, &area))
                 continue;
-            int rc = fn(ud, p, n, area, e);
-            if (rc)
-                return rc;
+            for (int side = 0; side < sides; ++side) {
+                if (side)
+                    for (int i = 0; i < 3; ++i)
+                        n[i] = -n[i];
+                int rc = fn(ud, p, n, area, e);
+                if (rc)
+                    return rc;
+            }
         }
     }
     return 0;

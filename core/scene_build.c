@@ -32,8 +32,14 @@ int lpv_scene_add_material(lpv_scene *s, const char *name, const float albedo[3]
     m->base_color_texture = -1;
     m->normal_texture = -1;
     m->double_sided = 1; /* code-built surfaces have always been two-sided */
-    if (emission)
+    if (emission) {
         memcpy(m->emission, emission, sizeof m->emission);
+        /* ... but their emitters lit from the front only: a double-sided
+         * emitter emits from both sides (glTF), so they stay single-sided;
+         * set double_sided afterwards for one that emits both ways */
+        if (emission[0] != 0.0f || emission[1] != 0.0f || emission[2] != 0.0f)
+            m->double_sided = 0;
+    }
     m->roughness = 1.0f;
     return (int)s->material_count++;
 }

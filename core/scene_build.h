@@ -16,9 +16,11 @@
 #include "scene.h"
 
 /* A diffuse material (metallic 0, roughness 1, double-sided, opaque, no
- * normal map) with linear
- * albedo rgb and emitted radiance emission (W/(m^2 sr), NULL = none).
- * Returns its index, or -1. */
+ * normal map) with linear albedo rgb and emitted radiance emission
+ * (W/(m^2 sr), NULL = none). An emitter (emission not all 0) is made
+ * single-sided instead: it emits from its front only, and the camera culls
+ * its back; set double_sided = 1 afterwards for one that emits from both
+ * sides (docs/area-lights.md). Returns its index, or -1. */
 int lpv_scene_add_material(lpv_scene *s, const char *name, const float albedo[3], const float emission[3]);
 
 /* A planar quad c0 c1 c2 c3 (counter-clockwise seen from its front) as two

@@ -151,7 +151,9 @@ int lpv_scene_builtin_cornell(lpv_scene *scene)
         memcpy(m->emission, obj->emission, sizeof m->emission);
         m->metallic = 0.0f;
         m->roughness = 0.9f;
-        m->double_sided = 1;
+        /* two-sided, except the lamp: a double-sided emitter would light the
+         * ceiling above it too (docs/area-lights.md); it lights the room */
+        m->double_sided = obj->emission[0] == 0.0f && obj->emission[1] == 0.0f && obj->emission[2] == 0.0f;
 
         /* A block's centre: the mean of its corners. */
         float block_centre[3] = {0, 0, 0};

@@ -7,7 +7,8 @@
  *   point, and wider spots: six 90-degree cube faces (+x -x +y -y +z -z), the
  *     octree thesis' omnidirectional injection;
  *   area light samples (emissive surfaces, docs/area-lights.md): five
- *     90-degree faces around the emitter's normal n (n, then +-t, +-b), each
+ *     90-degree faces around the normal n of the emitting side (n, then
+ *     +-t, +-b; a double-sided emitter's back is samples of its own), each
  *     a square tile of side max(min(N, 32), N/2) texels in layers after the
  *     punctual lights' (N = rsm_size), so K samples cost about 5K/4 layers
  *     instead of 5K (docs/area-lights.md: at the default N = 128, 64^2 faces
@@ -162,7 +163,7 @@ static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, floa
 {
     struct LpvLightBlock *b = &e->light_block;
     const int n = e->settings.rsm_size, side = area_face_side(n);
-    int added = 0;
+    int added = 0, back_fed = 0;
     for (size_t k = 0; k < e->area_sample_count; ++k) {
         if (lights + added >= LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS || faces + LPV_AREA_FACES > LPV_MAX_FACES)
             break;
@@ -196,11 +197,16 @@ static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, floa
         glm_vec3_negate_to(t, axes[2]);
         glm_vec3_copy(bt, axes[3]);
         glm_vec3_negate_to(bt, axes[4]);
+        /* Every sample sees the same surfaces: only the first one's feed the
+         * GV, and the first facing against it (the back of a double-sided
+         * emitter, docs/area-lights.md), which sees the other half of them. */
+        int feeds = k == 0;
+        if (k > 0 && !back_fed && glm_vec3_dot(nrm, b->lights[lights].direction_range) < -0.99f)
+            feeds = back_fed = 1;
         for (int i = 0; i < LPV_AREA_FACES; ++i) {
             struct LpvFaceGpu *f = &b->faces[faces];
             perspective_face(f, pos, axes[i], (float)(M_PI / 4.0), near_z, far_from(e, pos), l, side);
-            /* Every sample sees the same surfaces: only the first one's feed the GV. */
-            f->axis[3] = k == 0 ? 0.0f : 1.0f;
+            f->axis[3] = feeds ? 0.0f : 1.0f;
             area_tile(n, (int)k * LPV_AREA_FACES + i, layer, f->tile);
             ++faces;
         }

@@ -19,7 +19,7 @@ typedef struct ref_tri {
     float p0[3], e1[3], e2[3]; /* corners p0, p0 + e1, p0 + e2 */
     float vn[3][3];            /* vertex normals (unit; the front normal where the file's was bad) */
     float uv[3][2];
-    float front[3]; /* unit geometric normal of the front (emitting) side */
+    float front[3]; /* unit geometric normal of the front side (the emitting one, or the first of two) */
     int material;   /* -1 = none: black, not emissive */
 } ref_tri;
 
@@ -27,6 +27,7 @@ typedef struct ref_material {
     float albedo[3];
     float emission[3];
     int emits;
+    int sides;   /* emitting sides: 2 double-sided (glTF doubleSided: the back emits L_e too), else 1 */
     int texture; /* -1 = none */
 } ref_material;
 
@@ -48,7 +49,7 @@ struct lpv_ref {
     uint32_t light_count;
     /* emissive triangles for next-event estimation, by emitted power */
     uint32_t *emitters;  /* triangle indices */
-    double *emitter_cdf; /* emitter_count + 1 running sums of (L_r + L_g + L_b) A */
+    double *emitter_cdf; /* emitter_count + 1 running sums of (L_r + L_g + L_b) A x sides */
     uint32_t emitter_count;
     int emitters_are_lights;
     int max_bounces; /* converged paths' cap */
@@ -198,6 +199,7 @@ static int copy_materials(lpv_ref *r, const lpv_scene *s)
             dst->emission[i] = (isfinite(e) && e > 0.0f) ? e : 0.0f;
         }
         dst->emits = dst->emission[0] > 0.0f || dst->emission[1] > 0.0f || dst->emission[2] > 0.0f;
+        dst->sides = src->double_sided ? 2 : 1;
         int tex = src->base_color_texture;
         dst->texture = (tex >= 0 && (uint32_t)tex < s->texture_count) ? tex : -1;
     }
@@ -252,10 +254,11 @@ static int build_emitters(lpv_ref *r)
         const ref_tri *tr = &r->tris[t];
         if (tr->material < 0 || !r->materials[tr->material].emits)
             continue;
-        const float *e = r->materials[tr->material].emission;
+        const ref_material *m = &r->materials[tr->material];
+        const float *e = m->emission;
         r->emitters[r->emitter_count] = t;
         r->emitter_cdf[r->emitter_count + 1] =
-            r->emitter_cdf[r->emitter_count] + ((double)e[0] + e[1] + e[2]) * tri_area(tr);
+            r->emitter_cdf[r->emitter_count] + ((double)e[0] + e[1] + e[2]) * tri_area(tr) * m->sides;
         r->emitter_count++;
     }
     return 0;
@@ -432,7 +435,7 @@ typedef struct hit {
     float p[3];
     float ng[3];    /* unit geometric normal on the side the ray came from */
     float ns[3];    /* unit shading normal on that side */
-    int front;      /* 1 if the ray arrived on the emitting side */
+    int front;      /* 1 if the ray arrived on the front side */
     uint32_t tri;
     float u, v;
     float t;
@@ -575,7 +578,7 @@ static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
 static const float *hit_emission(const lpv_ref *r, const hit *h)
 {
     const ref_tri *tr = &r->tris[h->tri];
-    if (!h->front || tr->material < 0 || !r->materials[tr->material].emits)
+    if (tr->material < 0 || !r->materials[tr->material].emits || (!h->front && r->materials[tr->material].sides < 2))
         return NULL;
     return r->materials[tr->material].emission;
 }
@@ -640,9 +643,10 @@ static void direct(const lpv_ref *r, const float p[3], const float ns[3], const 
     }
 }
 
-/* One sample of the irradiance at p from the emissive surfaces (front sides),
- * by next-event estimation: a triangle by emitted power, a uniform point on
- * it, a shadow ray. Unbiased; ns the cosine's normal, ng the side's. */
+/* One sample of the irradiance at p from the emissive surfaces (their front
+ * sides, and the backs of double-sided ones), by next-event estimation: a
+ * triangle by emitted power, a uniform point on it, a shadow ray. Unbiased;
+ * ns the cosine's normal, ng the side's. */
 static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const float ns[3], const float ng[3],
                            double out[3])
 {
@@ -660,7 +664,8 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
             lo = mid + 1;
     }
     const ref_tri *tr = &r->tris[r->emitters[lo]];
-    const float *le = r->materials[tr->material].emission;
+    const ref_material *m = &r->materials[tr->material];
+    const float *le = m->emission;
     float s1 = sqrtf(pcg32_float(rng)), s2 = pcg32_float(rng);
     float b1 = s1 * (1.0f - s2), b2 = s1 * s2, q[3], d[3];
     for (int i = 0; i < 3; ++i) {
@@ -673,15 +678,29 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
     for (int i = 0; i < 3; ++i)
         w[i] = d[i] / dist;
     float cos_r = dot3(ns, w), cos_e = -dot3(tr->front, w);
+    if (m->sides == 2) /* p sees the side it faces, which emits either way */
+        cos_e = fabsf(cos_e);
     if (!(cos_r > 0.0f) || !(cos_e > 0.0f) || !(dot3(ng, w) > 0.0f))
         return;
-    float org[3];
-    for (int i = 0; i < 3; ++i)
+    /* The shadow ray leaves eps off the surface and is aimed at q from
+     * there: along w from the offset origin it would meet the emitter's
+     * plane eps (ng . n_e) / cos_e short of q, inside the 2 eps margin only
+     * when cos_e > 1/2, and so shadow itself at grazing angles (14 % of a
+     * large emitter's light lost 1 m under it). */
+    float org[3], to_q[3];
+    for (int i = 0; i < 3; ++i) {
         org[i] = p[i] + r->eps * ng[i];
-    if (occluded(r, org, w, dist - 2.0f * r->eps))
+        to_q[i] = q[i] - org[i];
+    }
+    float len = sqrtf(dot3(to_q, to_q));
+    if (!(len > 2.0f * r->eps))
+        return;
+    for (int i = 0; i < 3; ++i)
+        to_q[i] /= len;
+    if (occluded(r, org, to_q, len - 2.0f * r->eps))
         return;
     /* pdf per unit area of the point: weight(tr) / total */
-    double weight = ((double)le[0] + le[1] + le[2]);
+    double weight = ((double)le[0] + le[1] + le[2]) * m->sides;
     double g = (double)cos_r * cos_e / dist2 * total / weight;
     for (int i = 0; i < 3; ++i)
         out[i] = le[i] * g;

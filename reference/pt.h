@@ -12,7 +12,9 @@
  *
  * with E_direct the shadowed irradiance from the punctual lights (exactly the
  * KHR_lights_punctual falloffs of shaders/lights.glsl), L_e the material's
- * emission on the front side of an emissive triangle (core/emissive.c's rule),
+ * emission on the front side of an emissive triangle, and on its back too
+ * when the material is double-sided (glTF doubleSided; core/emissive.c's and
+ * core/area_lights.c's rule),
  * n_q the surface normal on the side the ray arrived from. b = 1 is the term
  * lpvd's LPV approximates with area lights off (`lpvd render --indirect-only
  * --area-lights off` = albedo/pi * E_lpv).
@@ -101,7 +103,7 @@ int lpv_ref_irradiance(const lpv_ref *ref, const float *points, const float *nor
 int lpv_ref_render_indirect(const lpv_ref *ref, const lpv_view *view, int bounces, int samples_per_pixel,
                             float *rgba_radiance, float *rgba_stderr);
 
-/* The full image: per pixel L_e (front side) + albedo/pi * (E_direct +
+/* The full image: per pixel L_e (emitting side) + albedo/pi * (E_direct +
  * E_ind(bounces)) at the first surface, emitters as lights whatever the
  * desc says: bounces = diffuse reflections of direct light, punctual and
  * emitted alike (1 = what lpvd's full frame approximates; 0 = direct only;

@@ -31,10 +31,16 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  light in the left one, the camera in the right one (dark).
   two-rooms-lit.glb  the same with the lamp in the camera's room (the 1 %
                  target of issue 30 is measured against it).
+  panel-room.glb DOUBLE-SIDED EMITTER (issue 30): a closed 5 x 2.8 x 4 m dining
+                 room lit only by a lamp panel hanging 0.5 m under the ceiling
+                 over the table, its front facing the ceiling, glTF doubleSided
+                 true: it lights the ceiling with its front and the table and
+                 floor with its back, as glTF viewers light it.
 
 Every object is an axis-aligned box (12 triangles) or a quad (2 triangles, its
 front the side its corners run counter-clockwise around); each material is one
-mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits).
+mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits);
+materials are single-sided (glTF's default) unless made with double_sided=True.
 lpvd divides the photometric light units by 683 lm/W (docs/units.md); the
 medium format is in docs/scenes.md.
 
@@ -101,7 +107,8 @@ def look_rotation(forward, up=(0.0, 1.0, 0.0)):
 
 class Scene:
     def __init__(self):
-        self.materials = []  # (name, rgb, roughness, emission): emission None or (rgb factor, strength in nits)
+        self.materials = []  # (name, rgb, roughness, emission, double_sided): emission None or
+                             # (rgb factor, strength in nits)
         self.boxes = {}      # material index -> list of (lo, hi)
         self.quads = {}      # material index -> list of 4 corners (counter-clockwise seen from the front)
         self.nodes = []
@@ -109,8 +116,8 @@ class Scene:
         self.cameras = []
         self.medium = None   # lpvd_medium object for the scene's extras, or None
 
-    def material(self, name, rgb, roughness=1.0, emission=None):
-        self.materials.append((name, rgb, roughness, emission))
+    def material(self, name, rgb, roughness=1.0, emission=None, double_sided=False):
+        self.materials.append((name, rgb, roughness, emission, double_sided))
         self.boxes[len(self.materials) - 1] = []
         self.quads[len(self.materials) - 1] = []
         return len(self.materials) - 1
@@ -148,7 +155,7 @@ class Scene:
             blob.extend(data)
             return len(views) - 1
 
-        for m, (name, _, _, _) in enumerate(self.materials):
+        for m, (name, _, _, _, _) in enumerate(self.materials):
             pos, nrm, idx = [], [], []
             for lo, hi in self.boxes[m]:
                 p, n, i = box(lo, hi)
@@ -186,15 +193,17 @@ class Scene:
         if self.medium is not None:
             scene["extras"] = {"lpvd_medium": self.medium}
         materials = []
-        for n, c, r, e in self.materials:
+        for n, c, r, e, two in self.materials:
             mat = {"name": n, "pbrMetallicRoughness": {"baseColorFactor": list(c) + [1.0],
                                                        "metallicFactor": 0.0, "roughnessFactor": r}}
+            if two:
+                mat["doubleSided"] = True
             if e is not None:
                 mat["emissiveFactor"] = list(e[0])
                 mat["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": e[1]}}
             materials.append(mat)
         used = ["KHR_lights_punctual"] if self.lights else []
-        if any(e is not None for _, _, _, e in self.materials):
+        if any(e is not None for _, _, _, e, _ in self.materials):
             used.append("KHR_materials_emissive_strength")
         doc = {"asset": {"version": "2.0", "generator": "lpvd scenes/make_scenes.py"}, "extensionsUsed": used}
         if self.lights:
@@ -409,6 +418,29 @@ def two_rooms(lit_side=-1):
     s.light("lamp", {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (2.0 * lit_side, 2.2, 0.0),
             (2.0 * lit_side, 0.0, 0.0))
     s.camera("Camera", (3.6, 1.6, 1.6), (0.0, 1.2, -0.6), 70.0)
+def panel_room():
+    s = Scene()
+    # a closed room x in [-2.5, 2.5], z in [-2, 2], y in [0, 2.8] (walls 10 cm thick)
+    wall = s.material("walls", (0.78, 0.76, 0.72))
+    floor = s.material("floor", (0.42, 0.36, 0.30))
+    green = s.material("green_wall", (0.25, 0.45, 0.30))
+    wood = s.material("table_wood", (0.55, 0.35, 0.18))
+    t = 0.1
+    s.add_box(floor, (-2.5 - t, -t, -2 - t), (2.5 + t, 0, 2 + t))      # floor
+    s.add_box(wall, (-2.5 - t, 2.8, -2 - t), (2.5 + t, 2.8 + t, 2 + t))  # ceiling
+    s.add_box(wall, (-2.5, 0, -2 - t), (2.5, 2.8, -2))                  # back wall
+    s.add_box(wall, (-2.5, 0, 2), (2.5, 2.8, 2 + t))                    # front wall (behind the camera)
+    s.add_box(green, (-2.5 - t, 0, -2 - t), (-2.5, 2.8, 2 + t))         # left wall, coloured
+    s.add_box(wall, (2.5, 0, -2 - t), (2.5 + t, 2.8, 2 + t))            # right wall
+    s.add_box(wood, (-0.9, 0.72, -0.45), (0.9, 0.77, 0.45))             # the dining table
+    for x, z in ((-0.85, -0.4), (0.8, -0.4), (-0.85, 0.35), (0.8, 0.35)):
+        s.add_box(wood, (x, 0.0, z), (x + 0.05, 0.72, z + 0.05))        # its legs
+    # the lamp: 2 W/(m^2 sr) (1366 nits / 683 lm/W) from each side, a 1.2 x 0.4 m
+    # panel 0.5 m under the ceiling, its front (counter-clockwise seen from
+    # above) facing the ceiling; doubleSided, so its back lights the table
+    panel = s.material("lamp_panel", (0.9, 0.9, 0.9), emission=((1.0, 0.95, 0.85), 1366.0), double_sided=True)
+    s.add_quad(panel, [(-0.6, 2.3, 0.2), (0.6, 2.3, 0.2), (0.6, 2.3, -0.2), (-0.6, 2.3, -0.2)])
+    s.camera("Camera", (2.1, 1.6, 1.7), (-0.6, 1.2, -0.9), 70.0)
     return s
 
 
@@ -419,7 +451,7 @@ def main():
                         ("lamp-box-panel", lambda: lamp_box("panel")),
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
-                        ("two-rooms-lit", lambda: two_rooms(+1))):
+                        ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

@@ -3,7 +3,8 @@
  * light samples (core/area_lights.h): either way the samples carry exactly
  * the surfaces' emitted flux (pi * L * A, per channel), sit on the emitters,
  * face the way the emitter faces, and are the same every time; area light
- * samples are exactly as many as asked for.
+ * samples are exactly as many as asked for. A double-sided emitter emits
+ * as much again from its back (glTF doubleSided, issue 30).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -173,6 +174,74 @@ static void test_area_samples_many_triangles(void **state)
     lpv_scene_free(&s);
 }
 
+/* Issue 30: a double-sided emitter (glTF doubleSided) emits pi L A from each
+ * side: VPLs and area light samples facing both ways, each side's summing to
+ * pi L A. Code-built emitters stay single-sided (front only, as before). */
+static void test_double_sided_both_sides(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    const float le[3] = {1.0f, 2.0f, 0.5f};
+    int m = lpv_scene_add_material(&s, "panel", (float[3]){0.8f, 0.8f, 0.8f}, le);
+    assert_int_equal(s.materials[m].double_sided, 0);
+    const float q[4][3] = {{0, 2, 0.5f}, {1, 2, 0.5f}, {1, 2, 0}, {0, 2, 0}}; /* 1 x 0.5 m facing up */
+    assert_true(lpv_scene_add_quad(&s, m, q, NULL) >= 0);
+    lpv_scene_compute_bounds(&s);
+    double one[3], two[3];
+    lpv_emissive_total_flux(&s, one);
+    for (int c = 0; c < 3; ++c)
+        assert_true(fabs(one[c] - M_PI * le[c] * 0.5) < 1e-5 * one[c]);
+    enum { MAX = 4096 };
+    lpv_vpl *v = calloc(MAX, sizeof *v);
+    size_t n = lpv_emissive_sample(&s, 1000, v, MAX);
+    for (size_t i = 0; i < n; ++i)
+        assert_true(v[i].normal[1] > 0.99f); /* single-sided: all up */
+
+    s.materials[m].double_sided = 1;
+    lpv_emissive_total_flux(&s, two);
+    for (int c = 0; c < 3; ++c)
+        assert_true(fabs(two[c] - 2.0 * one[c]) < 1e-5 * one[c]);
+    n = lpv_emissive_sample(&s, 1000, v, MAX);
+    assert_true(n >= 950 && n <= 1050);
+    double up[3] = {0, 0, 0}, down[3] = {0, 0, 0};
+    size_t n_up = 0;
+    for (size_t i = 0; i < n; ++i) {
+        assert_true(fabsf(v[i].position[1] - 2.0f) < 1e-5f);
+        assert_true(fabsf(fabsf(v[i].normal[1]) - 1.0f) < 1e-5f);
+        n_up += v[i].normal[1] > 0.0f;
+        for (int c = 0; c < 3; ++c)
+            *(v[i].normal[1] > 0.0f ? &up[c] : &down[c]) += v[i].flux[c];
+    }
+    assert_int_equal(2 * n_up, n);
+    for (int c = 0; c < 3; ++c) {
+        assert_true(fabs(up[c] - one[c]) < 1e-5 * one[c]);
+        assert_true(fabs(down[c] - one[c]) < 1e-5 * one[c]);
+    }
+    free(v);
+
+    lpv_emitter_list l;
+    assert_int_equal(lpv_emitters_collect(&s, &l), 0);
+    assert_int_equal(l.count, 4); /* two triangles, two sides */
+    assert_int_equal(l.surfaces, 1);
+    lpv_area_sample a[8];
+    assert_int_equal(lpv_area_lights_sample(&l, 8, a), 8);
+    for (int c = 0; c < 3; ++c)
+        up[c] = down[c] = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        assert_true(a[k].position[0] > 0.0f && a[k].position[0] < 1.0f && fabsf(a[k].position[1] - 2.0f) < 1e-5f);
+        assert_int_equal(a[k].normal[1] > 0.99f, k < 4); /* the front's four first, then the back's */
+        assert_int_equal(a[k].normal[1] < -0.99f, k >= 4);
+        for (int c = 0; c < 3; ++c)
+            *(k < 4 ? &up[c] : &down[c]) += M_PI * a[k].intensity[c];
+    }
+    for (int c = 0; c < 3; ++c) {
+        assert_true(fabs(up[c] - one[c]) < 1e-5 * one[c]);
+        assert_true(fabs(down[c] - one[c]) < 1e-5 * one[c]);
+    }
+    lpv_emitters_free(&l);
+    lpv_scene_free(&s);
+}
+
 static void test_area_samples_none(void **state)
 {
     (void)state;
@@ -195,7 +264,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell_light_quad),         cmocka_unit_test(test_no_emitters),
         cmocka_unit_test(test_area_samples_cornell),       cmocka_unit_test(test_area_samples_many_triangles),
-        cmocka_unit_test(test_area_samples_none),
+        cmocka_unit_test(test_area_samples_none),          cmocka_unit_test(test_double_sided_both_sides),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

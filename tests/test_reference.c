@@ -253,10 +253,12 @@ static double corner_integral(double a, double b, double c)
     return 0.5 * (A / sa * atan(B / sa) + B / sb * atan(A / sb));
 }
 
-static void build_rectangle(builder *b, const float L[3])
+/* double_sided as glTF's doubleSided: 1 = the back emits L too (issue 30). */
+static void build_rectangle(builder *b, const float L[3], int double_sided)
 {
     b_init(b);
     int m = b_material(b, 0.5f, 0.5f, 0.5f, L[0], L[1], L[2]);
+    b->s.materials[m].double_sided = double_sided;
     float n[3] = {0, 0, -1};
     /* 4 x 6 m at z = 1, front side towards -z (the probe at the origin). */
     float c0[3] = {-2, -3, 1}, c1[3] = {-2, 3, 1}, c2[3] = {2, 3, 1}, c3[3] = {2, -3, 1};
@@ -268,7 +270,7 @@ static void test_one_bounce_rectangle(void **state)
     (void)state;
     const float L[3] = {0.5f, 1.0f, 2.0f};
     builder b;
-    build_rectangle(&b, L);
+    build_rectangle(&b, L, 0);
     lpv_ref *ref = make_ref(&b.s, 0);
     double factor = 4.0 * corner_integral(2.0, 3.0, 1.0); /* E / L */
     float p[3] = {0, 0, 0}, n[3] = {0, 0, 1}, e[3], se[3];
@@ -279,11 +281,25 @@ static void test_one_bounce_rectangle(void **state)
         assert_true(se[c] > 0.0f && se[c] < 0.01 * want);
         assert_true(fabs(e[c] - want) <= 3.0 * se[c]);
     }
+    /* Next-event estimation on the emitter agrees: its shadow rays do not
+     * stop on the emitter short of the point they aim at (grazing angles). */
+    lpv_ref *lights = NULL;
+    char err[256] = "";
+    assert_int_equal(lpv_ref_create(&b.s, &(lpv_ref_desc){.emitters_are_lights = 1}, &lights, err, sizeof err), 0);
+    assert_int_equal(lpv_ref_emitter_irradiance(lights, p, n, 1, 65536, e, se), 0);
+    for (int c = 0; c < 3; ++c) {
+        double want = factor * L[c];
+        print_message("rectangle: emitter sampling E[%d] = %.6f +- %.6f, analytic %.6f\n", c, e[c], se[c], want);
+        assert_true(se[c] > 0.0f && se[c] < 0.01 * want);
+        assert_true(fabs(e[c] - want) <= 3.0 * se[c]);
+    }
+    lpv_ref_destroy(lights);
+    assert_int_equal(lpv_ref_irradiance(ref, p, n, 1, 1, 65536, e, se), 0);
     /* Nothing else in the scene: more bounces add nothing (same streams). */
     float e2[3], se2[3];
     assert_int_equal(lpv_ref_irradiance(ref, p, n, 1, 3, 65536, e2, se2), 0);
     assert_memory_equal(e, e2, sizeof e);
-    /* The back of the emitter does not emit. */
+    /* The back of the (single-sided) emitter does not emit. */
     float pb[3] = {0, 0, 2}, nb[3] = {0, 0, -1};
     assert_int_equal(lpv_ref_irradiance(ref, pb, nb, 1, 1, 1024, e2, se2), 0);
     assert_true(e2[0] == 0.0f && e2[1] == 0.0f && e2[2] == 0.0f);
@@ -298,6 +314,51 @@ static void test_one_bounce_rectangle(void **state)
         assert_true(ratio > 3.3 && ratio < 4.8);
         assert_true(fabs(lo[i] - hi[i]) <= 4.0 * sqrt((double)lo_se[i] * lo_se[i] + (double)hi_se[i] * hi_se[i]));
     }
+    lpv_ref_destroy(ref);
+    lpv_scene_free(&b.s);
+}
+
+/* Issue 30: a double-sided emitter (glTF doubleSided) emits L from its back
+ * as from its front. A probe 1 m behind the rectangle facing it gets what a
+ * probe 1 m in front gets (the analytic value), by paths that hit the back
+ * (emitters not lights) and by next-event estimation on the emitters; its
+ * flux is counted twice in the power the emitters are picked by. */
+static void test_double_sided_emitter_back(void **state)
+{
+    (void)state;
+    const float L[3] = {0.5f, 1.0f, 2.0f};
+    builder b;
+    build_rectangle(&b, L, 1);
+    lpv_ref *ref = make_ref(&b.s, 0);
+    const double factor = 4.0 * corner_integral(2.0, 3.0, 1.0);
+    const float pts[6] = {0, 0, 0, 0, 0, 2}, nrm[6] = {0, 0, 1, 0, 0, -1};
+    float e[6], se[6], ee[6], ese[6];
+    assert_int_equal(lpv_ref_irradiance(ref, pts, nrm, 2, 1, 65536, e, se), 0);
+    lpv_ref *lights = NULL;
+    char err[256] = "";
+    assert_int_equal(lpv_ref_create(&b.s, &(lpv_ref_desc){.emitters_are_lights = 1}, &lights, err, sizeof err), 0);
+    assert_int_equal(lpv_ref_emitter_irradiance(lights, pts, nrm, 2, 262144, ee, ese), 0);
+    for (int side = 0; side < 2; ++side)
+        for (int c = 0; c < 3; ++c) {
+            double want = factor * L[c];
+            const int i = 3 * side + c;
+            print_message("double-sided rectangle, %s: E[%d] = %.6f +- %.6f (paths), %.6f +- %.6f (emitter "
+                          "sampling), analytic %.6f\n",
+                          side ? "behind" : "in front", c, e[i], se[i], ee[i], ese[i], want);
+            assert_true(se[i] > 0.0f && se[i] < 0.01 * want);
+            assert_true(fabs(e[i] - want) <= 3.0 * se[i]);
+            assert_true(ese[i] > 0.0f && ese[i] < 0.01 * want);
+            assert_true(fabs(ee[i] - want) <= 3.0 * ese[i]);
+        }
+    /* the full frame seen from behind (direct light only: the emitter's own
+     * light does not reach it) is L, as from the front */
+    lpv_view v;
+    assert_int_equal(lpv_view_look_at((float[3]){0.3f, -0.2f, 3.0f}, (float[3]){0, 0, 1}, 0.5f, 8, 8, &v), 0);
+    float rgba[8 * 8 * 4];
+    assert_int_equal(lpv_ref_render_full(lights, &v, 0, 4, rgba, NULL), 0);
+    for (int c = 0; c < 3; ++c)
+        assert_true(fabsf(rgba[4 * (4 * 8 + 4) + c] - L[c]) < 1e-3f * L[c]);
+    lpv_ref_destroy(lights);
     lpv_ref_destroy(ref);
     lpv_scene_free(&b.s);
 }
@@ -740,7 +801,7 @@ static void test_texture_albedo(void **state)
     (void)state;
     const float L[3] = {0.5f, 1.0f, 2.0f};
     builder b;
-    build_rectangle(&b, L);
+    build_rectangle(&b, L, 0);
     /* A grey receiver at z = 0 facing the emitter. */
     int grey = b_material(&b, 0.8f, 0.8f, 0.8f, 0, 0, 0);
     float n[3] = {0, 0, 1};
@@ -862,6 +923,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_direct_analytic),
         cmocka_unit_test(test_one_bounce_rectangle),
+        cmocka_unit_test(test_double_sided_emitter_back),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_furnace_lit),
         cmocka_unit_test(test_furnace_converged),
