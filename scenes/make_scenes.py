@@ -418,6 +418,9 @@ def two_rooms(lit_side=-1):
     s.light("lamp", {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (2.0 * lit_side, 2.2, 0.0),
             (2.0 * lit_side, 0.0, 0.0))
     s.camera("Camera", (3.6, 1.6, 1.6), (0.0, 1.2, -0.6), 70.0)
+    return s
+
+
 def panel_room():
     s = Scene()
     # a closed room x in [-2.5, 2.5], z in [-2, 2], y in [0, 2.8] (walls 10 cm thick)
