@@ -207,9 +207,8 @@ static void test_camera_inside_long_tunnel(void **state)
     lpv_scene_free(&s);
 
     /* the scene file (scenes/make_scenes.py): its frame is mostly tunnel */
-    const char *src = getenv("LPVD_SOURCE_DIR");
     char path[1024], err[512];
-    snprintf(path, sizeof path, "%s/scenes/tunnel.glb", src ? src : ".");
+    snprintf(path, sizeof path, "%s/scenes/tunnel.glb", lpvt_source_dir());
     if (lpv_scene_load(path, &s, err, sizeof err) != 0)
         fail_msg("%s", err);
     assert_int_equal(s.default_camera_added, 1);
