@@ -182,6 +182,8 @@ void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
         p->cascades = in_use;
     }
 
+    p->iterations_warning = lpv_settings_iterations_note(s, p->iterations_reason, sizeof p->iterations_reason);
+
     render_passes(s, f, p, all);
 
     const int occlusion = s->lpv.occlusion == LPV_SWITCH_ON;

@@ -3,12 +3,14 @@
  *
  * Zero means "default" for every field, so a zero-initialised struct is a
  * valid configuration after lpv_settings_resolve(). The one consequence to
- * know: lpv.iterations = 0 resolves to the preset's iteration count.
+ * know: lpv.iterations = 0 resolves to the preset's iteration count scaled
+ * to the grid (lpv_settings_scaled_iterations).
  * Injection-only runs (0 steps) are valid for lpv_settings_validate(),
  * but only when the caller skips resolve or sets lpv.iterations after it.
  */
 #include "settings.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -160,6 +162,62 @@ lpv_preset lpv_preset_match(const lpv_settings *s)
     return LPV_PRESET_DEFAULT;
 }
 
+/* The longest of a grid's three axes (0 for an unset grid). */
+static int longest_axis(const int dims[3])
+{
+    int m = dims[0];
+    for (int i = 1; i < 3; ++i)
+        m = dims[i] > m ? dims[i] : m;
+    return m;
+}
+
+int lpv_settings_scaled_iterations(const lpv_settings *s, int *wanted)
+{
+    const preset_row *r = preset_row_of(s->preset);
+    if (!r)
+        r = preset_row_of(LPV_PRESET_BALANCED);
+    const int grid = longest_axis(s->grid_dims) > 0 ? longest_axis(s->grid_dims) : r->grid;
+    /* light moves about a cell per step: the preset's steps per cell of its
+     * own grid, so the light crosses the same share of the grid (the same
+     * metres over the same bounds) at any resolution; rounded up */
+    const long long n = ((long long)r->iterations * grid + r->grid - 1) / r->grid;
+    if (wanted)
+        *wanted = n > INT_MAX ? INT_MAX : (int)n;
+    return n < 1 ? 1 : n > LPV_MAX_ITERATIONS ? LPV_MAX_ITERATIONS : (int)n;
+}
+
+int lpv_settings_iterations_note(const lpv_settings *s, char *buf, unsigned long n)
+{
+    const preset_row *r = preset_row_of(s->preset);
+    const int grid = longest_axis(s->grid_dims) > 0 ? longest_axis(s->grid_dims) : 1, k = s->lpv.iterations;
+    int wanted = 0;
+    const int scaled = lpv_settings_scaled_iterations(s, &wanted);
+    if (k == 0) {
+        snprintf(buf, n, "iterations = 0: injection only, no light moves");
+        return 0;
+    }
+    if (k == scaled && r && wanted > scaled) {
+        snprintf(buf, n, "%d steps: the %s preset's %d at grid %d scaled to grid %d would be %d, clamped to the "
+                 "most (%d); light covers %.0f %% of the grid's longest axis", k, r->name, r->iterations, r->grid,
+                 grid, wanted, LPV_MAX_ITERATIONS, 100.0 * k / grid);
+        return 1;
+    }
+    if (k == scaled && r) {
+        snprintf(buf, n, "%d steps: the %s preset's %d at grid %d scaled to grid %d (light crosses %.0f %% of the "
+                 "grid's longest axis, as the preset's does)", k, r->name, r->iterations, r->grid, grid,
+                 100.0 * k / grid);
+        return 0;
+    }
+    if (2 * k < grid) {
+        snprintf(buf, n, "%d steps set explicitly cover only %.0f %% of the grid's %d cells (light moves about a "
+                 "cell a step): the volume stays dark far from the lights; leave iterations unset for %d", k,
+                 100.0 * k / grid, grid, scaled);
+        return 1;
+    }
+    snprintf(buf, n, "%d steps set explicitly (%.0f %% of the grid's longest axis)", k, 100.0 * k / grid);
+    return 0;
+}
+
 void lpv_settings_resolve(lpv_settings *s)
 {
     if (s->preset == LPV_PRESET_DEFAULT)
@@ -170,8 +228,8 @@ void lpv_settings_resolve(lpv_settings *s)
             if (s->grid_dims[i] == 0)
                 s->grid_dims[i] = p.grid_dims[i];
         }
-        if (s->lpv.iterations == 0)
-            s->lpv.iterations = p.lpv.iterations;
+        if (s->lpv.iterations == 0) /* after grid_dims: the count follows the grid */
+            s->lpv.iterations = lpv_settings_scaled_iterations(s, NULL);
         if (s->rsm_size == 0)
             s->rsm_size = p.rsm_size;
         if (s->lpv.occlusion == LPV_SWITCH_DEFAULT)

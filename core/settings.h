@@ -48,7 +48,8 @@ typedef enum lpv_preset {
  * technique gets a struct like this one inside lpv_settings, zero meaning
  * "the default" as everywhere. */
 typedef struct lpv_lpv_settings {
-    int iterations;         /* propagation steps; default: the preset's */
+    int iterations;         /* propagation steps; default: the preset's scaled to the grid
+                               (lpv_settings_scaled_iterations) */
     lpv_switch occlusion;   /* fuzzy occlusion from the geometry volume; default: the preset's (on) */
 
     /* Cascades (cascaded-LPV paper, section 4; docs/cascades.md). Every cascade
@@ -235,10 +236,25 @@ typedef struct lpv_settings {
 #define LPV_IV_MAX_SEED 99999999
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
- * grid_dims / iterations / rsm_size / occlusion take the preset's values, the
+ * grid_dims / rsm_size / occlusion take the preset's values, zero iterations
+ * the preset's scaled to the grid (lpv_settings_scaled_iterations), the
  * other zero fields the engine's defaults. An out-of-range preset is left as
  * is (and its fields untouched) for lpv_settings_validate() to report. */
 void lpv_settings_resolve(lpv_settings *s);
+
+/* The iteration count an unset iterations resolves to: the preset's count
+ * times the longest axis of s->grid_dims over the preset's grid, rounded up
+ * (light moves about a cell a step, so it crosses the same share of the grid,
+ * the same metres over the same bounds, at any resolution), clamped to
+ * 1..LPV_MAX_ITERATIONS. *wanted (if not NULL): the count before the clamp.
+ * A grid_dims of zeros counts as the preset's grid. */
+int lpv_settings_scaled_iterations(const lpv_settings *s, int *wanted);
+
+/* One sentence on why s->lpv.iterations (resolved) is what it is, for the
+ * plan and the warnings. Returns 1 when it is a warning: an explicit count
+ * under half the grid's longest axis (light stops short of the grid), or a
+ * scaled count the LPV_MAX_ITERATIONS clamp cut; else 0. */
+int lpv_settings_iterations_note(const lpv_settings *s, char *buf, unsigned long n);
 
 /* Writes a preset's values into *out: a zeroed lpv_settings with preset,
  * grid_dims, iterations, rsm_size and occlusion set (DEFAULT gives balanced).

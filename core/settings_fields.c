@@ -26,7 +26,8 @@
 static const lpv_field FIELDS[] = {
     /* The older knobs (the preset supplies the defaults of three of them). */
     {"iterations", "iterations", LPV_FIELD_INT, F(lpv.iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
-     "the preset's", "", "propagation steps", T_VOL, LPV_TECHNIQUE_LPV},
+     "the preset's x grid / its grid", "", "propagation steps (light moves about a cell a step)", T_VOL,
+     LPV_TECHNIQUE_LPV},
     {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
      "the preset's", "", "reflective shadow map side", T_VOL, ""},
     {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", "1024", "",

@@ -135,7 +135,7 @@ const char *lpv_settings_flags_help(void)
         lpv_settings s;
         lpv_preset_settings((lpv_preset)p, &s);
         char letters[5];
-        lpv_flags_append(help, sz, &len, "%28s%-10sgrid %d, %d iterations, RSM %d, occlusion %s, departures %s\n", "",
+        lpv_flags_append(help, sz, &len, "%28s%-10sgrid %d, %d iterations (scaled with --grid), RSM %d, occlusion %s, departures %s\n", "",
                          lpv_preset_name((lpv_preset)p), s.grid_dims[0], s.lpv.iterations, s.rsm_size,
                          s.lpv.occlusion == LPV_SWITCH_ON ? "on" : "off", lpv_settings_departures(&s, letters));
     }

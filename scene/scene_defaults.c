@@ -19,11 +19,17 @@
 #define FAN 5                /* rays per side of the fan that scores a view direction */
 #define LIGHT_RAYS 16        /* visible points per side sampled for the light */
 #define DEFAULT_YFOV 0.785398f /* 45 degrees */
+#define LONG_RATIO 4.0f      /* a long scene: its longest horizontal side is at least this x each other side */
+#define ALONG 9              /* candidate eye points along a long scene's long axis */
+#define WALLED 0.9f          /* a corridor candidate: this share of its rays not above the horizon's 12 degrees hit */
+#define SIDE_Y 0.2f          /* ... the rays with direction y under this (sin 11.5 degrees) */
+#define LEAVE_TRIES 8        /* surfaces the eye may step through to leave closed geometry */
 
 static const float GOLDEN = 2.39996323f; /* pi (3 - sqrt 5) */
 
 typedef struct probe {
     int hits, back;
+    int side_rays, side_hits; /* the rays under SIDE_Y: walls around, whether the sky is open or not */
     float mean, min;
 } probe;
 
@@ -67,14 +73,17 @@ typedef struct ctx {
 
 static probe probe_point(const ctx *c, const float p[3])
 {
-    probe pr = {0, 0, 0.0f, INFINITY};
+    probe pr = {0, 0, 0, 0, 0.0f, INFINITY};
     double sum = 0.0;
     for (int i = 0; i < PROBE_RAYS; ++i) {
         float d[3], t, f[3];
         fib_dir(i, PROBE_RAYS, d);
+        const int side = d[1] < SIDE_Y;
+        pr.side_rays += side;
         if (!lpv_raycast_hit(c->rc, p, d, c->eps, INFINITY, &t, f))
             continue;
         pr.hits++;
+        pr.side_hits += side;
         sum += t;
         pr.min = fminf(pr.min, t);
         if (dot3(f, d) > 0.0f)
@@ -199,6 +208,97 @@ static int interior_camera(const ctx *c, lpv_camera *cam)
     return 1;
 }
 
+/* A long scene (a tunnel, a street) or a roofless one: the lattice point
+ * (ALONG points along the horizontal axis `axis`, LATTICE x LATTICE across
+ * it) that is not inside closed geometry, has walls around it (WALLED of its
+ * rays below SIDE_Y hit, few of them back faces) and keeps the most room
+ * to the nearest surface (the middle of the cross-section; nearer the middle
+ * of the axis on a tie); looking along the axis, level or slightly down,
+ * whichever sees the most, stepped back half-way to what is behind it. From
+ * outside, a long scene is a line across the frame (issue 30: a 479 m x 2 m
+ * tunnel covered 0.3 % of it). Returns 0 when no point qualifies. */
+static int corridor_camera(const ctx *c, int axis, lpv_camera *cam)
+{
+    const int o1 = axis == 0 ? 1 : 0, o2 = axis == 2 ? 1 : 2;
+    const float shortest = fminf(c->hi[o1] - c->lo[o1], c->hi[o2] - c->lo[o2]);
+    float best[3] = {0}, best_score = -INFINITY;
+    int found = 0;
+    for (int k = 0; k < ALONG; ++k)
+        for (int j = 0; j < LATTICE; ++j)
+            for (int i = 0; i < LATTICE; ++i) {
+                float p[3];
+                const float fa = ((float)k + 0.5f) / ALONG;
+                p[axis] = c->lo[axis] + fa * (c->hi[axis] - c->lo[axis]);
+                p[o1] = c->lo[o1] + ((float)i + 0.5f) / LATTICE * (c->hi[o1] - c->lo[o1]);
+                p[o2] = c->lo[o2] + ((float)j + 0.5f) / LATTICE * (c->hi[o2] - c->lo[o2]);
+                probe pr = probe_point(c, p);
+                if (probe_inside(&pr) || (float)pr.side_hits < WALLED * (float)pr.side_rays || 8 * pr.back > pr.hits ||
+                    !(pr.min > 0.05f * shortest)) /* not in a gap between parts */
+                    continue;
+                const float score = pr.min * (1.0f - 0.01f * fabsf(fa - 0.5f));
+                if (!found || score > best_score) {
+                    memcpy(best, p, sizeof best);
+                    best_score = score;
+                    found = 1;
+                }
+            }
+    if (!found)
+        return 0;
+    float best_f[3] = {0}, best_content = -1.0f;
+    static const float ELEVATIONS[2] = {0.0f, -0.15f};
+    for (int sgn = 0; sgn < 2; ++sgn)
+        for (int e = 0; e < 2; ++e) {
+            float f[3] = {0.0f, sinf(ELEVATIONS[e]), 0.0f};
+            f[axis] = (sgn ? -1.0f : 1.0f) * cosf(ELEVATIONS[e]);
+            const float content = view_content(c, best, f);
+            if (content > best_content) {
+                best_content = content;
+                memcpy(best_f, f, sizeof best_f);
+            }
+        }
+    float back[3] = {-best_f[0], -best_f[1], -best_f[2]}, t;
+    if (lpv_raycast_hit(c->rc, best, back, c->eps, INFINITY, &t, NULL))
+        for (int a = 0; a < 3; ++a)
+            best[a] += 0.5f * t * back[a];
+    set_camera(cam, best, best_f);
+    return 1;
+}
+
+/* The scene's long horizontal axis (0 = x, 2 = z) when one is at least
+ * LONG_RATIO x each other side of the bounds, else -1. */
+static int long_axis(const ctx *c)
+{
+    float e[3];
+    for (int a = 0; a < 3; ++a)
+        e[a] = c->hi[a] - c->lo[a];
+    for (int a = 0; a < 3; a += 2)
+        if (e[a] >= LONG_RATIO * e[2 - a] && e[a] >= LONG_RATIO * e[1])
+            return a;
+    return -1;
+}
+
+/* Moves an eye that stands inside closed geometry (probe_inside) forward
+ * through the surfaces that close it in (each the first hit ahead), at most
+ * LEAVE_TRIES of them. Returns 0 when the eye ends outside, else -1. */
+static int leave_solid(const ctx *c, lpv_camera *cam)
+{
+    float f[3];
+    memcpy(f, cam->forward, sizeof f);
+    norm3(f);
+    for (int k = 0; k < LEAVE_TRIES; ++k) {
+        probe pr = probe_point(c, cam->eye);
+        if (!probe_inside(&pr))
+            return 0;
+        float t;
+        if (!lpv_raycast_hit(c->rc, cam->eye, f, c->eps, INFINITY, &t, NULL))
+            return -1;
+        for (int a = 0; a < 3; ++a)
+            cam->eye[a] += (t + 100.0f * c->eps) * f[a];
+    }
+    probe pr = probe_point(c, cam->eye);
+    return probe_inside(&pr) ? -1 : 0;
+}
+
 /* An object or open scene: a three-quarter view from the front (+Z, glTF's
  * front), the right and above, at the smallest distance that keeps all eight
  * corners of the bounds in a square 45-degree frame, plus 5 %. */
@@ -237,7 +337,15 @@ static int add_camera(lpv_scene *s, const ctx *c)
         return -1;
     s->cameras = cams;
     lpv_camera *cam = &cams[s->camera_count];
-    if (!interior_camera(c, cam))
+    /* a long scene first: seen from outside it is a line across the frame */
+    const int along = long_axis(c);
+    const float ex = c->hi[0] - c->lo[0], ez = c->hi[2] - c->lo[2];
+    if (!(along >= 0 && corridor_camera(c, along, cam)) && !interior_camera(c, cam) &&
+        !corridor_camera(c, ex >= ez ? 0 : 2, cam)) /* roofless: walls around, open sky */
+        framing_camera(c, cam);
+    /* never inside closed geometry: step out ahead, else frame from outside
+     * (outside the bounds, so outside every closed mesh) */
+    if (leave_solid(c, cam) != 0)
         framing_camera(c, cam);
     s->camera_count++;
     s->default_camera_added = 1;

@@ -36,6 +36,11 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  over the table, its front facing the ceiling, glTF doubleSided
                  true: it lights the ceiling with its front and the table and
                  floor with its back, as glTF viewers light it.
+  tunnel.glb     LONG (issue 30, docs/scenes.md "Defaults"): a closed tunnel
+                 240 m long, 3 m wide and 2.6 m high (walls, floor, roof and
+                 end caps 20 cm thick), lit from inside by six point lights
+                 (candela) 40 m apart under the roof; NO camera, so the
+                 default camera's rule for long scenes places the view.
 
 Every object is an axis-aligned box (12 triangles) or a quad (2 triangles, its
 front the side its corners run counter-clockwise around); each material is one
@@ -447,6 +452,25 @@ def panel_room():
     return s
 
 
+def tunnel():
+    s = Scene()
+    wall = s.material("tunnel_walls", (0.60, 0.58, 0.55))
+    floor = s.material("tunnel_floor", (0.35, 0.35, 0.36))
+    red = s.material("end_cap_red", (0.65, 0.15, 0.10))
+    L, W, H, t = 120.0, 1.5, 2.6, 0.2  # half length and half width, height, wall thickness
+    s.add_box(floor, (-W - t, -t, -L - t), (W + t, 0, L + t))          # floor
+    s.add_box(wall, (-W - t, H, -L - t), (W + t, H + t, L + t))         # roof
+    s.add_box(wall, (-W - t, 0, -L - t), (-W, H, L + t))                # left wall
+    s.add_box(wall, (W, 0, -L - t), (W + t, H, L + t))                  # right wall
+    s.add_box(red, (-W, 0, -L - t), (W, H, -L))                         # end cap, far (-z)
+    s.add_box(wall, (-W, 0, L), (W, H, L + t))                          # end cap, near (+z)
+    # 1500 cd = 2.2 W/sr: about 0.4 W/m^2 on the floor 2.4 m below each light
+    for z in (-100.0, -60.0, -20.0, 20.0, 60.0, 100.0):
+        s.light("lamp_%+d" % int(z), {"type": "point", "color": [1.0, 0.9, 0.75], "intensity": 1500.0},
+                (0.0, H - 0.2, z), (0.0, 0.0, z))
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
@@ -454,7 +478,7 @@ def main():
                         ("lamp-box-panel", lambda: lamp_box("panel")),
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
-                        ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room)):
+                        ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

@@ -179,6 +179,9 @@ int lpvd_cmd_render(int argc, char **argv)
         fprintf(stderr, "lpvd render: %s\n", err);
         goto done;
     }
+    const lpv_plan *plan = lpv_engine_last_plan(engine);
+    if (plan && plan->iterations_warning) /* light that stops short of the grid darkens the frame silently */
+        fprintf(stderr, "lpvd render: warning: %s\n", plan->iterations_reason);
     size_t pixels = (size_t)view.width * (size_t)view.height;
     rgba = malloc(pixels * 4 * sizeof(float));
     if (!rgba) {

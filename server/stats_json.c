@@ -4,11 +4,13 @@
 #include <string.h>
 
 /* A reason's length (it may fill its whole buffer without a NUL). */
-static int reason_len(const char *r)
+static int reason_len_n(const char *r, size_t max)
 {
-    const char *end = memchr(r, '\0', LPV_PLAN_REASON_MAX);
-    return end ? (int)(end - r) : LPV_PLAN_REASON_MAX;
+    const char *end = memchr(r, '\0', max);
+    return end ? (int)(end - r) : (int)max;
 }
+
+static int reason_len(const char *r) { return reason_len_n(r, LPV_PLAN_REASON_MAX); }
 
 static json_t *grid_json(const lpv_grid *g)
 {
@@ -43,10 +45,11 @@ json_t *lpvd_plan_json(const lpv_plan *p)
     }
     if (!passes)
         return NULL;
-    return json_pack("{s:s, s:s#, s:i, s:s#, s:b, s:s#, s:o}", "technique", p->technique, "technique_reason",
-                     p->technique_reason, reason_len(p->technique_reason), "cascades", p->cascades, "cascades_reason",
-                     p->cascades_reason,
-                     reason_len(p->cascades_reason), "recompute", p->recompute != 0,
+    return json_pack("{s:s, s:s#, s:i, s:s#, s:s#, s:b, s:b, s:s#, s:o}", "technique", p->technique,
+                     "technique_reason", p->technique_reason, reason_len(p->technique_reason), "cascades", p->cascades,
+                     "cascades_reason", p->cascades_reason, reason_len(p->cascades_reason), "iterations_reason",
+                     p->iterations_reason, reason_len_n(p->iterations_reason, sizeof p->iterations_reason), "iterations_warning",
+                     p->iterations_warning != 0, "recompute", p->recompute != 0,
                      "recompute_reason", p->recompute_reason,
                      reason_len(p->recompute_reason), "passes", passes);
 }

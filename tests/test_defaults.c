@@ -22,6 +22,7 @@
 #include "image_io.h"
 #include "scene_build.h"
 #include "scene_defaults.h"
+#include "scene_load.h"
 #include "test_util.h"
 #include "tonemap.h"
 #include "view.h"
@@ -39,14 +40,15 @@ static void box(lpv_scene *s, int m, float k, float x0, float y0, float z0, floa
  * read as metres): a 12 x 3 x 8 room of 0.2 thick walls, floor and ceiling
  * (closed boxes, outward faces), a dividing wall with a door gap, a pillar
  * and a crate. No camera, no light. */
-static void build_level(lpv_scene *s, float k)
+static void build_level_roof(lpv_scene *s, float k, int roof)
 {
     memset(s, 0, sizeof *s);
     int grey = lpv_scene_add_material(s, "grey", (float[3]){0.7f, 0.7f, 0.7f}, NULL);
     int red = lpv_scene_add_material(s, "red", (float[3]){0.7f, 0.1f, 0.1f}, NULL);
     assert_true(grey >= 0 && red >= 0);
     box(s, grey, k, -6.2f, -0.2f, -4.2f, 6.2f, 0.0f, 4.2f); /* floor */
-    box(s, grey, k, -6.2f, 3.0f, -4.2f, 6.2f, 3.2f, 4.2f);  /* ceiling */
+    if (roof)
+        box(s, grey, k, -6.2f, 3.0f, -4.2f, 6.2f, 3.2f, 4.2f); /* ceiling */
     box(s, grey, k, -6.2f, 0.0f, -4.2f, -6.0f, 3.0f, 4.2f); /* walls */
     box(s, red, k, 6.0f, 0.0f, -4.2f, 6.2f, 3.0f, 4.2f);
     box(s, grey, k, -6.0f, 0.0f, -4.2f, 6.0f, 3.0f, -4.0f);
@@ -55,8 +57,10 @@ static void build_level(lpv_scene *s, float k)
     box(s, grey, k, -3.3f, 0.0f, -0.3f, -2.7f, 3.0f, 0.3f); /* pillar */
     box(s, red, k, 3.0f, 0.0f, 1.5f, 4.0f, 1.0f, 2.5f);     /* crate */
     lpv_scene_compute_bounds(s);
-    snprintf(s->source, sizeof s->source, "test:level x%g", (double)k);
+    snprintf(s->source, sizeof s->source, "test:level x%g%s", (double)k, roof ? "" : ", roofless");
 }
+
+static void build_level(lpv_scene *s, float k) { build_level_roof(s, k, 1); }
 
 /* A closed "crankcase": a 2 x 1 x 1 box with a smaller box inside it and a
  * thin plate on top, so the old rule's spot (the bounds' centre, 10 % below
@@ -71,6 +75,25 @@ static void build_closed_object(lpv_scene *s, float k)
     box(s, m, k, -0.3f, 1.0f, -0.3f, 0.3f, 1.02f, 0.3f);
     lpv_scene_compute_bounds(s);
     snprintf(s->source, sizeof s->source, "test:closed object x%g", (double)k);
+}
+
+/* A closed tunnel (issue 30's long scene, scenes/make_scenes.py's tunnel):
+ * 240 m along z, 3 m wide, 2.6 m high, walls, floor, roof and end caps 0.2 m
+ * thick (closed boxes, outward faces). No camera, no light. */
+static void build_tunnel(lpv_scene *s)
+{
+    memset(s, 0, sizeof *s);
+    int grey = lpv_scene_add_material(s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    assert_true(grey >= 0);
+    const float L = 120.0f, Wd = 1.5f, Ht = 2.6f, t = 0.2f;
+    box(s, grey, 1.0f, -Wd - t, -t, -L - t, Wd + t, 0.0f, L + t); /* floor */
+    box(s, grey, 1.0f, -Wd - t, Ht, -L - t, Wd + t, Ht + t, L + t); /* roof */
+    box(s, grey, 1.0f, -Wd - t, 0.0f, -L - t, -Wd, Ht, L + t);      /* walls */
+    box(s, grey, 1.0f, Wd, 0.0f, -L - t, Wd + t, Ht, L + t);
+    box(s, grey, 1.0f, -Wd, 0.0f, -L - t, Wd, Ht, -L);             /* end caps */
+    box(s, grey, 1.0f, -Wd, 0.0f, L, Wd, Ht, L + t);
+    lpv_scene_compute_bounds(s);
+    snprintf(s->source, sizeof s->source, "test:tunnel");
 }
 
 static void add_defaults(lpv_scene *s)
@@ -144,6 +167,97 @@ static void test_camera_inside_enclosed_level(void **state)
     assert_true(lit > 0.5);
     free(rgba);
     lpv_scene_free(&s);
+}
+
+/* Inside the tunnel's air (x, y, z within its inner faces). */
+static int in_tunnel(const float p[3])
+{
+    return fabsf(p[0]) < 1.5f && p[1] > 0.0f && p[1] < 2.6f && fabsf(p[2]) < 120.0f;
+}
+
+/* Issue 30: the default camera framed a 479 m x 2 m tunnel from outside, a
+ * grey line on 99.7 % background. A long scene's default camera stands in
+ * its free space and looks along it. */
+static void test_camera_inside_long_tunnel(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    build_tunnel(&s);
+    add_defaults(&s);
+    const lpv_camera *c = &s.cameras[0];
+    print_message("tunnel camera eye (%.2f, %.2f, %.2f) forward (%.2f, %.2f, %.2f)\n", (double)c->eye[0],
+                  (double)c->eye[1], (double)c->eye[2], (double)c->forward[0], (double)c->forward[1],
+                  (double)c->forward[2]);
+    assert_true(in_tunnel(c->eye));
+    assert_false(lpv_defaults_inside_solid(&s, c->eye));
+    assert_true(fabsf(c->forward[2]) > 0.95f); /* along the tunnel */
+    lpv_scene_free(&s);
+
+    /* roofless: the level without its ceiling is seen from inside its walls, along its long side */
+    build_level_roof(&s, 1.0f, 0);
+    add_defaults(&s);
+    c = &s.cameras[0];
+    print_message("roofless level camera eye (%.2f, %.2f, %.2f) forward (%.2f, %.2f, %.2f)\n", (double)c->eye[0],
+                  (double)c->eye[1], (double)c->eye[2], (double)c->forward[0], (double)c->forward[1],
+                  (double)c->forward[2]);
+    assert_true(c->eye[0] > -6.0f && c->eye[0] < 6.0f && c->eye[1] > 0.0f && c->eye[1] < 3.0f &&
+                c->eye[2] > -4.0f && c->eye[2] < 4.0f);
+    assert_false(lpv_defaults_inside_solid(&s, c->eye));
+    assert_true(fabsf(c->forward[0]) > 0.95f);
+    lpv_scene_free(&s);
+
+    /* the scene file (scenes/make_scenes.py): its frame is mostly tunnel */
+    char path[1024], err[512];
+    snprintf(path, sizeof path, "%s/scenes/tunnel.glb", lpvt_source_dir());
+    if (lpv_scene_load(path, &s, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    assert_int_equal(s.default_camera_added, 1);
+    assert_true(in_tunnel(s.cameras[0].eye));
+    assert_true(fabsf(s.cameras[0].forward[2]) > 0.95f);
+    float *rgba = malloc((size_t)W * H * 4 * sizeof *rgba);
+    assert_non_null(rgba);
+    render(&s, LPV_TERMS_FULL, rgba);
+    double coverage, lit = lit_fraction(rgba, &coverage);
+    print_message("tunnel.glb: coverage %.3f, lit %.3f\n", coverage, lit);
+    assert_true(coverage > 0.5);
+    assert_true(lit > 0.5);
+    free(rgba);
+    lpv_scene_free(&s);
+}
+
+/* The scene of build(), with a closed 1 m crate centred where its default
+ * camera stood, chooses an eye outside the crate. */
+static void check_crate_at_eye(void (*build)(lpv_scene *), const char *what)
+{
+    lpv_scene s;
+    build(&s);
+    add_defaults(&s);
+    const float e[3] = {s.cameras[0].eye[0], s.cameras[0].eye[1], s.cameras[0].eye[2]};
+    lpv_scene_free(&s);
+    build(&s);
+    int m = lpv_scene_add_material(&s, "crate", (float[3]){0.5f, 0.3f, 0.2f}, NULL);
+    assert_true(m >= 0);
+    const float lo[3] = {e[0] - 0.5f, e[1] - 0.5f, e[2] - 0.5f}, hi[3] = {e[0] + 0.5f, e[1] + 0.5f, e[2] + 0.5f};
+    assert_true(lpv_scene_add_box(&s, m, lo, hi) >= 0);
+    lpv_scene_compute_bounds(&s);
+    assert_true(lpv_defaults_inside_solid(&s, e)); /* the old eye is inside the crate now */
+    add_defaults(&s);
+    const float *eye = s.cameras[0].eye;
+    print_message("%s: eye (%.2f, %.2f, %.2f) with a crate at (%.2f, %.2f, %.2f)\n", what, (double)eye[0],
+                  (double)eye[1], (double)eye[2], (double)e[0], (double)e[1], (double)e[2]);
+    assert_false(lpv_defaults_inside_solid(&s, eye));
+    assert_false(eye[0] > lo[0] && eye[0] < hi[0] && eye[1] > lo[1] && eye[1] < hi[1] && eye[2] > lo[2] &&
+                 eye[2] < hi[2]);
+    lpv_scene_free(&s);
+}
+
+static void build_level_m(lpv_scene *s) { build_level(s, 1.0f); }
+
+static void test_camera_never_inside_closed_object(void **state)
+{
+    (void)state;
+    check_crate_at_eye(build_tunnel, "tunnel");
+    check_crate_at_eye(build_level_m, "level");
 }
 
 static void test_light_never_inside_closed_geometry(void **state)
@@ -384,6 +498,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exposure_parse),
         cmocka_unit_test(test_camera_inside_enclosed_level),
+        cmocka_unit_test(test_camera_inside_long_tunnel),
+        cmocka_unit_test(test_camera_never_inside_closed_object),
         cmocka_unit_test(test_light_never_inside_closed_geometry),
         cmocka_unit_test(test_millimetre_scene_renders_like_metres),
         cmocka_unit_test(test_auto_exposure_ignores_light_scale),

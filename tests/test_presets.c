@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "options.h"
+#include "lpv_shared.h"
 #include "settings.h"
 
 typedef struct expected {
@@ -101,7 +102,7 @@ static void test_explicit_fields_override(void **state)
     lpv_settings s = {.preset = LPV_PRESET_FAST, .grid_dims = {64, 64, 64}, .lpv.occlusion = LPV_SWITCH_OFF};
     lpv_settings_resolve(&s);
     assert_int_equal(s.preset, LPV_PRESET_FAST);
-    assert_knobs(&s, 64, 4, 128, LPV_SWITCH_OFF); /* iterations and rsm_size from fast */
+    assert_knobs(&s, 64, 32, 128, LPV_SWITCH_OFF); /* iterations (scaled to the grid) and rsm_size from fast */
     assert_int_equal(lpv_preset_match(&s), LPV_PRESET_DEFAULT); /* no preset has these values */
 
     lpv_settings t = {.preset = LPV_PRESET_ACCURATE, .lpv.iterations = 12, .rsm_size = 512, .lpv.normal_bins = OFF};
@@ -109,6 +110,61 @@ static void test_explicit_fields_override(void **state)
     assert_knobs(&t, PRESETS[2].grid, 12, 512, LPV_SWITCH_ON);
     assert_int_equal(t.lpv.normal_bins, OFF); /* explicit wins over the preset's on */
     assert_int_equal(t.lpv.far_field, ON);
+}
+
+/* Issue 30: an unset iteration count follows the grid, so the light reaches
+ * as far in metres over the same bounds whatever the cell count (--grid 64
+ * kept 8 steps and a dining room went half black). Cells over fixed bounds
+ * are (bounds / longest axis) wide, so steps x cell size is the reach. */
+static void test_iterations_follow_grid(void **state)
+{
+    (void)state;
+    const double extent = 10.0; /* m, any bounds' longest side */
+    const int grids[][3] = {{16, 16, 16}, {32, 32, 32}, {64, 64, 64}, {64, 16, 8}, {12, 12, 12}};
+    for (int i = 0; i < NPRESETS; ++i) {
+        const double reach = PRESETS[i].iterations * (extent / PRESETS[i].grid); /* m, the preset's own */
+        for (size_t g = 0; g < sizeof grids / sizeof grids[0]; ++g) {
+            lpv_settings s = {.preset = PRESETS[i].preset};
+            memcpy(s.grid_dims, grids[g], sizeof s.grid_dims);
+            lpv_settings_resolve(&s);
+            const double cell = extent / grids[g][0]; /* the first axis is the longest */
+            print_message("%s grid %d: %d steps, %.3f m (the preset's %.3f m)\n", PRESETS[i].name, grids[g][0],
+                          s.lpv.iterations, s.lpv.iterations * cell, reach);
+            /* rounded up to whole steps: at least the preset's reach, less than a cell more */
+            assert_true(s.lpv.iterations * cell >= reach - 1e-9);
+            assert_true(s.lpv.iterations * cell < reach + cell);
+        }
+    }
+    /* an explicit count is honoured */
+    lpv_settings t = {.grid_dims = {64, 64, 64}, .lpv.iterations = 8};
+    lpv_settings_resolve(&t);
+    assert_int_equal(t.lpv.iterations, 8);
+}
+
+/* The plan's sentence on the count: why it is what it is, and a warning
+ * when the light stops short of the grid. */
+static void test_iterations_note(void **state)
+{
+    (void)state;
+    char why[256];
+    lpv_settings s = {.grid_dims = {64, 64, 64}};
+    lpv_settings_resolve(&s);
+    assert_int_equal(s.lpv.iterations, 64);
+    assert_int_equal(lpv_settings_iterations_note(&s, why, sizeof why), 0);
+    assert_non_null(strstr(why, "scaled to grid 64"));
+    lpv_settings t = {.grid_dims = {64, 64, 64}, .lpv.iterations = 8};
+    lpv_settings_resolve(&t);
+    assert_int_equal(lpv_settings_iterations_note(&t, why, sizeof why), 1); /* 8 of 64 cells */
+    assert_non_null(strstr(why, "8 steps set explicitly"));
+    t.lpv.iterations = 32; /* half the grid: no warning */
+    assert_int_equal(lpv_settings_iterations_note(&t, why, sizeof why), 0);
+    int wanted = 0; /* the clamp: a grid no validated setting reaches, to see it said */
+    lpv_settings u = {.grid_dims = {100000, 1, 1}, .preset = LPV_PRESET_BALANCED};
+    assert_int_equal(lpv_settings_scaled_iterations(&u, &wanted), LPV_MAX_ITERATIONS);
+    assert_int_equal(wanted, 100000);
+    u.lpv.iterations = LPV_MAX_ITERATIONS;
+    assert_int_equal(lpv_settings_iterations_note(&u, why, sizeof why), 1);
+    assert_non_null(strstr(why, "clamped"));
 }
 
 static void test_names_round_trip(void **state)
@@ -172,7 +228,7 @@ static void test_flags_override_in_any_order(void **state)
         lpv_settings s = o.settings;
         lpv_settings_resolve(&s);
         assert_int_equal(s.preset, LPV_PRESET_FAST);
-        assert_knobs(&s, 64, 4, 128, LPV_SWITCH_ON);
+        assert_knobs(&s, 64, 32, 128, LPV_SWITCH_ON); /* fast's 4 steps at grid 8, scaled to 64 */
     }
     assert_int_equal(lpvd_option_takes_value("preset"), 1);
     assert_non_null(strstr(LPVD_OPTIONS_HELP, "--preset"));
@@ -185,6 +241,8 @@ int main(void)
         cmocka_unit_test(test_explicit_fields_override),  cmocka_unit_test(test_names_round_trip),
         cmocka_unit_test(test_bad_name_rejected),         cmocka_unit_test(test_validate_rejects_out_of_range),
         cmocka_unit_test(test_flags_override_in_any_order),
+        cmocka_unit_test(test_iterations_follow_grid),
+        cmocka_unit_test(test_iterations_note),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

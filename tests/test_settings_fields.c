@@ -269,7 +269,7 @@ static void test_cli_flags(void **state)
     assert_int_equal(s.preset, LPV_PRESET_FAST);
     assert_int_equal(s.technique, LPV_TECHNIQUE_ID_LPV);
     assert_true(s.lpv.cascade_size == 12.0f && s.lpv.bounces == LPV_SWITCH_ON && s.fog_sigma_s == 0.02f);
-    assert_int_equal(s.lpv.iterations, 4); /* the preset's */
+    assert_int_equal(s.lpv.iterations, 16); /* fast's 4 at grid 8, scaled to the grid's longest axis (32) */
 }
 
 /* The technique table: every id has a name that maps back to it; an unset

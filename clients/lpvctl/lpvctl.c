@@ -589,6 +589,10 @@ static void print_plan(const json_t *plan)
     }
     printf("plan: cascades %lld (%s)\n", (long long)json_integer_value(json_object_get(plan, "cascades")),
            json_string_value(json_object_get(plan, "cascades_reason")) ? json_string_value(json_object_get(plan, "cascades_reason")) : "");
+    const char *iters = json_string_value(json_object_get(plan, "iterations_reason"));
+    if (iters && iters[0])
+        printf("plan: iterations%s %s\n", json_is_true(json_object_get(plan, "iterations_warning")) ? " WARNING" : "",
+               iters);
     printf("plan: recompute %s (%s)\n", json_is_true(json_object_get(plan, "recompute")) ? "yes" : "no",
            json_string_value(json_object_get(plan, "recompute_reason")) ? json_string_value(json_object_get(plan, "recompute_reason")) : "");
     size_t i;

@@ -109,6 +109,9 @@ def plan_lines(plan):
         return ["plan: none"]
     out = ["cascades: %s (%s)" % (plan.get("cascades"), plan.get("cascades_reason", "")),
            "recompute: %s (%s)" % ("yes" if plan.get("recompute") else "no", plan.get("recompute_reason", ""))]
+    if plan.get("iterations_reason"):
+        out.insert(1, "iterations%s: %s" % (" WARNING" if plan.get("iterations_warning") else "",
+                                            plan["iterations_reason"]))
     for p in plan.get("passes", []):
         out.append("  %-10s %-4s %s" % (p.get("name"), "run" if p.get("run") else "skip", p.get("reason", "")))
     return out
