@@ -278,6 +278,25 @@ static int lobe_minus(const float n[3], float lobe[4])
     return 1;
 }
 
+/* The 2-band irradiance e (any sign per channel) as light, one rule for the
+ * whole colour, as iv_lookup.glsl's iv_physical: none where its luminance
+ * y <= 0; else y kept and the chroma scaled by y / (y - 2 m), m the most
+ * negative channel (1 where none is negative), so no channel is clipped to
+ * exactly 0 while another stays lit. */
+static void physical(const float e[3], float rgb[3])
+{
+    const float y = e[0] * LPV_IV_LUMA_R + e[1] * LPV_IV_LUMA_G + e[2] * LPV_IV_LUMA_B;
+    if (!(y > 0.0f)) {
+        rgb[0] = rgb[1] = rgb[2] = 0.0f;
+        return;
+    }
+    float m = e[0] < e[1] ? e[0] : e[1];
+    m = m < e[2] ? m : e[2];
+    const float s = m >= 0.0f ? 1.0f : y / (y - 2.0f * m);
+    for (int ch = 0; ch < 3; ch++)
+        rgb[ch] = m >= 0.0f ? e[ch] : y + (e[ch] - y) * s;
+}
+
 static void irradiance(const lpv_grid *g, const held_by *held, const lpv_cell *vol, const float p[3], const float n[3],
                        int neighbours, float rgb[3])
 {
@@ -287,10 +306,10 @@ static void irradiance(const lpv_grid *g, const held_by *held, const lpv_cell *v
     if (!lobe_minus(n, lobe))
         return;
     reconstruct(g, held, vol, p, n, neighbours, &L);
-    for (int ch = 0; ch < 3; ch++) {
-        float e = dot4(cchannel(&L, ch), lobe);
-        rgb[ch] = e > 0.0f ? e : 0.0f;
-    }
+    float e[3];
+    for (int ch = 0; ch < 3; ch++)
+        e[ch] = dot4(cchannel(&L, ch), lobe);
+    physical(e, rgb);
 }
 
 void lpv_iv_reconstruct(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],

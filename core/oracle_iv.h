@@ -87,8 +87,11 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
 void lpv_iv_reconstruct(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
                         const float n[3], int neighbours, lpv_cell *out);
 
-/* Irradiance (W/m^2, rgb) at p for normal n: E = max(0, dot(L, lobe(-n^)))
- * per channel, L = lpv_iv_reconstruct. 0 where that gives 0. */
+/* Irradiance (W/m^2, rgb) at p for normal n: e = dot(L, lobe(-n^)) per
+ * channel, L = lpv_iv_reconstruct, made light as a whole colour: 0 where
+ * its luminance y <= 0, else y kept and the chroma scaled by y / (y - 2 m)
+ * where its most negative channel m < 0 (iv_lookup.glsl, iv_physical). 0
+ * where the reconstruction gives 0. */
 void lpv_iv_irradiance(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *vol, const float p[3],
                        const float n[3], int neighbours, float rgb[3]);
 

@@ -8,6 +8,28 @@ uniform float u_damping; // the LPV's; the imperfect volume has none
 
 #define LPV_HAS_AO 1
 
+// The irradiance e the 2-band reconstruction gives, any sign per channel, as
+// light: one rule for the whole colour (core/oracle_iv.c, physical). Near a
+// surface the voxels a point reads hold its own bright light arriving from
+// behind it, which the 2-band cosine lobe weighs negatively: a channel can
+// fall below 0 while another stays positive. Clamping each channel at 0
+// then left exactly 0 in red and green and kept blue (dark blue floors in
+// the courtyard). Instead the luminance y decides: none at y <= 0; else the
+// colour keeps y and its chroma shrinks by y / (y - 2 m), m its most
+// negative channel (1 where no channel is negative; every channel stays
+// above 0 and the colour stays continuous). No gain: y is the linear
+// estimate's own luminance.
+vec3 iv_physical(vec3 e)
+{
+    float y = dot(e, vec3(LPV_IV_LUMA_R, LPV_IV_LUMA_G, LPV_IV_LUMA_B));
+    if (!(y > 0.0))
+        return vec3(0.0);
+    float m = min(min(e.r, e.g), e.b);
+    if (m >= 0.0)
+        return e;
+    return vec3(y) + (e - vec3(y)) * (y / (y - 2.0 * m));
+}
+
 vec3 lpv_irradiance(vec3 p, vec3 n_in)
 {
     float len = length(n_in);
@@ -29,7 +51,7 @@ vec3 lpv_irradiance(vec3 p, vec3 n_in)
         b += w[k] * c.b;
     }
     vec4 lobe = sh_lobe(-n) / sum; // irradiance: the incoming light travels along -n
-    return max(vec3(dot(r, lobe), dot(g, lobe), dot(b, lobe)), 0.0);
+    return iv_physical(vec3(dot(r, lobe), dot(g, lobe), dot(b, lobe)));
 }
 
 // Ambient occlusion at a surface (paper 3.5): the visible directions'

@@ -329,6 +329,12 @@ struct IvVoxel {
 #define LPV_IV_BEHIND 0.001f
 /* The reconstruction's weight of a voxel that holds a surface, relative to an
  * empty one (iv_volume.glsl, iv_blend; docs/imperfect-volumes.md). */
+/* Luminance weights (Rec. 709, summing to 1) of the lookup's rule for a
+ * reconstructed irradiance with a channel below 0 (iv_lookup.glsl,
+ * iv_physical; core/oracle_iv.c). */
+#define LPV_IV_LUMA_R 0.2126f
+#define LPV_IV_LUMA_G 0.7152f
+#define LPV_IV_LUMA_B 0.0722f
 #define LPV_IV_HELD_WEIGHT 0.015625f /* one-dimensional workgroups of the IV's compute passes */
 
 /* Random numbers both sides draw identically: a 32-bit integer hash (Chris

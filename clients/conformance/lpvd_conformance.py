@@ -2053,12 +2053,21 @@ def _iv_lookup(d, vals, held, p, n):
         return [0.0, 0.0, 0.0]
     # 7
     lobe = [f32(SH_LOBE0), f32(f32(SH_LOBE1) * -nh[1]), f32(f32(SH_LOBE1) * -nh[2]), f32(f32(SH_LOBE1) * -nh[0])]
-    out = []
+    e3 = []
     for ch in range(3):
         L = [f32(acc[4 * ch + k] / total) for k in range(4)]
-        e = f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3]))
-        out.append(max(0.0, e))
-    return out
+        e3.append(f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3])))
+    # 8. made light as a whole colour: luminance y <= 0 gives 0; else y is
+    # kept and, where the most negative channel m < 0, the chroma scales
+    # by y / (y - 2 m)
+    y = f32(f32(f32(e3[0] * f32(0.2126)) + f32(e3[1] * f32(0.7152))) + f32(e3[2] * f32(0.0722)))
+    if not y > 0.0:
+        return [0.0, 0.0, 0.0]
+    m = min(e3)
+    if m >= 0.0:
+        return list(e3)
+    s = f32(y / f32(y - f32(2.0 * m)))
+    return list(f32(y + f32(f32(c - y) * s)) for c in e3)
 
 
 def _cascades_checks(h):

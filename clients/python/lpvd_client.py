@@ -298,12 +298,21 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
         for k in range(12):
             acc[k] += w * float(vals[k])
     lobe = (_LOBE0, f32(_LOBE1 * -nh[1]), f32(_LOBE1 * -nh[2]), f32(_LOBE1 * -nh[0]))
-    rgb = []
+    e3 = []
     for ch in range(3):
         L = [f32(acc[4 * ch + k] / total) for k in range(4)]
-        e = f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3]))
-        rgb.append(e if e > 0.0 else 0.0)
-    return tuple(rgb)
+        e3.append(f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3])))
+    # 8. made light as a whole colour: luminance y <= 0 gives 0; else y is
+    # kept and, where the most negative channel m < 0, the chroma scales
+    # by y / (y - 2 m)
+    y = f32(f32(f32(e3[0] * f32(0.2126)) + f32(e3[1] * f32(0.7152))) + f32(e3[2] * f32(0.0722)))
+    if not y > 0.0:
+        return (0.0, 0.0, 0.0)
+    m = min(e3)
+    if m >= 0.0:
+        return tuple(e3)
+    s = f32(y / f32(y - f32(2.0 * m)))
+    return tuple(f32(y + f32(f32(c - y) * s)) for c in e3)
 
 
 class Cascade(object):
