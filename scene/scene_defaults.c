@@ -163,6 +163,17 @@ static float view_content(const ctx *c, const float eye[3], const float f[3])
     return sum;
 }
 
+/* Steps the eye at p halfway back towards the surface behind it (seen
+ * along -f), so the view takes in more, and makes it the camera. */
+static void step_back_and_set(const ctx *c, lpv_camera *cam, float p[3], const float f[3])
+{
+    float back[3] = {-f[0], -f[1], -f[2]}, t;
+    if (lpv_raycast_hit(c->rc, p, back, c->eps, INFINITY, &t, NULL))
+        for (int a = 0; a < 3; ++a)
+            p[a] += 0.5f * t * back[a];
+    set_camera(cam, p, f);
+}
+
 /* Inside an enclosed scene: the lattice point with the most open space around
  * it (largest mean free distance) among those whose rays nearly all hit
  * front faces, looking where the most content is, stepped back half-way to
@@ -200,11 +211,7 @@ static int interior_camera(const ctx *c, lpv_camera *cam)
             memcpy(best_f, f, sizeof best_f);
         }
     }
-    float back[3] = {-best_f[0], -best_f[1], -best_f[2]}, t;
-    if (lpv_raycast_hit(c->rc, best, back, c->eps, INFINITY, &t, NULL))
-        for (int a = 0; a < 3; ++a)
-            best[a] += 0.5f * t * back[a];
-    set_camera(cam, best, best_f);
+    step_back_and_set(c, cam, best, best_f);
     return 1;
 }
 
@@ -256,11 +263,7 @@ static int corridor_camera(const ctx *c, int axis, lpv_camera *cam)
                 memcpy(best_f, f, sizeof best_f);
             }
         }
-    float back[3] = {-best_f[0], -best_f[1], -best_f[2]}, t;
-    if (lpv_raycast_hit(c->rc, best, back, c->eps, INFINITY, &t, NULL))
-        for (int a = 0; a < 3; ++a)
-            best[a] += 0.5f * t * back[a];
-    set_camera(cam, best, best_f);
+    step_back_and_set(c, cam, best, best_f);
     return 1;
 }
 
