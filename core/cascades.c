@@ -129,6 +129,16 @@ int lpv_cascades_count(const lpv_settings *s, int count)
     return 1 + levels < LPV_MAX_CASCADES ? 1 + levels : LPV_MAX_CASCADES;
 }
 
+float lpv_cascade_cross_section(const float bmin[3], const float bmax[3])
+{
+    float e[3];
+    for (int i = 0; i < 3; ++i)
+        e[i] = bmax[i] - bmin[i];
+    const float longest = fmaxf(e[0], fmaxf(e[1], e[2]));
+    const float second = e[0] + e[1] + e[2] - longest - fminf(e[0], fminf(e[1], e[2]));
+    return second > 0.0f && isfinite(longest) && longest >= LPV_CASCADE_LONG_RATIO * second ? second : 0.0f;
+}
+
 float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3])
 {
     if (s->lpv.cascade_size > 0.0f)
@@ -136,7 +146,19 @@ float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const 
     float longest = 0.0f;
     for (int i = 0; i < 3; ++i)
         longest = fmaxf(longest, bmax[i] - bmin[i]);
-    return longest > 0.0f && isfinite(longest) ? LPV_CASCADE_AUTO_FRACTION * longest : 1.0f;
+    if (!(longest > 0.0f) || !isfinite(longest))
+        return 1.0f;
+    const float quarter = LPV_CASCADE_AUTO_FRACTION * longest;
+    /* a long scene (a tunnel): cells about as wide as its cross-section, not
+     * a quarter of its length over the grid (a 240 m x 3 m tunnel at 8^3 had
+     * 7.5 m cells, wider than the tunnel, and carried a fifth of the
+     * reference's indirect light; docs/cascades.md, "Long scenes") */
+    const float cross = lpv_cascade_cross_section(bmin, bmax);
+    int cells = 1;
+    for (int i = 0; i < 3; ++i)
+        cells = s->grid_dims[i] > cells ? s->grid_dims[i] : cells;
+    const float fitted = (float)cells * LPV_CASCADE_LONG_CELL * cross;
+    return cross > 0.0f && fitted < quarter ? fitted : quarter;
 }
 
 int lpv_point_in_bounds(const float p[3], const float bmin[3], const float bmax[3])

@@ -67,8 +67,16 @@ int lpv_cascades_count(const lpv_settings *s, int count);
 
 /* The finest cascade's extent (m): cascade_size, or with cascade_size 0
  * (auto) LPV_CASCADE_AUTO_FRACTION x the longest side of [bmin, bmax]
- * (1 when that is empty). */
+ * (1 when that is empty); for a long scene (lpv_cascade_cross_section) the
+ * smaller of that and the grid's longest axis x LPV_CASCADE_LONG_CELL x the
+ * cross-section, so a cell is about as wide as the scene across
+ * (docs/cascades.md, "Long scenes"). */
 float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3]);
+
+/* A long scene's cross-section (m): the second-longest side of [bmin, bmax]
+ * when the longest is at least LPV_CASCADE_LONG_RATIO x it (a tunnel, a
+ * corridor, a street), else 0. */
+float lpv_cascade_cross_section(const float bmin[3], const float bmax[3]);
 
 /* 1 when p lies in the box [bmin, bmax] (faces included). */
 int lpv_point_in_bounds(const float p[3], const float bmin[3], const float bmax[3]);

@@ -86,6 +86,11 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
             (double)f->scene_extent, (double)f->scene_shortest);
         return 1;
     }
+    if (f->scene_cross > 0.0f && f->cascade_finest < LPV_CASCADE_AUTO_FRACTION * f->scene_extent * 0.999f) {
+        say(reason, n, "the camera is inside a long scene (%.3g m, %.3g m across): cascades from %.3g m, cells "
+            "about as wide as it", (double)f->scene_extent, (double)f->scene_cross, (double)f->cascade_finest);
+        return LPV_DEFAULT_CASCADES;
+    }
     say(reason, n, "the camera is inside a wide scene (%.3g m, shortest side %.3g m): cascades from a quarter of it",
         (double)f->scene_extent, (double)f->scene_shortest);
     return LPV_DEFAULT_CASCADES;

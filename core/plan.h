@@ -48,6 +48,8 @@ typedef struct lpv_plan_facts {
     int camera_inside;         /* the camera stands inside the scene's bounds */
     float scene_extent;        /* m, the scene bounds' longest axis */
     float scene_shortest;      /* m, the scene bounds' shortest axis */
+    float cascade_finest;      /* m, the finest cascade's extent (lpv_cascade_finest_size) */
+    float scene_cross;         /* m, a long scene's cross-section (lpv_cascade_cross_section), else 0 */
     int bounds_given;          /* the settings fix the grid bounds */
     int cascades_unfit;        /* snapped cascades cannot be placed over the scene (lpv_cascades_fit) */
     float scene_reach;         /* m, the scene bounds' largest |coordinate| */

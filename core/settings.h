@@ -60,7 +60,8 @@ typedef struct lpv_lpv_settings {
                                auto, LPV_DEFAULT_CASCADES only when the camera stands inside a wide
                                scene (LPV_CASCADE_WIDE_RATIO), else one grid; N = exactly N */
     float cascade_size;     /* m, the finest cascade's extent along its longest axis; 0 (default)
-                               = auto: LPV_CASCADE_AUTO_FRACTION of the scene's longest side */
+                               = auto: LPV_CASCADE_AUTO_FRACTION of the scene's longest side, or
+                               for a long scene cells as wide as it (lpv_cascade_finest_size) */
     float cascade_ratio;    /* cell size ratio of consecutive cascades; default 2 */
     float cascade_offset;   /* how far each cascade's centre sits ahead of the camera along
                                the view direction, as a fraction of its extent; default 0.25,
@@ -185,6 +186,10 @@ typedef struct lpv_settings {
                                             this x its shortest (a level, not a room), seen from inside */
 #define LPV_CASCADE_AUTO_FRACTION 0.25f  /* auto cascade_size: this x the scene's longest side, so
                                             3 cascades of ratio 2 span the whole scene */
+#define LPV_CASCADE_LONG_RATIO 4.0f    /* auto cascade_size of a long scene (longest side at least this x
+                                            the second longest): cells LPV_CASCADE_LONG_CELL x the
+                                            second longest (lpv_cascade_finest_size) */
+#define LPV_CASCADE_LONG_CELL 0.75f    /* measured on scenes/tunnel.glb (docs/cascades.md, "Long scenes") */
 #define LPV_DEFAULT_CASCADE_RATIO 2.0f
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f

@@ -21,8 +21,8 @@
 #define DEFAULT_YFOV 0.785398f /* 45 degrees */
 #define LONG_RATIO 4.0f      /* a long scene: its longest horizontal side is at least this x each other side */
 #define ALONG 9              /* candidate eye points along a long scene's long axis */
-#define WALLED 0.9f          /* a corridor candidate: this share of its rays not above the horizon's 12 degrees hit */
-#define SIDE_Y 0.2f          /* ... the rays with direction y under this (sin 11.5 degrees) */
+#define WALLED 0.9f          /* a corridor candidate: this share of its rays below SIDE_Y hit */
+#define SIDE_Y 0.2f          /* direction y under this: at most 11.5 degrees above the horizon */
 #define LEAVE_TRIES 8        /* surfaces the eye may step through to leave closed geometry */
 
 static const float GOLDEN = 2.39996323f; /* pi (3 - sqrt 5) */

@@ -237,6 +237,48 @@ static void test_cascade_count(void **state)
     assert_int_equal(plan_of((lpv_settings){.lpv.far_field_levels = 2}, f).cascades, 3);
 }
 
+/* Issue 30: a long scene's auto cascades get cells about as wide as its
+ * cross-section (LPV_CASCADE_LONG_CELL x it), not a quarter of its length
+ * over the grid; every other scene keeps the quarter. */
+static void test_long_scene_finest_cascade(void **state)
+{
+    (void)state;
+    const float tmin[3] = {-1.7f, -0.2f, -120.2f}, tmax[3] = {1.7f, 2.8f, 120.2f}; /* scenes/tunnel.glb */
+    assert_true(fabsf(lpv_cascade_cross_section(tmin, tmax) - 3.4f) < 1e-4f);
+    const int grids[3] = {8, 16, 32};
+    for (int g = 0; g < 3; ++g) {
+        lpv_settings s = resolved((lpv_settings){.grid_dims = {grids[g], grids[g], grids[g]}});
+        const float finest = lpv_cascade_finest_size(&s, tmin, tmax), cell = finest / (float)grids[g];
+        print_message("tunnel, grid %d: finest cascade %.4g m, cells %.3g m\n", grids[g], (double)finest,
+                      (double)cell);
+        /* cells under the tunnel's 3 m inside width, but never finer than a quarter of its length allows */
+        assert_true(cell <= 3.4f * LPV_CASCADE_LONG_CELL * 1.0001f);
+        assert_true(finest <= LPV_CASCADE_AUTO_FRACTION * 240.4f * 1.0001f);
+    }
+    lpv_settings s8 = resolved((lpv_settings){0});
+    assert_true(fabsf(lpv_cascade_finest_size(&s8, tmin, tmax) - 8.0f * LPV_CASCADE_LONG_CELL * 3.4f) < 1e-3f);
+    /* a room (12.4 x 3.2 x 8.4) and a wide but not long level (40 x 3 x 20): a quarter of the longest side */
+    const float rmin[3] = {-6.2f, -0.2f, -4.2f}, rmax[3] = {6.2f, 3.0f, 4.2f};
+    assert_true(lpv_cascade_cross_section(rmin, rmax) == 0.0f);
+    assert_true(fabsf(lpv_cascade_finest_size(&s8, rmin, rmax) - 0.25f * 12.4f) < 1e-4f);
+    const float wmin[3] = {0.0f, 0.0f, 0.0f}, wmax[3] = {40.0f, 3.0f, 20.0f};
+    assert_true(fabsf(lpv_cascade_finest_size(&s8, wmin, wmax) - 10.0f) < 1e-4f);
+    /* an explicit cascade_size wins */
+    lpv_settings e = resolved((lpv_settings){.lpv.cascade_size = 60.0f});
+    assert_true(lpv_cascade_finest_size(&e, tmin, tmax) == 60.0f);
+    /* the plan says why */
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_plan_facts f = baseline();
+    f.has_view = f.camera_inside = 1;
+    f.scene_extent = 240.4f;
+    f.scene_shortest = 3.0f;
+    f.scene_cross = lpv_cascade_cross_section(tmin, tmax);
+    f.cascade_finest = lpv_cascade_finest_size(&s8, tmin, tmax);
+    assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_non_null(strstr(why, "long scene"));
+    assert_reason(why);
+}
+
 static lpv_plan_facts steady(void)
 {
     lpv_plan_facts f = baseline();
@@ -596,6 +638,7 @@ int main(void)
         cmocka_unit_test(test_no_lights_skips_rsm),
         cmocka_unit_test(test_area_lights_replace_emissive_vpls),
         cmocka_unit_test(test_cascade_count),
+        cmocka_unit_test(test_long_scene_finest_cascade),
         cmocka_unit_test(test_recompute_rules),
         cmocka_unit_test(test_planner_off_runs_everything),
         cmocka_unit_test(test_bounce_needs_gv),
