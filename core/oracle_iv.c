@@ -176,7 +176,7 @@ static int corners(const lpv_grid *g, const held_by *held, const float p[3], con
         return 0;
     const float s = g->cell_size;
     float f[3];
-    int base[3], own[3];
+    int base[3];
     for (int a = 0; a < 3; a++) {
         float q = p[a] + 0.5f * s * nh[a];
         float u = (q - g->origin[a]) / s - 0.5f;
@@ -186,8 +186,6 @@ static int corners(const lpv_grid *g, const held_by *held, const float p[3], con
         float b = floorf(u);
         base[a] = (int)b;
         f[a] = u - b;
-        float fo = floorf((p[a] - g->origin[a]) / s - LPV_IV_BEHIND * nh[a]); /* as creation files p */
-        own[a] = fo >= -1.0f && fo <= (float)g->dims[a] ? (int)fo : -2; /* -2 matches no corner in the grid */
     }
     /* the corners by distance to q, then index (insertion sort, stable) */
     int order[8];
@@ -212,13 +210,12 @@ static int corners(const lpv_grid *g, const held_by *held, const float p[3], con
     int m = 0;
     for (int r = 0; r < neighbours; r++) {
         const int c = order[r];
-        int v[3], is_own = 1, inside = 1;
+        int v[3], inside = 1;
         for (int a = 0; a < 3; a++) {
             v[a] = base[a] + ((c >> a) & 1);
-            is_own &= v[a] == own[a];
             inside &= v[a] >= 0 && v[a] < g->dims[a];
         }
-        if (is_own || !inside)
+        if (!inside)
             continue;
         float t = 1.0f;
         for (int a = 0; a < 3; a++)
