@@ -132,8 +132,11 @@ long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, i
 /* The radiance march, I_k from emit: a voxel with no occupied voxel in its
  * 3x3x3 neighbourhood (itself included) gets 0 (the lookup never reads it).
  * Every other voxel v marches `rays` rays w_j = lpv_iv_ray(seed, v's index,
- * j, rays); a ray that hits voxel h brings L_ch = max(0, dot(emit_ch(h),
- * Y(-w))), an escaped one 0; I(v)_ch = 4 pi / rays * sum_j L_ch Y(-w_j)
+ * j, rays); a ray that hits voxel h brings L_ch = the radiance emit_ch(h)
+ * sends along -w read as the two Lambertian hemispheres it is the SH of
+ * (B_f / pi on the side of its dipole d, B_b / pi on the other, with
+ * B_f + B_b = e0 / LPV_IV_HEMI0 and (B_f - B_b) d = e1 / LPV_IV_HEMI1, as
+ * iv_gather.comp's emitted), an escaped one 0; I(v)_ch = 4 pi / rays * sum_j L_ch Y(-w_j)
  * (summed in double, rounded once). incoming is overwritten. */
 void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *emit, uint32_t seed, int rays,
                    lpv_cell *incoming);
