@@ -176,7 +176,7 @@ static int corners(const lpv_grid *g, const held_by *held, const float p[3], con
         return 0;
     const float s = g->cell_size;
     float f[3];
-    int base[3], own[3];
+    int base[3];
     for (int a = 0; a < 3; a++) {
         float q = p[a] + 0.5f * s * nh[a];
         float u = (q - g->origin[a]) / s - 0.5f;
@@ -186,8 +186,6 @@ static int corners(const lpv_grid *g, const held_by *held, const float p[3], con
         float b = floorf(u);
         base[a] = (int)b;
         f[a] = u - b;
-        float fo = floorf((p[a] - g->origin[a]) / s - LPV_IV_BEHIND * nh[a]); /* as creation files p */
-        own[a] = fo >= -1.0f && fo <= (float)g->dims[a] ? (int)fo : -2; /* -2 matches no corner in the grid */
     }
     /* the corners by distance to q, then index (insertion sort, stable) */
     int order[8];
@@ -212,13 +210,12 @@ static int corners(const lpv_grid *g, const held_by *held, const float p[3], con
     int m = 0;
     for (int r = 0; r < neighbours; r++) {
         const int c = order[r];
-        int v[3], is_own = 1, inside = 1;
+        int v[3], inside = 1;
         for (int a = 0; a < 3; a++) {
             v[a] = base[a] + ((c >> a) & 1);
-            is_own &= v[a] == own[a];
             inside &= v[a] >= 0 && v[a] < g->dims[a];
         }
-        if (is_own || !inside)
+        if (!inside)
             continue;
         float t = 1.0f;
         for (int a = 0; a < 3; a++)
@@ -447,6 +444,21 @@ long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, i
     return LPV_IV_ESCAPED;
 }
 
+/* The radiance one channel e of a voxel's emission sends along unit t: the
+ * two Lambertian hemispheres e is the projection of, B_f / pi along its
+ * dipole d and B_b / pi against it (B_f + B_b = e0 / HEMI0,
+ * (B_f - B_b) d = e1 / HEMI1), as iv_gather.comp reads it. */
+static float emitted(const float e[4], const float t[3])
+{
+    const float sum = e[0] / LPV_IV_HEMI0;
+    const float v[3] = {e[3] / LPV_IV_HEMI1, e[1] / LPV_IV_HEMI1, e[2] / LPV_IV_HEMI1};
+    float diff = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (diff > sum)
+        diff = sum;
+    const float side = v[0] * t[0] + v[1] * t[1] + v[2] * t[2] > 0.0f ? sum + diff : sum - diff;
+    return side > 0.0f ? side * (float)(0.5 / IV_PI) : 0.0f;
+}
+
 /* Y(-w) of ray j of voxel (x, y, z); w to dir. */
 static void ray(const lpv_grid *g, uint32_t seed, int x, int y, int z, int j, int rays, float dir[3], float y4[4])
 {
@@ -473,8 +485,9 @@ void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell
                     long h = lpv_iv_march(g, voxels, x, y, z, w, INFINITY);
                     if (h < 0)
                         continue; /* escaped: no light */
+                    const float back[3] = {-w[0], -w[1], -w[2]};
                     for (int ch = 0; ch < 3; ch++) {
-                        float L = dot4(cchannel(&emit[h], ch), yb);
+                        float L = emitted(cchannel(&emit[h], ch), back);
                         if (!(L > 0.0f))
                             continue;
                         for (int k = 0; k < 4; k++)

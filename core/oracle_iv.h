@@ -46,8 +46,7 @@ int lpv_iv_voxel_of(const lpv_grid *g, const float p[3], int cell[3]);
 
 /* The voxel of a surface point p facing n: floor((p - origin) / s -
  * LPV_IV_BEHIND n^), so a surface on a voxel face goes wholly to the voxel
- * behind it (lpv_shared.h). Creation files points with it and the
- * reconstruction finds the point's own voxel with it. */
+ * behind it (lpv_shared.h). Creation files points with it. */
 int lpv_iv_surface_voxel_of(const lpv_grid *g, const float p[3], const float n[3], int cell[3]);
 
 /* A voxel is occupied when at least one point landed in it. */
@@ -72,14 +71,16 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
 /* Reconstruction (3.4): the SH radiance L at surface point p with normal n
  * (normalised here) from vol (one per voxel, incoming radiance). Zero when n
  * is not unit-able (lpv_unit_direction) or p not finite. Otherwise, with
- * n^ = n / |n|: q = p + 0.5 s n^, own = lpv_iv_surface_voxel_of(p, n),
- * u = (q - origin) / s - 0.5, base = floor(u), f = u - base; corner
+ * n^ = n / |n|: q = p + 0.5 s n^, u = (q - origin) / s - 0.5, base = floor(u), f = u - base; corner
  * c = base + (i, j, k), i, j, k in {0, 1}, has index i + 2j + 4k and
  * trilinear weight t_c = prod(bit ? f : 1 - f). The `neighbours` (1..8,
  * clamped) corners nearest to q are kept (distance to the corner's voxel
  * centre; computed as |f - (i, j, k)|^2 in float, which is that distance
- * / s, squared; ties go to the lower corner index); of those, own and corners
- * outside the grid are skipped (own is not replaced by a farther corner).
+ * / s, squared; ties go to the lower corner index); of those, corners
+ * outside the grid are skipped (not replaced by a farther corner). The
+ * voxel holding p (lpv_iv_surface_voxel_of) is not skipped: it holds p's
+ * surface and weighs LPV_IV_HELD_WEIGHT like any such voxel; a cut there
+ * was a step in L wherever p crossed a voxel face.
  * w_c = t_c * max(0, dot(n^, normalize(centre_c - p))), 0 when
  * centre_c == p, times LPV_IV_HELD_WEIGHT when voxels (may be NULL: no
  * such factor) says c holds a surface; L = sum w_c vol(c) / sum w_c, 0 when
@@ -131,8 +132,11 @@ long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, i
 /* The radiance march, I_k from emit: a voxel with no occupied voxel in its
  * 3x3x3 neighbourhood (itself included) gets 0 (the lookup never reads it).
  * Every other voxel v marches `rays` rays w_j = lpv_iv_ray(seed, v's index,
- * j, rays); a ray that hits voxel h brings L_ch = max(0, dot(emit_ch(h),
- * Y(-w))), an escaped one 0; I(v)_ch = 4 pi / rays * sum_j L_ch Y(-w_j)
+ * j, rays); a ray that hits voxel h brings L_ch = the radiance emit_ch(h)
+ * sends along -w read as the two Lambertian hemispheres it is the SH of
+ * (B_f / pi on the side of its dipole d, B_b / pi on the other, with
+ * B_f + B_b = e0 / LPV_IV_HEMI0 and (B_f - B_b) d = e1 / LPV_IV_HEMI1, as
+ * iv_gather.comp's emitted), an escaped one 0; I(v)_ch = 4 pi / rays * sum_j L_ch Y(-w_j)
  * (summed in double, rounded once). incoming is overwritten. */
 void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *emit, uint32_t seed, int rays,
                    lpv_cell *incoming);

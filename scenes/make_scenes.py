@@ -46,6 +46,15 @@ Every object is an axis-aligned box (12 triangles) or a quad (2 triangles, its
 front the side its corners run counter-clockwise around); each material is one
 mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits);
 materials are single-sided (glTF's default) unless made with double_sided=True.
+  curved.glb     CURVED (issue 30): the room with a smooth-shaded white sphere
+                 and a smooth-shaded grey cylinder on its floor, lit by a spot
+                 light from above the red wall; the camera sees both where they
+                 turn away from the light (their indirect light should vary
+                 smoothly across voxels).
+
+Every object is an axis-aligned box (12 triangles), a quad (2 triangles, its
+front the side its corners run counter-clockwise around), or a UV sphere or
+upright cylinder with smooth vertex normals; each material is one mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits).
 lpvd divides the photometric light units by 683 lm/W (docs/units.md); the
 medium format is in docs/scenes.md.
 
@@ -75,6 +84,38 @@ def box(lo, hi):
         pos.extend(quad)
         nrm.extend([n] * 4)
         idx.extend([base, base + 1, base + 2, base, base + 2, base + 3])
+    return pos, nrm, idx
+
+
+def sphere(centre, radius, rings=16, segments=24):
+    """A UV sphere with smooth (radial) normals: vertices and indices."""
+    pos, nrm, idx = [], [], []
+    for i in range(rings + 1):
+        th = math.pi * i / rings
+        for j in range(segments + 1):
+            ph = 2.0 * math.pi * j / segments
+            n = (math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph))
+            nrm.append(n)
+            pos.append(tuple(c + radius * k for c, k in zip(centre, n)))
+    for i in range(rings):
+        for j in range(segments):
+            a, b = i * (segments + 1) + j, (i + 1) * (segments + 1) + j
+            idx.extend([a, a + 1, b, a + 1, b + 1, b])  # counter-clockwise seen from outside
+    return pos, nrm, idx
+
+
+def cylinder(base, radius, height, segments=32):
+    """An upright open cylinder (side only) with smooth (horizontal) normals."""
+    pos, nrm, idx = [], [], []
+    for j in range(segments + 1):
+        ph = 2.0 * math.pi * j / segments
+        n = (math.cos(ph), 0.0, math.sin(ph))
+        for h in (0.0, height):
+            nrm.append(n)
+            pos.append((base[0] + radius * n[0], base[1] + h, base[2] + radius * n[2]))
+    for j in range(segments):
+        a = 2 * j
+        idx.extend([a, a + 1, a + 2, a + 1, a + 3, a + 2])  # counter-clockwise seen from outside
     return pos, nrm, idx
 
 
@@ -116,6 +157,7 @@ class Scene:
                              # (rgb factor, strength in nits)
         self.boxes = {}      # material index -> list of (lo, hi)
         self.quads = {}      # material index -> list of 4 corners (counter-clockwise seen from the front)
+        self.meshes = {}     # material index -> list of (positions, normals, indices): spheres, cylinders
         self.nodes = []
         self.lights = []
         self.cameras = []
@@ -125,6 +167,7 @@ class Scene:
         self.materials.append((name, rgb, roughness, emission, double_sided))
         self.boxes[len(self.materials) - 1] = []
         self.quads[len(self.materials) - 1] = []
+        self.meshes[len(self.materials) - 1] = []
         return len(self.materials) - 1
 
     def add_box(self, mat, lo, hi):
@@ -132,6 +175,9 @@ class Scene:
 
     def add_quad(self, mat, corners):
         self.quads[mat].append(corners)
+
+    def add_mesh(self, mat, mesh):
+        self.meshes[mat].append(mesh)
 
     def light(self, name, light, position, target):
         self.lights.append(dict(light, name=name))
@@ -175,6 +221,10 @@ class Scene:
                 pos.extend(q)
                 nrm.extend([n] * 4)
                 idx.extend([base, base + 1, base + 2, base, base + 2, base + 3])
+            for p, n, i in self.meshes[m]:
+                idx.extend(len(pos) + k for k in i)
+                pos.extend(p)
+                nrm.extend(n)
             if not pos:
                 continue
             triangles += len(idx) // 3
@@ -471,6 +521,21 @@ def tunnel():
     return s
 
 
+def curved():
+    s = Scene()
+    room(s)
+    white = s.material("sphere_white", (0.80, 0.80, 0.80))
+    grey = s.material("cylinder_grey", (0.55, 0.55, 0.55))
+    s.add_mesh(white, sphere((0.3, 0.8, -0.5), 0.8))
+    s.add_mesh(grey, cylinder((-1.1, 0.0, 0.5), 0.45, 1.8))
+    # from high above the red wall down onto the floor in front of the sphere
+    s.light("spot", {"type": "spot", "color": [1.0, 0.95, 0.9], "intensity": 20000.0,
+                     "spot": {"innerConeAngle": 0.5, "outerConeAngle": 0.7}},
+            (-1.7, 2.9, -1.5), (0.8, 0.0, 0.6))
+    s.camera("Camera", (1.6, 1.6, 1.9), (-0.2, 0.7, -0.3), 60.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
@@ -478,7 +543,8 @@ def main():
                         ("lamp-box-panel", lambda: lamp_box("panel")),
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
-                        ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel)):
+                        ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel),
+                        ("curved", curved)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

@@ -23,6 +23,22 @@ uniform float u_ao_reach; // voxels
 
 bool occupied(ivec3 c) { int i = cell_index(c); return (occupancy[i >> 5] & (1u << uint(i & 31))) != 0u; }
 
+// The radiance one channel of a voxel's emission e sends along unit t
+// (core/oracle_iv.c, emitted): e is the SH of the Lambertian hemispheres of
+// the voxel's surfaces, so it is read back as the two hemispheres it is the
+// projection of, B_f / pi along its dipole d and B_b / pi against it
+// (B_f + B_b = e0 / HEMI0, (B_f - B_b) d = e1 / HEMI1), not as the 2-band
+// SH's own value: that one is 1.25 B / pi along the normal, 0.5 B / pi at
+// grazing and below 0 behind, and the gathered light of a floor, peaked
+// straight up, then read at the floor itself as -B / 16 per channel.
+float emitted(vec4 e, vec3 t)
+{
+    float sum = e.x / LPV_IV_HEMI0;
+    vec3 v = vec3(e.w, e.y, e.z) / LPV_IV_HEMI1;
+    float diff = min(length(v), sum);
+    return max(dot(v, t) > 0.0 ? sum + diff : sum - diff, 0.0) * (0.5 / LPV_PI);
+}
+
 bool needed(ivec3 c)
 {
     for (int z = -1; z <= 1; ++z)
@@ -99,9 +115,9 @@ void main()
         if (hit < 0)
             continue;
         LpvCell e = emit[hit];
-        r += max(dot(e.r, y), 0.0) * y;
-        g += max(dot(e.g, y), 0.0) * y;
-        b += max(dot(e.b, y), 0.0) * y;
+        r += emitted(e.r, -w) * y;
+        g += emitted(e.g, -w) * y;
+        b += emitted(e.b, -w) * y;
     }
     float k = sphere / float(u_rays);
     if (u_ao != 0)

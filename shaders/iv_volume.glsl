@@ -16,9 +16,11 @@ vec3 iv_centre(ivec3 c) { return (vec3(c) + 0.5 + cascade_origin_cells(0)) * gri
 
 // The reconstruction at a surface point p facing unit n: move half a voxel
 // along n to q, take the 8 voxels whose centres surround q (trilinear
-// weights), keep the u_iv_neighbours nearest to q, never the voxel holding p
-// itself (its radiance saw its own surface), and weight each by the cosine
-// between n and the direction from p to its centre (0 behind the surface).
+// weights), keep the u_iv_neighbours nearest to q, and weight each by the
+// cosine between n and the direction from p to its centre (0 behind the
+// surface). The voxel holding p is one of them like any other: it holds p's
+// surface, so it weighs LPV_IV_HELD_WEIGHT as below; cutting it out made a
+// step wherever p crossed a voxel face (voxel blocks on curved surfaces).
 // Voxels that hold a surface themselves weigh LPV_IV_HELD_WEIGHT as much:
 // their rays start among the surface's own voxels and see its own light (the
 // paper's "self intersections"), which the cosine alone lets through
@@ -29,7 +31,6 @@ vec3 iv_centre(ivec3 c) { return (vec3(c) + 0.5 + cascade_origin_cells(0)) * gri
 float iv_blend(vec3 p, vec3 n, out ivec3 cell[8], out float w[8])
 {
     vec3 q = p + 0.5 * grid_cell_size() * n;
-    ivec3 own = iv_cell_of(p, n);
     vec3 u = cascade_coords(0, q) - 0.5;
     vec3 b = floor(u);
     vec3 f = u - b;
@@ -53,7 +54,7 @@ float iv_blend(vec3 p, vec3 n, out ivec3 cell[8], out float w[8])
     for (int k = 0; k < 8; ++k) {
         vec3 dir = iv_centre(cell[k]) - p;
         float len = length(dir);
-        if (cell[k] == own || !cell_inside(cell[k]) || !(len > 0.0))
+        if (!cell_inside(cell[k]) || !(len > 0.0))
             w[k] = 0.0;
         else
             w[k] *= max(0.0, dot(n, dir / len)) *

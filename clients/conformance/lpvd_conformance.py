@@ -2006,7 +2006,7 @@ def _iv_lookup(d, vals, held, p, n):
     if not (math.isfinite(ln) and ln > f32(1e-8)):
         return [0.0, 0.0, 0.0]
     nh = [f32(v / ln) for v in n]
-    b, f, w = [0] * 3, [0.0] * 3, [0] * 3
+    b, f = [0] * 3, [0.0] * 3
     for a in range(3):
         # 2
         q = f32(p[a] + f32(f32(0.5 * s) * nh[a]))
@@ -2015,9 +2015,7 @@ def _iv_lookup(d, vals, held, p, n):
             return [0.0, 0.0, 0.0]
         b[a] = math.floor(u)
         f[a] = f32(u - b[a])
-        # 3
-        w[a] = math.floor(f32(f32(f32(p[a] - o[a]) / s) - f32(f32(0.001) * nh[a])))
-    # 4
+    # 3
     corners = []
     for c in range(8):
         bits = [(c >> a) & 1 for a in range(3)]
@@ -2027,13 +2025,13 @@ def _iv_lookup(d, vals, held, p, n):
             e = f32(f[a] - bits[a])
             dd = f32(dd + f32(e * e))
         corners.append((dd, c, [b[a] + bits[a] for a in range(3)], t))
-    # 5
+    # 4
     corners.sort(key=lambda e: (e[0], e[1]))
     total, acc = 0.0, [0.0] * 12
     for _, _, v, t in corners[:N]:
-        if v == w or not all(0 <= v[a] < dims[a] for a in range(3)):
+        if not all(0 <= v[a] < dims[a] for a in range(3)):
             continue
-        # 6
+        # 5
         dv = [f32(f32(o[a] + f32(f32(v[a] + 0.5) * s)) - p[a]) for a in range(3)]
         dl = f32(math.sqrt(f32(f32(f32(dv[0] * dv[0]) + f32(dv[1] * dv[1])) + f32(dv[2] * dv[2]))))
         cos = 0.0
@@ -2051,13 +2049,13 @@ def _iv_lookup(d, vals, held, p, n):
             acc[k] += wc * vals[12 * i + k]
     if not total > 0.0:
         return [0.0, 0.0, 0.0]
-    # 7
+    # 6
     lobe = [f32(SH_LOBE0), f32(f32(SH_LOBE1) * -nh[1]), f32(f32(SH_LOBE1) * -nh[2]), f32(f32(SH_LOBE1) * -nh[0])]
     e3 = []
     for ch in range(3):
         L = [f32(acc[4 * ch + k] / total) for k in range(4)]
         e3.append(f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3])))
-    # 8. made light as a whole colour: luminance y <= 0 gives 0; else y is
+    # 7. made light as a whole colour: luminance y <= 0 gives 0; else y is
     # kept and, where the most negative channel m < 0, the chroma scales
     # by y / (y - 2 m)
     y = f32(f32(f32(e3[0] * f32(0.2126)) + f32(e3[1] * f32(0.7152))) + f32(e3[2] * f32(0.0722)))

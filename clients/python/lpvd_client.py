@@ -218,7 +218,6 @@ def _f32(x):
 
 
 # R5.14's constants as the binary32 values the server and core use
-_IV_BEHIND = _f32(0.001)
 _IV_HELD_WEIGHT = 1.0 / 64.0
 _LOBE0 = _f32(SH_LOBE0)
 _LOBE1 = _f32(SH_LOBE1)
@@ -230,7 +229,7 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
     ``cell(x, y, z)`` a voxel's 12 values, ``held(x, y, z)`` its index entry
     (non-zero: the voxel holds a surface), ``neighbours`` the description's
     iv_neighbours. Step by step in binary32 as core/oracle_iv.c computes it
-    (lpv_iv_irradiance; the sums of step 7 in double, as there)."""
+    (lpv_iv_irradiance; the sums of step 6 in double, as there)."""
     f32 = _f32
     # 1. a finite p, a unit-able n
     p = [f32(float(v)) for v in p]
@@ -244,7 +243,7 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
     s = f32(cell_size)
     o = [f32(v) for v in origin]
     # 2. half a voxel in front of the surface, the 8 voxel centres around it
-    base, f, own = [0, 0, 0], [0.0, 0.0, 0.0], [0, 0, 0]
+    base, f = [0, 0, 0], [0.0, 0.0, 0.0]
     for a in range(3):
         q = f32(p[a] + f32(f32(0.5 * s) * nh[a]))
         u = f32(f32(f32(q - o[a]) / s) - 0.5)
@@ -253,10 +252,7 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
         b = float(int(u // 1))
         base[a] = int(b)
         f[a] = f32(u - b)
-        # 3. the point's own voxel, a thousandth of a voxel behind the surface
-        fo = f32(f32(f32(p[a] - o[a]) / s) - f32(_IV_BEHIND * nh[a]))
-        own[a] = int(fo // 1)
-    # 4. + 5. the corners by distance to q (ties: the lower number), the nearest `neighbours`
+    # 3. + 4. the corners by distance to q (ties: the lower number), the nearest `neighbours`
     d2 = []
     for c in range(8):
         acc = 0.0
@@ -269,9 +265,9 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
     idx, weight = [], []
     for c in order[:neighbours]:
         v = [base[a] + ((c >> a) & 1) for a in range(3)]
-        if v == own or not all(0 <= v[a] < dims[a] for a in range(3)):
+        if not all(0 <= v[a] < dims[a] for a in range(3)):
             continue
-        # 6. trilinear weight x the cosine towards the voxel's centre, 1/64 for a voxel holding a surface
+        # 5. trilinear weight x the cosine towards the voxel's centre, 1/64 for a voxel holding a surface
         t = 1.0
         for a in range(3):
             t = f32(t * (f[a] if (c >> a) & 1 else f32(1.0 - f[a])))
@@ -288,7 +284,7 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
             continue
         idx.append(v)
         weight.append(w)
-    # 7. the blend, then the cosine lobe around -n (radiance: no / s^2)
+    # 6. the blend, then the cosine lobe around -n (radiance: no / s^2)
     total = sum(weight)
     if not (total > 0.0):
         return (0.0, 0.0, 0.0)
@@ -302,7 +298,7 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
     for ch in range(3):
         L = [f32(acc[4 * ch + k] / total) for k in range(4)]
         e3.append(f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3])))
-    # 8. made light as a whole colour: luminance y <= 0 gives 0; else y is
+    # 7. made light as a whole colour: luminance y <= 0 gives 0; else y is
     # kept and, where the most negative channel m < 0, the chroma scales
     # by y / (y - 2 m)
     y = f32(f32(f32(e3[0] * f32(0.2126)) + f32(e3[1] * f32(0.7152))) + f32(e3[2] * f32(0.0722)))
