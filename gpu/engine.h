@@ -107,6 +107,19 @@ typedef struct lpv_engine_stats {
         int reprojected;       /* iv_reproject ran (the camera's pixels refined the volume) */
         int ao;                /* iv_ao ran (the ao frame term has a volume) */
     } iv;
+    /* where light can reach (core/reach.h, docs/propagation.md 6d): the
+     * scene's voxels of air and which a light reaches; the frame multiplies
+     * the technique's light by it */
+    struct {
+        int on;               /* the mask is in use (setting reach on, a scene, not unsure) */
+        int unsure;           /* a light had no air around it: nothing is taken away */
+        float voxel_m;        /* voxel side, m */
+        int dims[3];
+        unsigned components;  /* air spaces (6-connected) */
+        unsigned lit_components;
+        size_t dark_voxels;   /* air no light reaches */
+        size_t lit_voxels;
+    } reach;
     /* the volume these stats' tick computed: a copy, so a reader on another
      * thread (the daemon's encoder) gets it with the tick's cells */
     lpv_volume_desc volume;

@@ -136,6 +136,14 @@ static void record_stats(lpv_engine *e)
     s->area_lights = (unsigned)(e->light_block.counts[0] - e->light_block.counts[2]);
     s->rsm_faces = (unsigned)e->face_count;
     s->rsm_size = (unsigned)e->settings.rsm_size;
+    s->reach.on = e->reach_tex && !e->reach.unsure && e->settings.reach != LPV_SWITCH_OFF;
+    s->reach.unsure = e->reach.unsure;
+    s->reach.voxel_m = e->reach.voxel;
+    memcpy(s->reach.dims, e->reach.dims, sizeof s->reach.dims);
+    s->reach.components = e->reach.components;
+    s->reach.lit_components = e->reach.lit_components;
+    s->reach.dark_voxels = e->reach.dark_voxels;
+    s->reach.lit_voxels = e->reach.lit_voxels;
     s->vpls_rsm = e->rsm_vpl_count;
     s->vpls_emissive = e->plan.consumes.emissive_vpls ? e->emissive_vpl_count : 0;
     const int gv = e->plan.consumes.surfels;

@@ -95,6 +95,16 @@ json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, c
         json_decref(o);
         return NULL;
     }
+    json_t *reach = json_pack("{s:b, s:b, s:f, s:[i, i, i], s:i, s:i, s:I, s:I}", "on", st->reach.on != 0, "unsure",
+                              st->reach.unsure != 0, "voxel_m", (double)st->reach.voxel_m, "dims",
+                              st->reach.dims[0], st->reach.dims[1], st->reach.dims[2], "components",
+                              (int)st->reach.components, "lit_components", (int)st->reach.lit_components,
+                              "dark_voxels", (json_int_t)st->reach.dark_voxels, "lit_voxels",
+                              (json_int_t)st->reach.lit_voxels);
+    if (o && (!reach || json_object_set_new(o, "reach", reach) != 0)) {
+        json_decref(o);
+        return NULL;
+    }
     if (o && st->iv.on && json_object_set_new(o, "iv", iv_json(st)) != 0) {
         json_decref(o);
         return NULL;

@@ -54,6 +54,11 @@ static double frame_mean(const char *name, lpv_technique_id t, lpv_switch reach)
         lpv_engine_set_view(lpvt_engine, &v, err, sizeof err) != 0 || lpv_engine_tick(lpvt_engine, err, sizeof err))
         fail_msg("%s: %s", name, err);
     float *rgba = lpvt_render(W, H);
+    /* the stats say whether the mask was used, and what it found */
+    const lpv_engine_stats *st = lpv_engine_last_stats(lpvt_engine);
+    assert_int_equal(st->reach.on, reach != LPV_SWITCH_OFF);
+    assert_true(st->reach.voxel_m > 0.0f && st->reach.voxel_m < 0.05f);
+    assert_true(st->reach.lit_components >= 1 && st->reach.components > st->reach.lit_components);
     double sum = 0.0;
     size_t n = 0;
     for (size_t i = 0; i < (size_t)W * H; ++i)
