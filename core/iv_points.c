@@ -237,10 +237,32 @@ void lpv_iv_triangle_points(const float a[3], const float b[3], const float c[3]
     }
 }
 
-int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], lpv_grid *out)
+int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], float free_path, lpv_grid *out)
 {
     const int given = lpv_settings_bounds_given(s);
-    return lpv_grid_place_cubic(s->iv.resolution, given ? s->bounds_min : smin, given ? s->bounds_max : smax, out);
+    const float *lo = given ? s->bounds_min : smin, *hi = given ? s->bounds_max : smax;
+    int res = s->iv.resolution;
+    double longest = 0.0;
+    for (int i = 0; i < 3; i++)
+        longest = fmax(longest, (double)hi[i] - (double)lo[i]);
+    const double want = free_path > 0.0f && longest > LPV_IV_LONG_FREE_PATHS * (double)free_path
+                            ? longest / ((double)free_path / LPV_IV_FREE_PATH_VOXELS)
+                            : 0.0;
+    if (isfinite(want) && want > (double)res) {
+        /* the finest resolution up to `want` whose grid fits the cube's budget */
+        const double budget = pow((double)s->iv.resolution + 1.0, 3.0);
+        int lo_r = res, hi_r = (int)fmin(ceil(want), (double)LPV_MAX_GRID_DIM);
+        while (lo_r < hi_r) {
+            const int mid = lo_r + (hi_r - lo_r + 1) / 2;
+            lpv_grid g;
+            if (lpv_grid_place_cubic(mid, lo, hi, &g) == 0 && (double)lpv_grid_cell_count(&g) <= budget)
+                lo_r = mid;
+            else
+                hi_r = mid - 1;
+        }
+        res = lo_r;
+    }
+    return lpv_grid_place_cubic(res, lo, hi, out);
 }
 
 lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, float voxel)

@@ -45,9 +45,18 @@ typedef struct lpv_iv_point_stats {
 
 /* The imperfect volume's voxels for settings s over a scene's bounds
  * [smin, smax] (the settings' bounds when given): lpv_grid_place_cubic at
- * s->iv.resolution. The engine's cloud and the technique's volume both
- * place it here. Returns 0 or -1 (lpv_grid_place_cubic's). */
-int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], lpv_grid *out);
+ * s->iv.resolution voxels along the longest side, or more in a scene whose
+ * longest side is more than LPV_IV_LONG_FREE_PATHS free paths long (a
+ * tunnel, a corridor: 86 in the 240 m tunnel; rooms and courtyards are 2 to
+ * 5, and keep the setting): voxels of
+ * free_path / LPV_IV_FREE_PATH_VOXELS (free_path > 0: the scene's mean free
+ * path, core/reach.h), as many as keep the grid within the (resolution +
+ * 1)^3 voxels of a cube at the setting (the budget core/tick_cost.c
+ * counts). The engine's cloud and the technique's volume both place it
+ * here. Returns 0 or -1 (lpv_grid_place_cubic's). */
+#define LPV_IV_FREE_PATH_VOXELS 4.0
+#define LPV_IV_LONG_FREE_PATHS 8.0
+int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], float free_path, lpv_grid *out);
 
 /* The cloud's parameters under settings s for voxels of side `voxel` m
  * (emission always carried: the GPU drops it while area lights carry the

@@ -53,6 +53,7 @@ typedef struct lpv_plan_facts {
     int bounds_given;          /* the settings fix the grid bounds */
     int cascades_unfit;        /* snapped cascades cannot be placed over the scene (lpv_cascades_fit) */
     float scene_reach;         /* m, the scene bounds' largest |coordinate| */
+    float free_path;           /* m, the scene's mean free path (core/reach.h), 0 = unknown */
     /* what changed since the last computed tick */
     int first_tick;            /* nothing computed yet */
     int scene_changed;         /* geometry or materials */

@@ -113,7 +113,8 @@ static const lpv_field FIELDS[] = {
 
     /* Imperfect volumes (docs/imperfect-volumes.md). */
     {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "16", "",
-     "voxels along the scene's longest side", T_VOL, LPV_TECHNIQUE_IV},
+     "voxels along the scene's longest side (more in long scenes: a quarter of the free path each, within this cube's count)",
+     T_VOL, LPV_TECHNIQUE_IV},
     {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", "4", "",
      "random points per triangle (Turk's formula)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
     {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", "1", "",

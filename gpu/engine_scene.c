@@ -147,7 +147,7 @@ static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
 {
     const lpv_settings *s = &e->settings;
     lpv_grid g;
-    if (lpv_iv_place(s, e->scene_min, e->scene_max, &g) != 0)
+    if (lpv_iv_place(s, e->scene_min, e->scene_max, e->reach.free_path, &g) != 0)
         return lpv_error(err, err_size, "%s: cannot place the imperfect volume over the scene's bounds",
                          e->geometry.source);
     const lpv_iv_point_params p = lpv_iv_point_params_of(s, g.cell_size);

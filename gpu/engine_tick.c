@@ -42,6 +42,7 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
                               fminf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
     f->cascade_finest = lpv_cascade_finest_size(&e->settings, e->scene_min, e->scene_max);
     f->scene_cross = lpv_cascade_cross_section(e->scene_min, e->scene_max);
+    f->free_path = e->reach.free_path;
     f->bounds_given = lpv_settings_bounds_given(&e->settings);
     f->cascades_unfit = !lpv_cascades_fit(&e->settings, e->scene_min, e->scene_max, NULL, 0);
     for (int i = 0; i < 3; ++i)

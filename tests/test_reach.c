@@ -14,7 +14,9 @@
 
 #include <cmocka.h>
 
+#include "iv_points.h"
 #include "reach.h"
+#include "settings.h"
 #include "scene_build.h"
 
 static void add_box(lpv_scene *s, int m, float x0, float y0, float z0, float x1, float y1, float z1)
@@ -189,6 +191,52 @@ static void test_light_in_thin_slab(void **state)
     lpv_scene_free(&s);
 }
 
+/* The free path 4 V / S of a closed box, and iv's voxels from it: a long
+ * closed tunnel gets voxels a fraction of its width (at the same voxel
+ * budget as a cube at the setting), a room keeps the setting. */
+static void test_free_path_sizes_iv(void **state)
+{
+    (void)state;
+    for (int tunnel = 0; tunnel <= 1; ++tunnel) {
+        const float len = tunnel ? 240.0f : 4.0f, w = tunnel ? 3.0f : 4.0f, h = tunnel ? 2.6f : 3.0f;
+        lpv_scene s = {0};
+        int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+        /* six quads facing in: a closed box of zero-thickness walls */
+        const float x0 = -w / 2, x1 = w / 2, y0 = 0.0f, y1 = h, z0 = -len / 2, z1 = len / 2;
+        const float q[6][4][3] = {
+            {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}, {{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}},
+            {{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}, {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
+            {{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}, {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
+        for (int i = 0; i < 6; ++i)
+            assert_true(lpv_scene_add_quad(&s, grey, q[i], NULL) >= 0);
+        lpv_scene_compute_bounds(&s);
+        lpv_reach r;
+        char err[256];
+        assert_int_equal(lpv_reach_build(&r, &s, 0, err, sizeof err), 0);
+        const double area = 2.0 * ((double)w * h + (double)w * len + (double)h * len);
+        const double want = 4.0 * (double)w * h * len / area;
+        printf("%s: free path %.3f m (4 V / S = %.3f m), voxels %.3f m\n", tunnel ? "tunnel" : "room",
+               (double)r.free_path, want, (double)r.voxel);
+        /* the voxels inside the walls' conservative voxels are not air */
+        assert_true(fabs(r.free_path - want) < 0.1 * want);
+        lpv_settings set = {.technique = LPV_TECHNIQUE_ID_IV};
+        lpv_settings_resolve(&set);
+        lpv_grid g, plain;
+        assert_int_equal(lpv_iv_place(&set, s.bounds_min, s.bounds_max, r.free_path, &g), 0);
+        assert_int_equal(lpv_iv_place(&set, s.bounds_min, s.bounds_max, 0.0f, &plain), 0);
+        const double budget = pow(set.iv.resolution + 1.0, 3.0);
+        printf("  iv voxels %.3f m (%d x %d x %d), without the free path %.3f m\n", (double)g.cell_size, g.dims[0],
+               g.dims[1], g.dims[2], (double)plain.cell_size);
+        assert_true((double)lpv_grid_cell_count(&g) <= budget);
+        if (tunnel)
+            assert_true(g.cell_size < w / 3.0f && plain.cell_size > w);
+        else
+            assert_memory_equal(&g, &plain, sizeof g);
+        lpv_reach_free(&r);
+        lpv_scene_free(&s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -197,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_directional_and_emitters),
         cmocka_unit_test(test_two_rooms),
         cmocka_unit_test(test_light_in_thin_slab),
+        cmocka_unit_test(test_free_path_sizes_iv),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

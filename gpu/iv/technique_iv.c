@@ -97,7 +97,7 @@ static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, cha
     lpv_iv_gpu *v = (lpv_iv_gpu *)t;
     const lpv_settings *s = w->settings;
     lpv_grid g;
-    if (lpv_iv_place(s, w->bounds_min, w->bounds_max, &g) != 0)
+    if (lpv_iv_place(s, w->bounds_min, w->bounds_max, w->facts ? w->facts->free_path : 0.0f, &g) != 0)
         return lpv_error(err, err_size, "cannot place %d voxels over the %s bounds (not finite)", s->iv.resolution,
                          lpv_settings_bounds_given(s) ? "settings'" : "scene's");
     v->pending = g;
