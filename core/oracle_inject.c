@@ -104,31 +104,6 @@ size_t lpv_oracle_inject_surfels(const lpv_grid *g, const lpv_surfel *surfels, s
     return injected;
 }
 
-/* The blocking of one buffer's GV point sh towards w, where the light comes
- * from (y = Y(w)): the projected area of its surfels
- * facing that way, over the cell's face, times the lobe's peak (LPV_GV_PEAK,
- * so a covered face still blocks all). dot(sh, y) = D + b (D = 0.25 A, b =
- * 0.5 m.w for surfels of total area A and area-weighted normal sum m, in
- * cell faces) is that only at a surface's own normal: its DC term blocks a
- * third of the peak at grazing incidence, so a wall blocked a third of the
- * light running along it at every step, and a finer grid (more steps along
- * it) lost more light (docs/propagation.md 3, issue 30). The coherent part m
- * blocks as its projected area, 1.5 max(0, b) (exact for one orientation:
- * 0.75 a max(0, cos)); the part with no net orientation, A - |m| (two sides
- * of a thin wall, a curved object), keeps the DC term's isotropic blocking,
- * max(0, D - 0.5 |b|max), as before. Anything non-finite keeps the plain dot
- * (a NaN blocks fully downstream). shaders/gv_merge.comp does the same. */
-static float gv_blocking(const vec4 sh, const float y[4])
-{
-    float plain = lpv_sh_dot(sh, y);
-    if (!isfinite(sh[0]) || !isfinite(sh[1]) || !isfinite(sh[2]) || !isfinite(sh[3]))
-        return plain;
-    float dc = sh[0] * LPV_SH_C0;
-    float b = plain - dc;
-    float bmax = LPV_SH_C1 * sqrtf(sh[1] * sh[1] + sh[2] * sh[2] + sh[3] * sh[3]);
-    return 1.5f * fmaxf(b, 0.0f) + fmaxf(dc - 0.5f * bmax, 0.0f);
-}
-
 /* Per GV point and travel direction d keep the larger blocking potential
  * B(-d), towards where the light comes from: a surface seen by the camera and
  * by an RSM must block once, not twice, and a wall seen from inside by a
@@ -143,7 +118,7 @@ void lpv_oracle_gv_merge(const lpv_grid *g, const vec4 *src, lpv_gv_point *dst)
             float back[3] = {0.0f, 0.0f, 0.0f}, y[4];
             back[d / 2] = (d & 1) ? 1.0f : -1.0f;
             lpv_sh_basis(back, y);
-            float b = gv_blocking(src[i], y);
+            float b = lpv_sh_dot(src[i], y);
             float *slot = &dst[i].blocking[d / 4][d % 4];
             if (b > *slot || isnan(b))
                 *slot = b;

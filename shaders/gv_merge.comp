@@ -27,14 +27,7 @@ void main()
     ivec2 t = atlas_texel(ivec3(p.xy, id.z), d.xy);
     vec4 v = texelFetch(u_atlas_gv, t, 0);
     for (int dir = 0; dir < LPV_DIR_COUNT; ++dir) {
-        // as lpv_oracle_gv_merge's gv_blocking: the coherent part blocks as
-        // its projected area (nothing at grazing incidence), the part with
-        // no net orientation keeps the DC term's isotropic blocking
         float b = dot(v, sh_basis(-dir_vector(dir)));
-        if (!any(isnan(v)) && !any(isinf(v))) {
-            float dc = v.x * LPV_SH_C0;
-            b = 1.5 * max(b - dc, 0.0) + max(dc - 0.5 * LPV_SH_C1 * length(v.yzw), 0.0);
-        }
         if (b > gv_total[i].blocking[dir / 4][dir % 4] || isnan(b))
             gv_total[i].blocking[dir / 4][dir % 4] = b;
     }

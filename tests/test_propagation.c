@@ -581,42 +581,6 @@ static void test_wall_seen_from_both_sides(void **state)
     free(twice);
 }
 
-/* The blocking of one buffer's GV point (lpv_oracle_gv_merge) is the
- * projected area its surfels turn towards the light (issue 30): a floor of
- * area 1 cell^2 (normal +y) blocks light coming down onto it by the lobe's
- * peak (LPV_GV_PEAK: the whole face), light running along it (+x, -x, +z,
- * -z) not at all (before: 0.25, a third of the peak, at every step along a
- * wall, so finer grids with more steps lost more light), light from below
- * not at all; two back-to-back sides (a thin wall, no net orientation) keep
- * the DC term's 0.25 per unit area each way, as before. */
-static void test_grazing_light_passes(void **state)
-{
-    (void)state;
-    lpv_grid g = make_grid(4, 4, 4);
-    size_t gv_n = lpv_grid_gv_count(&g);
-    size_t at = lpv_grid_gv_index(&g, 2, 2, 2);
-    vec4 *sh = xcalloc(gv_n, sizeof(vec4));
-    lpv_gv_point *total = xcalloc(gv_n, sizeof *total);
-    lpv_surfel floor_s = {{2.0f, 2.0f, 2.0f, 1.0f}, {0.0f, 1.0f, 0.0f, 0.0f}};
-    assert_int_equal(lpv_oracle_inject_surfels(&g, &floor_s, 1, sh), 1);
-    lpv_oracle_gv_merge(&g, sh, total);
-    const float *b = &total[at].blocking[0][0]; /* d = 0..5: +x -x +y -y +z -z */
-    assert_float_equal(b[3], LPV_GV_PEAK, 1e-6f); /* travelling -y: down onto the floor */
-    assert_float_equal(b[2], 0.0f, 1e-6f);        /* +y: from below, its back */
-    assert_float_equal(b[0], 0.0f, 1e-6f);        /* along it */
-    assert_float_equal(b[1], 0.0f, 1e-6f);
-    assert_float_equal(b[4], 0.0f, 1e-6f);
-    assert_float_equal(b[5], 0.0f, 1e-6f);
-    lpv_surfel under = {{2.0f, 2.0f, 2.0f, 1.0f}, {0.0f, -1.0f, 0.0f, 0.0f}};
-    assert_int_equal(lpv_oracle_inject_surfels(&g, &under, 1, sh), 1);
-    memset(total, 0, gv_n * sizeof *total);
-    lpv_oracle_gv_merge(&g, sh, total);
-    for (int d = 0; d < 6; d++)
-        assert_float_equal(total[at].blocking[d / 4][d % 4], 0.5f, 1e-6f); /* 0.25 x area 2 */
-    free(sh);
-    free(total);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -632,7 +596,6 @@ int main(void)
         cmocka_unit_test(test_propagate_accumulates),
         cmocka_unit_test(test_occlusion_direction),
         cmocka_unit_test(test_wall_seen_from_both_sides),
-        cmocka_unit_test(test_grazing_light_passes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
