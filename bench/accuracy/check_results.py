@@ -2,7 +2,7 @@
 """check_results.py - checks an lpvd-accuracy results.csv (the CI sweep).
 
   check_results.py RESULTS.csv [--scene NAME --better POINT --worse POINT [--metric COLUMN]] [--rows N]
-                   [--lookup-steps LIST]
+                   [--lookup-steps LIST] [--not-worse KNOB=POINT>POINT[>POINT...]]...
 
 POINT is G:I:R:on|off:MODS:TECHNIQUE for an LPV point, or
 iv:RES:POINTS:RAYS:BOUNCES:on|off:NEIGHBOURS for an imperfect-volume one.
@@ -23,7 +23,12 @@ have them all, ref_noise2 > 0, at_ref_noise 0 or 1 and equal to
 rel_rmse < 2 ref_noise2, and rel_bias < rel_bias_own (converged light holds
 more light than any fewer bounces, so a frame is darker against it: a row
 where it is not was scored against the wrong reference). No timing is
-asserted. Standard library only.
+asserted. With --not-worse (issue 30, "knobs that never make it worse"; any
+number of them), KNOB=P1>P2>... lists one knob's settings from lower to
+higher quality: in every scene of the CSV, every higher setting Pj must score
+rel_rmse(Pj) <= rel_rmse(Pi) + 2 ref_noise2 against every lower one Pi (i < j),
+i.e. not worse against converged light by more than twice the converged
+reference's noise measured from its two seeds. Standard library only.
 """
 import argparse
 import csv
@@ -52,6 +57,36 @@ def key(row):
                                   row["technique"])
 
 
+def not_worse(rows, chain):
+    """--not-worse KNOB=P1>P2>...: per scene, a higher setting may not score a
+    rel_rmse above a lower one's plus 2 ref_noise2. Prints every pair with its
+    margin (tolerance minus excess; negative fails) and returns the problems."""
+    knob, _, points = chain.partition("=")
+    points = points.split(">")
+    if not knob or len(points) < 2:
+        return ["--not-worse %r: want KNOB=P1>P2[>...]" % chain]
+    problems = []
+    for scene in sorted({r["scene"] for r in rows}):
+        sel = {key(r): r for r in rows if r["scene"] == scene}
+        missing = [p for p in points if p not in sel]
+        if missing:
+            problems.append("scene %s, knob %s: points %s not in the CSV" % (scene, knob, ", ".join(missing)))
+            continue
+        for i in range(len(points)):
+            for j in range(i + 1, len(points)):
+                lo, hi = sel[points[i]], sel[points[j]]
+                e_lo, e_hi = float(lo["rel_rmse"]), float(hi["rel_rmse"])
+                tol = 2.0 * float(hi["ref_noise2"])
+                ok = e_hi <= e_lo + tol
+                print("%-4s %-9s %-10s %s %.4f -> %s %.4f (%+.4f, allowed +%.4f)"
+                      % ("ok" if ok else "FAIL", scene, knob, points[i], e_lo, points[j], e_hi, e_hi - e_lo, tol))
+                if not ok:
+                    problems.append("scene %s, knob %s: %s scores rel_rmse %.4f, worse than the lower %s's %.4f by "
+                                    "%.4f > 2 ref_noise2 = %.4f" % (scene, knob, points[j], e_hi, points[i], e_lo,
+                                                                    e_hi - e_lo, tol))
+    return problems
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("csv")
@@ -61,6 +96,7 @@ def main():
     ap.add_argument("--rows", type=int)
     ap.add_argument("--lookup-steps")
     ap.add_argument("--metric", default="rel_rmse", choices=("rel_rmse", "rel_rmse_own"))
+    ap.add_argument("--not-worse", action="append", default=[], metavar="KNOB=P1>P2[>P3...]")
     a = ap.parse_args()
     problems = []
     with open(a.csv, newline="") as f:
@@ -135,6 +171,8 @@ def main():
             if not b < w:
                 problems.append("scene %s: %s (%s %.4f) is not more accurate than %s (%.4f)"
                                 % (a.scene, a.better, m, b, a.worse, w))
+    for chain in a.not_worse:
+        problems += not_worse(rows, chain)
     if a.lookup_steps:
         want = sorted(a.lookup_steps.split(","))
         by_point = {}
