@@ -318,10 +318,10 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *
 
 lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_facts *f, char *why, size_t n)
 {
-    if (s->technique != LPV_TECHNIQUE_ID_AUTO) {
-        const lpv_technique_id t = s->technique == LPV_TECHNIQUE_ID_DEFAULT ? LPV_TECHNIQUE_ID_DEFAULT_IS : s->technique;
+    const lpv_technique_id asked = s->technique == LPV_TECHNIQUE_ID_DEFAULT ? LPV_TECHNIQUE_ID_DEFAULT_IS : s->technique;
+    if (asked != LPV_TECHNIQUE_ID_AUTO) { /* also when the default is auto: the rules below */
         say(why, n, "requested");
-        return t;
+        return asked;
     }
     /* The rules follow the front of the accuracy set against converged light
      * (docs/accuracy.md, "Which technique by default (issue 30)"): the
