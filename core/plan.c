@@ -318,14 +318,16 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *
 
 lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_facts *f, char *why, size_t n)
 {
-    if (s->technique != LPV_TECHNIQUE_ID_AUTO) {
-        const lpv_technique_id t = s->technique == LPV_TECHNIQUE_ID_DEFAULT ? LPV_TECHNIQUE_ID_LPV : s->technique;
+    const lpv_technique_id asked = s->technique == LPV_TECHNIQUE_ID_DEFAULT ? LPV_TECHNIQUE_ID_DEFAULT_IS : s->technique;
+    if (asked != LPV_TECHNIQUE_ID_AUTO) { /* also when the default is auto: the rules below */
         say(why, n, "requested");
-        return t;
+        return asked;
     }
-    /* The rules follow the three-technique front of the accuracy sweep
-     * (docs/accuracy.md, "Three techniques"): the imperfect volume is the
-     * more accurate on every scene measured, the cascaded LPV the cheaper. */
+    /* The rules follow the front of the accuracy set against converged light
+     * (docs/accuracy.md, "Which technique by default (issue 30)"): the
+     * imperfect volume is the most accurate on every scene whose cross-section
+     * its voxels resolve, the cascaded LPV the cheaper, and the better where
+     * they do not (a tunnel); the octree is best on none. */
     if (s->preset == LPV_PRESET_FAST) {
         say(why, n, "auto: preset fast asks for the cheapest technique, the cascaded LPV");
         return LPV_TECHNIQUE_ID_LPV;
@@ -335,7 +337,22 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
             f->occluder_triangles, LPV_AUTO_IV_MAX_TRIANGLES);
         return LPV_TECHNIQUE_ID_LPV;
     }
-    say(why, n, "auto: the imperfect volume, the most accurate technique on every scene of the sweep (preset %s)",
+    const int res = s->iv.resolution > 0 ? s->iv.resolution : LPV_IV_DEFAULT_RESOLUTION;
+    if (f && f->scene_extent > 0.0f && f->scene_middle > 0.0f && !f->bounds_given) {
+        const float voxel = f->scene_extent / (float)res;
+        const float across = f->scene_middle / voxel;
+        if (across < LPV_AUTO_IV_MIN_VOXELS_ACROSS) {
+            say(why, n,
+                "auto: the cascaded LPV: iv's %.3g m voxels (%.4g m / %d) fit %.2g times across the scene's %.3g m, "
+                "under %.3g",
+                voxel, f->scene_extent, res, across, f->scene_middle, LPV_AUTO_IV_MIN_VOXELS_ACROSS);
+            return LPV_TECHNIQUE_ID_LPV;
+        }
+        say(why, n, "auto: the imperfect volume: its %.3g m voxels fit %.3g times across the scene's %.3g m (preset %s)",
+            voxel, across, f->scene_middle, lpv_preset_name(s->preset));
+        return LPV_TECHNIQUE_ID_IV;
+    }
+    say(why, n, "auto: the imperfect volume, the most accurate technique of the accuracy set (preset %s)",
         lpv_preset_name(s->preset));
     return LPV_TECHNIQUE_ID_IV;
 }

@@ -48,6 +48,8 @@ typedef struct lpv_plan_facts {
     int camera_inside;         /* the camera stands inside the scene's bounds */
     float scene_extent;        /* m, the scene bounds' longest axis */
     float scene_shortest;      /* m, the scene bounds' shortest axis */
+    float scene_middle;        /* m, the scene bounds' middle axis (the second longest: a tunnel's
+                                  width, a room's depth) */
     float cascade_finest;      /* m, the finest cascade's extent (lpv_cascade_finest_size) */
     float scene_cross;         /* m, a long scene's cross-section (lpv_cascade_cross_section), else 0 */
     int bounds_given;          /* the settings fix the grid bounds */
@@ -71,6 +73,12 @@ typedef struct lpv_plan_facts {
 
 /* Technique auto (LPV_TECHNIQUE_ID_AUTO): what the planner runs instead. */
 #define LPV_AUTO_IV_MAX_TRIANGLES 1000000 /* above: the imperfect volume's point cloud costs seconds per change */
+/* The imperfect volume's cubic voxels (the longest axis over iv_resolution)
+ * must fit this many times across the scene's middle axis, else auto runs
+ * the cascaded LPV, whose cascades follow a long scene's cross-section: the
+ * 240 m tunnel's 15 m voxels over its 3.4 m width left iv the worst of the
+ * three there (docs/accuracy.md, "Which technique by default (issue 30)"). */
+#define LPV_AUTO_IV_MIN_VOXELS_ACROSS 2.0f
 
 typedef struct lpv_plan {
     char technique[16];                     /* the technique that computed the volume (its class's name) */

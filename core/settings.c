@@ -120,7 +120,7 @@ const char *lpv_preset_names(void)
 
 /* The techniques' names, indexed by lpv_technique_id: ONE table. */
 static const char *const TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
-    [LPV_TECHNIQUE_ID_DEFAULT] = NULL, /* not a row: resolves to lpv */
+    [LPV_TECHNIQUE_ID_DEFAULT] = NULL, /* not a row: resolves to LPV_TECHNIQUE_ID_DEFAULT_IS */
     [LPV_TECHNIQUE_ID_LPV] = LPV_TECHNIQUE_LPV,
     [LPV_TECHNIQUE_ID_OCTREE] = LPV_TECHNIQUE_OCTREE,
     [LPV_TECHNIQUE_ID_IV] = LPV_TECHNIQUE_IV,
@@ -140,7 +140,7 @@ int lpv_technique_from_name(const char *name, lpv_technique_id *out)
 const char *lpv_technique_name(lpv_technique_id t)
 {
     if (t == LPV_TECHNIQUE_ID_DEFAULT)
-        t = LPV_TECHNIQUE_ID_LPV;
+        t = LPV_TECHNIQUE_ID_DEFAULT_IS;
     return (int)t > (int)LPV_TECHNIQUE_ID_DEFAULT && (int)t < (int)LPV_TECHNIQUE_ID_COUNT_ ? TECHNIQUES[t] : NULL;
 }
 
@@ -244,7 +244,7 @@ void lpv_settings_resolve(lpv_settings *s)
             s->scene_surfels = p.scene_surfels;
     }
     if (s->technique == LPV_TECHNIQUE_ID_DEFAULT)
-        s->technique = LPV_TECHNIQUE_ID_LPV;
+        s->technique = LPV_TECHNIQUE_ID_DEFAULT_IS;
     if (s->shadow_size == 0)
         s->shadow_size = LPV_DEFAULT_SHADOW_SIZE;
     if (s->indirect_gain == 0.0f)

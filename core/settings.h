@@ -12,8 +12,9 @@
 #define LPV_TECHNIQUE_IV "iv"         /* imperfect volumes (gpu/iv/) */
 #define LPV_TECHNIQUE_AUTO "auto"     /* the planner chooses from the scene and the preset (core/plan.c) */
 
-/* Which technique computes the volume; 0 means "the default" (lpv). The
- * names are core/settings.c's technique table, the classes gpu/technique.c's. */
+/* Which technique computes the volume; 0 means "the default"
+ * (LPV_TECHNIQUE_ID_DEFAULT_IS, below). The names are core/settings.c's
+ * technique table, the classes gpu/technique.c's. */
 typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_DEFAULT = 0,
     LPV_TECHNIQUE_ID_LPV = 1,
@@ -22,6 +23,13 @@ typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_AUTO = 4, /* not a class: the engine resolves it (lpv_technique_choose) */
     LPV_TECHNIQUE_ID_COUNT_ /* one past the last; not a technique */
 } lpv_technique_id;
+
+/* The technique when none is named (lpvd render, serve, batch and the
+ * library): written here once; lpv_settings_resolve, lpv_technique_name,
+ * lpv_technique_choose and gpu/technique.c read it; lpv, octree, iv or
+ * auto (then lpv_technique_choose's rules decide). Why it is lpv:
+ * docs/accuracy.md, "Which technique by default (issue 30)". */
+#define LPV_TECHNIQUE_ID_DEFAULT_IS LPV_TECHNIQUE_ID_LPV
 
 /* Tri-state switch: 0 means "the default". */
 typedef enum lpv_switch {
@@ -124,7 +132,7 @@ typedef struct lpv_settings {
     float indirect_gain;    /* artistic factor on the indirect term; default 1 (0 = default) */
     int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
     lpv_preset preset;      /* supplies the defaults marked "the preset's"; default balanced */
-    lpv_technique_id technique; /* the GI technique; default lpv */
+    lpv_technique_id technique; /* the GI technique; default LPV_TECHNIQUE_ID_DEFAULT_IS */
 
     /* Effects read at render time (docs/effects.md). */
     lpv_switch glossy;      /* glossy reflections by marching the volume; default on (run
@@ -273,7 +281,7 @@ int lpv_preset_from_name(const char *name, lpv_preset *out);
 /* "lpv" (LPV_TECHNIQUE_LPV, ...) -> *out. Returns 0, or -1 for any other
  * name (out untouched). */
 int lpv_technique_from_name(const char *name, lpv_technique_id *out);
-/* The technique's name ("lpv" for DEFAULT), or NULL for an unknown value. */
+/* The technique's name (LPV_TECHNIQUE_ID_DEFAULT_IS's for DEFAULT), or NULL for an unknown value. */
 const char *lpv_technique_name(lpv_technique_id t);
 /* The technique names, comma separated, for help and errors. */
 const char *lpv_technique_names(void);

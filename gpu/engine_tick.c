@@ -40,6 +40,16 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
                             fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
     f->scene_shortest = fminf(e->scene_max[0] - e->scene_min[0],
                               fminf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
+    {
+        float e3[3], lo = INFINITY, hi = 0.0f, sum = 0.0f;
+        for (int i = 0; i < 3; ++i) {
+            e3[i] = e->scene_max[i] - e->scene_min[i];
+            lo = fminf(lo, e3[i]);
+            hi = fmaxf(hi, e3[i]);
+            sum += e3[i];
+        }
+        f->scene_middle = sum - lo - hi;
+    }
     f->cascade_finest = lpv_cascade_finest_size(&e->settings, e->scene_min, e->scene_max);
     f->scene_cross = lpv_cascade_cross_section(e->scene_min, e->scene_max);
     f->free_path = e->reach.free_path;

@@ -13,6 +13,6 @@ static const lpv_technique_class *const CLASSES[LPV_TECHNIQUE_ID_COUNT_] = {
 const lpv_technique_class *lpv_technique_class_of(lpv_technique_id id)
 {
     if (id == LPV_TECHNIQUE_ID_DEFAULT)
-        id = LPV_TECHNIQUE_ID_LPV;
+        id = LPV_TECHNIQUE_ID_DEFAULT_IS;
     return (int)id > (int)LPV_TECHNIQUE_ID_DEFAULT && (int)id < (int)LPV_TECHNIQUE_ID_COUNT_ ? CLASSES[id] : NULL;
 }

@@ -21,6 +21,8 @@
 #include "context.h"
 #include "engine.h"
 #include "scene_build.h"
+#include "scene_defaults.h"
+#include "scene_load.h"
 #include "test_util.h"
 
 #define DIM 16
@@ -398,6 +400,36 @@ static void test_tick_after_media_render(void **state)
     lpv_scene_free(&scene);
 }
 
+/* Technique auto on the accuracy set's files, from the facts the engine
+ * gathers (the bounds' middle axis): the 240 m tunnel, whose 3.4 m width the
+ * imperfect volume's 15 m voxels do not resolve, gets the cascaded LPV (iv
+ * is its worst technique, docs/accuracy.md "Which technique by default
+ * (issue 30)"); the blinds room gets iv, its most accurate. */
+static void test_auto_follows_the_cross_section(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *name, *technique;
+    } CASES[] = {{"tunnel", "lpv"}, {"blinds", "iv"}};
+    for (size_t i = 0; i < sizeof CASES / sizeof CASES[0]; ++i) {
+        char path[1024], err[512] = "";
+        snprintf(path, sizeof path, "%s/scenes/%s.glb", lpvt_source_dir(), CASES[i].name);
+        lpv_scene scene = {0};
+        if (lpv_scene_load(path, &scene, err, sizeof err) != 0 || lpv_scene_add_defaults(&scene, err, sizeof err) != 0)
+            fail_msg("%s: %s", path, err);
+        lpv_settings s = {.technique = LPV_TECHNIQUE_ID_AUTO};
+        lpv_settings_resolve(&s);
+        lpv_view v;
+        lpv_view_from_camera(&scene.cameras[0], IMG, IMG, &v);
+        set_all(&scene, s, &v);
+        tick();
+        print_message("auto on %s: %s (%s)\n", CASES[i].name, plan()->technique, plan()->technique_reason);
+        assert_string_equal(plan()->technique, CASES[i].technique);
+        assert_non_null(strstr(plan()->technique_reason, "voxels"));
+        lpv_scene_free(&scene);
+    }
+}
+
 int main(void)
 {
     /* test_nothing_glossy_no_medium_no_emissive renders with the media pass forced on; should the media pass leak
@@ -409,6 +441,7 @@ int main(void)
         cmocka_unit_test(test_no_occluders_forced_gv_with_camera),
         cmocka_unit_test(test_nothing_glossy_no_medium_no_emissive),
         cmocka_unit_test(test_tick_after_media_render),
+        cmocka_unit_test(test_auto_follows_the_cross_section),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
