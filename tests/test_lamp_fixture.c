@@ -14,10 +14,10 @@
  * the direct-only frame of the floor 0.5 to 1.5 m from the box must be at
  * most 1e-3 of the same lamp's without the box (the default technique).
  *   3. A point light 2 m over the same floor, 5 cm from a small cube (so
- *      its near planes are the rule's precision floor), lights a wall facing
- *      it at 63 degrees 10, 40 and 150 m away without acne (a smaller near plane costs
- *      depth precision; the floor of the rule keeps it): the direct frame
- *      over I cos / r^2 is 1.
+ *      its near planes are the rule's precision floor), lights a wall at 63
+ *      degrees to its face's axis 10, 40 and 150 m away without acne (a
+ *      smaller near plane costs depth precision; the floor of the rule keeps
+ *      it): the direct frame over I cos / r^2 is 1.
  */
 #include <math.h>
 #include <setjmp.h>
