@@ -82,20 +82,24 @@ static float far_from(const lpv_engine *e, const vec3 p)
  * voxels, core/reach.h, show clear air that far; cached per light). A point at
  * distance d can lie at depth d / sqrt(3) along a 90-degree face's axis (the
  * face's corner), so 0.5 d keeps everything at distance >= d in front of the
- * near plane. The floor keeps the depth precision: a perspective depth
- * stored as GL_DEPTH_COMPONENT32F (pass_shadow.c, pass_rsm.c) near 1 has a
- * step of 2^-24, so a receiver at depth z (m) along the face's axis is known
- * to eps z^2 / near (eps = 2^-23 with the projection's arithmetic); that must
- * stay under NEAR_PRECISION_TEXELS of the texel there, 2 tan(half fov) z /
- * size, for the farthest z the face sees (the farthest corner of the scene's
- * bounds along its axis): near >= eps z_max size / (2 tan(half) x 0.25), a
- * quarter of the smallest depth bias (0.5 texel, shadow.glsl). Where the
- * floor passes the old value, the old value stays (its precision was
- * enough before). */
+ * near plane. The floor keeps the depth precision. The shadow maps hold
+ * reversed depth (pass_shadow.c: near / depth, float precision relative at
+ * every depth), so theirs is only NEAR_REVERSED_FLOOR x the radius. The
+ * RSMs keep the standard projection: a depth stored as
+ * GL_DEPTH_COMPONENT32F (pass_rsm.c) near 1 has a step of 2^-24, so a
+ * receiver at depth z (m) along the face's axis is known to eps z^2 / near
+ * (eps = 2^-23 with the projection's arithmetic); that must stay under
+ * NEAR_PRECISION_TEXELS of the texel there, 2 tan(half fov) z / size, for
+ * the farthest z the face sees (the farthest corner of the scene's bounds
+ * along its axis): near >= eps z_max size / (2 tan(half) x 0.25), a quarter
+ * of the smallest depth bias (0.5 texel, shadow.glsl). Where the floor
+ * passes the old value, the old value stays (its precision was enough
+ * before). */
 #define NEAR_FRACTION 0.5f
 #define NEAR_OLD_FRACTION 1e-3f      /* x the scene's bounding radius: the cap */
 #define NEAR_DEPTH_EPS 1.1920929e-7f /* 2^-23 */
 #define NEAR_PRECISION_TEXELS 0.25f
+#define NEAR_REVERSED_FLOOR 1e-6f /* x the radius: a reversed-depth face's floor (size 0) */
 #define NEAR_SEARCH_MAX 32 /* voxels each side of the eye, at most */
 
 /* 1 when a solid reach voxel (core/reach.h: every surface lies in a solid
@@ -237,7 +241,8 @@ static float nearest_surface(const lpv_engine *e, const vec3 p, const float *n, 
 
 /* The near plane of a perspective face of `size` texels from eye along the
  * unit axis, half field of view atan(tan_half), d from nearest_surface: the
- * rule above. */
+ * rule above; size 0: a face of reversed depth (a shadow map), whose floor
+ * is NEAR_REVERSED_FLOOR x the radius. */
 static float face_near(const lpv_engine *e, const vec3 eye, const vec3 axis, float tan_half, int size, float d,
                        float radius)
 {
@@ -250,7 +255,8 @@ static float face_near(const lpv_engine *e, const vec3 eye, const vec3 axis, flo
             zmax = z;
     }
     const float cap = NEAR_OLD_FRACTION * radius;
-    const float floor_z = NEAR_DEPTH_EPS * zmax * (float)size / (2.0f * NEAR_PRECISION_TEXELS * tan_half);
+    const float floor_z = size > 0 ? NEAR_DEPTH_EPS * zmax * (float)size / (2.0f * NEAR_PRECISION_TEXELS * tan_half)
+                                   : NEAR_REVERSED_FLOOR * radius;
     const float near_z = fmaxf(floor_z, NEAR_FRACTION * d);
     return near_z < cap ? near_z : cap;
 }
@@ -541,13 +547,18 @@ static void shadow_perspective_face(const lpv_engine *e, struct LpvShadowFaceGpu
     /* Widen the face so the central 2 tan_half of it keeps
      * LPV_SHADOW_BORDER_TEXELS free on each side. */
     float t = tan_half * (float)size / ((float)size - 2.0f * LPV_SHADOW_BORDER_TEXELS);
-    const float near_z = face_near(e, eye, dir, t, size, d, radius), far_z = far_from(e, eye);
+    const float near_z = face_near(e, eye, dir, t, 0, d, radius);
     mat4 view, proj;
     vec3 centre, up;
     glm_vec3_add((float *)eye, (float *)dir, centre);
     any_up(dir, up);
     glm_lookat((float *)eye, centre, up, view);
-    glm_perspective(2.0f * atanf(t), 1.0f, near_z, far_z, proj);
+    /* Reversed depth with no far plane (pass_shadow.c draws with clip z in
+     * [0, w]): clip z = near, w = depth, so the map holds near / depth. */
+    glm_mat4_zero(proj);
+    proj[0][0] = proj[1][1] = 1.0f / t;
+    proj[2][3] = -1.0f;
+    proj[3][2] = near_z;
     glm_mat4_mul(proj, view, f->view_proj);
     f->info[0] = 2.0f * t / (float)size; /* m per texel per m of depth */
     f->info[1] = 1.0f;
@@ -598,7 +609,12 @@ int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *
                 return lpv_error(err, err_size, "light %d: shadow cascades cannot be fitted to this view", l);
             for (int k = 0; k < LPV_SHADOW_CASCADES; ++k) {
                 struct LpvShadowFaceGpu *f = &b->faces[faces++];
-                glm_mat4_copy(c[k].view_proj, f->view_proj);
+                /* reversed depth in [0, 1] as the perspective faces' (the
+                 * cascade's near plane at 1, its far plane at 0) */
+                mat4 reverse = GLM_MAT4_IDENTITY_INIT;
+                reverse[2][2] = -0.5f;
+                reverse[3][2] = 0.5f;
+                glm_mat4_mul(reverse, c[k].view_proj, f->view_proj);
                 f->info[0] = c[k].texel;
                 f->info[1] = 0.0f;
                 f->info[2] = (float)l;

@@ -13,11 +13,12 @@
  *      under its lid;
  * the direct-only frame of the floor 0.5 to 1.5 m from the box must be at
  * most 1e-3 of the same lamp's without the box (the default technique).
- *   3. A point light 2 m over the same floor, 5 cm from a small cube (so
- *      its near planes are the rule's precision floor), lights a wall at 63
- *      degrees to its face's axis 10, 40 and 150 m away without acne (a
- *      smaller near plane costs depth precision; the floor of the rule keeps
- *      it): the direct frame over I cos / r^2 is 1.
+ *   3. A point light 2 m over the same floor, 1 mm from a small cube (so
+ *      its shadow-map faces' near planes are 0.5 mm), lights a wall at 63
+ *      degrees to its face's axis 10, 40 and 150 m away without acne (with
+ *      the standard depth mapping a near plane that small loses the depth
+ *      precision at such distances; the shadow maps hold reversed depth,
+ *      pass_shadow.c): the direct frame over I cos / r^2 is 1.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -188,10 +189,9 @@ static void test_far_wall_lit(void **state)
         const float D = walls[k];
         lpv_scene s = {0};
         int grey = big_floor(&s);
-        /* a 10 cm cube 5 cm behind the lamp: the near planes of the faces
-         * along the floor are the precision floor's (0.05 m), the others
-         * 0.025 m */
-        assert_true(lpv_scene_add_box(&s, grey, (float[3]){-0.15f, h - 0.05f, -0.05f}, (float[3]){-0.05f, h + 0.05f, 0.05f}) >=
+        /* a 10 cm cube 1 mm behind the lamp: its shadow-map faces' near
+         * planes are 0.5 mm */
+        assert_true(lpv_scene_add_box(&s, grey, (float[3]){-0.101f, h - 0.05f, -0.05f}, (float[3]){-0.001f, h + 0.05f, 0.05f}) >=
                     0);
         /* the wall x = D + z / 2 (its depth varies across the face that sees
          * it), facing the lamp */
