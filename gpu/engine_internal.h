@@ -147,6 +147,8 @@ struct lpv_engine {
      * search radius, geometry_sig */
     float light_clearance[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
     float light_clearance_key[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS][8];
+    int light_clearance_pending[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* lights whose triangles are to scan */
+    int light_clearance_pending_count;
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
     /* the VPLs that carry light, in order, and their draw command (compact.h):

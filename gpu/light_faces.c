@@ -78,8 +78,9 @@ static float far_from(const lpv_engine *e, const vec3 p)
  * maps:
  *   near = min(1e-3 x radius, max(precision floor, 0.5 x d)),
  * d the distance from the eye to the nearest surface that can shadow what
- * the light lights (nearest_surface: the scene's triangles, unless the reach
- * voxels, core/reach.h, show clear air that far; cached per light). A point at
+ * the light lights (light_clearance and scan_triangles: the scene's
+ * triangles, unless the reach voxels, core/reach.h, show clear air that far;
+ * kept per light). A point at
  * distance d can lie at depth d / sqrt(3) along a 90-degree face's axis (the
  * face's corner), so 0.5 d keeps everything at distance >= d in front of the
  * near plane. The floor keeps the depth precision. The shadow maps hold
@@ -189,56 +190,6 @@ static float triangle_distance2(const vec3 p, const vec3 a, const vec3 b, const 
     return glm_vec3_distance2((float *)p, q);
 }
 
-/* The distance (m) from p to the nearest of the scene's triangles, up to
- * `within` (returned when nothing is closer). The reach voxels answer first
- * when the air around p is clear (and every surface is opaque: the voxels
- * hold only those). For an area light sample (n: its emitting
- * side, else NULL) only what lies in front of its plane can shadow a
- * receiver it lights, and its own emitter lies in the plane: triangles with
- * no vertex in front of the plane do not count (a triangle that crosses it
- * counts whole). */
-static float nearest_surface(const lpv_engine *e, const vec3 p, const float *n, float within)
-{
-    const lpv_scene *g = &e->geometry;
-    /* the voxels hold the opaque surfaces only; cut-out and blended ones
-     * cast shadows too */
-    int all_opaque = 1;
-    for (uint32_t m = 0; m < g->material_count; ++m)
-        all_opaque &= g->materials[m].alpha_mode == LPV_ALPHA_OPAQUE;
-    if (all_opaque && !solid_nearby(&e->reach, p, within))
-        return within;
-    if (!g->vertices || !g->indices)
-        return 0.0f; /* no geometry to tell: the floor of the rule */
-    const float scale = 1.0f + fmaxf(fabsf(p[0]), fmaxf(fabsf(p[1]), fabsf(p[2])));
-    const float eps = 1e-5f * scale; /* off the plane: past the float error of the sample's position */
-    float best2 = within * within;
-    for (uint32_t t = 0; t + 2 < g->index_count; t += 3) {
-        if (g->indices[t] >= g->vertex_count || g->indices[t + 1] >= g->vertex_count ||
-            g->indices[t + 2] >= g->vertex_count)
-            continue;
-        const float *v[3];
-        int outside = 0, ahead = 0;
-        for (int k = 0; k < 3; ++k) {
-            v[k] = g->vertices[g->indices[t + (uint32_t)k]].position;
-            if (n && (v[k][0] - p[0]) * n[0] + (v[k][1] - p[1]) * n[1] + (v[k][2] - p[2]) * n[2] > eps)
-                ahead = 1;
-        }
-        if (n && !ahead)
-            continue; /* in the emitter's plane or behind it */
-        for (int i = 0; i < 3 && !outside; ++i) { /* the triangle's box is farther than the best: skip */
-            const float lo = fminf(v[0][i], fminf(v[1][i], v[2][i])), hi = fmaxf(v[0][i], fmaxf(v[1][i], v[2][i]));
-            const float out = p[i] < lo ? lo - p[i] : (p[i] > hi ? p[i] - hi : 0.0f);
-            outside = out * out > best2;
-        }
-        if (outside)
-            continue;
-        const float d2 = triangle_distance2(p, v[0], v[1], v[2]);
-        if (d2 < best2)
-            best2 = d2;
-    }
-    return sqrtf(best2);
-}
-
 /* The near plane of a perspective face of `size` texels from eye along the
  * unit axis, half field of view atan(tan_half), d from nearest_surface: the
  * rule above; size 0: a face of reversed depth (a shadow map), whose floor
@@ -261,18 +212,94 @@ static float face_near(const lpv_engine *e, const vec3 eye, const vec3 axis, flo
     return near_z < cap ? near_z : cap;
 }
 
+/* The distances (m) from the lights pending in e->light_clearance_pending
+ * (their position, normal and search radius in light_clearance_key) to the
+ * nearest of the scene's triangles, up to the search radius (the answer
+ * when nothing is closer), into e->light_clearance: one pass over the
+ * triangles for all of them (a triangle's vertices are read once). For an
+ * area light sample (a non-zero normal n: its emitting side) only what lies
+ * in front of its plane can shadow a receiver it lights, and its own
+ * emitter lies in the plane: triangles with no vertex in front of the plane
+ * do not count (a triangle that crosses it counts whole). */
+static void scan_triangles(lpv_engine *e)
+{
+    const lpv_scene *g = &e->geometry;
+    const int count = e->light_clearance_pending_count;
+    float best2[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS], eps[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
+    int has_n[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
+    for (int j = 0; j < count; ++j) {
+        const float *k = e->light_clearance_key[e->light_clearance_pending[j]];
+        best2[j] = k[6] * k[6];
+        has_n[j] = k[3] != 0.0f || k[4] != 0.0f || k[5] != 0.0f;
+        /* off the plane: past the float error of the sample's position */
+        eps[j] = 1e-5f * (1.0f + fmaxf(fabsf(k[0]), fmaxf(fabsf(k[1]), fabsf(k[2]))));
+    }
+    if (!g->vertices || !g->indices)
+        for (int j = 0; j < count; ++j)
+            best2[j] = 0.0f; /* no geometry to tell: the floor of the rule */
+    for (uint32_t t = 0; g->vertices && g->indices && t + 2 < g->index_count; t += 3) {
+        if (g->indices[t] >= g->vertex_count || g->indices[t + 1] >= g->vertex_count ||
+            g->indices[t + 2] >= g->vertex_count)
+            continue;
+        const float *v[3];
+        float lo[3], hi[3];
+        for (int k = 0; k < 3; ++k)
+            v[k] = g->vertices[g->indices[t + (uint32_t)k]].position;
+        for (int i = 0; i < 3; ++i) {
+            lo[i] = fminf(v[0][i], fminf(v[1][i], v[2][i]));
+            hi[i] = fmaxf(v[0][i], fmaxf(v[1][i], v[2][i]));
+        }
+        for (int j = 0; j < count; ++j) {
+            const float *k = e->light_clearance_key[e->light_clearance_pending[j]];
+            float box2 = 0.0f; /* the triangle's box farther than the best: skip */
+            for (int i = 0; i < 3; ++i) {
+                const float out = k[i] < lo[i] ? lo[i] - k[i] : (k[i] > hi[i] ? k[i] - hi[i] : 0.0f);
+                box2 += out * out;
+            }
+            if (box2 > best2[j])
+                continue;
+            if (has_n[j]) {
+                int ahead = 0;
+                for (int m = 0; m < 3; ++m)
+                    ahead |= (v[m][0] - k[0]) * k[3] + (v[m][1] - k[1]) * k[4] + (v[m][2] - k[2]) * k[5] > eps[j];
+                if (!ahead)
+                    continue; /* in the emitter's plane or behind it */
+            }
+            const float d2 = triangle_distance2(k, v[0], v[1], v[2]);
+            if (d2 < best2[j])
+                best2[j] = d2;
+        }
+    }
+    for (int j = 0; j < count; ++j)
+        e->light_clearance[e->light_clearance_pending[j]] = sqrtf(best2[j]);
+    e->light_clearance_pending_count = 0;
+}
+
 /* The d of face_near for light l of the light block at p (n: an area light
- * sample's emitting side, else NULL), found again only when the light, the
- * scene's size or its geometry changed (a scan of the triangles near a
- * light). */
+ * sample's emitting side, else NULL), kept per light and found again only
+ * when the light, the scene's size or its geometry changed. The reach
+ * voxels answer when the air around p is clear out to the search radius
+ * (and every material is opaque: the voxels hold only the opaque surfaces;
+ * cut-out and blended ones cast shadows too); otherwise the light waits for
+ * scan_triangles (lpv_light_faces_build builds the faces again after it)
+ * and 0 stands in meanwhile. */
 static float light_clearance(lpv_engine *e, int l, const vec3 p, const float *n, float radius)
 {
     const float within = NEAR_OLD_FRACTION * radius / NEAR_FRACTION;
     float key[8] = {p[0], p[1], p[2], n ? n[0] : 0.0f, n ? n[1] : 0.0f, n ? n[2] : 0.0f, within, 0.0f};
     memcpy(&key[7], &e->geometry_sig, sizeof key[7]); /* the low half of the signature */
     if (memcmp(key, e->light_clearance_key[l], sizeof key) != 0) {
-        e->light_clearance[l] = nearest_surface(e, p, n, within);
         memcpy(e->light_clearance_key[l], key, sizeof key);
+        const lpv_scene *g = &e->geometry;
+        int all_opaque = 1;
+        for (uint32_t m = 0; m < g->material_count; ++m)
+            all_opaque &= g->materials[m].alpha_mode == LPV_ALPHA_OPAQUE;
+        if (all_opaque && !solid_nearby(&e->reach, p, within))
+            e->light_clearance[l] = within;
+        else {
+            e->light_clearance[l] = 0.0f;
+            e->light_clearance_pending[e->light_clearance_pending_count++] = l;
+        }
     }
     return e->light_clearance[l];
 }
@@ -428,7 +455,19 @@ static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, floa
     return added;
 }
 
+static void build_faces(lpv_engine *e);
+
 void lpv_light_faces_build(lpv_engine *e)
+{
+    e->light_clearance_pending_count = 0;
+    build_faces(e);
+    if (e->light_clearance_pending_count > 0) { /* lights near surfaces: their distances, then their faces */
+        scan_triangles(e);
+        build_faces(e);
+    }
+}
+
+static void build_faces(lpv_engine *e)
 {
     struct LpvLightBlock *b = &e->light_block;
     memset(b, 0, sizeof *b);
