@@ -140,6 +140,15 @@ struct lpv_engine {
     int punctual_faces;   /* faces (= layers) of the punctual lights; area faces follow */
     int rsm_layers;       /* layers in use: punctual faces + those the area faces' tiles fill */
     int area_face_side;   /* texels of an area light face's tile */
+    /* each light's clearance (light_faces.c: the distance from its eye to
+     * the nearest surface that can shadow what it lights, for its faces'
+     * near planes), per light of light_block, and what it was found for:
+     * position, normal (an area light sample's; 0 for a punctual light),
+     * search radius, geometry_sig */
+    float light_clearance[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
+    float light_clearance_key[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS][8];
+    int light_clearance_pending[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* lights whose triangles are to scan */
+    int light_clearance_pending_count;
     GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
     GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
     /* the VPLs that carry light, in order, and their draw command (compact.h):

@@ -1,6 +1,7 @@
 /*
  * pass_shadow.c - the shadow maps of direct light (docs/shadows.md): every
- * shadow-map face (lpv_shadow_faces_build) renders the scene's depth alone
+ * shadow-map face (lpv_shadow_faces_build) renders the scene's depth alone,
+ * reversed (near / depth, docs/shadows.md "Near planes"),
  * into one layer of a DEPTH32F array texture of shadow_size^2 texels (an
  * area light sample's face: into one tile of a layer), which
  * shadow.glsl samples with hardware-compare PCF. Separate from the RSMs,
@@ -45,7 +46,9 @@ static int allocate(lpv_engine *e, int size, int layers, char *err, size_t err_s
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    /* reversed depth (docs/shadows.md "Near planes"): nearer is larger, so
+     * a receiver is lit where its depth is at least the map's */
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
     glGenFramebuffers(1, &e->shadow_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_fbo);
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, 0);
@@ -114,7 +117,7 @@ static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int
         const float t = -1.0f + 2.0f * (float)(i % EDGE_SAMPLES) / (float)(EDGE_SAMPLES - 1);
         const int edge = i / EDGE_SAMPLES;
         const float u = edge < 2 ? t : (edge == 2 ? -1.0f : 1.0f), v = edge < 2 ? (edge == 0 ? -1.0f : 1.0f) : t;
-        vec4 ndc = {u, v, 0.0f, 1.0f}, w;
+        vec4 ndc = {u, v, 0.5f, 1.0f}, w; /* a point in front of the eye (depth 0 is infinitely far) */
         glm_mat4_mulv(inv, ndc, w);
         if (!(fabsf(w[3]) > 1e-20f))
             continue;
@@ -168,12 +171,17 @@ static void draw(lpv_engine *e)
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE); /* both sides cast: single-sided walls still block */
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    /* Reversed depth (docs/shadows.md "Near planes"): clip z in [0, w] is
+     * stored as it is, near / distance for a perspective face, 1 at the
+     * near plane and 0 infinitely far, so the float's relative precision
+     * holds at every distance; the nearest surface is the largest. */
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
     const GLuint prog = lpv_engine_material_program(e, e->prog_shadow, e->prog_shadow_plain);
     glUseProgram(prog);
     GLint loc_vp = glGetUniformLocation(prog, "u_view_proj");
-    const float far_depth = 1.0f;
+    const float far_depth = 0.0f;
     glEnable(GL_SCISSOR_TEST);
     for (int f = 0; f < faces; ++f) {
         /* A face fills its layer, or (area light samples) one tile of it, or
@@ -198,6 +206,8 @@ static void draw(lpv_engine *e)
     }
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     lpv_timer_end(&e->timer);
 }

@@ -36,6 +36,11 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  over the table, its front facing the ceiling, glTF doubleSided
                  true: it lights the ceiling with its front and the table and
                  floor with its back, as glTF viewers light it.
+  lamp-fixture.glb  ENCLOSED LIGHT IN A LARGE SCENE (issue 30, docs/shadows.md
+                 "Near planes"): a 400 m ground with a point light in a closed
+                 0.2 m box and an emissive panel in a closed 0.3 m box, and
+                 the same two lamps without their boxes for comparison: only
+                 the open lamps may light the ground.
   tunnel.glb     LONG (issue 30, docs/scenes.md "Defaults"): a closed tunnel
                  240 m long, 3 m wide and 2.6 m high (walls, floor, roof and
                  end caps 20 cm thick), lit from inside by six point lights
@@ -536,6 +541,37 @@ def curved():
     return s
 
 
+def lamp_fixture():
+    """A 400 m ground (so the scene's bounding radius is about 283 m) with,
+    3 m apart: at the back, a point light 10 cm over the ground in a closed
+    0.2 m box (left) and an emissive 10 cm panel facing down 5 cm under the
+    lid of a closed 0.3 m box (right); at the front, the same two lamps
+    without their boxes. The camera looks down at all four. The boxes' walls are nearer their lamps than the lights'
+    old near planes (1e-3 x the radius, 0.28 m), which let the boxed lamps
+    light the ground as the open ones do."""
+    s = Scene()
+    ground = s.material("ground", (0.50, 0.50, 0.50))
+    grey = s.material("fixture_grey", (0.60, 0.60, 0.60))
+    # 136600 nits = 200 W/(m^2 sr): 2 W/sr along the normal from 0.01 m^2
+    panel = s.material("lamp_panel", (0.9, 0.9, 0.9), emission=((1.0, 0.95, 0.85), 136600.0))
+    s.add_box(ground, (-200.0, -0.2, -200.0), (200.0, 0.0, 200.0))
+    for z, enclosed in ((-1.5, True), (1.5, False)):
+        x = -1.5
+        if enclosed:
+            s.add_box(grey, (x - 0.1, 0.0, z - 0.1), (x + 0.1, 0.2, z + 0.1))
+        # 4600 cd = 6.7 W/sr
+        s.light("lamp_%s" % ("boxed" if enclosed else "open"),
+                {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (x, 0.1, z), (x, 0.0, z))
+    for z, enclosed in ((-1.5, True), (1.5, False)):
+        x = 1.5
+        if enclosed:
+            s.add_box(grey, (x - 0.15, 0.0, z - 0.15), (x + 0.15, 0.3, z + 0.15))
+        a, y = 0.05, 0.25  # counter-clockwise seen from below: facing down
+        s.add_quad(panel, [(x - a, y, z - a), (x + a, y, z - a), (x + a, y, z + a), (x - a, y, z + a)])
+    s.camera("Camera", (0.0, 6.0, 5.0), (0.0, 0.0, 0.0), 65.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
@@ -544,7 +580,7 @@ def main():
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
                         ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel),
-                        ("curved", curved)):
+                        ("curved", curved), ("lamp-fixture", lamp_fixture)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))

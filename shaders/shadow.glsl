@@ -177,8 +177,8 @@ float shadow_visibility_of(int l, vec3 p, vec3 n, int taps, const int kind)
     vec3 ndc = clip.xyz / clip.w;
     if (any(greaterThan(abs(ndc.xy), vec2(1.0))))
         return S.faces[f].info.y == 0.0 ? 1.0 : 0.0; // outside a spot's face is outside its cone
-    vec3 uvz = ndc * 0.5 + 0.5;
-    return shadow_pcf(f, uvz.xy, uvz.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
+    // the maps hold reversed depth in [0, 1] as it is (pass_shadow.c)
+    return shadow_pcf(f, ndc.xy * 0.5 + 0.5, ndc.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
 }
 
 float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)
