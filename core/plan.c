@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "cascades.h"
+#include "iv_points.h"
 #include "lpv_shared.h"
 
 static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
@@ -339,13 +340,21 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
     }
     const int res = s->iv.resolution > 0 ? s->iv.resolution : LPV_IV_DEFAULT_RESOLUTION;
     if (f && f->scene_extent > 0.0f && f->scene_middle > 0.0f && !f->bounds_given) {
-        const float voxel = f->scene_extent / (float)res;
+        /* the voxels iv would place with these settings (lpv_iv_place: finer in
+         * long scenes, from the free path), over bounds of the scene's axes */
+        const float ext[3] = {f->scene_extent, f->scene_middle, f->scene_shortest > 0.0f ? f->scene_shortest : 0.0f};
+        const float origin[3] = {0.0f, 0.0f, 0.0f};
+        lpv_settings placed = *s;
+        placed.iv.resolution = res;
+        lpv_grid g;
+        const float voxel = lpv_iv_place(&placed, origin, ext, f->free_path, &g) == 0 ? g.cell_size
+                                                                                       : f->scene_extent / (float)res;
         const float across = f->scene_middle / voxel;
         if (across < LPV_AUTO_IV_MIN_VOXELS_ACROSS) {
             say(why, n,
-                "auto: the cascaded LPV: iv's %.3g m voxels (%.4g m / %d) fit %.2g times across the scene's %.3g m, "
-                "under %.3g",
-                voxel, f->scene_extent, res, across, f->scene_middle, LPV_AUTO_IV_MIN_VOXELS_ACROSS);
+                "auto: the cascaded LPV: iv's %.3g m voxels (iv_resolution %d over %.4g m) fit %.2g times across "
+                "the scene's %.3g m, under %.3g",
+                voxel, res, f->scene_extent, across, f->scene_middle, LPV_AUTO_IV_MIN_VOXELS_ACROSS);
             return LPV_TECHNIQUE_ID_LPV;
         }
         say(why, n, "auto: the imperfect volume: its %.3g m voxels fit %.3g times across the scene's %.3g m (preset %s)",

@@ -410,14 +410,17 @@ static void test_auto_follows_the_cross_section(void **state)
     (void)state;
     static const struct {
         const char *name, *technique;
-    } CASES[] = {{"tunnel", "lpv"}, {"blinds", "iv"}};
+        int iv_resolution; /* 0: the default */
+    } CASES[] = {{"tunnel", "iv", 0}, {"tunnel", "lpv", 4}, {"blinds", "iv", 0}};
     for (size_t i = 0; i < sizeof CASES / sizeof CASES[0]; ++i) {
         char path[1024], err[512] = "";
         snprintf(path, sizeof path, "%s/scenes/%s.glb", lpvt_source_dir(), CASES[i].name);
         lpv_scene scene = {0};
         if (lpv_scene_load(path, &scene, err, sizeof err) != 0 || lpv_scene_add_defaults(&scene, err, sizeof err) != 0)
             fail_msg("%s: %s", path, err);
-        lpv_settings s = {.technique = LPV_TECHNIQUE_ID_AUTO};
+        /* at iv_resolution 4 the voxel budget (5^3) leaves the tunnel's voxels
+         * wider than half its cross-section: the LPV */
+        lpv_settings s = {.technique = LPV_TECHNIQUE_ID_AUTO, .iv.resolution = CASES[i].iv_resolution};
         lpv_settings_resolve(&s);
         lpv_view v;
         lpv_view_from_camera(&scene.cameras[0], IMG, IMG, &v);
