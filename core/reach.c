@@ -330,6 +330,14 @@ float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3])
     return dark ? 0.0f : 1.0f;
 }
 
+int lpv_reach_lit_at(const lpv_reach *r, const float p[3])
+{
+    if (!r->mask || r->unsure)
+        return 0;
+    const long v = voxel_at(r, p);
+    return v >= 0 && r->mask[v] == LPV_REACH_LIT;
+}
+
 void lpv_reach_free(lpv_reach *r)
 {
     free(r->label);

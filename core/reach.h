@@ -91,6 +91,12 @@ void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count);
  * GPU's reach.glsl is the same rule. */
 float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3]);
 
+/* 1 when p lies in air a light reaches (and the mask is sure), else 0 (dark
+ * air, a solid voxel, outside the grid, or an unsure mask). A camera there
+ * sees only surfaces that face that air, so its frame need not read the
+ * mask per pixel (gpu/reach_volume.c). */
+int lpv_reach_lit_at(const lpv_reach *r, const float p[3]);
+
 void lpv_reach_free(lpv_reach *r);
 
 #endif /* LPV_REACH_H */

@@ -112,6 +112,8 @@ typedef struct lpv_engine_stats {
      * the technique's light by it */
     struct {
         int on;               /* the mask is in use (setting reach on, a scene, not unsure) */
+        int per_pixel;        /* the frame reads it per pixel: the camera does not stand in lit air (in
+                                 lit air every surface it sees faces that air, so it reads 1) */
         int unsure;           /* a light had no air around it: nothing is taken away */
         float voxel_m;        /* voxel side, m */
         int dims[3];

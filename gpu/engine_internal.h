@@ -218,6 +218,10 @@ int lpv_engine_reach_build(lpv_engine *e, const lpv_scene *scene, char *err, siz
 void lpv_engine_reach_light(lpv_engine *e);
 void lpv_engine_reach_free(lpv_engine *e);
 void lpv_engine_bind_lookup(const lpv_engine *e, GLuint prog, float damping);
+/* The mask is built and switched on (setting reach, a sure mask); and the
+ * frame reads it per pixel (the camera does not stand in lit air). */
+int lpv_engine_reach_in_use(const lpv_engine *e);
+int lpv_engine_reach_per_pixel(const lpv_engine *e);
 void lpv_engine_update_area_samples(lpv_engine *e);
 /* The emissive VPLs and scene surfels under the current settings, from
  * e->geometry (engine_scene.c). */

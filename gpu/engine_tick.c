@@ -147,7 +147,8 @@ static void record_stats(lpv_engine *e)
     s->area_lights = (unsigned)(e->light_block.counts[0] - e->light_block.counts[2]);
     s->rsm_faces = (unsigned)e->face_count;
     s->rsm_size = (unsigned)e->settings.rsm_size;
-    s->reach.on = e->reach_tex && !e->reach.unsure && e->settings.reach != LPV_SWITCH_OFF;
+    s->reach.on = lpv_engine_reach_in_use(e);
+    s->reach.per_pixel = lpv_engine_reach_per_pixel(e);
     s->reach.unsure = e->reach.unsure;
     s->reach.voxel_m = e->reach.voxel;
     memcpy(s->reach.dims, e->reach.dims, sizeof s->reach.dims);

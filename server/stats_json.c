@@ -95,7 +95,8 @@ json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, c
         json_decref(o);
         return NULL;
     }
-    json_t *reach = json_pack("{s:b, s:b, s:f, s:[i, i, i], s:i, s:i, s:I, s:I}", "on", st->reach.on != 0, "unsure",
+    json_t *reach = json_pack("{s:b, s:b, s:b, s:f, s:[i, i, i], s:i, s:i, s:I, s:I}", "on", st->reach.on != 0,
+                              "per_pixel", st->reach.per_pixel != 0, "unsure",
                               st->reach.unsure != 0, "voxel_m", (double)st->reach.voxel_m, "dims",
                               st->reach.dims[0], st->reach.dims[1], st->reach.dims[2], "components",
                               (int)st->reach.components, "lit_components", (int)st->reach.lit_components,
