@@ -335,7 +335,7 @@ int lpv_reach_lit_at(const lpv_reach *r, const float p[3])
     if (!r->mask || r->unsure)
         return 0;
     const long v = voxel_at(r, p);
-    return v >= 0 && r->mask[v] == LPV_REACH_LIT;
+    return r->mask[v >= 0 ? (size_t)v : 0] == LPV_REACH_LIT; /* outside the grid: the margin's air, voxel 0 */
 }
 
 void lpv_reach_free(lpv_reach *r)

@@ -92,7 +92,8 @@ void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count);
 float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3]);
 
 /* 1 when p lies in air a light reaches (and the mask is sure), else 0 (dark
- * air, a solid voxel, outside the grid, or an unsure mask). A camera there
+ * air, a solid voxel, or an unsure mask); a point outside the grid lies in
+ * the outside air, which the margin's voxels hold. A camera there
  * sees only surfaces that face that air, so its frame need not read the
  * mask per pixel (gpu/reach_volume.c). */
 int lpv_reach_lit_at(const lpv_reach *r, const float p[3]);
