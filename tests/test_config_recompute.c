@@ -132,6 +132,8 @@ static void build_room(lpv_scene *s, float light_x, uint8_t texel)
 static lpv_settings small_settings(void)
 {
     lpv_settings s = {0};
+    s.technique = LPV_TECHNIQUE_ID_LPV; /* the passes counted are the LPV's (inject, propagate); auto is the default
+                                         * since issue 30 */
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = 8;
     s.rsm_size = 32;
     s.shadow_size = 64;
