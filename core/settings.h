@@ -27,9 +27,10 @@ typedef enum lpv_technique_id {
 /* The technique when none is named (lpvd render, serve, batch and the
  * library): written here once; lpv_settings_resolve, lpv_technique_name,
  * lpv_technique_choose and gpu/technique.c read it; lpv, octree, iv or
- * auto (then lpv_technique_choose's rules decide). Why it is lpv:
+ * auto (then lpv_technique_choose's rules decide). Why it is auto (the
+ * best light for the time on the accuracy set against converged light):
  * docs/accuracy.md, "Which technique by default (issue 30)". */
-#define LPV_TECHNIQUE_ID_DEFAULT_IS LPV_TECHNIQUE_ID_LPV
+#define LPV_TECHNIQUE_ID_DEFAULT_IS LPV_TECHNIQUE_ID_AUTO
 
 /* Tri-state switch: 0 means "the default". */
 typedef enum lpv_switch {

@@ -12,9 +12,9 @@
 /* The flags with their own syntax; the knobs follow from the field table. */
 static const lpv_flag OWN_SYNTAX[] = {
     {"technique", 0, "NAME",
-     "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV, the default), " LPV_TECHNIQUE_OCTREE
-     " (octree LPV:\na cubic power-of-two grid), " LPV_TECHNIQUE_IV " (imperfect volumes: the --iv-* knobs) or "
-     LPV_TECHNIQUE_AUTO " (the planner\nchooses from the scene and the preset, and says why)"},
+     "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV), " LPV_TECHNIQUE_OCTREE
+     " (octree LPV: a cubic power-of-two\ngrid), " LPV_TECHNIQUE_IV " (imperfect volumes: the --iv-* knobs) or "
+     LPV_TECHNIQUE_AUTO " (the default: the planner\nchooses from the scene and the preset, and says why)"},
     {"preset", 0, "NAME", "quality preset (default balanced; docs/accuracy.md):"},
     {"grid", 0, "N | NxMxK", "LPV cells per axis (default: the preset's)"},
     {"bounds", 0, "x0,y0,z0,x1,y1,z1", "grid bounds in m (default: the scene's bounds)"},

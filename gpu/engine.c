@@ -308,11 +308,18 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     if (lpv_settings_validate(&s, err, err_size) != 0)
         return -1;
     char knob[sizeof e->settings_knob];
-    const unsigned touches = lpv_settings_touches(&e->settings, &s, knob, sizeof knob);
+    unsigned touches = lpv_settings_touches(&e->settings, &s, knob, sizeof knob);
     if (!touches)
         return 0;
+    const lpv_technique_id was = e->tech_id;
     if (lpv_engine_resolve_technique(e, &s, err, err_size) != 0)
         return -1; /* the technique touches the volume: the next tick computes it anew */
+    if (e->tech_id != was) { /* auto chose another technique (a preset, say): everything anew, as when one is named
+                              * (lpv_settings_touches), the scene's samples being the technique's own */
+        touches |= LPV_TOUCH_VOLUME | LPV_TOUCH_SAMPLES | LPV_TOUCH_SHADOWS | LPV_TOUCH_SHADING;
+        if (!knob[0]) /* no knob of the volume's changed: the plan's reason names the technique */
+            snprintf(knob, sizeof knob, "technique");
+    }
     e->settings = s;
     e->tech->cls->configure(e->tech, &e->settings);
     e->ticked = 0; /* a render or read-back follows a tick under the new settings */

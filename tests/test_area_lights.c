@@ -418,7 +418,7 @@ static void test_energy_no_double_count(void **state)
      * what reaches it (the point-to-square form factor of a 20 m floor 1 m
      * below: 0.9969), and nothing from the emitter itself */
     const double caught = 4.0 * corner(big, big, HEIGHT) / M_PI;
-    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 256, .lpv.cascades = 1}; /* all of it in one grid */
+    lpv_settings set = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 256, .lpv.cascades = 1}; /* all of it in one grid */
     run(&s, set, NULL);
     double on = injected_flux();
     const lpv_plan *p = lpv_engine_last_plan(lpvt_engine);
@@ -451,7 +451,7 @@ static void test_plan_says_why(void **state)
     (void)state;
     lpv_scene s;
     build(&s, 0, FLOOR_HALF);
-    lpv_settings set = {.grid_dims = {8, 8, 8}, .rsm_size = 32, .area_light_samples = 12};
+    lpv_settings set = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {8, 8, 8}, .rsm_size = 32, .area_light_samples = 12};
     run(&s, set, NULL);
     const lpv_plan *p = lpv_engine_last_plan(lpvt_engine);
     print_message("rsm: %s\nemissive: %s\n", p->pass[LPV_PASS_RSM].reason, p->pass[LPV_PASS_EMISSIVE].reason);

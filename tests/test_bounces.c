@@ -49,7 +49,7 @@ static void build_box(lpv_scene *s, float a)
 
 static lpv_settings box_settings(int iterations, lpv_switch bounces, float intensity)
 {
-    lpv_settings s = {0};
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV};
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
     s.lpv.iterations = iterations;

@@ -191,7 +191,7 @@ static void test_wall_injected_flux_and_exitance(void **state)
     (void)state;
     lpv_scene s;
     make_wall(&s);
-    lpv_settings set = {0};
+    lpv_settings set = {.technique = LPV_TECHNIQUE_ID_LPV};
     engine_run(&s, &set, NULL);
     double flux[3];
     injected_flux(flux);
@@ -233,7 +233,7 @@ static void test_emissive_wall_injected_flux(void **state)
     const float wall[4][3] = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
     assert_true(lpv_scene_add_quad(&s, m, wall, NULL) >= 0);
     lpv_scene_compute_bounds(&s);
-    lpv_settings set = {.area_lights = LPV_SWITCH_OFF};
+    lpv_settings set = {.technique = LPV_TECHNIQUE_ID_LPV, .area_lights = LPV_SWITCH_OFF};
     engine_run(&s, &set, NULL);
     double flux[3], want = M_PI * le * 4.0 * h * h;
     injected_flux(flux);
@@ -262,7 +262,7 @@ static void wall_probe_profile(int paper)
     float lpvd[3][K];
     float cell = 0.0f;
     for (int it = 0; it < 3; it++) {
-        lpv_settings set = {.lpv.iterations = iters[it]};
+        lpv_settings set = {.technique = LPV_TECHNIQUE_ID_LPV, .lpv.iterations = iters[it]};
         if (paper) {
             set.grid_dims[0] = set.grid_dims[1] = set.grid_dims[2] = 32;
             set.lpv.central_transport = set.lpv.normal_bins = set.lpv.far_field = set.scene_surfels = LPV_SWITCH_OFF;

@@ -29,6 +29,7 @@
 static lpv_settings room_settings(void)
 {
     lpv_settings s = {0};
+    s.technique = LPV_TECHNIQUE_ID_LPV; /* the LPV's cascades (the default is auto since issue 30) */
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 64;
     s.lpv.iterations = 4;

@@ -363,9 +363,11 @@ static void test_tick_volume_query(void **state)
     (void)state;
     REQUIRE_DAEMON();
     lpvc *c = open_client();
-    /* the local lookup below is R5.7's, exact for one volume per cascade:
-     * normal bins and the far field (the defaults) are off here (docs/protocol.md) */
-    OK(c, lpvc_config_json(c, "{\"normal_bins\": false, \"far_field\": false}"));
+    /* the local lookup below is R5.7's on the LPV's SH cells (lpv named: the
+     * default technique is auto since issue 30), exact for one volume per
+     * cascade: normal bins and the far field (the LPV's defaults) are off here
+     * (docs/protocol.md) */
+    OK(c, lpvc_config_json(c, "{\"technique\": \"lpv\", \"normal_bins\": false, \"far_field\": false}"));
     int64_t tick = -1;
     OK(c, lpvc_tick(c, &tick));
     assert_true(tick >= 1);

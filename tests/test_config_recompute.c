@@ -132,6 +132,8 @@ static void build_room(lpv_scene *s, float light_x, uint8_t texel)
 static lpv_settings small_settings(void)
 {
     lpv_settings s = {0};
+    s.technique = LPV_TECHNIQUE_ID_LPV; /* the passes counted are the LPV's (inject, propagate); auto is the default
+                                         * since issue 30 */
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = 8;
     s.rsm_size = 32;
     s.shadow_size = 64;
@@ -272,6 +274,44 @@ static void test_sampling_knob_resamples_without_upload(void **state)
     lpv_scene_free(&room);
 }
 
+/* auto's choice changing with a knob (the fast preset: the cascaded LPV) is a
+ * change of technique: the scene is sampled again for the chosen one (iv
+ * samples a point cloud, the LPV emissive VPLs and surfels), so the frame is
+ * the one of the same settings on a scene uploaded afresh (issue 30: auto
+ * being the default, `lpvd batch` items whose preset is fast after a scene
+ * set under balanced read iv's samples with the LPV) */
+static void test_auto_choice_change_resamples(void **state)
+{
+    (void)state;
+    lpv_scene room;
+    lpv_settings s = small_settings();
+    s.technique = LPV_TECHNIQUE_ID_AUTO;
+    start(&room, &s);
+    assert_string_equal(lpv_engine_last_plan(lpvt_engine)->technique, LPV_TECHNIQUE_IV);
+    const lpv_engine_counters c0 = counters();
+
+    s.preset = LPV_PRESET_FAST;
+    settings(&s);
+    const lpv_plan *p = tick();
+    assert_string_equal(p->technique, LPV_TECHNIQUE_LPV);
+    assert_true(p->recompute);
+    assert_int_equal(counters().scene_uploads, c0.scene_uploads);
+    assert_int_equal(counters().scene_samplings, c0.scene_samplings + 1);
+    float *switched = render();
+
+    lpv_scene other;
+    build_room(&other, -0.5f, 1);
+    scene(&other);
+    scene(&room);
+    lpv_scene_free(&other);
+    tick();
+    float *fresh = render();
+    assert_true(same_image(switched, fresh));
+    free(switched);
+    free(fresh);
+    lpv_scene_free(&room);
+}
+
 static void test_volume_knob_recomputes_without_upload(void **state)
 {
     (void)state;
@@ -343,6 +383,7 @@ int main(void)
     const struct CMUnitTest gl[] = {
         cmocka_unit_test(test_shading_knob_uploads_and_propagates_nothing),
         cmocka_unit_test(test_sampling_knob_resamples_without_upload),
+        cmocka_unit_test(test_auto_choice_change_resamples),
         cmocka_unit_test(test_volume_knob_recomputes_without_upload),
         cmocka_unit_test(test_moved_light_uploads_nothing),
         cmocka_unit_test(test_new_texture_is_uploaded),

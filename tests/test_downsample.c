@@ -156,7 +156,9 @@ typedef struct snapshot {
 static void snap(const lpv_scene *scene, const lpv_view *view, int cam_step, int rsm_step, snapshot *s)
 {
     char err[512];
-    lpv_settings st = {0}; /* balanced: 8^3, far field, normal bins, scene surfels */
+    /* the LPV's volumes are compared (the default technique is auto since issue 30): balanced, 8^3, far field,
+     * normal bins, scene surfels */
+    lpv_settings st = {.technique = LPV_TECHNIQUE_ID_LPV};
     st.camera_surfel_step = cam_step;
     st.rsm_vpl_step = rsm_step;
     assert_int_equal(lpv_engine_set_settings(lpvt_engine, &st, err, sizeof err), 0);

@@ -73,7 +73,10 @@ static lpv_view room_view(void)
 
 static lpv_settings small_settings(void)
 {
-    lpv_settings set = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4};
+    /* the paper's effects on the LPV's volume (attenuation during its propagation): lpv named, the default
+     * technique being auto since issue 30 */
+    lpv_settings set = {
+        .technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4};
     return set;
 }
 

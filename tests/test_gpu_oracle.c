@@ -102,7 +102,7 @@ static void assert_close(const char *what, const float *gpu, const float *ref, s
 static void test_injection_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF};
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF};
     tick(f, &s, 0);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
@@ -139,7 +139,7 @@ static float *blocking_of(const lpv_gv_point *gv, size_t n)
 static void test_geometry_volume_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_ON};
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_ON};
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t gv_n = lpv_grid_gv_count(g), cells = lpv_grid_cell_count(g);
@@ -197,7 +197,7 @@ static void test_geometry_volume_matches_oracle(void **state)
 
 static void check_propagation(fixture *f, lpv_switch occlusion, int iterations)
 {
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = iterations,
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = iterations,
                       .lpv.occlusion = occlusion};
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
@@ -234,7 +234,7 @@ static void test_propagation_matches_oracle(void **state)
 static void test_lookup_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 8};
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 8};
     tick(f, &s, 1);
     const lpv_grid *g = lpv_engine_grid(f->engine);
     size_t cells = lpv_grid_cell_count(g);
@@ -274,7 +274,7 @@ static void test_central_transport_matches_oracle(void **state)
 {
     fixture *f = *state;
     for (int occ = 0; occ < 2; ++occ) {
-        lpv_settings s = {.grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 6,
+        lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 6,
                           .lpv.occlusion = occ ? LPV_SWITCH_ON : LPV_SWITCH_OFF,
                           .lpv.central_transport = LPV_SWITCH_ON};
         tick(f, &s, 1);
@@ -311,7 +311,7 @@ static void test_central_transport_matches_oracle(void **state)
 static void test_normal_bins_match_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.grid_dims = {12, 12, 12}, .rsm_size = 64, .lpv.iterations = 5,
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {12, 12, 12}, .rsm_size = 64, .lpv.iterations = 5,
                       .lpv.occlusion = LPV_SWITCH_ON,
                       .lpv.normal_bins = LPV_SWITCH_ON, .lpv.central_transport = LPV_SWITCH_ON};
     tick(f, &s, 1);

@@ -38,7 +38,8 @@ static void render_grid(const lpv_scene *scene, int n, lpv_switch occlusion, flo
     char err[1024] = "";
     lpv_view view;
     lpv_view_from_camera(&scene->cameras[0], W, H, &view);
-    const lpv_settings s = {.grid_dims = {n, n, n}, .lpv.occlusion = occlusion};
+    /* the LPV's grid and propagation (the default technique is auto since issue 30) */
+    const lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {n, n, n}, .lpv.occlusion = occlusion};
     if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) ||
         lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) ||
         lpv_engine_set_view(lpvt_engine, &view, err, sizeof err) || lpv_engine_tick(lpvt_engine, err, sizeof err) ||

@@ -217,7 +217,7 @@ static void load_glb(const unsigned char *data, size_t len, lpv_scene *s, lpv_gl
 static void render(const lpv_scene *scene, const lpv_view *view, float *rgba)
 {
     char err[1024] = "";
-    lpv_settings s = {.rsm_size = 512};
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .rsm_size = 512};
     if (lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err) ||
         lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) ||
         lpv_engine_set_view(lpvt_engine, view, err, sizeof err) || lpv_engine_tick(lpvt_engine, err, sizeof err) ||

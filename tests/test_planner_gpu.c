@@ -31,6 +31,8 @@
 static lpv_settings small_settings(void)
 {
     lpv_settings s = {0};
+    s.technique = LPV_TECHNIQUE_ID_LPV; /* the LPV's passes and cascades (the default is auto since issue 30; auto's
+                                         * own choice: test_auto_follows_the_cross_section) */
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;
     s.rsm_size = 32;
     s.lpv.iterations = 4;

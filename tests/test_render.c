@@ -42,8 +42,10 @@ static void render_damped(const lpv_scene *scene, lpv_frame_terms terms, float d
     /* Issue 2's configuration (32^3, 8 iterations, RSM 256^2), not the
      * default preset: at balanced's 4 steps light from the green wall barely
      * reaches the floor 2.3 cells away, and the warm spot keeps red ahead
-     * of green there (docs/accuracy.md, "Presets"). */
-    const lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256, .lpv.damping = damping};
+     * of green there (docs/accuracy.md, "Presets"). The LPV named: its
+     * propagation and damping are tested (the default is auto since issue 30). */
+    const lpv_settings s = {
+        .technique = LPV_TECHNIQUE_ID_LPV, .lpv.iterations = 8, .rsm_size = 256, .lpv.damping = damping};
     render_with(scene, &s, terms, W, H, view, rgba);
 }
 
@@ -127,7 +129,9 @@ static void test_damping_only_darkens(void **state)
 /* The Cornell box's indirect-only frame at lookup step `step`, w x h. */
 static void render_step(const lpv_scene *scene, int step, int w, int h, float *rgba)
 {
-    const lpv_settings s = {.lpv.iterations = 8, .rsm_size = 256, .lookup_step = step};
+    /* the LPV's lookup (the default technique is auto since issue 30) */
+    const lpv_settings s = {
+        .technique = LPV_TECHNIQUE_ID_LPV, .lpv.iterations = 8, .rsm_size = 256, .lookup_step = step};
     lpv_view view;
     render_with(scene, &s, LPV_TERMS_INDIRECT_ONLY, w, h, &view, rgba);
 }
@@ -216,7 +220,9 @@ static size_t check_second_pass(int w, int h)
         for (int k = 0; k < 3; ++k)
             n[k] /= sqrtf(len);
     }
-    const lpv_settings s = {0}; /* the default preset: normal bins, two cascades */
+    /* the LPV at the default preset: normal bins, two cascades (lpv named: the default technique is auto since
+     * issue 30, and the two passes are the LPV's lookup) */
+    const lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV};
     lpv_view view;
     const size_t pixels = (size_t)w * (size_t)h;
     float *a = calloc(pixels * 4, sizeof *a), *b = calloc(pixels * 4, sizeof *b);

@@ -312,10 +312,13 @@ static void test_happy_path(void **state)
     expect_error(&c, LPVP_TICK, "{}", LPVP_E_HELLO_REQUIRED);
     hello(&c);
 
-    /* one volume per cascade, the paper's lookup (R5.7): the volume layout
-     * and the local lookup below hold exactly (normal bins and the far field
-     * are the defaults; docs/protocol.md, "Volumes and the defaults") */
-    request(&c, LPVP_CONFIG, "{\"grid\": [8, 8, 8], \"iterations\": 2, \"normal_bins\": false, \"far_field\": false}",
+    /* the LPV's volume, one per cascade, the paper's lookup (R5.7): the
+     * volume layout and the local lookup below hold exactly (lpv named: the
+     * default technique is auto since issue 30; normal bins and the far field
+     * are the LPV's defaults; docs/protocol.md, "Volumes and the defaults") */
+    request(&c, LPVP_CONFIG,
+            "{\"technique\": \"lpv\", \"grid\": [8, 8, 8], \"iterations\": 2, \"normal_bins\": false, "
+            "\"far_field\": false}",
             NULL, 0, &m);
     assert_int_equal(m.type, LPVP_REPLY(LPVP_CONFIG));
     json_int_t rev = revision_of(&m);
@@ -526,17 +529,20 @@ static void test_sharing_coalesces(void **state)
     msg m;
     conn_open(&blocker);
     hello(&blocker);
-    /* a long tick (the paper's pipeline: the departures would make it minutes) */
+    /* a long tick (the paper's pipeline: the departures would make it minutes); the LPV named in every CONFIG
+     * here, its iterations telling the worlds apart (the default technique is auto since issue 30) */
     request(&blocker, LPVP_CONFIG,
-            "{\"grid\": [96, 96, 96], \"iterations\": 48, \"rsm_size\": 512, \"normal_bins\": false, "
-            "\"far_field\": false}",
+            "{\"technique\": \"lpv\", \"grid\": [96, 96, 96], \"iterations\": 48, \"rsm_size\": 512, "
+            "\"normal_bins\": false, \"far_field\": false}",
             NULL, 0, &m);
     assert_int_equal(m.type, LPVP_REPLY(LPVP_CONFIG));
     msg_free(&m);
     for (int i = 0; i < N + OTHERS; ++i) {
         conn *c = i < N ? &same[i] : &other[i - N];
         char cfg[160];
-        snprintf(cfg, sizeof cfg, "{\"grid\": [8, 8, 8], \"iterations\": %d, \"normal_bins\": false, \"far_field\": false}",
+        snprintf(cfg, sizeof cfg,
+                 "{\"technique\": \"lpv\", \"grid\": [8, 8, 8], \"iterations\": %d, \"normal_bins\": false, "
+                 "\"far_field\": false}",
                  i < N ? 2 : 3 + (i - N));
         conn_open(c);
         hello(c);

@@ -33,6 +33,7 @@ static int departures;
 static lpv_settings temporal_settings(void)
 {
     lpv_settings s = {0};
+    s.technique = LPV_TECHNIQUE_ID_LPV; /* the LPV's cascades (the default is auto since issue 30) */
     if (!departures)
         s.lpv.far_field = s.lpv.normal_bins = LPV_SWITCH_OFF;
     s.grid_dims[0] = s.grid_dims[1] = s.grid_dims[2] = DIM;

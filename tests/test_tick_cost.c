@@ -56,7 +56,7 @@ static void test_each_technique_counts_its_work(void **state)
 {
     (void)state;
     /* lpv: cells x cascades x bins x iterations, auto cascades at the planner's most (3) */
-    lpv_settings l = {.grid_dims = {16, 16, 16}, .lpv.iterations = 10, .lpv.normal_bins = LPV_SWITCH_ON,
+    lpv_settings l = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .lpv.iterations = 10, .lpv.normal_bins = LPV_SWITCH_ON,
                       .lpv.far_field = LPV_SWITCH_OFF};
     assert_true(cost_of(l) == 4096.0 * 3 * 6 * 10);
     l.lpv.cascades = 1;

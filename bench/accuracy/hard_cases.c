@@ -77,13 +77,13 @@ static int point_light(lpv_scene *s, float x, float y, float z, float intensity)
 /* Room plus one light at the centre; the grid as given. */
 static int centred(lpv_hard_scene *h, float intensity, int gx, int gy, int gz, int iterations)
 {
-    h->settings = (lpv_settings){.grid_dims = {gx, gy, gz}, .rsm_size = 32, .lpv.iterations = iterations};
+    h->settings = (lpv_settings){.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {gx, gy, gz}, .rsm_size = 32, .lpv.iterations = iterations};
     return make_room(&h->scene, NULL) < 0 ? -1 : point_light(&h->scene, 0.5f, 0.5f, 0.5f, intensity);
 }
 
 static int build_dynamic_range(lpv_hard_scene *h)
 {
-    h->settings = (lpv_settings){.grid_dims = {16, 16, 16}, .rsm_size = 64};
+    h->settings = (lpv_settings){.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64};
     if (make_room(&h->scene, NULL) < 0)
         return -1;
     return point_light(&h->scene, 0.2f, 0.5f, 0.5f, 1e3f) | point_light(&h->scene, 0.8f, 0.5f, 0.5f, 1e-3f);
@@ -91,7 +91,7 @@ static int build_dynamic_range(lpv_hard_scene *h)
 
 static int build_light_on_corner(lpv_hard_scene *h)
 {
-    h->settings = (lpv_settings){.grid_dims = {8, 8, 8}, .rsm_size = 32, .bounds_min = {0, 0, 0}, .bounds_max = {1, 1, 1}};
+    h->settings = (lpv_settings){.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {8, 8, 8}, .rsm_size = 32, .bounds_min = {0, 0, 0}, .bounds_max = {1, 1, 1}};
     lpv_grid g;
     if (make_room(&h->scene, NULL) < 0 ||
         lpv_grid_place(h->settings.grid_dims, h->settings.bounds_min, h->settings.bounds_max, &g) != 0)
@@ -104,7 +104,7 @@ static int build_light_on_corner(lpv_hard_scene *h)
 
 static int build_vpls_on_boundary(lpv_hard_scene *h)
 {
-    h->settings = (lpv_settings){.grid_dims = {8, 8, 8}, .rsm_size = 32, .bounds_min = {0, 0, 0}, .bounds_max = {1, 1, 1}};
+    h->settings = (lpv_settings){.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {8, 8, 8}, .rsm_size = 32, .bounds_min = {0, 0, 0}, .bounds_max = {1, 1, 1}};
     lpv_grid g;
     if (make_room(&h->scene, NULL) < 0 ||
         lpv_grid_place(h->settings.grid_dims, h->settings.bounds_min, h->settings.bounds_max, &g) != 0)
@@ -125,7 +125,7 @@ static int build_vpls_on_boundary(lpv_hard_scene *h)
  * leak through it shows there. */
 static int build_thin_wall(lpv_hard_scene *h)
 {
-    h->settings = (lpv_settings){.grid_dims = {16, 16, 16}, .rsm_size = 64};
+    h->settings = (lpv_settings){.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64};
     int m = make_room(&h->scene, NULL);
     if (m < 0)
         return -1;
@@ -147,7 +147,7 @@ static int build_thin_wall(lpv_hard_scene *h)
 
 static int build_degenerate(lpv_hard_scene *h)
 {
-    h->settings = (lpv_settings){.grid_dims = {8, 8, 8}, .rsm_size = 32};
+    h->settings = (lpv_settings){.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {8, 8, 8}, .rsm_size = 32};
     lpv_scene *s = &h->scene;
     int m = make_room(s, (const float[3]){NAN, NAN, NAN});
     if (m < 0)

@@ -89,7 +89,7 @@ typedef struct point {
     int bounces;        /* 1 = on */
     float damping;      /* 0 = off */
     char label[32];     /* the features block's name of the point */
-    lpv_technique_id technique; /* 0 (DEFAULT): the cascaded LPV */
+    lpv_technique_id technique; /* 0 (DEFAULT): the cascaded LPV (lpv_of: not the engine's default, auto) */
     /* technique iv: its knobs (0 = --iv-* or the engine's default); of the
      * LPV's knobs only rsm applies (the lights' shadow maps) */
     lpv_acc_iv_knobs iv;
@@ -154,6 +154,10 @@ static lpv_switch on_off(int on)
     return on ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
 }
 
+/* A point's technique: 0 (the presets' and the features' points) is the
+ * cascaded LPV, whatever the engine's default (auto since issue 30). */
+static lpv_technique_id lpv_of(lpv_technique_id t) { return t == LPV_TECHNIQUE_ID_DEFAULT ? LPV_TECHNIQUE_ID_LPV : t; }
+
 /* The engine settings of a point: exactly its knobs, nothing from a preset. */
 static lpv_settings point_settings(const point *p)
 {
@@ -165,11 +169,11 @@ static lpv_settings point_settings(const point *p)
                           .lpv.normal_bins = on_off(p->mods & MOD_BINS),
                           .lpv.far_field = on_off(p->mods & MOD_FAR),
                           .scene_surfels = on_off(p->mods & MOD_SURFELS),
-                          .technique = p->technique};
+                          .technique = lpv_of(p->technique)};
 }
 
 /* The point's technique by name: "lpv", "octree". */
-static const char *tech_name(int technique) { return lpv_technique_name((lpv_technique_id)technique); }
+static const char *tech_name(int technique) { return lpv_technique_name(lpv_of((lpv_technique_id)technique)); }
 
 /* Whether the technique can run the point: the octree halves a cubic
  * power-of-two grid, and its levels are single grids (no normal bins, no far
@@ -2280,7 +2284,7 @@ add_features:
             st.lpv.normal_bins = on_off(pts[p].mods & MOD_BINS);
             st.lpv.far_field = on_off(pts[p].mods & MOD_FAR);
             st.scene_surfels = on_off(pts[p].mods & MOD_SURFELS);
-            st.technique = pts[p].technique;
+            st.technique = lpv_of(pts[p].technique);
             st.camera_surfel_step = step_setting(pts[p].cstep, st.camera_surfel_step);
             st.rsm_vpl_step = step_setting(pts[p].rstep, st.rsm_vpl_step);
             if (pts[p].lstep)

@@ -483,8 +483,13 @@ def textured_glb(tex_w, tex_h):
 # normal_bins and far_field off: the volume is then exactly what the server's
 # QUERY_IRRADIANCE reads with R5.7's lookup (with bins on the volume is the
 # bins' sum, which the server reads per bin; with the far field the server sums
-# its levels), so the R5.1/R4.7 cross-check can hold to float rounding
-SMALL_CONFIG = {"grid": [16, 16, 16], "iterations": 4, "rsm_size": 64, "normal_bins": False, "far_field": False}
+# its levels), so the R5.1/R4.7 cross-check can hold to float rounding.
+# technique lpv named: the volume cases read the LPV's grid (its dims are the
+# configured grid, R5.1) and R5.7's lookup; lpvd's default is "auto" since
+# issue 30, whose volume is mostly the imperfect volume's voxels (R5.14,
+# placed by iv_resolution, not grid), which IV_CONFIG's cases check
+SMALL_CONFIG = {"technique": "lpv", "grid": [16, 16, 16], "iterations": 4, "rsm_size": 64, "normal_bins": False,
+                "far_field": False}
 
 
 # ---------------------------------------------------------------------------
@@ -1658,6 +1663,11 @@ def c_knob_touches(ctx):
 @case("R4.12 R4.11", "CONFIG accepts every described knob across its described range and echoes it resolved")
 def c_config_knobs(ctx):
     c, knobs, presets = _knobs(ctx)
+    # technique lpv named, as the session was before issue 30 made lpvd's default "auto": every knob of another
+    # technique is then accepted and kept without effect (R4.14), so its whole described range can be echoed. With
+    # auto or iv the imperfect volume's cost counts, and iv_resolution 256 at the default 128 rays is over lpvd's
+    # default tick budget: LIMIT (R4.6a), whatever the description's max says
+    _preset_config(c, {"technique": "lpv"})
     n = 0
     for k in knobs:
         for v in _in_range(k):
@@ -2370,7 +2380,7 @@ SH_LOBE1 = math.sqrt(math.pi / 3.0)
 @case("R5.1 R4.7", "volume layout (x fastest, r0..r3 g0..g3 b0..b3, Y00 Y1-1 Y10 Y11) agrees with the "
       "server's own irradiance lookup at cell centres")
 def c_volume_layout(ctx):
-    c, cfg, t = ctx.scene_session(config={"grid": [12, 10, 8], "iterations": 4, "rsm_size": 64,
+    c, cfg, t = ctx.scene_session(config={"technique": "lpv", "grid": [12, 10, 8], "iterations": 4, "rsm_size": 64,
                                           "normal_bins": False, "far_field": False},  # see SMALL_CONFIG
                                   light={"id": "lay-%d" % os.getpid(), "type": "point", "color": [1.0, 0.6, 0.3],
                                          "intensity": 30.0, "position": [0.55, 0.6, -0.35]})
@@ -2483,7 +2493,8 @@ def c_volume_defaults(ctx):
 
 @case("R5.1", "CONFIG grid change is reflected in the volume dims (non-cubic grid, x fastest size)")
 def c_volume_dims(ctx):
-    c, cfg, t = ctx.scene_session(config={"grid": [8, 12, 6], "iterations": 4, "rsm_size": 64})
+    # the LPV's grid (see SMALL_CONFIG: auto, the default since issue 30, places iv's voxels by iv_resolution)
+    c, cfg, t = ctx.scene_session(config={"technique": "lpv", "grid": [8, 12, 6], "iterations": 4, "rsm_size": 64})
     f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
     cells = _vol_header_checks(f.body, "fp32", "none", [8, 12, 6])
     check(all(e["dims"] == [8, 12, 6] for e in f.body["cascades"]), "cascade dims %r, expected [8, 12, 6] each"

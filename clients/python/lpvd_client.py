@@ -1261,10 +1261,12 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
         if "damping" not in str(e):
             raise AssertionError("the refusal does not name damping: %s" % e)
     say("HELLO describes %d knobs and the presets %s" % (len(knobs), ", ".join(c.presets)))
-    # The local lookup below is R5.7's: exact for one volume per cascade, so
-    # normal bins and the far field (the defaults) are off (docs/protocol.md,
-    # "Volumes and the defaults").
-    c.config(normal_bins=False, far_field=False)
+    # The local lookup below is R5.7's on the cascaded LPV's volume (named:
+    # lpvd's default technique is auto since issue 30, whose volume is mostly
+    # iv's voxels, R5.14, tested in _self_test_iv): exact for one volume per
+    # cascade, so normal bins and the far field (the LPV's defaults) are off
+    # (docs/protocol.md, "Volumes and the defaults").
+    c.config(technique="lpv", normal_bins=False, far_field=False)
     if glb is not None:
         with open(glb, "rb") as f:
             r = c.scene_load_glb(f.read())

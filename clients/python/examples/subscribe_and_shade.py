@@ -98,8 +98,11 @@ def main(argv):
     if args.glb:
         with open(args.glb, "rb") as f:
             print("loaded: %s" % c.scene_load_glb(f.read()))
-    # This example shades with R5.7's lookup, which is the server's exactly for
-    # one volume per cascade: normal bins and the far field (the defaults) off.
+    # This example shades with the volume's own lookup: R5.14's for the
+    # imperfect volume's voxels (which lpvd's default technique, auto, picks on
+    # most scenes), R5.7's for the LPV's cells, which is the server's exactly
+    # for one volume per cascade: the LPV's normal bins and far field (its
+    # defaults) off.
     c.config(normal_bins=False, far_field=False)
     c.subscribe("volume", format=args.format, delta=True)
     fixed = read_points(args.points) if args.points else None
