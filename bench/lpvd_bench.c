@@ -122,7 +122,10 @@ int main(int argc, char **argv)
     int repeat = 15, warmup = 3;
     const char *only = NULL, *frame_dir = NULL;
     const char *scene_path = NULL;
-    lpvd_options opt = {0};
+    /* its configurations are the cascaded LPV's (grid, iterations,
+     * departures): the LPV unless --technique names another (the engine's
+     * default is auto since issue 30) */
+    lpvd_options opt = {.settings = {.technique = LPV_TECHNIQUE_ID_LPV}};
     char err[1024];
     lpv_flag_group groups[4] = {{FLAGS, B_COUNT, NULL, NULL}};
     int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 1);

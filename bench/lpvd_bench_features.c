@@ -340,7 +340,9 @@ int main(int argc, char **argv)
 {
     int repeat = 7, warmup = 2, skip_stages = 0, skip_planner = 0;
     const char *scenes_dir = LPVD_BENCH_SCENES_DIR;
-    lpvd_options opt = {0};
+    /* the features are the cascaded LPV's: the LPV unless --technique names
+     * another (the engine's default is auto since issue 30) */
+    lpvd_options opt = {.settings = {.technique = LPV_TECHNIQUE_ID_LPV}};
     char err[1024];
     lpv_flag_group groups[4] = {{FLAGS, B_COUNT, NULL, NULL}};
     int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 1);

@@ -187,6 +187,8 @@ static int run_scene(lpv_engine *e, const lpv_acc_emissive_desc *d, const char *
         fprintf(stderr, "lpvd-accuracy: %s\n", err);
     for (int p = 0; p < NPOINTS; ++p) {
         lpv_settings st = d->opt->settings;
+        if (st.technique == LPV_TECHNIQUE_ID_DEFAULT) /* the published table is the LPV's (not auto, the default) */
+            st.technique = LPV_TECHNIQUE_ID_LPV;
         st.area_lights = POINTS[p].samples ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
         st.area_light_samples = POINTS[p].samples;
         if (POINTS[p].step)
