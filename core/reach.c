@@ -212,6 +212,30 @@ static long voxel_at(const lpv_reach *r, const float p[3])
     return (long)voxel_index(r, c[0], c[1], c[2]);
 }
 
+/* Lights the air components among the 26 voxels around voxel v (dir NULL),
+ * or among those on dir's side of it (their offset . dir >= 0.5). Returns
+ * how many air voxels it found. */
+static int light_around(const lpv_reach *r, long v, const float *dir, unsigned char *lit)
+{
+    const int x = (int)((size_t)v % (size_t)r->dims[0]), y = (int)(((size_t)v / (size_t)r->dims[0]) % (size_t)r->dims[1]),
+              z = (int)((size_t)v / ((size_t)r->dims[0] * (size_t)r->dims[1]));
+    int found = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int X = x + dx, Y = y + dy, Z = z + dz;
+                if (X < 0 || Y < 0 || Z < 0 || X >= r->dims[0] || Y >= r->dims[1] || Z >= r->dims[2] ||
+                    (dir && (float)dx * dir[0] + (float)dy * dir[1] + (float)dz * dir[2] < 0.5f))
+                    continue;
+                const uint32_t l = r->label[voxel_index(r, X, Y, Z)];
+                if (l) {
+                    lit[l] = 1;
+                    found++;
+                }
+            }
+    return found;
+}
+
 /* Lights the component of the voxel holding p, or, when that voxel is
  * solid, the components of the air voxels around it. Returns 0, or -1 when
  * there is no air there at all. A point outside the grid lights the outside. */
@@ -226,22 +250,7 @@ static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
         lit[r->label[v]] = 1;
         return 0;
     }
-    const int x = (int)((size_t)v % (size_t)r->dims[0]), y = (int)(((size_t)v / (size_t)r->dims[0]) % (size_t)r->dims[1]),
-              z = (int)((size_t)v / ((size_t)r->dims[0] * (size_t)r->dims[1]));
-    int found = 0;
-    for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-                int X = x + dx, Y = y + dy, Z = z + dz;
-                if (X < 0 || Y < 0 || Z < 0 || X >= r->dims[0] || Y >= r->dims[1] || Z >= r->dims[2])
-                    continue;
-                uint32_t l = r->label[voxel_index(r, X, Y, Z)];
-                if (l) {
-                    lit[l] = 1;
-                    found = 1;
-                }
-            }
-    return found ? 0 : -1;
+    return light_around(r, v, NULL, lit) ? 0 : -1;
 }
 
 void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
@@ -268,22 +277,10 @@ void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
      * closer to a surface than a voxel (a panel flush on a ceiling) finds
      * none and lights nothing: its light goes into that surface. */
     for (size_t i = 0; i < r->emitter_seed_count; ++i) {
-        const float *c = &r->emitter_seeds[6 * i], *dir = c + 3;
-        long v = voxel_at(r, c);
-        if (v < 0)
-            continue;
-        const int x = (int)((size_t)v % (size_t)r->dims[0]),
-                  y = (int)(((size_t)v / (size_t)r->dims[0]) % (size_t)r->dims[1]),
-                  z = (int)((size_t)v / ((size_t)r->dims[0] * (size_t)r->dims[1]));
-        for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int X = x + dx, Y = y + dy, Z = z + dz;
-                    if ((float)dx * dir[0] + (float)dy * dir[1] + (float)dz * dir[2] < 0.5f || X < 0 || Y < 0 ||
-                        Z < 0 || X >= r->dims[0] || Y >= r->dims[1] || Z >= r->dims[2])
-                        continue;
-                    lit[r->label[voxel_index(r, X, Y, Z)]] = 1; /* lit[0], solid, is never read */
-                }
+        const float *c = &r->emitter_seeds[6 * i];
+        const long v = voxel_at(r, c);
+        if (v >= 0)
+            light_around(r, v, c + 3, lit);
     }
     for (uint32_t c = 1; c <= r->components; ++c)
         r->lit_components += lit[c];

@@ -399,24 +399,33 @@ static void test_hard_cases(void **state)
  * that left R = G = 0, B > 0 on 7 % of the pixels; the lookup's rule for
  * the whole colour (iv_physical) leaves no channel at exactly 0 while
  * another is lit. */
-static void test_no_clipped_channel(void **state)
+/* The indirect-only frame (w x h, calloc'd) of scenes/NAME.glb from its
+ * camera with every iv knob at its default; *v gets the view. */
+static float *iv_default_frame(const char *name, int w, int h, lpv_view *v)
 {
-    (void)state;
     char path[1024], err[1024] = "";
-    snprintf(path, sizeof path, "%s/scenes/courtyard.glb", lpvt_source_dir());
+    snprintf(path, sizeof path, "%s/scenes/%s.glb", lpvt_source_dir(), name);
     lpv_scene scene = {0};
     if (lpv_scene_load(path, &scene, err, sizeof err) != 0)
         fail_msg("%s", err);
     assert_true(scene.camera_count > 0);
-    enum { W = 128, H = 128 };
-    lpv_view v;
-    lpv_view_from_camera(&scene.cameras[0], W, H, &v);
+    lpv_view_from_camera(&scene.cameras[0], w, h, v);
     lpv_settings s = {0};
-    s.technique = LPV_TECHNIQUE_ID_IV; /* every iv knob at its default */
-    tick(&scene, &s, &v);
-    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
+    s.technique = LPV_TECHNIQUE_ID_IV;
+    tick(&scene, &s, v);
+    float *rgba = calloc((size_t)w * h * 4, sizeof *rgba);
     assert_non_null(rgba);
     assert_int_equal(lpv_engine_render(lpvt_engine, LPV_TERMS_INDIRECT_ONLY, rgba, err, sizeof err), 0);
+    lpv_scene_free(&scene);
+    return rgba;
+}
+
+static void test_no_clipped_channel(void **state)
+{
+    (void)state;
+    enum { W = 128, H = 128 };
+    lpv_view v;
+    float *rgba = iv_default_frame("courtyard", W, H, &v);
     int lit = 0, clipped = 0;
     for (size_t i = 0; i < (size_t)W * H; ++i) {
         const float *px = &rgba[4 * i];
@@ -430,7 +439,6 @@ static void test_no_clipped_channel(void **state)
     assert_true(lit > W * H / 4);
     assert_int_equal(clipped, 0);
     free(rgba);
-    lpv_scene_free(&scene);
 }
 
 /* The largest step of the indirect light's luminance between two
@@ -506,21 +514,9 @@ static double sphere_max_step(const lpv_view *v, const float *rgba, int *pixels)
 static void test_curved_surface_smooth(void **state)
 {
     (void)state;
-    char path[1024], err[1024] = "";
-    snprintf(path, sizeof path, "%s/scenes/curved.glb", lpvt_source_dir());
-    lpv_scene scene = {0};
-    if (lpv_scene_load(path, &scene, err, sizeof err) != 0)
-        fail_msg("%s", err);
-    assert_true(scene.camera_count > 0);
     enum { W = 256, H = 256 };
     lpv_view v;
-    lpv_view_from_camera(&scene.cameras[0], W, H, &v);
-    lpv_settings s = {0};
-    s.technique = LPV_TECHNIQUE_ID_IV; /* every iv knob at its default */
-    tick(&scene, &s, &v);
-    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
-    assert_non_null(rgba);
-    assert_int_equal(lpv_engine_render(lpvt_engine, LPV_TERMS_INDIRECT_ONLY, rgba, err, sizeof err), 0);
+    float *rgba = iv_default_frame("curved", W, H, &v);
     int pixels = 0;
     double step = sphere_max_step(&v, rgba, &pixels);
     print_message("curved.glb sphere, iv defaults: %d pixels, largest step between neighbours %.4f of the mean\n",
@@ -528,7 +524,6 @@ static void test_curved_surface_smooth(void **state)
     assert_true(pixels > 1000);
     assert_true(step < 0.3);
     free(rgba);
-    lpv_scene_free(&scene);
 }
 
 int main(void)
