@@ -20,7 +20,7 @@ int lpv_emitters_collect(const lpv_scene *s, lpv_emitter_list *list)
     size_t cap = 0;
     for (uint32_t d = 0; d < s->draw_count; ++d)
         if (emits(s, s->draws[d].material))
-            cap += s->draws[d].index_count / 3 * (s->materials[s->draws[d].material].double_sided ? 2u : 1u);
+            cap += s->draws[d].index_count / 3 * (size_t)lpv_material_emitting_sides(&s->materials[s->draws[d].material]);
     if (!cap)
         return 0;
     list->tris = malloc(cap * sizeof *list->tris);
@@ -46,7 +46,7 @@ int lpv_emitters_collect(const lpv_scene *s, lpv_emitter_list *list)
          * the Khronos viewer light it) emits the same radiance from its back:
          * the draw's triangles again, facing the other way, after its front
          * ones so that the samples of one side stay one patch. */
-        if (s->materials[dr->material].double_sided)
+        if (lpv_material_emitting_sides(&s->materials[dr->material]) == 2)
             for (size_t t = before, front_end = list->count; t < front_end && list->count < cap; ++t) {
                 lpv_emitter_tri *o = &list->tris[list->count++];
                 *o = list->tris[t];

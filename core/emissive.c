@@ -41,7 +41,7 @@ static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *
         if (!material_emits(s, dr->material))
             continue;
         const float *e = s->materials[dr->material].emission;
-        const int sides = s->materials[dr->material].double_sided ? 2 : 1;
+        const int sides = lpv_material_emitting_sides(&s->materials[dr->material]);
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
             const float *p[3];
             float n[3];

@@ -141,6 +141,8 @@ void lpv_scene_compute_bounds(lpv_scene *scene)
     }
 }
 
+int lpv_material_emitting_sides(const lpv_material *m) { return m->double_sided ? 2 : 1; }
+
 float lpv_material_alpha_cutoff(const lpv_material *m)
 {
     switch (m->alpha_mode) {

@@ -188,6 +188,12 @@ int lpv_light_check_intensity(const lpv_light *light, char *err, size_t err_size
  * cutoff, LPV_ALPHA_BLEND_THRESHOLD for BLEND); 0 (nothing is cut) for OPAQUE. */
 float lpv_material_alpha_cutoff(const lpv_material *m);
 
+/* The sides an emissive material emits from: 2 when double-sided (glTF's
+ * doubleSided, as Blender, three.js and the Khronos viewer light it: the
+ * back emits the same radiance), else 1 (the front). The emitters' samples
+ * and VPLs and the reference count sides by it. */
+int lpv_material_emitting_sides(const lpv_material *m);
+
 /* A texture's uv transform as the 2x3 matrix (rows) applied to (u, v, 1):
  * u' = m[0] u + m[1] v + m[2], v' = m[3] u + m[4] v + m[5]. */
 void lpv_uv_transform_matrix(const lpv_uv_transform *t, float m[6]);

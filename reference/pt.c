@@ -199,7 +199,7 @@ static int copy_materials(lpv_ref *r, const lpv_scene *s)
             dst->emission[i] = (isfinite(e) && e > 0.0f) ? e : 0.0f;
         }
         dst->emits = dst->emission[0] > 0.0f || dst->emission[1] > 0.0f || dst->emission[2] > 0.0f;
-        dst->sides = src->double_sided ? 2 : 1;
+        dst->sides = lpv_material_emitting_sides(src);
         int tex = src->base_color_texture;
         dst->texture = (tex >= 0 && (uint32_t)tex < s->texture_count) ? tex : -1;
     }
