@@ -253,24 +253,23 @@ static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
     return light_around(r, v, NULL, lit) ? 0 : -1;
 }
 
-void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
+int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
 {
     const size_t n = voxel_count(r->dims);
-    r->unsure = 0;
-    r->lit_components = 0;
-    r->solid_voxels = r->dark_voxels = r->lit_voxels = 0;
     unsigned char *lit = calloc((size_t)r->components + 1, 1);
     if (!lit || !r->label || !r->mask) {
         free(lit);
+        const int changed = !r->unsure;
         r->unsure = 1;
-        return;
+        return changed;
     }
+    int unsure = 0;
     for (size_t i = 0; i < light_count; ++i) {
         const lpv_light *l = &lights[i];
         if (l->type == LPV_LIGHT_DIRECTIONAL)
             lit[r->label[0]] = 1;
         else if (light_at(r, l->position, lit) != 0)
-            r->unsure = 1;
+            unsure = 1;
     }
     /* An emitter lights the air voxels next to its centroid's voxel on each
      * side (of the 26 around it, those on that side of the triangle). A side
@@ -282,6 +281,16 @@ void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
         if (v >= 0)
             light_around(r, v, c + 3, lit);
     }
+    lit[0] = 0; /* solid: never read */
+    if (r->lit && unsure == r->unsure && memcmp(lit, r->lit, (size_t)r->components + 1) == 0) {
+        free(lit);
+        return 0;
+    }
+    free(r->lit);
+    r->lit = lit;
+    r->unsure = unsure;
+    r->lit_components = 0;
+    r->solid_voxels = r->dark_voxels = r->lit_voxels = 0;
     for (uint32_t c = 1; c <= r->components; ++c)
         r->lit_components += lit[c];
     for (size_t v = 0; v < n; ++v) {
@@ -291,7 +300,7 @@ void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
         r->dark_voxels += r->mask[v] == LPV_REACH_DARK;
         r->lit_voxels += r->mask[v] == LPV_REACH_LIT;
     }
-    free(lit);
+    return 1;
 }
 
 float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3])
@@ -340,5 +349,6 @@ void lpv_reach_free(lpv_reach *r)
     free(r->label);
     free(r->mask);
     free(r->emitter_seeds);
+    free(r->lit);
     memset(r, 0, sizeof *r);
 }

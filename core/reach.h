@@ -67,6 +67,7 @@ typedef struct lpv_reach {
     int unsure;        /* 1: a light's seed had no air around it; every voxel reads lit */
     size_t solid_voxels, dark_voxels, lit_voxels;
     uint32_t lit_components;
+    unsigned char *lit;   /* per component 0..components: lit by the last lpv_reach_light (NULL before) */
 } lpv_reach;
 
 /* Voxelizes the scene's opaque triangles (alpha mode OPAQUE; cut-out and
@@ -79,8 +80,11 @@ typedef struct lpv_reach {
 int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, char *err, size_t err_size);
 
 /* The mask for these punctual lights and the emitters recorded by build:
- * the components holding a light are lit, the rest of the air dark. */
-void lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count);
+ * the components holding a light are lit, the rest of the air dark.
+ * Returns 1 when the mask changed, 0 when the lights light the same spaces
+ * as at the last call (a light moved within its room: the daemon's common
+ * LIGHT_SET), so the caller need not send it again. */
+int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count);
 
 /* 1 when light can reach the air in front of a surface at p facing n (unit),
  * 0 when that air is a component no light reaches: the first non-solid voxel

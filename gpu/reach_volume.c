@@ -32,7 +32,10 @@ void lpv_engine_reach_light(lpv_engine *e)
 {
     if (!e->reach.mask)
         return;
-    lpv_reach_light(&e->reach, e->lights, e->light_count);
+    /* the lights light the same spaces as before (one moved in its room):
+     * the texture holds the mask already */
+    if (!lpv_reach_light(&e->reach, e->lights, e->light_count) && e->reach_tex)
+        return;
     if (!e->reach_tex) {
         glGenTextures(1, &e->reach_tex);
         glBindTexture(GL_TEXTURE_3D, e->reach_tex);

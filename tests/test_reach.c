@@ -78,6 +78,15 @@ static void test_closed_box_keeps_its_light(void **state)
     assert_true(r.components >= 3); /* outside, room, box (and the walls' insides) */
     assert_int_equal(r.lit_components, 1);
     assert_true(r.voxel < 0.05f); /* finer than the room's walls are thick */
+    /* the lamp moves within its box: the same spaces are lit, nothing to send
+     * again; out of the box into the room: the room is lit */
+    s.lights[0].position[0] = 0.1f;
+    assert_int_equal(lpv_reach_light(&r, s.lights, s.light_count), 0);
+    assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 0.0f);
+    s.lights[0].position[1] = 2.0f;
+    assert_int_equal(lpv_reach_light(&r, s.lights, s.light_count), 1);
+    assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 1.0f);
+    assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.52f, 0.0f}, UP) == 0.0f);
     lpv_reach_free(&r);
     lpv_scene_free(&s);
 }
