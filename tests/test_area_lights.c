@@ -105,17 +105,6 @@ static lpv_view floor_view(void)
     return v;
 }
 
-/* The floor point under pixel (x, y), or 0 if the pixel misses the floor. */
-static int floor_point(const lpv_view *v, int x, int y, float p[3])
-{
-    float org[3], dir[3], tmin, tmax;
-    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
-    if (!(dir[1] < 0.0f))
-        return 0;
-    float t = -org[1] / dir[1];
-    p[0] = org[0] + t * dir[0], p[1] = 0.0f, p[2] = org[2] + t * dir[2];
-    return 1;
-}
 
 /* lpvd's direct irradiance (from the direct-only frame) against the analytic
  * one over the floor within 1 m of the emitter's foot: the mean and the
@@ -138,7 +127,7 @@ static void direct_error(int samples, double *mean_err, double *max_err, double 
         for (int x = 0; x < W; ++x) {
             float p[3];
             const float *px = &rgba[4 * ((size_t)y * W + x)];
-            if (!floor_point(&v, x, y, p) || px[3] < 0.5f || hypotf(p[0], p[2]) > 1.0f)
+            if (!lpvt_floor_point(&v, x, y, p) || px[3] < 0.5f || hypotf(p[0], p[2]) > 1.0f)
                 continue;
             double want = analytic_e(p[0], p[2]), got = px[1] * M_PI / RHO;
             double e = fabs(got - want) / want;
@@ -208,7 +197,7 @@ static void test_reference_agrees(void **state)
         for (int x = 0; x < W; ++x) {
             float p[3];
             const float *px = &full[4 * ((size_t)y * W + x)];
-            if (!floor_point(&v, x, y, p) || hypotf(p[0], p[2]) > 1.0f || px[1] > 0.5f * LE)
+            if (!lpvt_floor_point(&v, x, y, p) || hypotf(p[0], p[2]) > 1.0f || px[1] > 0.5f * LE)
                 continue;
             double want = RHO / M_PI * analytic_e(p[0], p[2]);
             assert_true(fabs(px[1] - want) < 4.0 * fse[4 * ((size_t)y * W + x) + 1] + 1e-6);
@@ -256,7 +245,7 @@ static double direct_ratio_facing_up(int double_sided, lpv_technique_id techniqu
         for (int x = 0; x < W; ++x) {
             float p[3];
             const float *px = &rgba[4 * ((size_t)y * W + x)];
-            if (!floor_point(&v, x, y, p) || px[3] < 0.5f || hypotf(p[0], p[2]) > 1.0f)
+            if (!lpvt_floor_point(&v, x, y, p) || px[3] < 0.5f || hypotf(p[0], p[2]) > 1.0f)
                 continue;
             got += px[1] * M_PI / RHO;
             want += analytic_e(p[0], p[2]);
@@ -349,7 +338,7 @@ static void test_occluder_casts_shadow(void **state)
         for (int x = 0; x < W; ++x) {
             float p[3];
             const float *px = &rgba[4 * ((size_t)y * W + x)];
-            if (!floor_point(&v, x, y, p) || px[3] < 0.5f)
+            if (!lpvt_floor_point(&v, x, y, p) || px[3] < 0.5f)
                 continue;
             double d = fmax(fabsf(p[0]), fabsf(p[2]));
             if (d < 0.3) {
@@ -567,7 +556,7 @@ static void test_area_shadow_step_keeps_penumbra(void **state)
                 const size_t i = 4 * ((size_t)y * W + x);
                 assert_true(isfinite(blocks[i]) && isfinite(blocks[i + 1]) && isfinite(blocks[i + 2]));
                 float p[3];
-                if (!floor_point(&v, x, y, p) || every[i + 3] < 0.5f || ray_hits_box(&v, x, y, plate_lo, plate_hi))
+                if (!lpvt_floor_point(&v, x, y, p) || every[i + 3] < 0.5f || ray_hits_box(&v, x, y, plate_lo, plate_hi))
                     continue; /* not the floor, or the plate in front of it */
                 const double a = every[i + 1] * M_PI / RHO, b = blocks[i + 1] * M_PI / RHO;
                 diff2 += (a - b) * (a - b);

@@ -76,18 +76,6 @@ static float *render_direct(lpv_scene *s, const float eye[3], const float target
     return rgba;
 }
 
-/* The point where pixel (x, y)'s ray meets the plane y = 0, or -1. */
-static int floor_point(const lpv_view *v, int x, int y, float p[3])
-{
-    float org[3], dir[3], tmin, tmax;
-    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
-    if (!(dir[1] < 0.0f))
-        return -1;
-    float t = -org[1] / dir[1];
-    for (int i = 0; i < 3; ++i)
-        p[i] = org[i] + t * dir[i];
-    return 0;
-}
 
 /* Mean direct radiance (rgb averaged) of the floor pixels 0.5 to 1.5 m from
  * the vertical axis through the origin, seen from 3 m up. */
@@ -101,7 +89,7 @@ static double ring_direct(lpv_scene *s)
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             float p[3];
-            if (floor_point(&view, x, y, p) != 0)
+            if (!lpvt_floor_point(&view, x, y, p))
                 continue;
             const float r = hypotf(p[0], p[2]);
             if (r < 0.5f || r > 1.5f)
@@ -149,9 +137,9 @@ static double panel_lamp(int boxed)
     return v;
 }
 
-/* The direct light is the shadow maps' for every technique: the default
- * one, then the other two. */
-static const lpv_technique_id TECHNIQUES[] = {LPV_TECHNIQUE_ID_DEFAULT, LPV_TECHNIQUE_ID_OCTREE, LPV_TECHNIQUE_ID_IV};
+/* The direct light is the shadow maps' for every technique: each one named
+ * (the default, auto, is one of them on any scene). */
+static const lpv_technique_id TECHNIQUES[] = {LPV_TECHNIQUE_ID_LPV, LPV_TECHNIQUE_ID_OCTREE, LPV_TECHNIQUE_ID_IV};
 
 static void test_point_light_in_small_box(void **state)
 {

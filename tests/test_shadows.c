@@ -84,18 +84,6 @@ static lpv_ref *reference_of(const lpv_scene *s)
     return ref;
 }
 
-/* The point where pixel (x, y)'s ray meets the plane y = 0, or -1. */
-static int floor_point(const lpv_view *v, int x, int y, float p[3])
-{
-    float org[3], dir[3], tmin, tmax;
-    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
-    if (!(dir[1] < 0.0f))
-        return -1;
-    float t = -org[1] / dir[1];
-    for (int i = 0; i < 3; ++i)
-        p[i] = org[i] + t * dir[i];
-    return 0;
-}
 
 /* ---- 1. a point light, an occluding square, a plane --------------------- */
 
@@ -148,7 +136,7 @@ static void test_point_light_shadow_edge(void **state)
         for (int x = 0; x < W; ++x) {
             float p[3];
             const float *px = &rgba[4 * ((size_t)y * W + (size_t)x)];
-            if (floor_point(&view, x, y, p) != 0 || px[3] < 0.5f)
+            if (!lpvt_floor_point(&view, x, y, p) || px[3] < 0.5f)
                 continue;
             double r2 = (double)p[0] * p[0] + (double)p[2] * p[2] + (double)LIGHT_H * LIGHT_H;
             double unshadowed = ALBEDO / M_PI * LIGHT_I * LIGHT_H / (r2 * sqrt(r2));
@@ -272,7 +260,7 @@ static void test_small_box_under_a_low_sun(void **state)
         for (int x = 0; x < W; ++x) {
             float p[3], org[3], dir[3], tmin, tmax, t, hit[3];
             const float *px = &rgba[4 * ((size_t)y * W + (size_t)x)];
-            if (floor_point(&view, x, y, p) != 0 || px[3] < 0.5f)
+            if (!lpvt_floor_point(&view, x, y, p) || px[3] < 0.5f)
                 continue;
             lpv_ref_pixel_ray(&view, x, y, org, dir, &tmin, &tmax);
             if (!lpv_ref_first_hit(ref, org, dir, tmin, tmax, &t, hit) || fabsf(hit[1]) > 1e-4f)
@@ -373,7 +361,7 @@ static void test_wide_spot_rim_shadows(void **state)
         for (int x = 0; x < W; ++x) {
             float p[3];
             const float *px = &rgba[4 * ((size_t)y * W + (size_t)x)];
-            if (floor_point(&view, x, y, p) != 0 || px[3] < 0.5f)
+            if (!lpvt_floor_point(&view, x, y, p) || px[3] < 0.5f)
                 continue;
             int on_box = 0, near_edge = 0, shadowed = -1;
             for (int b = 0; b < BOXES; ++b) {

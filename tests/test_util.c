@@ -3,6 +3,7 @@
 
 #include "context.h"
 #include "engine.h"
+#include "pt.h"
 #include "view.h"
 
 #include <setjmp.h>
@@ -115,6 +116,17 @@ const char *lpvt_json(const char *fmt, ...)
         if (*c == '\'')
             *c = '"';
     return p;
+}
+
+int lpvt_floor_point(const lpv_view *v, int x, int y, float p[3])
+{
+    float org[3], dir[3], tmin, tmax;
+    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
+    if (!(dir[1] < 0.0f))
+        return 0;
+    const float t = -org[1] / dir[1];
+    p[0] = org[0] + t * dir[0], p[1] = 0.0f, p[2] = org[2] + t * dir[2];
+    return 1;
 }
 
 void lpvt_patch(const lpv_view *v, const float *rgba, int width, int height, const float p[3], int radius,

@@ -49,6 +49,11 @@ int lpvt_gl_teardown(void **state);
  * in *calls, its gpu_ms in *ms, either may be NULL), else 0. */
 int lpvt_stage(const char *name, unsigned *calls, double *ms);
 
+/* The point where pixel (x, y)'s primary ray (lpv_ref_pixel_ray) meets the
+ * floor plane y = 0: 1 and p, or 0 when the ray does not go down. */
+struct lpv_view;
+int lpvt_floor_point(const struct lpv_view *v, int x, int y, float p[3]);
+
 /* Mean radiance (rgb) over the (2 radius + 1)^2 pixels of a width x height
  * RGBA float frame where world point p lands in view v; fails the test when
  * the patch leaves the frame or a pixel saw no geometry. */
