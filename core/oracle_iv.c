@@ -91,8 +91,19 @@ static int near_occupied(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, i
 
 /* ---- Creation (3.1) -------------------------------------------------------- */
 
-/* Accumulators per voxel: 12 SH, 3 normal, 3 albedo, 1 count. */
-#define ACC 19
+/* Accumulators per voxel: 12 SH, 3 normal, 3 albedo, 1 count, 3 folded normal. */
+#define ACC 22
+
+/* LPV_IV_FOLD (lpv_shared.h): n times the sign of its largest component,
+ * ties x before y before z, as iv_splat.vert folds it. */
+static void fold(const float n[3], float out[3])
+{
+    const float ax = fabsf(n[0]), ay = fabsf(n[1]), az = fabsf(n[2]);
+    const float major = ax >= ay && ax >= az ? n[0] : ay >= az ? n[1] : n[2];
+    const float s = major >= 0.0f ? 1.0f : -1.0f;
+    for (int k = 0; k < 3; k++)
+        out[k] = s * n[k];
+}
 
 int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*radiosity)[3], size_t n,
                   lpv_iv_voxel *voxels, size_t *taken)
@@ -121,9 +132,12 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
         for (int ch = 0; ch < 3; ch++)
             for (int k = 0; k < 4; k++)
                 a[4 * ch + k] += (double)B[ch] * (double)h[k];
+        float f[3];
+        fold(pt->normal, f);
         for (int k = 0; k < 3; k++) {
             a[12 + k] += pt->normal[k];
             a[15 + k] += pt->albedo[k];
+            a[19 + k] += f[k];
         }
         a[18] += 1.0;
         used++;
@@ -141,6 +155,7 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
         for (int k = 0; k < 3; k++) {
             o->normal[k] = (float)(a[12 + k] / a[18]);
             o->albedo[k] = (float)(a[15 + k] / a[18]);
+            o->fold[k] = (float)(a[19 + k] / a[18]);
         }
         o->normal[3] = (float)a[18];
     }
@@ -363,6 +378,54 @@ float lpv_iv_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, const vec4 *ao, c
 
 /* ---- Emission per bounce --------------------------------------------------- */
 
+/* The voxel's axis a, the share *front of its points facing it (the rest
+ * face -a, if every normal is +-a) and how two-sided it is, *two (sides):
+ * the mean normal m where the points mostly agree (one surface, a corner),
+ * else the folded mean f (LPV_IV_FOLD: a wall's two faces);
+ * *front = (1 + m.a) / 2, *two = 1 - |m| / |f|. 0 where neither gives an
+ * axis. As iv_emit.comp's iv_axis. */
+static int axis_of(const lpv_iv_voxel *h, float a[3], float *front, float *two)
+{
+    const float *m = h->normal, *f = h->fold;
+    const float lm = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    const float lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    float t = lf > 1e-3f ? 1.0f - lm / lf : 0.0f;
+    *two = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+    const float *src = m;
+    float len = lm;
+    if (!(lm >= LPV_IV_ONE_SIDED * lf && lm > 1e-3f)) {
+        if (!(lf > 1e-3f))
+            return 0;
+        src = f;
+        len = lf;
+    }
+    for (int k = 0; k < 3; k++)
+        a[k] = src[k] / len;
+    const float c = 0.5f * (1.0f + (m[0] * a[0] + m[1] * a[1] + m[2] * a[2]));
+    *front = c < 0.0f ? 0.0f : c > 1.0f ? 1.0f : c;
+    return 1;
+}
+
+/* One channel's SH e read along the axis as two hemispheres, B_f and B_b,
+ * each shown at its own radiance B / share, the mean over the points facing
+ * that way, to the degree two the voxel is two-sided (a thin wall's two
+ * faces share it, and the plain mean showed each at half its light);
+ * iv_emit.comp's iv_sides says why. */
+static void sides(float e[4], const float a[3], float front, float back, float two, const float hf[4],
+                  const float hb[4])
+{
+    const float sum = e[0] / LPV_IV_HEMI0;
+    if (!(sum > 0.0f) || !(two > 0.0f))
+        return;
+    float diff = (e[3] * a[0] + e[1] * a[1] + e[2] * a[2]) / LPV_IV_HEMI1;
+    diff = diff < -sum ? -sum : diff > sum ? sum : diff;
+    const float bf = 0.5f * (sum + diff), bb = 0.5f * (sum - diff);
+    const float kf = two * (1.0f / (front > LPV_IV_SIDE_MIN ? front : LPV_IV_SIDE_MIN) - 1.0f);
+    const float kb = two * (1.0f / (back > LPV_IV_SIDE_MIN ? back : LPV_IV_SIDE_MIN) - 1.0f);
+    for (int k = 0; k < 4; k++)
+        e[k] += bf * kf * hf[k] + bb * kb * hb[k];
+}
+
 void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *incoming, int bounce, int neighbours,
                  lpv_cell *emit)
 {
@@ -378,29 +441,28 @@ void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *
                 memcpy(e->r, h->r, sizeof e->r);
                 memcpy(e->g, h->g, sizeof e->g);
                 memcpy(e->b, h->b, sizeof e->b);
-                if (bounce <= 1 || !incoming)
+                float nh[3], front, two;
+                if (!axis_of(h, nh, &front, &two))
                     continue;
-                const float *m = h->normal;
-                if (!(sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) > 1e-3f))
-                    continue;
-                /* two sides: the points facing n^ = m / |m| (a share (1 + |m|) / 2 of them, if every
-                 * normal is +-n^) re-emit what arrives on that side, the rest what arrives on the other */
-                const float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-                const float nh[3] = {m[0] / len, m[1] / len, m[2] / len}, nb[3] = {-nh[0], -nh[1], -nh[2]};
-                const float front = 0.5f * (1.0f + (len < 1.0f ? len : 1.0f)), back = 1.0f - front;
-                const float p[3] = {centre_of(g, 0, x), centre_of(g, 1, y), centre_of(g, 2, z)};
-                float Ef[3], Eb[3] = {0.0f, 0.0f, 0.0f}, hf[4], hb[4];
-                lpv_iv_irradiance(g, voxels, incoming, p, nh, neighbours, Ef);
-                if (back > 0.0f)
-                    lpv_iv_irradiance(g, voxels, incoming, p, nb, neighbours, Eb);
+                const float back = 1.0f - front, nb[3] = {-nh[0], -nh[1], -nh[2]};
+                float hf[4], hb[4];
                 hemi(nh, hf);
                 hemi(nb, hb);
-                for (int ch = 0; ch < 3; ch++) {
-                    float af = h->albedo[ch] * Ef[ch] * front, ab = h->albedo[ch] * Eb[ch] * back;
-                    float *c = channel(e, ch);
-                    for (int k = 0; k < 4; k++)
-                        c[k] += af * hf[k] + ab * hb[k];
+                if (bounce > 1 && incoming) {
+                    const float p[3] = {centre_of(g, 0, x), centre_of(g, 1, y), centre_of(g, 2, z)};
+                    float Ef[3], Eb[3] = {0.0f, 0.0f, 0.0f};
+                    lpv_iv_irradiance(g, voxels, incoming, p, nh, neighbours, Ef);
+                    if (back > 0.0f)
+                        lpv_iv_irradiance(g, voxels, incoming, p, nb, neighbours, Eb);
+                    for (int ch = 0; ch < 3; ch++) {
+                        float af = h->albedo[ch] * Ef[ch] * front, ab = h->albedo[ch] * Eb[ch] * back;
+                        float *c = channel(e, ch);
+                        for (int k = 0; k < 4; k++)
+                            c[k] += af * hf[k] + ab * hb[k];
+                    }
                 }
+                for (int ch = 0; ch < 3; ch++)
+                    sides(channel(e, ch), nh, front, back, two, hf, hb);
             }
         }
     }
@@ -444,11 +506,7 @@ long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, i
     return LPV_IV_ESCAPED;
 }
 
-/* The radiance one channel e of a voxel's emission sends along unit t: the
- * two Lambertian hemispheres e is the projection of, B_f / pi along its
- * dipole d and B_b / pi against it (B_f + B_b = e0 / HEMI0,
- * (B_f - B_b) d = e1 / HEMI1), as iv_gather.comp reads it. */
-static float emitted(const float e[4], const float t[3])
+float lpv_iv_emitted(const float e[4], const float t[3])
 {
     const float sum = e[0] / LPV_IV_HEMI0;
     const float v[3] = {e[3] / LPV_IV_HEMI1, e[1] / LPV_IV_HEMI1, e[2] / LPV_IV_HEMI1};
@@ -487,7 +545,7 @@ void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell
                         continue; /* escaped: no light */
                     const float back[3] = {-w[0], -w[1], -w[2]};
                     for (int ch = 0; ch < 3; ch++) {
-                        float L = emitted(cchannel(&emit[h], ch), back);
+                        float L = lpv_iv_emitted(cchannel(&emit[h], ch), back);
                         if (!(L > 0.0f))
                             continue;
                         for (int k = 0; k < 4; k++)

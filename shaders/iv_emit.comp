@@ -1,15 +1,63 @@
 // iv_emit.comp - what every occupied voxel sends out in bounce u_bounce:
 // its direct light, plus from the second bounce on its albedo times the
 // irradiance the previous gather reconstructs at its centre over the
-// hemisphere it arrives on, for each side of its mean normal in proportion
-// to the points facing that way (a thin wall's voxel holds both sides;
-// core/oracle_iv.h, lpv_iv_emit). The two volumes alternate (paper 3.3).
-// Empty voxels send nothing.
+// hemisphere it arrives on, for each side of its axis in proportion to the
+// points facing that way (a thin wall's voxel holds both sides;
+// core/oracle_iv.h, lpv_iv_emit). Then each side is shown at its own
+// radiance (iv_sides). The two volumes alternate (paper 3.3). Empty voxels
+// send nothing.
 layout(local_size_x = LPV_IV_WG) in;
 
 layout(std430, binding = LPV_SSBO_IV_VOXELS) readonly buffer Voxels { IvVoxel voxels[]; };
 layout(std430, binding = LPV_SSBO_IV_EMIT) writeonly buffer Emit { LpvCell emit[]; };
 uniform int u_bounce; // 1: direct light only
+
+// The voxel's SH e is the mean over its points of B / pi over each point's
+// hemisphere, so a wall whose two faces share the voxel showed each face at
+// half its radiance (the other half of the points face away): the lit side
+// of every thin wall, in a room of box walls, at half its light, which
+// darkened every bounce (two-rooms: -0.28 of the 1-bounce reference's
+// light). Read along the axis a as two hemispheres B_f (its share of the
+// points cf) and B_b (cb), each side's light becomes B / c, the mean over
+// the points that face that way, to the degree t the voxel is two-sided:
+// t = 1 - |m| / |f| (m the mean normal, f the folded one) is 1 for a wall's
+// two faces, 0 for one surface or a corner (their points agree: |m| = |f|),
+// whose readback stays the plain mean, and 2 min(cf, cb) in between, which
+// keeps every factor t (1 / c - 1) at most 2 (a few points a curved surface
+// has facing backwards are not spread over the voxel's face).
+vec4 iv_sides(vec4 e, vec3 a, float cf, float cb, float t)
+{
+    float sum = e.x / LPV_IV_HEMI0;
+    if (!(sum > 0.0) || !(t > 0.0))
+        return e;
+    float diff = clamp(dot(vec3(e.w, e.y, e.z) / LPV_IV_HEMI1, a), -sum, sum);
+    float bf = 0.5 * (sum + diff), bb = 0.5 * (sum - diff);
+    float kf = t * (1.0 / max(cf, LPV_IV_SIDE_MIN) - 1.0), kb = t * (1.0 / max(cb, LPV_IV_SIDE_MIN) - 1.0);
+    vec4 hf = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * a.y, LPV_IV_HEMI1 * a.z, LPV_IV_HEMI1 * a.x);
+    vec4 hb = vec4(LPV_IV_HEMI0, -hf.yzw);
+    return e + bf * kf * hf + bb * kb * hb;
+}
+
+// The voxel's axis a, the share cf of its points facing it (the rest face
+// -a, if every normal is +-a) and how two-sided it is, t (iv_sides): the
+// mean normal m where the points mostly agree (one surface, a corner), else
+// the folded mean f (LPV_IV_FOLD: a wall's two faces); cf = (1 + m.a) / 2.
+// False where neither gives an axis.
+bool iv_axis(vec3 m, vec3 f, out vec3 a, out float cf, out float t)
+{
+    float lm = length(m), lf = length(f);
+    a = vec3(0.0);
+    cf = 1.0;
+    t = lf > 1e-3 ? clamp(1.0 - lm / lf, 0.0, 1.0) : 0.0;
+    if (lm >= LPV_IV_ONE_SIDED * lf && lm > 1e-3)
+        a = m / lm;
+    else if (lf > 1e-3)
+        a = f / lf;
+    else
+        return false;
+    cf = clamp(0.5 * (1.0 + dot(m, a)), 0.0, 1.0);
+    return true;
+}
 
 void main()
 {
@@ -23,20 +71,24 @@ void main()
         o.r = v.r;
         o.g = v.g;
         o.b = v.b;
-        vec3 m = v.normal.xyz;
-        float len = length(m);
-        if (u_bounce > 1 && len > 1e-3) {
-            ivec3 d = grid_dims();
-            ivec3 c = ivec3(i % d.x, (i / d.x) % d.y, i / (d.x * d.y));
-            vec3 nh = m / len;
-            float front = 0.5 * (1.0 + min(len, 1.0)), back = 1.0 - front;
-            vec3 ef = lpv_irradiance(iv_centre(c), nh) * v.albedo.rgb * front;
-            vec3 eb = back > 0.0 ? lpv_irradiance(iv_centre(c), -nh) * v.albedo.rgb * back : vec3(0.0);
-            vec4 hf = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * nh.y, LPV_IV_HEMI1 * nh.z, LPV_IV_HEMI1 * nh.x);
-            vec4 hb = vec4(LPV_IV_HEMI0, -hf.yzw);
-            o.r += ef.r * hf + eb.r * hb;
-            o.g += ef.g * hf + eb.g * hb;
-            o.b += ef.b * hf + eb.b * hb;
+        vec3 a;
+        float cf, t;
+        if (iv_axis(v.normal.xyz, v.fold.xyz, a, cf, t)) {
+            float cb = 1.0 - cf;
+            if (u_bounce > 1) {
+                ivec3 d = grid_dims();
+                ivec3 c = ivec3(i % d.x, (i / d.x) % d.y, i / (d.x * d.y));
+                vec3 ef = lpv_irradiance(iv_centre(c), a) * v.albedo.rgb * cf;
+                vec3 eb = cb > 0.0 ? lpv_irradiance(iv_centre(c), -a) * v.albedo.rgb * cb : vec3(0.0);
+                vec4 hf = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * a.y, LPV_IV_HEMI1 * a.z, LPV_IV_HEMI1 * a.x);
+                vec4 hb = vec4(LPV_IV_HEMI0, -hf.yzw);
+                o.r += ef.r * hf + eb.r * hb;
+                o.g += ef.g * hf + eb.g * hb;
+                o.b += ef.b * hf + eb.b * hb;
+            }
+            o.r = iv_sides(o.r, a, cf, cb, t);
+            o.g = iv_sides(o.g, a, cf, cb, t);
+            o.b = iv_sides(o.b, a, cf, cb, t);
         }
     }
     emit[i] = o;

@@ -7,6 +7,7 @@ layout(binding = 1) uniform sampler2D u_sum_g;
 layout(binding = 2) uniform sampler2D u_sum_b;
 layout(binding = 3) uniform sampler2D u_sum_n;
 layout(binding = 4) uniform sampler2D u_sum_a;
+layout(binding = 5) uniform sampler2D u_sum_f;
 layout(std430, binding = LPV_SSBO_IV_VOXELS) writeonly buffer Voxels { IvVoxel voxels[]; };
 layout(std430, binding = LPV_SSBO_IV_OCCUPANCY) buffer Occupancy { uint occupancy[]; };
 
@@ -26,6 +27,7 @@ void main()
     v.b = texelFetch(u_sum_b, t, 0) * k;
     v.normal = vec4(n.xyz * k, n.w);
     v.albedo = texelFetch(u_sum_a, t, 0) * k;
+    v.fold = texelFetch(u_sum_f, t, 0) * k;
     voxels[i] = v;
     if (n.w > 0.0)
         atomicOr(occupancy[i >> 5], 1u << uint(i & 31));

@@ -4,12 +4,14 @@ flat in vec4 v_g;
 flat in vec4 v_b;
 flat in vec4 v_n;
 flat in vec4 v_a;
+flat in vec4 v_f;
 
 layout(location = 0) out vec4 o_r;
 layout(location = 1) out vec4 o_g;
 layout(location = 2) out vec4 o_b;
 layout(location = 3) out vec4 o_n;
 layout(location = 4) out vec4 o_a;
+layout(location = 5) out vec4 o_f;
 
 void main()
 {
@@ -18,4 +20,5 @@ void main()
     o_b = v_b;
     o_n = v_n;
     o_a = v_a;
+    o_f = v_f;
 }

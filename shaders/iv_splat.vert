@@ -2,7 +2,8 @@
 // 3.2): a point of the cloud (u_source 0) or a visible pixel of the camera's
 // G-buffer (u_source 1). Each is lit here (iv_direct.glsl) and carries its
 // outgoing radiance B / pi over its normal's hemisphere as SH (B = albedo x
-// E_direct + pi x emission), its normal, its albedo and a count of 1; the
+// E_direct + pi x emission), its normal, its albedo, a count of 1 and its
+// folded normal (LPV_IV_FOLD); the
 // atlas sums them and iv_resolve.comp divides by the count.
 layout(std430, binding = LPV_SSBO_IV_POINTS) readonly buffer Points { IvPoint points[]; };
 layout(binding = 0) uniform sampler2D u_gbuf_position;
@@ -22,12 +23,13 @@ flat out vec4 v_g;
 flat out vec4 v_b;
 flat out vec4 v_n;
 flat out vec4 v_a;
+flat out vec4 v_f;
 
 void main()
 {
     gl_PointSize = 1.0;
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
-    v_r = v_g = v_b = v_n = v_a = vec4(0.0);
+    v_r = v_g = v_b = v_n = v_a = v_f = vec4(0.0);
     vec3 p, n, albedo, emission;
     if (u_source == 0) {
         IvPoint q = points[u_first + gl_VertexID];
@@ -64,6 +66,8 @@ void main()
     v_b = h * radiosity.b;
     v_n = vec4(n, 1.0);
     v_a = vec4(albedo, 0.0);
+    vec3 an = abs(n); // LPV_IV_FOLD
+    v_f = vec4((an.x >= an.y && an.x >= an.z ? n.x : an.y >= an.z ? n.y : n.z) >= 0.0 ? n : -n, 0.0);
     vec2 texel = vec2(atlas_texel(c, grid_dims().xy)) + 0.5;
     gl_Position = vec4(texel / u_atlas_size * 2.0 - 1.0, 0.0, 1.0);
 }

@@ -287,7 +287,16 @@ struct IvVoxel {
     vec4 b;        /*   radiosity, W/m^2), LPV_IV_HEMI0 / LPV_IV_HEMI1 below                 */
     vec4 normal;   /* xyz the mean of the points' unit normals (not unit); w points, 0 = empty */
     vec4 albedo;   /* rgb the points' mean albedo (the bounces' reflectance); a unused */
+    vec4 fold;     /* xyz the mean of the points' folded normals (LPV_IV_FOLD); w unused */
 };
+
+/* LPV_IV_FOLD: a point's normal n folded to s n, s the sign of its largest
+ * component (ties: x before y before z). The two faces of a wall, n and -n,
+ * add up to one axis there where their plain mean cancels: a wall thinner
+ * than a voxel puts both faces in it, and the voxel shows each side at its
+ * own radiance along that axis (iv_emit.comp, lpv_iv_emit). */
+#define LPV_IV_ONE_SIDED 0.5f /* the mean normal is the axis when |m| >= this x |folded mean| */
+#define LPV_IV_SIDE_MIN 0.05f /* the least share of a voxel's points a side is divided by */
 
 /* The SH of a hemisphere of unit radiance around n, divided by pi:
  * (HEMI0, HEMI1 n.y, HEMI1 n.z, HEMI1 n.x), so radiosity B x this is the SH

@@ -702,10 +702,96 @@ static void test_run_matches_steps(void **state)
     furnace_free(&f);
 }
 
+/* A wall thinner than a voxel puts both its faces in one voxel. Each face
+ * must send its own radiance B / pi, not the mean over both faces' points
+ * (half the lit face's light: a room of box walls came out at 0.72 of the
+ * 1-bounce reference's light, issue 30), and a voxel whose points all agree
+ * (one surface, a corner) keeps the plain mean. */
+#define TWO_SIDED_PI 3.14159265358979323846
+
+static float sent(const lpv_cell *e, float x, float y, float z)
+{
+    const float t[3] = {x, y, z};
+    return lpv_iv_emitted(e->r, t);
+}
+
+static void test_two_sided_wall(void **state)
+{
+    (void)state;
+    lpv_grid g = {{3, 3, 3}, {0.0f, 0.0f, 0.0f}, 1.0f};
+    const size_t cells = lpv_grid_cell_count(&g), mid = lpv_grid_index(&g, 1, 1, 1);
+    const float alb[3] = {0.5f, 0.5f, 0.5f}, px[3] = {1.0f, 0.0f, 0.0f}, nx[3] = {-1.0f, 0.0f, 0.0f};
+    const float py[3] = {0.0f, 1.0f, 0.0f};
+    lpv_iv_voxel *vox = xcalloc(cells, sizeof *vox);
+    lpv_cell *emit = xcalloc(cells, sizeof *emit), *in = xcalloc(cells, sizeof *in);
+    enum { N = 8 };
+    lpv_iv_point pts[2 * N];
+    float B[2 * N][3];
+    const float ipi = (float)(1.0 / TWO_SIDED_PI);
+    /* faces at x = 1.45 (facing -x) and 1.55 (facing +x), a 10 cm wall */
+    struct {
+        float lit, dark; /* B of the +x face, of the -x face */
+        int faces;       /* 1: the +x face alone; 2: both */
+    } cases[] = {{2.0f, 0.0f, 2}, {2.0f, 1.0f, 2}, {2.0f, 0.0f, 1}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        size_t n = 0;
+        for (int i = 0; i < N; i++) {
+            const float y = 1.1f + 0.1f * (float)i, z = 1.8f - 0.09f * (float)i;
+            pts[n] = point((float[3]){1.55f, y, z}, px, alb);
+            B[n][0] = B[n][1] = B[n][2] = cases[c].lit;
+            n++;
+            if (cases[c].faces == 2) {
+                pts[n] = point((float[3]){1.45f, y, z}, nx, alb);
+                B[n][0] = B[n][1] = B[n][2] = cases[c].dark;
+                n++;
+            }
+        }
+        assert_int_equal(lpv_iv_create(&g, pts, (const float(*)[3])B, n, vox, NULL), 0);
+        assert_true(vox[mid].normal[3] == (float)n);
+        lpv_iv_emit(&g, vox, in, 1, 8, emit);
+        print_message("wall %zu: +x %.4f (want %.4f), -x %.4f (want %.4f) W/(m^2 sr)\n", c,
+                      (double)sent(&emit[mid], 1, 0, 0), (double)(cases[c].lit * ipi),
+                      (double)sent(&emit[mid], -1, 0, 0), (double)(cases[c].faces == 2 ? cases[c].dark * ipi : 0.0f));
+        assert_float_equal(sent(&emit[mid], 1, 0, 0), cases[c].lit * ipi, 1e-5);
+        assert_float_equal(sent(&emit[mid], -1, 0, 0), cases[c].faces == 2 ? cases[c].dark * ipi : 0.0f, 1e-5);
+        /* the second bounce: uniform radiance L arriving everywhere, E = pi L on either side, each face sends
+         * its direct light plus albedo x E, B / pi again */
+        const float L = 3.0f;
+        for (size_t k = 0; k < cells; k++) {
+            memset(&in[k], 0, sizeof in[k]);
+            in[k].r[0] = in[k].g[0] = in[k].b[0] = L * (float)(4.0 * TWO_SIDED_PI * LPV_SH_C0);
+        }
+        lpv_iv_emit(&g, vox, in, 2, 8, emit);
+        const float back = cases[c].faces == 2 ? (cases[c].dark + alb[0] * (float)TWO_SIDED_PI * L) * ipi : 0.0f;
+        assert_float_equal(sent(&emit[mid], 1, 0, 0), (cases[c].lit + alb[0] * (float)TWO_SIDED_PI * L) * ipi, 1e-4);
+        assert_float_equal(sent(&emit[mid], -1, 0, 0), back, 1e-4);
+        memset(in, 0, cells * sizeof *in);
+    }
+    /* a corner: a floor (+y) and a wall (+x) in one voxel, both lit; their points agree, the emission is the
+     * plain mean of the points' hemispheres */
+    size_t n = 0;
+    for (int i = 0; i < N; i++) {
+        pts[n] = point((float[3]){1.1f + 0.1f * (float)i, 1.05f, 1.5f}, py, alb);
+        B[n][0] = B[n][1] = B[n][2] = 1.0f;
+        n++;
+        pts[n] = point((float[3]){1.05f, 1.1f + 0.1f * (float)i, 1.5f}, px, alb);
+        B[n][0] = B[n][1] = B[n][2] = 1.0f;
+        n++;
+    }
+    assert_int_equal(lpv_iv_create(&g, pts, (const float(*)[3])B, n, vox, NULL), 0);
+    lpv_iv_emit(&g, vox, in, 1, 8, emit);
+    for (int k = 0; k < 4; k++)
+        assert_float_equal(emit[mid].r[k], vox[mid].r[k], 1e-7);
+    free(vox);
+    free(emit);
+    free(in);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_create_means),
+        cmocka_unit_test(test_two_sided_wall),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_energy_albedo_one),
         cmocka_unit_test(test_ao_open_plane),

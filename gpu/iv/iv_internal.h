@@ -12,8 +12,8 @@
 #include "gl_util.h"
 #include "technique.h"
 
-/* The atlas's attachments: r, g, b SH sums, normal + count, albedo. */
-#define IV_ATTACHMENTS 5
+/* The atlas's attachments: r, g, b SH sums, normal + count, albedo, folded normal. */
+#define IV_ATTACHMENTS 6
 
 typedef struct lpv_iv_gpu {
     lpv_technique base;

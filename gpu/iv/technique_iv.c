@@ -110,8 +110,8 @@ static void memory_need(const lpv_technique *t, lpv_memory_need *n)
 {
     const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
     const lpv_grid *g = v->cells ? &v->grid : &v->pending;
-    /* per voxel: the atlas (5 x 16), IvVoxel (80), emission and two
-     * radiance volumes (3 x 48), AO (16): 320 bytes, within one LPV cell's */
+    /* per voxel: the atlas (6 x 16), IvVoxel (96), emission and two
+     * radiance volumes (3 x 48), AO (16): 352 bytes, within one LPV cell's */
     n->cells += lpv_grid_cell_count(g);
     n->cascades = 1;
     memcpy(n->grid_dims, g->dims, sizeof n->grid_dims);
