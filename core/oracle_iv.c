@@ -611,6 +611,45 @@ static int check(const lpv_iv_desc *d, int need_bounces, char *err, size_t err_s
     return 0;
 }
 
+void lpv_iv_total(size_t cells, const lpv_cell *incoming, double total[3])
+{
+    total[0] = total[1] = total[2] = 0.0;
+    for (size_t i = 0; i < cells; i++) {
+        total[0] += incoming[i].r[0];
+        total[1] += incoming[i].g[0];
+        total[2] += incoming[i].b[0];
+    }
+}
+
+void lpv_iv_tail_ratio(const double (*totals)[3], int K, float r[3])
+{
+    for (int ch = 0; ch < 3; ch++) {
+        r[ch] = 0.0f;
+        if (K < 2)
+            continue;
+        const double d0 = totals[K - 1][ch] - (K >= 3 ? totals[K - 2][ch] : 0.0);
+        const double d1 = totals[K][ch] - totals[K - 1][ch];
+        if (!(d0 > 0.0) || !(d1 > 0.0))
+            continue;
+        const double q = d1 / d0;
+        r[ch] = q < LPV_IV_TAIL_MAX_RATIO ? (float)q : LPV_IV_TAIL_MAX_RATIO;
+    }
+}
+
+void lpv_iv_add_tail(size_t cells, const lpv_cell *before, const float r[3], lpv_cell *last)
+{
+    for (size_t i = 0; i < cells; i++)
+        for (int ch = 0; ch < 3; ch++) {
+            float *a = channel(&last[i], ch);
+            const float *b = cchannel(&before[i], ch);
+            if (!(r[ch] > 0.0f) || !(a[0] - b[0] > 0.0f)) /* no light from the last bounce here: no tail */
+                continue;
+            const float f = r[ch] / (1.0f - r[ch]);
+            for (int k = 0; k < 4; k++)
+                a[k] += (a[k] - b[k]) * f;
+        }
+}
+
 int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, char *err, size_t err_size)
 {
     if (check(d, 1, err, err_size) != 0)
@@ -631,10 +670,18 @@ int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, c
         goto done;
     }
     memset(incoming, 0, cells * sizeof *incoming); /* I_0 */
+    double totals[LPV_IV_TAIL_SLOTS][3] = {{0.0}};
     for (int k = 1; k <= d->bounces; k++) {
         memcpy(prev, incoming, cells * sizeof *prev);
         lpv_iv_emit(g, vox, prev, k, d->neighbours, emit);
         lpv_iv_gather(g, vox, emit, d->seed, d->rays, incoming);
+        if (k < LPV_IV_TAIL_SLOTS)
+            lpv_iv_total(cells, incoming, totals[k]);
+    }
+    if (d->tail && d->bounces < LPV_IV_TAIL_SLOTS) {
+        float r[3];
+        lpv_iv_tail_ratio((const double(*)[3])totals, d->bounces, r);
+        lpv_iv_add_tail(cells, prev, r, incoming);
     }
     rc = 0;
 done:

@@ -301,6 +301,8 @@ void lpv_settings_resolve(lpv_settings *s)
         iv->bounces = LPV_IV_DEFAULT_BOUNCES;
     if (iv->reprojection == LPV_SWITCH_DEFAULT)
         iv->reprojection = LPV_SWITCH_ON;
+    if (iv->tail == LPV_SWITCH_DEFAULT)
+        iv->tail = LPV_SWITCH_ON;
     if (iv->neighbours == 0)
         iv->neighbours = LPV_IV_DEFAULT_NEIGHBOURS;
     if (iv->ao == LPV_SWITCH_DEFAULT)
@@ -428,7 +430,7 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
                     {"central_transport", s->lpv.central_transport}, {"normal_bins", s->lpv.normal_bins},
                     {"far_field", s->lpv.far_field}, {"scene_surfels", s->scene_surfels},
                     {"area_lights", s->area_lights}, {"reach", s->reach}, {"iv_reprojection", s->iv.reprojection},
-                    {"iv_ao", s->iv.ao}};
+                    {"iv_tail", s->iv.tail}, {"iv_ao", s->iv.ao}};
     for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
         if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
             return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",

@@ -123,6 +123,7 @@ struct lpv_engine {
     uint64_t scene_surfel_grid_sig; /* the cascades the buffer's groups are for; 0 = none yet */
     GLuint iv_points;         /* the imperfect volume's point cloud (technique iv only), 0 = none */
     size_t iv_point_count;
+    float iv_points_voxel;    /* m: the voxel size the cloud was made for (its pieces are split by it) */
     /* the scene's flat surfaces' normals for the lookup (core/scene_planes.h) */
     float lookup_planes[LPV_MAX_LOOKUP_PLANES][3];
     int lookup_plane_count;
@@ -226,6 +227,10 @@ void lpv_engine_update_area_samples(lpv_engine *e);
 /* The emissive VPLs and scene surfels under the current settings, from
  * e->geometry (engine_scene.c). */
 int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size);
+/* 1 when the imperfect volume's point cloud was made for another voxel size
+ * than the current settings place (iv_resolution, the bounds, the free path):
+ * it must be made again, its pieces being split by the voxel. */
+int lpv_engine_iv_points_stale(const lpv_engine *e);
 
 /* The frame program of a variant (LPV_FRAME_* bits), built on first use and
  * kept until the technique changes; 0 with err set if it does not build. */

@@ -160,11 +160,21 @@ static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
     if (n)
         glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *pts), pts);
     e->iv_point_count = n;
+    e->iv_points_voxel = g.cell_size;
     free(pts);
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "%s: GL error while storing %zu imperfect-volume points", e->geometry.source,
                          n);
     return 0;
+}
+
+int lpv_engine_iv_points_stale(const lpv_engine *e)
+{
+    lpv_grid g;
+    if (e->tech_id != LPV_TECHNIQUE_ID_IV || !e->iv_points)
+        return 0;
+    return lpv_iv_place(&e->settings, e->scene_min, e->scene_max, e->reach.free_path, &g) == 0 &&
+           g.cell_size != e->iv_points_voxel;
 }
 
 /* The scene's samples under the current settings, from the engine's copy of

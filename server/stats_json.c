@@ -62,6 +62,13 @@ static json_t *iv_json(const lpv_engine_stats *st)
                           "points_per_piece", st->iv.points_per_piece, "voxels", (json_int_t)st->iv.voxels, "bounces",
                           st->iv.bounces, "bounces_requested", st->iv.bounces_requested, "rays", st->iv.rays,
                           "reprojected", st->iv.reprojected != 0, "ao", st->iv.ao != 0);
+    if (o && (json_object_set_new(o, "tail", json_boolean(st->iv.tail != 0)) != 0 ||
+              json_object_set_new(o, "tail_ratio",
+                                  json_pack("[f, f, f]", (double)st->iv.tail_ratio[0], (double)st->iv.tail_ratio[1],
+                                            (double)st->iv.tail_ratio[2])) != 0)) {
+        json_decref(o);
+        return NULL;
+    }
     if (o && st->iv.occupied >= 0 && json_object_set_new(o, "occupied", json_integer(st->iv.occupied)) != 0) {
         json_decref(o);
         return NULL;

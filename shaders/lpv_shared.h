@@ -323,7 +323,7 @@ struct IvVoxel {
 #define LPV_TIE_CELLS 0.00390625f
 #define LPV_VPL_SHIFT_CELLS (0.5f + LPV_TIE_CELLS)
 
-#define LPV_IV_WG 64
+#define LPV_IV_WG 64 /* one-dimensional workgroups of the IV's compute passes */
 /* Reprojection takes at most about this many of the G-buffer's pixels, a
  * regular subset (every k-th pixel in x and y): a voxel seen by the camera
  * still gets many, and a 512x512 view costs a quarter (paper 3.2: "the
@@ -338,13 +338,22 @@ struct IvVoxel {
 #define LPV_IV_BEHIND 0.001f
 /* The reconstruction's weight of a voxel that holds a surface, relative to an
  * empty one (iv_volume.glsl, iv_blend; docs/imperfect-volumes.md). */
+#define LPV_IV_HELD_WEIGHT 0.015625f
 /* Luminance weights (Rec. 709, summing to 1) of the lookup's rule for a
  * reconstructed irradiance with a channel below 0 (iv_lookup.glsl,
  * iv_physical; core/oracle_iv.c). */
 #define LPV_IV_LUMA_R 0.2126f
 #define LPV_IV_LUMA_G 0.7152f
 #define LPV_IV_LUMA_B 0.0722f
-#define LPV_IV_HELD_WEIGHT 0.015625f /* one-dimensional workgroups of the IV's compute passes */
+/* The bounces after the gathered ones as a geometric series (iv_tail.comp,
+ * core/oracle_iv.c lpv_iv_tail): the ratio is at most this (a factor
+ * r / (1 - r) of 9 on the last bounce); the totals S_k sit in slots 1..K of
+ * a float buffer, the ratios used in LPV_IV_TAIL_RATIO_SLOT, three floats
+ * (r, g, b) a slot. */
+#define LPV_IV_TAIL_MAX_RATIO 0.9f
+#define LPV_IV_TAIL_SLOTS 16
+#define LPV_IV_TAIL_RATIO_SLOT 15
+#define LPV_IV_TAIL_WG 256
 
 /* Random numbers both sides draw identically: a 32-bit integer hash (Chris
  * Wellons' lowbias32) and a uniform float in [0, 1) from its top 24 bits. */
@@ -420,6 +429,8 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_IV_OCCUPANCY 12 /* one bit per voxel, 32 to a uint, voxel index order */
 #define LPV_SSBO_IV_EMIT 13     /* LpvCell per voxel: what each occupied voxel sends out this bounce */
 #define LPV_SSBO_IV_AO 14       /* vec4 per voxel: the SH of the visible directions (travel convention) */
+#define LPV_SSBO_IV_TAIL 3       /* float[3 x LPV_IV_TAIL_SLOTS]: iv_tail.comp's totals and ratio (shares 3 with
+                                    LPV_SSBO_TRANSMIT, which no iv pass binds) */
 #define LPV_SSBO_SHADE_REST 15  /* the frame's pixels left for shade_rest.comp (shading.glsl, LPV_LOOKUP_SPLIT) */
 #define LPV_SSBO_COMPACT_HEAD 0 /* compact.comp: the draw command, then a count per chunk */
 #define LPV_SSBO_COMPACT_DST 4  /* compact.comp: the live samples, in order */

@@ -20,14 +20,15 @@ typedef struct lpv_iv_gpu {
     lpv_settings settings;
     lpv_grid grid;    /* of the last commit */
     lpv_grid pending; /* of the last place */
-    GLuint prog_splat, prog_resolve, prog_emit, prog_gather;
-    GLuint empty_vao, grid_ubo;
+    GLuint prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail;
+    GLuint empty_vao, grid_ubo, tail; /* tail: iv_tail.comp's totals and ratio */
     lpv_atlas atlas;
     GLuint voxels, occupancy, emit, radiance[2], ao;
     int result;       /* radiance[result] holds the last gather: what the lookup reads */
     size_t cells;     /* allocated for */
     int alloc_dims[3];
     int bounces_run;  /* by the last computed tick */
+    int tail_run;     /* the last computed tick added the tail (iv_tail.comp) */
 } lpv_iv_gpu;
 
 /* Zeroes a buffer (floats or bits alike). */
@@ -38,8 +39,11 @@ void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in);
 /* One march over the volume: radiance from the emission (ao 0) into out, or
  * visibility into the AO volume (ao 1). */
 void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int ao, lpv_timer *timer);
-/* iv_gather: bounces 1..K, each an emission pass and a march; the result in
+/* iv_gather: bounces 1..K, each an emission pass and a march, then with
+ * iv_tail on the bounces after K as a geometric series; the result in
  * v->radiance[v->result]. */
 void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in);
+/* The ratios (r, g, b) the last tail used (0: none), read back from the GPU. */
+void lpv_iv_gpu_tail_ratio(const lpv_iv_gpu *v, float rgb[3]);
 
 #endif /* LPV_IV_INTERNAL_H */

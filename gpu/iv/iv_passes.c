@@ -6,6 +6,8 @@
 
 #include "iv_internal.h"
 
+_Static_assert(LPV_IV_MAX_BOUNCES < LPV_IV_TAIL_RATIO_SLOT, "a total per bounce below the ratio's slot");
+
 static GLuint groups(const lpv_iv_gpu *v) { return lpv_div_up(v->cells, LPV_IV_WG); }
 
 void lpv_iv_clear_buffer(GLuint b)
@@ -95,12 +97,33 @@ void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int a
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-/* Bounces 1..K: emission from the previous gather, then a march. */
+/* iv_tail.comp: mode 0 sums `last` into slot k (one workgroup), mode 1
+ * adds the tail to `last` from `before` (bounce K - 1). */
+static void tail_pass(lpv_iv_gpu *v, int mode, int k, GLuint last, GLuint before, lpv_timer *timer)
+{
+    glUseProgram(v->prog_tail);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, last);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, mode ? before : last);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_TAIL, v->tail);
+    glUniform1i(glGetUniformLocation(v->prog_tail, "u_mode"), mode);
+    glUniform1i(glGetUniformLocation(v->prog_tail, "u_bounce"), k);
+    glDispatchCompute(mode ? lpv_div_up(v->cells, LPV_IV_TAIL_WG) : 1, 1, 1);
+    lpv_timer_count(timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+/* Bounces 1..K: emission from the previous gather, then a march; then the
+ * tail (iv_tail on, K >= 2): the totals of the last three gathers and the
+ * series they set. */
 void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
 {
     const lpv_settings *s = in->settings;
     lpv_timer_begin(in->timer, "iv_gather");
     int prev = 0, cur = 0;
+    const int tail = s->iv.tail == LPV_SWITCH_ON && s->iv.bounces >= 2;
+    if (tail)
+        lpv_iv_clear_buffer(v->tail); /* S_0 = 0 */
     for (int k = 1; k <= s->iv.bounces; ++k) {
         cur = k == 1 ? 0 : 1 - prev;
         glUseProgram(v->prog_emit);
@@ -116,10 +139,25 @@ void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
         lpv_timer_count(in->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         lpv_iv_march_volume(v, s, v->radiance[cur], 0, in->timer);
+        if (tail && k >= s->iv.bounces - 2)
+            tail_pass(v, 0, k, v->radiance[cur], 0, in->timer);
         prev = cur;
     }
+    if (tail)
+        tail_pass(v, 1, s->iv.bounces, v->radiance[cur], v->radiance[1 - cur], in->timer);
     v->result = cur;
     v->bounces_run = s->iv.bounces;
+    v->tail_run = tail;
     lpv_timer_end(in->timer);
+}
+
+void lpv_iv_gpu_tail_ratio(const lpv_iv_gpu *v, float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!v->tail_run)
+        return;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, v->tail);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 3 * LPV_IV_TAIL_RATIO_SLOT * sizeof(float), 3 * sizeof(float), rgb);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
 }
 

@@ -16,7 +16,8 @@
  *                 plus its albedo times the previous gather's irradiance),
  *                 then every voxel a lookup reads marches its rays and
  *                 stores the arriving radiance as SH (3.3), ping-ponging
- *                 two volumes
+ *                 two volumes; then the bounces after the last as the
+ *                 geometric series the last ones set (iv_tail.comp)
  *   iv_ao         the same march for visibility within a reach (3.5)
  *
  * The lookup (iv_volume.glsl, iv_lookup.glsl) reconstructs irradiance at a
@@ -55,11 +56,12 @@ static void destroy(lpv_technique *t)
     if (!v)
         return;
     free_storage(v);
-    GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather};
+    GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (progs[i])
             glDeleteProgram(progs[i]);
     lpv_gl_delete_buffer(&v->grid_ubo);
+    lpv_gl_delete_buffer(&v->tail);
     if (v->empty_vao)
         glDeleteVertexArrays(1, &v->empty_vao);
     free(v);
@@ -77,7 +79,8 @@ static lpv_technique *create(char *err, size_t err_size)
     v->prog_resolve = v->prog_splat ? lpv_program_build("iv_resolve.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
     v->prog_emit = v->prog_resolve ? lpv_program_build("iv_emit.comp", NULL, NULL, LOOKUP, err, err_size) : 0;
     v->prog_gather = v->prog_emit ? lpv_program_build("iv_gather.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
-    if (!v->prog_gather) {
+    v->prog_tail = v->prog_gather ? lpv_program_build("iv_tail.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
+    if (!v->prog_tail) {
         destroy(&v->base);
         return NULL;
     }
@@ -86,6 +89,7 @@ static lpv_technique *create(char *err, size_t err_size)
     glBindBuffer(GL_UNIFORM_BUFFER, v->grid_ubo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
+    v->tail = lpv_gl_new_ssbo(3 * LPV_IV_TAIL_SLOTS * sizeof(float));
     lpv_settings_resolve(&v->settings);
     return &v->base;
 }
@@ -186,6 +190,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
     } else {
         v->result = 0;
         v->bounces_run = 0;
+        v->tail_run = 0;
         lpv_iv_clear_buffer(v->radiance[0]);
     }
     if (p->pass[LPV_PASS_IV_AO].run) {
@@ -270,6 +275,10 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     s->iterations = last->pass[LPV_PASS_IV_GATHER].run ? v->bounces_run : 0;
     s->cell_steps = 0.0;
     s->occlusion = 1; /* the march stops at occupied voxels */
+    s->iv.tail = last->pass[LPV_PASS_IV_GATHER].run && v->tail_run;
+    memset(s->iv.tail_ratio, 0, sizeof s->iv.tail_ratio);
+    if (s->iv.tail)
+        lpv_iv_gpu_tail_ratio(v, s->iv.tail_ratio);
 }
 
 const lpv_technique_class lpv_technique_iv = {
