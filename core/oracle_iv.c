@@ -621,30 +621,31 @@ void lpv_iv_total(size_t cells, const lpv_cell *incoming, double total[3])
     }
 }
 
-void lpv_iv_tail_ratio(const double (*totals)[3], int K, float r[3])
+void lpv_iv_tail_share(const double (*totals)[3], int K, float q[3])
 {
+    const double most = (double)LPV_IV_TAIL_MAX_RATIO * (double)LPV_IV_TAIL_MAX_RATIO;
     for (int ch = 0; ch < 3; ch++) {
-        r[ch] = 0.0f;
-        if (K < 2)
+        q[ch] = 0.0f;
+        if (K < 3)
             continue;
-        const double d0 = totals[K - 1][ch] - (K >= 3 ? totals[K - 2][ch] : 0.0);
+        const double d0 = totals[K - 2][ch] - (K >= 4 ? totals[K - 3][ch] : 0.0);
         const double d1 = totals[K][ch] - totals[K - 1][ch];
         if (!(d0 > 0.0) || !(d1 > 0.0))
             continue;
-        const double q = d1 / d0;
-        r[ch] = q < LPV_IV_TAIL_MAX_RATIO ? (float)q : LPV_IV_TAIL_MAX_RATIO;
+        const double v = d1 / d0;
+        q[ch] = (float)(v < most ? v : most);
     }
 }
 
-void lpv_iv_add_tail(size_t cells, const lpv_cell *before, const float r[3], lpv_cell *last)
+void lpv_iv_add_tail(size_t cells, const lpv_cell *base, const float q[3], lpv_cell *last)
 {
     for (size_t i = 0; i < cells; i++)
         for (int ch = 0; ch < 3; ch++) {
             float *a = channel(&last[i], ch);
-            const float *b = cchannel(&before[i], ch);
-            if (!(r[ch] > 0.0f) || !(a[0] - b[0] > 0.0f)) /* no light from the last bounce here: no tail */
+            const float *b = cchannel(&base[i], ch);
+            if (!(q[ch] > 0.0f) || !(a[0] - b[0] > 0.0f)) /* no light from the last two bounces here: no tail */
                 continue;
-            const float f = r[ch] / (1.0f - r[ch]);
+            const float f = q[ch] / (1.0f - q[ch]);
             for (int k = 0; k < 4; k++)
                 a[k] += (a[k] - b[k]) * f;
         }
@@ -659,8 +660,9 @@ int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, c
     lpv_iv_voxel *own = voxels ? NULL : malloc(cells * sizeof *own);
     lpv_cell *emit = malloc(cells * sizeof *emit);
     lpv_cell *prev = malloc(cells * sizeof *prev);
+    lpv_cell *base = d->tail ? malloc(cells * sizeof *base) : NULL; /* I_{K-2} */
     int rc = -1;
-    if ((!voxels && !own) || !emit || !prev) {
+    if ((!voxels && !own) || !emit || !prev || (d->tail && !base)) {
         lpv_error(err, err_size, "iv: out of memory for %zu voxels", cells);
         goto done;
     }
@@ -672,22 +674,25 @@ int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, c
     memset(incoming, 0, cells * sizeof *incoming); /* I_0 */
     double totals[LPV_IV_TAIL_SLOTS][3] = {{0.0}};
     for (int k = 1; k <= d->bounces; k++) {
+        if (base && k == d->bounces && k >= 3)
+            memcpy(base, prev, cells * sizeof *base); /* prev still holds I_{k-2} */
         memcpy(prev, incoming, cells * sizeof *prev);
         lpv_iv_emit(g, vox, prev, k, d->neighbours, emit);
         lpv_iv_gather(g, vox, emit, d->seed, d->rays, incoming);
         if (k < LPV_IV_TAIL_SLOTS)
             lpv_iv_total(cells, incoming, totals[k]);
     }
-    if (d->tail && d->bounces < LPV_IV_TAIL_SLOTS) {
-        float r[3];
-        lpv_iv_tail_ratio((const double(*)[3])totals, d->bounces, r);
-        lpv_iv_add_tail(cells, prev, r, incoming);
+    if (base && d->bounces >= 3 && d->bounces < LPV_IV_TAIL_SLOTS) {
+        float q[3];
+        lpv_iv_tail_share((const double(*)[3])totals, d->bounces, q);
+        lpv_iv_add_tail(cells, base, q, incoming);
     }
     rc = 0;
 done:
     free(own);
     free(emit);
     free(prev);
+    free(base);
     return rc;
 }
 

@@ -159,17 +159,18 @@ void lpv_iv_gather_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, uint32_t se
 float lpv_iv_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, const vec4 *ao, const float p[3], const float n[3],
                 int neighbours);
 
-/* The bounces after the K gathered ones as the geometric series they set
- * (iv_tail.comp), per channel: lpv_iv_total is S_k, every voxel's DC term
- * of I_k summed in double (total[ch]); lpv_iv_tail_ratio with totals[0] =
- * S_0 = 0 .. totals[K] gives r = (S_K - S_{K-1}) / (S_{K-1} - S_{K-2}),
- * clamped to [0, LPV_IV_TAIL_MAX_RATIO], 0 when K < 2 or either difference
- * is not above 0; lpv_iv_add_tail makes last (I_K) into
- * I_K + (I_K - before) r / (1 - r), before = I_{K-1}, for each voxel's
- * channel whose DC term the last bounce raised (the others keep I_K). */
+/* The bounces after the K gathered ones as the series they set, two
+ * bounces at a time (iv_tail.comp says why), per channel: lpv_iv_total is
+ * S_k, every voxel's DC term of I_k summed in double (total[ch]);
+ * lpv_iv_tail_share with totals[0] = S_0 = 0 .. totals[K] gives
+ * q = D_K / D_{K-2} (D_k = S_k - S_{k-1}), clamped to
+ * [0, LPV_IV_TAIL_MAX_RATIO^2], 0 when K < 3 or either difference is not
+ * above 0; lpv_iv_add_tail makes last (I_K) into
+ * I_K + (I_K - base) q / (1 - q), base = I_{K-2}, for each voxel's channel
+ * whose DC term the last two bounces raised (the others keep I_K). */
 void lpv_iv_total(size_t cells, const lpv_cell *incoming, double total[3]);
-void lpv_iv_tail_ratio(const double (*totals)[3], int K, float r[3]);
-void lpv_iv_add_tail(size_t cells, const lpv_cell *before, const float r[3], lpv_cell *last);
+void lpv_iv_tail_share(const double (*totals)[3], int K, float q[3]);
+void lpv_iv_add_tail(size_t cells, const lpv_cell *base, const float q[3], lpv_cell *last);
 
 /* The whole volume. */
 typedef struct lpv_iv_desc {
@@ -181,7 +182,7 @@ typedef struct lpv_iv_desc {
     int rays;                     /* per voxel, >= 1 */
     int bounces;                  /* K >= 1 */
     int neighbours;               /* 1..8 */
-    int tail;                     /* 1: the bounces after K as a geometric series (lpv_iv_add_tail) */
+    int tail;                     /* 1: the bounces after K (>= 3) as a series (lpv_iv_add_tail) */
 } lpv_iv_desc;
 
 /* create, then for k = 1..K emit_k and gather_k: incoming gets I_K (which

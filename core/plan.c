@@ -310,8 +310,8 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *
         decide(p, LPV_PASS_IV_GATHER, 1, "%s: %d bounces requested, %d rays per voxel%s", LPV_TECHNIQUE_IV,
                s->iv.bounces, s->iv.rays,
                s->iv.tail != LPV_SWITCH_ON ? ", no tail (iv_tail off)"
-               : s->iv.bounces < 2         ? ", no tail (one bounce sets no ratio)"
-                                           : ", the bounces after them as the geometric series they set");
+               : s->iv.bounces < 3         ? ", no tail (fewer than 3 bounces set no ratio)"
+                                           : ", the bounces after them as the series they set");
     if (s->iv.ao != LPV_SWITCH_ON)
         decide(p, LPV_PASS_IV_AO, 0, "ambient occlusion off");
     else if (!filled)

@@ -113,7 +113,7 @@ typedef struct lpv_iv_settings {
     int seed;               /* the points' and the rays' random seed; default 1 */
     int rays;               /* stratified rays per voxel; default LPV_IV_DEFAULT_RAYS */
     int bounces;            /* diffuse bounces (ping-pong passes); default LPV_IV_DEFAULT_BOUNCES */
-    lpv_switch tail;        /* the bounces after these as the geometric series the last ones set
+    lpv_switch tail;        /* the bounces after these (3 or more) as the series the last ones set
                                (iv_tail.comp); default on */
     lpv_switch reprojection; /* the camera's visible points refine the volume; default on */
     int neighbours;         /* the reconstruction blends the nearest this many of the 8 voxels around

@@ -126,7 +126,7 @@ static const lpv_field FIELDS[] = {
     {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", "3", "",
      "diffuse bounces (ping-pong passes over two volumes)", T_VOL, LPV_TECHNIQUE_IV},
     {"iv_tail", "iv-tail", LPV_FIELD_SWITCH, F(iv.tail), 0, 1, 0, "", "on", "",
-     "the bounces after iv_bounces as the geometric series the last ones set", T_VOL, LPV_TECHNIQUE_IV},
+     "the bounces after iv_bounces (3 or more) as the series the last ones set", T_VOL, LPV_TECHNIQUE_IV},
     {"iv_reprojection", "iv-reprojection", LPV_FIELD_SWITCH, F(iv.reprojection), 0, 1, 0, "", "on", "",
      "the camera's visible points refine the volume", T_VOL, LPV_TECHNIQUE_IV},
     {"iv_neighbours", "iv-neighbours", LPV_FIELD_INT, F(iv.neighbours), 1, 8, 0, "", "8", "the paper's text: 6",

@@ -103,8 +103,9 @@ typedef struct lpv_engine_stats {
                                   its stats; the daemon counts them from the index it sends, SPEC R5.14) */
         int bounces;           /* gathered (0 when iv_gather did not run) */
         int bounces_requested; /* settings iv.bounces */
-        int tail;              /* the bounces after these were added as a geometric series (iv_tail) */
-        float tail_ratio[3];   /* its ratio r per channel (the last bounce's light x r / (1 - r) added); 0 without */
+        int tail;              /* the bounces after these were added as a series (iv_tail) */
+        float tail_ratio[3];   /* its per-bounce ratio per channel (the square root of the share q two
+                                  bounces keep; iv_tail.comp); 0 without */
         int rays;              /* marched per voxel and bounce */
         int reprojected;       /* iv_reproject ran (the camera's pixels refined the volume) */
         int ao;                /* iv_ao ran (the ao frame term has a volume) */

@@ -1,23 +1,27 @@
 // iv_tail.comp - the bounces after the K the volume gathers, as the
-// geometric series they tend to (iv_tail, docs/imperfect-volumes.md). Every
-// bounce multiplies the light left by about the same ratio once its shape
-// has settled (the dominant eigenvalue of the scene's transfer), so with I_k
-// the radiance gathered after bounce k and S_k its total per channel (every
-// voxel's DC term; per channel, since a red wall keeps red light longer),
-//   r = (S_K - S_{K-1}) / (S_{K-1} - S_{K-2})    (S_0 = 0)
-//   I = I_K + (I_K - I_{K-1}) r / (1 - r)
-// the last bounce's light times r + r^2 + ... . One ratio per channel for
-// the whole volume: a voxel's own ratio is the noise of its rays. r is clamped to
-// [0, LPV_IV_TAIL_MAX_RATIO]; with K < 2 there is no ratio and no tail. A
-// voxel's channel whose last bounce brought it no light gets none.
-// u_mode 0: one workgroup sums I_K (binding LPV_SSBO_LPV_OUT) into slot
+// series they tend to (iv_tail, docs/imperfect-volumes.md). Once the light's
+// shape has settled every bounce brings about the same share of the one
+// before (the dominant eigenvalue of the scene's transfer), but a room lit
+// from above alternates first: the ceiling's light, then the floor's, with
+// other albedos (the path tracer's panel room: 0.84 then 0.46 of the bounce
+// before). So the series steps two bounces at a time: with I_k the radiance
+// gathered after bounce k, S_k its total per channel (every voxel's DC
+// term; per channel, since a red wall keeps red light longer) and
+// D_k = S_k - S_{k-1},
+//   q = D_K / D_{K-2}    (S_0 = 0; the share two bounces keep)
+//   I = I_K + (I_K - I_{K-2}) q / (1 - q)
+// the last two bounces' light times q + q^2 + ... . One q per channel for the
+// whole volume: a voxel's own would be the noise of its rays. q is clamped
+// to [0, LPV_IV_TAIL_MAX_RATIO^2]; with K < 3 there is none and no tail. A
+// voxel's channel whose last two bounces brought it no light gets none.
+// u_mode 0: one workgroup sums I_k (binding LPV_SSBO_LPV_OUT) into slot
 // u_bounce (three floats a slot: r, g, b); u_mode 1: every voxel adds its
-// tail (I_{K-1} at LPV_SSBO_LPV_ACC) and invocation 0 records the ratios in
-// LPV_IV_TAIL_RATIO_SLOT for the stats.
+// tail (I_{K-2} at LPV_SSBO_LPV_ACC) and invocation 0 records sqrt(q), the
+// per-bounce ratio, in LPV_IV_TAIL_RATIO_SLOT for the stats.
 layout(local_size_x = LPV_IV_TAIL_WG) in;
 
 layout(std430, binding = LPV_SSBO_LPV_OUT) buffer Last { LpvCell last[]; };
-layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer Before { LpvCell before[]; };
+layout(std430, binding = LPV_SSBO_LPV_ACC) readonly buffer Before { LpvCell before[]; }; // I_{K-2}
 layout(std430, binding = LPV_SSBO_IV_TAIL) buffer Sums { float sums[]; };
 
 uniform int u_mode;
@@ -27,18 +31,19 @@ shared vec3 part[LPV_IV_TAIL_WG];
 
 vec3 sum_at(int k) { return k <= 0 ? vec3(0.0) : vec3(sums[3 * k], sums[3 * k + 1], sums[3 * k + 2]); }
 
-float ratio_of(float s2, float s1, float s0)
+float share_of(float s3, float s2, float s1, float s0)
 {
-    float d0 = s1 - s2, d1 = s0 - s1;
-    return d0 > 0.0 && d1 > 0.0 ? min(d1 / d0, LPV_IV_TAIL_MAX_RATIO) : 0.0;
+    float d0 = s2 - s3, d1 = s0 - s1;
+    return d0 > 0.0 && d1 > 0.0 ? min(d1 / d0, LPV_IV_TAIL_MAX_RATIO * LPV_IV_TAIL_MAX_RATIO) : 0.0;
 }
 
-vec3 tail_ratio(int k)
+// q per channel after bounce k (0 before the third)
+vec3 tail_share(int k)
 {
-    if (k < 2)
+    if (k < 3)
         return vec3(0.0);
-    vec3 s2 = sum_at(k - 2), s1 = sum_at(k - 1), s0 = sum_at(k);
-    return vec3(ratio_of(s2.x, s1.x, s0.x), ratio_of(s2.y, s1.y, s0.y), ratio_of(s2.z, s1.z, s0.z));
+    vec3 s3 = sum_at(k - 3), s2 = sum_at(k - 2), s1 = sum_at(k - 1), s0 = sum_at(k);
+    return vec3(share_of(s3.x, s2.x, s1.x, s0.x), share_of(s3.y, s2.y, s1.y, s0.y), share_of(s3.z, s2.z, s1.z, s0.z));
 }
 
 void main()
@@ -64,19 +69,19 @@ void main()
         return;
     }
     int i = int(gl_GlobalInvocationID.x);
-    vec3 r = tail_ratio(u_bounce);
+    vec3 q = tail_share(u_bounce);
     if (i == 0) {
-        sums[3 * LPV_IV_TAIL_RATIO_SLOT] = r.x;
-        sums[3 * LPV_IV_TAIL_RATIO_SLOT + 1] = r.y;
-        sums[3 * LPV_IV_TAIL_RATIO_SLOT + 2] = r.z;
+        sums[3 * LPV_IV_TAIL_RATIO_SLOT] = sqrt(q.x);
+        sums[3 * LPV_IV_TAIL_RATIO_SLOT + 1] = sqrt(q.y);
+        sums[3 * LPV_IV_TAIL_RATIO_SLOT + 2] = sqrt(q.z);
     }
     if (i >= n)
         return;
-    vec3 f = r / (1.0 - r);
+    vec3 f = q / (1.0 - q);
     LpvCell a = last[i], b = before[i];
     vec4 dr = a.r - b.r, dg = a.g - b.g, db = a.b - b.b;
-    // a channel whose last bounce took light away here (the lookup's
+    // a channel whose last two bounces took light away here (the lookup's
     // non-linear rule can) gets no tail: it would run below zero
-    last[i] = LpvCell(dr.x > 0.0 ? a.r + dr * f.x : a.r, dg.x > 0.0 ? a.g + dg * f.y : a.g,
-                      db.x > 0.0 ? a.b + db * f.z : a.b);
+    last[i] = LpvCell(dr.x > 0.0 && f.x > 0.0 ? a.r + dr * f.x : a.r, dg.x > 0.0 && f.y > 0.0 ? a.g + dg * f.y : a.g,
+                      db.x > 0.0 && f.z > 0.0 ? a.b + db * f.z : a.b);
 }

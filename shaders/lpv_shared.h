@@ -345,11 +345,12 @@ struct IvVoxel {
 #define LPV_IV_LUMA_R 0.2126f
 #define LPV_IV_LUMA_G 0.7152f
 #define LPV_IV_LUMA_B 0.0722f
-/* The bounces after the gathered ones as a geometric series (iv_tail.comp,
- * core/oracle_iv.c lpv_iv_tail): the ratio is at most this (a factor
- * r / (1 - r) of 9 on the last bounce); the totals S_k sit in slots 1..K of
- * a float buffer, the ratios used in LPV_IV_TAIL_RATIO_SLOT, three floats
- * (r, g, b) a slot. */
+/* The bounces after the gathered ones as a series (iv_tail.comp,
+ * core/oracle_iv.c lpv_iv_add_tail): the per-bounce ratio is at most this
+ * (the share two bounces keep at most its square, a factor q / (1 - q) of
+ * 4.3 on the last two bounces); the totals S_k sit in slots 1..K of a float
+ * buffer, the per-bounce ratios used in LPV_IV_TAIL_RATIO_SLOT, three
+ * floats (r, g, b) a slot. */
 #define LPV_IV_TAIL_MAX_RATIO 0.9f
 #define LPV_IV_TAIL_SLOTS 16
 #define LPV_IV_TAIL_RATIO_SLOT 15

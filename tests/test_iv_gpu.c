@@ -264,24 +264,26 @@ static void test_thick_walls_match_oracle(void **state)
                      sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) < 0.2f;
     }
     lpv_cell *gpu = read_radiance(), *cpu = calloc(cells, sizeof *cpu), *emit = calloc(cells, sizeof *emit);
-    lpv_cell *before = calloc(cells, sizeof *before);
+    lpv_cell *base = calloc(cells, sizeof *base), *before = calloc(cells, sizeof *before); /* I_{k-2}, I_{k-1} */
     double totals[LPV_IV_TAIL_SLOTS][3] = {{0.0}};
     for (int k = 1; k <= bounces; ++k) {
-        memcpy(before, cpu, cells * sizeof *cpu);
+        memcpy(base, before, cells * sizeof *base);
+        memcpy(before, cpu, cells * sizeof *before);
         lpv_iv_emit(g, vox, cpu, k, r->iv.neighbours, emit);
         lpv_iv_gather(g, vox, emit, (uint32_t)r->iv.seed, rays, cpu);
         lpv_iv_total(cells, cpu, totals[k]);
     }
-    float ratio[3];
-    lpv_iv_tail_ratio((const double(*)[3])totals, bounces, ratio);
-    lpv_iv_add_tail(cells, before, ratio, cpu);
-    print_message("thick walls: tail ratio (red) GPU %.6f, oracle %.6f (red per bounce %.4g %.4g %.4g)\n",
-                  (double)st->iv.tail_ratio[0], (double)ratio[0], totals[1][0], totals[2][0] - totals[1][0],
+    float q[3];
+    lpv_iv_tail_share((const double(*)[3])totals, bounces, q);
+    lpv_iv_add_tail(cells, base, q, cpu);
+    print_message("thick walls: per-bounce tail ratio (red) GPU %.6f, oracle %.6f (red per bounce %.4g %.4g %.4g)\n",
+                  (double)st->iv.tail_ratio[0], sqrt((double)q[0]), totals[1][0], totals[2][0] - totals[1][0],
                   totals[3][0] - totals[2][0]);
     assert_true(st->iv.tail);
     for (int ch = 0; ch < 3; ++ch) {
-        assert_true(ratio[ch] > 0.3f && ratio[ch] < LPV_IV_TAIL_MAX_RATIO);
-        assert_true(fabsf(st->iv.tail_ratio[ch] - ratio[ch]) <= 1e-4f * ratio[ch]);
+        const float per_bounce = sqrtf(q[ch]);
+        assert_true(per_bounce > 0.3f && per_bounce < LPV_IV_TAIL_MAX_RATIO);
+        assert_true(fabsf(st->iv.tail_ratio[ch] - per_bounce) <= 1e-4f * per_bounce);
     }
     print_message("thick walls: %zu two-sided voxels\n", two_sided);
     assert_true(two_sided > 20);
@@ -290,6 +292,7 @@ static void test_thick_walls_match_oracle(void **state)
     free(gpu);
     free(cpu);
     free(emit);
+    free(base);
     free(before);
     lpv_scene_free(&scene);
 }
@@ -488,14 +491,16 @@ static void test_hard_cases(void **state)
                 assert_true(isfinite(rgba[j]) && rgba[j] >= 0.0f);
             free(rgba);
         }
-        { /* and the tail after the three (iv_tail): finite, adding light, at most what its capped ratio allows */
+        { /* and the tail after the three (iv_tail): finite, adding light, at most what its capped share allows
+             * of the last two bounces */
             lpv_settings s = iv_settings(16, 16, 3);
             memcpy(s.bounds_min, h.settings.bounds_min, sizeof s.bounds_min);
             memcpy(s.bounds_max, h.settings.bounds_max, sizeof s.bounds_max);
             s.iv.reprojection = LPV_SWITCH_ON;
             s.iv.tail = LPV_SWITCH_ON;
             tick(&h.scene, &s, &v);
-            const double et = total_dc(), cap = LPV_IV_TAIL_MAX_RATIO / (1.0 - LPV_IV_TAIL_MAX_RATIO);
+            const double most = (double)LPV_IV_TAIL_MAX_RATIO * LPV_IV_TAIL_MAX_RATIO, cap = most / (1.0 - most);
+            const double et = total_dc();
             const float *r = lpv_engine_last_stats(lpvt_engine)->iv.tail_ratio;
             print_message("%-28s tail ratio %.4f %.4f %.4f adds %.4g\n", info->name, (double)r[0], (double)r[1],
                           (double)r[2], et - e[3]);
@@ -503,7 +508,7 @@ static void test_hard_cases(void **state)
                 assert_true(r[ch] >= 0.0f && r[ch] <= LPV_IV_TAIL_MAX_RATIO);
             assert_true(isfinite(et));
             assert_true(et >= e[3] * (1.0 - 1e-6) - 1e-30);
-            assert_true(et - e[3] <= cap * (e[3] - e[2]) * (1.0 + 1e-3) + 1e-6 * e[3] + 1e-30);
+            assert_true(et - e[3] <= cap * (e[3] - e[1]) * (1.0 + 1e-3) + 1e-6 * e[3] + 1e-30);
             float *rgba = calloc((size_t)32 * 32 * 4, sizeof *rgba);
             char err[512];
             assert_int_equal(lpv_engine_render(lpvt_engine, LPV_TERMS_FULL, rgba, err, sizeof err), 0);

@@ -23,7 +23,7 @@ typedef struct lpv_iv_gpu {
     GLuint prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail;
     GLuint empty_vao, grid_ubo, tail; /* tail: iv_tail.comp's totals and ratio */
     lpv_atlas atlas;
-    GLuint voxels, occupancy, emit, radiance[2], ao;
+    GLuint voxels, occupancy, emit, radiance[2], tail_base, ao; /* tail_base: I_{K-2} for the tail */
     int result;       /* radiance[result] holds the last gather: what the lookup reads */
     size_t cells;     /* allocated for */
     int alloc_dims[3];
@@ -40,7 +40,7 @@ void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in);
  * visibility into the AO volume (ao 1). */
 void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int ao, lpv_timer *timer);
 /* iv_gather: bounces 1..K, each an emission pass and a march, then with
- * iv_tail on the bounces after K as a geometric series; the result in
+ * iv_tail on (K >= 3) the bounces after K as a series; the result in
  * v->radiance[v->result]. */
 void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in);
 /* The ratios (r, g, b) the last tail used (0: none), read back from the GPU. */

@@ -98,7 +98,7 @@ void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int a
 }
 
 /* iv_tail.comp: mode 0 sums `last` into slot k (one workgroup), mode 1
- * adds the tail to `last` from `before` (bounce K - 1). */
+ * adds the tail to `last` from `before` (I_{K-2}). */
 static void tail_pass(lpv_iv_gpu *v, int mode, int k, GLuint last, GLuint before, lpv_timer *timer)
 {
     glUseProgram(v->prog_tail);
@@ -114,14 +114,15 @@ static void tail_pass(lpv_iv_gpu *v, int mode, int k, GLuint last, GLuint before
 }
 
 /* Bounces 1..K: emission from the previous gather, then a march; then the
- * tail (iv_tail on, K >= 2): the totals of the last three gathers and the
- * series they set. */
+ * tail (iv_tail on, K >= 3): the totals of the last four gathers and the
+ * series they set, from I_K and I_{K-2} (kept in v->tail_base before the last
+ * gather overwrites it). */
 void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
 {
     const lpv_settings *s = in->settings;
     lpv_timer_begin(in->timer, "iv_gather");
     int prev = 0, cur = 0;
-    const int tail = s->iv.tail == LPV_SWITCH_ON && s->iv.bounces >= 2;
+    const int tail = s->iv.tail == LPV_SWITCH_ON && s->iv.bounces >= 3;
     if (tail)
         lpv_iv_clear_buffer(v->tail); /* S_0 = 0 */
     for (int k = 1; k <= s->iv.bounces; ++k) {
@@ -138,13 +139,18 @@ void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
         glDispatchCompute(groups(v), 1, 1);
         lpv_timer_count(in->timer, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        if (tail && k == s->iv.bounces) { /* radiance[cur] holds I_{K-2} until this march */
+            glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+            glCopyNamedBufferSubData(v->radiance[cur], v->tail_base, 0, 0,
+                                     (GLsizeiptr)(v->cells * sizeof(struct LpvCell)));
+        }
         lpv_iv_march_volume(v, s, v->radiance[cur], 0, in->timer);
-        if (tail && k >= s->iv.bounces - 2)
+        if (tail && k >= s->iv.bounces - 3)
             tail_pass(v, 0, k, v->radiance[cur], 0, in->timer);
         prev = cur;
     }
     if (tail)
-        tail_pass(v, 1, s->iv.bounces, v->radiance[cur], v->radiance[1 - cur], in->timer);
+        tail_pass(v, 1, s->iv.bounces, v->radiance[cur], v->tail_base, in->timer);
     v->result = cur;
     v->bounces_run = s->iv.bounces;
     v->tail_run = tail;

@@ -17,7 +17,7 @@
  *                 then every voxel a lookup reads marches its rays and
  *                 stores the arriving radiance as SH (3.3), ping-ponging
  *                 two volumes; then the bounces after the last as the
- *                 geometric series the last ones set (iv_tail.comp)
+ *                 series the last ones set (iv_tail.comp)
  *   iv_ao         the same march for visibility within a reach (3.5)
  *
  * The lookup (iv_volume.glsl, iv_lookup.glsl) reconstructs irradiance at a
@@ -45,6 +45,7 @@ static void free_storage(lpv_iv_gpu *v)
     lpv_gl_delete_buffer(&v->emit);
     lpv_gl_delete_buffer(&v->radiance[0]);
     lpv_gl_delete_buffer(&v->radiance[1]);
+    lpv_gl_delete_buffer(&v->tail_base);
     lpv_gl_delete_buffer(&v->ao);
     v->cells = 0;
     memset(v->alloc_dims, 0, sizeof v->alloc_dims);
@@ -114,8 +115,9 @@ static void memory_need(const lpv_technique *t, lpv_memory_need *n)
 {
     const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
     const lpv_grid *g = v->cells ? &v->grid : &v->pending;
-    /* per voxel: the atlas (6 x 16), IvVoxel (96), emission and two
-     * radiance volumes (3 x 48), AO (16): 352 bytes, within one LPV cell's */
+    /* per voxel: the atlas (6 x 16), IvVoxel (96), emission, two radiance
+     * volumes and the tail's base (4 x 48), AO (16): 400 bytes, within one
+     * LPV cell's */
     n->cells += lpv_grid_cell_count(g);
     n->cascades = 1;
     memcpy(n->grid_dims, g->dims, sizeof n->grid_dims);
@@ -160,6 +162,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     v->emit = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
     v->radiance[0] = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
     v->radiance[1] = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
+    v->tail_base = lpv_gl_new_ssbo(cells * sizeof(struct LpvCell));
     v->ao = lpv_gl_new_ssbo(cells * 4 * sizeof(float));
     v->cells = cells;
     memcpy(v->alloc_dims, v->grid.dims, sizeof v->alloc_dims);
