@@ -46,20 +46,24 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  end caps 20 cm thick), lit from inside by six point lights
                  (candela) 40 m apart under the roof; NO camera, so the
                  default camera's rule for long scenes places the view.
-
-Every object is an axis-aligned box (12 triangles) or a quad (2 triangles, its
-front the side its corners run counter-clockwise around); each material is one
-mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits);
-materials are single-sided (glTF's default) unless made with double_sided=True.
   curved.glb     CURVED (issue 30): the room with a smooth-shaded white sphere
                  and a smooth-shaded grey cylinder on its floor, lit by a spot
                  light from above the red wall; the camera sees both where they
                  turn away from the light (their indirect light should vary
                  smoothly across voxels).
+  box-walls.glb  THICK WALLS (issue 30, docs/imperfect-volumes.md "Limits"): the
+                 closed room of 10 cm box walls (each wall's two faces share a
+                 voxel of the imperfect volume), empty, lit by glossy.glb's
+                 point light; thin-walls.glb is the same room of single quads
+                 facing in. The pair isolates what thick walls cost a
+                 technique (the imperfect volume's first bounce: -0.105
+                 against -0.017).
 
 Every object is an axis-aligned box (12 triangles), a quad (2 triangles, its
 front the side its corners run counter-clockwise around), or a UV sphere or
-upright cylinder with smooth vertex normals; each material is one mesh. Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits).
+upright cylinder with smooth vertex normals; each material is one mesh.
+Emission is glTF's emissiveFactor x KHR_materials_emissive_strength (nits);
+materials are single-sided (glTF's default) unless made with double_sided=True.
 lpvd divides the photometric light units by 683 lm/W (docs/units.md); the
 medium format is in docs/scenes.md.
 
@@ -572,6 +576,27 @@ def lamp_fixture():
     return s
 
 
+def walls_room(thin):
+    """glossy.glb's room and point light, empty: with its 10 cm box walls
+    (thin=False, room()) or with six single quads facing in at the walls'
+    inner faces (thin=True), same materials."""
+    s = Scene()
+    if thin:
+        wall = s.material("walls", (0.75, 0.75, 0.72))
+        red = s.material("red_wall", (0.70, 0.12, 0.10))
+        floor = s.material("floor", (0.45, 0.45, 0.45))
+        pos, _, idx = box((-2, 0, -2), (2, 3, 2))
+        # box()'s faces face out, in the order +x, -x, +y, -y, +z, -z: each quad reversed faces in
+        for k, mat in enumerate((wall, red, wall, floor, wall, wall)):
+            s.add_quad(mat, list(reversed(pos[4 * k:4 * k + 4])))
+    else:
+        room(s)
+    s.light("point", {"type": "point", "color": [1.0, 0.95, 0.9], "intensity": 4600.0}, (0.3, 2.6, 0.2),
+            (0.3, 0.0, 0.2))
+    s.camera("Camera", (1.2, 1.6, 1.8), (-1.4, 0.4, -0.8), 60.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
@@ -580,7 +605,8 @@ def main():
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
                         ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel),
-                        ("curved", curved), ("lamp-fixture", lamp_fixture)):
+                        ("curved", curved), ("lamp-fixture", lamp_fixture),
+                        ("box-walls", lambda: walls_room(False)), ("thin-walls", lambda: walls_room(True))):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))
