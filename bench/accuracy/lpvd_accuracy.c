@@ -1031,6 +1031,25 @@ static const char *md_rmse(double rel_rmse, int at_noise, char *buf, size_t size
 }
 
 /* "on"/"off" of an lpv_switch value (iv_reprojection). */
+/* The own reference of a point with ref_bounces b: "converged" (0: an
+ * imperfect volume whose tail models every bounce) or "B bounce(s)"; and as
+ * a table cell, "all" or B. */
+static const char *own_text(int b, char buf[32])
+{
+    if (b == 0)
+        return "converged";
+    snprintf(buf, 32, "%d bounce(s)", b);
+    return buf;
+}
+
+static const char *bounces_cell(int b, char buf[16])
+{
+    if (b == 0)
+        return "all";
+    snprintf(buf, 16, "%d", b);
+    return buf;
+}
+
 static const char *switch_name(int v)
 {
     return v == LPV_SWITCH_ON ? "on" : v == LPV_SWITCH_OFF ? "off" : "default";
@@ -1204,9 +1223,10 @@ static void write_md_iv_table(FILE *f, const result *const *rows, int k)
         for (int st = ST_IV_POINTS; st <= ST_IV_GATHER; ++st)
             md_cell_ms(f, iv, x->stage_ms[st]);
         char rm[40];
-        fprintf(f, " %.2f | %s%s%s | %+.3f | %.3f | %.3f | %d | %.3f | %+.3f | %.3f | %s |\n", x->stage_ms[ST_SHADE],
+        fprintf(f, " %.2f | %s%s%s | %+.3f | %.3f | %.3f | %s | %.3f | %+.3f | %.3f | %s |\n", x->stage_ms[ST_SHADE],
                 b, md_rmse(x->m.rel_rmse, x->at_noise, rm, sizeof rm), b, x->m.rel_bias, x->m.rel_mae,
-                x->m.ref_noise, x->ref_bounces, x->own.rel_rmse, x->own.rel_bias, x->rel_rmse_1b,
+                x->m.ref_noise, bounces_cell(x->ref_bounces, (char[16]){0}),
+                x->own.rel_rmse, x->own.rel_bias, x->rel_rmse_1b,
                 x->pareto ? "**◆**" : "");
     }
     fputc('\n', f);
@@ -2363,7 +2383,10 @@ add_features:
                 }
             }
             const int ivb = res->iv.v[LPV_ACC_IV_BOUNCES];
-            if (is_iv(&pts[p]) && ivb > 1 && ivb <= LPV_IV_MAX_BOUNCES) { /* its own bounces' reference */
+            /* an imperfect volume whose tail adds the bounces after its last (iv_tail, 3 or more bounces) models
+             * every bounce: its own reference is converged light (ref_bounces 0) */
+            const int iv_all = is_iv(&pts[p]) && ivb >= 3 && lpv_engine_settings(engine)->iv.tail == LPV_SWITCH_ON;
+            if (is_iv(&pts[p]) && !iv_all && ivb > 1 && ivb <= LPV_IV_MAX_BOUNCES) { /* its own bounces' reference */
                 const float *bimg = bounce_reference(se, &scene, &view, &rsrc, ivb, &bref[ivb], &bref_se[ivb]);
                 lpv_acc_metrics mb;
                 if (!bimg) {
@@ -2384,6 +2407,10 @@ add_features:
             if (lpv_acc_compare(rgba, cref, cref_se, view.width, view.height, &res->m) != 0)
                 fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both the converged reference and "
                                 "lpvd\n", se->name);
+            if (iv_all) {
+                res->own = res->m;
+                res->ref_bounces = 0;
+            }
             res->at_noise = at_ref_noise(res->m.rel_rmse, se->ref_noise2);
             cmp_ref = cref;
             const float *base_ref = cref;
@@ -2424,14 +2451,14 @@ add_features:
                 fprintf(stderr,
                         "lpvd-accuracy: %s %d/%d: iv, resolution %d, points %d, rays %d, bounces %d, reprojection %s, "
                         "neighbours %d, rsm %d: %.2f ms/tick (iv_points %.2f, iv_reproject %.2f, iv_resolve %.2f, "
-                        "iv_gather %.2f, shade %.2f), rel_rmse %.4f rel_bias %+.4f vs converged%s; %.4f %+.4f vs %d "
-                        "bounce(s) (%.4f vs 1)\n",
+                        "iv_gather %.2f, shade %.2f), rel_rmse %.4f rel_bias %+.4f vs converged%s; %.4f %+.4f vs %s "
+                        "(%.4f vs 1)\n",
                         se->name, p + 1, npts, res->iv.v[0], res->iv.v[1], res->iv.v[2], res->iv.v[3],
                         switch_name(res->iv.v[4]), res->iv.v[5], pts[p].rsm, res->ms_total,
                         res->stage_ms[ST_IV_POINTS], res->stage_ms[ST_IV_REPROJECT], res->stage_ms[ST_IV_RESOLVE],
                         res->stage_ms[ST_IV_GATHER], res->stage_ms[ST_SHADE], res->m.rel_rmse, res->m.rel_bias,
                         res->at_noise ? " (at the reference's noise)" : "", res->own.rel_rmse, res->own.rel_bias,
-                        res->ref_bounces, res->rel_rmse_1b);
+                        own_text(res->ref_bounces, (char[32]){0}), res->rel_rmse_1b);
             else
                 fprintf(stderr,
                         "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s%s: "
