@@ -2751,13 +2751,22 @@ def c_plan_iv(ctx):
           and 0 < st.get("occupied", 0) < cells and st.get("ao") is False,
           "TICK stats iv %r: expected points > 0, voxels %d, 3 bounces of 3, %d rays, 0 < occupied < voxels, ao "
           "false" % (st, cells, IV_CONFIG["iv_rays"]))
+    # the bounces after the three as a series (iv_tail, on by default): its per-bounce ratio per channel
+    ratio = st.get("tail_ratio")
+    check(st.get("tail") is True and isinstance(ratio, list) and len(ratio) == 3
+          and all(isinstance(x, (int, float)) and 0.0 <= x < 1.0 for x in ratio),
+          "TICK stats iv %r: expected tail true and tail_ratio three numbers in [0, 1) (iv_tail on, 3 bounces)"
+          % (st,))
     sp = expect_reply(c.request(STATS, {}), STATS).body.get("plan") or {}
     check(sp.get("iv") == st and sp.get("plan") == plan, "STATS plan differs from the TICK reply's stats for the same "
           "tick: iv %r vs %r" % (sp.get("iv"), st))
-    expect_reply(c.request(CONFIG, {"iv_reprojection": False}), CONFIG)
+    expect_reply(c.request(CONFIG, {"iv_reprojection": False, "iv_tail": False}), CONFIG)
     t2 = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
     r2 = {p["name"]: p for p in t2.body["stats"]["plan"]["passes"]}["iv_reproject"]
     check(not r2["run"] and "reprojection off" in r2["reason"], "iv_reproject %r with iv_reprojection false" % (r2,))
+    st2 = t2.body["stats"].get("iv") or {}
+    check(st2.get("tail") is False and st2.get("tail_ratio") == [0, 0, 0],
+          "TICK stats iv %r with iv_tail false: expected tail false and tail_ratio [0, 0, 0]" % (st2,))
     return "iv_gather: %s; iv_reproject: %s / %s; stats %s" % (g["reason"], r["reason"], r2["reason"],
                                                                 json.dumps(st, sort_keys=True))
 
