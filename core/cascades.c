@@ -131,11 +131,9 @@ int lpv_cascades_count(const lpv_settings *s, int count)
 
 float lpv_cascade_cross_section(const float bmin[3], const float bmax[3])
 {
-    float e[3];
-    for (int i = 0; i < 3; ++i)
-        e[i] = bmax[i] - bmin[i];
-    const float longest = fmaxf(e[0], fmaxf(e[1], e[2]));
-    const float second = e[0] + e[1] + e[2] - longest - fminf(e[0], fminf(e[1], e[2]));
+    float sides[3];
+    lpv_box_sides(bmin, bmax, sides);
+    const float longest = sides[2], second = sides[1];
     return second > 0.0f && isfinite(longest) && longest >= LPV_CASCADE_LONG_RATIO * second ? second : 0.0f;
 }
 

@@ -116,3 +116,16 @@ int lpv_grid_gv_point_of(const lpv_grid *g, const float p[3], int point[3])
     }
     return 1;
 }
+
+void lpv_box_sides(const float bmin[3], const float bmax[3], float sides[3])
+{
+    for (int i = 0; i < 3; ++i)
+        sides[i] = bmax[i] - bmin[i];
+    for (int i = 0; i < 2; ++i) /* three elements: two passes of bubble sort */
+        for (int j = 0; j < 2 - i; ++j)
+            if (sides[j] > sides[j + 1]) {
+                const float t = sides[j];
+                sides[j] = sides[j + 1];
+                sides[j + 1] = t;
+            }
+}

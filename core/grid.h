@@ -39,6 +39,10 @@ double lpv_grid_cell_size_over(const int dims[3], const float bmin[3], const flo
  * dimension is outside 1..LPV_MAX_GRID_DIM. */
 int lpv_grid_place(const int dims[3], const float bmin[3], const float bmax[3], lpv_grid *out);
 
+/* The box [bmin, bmax]'s sides (m), shortest first: sides[1] is its middle
+ * axis (a tunnel's cross-section), sides[2] its longest. */
+void lpv_box_sides(const float bmin[3], const float bmax[3], float sides[3]);
+
 /* Places cubic voxels over [bmin, bmax] for the imperfect volume:
  * `resolution` voxels of side longest / resolution span the longest side,
  * the other axes as many as they need; one more voxel per axis puts the

@@ -679,7 +679,7 @@ int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, c
         memcpy(prev, incoming, cells * sizeof *prev);
         lpv_iv_emit(g, vox, prev, k, d->neighbours, emit);
         lpv_iv_gather(g, vox, emit, d->seed, d->rays, incoming);
-        if (k < LPV_IV_TAIL_SLOTS)
+        if (base && k >= d->bounces - 3 && k < LPV_IV_TAIL_SLOTS) /* the tail's four totals */
             lpv_iv_total(cells, incoming, totals[k]);
     }
     if (base && d->bounces >= 3 && d->bounces < LPV_IV_TAIL_SLOTS) {

@@ -127,13 +127,13 @@ void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *
  * Woo), t the distance where it enters each: t > reach: LPV_IV_BEYOND;
  * outside the grid: LPV_IV_ESCAPED; the ray's own voxel: on; occupied:
  * that voxel's index. reach is in m; INFINITY for the radiance march. */
+long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z, const float w[3], float reach);
+
 /* The radiance (W/(m^2 sr)) one channel e of a voxel's emission sends along
  * unit t: the two Lambertian hemispheres e is the projection of, B_f / pi
  * along its dipole d and B_b / pi against it (B_f + B_b = e0 / HEMI0,
  * (B_f - B_b) d = e1 / HEMI1), as iv_gather.comp reads it. */
 float lpv_iv_emitted(const float e[4], const float t[3]);
-
-long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z, const float w[3], float reach);
 
 /* The radiance march, I_k from emit: a voxel with no occupied voxel in its
  * 3x3x3 neighbourhood (itself included) gets 0 (the lookup never reads it).

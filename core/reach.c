@@ -144,12 +144,14 @@ int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, cha
     for (size_t v = 0; v < n; ++v)
         r->label[v] = 1;
     double opaque_area = 0.0;
+    r->all_opaque = 1;
     for (uint32_t d = 0; d < scene->draw_count; ++d) {
         const lpv_draw *dr = &scene->draws[d];
         const lpv_material *m =
             dr->material >= 0 && (uint32_t)dr->material < scene->material_count ? &scene->materials[dr->material] : NULL;
         const int opaque = !m || m->alpha_mode == LPV_ALPHA_OPAQUE;
         const int emits = is_emissive(m);
+        r->all_opaque &= opaque;
         if (!opaque && !emits)
             continue;
         for (uint32_t i = 0; i + 2 < dr->index_count; i += 3) {
@@ -342,6 +344,40 @@ int lpv_reach_lit_at(const lpv_reach *r, const float p[3])
         return 0;
     const long v = voxel_at(r, p);
     return r->mask[v >= 0 ? (size_t)v : 0] == LPV_REACH_LIT; /* outside the grid: the margin's air, voxel 0 */
+}
+
+int lpv_reach_solid_within(const lpv_reach *r, const float p[3], float within)
+{
+    if (!r->label || !(r->voxel > 0.0f))
+        return 1;
+    const float v = r->voxel;
+    int lo[3], hi[3];
+    for (int i = 0; i < 3; ++i) {
+        lo[i] = (int)floorf((p[i] - within - r->origin[i]) / v);
+        hi[i] = (int)floorf((p[i] + within - r->origin[i]) / v);
+        if (lo[i] < 0)
+            lo[i] = 0;
+        if (hi[i] > r->dims[i] - 1)
+            hi[i] = r->dims[i] - 1;
+        if (hi[i] - lo[i] > 2 * LPV_REACH_SEARCH_MAX)
+            return 1;
+    }
+    for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y)
+            for (int x = lo[0]; x <= hi[0]; ++x) {
+                if (r->label[voxel_index(r, x, y, z)] != 0)
+                    continue; /* air */
+                const int idx[3] = {x, y, z};
+                float d2 = 0.0f;
+                for (int i = 0; i < 3; ++i) {
+                    const float b0 = r->origin[i] + v * (float)idx[i], b1 = b0 + v;
+                    const float out = p[i] < b0 ? b0 - p[i] : (p[i] > b1 ? p[i] - b1 : 0.0f);
+                    d2 += out * out;
+                }
+                if (d2 <= within * within)
+                    return 1;
+            }
+    return 0;
 }
 
 void lpv_reach_free(lpv_reach *r)

@@ -63,6 +63,8 @@ typedef struct lpv_reach {
      * a 4 x 3 x 4 m room, tens of m in an open courtyard. The free distance
      * lpvd sizes iv's voxels from in long scenes; 0 without surfaces. */
     float free_path;
+    int all_opaque;    /* 1: every material of the scene is opaque, so the voxels hold every surface
+                          (cut-out and blended ones are not voxelized but still cast shadows) */
     /* lpv_reach_light's result: */
     int unsure;        /* 1: a light's seed had no air around it; every voxel reads lit */
     size_t solid_voxels, dark_voxels, lit_voxels;
@@ -102,6 +104,13 @@ float lpv_reach_at(const lpv_reach *r, const float p[3], const float n[3]);
  * mask per pixel (gpu/reach_volume.c). */
 int lpv_reach_lit_at(const lpv_reach *r, const float p[3]);
 
+/* 1 when a solid voxel lies within `within` (m) of p, or when there are no
+ * voxels or the voxels are much finer than `within` (more than
+ * LPV_REACH_SEARCH_MAX each side: the caller must look at the triangles); 0
+ * when the air around p is clear that far. Every opaque surface lies in a
+ * solid voxel, so 0 means no opaque surface is that near. */
+#define LPV_REACH_SEARCH_MAX 32
+int lpv_reach_solid_within(const lpv_reach *r, const float p[3], float within);
 void lpv_reach_free(lpv_reach *r);
 
 #endif /* LPV_REACH_H */

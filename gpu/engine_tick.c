@@ -36,20 +36,11 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->has_medium = e->medium.medium.present || e->settings.fog_sigma_s > 0.0f || e->settings.fog_sigma_a > 0.0f;
     f->has_view = e->has_view;
     f->camera_inside = e->has_view && lpv_point_in_bounds(e->view.eye, e->scene_min, e->scene_max);
-    f->scene_extent = fmaxf(e->scene_max[0] - e->scene_min[0],
-                            fmaxf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
-    f->scene_shortest = fminf(e->scene_max[0] - e->scene_min[0],
-                              fminf(e->scene_max[1] - e->scene_min[1], e->scene_max[2] - e->scene_min[2]));
-    {
-        float e3[3], lo = INFINITY, hi = 0.0f, sum = 0.0f;
-        for (int i = 0; i < 3; ++i) {
-            e3[i] = e->scene_max[i] - e->scene_min[i];
-            lo = fminf(lo, e3[i]);
-            hi = fmaxf(hi, e3[i]);
-            sum += e3[i];
-        }
-        f->scene_middle = sum - lo - hi;
-    }
+    float sides[3];
+    lpv_box_sides(e->scene_min, e->scene_max, sides);
+    f->scene_shortest = sides[0];
+    f->scene_middle = sides[1];
+    f->scene_extent = sides[2];
     f->cascade_finest = lpv_cascade_finest_size(&e->settings, e->scene_min, e->scene_max);
     f->scene_cross = lpv_cascade_cross_section(e->scene_min, e->scene_max);
     f->free_path = e->reach.free_path;

@@ -101,44 +101,6 @@ static float far_from(const lpv_engine *e, const vec3 p)
 #define NEAR_DEPTH_EPS 1.1920929e-7f /* 2^-23 */
 #define NEAR_PRECISION_TEXELS 0.25f
 #define NEAR_REVERSED_FLOOR 1e-6f /* x the radius: a reversed-depth face's floor (size 0) */
-#define NEAR_SEARCH_MAX 32 /* voxels each side of the eye, at most */
-
-/* 1 when a solid reach voxel (core/reach.h: every surface lies in a solid
- * voxel) lies within `within` of p, or when there are no voxels; 0 when the
- * air around p is clear that far. */
-static int solid_nearby(const lpv_reach *r, const vec3 p, float within)
-{
-    if (!r->label || !(r->voxel > 0.0f))
-        return 1;
-    const float v = r->voxel;
-    int lo[3], hi[3];
-    for (int i = 0; i < 3; ++i) {
-        lo[i] = (int)floorf((p[i] - within - r->origin[i]) / v);
-        hi[i] = (int)floorf((p[i] + within - r->origin[i]) / v);
-        if (lo[i] < 0)
-            lo[i] = 0;
-        if (hi[i] > r->dims[i] - 1)
-            hi[i] = r->dims[i] - 1;
-        if (hi[i] - lo[i] > 2 * NEAR_SEARCH_MAX)
-            return 1; /* voxels much finer than the search: let the triangles tell */
-    }
-    for (int z = lo[2]; z <= hi[2]; ++z)
-        for (int y = lo[1]; y <= hi[1]; ++y)
-            for (int x = lo[0]; x <= hi[0]; ++x) {
-                if (r->label[((size_t)z * (size_t)r->dims[1] + (size_t)y) * (size_t)r->dims[0] + (size_t)x] != 0)
-                    continue; /* air */
-                const int idx[3] = {x, y, z};
-                float d2 = 0.0f;
-                for (int i = 0; i < 3; ++i) {
-                    const float b0 = r->origin[i] + v * (float)idx[i], b1 = b0 + v;
-                    const float out = p[i] < b0 ? b0 - p[i] : (p[i] > b1 ? p[i] - b1 : 0.0f);
-                    d2 += out * out;
-                }
-                if (d2 <= within * within)
-                    return 1;
-            }
-    return 0;
-}
 
 /* The squared distance from p to triangle abc (Ericson, Real-Time Collision
  * Detection 5.1.5: the closest point by the Voronoi regions). */
@@ -290,11 +252,7 @@ static float light_clearance(lpv_engine *e, int l, const vec3 p, const float *n,
     memcpy(&key[7], &e->geometry_sig, sizeof key[7]); /* the low half of the signature */
     if (memcmp(key, e->light_clearance_key[l], sizeof key) != 0) {
         memcpy(e->light_clearance_key[l], key, sizeof key);
-        const lpv_scene *g = &e->geometry;
-        int all_opaque = 1;
-        for (uint32_t m = 0; m < g->material_count; ++m)
-            all_opaque &= g->materials[m].alpha_mode == LPV_ALPHA_OPAQUE;
-        if (all_opaque && !solid_nearby(&e->reach, p, within))
+        if (e->reach.all_opaque && !lpv_reach_solid_within(&e->reach, p, within))
             e->light_clearance[l] = within;
         else {
             e->light_clearance[l] = 0.0f;

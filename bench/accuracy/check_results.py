@@ -142,10 +142,9 @@ def main():
             if row["at_ref_noise"] != ("1" if rmse < 2 * noise2 else "0"):
                 problems.append("line %d: at_ref_noise=%s with rel_rmse %s and ref_noise2 %s"
                                 % (n, row["at_ref_noise"], row["rel_rmse"], row["ref_noise2"]))
+            # ref_bounces 0: the point's own reference is converged light itself (an imperfect volume's tail),
+            # so its own figures are its converged ones and there is nothing to compare
             all_bounces = (row.get("ref_bounces") or "").strip() == "0"
-            if all_bounces and bias != bias_own:
-                problems.append("line %d: rel_bias %+.4f and rel_bias_own %+.4f differ with ref_bounces 0 (both "
-                                "against converged light)" % (n, bias, bias_own))
             if not all_bounces and not bias < bias_own:
                 problems.append("line %d: rel_bias %+.4f vs converged light is not below rel_bias_own %+.4f vs %s "
                                 "bounce(s)" % (n, bias, bias_own, row.get("ref_bounces")))

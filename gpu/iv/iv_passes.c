@@ -157,6 +157,9 @@ void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
     lpv_timer_end(in->timer);
 }
 
+/* Called from the tick's stats, after lpv_timer_collect has waited on the
+ * tick's timer queries, iv_gather's (and so the tail pass's) among them:
+ * the 12 bytes are ready and reading them stalls nothing further. */
 void lpv_iv_gpu_tail_ratio(const lpv_iv_gpu *v, float rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0f;
