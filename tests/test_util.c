@@ -1,4 +1,5 @@
 /* test_util.c - see test_util.h. */
+#define _XOPEN_SOURCE 700 /* nftw */
 #include "test_util.h"
 
 #include "context.h"
@@ -6,6 +7,7 @@
 #include "pt.h"
 #include "view.h"
 
+#include <ftw.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -32,18 +34,39 @@ const char *lpvt_source_dir(void)
     return d ? d : ".";
 }
 
+static char tmpdir_path[256];
+static pid_t tmpdir_owner;
+
+static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    if (remove(path) != 0)
+        perror(path);
+    return 0;
+}
+
+/* Every test program left its directory behind (hundreds in /tmp after a
+ * few runs of the suite): the process that made it removes it at exit; a
+ * forked child that calls exit() does not, its parent may still use it. */
+static void remove_tmpdir(void)
+{
+    if (tmpdir_path[0] && getpid() == tmpdir_owner)
+        nftw(tmpdir_path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
 const char *lpvt_tmpdir(void)
 {
-    static char path[256];
-    if (!path[0]) {
+    if (!tmpdir_path[0]) {
         const char *base = getenv("TMPDIR");
-        snprintf(path, sizeof path, "%s/lpvd-test-XXXXXX", base ? base : "/tmp");
-        if (!mkdtemp(path)) {
+        snprintf(tmpdir_path, sizeof tmpdir_path, "%s/lpvd-test-XXXXXX", base ? base : "/tmp");
+        if (!mkdtemp(tmpdir_path)) {
             perror("mkdtemp");
             abort();
         }
+        tmpdir_owner = getpid();
+        atexit(remove_tmpdir);
     }
-    return path;
+    return tmpdir_path;
 }
 
 const char *lpvt_write_file(const char *dir, const char *name, const void *data, size_t size)

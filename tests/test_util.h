@@ -12,8 +12,9 @@ const char *lpvt_shared_dir(void);
 /* The source tree (LPVD_SOURCE_DIR). */
 const char *lpvt_source_dir(void);
 
-/* A fresh temporary folder for this test process (removed by the OS's tmp
- * cleaning, not by the test). Never NULL; aborts on failure. */
+/* A fresh temporary folder for this test process ($TMPDIR or /tmp), removed
+ * with everything in it when the process that made it exits normally (a
+ * crashed test leaves it to look at). Never NULL; aborts on failure. */
 const char *lpvt_tmpdir(void);
 
 /* Writes size bytes to dir/name and returns the full path in a static buffer
