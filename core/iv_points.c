@@ -104,6 +104,20 @@ static void turk(uint32_t seed, uint32_t key, int k, double *b0, double *b1, dou
 
 static void emit_piece(walk *w, const double pb[3][3])
 {
+    /* the area each of the piece's points stands for (LPV_IV_COVER) */
+    double corner[3][3], e1[3], e2[3];
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 3; ++i)
+            corner[c][i] = pb[c][0] * w->v[0]->position[i] + pb[c][1] * w->v[1]->position[i] +
+                           pb[c][2] * w->v[2]->position[i];
+    for (int i = 0; i < 3; ++i) {
+        e1[i] = corner[1][i] - corner[0][i];
+        e2[i] = corner[2][i] - corner[0][i];
+    }
+    const double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+                 cz = e1[0] * e2[1] - e1[1] * e2[0];
+    const double piece_area = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+    const float point_area = w->n > 0 && isfinite(piece_area) ? (float)(piece_area / w->n) : 0.0f;
     for (int k = 0; k < w->n && w->count < w->max; ++k) {
         double t0, t1, t2;
         turk(w->seed, (uint32_t)w->pieces, k, &t0, &t1, &t2);
@@ -129,6 +143,7 @@ static void emit_piece(walk *w, const double pb[3][3])
             o->emission[i] = w->emission && w->m ? w->m->emission[i] : 0.0f;
         }
         o->position[3] = 1.0f;
+        o->normal[3] = point_area;
     }
 }
 

@@ -57,13 +57,23 @@ int lpv_iv_voxel_of(const lpv_grid *g, const float p[3], int cell[3])
     return 1;
 }
 
-int lpv_iv_surface_voxel_of(const lpv_grid *g, const float p[3], const float n[3], int cell[3])
+/* p in voxels from the grid's corner, moved LPV_IV_BEHIND against unit n
+ * (iv_volume.glsl's iv_coords_of). */
+static void surface_coords(const lpv_grid *g, const float p[3], const float n[3], float u[3])
 {
     float nh[3] = {0.0f, 0.0f, 0.0f};
     if (!lpv_unit_direction(n, nh))
         nh[0] = nh[1] = nh[2] = 0.0f;
+    for (int a = 0; a < 3; a++)
+        u[a] = (p[a] - g->origin[a]) / g->cell_size - LPV_IV_BEHIND * nh[a];
+}
+
+int lpv_iv_surface_voxel_of(const lpv_grid *g, const float p[3], const float n[3], int cell[3])
+{
+    float u[3];
+    surface_coords(g, p, n, u);
     for (int a = 0; a < 3; a++) {
-        float fc = floorf((p[a] - g->origin[a]) / g->cell_size - LPV_IV_BEHIND * nh[a]);
+        float fc = floorf(u[a]);
         if (!(fc >= 0.0f && fc < (float)g->dims[a]))
             return 0;
         cell[a] = (int)fc;
@@ -92,17 +102,20 @@ static int near_occupied(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, i
 /* ---- Creation (3.1) -------------------------------------------------------- */
 
 /* Accumulators per voxel: 12 SH, 3 normal, 3 albedo, 1 count, 3 folded normal. */
-#define ACC 22
+/* per voxel: 12 SH, normal (3), albedo (3), count, fold (3), area, signed area,
+ * greatest place (3), 1 - least place (3) */
+#define ACC 30
 
 /* LPV_IV_FOLD (lpv_shared.h): n times the sign of its largest component,
  * ties x before y before z, as iv_splat.vert folds it. */
-static void fold(const float n[3], float out[3])
+static float fold(const float n[3], float out[3])
 {
     const float ax = fabsf(n[0]), ay = fabsf(n[1]), az = fabsf(n[2]);
     const float major = ax >= ay && ax >= az ? n[0] : ay >= az ? n[1] : n[2];
     const float s = major >= 0.0f ? 1.0f : -1.0f;
     for (int k = 0; k < 3; k++)
         out[k] = s * n[k];
+    return s;
 }
 
 int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*radiosity)[3], size_t n,
@@ -133,13 +146,22 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
             for (int k = 0; k < 4; k++)
                 a[4 * ch + k] += (double)B[ch] * (double)h[k];
         float f[3];
-        fold(pt->normal, f);
+        const float fs = fold(pt->normal, f);
+        const float area = pt->normal[3] >= 0.0f && isfinite(pt->normal[3]) ? pt->normal[3] : 0.0f;
+        float u[3];
+        surface_coords(g, pt->position, pt->normal, u);
         for (int k = 0; k < 3; k++) {
             a[12 + k] += pt->normal[k];
             a[15 + k] += pt->albedo[k];
             a[19 + k] += f[k];
+            float local = u[k] - (float)v[k];
+            local = local < 0.0f ? 0.0f : local > 1.0f ? 1.0f : local;
+            a[24 + k] = local > a[24 + k] ? local : a[24 + k];
+            a[27 + k] = 1.0f - local > a[27 + k] ? 1.0f - local : a[27 + k];
         }
         a[18] += 1.0;
+        a[22] += area;
+        a[23] += fs * area;
         used++;
     }
     for (size_t c = 0; c < cells; c++) {
@@ -158,6 +180,29 @@ int lpv_iv_create(const lpv_grid *g, const lpv_iv_point *points, const float (*r
             o->fold[k] = (float)(a[19 + k] / a[18]);
         }
         o->normal[3] = (float)a[18];
+        /* LPV_IV_COVER: the cloud's area over a voxel face's, plain and
+         * signed; the points' extent, widened by (N + 1) / (N - 1) */
+        const double face = 1.0 / ((double)g->cell_size * (double)g->cell_size);
+        o->albedo[3] = (float)(a[22] * face);
+        o->fold[3] = (float)(a[23] * face);
+        const float widen = a[18] >= 2.0 ? (float)((a[18] + 1.0) / (a[18] - 1.0)) : 0.0f;
+        float span[3], lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            hi[k] = (float)a[24 + k];
+            lo[k] = 1.0f - (float)a[27 + k];
+            span[k] = hi[k] - lo[k];
+            const float e = span[k] * widen;
+            o->extent[k] = e < 0.0f ? 0.0f : e > 1.0f ? 1.0f : e;
+        }
+        /* LPV_IV_SLAB: across the axis the points' folded normals agree on, if they lie thin on it */
+        const float fx = fabsf(o->fold[0]), fy = fabsf(o->fold[1]), fz = fabsf(o->fold[2]);
+        const int axis = fx >= fy && fx >= fz ? 0 : fy >= fz ? 1 : 2;
+        o->slab[0] = -1.0f;
+        if (fabsf(o->fold[axis]) >= LPV_IV_FLAT && span[axis] <= LPV_IV_SLAB_MAX) {
+            o->slab[0] = (float)axis;
+            o->slab[1] = lo[axis];
+            o->slab[2] = hi[axis];
+        }
     }
     free(acc);
     if (taken)
@@ -378,19 +423,16 @@ float lpv_iv_ao(const lpv_grid *g, const lpv_iv_voxel *voxels, const vec4 *ao, c
 
 /* ---- Emission per bounce --------------------------------------------------- */
 
-/* The voxel's axis a, the share *front of its points facing it (the rest
- * face -a, if every normal is +-a) and how two-sided it is, *two (sides):
- * the mean normal m where the points mostly agree (one surface, a corner),
- * else the folded mean f (LPV_IV_FOLD: a wall's two faces);
- * *front = (1 + m.a) / 2, *two = 1 - |m| / |f|. 0 where neither gives an
+/* The voxel's axis a and the share *front of its points facing it (the
+ * rest face -a, if every normal is +-a): the mean normal m where the points
+ * mostly agree (one surface, a corner), else the folded mean f (LPV_IV_FOLD:
+ * a wall's two faces); *front = (1 + m.a) / 2. 0 where neither gives an
  * axis. As iv_emit.comp's iv_axis. */
-static int axis_of(const lpv_iv_voxel *h, float a[3], float *front, float *two)
+static int axis_of(const lpv_iv_voxel *h, float a[3], float *front)
 {
     const float *m = h->normal, *f = h->fold;
     const float lm = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
     const float lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    float t = lf > 1e-3f ? 1.0f - lm / lf : 0.0f;
-    *two = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
     const float *src = m;
     float len = lm;
     if (!(lm >= LPV_IV_ONE_SIDED * lf && lm > 1e-3f)) {
@@ -406,24 +448,55 @@ static int axis_of(const lpv_iv_voxel *h, float a[3], float *front, float *two)
     return 1;
 }
 
+static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
+
+/* How much of its mean radiance each side shows, *kf and *kb
+ * (LPV_IV_COVER): where the points all lie along one axis and the cloud
+ * gave their area, the part of the voxel face the side covers (its area
+ * over LPV_IV_COVER_AREA of the face's, at most the points' extent across
+ * the axis over LPV_IV_COVER_ACROSS), between its share and 1; elsewhere
+ * c + t (1 - c), t = 1 - |m| / |f|. As iv_emit.comp's iv_cover. */
+static void cover(const lpv_iv_voxel *h, const float a[3], float front, float *kf, float *kb)
+{
+    const float back = 1.0f - front;
+    const float *m = h->normal, *f = h->fold;
+    const float lm = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    const float lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (lf >= LPV_IV_FLAT && h->albedo[3] > 0.0f) {
+        const float plus = 0.5f * (h->albedo[3] + h->fold[3]), minus = 0.5f * (h->albedo[3] - h->fold[3]);
+        const int front_plus = a[0] * f[0] + a[1] * f[1] + a[2] * f[2] >= 0.0f;
+        const float ax = fabsf(a[0]), ay = fabsf(a[1]), az = fabsf(a[2]);
+        const float *e = h->extent;
+        const float across = ax >= ay && ax >= az ? e[1] * e[2] : ay >= az ? e[0] * e[2] : e[0] * e[1];
+        const float af = (front_plus ? plus : minus) / LPV_IV_COVER_AREA, ab = (front_plus ? minus : plus) / LPV_IV_COVER_AREA;
+        const float x = across / LPV_IV_COVER_ACROSS;
+        *kf = clampf(af < x ? af : x, front, 1.0f);
+        *kb = clampf(ab < x ? ab : x, back, 1.0f);
+        return;
+    }
+    const float t = lf > 1e-3f ? clampf(1.0f - lm / lf, 0.0f, 1.0f) : 0.0f;
+    *kf = front + t * (1.0f - front);
+    *kb = back + t * (1.0f - back);
+}
+
 /* One channel's SH e read along the axis as two hemispheres, B_f and B_b,
- * each shown at its own radiance B / share, the mean over the points facing
- * that way, to the degree two the voxel is two-sided (a thin wall's two
- * faces share it, and the plain mean showed each at half its light);
+ * each shown at the part kf, kb of its mean radiance B / share (cover);
  * iv_emit.comp's iv_sides says why. */
-static void sides(float e[4], const float a[3], float front, float back, float two, const float hf[4],
+static void sides(float e[4], const float a[3], float front, float back, float kf, float kb, const float hf[4],
                   const float hb[4])
 {
     const float sum = e[0] / LPV_IV_HEMI0;
-    if (!(sum > 0.0f) || !(two > 0.0f))
+    if (!(sum > 0.0f))
         return;
     float diff = (e[3] * a[0] + e[1] * a[1] + e[2] * a[2]) / LPV_IV_HEMI1;
     diff = diff < -sum ? -sum : diff > sum ? sum : diff;
     const float bf = 0.5f * (sum + diff), bb = 0.5f * (sum - diff);
-    const float kf = two * (1.0f / (front > LPV_IV_SIDE_MIN ? front : LPV_IV_SIDE_MIN) - 1.0f);
-    const float kb = two * (1.0f / (back > LPV_IV_SIDE_MIN ? back : LPV_IV_SIDE_MIN) - 1.0f);
+    float xf = kf / (front > LPV_IV_SIDE_MIN ? front : LPV_IV_SIDE_MIN) - 1.0f;
+    float xb = kb / (back > LPV_IV_SIDE_MIN ? back : LPV_IV_SIDE_MIN) - 1.0f;
+    xf = xf > 0.0f ? xf : 0.0f;
+    xb = xb > 0.0f ? xb : 0.0f;
     for (int k = 0; k < 4; k++)
-        e[k] += bf * kf * hf[k] + bb * kb * hb[k];
+        e[k] += bf * xf * hf[k] + bb * xb * hb[k];
 }
 
 void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *incoming, int bounce, int neighbours,
@@ -441,8 +514,8 @@ void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *
                 memcpy(e->r, h->r, sizeof e->r);
                 memcpy(e->g, h->g, sizeof e->g);
                 memcpy(e->b, h->b, sizeof e->b);
-                float nh[3], front, two;
-                if (!axis_of(h, nh, &front, &two))
+                float nh[3], front;
+                if (!axis_of(h, nh, &front))
                     continue;
                 const float back = 1.0f - front, nb[3] = {-nh[0], -nh[1], -nh[2]};
                 float hf[4], hb[4];
@@ -461,8 +534,10 @@ void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *
                             c[k] += af * hf[k] + ab * hb[k];
                     }
                 }
+                float kf, kb;
+                cover(h, nh, front, &kf, &kb);
                 for (int ch = 0; ch < 3; ch++)
-                    sides(channel(e, ch), nh, front, back, two, hf, hb);
+                    sides(channel(e, ch), nh, front, back, kf, kb, hf, hb);
             }
         }
     }
@@ -525,6 +600,77 @@ static void ray(const lpv_grid *g, uint32_t seed, int x, int y, int z, int j, in
     basis(back, y4);
 }
 
+static int occupied_at(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
+{
+    return x >= 0 && y >= 0 && z >= 0 && x < g->dims[0] && y < g->dims[1] && z < g->dims[2] &&
+           lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]);
+}
+
+/* c's one occupied face neighbour own (and the unit axis side from it to c),
+ * if it has exactly one. As iv_gather.comp's surface_beside. */
+static int surface_beside(const lpv_grid *g, const lpv_iv_voxel *voxels, const int c[3], int own[3], float side[3])
+{
+    int n = 0;
+    for (int k = 0; k < 3; k++)
+        for (int sgn = -1; sgn <= 1; sgn += 2) {
+            int q[3] = {c[0], c[1], c[2]};
+            q[k] += sgn;
+            if (occupied_at(g, voxels, q[0], q[1], q[2])) {
+                n++;
+                memcpy(own, q, sizeof q);
+                side[0] = side[1] = side[2] = 0.0f;
+                side[k] = -(float)sgn;
+            }
+        }
+    return n == 1;
+}
+
+/* Whether a surface ray's stretch through occupied voxel h at q, from
+ * o + t_in w to o + t_out w (in voxels), meets its surface: passes through
+ * its slab (LPV_IV_SLAB, widened by LPV_IV_SLAB_PAD), anywhere in it where
+ * it has none. As iv_gather.comp's meets. */
+static int meets(const lpv_iv_voxel *h, const int q[3], const float o[3], const float w[3], float t_in, float t_out)
+{
+    if (h->slab[0] < 0.0f)
+        return 1;
+    const int k = (int)h->slab[0];
+    const float x_in = o[k] - (float)q[k] + t_in * w[k], x_out = o[k] - (float)q[k] + t_out * w[k];
+    const float top = x_in > x_out ? x_in : x_out, bottom = x_in < x_out ? x_in : x_out;
+    return top >= h->slab[1] - LPV_IV_SLAB_PAD && bottom <= h->slab[2] + LPV_IV_SLAB_PAD;
+}
+
+/* The radiance march from o (in voxels) along w: every voxel the ray
+ * crosses but c and own, until an occupied one (with surf, one whose slab
+ * it meets: LPV_IV_SURFACE_GATHER) or the grid's edge (LPV_IV_ESCAPED). */
+static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int c[3], const int own[3],
+                       const float o[3], const float w[3], int surf)
+{
+    float inv[3], cross[3];
+    int q[3], st[3];
+    for (int a = 0; a < 3; a++) {
+        q[a] = (int)floorf(o[a]);
+        st[a] = w[a] > 0.0f ? 1 : w[a] < 0.0f ? -1 : 0;
+        inv[a] = fabsf(w[a]) > 1e-12f ? 1.0f / fabsf(w[a]) : 1e30f;
+        cross[a] = (w[a] > 0.0f ? (float)q[a] + 1.0f - o[a] : o[a] - (float)q[a]) * inv[a];
+    }
+    float t = 0.0f;
+    const long max_steps = (long)g->dims[0] + g->dims[1] + g->dims[2] + 3;
+    for (long i = 0; i < max_steps; i++) {
+        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= g->dims[0] || q[1] >= g->dims[1] || q[2] >= g->dims[2])
+            return LPV_IV_ESCAPED;
+        const size_t h = lpv_grid_index(g, q[0], q[1], q[2]);
+        const int a = cross[0] < cross[1] ? (cross[0] < cross[2] ? 0 : 2) : (cross[1] < cross[2] ? 1 : 2);
+        const int skip = (q[0] == c[0] && q[1] == c[1] && q[2] == c[2]) ||
+                         (q[0] == own[0] && q[1] == own[1] && q[2] == own[2]);
+        if (!skip && lpv_iv_occupied(&voxels[h]) && (!surf || meets(&voxels[h], q, o, w, t, cross[a])))
+            return (long)h;
+        t = cross[a];
+        q[a] += st[a];
+        cross[a] += inv[a];
+    }
+    return LPV_IV_ESCAPED;
+}
+
 void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *emit, uint32_t seed, int rays,
                    lpv_cell *incoming)
 {
@@ -536,22 +682,54 @@ void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell
                 memset(out, 0, sizeof *out);
                 if (!near_occupied(g, voxels, x, y, z))
                     continue;
-                double acc[3][4] = {{0.0}};
+                const int c[3] = {x, y, z};
+                const float start = lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]) ? LPV_IV_START : 0.0f;
+                float axis[3] = {0.0f, 0.0f, 0.0f}, side[3] = {0.0f, 0.0f, 0.0f}, origin[3];
+                int own[3] = {x, y, z}, surf = 0;
+                for (int k = 0; k < 3; k++)
+                    origin[k] = (float)c[k] + 0.5f;
+                /* LPV_IV_SURFACE_GATHER: on the slab of the one surface beside it */
+                if (start == 0.0f && surface_beside(g, voxels, c, own, side)) {
+                    const int k = side[0] != 0.0f ? 0 : side[1] != 0.0f ? 1 : 2;
+                    const float *slab = voxels[lpv_grid_index(g, own[0], own[1], own[2])].slab;
+                    surf = slab[0] == (float)k;
+                    if (surf) {
+                        origin[k] = (float)own[k] + (side[k] > 0.0f ? slab[2] : slab[1]) + LPV_IV_SLAB_PAD * side[k];
+                        memcpy(axis, side, sizeof axis); /* LPV_IV_AXIS_L0 */
+                    } else {
+                        memcpy(own, c, sizeof own);
+                    }
+                }
+                double acc[3][4] = {{0.0}}, e_plus[3] = {0.0}, e_minus[3] = {0.0};
                 for (int j = 0; j < rays; j++) {
                     float w[3], yb[4];
                     ray(g, seed, x, y, z, j, rays, w, yb);
-                    long h = lpv_iv_march(g, voxels, x, y, z, w, INFINITY);
+                    long h;
+                    if (surf && w[0] * side[0] + w[1] * side[1] + w[2] * side[2] <= 0.0f) {
+                        h = (long)lpv_grid_index(g, own[0], own[1], own[2]); /* into the surface */
+                    } else {
+                        float o[3];
+                        for (int k = 0; k < 3; k++)
+                            o[k] = surf ? origin[k] : (float)c[k] + 0.5f + start * w[k];
+                        h = march_from(g, voxels, c, own, o, w, surf);
+                    }
                     if (h < 0)
                         continue; /* escaped: no light */
                     const float back[3] = {-w[0], -w[1], -w[2]};
+                    const float up = axis[0] * w[0] + axis[1] * w[1] + axis[2] * w[2];
                     for (int ch = 0; ch < 3; ch++) {
                         float L = lpv_iv_emitted(cchannel(&emit[h], ch), back);
                         if (!(L > 0.0f))
                             continue;
                         for (int k = 0; k < 4; k++)
                             acc[ch][k] += (double)(L * yb[k]);
+                        e_plus[ch] += (double)(L * (up > 0.0f ? up : 0.0f));
+                        e_minus[ch] += (double)(L * (up < 0.0f ? -up : 0.0f));
                     }
                 }
+                if (axis[0] != 0.0f || axis[1] != 0.0f || axis[2] != 0.0f) /* LPV_IV_AXIS_L0 */
+                    for (int ch = 0; ch < 3; ch++)
+                        acc[ch][0] = (e_plus[ch] + e_minus[ch]) / (2.0 * LPV_SH_LOBE0);
                 for (int ch = 0; ch < 3; ch++)
                     for (int k = 0; k < 4; k++)
                         channel(out, ch)[k] = (float)(acc[ch][k] * scale);

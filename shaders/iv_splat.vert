@@ -3,8 +3,10 @@
 // G-buffer (u_source 1). Each is lit here (iv_direct.glsl) and carries its
 // outgoing radiance B / pi over its normal's hemisphere as SH (B = albedo x
 // E_direct + pi x emission), its normal, its albedo, a count of 1 and its
-// folded normal (LPV_IV_FOLD); the
-// atlas sums them and iv_resolve.comp divides by the count.
+// folded normal (LPV_IV_FOLD); the atlas sums them and iv_resolve.comp
+// divides by the count. A cloud point also carries its area, plain and
+// signed by its fold, and every point its place in the voxel to the two
+// attachments that keep the greatest (LPV_IV_COVER).
 layout(std430, binding = LPV_SSBO_IV_POINTS) readonly buffer Points { IvPoint points[]; };
 layout(binding = 0) uniform sampler2D u_gbuf_position;
 layout(binding = 1) uniform sampler2D u_gbuf_normal;
@@ -24,13 +26,16 @@ flat out vec4 v_b;
 flat out vec4 v_n;
 flat out vec4 v_a;
 flat out vec4 v_f;
+flat out vec4 v_hi;
+flat out vec4 v_lo;
 
 void main()
 {
     gl_PointSize = 1.0;
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
-    v_r = v_g = v_b = v_n = v_a = v_f = vec4(0.0);
+    v_r = v_g = v_b = v_n = v_a = v_f = v_hi = v_lo = vec4(0.0);
     vec3 p, n, albedo, emission;
+    float area = 0.0; // m^2; the camera's pixels carry none (LPV_IV_COVER)
     if (u_source == 0) {
         IvPoint q = points[u_first + gl_VertexID];
         if (q.position.w == 0.0)
@@ -39,6 +44,7 @@ void main()
         n = q.normal.xyz;
         albedo = q.albedo.rgb;
         emission = q.emission.rgb;
+        area = q.normal.w;
     } else {
         int cols = (u_gbuf_size.x + u_stride - 1) / u_stride;
         ivec2 t = ivec2(gl_VertexID % cols, gl_VertexID / cols) * u_stride;
@@ -54,7 +60,8 @@ void main()
     if (!finite3(p) || !(len > 1e-8) || isinf(len) || !finite3(albedo) || !finite3(emission))
         return;
     n /= len;
-    ivec3 c = iv_cell_of(p, n);
+    vec3 u = iv_coords_of(p, n);
+    ivec3 c = ivec3(floor(u));
     if (!cell_inside(c))
         return;
     vec3 radiosity = albedo * iv_direct_irradiance(p, n) + LPV_PI * u_emission * emission;
@@ -65,9 +72,15 @@ void main()
     v_g = h * radiosity.g;
     v_b = h * radiosity.b;
     v_n = vec4(n, 1.0);
-    v_a = vec4(albedo, 0.0);
+    if (!(area >= 0.0) || isinf(area))
+        area = 0.0;
+    v_a = vec4(albedo, area);
     vec3 an = abs(n); // LPV_IV_FOLD
-    v_f = vec4((an.x >= an.y && an.x >= an.z ? n.x : an.y >= an.z ? n.y : n.z) >= 0.0 ? n : -n, 0.0);
+    float fs = (an.x >= an.y && an.x >= an.z ? n.x : an.y >= an.z ? n.y : n.z) >= 0.0 ? 1.0 : -1.0;
+    v_f = vec4(fs * n, fs * area);
+    vec3 local = clamp(u - vec3(c), 0.0, 1.0);
+    v_hi = vec4(local, 0.0);
+    v_lo = vec4(1.0 - local, 0.0);
     vec2 texel = vec2(atlas_texel(c, grid_dims().xy)) + 0.5;
     gl_Position = vec4(texel / u_atlas_size * 2.0 - 1.0, 0.0, 1.0);
 }

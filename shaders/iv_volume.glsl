@@ -11,7 +11,9 @@ bool iv_occupied(ivec3 c)
 }
 
 // The voxel a surface point facing n belongs to (LPV_IV_BEHIND).
-ivec3 iv_cell_of(vec3 p, vec3 n) { return ivec3(floor(cascade_coords(0, p) - LPV_IV_BEHIND * n)); }
+// p in voxels from the volume's corner, moved LPV_IV_BEHIND against n
+vec3 iv_coords_of(vec3 p, vec3 n) { return cascade_coords(0, p) - LPV_IV_BEHIND * n; }
+ivec3 iv_cell_of(vec3 p, vec3 n) { return ivec3(floor(iv_coords_of(p, n))); }
 vec3 iv_centre(ivec3 c) { return (vec3(c) + 0.5 + cascade_origin_cells(0)) * grid_cell_size(); }
 
 // The reconstruction at a surface point p facing unit n: move half a voxel

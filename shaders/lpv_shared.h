@@ -275,7 +275,8 @@ struct LpvViewBlock {
  * triangle; the GPU lights it every tick. */
 struct IvPoint {
     vec4 position; /* xyz world (m); w 1 = a point, 0 = skip */
-    vec4 normal;   /* xyz unit interpolated normal of the triangle's front; w unused */
+    vec4 normal;   /* xyz unit interpolated normal of the triangle's front; w the area it stands for (m^2:
+                      its piece's over the piece's points; 0 = not known, LPV_IV_COVER) */
     vec4 albedo;   /* rgb diffuse albedo (the material's base colour); a unused */
     vec4 emission; /* rgb emitted radiance W/(m^2 sr) (0 where area lights carry the emitters); a unused */
 };
@@ -286,8 +287,15 @@ struct IvVoxel {
     vec4 g;        /*   points of B / pi over the hemisphere of the point's normal (B = its  */
     vec4 b;        /*   radiosity, W/m^2), LPV_IV_HEMI0 / LPV_IV_HEMI1 below                 */
     vec4 normal;   /* xyz the mean of the points' unit normals (not unit); w points, 0 = empty */
-    vec4 albedo;   /* rgb the points' mean albedo (the bounces' reflectance); a unused */
-    vec4 fold;     /* xyz the mean of the points' folded normals (LPV_IV_FOLD); w unused */
+    vec4 albedo;   /* rgb the points' mean albedo (the bounces' reflectance); a the cloud's area in the
+                      voxel over a voxel face's (LPV_IV_COVER; 0: not known) */
+    vec4 fold;     /* xyz the mean of the points' folded normals (LPV_IV_FOLD); w as albedo.a, each
+                      point's area signed by its fold (+1: n is its folded normal, -1: -n is) */
+    vec4 extent;   /* xyz the points' extent along x, y, z in voxels (their range, widened by
+                      (N + 1) / (N - 1) for N points, at most 1; 0 for one point); w unused */
+    vec4 slab;     /* the points' extent across their surface (LPV_IV_SLAB): x the axis (0, 1, 2; -1:
+                      none, a block), y, z their least and greatest coordinate on it (voxels from the
+                      voxel's lower corner); w unused */
 };
 
 /* LPV_IV_FOLD: a point's normal n folded to s n, s the sign of its largest
@@ -297,6 +305,44 @@ struct IvVoxel {
  * own radiance along that axis (iv_emit.comp, lpv_iv_emit). */
 #define LPV_IV_ONE_SIDED 0.5f /* the mean normal is the axis when |m| >= this x |folded mean| */
 #define LPV_IV_SIDE_MIN 0.05f /* the least share of a voxel's points a side is divided by */
+/* LPV_IV_COVER: how much of a two-sided voxel's face each side shows. The
+ * SH is the mean over the points, so a side with share c of them shows c of
+ * its radiance; a wall's two faces each cover the whole voxel face and
+ * should show all of theirs. Point counts are no measure of that: the
+ * camera's pixels land on the seen face only (a seen wall's voxel at
+ * 0.7-0.9 of its points) and 4 points a piece split a wall unevenly
+ * between its faces, so a room of 10 cm box walls got 0.91 of the same
+ * room of single quads at one bounce, 0.95 with the camera's pixels left
+ * out (box-walls, thin-walls; 2026-11-28). Where a voxel's points all lie
+ * along one axis (|folded mean| >= LPV_IV_FLAT) and the cloud says how much
+ * area they stand for, each side shows the part of the voxel face it covers:
+ * its area over the face's (every voxel face at least once: a wall is 1),
+ * at most the points' extent across the axis (a stack of slats that cover
+ * a quarter of the face shows a quarter, however many there are), never
+ * less than its share c nor more than all. Both are estimates from a few
+ * random points (a wall's voxel gets its area within about a third and
+ * its extent within a fifth), and taking the smaller of 1 and a noisy
+ * estimate loses light on average, so a side counts as covering the face
+ * once its area reaches LPV_IV_COVER_AREA of it and its extent
+ * LPV_IV_COVER_ACROSS of it (a room of 2 cm double-faced walls then gets
+ * 1.000 of the single-quad room's light at one bounce; 0.927 with both 1).
+ * Elsewhere (corners, curved pieces, hand-made points without area) the
+ * count rule stays: t = 1 - |m| / |f| of the way from c to all. */
+#define LPV_IV_FLAT 0.9f
+#define LPV_IV_COVER_AREA 0.5f
+#define LPV_IV_COVER_ACROSS 0.6f
+/* LPV_IV_SLAB: a voxel whose points' folded normals agree on a lattice
+ * axis (that component of their mean at least LPV_IV_FLAT: a wall, a floor,
+ * both faces of a thin wall) and that lie within LPV_IV_SLAB_MAX voxels of
+ * each other along it holds a slab across it, from their least to their
+ * greatest coordinate on it (IvVoxel.slab). A corner's normals disagree,
+ * and a sliver of another surface in the voxel (a wall's foot in a floor's
+ * voxel) widens the extent past the limit (it is the points' own min and
+ * max): neither has a slab. The surface gather (LPV_IV_SURFACE_GATHER) starts on it and lets its
+ * rays pass the voxels of the same surface beside it where they run clear
+ * of their slab (widened by LPV_IV_SLAB_PAD voxels each way). */
+#define LPV_IV_SLAB_MAX 0.5f
+#define LPV_IV_SLAB_PAD 0.02f
 
 /* The SH of a hemisphere of unit radiance around n, divided by pi:
  * (HEMI0, HEMI1 n.y, HEMI1 n.z, HEMI1 n.x), so radiosity B x this is the SH
@@ -307,6 +353,33 @@ struct IvVoxel {
 /* The march (paper section 3.3): rays start sqrt(3)/2 voxels from the voxel
  * centre (the voxel's bounding sphere) and step one voxel. */
 #define LPV_IV_START 0.86602540378443865f
+/* LPV_IV_AXIS_L0: the 2-band irradiance R0 + R1.n (R0 the L0 term, R1 the
+ * dipole) flattens the cosine: it gives 3/4 of a source straight along n and
+ * 1/4 of one at grazing, and weighs the light from behind a surface by
+ * 1/4 - |cos|/2. With the path tracer's own radiance in box-walls' room
+ * (a lamp under the ceiling, 2026-11-28) that made the floor 0.82-0.88 of
+ * its 1-bounce irradiance and the ceiling 1.08-1.12, and a sunlit floor
+ * seen from above with little else in view (the courtyard) read its own
+ * light from behind as none or less (black patches on the ground). The
+ * dipole already gives E(a) - E(-a) exactly for any axis a (both are the
+ * rays' first moment), so an empty voxel that gathers on a surface
+ * (LPV_IV_SURFACE_GATHER: over a floor, beside a wall) sets R0 = (E(a) + E(-a)) / 2 from the rays'
+ * exact cosine sums along the axis a from that surface to it (its
+ * normal): the volume is then exact for the surface beside it and
+ * keeps the linear fit around that R0 for other normals. Other voxels keep
+ * the projection's R0 (along an edge's diagonal the exact sums weigh the
+ * corner voxels most, which show 0.85 of a uniform radiance there: the
+ * furnace's edge voxels got 0.95 of it). */
+/* LPV_IV_SURFACE_GATHER: an empty voxel with one occupied face neighbour
+ * (a floor's voxel under it) gathers on that surface, not at its own centre
+ * up to a voxel and a half away from it: irradiance changes with the height
+ * above a floor (box-walls: +9 % at half a voxel, +23 % at one and a half
+ * with the path tracer), and the lookups it serves are on the surface. Its
+ * rays start on the slab's face towards the voxel (LPV_IV_SLAB); those into
+ * the surface see the surface voxel's own light, the others go on through
+ * it and through the voxels of the same surface where they run clear of its
+ * slab. Without a slab on that axis (a corner, a tilted piece), the voxel's
+ * centre as before. */
 /* Where a sample lands in the LPV (docs/propagation.md §2): a VPL in the cell
  * holding its position moved LPV_VPL_SHIFT_CELLS cells along its normal, a
  * surfel on the geometry-volume point nearest its position moved

@@ -843,11 +843,127 @@ static void test_two_sided_wall(void **state)
     free(in);
 }
 
+/* LPV_IV_COVER, with the cloud's areas. One voxel (1 m) holds a wall's two
+ * faces: the lit one (B = 1, facing +x) with 12 points, the dark one with 4,
+ * each face 1 m^2. Each side shows its own radiance, 1 / pi towards +x: the
+ * count rule showed c + t (1 - c) = 0.875 of it (c = 0.75, t = 1 - |m| / |f|
+ * = 0.5). A stack of three slats a quarter of the voxel deep (tops lit,
+ * B = 1, bottoms dark, equal counts): the tops cover a quarter of the face
+ * seen from above, and the voxel shows at most 0.6 of their radiance
+ * upwards (their share 1/2, the extent's cap), where the count rule (t = 1)
+ * showed all of it over the whole face. */
+static void test_cover_from_areas(void **state)
+{
+    (void)state;
+    lpv_grid g = {{3, 3, 3}, {0.0f, 0.0f, 0.0f}, 1.0f};
+    const size_t cells = lpv_grid_cell_count(&g);
+    const float alb[3] = {0.5f, 0.5f, 0.5f};
+    lpv_iv_point pts[64];
+    float B[64][3];
+    size_t n = 0;
+    for (int side = 0; side < 2; side++) {
+        const int count = side == 0 ? 12 : 4;
+        for (int k = 0; k < count; k++) {
+            const float p[3] = {1.45f + 0.1f * (float)side, 1.05f + 0.9f * (float)(k % 4) / 3.0f,
+                                1.05f + 0.9f * (float)(k / 4) / (float)(count / 4 > 1 ? count / 4 - 1 : 1)};
+            const float nrm[3] = {side == 0 ? 1.0f : -1.0f, 0.0f, 0.0f};
+            pts[n] = point(p, nrm, alb);
+            pts[n].normal[3] = 1.0f / (float)count; /* m^2: the face over its points */
+            B[n][0] = B[n][1] = B[n][2] = side == 0 ? 1.0f : 0.0f;
+            n++;
+        }
+    }
+    lpv_iv_voxel *vox = xcalloc(cells, sizeof *vox);
+    lpv_cell *emit = xcalloc(cells, sizeof *emit);
+    assert_int_equal(lpv_iv_create(&g, pts, (const float(*)[3])B, n, vox, NULL), 0);
+    lpv_iv_emit(&g, vox, NULL, 1, 8, emit);
+    const lpv_cell *e = &emit[lpv_grid_index(&g, 1, 1, 1)];
+    const float wall = sent(e, 1.0f, 0.0f, 0.0f) * (float)TWO_SIDED_PI;
+    print_message("wall, 12 + 4 points: +x side shows %.4f of its radiance\n", (double)wall);
+    assert_true(fabsf(wall - 1.0f) < 0.02f);
+
+    n = 0;
+    for (int slat = 0; slat < 3; slat++)
+        for (int side = 0; side < 2; side++)
+            for (int k = 0; k < 4; k++) {
+                const float y = 1.2f + 0.3f * (float)slat + (side == 0 ? 0.01f : -0.01f);
+                const float p[3] = {1.02f + 0.2f * (float)(k % 2), y, 1.1f + 0.8f * (float)(k / 2)};
+                const float nrm[3] = {0.0f, side == 0 ? 1.0f : -1.0f, 0.0f};
+                pts[n] = point(p, nrm, alb);
+                pts[n].normal[3] = 0.25f / 4.0f; /* a slat face, 0.25 x 1 m, over its 4 points */
+                B[n][0] = B[n][1] = B[n][2] = side == 0 ? 1.0f : 0.0f;
+                n++;
+            }
+    assert_int_equal(lpv_iv_create(&g, pts, (const float(*)[3])B, n, vox, NULL), 0);
+    lpv_iv_emit(&g, vox, NULL, 1, 8, emit);
+    const float up = sent(&emit[lpv_grid_index(&g, 1, 1, 1)], 0.0f, 1.0f, 0.0f) * (float)TWO_SIDED_PI;
+    print_message("three slats a quarter deep: the tops show %.4f of their radiance upwards\n", (double)up);
+    assert_true(up >= 0.45f && up <= 0.6f);
+    free(vox);
+    free(emit);
+}
+
+/* LPV_IV_AXIS_L0 and LPV_IV_SURFACE_GATHER: a dark 9 x 9 m floor under a
+ * lit ceiling of the same size 15.9 m above it, nothing else. The
+ * irradiance on the floor's middle is E = L int h^2 / r^4 over the ceiling
+ * (L = B / pi). The 2-band projection gives about 3/4 of a light this
+ * concentrated (its irradiance is R0 + R1.n, 1/4 + cos / 2 of each ray), and
+ * gathering at the centre of the voxel above the floor, 1.4 m nearer the
+ * light, about 1.2 times it: 0.90 of E before; on the floor, with the rays'
+ * exact cosine sums, E. */
+static void test_concentrated_light_overhead(void **state)
+{
+    (void)state;
+    lpv_grid g = {{9, 17, 9}, {0.0f, 0.0f, 0.0f}, 1.0f};
+    const size_t cells = lpv_grid_cell_count(&g);
+    const float alb[3] = {0.5f, 0.5f, 0.5f}, Bpatch = 10.0f;
+    const int per = 4;
+    size_t n = 0, cap = (size_t)2 * 81 * per * per;
+    lpv_iv_point *pts = xcalloc(cap, sizeof *pts);
+    float(*B)[3] = xcalloc(cap, sizeof *B);
+    for (int layer = 0; layer < 2; layer++)
+        for (int i = 0; i < 9 * per; i++)
+            for (int j = 0; j < 9 * per; j++) {
+                const float x = ((float)i + 0.5f) / (float)per, z = ((float)j + 0.5f) / (float)per;
+                const float p[3] = {x, layer == 0 ? 0.1f : 16.02f, z};
+                const float nrm[3] = {0.0f, layer == 0 ? 1.0f : -1.0f, 0.0f};
+                pts[n] = point(p, nrm, alb);
+                B[n][0] = B[n][1] = B[n][2] = layer == 1 ? Bpatch : 0.0f;
+                n++;
+            }
+    lpv_iv_desc d = {g, pts, (const float(*)[3])B, n, 3u, 16384, 1, 8, 0};
+    lpv_iv_voxel *vox = xcalloc(cells, sizeof *vox);
+    lpv_cell *I = xcalloc(cells, sizeof *I);
+    char err[256] = "";
+    if (lpv_iv_run(&d, vox, I, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    const double h = 16.02 - 0.1, L = Bpatch / TWO_SIDED_PI;
+    double want = 0.0;
+    const int steps = 200;
+    for (int i = 0; i < steps; i++)
+        for (int j = 0; j < steps; j++) {
+            const double x = -4.5 + 9.0 * (i + 0.5) / steps, z = -4.5 + 9.0 * (j + 0.5) / steps;
+            const double r2 = x * x + z * z + h * h;
+            want += L * h * h / (r2 * r2) * (81.0 / (steps * steps));
+        }
+    const float p[3] = {4.5f, 0.1f, 4.5f}, up[3] = {0.0f, 1.0f, 0.0f};
+    float E[3];
+    lpv_iv_irradiance(&g, vox, I, p, up, 8, E);
+    print_message("floor under a lit ceiling: E %.4f W/m^2, want %.4f (%.3f)\n", (double)E[0], want, E[0] / want);
+    assert_true(fabs(E[0] / want - 1.0) < 0.05);
+    free(pts);
+    free(B);
+    free(vox);
+    free(I);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_create_means),
         cmocka_unit_test(test_two_sided_wall),
+        cmocka_unit_test(test_cover_from_areas),
+        cmocka_unit_test(test_concentrated_light_overhead),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_furnace_tail),
         cmocka_unit_test(test_energy_albedo_one),

@@ -12,8 +12,12 @@
 #include "gl_util.h"
 #include "technique.h"
 
-/* The atlas's attachments: r, g, b SH sums, normal + count, albedo, folded normal. */
-#define IV_ATTACHMENTS 6
+/* The atlas's attachments: r, g, b SH sums, normal + count, albedo + area,
+ * folded normal + signed area (added), then the points' greatest place in
+ * the voxel and 1 - their least (from IV_ATTACHMENT_MAX on: the greatest
+ * kept; LPV_IV_COVER). */
+#define IV_ATTACHMENTS 8
+#define IV_ATTACHMENT_MAX 6
 
 typedef struct lpv_iv_gpu {
     lpv_technique base;

@@ -24,6 +24,8 @@ void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
     const lpv_plan *p = in->plan;
     GLuint prog = v->prog_splat;
     lpv_atlas_begin(&v->atlas, prog, v->grid_ubo, v->empty_vao);
+    for (GLuint i = IV_ATTACHMENT_MAX; i < IV_ATTACHMENTS; ++i)
+        glBlendEquationi(i, GL_MAX); /* the points' extent (LPV_IV_COVER); the atlas was cleared to 0 */
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
     glActiveTexture(GL_TEXTURE0 + 5);
     glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
@@ -84,6 +86,7 @@ void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int a
     glUseProgram(prog);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_VOXELS, v->voxels);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_EMIT, v->emit);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, out);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_AO, v->ao);

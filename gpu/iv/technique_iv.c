@@ -115,9 +115,9 @@ static void memory_need(const lpv_technique *t, lpv_memory_need *n)
 {
     const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
     const lpv_grid *g = v->cells ? &v->grid : &v->pending;
-    /* per voxel: the atlas (6 x 16), IvVoxel (96), emission, two radiance
-     * volumes and the tail's base (4 x 48), AO (16): 400 bytes, within one
-     * LPV cell's */
+    /* per voxel: the atlas (8 x 16), IvVoxel (128), emission, two radiance
+     * volumes and the tail's base (4 x 48), AO (16): 464 bytes, within one
+     * LPV cell's (LPV_MEM_CELL) */
     n->cells += lpv_grid_cell_count(g);
     n->cascades = 1;
     memcpy(n->grid_dims, g->dims, sizeof n->grid_dims);
