@@ -241,7 +241,7 @@ typedef struct lpv_settings {
 #define LPV_IV_DEFAULT_SPLIT 1.0f
 #define LPV_IV_DEFAULT_SEED 1
 #define LPV_IV_DEFAULT_RAYS 128
-#define LPV_IV_DEFAULT_BOUNCES 3
+#define LPV_IV_DEFAULT_BOUNCES 4
 #define LPV_IV_DEFAULT_NEIGHBOURS 8
 #define LPV_IV_AO_VOXELS 4.0f
 #define LPV_IV_DEFAULT_MAX_POINTS (1 << 20)

@@ -123,7 +123,7 @@ static const lpv_field FIELDS[] = {
      "random seed of the points and the rays", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
     {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", "128", "",
      "stratified rays marched per voxel", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", "3", "",
+    {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", "4", "",
      "diffuse bounces (ping-pong passes over two volumes)", T_VOL, LPV_TECHNIQUE_IV},
     {"iv_tail", "iv-tail", LPV_FIELD_SWITCH, F(iv.tail), 0, 1, 0, "", "on", "",
      "the bounces after iv_bounces (3 or more) as the series the last ones set", T_VOL, LPV_TECHNIQUE_IV},

@@ -533,7 +533,7 @@ static lpv_plan plan_iv(lpv_settings s, lpv_plan_facts f)
 
 /* The imperfect volume's plan: its own passes, none of the LPV's, the RSMs
  * for the points' shadows, the G-buffer only for reprojection, and reasons a
- * user can read ("iv: 3 bounces requested", "reprojection skipped: no camera"). */
+ * user can read ("iv: 4 bounces requested", "reprojection skipped: no camera"). */
 static void test_iv_plan(void **state)
 {
     (void)state;
@@ -554,7 +554,7 @@ static void test_iv_plan(void **state)
     assert_string_equal(p.pass[LPV_PASS_IV_REPROJECT].reason, "reprojection skipped: no camera");
     assert_false(p.pass[LPV_PASS_GBUFFER].run);
     assert_true(p.pass[LPV_PASS_IV_GATHER].run);
-    assert_non_null(strstr(p.pass[LPV_PASS_IV_GATHER].reason, "iv: 3 bounces requested"));
+    assert_non_null(strstr(p.pass[LPV_PASS_IV_GATHER].reason, "iv: 4 bounces requested"));
     assert_false(p.pass[LPV_PASS_IV_AO].run);
     assert_int_equal(p.cascades, 1);
 
