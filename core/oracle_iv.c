@@ -83,19 +83,20 @@ int lpv_iv_surface_voxel_of(const lpv_grid *g, const float p[3], const float n[3
 
 /* 1 when any voxel of the 3x3x3 block around (x, y, z), itself included and
  * clipped to the grid, is occupied. */
+/* 1 when voxel (x, y, z) is inside the grid and holds a surface. */
+static int occupied_at(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
+{
+    return x >= 0 && y >= 0 && z >= 0 && x < g->dims[0] && y < g->dims[1] && z < g->dims[2] &&
+           lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]);
+}
+
 static int near_occupied(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
 {
-    for (int dz = -1; dz <= 1; dz++) {
-        for (int dy = -1; dy <= 1; dy++) {
-            for (int dx = -1; dx <= 1; dx++) {
-                int a = x + dx, b = y + dy, c = z + dz;
-                if (a < 0 || b < 0 || c < 0 || a >= g->dims[0] || b >= g->dims[1] || c >= g->dims[2])
-                    continue;
-                if (lpv_iv_occupied(&voxels[lpv_grid_index(g, a, b, c)]))
+    for (int dz = -1; dz <= 1; dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++)
+                if (occupied_at(g, voxels, x + dx, y + dy, z + dz))
                     return 1;
-            }
-        }
-    }
     return 0;
 }
 
@@ -545,41 +546,6 @@ void lpv_iv_emit(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *
 
 /* ---- The march (3.3, 3.5) -------------------------------------------------- */
 
-long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z, const float w[3], float reach)
-{
-    const float s = g->cell_size;
-    const int v[3] = {x, y, z};
-    /* in voxels: occupied voxels start LPV_IV_START out (their own surface),
-     * empty ones at the centre; then every voxel the ray crosses
-     * (Amanatides & Woo), as iv_gather.comp walks them */
-    const float start = lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]) ? LPV_IV_START : 0.0f;
-    float o[3], inv[3], cross[3];
-    int q[3], st[3];
-    for (int a = 0; a < 3; a++) {
-        o[a] = (float)v[a] + 0.5f + start * w[a];
-        q[a] = (int)floorf(o[a]);
-        st[a] = w[a] > 0.0f ? 1 : w[a] < 0.0f ? -1 : 0;
-        inv[a] = fabsf(w[a]) > 1e-12f ? 1.0f / fabsf(w[a]) : 1e30f;
-        cross[a] = (w[a] > 0.0f ? (float)q[a] + 1.0f - o[a] : o[a] - (float)q[a]) * inv[a];
-    }
-    const float reach_voxels = reach / s;
-    float t = start;
-    const long max_steps = (long)g->dims[0] + g->dims[1] + g->dims[2] + 3;
-    for (long i = 0; i < max_steps; i++) {
-        if (t > reach_voxels)
-            return LPV_IV_BEYOND;
-        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= g->dims[0] || q[1] >= g->dims[1] || q[2] >= g->dims[2])
-            return LPV_IV_ESCAPED;
-        size_t h = lpv_grid_index(g, q[0], q[1], q[2]);
-        if (!(q[0] == v[0] && q[1] == v[1] && q[2] == v[2]) && lpv_iv_occupied(&voxels[h]))
-            return (long)h;
-        int a = cross[0] < cross[1] ? (cross[0] < cross[2] ? 0 : 2) : (cross[1] < cross[2] ? 1 : 2);
-        t = start + cross[a];
-        q[a] += st[a];
-        cross[a] += inv[a];
-    }
-    return LPV_IV_ESCAPED;
-}
 
 float lpv_iv_emitted(const float e[4], const float t[3])
 {
@@ -598,12 +564,6 @@ static void ray(const lpv_grid *g, uint32_t seed, int x, int y, int z, int j, in
     lpv_iv_ray(seed, (uint32_t)lpv_grid_index(g, x, y, z), (uint32_t)j, (uint32_t)rays, dir);
     const float back[3] = {-dir[0], -dir[1], -dir[2]};
     basis(back, y4);
-}
-
-static int occupied_at(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
-{
-    return x >= 0 && y >= 0 && z >= 0 && x < g->dims[0] && y < g->dims[1] && z < g->dims[2] &&
-           lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]);
 }
 
 /* c's one occupied face neighbour own (and the unit axis side from it to c),
@@ -639,11 +599,13 @@ static int meets(const lpv_iv_voxel *h, const int q[3], const float o[3], const 
     return top >= h->slab[1] - LPV_IV_SLAB_PAD && bottom <= h->slab[2] + LPV_IV_SLAB_PAD;
 }
 
-/* The radiance march from o (in voxels) along w: every voxel the ray
- * crosses but c and own, until an occupied one (with surf, one whose slab
- * it meets: LPV_IV_SURFACE_GATHER) or the grid's edge (LPV_IV_ESCAPED). */
+/* The march from o (in voxels) along w (Amanatides & Woo, as iv_gather.comp
+ * walks it): every voxel the ray crosses but c and own, until an occupied
+ * one (with surf, one whose slab it meets: LPV_IV_SURFACE_GATHER), the
+ * grid's edge (LPV_IV_ESCAPED) or, entering a voxel more than reach voxels
+ * from the start (start + the distance from o), LPV_IV_BEYOND. */
 static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int c[3], const int own[3],
-                       const float o[3], const float w[3], int surf)
+                       const float o[3], const float w[3], int surf, float start, float reach)
 {
     float inv[3], cross[3];
     int q[3], st[3];
@@ -656,6 +618,8 @@ static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int 
     float t = 0.0f;
     const long max_steps = (long)g->dims[0] + g->dims[1] + g->dims[2] + 3;
     for (long i = 0; i < max_steps; i++) {
+        if (start + t > reach)
+            return LPV_IV_BEYOND;
         if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= g->dims[0] || q[1] >= g->dims[1] || q[2] >= g->dims[2])
             return LPV_IV_ESCAPED;
         const size_t h = lpv_grid_index(g, q[0], q[1], q[2]);
@@ -669,6 +633,18 @@ static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int 
         cross[a] += inv[a];
     }
     return LPV_IV_ESCAPED;
+}
+
+long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z, const float w[3], float reach)
+{
+    /* occupied voxels start LPV_IV_START out (their own surface), empty
+     * ones at the centre */
+    const int c[3] = {x, y, z};
+    const float start = lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]) ? LPV_IV_START : 0.0f;
+    float o[3];
+    for (int a = 0; a < 3; a++)
+        o[a] = (float)c[a] + 0.5f + start * w[a];
+    return march_from(g, voxels, c, c, o, w, 0, start, reach / g->cell_size);
 }
 
 void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *emit, uint32_t seed, int rays,
@@ -711,7 +687,7 @@ void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell
                         float o[3];
                         for (int k = 0; k < 3; k++)
                             o[k] = surf ? origin[k] : (float)c[k] + 0.5f + start * w[k];
-                        h = march_from(g, voxels, c, own, o, w, surf);
+                        h = march_from(g, voxels, c, own, o, w, surf, start, INFINITY);
                     }
                     if (h < 0)
                         continue; /* escaped: no light */

@@ -338,9 +338,9 @@ struct IvVoxel {
  * greatest coordinate on it (IvVoxel.slab). A corner's normals disagree,
  * and a sliver of another surface in the voxel (a wall's foot in a floor's
  * voxel) widens the extent past the limit (it is the points' own min and
- * max): neither has a slab. The surface gather (LPV_IV_SURFACE_GATHER) starts on it and lets its
- * rays pass the voxels of the same surface beside it where they run clear
- * of their slab (widened by LPV_IV_SLAB_PAD voxels each way). */
+ * max): neither has a slab. The surface gather (LPV_IV_SURFACE_GATHER)
+ * starts on it, and its rays pass every occupied voxel whose slab they run
+ * clear of (widened by LPV_IV_SLAB_PAD voxels each way). */
 #define LPV_IV_SLAB_MAX 0.5f
 #define LPV_IV_SLAB_PAD 0.02f
 
@@ -377,8 +377,7 @@ struct IvVoxel {
  * with the path tracer), and the lookups it serves are on the surface. Its
  * rays start on the slab's face towards the voxel (LPV_IV_SLAB); those into
  * the surface see the surface voxel's own light, the others go on through
- * it and through the voxels of the same surface where they run clear of its
- * slab. Without a slab on that axis (a corner, a tilted piece), the voxel's
+ * it and through every occupied voxel whose slab they run clear of. Without a slab on that axis (a corner, a tilted piece), the voxel's
  * centre as before. */
 /* Where a sample lands in the LPV (docs/propagation.md §2): a VPL in the cell
  * holding its position moved LPV_VPL_SHIFT_CELLS cells along its normal, a
