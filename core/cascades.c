@@ -12,7 +12,7 @@
 _Static_assert(LPV_MAX_CASCADES == 4, "lpv_cascade_set's arrays hold LPV_MAX_CASCADES entries");
 
 int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
-                       const float *forward, lpv_cascade_set *out)
+                       const float *forward, float view_chord, lpv_cascade_set *out)
 {
     memset(out, 0, sizeof *out);
     if (count < 1 || count > LPV_MAX_CASCADES)
@@ -73,7 +73,7 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
             anchor[i] = enters ? eye[i] + forward[i] * t0 : fmin(fmax(eye[i], bmin[i]), bmax[i]);
     }
     const double offset = s->lpv.cascade_offset > 0.0f ? s->lpv.cascade_offset : 0.0;
-    double cell = (double)lpv_cascade_finest_size(s, bmin, bmax) / longest;
+    double cell = (double)lpv_cascade_finest_size(s, bmin, bmax, view_chord) / longest;
     for (int k = 0; k < count; ++k, cell *= s->lpv.cascade_ratio) {
         lpv_grid *g = &out->grid[k];
         memcpy(g->dims, s->grid_dims, sizeof g->dims);
@@ -101,7 +101,8 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
     return 0;
 }
 
-int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], char *why, size_t n)
+int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], float view_chord, char *why,
+                     size_t n)
 {
     int longest = 1;
     double reach = 0.0;
@@ -109,7 +110,7 @@ int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bma
         longest = s->grid_dims[i] > longest ? s->grid_dims[i] : longest;
         reach = fmax(reach, fmax(fabs((double)bmin[i]), fabs((double)bmax[i])));
     }
-    const double cell = (double)lpv_cascade_finest_size(s, bmin, bmax) / longest;
+    const double cell = (double)lpv_cascade_finest_size(s, bmin, bmax, view_chord) / longest;
     /* lpv_cascades_place: the anchor lies in the bounds, the origin half a grid below it */
     const double room = LPV_CASCADE_MAX_ORIGIN_CELLS - longest / 2 - 1;
     if (isfinite(reach) && cell > 0.0 && reach / cell + 1.0 <= room)
@@ -137,7 +138,7 @@ float lpv_cascade_cross_section(const float bmin[3], const float bmax[3])
     return second > 0.0f && isfinite(longest) && longest >= LPV_CASCADE_LONG_RATIO * second ? second : 0.0f;
 }
 
-float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3])
+float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3], float view_chord)
 {
     if (s->lpv.cascade_size > 0.0f)
         return s->lpv.cascade_size;
@@ -147,14 +148,24 @@ float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const 
     if (!(longest > 0.0f) || !isfinite(longest))
         return 1.0f;
     const float quarter = LPV_CASCADE_AUTO_FRACTION * longest;
-    /* a long scene (a tunnel): cells about as wide as its cross-section, not
-     * a quarter of its length over the grid (a 240 m x 3 m tunnel at 8^3 had
-     * 7.5 m cells, wider than the tunnel, and carried a fifth of the
-     * reference's indirect light; docs/cascades.md, "Long scenes") */
-    const float cross = lpv_cascade_cross_section(bmin, bmax);
     int cells = 1;
     for (int i = 0; i < 3; ++i)
         cells = s->grid_dims[i] > cells ? s->grid_dims[i] : cells;
+    /* the space the camera stands in, measured (core/reach.h): cells about
+     * as wide as it (LPV_VIEW_ACROSS x its median chord), the
+     * quarter divided by the nearest power of sqrt(2), so the size changes
+     * only when the camera walks into a space 1.4 times as large or small (docs/cascades.md, "Long
+     * scenes": a 240 m x 3 m tunnel at 8^3 had 7.5 m cells, wider than
+     * the tunnel, and a fifth of the reference's indirect light) */
+    if (view_chord > 0.0f) {
+        const double fitted = (double)cells * LPV_VIEW_ACROSS * (double)view_chord;
+        if (!isfinite(fitted) || fitted >= (double)quarter)
+            return quarter;
+        const double steps = floor(2.0 * log2((double)quarter / fitted) + 0.5); /* half octaves */
+        return (float)((double)quarter * pow(2.0, -0.5 * fmin(steps, 60.0)));
+    }
+    /* no measure (no camera inside, no voxels): a long scene's bounds */
+    const float cross = lpv_cascade_cross_section(bmin, bmax);
     const float fitted = (float)cells * LPV_CASCADE_LONG_CELL * cross;
     return cross > 0.0f && fitted < quarter ? fitted : quarter;
 }

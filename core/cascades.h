@@ -37,7 +37,7 @@ typedef struct lpv_cascade_set {
 
 /* Places `count` (1..LPV_MAX_CASCADES) cascades for resolved settings s over
  * the scene bounds [bmin, bmax]; eye and forward (unit) may be NULL (no
- * camera). Returns 0, or -1 when a grid cannot be placed (non-finite input,
+ * camera); view_chord as lpv_cascade_finest_size's. Returns 0, or -1 when a grid cannot be placed (non-finite input,
  * dims out of range).
  *
  * Far field (s->lpv.far_field on, L = s->lpv.far_field_levels): one grid over the bounds gets L coarser
@@ -46,19 +46,20 @@ typedef struct lpv_cascade_set {
  * cells are unions of 2^3 cells of level k - 1 (at most LPV_MAX_CASCADES in
  * all); camera-following cascades hand off when their ratio is 2. */
 int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], const float bmax[3], const float *eye,
-                       const float *forward, lpv_cascade_set *out);
+                       const float *forward, float view_chord, lpv_cascade_set *out);
 
 /* A snapped cascade's origin is a whole number of its cells held in a float:
  * exact up to 2^24, and 1e7 leaves room for the grid's own cells. */
 #define LPV_CASCADE_MAX_ORIGIN_CELLS 1e7
 
 /* 1 when snapped cascades of settings s (more than one; their finest cell:
- * lpv_cascade_finest_size / the longest grid side) can be placed wherever
+ * lpv_cascade_finest_size(s, bmin, bmax, view_chord) / the longest grid side) can be placed wherever
  * the camera stands over the scene bounds [bmin, bmax]: the finest cascade's
  * origin, counted in its cells, stays within LPV_CASCADE_MAX_ORIGIN_CELLS.
  * Else 0, with the reason in why: the cell size, how far from the origin
  * the scene reaches, and the smallest cascade_size that fits. */
-int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], char *why, size_t n);
+int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], float view_chord, char *why,
+                     size_t n);
 
 /* How many grids lpv_cascades_place(s, count, ...) places: count, or for one
  * grid over the bounds with the far field on 1 + far_field_levels (at most
@@ -67,11 +68,14 @@ int lpv_cascades_count(const lpv_settings *s, int count);
 
 /* The finest cascade's extent (m): cascade_size, or with cascade_size 0
  * (auto) LPV_CASCADE_AUTO_FRACTION x the longest side of [bmin, bmax]
- * (1 when that is empty); for a long scene (lpv_cascade_cross_section) the
- * smaller of that and the grid's longest axis x LPV_CASCADE_LONG_CELL x the
- * cross-section, so a cell is about as wide as the scene across
- * (docs/cascades.md, "Long scenes"). */
-float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3]);
+ * (1 when that is empty), made smaller where the space around the camera
+ * is: view_chord (m, lpv_reach_view_chord at the eye; 0 = not measured,
+ * INFINITY = open) gives cells of about LPV_VIEW_ACROSS x it, the
+ * quarter divided by the nearest whole power of sqrt(2) (never more than
+ * the quarter). Not measured, a long scene (lpv_cascade_cross_section) gets
+ * the grid's longest axis x LPV_CASCADE_LONG_CELL x its cross-section
+ * from its bounds (docs/cascades.md, "Long scenes and narrow spaces"). */
+float lpv_cascade_finest_size(const lpv_settings *s, const float bmin[3], const float bmax[3], float view_chord);
 
 /* A long scene's cross-section (m): the second-longest side of [bmin, bmax]
  * when the longest is at least LPV_CASCADE_LONG_RATIO x it (a tunnel, a

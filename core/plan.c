@@ -5,6 +5,8 @@
  */
 #include "plan.h"
 
+#include <math.h>
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -81,6 +83,14 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
         say(reason, n, "the camera stands outside the scene (%.3g m): one grid over all of it",
             (double)f->scene_extent);
         return 1;
+    }
+    /* the space the camera stands in (core/reach.h), whatever the bounds: a
+     * tunnel under a wide terrain, a corridor of a level */
+    if (f->view_chord > 0.0f && isfinite(f->view_chord) &&
+        f->cascade_finest < LPV_CASCADE_AUTO_FRACTION * f->scene_extent * 0.999f) {
+        say(reason, n, "the camera's space is %.3g m across (median chord) in a %.3g m scene: cascades from %.3g m",
+            (double)f->view_chord, (double)f->scene_extent, (double)f->cascade_finest);
+        return LPV_DEFAULT_CASCADES;
     }
     if (f->scene_extent < LPV_CASCADE_WIDE_RATIO * f->scene_shortest) {
         say(reason, n, "the camera is inside a scene of similar sides (%.3g m, shortest %.3g m): one grid over it",
@@ -352,16 +362,19 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
         lpv_grid g;
         const float voxel = lpv_iv_place(&placed, origin, ext, f->free_path, &g) == 0 ? g.cell_size
                                                                                        : f->scene_extent / (float)res;
-        const float across = f->scene_middle / voxel;
+        /* across the scene's middle axis, or the space the camera stands in
+         * where that is narrower (a tunnel under wide ground) */
+        const float room = f->view_chord > 0.0f ? LPV_VIEW_ACROSS * f->view_chord : INFINITY;
+        const float width = room < f->scene_middle ? room : f->scene_middle;
+        const char *whose = room < f->scene_middle ? "camera's space" : "scene";
+        const float across = width / voxel;
         if (across < LPV_AUTO_IV_MIN_VOXELS_ACROSS) {
-            say(why, n,
-                "auto: the cascaded LPV: iv's %.3g m voxels (iv_resolution %d over %.4g m) fit %.2g times across "
-                "the scene's %.3g m, under %.3g",
-                voxel, res, f->scene_extent, across, f->scene_middle, LPV_AUTO_IV_MIN_VOXELS_ACROSS);
+            say(why, n, "auto: the cascaded LPV: iv's %.3g m voxels (iv_resolution %d) fit %.2g times across the %s "
+                "(%.3g m), under %.3g", voxel, res, across, whose, width, LPV_AUTO_IV_MIN_VOXELS_ACROSS);
             return LPV_TECHNIQUE_ID_LPV;
         }
-        say(why, n, "auto: the imperfect volume: its %.3g m voxels fit %.3g times across the scene's %.3g m (preset %s)",
-            voxel, across, f->scene_middle, lpv_preset_name(s->preset));
+        say(why, n, "auto: the imperfect volume: its %.3g m voxels fit %.3g times across the %s (%.3g m; preset %s)",
+            voxel, across, whose, width, lpv_preset_name(s->preset));
         return LPV_TECHNIQUE_ID_IV;
     }
     say(why, n, "auto: the imperfect volume, the most accurate technique of the accuracy set (preset %s)",

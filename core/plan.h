@@ -50,6 +50,8 @@ typedef struct lpv_plan_facts {
     float scene_shortest;      /* m, the scene bounds' shortest axis */
     float scene_middle;        /* m, the scene bounds' middle axis (the second longest: a tunnel's
                                   width, a room's depth) */
+    float view_chord;          /* m, how wide the space is around a camera inside the scene
+                                  (lpv_reach_view_chord; 0 = not measured, INFINITY = open) */
     float cascade_finest;      /* m, the finest cascade's extent (lpv_cascade_finest_size) */
     float scene_cross;         /* m, a long scene's cross-section (lpv_cascade_cross_section), else 0 */
     int bounds_given;          /* the settings fix the grid bounds */

@@ -380,6 +380,60 @@ int lpv_reach_solid_within(const lpv_reach *r, const float p[3], float within)
     return 0;
 }
 
+/* How far from o (a point inside the grid, in voxels) along unit w a ray
+ * runs before it enters a solid voxel, in voxels (Amanatides & Woo);
+ * INFINITY when it leaves the grid first. */
+static double free_run(const lpv_reach *r, const double o[3], const float w[3])
+{
+    int q[3], st[3];
+    double next[3], step[3];
+    for (int a = 0; a < 3; ++a) {
+        q[a] = (int)floor(o[a]);
+        st[a] = w[a] > 0.0f ? 1 : -1;
+        step[a] = fabs((double)w[a]) > 1e-12 ? 1.0 / fabs((double)w[a]) : INFINITY;
+        next[a] = w[a] > 0.0f ? ((double)q[a] + 1.0 - o[a]) * step[a] : (o[a] - (double)q[a]) * step[a];
+    }
+    double t = 0.0;
+    for (;;) {
+        for (int a = 0; a < 3; ++a)
+            if (q[a] < 0 || q[a] >= r->dims[a])
+                return INFINITY;
+        if (r->label[voxel_index(r, q[0], q[1], q[2])] == 0)
+            return t;
+        const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+        t = next[a];
+        next[a] += step[a];
+        q[a] += st[a];
+    }
+}
+
+static int compare_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+float lpv_reach_view_chord(const lpv_reach *r, const float p[3])
+{
+    if (!r->label || !(r->voxel > 0.0f))
+        return 0.0f;
+    const long v = voxel_at(r, p);
+    if (v < 0 || r->label[v] == 0)
+        return 0.0f;
+    double o[3], run[LPV_REACH_VIEW_RAYS];
+    for (int k = 0; k < 3; ++k)
+        o[k] = ((double)p[k] - (double)r->origin[k]) / (double)r->voxel;
+    for (uint32_t j = 0; j < LPV_REACH_VIEW_RAYS; ++j) {
+        float w[3];
+        lpv_iv_ray(1u, 0u, j, LPV_REACH_VIEW_RAYS, w);
+        const float back[3] = {-w[0], -w[1], -w[2]};
+        run[j] = free_run(r, o, w) + free_run(r, o, back);
+    }
+    qsort(run, LPV_REACH_VIEW_RAYS, sizeof run[0], compare_double);
+    const double median = 0.5 * (run[LPV_REACH_VIEW_RAYS / 2 - 1] + run[LPV_REACH_VIEW_RAYS / 2]);
+    return isfinite(median) ? (float)(median * (double)r->voxel) : INFINITY;
+}
+
 void lpv_reach_free(lpv_reach *r)
 {
     free(r->label);

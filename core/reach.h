@@ -111,6 +111,21 @@ int lpv_reach_lit_at(const lpv_reach *r, const float p[3]);
  * solid voxel, so 0 means no opaque surface is that near. */
 #define LPV_REACH_SEARCH_MAX 32
 int lpv_reach_solid_within(const lpv_reach *r, const float p[3], float within);
+/* How wide the space around a point is (m; issue 30, docs/cascades.md
+ * "Long scenes and narrow spaces"): the median length of the chords through p along
+ * LPV_REACH_VIEW_RAYS stratified directions (lpv_iv_ray's, a fixed seed),
+ * each from the first solid voxel behind p to the first ahead, by a 3-D DDA
+ * through the voxels; a chord that leaves the grid on either side is open
+ * and counts as infinitely long. The local counterpart of the free path (a
+ * convex room's mean chord is 4 V / S), whatever the scene's bounds and
+ * wherever in the space p stands: 3.4 m in a 3 m x 2.6 m tunnel however
+ * long it is or whatever ground lies over it, 4.4 m in panel-room's 4.2 m x
+ * 2.8 m x 4.2 m room seen from near a corner. INFINITY where more than half
+ * the chords are open (a courtyard under the sky); 0 when it cannot tell
+ * (no voxels, p outside the grid or in a solid voxel). */
+#define LPV_REACH_VIEW_RAYS 128
+float lpv_reach_view_chord(const lpv_reach *r, const float p[3]);
+
 void lpv_reach_free(lpv_reach *r);
 
 #endif /* LPV_REACH_H */

@@ -67,10 +67,13 @@ typedef struct lpv_lpv_settings {
     int cascades;           /* 0 = auto (core/plan.c): with an explicit cascade_size, one grid when
                                the scene fits in it, else LPV_DEFAULT_CASCADES; with cascade_size
                                auto, LPV_DEFAULT_CASCADES only when the camera stands inside a wide
-                               scene (LPV_CASCADE_WIDE_RATIO), else one grid; N = exactly N */
+                               scene (LPV_CASCADE_WIDE_RATIO) or in a space narrower than a quarter
+                               of the scene's cascades (lpv_plan_facts.view_chord), else one grid;
+                               N = exactly N */
     float cascade_size;     /* m, the finest cascade's extent along its longest axis; 0 (default)
                                = auto: LPV_CASCADE_AUTO_FRACTION of the scene's longest side, or
-                               for a long scene cells as wide as it (lpv_cascade_finest_size) */
+                               cells as wide as the space around the camera where that is
+                               narrower (lpv_cascade_finest_size) */
     float cascade_ratio;    /* cell size ratio of consecutive cascades; default 2 */
     float cascade_offset;   /* how far each cascade's centre sits ahead of the camera along
                                the view direction, as a fraction of its extent; default 0.25,
@@ -200,7 +203,13 @@ typedef struct lpv_settings {
 #define LPV_CASCADE_LONG_RATIO 4.0f    /* auto cascade_size of a long scene (longest side at least this x
                                             the second longest): cells LPV_CASCADE_LONG_CELL x the
                                             second longest (lpv_cascade_finest_size) */
-#define LPV_CASCADE_LONG_CELL 0.75f    /* measured on scenes/tunnel.glb (docs/cascades.md, "Long scenes") */
+#define LPV_CASCADE_LONG_CELL 0.75f    /* measured on scenes/tunnel.glb (docs/cascades.md, "Long scenes and
+                                            narrow spaces"); used where the camera's space is not measured */
+#define LPV_VIEW_ACROSS 0.75f          /* the width of the space the camera stands in, as a share of its
+                                            median chord (core/reach.h, lpv_reach_view_chord: 3.4 m in a 3 m
+                                            x 2.6 m tunnel); the auto cascades' cells (lpv_cascade_finest_size)
+                                            and iv's voxels (auto) measure against it. The long scene's
+                                            LPV_CASCADE_LONG_CELL of its cross-section, measured instead */
 #define LPV_DEFAULT_CASCADE_RATIO 2.0f
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f

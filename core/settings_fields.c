@@ -43,7 +43,7 @@ static const lpv_field FIELDS[] = {
     {"cascades", "cascades", LPV_FIELD_INT, F(lpv.cascades), 0, LPV_MAX_CASCADES, 0, "", "auto", "0 = auto",
      "cascade count (auto: one grid unless the camera is inside the scene, else 3)", T_VOL, LPV_TECHNIQUE_LPV},
     {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(lpv.cascade_size), 0, 1e6, 0, "m", "auto",
-     "0 = auto: a quarter of the scene's longest side (a long scene's: cells about as wide as it)",
+     "0 = auto: a quarter of the scene's longest side, or cells about as wide as the camera's space",
      "the finest cascade's extent along its longest axis", T_VOL, LPV_TECHNIQUE_LPV},
     {"cascade_ratio", "cascade-ratio", LPV_FIELD_FLOAT, F(lpv.cascade_ratio), 1.25, 8, 0, "", "2", "",
      "cell size ratio of consecutive cascades", T_VOL, LPV_TECHNIQUE_LPV},

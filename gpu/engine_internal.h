@@ -133,6 +133,8 @@ struct lpv_engine {
     size_t area_sample_count;                           /* 0: area lights off or no emitter */
     lpv_reach reach;          /* where light can reach (core/reach.h), for the scene's geometry */
     GLuint reach_tex;         /* its mask for reach.glsl (R8UI 3D), 0 = none */
+    float view_chord;          /* m, lpv_reach_view_chord at view_chord_eye (0 = not measured) */
+    float view_chord_eye[3];
 
     /* lights and RSMs */
     struct LpvLightBlock light_block;
@@ -218,6 +220,9 @@ void lpv_engine_free_scene(lpv_engine *e);
 int lpv_engine_reach_build(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
 void lpv_engine_reach_light(lpv_engine *e);
 void lpv_engine_reach_free(lpv_engine *e);
+/* Measures how wide the space around the camera's eye is (view_chord) again when
+ * the eye has moved a reach voxel or more since it was measured. */
+void lpv_engine_reach_view(lpv_engine *e);
 void lpv_engine_bind_lookup(const lpv_engine *e, GLuint prog, float damping);
 /* The mask is built and switched on (setting reach, a sure mask); and the
  * frame reads it per pixel (the camera does not stand in lit air). */

@@ -41,11 +41,12 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->scene_shortest = sides[0];
     f->scene_middle = sides[1];
     f->scene_extent = sides[2];
-    f->cascade_finest = lpv_cascade_finest_size(&e->settings, e->scene_min, e->scene_max);
+    f->view_chord = f->camera_inside ? e->view_chord : 0.0f;
+    f->cascade_finest = lpv_cascade_finest_size(&e->settings, e->scene_min, e->scene_max, f->view_chord);
     f->scene_cross = lpv_cascade_cross_section(e->scene_min, e->scene_max);
     f->free_path = e->reach.free_path;
     f->bounds_given = lpv_settings_bounds_given(&e->settings);
-    f->cascades_unfit = !lpv_cascades_fit(&e->settings, e->scene_min, e->scene_max, NULL, 0);
+    f->cascades_unfit = !lpv_cascades_fit(&e->settings, e->scene_min, e->scene_max, f->view_chord, NULL, 0);
     for (int i = 0; i < 3; ++i)
         f->scene_reach = fmaxf(f->scene_reach, fmaxf(fabsf(e->scene_min[i]), fabsf(e->scene_max[i])));
     f->first_tick = !e->computed;

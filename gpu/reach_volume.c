@@ -13,6 +13,7 @@
 void lpv_engine_reach_free(lpv_engine *e)
 {
     lpv_reach_free(&e->reach);
+    e->view_chord = 0.0f;
     if (e->reach_tex)
         glDeleteTextures(1, &e->reach_tex);
     e->reach_tex = 0;
@@ -25,7 +26,23 @@ int lpv_engine_reach_build(lpv_engine *e, const lpv_scene *scene, char *err, siz
         lpv_reach_free(&e->reach); /* a scene without bounds: everything reads lit */
         return lpv_error(err, err_size, "%s: %s", scene->source, err);
     }
+    lpv_engine_reach_view(e);
     return 0;
+}
+
+void lpv_engine_reach_view(lpv_engine *e)
+{
+    if (!e->has_view || !e->reach.label) {
+        e->view_chord = 0.0f;
+        return;
+    }
+    float d2 = 0.0f;
+    for (int i = 0; i < 3; ++i)
+        d2 += (e->view.eye[i] - e->view_chord_eye[i]) * (e->view.eye[i] - e->view_chord_eye[i]);
+    if (e->view_chord != 0.0f && d2 < e->reach.voxel * e->reach.voxel)
+        return;
+    e->view_chord = lpv_reach_view_chord(&e->reach, e->view.eye);
+    memcpy(e->view_chord_eye, e->view.eye, sizeof e->view_chord_eye);
 }
 
 void lpv_engine_reach_light(lpv_engine *e)

@@ -46,6 +46,9 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  end caps 20 cm thick), lit from inside by six point lights
                  (candela) 40 m apart under the roof; NO camera, so the
                  default camera's rule for long scenes places the view.
+  tunnel-terrain.glb  the tunnel under a 240 m x 240 m, 10 m thick block of
+                 ground (issue 30): wide bounds, narrow air; a camera inside,
+                 2 m from a lamp, looking along it (docs/cascades.md, "Long scenes").
   curved.glb     CURVED (issue 30): the room with a smooth-shaded white sphere
                  and a smooth-shaded grey cylinder on its floor, lit by a spot
                  light from above the red wall; the camera sees both where they
@@ -530,6 +533,18 @@ def tunnel():
     return s
 
 
+def tunnel_terrain():
+    """The tunnel under a hill: the same tunnel with a 10 m thick block of
+    ground over it, 240 m x 240 m, so its bounds are wide, not long, and only
+    the space around the camera says how narrow its air is; the camera stands
+    inside, 2 m from a lamp, looking along it."""
+    s = tunnel()
+    ground = s.material("hill_ground", (0.40, 0.38, 0.30))
+    s.add_box(ground, (-120.0, 2.8, -120.2), (120.0, 12.8, 120.2))
+    s.camera("Camera", (0.0, 1.6, -58.0), (0.0, 1.3, -100.0), 70.0)
+    return s
+
+
 def curved():
     s = Scene()
     room(s)
@@ -605,6 +620,7 @@ def main():
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
                         ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel),
+                        ("tunnel-terrain", tunnel_terrain),
                         ("curved", curved), ("lamp-fixture", lamp_fixture),
                         ("box-walls", lambda: walls_room(False)), ("thin-walls", lambda: walls_room(True))):
         data, tris = build().glb()

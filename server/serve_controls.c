@@ -190,7 +190,7 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
     char why[320];
     const lpv_scene *sc = &c->scene->scene;
     if (chk.lpv.cascades > 1 && !lpv_settings_bounds_given(&chk) &&
-        !lpv_cascades_fit(&chk, sc->bounds_min, sc->bounds_max, why, sizeof why)) {
+        !lpv_cascades_fit(&chk, sc->bounds_min, sc->bounds_max, 0.0f, why, sizeof why)) {
         snprintf(err, sizeof err, "cascade_size: %s", why);
         goto bad;
     }

@@ -107,7 +107,7 @@ static void check_placement_and_volumes(int departures)
     assert_int_equal(lpv_engine_last_plan(lpvt_engine)->cascades, 3);
     lpv_settings r = *lpv_engine_settings(lpvt_engine);
     lpv_cascade_set want;
-    assert_int_equal(lpv_cascades_place(&r, 3, scene.bounds_min, scene.bounds_max, v.eye, v.forward, &want), 0);
+    assert_int_equal(lpv_cascades_place(&r, 3, scene.bounds_min, scene.bounds_max, v.eye, v.forward, 0.0f, &want), 0);
     for (int k = 0; k < 3; ++k) {
         const lpv_grid *g = lpv_engine_cascade(lpvt_engine, k);
         assert_memory_equal(g->dims, want.grid[k].dims, sizeof g->dims);

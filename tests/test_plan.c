@@ -248,7 +248,7 @@ static void test_long_scene_finest_cascade(void **state)
     const int grids[3] = {8, 16, 32};
     for (int g = 0; g < 3; ++g) {
         lpv_settings s = resolved((lpv_settings){.grid_dims = {grids[g], grids[g], grids[g]}});
-        const float finest = lpv_cascade_finest_size(&s, tmin, tmax), cell = finest / (float)grids[g];
+        const float finest = lpv_cascade_finest_size(&s, tmin, tmax, 0.0f), cell = finest / (float)grids[g];
         print_message("tunnel, grid %d: finest cascade %.4g m, cells %.3g m\n", grids[g], (double)finest,
                       (double)cell);
         /* cells under the tunnel's 3 m inside width, but never finer than a quarter of its length allows */
@@ -256,16 +256,16 @@ static void test_long_scene_finest_cascade(void **state)
         assert_true(finest <= LPV_CASCADE_AUTO_FRACTION * 240.4f * 1.0001f);
     }
     lpv_settings s8 = resolved((lpv_settings){0});
-    assert_true(fabsf(lpv_cascade_finest_size(&s8, tmin, tmax) - 8.0f * LPV_CASCADE_LONG_CELL * 3.4f) < 1e-3f);
+    assert_true(fabsf(lpv_cascade_finest_size(&s8, tmin, tmax, 0.0f) - 8.0f * LPV_CASCADE_LONG_CELL * 3.4f) < 1e-3f);
     /* a room (12.4 x 3.2 x 8.4) and a wide but not long level (40 x 3 x 20): a quarter of the longest side */
     const float rmin[3] = {-6.2f, -0.2f, -4.2f}, rmax[3] = {6.2f, 3.0f, 4.2f};
     assert_true(lpv_cascade_cross_section(rmin, rmax) == 0.0f);
-    assert_true(fabsf(lpv_cascade_finest_size(&s8, rmin, rmax) - 0.25f * 12.4f) < 1e-4f);
+    assert_true(fabsf(lpv_cascade_finest_size(&s8, rmin, rmax, 0.0f) - 0.25f * 12.4f) < 1e-4f);
     const float wmin[3] = {0.0f, 0.0f, 0.0f}, wmax[3] = {40.0f, 3.0f, 20.0f};
-    assert_true(fabsf(lpv_cascade_finest_size(&s8, wmin, wmax) - 10.0f) < 1e-4f);
+    assert_true(fabsf(lpv_cascade_finest_size(&s8, wmin, wmax, 0.0f) - 10.0f) < 1e-4f);
     /* an explicit cascade_size wins */
     lpv_settings e = resolved((lpv_settings){.lpv.cascade_size = 60.0f});
-    assert_true(lpv_cascade_finest_size(&e, tmin, tmax) == 60.0f);
+    assert_true(lpv_cascade_finest_size(&e, tmin, tmax, 0.0f) == 60.0f);
     /* the plan says why */
     char why[LPV_PLAN_REASON_MAX];
     lpv_plan_facts f = baseline();
@@ -273,7 +273,7 @@ static void test_long_scene_finest_cascade(void **state)
     f.scene_extent = 240.4f;
     f.scene_shortest = 3.0f;
     f.scene_cross = lpv_cascade_cross_section(tmin, tmax);
-    f.cascade_finest = lpv_cascade_finest_size(&s8, tmin, tmax);
+    f.cascade_finest = lpv_cascade_finest_size(&s8, tmin, tmax, 0.0f);
     assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
     assert_non_null(strstr(why, "long scene"));
     assert_reason(why);
@@ -395,7 +395,7 @@ static void test_place_snapping_and_nesting(void **state)
     lpv_settings s = cascade_settings();
     const float eye[3] = {1.37f, 1.61f, -2.93f}, fwd[3] = {0.6f, 0.0f, -0.8f};
     lpv_cascade_set set;
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, fwd, &set), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, fwd, 0.0f, &set), 0);
     assert_int_equal(set.count, 3);
     assert_true(set.snapped);
     /* cascade 0's cell: cascade_size / max(dims) = 8 / 16 */
@@ -428,12 +428,12 @@ static void test_place_snapping_and_nesting(void **state)
     /* the offset really moves the grid: forward -z puts cascade 0's centre 0.25 * 8 m = 2 m ahead (the coarser
      * ones reach the scene's border and are kept over it) */
     lpv_cascade_set none;
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, NULL, &none), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, NULL, 0.0f, &none), 0);
     double dz = (set.grid[0].origin[2] - none.grid[0].origin[2]);
     assert_true(fabs(dz - (-0.8 * 0.25 * 8.0)) <= set.grid[0].cell_size);
     /* no camera: centred on the scene's centre */
     lpv_cascade_set scene;
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, NULL, NULL, &scene), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, NULL, NULL, 0.0f, &scene), 0);
     for (int i = 0; i < 3; ++i) {
         double c = scene.grid[0].origin[i] + 0.5 * 8.0, want = 0.5 * (BMIN[i] + BMAX[i]);
         assert_true(fabs(c - want) <= 0.5 + 1e-6);
@@ -444,7 +444,7 @@ static void test_place_snapping_and_nesting(void **state)
     const float *dirs[2] = {at, away};
     for (int d = 0; d < 2; ++d) {
         lpv_cascade_set o;
-        assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, outside, dirs[d], &o), 0);
+        assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, outside, dirs[d], 0.0f, &o), 0);
         for (int k = 0; k < 3; ++k)
             for (int i = 0; i < 3; ++i) {
                 double lo = o.grid[k].origin[i], hi = lo + (double)o.grid[k].cell_size * o.grid[k].dims[i];
@@ -457,7 +457,7 @@ static void test_place_snapping_and_nesting(void **state)
     }
     /* one cascade: the classic grid over the bounds, not snapped */
     lpv_cascade_set one;
-    assert_int_equal(lpv_cascades_place(&s, 1, BMIN, BMAX, eye, fwd, &one), 0);
+    assert_int_equal(lpv_cascades_place(&s, 1, BMIN, BMAX, eye, fwd, 0.0f, &one), 0);
     assert_int_equal(one.count, 1);
     assert_false(one.snapped);
     assert_false(one.handoff);
@@ -468,7 +468,7 @@ static void test_place_snapping_and_nesting(void **state)
     ff.lpv.far_field = LPV_SWITCH_ON;
     assert_int_equal(resolved((lpv_settings){0}).lpv.far_field, LPV_SWITCH_ON);
     lpv_cascade_set far;
-    assert_int_equal(lpv_cascades_place(&ff, 1, BMIN, BMAX, eye, fwd, &far), 0);
+    assert_int_equal(lpv_cascades_place(&ff, 1, BMIN, BMAX, eye, fwd, 0.0f, &far), 0);
     assert_int_equal(far.count, 1 + ff.lpv.far_field_levels);
     assert_false(far.snapped);
     assert_true(far.handoff);
@@ -485,9 +485,9 @@ static void test_place_snapping_and_nesting(void **state)
             assert_true(fabs(d - round(d)) <= 1e-4);
         }
     }
-    assert_int_equal(lpv_cascades_place(&s, 5, BMIN, BMAX, eye, fwd, &one), -1);
+    assert_int_equal(lpv_cascades_place(&s, 5, BMIN, BMAX, eye, fwd, 0.0f, &one), -1);
     const float bad[3] = {NAN, 0, 0};
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, bad, fwd, &one), -1);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, bad, fwd, 0.0f, &one), -1);
 }
 
 static void test_place_temporal(void **state)
@@ -500,14 +500,14 @@ static void test_place_temporal(void **state)
      * finest cell (0.2 m) keeps floor(x / cell) in every cascade; y and z stay put */
     float eye[3] = {0.3f * c0, 1.26f, 0.77f};
     lpv_cascade_set a, b, c;
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, fwd, &a), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, eye, fwd, 0.0f, &a), 0);
     float moved[3] = {eye[0] + 0.4f * c0, eye[1], eye[2]};
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, moved, fwd, &b), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, moved, fwd, 0.0f, &b), 0);
     assert_true(lpv_cascades_equal(&a, &b));
     /* moving by exactly one finest cell along x: cascade 0 shifts by exactly one cell, the others (0.5 and 0.25
      * of their cells, from 0.15 and 0.075) stay */
     float step[3] = {eye[0] + c0, eye[1], eye[2]};
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, step, fwd, &c), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, step, fwd, 0.0f, &c), 0);
     assert_false(lpv_cascades_equal(&a, &c));
     assert_float_equal(c.origin_cells[0][0], a.origin_cells[0][0] + 1.0f, 0.0f);
     assert_float_equal(c.origin_cells[0][1], a.origin_cells[0][1], 0.0f);
@@ -516,8 +516,8 @@ static void test_place_temporal(void **state)
         assert_memory_equal(c.origin_cells[k], a.origin_cells[k], sizeof c.origin_cells[k]);
     /* a move that crosses a cell boundary of floor(centre / cell) changes the set even though it is small */
     float cross[3] = {0.99f * c0, eye[1], eye[2]}, cross2[3] = {1.01f * c0, eye[1], eye[2]};
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, cross, fwd, &a), 0);
-    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, cross2, fwd, &b), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, cross, fwd, 0.0f, &a), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, BMIN, BMAX, cross2, fwd, 0.0f, &b), 0);
     assert_false(lpv_cascades_equal(&a, &b));
 }
 

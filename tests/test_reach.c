@@ -246,6 +246,79 @@ static void test_free_path_sizes_iv(void **state)
     }
 }
 
+/* A closed box of zero-thickness walls facing in, x in [-w/2, w/2], y in
+ * [0, h], z in [-len/2, len/2], and with slab a 240 m x 240 m block of
+ * ground 10 m thick on it (wide bounds, narrow air). */
+static void closed_box(lpv_scene *s, float w, float h, float len, int slab)
+{
+    memset(s, 0, sizeof *s);
+    int grey = lpv_scene_add_material(s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    const float x0 = -w / 2, x1 = w / 2, y0 = 0.0f, y1 = h, z0 = -len / 2, z1 = len / 2;
+    const float q[6][4][3] = {
+        {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}, {{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}},
+        {{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}, {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
+        {{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}, {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
+    for (int i = 0; i < 6; ++i)
+        assert_true(lpv_scene_add_quad(s, grey, q[i], NULL) >= 0);
+    if (slab)
+        add_box(s, grey, -120.0f, h + 0.2f, -120.0f, 120.0f, h + 10.2f, 120.0f);
+    lpv_scene_compute_bounds(s);
+}
+
+static float chord_at(const lpv_scene *s, const float p[3])
+{
+    lpv_reach r;
+    char err[256];
+    assert_int_equal(lpv_reach_build(&r, s, 0, err, sizeof err), 0);
+    const float c = lpv_reach_view_chord(&r, p);
+    lpv_reach_free(&r);
+    return c;
+}
+
+/* How wide the space around a point is, whatever the bounds: the median
+ * chord in a 3 m x 2.6 m tunnel is about the same 60 m or 240 m long and
+ * under a 240 m wide block of ground, a few metres where the bounds' sides
+ * (240 m) say nothing of it; in a room it is about the same from the middle
+ * and a quarter of the way from the walls (nearer a corner the oblique
+ * chords are cut short); open ground gives INFINITY, a point outside the
+ * voxels 0. */
+static void test_view_chord(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    const float mid[3] = {0.0f, 1.3f, 0.0f};
+    float tunnel[3];
+    for (int k = 0; k < 3; ++k) {
+        closed_box(&s, 3.0f, 2.6f, k == 0 ? 60.0f : 240.0f, k == 2);
+        tunnel[k] = chord_at(&s, mid);
+        lpv_scene_free(&s);
+    }
+    printf("tunnel chords: 60 m %.3f, 240 m %.3f, under ground %.3f\n", (double)tunnel[0], (double)tunnel[1],
+           (double)tunnel[2]);
+    /* under the ground the bounds hold 12 times the volume in the same voxel
+     * budget: voxels of 0.7 m instead of 0.23 m, and a wall's conservative
+     * voxels take up to one off each side of the air */
+    for (int k = 0; k < 3; ++k) {
+        assert_true(tunnel[k] > 2.4f && tunnel[k] < 6.0f);
+        assert_true(fabsf(tunnel[k] - tunnel[1]) < (k == 2 ? 0.25f : 0.1f) * tunnel[1]);
+    }
+    closed_box(&s, 4.0f, 3.0f, 4.0f, 0);
+    const float centre = chord_at(&s, (float[3]){0.0f, 1.5f, 0.0f}),
+                aside = chord_at(&s, (float[3]){1.0f, 1.0f, 1.0f});
+    printf("room chords: centre %.3f, a quarter of the way from the walls %.3f\n", (double)centre, (double)aside);
+    assert_true(centre > 3.0f && centre < 6.0f);
+    assert_true(fabsf(aside - centre) < 0.25f * centre);
+    lpv_scene_free(&s);
+    memset(&s, 0, sizeof s);
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    add_box(&s, grey, -50.0f, -0.1f, -50.0f, 50.0f, 0.0f, 50.0f);
+    add_box(&s, grey, 40.0f, 0.0f, 40.0f, 40.2f, 5.0f, 40.2f); /* a post: bounds 5 m high */
+    lpv_scene_compute_bounds(&s);
+    assert_true(isinf(chord_at(&s, (float[3]){0.0f, 1.0f, 0.0f})));
+    assert_true(chord_at(&s, (float[3]){0.0f, 500.0f, 0.0f}) == 0.0f);
+    lpv_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -255,6 +328,7 @@ int main(void)
         cmocka_unit_test(test_two_rooms),
         cmocka_unit_test(test_light_in_thin_slab),
         cmocka_unit_test(test_free_path_sizes_iv),
+        cmocka_unit_test(test_view_chord),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

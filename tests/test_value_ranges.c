@@ -151,20 +151,20 @@ static void test_cascades_fit(void **state)
     lpv_settings_resolve(&s);
     const float bmin[3] = {-1, 0, -1}, bmax[3] = {1, 2, 1};
     s.lpv.cascade_size = 0.0f; /* auto */
-    assert_int_equal(lpv_cascades_fit(&s, bmin, bmax, NULL, 0), 1);
+    assert_int_equal(lpv_cascades_fit(&s, bmin, bmax, 0.0f, NULL, 0), 1);
     lpv_cascade_set set;
-    assert_int_equal(lpv_cascades_place(&s, 3, bmin, bmax, bmax, (float[3]){0, 0, -1}, &set), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, bmin, bmax, bmax, (float[3]){0, 0, -1}, 0.0f, &set), 0);
     s.lpv.cascade_size = 1e-30f;
     char why[320] = "";
-    assert_int_equal(lpv_cascades_fit(&s, bmin, bmax, why, sizeof why), 0);
-    assert_int_equal(lpv_cascades_place(&s, 3, bmin, bmax, bmax, (float[3]){0, 0, -1}, &set), -1);
+    assert_int_equal(lpv_cascades_fit(&s, bmin, bmax, 0.0f, why, sizeof why), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, bmin, bmax, bmax, (float[3]){0, 0, -1}, 0.0f, &set), -1);
     const char *at = strstr(why, "cascade_size ");
     assert_non_null(at);
     s.lpv.cascade_size = strtof(at + strlen("cascade_size "), NULL);
     assert_true(s.lpv.cascade_size > 0.0f);
-    assert_int_equal(lpv_cascades_fit(&s, bmin, bmax, NULL, 0), 1);
+    assert_int_equal(lpv_cascades_fit(&s, bmin, bmax, 0.0f, NULL, 0), 1);
     /* the farthest anchor the bounds allow, the camera at a corner */
-    assert_int_equal(lpv_cascades_place(&s, 3, bmin, bmax, bmax, (float[3]){0, 0, -1}, &set), 0);
+    assert_int_equal(lpv_cascades_place(&s, 3, bmin, bmax, bmax, (float[3]){0, 0, -1}, 0.0f, &set), 0);
 }
 
 /* The planner's own choice of cascades (cascades 0) falls back to one grid

@@ -25,7 +25,8 @@ int lpv_cascaded_place(lpv_cascaded *c, const lpv_technique_where *w, int *moved
             f[i] = len > 0.0f ? fwd[i] / len : 0.0f;
         fwd = f;
     }
-    if (lpv_cascades_place(w->settings, count, w->bounds_min, w->bounds_max, w->eye, fwd, &c->pending) != 0)
+    if (lpv_cascades_place(w->settings, count, w->bounds_min, w->bounds_max, w->eye, fwd, w->facts->view_chord,
+                           &c->pending) != 0)
         return lpv_error(err, err_size, "%d cascades of %dx%dx%d cells cannot be placed", count,
                          w->settings->grid_dims[0], w->settings->grid_dims[1], w->settings->grid_dims[2]);
     if (moved)
