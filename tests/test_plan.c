@@ -279,6 +279,51 @@ static void test_long_scene_finest_cascade(void **state)
     assert_reason(why);
 }
 
+/* Issue 30: with the space around the camera measured (the median chord
+ * through the eye, core/reach.h) the auto cascades' cells are
+ * LPV_VIEW_ACROSS x it whatever the bounds, the quarter divided by a whole
+ * power of sqrt(2); a space wider than that, or open, keeps the quarter,
+ * and the plan runs cascades in a wide-bounded scene whose air is narrow. */
+static void test_finest_cascade_from_the_camera_space(void **state)
+{
+    (void)state;
+    const float hmin[3] = {-120.0f, -0.2f, -120.2f}, hmax[3] = {120.0f, 12.8f, 120.2f}; /* tunnel-terrain.glb */
+    const int grids[3] = {8, 16, 32};
+    for (int g = 0; g < 3; ++g) {
+        lpv_settings s = resolved((lpv_settings){.grid_dims = {grids[g], grids[g], grids[g]}});
+        const float quarter = 0.25f * 240.4f, finest = lpv_cascade_finest_size(&s, hmin, hmax, 3.4f);
+        const float cell = finest / (float)grids[g], want = LPV_VIEW_ACROSS * 3.4f;
+        const double steps = 2.0 * log2((double)quarter / (double)finest);
+        print_message("under the hill, grid %d: finest %.4g m, cells %.3g m (%.3g half octaves)\n", grids[g],
+                      (double)finest, (double)cell, steps);
+        assert_true(fabs(steps - floor(steps + 0.5)) < 1e-4);        /* a whole power of sqrt(2) */
+        assert_true(cell > want / 1.42f && cell < want * 1.42f);     /* the nearest one */
+        assert_true(lpv_cascade_finest_size(&s, hmin, hmax, 0.0f) == quarter); /* bounds alone: wide, a quarter */
+    }
+    lpv_settings s8 = resolved((lpv_settings){0});
+    /* a room's space (4.4 m chord in a 4.2 m room) and open ground: the quarter */
+    const float rmin[3] = {-2.1f, -0.1f, -2.1f}, rmax[3] = {2.1f, 2.9f, 2.1f};
+    assert_true(lpv_cascade_finest_size(&s8, rmin, rmax, 4.4f) == 0.25f * 4.2f);
+    assert_true(lpv_cascade_finest_size(&s8, hmin, hmax, INFINITY) == 0.25f * 240.4f);
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_plan_facts f = baseline();
+    f.has_view = f.camera_inside = 1;
+    f.scene_extent = 240.4f;
+    f.scene_middle = 240.0f;
+    f.scene_shortest = 13.0f;
+    f.view_chord = 2.41f;
+    f.cascade_finest = lpv_cascade_finest_size(&s8, hmin, hmax, f.view_chord);
+    assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_non_null(strstr(why, "median chord"));
+    assert_reason(why);
+    /* auto: iv's voxels over these bounds do not fit twice across the camera's space */
+    lpv_settings a = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_AUTO});
+    assert_int_equal(lpv_technique_choose(&a, &f, why, sizeof why), LPV_TECHNIQUE_ID_LPV);
+    assert_non_null(strstr(why, "camera's space"));
+    f.view_chord = 0.0f; /* not measured: the scene's middle axis, 240 m */
+    assert_int_equal(lpv_technique_choose(&a, &f, why, sizeof why), LPV_TECHNIQUE_ID_IV);
+}
+
 static lpv_plan_facts steady(void)
 {
     lpv_plan_facts f = baseline();
@@ -707,6 +752,7 @@ int main(void)
         cmocka_unit_test(test_area_lights_replace_emissive_vpls),
         cmocka_unit_test(test_cascade_count),
         cmocka_unit_test(test_long_scene_finest_cascade),
+        cmocka_unit_test(test_finest_cascade_from_the_camera_space),
         cmocka_unit_test(test_recompute_rules),
         cmocka_unit_test(test_planner_off_runs_everything),
         cmocka_unit_test(test_bounce_needs_gv),
