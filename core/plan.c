@@ -353,28 +353,31 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
     }
     const int res = s->iv.resolution > 0 ? s->iv.resolution : LPV_IV_DEFAULT_RESOLUTION;
     if (f && f->scene_extent > 0.0f && f->scene_middle > 0.0f && !f->bounds_given) {
-        /* the voxels iv would place with these settings (lpv_iv_place: finer in
-         * long scenes, from the free path), over bounds of the scene's axes */
-        const float ext[3] = {f->scene_extent, f->scene_middle, f->scene_shortest > 0.0f ? f->scene_shortest : 0.0f};
+        /* the voxels iv would place with these settings (lpv_iv_place: over
+         * where light can go, finer in long scenes from the free path), and
+         * the middle side of that box */
+        const int lit = f->lit_max[0] > f->lit_min[0];
+        float side[3];
+        if (lit)
+            lpv_box_sides(f->lit_min, f->lit_max, side);
+        const float ext[3] = {lit ? side[2] : f->scene_extent, lit ? side[1] : f->scene_middle,
+                              lit ? side[0] : (f->scene_shortest > 0.0f ? f->scene_shortest : 0.0f)};
         const float origin[3] = {0.0f, 0.0f, 0.0f};
         lpv_settings placed = *s;
         placed.iv.resolution = res;
         lpv_grid g;
-        const float voxel = lpv_iv_place(&placed, origin, ext, f->free_path, &g) == 0 ? g.cell_size
-                                                                                       : f->scene_extent / (float)res;
-        /* across the scene's middle axis, or the space the camera stands in
-         * where that is narrower (a tunnel under wide ground) */
-        const float room = f->view_chord > 0.0f ? LPV_VIEW_ACROSS * f->view_chord : INFINITY;
-        const float width = room < f->scene_middle ? room : f->scene_middle;
-        const char *whose = room < f->scene_middle ? "camera's space" : "scene";
-        const float across = width / voxel;
+        const float voxel = lpv_iv_place(&placed, origin, ext, lit ? f->lit_free_path : f->free_path, &g) == 0
+                                ? g.cell_size
+                                : ext[0] / (float)res;
+        const float across = ext[1] / voxel;
+        const char *whose = lit ? "lit space" : "scene";
         if (across < LPV_AUTO_IV_MIN_VOXELS_ACROSS) {
             say(why, n, "auto: the cascaded LPV: iv's %.3g m voxels (iv_resolution %d) fit %.2g times across the %s "
-                "(%.3g m), under %.3g", voxel, res, across, whose, width, LPV_AUTO_IV_MIN_VOXELS_ACROSS);
+                "(%.3g m), under %.3g", voxel, res, across, whose, ext[1], LPV_AUTO_IV_MIN_VOXELS_ACROSS);
             return LPV_TECHNIQUE_ID_LPV;
         }
         say(why, n, "auto: the imperfect volume: its %.3g m voxels fit %.3g times across the %s (%.3g m; preset %s)",
-            voxel, across, whose, width, lpv_preset_name(s->preset));
+            voxel, across, whose, ext[1], lpv_preset_name(s->preset));
         return LPV_TECHNIQUE_ID_IV;
     }
     say(why, n, "auto: the imperfect volume, the most accurate technique of the accuracy set (preset %s)",

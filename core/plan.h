@@ -58,6 +58,11 @@ typedef struct lpv_plan_facts {
     int cascades_unfit;        /* snapped cascades cannot be placed over the scene (lpv_cascades_fit) */
     float scene_reach;         /* m, the scene bounds' largest |coordinate| */
     float free_path;           /* m, the scene's mean free path (core/reach.h), 0 = unknown */
+    float lit_min[3], lit_max[3]; /* m, where light can go when that is much less than the scene: the lit
+                                  air's box (core/reach.h lit_min, within the bounds, at most
+                                  LPV_REACH_LIT_BOX_SHARE of their volume), what the imperfect volume then
+                                  covers; all 0: the scene's bounds */
+    float lit_free_path;       /* m, the free path of the lit air (with lit_min) */
     /* what changed since the last computed tick */
     int first_tick;            /* nothing computed yet */
     int scene_changed;         /* geometry or materials */

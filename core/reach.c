@@ -255,6 +255,40 @@ static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
     return light_around(r, v, NULL, lit) ? 0 : -1;
 }
 
+/* lpv_reach.lit_box, lit_min, lit_max and lit_free_path from the mask. */
+static void lit_box(lpv_reach *r)
+{
+    r->lit_box = 0;
+    r->lit_free_path = 0.0f;
+    if (r->unsure || !r->lit_voxels)
+        return;
+    int lo[3] = {r->dims[0], r->dims[1], r->dims[2]}, hi[3] = {-1, -1, -1};
+    size_t faces = 0;
+    for (int z = 0; z < r->dims[2]; ++z)
+        for (int y = 0; y < r->dims[1]; ++y)
+            for (int x = 0; x < r->dims[0]; ++x) {
+                if (r->mask[voxel_index(r, x, y, z)] != LPV_REACH_LIT)
+                    continue;
+                const int c[3] = {x, y, z};
+                for (int k = 0; k < 3; ++k) {
+                    lo[k] = c[k] < lo[k] ? c[k] : lo[k];
+                    hi[k] = c[k] > hi[k] ? c[k] : hi[k];
+                    for (int sgn = -1; sgn <= 1; sgn += 2) {
+                        int q[3] = {x, y, z};
+                        q[k] += sgn;
+                        faces += q[k] >= 0 && q[k] < r->dims[k] &&
+                                 r->mask[voxel_index(r, q[0], q[1], q[2])] == LPV_REACH_SOLID;
+                    }
+                }
+            }
+    for (int k = 0; k < 3; ++k) {
+        r->lit_min[k] = r->origin[k] + r->voxel * (float)(lo[k] - 1);
+        r->lit_max[k] = r->origin[k] + r->voxel * (float)(hi[k] + 2);
+    }
+    r->lit_box = 1;
+    r->lit_free_path = faces ? (float)(4.0 * (double)r->lit_voxels * (double)r->voxel / (double)faces) : 0.0f;
+}
+
 int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
 {
     const size_t n = voxel_count(r->dims);
@@ -263,6 +297,7 @@ int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
         free(lit);
         const int changed = !r->unsure;
         r->unsure = 1;
+        r->lit_box = 0;
         return changed;
     }
     int unsure = 0;
@@ -302,6 +337,7 @@ int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
         r->dark_voxels += r->mask[v] == LPV_REACH_DARK;
         r->lit_voxels += r->mask[v] == LPV_REACH_LIT;
     }
+    lit_box(r);
     return 1;
 }
 

@@ -70,7 +70,20 @@ typedef struct lpv_reach {
     size_t solid_voxels, dark_voxels, lit_voxels;
     uint32_t lit_components;
     unsigned char *lit;   /* per component 0..components: lit by the last lpv_reach_light (NULL before) */
+    /* The box of the lit air, grown by one voxel so it holds the surfaces
+     * around it (world, m), and that air's free path 4 V / S (V its voxels,
+     * S the faces between them and solid voxels): where light can go, and
+     * how far it runs there, for a volume that need cover no more (the
+     * imperfect volume: a lit tunnel under a 240 m hill is 3 m across, not
+     * 240 m). lit_box 0 when unsure or nothing is lit. */
+    int lit_box;
+    float lit_min[3], lit_max[3];
+    float lit_free_path;
 } lpv_reach;
+/* A volume covers the lit box instead of the scene's bounds where the box
+ * (within the bounds) holds at most this share of their volume
+ * (lpv_engine_lit_region). */
+#define LPV_REACH_LIT_BOX_SHARE 0.5
 
 /* Voxelizes the scene's opaque triangles (alpha mode OPAQUE; cut-out and
  * blended surfaces let light through) over its bounds grown by

@@ -207,9 +207,9 @@ typedef struct lpv_settings {
                                             narrow spaces"); used where the camera's space is not measured */
 #define LPV_VIEW_ACROSS 0.75f          /* the width of the space the camera stands in, as a share of its
                                             median chord (core/reach.h, lpv_reach_view_chord: 3.4 m in a 3 m
-                                            x 2.6 m tunnel); the auto cascades' cells (lpv_cascade_finest_size)
-                                            and iv's voxels (auto) measure against it. The long scene's
-                                            LPV_CASCADE_LONG_CELL of its cross-section, measured instead */
+                                            x 2.6 m tunnel): the auto cascades' cells (lpv_cascade_finest_size).
+                                            The long scene's LPV_CASCADE_LONG_CELL of its cross-section,
+                                            measured instead */
 #define LPV_DEFAULT_CASCADE_RATIO 2.0f
 #define LPV_DEFAULT_CASCADE_OFFSET 0.25f
 #define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f

@@ -364,15 +364,6 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
     e->view = *view;
     e->has_view = 1;
     lpv_engine_reach_view(e);
-    /* auto's choice reads the space the camera stands in (lpv_plan_facts
-     * view_chord): made again while nothing of this scene is computed, so the
-     * first camera counts and later moves never switch the technique */
-    if (e->has_scene && (!e->computed || e->scene_dirty)) {
-        const lpv_technique_id was = e->tech_id;
-        if (lpv_engine_resolve_technique(e, &e->settings, err, err_size) != 0 ||
-            (e->tech_id != was && lpv_engine_sample_scene(e, err, err_size) != 0))
-            return -1;
-    }
     return 0;
 }
 

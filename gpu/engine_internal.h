@@ -220,6 +220,11 @@ void lpv_engine_free_scene(lpv_engine *e);
 int lpv_engine_reach_build(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size);
 void lpv_engine_reach_light(lpv_engine *e);
 void lpv_engine_reach_free(lpv_engine *e);
+/* Where light can go and its free path: the lit air's box (core/reach.h)
+ * within the scene's bounds while the reach mask is in use and the box holds
+ * at most LPV_REACH_LIT_BOX_SHARE of the bounds' volume, else the scene's
+ * bounds and free path (returns 0). The imperfect volume covers this box. */
+int lpv_engine_lit_region(const lpv_engine *e, float min[3], float max[3], float *free_path);
 /* Measures how wide the space around the camera's eye is (view_chord) again when
  * the eye has moved a reach voxel or more since it was measured. */
 void lpv_engine_reach_view(lpv_engine *e);

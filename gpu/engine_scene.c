@@ -147,7 +147,9 @@ static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
 {
     const lpv_settings *s = &e->settings;
     lpv_grid g;
-    if (lpv_iv_place(s, e->scene_min, e->scene_max, e->reach.free_path, &g) != 0)
+    float lo[3], hi[3], free_path;
+    lpv_engine_lit_region(e, lo, hi, &free_path);
+    if (lpv_iv_place(s, lo, hi, free_path, &g) != 0)
         return lpv_error(err, err_size, "%s: cannot place the imperfect volume over the scene's bounds",
                          e->geometry.source);
     const lpv_iv_point_params p = lpv_iv_point_params_of(s, g.cell_size);
@@ -173,7 +175,9 @@ int lpv_engine_iv_points_stale(const lpv_engine *e)
     lpv_grid g;
     if (e->tech_id != LPV_TECHNIQUE_ID_IV || !e->iv_points)
         return 0;
-    return lpv_iv_place(&e->settings, e->scene_min, e->scene_max, e->reach.free_path, &g) == 0 &&
+    float lo[3], hi[3], free_path;
+    lpv_engine_lit_region(e, lo, hi, &free_path);
+    return lpv_iv_place(&e->settings, lo, hi, free_path, &g) == 0 &&
            g.cell_size != e->iv_points_voxel;
 }
 

@@ -45,6 +45,11 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->cascade_finest = lpv_cascade_finest_size(&e->settings, e->scene_min, e->scene_max, f->view_chord);
     f->scene_cross = lpv_cascade_cross_section(e->scene_min, e->scene_max);
     f->free_path = e->reach.free_path;
+    if (!lpv_engine_lit_region(e, f->lit_min, f->lit_max, &f->lit_free_path)) { /* the scene's: as unknown */
+        memset(f->lit_min, 0, sizeof f->lit_min);
+        memset(f->lit_max, 0, sizeof f->lit_max);
+        f->lit_free_path = 0.0f;
+    }
     f->bounds_given = lpv_settings_bounds_given(&e->settings);
     f->cascades_unfit = !lpv_cascades_fit(&e->settings, e->scene_min, e->scene_max, f->view_chord, NULL, 0);
     for (int i = 0; i < 3; ++i)

@@ -5,6 +5,7 @@
  * in every pass that looks the technique's volume up (docs/propagation.md,
  * "Enclosed lights").
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -71,6 +72,27 @@ void lpv_engine_reach_light(lpv_engine *e)
 int lpv_engine_reach_in_use(const lpv_engine *e)
 {
     return e->reach_tex && !e->reach.unsure && e->settings.reach != LPV_SWITCH_OFF;
+}
+
+int lpv_engine_lit_region(const lpv_engine *e, float min[3], float max[3], float *free_path)
+{
+    double box = 1.0, bounds = 1.0;
+    for (int k = 0; k < 3; ++k) {
+        min[k] = e->reach.lit_min[k] > e->scene_min[k] ? e->reach.lit_min[k] : e->scene_min[k];
+        max[k] = e->reach.lit_max[k] < e->scene_max[k] ? e->reach.lit_max[k] : e->scene_max[k];
+        box *= fmax((double)max[k] - (double)min[k], 0.0);
+        bounds *= (double)e->scene_max[k] - (double)e->scene_min[k];
+    }
+    /* the lit box pays where it is much smaller than the scene (a lit tunnel
+     * under a wide hill); a room's lit air is most of its bounds, and a
+     * grid a few per cent smaller only moves where its voxels fall */
+    const int lit = lpv_engine_reach_in_use(e) && e->reach.lit_box && box <= LPV_REACH_LIT_BOX_SHARE * bounds;
+    if (!lit) {
+        memcpy(min, e->scene_min, sizeof e->scene_min);
+        memcpy(max, e->scene_max, sizeof e->scene_max);
+    }
+    *free_path = lit ? e->reach.lit_free_path : e->reach.free_path;
+    return lit;
 }
 
 /* A perspective camera standing in air a light reaches sees only surfaces

@@ -316,12 +316,36 @@ static void test_finest_cascade_from_the_camera_space(void **state)
     assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
     assert_non_null(strstr(why, "median chord"));
     assert_reason(why);
-    /* auto: iv's voxels over these bounds do not fit twice across the camera's space */
+}
+
+/* Issue 30: auto places iv's voxels over where light can go (the lit air's
+ * box, lpv_plan_facts.lit_min) when the engine found it much smaller than the
+ * scene: a lit tunnel under a 240 m hill gets 1 m voxels and iv, as the
+ * tunnel alone; with a coarse resolution there the LPV. */
+static void test_auto_over_the_lit_space(void **state)
+{
+    (void)state;
+    char why[LPV_PLAN_REASON_MAX];
+    lpv_plan_facts f = baseline();
+    f.scene_extent = 240.4f;
+    f.scene_middle = 240.0f;
+    f.scene_shortest = 13.0f;
+    const float lmin[3] = {-2.4f, -0.9f, -120.2f}, lmax[3] = {2.4f, 3.5f, 120.2f}; /* tunnel-terrain's lit box */
+    memcpy(f.lit_min, lmin, sizeof lmin);
+    memcpy(f.lit_max, lmax, sizeof lmax);
+    f.lit_free_path = 2.4f;
     lpv_settings a = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_AUTO});
-    assert_int_equal(lpv_technique_choose(&a, &f, why, sizeof why), LPV_TECHNIQUE_ID_LPV);
-    assert_non_null(strstr(why, "camera's space"));
-    f.view_chord = 0.0f; /* not measured: the scene's middle axis, 240 m */
     assert_int_equal(lpv_technique_choose(&a, &f, why, sizeof why), LPV_TECHNIQUE_ID_IV);
+    print_message("%s\n", why);
+    assert_non_null(strstr(why, "lit space"));
+    assert_reason(why);
+    lpv_settings coarse = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_AUTO, .iv.resolution = 4});
+    assert_int_equal(lpv_technique_choose(&coarse, &f, why, sizeof why), LPV_TECHNIQUE_ID_LPV);
+    /* the bounds alone (no lit box): iv's 15 m voxels fit 16 times across the 240 m middle side */
+    memset(f.lit_min, 0, sizeof f.lit_min);
+    memset(f.lit_max, 0, sizeof f.lit_max);
+    assert_int_equal(lpv_technique_choose(&a, &f, why, sizeof why), LPV_TECHNIQUE_ID_IV);
+    assert_non_null(strstr(why, "across the scene"));
 }
 
 static lpv_plan_facts steady(void)
@@ -753,6 +777,7 @@ int main(void)
         cmocka_unit_test(test_cascade_count),
         cmocka_unit_test(test_long_scene_finest_cascade),
         cmocka_unit_test(test_finest_cascade_from_the_camera_space),
+        cmocka_unit_test(test_auto_over_the_lit_space),
         cmocka_unit_test(test_recompute_rules),
         cmocka_unit_test(test_planner_off_runs_everything),
         cmocka_unit_test(test_bounce_needs_gv),

@@ -319,6 +319,34 @@ static void test_view_chord(void **state)
     lpv_scene_free(&s);
 }
 
+/* Where light can go: a lamp in the tunnel under the hill lights only the
+ * tunnel's air, so the lit box is the tunnel (grown by a voxel), 240 m long
+ * but a few metres across where the bounds are 240 m wide, and its free
+ * path is the tunnel's (4 V / S = 2.8 m for 3 m x 2.6 m), not the open
+ * air's under the hill; a light outside the tunnel lights the rest. */
+static void test_lit_box(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    closed_box(&s, 3.0f, 2.6f, 240.0f, 1);
+    assert_non_null(lpv_scene_add_point_light(&s, (float[3]){0.0f, 1.3f, 20.0f}, 5.0f));
+    lpv_reach r;
+    build_and_light(&r, &s);
+    printf("lit box [%.2f %.2f %.2f] .. [%.2f %.2f %.2f], voxel %.3f m, lit free path %.3f m, scene's %.3f m\n",
+           (double)r.lit_min[0], (double)r.lit_min[1], (double)r.lit_min[2], (double)r.lit_max[0],
+           (double)r.lit_max[1], (double)r.lit_max[2], (double)r.voxel, (double)r.lit_free_path, (double)r.free_path);
+    assert_int_equal(r.lit_box, 1);
+    assert_true(r.lit_min[0] > -1.5f - 2.0f * r.voxel && r.lit_max[0] < 1.5f + 2.0f * r.voxel);
+    assert_true(r.lit_min[1] > -2.0f * r.voxel && r.lit_max[1] < 2.6f + 2.0f * r.voxel);
+    assert_true(r.lit_max[2] - r.lit_min[2] > 235.0f);
+    /* the walls' conservative voxels (0.78 m here) take air off each side */
+    const float tunnel = 4.0f * 3.0f * 2.6f / (2.0f * (3.0f + 2.6f));
+    assert_true(r.lit_free_path > 0.6f * tunnel && r.lit_free_path < 1.1f * tunnel);
+    assert_true(r.free_path > 3.0f * tunnel); /* the scene's: the open air under the hill */
+    lpv_reach_free(&r);
+    lpv_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -329,6 +357,7 @@ int main(void)
         cmocka_unit_test(test_light_in_thin_slab),
         cmocka_unit_test(test_free_path_sizes_iv),
         cmocka_unit_test(test_view_chord),
+        cmocka_unit_test(test_lit_box),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -102,7 +102,11 @@ static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, cha
     lpv_iv_gpu *v = (lpv_iv_gpu *)t;
     const lpv_settings *s = w->settings;
     lpv_grid g;
-    if (lpv_iv_place(s, w->bounds_min, w->bounds_max, w->facts ? w->facts->free_path : 0.0f, &g) != 0)
+    /* over where light can go (the lit air's box, lpv_plan_facts.lit_min) */
+    const lpv_plan_facts *f = w->facts;
+    const int lit = f && f->lit_max[0] > f->lit_min[0];
+    if (lpv_iv_place(s, lit ? f->lit_min : w->bounds_min, lit ? f->lit_max : w->bounds_max,
+                     f ? (lit ? f->lit_free_path : f->free_path) : 0.0f, &g) != 0)
         return lpv_error(err, err_size, "cannot place %d voxels over the %s bounds (not finite)", s->iv.resolution,
                          lpv_settings_bounds_given(s) ? "settings'" : "scene's");
     v->pending = g;
