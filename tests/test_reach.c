@@ -200,6 +200,25 @@ static void test_light_in_thin_slab(void **state)
     lpv_scene_free(&s);
 }
 
+/* A closed box of zero-thickness walls facing in, x in [-w/2, w/2], y in
+ * [0, h], z in [-len/2, len/2], and with slab a 240 m x 240 m block of
+ * ground 10 m thick on it (wide bounds, narrow air). */
+static void closed_box(lpv_scene *s, float w, float h, float len, int slab)
+{
+    memset(s, 0, sizeof *s);
+    int grey = lpv_scene_add_material(s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    const float x0 = -w / 2, x1 = w / 2, y0 = 0.0f, y1 = h, z0 = -len / 2, z1 = len / 2;
+    const float q[6][4][3] = {
+        {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}, {{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}},
+        {{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}, {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
+        {{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}, {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
+    for (int i = 0; i < 6; ++i)
+        assert_true(lpv_scene_add_quad(s, grey, q[i], NULL) >= 0);
+    if (slab)
+        add_box(s, grey, -120.0f, h + 0.2f, -120.0f, 120.0f, h + 10.2f, 120.0f);
+    lpv_scene_compute_bounds(s);
+}
+
 /* The free path 4 V / S of a closed box, and iv's voxels from it: a long
  * closed tunnel gets voxels a fraction of its width (at the same voxel
  * budget as a cube at the setting), a room keeps the setting. */
@@ -208,17 +227,8 @@ static void test_free_path_sizes_iv(void **state)
     (void)state;
     for (int tunnel = 0; tunnel <= 1; ++tunnel) {
         const float len = tunnel ? 240.0f : 4.0f, w = tunnel ? 3.0f : 4.0f, h = tunnel ? 2.6f : 3.0f;
-        lpv_scene s = {0};
-        int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
-        /* six quads facing in: a closed box of zero-thickness walls */
-        const float x0 = -w / 2, x1 = w / 2, y0 = 0.0f, y1 = h, z0 = -len / 2, z1 = len / 2;
-        const float q[6][4][3] = {
-            {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}, {{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}},
-            {{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}, {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
-            {{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}, {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
-        for (int i = 0; i < 6; ++i)
-            assert_true(lpv_scene_add_quad(&s, grey, q[i], NULL) >= 0);
-        lpv_scene_compute_bounds(&s);
+        lpv_scene s;
+        closed_box(&s, w, h, len, 0);
         lpv_reach r;
         char err[256];
         assert_int_equal(lpv_reach_build(&r, &s, 0, err, sizeof err), 0);
@@ -244,25 +254,6 @@ static void test_free_path_sizes_iv(void **state)
         lpv_reach_free(&r);
         lpv_scene_free(&s);
     }
-}
-
-/* A closed box of zero-thickness walls facing in, x in [-w/2, w/2], y in
- * [0, h], z in [-len/2, len/2], and with slab a 240 m x 240 m block of
- * ground 10 m thick on it (wide bounds, narrow air). */
-static void closed_box(lpv_scene *s, float w, float h, float len, int slab)
-{
-    memset(s, 0, sizeof *s);
-    int grey = lpv_scene_add_material(s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
-    const float x0 = -w / 2, x1 = w / 2, y0 = 0.0f, y1 = h, z0 = -len / 2, z1 = len / 2;
-    const float q[6][4][3] = {
-        {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}, {{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}},
-        {{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}, {{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}},
-        {{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}, {{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}};
-    for (int i = 0; i < 6; ++i)
-        assert_true(lpv_scene_add_quad(s, grey, q[i], NULL) >= 0);
-    if (slab)
-        add_box(s, grey, -120.0f, h + 0.2f, -120.0f, 120.0f, h + 10.2f, 120.0f);
-    lpv_scene_compute_bounds(s);
 }
 
 static float chord_at(const lpv_scene *s, const float p[3])
