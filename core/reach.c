@@ -255,43 +255,8 @@ static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
     return light_around(r, v, NULL, lit) ? 0 : -1;
 }
 
-/* lpv_reach.lit_box, lit_min, lit_max and lit_free_path from the mask. */
-static void lit_box(lpv_reach *r)
-{
-    r->lit_box = 0;
-    r->lit_free_path = 0.0f;
-    if (r->unsure || !r->lit_voxels)
-        return;
-    int lo[3] = {r->dims[0], r->dims[1], r->dims[2]}, hi[3] = {-1, -1, -1};
-    size_t faces = 0;
-    for (int z = 0; z < r->dims[2]; ++z)
-        for (int y = 0; y < r->dims[1]; ++y)
-            for (int x = 0; x < r->dims[0]; ++x) {
-                if (r->mask[voxel_index(r, x, y, z)] != LPV_REACH_LIT)
-                    continue;
-                const int c[3] = {x, y, z};
-                for (int k = 0; k < 3; ++k) {
-                    lo[k] = c[k] < lo[k] ? c[k] : lo[k];
-                    hi[k] = c[k] > hi[k] ? c[k] : hi[k];
-                    for (int sgn = -1; sgn <= 1; sgn += 2) {
-                        int q[3] = {x, y, z};
-                        q[k] += sgn;
-                        faces += q[k] >= 0 && q[k] < r->dims[k] &&
-                                 r->mask[voxel_index(r, q[0], q[1], q[2])] == LPV_REACH_SOLID;
-                    }
-                }
-            }
-    for (int k = 0; k < 3; ++k) {
-        r->lit_min[k] = r->origin[k] + r->voxel * (float)(lo[k] - 1);
-        r->lit_max[k] = r->origin[k] + r->voxel * (float)(hi[k] + 2);
-    }
-    r->lit_box = 1;
-    r->lit_free_path = faces ? (float)(4.0 * (double)r->lit_voxels * (double)r->voxel / (double)faces) : 0.0f;
-}
-
 int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
 {
-    const size_t n = voxel_count(r->dims);
     unsigned char *lit = calloc((size_t)r->components + 1, 1);
     if (!lit || !r->label || !r->mask) {
         free(lit);
@@ -330,14 +295,39 @@ int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
     r->solid_voxels = r->dark_voxels = r->lit_voxels = 0;
     for (uint32_t c = 1; c <= r->components; ++c)
         r->lit_components += lit[c];
-    for (size_t v = 0; v < n; ++v) {
-        const uint32_t l = r->label[v];
-        r->mask[v] = !l ? LPV_REACH_SOLID : (lit[l] || r->unsure) ? LPV_REACH_LIT : LPV_REACH_DARK;
-        r->solid_voxels += !l;
-        r->dark_voxels += r->mask[v] == LPV_REACH_DARK;
-        r->lit_voxels += r->mask[v] == LPV_REACH_LIT;
+    /* in the same pass, the lit air's box and the faces between it and
+     * solid voxels (its free path; lit_box, lit_min, lit_max) */
+    int lo[3] = {r->dims[0], r->dims[1], r->dims[2]}, hi[3] = {-1, -1, -1};
+    size_t faces = 0;
+    for (int z = 0; z < r->dims[2]; ++z)
+        for (int y = 0; y < r->dims[1]; ++y)
+            for (int x = 0; x < r->dims[0]; ++x) {
+                const size_t v = voxel_index(r, x, y, z);
+                const uint32_t l = r->label[v];
+                r->mask[v] = !l ? LPV_REACH_SOLID : (lit[l] || r->unsure) ? LPV_REACH_LIT : LPV_REACH_DARK;
+                r->solid_voxels += !l;
+                r->dark_voxels += r->mask[v] == LPV_REACH_DARK;
+                if (r->mask[v] != LPV_REACH_LIT)
+                    continue;
+                r->lit_voxels++;
+                const int c[3] = {x, y, z};
+                for (int k = 0; k < 3; ++k) {
+                    lo[k] = c[k] < lo[k] ? c[k] : lo[k];
+                    hi[k] = c[k] > hi[k] ? c[k] : hi[k];
+                    for (int sgn = -1; sgn <= 1; sgn += 2) {
+                        int q[3] = {x, y, z};
+                        q[k] += sgn;
+                        faces += q[k] >= 0 && q[k] < r->dims[k] && r->label[voxel_index(r, q[0], q[1], q[2])] == 0;
+                    }
+                }
+            }
+    r->lit_box = !r->unsure && r->lit_voxels > 0;
+    for (int k = 0; k < 3 && r->lit_box; ++k) {
+        r->lit_min[k] = r->origin[k] + r->voxel * (float)(lo[k] - 1);
+        r->lit_max[k] = r->origin[k] + r->voxel * (float)(hi[k] + 2);
     }
-    lit_box(r);
+    r->lit_free_path =
+        r->lit_box && faces ? (float)(4.0 * (double)r->lit_voxels * (double)r->voxel / (double)faces) : 0.0f;
     return 1;
 }
 
