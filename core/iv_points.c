@@ -18,6 +18,7 @@ typedef struct walk {
     const lpv_vertex *v[3];
     float front[3];
     double limit;          /* m: the longest edge a piece may keep */
+    const float *box_min, *box_max; /* NULL: every piece */
     size_t pieces;         /* counted or written so far */
     /* writing (NULL when counting) */
     struct IvPoint *out;
@@ -32,6 +33,7 @@ typedef struct walk {
 typedef struct splitter {
     const float *p[3];     /* the triangle's corners, world */
     double limit;
+    const float *box_min, *box_max; /* NULL: keep every piece */
     lpv_iv_piece_fn fn;
     void *user;
     size_t pieces;
@@ -56,6 +58,11 @@ static void split(splitter *sp, const piece *pc, int depth)
     double p[3][3];
     for (int i = 0; i < 3; ++i)
         world_of(sp, pc->b[i], p[i]);
+    if (sp->box_min) /* a piece wholly outside the box, and all its halves, go */
+        for (int i = 0; i < 3; ++i)
+            if (fmax(fmax(p[0][i], p[1][i]), p[2][i]) < (double)sp->box_min[i] ||
+                fmin(fmin(p[0][i], p[1][i]), p[2][i]) > (double)sp->box_max[i])
+                return;
     int longest = 0;
     double best = -1.0;
     for (int e = 0; e < 3; ++e) {
@@ -86,7 +93,14 @@ static void split(splitter *sp, const piece *pc, int depth)
 size_t lpv_iv_split_triangle(const float a[3], const float b[3], const float c[3], double limit, lpv_iv_piece_fn fn,
                              void *user)
 {
-    splitter sp = {{a, b, c}, limit, fn, user, 0};
+    return lpv_iv_split_triangle_in(a, b, c, limit, NULL, NULL, fn, user);
+}
+
+size_t lpv_iv_split_triangle_in(const float a[3], const float b[3], const float c[3], double limit,
+                                const float box_min[3], const float box_max[3], lpv_iv_piece_fn fn, void *user)
+{
+    splitter sp = {{a, b, c}, limit, box_min && box_max ? box_min : NULL, box_min && box_max ? box_max : NULL, fn,
+                   user, 0};
     piece whole = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
     split(&sp, &whole, 0);
     return sp.pieces;
@@ -170,7 +184,8 @@ static void walk_scene(walk *w)
             if (dr->first_index + t + 3 > s->index_count ||
                 !lpv_scene_triangle(s, dr->first_index + t, w->v, w->front, &area))
                 continue;
-            lpv_iv_split_triangle(w->v[0]->position, w->v[1]->position, w->v[2]->position, w->limit, walk_piece, w);
+            lpv_iv_split_triangle_in(w->v[0]->position, w->v[1]->position, w->v[2]->position, w->limit, w->box_min,
+                                     w->box_max, walk_piece, w);
         }
     }
 }
@@ -202,7 +217,9 @@ int lpv_iv_points_make(const lpv_scene *scene, const lpv_iv_point_params *p, str
     st.points_per_piece = p->points > 0 ? p->points : 1;
     const size_t budget = p->max_points > 0 ? p->max_points : 1;
     /* the pieces at this split; coarser splits until one point each fits */
-    walk w = {.scene = scene};
+    walk w = {.scene = scene,
+              .box_min = p->has_box ? p->box_min : NULL,
+              .box_max = p->has_box ? p->box_max : NULL};
     for (;;) {
         w.limit = (double)st.split * (double)p->voxel;
         w.pieces = 0;
@@ -280,12 +297,18 @@ int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3]
     return lpv_grid_place_cubic(res, lo, hi, out);
 }
 
-lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, float voxel)
+lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, const lpv_grid *g)
 {
-    return (lpv_iv_point_params){.voxel = voxel,
-                                 .points = s->iv.points,
-                                 .split = s->iv.split,
-                                 .seed = (uint32_t)s->iv.seed,
-                                 .max_points = (size_t)s->iv.max_points,
-                                 .emission = 1};
+    lpv_iv_point_params p = {.voxel = g->cell_size,
+                             .points = s->iv.points,
+                             .split = s->iv.split,
+                             .seed = (uint32_t)s->iv.seed,
+                             .max_points = (size_t)s->iv.max_points,
+                             .emission = 1,
+                             .has_box = 1};
+    for (int i = 0; i < 3; ++i) {
+        p.box_min[i] = g->origin[i];
+        p.box_max[i] = g->origin[i] + (float)g->dims[i] * g->cell_size;
+    }
+    return p;
 }

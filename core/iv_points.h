@@ -32,6 +32,11 @@ typedef struct lpv_iv_point_params {
     uint32_t seed;
     size_t max_points; /* the budget: fewer points per piece, then coarser splitting, to stay under it */
     int emission;      /* 1: points carry their material's emission; 0: none (area lights carry it) */
+    /* Where the volume lies (m), when has_box: pieces wholly outside it get
+     * no points and cost none of the budget (a tunnel under a 240 m hill:
+     * the hill's faces took the budget down to one point a piece). */
+    int has_box;
+    float box_min[3], box_max[3];
 } lpv_iv_point_params;
 
 typedef struct lpv_iv_point_stats {
@@ -58,10 +63,10 @@ typedef struct lpv_iv_point_stats {
 #define LPV_IV_LONG_FREE_PATHS 8.0
 int lpv_iv_place(const lpv_settings *s, const float smin[3], const float smax[3], float free_path, lpv_grid *out);
 
-/* The cloud's parameters under settings s for voxels of side `voxel` m
- * (emission always carried: the GPU drops it while area lights carry the
- * emitters). */
-lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, float voxel);
+/* The cloud's parameters under settings s for the volume g it is made for:
+ * its voxel side and its box (has_box set); emission always carried (the
+ * GPU drops it while area lights carry the emitters). */
+lpv_iv_point_params lpv_iv_point_params_of(const lpv_settings *s, const lpv_grid *g);
 
 /* The cloud for `scene` under p. *out is malloc'ed (free() it), *count its
  * points. Returns 0, or -1 out of memory (*out NULL, *count 0). Deterministic
@@ -79,6 +84,11 @@ int lpv_iv_points_make(const lpv_scene *scene, const lpv_iv_point_params *p, str
 typedef void (*lpv_iv_piece_fn)(const double bary[3][3], void *user);
 size_t lpv_iv_split_triangle(const float a[3], const float b[3], const float c[3], double limit, lpv_iv_piece_fn fn,
                              void *user);
+/* The same, keeping only the pieces that reach into [box_min, box_max] (m;
+ * both NULL: every piece): a piece wholly outside is dropped before it is
+ * cut further. */
+size_t lpv_iv_split_triangle_in(const float a[3], const float b[3], const float c[3], double limit,
+                                const float box_min[3], const float box_max[3], lpv_iv_piece_fn fn, void *user);
 
 /* One triangle's points (no splitting), for the voxelization report and the
  * tests: n points on (a, b, c) from `key`, Turk's formula. Writes 3 floats each. */

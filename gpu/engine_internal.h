@@ -123,7 +123,7 @@ struct lpv_engine {
     uint64_t scene_surfel_grid_sig; /* the cascades the buffer's groups are for; 0 = none yet */
     GLuint iv_points;         /* the imperfect volume's point cloud (technique iv only), 0 = none */
     size_t iv_point_count;
-    float iv_points_voxel;    /* m: the voxel size the cloud was made for (its pieces are split by it) */
+    lpv_grid iv_points_grid;  /* the volume the cloud was made for (its pieces split by its voxel, kept in its box) */
     /* the scene's flat surfaces' normals for the lookup (core/scene_planes.h) */
     float lookup_planes[LPV_MAX_LOOKUP_PLANES][3];
     int lookup_plane_count;

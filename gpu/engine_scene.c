@@ -152,7 +152,7 @@ static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
     if (lpv_iv_place(s, lo, hi, free_path, &g) != 0)
         return lpv_error(err, err_size, "%s: cannot place the imperfect volume over the scene's bounds",
                          e->geometry.source);
-    const lpv_iv_point_params p = lpv_iv_point_params_of(s, g.cell_size);
+    const lpv_iv_point_params p = lpv_iv_point_params_of(s, &g);
     struct IvPoint *pts = NULL;
     size_t n = 0;
     if (lpv_iv_points_make(&e->geometry, &p, &pts, &n, &e->iv_point_stats) != 0)
@@ -162,7 +162,7 @@ static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
     if (n)
         glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *pts), pts);
     e->iv_point_count = n;
-    e->iv_points_voxel = g.cell_size;
+    e->iv_points_grid = g;
     free(pts);
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "%s: GL error while storing %zu imperfect-volume points", e->geometry.source,
@@ -177,8 +177,11 @@ int lpv_engine_iv_points_stale(const lpv_engine *e)
         return 0;
     float lo[3], hi[3], free_path;
     lpv_engine_lit_region(e, lo, hi, &free_path);
-    return lpv_iv_place(&e->settings, lo, hi, free_path, &g) == 0 &&
-           g.cell_size != e->iv_points_voxel;
+    if (lpv_iv_place(&e->settings, lo, hi, free_path, &g) != 0)
+        return 0;
+    const lpv_grid *had = &e->iv_points_grid; /* its pieces were split by its voxel and kept in its box */
+    return g.cell_size != had->cell_size || memcmp(g.origin, had->origin, sizeof g.origin) != 0 ||
+           memcmp(g.dims, had->dims, sizeof g.dims) != 0;
 }
 
 /* The scene's samples under the current settings, from the engine's copy of

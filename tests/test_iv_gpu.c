@@ -98,7 +98,7 @@ static void test_creation_matches_oracle(void **state)
     tick(&scene, &s, NULL);
     const lpv_grid *g = lpv_engine_grid(lpvt_engine);
     const lpv_settings *r = lpv_engine_settings(lpvt_engine);
-    const lpv_iv_point_params pp = lpv_iv_point_params_of(r, g->cell_size);
+    const lpv_iv_point_params pp = lpv_iv_point_params_of(r, g);
     struct IvPoint *pts = NULL;
     size_t n = 0;
     assert_int_equal(lpv_iv_points_make(&scene, &pp, &pts, &n, NULL), 0);
@@ -393,7 +393,7 @@ static void test_resolution_change_remakes_cloud(void **state)
     assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
     const size_t changed = lpv_engine_last_stats(lpvt_engine)->iv.points;
     const lpv_iv_point_params pp =
-        lpv_iv_point_params_of(lpv_engine_settings(lpvt_engine), lpv_engine_grid(lpvt_engine)->cell_size);
+        lpv_iv_point_params_of(lpv_engine_settings(lpvt_engine), lpv_engine_grid(lpvt_engine));
     struct IvPoint *pts = NULL;
     size_t want = 0;
     assert_int_equal(lpv_iv_points_make(&scene, &pp, &pts, &want, NULL), 0);

@@ -2,7 +2,8 @@
  * test_iv_voxelize.c - the conservative voxelization of core/iv_voxelize.h
  * (triangle/box overlap by separating axes) against clipping, its edge
  * cases, the point cloud landing only in it, the splitting of
- * core/iv_points.c, and the miss fraction falling with more points.
+ * core/iv_points.c, the cloud kept in its volume's box, and the miss
+ * fraction falling with more points.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -19,6 +20,7 @@
 #include "iv_points.h"
 #include "iv_voxelize.h"
 #include "oracle_iv.h"
+#include "scene_build.h"
 #include "test_util.h"
 
 static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
@@ -329,6 +331,55 @@ static void test_split(void **state)
     }
 }
 
+/* The cloud is made for a volume: pieces wholly outside its box get no
+ * points and cost none of the budget. A 3 m room on a 2 km ground (a
+ * tunnel under a hill: the hill's faces took the budget and left one point
+ * a piece for the tunnel): without the box the ground's pieces exhaust the
+ * budget and the room's pieces get fewer points; with it, every piece of
+ * the room keeps its points and none lies farther outside the box than a
+ * piece reaches. */
+static void test_cloud_kept_in_its_box(void **state)
+{
+    (void)state;
+    lpv_scene scene;
+    memset(&scene, 0, sizeof scene);
+    const int grey = lpv_scene_add_material(&scene, "grey", (float[3]){0.5f, 0.5f, 0.5f}, NULL);
+    assert_true(grey >= 0);
+    assert_true(lpv_scene_add_box(&scene, grey, (float[3]){-1000, -1, -1000}, (float[3]){1000, 0, 1000}) >= 0);
+    assert_true(lpv_scene_add_box(&scene, grey, (float[3]){-1.5f, 0, -1.5f}, (float[3]){1.5f, 3, 1.5f}) >= 0);
+    lpv_grid g;
+    assert_int_equal(lpv_grid_place_cubic(16, (float[3]){-1.5f, 0, -1.5f}, (float[3]){1.5f, 3, 1.5f}, &g), 0);
+    lpv_settings s = {0};
+    s.iv.points = 4;
+    s.iv.split = 2.0f;
+    s.iv.seed = 1;
+    s.iv.max_points = 200000;
+    lpv_iv_point_params boxed = lpv_iv_point_params_of(&s, &g), open = boxed;
+    assert_true(boxed.has_box);
+    open.has_box = 0;
+    struct IvPoint *pts = NULL;
+    size_t n_open = 0, n_boxed = 0;
+    lpv_iv_point_stats st_open, st_boxed;
+    assert_int_equal(lpv_iv_points_make(&scene, &open, &pts, &n_open, &st_open), 0);
+    free(pts);
+    assert_int_equal(lpv_iv_points_make(&scene, &boxed, &pts, &n_boxed, &st_boxed), 0);
+    print_message("open: %zu points, %d a piece, split %g; boxed: %zu points, %d a piece, split %g\n", n_open,
+                  st_open.points_per_piece, (double)st_open.split, n_boxed, st_boxed.points_per_piece,
+                  (double)st_boxed.split);
+    assert_true(st_open.budget_cut);
+    assert_false(st_boxed.budget_cut);
+    assert_int_equal(st_boxed.points_per_piece, 4);
+    assert_true(n_boxed > 0);
+    const float reach = boxed.split * boxed.voxel; /* a kept piece's edges are at most this long */
+    for (size_t i = 0; i < n_boxed; ++i)
+        for (int k = 0; k < 3; ++k) {
+            assert_true(pts[i].position[k] >= boxed.box_min[k] - reach);
+            assert_true(pts[i].position[k] <= boxed.box_max[k] + reach);
+        }
+    free(pts);
+    lpv_scene_free(&scene);
+}
+
 /* More points miss less: over 300 random 4-voxel triangles the miss fraction
  * with N = 19 is below that with N = 1 (measured 0.46 vs 0.92; 0.47 vs
  * 0.92 in lpvd-iv-voxelize's table), and splitting to 1 voxel misses less
@@ -379,6 +430,7 @@ int main(void)
         cmocka_unit_test(test_edge_cases),
         cmocka_unit_test(test_points_inside_set),
         cmocka_unit_test(test_split),
+        cmocka_unit_test(test_cloud_kept_in_its_box),
         cmocka_unit_test(test_miss_fraction_falls),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -87,12 +87,7 @@ static double cloud_cpu_ms(const lpv_scene *scene, const lpv_settings *resolved,
     if (lpv_grid_place_cubic(resolved->iv.resolution, given ? resolved->bounds_min : scene->bounds_min,
                              given ? resolved->bounds_max : scene->bounds_max, &g) != 0)
         return NAN;
-    lpv_iv_point_params p = {.voxel = g.cell_size,
-                             .points = resolved->iv.points,
-                             .split = resolved->iv.split,
-                             .seed = (uint32_t)resolved->iv.seed,
-                             .max_points = (size_t)resolved->iv.max_points,
-                             .emission = 1};
+    const lpv_iv_point_params p = lpv_iv_point_params_of(resolved, &g);
     double ms[IV_MAX_TICKS];
     int n = 0;
     for (int r = 0; r < runs && r < IV_MAX_TICKS; ++r) {
