@@ -53,29 +53,36 @@ static int place(lpv_reach *r, const float bmin[3], const float bmax[3], size_t 
 
 /* Marks every voxel triangle (a, b, c) touches as solid (label 0; the
  * labels start at 1 = air). */
-static void voxelize_triangle(lpv_reach *r, const float *p[3])
+/* Triangle p's conservative voxels in a grid of cubic voxels (lower corner
+ * origin, side, dims; x fastest) set to 0 in cells (0 = solid). */
+static void voxelize_into(const float origin[3], double side, const int dims[3], uint32_t *cells, const float *p[3])
 {
     double tri[3][3];
     int lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
         for (int i = 0; i < 3; ++i)
-            tri[i][k] = ((double)p[i][k] - (double)r->origin[k]) / (double)r->voxel;
+            tri[i][k] = ((double)p[i][k] - (double)origin[k]) / side;
         double mn = fmin(tri[0][k], fmin(tri[1][k], tri[2][k])) - LPV_IV_VOXELIZE_EPS;
         double mx = fmax(tri[0][k], fmax(tri[1][k], tri[2][k])) + LPV_IV_VOXELIZE_EPS;
-        if (!(mx >= 0.0 && mn < (double)r->dims[k]))
+        if (!(mx >= 0.0 && mn < (double)dims[k]))
             return;
         lo[k] = mn < 0.0 ? 0 : (int)floor(mn);
-        hi[k] = mx >= (double)r->dims[k] ? r->dims[k] - 1 : (int)floor(mx);
+        hi[k] = mx >= (double)dims[k] ? dims[k] - 1 : (int)floor(mx);
     }
     const double half[3] = {0.5 + LPV_IV_VOXELIZE_EPS, 0.5 + LPV_IV_VOXELIZE_EPS, 0.5 + LPV_IV_VOXELIZE_EPS};
     for (int z = lo[2]; z <= hi[2]; ++z)
         for (int y = lo[1]; y <= hi[1]; ++y)
             for (int x = lo[0]; x <= hi[0]; ++x) {
                 const double centre[3] = {x + 0.5, y + 0.5, z + 0.5};
-                size_t v = voxel_index(r, x, y, z);
-                if (r->label[v] != 0 && lpv_iv_tri_box_overlap(centre, half, tri))
-                    r->label[v] = 0;
+                const size_t v = (size_t)x + (size_t)dims[0] * ((size_t)y + (size_t)dims[1] * (size_t)z);
+                if (cells[v] != 0 && lpv_iv_tri_box_overlap(centre, half, tri))
+                    cells[v] = 0;
             }
+}
+
+static void voxelize_triangle(lpv_reach *r, const float *p[3])
+{
+    voxelize_into(r->origin, (double)r->voxel, r->dims, r->label, p);
 }
 
 /* Labels the air (label 1 on entry) with components 1..n by flood fill. */
@@ -120,6 +127,15 @@ static int is_emissive(const lpv_material *m)
     return m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
 }
 
+/* Only opaque surfaces are voxelized: cut-out and blended ones let light through. */
+static int is_opaque(const lpv_material *m) { return !m || m->alpha_mode == LPV_ALPHA_OPAQUE; }
+
+static const lpv_material *material_of(const lpv_scene *scene, const lpv_draw *dr)
+{
+    return dr->material >= 0 && (uint32_t)dr->material < scene->material_count ? &scene->materials[dr->material]
+                                                                                 : NULL;
+}
+
 int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, char *err, size_t err_size)
 {
     memset(r, 0, sizeof *r);
@@ -133,8 +149,7 @@ int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, cha
     size_t emissive = 0;
     for (uint32_t d = 0; d < scene->draw_count; ++d) {
         const lpv_draw *dr = &scene->draws[d];
-        const lpv_material *m =
-            dr->material >= 0 && (uint32_t)dr->material < scene->material_count ? &scene->materials[dr->material] : NULL;
+        const lpv_material *m = material_of(scene, dr);
         if (is_emissive(m))
             emissive += dr->index_count / 3;
     }
@@ -147,9 +162,8 @@ int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, cha
     r->all_opaque = 1;
     for (uint32_t d = 0; d < scene->draw_count; ++d) {
         const lpv_draw *dr = &scene->draws[d];
-        const lpv_material *m =
-            dr->material >= 0 && (uint32_t)dr->material < scene->material_count ? &scene->materials[dr->material] : NULL;
-        const int opaque = !m || m->alpha_mode == LPV_ALPHA_OPAQUE;
+        const lpv_material *m = material_of(scene, dr);
+        const int opaque = is_opaque(m);
         const int emits = is_emissive(m);
         r->all_opaque &= opaque;
         if (!opaque && !emits)
@@ -238,10 +252,179 @@ static int light_around(const lpv_reach *r, long v, const float *dir, unsigned c
     return found;
 }
 
+/* Whether triangle t's box meets [lo, hi]. */
+static int box_touches(const lpv_vertex *const t[3], const float lo[3], const float hi[3])
+{
+    for (int k = 0; k < 3; ++k)
+        if (fmaxf(t[0]->position[k], fmaxf(t[1]->position[k], t[2]->position[k])) < lo[k] ||
+            fminf(t[0]->position[k], fminf(t[1]->position[k], t[2]->position[k])) > hi[k])
+            return 0;
+    return 1;
+}
+
+/* Whether the segment from p to q crosses triangle t (Moller-Trumbore, both
+ * sides; a touch at either end counts). */
+static int segment_crosses(const float p[3], const double q[3], const lpv_vertex *const t[3])
+{
+    double d[3], e1[3], e2[3], h[3], sv[3], qv[3];
+    for (int k = 0; k < 3; ++k) {
+        d[k] = q[k] - (double)p[k];
+        e1[k] = (double)t[1]->position[k] - (double)t[0]->position[k];
+        e2[k] = (double)t[2]->position[k] - (double)t[0]->position[k];
+        sv[k] = (double)p[k] - (double)t[0]->position[k];
+    }
+    h[0] = d[1] * e2[2] - d[2] * e2[1];
+    h[1] = d[2] * e2[0] - d[0] * e2[2];
+    h[2] = d[0] * e2[1] - d[1] * e2[0];
+    const double a = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+    if (fabs(a) < 1e-18)
+        return 0; /* parallel: the segment runs along its plane */
+    const double f = 1.0 / a, u = f * (sv[0] * h[0] + sv[1] * h[1] + sv[2] * h[2]);
+    if (u < 0.0 || u > 1.0)
+        return 0;
+    qv[0] = sv[1] * e1[2] - sv[2] * e1[1];
+    qv[1] = sv[2] * e1[0] - sv[0] * e1[2];
+    qv[2] = sv[0] * e1[1] - sv[1] * e1[0];
+    const double v = f * (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]);
+    if (v < 0.0 || u + v > 1.0)
+        return 0;
+    const double w = f * (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]);
+    return w >= 0.0 && w <= 1.0;
+}
+
+/* A light in a solid voxel, looked at closer: the scene's opaque triangles
+ * voxelized again over the 3 x 3 x 3 voxels around it, LPV_REACH_CLOSER
+ * times finer, and the air around the light flood-filled there; the
+ * components of the voxels that air reaches are lit. The voxels alone
+ * cannot tell which side of a surface in the light's voxel the light is on:
+ * a lamp 0.2 m under a ceiling, in a 240 m scene's 0.78 m voxels, lit every
+ * air voxel around, the hollow inside of the hill over the ceiling as well
+ * as the tunnel under it, and the imperfect volume then spread over the
+ * whole hill (docs/propagation.md, "Enclosed lights"). Where the light
+ * lies in a surface even at the finer size, its air is the fine voxels
+ * around it that the segment from it crosses no triangle to. Returns the
+ * fine voxels of air voxels reached (0 when none: the caller then lights
+ * every air voxel around), -1 out of memory. */
+static int light_in_solid(const lpv_reach *r, const lpv_scene *scene, const float p[3], long v, unsigned char *lit)
+{
+    const int S = LPV_REACH_CLOSER;
+    const int c[3] = {(int)(v % r->dims[0]), (int)((v / r->dims[0]) % r->dims[1]),
+                      (int)(v / ((long)r->dims[0] * r->dims[1]))};
+    int lo[3], dims[3];
+    float origin[3], top[3];
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = c[k] > 0 ? c[k] - 1 : 0;
+        const int hi = c[k] + 1 < r->dims[k] ? c[k] + 1 : r->dims[k] - 1;
+        dims[k] = (hi - lo[k] + 1) * S;
+        origin[k] = r->origin[k] + (float)lo[k] * r->voxel;
+        top[k] = r->origin[k] + (float)(hi + 1) * r->voxel;
+    }
+    const size_t n = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    uint32_t *cell = malloc(n * sizeof *cell), *queue = malloc(n * sizeof *queue);
+    if (!cell || !queue) {
+        free(cell);
+        free(queue);
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i)
+        cell[i] = 1; /* air, not yet reached */
+    const double side = (double)r->voxel / S;
+    int s[3];
+    float near_lo[3], near_hi[3]; /* the light's fine voxel and the 26 around it */
+    for (int k = 0; k < 3; ++k) {
+        const double q = floor(((double)p[k] - (double)origin[k]) / side);
+        s[k] = q < 0.0 ? 0 : q >= (double)dims[k] ? dims[k] - 1 : (int)q;
+        near_lo[k] = origin[k] + (float)((s[k] - 1) * side);
+        near_hi[k] = origin[k] + (float)((s[k] + 2) * side);
+    }
+    const lpv_vertex **close = NULL; /* triangles by the light, 3 corners each: the side it is on */
+    size_t close_n = 0, close_cap = 0;
+    int failed = 0;
+    for (uint32_t d = 0; d < scene->draw_count && !failed; ++d) {
+        const lpv_draw *dr = &scene->draws[d];
+        if (!is_opaque(material_of(scene, dr)))
+            continue;
+        for (uint32_t i = 0; i + 2 < dr->index_count; i += 3) {
+            const lpv_vertex *t[3];
+            float front[3];
+            double area;
+            if (!lpv_scene_triangle(scene, dr->first_index + i, t, front, &area) ||
+                !box_touches(t, origin, top))
+                continue;
+            voxelize_into(origin, side, dims, cell, (const float *[3]){t[0]->position, t[1]->position, t[2]->position});
+            if (!box_touches(t, near_lo, near_hi))
+                continue;
+            if (close_n == close_cap) {
+                close_cap = close_cap ? 2 * close_cap : 48;
+                const lpv_vertex **grown = realloc(close, close_cap * 3 * sizeof *close);
+                if (!grown) {
+                    failed = 1;
+                    break;
+                }
+                close = grown;
+            }
+            memcpy(&close[3 * close_n++], t, sizeof t);
+        }
+    }
+    if (failed) {
+        free(close);
+        free(cell);
+        free(queue);
+        return -1;
+    }
+    /* the light's own fine voxel, or where it lies in a surface even at this
+     * size, the air ones around it that no surface separates from it */
+    const size_t own = (size_t)s[0] + (size_t)dims[0] * ((size_t)s[1] + (size_t)dims[1] * (size_t)s[2]);
+    size_t head = 0, tail = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int x = s[0] + dx, y = s[1] + dy, z = s[2] + dz;
+                if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2])
+                    continue;
+                const size_t i = (size_t)x + (size_t)dims[0] * ((size_t)y + (size_t)dims[1] * (size_t)z);
+                if (cell[i] != 1 || (i != own && cell[own] != 0))
+                    continue;
+                const double q[3] = {origin[0] + (x + 0.5) * side, origin[1] + (y + 0.5) * side,
+                                     origin[2] + (z + 0.5) * side};
+                int clear = 1;
+                for (size_t k = 0; k < close_n && clear && i != own; ++k)
+                    clear = !segment_crosses(p, q, &close[3 * k]);
+                if (clear) {
+                    cell[i] = 2;
+                    queue[tail++] = (uint32_t)i;
+                }
+            }
+    free(close);
+    int found = 0;
+    const size_t sy = (size_t)dims[0], sz = (size_t)dims[0] * (size_t)dims[1];
+    while (head < tail) {
+        const size_t i = queue[head++];
+        const int x = (int)(i % sy), y = (int)((i / sy) % (size_t)dims[1]), z = (int)(i / sz);
+        const uint32_t l = r->label[voxel_index(r, lo[0] + x / S, lo[1] + y / S, lo[2] + z / S)];
+        if (l) {
+            lit[l] = 1;
+            found++;
+        }
+        const size_t nb[6] = {i - 1, i + 1, i - sy, i + sy, i - sz, i + sz};
+        const int ok[6] = {x > 0, x + 1 < dims[0], y > 0, y + 1 < dims[1], z > 0, z + 1 < dims[2]};
+        for (int k = 0; k < 6; ++k)
+            if (ok[k] && cell[nb[k]] == 1) {
+                cell[nb[k]] = 2;
+                queue[tail++] = (uint32_t)nb[k];
+            }
+    }
+    free(cell);
+    free(queue);
+    return found;
+}
+
 /* Lights the component of the voxel holding p, or, when that voxel is
- * solid, the components of the air voxels around it. Returns 0, or -1 when
- * there is no air there at all. A point outside the grid lights the outside. */
-static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
+ * solid, the components its light reaches (light_in_solid; without the
+ * scene, or where that finds none, every air voxel around it). Returns 0,
+ * or -1 when there is no air there at all. A point outside the grid lights
+ * the outside. */
+static int light_at(const lpv_reach *r, const lpv_scene *scene, const float p[3], unsigned char *lit)
 {
     long v = voxel_at(r, p);
     if (v < 0) {
@@ -252,10 +435,12 @@ static int light_at(const lpv_reach *r, const float p[3], unsigned char *lit)
         lit[r->label[v]] = 1;
         return 0;
     }
+    if (scene && light_in_solid(r, scene, p, v, lit) > 0)
+        return 0;
     return light_around(r, v, NULL, lit) ? 0 : -1;
 }
 
-int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
+int lpv_reach_light(lpv_reach *r, const lpv_scene *scene, const lpv_light *lights, size_t light_count)
 {
     unsigned char *lit = calloc((size_t)r->components + 1, 1);
     if (!lit || !r->label || !r->mask) {
@@ -270,7 +455,7 @@ int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count)
         const lpv_light *l = &lights[i];
         if (l->type == LPV_LIGHT_DIRECTIONAL)
             lit[r->label[0]] = 1;
-        else if (light_at(r, l->position, lit) != 0)
+        else if (light_at(r, scene, l->position, lit) != 0)
             unsure = 1;
     }
     /* An emitter lights the air voxels next to its centroid's voxel on each

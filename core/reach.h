@@ -95,11 +95,16 @@ typedef struct lpv_reach {
 int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, char *err, size_t err_size);
 
 /* The mask for these punctual lights and the emitters recorded by build:
- * the components holding a light are lit, the rest of the air dark.
- * Returns 1 when the mask changed, 0 when the lights light the same spaces
- * as at the last call (a light moved within its room: the daemon's common
- * LIGHT_SET), so the caller need not send it again. */
-int lpv_reach_light(lpv_reach *r, const lpv_light *lights, size_t light_count);
+ * the components holding a light are lit, the rest of the air dark. A
+ * light in a solid voxel (a lamp close under a ceiling) lights the
+ * components its air reaches in a closer look at the scene's surfaces
+ * around it, LPV_REACH_CLOSER times finer (scene: the one built from; NULL:
+ * every air voxel around it). Returns 1 when the mask changed, 0 when the
+ * lights light the same spaces as at the last call (a light moved within
+ * its room: the daemon's common LIGHT_SET), so the caller need not send it
+ * again. */
+#define LPV_REACH_CLOSER 8
+int lpv_reach_light(lpv_reach *r, const lpv_scene *scene, const lpv_light *lights, size_t light_count);
 
 /* 1 when light can reach the air in front of a surface at p facing n (unit),
  * 0 when that air is a component no light reaches: the first non-solid voxel

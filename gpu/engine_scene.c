@@ -344,6 +344,10 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, tangent));
     glBindVertexArray(0);
 
+    /* before the lights: a light in a solid reach voxel is looked at closer
+     * in the copy (lpv_reach_light), as on every later light change */
+    if (lpv_scene_copy_geometry(&e->geometry, scene) != 0)
+        return lpv_error(err, err_size, "%s: out of memory for the engine's copy of the geometry", scene->source);
     if (lpv_engine_reach_build(e, scene, err, err_size) != 0)
         return -1;
     set_lights(e, scene);
@@ -360,8 +364,6 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     if (lpv_emitters_collect(scene, &e->emitters) != 0)
         return lpv_error(err, err_size, "%s: out of memory for the emissive triangles", scene->source);
     lpv_engine_update_area_samples(e);
-    if (lpv_scene_copy_geometry(&e->geometry, scene) != 0)
-        return lpv_error(err, err_size, "%s: out of memory for the engine's copy of the geometry", scene->source);
     e->has_scene = 1; /* auto's choice reads the scene's facts */
     if (lpv_engine_resolve_technique(e, &e->settings, err, err_size) != 0 || lpv_engine_sample_scene(e, err, err_size))
         return -1;

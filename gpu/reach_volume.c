@@ -52,7 +52,7 @@ void lpv_engine_reach_light(lpv_engine *e)
         return;
     /* the lights light the same spaces as before (one moved in its room):
      * the texture holds the mask already */
-    if (!lpv_reach_light(&e->reach, e->lights, e->light_count) && e->reach_tex)
+    if (!lpv_reach_light(&e->reach, &e->geometry, e->lights, e->light_count) && e->reach_tex)
         return;
     if (!e->reach_tex) {
         glGenTextures(1, &e->reach_tex);

@@ -53,7 +53,7 @@ static void build_and_light(lpv_reach *r, const lpv_scene *s)
 {
     char err[256];
     assert_int_equal(lpv_reach_build(r, s, 0, err, sizeof err), 0);
-    lpv_reach_light(r, s->lights, s->light_count);
+    lpv_reach_light(r, s, s->lights, s->light_count);
     assert_int_equal(r->unsure, 0);
 }
 
@@ -81,10 +81,10 @@ static void test_closed_box_keeps_its_light(void **state)
     /* the lamp moves within its box: the same spaces are lit, nothing to send
      * again; out of the box into the room: the room is lit */
     s.lights[0].position[0] = 0.1f;
-    assert_int_equal(lpv_reach_light(&r, s.lights, s.light_count), 0);
+    assert_int_equal(lpv_reach_light(&r, &s, s.lights, s.light_count), 0);
     assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 0.0f);
     s.lights[0].position[1] = 2.0f;
-    assert_int_equal(lpv_reach_light(&r, s.lights, s.light_count), 1);
+    assert_int_equal(lpv_reach_light(&r, &s, s.lights, s.light_count), 1);
     assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 1.0f);
     assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.52f, 0.0f}, UP) == 0.0f);
     lpv_reach_free(&r);
@@ -131,14 +131,14 @@ static void test_directional_and_emitters(void **state)
     char err[256];
     assert_int_equal(lpv_reach_build(&r, &s, 0, err, sizeof err), 0);
     /* no lights at all: only the emitter's shell is lit */
-    lpv_reach_light(&r, NULL, 0);
+    lpv_reach_light(&r, &s, NULL, 0);
     assert_int_equal(r.unsure, 0);
     assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.0f, 0.0f}, UP) == 0.0f);
     assert_true(lpv_reach_at(&r, (float[3]){-2.5f, 0.05f, -2.5f}, UP) == 1.0f); /* under the panel */
     assert_true(lpv_reach_at(&r, (float[3]){-2.5f, 0.95f, -2.5f}, DOWN) == 1.0f); /* above its back */
     /* a sun: the ground and the block's faces are lit, the shell's inside still is */
     lpv_light sun = {.type = LPV_LIGHT_DIRECTIONAL, .color = {1, 1, 1}, .intensity = 1.0f, .direction = {0, -1, 0}};
-    lpv_reach_light(&r, &sun, 1);
+    lpv_reach_light(&r, &s, &sun, 1);
     assert_true(lpv_reach_at(&r, (float[3]){0.0f, 0.0f, 0.0f}, UP) == 1.0f);
     assert_true(lpv_reach_at(&r, (float[3]){3.0f, 1.0f, 2.0f}, PX) == 1.0f);
     assert_true(lpv_reach_at(&r, (float[3]){-2.5f, 0.05f, -2.5f}, UP) == 1.0f);
@@ -196,6 +196,52 @@ static void test_light_in_thin_slab(void **state)
     assert_true(r.voxel > 0.005f);
     assert_true(lpv_reach_at(&r, (float[3]){1.0f, 0.0f, 1.0f}, UP) == 1.0f);
     assert_true(lpv_reach_at(&r, (float[3]){1.0f, -0.005f, 1.0f}, DOWN) == 1.0f);
+    lpv_reach_free(&r);
+    lpv_scene_free(&s);
+}
+
+/* A lamp closer under a ceiling than the voxels are wide: its voxel is
+ * solid, and the air on both sides of the ceiling lies around it. Above the
+ * ceiling is the hollow inside of a 3 m block (a hill, the next storey): the
+ * lamp lights the room under it and not that. Looked at closer
+ * (LPV_REACH_CLOSER), the lamp's air is the room's; every air voxel around
+ * it lit the block's inside too, with 0.5 m voxels, at every height in the
+ * solid voxel. */
+static void test_lamp_under_a_thick_ceiling(void **state)
+{
+    (void)state;
+    lpv_scene s = {0};
+    int grey = lpv_scene_add_material(&s, "grey", (float[3]){0.6f, 0.6f, 0.6f}, NULL);
+    add_box(&s, grey, -10.0f, -0.2f, -10.0f, 10.0f, 0.0f, 10.0f); /* floor */
+    add_box(&s, grey, -10.0f, 2.6f, -10.0f, 10.0f, 5.6f, 10.0f);  /* the block over the room, hollow */
+    lpv_light *lamp = lpv_scene_add_point_light(&s, (float[3]){0.0f, 2.4f, 0.0f}, 5.0f);
+    assert_non_null(lamp);
+    lpv_scene_compute_bounds(&s);
+    char err[256];
+    lpv_reach r;
+    assert_int_equal(lpv_reach_build(&r, &s, 20000, err, sizeof err), 0);
+    assert_true(r.voxel > 0.3f);
+    int tried = 0;
+    for (float below = 0.05f; below < 1.0f; below += 0.1f) {
+        lamp->position[1] = 2.6f - below * r.voxel;
+        int c[3];
+        for (int k = 0; k < 3; ++k)
+            c[k] = (int)floorf((lamp->position[k] - r.origin[k]) / r.voxel);
+        if (r.label[(size_t)c[0] + (size_t)r.dims[0] * ((size_t)c[1] + (size_t)r.dims[1] * (size_t)c[2])] != 0)
+            continue; /* the lamp's voxel is air: nothing to look at closer */
+        lpv_reach_light(&r, &s, s.lights, s.light_count);
+        assert_int_equal(r.unsure, 0);
+        assert_int_equal(lpv_reach_lit_at(&r, (float[3]){0.0f, 1.2f, 3.0f}), 1);  /* the room */
+        assert_int_equal(lpv_reach_lit_at(&r, (float[3]){0.0f, 4.1f, 0.0f}), 0);  /* inside the block */
+        assert_int_equal(lpv_reach_lit_at(&r, (float[3]){3.0f, 4.1f, -3.0f}), 0);
+        assert_int_equal(r.lit_components, 1);
+        /* without the scene, every air voxel around the lamp: the block's inside too */
+        lpv_reach_light(&r, NULL, s.lights, s.light_count);
+        assert_int_equal(lpv_reach_lit_at(&r, (float[3]){0.0f, 4.1f, 0.0f}), 1);
+        tried++;
+    }
+    print_message("voxel %.3f m: %d lamp heights in a solid voxel\n", (double)r.voxel, tried);
+    assert_true(tried >= 2);
     lpv_reach_free(&r);
     lpv_scene_free(&s);
 }
@@ -346,6 +392,7 @@ int main(void)
         cmocka_unit_test(test_directional_and_emitters),
         cmocka_unit_test(test_two_rooms),
         cmocka_unit_test(test_light_in_thin_slab),
+        cmocka_unit_test(test_lamp_under_a_thick_ceiling),
         cmocka_unit_test(test_free_path_sizes_iv),
         cmocka_unit_test(test_view_chord),
         cmocka_unit_test(test_lit_box),
