@@ -49,6 +49,9 @@ as glTF 2.0 binary files next to this script. Python standard library only.
   tunnel-terrain.glb  the tunnel under a 240 m x 240 m, 10 m thick block of
                  ground (issue 30): wide bounds, narrow air; a camera inside,
                  2 m from a lamp, looking along it (docs/cascades.md, "Long scenes").
+  tunnel-hill.glb  the tunnel without its roof, the hill's underside its
+                 ceiling: each lamp 0.2 m under a solid 10 m thick, in reach
+                 voxels of 0.78 m (docs/propagation.md, "Enclosed lights").
   curved.glb     CURVED (issue 30): the room with a smooth-shaded white sphere
                  and a smooth-shaded grey cylinder on its floor, lit by a spot
                  light from above the red wall; the camera sees both where they
@@ -545,6 +548,22 @@ def tunnel_terrain():
     return s
 
 
+def tunnel_hill():
+    """The tunnel whose ceiling is the hill's own underside: no roof of its
+    own, the 240 m x 240 m block of ground 10 m thick resting on its walls,
+    so each lamp hangs 0.2 m under a solid 10 m thick. In a 240 m scene the
+    reach voxels are 0.78 m, every lamp's voxel is solid, and the voxels
+    alone cannot tell the tunnel's air from the hill's hollow inside
+    (docs/propagation.md, "Enclosed lights"). The camera as in
+    tunnel-terrain."""
+    s = tunnel()
+    s.boxes = {m: [b for b in boxes if b[0][1] != 2.6] for m, boxes in s.boxes.items()}  # no roof
+    ground = s.material("hill_ground", (0.40, 0.38, 0.30))
+    s.add_box(ground, (-120.0, 2.6, -120.2), (120.0, 12.6, 120.2))
+    s.camera("Camera", (0.0, 1.6, -58.0), (0.0, 1.3, -100.0), 70.0)
+    return s
+
+
 def curved():
     s = Scene()
     room(s)
@@ -620,7 +639,7 @@ def main():
                         ("lamp-open", lambda: lamp_box(enclosed=False)),
                         ("lamp-open-panel", lambda: lamp_box("panel", enclosed=False)), ("two-rooms", two_rooms),
                         ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel),
-                        ("tunnel-terrain", tunnel_terrain),
+                        ("tunnel-terrain", tunnel_terrain), ("tunnel-hill", tunnel_hill),
                         ("curved", curved), ("lamp-fixture", lamp_fixture),
                         ("box-walls", lambda: walls_room(False)), ("thin-walls", lambda: walls_room(True))):
         data, tris = build().glb()
