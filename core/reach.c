@@ -51,8 +51,6 @@ static int place(lpv_reach *r, const float bmin[3], const float bmax[3], size_t 
     return -1;
 }
 
-/* Marks every voxel triangle (a, b, c) touches as solid (label 0; the
- * labels start at 1 = air). */
 /* Triangle p's conservative voxels in a grid of cubic voxels (lower corner
  * origin, side, dims; x fastest) set to 0 in cells (0 = solid). */
 static void voxelize_into(const float origin[3], double side, const int dims[3], uint32_t *cells, const float *p[3])
@@ -80,6 +78,8 @@ static void voxelize_into(const float origin[3], double side, const int dims[3],
             }
 }
 
+/* Marks every voxel triangle p touches as solid (label 0; the labels start
+ * at 1 = air). */
 static void voxelize_triangle(lpv_reach *r, const float *p[3])
 {
     voxelize_into(r->origin, (double)r->voxel, r->dims, r->label, p);
