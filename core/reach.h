@@ -99,7 +99,8 @@ int lpv_reach_build(lpv_reach *r, const lpv_scene *scene, size_t max_voxels, cha
  * light in a solid voxel (a lamp close under a ceiling) lights the
  * components its air reaches in a closer look at the scene's surfaces
  * around it, LPV_REACH_CLOSER times finer (scene: the one built from; NULL:
- * every air voxel around it). Returns 1 when the mask changed, 0 when the
+ * every air voxel around it; one pass over the scene's triangles for each
+ * such light, every call). Returns 1 when the mask changed, 0 when the
  * lights light the same spaces as at the last call (a light moved within
  * its room: the daemon's common LIGHT_SET), so the caller need not send it
  * again. */
