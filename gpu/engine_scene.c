@@ -179,9 +179,7 @@ int lpv_engine_iv_points_stale(const lpv_engine *e)
     lpv_engine_lit_region(e, lo, hi, &free_path);
     if (lpv_iv_place(&e->settings, lo, hi, free_path, &g) != 0)
         return 0;
-    const lpv_grid *had = &e->iv_points_grid; /* its pieces were split by its voxel and kept in its box */
-    return g.cell_size != had->cell_size || memcmp(g.origin, had->origin, sizeof g.origin) != 0 ||
-           memcmp(g.dims, had->dims, sizeof g.dims) != 0;
+    return memcmp(&g, &e->iv_points_grid, sizeof g) != 0; /* its pieces were split by its voxel, kept in its box */
 }
 
 /* The scene's samples under the current settings, from the engine's copy of
@@ -262,9 +260,13 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     e->shadow_valid = 0;
     e->ticked = 0;
     if (e->has_scene && sig == e->geometry_sig) {
-        /* the same geometry, materials and textures: only the lights are new */
+        /* the same geometry, materials and textures: only the lights are new,
+         * but they may light other spaces, and the imperfect volume's cloud
+         * is kept in the box of the lit ones */
         e->lights_dirty = 1;
         set_lights(e, scene);
+        if (lpv_engine_iv_points_stale(e) && lpv_engine_sample_scene(e, err, err_size) != 0)
+            return -1;
         return lpv_engine_place_volume(e, err, err_size);
     }
     e->scene_dirty = 1;
