@@ -225,41 +225,14 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     return e;
 }
 
-static void free_rsm(lpv_engine *e)
-{
-    lpv_gl_delete_texture(&e->rsm_position);
-    lpv_gl_delete_texture(&e->rsm_normal);
-    lpv_gl_delete_texture(&e->rsm_flux);
-    lpv_gl_delete_texture(&e->rsm_albedo);
-    lpv_gl_delete_texture(&e->rsm_depth);
-    lpv_gl_delete_framebuffer(&e->rsm_fbo);
-    lpv_gl_delete_buffer(&e->vpls);
-    lpv_gl_delete_buffer(&e->surfels);
-    e->rsm_alloc_size = e->rsm_alloc_faces = 0;
-}
-
-static void free_camera(lpv_engine *e)
-{
-    for (int i = 0; i < 4; ++i)
-        lpv_gl_delete_texture(&e->gbuf_tex[i]);
-    lpv_gl_delete_texture(&e->gbuf_depth);
-    lpv_gl_delete_texture(&e->frame_tex);
-    lpv_gl_delete_framebuffer(&e->gbuf_fbo);
-    lpv_gl_delete_framebuffer(&e->frame_fbo);
-    lpv_gl_delete_buffer(&e->camera_surfels);
-    lpv_gl_delete_buffer(&e->shade_rest);
-    lpv_gl_delete_buffer(&e->area_rest);
-    e->gbuf_w = e->gbuf_h = 0;
-    lpv_frame_blocks_free(e);
-}
-
 void lpv_engine_destroy(lpv_engine *e)
 {
     if (!e)
         return;
     lpv_engine_free_scene(e);
-    free_rsm(e);
-    free_camera(e);
+    lpv_pass_rsm_free(e);
+    lpv_pass_camera_free(e);
+    lpv_frame_blocks_free(e);
     lpv_pass_shadow_free(e);
     lpv_medium_free(&e->medium);
     lpv_gl_delete_buffer(&e->query_in);

@@ -295,6 +295,11 @@ int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *
  * changed; records the "shadow" stage when it draws. Returns 0 or -1. */
 int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size);
 void lpv_pass_shadow_free(lpv_engine *e);
+/* Each producer deletes what it made (also what a failed allocation left):
+ * the passes call these before remaking their storage, and
+ * lpv_engine_destroy calls them, so each list of objects is written once. */
+void lpv_pass_rsm_free(lpv_engine *e);
+void lpv_pass_camera_free(lpv_engine *e);
 
 /* The storage the engine's own producers call for (RSMs, shadow maps, the
  * image; memory_limits.c); the technique adds its own. */

@@ -11,21 +11,20 @@
 
 #include "engine_internal.h"
 
-static void free_targets(lpv_engine *e)
+/* Deletes the G-buffer, the frame and the camera's surfels and pixel lists
+ * (a partly failed allocation too); the engine's destroy calls it too, so
+ * this is the one list of them. */
+void lpv_pass_camera_free(lpv_engine *e)
 {
-    if (e->gbuf_fbo) {
-        glDeleteTextures(4, e->gbuf_tex);
-        glDeleteTextures(1, &e->gbuf_depth);
-        glDeleteTextures(1, &e->frame_tex);
-        glDeleteFramebuffers(1, &e->gbuf_fbo);
-        glDeleteFramebuffers(1, &e->frame_fbo);
-        glDeleteBuffers(1, &e->camera_surfels);
-        glDeleteBuffers(1, &e->shade_rest);
-        glDeleteBuffers(1, &e->area_rest);
-    }
-    memset(e->gbuf_tex, 0, sizeof e->gbuf_tex);
-    e->gbuf_depth = e->frame_tex = e->gbuf_fbo = e->frame_fbo = e->camera_surfels = e->shade_rest = 0;
-    e->area_rest = 0;
+    for (int i = 0; i < 4; ++i)
+        lpv_gl_delete_texture(&e->gbuf_tex[i]);
+    lpv_gl_delete_texture(&e->gbuf_depth);
+    lpv_gl_delete_texture(&e->frame_tex);
+    lpv_gl_delete_framebuffer(&e->gbuf_fbo);
+    lpv_gl_delete_framebuffer(&e->frame_fbo);
+    lpv_gl_delete_buffer(&e->camera_surfels);
+    lpv_gl_delete_buffer(&e->shade_rest);
+    lpv_gl_delete_buffer(&e->area_rest);
     e->gbuf_w = e->gbuf_h = 0;
     e->camera_surfel_w = e->camera_surfel_h = e->camera_surfel_slots = 0;
 }
@@ -37,7 +36,7 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     const int w = e->view.width, h = e->view.height;
     if (e->gbuf_w == w && e->gbuf_h == h)
         return 0;
-    free_targets(e);
+    lpv_pass_camera_free(e);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
     static const GLenum formats[4] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F};
@@ -75,7 +74,7 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     }
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
-        free_targets(e);
+        lpv_pass_camera_free(e);
         return lpv_error(err, err_size, "could not allocate the %dx%d G-buffer, frame and surfels (GL error 0x%04x)", w,
                          h, gl_err);
     }

@@ -23,23 +23,20 @@ static GLuint array_texture(GLenum format, int size, int layers)
     return t;
 }
 
-/* Deletes the RSM textures and buffers (a partly failed allocation too). */
-static void free_rsm_storage(lpv_engine *e)
+/* Deletes the RSM textures and buffers (a partly failed allocation too);
+ * the engine's destroy calls it too, so this is the one list of them. */
+void lpv_pass_rsm_free(lpv_engine *e)
 {
-    GLuint tex[] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo, e->rsm_depth};
-    for (int i = 0; i < 5; ++i)
-        if (tex[i])
-            glDeleteTextures(1, &tex[i]);
-    if (e->rsm_fbo)
-        glDeleteFramebuffers(1, &e->rsm_fbo);
-    if (e->vpls)
-        glDeleteBuffers(1, &e->vpls);
-    if (e->surfels)
-        glDeleteBuffers(1, &e->surfels);
+    lpv_gl_delete_texture(&e->rsm_position);
+    lpv_gl_delete_texture(&e->rsm_normal);
+    lpv_gl_delete_texture(&e->rsm_flux);
+    lpv_gl_delete_texture(&e->rsm_albedo);
+    lpv_gl_delete_texture(&e->rsm_depth);
+    lpv_gl_delete_framebuffer(&e->rsm_fbo);
+    lpv_gl_delete_buffer(&e->vpls);
+    lpv_gl_delete_buffer(&e->surfels);
     lpv_gl_delete_buffer(&e->vpls_live);
     lpv_gl_delete_buffer(&e->vpls_draw);
-    e->rsm_position = e->rsm_normal = e->rsm_flux = e->rsm_albedo = e->rsm_depth = e->rsm_fbo = 0;
-    e->vpls = e->surfels = 0;
     e->rsm_alloc_size = e->rsm_alloc_faces = 0;
 }
 
@@ -66,7 +63,7 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
 
-    free_rsm_storage(e);
+    lpv_pass_rsm_free(e);
     e->rsm_position = array_texture(GL_RGBA32F, size, layers);
     e->rsm_normal = array_texture(GL_RGBA32F, size, layers);
     e->rsm_flux = array_texture(GL_RGBA32F, size, layers);
@@ -90,7 +87,7 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)lpv_compact_head_bytes(texels), NULL, GL_DYNAMIC_COPY);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
-        free_rsm_storage(e);
+        lpv_pass_rsm_free(e);
         return lpv_error(err, err_size, "could not allocate the RSMs: rsm_size %d x %d layers = %.2f GB (GL error "
                          "0x%04x)", size, layers, (double)lpv_memory_rsm_bytes(&need) / 1e9, gl_err);
     }
