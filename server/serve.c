@@ -7,6 +7,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -293,16 +294,24 @@ static void exit_deadline_cb(uv_timer_t *t)
 
 static void begin_shutdown(sv_server *s, int signum)
 {
-    if (s->stopping)
+    if (s->stopping) {
+        /* a supervisor repeating its SIGTERM, or a ^C after it: the stop in
+         * progress already answers every client; dying now would lose those
+         * answers (issue 31, item 8) */
+        fprintf(stderr, "lpvd serve: %s: already stopping\n", signum == SIGINT ? "SIGINT" : "SIGTERM");
         return;
+    }
     s->stopping = 1;
     fprintf(stderr, "lpvd serve: %s: finishing the tick in flight, saying BYE to %d client(s)\n",
             signum == SIGINT ? "SIGINT" : "SIGTERM", s->conn_count);
     sv_net_stop_listening(s);
     uv_timer_stop(&s->idle_timer);
     uv_close((uv_handle_t *)&s->idle_timer, NULL);
-    uv_close((uv_handle_t *)&s->sigterm, NULL);
-    uv_close((uv_handle_t *)&s->sigint, NULL);
+    /* SIGTERM and SIGINT stay handled until the process ends (closed, their
+     * default action would kill it); unref'd, they keep the loop from ending
+     * no longer than the rest */
+    uv_unref((uv_handle_t *)&s->sigterm);
+    uv_unref((uv_handle_t *)&s->sigint);
     uv_close((uv_handle_t *)&s->sighup, NULL);
     for (sv_world *w = s->worlds; w; w = w->next)
         if (w->timer_init)
@@ -364,6 +373,13 @@ int lpvd_cmd_serve(int argc, char **argv)
 {
     static sv_server srv; /* one per process; its address is stable for the handles */
     sv_server *s = &srv;
+    /* A daemon that runs for months gives back what a world took when the
+     * world goes: glibc's threshold for serving a block from mmap rises to
+     * the largest block freed (up to 32 MiB on 64-bit), after which a world's
+     * textures and buffers (llvmpipe's storage is malloc'ed) come from the
+     * heap and stay in it. A fixed threshold keeps every block over it in
+     * its own mapping, unmapped when freed (issue 31, item 1). */
+    mallopt(M_MMAP_THRESHOLD, SV_MMAP_THRESHOLD);
     memset(s, 0, sizeof *s);
     sv_config *cfg = &s->cfg;
     cfg->max_body = LPVP_DEFAULT_MAX_BODY;
@@ -635,6 +651,8 @@ int lpvd_cmd_serve(int argc, char **argv)
 out:
     uv_walk(s->loop, close_walk, NULL);
     uv_run(s->loop, UV_RUN_DEFAULT);
+    signal(SIGTERM, SIG_IGN); /* closing their handles restored the default (kill); the rest is cleanup */
+    signal(SIGINT, SIG_IGN);
     if (s->builtin)
         sv_scene_unref(s, s->builtin);
     while (s->scenes) { /* none should be left; free anyway */
