@@ -104,6 +104,8 @@ typedef struct sv_config {
 
 #define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
 #define SV_DEFAULT_MAX_REQUEST_MEMORY ((uint64_t)1 << 30)
+/* Blocks over this come from their own mapping, given back when freed (serve.c). */
+#define SV_MMAP_THRESHOLD (256 * 1024)
 #define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)
 #define SV_DEFAULT_MAX_WORLD_MEMORY ((uint64_t)1 << 30)
 #define SV_DEFAULT_HANDSHAKE_TIMEOUT 10.0

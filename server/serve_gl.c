@@ -7,6 +7,7 @@
  */
 #include "serve.h"
 
+#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -311,6 +312,7 @@ static void *gl_main(void *arg)
         case SV_JOB_DESTROY:
             lpv_engine_destroy(j->world->engine);
             j->world->engine = NULL;
+            malloc_trim(0); /* the heap's free pages back to the system (serve.c, mallopt) */
             break;
         case SV_JOB_QUIT: quit = 1; break;
         }
