@@ -2,6 +2,7 @@
 #include "batch_render.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <glob.h>
 #include <limits.h>
 #include <math.h>
@@ -21,6 +22,7 @@
 #include "serve.h"
 #include "stats_json.h"
 #include "tonemap.h"
+#include "write_beneath.h"
 
 /* The volume as GET_VOLUME would send it, between its two files' writers. */
 typedef struct volume_out {
@@ -32,6 +34,7 @@ typedef struct volume_out {
 struct lpvd_batch_renderer {
     const lpvd_batch_job *job;
     char out[PATH_MAX];
+    int out_fd; /* --out, opened once: every output is written beneath it (core/write_beneath.h) */
     char root[PATH_MAX]; /* the job folder, resolved: scenes and points stay inside */
     lpv_gl_context *ctx;
     lpv_engine *engine;
@@ -83,9 +86,19 @@ static int inside(const char *root, const char *dir, const char *rel, char out[P
  * must be finite and within LPV_MAX_COORD. */
 static int load_points(lpvd_batch_renderer *r, const char *path, char *err, size_t n)
 {
-    FILE *f = fopen(path, "r");
-    if (!f)
+    /* O_NONBLOCK and a regular file only: a FIFO there would block the batch
+     * for good (issue 31, item 9) */
+    const int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
         return lpv_error(err, n, "points %s: %s", r->job->points_path, strerror(errno));
+    struct stat st = {0};
+    FILE *f = NULL;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || fcntl(fd, F_SETFL, 0) != 0 || !(f = fdopen(fd, "r"))) {
+        const int e = errno;
+        close(fd);
+        return lpv_error(err, n, "points %s: %s", r->job->points_path,
+                         S_ISREG(st.st_mode) ? strerror(e) : "not a regular file (a FIFO, a device or a folder)");
+    }
     long got = lpv_points_csv_read(f, r->job->points_path, &r->points, &r->normals, err, n);
     fclose(f);
     if (got < 0)
@@ -110,6 +123,11 @@ lpvd_batch_renderer *lpvd_batch_renderer_create(const lpvd_batch_job *job, lpv_b
     r->job = job;
     r->scene_index = r->scene_time = r->engine_scene = r->engine_lights = -1;
     snprintf(r->out, sizeof r->out, "%s", out_dir);
+    r->out_fd = open(out_dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (r->out_fd < 0) {
+        lpv_error(err, n, "%s: %s", out_dir, strerror(errno));
+        goto bad;
+    }
     if (!realpath(job->dir, r->root)) {
         lpv_error(err, n, "%s: %s", job->dir, strerror(errno));
         goto bad;
@@ -147,6 +165,8 @@ void lpvd_batch_renderer_destroy(lpvd_batch_renderer *r)
         return;
     lpv_engine_destroy(r->engine);
     lpv_gl_context_destroy(r->ctx);
+    if (r->out_fd > 0)
+        close(r->out_fd);
     lpv_scene_free(&r->scene);
     free(r->points);
     free(r->normals);
@@ -202,45 +222,54 @@ static int orbit_view(const lpvd_batch_camera *c, const lpv_scene *s, int w, int
     return lpv_view_look_at(eye, centre, fov, w, h, v);
 }
 
-/* path = out/rel; written by fn to a temporary name in the same folder with
- * the same extension, then renamed. */
+/* out/rel, written by fn to a temporary name in the same folder with the
+ * same extension, then renamed; never through a link (core/write_beneath.h). */
 typedef int (*writer)(lpvd_batch_renderer *r, const char *path, char *err, size_t n);
+
+typedef struct write_call {
+    lpvd_batch_renderer *r;
+    writer fn;
+} write_call;
+
+static int call_writer(const char *path, void *arg, char *err, size_t n)
+{
+    const write_call *c = arg;
+    return c->fn(c->r, path, err, n);
+}
+
+/* What a process killed while writing rel left (SIGKILL, a lost node):
+ * never an output, since only the manifest says what is done; removed here,
+ * as no other process renders this item at the same time. */
+static void remove_leftovers(lpvd_batch_renderer *r, const char *rel)
+{
+    const char *slash = strrchr(rel, '/'), *name = slash ? slash + 1 : rel;
+    char folder[PATH_MAX], pattern[2 * PATH_MAX];
+    snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - rel) : 0, rel);
+    const int fd = lpv_dir_make_beneath(r->out_fd, folder);
+    if (fd < 0)
+        return; /* the write says why */
+    const char *ext = strrchr(name, '.');
+    if (!ext || ext == name)
+        ext = name + strlen(name);
+    char leftover[PATH_MAX];
+    snprintf(leftover, sizeof leftover, "%.*s.tmp-*%s", (int)(ext - name), name, ext);
+    glob_t g;
+    if (lpv_fd_path(fd, leftover, pattern, sizeof pattern) == 0 &&
+        glob(pattern, GLOB_NOSORT | GLOB_NOESCAPE, NULL, &g) == 0) {
+        for (size_t i = 0; i < g.gl_pathc; ++i)
+            unlinkat(fd, strrchr(g.gl_pathv[i], '/') + 1, 0);
+        globfree(&g);
+    }
+    close(fd);
+}
 
 static int write_atomic(lpvd_batch_renderer *r, const char *rel, writer fn, json_t *outputs, const char *kind,
                         char *err, size_t n)
 {
-    char path[2 * PATH_MAX], tmp[2 * PATH_MAX + 64];
-    if ((size_t)snprintf(path, sizeof path, "%s/%s", r->out, rel) >= sizeof path)
-        return lpv_error(err, n, "%s/%s: path too long", r->out, rel);
-    char *slash = strrchr(path, '/');
-    for (char *p = path + strlen(r->out) + 1; p <= slash; ++p) /* the id's folders */
-        if (*p == '/') {
-            *p = '\0';
-            int made = mkdir(path, 0777) == 0 || errno == EEXIST;
-            *p = '/';
-            if (!made)
-                return lpv_error(err, n, "%s: %s", path, strerror(errno));
-        }
-    const char *ext = strrchr(slash, '.');
-    /* what a process killed while writing this item left (SIGKILL, a lost
-     * node): never an output, since only the manifest says what is done;
-     * removed here, as no other process renders this item at the same time */
-    glob_t g;
-    snprintf(tmp, sizeof tmp, "%.*s.tmp-*%s", (int)(ext - path), path, ext);
-    if (glob(tmp, GLOB_NOSORT | GLOB_NOESCAPE, NULL, &g) == 0)
-        for (size_t i = 0; i < g.gl_pathc; ++i)
-            unlink(g.gl_pathv[i]);
-    globfree(&g);
-    snprintf(tmp, sizeof tmp, "%.*s.tmp-%ld%s", (int)(ext - path), path, (long)getpid(), ext);
-    if (fn(r, tmp, err, n) != 0) {
-        unlink(tmp);
+    remove_leftovers(r, rel);
+    write_call c = {.r = r, .fn = fn};
+    if (lpv_write_beneath(r->out_fd, rel, call_writer, &c, err, n) != 0)
         return -1;
-    }
-    if (rename(tmp, path) != 0) {
-        int e = errno;
-        unlink(tmp);
-        return lpv_error(err, n, "%s: %s", path, strerror(e));
-    }
     json_array_append_new(outputs, json_pack("{s:s, s:s}", "kind", kind, "path", rel));
     return 0;
 }

@@ -13,6 +13,11 @@
   errors   bad job files are refused with exit 2 and a message naming the key
   features animation times (the frame at t equals the file posed there),
            light overrides, irradiance at points, ambient occlusion
+  links    symbolic links inside --out are never written through (issue 31,
+           item 7): a linked item folder fails that item, naming the link; a
+           link in place of an output, a manifest, contact.png is replaced, or
+           refused, never its target written; a linked thumbs/ is refused;
+           and a FIFO as the points file is refused at once (item 9)
   schema   the example job (scenes/batch-example.json) is valid against
            docs/batch.schema.json and `lpvd batch --list` expands it; job files
            the schema refuses, lpvd refuses too
@@ -452,11 +457,95 @@ def case_features(lpvd, source, tmp):
           [e.get("error") for e in lines][:1])
 
 
+def case_links(lpvd, source, tmp):
+    victims = os.path.join(tmp, "victims")
+    os.makedirs(os.path.join(victims, "dir"))
+    vfile = os.path.join(victims, "file")
+
+    def reset_victim():
+        with open(vfile, "w") as f:
+            f.write("precious\n")
+
+    def victim_intact(what):
+        with open(vfile, "rb") as f:
+            check(f.read() == b"precious\n", what + ": the link's target file is unchanged")
+        check(os.listdir(os.path.join(victims, "dir")) == [], what + ": nothing written into the linked folder")
+
+    job = {"lpvd_batch": 1, "size": [32, 32], "scenes": [{"name": "cornell"}],
+           "cameras": [{"name": "file"}], "settings": [{"name": "a", "preset": "fast"}, {"name": "b", "preset": "fast"}],
+           "outputs": ["png"]}
+    path = os.path.join(tmp, "job.json")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    ids = [i[1] for i in listed(lpvd, path)]
+    check(len(ids) == 2 and ids[0].startswith("cornell/"), "the job's items: %r" % ids)
+    folder = os.path.dirname(ids[1])  # cornell/...: the items' folder
+
+    # 1. the manifest is a link: refused before anything is rendered
+    reset_victim()
+    out = os.path.join(tmp, "o1")
+    os.makedirs(out)
+    os.symlink(vfile, os.path.join(out, "manifest-0-of-1.jsonl"))
+    rc, _, err = run(lpvd, path, "--out", out, "--progress", "off")
+    check(rc != 0 and "manifest-0-of-1.jsonl" in err and "symbolic link" in err,
+          "a linked manifest is refused, naming it: rc %d, %s" % (rc, err.strip()[-300:]))
+    victim_intact("linked manifest")
+
+    # 2. the items' top folder is a link; then item b's output is a link
+    reset_victim()
+    out = os.path.join(tmp, "o2")
+    os.makedirs(out)
+    os.symlink(os.path.join(victims, "dir"), os.path.join(out, "cornell"))
+    rc, _, err = run(lpvd, path, "--out", out, "--progress", "off")
+    lines = manifest_lines(out)
+    check(rc == 1 and len(lines) == 2 and all("symbolic link" in e.get("error", "") for e in lines),
+          "items under a linked folder fail, naming the link: rc %d, %r" % (rc, [e.get("error") for e in lines]))
+    victim_intact("linked item folder")
+    os.unlink(os.path.join(out, "cornell"))
+    os.makedirs(os.path.join(out, folder))
+    b = os.path.join(out, ids[1] + ".png")
+    os.symlink(vfile, b)
+    if os.path.lexists(os.path.join(out, "contact.png")):
+        os.unlink(os.path.join(out, "contact.png"))
+    os.symlink(vfile, os.path.join(out, "contact.png"))
+    rc, _, err = run(lpvd, path, "--out", out, "--progress", "off")
+    check(rc == 0 and not os.path.islink(b) and os.path.getsize(b) > 0,
+          "a link in place of an output is replaced by the image: rc %d, %s" % (rc, err.strip()[-300:]))
+    victim_intact("linked output")
+
+    # 3. the report: a linked thumbs/ is refused; a linked contact.png is replaced
+    shutil.rmtree(os.path.join(out, "thumbs"), ignore_errors=True)
+    os.symlink(os.path.join(victims, "dir"), os.path.join(out, "thumbs"))
+    rc, _, err = run(lpvd, path, "--out", out, "--report", "--progress", "off")
+    check(rc != 0 and "thumbs" in err and "symbolic link" in err,
+          "a linked thumbs/ is refused, naming it: rc %d, %s" % (rc, err.strip()[-300:]))
+    victim_intact("linked thumbs/")
+    os.unlink(os.path.join(out, "thumbs"))
+    rc, _, err = run(lpvd, path, "--out", out, "--report", "--progress", "off")
+    contact = os.path.join(out, "contact.png")
+    check(rc == 0 and not os.path.islink(contact) and os.path.getsize(contact) > 0,
+          "a link in place of contact.png is replaced by the sheet: rc %d, %s" % (rc, err.strip()[-300:]))
+    victim_intact("linked contact.png")
+
+    # 4. a FIFO as the points file: refused at once, not waited on
+    fifo_job = dict(job, outputs=["png", {"points": "pts.csv"}])
+    os.mkfifo(os.path.join(tmp, "pts.csv"))
+    with open(path, "w") as f:
+        json.dump(fifo_job, f)
+    t0 = time.monotonic()
+    try:
+        rc, _, err = run(lpvd, path, "--out", os.path.join(tmp, "o4"), "--progress", "off", timeout=60)
+    except subprocess.TimeoutExpired:
+        rc, err = None, "still running after 60 s"
+    check(rc not in (None, 0) and "pts.csv" in err and "not a regular file" in err,
+          "a FIFO as the points file is refused in %.1f s: rc %r, %s" % (time.monotonic() - t0, rc, err.strip()[-300:]))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--lpvd", required=True)
     ap.add_argument("--source", required=True)
-    ap.add_argument("case", choices=["shards", "resume", "failures", "errors", "features", "schema"])
+    ap.add_argument("case", choices=["shards", "resume", "failures", "errors", "features", "schema", "links"])
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="lpvd-batch-")
     try:
