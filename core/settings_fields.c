@@ -7,6 +7,7 @@
 #include "settings_fields.h"
 
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -222,6 +223,14 @@ int lpv_field_set_number(lpv_settings *s, const lpv_field *f, double v, char *er
                      f->note[0] ? "; " : "", f->note);
         return -1;
     }
+    if (f->kind == LPV_FIELD_FLOAT && v != 0.0 && fabs(v) < FLT_MIN) {
+        /* it would round to 0 (or lose its digits) in the setting's float,
+         * and 0 often means "the default" or "none" (issue 31, item 12) */
+        if (err && n)
+            snprintf(err, n, "%g is too small: it would round to 0 in a 32-bit float (the smallest nonzero value "
+                     "is %.9g)", v, (double)FLT_MIN);
+        return -1;
+    }
     char *p = (char *)s + f->offset;
     if (f->kind == LPV_FIELD_INT)
         *(int *)p = (int)v;
@@ -251,7 +260,7 @@ int lpv_field_set_string(lpv_settings *s, const lpv_field *f, const char *v, cha
         char *end;
         double x = strtod(v, &end);
         if (end != v && !*end && in_range(f, x))
-            return lpv_field_set_number(s, f, x, NULL, 0);
+            return lpv_field_set_number(s, f, x, err, n);
     }
     if (err && n)
         snprintf(err, n, "expected %s%s%s", want, f->note[0] ? "; " : "", f->note);

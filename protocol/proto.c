@@ -638,6 +638,12 @@ int lpvp_get_float(const json_t *obj, const char *key, int required, double min,
             lpvp_set_error(err, err_n, "%s: %.9g does not fit in a float", key, d);
             return LPVP_FIELD_BAD;
         }
+        if (d != 0.0 && fabs(d) < 1.17549435082228751e-38) { /* FLT_MIN: it would round to 0, often "none" */
+            lpvp_set_error(err, err_n,
+                           "%s: %g is too small: it would round to 0 in a 32-bit float (the smallest nonzero value "
+                           "is 1.17549435e-38)", key, d);
+            return LPVP_FIELD_BAD;
+        }
         *out = (float)d;
     }
     return st;

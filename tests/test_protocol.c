@@ -625,7 +625,7 @@ static void test_field_getters(void **state)
         "{\"i\": 42, \"neg\": -5, \"r\": 512.0, \"half\": 1.5, \"big\": 1e300, \"s\": \"hello\","
         " \"t\": true, \"f\": false, \"z\": null, \"eye\": [1, 2.5, -3], \"bad3\": [1, \"x\", 3],"
         " \"two\": [1, 2], \"grid\": [32, 32, 16], \"o\": {\"x\": 1}, \"arr\": [1,2,3,4],"
-        " \"fmt\": \"fp32\", \"huge\": 1e39, \"mat\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}";
+        " \"fmt\": \"fp32\", \"huge\": 1e39, \"tiny\": 1e-300, \"zero\": 0.0, \"mat\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}";
     json_t *j = lpvp_body_parse(body, strlen(body), err, sizeof err);
     assert_non_null(j);
 
@@ -669,6 +669,11 @@ static void test_field_getters(void **state)
     assert_true(fl == 1.5f);
     assert_int_equal(lpvp_get_float(j, "huge", 1, -1e300, 1e300, &fl, err, sizeof err),
                      LPVP_FIELD_BAD);
+    /* a light's range 1e-300 became 0, "unlimited" (issue 31, item 12) */
+    assert_int_equal(lpvp_get_float(j, "tiny", 1, 0, 1e9, &fl, err, sizeof err), LPVP_FIELD_BAD);
+    assert_non_null(strstr(err, "tiny: 1e-300 is too small"));
+    assert_int_equal(lpvp_get_float(j, "zero", 1, 0, 1e9, &fl, err, sizeof err), LPVP_FIELD_OK);
+    assert_true(fl == 0.0f);
 
     int b = -1;
     assert_int_equal(lpvp_get_bool(j, "t", 1, &b, err, sizeof err), LPVP_FIELD_OK);

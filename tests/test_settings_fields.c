@@ -210,6 +210,15 @@ static void test_bad_strings(void **state)
     assert_int_equal(lpv_field_set_string(&s, cascades, "0", err, sizeof err), 0); /* 0 = auto */
     assert_int_equal(lpv_field_set_string(&s, lpv_field_by_key("cascade_offset"), "-0.5", err, sizeof err), 0);
     assert_true(lpv_field_get(&s, lpv_field_by_key("cascade_offset")) == -0.5);
+    /* a value that would round to 0 in the float, where 0 means the default
+     * (indirect_gain 1e-300 became 1.0; issue 31, item 12), is refused */
+    const lpv_field *gain = lpv_field_by_key("indirect_gain");
+    assert_int_equal(lpv_field_set_number(&s, gain, 1e-300, err, sizeof err), -1);
+    assert_non_null(strstr(err, "too small"));
+    assert_int_equal(lpv_field_set_string(&s, gain, "1e-40", err, sizeof err), -1); /* subnormal: digits lost */
+    assert_non_null(strstr(err, "too small"));
+    assert_int_equal(lpv_field_set_string(&s, gain, "1e-30", err, sizeof err), 0);
+    assert_true(lpv_field_get(&s, gain) > 0.0);
     lpv_settings zero = {0};
     assert_memory_equal(&zero.glossy, &s.glossy, sizeof s.glossy); /* failures left it alone */
 }

@@ -936,6 +936,9 @@ def c_bad_field(ctx):
         (LIGHT_SET, {"id": "l1", "type": "laser", "intensity": 1.0, "position": [0, 1, 0]}, "type"),
         (LIGHT_SET, {"type": "point", "intensity": 1.0, "position": [0, 1, 0]}, "id"),
         (LIGHT_SET, {"id": "l1", "type": "point", "intensity": 1.0, "position": [0, 1]}, "position"),
+        # values that would round to 0 in a 32-bit float, where 0 means "none" or "the default"
+        (LIGHT_SET, {"id": "l1", "type": "point", "intensity": 1.0, "position": [0, 1, 0], "range": 1e-300}, "range"),
+        (CONFIG, {"indirect_gain": 1e-300}, "indirect_gain"),
         (LIGHT_REMOVE, {"id": 5}, "id"),
         (QUERY_IRRADIANCE, {}, "count"),
         (QUERY_IRRADIANCE, {"count": "3"}, "count"),
