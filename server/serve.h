@@ -104,6 +104,15 @@ typedef struct sv_config {
 
 #define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
 #define SV_DEFAULT_MAX_REQUEST_MEMORY ((uint64_t)1 << 30)
+/* QUERY_IRRADIANCE's largest count (HELLO limits.max_query_points): the
+ * request's count x 24 bytes plus its JSON within --max-message, and the
+ * reply's count x 12 bytes plus its header and JSON within --max-queue.
+ * SV_QUERY_*_ROOM: bytes kept for the JSON (and the reply's header). */
+#define SV_QUERY_BODY_ROOM 64u
+#define SV_QUERY_REPLY_ROOM 256u
+uint64_t sv_query_points_by_message(const sv_config *cfg);
+uint64_t sv_query_points_by_queue(const sv_config *cfg);
+uint64_t sv_max_query_points(const sv_config *cfg);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
 #define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)

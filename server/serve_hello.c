@@ -69,8 +69,10 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
                             s->cfg.max_tick_rate, "idle_timeout", s->cfg.idle_timeout, "max_queue",
                             (json_int_t)s->cfg.max_queue, "max_preauth_body", (json_int_t)s->cfg.max_preauth_body,
                             "handshake_timeout", s->cfg.handshake_timeout, "max_preauth", s->cfg.max_preauth);
-    if (lim)
+    if (lim) {
         json_object_set_new(lim, "max_request_memory", json_integer((json_int_t)s->cfg.max_request_memory));
+        json_object_set_new(lim, "max_query_points", json_integer((json_int_t)sv_max_query_points(&s->cfg)));
+    }
     if (lim) { /* the per-scene budgets (R4.5) */
         json_object_set_new(lim, "max_scene_texels", json_integer((json_int_t)s->cfg.max_scene_texels));
         json_object_set_new(lim, "max_scene_bytes", json_integer((json_int_t)s->cfg.max_scene_bytes));

@@ -153,13 +153,38 @@ void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     submit(c, jb);
 }
 
+uint64_t sv_query_points_by_message(const sv_config *cfg)
+{
+    return cfg->max_message > SV_QUERY_BODY_ROOM ? (cfg->max_message - SV_QUERY_BODY_ROOM) / 24 : 0;
+}
+
+uint64_t sv_query_points_by_queue(const sv_config *cfg)
+{
+    return cfg->max_queue > SV_QUERY_REPLY_ROOM ? (cfg->max_queue - SV_QUERY_REPLY_ROOM) / 12 : 0;
+}
+
+uint64_t sv_max_query_points(const sv_config *cfg)
+{
+    const uint64_t a = sv_query_points_by_message(cfg), b = sv_query_points_by_queue(cfg);
+    return a < b ? a : b;
+}
+
 void sv_do_query(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     int64_t count = 0;
-    if (lpvp_get_int(j, "count", 1, 0, (int64_t)(c->srv->cfg.max_message / 24), &count, err, sizeof err) !=
+    const sv_config *cfg = &c->srv->cfg;
+    if (lpvp_get_int(j, "count", 1, 0, (int64_t)sv_query_points_by_message(cfg), &count, err, sizeof err) !=
         LPVP_FIELD_OK) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if ((uint64_t)count > sv_query_points_by_queue(cfg)) { /* refused before it is computed (issue 31, item 10) */
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                     "count %lld: the reply (%lld x 12 bytes) would be over this server's per-client queue limit of "
+                     "%llu bytes (--max-queue); at most %llu points a query (HELLO limits.max_query_points)",
+                     (long long)count, (long long)count, (unsigned long long)cfg->max_queue,
+                     (unsigned long long)sv_max_query_points(cfg));
         return;
     }
     if (r->att_len != (size_t)count * 24) {
