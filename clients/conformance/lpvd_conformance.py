@@ -1792,6 +1792,20 @@ def c_query_bad_size(ctx):
     return "7 mismatches refused"
 
 
+@case("R4.7", "QUERY_IRRADIANCE over HELLO's limits.max_query_points is refused before its attachment is read")
+def c_query_over_max(ctx):
+    c, _, _ = ctx.scene_session()
+    n = (ctx.limits or {}).get("max_query_points")
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+        raise Fail("HELLO limits.max_query_points is %r, expected a positive integer" % (n,))
+    rid = c.send(QUERY_IRRADIANCE, {"count": n + 1}, _points(1))
+    f = c.recv_reply(rid)
+    if f.type != ERROR or f.err_name not in ("BAD_FIELD", "LIMIT") or "count" not in json.dumps(f.body):
+        raise Fail("count max_query_points + 1 = %d: expected BAD_FIELD or LIMIT naming count, got %r" % (n + 1, f))
+    ctx.ping(c)
+    return "max_query_points %d; %d refused (%s)" % (n, n + 1, f.err_name)
+
+
 @case("R4.7 R3.3", "QUERY_IRRADIANCE after a tick: count x 12 bytes of finite, non-negative irradiance")
 def c_query_ok(ctx):
     c, _, t = ctx.scene_session()
