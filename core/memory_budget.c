@@ -5,9 +5,12 @@
 #include "memory_budget.h"
 
 #include "lpv_shared.h" /* LPV_LOOKUP_NORMAL_TEXELS */
+#include "cascades.h"
+#include "settings.h"
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 static uint64_t texels(int size, int faces)
 {
@@ -72,7 +75,9 @@ static int fail(char *err, size_t err_size, const char *fmt, ...)
     if (err && err_size) {
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err, err_size, fmt, ap);
+        const int k = snprintf(err, err_size, "%s", LPV_MEMORY_REFUSED);
+        if (k >= 0 && (size_t)k < err_size)
+            vsnprintf(err + k, err_size - (size_t)k, fmt, ap);
         va_end(ap);
     }
     return -1;
@@ -150,4 +155,23 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
                 "%.2f GB) the engine needs %.2f GB, and the limit is %.2f GB (%s)",
                 what, gb(part[big]), kind[big], gb(part[0]), gb(part[1]), gb(part[2]), gb(part[3]), gb(total),
                 gb(lim->budget), lim->budget_source);
+}
+
+void lpv_memory_need_floor(const lpv_settings *s, int light_faces, lpv_memory_need *n)
+{
+    memset(n, 0, sizeof *n);
+    const int faces = light_faces > 1 ? light_faces : 1;
+    n->rsm_size = s->rsm_size;
+    n->rsm_faces = faces;
+    n->shadow_size = s->shadow_size;
+    n->shadow_faces = faces;
+    if (s->technique != LPV_TECHNIQUE_ID_LPV && s->technique != LPV_TECHNIQUE_ID_OCTREE)
+        return;
+    /* the cascades asked for, and the far field's levels the LPV adds to one */
+    const int asked = s->lpv.cascades > 0 ? s->lpv.cascades : 1;
+    const size_t k = (size_t)(s->technique == LPV_TECHNIQUE_ID_LPV ? lpv_cascades_count(s, asked) : 1);
+    n->cells = (size_t)s->grid_dims[0] * (size_t)s->grid_dims[1] * (size_t)s->grid_dims[2] * k;
+    n->gv_points = (size_t)(s->grid_dims[0] + 1) * (size_t)(s->grid_dims[1] + 1) * (size_t)(s->grid_dims[2] + 1) * k;
+    n->cascades = (int)k;
+    memcpy(n->grid_dims, s->grid_dims, sizeof n->grid_dims);
 }

@@ -65,10 +65,22 @@ uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n);
 uint64_t lpv_memory_image_bytes(const lpv_memory_need *n);
 uint64_t lpv_memory_total_bytes(const lpv_memory_need *n);
 
-/* 0 when n fits the limits; else -1 with a message that names the setting
- * that asks for the most, its estimate and the limit, e.g.
- * "rsm_size 2048 x 48 light faces needs 9.66 GB for one VPL buffer; a shader
- * storage buffer may hold at most 2.15 GB". */
+/* 0 when n fits the limits; else -1 with a message that starts with
+ * LPV_MEMORY_REFUSED and names the setting that asks for the most, its
+ * estimate and the limit, e.g. "does not fit: rsm_size 2048 x 48 light faces
+ * needs 9.66 GB for one VPL buffer; a shader storage buffer may hold at most
+ * 2.15 GB". The prefix tells a caller (the daemon: ERROR LIMIT, not INTERNAL)
+ * that the settings ask for more than this device or server allows. */
+#define LPV_MEMORY_REFUSED "does not fit: "
 int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, char *err, size_t err_size);
+
+/* The least any scene needs under settings s (resolved, core/settings.h):
+ * one light face of RSM and of shadow map at their sizes times light_faces
+ * (at least 1), and for the LPV and the octree their grid at the cascades
+ * asked for (at least one, and the LPV's far-field levels); nothing for the imperfect volume or auto, whose
+ * grids the scene places. What fails lpv_memory_check here can never run, so
+ * the daemon refuses it at CONFIG (issue 31, item 11). */
+struct lpv_settings;
+void lpv_memory_need_floor(const struct lpv_settings *s, int light_faces, lpv_memory_need *n);
 
 #endif /* LPV_MEMORY_BUDGET_H */

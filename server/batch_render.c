@@ -16,6 +16,7 @@
 #include "engine.h"
 #include "error.h"
 #include "image_io.h"
+#include "memory_limits.h"
 #include "points_csv.h"
 
 #include "scene_load.h"
@@ -153,6 +154,16 @@ lpvd_batch_renderer *lpvd_batch_renderer_create(const lpvd_batch_job *job, lpv_b
     r->engine = lpv_engine_create(err, n);
     if (!r->engine)
         goto bad;
+    { /* a size whose frame this GL can never hold fails every item: say so once, before any (issue 31, item 11) */
+        lpv_memory_limits lim;
+        lpv_memory_limits_query(&lim);
+        const lpv_memory_need need = {.image_w = job->width, .image_h = job->height};
+        char why[512];
+        if (lpv_memory_check(&need, &lim, why, sizeof why) != 0) {
+            lpv_error(err, n, "size %dx%d: %s", job->width, job->height, why);
+            goto bad;
+        }
+    }
     return r;
 bad:
     lpvd_batch_renderer_destroy(r);

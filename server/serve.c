@@ -612,6 +612,15 @@ int lpvd_cmd_serve(int argc, char **argv)
         fprintf(stderr, "lpvd serve: %s\n", err);
         goto out;
     }
+    /* HELLO's max_grid and CONFIG's check say only what can run: a grid
+     * whose storage alone is over one world's memory never could (issue 31,
+     * item 11) */
+    const int fits = sv_grid_that_fits(s, cfg->max_grid);
+    if (fits < cfg->max_grid) {
+        fprintf(stderr, "lpvd serve: --max-grid %d lowered to %d: a larger grid's LPV storage alone is over %s\n",
+                cfg->max_grid, fits, s->gl_limits.budget_source);
+        cfg->max_grid = fits;
+    }
     if (sv_net_listen(s, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd serve: %s\n", err);
         sv_net_stop_listening(s);

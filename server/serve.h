@@ -36,6 +36,7 @@
 #include "engine.h"
 #include "gltf_load.h"
 #include "hash.h"
+#include "memory_budget.h"
 #include "scene.h"
 #include "settings.h"
 #include "tonemap.h"
@@ -113,6 +114,15 @@ typedef struct sv_config {
 uint64_t sv_query_points_by_message(const sv_config *cfg);
 uint64_t sv_query_points_by_queue(const sv_config *cfg);
 uint64_t sv_max_query_points(const sv_config *cfg);
+/* 0 when the least any scene needs under settings s (resolved) with
+ * light_faces light faces fits one world (core/memory_budget.h,
+ * lpv_memory_need_floor); else -1 with err (CONFIG's ERROR LIMIT). */
+struct sv_server;
+int sv_memory_floor_check(const struct sv_server *s, const lpv_settings *st, int light_faces, char *err, size_t n);
+/* The largest cubic grid up to n cells a side that one world can hold: one
+ * LPV cascade without far field, one point light (six faces) at the sessions'
+ * default RSM and shadow sizes (n when it fits). */
+int sv_grid_that_fits(const struct sv_server *s, int n);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
 #define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)
@@ -412,6 +422,7 @@ struct sv_server {
     char gl_backend[32];
     char gl_renderer[256];
     lpv_gl_context *gl_ctx;
+    lpv_memory_limits gl_limits; /* the GL's, with --max-world-memory as the budget (sv_gl_start) */
     /* counters */
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */

@@ -82,6 +82,14 @@ void sv_do_camera_set(sv_conn *c, sv_request *r, json_t *j)
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
         return;
     }
+    { /* a frame one world can never hold would fail every tick (issue 31, item 11) */
+        const lpv_memory_need need = {.image_w = (int)w, .image_h = (int)h};
+        if (lpv_memory_check(&need, &c->srv->gl_limits, err, sizeof err) != 0) {
+            sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "width x height %lldx%lld: %s", (long long)w, (long long)h,
+                         err);
+            return;
+        }
+    }
     const json_t *cam = json_object_get(j, "camera");
     const lpv_scene *sc = &c->scene->scene;
     lpv_view v;
@@ -194,7 +202,8 @@ void sv_do_config(sv_conn *c, sv_request *r, json_t *j)
         snprintf(err, sizeof err, "cascade_size: %s", why);
         goto bad;
     }
-    if (sv_tick_cost_check(&s->cfg, &chk, err, sizeof err) != 0) { /* R4.6a: the settings as a whole */
+    if (sv_tick_cost_check(&s->cfg, &chk, err, sizeof err) != 0 || /* R4.6a: the settings as a whole */
+        sv_memory_floor_check(s, &chk, (int)c->light_count, err, sizeof err) != 0) {
         sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0, "%s", err);
         return;
     }
@@ -218,6 +227,27 @@ int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, s
     snprintf(err, n, "tick cost: %s = %.0f cell-steps, over the server's budget of %llu a tick (--max-tick-cost); "
              "lower %s", tc.terms, tc.cell_steps, (unsigned long long)cfg->max_tick_cost, tc.lower);
     return -1;
+}
+
+int sv_memory_floor_check(const sv_server *s, const lpv_settings *st, int light_faces, char *err, size_t n)
+{
+    lpv_memory_need need;
+    lpv_memory_need_floor(st, light_faces, &need);
+    return lpv_memory_check(&need, &s->gl_limits, err, n);
+}
+
+int sv_grid_that_fits(const sv_server *s, int n)
+{
+    lpv_settings base = s->cfg.settings; /* the sessions' default RSM and shadow sizes, one point light */
+    lpv_settings_resolve(&base);
+    for (; n > 1; --n) {
+        lpv_settings st = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {n, n, n}, .rsm_size = base.rsm_size,
+                           .shadow_size = base.shadow_size};
+        st.lpv.cascades = 1; /* and no far field */
+        if (sv_memory_floor_check(s, &st, 6, NULL, 0) == 0) /* a point light's six faces */
+            break;
+    }
+    return n;
 }
 
 /* CONFIG's reply and STATS' "config": the session's settings, resolved. */

@@ -6,6 +6,7 @@
  * (serve_world.c, sv_world_jobs_done) replies and streams.
  */
 #include "serve.h"
+#include "memory_limits.h"
 
 #include <malloc.h>
 #include <math.h>
@@ -198,7 +199,7 @@ static void gl_tick(sv_server *s, sv_job *j)
         lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
         /* the engine's memory refusals name their budget's source: the cap
          * gl_apply set is the server's limit, so LIMIT (R7.6), not a fault */
-        j->status = strstr(j->err, "--max-world-memory") ? LPVP_E_LIMIT : LPVP_E_INTERNAL;
+        j->status = strstr(j->err, LPV_MEMORY_REFUSED) ? LPVP_E_LIMIT : LPVP_E_INTERNAL;
         return;
     }
     w->gl_ticked = 1;
@@ -291,6 +292,12 @@ static void *gl_main(void *arg)
     s->gl_ctx = ctx;
     snprintf(s->gl_backend, sizeof s->gl_backend, "%s", lpv_backend_name(lpv_gl_context_backend(ctx)));
     snprintf(s->gl_renderer, sizeof s->gl_renderer, "%s", lpv_gl_context_renderer(ctx));
+    lpv_memory_limits_query(&s->gl_limits);
+    if (s->cfg.max_world_memory && s->cfg.max_world_memory < s->gl_limits.budget) { /* as every world's engine */
+        s->gl_limits.budget = s->cfg.max_world_memory;
+        snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "--max-world-memory %llu",
+                 (unsigned long long)s->cfg.max_world_memory);
+    }
     s->gl_ready = 1;
     pthread_cond_broadcast(&s->cv);
     for (;;) {

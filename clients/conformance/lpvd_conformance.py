@@ -1678,8 +1678,10 @@ def c_config_knobs(ctx):
             check(_same(k["type"], cfg.get(k["name"]), v),
                   "CONFIG {%r: %r}: effective config says %r" % (k["name"], v, cfg.get(k["name"])))
             n += 1
-    # every knob at once, next to a preset: each one's value wins over the preset's
-    both = {k["name"]: _in_range(k)[1] for k in knobs}
+    # every knob at once, next to a preset: each one's value wins over the preset's. The middle of each range
+    # (the maximum for booleans' index): every knob at its maximum together may not fit one world (rsm_size and
+    # shadow_size at their ends need more than lpvd's default --max-world-memory), which R4.6a lets a server refuse
+    both = {k["name"]: _in_range(k)[2 if k["type"] != "bool" and len(_in_range(k)) > 2 else 1] for k in knobs}
     both["preset"] = presets[0]
     cfg = _preset_config(c, both)
     for k in knobs:
