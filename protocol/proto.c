@@ -219,6 +219,11 @@ static size_t payload_len(const lpvp_header *h)
     return (size_t)h->json_length + (size_t)h->attachment_length;
 }
 
+uint64_t lpvp_parser_payload_have(const lpvp_parser *p)
+{
+    return !p->failed && p->hdr_have == LPVP_HEADER_SIZE ? (uint64_t)p->buf_have : 0;
+}
+
 uint64_t lpvp_parser_frame_payload(const lpvp_parser *p)
 {
     return !p->failed && p->hdr_have == LPVP_HEADER_SIZE ? payload_len(&p->header) : 0;

@@ -238,6 +238,10 @@ typedef struct lpvp_parser {
 /* lim NULL = defaults. Never fails (no allocation). */
 void lpvp_parser_init(lpvp_parser *p, const lpvp_limits *lim);
 
+/* Payload bytes (body + attachment) of the frame being read that have
+ * arrived so far; 0 before its header is complete. */
+uint64_t lpvp_parser_payload_have(const lpvp_parser *p);
+
 /* Consumes bytes from data[0..len) up to the end of the first frame
  * completed by them. Returns an enum lpvp_parse_status; *consumed is the
  * number of bytes used: len on NEED_MORE; up to the end of the frame on

@@ -248,6 +248,7 @@ static void idle_cb(uv_timer_t *t)
             sv_conn_close_after_write(c);
             continue;
         }
+        sv_net_shrink_stalled(c, now);
         if (limit && now - c->last_rx_ms > limit && !c->busy) {
             fprintf(stderr, "lpvd serve: client %llu (%s) idle for %g s: BYE\n", (unsigned long long)c->id, c->peer,
                     s->cfg.idle_timeout);

@@ -123,6 +123,13 @@ int sv_memory_floor_check(const struct sv_server *s, const lpv_settings *st, int
  * LPV cascade without far field, one point light (six faces) at the sessions'
  * default RSM and shadow sizes (n when it fits). */
 int sv_grid_that_fits(const struct sv_server *s, int n);
+/* A frame whose sender sends nothing for this long keeps, of its
+ * reservation against --max-request-memory, only what has arrived; the rest
+ * goes to the frames waiting, and the sender waits its turn for it when it
+ * sends again (R7.5; four headers declaring 256 MiB and nothing after had held
+ * the whole budget until the idle timeout). */
+#define SV_RESERVE_STALL_MS 2000u
+void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
 #define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)
@@ -346,6 +353,8 @@ struct sv_conn {
     size_t pending_count, pending_bytes;
     uint64_t reserved;      /* payload of the frame being read, held against --max-request-memory */
     uint64_t wait_memory;   /* reading stopped until that reservation fits (R7.5): its turn, 0 = not waiting */
+    uint64_t payload_ms;    /* when the frame being read last got payload bytes (or its header) */
+    int reserve_shrunk;     /* the reservation was cut to what had arrived (a stalled sender, R7.5) */
     int busy;               /* a request is being processed asynchronously */
     int work_inflight;      /* that request runs on a libuv worker (a scene load): it cannot be cancelled */
     uint32_t work_request_id;

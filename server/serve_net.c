@@ -334,6 +334,7 @@ static int enqueue_frame(sv_conn *c, const lpvp_frame *f)
     /* the reservation, if the frame had one, becomes the pending request */
     c->srv->request_bytes += r->json_len + r->att_len - c->reserved;
     c->reserved = 0;
+    c->reserve_shrunk = 0;
     return 0;
 }
 
@@ -343,13 +344,32 @@ static int reserve_frame(sv_conn *c)
 {
     sv_server *s = c->srv;
     uint64_t need = lpvp_parser_frame_payload(&c->parser);
-    if (need == 0 || c->reserved)
+    if (need == 0 || (c->reserved && !c->reserve_shrunk))
         return 0;
-    if (s->request_bytes + need > s->cfg.max_request_memory)
+    const uint64_t more = need > c->reserved ? need - c->reserved : 0; /* a shrunk one holds what arrived */
+    if (s->request_bytes + more > s->cfg.max_request_memory)
         return 1;
+    if (!c->reserved)
+        c->payload_ms = sv_now_ms();
     c->reserved = need;
-    s->request_bytes += need;
+    c->reserve_shrunk = 0;
+    s->request_bytes += more;
     return 0;
+}
+
+static void release_request_bytes(sv_conn *c, uint64_t bytes);
+
+void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms)
+{
+    if (!c->reserved || c->reserve_shrunk || c->wait_memory || now_ms - c->payload_ms < SV_RESERVE_STALL_MS)
+        return;
+    const uint64_t have = lpvp_parser_payload_have(&c->parser);
+    if (have >= c->reserved)
+        return;
+    const uint64_t freed = c->reserved - have;
+    c->reserved = have;
+    c->reserve_shrunk = 1;
+    release_request_bytes(c, freed); /* the frames waiting get it, first come first served */
 }
 
 static void release_request_bytes(sv_conn *c, uint64_t bytes)
@@ -391,8 +411,11 @@ static void on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
     while (off < len && !c->closing && !c->close_after_write) {
         size_t used = 0;
         lpvp_frame f;
+        const uint64_t had = lpvp_parser_payload_have(&c->parser);
         int stt = lpvp_parser_feed(&c->parser, buf->base + off, len - off, &used, &f);
         off += used;
+        if (stt == LPVP_PARSE_NEED_MORE && lpvp_parser_payload_have(&c->parser) > had)
+            c->payload_ms = sv_now_ms(); /* the sender is not stalled (sv_net_shrink_stalled) */
         if (stt == LPVP_PARSE_NEED_MORE && reserve_frame(c) != 0)
             c->wait_memory = ++c->srv->memory_waits; /* all of this read is in the parser: stop reading below */
         if (stt == LPVP_PARSE_FRAME) {
