@@ -129,7 +129,21 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
  * sends again (R7.5; four headers declaring 256 MiB and nothing after had held
  * the whole budget until the idle timeout). */
 #define SV_RESERVE_STALL_MS 2000u
+/* Connections that have not said HELLO (R4.1a): past --max-preauth the
+ * oldest of the peer holding the most of them goes, but only once it has
+ * had SV_PREAUTH_GRACE_MS to say HELLO and has nothing waiting to be read
+ * (a burst of clients connecting at once is let in); at
+ * SV_PREAUTH_HARD_FACTOR x --max-preauth it goes whatever its age. */
+#define SV_PREAUTH_GRACE_MS 1000u
+/* Connections the kernel queues before the loop accepts them (capped by
+ * net.core.somaxconn): a connect flood filling a short queue made other
+ * clients' connect fail with EAGAIN before lpvd saw them. */
+#define SV_LISTEN_BACKLOG 4096
+#define SV_PREAUTH_HARD_FACTOR 4
 void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms);
+/* Takes c out of the server's pre-HELLO list (HELLO succeeded, or c is
+ * closing); no-op when it is not in it. */
+void sv_net_preauth_leave(sv_conn *c);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
 #define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)
@@ -344,6 +358,7 @@ struct sv_conn {
     int closing, closed;
     int close_after_write;  /* close when the write queue drains */
     char peer[96];
+    char peer_key[96];      /* who is at the other end, for the pre-HELLO quota: "pid N" (Unix) or the address */
     /* reading */
     lpvp_parser parser;
     uint8_t rbuf[65536];
@@ -389,7 +404,9 @@ struct sv_conn {
     sv_world *world;        /* ref */
     uint64_t world_gen;
     sv_sub subs[2];
-    sv_conn *next;
+    sv_conn *next, *prev;   /* in the server's conns */
+    sv_conn *pre_prev, *pre_next; /* in the server's preauth list while in_preauth */
+    int in_preauth;
 };
 
 struct sv_server {
@@ -407,6 +424,11 @@ struct sv_server {
     int works_inflight;     /* requests running on libuv workers, all sessions */
     sv_conn *conns;
     int conn_count;
+    /* the open connections that have not said HELLO, also in conns: the
+     * pre-HELLO quota looks at these only, so a connect flood that makes
+     * conns long costs each accept no more than the quota (R4.1a) */
+    sv_conn *preauth;
+    int preauth_count;
     uint64_t request_bytes; /* reserved + pending request bytes of every connection (R7.5) */
     uint64_t memory_waits;  /* turns handed out to connections waiting for request memory */
     uint64_t scenes_bytes;  /* sv_scene.bytes of every live scene, once each (--max-scenes-memory) */

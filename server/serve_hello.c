@@ -60,6 +60,7 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
     if (sv_net_admit_session(c, r->request_id) != 0)
         return;
     c->hello = 1;
+    sv_net_preauth_leave(c);
     char server[64];
     snprintf(server, sizeof server, "lpvd %s", LPVD_VERSION);
     json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I, s:I, s:f, s:i}", "max_body",

@@ -1,3 +1,4 @@
+#define _GNU_SOURCE /* struct ucred */
 /*
  * serve_net.c - the network side of `lpvd serve`, all on the libuv loop:
  * listeners (Unix socket, TCP), connections, frame reading through the
@@ -98,21 +99,51 @@ static void on_closed(uv_handle_t *h)
     sv_conn *c = h->data;
     sv_server *s = c->srv;
     c->closed = 1;
-    for (sv_conn **p = &s->conns; *p; p = &(*p)->next)
-        if (*p == c) {
-            *p = c->next;
-            break;
-        }
+    if (c->prev) /* doubly linked: a flood's thousands of closes cost O(1) each */
+        c->prev->next = c->next;
+    else
+        s->conns = c->next;
+    if (c->next)
+        c->next->prev = c->prev;
     s->conn_count--;
     free_pending_requests(c);
     sv_session_free(c);
     sv_conn_unref(c);
 }
 
+void sv_net_preauth_leave(sv_conn *c)
+{
+    if (!c->in_preauth)
+        return;
+    sv_server *s = c->srv;
+    if (c->pre_prev)
+        c->pre_prev->pre_next = c->pre_next;
+    else
+        s->preauth = c->pre_next;
+    if (c->pre_next)
+        c->pre_next->pre_prev = c->pre_prev;
+    c->pre_prev = c->pre_next = NULL;
+    c->in_preauth = 0;
+    s->preauth_count--;
+}
+
+static void preauth_join(sv_conn *c)
+{
+    sv_server *s = c->srv;
+    c->pre_prev = NULL;
+    c->pre_next = s->preauth;
+    if (s->preauth)
+        s->preauth->pre_prev = c;
+    s->preauth = c;
+    c->in_preauth = 1;
+    s->preauth_count++;
+}
+
 void sv_conn_close(sv_conn *c)
 {
     if (!c || c->closing)
         return;
+    sv_net_preauth_leave(c);
     c->closing = 1;
     if (c->reading) {
         uv_read_stop(&c->h.stream);
@@ -131,6 +162,7 @@ void sv_conn_close_after_write(sv_conn *c)
         c->reading = 0;
     }
     free_pending_requests(c);
+    sv_net_preauth_leave(c);
     c->close_after_write = 1;
     c->close_deadline_ms = sv_now_ms() + 5000;
     if (c->wq_count == 0)
@@ -375,6 +407,8 @@ void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms)
 static void release_request_bytes(sv_conn *c, uint64_t bytes)
 {
     sv_server *s = c->srv;
+    if (bytes == 0) /* nothing freed, nobody newly fits (every close comes here: keep it cheap under a flood) */
+        return;
     s->request_bytes -= bytes < s->request_bytes ? bytes : s->request_bytes;
     /* first come, first served: a big frame waiting is not overtaken by smaller ones behind it */
     for (;;) {
@@ -475,6 +509,8 @@ void sv_net_resume_reading(sv_conn *c)
  * a client that just disconnected is reusable at once. */
 static int active_clients(sv_server *s, const sv_conn *except, int authenticated)
 {
+    if (!authenticated) /* the pre-HELLO list holds exactly those */
+        return s->preauth_count - (except && except->in_preauth);
     int n = 0;
     for (sv_conn *c = s->conns; c; c = c->next)
         if (c != except && !c->closing && !c->close_after_write && !c->hello == !authenticated)
@@ -482,10 +518,11 @@ static int active_clients(sv_server *s, const sv_conn *except, int authenticated
     return n;
 }
 
-static void reap_gone(sv_server *s, const sv_conn *except)
+static void reap_gone(sv_server *s, const sv_conn *except, int authenticated)
 {
-    for (sv_conn *c = s->conns; c; c = c->next) {
-        if (c == except || c->closing)
+    for (sv_conn *c = authenticated ? s->conns : s->preauth, *next; c; c = next) {
+        next = authenticated ? c->next : c->pre_next; /* sv_conn_close takes c out of the pre-HELLO list */
+        if (c == except || c->closing || !c->hello != !authenticated) /* only the quota in question's */
             continue;
         uv_os_fd_t fd;
         if (uv_fileno((uv_handle_t *)&c->h.stream, &fd) != 0)
@@ -495,6 +532,73 @@ static void reap_gone(sv_server *s, const sv_conn *except)
         if (r == 0 || (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR))
             sv_conn_close(c);
     }
+}
+
+/* c->peer_key: the peer process on a Unix socket (SO_PEERCRED), its address
+ * on TCP. */
+static void peer_key_of(sv_conn *c, int is_tcp)
+{
+    uv_os_fd_t fd;
+    if (!is_tcp && uv_fileno((uv_handle_t *)&c->h.stream, &fd) == 0) {
+        struct ucred cred;
+        socklen_t len = sizeof cred;
+        if (getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &cred, &len) == 0) {
+            snprintf(c->peer_key, sizeof c->peer_key, "pid %ld", (long)cred.pid);
+            return;
+        }
+    }
+    snprintf(c->peer_key, sizeof c->peer_key, "%s", c->peer);
+}
+
+static int has_bytes_waiting(sv_conn *c)
+{
+    uv_os_fd_t fd;
+    char b;
+    return uv_fileno((uv_handle_t *)&c->h.stream, &fd) == 0 && recv(fd, &b, 1, MSG_PEEK | MSG_DONTWAIT) == 1;
+}
+
+static int by_peer_then_age(const void *a, const void *b)
+{
+    const sv_conn *x = *(sv_conn *const *)a, *y = *(sv_conn *const *)b;
+    const int k = strcmp(x->peer_key, y->peer_key);
+    return k ? k : (x->id > y->id) - (x->id < y->id);
+}
+
+/* The connection waiting for HELLO that goes (on_connection), or NULL:
+ * sorted by peer, so a flood of thousands costs n log n, not n^2. */
+static sv_conn *preauth_victim(sv_server *s, const sv_conn *newcomer, int hard)
+{
+    const size_t n = (size_t)s->preauth_count;
+    sv_conn **all = n ? malloc(n * sizeof *all) : NULL;
+    if (!all)
+        return NULL;
+    size_t k = 0;
+    for (sv_conn *o = s->preauth; o && k < n; o = o->pre_next)
+        if (o != newcomer)
+            all[k++] = o;
+    qsort(all, k, sizeof *all, by_peer_then_age);
+    const uint64_t now = sv_now_ms();
+    sv_conn *victim = NULL;
+    size_t victim_count = 0;
+    for (size_t i = 0; i < k;) {
+        size_t j = i;
+        while (j < k && strcmp(all[j]->peer_key, all[i]->peer_key) == 0)
+            j++;
+        /* this peer holds j - i; its oldest that may go */
+        for (size_t q = i; q < j; ++q) {
+            sv_conn *o = all[q];
+            if (!hard && (now - o->accepted_ms < SV_PREAUTH_GRACE_MS || has_bytes_waiting(o)))
+                continue;
+            if (!victim || j - i > victim_count || (j - i == victim_count && o->id < victim->id)) {
+                victim = o;
+                victim_count = j - i;
+            }
+            break;
+        }
+        i = j;
+    }
+    free(all);
+    return victim;
 }
 
 static void on_connection(uv_stream_t *server, int status)
@@ -516,6 +620,9 @@ static void on_connection(uv_stream_t *server, int status)
     }
     c->h.stream.data = c;
     c->next = s->conns;
+    c->prev = NULL;
+    if (s->conns)
+        s->conns->prev = c;
     s->conns = c;
     s->conn_count++;
     lpvp_limits lim = conn_limits(s, 0);
@@ -541,24 +648,29 @@ static void on_connection(uv_stream_t *server, int status)
     }
     c->last_rx_ms = c->accepted_ms = sv_now_ms();
     sv_session_init(c);
+    preauth_join(c);
+    peer_key_of(c, is_tcp);
     /* R4.1a: connections that have not said HELLO have their own small
-     * quota and never take a --max-clients slot. When it is full the oldest
-     * of them goes, not the newcomer: refusing newcomers would let anyone
-     * who keeps --max-preauth connections open shut every client out, while
-     * a client that says HELLO at once is through long before it is the
-     * oldest. */
+     * quota and never take a --max-clients slot. When it is full, one of them
+     * goes, not the newcomer: refusing newcomers would let anyone who keeps
+     * --max-preauth connections open shut every client out. Which one
+     * (issue 31, item 4: 50 clients connecting at once lost 14-16, and a
+     * flood of connections from one process evicted others' HELLOs): the
+     * oldest of the peer that holds the most, among those that have had
+     * SV_PREAUTH_GRACE_MS and have nothing waiting to be read (a HELLO in
+     * flight); none such, the newcomer is let in up to
+     * SV_PREAUTH_HARD_FACTOR x the quota, then the grace goes too. */
     if (active_clients(s, c, 0) >= s->cfg.max_preauth)
-        reap_gone(s, c);
-    if (active_clients(s, c, 0) >= s->cfg.max_preauth) {
-        sv_conn *oldest = NULL;
-        for (sv_conn *o = s->conns; o; o = o->next)
-            if (o != c && !o->hello && !o->closing && !o->close_after_write && (!oldest || o->id < oldest->id))
-                oldest = o;
-        if (oldest) {
-            sv_send_error(oldest, 0, LPVP_E_LIMIT,
+        reap_gone(s, c, 0);
+    const int waiting = active_clients(s, c, 0);
+    if (waiting >= s->cfg.max_preauth) {
+        const int hard = waiting >= SV_PREAUTH_HARD_FACTOR * s->cfg.max_preauth;
+        sv_conn *victim = preauth_victim(s, c, hard);
+        if (victim) {
+            sv_send_error(victim, 0, LPVP_E_LIMIT,
                           "closed to let a newer connection in: at most %d connections may wait for HELLO "
-                          "(--max-preauth), and this was the oldest", s->cfg.max_preauth);
-            sv_conn_close_after_write(oldest);
+                          "(--max-preauth), and this was the oldest of the peer holding the most", s->cfg.max_preauth);
+            sv_conn_close_after_write(victim);
         }
     }
     if (uv_read_start(&c->h.stream, on_alloc, on_read) == 0)
@@ -571,7 +683,7 @@ int sv_net_admit_session(sv_conn *c, uint32_t request_id)
 {
     sv_server *s = c->srv;
     if (active_clients(s, c, 1) >= s->cfg.max_clients)
-        reap_gone(s, c);
+        reap_gone(s, c, 1);
     if (active_clients(s, c, 1) < s->cfg.max_clients)
         return 0;
     sv_send_error(c, request_id, LPVP_E_LIMIT, "too many clients: the server accepts at most %d (--max-clients)",
@@ -640,7 +752,7 @@ int sv_net_listen(sv_server *s, char *err, size_t n)
         if (rc == 0)
             chmod(cfg->socket_path, 0600);
         if (rc == 0)
-            rc = uv_listen((uv_stream_t *)&s->unix_listener, 128, on_connection);
+            rc = uv_listen((uv_stream_t *)&s->unix_listener, SV_LISTEN_BACKLOG, on_connection);
         if (rc != 0) {
             snprintf(err, n, "--socket %s: %s", cfg->socket_path, uv_strerror(rc));
             return -1;
@@ -672,7 +784,7 @@ int sv_net_listen(sv_server *s, char *err, size_t n)
         s->tcp_on = 1;
         int rc = uv_tcp_bind(&s->tcp_listener, (struct sockaddr *)&ss, 0);
         if (rc == 0)
-            rc = uv_listen((uv_stream_t *)&s->tcp_listener, 128, on_connection);
+            rc = uv_listen((uv_stream_t *)&s->tcp_listener, SV_LISTEN_BACKLOG, on_connection);
         if (rc != 0) {
             snprintf(err, n, "--listen %s:%d: %s", cfg->listen_host, cfg->listen_port, uv_strerror(rc));
             return -1;
