@@ -325,6 +325,7 @@ static void begin_shutdown(sv_server *s, int signum)
     /* the rest (a load on a worker, requests queued behind it) get SHUTTING_DOWN, then BYE (R3.1, R7.4) */
     for (sv_conn *c = s->conns; c; c = c->next)
         sv_session_shutdown(c);
+    sv_scene_loads_drop(s); /* those not started: answered SHUTTING_DOWN just now */
     uv_close((uv_handle_t *)&s->done_async, NULL);
     if (uv_timer_init(s->loop, &s->exit_timer) == 0) { /* unref'd: only matters while a worker holds the loop */
         s->exit_timer.data = s;

@@ -139,6 +139,13 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
  * net.core.somaxconn): a connect flood filling a short queue made other
  * clients' connect fail with EAGAIN before lpvd saw them. */
 #define SV_LISTEN_BACKLOG 4096
+/* Scene loads (parsing) running at once on libuv's 4 workers; the others
+ * are kept for encodings (GET_VOLUME, GET_FRAME, queries), which four
+ * clients re-parsing a 68 MB scene had delayed by 5-7 s (issue 31, item 6). */
+#define SV_MAX_LOADS 2
+/* Drops the scene loads still waiting for a worker (their requests were
+ * answered SHUTTING_DOWN): at shutdown. */
+void sv_scene_loads_drop(struct sv_server *s);
 #define SV_PREAUTH_HARD_FACTOR 4
 void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms);
 /* Takes c out of the server's pre-HELLO list (HELLO succeeded, or c is
@@ -429,6 +436,10 @@ struct sv_server {
      * conns long costs each accept no more than the quota (R4.1a) */
     sv_conn *preauth;
     int preauth_count;
+    /* scene loads on libuv's workers: at most SV_MAX_LOADS at once, the rest
+     * wait here in order (serve_scene.c), so encodings always find a worker */
+    int loads_running;
+    struct load_work *loads_wait_head, *loads_wait_tail;
     uint64_t request_bytes; /* reserved + pending request bytes of every connection (R7.5) */
     uint64_t memory_waits;  /* turns handed out to connections waiting for request memory */
     uint64_t scenes_bytes;  /* sv_scene.bytes of every live scene, once each (--max-scenes-memory) */

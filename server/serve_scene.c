@@ -34,6 +34,8 @@ static json_t *scene_json(const lpv_scene *sc)
 
 typedef struct load_work {
     uv_work_t req;
+    struct load_work *next_wait; /* in the server's queue of loads waiting for a worker */
+    int started;                 /* on a worker (counted in loads_running) */
     sv_conn *c;
     uint32_t request_id;
     uint16_t type;
@@ -251,12 +253,19 @@ static void free_sv_scene_unlisted(sv_scene *sc)
     free(sc);
 }
 
+static void start_waiting_loads(sv_server *s);
+
 static void load_done(uv_work_t *req, int status)
 {
     load_work *w = req->data;
     sv_conn *c = w->c;
     sv_server *s = c->srv;
-    (void)status;
+    if (w->started)
+        s->loads_running--;
+    if (status == UV_ECANCELED && !w->status) { /* never ran: its session went or the server is stopping */
+        w->status = s->stopping ? LPVP_E_SHUTTING_DOWN : LPVP_E_INTERNAL;
+        snprintf(w->err, sizeof w->err, "the load could not start");
+    }
     if (!c->closing && !c->close_after_write) {
         char err[1024];
         if (w->status == LPVP_E_SCENE_INVALID && w->type == LPVP_SCENE_UPDATE) {
@@ -346,6 +355,37 @@ static void load_done(uv_work_t *req, int status)
     free(w);
     sv_session_pump(c);
     sv_conn_unref(c);
+    start_waiting_loads(s);
+}
+
+/* Starts waiting loads while fewer than SV_MAX_LOADS run; one whose session
+ * has gone ends at once, unrun. */
+static void start_waiting_loads(sv_server *s)
+{
+    while (s->loads_wait_head && s->loads_running < SV_MAX_LOADS) {
+        load_work *w = s->loads_wait_head;
+        s->loads_wait_head = w->next_wait;
+        if (!s->loads_wait_head)
+            s->loads_wait_tail = NULL;
+        if (w->c->closing || w->c->close_after_write || s->stopping ||
+            uv_queue_work(s->loop, &w->req, load_run, load_done) != 0) {
+            load_done(&w->req, UV_ECANCELED);
+            continue;
+        }
+        w->started = 1;
+        s->loads_running++;
+    }
+}
+
+void sv_scene_loads_drop(sv_server *s)
+{
+    while (s->loads_wait_head) {
+        load_work *w = s->loads_wait_head;
+        s->loads_wait_head = w->next_wait;
+        if (!s->loads_wait_head)
+            s->loads_wait_tail = NULL;
+        load_done(&w->req, UV_ECANCELED);
+    }
 }
 
 static int start_load(sv_conn *c, load_work *w)
@@ -359,10 +399,22 @@ static int start_load(sv_conn *c, load_work *w)
     w->limits.max_bytes = c->srv->cfg.max_scene_bytes;
     c->refs++;
     c->busy = 1;
-    if (uv_queue_work(c->srv->loop, &w->req, load_run, load_done) != 0) {
-        c->busy = 0;
-        c->refs--;
-        return -1;
+    sv_server *s = c->srv;
+    if (s->loads_running < SV_MAX_LOADS) {
+        if (uv_queue_work(s->loop, &w->req, load_run, load_done) != 0) {
+            c->busy = 0;
+            c->refs--;
+            return -1;
+        }
+        w->started = 1;
+        s->loads_running++;
+    } else { /* waits its turn for a worker (start_waiting_loads) */
+        w->next_wait = NULL;
+        if (s->loads_wait_tail)
+            s->loads_wait_tail->next_wait = w;
+        else
+            s->loads_wait_head = w;
+        s->loads_wait_tail = w;
     }
     sv_session_work_begin(c, w->request_id);
     return 0;

@@ -37,7 +37,7 @@ add_test(NAME conformance
 
 set(_lpvd_serve_tests conformance)
 foreach(_name midmessage slow_reader churn sigterm sighup fifo preauth sigterm_load request_memory root_race
-                scene_budgets fair_gl encode_offloop memory_budgets world_churn sigterm_frame query_limits settings_that_run stalled_headers preauth_burst)
+                scene_budgets fair_gl encode_offloop memory_budgets world_churn sigterm_frame query_limits settings_that_run stalled_headers preauth_burst loads_and_encodes)
   add_test(NAME reliability_${_name}
     COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_serve_dir}/reliability/${_name}.py" --lpvd "$<TARGET_FILE:lpvd>")
   list(APPEND _lpvd_serve_tests reliability_${_name})
@@ -49,5 +49,5 @@ set_tests_properties(${_lpvd_serve_tests} PROPERTIES
 # Latency and memory bounds: do not share the two cores with other tests
 # (sigterm_load's daemon parses a 144 MB scene).
 set_tests_properties(reliability_slow_reader reliability_churn reliability_preauth reliability_sigterm_load reliability_request_memory
-  reliability_scene_budgets reliability_world_churn
+  reliability_scene_budgets reliability_world_churn reliability_loads_and_encodes reliability_preauth_burst
   PROPERTIES RUN_SERIAL TRUE)
