@@ -221,6 +221,8 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     lpv_timer_init(&e->timer);
     lpv_settings_resolve(&e->settings);
     lpv_memory_limits_query(&e->mem_limits);
+    e->mem_device_budget = e->mem_limits.budget;
+    snprintf(e->mem_device_source, sizeof e->mem_device_source, "%s", e->mem_limits.budget_source);
     e->tech->cls->describe(e->tech, &e->desc);
     return e;
 }

@@ -149,6 +149,16 @@ void lpv_engine_destroy(lpv_engine *e);
  * the current budget changes nothing. */
 void lpv_engine_cap_memory(lpv_engine *e, uint64_t bytes, const char *source);
 
+/* Sets the memory the engine may allocate to bytes, or to the device's
+ * budget when that is lower (whatever earlier caps said): for a cap that
+ * moves, like the daemon's share of all worlds' memory. */
+void lpv_engine_set_memory_cap(lpv_engine *e, uint64_t bytes, const char *source);
+
+/* Bytes of storage the engine's current settings, lights, view and
+ * technique call for (core/memory_budget.h's estimate): what it holds after
+ * a tick. */
+uint64_t lpv_engine_memory_bytes(const lpv_engine *e);
+
 /* Uploads the scene (geometry, materials, textures, lights) and samples its
  * emissive surfaces into VPLs and keeps them for the area light samples. The
  * scene may be freed afterwards (the engine keeps a copy of its geometry to

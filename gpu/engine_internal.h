@@ -169,7 +169,9 @@ struct lpv_engine {
     int shadow_alloc_size, shadow_alloc_faces;
     int shadow_valid;     /* 0: the maps must be redrawn (scene, settings, invalidate) */
 
-    lpv_memory_limits mem_limits; /* of the context, read at create */
+    lpv_memory_limits mem_limits; /* of the context, read at create; the budget lowered by caps */
+    uint64_t mem_device_budget;    /* the budget as read at create */
+    char mem_device_source[160];
 
     int ticked;               /* a tick ran since the last change that discards the volume */
 

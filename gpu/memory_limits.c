@@ -97,6 +97,25 @@ void lpv_engine_cap_memory(lpv_engine *e, uint64_t bytes, const char *source)
     snprintf(e->mem_limits.budget_source, sizeof e->mem_limits.budget_source, "%s", source);
 }
 
+void lpv_engine_set_memory_cap(lpv_engine *e, uint64_t bytes, const char *source)
+{
+    if (bytes >= e->mem_device_budget) {
+        e->mem_limits.budget = e->mem_device_budget;
+        snprintf(e->mem_limits.budget_source, sizeof e->mem_limits.budget_source, "%s", e->mem_device_source);
+        return;
+    }
+    e->mem_limits.budget = bytes;
+    snprintf(e->mem_limits.budget_source, sizeof e->mem_limits.budget_source, "%s", source);
+}
+
+uint64_t lpv_engine_memory_bytes(const lpv_engine *e)
+{
+    lpv_memory_need need;
+    lpv_engine_memory_need(e, &need);
+    e->tech->cls->memory_need(e->tech, &need);
+    return lpv_memory_total_bytes(&need);
+}
+
 int lpv_engine_memory_check(const lpv_engine *e, char *err, size_t err_size)
 {
     lpv_memory_need need;

@@ -49,6 +49,8 @@ static void usage(FILE *f)
             "  --max-body BYTES        json of one message (default 1048576)\n"
             "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
             "  --max-world-memory BYTES  GPU storage one world (one computation) may take (default %llu)\n"
+            "  --max-memory BYTES      GPU storage all worlds together may take (default: half of the video\n"
+            "                          memory, or of RAM where the driver reports none, as lpvd render's budget)\n"
             "  --max-request-memory BYTES  request bytes held for all clients together; a frame that does not\n"
             "                          fit waits, unread (default %llu, at least --max-message)\n"
             "  --max-triangles N       per scene (default 10000000)\n"
@@ -368,7 +370,7 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-scenes-memory", "max-world-memory", "max-grid",
+    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-scenes-memory", "max-world-memory", "max-memory", "max-grid",
     "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory",
     "handshake-timeout", "max-preauth", NULL};
 
@@ -523,6 +525,9 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "max-world-memory")) {
             bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 44, &u);
             cfg->max_world_memory = u;
+        } else if (!strcmp(name, "max-memory")) {
+            bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 48, &u);
+            cfg->max_memory = u;
         } else if (!strcmp(name, "max-scenes-memory")) {
             bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
             cfg->max_scenes_memory = u;

@@ -81,6 +81,7 @@ typedef struct sv_config {
     uint64_t max_request_memory; /* request bytes held, all connections (R7.5); >= max_message */
     uint64_t max_scenes_memory;  /* bytes of all live scenes together (R4.5c); >= max_scene_bytes */
     uint64_t max_world_memory;   /* GPU storage of one world's engine (R7.6) */
+    uint64_t max_memory;         /* GPU storage of all worlds together; 0 = the device's budget (sv_gl_start) */
     int max_clients;
     uint64_t max_triangles;
     int max_texture;
@@ -247,6 +248,7 @@ struct sv_world {
     lpv_engine *engine;
     uint64_t gl_applied_gen;
     int gl_has_applied;
+    uint64_t gl_mem_bytes;  /* the engine's storage after its last job (GL thread; sv_server.gl_worlds_bytes) */
     sv_inputs *gl_applied;  /* borrowed: only compared by content */
     lpv_settings gl_settings;
     lpv_view gl_view;
@@ -465,6 +467,12 @@ struct sv_server {
     char gl_renderer[256];
     lpv_gl_context *gl_ctx;
     lpv_memory_limits gl_limits; /* the GL's, with --max-world-memory as the budget (sv_gl_start) */
+    /* all worlds' GPU storage (R7.6a), on the GL thread only: what each
+     * world's engine holds (sv_world.gl_mem_bytes) summed, against the
+     * daemon's budget (--max-memory, else the device's) */
+    uint64_t gl_worlds_bytes;
+    uint64_t worlds_budget;
+    char worlds_budget_source[96];
     /* counters */
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */

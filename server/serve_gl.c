@@ -147,6 +147,31 @@ static uint64_t scene_sig(const sv_inputs *in)
     return h;
 }
 
+/* The world's cap: --max-world-memory, or what the other worlds leave of
+ * the daemon's budget for all of them (R7.6a), whichever is lower. */
+static void set_world_cap(sv_world *w)
+{
+    sv_server *s = w->srv;
+    const uint64_t others = s->gl_worlds_bytes - w->gl_mem_bytes;
+    const uint64_t left = s->worlds_budget > others ? s->worlds_budget - others : 0;
+    char cap[256];
+    if (left < s->cfg.max_world_memory) {
+        snprintf(cap, sizeof cap, "all worlds' budget, %s, of which other worlds hold %.2f GB (--max-memory)",
+                 s->worlds_budget_source, (double)others / 1e9);
+        lpv_engine_set_memory_cap(w->engine, left, cap);
+    } else { /* bounds the daemon's GPU memory: worlds x this (docs/server.md, "Worst-case memory") */
+        snprintf(cap, sizeof cap, "--max-world-memory %llu", (unsigned long long)s->cfg.max_world_memory);
+        lpv_engine_set_memory_cap(w->engine, s->cfg.max_world_memory, cap);
+    }
+}
+
+/* Records what the world's engine holds now in the daemon's sum. */
+static void note_world_bytes(sv_world *w, uint64_t bytes)
+{
+    w->srv->gl_worlds_bytes += bytes - w->gl_mem_bytes;
+    w->gl_mem_bytes = bytes;
+}
+
 /* Brings the world's engine to the job's inputs. */
 static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, size_t n)
 {
@@ -154,11 +179,9 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
         w->engine = lpv_engine_create(err, n);
         if (!w->engine)
             return -1;
-        char cap[64]; /* bounds the daemon's GPU memory: worlds x this (docs/server.md, "Worst-case memory") */
-        snprintf(cap, sizeof cap, "--max-world-memory %llu", (unsigned long long)w->srv->cfg.max_world_memory);
-        lpv_engine_cap_memory(w->engine, w->srv->cfg.max_world_memory, cap);
         w->gl_has_applied = 0;
     }
+    set_world_cap(w);
     if (w->gl_has_applied && w->gl_applied_gen == gen)
         return 0;
     uint64_t sig = scene_sig(in);
@@ -204,6 +227,7 @@ static void gl_tick(sv_server *s, sv_job *j)
     }
     w->gl_ticked = 1;
     w->gl_ticked_gen = j->gen;
+    note_world_bytes(w, lpv_engine_memory_bytes(w->engine));
     sv_result *r = sv_result_take(w->engine, j->inputs->view.width, j->inputs->view.height, j->terms_mask, j->err,
                                   sizeof j->err);
     if (!r) {
@@ -293,6 +317,13 @@ static void *gl_main(void *arg)
     snprintf(s->gl_backend, sizeof s->gl_backend, "%s", lpv_backend_name(lpv_gl_context_backend(ctx)));
     snprintf(s->gl_renderer, sizeof s->gl_renderer, "%s", lpv_gl_context_renderer(ctx));
     lpv_memory_limits_query(&s->gl_limits);
+    s->worlds_budget = s->cfg.max_memory ? s->cfg.max_memory : s->gl_limits.budget;
+    if (s->cfg.max_memory)
+        snprintf(s->worlds_budget_source, sizeof s->worlds_budget_source, "--max-memory %llu",
+                 (unsigned long long)s->cfg.max_memory);
+    else
+        snprintf(s->worlds_budget_source, sizeof s->worlds_budget_source, "%.2f GB, the device's budget",
+                 (double)s->gl_limits.budget / 1e9);
     if (s->cfg.max_world_memory && s->cfg.max_world_memory < s->gl_limits.budget) { /* as every world's engine */
         s->gl_limits.budget = s->cfg.max_world_memory;
         snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "--max-world-memory %llu",
@@ -319,6 +350,7 @@ static void *gl_main(void *arg)
         case SV_JOB_DESTROY:
             lpv_engine_destroy(j->world->engine);
             j->world->engine = NULL;
+            note_world_bytes(j->world, 0);
             malloc_trim(0); /* the heap's free pages back to the system (serve.c, mallopt) */
             break;
         case SV_JOB_QUIT: quit = 1; break;
