@@ -64,6 +64,9 @@ static void usage(FILE *f)
             "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
             "  --max-tick-cost N       cell-steps one tick may cost: CONFIG over it gets LIMIT (default "
             SV_STR(SV_DEFAULT_MAX_TICK_COST) ")\n"
+            "  --max-tick-ms MS        a world whose tick after a change took longer on the GL thread is refused\n"
+            "                          such ticks (LIMIT) until its settings or camera size change (default "
+            SV_STR(SV_DEFAULT_MAX_TICK_MS) ";\n                          0 = no limit)\n"
             "  --idle-timeout S        a session with no complete frame for S s is sent BYE and closed\n"
             "                          (default 300)\n"
             "Before HELLO (a connection that has not yet said HELLO with the token):\n"
@@ -370,7 +373,7 @@ static void close_walk(uv_handle_t *h, void *arg)
 
 static const char *const SERVE_VALUE_FLAGS[] = {
     "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-scenes-memory", "max-world-memory", "max-memory", "max-grid",
+    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-scenes-memory", "max-world-memory", "max-memory", "max-tick-ms", "max-grid",
     "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory",
     "handshake-timeout", "max-preauth", NULL};
 
@@ -393,6 +396,7 @@ int lpvd_cmd_serve(int argc, char **argv)
     cfg->max_request_memory = SV_DEFAULT_MAX_REQUEST_MEMORY;
     cfg->max_scenes_memory = SV_DEFAULT_MAX_SCENES_MEMORY;
     cfg->max_world_memory = SV_DEFAULT_MAX_WORLD_MEMORY;
+    cfg->max_tick_ms = (double)SV_DEFAULT_MAX_TICK_MS;
     cfg->max_clients = 64;
     cfg->max_triangles = 10000000;
     cfg->max_texture = 8192;
@@ -525,6 +529,9 @@ int lpvd_cmd_serve(int argc, char **argv)
         } else if (!strcmp(name, "max-world-memory")) {
             bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 44, &u);
             cfg->max_world_memory = u;
+        } else if (!strcmp(name, "max-tick-ms")) {
+            bad = parse_num(v, 0.0, 1e9, &d);
+            cfg->max_tick_ms = d;
         } else if (!strcmp(name, "max-memory")) {
             bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 48, &u);
             cfg->max_memory = u;

@@ -82,6 +82,7 @@ typedef struct sv_config {
     uint64_t max_scenes_memory;  /* bytes of all live scenes together (R4.5c); >= max_scene_bytes */
     uint64_t max_world_memory;   /* GPU storage of one world's engine (R7.6) */
     uint64_t max_memory;         /* GPU storage of all worlds together; 0 = the device's budget (sv_gl_start) */
+    double max_tick_ms;          /* a world whose ticks after a change took longer is refused them (0 = off) */
     int max_clients;
     uint64_t max_triangles;
     int max_texture;
@@ -144,6 +145,16 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
  * are kept for encodings (GET_VOLUME, GET_FRAME, queries), which four
  * clients re-parsing a 68 MB scene had delayed by 5-7 s (issue 31, item 6). */
 #define SV_MAX_LOADS 2
+/* --max-tick-ms's default: a world whose tick after a change of its inputs
+ * took longer on the GL thread is refused such ticks (LIMIT) until its
+ * settings, scene or camera size change; with the GL thread's cheap-first
+ * turns (serve_gl.c) another client's cheap tick then waits at most about
+ * this long (issue 31, item 2). */
+#define SV_DEFAULT_MAX_TICK_MS 1000
+/* A job expected to take less than this (its world's measured ticks) runs
+ * before the expensive ones, at most SV_CHEAP_IN_A_ROW in a row. */
+#define SV_CHEAP_JOB_MS 150.0
+#define SV_CHEAP_IN_A_ROW 8
 /* Drops the scene loads still waiting for a worker (their requests were
  * answered SHUTTING_DOWN): at shutdown. */
 void sv_scene_loads_drop(struct sv_server *s);
@@ -249,6 +260,10 @@ struct sv_world {
     uint64_t gl_applied_gen;
     int gl_has_applied;
     uint64_t gl_mem_bytes;  /* the engine's storage after its last job (GL thread; sv_server.gl_worlds_bytes) */
+    /* what its ticks really took on the GL thread (GL thread only; serve_gl.c) */
+    double gl_last_ms;      /* the last tick */
+    double gl_change_ms;    /* the last tick after a change of its inputs (what a light move costs) */
+    uint64_t gl_change_sig; /* the settings, scene and view size that tick ran with */
     sv_inputs *gl_applied;  /* borrowed: only compared by content */
     lpv_settings gl_settings;
     lpv_view gl_view;
@@ -460,6 +475,7 @@ struct sv_server {
     sv_job *jobs_head, *jobs_tail;
     size_t jobs_queued;
     uint64_t gl_last_world; /* id of the world whose job the GL thread took last (fair turns) */
+    int gl_cheap_run;       /* cheap jobs taken in a row before an expensive one (SV_CHEAP_IN_A_ROW) */
     sv_job *done_head, *done_tail;
     int gl_ready;           /* 1 ok, -1 failed */
     char gl_err[1024];

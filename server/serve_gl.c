@@ -87,23 +87,48 @@ void sv_job_submit(sv_server *s, sv_job *j)
  * most the job running now, never by its whole backlog. A job without a
  * world (QUIT) goes when no world has a job left. Call with s->mu held and
  * the queue not empty. */
+/* What job j should take on the GL thread, from its world's measured
+ * ticks: a render or query of a ticked world, or a tick with nothing
+ * changed, its last tick's time; a tick after a change, its last such
+ * tick's; a world never ticked, unknown (expensive). */
+static double expected_ms(const sv_job *j)
+{
+    const sv_world *w = j->world;
+    if (!w || j->kind == SV_JOB_DESTROY)
+        return 0.0;
+    if (!w->gl_ticked)
+        return 1e30;
+    if (j->kind != SV_JOB_TICK || j->gen == w->gl_ticked_gen)
+        return w->gl_last_ms;
+    return w->gl_change_ms;
+}
+
+/* Worlds in turn (by id, wrapping round), cheap jobs first: a job expected
+ * to take under SV_CHEAP_JOB_MS goes before the expensive ones, at most
+ * SV_CHEAP_IN_A_ROW in a row, so a client's cheap tick does not wait for
+ * every heavy world's tick queued before it (issue 31, item 2). */
 static sv_job *take_next_locked(sv_server *s)
 {
     sv_job **best = NULL;
     uint64_t best_d = 0;
+    int best_cheap = 0;
+    const int cheap_first = s->gl_cheap_run < SV_CHEAP_IN_A_ROW;
     for (sv_job **p = &s->jobs_head; *p; p = &(*p)->next) {
         if (!(*p)->world) {
             if (!best)
                 best = p;
             continue;
         }
+        const int cheap = cheap_first && expected_ms(*p) < SV_CHEAP_JOB_MS;
         uint64_t d = (*p)->world->id - s->gl_last_world - 1; /* turns until this world's, wrapping */
-        if (!best || !(*best)->world || d < best_d) {
+        if (!best || !(*best)->world || cheap > best_cheap || (cheap == best_cheap && d < best_d)) {
             best = p;
             best_d = d;
+            best_cheap = cheap;
         }
     }
     sv_job *j = *best;
+    s->gl_cheap_run = best_cheap ? s->gl_cheap_run + 1 : 0;
     *best = j->next;
     if (s->jobs_tail == j) {
         s->jobs_tail = NULL;
@@ -213,10 +238,31 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     return 0;
 }
 
+/* The settings, scene and view size a tick runs with: what its cost
+ * depends on (a light moving does not change it). */
+static uint64_t cost_sig(const sv_inputs *in)
+{
+    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, &in->settings, sizeof in->settings);
+    h = lpv_hash_bytes(h, &in->scene, sizeof in->scene);
+    h = lpv_hash_bytes(h, &in->light_count, sizeof in->light_count);
+    h = lpv_hash_bytes(h, &in->view.width, sizeof in->view.width);
+    return lpv_hash_bytes(h, &in->view.height, sizeof in->view.height);
+}
+
 static void gl_tick(sv_server *s, sv_job *j)
 {
-    (void)s;
     sv_world *w = j->world;
+    const int changed = !w->gl_ticked || j->gen != w->gl_ticked_gen;
+    const uint64_t sig = cost_sig(j->inputs);
+    if (changed && s->cfg.max_tick_ms > 0.0 && w->gl_change_ms > s->cfg.max_tick_ms && w->gl_change_sig == sig) {
+        /* measured, not estimated: refused before it holds the GL thread again */
+        j->status = LPVP_E_LIMIT;
+        snprintf(j->err, sizeof j->err,
+                 "this world's last tick after a change took %.0f ms on the GL thread, over this server's %.0f ms "
+                 "(--max-tick-ms): lower grid, iterations, cascades, rsm_size, the iv knobs or the camera size",
+                 w->gl_change_ms, s->cfg.max_tick_ms);
+        return;
+    }
     double t0 = wall_ms();
     if (gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err) != 0 ||
         lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
@@ -238,6 +284,11 @@ static void gl_tick(sv_server *s, sv_job *j)
     r->tick = ++w->gl_ticks;
     r->tick_ms = wall_ms() - t0;
     j->result = r;
+    w->gl_last_ms = r->tick_ms;
+    if (changed) {
+        w->gl_change_ms = r->tick_ms;
+        w->gl_change_sig = sig;
+    }
 }
 
 static int gl_ready_for(sv_world *w, sv_job *j)
