@@ -9,7 +9,7 @@ nothing changed every 0.2 s. Reported: C's TICK round trips (p50, p99, max),
 and what H1 and H2 got (ticks, LIMIT refusals, their tick times). The target
 (issue 31): C answered within 1 s.
 
-    python3 bench/serve_fairness.py --lpvd build/server/lpvd [--vs OTHER_LPVD] [--seconds 30]
+    python3 bench/serve_fairness.py --lpvd build/server/lpvd [--max-tick-ms 1000] [--vs OTHER_LPVD] [--seconds 30]
 
 With --vs the same run is made against a second binary (side by side, one
 machine, one session: bench/build_baseline.sh builds an earlier revision).
@@ -58,8 +58,8 @@ def heavy(ep, i, stop, out):
     c.close()
 
 
-def run(lpvd, seconds):
-    with harness.Daemon(lpvd, quiet=True) as d:
+def run(lpvd, seconds, extra):
+    with harness.Daemon(lpvd, quiet=True, extra=extra) as d:
         ep = ("unix", d.unix)
         c = lc.Conn(ep, timeout=600)
         hello(c)
@@ -89,10 +89,14 @@ def main():
     ap.add_argument("--lpvd", required=True)
     ap.add_argument("--vs", help="a second lpvd binary, run the same way after the first")
     ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--max-tick-ms", action="append", default=[],
+                    help="also run --lpvd with this --max-tick-ms (repeatable)")
     a = ap.parse_args()
     rows = []
-    for name, binary in [("this", a.lpvd)] + ([("vs", a.vs)] if a.vs else []):
-        rtt, out = run(os.path.abspath(binary), a.seconds)
+    runs = [("this", a.lpvd, [])] + [("this, --max-tick-ms %s" % m, a.lpvd, ["--max-tick-ms", m])
+                                      for m in a.max_tick_ms] + ([("vs", a.vs, [])] if a.vs else [])
+    for name, binary, extra in runs:
+        rtt, out = run(os.path.abspath(binary), a.seconds, extra)
         hticks = sum(v[0] for v in out.values())
         hlim = sum(v[1] for v in out.values())
         hms = [m for v in out.values() for m in v[2]]

@@ -146,11 +146,15 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
  * clients re-parsing a 68 MB scene had delayed by 5-7 s (issue 31, item 6). */
 #define SV_MAX_LOADS 2
 /* --max-tick-ms's default: a world whose tick after a change of its inputs
- * took longer on the GL thread is refused such ticks (LIMIT) until its
- * settings, scene or camera size change; with the GL thread's cheap-first
- * turns (serve_gl.c) another client's cheap tick then waits at most about
- * this long (issue 31, item 2). */
-#define SV_DEFAULT_MAX_TICK_MS 1000
+ * (its second such tick or later: the first after a load or a settings
+ * change also does one-time work) took longer on the GL thread is refused
+ * such ticks (LIMIT) until its settings, scene or camera size change; with
+ * the GL thread's cheap-first turns (serve_gl.c) another client's cheap tick
+ * then waits at most about this long (issue 31, item 2). 5 s: a bound on the
+ * pathological (an iv tick of 45 s), loose enough for the default settings
+ * under a sanitizer on 2 cores; a daemon that must answer within a second
+ * sets 1000. */
+#define SV_DEFAULT_MAX_TICK_MS 5000
 /* A job expected to take less than this (its world's measured ticks) runs
  * before the expensive ones, at most SV_CHEAP_IN_A_ROW in a row. */
 #define SV_CHEAP_JOB_MS 150.0
@@ -264,6 +268,7 @@ struct sv_world {
     double gl_last_ms;      /* the last tick */
     double gl_change_ms;    /* the last tick after a change of its inputs (what a light move costs) */
     uint64_t gl_change_sig; /* the settings, scene and view size that tick ran with */
+    uint64_t gl_seen_sig;   /* those of its last tick */
     sv_inputs *gl_applied;  /* borrowed: only compared by content */
     lpv_settings gl_settings;
     lpv_view gl_view;

@@ -87,6 +87,17 @@ void sv_job_submit(sv_server *s, sv_job *j)
  * most the job running now, never by its whole backlog. A job without a
  * world (QUIT) goes when no world has a job left. Call with s->mu held and
  * the queue not empty. */
+/* The settings, scene and view size a tick runs with: what its cost
+ * depends on (a light moving does not change it). */
+static uint64_t cost_sig(const sv_inputs *in)
+{
+    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, &in->settings, sizeof in->settings);
+    h = lpv_hash_bytes(h, &in->scene, sizeof in->scene);
+    h = lpv_hash_bytes(h, &in->light_count, sizeof in->light_count);
+    h = lpv_hash_bytes(h, &in->view.width, sizeof in->view.width);
+    return lpv_hash_bytes(h, &in->view.height, sizeof in->view.height);
+}
+
 /* What job j should take on the GL thread, from its world's measured
  * ticks: a render or query of a ticked world, or a tick with nothing
  * changed, its last tick's time; a tick after a change, its last such
@@ -100,7 +111,9 @@ static double expected_ms(const sv_job *j)
         return 1e30;
     if (j->kind != SV_JOB_TICK || j->gen == w->gl_ticked_gen)
         return w->gl_last_ms;
-    return w->gl_change_ms;
+    /* a change: its last such tick's time, or, none measured with these
+     * settings yet, its last tick's (the first after a load: dearer) */
+    return w->gl_change_sig == cost_sig(j->inputs) && w->gl_change_ms > 0.0 ? w->gl_change_ms : w->gl_last_ms;
 }
 
 /* Worlds in turn (by id, wrapping round), cheap jobs first: a job expected
@@ -238,17 +251,6 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     return 0;
 }
 
-/* The settings, scene and view size a tick runs with: what its cost
- * depends on (a light moving does not change it). */
-static uint64_t cost_sig(const sv_inputs *in)
-{
-    uint64_t h = lpv_hash_bytes(LPV_HASH_INIT, &in->settings, sizeof in->settings);
-    h = lpv_hash_bytes(h, &in->scene, sizeof in->scene);
-    h = lpv_hash_bytes(h, &in->light_count, sizeof in->light_count);
-    h = lpv_hash_bytes(h, &in->view.width, sizeof in->view.width);
-    return lpv_hash_bytes(h, &in->view.height, sizeof in->view.height);
-}
-
 static void gl_tick(sv_server *s, sv_job *j)
 {
     sv_world *w = j->world;
@@ -285,10 +287,11 @@ static void gl_tick(sv_server *s, sv_job *j)
     r->tick_ms = wall_ms() - t0;
     j->result = r;
     w->gl_last_ms = r->tick_ms;
-    if (changed) {
+    if (changed && w->gl_seen_sig == sig) { /* not its first with these settings: that one does one-time work */
         w->gl_change_ms = r->tick_ms;
         w->gl_change_sig = sig;
     }
+    w->gl_seen_sig = sig;
 }
 
 static int gl_ready_for(sv_world *w, sv_job *j)
