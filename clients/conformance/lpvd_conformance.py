@@ -1794,6 +1794,32 @@ def c_query_bad_size(ctx):
     return "7 mismatches refused"
 
 
+@case("R7.6 R4.6a", "settings at the advertised limits either tick or are refused with LIMIT, never INTERNAL")
+def c_limits_tick_or_limit(ctx):
+    c, _, _ = ctx.scene_session()
+    mg = ctx.max_grid()
+    if not mg:
+        return "no max_grid advertised: skipped"
+    seen = []
+    for body in ({"technique": "lpv", "grid": [mg] * 3, "cascades": 1, "far_field": False, "normal_bins": False,
+                  "iterations": 1},
+                 {"technique": "lpv", "grid": [mg] * 3, "cascades": 4, "iterations": 1}):
+        f = c.request(CONFIG, body)
+        if f.type == ERROR:
+            expect_error(f, "LIMIT")
+            seen.append("CONFIG LIMIT")
+            continue
+        t = c.request(TICK, {}, timeout=ctx.tick_timeout)
+        if t.type == ERROR:
+            if t.err_name != "LIMIT":
+                raise Fail("CONFIG %s accepted, then TICK: %s (expected a reply or LIMIT)" % (json.dumps(body), t))
+            seen.append("TICK LIMIT")
+        else:
+            seen.append("ticked")
+    ctx.ping(c)
+    return "max_grid %d: %s" % (mg, ", ".join(seen))
+
+
 @case("R4.7", "QUERY_IRRADIANCE over HELLO's limits.max_query_points is refused before its attachment is read")
 def c_query_over_max(ctx):
     c, _, _ = ctx.scene_session()
