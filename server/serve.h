@@ -149,16 +149,13 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
  * (its second such tick or later: the first after a load or a settings
  * change also does one-time work) took longer on the GL thread is refused
  * such ticks (LIMIT) until its settings, scene or camera size change; with
- * the GL thread's cheap-first turns (serve_gl.c) another client's cheap tick
- * then waits at most about this long (issue 31, item 2). 5 s: a bound on the
+ * the GL thread's worlds in turn another client's tick then waits at most
+ * about this long for each other world with a job queued (issue 31, item 2). 5 s: a bound on the
  * pathological (an iv tick of 45 s), loose enough for the default settings
  * under a sanitizer on 2 cores; a daemon that must answer within a second
  * sets 1000. */
 #define SV_DEFAULT_MAX_TICK_MS 5000
-/* A job expected to take less than this (its world's measured ticks) runs
- * before the expensive ones, at most SV_CHEAP_IN_A_ROW in a row. */
-#define SV_CHEAP_JOB_MS 150.0
-#define SV_CHEAP_IN_A_ROW 8
+
 /* Drops the scene loads still waiting for a worker (their requests were
  * answered SHUTTING_DOWN): at shutdown. */
 void sv_scene_loads_drop(struct sv_server *s);
@@ -265,7 +262,6 @@ struct sv_world {
     int gl_has_applied;
     uint64_t gl_mem_bytes;  /* the engine's storage after its last job (GL thread; sv_server.gl_worlds_bytes) */
     /* what its ticks really took on the GL thread (GL thread only; serve_gl.c) */
-    double gl_last_ms;      /* the last tick */
     double gl_change_ms;    /* the last tick after a change of its inputs (what a light move costs) */
     uint64_t gl_change_sig; /* the settings, scene and view size that tick ran with */
     uint64_t gl_seen_sig;   /* those of its last tick */
@@ -480,7 +476,6 @@ struct sv_server {
     sv_job *jobs_head, *jobs_tail;
     size_t jobs_queued;
     uint64_t gl_last_world; /* id of the world whose job the GL thread took last (fair turns) */
-    int gl_cheap_run;       /* cheap jobs taken in a row before an expensive one (SV_CHEAP_IN_A_ROW) */
     sv_job *done_head, *done_tail;
     int gl_ready;           /* 1 ok, -1 failed */
     char gl_err[1024];

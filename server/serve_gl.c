@@ -98,50 +98,23 @@ static uint64_t cost_sig(const sv_inputs *in)
     return lpv_hash_bytes(h, &in->view.height, sizeof in->view.height);
 }
 
-/* What job j should take on the GL thread, from its world's measured
- * ticks: a render or query of a ticked world, or a tick with nothing
- * changed, its last tick's time; a tick after a change, its last such
- * tick's; a world never ticked, unknown (expensive). */
-static double expected_ms(const sv_job *j)
-{
-    const sv_world *w = j->world;
-    if (!w || j->kind == SV_JOB_DESTROY)
-        return 0.0;
-    if (!w->gl_ticked)
-        return 1e30;
-    if (j->kind != SV_JOB_TICK || j->gen == w->gl_ticked_gen)
-        return w->gl_last_ms;
-    /* a change: its last such tick's time, or, none measured with these
-     * settings yet, its last tick's (the first after a load: dearer) */
-    return w->gl_change_sig == cost_sig(j->inputs) && w->gl_change_ms > 0.0 ? w->gl_change_ms : w->gl_last_ms;
-}
-
-/* Worlds in turn (by id, wrapping round), cheap jobs first: a job expected
- * to take under SV_CHEAP_JOB_MS goes before the expensive ones, at most
- * SV_CHEAP_IN_A_ROW in a row, so a client's cheap tick does not wait for
- * every heavy world's tick queued before it (issue 31, item 2). */
 static sv_job *take_next_locked(sv_server *s)
 {
     sv_job **best = NULL;
     uint64_t best_d = 0;
-    int best_cheap = 0;
-    const int cheap_first = s->gl_cheap_run < SV_CHEAP_IN_A_ROW;
     for (sv_job **p = &s->jobs_head; *p; p = &(*p)->next) {
         if (!(*p)->world) {
             if (!best)
                 best = p;
             continue;
         }
-        const int cheap = cheap_first && expected_ms(*p) < SV_CHEAP_JOB_MS;
         uint64_t d = (*p)->world->id - s->gl_last_world - 1; /* turns until this world's, wrapping */
-        if (!best || !(*best)->world || cheap > best_cheap || (cheap == best_cheap && d < best_d)) {
+        if (!best || !(*best)->world || d < best_d) {
             best = p;
             best_d = d;
-            best_cheap = cheap;
         }
     }
     sv_job *j = *best;
-    s->gl_cheap_run = best_cheap ? s->gl_cheap_run + 1 : 0;
     *best = j->next;
     if (s->jobs_tail == j) {
         s->jobs_tail = NULL;
@@ -286,7 +259,6 @@ static void gl_tick(sv_server *s, sv_job *j)
     r->tick = ++w->gl_ticks;
     r->tick_ms = wall_ms() - t0;
     j->result = r;
-    w->gl_last_ms = r->tick_ms;
     if (changed && w->gl_seen_sig == sig) { /* not its first with these settings: that one does one-time work */
         w->gl_change_ms = r->tick_ms;
         w->gl_change_sig = sig;
