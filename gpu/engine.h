@@ -143,15 +143,11 @@ lpv_engine_counters lpv_engine_get_counters(const lpv_engine *e);
 lpv_engine *lpv_engine_create(char *err, size_t err_size);
 void lpv_engine_destroy(lpv_engine *e);
 
-/* Lowers the memory the engine may allocate (its budget starts at half of
- * the video memory or RAM, gpu/memory_limits.c) to bytes; source says where
- * the cap comes from in refusals (e.g. "--max-world-memory"). A cap above
- * the current budget changes nothing. */
-void lpv_engine_cap_memory(lpv_engine *e, uint64_t bytes, const char *source);
-
 /* Sets the memory the engine may allocate to bytes, or to the device's
- * budget when that is lower (whatever earlier caps said): for a cap that
- * moves, like the daemon's share of all worlds' memory. */
+ * budget (half of the video memory or RAM, gpu/memory_limits.c) when that
+ * is lower, whatever earlier calls said; source says where the cap comes
+ * from in refusals (e.g. "--max-world-memory"). The daemon sets it before
+ * every tick: its share of all worlds' memory moves. */
 void lpv_engine_set_memory_cap(lpv_engine *e, uint64_t bytes, const char *source);
 
 /* Bytes of storage the engine's current settings, lights, view and

@@ -89,14 +89,6 @@ void lpv_engine_memory_need(const lpv_engine *e, lpv_memory_need *n)
     }
 }
 
-void lpv_engine_cap_memory(lpv_engine *e, uint64_t bytes, const char *source)
-{
-    if (bytes == 0 || bytes >= e->mem_limits.budget)
-        return;
-    e->mem_limits.budget = bytes;
-    snprintf(e->mem_limits.budget_source, sizeof e->mem_limits.budget_source, "%s", source);
-}
-
 void lpv_engine_set_memory_cap(lpv_engine *e, uint64_t bytes, const char *source)
 {
     if (bytes >= e->mem_device_budget) {

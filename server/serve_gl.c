@@ -350,10 +350,16 @@ static void *gl_main(void *arg)
     else
         snprintf(s->worlds_budget_source, sizeof s->worlds_budget_source, "%.2f GB, the device's budget",
                  (double)s->gl_limits.budget / 1e9);
-    if (s->cfg.max_world_memory && s->cfg.max_world_memory < s->gl_limits.budget) { /* as every world's engine */
+    /* what one world can ever hold (CONFIG's floor check, --max-grid): the
+     * least of the device's budget, --max-world-memory and all worlds' */
+    if (s->cfg.max_world_memory && s->cfg.max_world_memory < s->gl_limits.budget) {
         s->gl_limits.budget = s->cfg.max_world_memory;
         snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "--max-world-memory %llu",
                  (unsigned long long)s->cfg.max_world_memory);
+    }
+    if (s->worlds_budget < s->gl_limits.budget) {
+        s->gl_limits.budget = s->worlds_budget;
+        snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "%s", s->worlds_budget_source);
     }
     s->gl_ready = 1;
     pthread_cond_broadcast(&s->cv);
