@@ -77,9 +77,16 @@ void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, s
     if (!count)
         return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
-    glUniform1i(glGetUniformLocation(prog, "u_first"), (GLint)first);
-    glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)count, (GLsizei)instances);
-    lpv_timer_count(timer, 1);
+    const GLint loc = glGetUniformLocation(prog, "u_first");
+    for (size_t done = 0; done < count && !lpv_timer_abandoned(timer);) {
+        const size_t n = count - done < LPV_ATLAS_SPLAT_CHUNK ? count - done : LPV_ATLAS_SPLAT_CHUNK;
+        glUniform1i(loc, (GLint)(first + done));
+        glDrawArraysInstanced(GL_POINTS, 0, (GLsizei)n, (GLsizei)instances);
+        lpv_timer_count(timer, 1);
+        done += n;
+        if (done < count)
+            lpv_timer_yield(timer);
+    }
 }
 
 void lpv_atlas_splat_indirect(GLuint prog, GLuint binding, GLuint buffer, GLuint draw, int instances, lpv_timer *timer)

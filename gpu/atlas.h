@@ -32,7 +32,10 @@ void lpv_atlas_destroy(lpv_atlas *a);
 void lpv_atlas_begin(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
 void lpv_atlas_begin_keep(const lpv_atlas *a, GLuint prog, GLuint grid_ubo, GLuint empty_vao);
 /* Draws count points of elements [first, first + count) of buffer at binding,
- * `instances` times (gl_InstanceID: the cascade, for splats into every one). */
+ * `instances` times (gl_InstanceID: the cascade, for splats into every one),
+ * in draws of LPV_ATLAS_SPLAT_CHUNK points with a yield point between them
+ * (timer.h): blending follows primitive order, so the sum is the same. */
+#define LPV_ATLAS_SPLAT_CHUNK ((size_t)1 << 19)
 void lpv_atlas_splat(GLuint prog, GLuint binding, GLuint buffer, size_t first, size_t count, int instances,
                      lpv_timer *timer);
 /* The same for the samples compacted into buffer with their count in the

@@ -177,8 +177,20 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
  * plan says "recompute requested"): for benchmarks that time full ticks. */
 void lpv_engine_invalidate(lpv_engine *e);
 
-/* Runs one tick: RSMs through propagation. */
+/* Runs one tick: RSMs through propagation. A tick whose yield hook asked it
+ * to stop (lpv_engine_set_yield) returns -1 with err starting with
+ * LPV_TICK_ABANDONED; the next tick recomputes everything. */
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size);
+#define LPV_TICK_ABANDONED "abandoned: "
+
+/* Lets the caller run other work while a tick or a render of this engine is
+ * under way: between the passes, and between the steps of a long pass, once
+ * every_ms of wall time has passed since the last time, the engine finishes
+ * what it submitted and calls fn(arg) (gpu/timer.h, "Yield points"). fn may
+ * make another GL context current and run other engines there, and must make
+ * this engine's context current again before it returns; a nonzero return
+ * abandons the tick. fn NULL (the default) never yields. */
+void lpv_engine_set_yield(lpv_engine *e, int (*fn)(void *arg), void *arg, double every_ms);
 
 /* Shades the view after a tick into rgba (width*height*4 floats, linear
  * radiance W/(m^2 sr), top row first, alpha 1 where geometry was hit). */

@@ -178,6 +178,20 @@ static void record_stats(lpv_engine *e)
     }
 }
 
+void lpv_engine_set_yield(lpv_engine *e, int (*fn)(void *arg), void *arg, double every_ms)
+{
+    lpv_timer_set_yield(&e->timer, fn, arg, every_ms);
+}
+
+/* The tick's caller asked it to stop at a yield point: what it computed so
+ * far is partial, so the next tick starts over. */
+static int abandoned(lpv_engine *e, char *err, size_t err_size)
+{
+    e->forced = 1;
+    lpv_timer_collect(&e->timer); /* the next pass begins a new frame */
+    return lpv_error(err, err_size, "%snobody wants this tick any more", LPV_TICK_ABANDONED);
+}
+
 int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
 {
     if (!e->has_scene)
@@ -217,16 +231,22 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
         return -1;
     if (p->pass[LPV_PASS_RSM].run)
         lpv_pass_rsm_run(e);
+    if (lpv_timer_abandoned(&e->timer))
+        return abandoned(e, err, err_size);
     /* the shared producers, once per tick; then the technique on what they made */
     if (p->pass[LPV_PASS_GBUFFER].run) {
         if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
             return -1;
         e->gbuf_stale = 0;
     }
+    if (lpv_timer_abandoned(&e->timer))
+        return abandoned(e, err, err_size);
     lpv_technique_inputs in;
     technique_inputs(e, &in);
     if (t->tick(e->tech, &in, err, err_size) != 0)
         return -1;
+    if (lpv_timer_abandoned(&e->timer))
+        return abandoned(e, err, err_size);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR)
         return lpv_error(err, err_size, "GL error 0x%04x during the tick", gl_err);

@@ -30,6 +30,8 @@ static void new_frame(lpv_timer *t)
     t->dropped = 0;
     t->last_stage = -1;
     t->collected = 0;
+    t->abandoned = 0;
+    t->yield_last_ms = now_ms();
     memset(t->stages, 0, sizeof t->stages);
 }
 
@@ -97,10 +99,8 @@ void lpv_timer_begin(lpv_timer *t, const char *stage)
     t->open_cpu_ms = now_ms();
 }
 
-void lpv_timer_end(lpv_timer *t)
+static void end_span(lpv_timer *t)
 {
-    if (!t || t->open_stage < 0)
-        return;
     if (t->open_span >= 0) {
         /* llvmpipe (and tiled GPUs) defer draws until a flush: without the
          * finish, a stage of draws would be billed to whichever later stage
@@ -118,6 +118,50 @@ void lpv_timer_end(lpv_timer *t)
     t->open_span = -1;
 }
 
+void lpv_timer_end(lpv_timer *t)
+{
+    if (!t || t->open_stage < 0)
+        return;
+    end_span(t);
+    lpv_timer_yield(t);
+}
+
+void lpv_timer_set_yield(lpv_timer *t, int (*fn)(void *arg), void *arg, double every_ms)
+{
+    if (!t)
+        return;
+    t->yield_fn = fn;
+    t->yield_arg = arg;
+    t->yield_every_ms = every_ms;
+    t->yield_last_ms = now_ms();
+}
+
+void lpv_timer_yield(lpv_timer *t)
+{
+    if (!t || !t->yield_fn || t->yielding || t->abandoned || now_ms() - t->yield_last_ms < t->yield_every_ms)
+        return;
+    char stage[LPV_TIMER_NAME_MAX] = "";
+    const int reopen = t->open_stage >= 0;
+    if (reopen) {
+        memcpy(stage, t->stages[t->open_stage].name, sizeof stage);
+        end_span(t);
+    } else {
+        glFinish(); /* what was submitted since the last span is done before another's work */
+    }
+    t->yielding = 1;
+    if (t->yield_fn(t->yield_arg) != 0)
+        t->abandoned = 1;
+    t->yielding = 0;
+    t->yield_last_ms = now_ms();
+    if (reopen)
+        lpv_timer_begin(t, stage);
+}
+
+int lpv_timer_abandoned(const lpv_timer *t)
+{
+    return t && t->abandoned;
+}
+
 void lpv_timer_count(lpv_timer *t, unsigned n)
 {
     if (!t)
@@ -132,7 +176,7 @@ int lpv_timer_collect(lpv_timer *t)
     if (!t)
         return 0;
     if (t->open_stage >= 0)
-        lpv_timer_end(t);
+        end_span(t); /* no yield point: the frame is over */
     if (t->collected)
         return t->stage_count;
 

@@ -75,6 +75,11 @@ typedef struct lpv_timer {
     double open_cpu_ms;
     int queries_ready; /* 1 once the queries exist, -1 if timestamps are unsupported */
     int collected;     /* 1: the next begin starts a new frame */
+    int (*yield_fn)(void *arg); /* lpv_timer_set_yield */
+    void *yield_arg;
+    double yield_every_ms, yield_last_ms;
+    int yielding;      /* inside yield_fn: no nested yield */
+    int abandoned;     /* yield_fn asked the work to stop; until the next frame */
 } lpv_timer;
 
 /* Zeroes the timer. No GL call. */
@@ -96,8 +101,28 @@ int lpv_timer_collect(lpv_timer *t);
 /* The stage called `name` in the current results, or NULL. */
 const lpv_timer_stage *lpv_timer_find(const lpv_timer *t, const char *name);
 
+/*
+ * Yield points. A caller that shares one thread among several timers' work
+ * (the daemon's GL thread, one engine per world) registers fn: at a yield
+ * point, once every_ms of wall time has passed since the frame began or
+ * since the last yield, the timer ends the open span (its glFinish: the work
+ * so far is done), calls fn(arg) and begins the span again under the same
+ * name, so the time fn spends is billed to no stage. fn may make another
+ * context current and run GL work there, as long as it makes this timer's
+ * context current again before it returns; it returns nonzero when nobody
+ * wants this work any more, and lpv_timer_abandoned says so until the next
+ * frame. The end of every span is a yield point; passes add lpv_timer_yield
+ * between the steps of a long stage (propagation iterations, chunks of one
+ * big draw or dispatch). The timer holds the hook because every pass gets the
+ * timer and marks its ends with it. Without a hook (fn NULL, the default)
+ * a yield point costs a test.
+ */
+void lpv_timer_set_yield(lpv_timer *t, int (*fn)(void *arg), void *arg, double every_ms);
+void lpv_timer_yield(lpv_timer *t);
+int lpv_timer_abandoned(const lpv_timer *t);
+
 /* Deletes the GL queries (the context that was current at the first begin
- * must be current) and zeroes the timer. */
+ * must be current) and zeroes the timer, the yield hook included. */
 void lpv_timer_destroy(lpv_timer *t);
 
 #endif /* LPV_TIMER_H */

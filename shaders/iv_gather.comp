@@ -22,6 +22,7 @@ layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell gather
 layout(std430, binding = LPV_SSBO_IV_AO) writeonly buffer Ao { vec4 ao[]; };
 
 uniform int u_rays;
+uniform int u_cell_first; // this dispatch's first cell (the march goes in chunks)
 uniform uint u_seed;
 uniform int u_ao;
 uniform float u_ao_reach; // voxels
@@ -93,7 +94,7 @@ bool needed(ivec3 c)
 
 void main()
 {
-    int i = int(gl_GlobalInvocationID.x);
+    int i = u_cell_first + int(gl_GlobalInvocationID.x);
     if (i >= grid_cells())
         return;
     ivec3 d = grid_dims();

@@ -18,6 +18,9 @@
  * kept; LPV_IV_COVER). */
 #define IV_ATTACHMENTS 8
 #define IV_ATTACHMENT_MAX 6
+/* Rays per dispatch of a march (lpv_iv_march_volume): 32768 voxels at the
+ * default 128 rays, a few tens of ms on llvmpipe. */
+#define LPV_IV_MARCH_CHUNK_RAYS ((size_t)1 << 22)
 
 typedef struct lpv_iv_gpu {
     lpv_technique base;

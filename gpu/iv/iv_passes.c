@@ -95,8 +95,21 @@ void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int a
     glUniform1i(glGetUniformLocation(prog, "u_ao"), ao);
     const float reach = s->iv.ao_distance > 0.0f ? s->iv.ao_distance / v->grid.cell_size : LPV_IV_AO_VOXELS;
     glUniform1f(glGetUniformLocation(prog, "u_ao_reach"), reach);
-    glDispatchCompute(groups(v), 1, 1);
-    lpv_timer_count(timer, 1);
+    /* in chunks of about LPV_IV_MARCH_CHUNK_RAYS rays, a yield point between
+     * them (timer.h): one dispatch of a fine volume with many rays took
+     * seconds; the cells are independent, so the result is the same */
+    const GLint loc_first = glGetUniformLocation(prog, "u_cell_first");
+    size_t chunk = LPV_IV_MARCH_CHUNK_RAYS / (size_t)(s->iv.rays > 0 ? s->iv.rays : 1);
+    chunk = chunk < LPV_IV_WG ? LPV_IV_WG : chunk / LPV_IV_WG * LPV_IV_WG;
+    for (size_t first = 0; first < v->cells && !lpv_timer_abandoned(timer);) {
+        const size_t n = v->cells - first < chunk ? v->cells - first : chunk;
+        glUniform1i(loc_first, (GLint)first);
+        glDispatchCompute(lpv_div_up(n, LPV_IV_WG), 1, 1);
+        lpv_timer_count(timer, 1);
+        first += n;
+        if (first < v->cells)
+            lpv_timer_yield(timer);
+    }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
@@ -128,7 +141,7 @@ void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
     const int tail = s->iv.tail == LPV_SWITCH_ON && s->iv.bounces >= 3;
     if (tail)
         lpv_iv_clear_buffer(v->tail); /* S_0 = 0 */
-    for (int k = 1; k <= s->iv.bounces; ++k) {
+    for (int k = 1; k <= s->iv.bounces && !lpv_timer_abandoned(in->timer); ++k) {
         cur = k == 1 ? 0 : 1 - prev;
         glUseProgram(v->prog_emit);
         glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);

@@ -49,7 +49,9 @@ void lpv_pass_propagate_run(lpv_cascaded *c, const lpv_technique_inputs *in, int
     const GLuint groups[3] = {lpv_div_up((size_t)c->grid.dims[0], LPV_PROP_WG_X),
                               lpv_div_up((size_t)c->grid.dims[1], LPV_PROP_WG_Y),
                               (GLuint)(c->grid.dims[2] * lpv_volumes(c))};
-    for (int i = 0; i < iterations; ++i) {
+    /* each step is a yield point: a long propagation lets other worlds'
+     * work run between its steps (timer.h) */
+    for (int i = 0; i < iterations && !lpv_timer_abandoned(timer); lpv_timer_yield(timer), ++i) {
         GLuint out = cur == c->lpv_ping ? c->lpv_pong : c->lpv_ping;
         const int handoff_next = (i + 1) % every == 0 && (i + 1) / every < levels && i + 1 < iterations;
         glUseProgram(prog);
