@@ -10,12 +10,14 @@ and what H1 and H2 got (ticks, LIMIT refusals, their tick times). The target
 (issue 31): C answered within 1 s.
 
     python3 bench/serve_fairness.py --lpvd build/server/lpvd [--max-tick-ms 1000] [--vs OTHER_LPVD] [--seconds 30]
+        [--heavy '{"technique": "iv", "iv_rays": 64, "iv_resolution": 64}']
 
 With --vs the same run is made against a second binary (side by side, one
 machine, one session: bench/build_baseline.sh builds an earlier revision).
 """
 
 import argparse
+import json
 import os
 import sys
 import threading
@@ -37,7 +39,7 @@ def pct(v, p):
 def heavy(ep, i, stop, out):
     c = lc.Conn(ep, timeout=600)
     hello(c)
-    ok(c.request(lc.CONFIG, HEAVY, timeout=60), lc.CONFIG)
+    ok(c.request(lc.CONFIG, HEAVY, timeout=600), lc.CONFIG)
     ticks, limits, ms = 0, 0, []
     k = 0
     while not stop.is_set():
@@ -89,9 +91,13 @@ def main():
     ap.add_argument("--lpvd", required=True)
     ap.add_argument("--vs", help="a second lpvd binary, run the same way after the first")
     ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--heavy", help="the heavy clients' CONFIG as JSON (default %s)" % json.dumps(HEAVY))
     ap.add_argument("--max-tick-ms", action="append", default=[],
                     help="also run --lpvd with this --max-tick-ms (repeatable)")
     a = ap.parse_args()
+    if a.heavy:
+        HEAVY.clear()
+        HEAVY.update(json.loads(a.heavy))
     rows = []
     runs = [("this", a.lpvd, [])] + [("this, --max-tick-ms %s" % m, a.lpvd, ["--max-tick-ms", m])
                                       for m in a.max_tick_ms] + ([("vs", a.vs, [])] if a.vs else [])

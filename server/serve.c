@@ -49,8 +49,9 @@ static void usage(FILE *f)
             "  --max-body BYTES        json of one message (default 1048576)\n"
             "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
             "  --max-world-memory BYTES  GPU storage one world (one computation) may take (default %llu)\n"
-            "  --max-memory BYTES      GPU storage all worlds together may take (default: half of the video\n"
-            "                          memory, or of RAM where the driver reports none, as lpvd render's budget)\n"
+            "  --max-memory BYTES      all worlds' storage, live scenes, requests and replies together (default:\n"
+            "                          half of the machine's memory, or of its cgroup's limit; the worlds also\n"
+            "                          stay within half of the video memory)\n"
             "  --max-request-memory BYTES  request bytes held for all clients together; a frame that does not\n"
             "                          fit waits, unread (default %llu, at least --max-message)\n"
             "  --max-triangles N       per scene (default 10000000)\n"
@@ -606,6 +607,10 @@ int lpvd_cmd_serve(int argc, char **argv)
      * own path later changes nothing */
     if (cfg->scene_root[0] && (s->root_fd = open(cfg->scene_root, O_RDONLY | O_DIRECTORY | O_CLOEXEC)) < 0) {
         fprintf(stderr, "lpvd serve: --scene-root %s: %s\n", cfg->scene_root, strerror(errno));
+        return 2;
+    }
+    if (sv_memory_init(&s->mem, cfg->max_memory, cfg->max_message, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd serve: %s\n", err);
         return 2;
     }
     signal(SIGPIPE, SIG_IGN);

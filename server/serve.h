@@ -36,6 +36,7 @@
 #include "engine.h"
 #include "gltf_load.h"
 #include "hash.h"
+#include "serve_memory.h"
 #include "memory_budget.h"
 #include "scene.h"
 #include "settings.h"
@@ -81,7 +82,8 @@ typedef struct sv_config {
     uint64_t max_request_memory; /* request bytes held, all connections (R7.5); >= max_message */
     uint64_t max_scenes_memory;  /* bytes of all live scenes together (R4.5c); >= max_scene_bytes */
     uint64_t max_world_memory;   /* GPU storage of one world's engine (R7.6) */
-    uint64_t max_memory;         /* GPU storage of all worlds together; 0 = the device's budget (sv_gl_start) */
+    uint64_t max_memory;         /* worlds, scenes, requests and replies together; 0 = half the
+                                    machine's memory (serve_memory.h) */
     double max_tick_ms;          /* a world whose ticks after a change took longer is refused them (0 = off) */
     int max_clients;
     uint64_t max_triangles;
@@ -148,13 +150,21 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
 /* --max-tick-ms's default: a world whose tick after a change of its inputs
  * (its second such tick or later: the first after a load or a settings
  * change also does one-time work) took longer on the GL thread is refused
- * such ticks (LIMIT) until its settings, scene or camera size change; with
- * the GL thread's worlds in turn another client's tick then waits at most
- * about this long for each other world with a job queued (issue 31, item 2). 5 s: a bound on the
+ * such ticks (LIMIT) until its settings, scene or camera size change: a
+ * bound on the GL time one world takes from the others (another client's
+ * wait is bounded by the yield points, SV_GL_SLICE_MS). 5 s: a bound on the
  * pathological (an iv tick of 45 s), loose enough for the default settings
- * under a sanitizer on 2 cores; a daemon that must answer within a second
- * sets 1000. */
+ * under a sanitizer on 2 cores. */
 #define SV_DEFAULT_MAX_TICK_MS 5000
+/* The GL thread's yield points (serve_gl.c): a world's tick or render stops
+ * at the first yield point after SV_GL_SLICE_MS of GL time and the queued
+ * jobs of other worlds run there, for up to SV_GL_YIELD_MS, before it goes
+ * on; so a cheap job waits about one slice per heavy job ahead of it, not
+ * the heavy job's whole length (issue 31, item 2). Jobs run at a yield point
+ * may yield in turn, SV_GL_MAX_DEPTH deep at most. */
+#define SV_GL_SLICE_MS 100.0
+#define SV_GL_YIELD_MS 400.0
+#define SV_GL_MAX_DEPTH 4
 
 /* Drops the scene loads still waiting for a worker (their requests were
  * answered SHUTTING_DOWN): at shutdown. */
@@ -257,10 +267,14 @@ struct sv_world {
     sv_server *srv;
     sv_world *next;
     /* GL thread only */
+    lpv_gl_context *gl_ctx; /* the world's own context: its GL state survives
+                               another world's jobs run while its own waits
+                               at a yield point (serve_gl.c) */
     lpv_engine *engine;
+    int gl_busy;            /* a job of this world is running or waiting at a yield point */
     uint64_t gl_applied_gen;
     int gl_has_applied;
-    uint64_t gl_mem_bytes;  /* the engine's storage after its last job (GL thread; sv_server.gl_worlds_bytes) */
+    uint64_t gl_mem_bytes;  /* the engine's storage after its last job (GL thread; its part of SV_MEM_WORLDS) */
     /* what its ticks really took on the GL thread (GL thread only; serve_gl.c) */
     double gl_change_ms;    /* the last tick after a change of its inputs (what a light move costs) */
     uint64_t gl_change_sig; /* the settings, scene and view size that tick ran with */
@@ -302,6 +316,8 @@ struct sv_job {
     int cancelled;          /* no request, subscriber or timer wants it: the GL thread skips it (under
                                srv->mu; sv_gl_cancel) */
     sv_waiter *joined;      /* tick: more requests answered by this job, in order */
+    double yielded_ms;      /* GL thread: time other worlds' jobs ran at its yield points,
+                               not billed to it (gl_yield) */
     unsigned terms_mask;    /* tick: which frames to render (1 << terms); under srv->mu until started */
     int terms;              /* render */
     lpv_display display;    /* render: how an rgba8/png frame is shown */
@@ -458,9 +474,7 @@ struct sv_server {
      * wait here in order (serve_scene.c), so encodings always find a worker */
     int loads_running;
     struct load_work *loads_wait_head, *loads_wait_tail;
-    uint64_t request_bytes; /* reserved + pending request bytes of every connection (R7.5) */
     uint64_t memory_waits;  /* turns handed out to connections waiting for request memory */
-    uint64_t scenes_bytes;  /* sv_scene.bytes of every live scene, once each (--max-scenes-memory) */
     uint64_t next_conn_id;
     sv_world *worlds;
     int world_count;
@@ -476,6 +490,11 @@ struct sv_server {
     sv_job *jobs_head, *jobs_tail;
     size_t jobs_queued;
     uint64_t gl_last_world; /* id of the world whose job the GL thread took last (fair turns) */
+    /* the jobs the GL thread has started and not finished: [0] runs, each
+     * later one ran at a yield point of the one before (serve_gl.c); under mu */
+    sv_job *gl_stack[SV_GL_MAX_DEPTH];
+    int gl_depth;
+    uint64_t gl_jobs_between; /* jobs run at another world's yield point (STATS) */
     sv_job *done_head, *done_tail;
     int gl_ready;           /* 1 ok, -1 failed */
     char gl_err[1024];
@@ -483,17 +502,14 @@ struct sv_server {
     char gl_renderer[256];
     lpv_gl_context *gl_ctx;
     lpv_memory_limits gl_limits; /* the GL's, with --max-world-memory as the budget (sv_gl_start) */
-    /* all worlds' GPU storage (R7.6a), on the GL thread only: what each
-     * world's engine holds (sv_world.gl_mem_bytes) summed, against the
-     * daemon's budget (--max-memory, else the device's) */
-    uint64_t gl_worlds_bytes;
-    uint64_t worlds_budget;
-    char worlds_budget_source[96];
+    /* what the worlds, scenes, requests and replies hold, against
+     * --max-memory (R7.6a, serve_memory.h) */
+    sv_memory mem;
     /* counters */
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */
     uint64_t ticks_coalesced; /* TICK requests answered by another request's tick */
-    uint64_t ticks_cancelled; /* queued ticks skipped because every requester had gone */
+    uint64_t ticks_cancelled; /* ticks skipped or abandoned because every requester had gone */
     uint64_t requests;
     int exit_code;
 };
@@ -543,9 +559,10 @@ void sv_job_submit(sv_server *s, sv_job *j);
 sv_job *sv_job_new(sv_job_kind kind, sv_world *w);
 void sv_job_free(sv_job *j);
 size_t sv_jobs_queued(sv_server *s);
-/* Marks w's jobs that have not started and that wanted(j, arg) says nobody
- * wants any more: the GL thread skips them (no GL time) and they complete
- * with no result. Destroy jobs are never cancelled. Loop thread. */
+/* Marks w's jobs that wanted(j, arg) says nobody wants any more: the GL
+ * thread skips those not started (no GL time), abandons a running tick at
+ * its next yield point, and they complete with no result. Destroy jobs are
+ * never cancelled. Loop thread. */
 void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void *arg), void *arg);
 
 /* serve_world.c */

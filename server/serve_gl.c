@@ -79,14 +79,6 @@ void sv_job_submit(sv_server *s, sv_job *j)
     pthread_mutex_unlock(&s->mu);
 }
 
-/* Fair GL time: which queued job runs next, unlinked from the queue. Worlds
- * take turns: the oldest job of the first world after the one served last
- * (by id, wrapping round) that has a job queued. So a world's jobs still run
- * in the order they were queued (its destroy job last), and a world with many
- * jobs (sessions sharing it, each with a request) delays another world by at
- * most the job running now, never by its whole backlog. A job without a
- * world (QUIT) goes when no world has a job left. Call with s->mu held and
- * the queue not empty. */
 /* The settings, scene and view size a tick runs with: what its cost
  * depends on (a light moving does not change it). */
 static uint64_t cost_sig(const sv_inputs *in)
@@ -98,22 +90,36 @@ static uint64_t cost_sig(const sv_inputs *in)
     return lpv_hash_bytes(h, &in->view.height, sizeof in->view.height);
 }
 
-static sv_job *take_next_locked(sv_server *s)
+/* Fair GL time: which queued job runs next, unlinked from the queue, or
+ * NULL. Worlds take turns: the oldest job of the first world after the one
+ * served last (by id, wrapping round) that has a job queued. So a world's
+ * jobs still run in the order they were queued (its destroy job last), and a
+ * world with many jobs (sessions sharing it, each with a request) delays
+ * another world by at most a slice of the job running now (gl_yield), never
+ * by its whole backlog. A job without a world (QUIT) goes when no world has
+ * a job left. Only worlds with no job started are taken from (at a yield
+ * point, the worlds whose jobs wait there), and at a yield point (`between`)
+ * never QUIT. Call with s->mu held. */
+static sv_job *take_next_locked(sv_server *s, int between)
 {
     sv_job **best = NULL;
     uint64_t best_d = 0;
     for (sv_job **p = &s->jobs_head; *p; p = &(*p)->next) {
         if (!(*p)->world) {
-            if (!best)
+            if (!best && !between)
                 best = p;
             continue;
         }
+        if ((*p)->world->gl_busy)
+            continue;
         uint64_t d = (*p)->world->id - s->gl_last_world - 1; /* turns until this world's, wrapping */
         if (!best || !(*best)->world || d < best_d) {
             best = p;
             best_d = d;
         }
     }
+    if (!best)
+        return NULL;
     sv_job *j = *best;
     *best = j->next;
     if (s->jobs_tail == j) {
@@ -123,8 +129,12 @@ static sv_job *take_next_locked(sv_server *s)
     }
     j->next = NULL;
     s->jobs_queued--;
-    if (j->world)
+    j->started = 1; /* from now on no request joins it (sv_world_join_tick) */
+    if (j->world) {
         s->gl_last_world = j->world->id;
+        j->world->gl_busy = 1;
+        s->gl_stack[s->gl_depth++] = j; /* sv_gl_cancel finds it there */
+    }
     return j;
 }
 
@@ -134,6 +144,12 @@ void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void
     for (sv_job *j = s->jobs_head; j; j = j->next)
         if (j->world == w && !j->started && !j->cancelled && j->kind != SV_JOB_DESTROY && !wanted(j, arg))
             j->cancelled = 1;
+    /* a tick under way stops at its next yield point (gl_yield) */
+    for (int i = 0; i < s->gl_depth; ++i) {
+        sv_job *j = s->gl_stack[i];
+        if (j->world == w && j->kind == SV_JOB_TICK && !j->cancelled && !wanted(j, arg))
+            j->cancelled = 1;
+    }
     pthread_mutex_unlock(&s->mu);
 }
 
@@ -158,17 +174,20 @@ static uint64_t scene_sig(const sv_inputs *in)
     return h;
 }
 
-/* The world's cap: --max-world-memory, or what the other worlds leave of
- * the daemon's budget for all of them (R7.6a), whichever is lower. */
+/* The world's cap: --max-world-memory, or what the daemon's budget leaves
+ * it beside the other worlds, the scenes, the requests and the replies
+ * (R7.6a, serve_memory.h), whichever is lower. */
 static void set_world_cap(sv_world *w)
 {
     sv_server *s = w->srv;
-    const uint64_t others = s->gl_worlds_bytes - w->gl_mem_bytes;
-    const uint64_t left = s->worlds_budget > others ? s->worlds_budget - others : 0;
-    char cap[256];
+    const uint64_t room = sv_memory_room(&s->mem, SV_MEM_WORLDS); /* for all worlds together */
+    const uint64_t others = sv_memory_held(&s->mem, SV_MEM_WORLDS) - w->gl_mem_bytes;
+    const uint64_t left = room > others ? room - others : 0;
+    char cap[400];
     if (left < s->cfg.max_world_memory) {
-        snprintf(cap, sizeof cap, "all worlds' budget, %s, of which other worlds hold %.2f GB (--max-memory)",
-                 s->worlds_budget_source, (double)others / 1e9);
+        char held[320];
+        sv_memory_describe(&s->mem, held, sizeof held);
+        snprintf(cap, sizeof cap, "%s; this world holds %.3f GB of that", held, (double)w->gl_mem_bytes / 1e9);
         lpv_engine_set_memory_cap(w->engine, left, cap);
     } else { /* bounds the daemon's GPU memory: worlds x this (docs/server.md, "Worst-case memory") */
         snprintf(cap, sizeof cap, "--max-world-memory %llu", (unsigned long long)s->cfg.max_world_memory);
@@ -176,16 +195,23 @@ static void set_world_cap(sv_world *w)
     }
 }
 
-/* Records what the world's engine holds now in the daemon's sum. */
+/* Records what the world's engine holds now in the daemon's budget. */
 static void note_world_bytes(sv_world *w, uint64_t bytes)
 {
-    w->srv->gl_worlds_bytes += bytes - w->gl_mem_bytes;
+    sv_memory_sub(&w->srv->mem, SV_MEM_WORLDS, w->gl_mem_bytes);
+    sv_memory_add(&w->srv->mem, SV_MEM_WORLDS, bytes);
     w->gl_mem_bytes = bytes;
 }
 
 /* Brings the world's engine to the job's inputs. */
 static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, size_t n)
 {
+    if (!w->gl_ctx) { /* current once made; the daemon's backend */
+        lpv_gl_context_desc desc = {.backend = lpv_gl_context_backend(w->srv->gl_ctx)};
+        w->gl_ctx = lpv_gl_context_create(&desc, err, n);
+        if (!w->gl_ctx)
+            return -1;
+    }
     if (!w->engine) {
         w->engine = lpv_engine_create(err, n);
         if (!w->engine)
@@ -224,6 +250,8 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     return 0;
 }
 
+static int gl_yield(void *arg);
+
 static void gl_tick(sv_server *s, sv_job *j)
 {
     sv_world *w = j->world;
@@ -239,8 +267,12 @@ static void gl_tick(sv_server *s, sv_job *j)
         return;
     }
     double t0 = wall_ms();
-    if (gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err) != 0 ||
-        lpv_engine_tick(w->engine, j->err, sizeof j->err) != 0) {
+    int rc = gl_apply(w, j->inputs, j->gen, j->err, sizeof j->err);
+    if (rc == 0) {
+        lpv_engine_set_yield(w->engine, gl_yield, j, SV_GL_SLICE_MS); /* a new engine has none yet */
+        rc = lpv_engine_tick(w->engine, j->err, sizeof j->err);
+    }
+    if (rc != 0) {
         /* the engine's memory refusals name their budget's source: the cap
          * gl_apply set is the server's limit, so LIMIT (R7.6), not a fault */
         j->status = strstr(j->err, LPV_MEMORY_REFUSED) ? LPVP_E_LIMIT : LPVP_E_INTERNAL;
@@ -257,7 +289,7 @@ static void gl_tick(sv_server *s, sv_job *j)
     }
     r->gen = j->gen;
     r->tick = ++w->gl_ticks;
-    r->tick_ms = wall_ms() - t0;
+    r->tick_ms = wall_ms() - t0 - j->yielded_ms; /* its own GL time, not other worlds' */
     j->result = r;
     if (changed && w->gl_seen_sig == sig) { /* not its first with these settings: that one does one-time work */
         w->gl_change_ms = r->tick_ms;
@@ -325,6 +357,90 @@ static void gl_query(sv_job *j)
     j->tick = w->gl_ticks;
 }
 
+/* Runs one job of a world, taken by take_next_locked, on the GL thread in
+ * the world's context, and hands it to the loop. Its world is busy until
+ * then: no other job of it runs at one of this job's yield points. */
+static void run_job(sv_server *s, sv_job *j)
+{
+    sv_world *w = j->world;
+    pthread_mutex_lock(&s->mu);
+    const int cancelled = j->cancelled;
+    pthread_mutex_unlock(&s->mu);
+
+    if (cancelled) { /* nobody wants it any more (sv_gl_cancel): no GL time */
+        j->status = LPVP_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "cancelled: every request for it is gone");
+    } else if (w->gl_ctx && lpv_gl_context_make_current(w->gl_ctx) != 0) {
+        j->status = LPVP_E_INTERNAL;
+        snprintf(j->err, sizeof j->err, "cannot make this world's GL context current");
+    } else {
+        if (w->engine) /* a tick's gl_apply creates it and sets it too */
+            lpv_engine_set_yield(w->engine, gl_yield, j, SV_GL_SLICE_MS);
+        switch (j->kind) {
+        case SV_JOB_TICK: gl_tick(s, j); break;
+        case SV_JOB_RENDER: gl_render(j); break;
+        case SV_JOB_QUERY: gl_query(j); break;
+        case SV_JOB_DESTROY:
+            lpv_engine_destroy(w->engine);
+            w->engine = NULL;
+            lpv_gl_context_destroy(w->gl_ctx);
+            w->gl_ctx = NULL;
+            note_world_bytes(w, 0);
+            malloc_trim(0); /* the heap's free pages back to the system (serve.c, mallopt) */
+            break;
+        case SV_JOB_QUIT: break;
+        }
+        if (w->engine)
+            lpv_engine_set_yield(w->engine, NULL, NULL, 0.0);
+    }
+
+    pthread_mutex_lock(&s->mu);
+    s->gl_depth--;
+    w->gl_busy = 0;
+    j->next = NULL;
+    if (s->done_tail)
+        s->done_tail->next = j;
+    else
+        s->done_head = j;
+    s->done_tail = j;
+    pthread_mutex_unlock(&s->mu);
+    uv_async_send(&s->done_async);
+}
+
+/* A world's tick or render at a yield point (lpv_engine_set_yield): the
+ * queued jobs of other worlds run here, each in its own world's context, for
+ * up to SV_GL_YIELD_MS; then the paused job's context is current again.
+ * Returns nonzero when the paused job is a tick nobody wants any more
+ * (sv_gl_cancel): the engine abandons it. */
+static int gl_yield(void *arg)
+{
+    sv_job *paused = arg;
+    sv_world *w = paused->world;
+    sv_server *s = w->srv;
+    const double t0 = wall_ms();
+    /* what the paused world's settings hold counts against the others' caps now */
+    if (w->engine)
+        note_world_bytes(w, lpv_engine_memory_bytes(w->engine));
+    for (int ran = 0;; ran = 1) {
+        pthread_mutex_lock(&s->mu);
+        sv_job *j = s->gl_depth < SV_GL_MAX_DEPTH && (!ran || wall_ms() - t0 < SV_GL_YIELD_MS)
+                        ? take_next_locked(s, 1)
+                        : NULL;
+        if (j)
+            s->gl_jobs_between++;
+        pthread_mutex_unlock(&s->mu);
+        if (!j)
+            break;
+        run_job(s, j);
+        lpv_gl_context_make_current(w->gl_ctx);
+    }
+    paused->yielded_ms += wall_ms() - t0;
+    pthread_mutex_lock(&s->mu);
+    const int stop = paused->kind == SV_JOB_TICK && paused->cancelled;
+    pthread_mutex_unlock(&s->mu);
+    return stop;
+}
+
 static void *gl_main(void *arg)
 {
     sv_server *s = arg;
@@ -343,64 +459,34 @@ static void *gl_main(void *arg)
     snprintf(s->gl_backend, sizeof s->gl_backend, "%s", lpv_backend_name(lpv_gl_context_backend(ctx)));
     snprintf(s->gl_renderer, sizeof s->gl_renderer, "%s", lpv_gl_context_renderer(ctx));
     lpv_memory_limits_query(&s->gl_limits);
-    s->worlds_budget = s->cfg.max_memory ? s->cfg.max_memory : s->gl_limits.budget;
-    if (s->cfg.max_memory)
-        snprintf(s->worlds_budget_source, sizeof s->worlds_budget_source, "--max-memory %llu",
-                 (unsigned long long)s->cfg.max_memory);
-    else
-        snprintf(s->worlds_budget_source, sizeof s->worlds_budget_source, "%.2f GB, the device's budget",
-                 (double)s->gl_limits.budget / 1e9);
     /* what one world can ever hold (CONFIG's floor check, --max-grid): the
-     * least of the device's budget, --max-world-memory and all worlds' */
+     * least of the device's budget, --max-world-memory and the daemon's
+     * budget less the room kept for one message */
     if (s->cfg.max_world_memory && s->cfg.max_world_memory < s->gl_limits.budget) {
         s->gl_limits.budget = s->cfg.max_world_memory;
         snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "--max-world-memory %llu",
                  (unsigned long long)s->cfg.max_world_memory);
     }
-    if (s->worlds_budget < s->gl_limits.budget) {
-        s->gl_limits.budget = s->worlds_budget;
-        snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "%s", s->worlds_budget_source);
+    const uint64_t daemon = s->mem.budget - s->mem.headroom;
+    if (daemon < s->gl_limits.budget) {
+        s->gl_limits.budget = daemon;
+        snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "%s less --max-message",
+                 s->mem.source);
     }
     s->gl_ready = 1;
     pthread_cond_broadcast(&s->cv);
     for (;;) {
         while (!s->jobs_head)
             pthread_cond_wait(&s->cv, &s->mu);
-        sv_job *j = take_next_locked(s);
-        j->started = 1; /* from now on no request joins it (sv_world_join_tick) */
-        int cancelled = j->cancelled;
-        pthread_mutex_unlock(&s->mu);
-
-        int quit = 0;
-        if (cancelled) { /* nobody wants it any more (sv_gl_cancel): no GL time */
-            j->status = LPVP_E_INTERNAL;
-            snprintf(j->err, sizeof j->err, "cancelled: every request for it is gone");
-        } else switch (j->kind) {
-        case SV_JOB_TICK: gl_tick(s, j); break;
-        case SV_JOB_RENDER: gl_render(j); break;
-        case SV_JOB_QUERY: gl_query(j); break;
-        case SV_JOB_DESTROY:
-            lpv_engine_destroy(j->world->engine);
-            j->world->engine = NULL;
-            note_world_bytes(j->world, 0);
-            malloc_trim(0); /* the heap's free pages back to the system (serve.c, mallopt) */
-            break;
-        case SV_JOB_QUIT: quit = 1; break;
-        }
-
-        pthread_mutex_lock(&s->mu);
-        if (quit) {
+        sv_job *j = take_next_locked(s, 0); /* no world is busy here: never NULL */
+        if (!j)
+            continue;
+        if (j->kind == SV_JOB_QUIT) {
             free(j);
             break;
         }
-        j->next = NULL;
-        if (s->done_tail)
-            s->done_tail->next = j;
-        else
-            s->done_head = j;
-        s->done_tail = j;
         pthread_mutex_unlock(&s->mu);
-        uv_async_send(&s->done_async);
+        run_job(s, j);
         pthread_mutex_lock(&s->mu);
     }
     pthread_mutex_unlock(&s->mu);

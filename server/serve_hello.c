@@ -73,7 +73,7 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
     if (lim) {
         json_object_set_new(lim, "max_request_memory", json_integer((json_int_t)s->cfg.max_request_memory));
         json_object_set_new(lim, "max_query_points", json_integer((json_int_t)sv_max_query_points(&s->cfg)));
-        json_object_set_new(lim, "max_memory", json_integer((json_int_t)s->worlds_budget));
+        json_object_set_new(lim, "max_memory", json_integer((json_int_t)s->mem.budget));
         json_object_set_new(lim, "max_tick_ms", json_real(s->cfg.max_tick_ms));
     }
     if (lim) { /* the per-scene budgets (R4.5) */

@@ -50,12 +50,16 @@ typedef struct sv_wreq {
     uint8_t *att;
     size_t att_len;
     int stream;
+    sv_memory *mem;   /* the daemon's budget, once the frame counts in its replies' term */
+    uint64_t counted;
 } sv_wreq;
 
 static void wreq_free(sv_wreq *w)
 {
     if (!w)
         return;
+    if (w->mem)
+        sv_memory_sub(w->mem, SV_MEM_REPLIES, w->counted);
     free(w->head);
     free(w->att);
     free(w);
@@ -252,6 +256,23 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
         sv_conn_close(c);
         return -1;
     }
+    const size_t bytes = w->head_len + w->att_len;
+    if (type != LPVP_ERROR && type != LPVP_BYE_REPLY && !sv_memory_fits(&c->srv->mem, SV_MEM_REPLIES, bytes)) {
+        /* R7.6a: over the daemon's budget. A stream message is dropped, as
+         * one a newer replaces would be; a reply becomes an ERROR */
+        wreq_free(w);
+        if (stream != SV_STREAM_NONE) {
+            c->stream_dropped++;
+            return 0;
+        }
+        char budget[320];
+        sv_memory_describe(&c->srv->mem, budget, sizeof budget);
+        return sv_send_error(c, request_id, LPVP_E_LIMIT, "the %s reply is %zu bytes; %s: not sent",
+                             lpvp_type_name((uint16_t)(type & ~LPVP_REPLY_BIT)), bytes, budget);
+    }
+    w->mem = &c->srv->mem;
+    w->counted = bytes;
+    sv_memory_add(w->mem, SV_MEM_REPLIES, bytes);
     if (stream != SV_STREAM_NONE) {
         if (c->stream_inflight[stream]) { /* R5.5: newest replaces the unsent one */
             if (c->stream_pending[stream])
@@ -364,7 +385,8 @@ static int enqueue_frame(sv_conn *c, const lpvp_frame *f)
     c->pending_count++;
     c->pending_bytes += r->json_len + r->att_len;
     /* the reservation, if the frame had one, becomes the pending request */
-    c->srv->request_bytes += r->json_len + r->att_len - c->reserved;
+    sv_memory_add(&c->srv->mem, SV_MEM_REQUESTS, r->json_len + r->att_len);
+    sv_memory_sub(&c->srv->mem, SV_MEM_REQUESTS, c->reserved);
     c->reserved = 0;
     c->reserve_shrunk = 0;
     return 0;
@@ -379,13 +401,17 @@ static int reserve_frame(sv_conn *c)
     if (need == 0 || (c->reserved && !c->reserve_shrunk))
         return 0;
     const uint64_t more = need > c->reserved ? need - c->reserved : 0; /* a shrunk one holds what arrived */
-    if (s->request_bytes + more > s->cfg.max_request_memory)
+    /* within --max-request-memory and the daemon's budget, whose other terms
+     * always leave one --max-message free (serve_memory.h): so a frame waits
+     * only for requests before it to be handled */
+    if (sv_memory_held(&s->mem, SV_MEM_REQUESTS) + more > s->cfg.max_request_memory ||
+        !sv_memory_fits(&s->mem, SV_MEM_REQUESTS, more))
         return 1;
     if (!c->reserved)
         c->payload_ms = sv_now_ms();
     c->reserved = need;
     c->reserve_shrunk = 0;
-    s->request_bytes += more;
+    sv_memory_add(&s->mem, SV_MEM_REQUESTS, more);
     return 0;
 }
 
@@ -409,7 +435,8 @@ static void release_request_bytes(sv_conn *c, uint64_t bytes)
     sv_server *s = c->srv;
     if (bytes == 0) /* nothing freed, nobody newly fits (every close comes here: keep it cheap under a flood) */
         return;
-    s->request_bytes -= bytes < s->request_bytes ? bytes : s->request_bytes;
+    const uint64_t held = sv_memory_held(&s->mem, SV_MEM_REQUESTS);
+    sv_memory_sub(&s->mem, SV_MEM_REQUESTS, bytes < held ? bytes : held);
     /* first come, first served: a big frame waiting is not overtaken by smaller ones behind it */
     for (;;) {
         sv_conn *first = NULL;

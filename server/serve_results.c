@@ -262,12 +262,25 @@ void sv_do_stats(sv_conn *c, sv_request *r)
         (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
         "revision", (json_int_t)c->revision);
     /* R7.5: request bytes held for all connections, against --max-request-memory */
-    json_object_set_new(json_object_get(b, "queues"), "request_bytes", json_integer((json_int_t)s->request_bytes));
+    json_object_set_new(json_object_get(b, "queues"), "request_bytes",
+                        json_integer((json_int_t)sv_memory_held(&s->mem, SV_MEM_REQUESTS)));
+    /* R7.6a: the daemon's one budget and what each term holds */
+    json_t *mem = json_pack("{s:I}", "budget", (json_int_t)s->mem.budget);
+    for (int t = 0; mem && t < SV_MEM_TERMS; ++t)
+        json_object_set_new(mem, sv_mem_term_name((sv_mem_term)t),
+                            json_integer((json_int_t)sv_memory_held(&s->mem, (sv_mem_term)t)));
+    if (mem)
+        json_object_set_new(b, "memory", mem);
     /* tick coalescing (R7.2): computed ticks vs TICK requests answered by a tick queued for another */
     json_object_set_new(b, "ticks_computed", json_integer((json_int_t)s->ticks));
     json_object_set_new(b, "ticks_coalesced", json_integer((json_int_t)s->ticks_coalesced));
-    /* fair GL time: queued ticks skipped because every request for them had gone */
+    /* fair GL time: ticks skipped or abandoned because every request for them
+     * had gone; jobs run at another world's yield point (serve_gl.c) */
     json_object_set_new(b, "ticks_cancelled", json_integer((json_int_t)s->ticks_cancelled));
+    pthread_mutex_lock(&s->mu);
+    const uint64_t between = s->gl_jobs_between;
+    pthread_mutex_unlock(&s->mu);
+    json_object_set_new(b, "gl_jobs_between", json_integer((json_int_t)between));
     json_object_set_new(b, "world_ticks_computed", json_integer((json_int_t)(c->world ? c->world->ticks_computed : 0)));
     json_object_set_new(b, "world_ticks_coalesced",
                         json_integer((json_int_t)(c->world ? c->world->ticks_coalesced : 0)));

@@ -59,7 +59,7 @@ void sv_scene_unref(sv_server *s, sv_scene *sc)
         }
     if (s->builtin == sc)
         s->builtin = NULL;
-    s->scenes_bytes -= sc->bytes;
+    sv_memory_sub(&s->mem, SV_MEM_SCENES, sc->bytes);
     lpv_scene_free(&sc->scene);
     free(sc->glb);
     free(sc->base_dir);
@@ -82,13 +82,23 @@ static sv_scene *scene_equal(sv_server *s, const sv_scene *sc)
 
 int sv_scene_fits(sv_server *s, const sv_scene *sc, char *err, size_t n)
 {
-    if (scene_equal(s, sc) || s->scenes_bytes + sc->bytes <= s->cfg.max_scenes_memory)
+    if (scene_equal(s, sc))
         return 1;
-    snprintf(err, n, "the scene needs %llu bytes; the server's scenes take %llu of the %llu bytes all scenes may "
-             "take together (--max-scenes-memory): try again when sessions have let theirs go",
-             (unsigned long long)sc->bytes, (unsigned long long)s->scenes_bytes,
-             (unsigned long long)s->cfg.max_scenes_memory);
-    return 0;
+    const uint64_t held = sv_memory_held(&s->mem, SV_MEM_SCENES);
+    if (held + sc->bytes > s->cfg.max_scenes_memory) {
+        snprintf(err, n, "the scene needs %llu bytes; the server's scenes take %llu of the %llu bytes all scenes may "
+                 "take together (--max-scenes-memory): try again when sessions have let theirs go",
+                 (unsigned long long)sc->bytes, (unsigned long long)held, (unsigned long long)s->cfg.max_scenes_memory);
+        return 0;
+    }
+    if (!sv_memory_fits(&s->mem, SV_MEM_SCENES, sc->bytes)) { /* R7.6a */
+        char budget[320];
+        sv_memory_describe(&s->mem, budget, sizeof budget);
+        snprintf(err, n, "the scene needs %llu bytes; %s: try again when sessions have let theirs go",
+                 (unsigned long long)sc->bytes, budget);
+        return 0;
+    }
+    return 1;
 }
 
 sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc)
@@ -107,7 +117,7 @@ sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc)
     sc->refs = 1;
     sc->next = s->scenes;
     s->scenes = sc;
-    s->scenes_bytes += sc->bytes;
+    sv_memory_add(&s->mem, SV_MEM_SCENES, sc->bytes);
     return sc;
 }
 

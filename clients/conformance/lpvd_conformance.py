@@ -2733,6 +2733,24 @@ def c_stats(ctx):
     return "clients %r, worlds %r, ticks %r" % (f.body["clients"], f.body["worlds"], f.body["ticks"])
 
 
+@case("R7.6a", "STATS memory: the budget is HELLO's limits.max_memory and its parts, after a tick, fit in it")
+def c_stats_memory(ctx):
+    c, _, _ = ctx.scene_session()
+    budget = (ctx.limits or {}).get("max_memory")
+    check(isinstance(budget, int) and not isinstance(budget, bool) and budget > 0,
+          "HELLO limits.max_memory is %r, expected a positive integer" % (budget,))
+    m = expect_reply(c.request(STATS, {}), STATS).body.get("memory")
+    check(isinstance(m, dict), "STATS has no memory object: %r" % (m,))
+    parts = ("worlds", "scenes", "requests", "replies")
+    bad = [k for k in parts if not isinstance(m.get(k), int) or isinstance(m.get(k), bool) or m.get(k) < 0]
+    check(not bad, "STATS memory parts %r are not non-negative integers: %r" % (bad, m))
+    check(m.get("budget") == budget, "STATS memory.budget %r, HELLO limits.max_memory %r" % (m.get("budget"), budget))
+    total = sum(m[k] for k in parts)
+    check(total <= budget, "the parts hold %d bytes, over the budget of %d" % (total, budget))
+    check(m["worlds"] > 0, "a world has ticked but memory.worlds is 0")
+    return "%s of %d bytes" % (", ".join("%s %d" % (k, m[k]) for k in parts), budget)
+
+
 @case("R8.1 R8.2 R5.6", "the tick plan (every pass named, run + reason) is in STATS, the TICK reply, "
       "GET_VOLUME and GET_FRAME; STATS lists the cascades as the volume does")
 def c_plan(ctx):
