@@ -29,6 +29,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(HERE), "tests", "reliability"))
 from rel_common import harness, lc, hello, ok  # noqa: E402
 
 HEAVY = {"technique": "lpv", "grid": [36, 36, 36]}
+FRAME = None  # --heavy-frame WxH: the heavy clients also fetch a frame of that size each loop
 
 
 def pct(v, p):
@@ -40,6 +41,9 @@ def heavy(ep, i, stop, out):
     c = lc.Conn(ep, timeout=600)
     hello(c)
     ok(c.request(lc.CONFIG, HEAVY, timeout=600), lc.CONFIG)
+    if FRAME:
+        ok(c.request(lc.CAMERA_SET, {"eye": [0.0, 1.0, 3.5], "target": [0.0, 1.0, 0.0], "width": FRAME[0],
+                                     "height": FRAME[1]}, timeout=60), lc.CAMERA_SET)
     ticks, limits, ms = 0, 0, []
     k = 0
     while not stop.is_set():
@@ -48,6 +52,9 @@ def heavy(ep, i, stop, out):
                                     "position": [0.05 * (k % 7), 1.0, 0.1 * i]}, timeout=60), lc.LIGHT_SET)
         t0 = time.monotonic()
         f = c.request(lc.TICK, {}, timeout=600)
+        if f.type == (lc.TICK | lc.REPLY) and FRAME:  # and a frame rendered for it (a render job)
+            f = c.request(lc.GET_FRAME, {"format": "rgba8"}, timeout=600)
+            f = f if f.type == lc.ERROR else lc.Frame(lc.TICK | lc.REPLY, f.rid, {}, b"", b"")
         if f.type == (lc.TICK | lc.REPLY):
             ticks += 1
             ms.append((time.monotonic() - t0) * 1000.0)
@@ -91,10 +98,15 @@ def main():
     ap.add_argument("--lpvd", required=True)
     ap.add_argument("--vs", help="a second lpvd binary, run the same way after the first")
     ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--heavy-frame", help="WxH: the heavy clients set a camera of that size and fetch a frame "
+                                          "after each tick (a render job on the GL thread)")
     ap.add_argument("--heavy", help="the heavy clients' CONFIG as JSON (default %s)" % json.dumps(HEAVY))
     ap.add_argument("--max-tick-ms", action="append", default=[],
                     help="also run --lpvd with this --max-tick-ms (repeatable)")
     a = ap.parse_args()
+    if a.heavy_frame:
+        global FRAME
+        FRAME = tuple(int(v) for v in a.heavy_frame.lower().split("x"))
     if a.heavy:
         HEAVY.clear()
         HEAVY.update(json.loads(a.heavy))

@@ -235,6 +235,9 @@ static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms te
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
 }
 
+/* Pixels per dispatch of the frame's shading: 1024 rows of 512. */
+#define LPV_SHADE_BAND_PIXELS ((size_t)1 << 19)
+
 /* The frame (shading.glsl) as a compute pass writing the frame texture: on
  * llvmpipe it costs what the full-screen triangle did, and on a GPU whose
  * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
@@ -292,7 +295,20 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
         start_list(e->area_rest, LPV_SSBO_AREA_REST);
     use_shading_program(e, prog, terms);
     glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
+    /* in bands of about LPV_SHADE_BAND_PIXELS, a yield point between them
+     * (timer.h): a large view's one dispatch took seconds on llvmpipe; the
+     * pixels are independent, so the frame is the same */
+    const GLint loc_row = glGetUniformLocation(prog, "u_row_first");
+    int rows = (int)(LPV_SHADE_BAND_PIXELS / (size_t)(e->gbuf_w > 0 ? e->gbuf_w : 1));
+    rows = rows < LPV_WG_2D ? LPV_WG_2D : rows / LPV_WG_2D * LPV_WG_2D;
+    for (int y = 0; y < e->gbuf_h;) {
+        const int n = e->gbuf_h - y < rows ? e->gbuf_h - y : rows;
+        glUniform1i(loc_row, y);
+        glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)n, LPV_WG_2D), 1);
+        y += n;
+        if (y < e->gbuf_h)
+            lpv_timer_yield(&e->timer);
+    }
     /* the listed pixels' indirect light, then their area light */
     if (split)
         run_list(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, e->shade_rest, terms);
