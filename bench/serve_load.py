@@ -11,7 +11,9 @@ zstd) and a one-point QUERY_IRRADIANCE:
             recomputed every tick.
 Reported per run: clients admitted, errors, and for each request its p50
 and p99 round trip (the issue's bar for the shared case: p99 <= 3 x p50),
-and the daemon's VmRSS before the first run and after each.
+and the daemon's VmRSS before the first run and after each; at the end also
+its anonymous and file-backed parts (RssAnon; RssFile: the GL driver's and
+LLVM's code, paged in at the first tick, and the shader cache's index).
 
     python3 bench/serve_load.py --lpvd build/server/lpvd [--clients 50] [--seconds 60]
 """
@@ -92,6 +94,17 @@ def run(d, mode, clients, seconds, glb):
     return admitted, errors, stats
 
 
+def rss_parts(pid):
+    """(RssAnon, RssFile + RssShmem) in KiB: what the daemon allocated, and the pages of files it maps."""
+    v = {}
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            k, _, rest = line.partition(":")
+            if k in ("RssAnon", "RssFile", "RssShmem"):
+                v[k] = int(rest.split()[0])
+    return v.get("RssAnon", 0), v.get("RssFile", 0) + v.get("RssShmem", 0)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--lpvd", required=True)
@@ -102,6 +115,7 @@ def main():
     with harness.Daemon(os.path.abspath(a.lpvd), tcp=True, token=True, quiet=True) as d:
         time.sleep(0.5)
         rss0 = d.rss_kib()
+        parts0 = rss_parts(d.proc.pid)
         print("VmRSS before: %.1f MiB" % (rss0 / 1024.0), flush=True)
         print("| run | admitted | errors | TICK n / p50 / p99 ms | GET_VOLUME n / p50 / p99 ms | "
               "QUERY n / p50 / p99 ms | VmRSS after MiB |")
@@ -116,6 +130,11 @@ def main():
                 print("  error: %s" % e)
         print("VmRSS after both: %.1f MiB (%+.1f %% of before)" %
               (d.rss_kib() / 1024.0, 100.0 * (d.rss_kib() - rss0) / rss0))
+        parts1 = rss_parts(d.proc.pid)
+        print("of which: anonymous %.1f -> %.1f MiB (%+.1f %%), file-backed (library code paged in, the shader "
+              "cache's index) %.1f -> %.1f MiB" % (parts0[0] / 1024.0, parts1[0] / 1024.0,
+                                                  100.0 * (parts1[0] - parts0[0]) / parts0[0],
+                                                  parts0[1] / 1024.0, parts1[1] / 1024.0))
     return 0
 
 
