@@ -441,6 +441,51 @@ static int gl_yield(void *arg)
     return stop;
 }
 
+/* One tick and one small frame of the built-in box at the daemon's default
+ * settings, in the daemon's own context, before the first client: a GL that
+ * cannot build or run lpvd's passes fails the start with the reason, not
+ * every client's TICK with INTERNAL. */
+static int self_test(sv_server *s, char *err, size_t n)
+{
+    lpv_scene box;
+    if (lpv_scene_builtin_cornell(&box) != 0) {
+        snprintf(err, n, "self-test: cannot build the built-in box");
+        return -1;
+    }
+    enum { W = 64, H = 48 };
+    lpv_view view;
+    lpv_view_frame_bounds(&box, W, H, &view);
+    char why[512] = "";
+    /* a context of its own, like a world's: what the driver keeps for a
+     * context's programs goes with it (in the daemon's context, 88 MiB stayed) */
+    lpv_gl_context_desc desc = {.backend = lpv_gl_context_backend(s->gl_ctx)};
+    lpv_gl_context *ctx = lpv_gl_context_create(&desc, why, sizeof why);
+    float *rgba = ctx ? malloc(sizeof(float) * 4 * W * H) : NULL;
+    lpv_engine *e = rgba ? lpv_engine_create(why, sizeof why) : NULL;
+    int rc = !e || lpv_engine_set_settings(e, &s->cfg.settings, why, sizeof why) != 0 ||
+                     lpv_engine_set_scene(e, &box, why, sizeof why) != 0 ||
+                     lpv_engine_set_view(e, &view, why, sizeof why) != 0 ||
+                     lpv_engine_tick(e, why, sizeof why) != 0 ||
+                     lpv_engine_render(e, LPV_TERMS_FULL, rgba, why, sizeof why) != 0
+                 ? -1
+                 : 0;
+    if (rc != 0 && strstr(why, LPV_MEMORY_REFUSED)) { /* the GL works; its memory is small for the defaults */
+        fprintf(stderr, "lpvd serve: warning: the built-in box at the default settings does not fit this GL's "
+                        "memory (%s); clients need smaller settings\n", why);
+        rc = 0;
+    } else if (rc != 0) {
+        snprintf(err, n, "the GL (%s) cannot run lpvd's passes on the built-in box at the default settings: %s",
+                 s->gl_renderer, why[0] ? why : "out of memory");
+    }
+    lpv_engine_destroy(e);
+    lpv_gl_context_destroy(ctx);
+    lpv_gl_context_make_current(s->gl_ctx);
+    free(rgba);
+    lpv_scene_free(&box);
+    malloc_trim(0);
+    return rc;
+}
+
 static void *gl_main(void *arg)
 {
     sv_server *s = arg;
@@ -449,7 +494,7 @@ static void *gl_main(void *arg)
     lpv_gl_context *ctx = lpv_gl_context_create(&desc, err, sizeof err);
     pthread_mutex_lock(&s->mu);
     if (!ctx) {
-        snprintf(s->gl_err, sizeof s->gl_err, "%s", err);
+        snprintf(s->gl_err, sizeof s->gl_err, "no OpenGL 4.5 context: %s", err);
         s->gl_ready = -1;
         pthread_cond_broadcast(&s->cv);
         pthread_mutex_unlock(&s->mu);
@@ -472,6 +517,16 @@ static void *gl_main(void *arg)
         s->gl_limits.budget = daemon;
         snprintf(s->gl_limits.budget_source, sizeof s->gl_limits.budget_source, "%s less --max-message",
                  s->mem.source);
+    }
+    /* mu is held: the loop waits for gl_ready, nothing else runs yet */
+    if (self_test(s, err, sizeof err) != 0) {
+        snprintf(s->gl_err, sizeof s->gl_err, "%s", err);
+        s->gl_ready = -1;
+        pthread_cond_broadcast(&s->cv);
+        pthread_mutex_unlock(&s->mu);
+        lpv_gl_context_destroy(ctx);
+        s->gl_ctx = NULL;
+        return NULL;
     }
     s->gl_ready = 1;
     pthread_cond_broadcast(&s->cv);
@@ -514,7 +569,7 @@ int sv_gl_start(sv_server *s, char *err, size_t n)
     if (s->gl_ready < 0) {
         pthread_join(s->gl_thread, NULL);
         s->gl_started = 0;
-        snprintf(err, n, "no OpenGL 4.5 context: %s", s->gl_err);
+        snprintf(err, n, "%s", s->gl_err);
         return -1;
     }
     return 0;
