@@ -224,6 +224,13 @@ class Daemon:
                     return int(line.split()[1])
         return 0
 
+    def reset_peak(self):
+        """Sets VmHWM back to the RSS now (proc(5): clear_refs "5"), so a peak read later is that of what
+        follows: the start's self-test (serve_gl.c) leaves VmHWM well above the RSS at rest, which
+        would hide any growth smaller than that."""
+        with open("/proc/%d/clear_refs" % self.pid, "w") as fh:
+            fh.write("5")
+
     def fd_count(self):
         return len(os.listdir("/proc/%d/fd" % self.pid))
 

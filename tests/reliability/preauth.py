@@ -96,6 +96,7 @@ def case_memory(rep, lpvd):
         hello(c0, d.token)
         c0.close()
         time.sleep(0.5)
+        d.reset_peak()
         base = hwm_kib(d)
         rss0 = d.rss_kib()
         threads = []

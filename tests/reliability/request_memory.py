@@ -65,6 +65,7 @@ def main():
             conns.append(c)
         time.sleep(0.5)
         base = status_kib(d.pid, "VmRSS")
+        d.reset_peak()
         att = b"\0" * (MAX_MESSAGE - 64)  # json + attachment within --max-message
         frames = [lc.encode_frame(lc.STATS, 1000 + i, {}, att) for i in range(CLIENTS)]
         errors = []

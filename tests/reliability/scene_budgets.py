@@ -104,6 +104,7 @@ def main():
         rep.check(lim.get("max_scene_texels") == 64 << 20 and lim.get("max_scene_bytes") == 2 << 30,
                   "HELLO limits: max_scene_texels 67108864, max_scene_bytes 2147483648", json.dumps(lim))
         big = png(8192, 8192)
+        d.reset_peak()
         before = peak_kib(d)
         expect(rep, c, textured_glb([big, big]), "LIMIT", ["--max-scene-texels", "134217728", "67108864"],
                "two all-zero 8192x8192 PNGs (%d KB each)" % (len(big) // 1024))
@@ -121,6 +122,7 @@ def main():
                             "png-stored-block-2gib")
         with open(seed, "rb") as fh:
             bogus = fh.read()
+        d.reset_peak()
         before = peak_kib(d)
         expect(rep, c, textured_glb([bogus]), "SCENE_INVALID", ["image 0"], "a 1x8 PNG whose zlib block claims 2 GiB")
         rise_mb = (peak_kib(d) - before) / 1024.0
