@@ -497,7 +497,7 @@ struct sv_server {
     uint64_t gl_jobs_between; /* jobs run at another world's yield point (STATS) */
     sv_job *done_head, *done_tail;
     int gl_ready;           /* 1 ok, -1 failed */
-    char gl_err[1024];
+    char gl_err[1100];      /* "no OpenGL 4.5 context: " + the backends' reasons (1024) */
     char gl_backend[32];
     char gl_renderer[256];
     lpv_gl_context *gl_ctx;
