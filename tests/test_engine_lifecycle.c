@@ -1,9 +1,10 @@
 /*
  * test_engine_lifecycle.c - an engine that goes away leaves no GL object
- * behind (issue 31, item 1): the daemon runs every world's engine in one GL
- * context for months, so a texture, buffer, framebuffer or program an engine
- * forgets stays in that context for good (a world that ticked with a light
- * kept 20-26 MiB after it went away).
+ * behind (issue 31, item 1): `lpvd batch` runs scene after scene in one GL
+ * context, and the daemon ran every world's engine in one for months (now
+ * each world has its own, destroyed with it), so a texture, buffer,
+ * framebuffer or program an engine forgets stays in its context for good (a
+ * world that ticked with a light kept 20-26 MiB after it went away).
  *
  * The census counts the live names of every GL object type that has a glIs*
  * query, over the first LPVT_NAMES names of each (Mesa hands out the lowest
