@@ -183,9 +183,9 @@ static void set_world_cap(sv_world *w)
     const uint64_t room = sv_memory_room(&s->mem, SV_MEM_WORLDS); /* for all worlds together */
     const uint64_t others = sv_memory_held(&s->mem, SV_MEM_WORLDS) - w->gl_mem_bytes;
     const uint64_t left = room > others ? room - others : 0;
-    char cap[400];
+    char cap[SV_MEMORY_DESCRIBE_SIZE + 64];
     if (left < s->cfg.max_world_memory) {
-        char held[320];
+        char held[SV_MEMORY_DESCRIBE_SIZE];
         sv_memory_describe(&s->mem, held, sizeof held);
         snprintf(cap, sizeof cap, "%s; this world holds %.3f GB of that", held, (double)w->gl_mem_bytes / 1e9);
         lpv_engine_set_memory_cap(w->engine, left, cap);

@@ -57,7 +57,9 @@ int sv_memory_fits(const sv_memory *m, sv_mem_term t, uint64_t more);
 uint64_t sv_memory_room(const sv_memory *m, sv_mem_term t);
 
 /* "the daemon's memory budget (--max-memory N): worlds 1.2 GB, scenes ...,
- * requests ..., replies ..." for refusals. */
+ * requests ..., replies ..." for refusals; a buffer of
+ * SV_MEMORY_DESCRIBE_SIZE holds it whole (the source is at most 95 bytes). */
+#define SV_MEMORY_DESCRIBE_SIZE 384
 void sv_memory_describe(const sv_memory *m, char *buf, size_t size);
 
 const char *sv_mem_term_name(sv_mem_term t);

@@ -265,7 +265,7 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
             c->stream_dropped++;
             return 0;
         }
-        char budget[320];
+        char budget[SV_MEMORY_DESCRIBE_SIZE];
         sv_memory_describe(&c->srv->mem, budget, sizeof budget);
         return sv_send_error(c, request_id, LPVP_E_LIMIT, "the %s reply is %zu bytes; %s: not sent",
                              lpvp_type_name((uint16_t)(type & ~LPVP_REPLY_BIT)), bytes, budget);

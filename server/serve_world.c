@@ -92,7 +92,7 @@ int sv_scene_fits(sv_server *s, const sv_scene *sc, char *err, size_t n)
         return 0;
     }
     if (!sv_memory_fits(&s->mem, SV_MEM_SCENES, sc->bytes)) { /* R7.6a */
-        char budget[320];
+        char budget[SV_MEMORY_DESCRIBE_SIZE];
         sv_memory_describe(&s->mem, budget, sizeof budget);
         snprintf(err, n, "the scene needs %llu bytes; %s: try again when sessions have let theirs go",
                  (unsigned long long)sc->bytes, budget);

@@ -57,7 +57,7 @@ static void test_terms_share_one_budget(void **state)
     assert_false(sv_memory_fits(&m, SV_MEM_REPLIES, 1));
     assert_int_equal(sv_memory_total(&m), 400 * MB);
     /* described for refusals: each term and the budget's source */
-    char d[320];
+    char d[SV_MEMORY_DESCRIBE_SIZE];
     sv_memory_describe(&m, d, sizeof d);
     assert_non_null(strstr(d, "--max-memory 500000000"));
     assert_non_null(strstr(d, "worlds 0.300 GB"));
