@@ -256,6 +256,14 @@ static void set_lights(lpv_engine *e, const lpv_scene *scene)
 
 int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_t err_size)
 {
+    /* nothing to light or see: a frame of background and exit 0 would pass
+     * for a render (issue 32); the file's loader has said what it dropped */
+    size_t triangles = 0;
+    for (uint32_t d = 0; d < scene->draw_count; ++d)
+        triangles += scene->draws[d].index_count / 3;
+    if (!triangles)
+        return lpv_error(err, err_size, "%s: no triangles to draw (a scene needs a surface; points and lines carry "
+                         "none)", scene->source);
     uint64_t sig = geometry_signature(scene);
     e->shadow_valid = 0;
     e->ticked = 0;

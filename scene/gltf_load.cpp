@@ -85,6 +85,7 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
         fail_budget(ctx);
     size_t json_off = 0, json_len = size;
     const bool is_glb = check_container(data, size, &json_off, &json_len);
+    check_schema_types(reinterpret_cast<const char *>(data) + json_off, json_len, ctx);
 
     tinygltf::TinyGLTF loader;
     set_fs_callbacks(loader, &ctx);

@@ -771,6 +771,79 @@ static void test_glb_header_lies(void **state)
     free(g);
 }
 
+/* The glTF 2.0 schema's JSON types of the fields lpvd reads (issue 32,
+ * scene/gltf_schema.cpp): a wrong one is refused with its JSON path, where
+ * tinygltf skipped it and loaded the rest (a mesh without primitives, a
+ * material without its texture); a name that is not a string only warns. */
+static void test_schema_types(void **state)
+{
+    (void)state;
+    bin b;
+    tri_bin(&b);
+    static const char *const T = "{'asset':{'version':'2.0'},'buffers':[{'byteLength':36}],"
+                                 "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                                 "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],";
+    const struct {
+        const char *name, *rest, *words;
+    } bad[] = {
+        {"prim-object.glb", "'meshes':[{'primitives':{'attributes':{'POSITION':0}}}],'nodes':[{'mesh':0}],"
+                            "'scenes':[{'nodes':[0]}],'scene':0}",
+         "meshes[0].primitives: expected an array, found an object"},
+        {"attr-string.glb", "'meshes':[{'primitives':[{'attributes':{'POSITION':'0'}}]}],'nodes':[{'mesh':0}],"
+                            "'scenes':[{'nodes':[0]}],'scene':0}",
+         "meshes[0].primitives[0].attributes.POSITION: expected an index (an integer >= 0), found a string"},
+        {"mesh-negative.glb", "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],'nodes':[{'mesh':-1}],"
+                              "'scenes':[{'nodes':[0]}],'scene':0}",
+         "nodes[0].mesh: expected an index (an integer >= 0), found a negative integer"},
+        {"mesh-half.glb", "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],'nodes':[{'mesh':0.5}],"
+                          "'scenes':[{'nodes':[0]}],'scene':0}",
+         "nodes[0].mesh: expected an index (an integer >= 0), found a fractional number"},
+        /* tinygltf reads 0.0 as no index at all: the mesh would have no vertices */
+        {"position-float.glb", "'meshes':[{'primitives':[{'attributes':{'POSITION':0.0}}]}],'nodes':[{'mesh':0}],"
+                               "'scenes':[{'nodes':[0]}],'scene':0}",
+         "attributes.POSITION: expected an index (an integer >= 0), found a number with a decimal point"},
+        {"pbr-array.glb", "'materials':[{'pbrMetallicRoughness':['x']}],"
+                          "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'material':0}]}],"
+                          "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}],'scene':0}",
+         "materials[0].pbrMetallicRoughness: expected an object, found an array"},
+        {"factor-string.glb", "'materials':[{'emissiveFactor':[1,'1',1]}],"
+                              "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'material':0}]}],"
+                              "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}],'scene':0}",
+         "materials[0].emissiveFactor[1]: expected a number, found a string"},
+        {"matrix-null.glb", "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                            "'nodes':[{'mesh':0,'matrix':null}],'scenes':[{'nodes':[0]}],'scene':0}",
+         "nodes[0].matrix: expected an array, found null"},
+        {"light-type.glb", "'extensions':{'KHR_lights_punctual':{'lights':[{'type':1}]}},"
+                           "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],'nodes':[{'mesh':0}],"
+                           "'scenes':[{'nodes':[0]}],'scene':0}",
+         "extensions.KHR_lights_punctual.lights[0].type: expected a string, found an integer"},
+        {"top-array.glb", "'meshes':{},'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}],'scene':0}",
+         "meshes: expected an array, found an object"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i)
+        expect_fail_glb(bad[i].name, J("%s%s", T, bad[i].rest), &b, bad[i].words);
+
+    /* fine: free-form extras and unknown extensions with any types; a name
+     * that is a number is a warning */
+    char path[512];
+    write_glb(path, "schema-ok.glb",
+              J("%s%s", T,
+                "'meshes':[{'name':7,'primitives':[{'attributes':{'POSITION':0},'extras':{'mode':'x'}}]}],"
+                "'nodes':[{'mesh':0,'extensions':{'EXT_unknown':{'light':'x'}}}],'scenes':[{'nodes':[0]}],"
+                "'scene':0}"),
+              &b);
+    lpv_scene s;
+    lpv_gltf_warnings w;
+    char err[512] = "";
+    assert_int_equal(lpv_gltf_load_file_w(path, &s, &w, err, sizeof err), 0);
+    assert_int_equal(s.index_count, 3);
+    int named = 0;
+    for (int i = 0; i < w.count; ++i)
+        named += strstr(w.line[i], "meshes[0].name: expected a string, found an integer") != NULL;
+    assert_int_equal(named, 1);
+    lpv_scene_free(&s);
+}
+
 static void test_invalid_json(void **state)
 {
     (void)state;
@@ -1923,6 +1996,7 @@ int main(void)
         cmocka_unit_test(test_animation_warnings),
         cmocka_unit_test(test_animation_defects),
         cmocka_unit_test(test_animation_scene_load),
+        cmocka_unit_test(test_schema_types),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
