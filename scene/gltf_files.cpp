@@ -3,7 +3,11 @@
  * file, and the external URIs tinygltf asks for through our FsCallbacks, which
  * refuse ".." components and absolute paths, and open the rest beneath the
  * scene's folder descriptor with no symbolic link on the way, in one step
- * (core/open_beneath.h): nothing outside the folder is ever opened.
+ * (core/open_beneath.h): nothing outside the folder is ever opened. The one
+ * exception is a load of the invoking user's own file (lpv_gltf_load_file_user:
+ * lpvd render, lpvd-reference, the benchmarks), whose URIs open where they
+ * point, as any program the user runs would open them: real projects keep
+ * their images in ../textures.
  */
 #include "gltf_internal.hpp"
 
@@ -72,6 +76,24 @@ PathCheck open_external(Ctx *ctx, const std::string &candidate, int *fd)
         if (ctx->refusal.empty())
             ctx->refusal = "external URI " + show_uri(rel) + " contains a NUL byte (refused)";
         return PATH_REFUSED;
+    }
+    if (ctx->user_paths) { /* lpv_gltf_load_file_user: where the URI says, as the user could open it */
+        int f = rel[0] == '/' ? open(rel.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)
+                              : openat(ctx->dir_fd, rel.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+        struct stat st;
+        if (f < 0 || fstat(f, &st) != 0 || !S_ISREG(st.st_mode)) {
+            int e = f < 0 ? errno : 0;
+            if (f >= 0)
+                close(f);
+            if (ctx->missing.empty())
+                ctx->missing = "external file " + show_uri(rel) +
+                               (f >= 0 ? std::string(" is not a regular file")
+                                       : e == ENOENT ? std::string(" not found")
+                                                     : " cannot be opened: " + std::string(strerror(e)));
+            return PATH_MISSING;
+        }
+        *fd = f;
+        return PATH_OK;
     }
     if (rel[0] == '/') {
         if (ctx->refusal.empty())

@@ -78,6 +78,8 @@ std::string show_uri(const std::string &s);
 struct Ctx {
     std::string label;
     bool allow_external = false; /* false for memory loads without a base folder */
+    bool user_paths = false;     /* the invoking user's own files (lpv_gltf_load_file_user): URIs may be
+                                    absolute or leave the folder, as any program the user runs reads them */
     int dir_fd = -1;             /* the scene's folder: external URIs open beneath it (open_beneath.h) */
     std::string refusal;         /* first security refusal: always fatal */
     std::string missing;         /* first external file that could not be read */

@@ -246,7 +246,7 @@ template <class F> int guarded(const char *name, lpv_scene *out, char *err, size
 /* A file's load: the scene (posed by animation when it is given), or with
  * list the file's animations only (out then stays zeroed). */
 int load_file(const char *path, const lpv_gltf_animation_time *animation, lpv_gltf_animation_list *list,
-              lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size)
+              lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size, bool user_paths = false)
 {
     if (!begin_load(path ? path : "(null)", out, warnings, err, err_size))
         return -1;
@@ -261,6 +261,7 @@ int load_file(const char *path, const lpv_gltf_animation_time *animation, lpv_gl
         ctx.sink = warnings;
         ctx.animation = animation;
         ctx.animation_list = list;
+        ctx.user_paths = user_paths;
         std::string p(path);
         size_t slash = p.find_last_of('/');
         std::string dir = slash == std::string::npos ? std::string(".")
@@ -305,6 +306,12 @@ extern "C" int lpv_gltf_load_file_animated_w(const char *path, const lpv_gltf_an
                                              lpv_gltf_warnings *warnings, char *err, size_t err_size)
 {
     return load_file(path, at, nullptr, out, warnings, err, err_size);
+}
+
+extern "C" int lpv_gltf_load_file_user(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out,
+                                       lpv_gltf_warnings *warnings, char *err, size_t err_size)
+{
+    return load_file(path, at, nullptr, out, warnings, err, err_size, true);
 }
 
 extern "C" int lpv_gltf_animations(const char *path, lpv_gltf_animation_list *out, char *err, size_t err_size)

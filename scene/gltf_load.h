@@ -111,6 +111,16 @@ typedef struct lpv_gltf_animation_time {
  * refused when at is given. */
 int lpv_gltf_load_file_animated(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out, char *err,
                                 size_t err_size);
+/* lpv_gltf_load_file_animated_w for the invoking user's own file (lpvd
+ * render, lpvd-reference, the benchmarks): its external URIs may be absolute
+ * paths or leave the file's folder (through ".." or a symbolic link), and
+ * open as the user opens any file; a project's images in ../textures load.
+ * The daemon (lpv_gltf_load_at) and batch jobs (lpv_gltf_load_file) keep
+ * every URI beneath the scene's folder: their files come from others
+ * (docs/scenes.md, "Where external files may lie"). at and warnings may be
+ * NULL. */
+int lpv_gltf_load_file_user(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out,
+                            lpv_gltf_warnings *warnings, char *err, size_t err_size);
 /* The same with the warnings stored in *warnings, like lpv_gltf_load_file_w. */
 int lpv_gltf_load_file_animated_w(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out,
                                   lpv_gltf_warnings *warnings, char *err, size_t err_size);

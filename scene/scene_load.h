@@ -19,4 +19,10 @@ int lpv_scene_load(const char *path, lpv_scene *out, char *err, size_t err_size)
 int lpv_scene_load_animated(const char *path, const lpv_gltf_animation_time *at, lpv_scene *out, char *err,
                             size_t err_size);
 
+/* lpv_scene_load for the invoking user's own file (lpvd render,
+ * lpvd-reference, the benchmarks): external URIs may lie outside the scene's
+ * folder (lpv_gltf_load_file_user). Batch jobs and the daemon use the calls
+ * above, which keep them beneath it. */
+int lpv_scene_load_user(const char *path, lpv_scene *out, char *err, size_t err_size);
+
 #endif

@@ -149,7 +149,7 @@ int lpvd_cmd_render(int argc, char **argv)
         opt.settings.iv.ao = LPV_SWITCH_ON;
     }
     lpv_scene scene;
-    if (lpv_scene_load(scene_path, &scene, err, sizeof err) != 0) {
+    if (lpv_scene_load_user(scene_path, &scene, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd render: %s\n", err);
         return 1;
     }

@@ -695,6 +695,66 @@ static void test_gltf_external_bin_and_data_uri(void **state)
     free(g);
 }
 
+/* A project's layout (issue 32, item 4): levels/level.gltf whose buffer
+ * and image lie in ../shared and at an absolute path. The user's own load
+ * (lpvd render, lpvd-reference) reads them; the rooted load the daemon and
+ * batch jobs use refuses them, naming the URI. */
+static void test_user_paths_outside_the_folder(void **state)
+{
+    (void)state;
+    char root[512], levels[1024], shared[1024], path[512], abs_png[512];
+    make_subdir(root, "project");
+    snprintf(levels, sizeof levels, "%s/levels", root);
+    snprintf(shared, sizeof shared, "%s/shared", root);
+    mkdir(levels, 0700);
+    mkdir(shared, 0700);
+    bin b;
+    tri_bin(&b);
+    write_file(path, shared, "tri.bin", b.b, b.n);
+    write_file(abs_png, shared, "t.png", png_2x2, sizeof png_2x2);
+    assert_true(abs_png[0] == '/');
+    for (int absolute = 0; absolute <= 1; ++absolute) {
+        const char *json = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'../shared/tri.bin'}],"
+                             "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                             "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                             "'images':[{'uri':'%s'}],'textures':[{'source':0}],"
+                             "'materials':[{'pbrMetallicRoughness':{'baseColorTexture':{'index':0}}}],"
+                             "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'material':0}]}],"
+                             "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}",
+                             absolute ? abs_png : "../shared/t.png");
+        write_file(path, levels, absolute ? "absolute.gltf" : "level.gltf", json, strlen(json));
+        lpv_scene s;
+        char err[768] = "";
+        assert_int_equal(lpv_gltf_load_file_user(path, NULL, &s, NULL, err, sizeof err), 0);
+        assert_int_equal(s.vertex_count, 3);
+        assert_int_equal(s.texture_count, 1);
+        assert_int_equal(s.textures[0].width, 2);
+        assert_int_equal(s.materials[0].base_color_texture, 0);
+        lpv_scene_free(&s);
+        /* the commands' call: lpv_scene_load_user */
+        assert_int_equal(lpv_scene_load_user(path, &s, err, sizeof err), 0);
+        assert_int_equal(s.texture_count, 1);
+        lpv_scene_free(&s);
+        /* rooted: refused, the URI named */
+        expect_fail_path(path, "../shared/tri.bin");
+        assert_int_equal(lpv_scene_load(path, &s, err, sizeof err), -1);
+        assert_non_null(strstr(err, "leaves the scene's folder"));
+    }
+    /* a missing file outside is still named as missing */
+    const char *gone = J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':36,'uri':'../nowhere/tri.bin'}],"
+                         "'bufferViews':[{'buffer':0,'byteLength':36}],"
+                         "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}],"
+                         "'meshes':[{'primitives':[{'attributes':{'POSITION':0}}]}],"
+                         "'nodes':[{'mesh':0}],'scenes':[{'nodes':[0]}]}");
+    write_file(path, levels, "gone.gltf", gone, strlen(gone));
+    lpv_scene s;
+    char err[768] = "";
+    assert_int_equal(lpv_gltf_load_file_user(path, NULL, &s, NULL, err, sizeof err), -1);
+    print_message("    gone.gltf (user) -> %s\n", err);
+    assert_non_null(strstr(err, "../nowhere/tri.bin"));
+    assert_non_null(strstr(err, "not found"));
+}
+
 /* ---- (b) malformed and hostile files ---------------------------------------- */
 
 static void test_truncated_glb(void **state)
@@ -1997,6 +2057,7 @@ int main(void)
         cmocka_unit_test(test_animation_defects),
         cmocka_unit_test(test_animation_scene_load),
         cmocka_unit_test(test_schema_types),
+        cmocka_unit_test(test_user_paths_outside_the_folder),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
