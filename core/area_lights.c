@@ -1,5 +1,6 @@
 /* area_lights.c - see area_lights.h. */
 #include "area_lights.h"
+#include "material_sample.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -39,7 +40,7 @@ int lpv_emitters_collect(const lpv_scene *s, lpv_emitter_list *list)
                 continue;
             for (int k = 0; k < 3; ++k)
                 memcpy(o->p[k], v[k]->position, sizeof o->p[k]);
-            memcpy(o->emission, s->materials[dr->material].emission, sizeof o->emission);
+            lpv_triangle_emission(s, &s->materials[dr->material], v, o->emission); /* its emissiveTexture's mean */
             list->count++;
         }
         /* A double-sided emitter (glTF doubleSided, as Blender, three.js and

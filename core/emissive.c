@@ -1,5 +1,6 @@
 /* emissive.c - see emissive.h. */
 #include "emissive.h"
+#include "material_sample.h"
 
 #include <math.h>
 #include <string.h>
@@ -12,14 +13,17 @@ static int material_emits(const lpv_scene *s, int m)
     return (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) && isfinite(e[0] + e[1] + e[2]);
 }
 
-/* A usable triangle's corners, front normal and area (lpv_scene_triangle). */
-static int triangle(const lpv_scene *s, uint32_t first, const float *p[3], float n[3], double *area)
+/* A usable triangle's corners, front normal, area (lpv_scene_triangle) and
+ * mean emitted radiance (its emissiveTexture's mean, core/material_sample.h). */
+static int triangle(const lpv_scene *s, uint32_t first, const lpv_material *m, const float *p[3], float n[3],
+                    double *area, float e[3])
 {
     const lpv_vertex *v[3];
     if (!lpv_scene_triangle(s, first, v, n, area))
         return 0;
     for (int k = 0; k < 3; ++k)
         p[k] = v[k]->position;
+    lpv_triangle_emission(s, m, v, e);
     return 1;
 }
 
@@ -40,13 +44,13 @@ static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *
         const lpv_draw *dr = &s->draws[d];
         if (!material_emits(s, dr->material))
             continue;
-        const float *e = s->materials[dr->material].emission;
-        const int sides = lpv_material_emitting_sides(&s->materials[dr->material]);
+        const lpv_material *m = &s->materials[dr->material];
+        const int sides = lpv_material_emitting_sides(m);
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
             const float *p[3];
-            float n[3];
+            float n[3], e[3];
             double area;
-            if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, p, n, &area))
+            if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, m, p, n, &area, e))
                 continue;
             for (int side = 0; side < sides; ++side) {
                 if (side)

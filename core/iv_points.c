@@ -2,6 +2,7 @@
  * iv_points.c - the imperfect volume's point cloud (see iv_points.h).
  */
 #include "iv_points.h"
+#include "material_sample.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -151,10 +152,22 @@ static void emit_piece(walk *w, const double pb[3][3])
          * side, else the winding's */
         double dot = n[0] * w->front[0] + n[1] * w->front[1] + n[2] * w->front[2];
         const int usable = isfinite(len2) && len2 > 1e-12 && dot > 0.0;
+        /* the material at the point (its textures: core/material_sample.h) */
+        float uv0[2] = {0, 0}, uv1[2] = {0, 0}, albedo[3] = {1, 1, 1}, emission[3] = {0, 0, 0};
+        for (int j = 0; j < 3; ++j)
+            for (int c = 0; c < 2; ++c) {
+                uv0[c] += (float)b[j] * w->v[j]->uv[c];
+                uv1[c] += (float)b[j] * w->v[j]->uv1[c];
+            }
+        if (w->m) {
+            lpv_material_albedo_at(w->scene, w->m, uv0, uv1, albedo);
+            if (w->emission)
+                lpv_material_emission_at(w->scene, w->m, uv0, uv1, emission);
+        }
         for (int i = 0; i < 3; ++i) {
             o->normal[i] = usable ? (float)(n[i] / sqrt(len2)) : w->front[i];
-            o->albedo[i] = w->m ? w->m->base_color[i] : 1.0f;
-            o->emission[i] = w->emission && w->m ? w->m->emission[i] : 0.0f;
+            o->albedo[i] = albedo[i];
+            o->emission[i] = emission[i];
         }
         o->position[3] = 1.0f;
         o->normal[3] = point_area;

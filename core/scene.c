@@ -141,6 +141,19 @@ void lpv_scene_compute_bounds(lpv_scene *scene)
     }
 }
 
+void lpv_material_init(lpv_material *m)
+{
+    memset(m, 0, sizeof *m);
+    m->base_color[0] = m->base_color[1] = m->base_color[2] = m->base_color[3] = 1.0f;
+    m->roughness = 1.0f;
+    m->alpha_cutoff = 0.5f;
+    m->normal_scale = 1.0f;
+    m->base_color_texture = m->normal_texture = m->metallic_roughness_texture = m->emissive_texture = -1;
+    lpv_uv_transform *uv[] = {&m->base_color_uv, &m->normal_uv, &m->metallic_roughness_uv, &m->emissive_uv};
+    for (size_t i = 0; i < sizeof uv / sizeof uv[0]; ++i)
+        uv[i]->scale[0] = uv[i]->scale[1] = 1.0f;
+}
+
 int lpv_material_emitting_sides(const lpv_material *m) { return m->double_sided ? 2 : 1; }
 
 float lpv_material_alpha_cutoff(const lpv_material *m)

@@ -98,7 +98,17 @@ typedef struct lpv_material {
     int normal_texture;     /* index into textures, -1 = none; must be a linear texture to be used */
     float normal_scale;     /* glTF normalTexture.scale: tangent-space x, y multiplied by it */
     lpv_uv_transform normal_uv;
+    int metallic_roughness_texture; /* index into textures, -1 = none; linear: G x roughness, B x metallic */
+    lpv_uv_transform metallic_roughness_uv;
+    int emissive_texture;   /* index into textures, -1 = none; sRGB colour x emission */
+    lpv_uv_transform emissive_uv;
 } lpv_material;
+
+/* A material at glTF's defaults: white, opaque, metallic 0, roughness 1,
+ * single-sided, no emission, no texture (-1) and identity uv transforms.
+ * Every builder starts from it, so that a field added here has its default
+ * in one place. */
+void lpv_material_init(lpv_material *m);
 
 typedef struct lpv_vertex {
     float position[3]; /* world, m */

@@ -25,12 +25,9 @@ int lpv_scene_add_material(lpv_scene *s, const char *name, const float albedo[3]
     if (grow((void **)&s->materials, s->material_count + 1, sizeof *s->materials) != 0)
         return -1;
     lpv_material *m = &s->materials[s->material_count];
-    memset(m, 0, sizeof *m);
+    lpv_material_init(m);
     snprintf(m->name, sizeof m->name, "%s", name ? name : "");
     memcpy(m->base_color, albedo, 3 * sizeof(float));
-    m->base_color[3] = 1.0f;
-    m->base_color_texture = -1;
-    m->normal_texture = -1;
     m->double_sided = 1; /* code-built surfaces have always been two-sided */
     if (emission) {
         memcpy(m->emission, emission, sizeof m->emission);
@@ -40,7 +37,6 @@ int lpv_scene_add_material(lpv_scene *s, const char *name, const float albedo[3]
         if (emission[0] != 0.0f || emission[1] != 0.0f || emission[2] != 0.0f)
             m->double_sided = 0;
     }
-    m->roughness = 1.0f;
     return (int)s->material_count++;
 }
 

@@ -141,15 +141,12 @@ int lpv_scene_builtin_cornell(lpv_scene *scene)
     for (int o = 0; o < CORNELL_OBJECT_COUNT; o++) {
         const cornell_object *obj = &cornell_objects[o];
         lpv_material *m = &scene->materials[o];
+        lpv_material_init(m);
         strncpy(m->name, obj->name, LPV_NAME_MAX - 1);
         m->base_color[0] = obj->kd[0];
         m->base_color[1] = obj->kd[1];
         m->base_color[2] = obj->kd[2];
-        m->base_color[3] = 1.0f;
-        m->base_color_texture = -1;
-        m->normal_texture = -1;
         memcpy(m->emission, obj->emission, sizeof m->emission);
-        m->metallic = 0.0f;
         m->roughness = 0.9f;
         /* two-sided, except the lamp: a double-sided emitter would light the
          * ceiling above it too (docs/area-lights.md); it lights the room */

@@ -35,6 +35,12 @@ typedef struct lpv_gpu_material {
     float normal_scale;
     int normal_uv_set;
     float normal_uv[6];
+    int mr_texture;       /* metallicRoughnessTexture: index into lpv_engine.textures (linear), -1 none */
+    int mr_uv_set;
+    float mr_uv[6];
+    int emissive_texture; /* emissiveTexture: index into lpv_engine.textures (sRGB), -1 none */
+    int emissive_uv_set;
+    float emissive_uv[6];
 } lpv_gpu_material;
 
 typedef struct lpv_gpu_draw {

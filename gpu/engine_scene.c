@@ -10,6 +10,7 @@
 
 #include "emissive.h"
 #include "engine_internal.h"
+#include "material_sample.h"
 #include "error.h"
 #include "hash.h"
 #include "scene_planes.h"
@@ -321,12 +322,19 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         g->normal_scale = m->normal_scale;
         g->normal_uv_set = m->normal_uv.texcoord == 1;
         lpv_uv_transform_matrix(&m->normal_uv, g->normal_uv);
+        g->mr_texture = lpv_material_texture(scene, m->metallic_roughness_texture, 1);
+        g->mr_uv_set = m->metallic_roughness_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->metallic_roughness_uv, g->mr_uv);
+        g->emissive_texture = lpv_material_texture(scene, m->emissive_texture, 0);
+        g->emissive_uv_set = m->emissive_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->emissive_uv, g->emissive_uv);
     }
     e->material_count = scene->material_count;
     e->materials_plain = 1;
     for (uint32_t i = 0; i < e->material_count; ++i) {
         const lpv_gpu_material *g = &e->materials[i];
-        if (g->texture >= 0 || g->normal_texture >= 0 || g->alpha_cutoff > 0.0f)
+        if (g->texture >= 0 || g->normal_texture >= 0 || g->mr_texture >= 0 || g->emissive_texture >= 0 ||
+            g->alpha_cutoff > 0.0f)
             e->materials_plain = 0;
     }
     if (upload_textures(e, scene, err, err_size) != 0)
@@ -407,6 +415,14 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
     GLint loc_normal_set = glGetUniformLocation(prog, "u_normal_uv_set");
     GLint loc_normal_row0 = glGetUniformLocation(prog, "u_normal_uv_row0");
     GLint loc_normal_row1 = glGetUniformLocation(prog, "u_normal_uv_row1");
+    GLint loc_has_mr = glGetUniformLocation(prog, "u_has_mr_texture");
+    GLint loc_mr_set = glGetUniformLocation(prog, "u_mr_uv_set");
+    GLint loc_mr_row0 = glGetUniformLocation(prog, "u_mr_uv_row0");
+    GLint loc_mr_row1 = glGetUniformLocation(prog, "u_mr_uv_row1");
+    GLint loc_has_emissive = glGetUniformLocation(prog, "u_has_emissive_texture");
+    GLint loc_emissive_set = glGetUniformLocation(prog, "u_emissive_uv_set");
+    GLint loc_emissive_row0 = glGetUniformLocation(prog, "u_emissive_uv_row0");
+    GLint loc_emissive_row1 = glGetUniformLocation(prog, "u_emissive_uv_row1");
     glBindVertexArray(e->vao);
     glCullFace(GL_BACK);
     glFrontFace(GL_CCW); /* glTF's front faces; the loader rewinds mirrored nodes */
@@ -414,7 +430,8 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
         const lpv_gpu_draw *d = &e->draws[i];
         static const lpv_gpu_material fallback = {
             .base_color = {1, 1, 1, 1}, .roughness = 1.0f, .texture = -1, .double_sided = 1,
-            .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0}};
+            .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0},
+            .mr_texture = -1, .mr_uv = {1, 0, 0, 0, 1, 0}, .emissive_texture = -1, .emissive_uv = {1, 0, 0, 0, 1, 0}};
         const lpv_gpu_material *m =
             (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
         glUniform4fv(loc_color, 1, m->base_color);
@@ -432,10 +449,20 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
         glUniform1i(loc_normal_set, m->normal_uv_set);
         glUniform3fv(loc_normal_row0, 1, &m->normal_uv[0]);
         glUniform3fv(loc_normal_row1, 1, &m->normal_uv[3]);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, m->texture >= 0 ? e->textures[m->texture] : 0);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, m->normal_texture >= 0 ? e->textures[m->normal_texture] : 0);
+        glUniform1i(loc_has_mr, m->mr_texture >= 0);
+        glUniform1i(loc_mr_set, m->mr_uv_set);
+        glUniform3fv(loc_mr_row0, 1, &m->mr_uv[0]);
+        glUniform3fv(loc_mr_row1, 1, &m->mr_uv[3]);
+        glUniform1i(loc_has_emissive, m->emissive_texture >= 0);
+        glUniform1i(loc_emissive_set, m->emissive_uv_set);
+        glUniform3fv(loc_emissive_row0, 1, &m->emissive_uv[0]);
+        glUniform3fv(loc_emissive_row1, 1, &m->emissive_uv[3]);
+        /* material.glsl's units: base colour, normal, metallic-roughness, emissive */
+        const int unit_texture[4] = {m->texture, m->normal_texture, m->mr_texture, m->emissive_texture};
+        for (int u = 0; u < 4; ++u) {
+            glActiveTexture(GL_TEXTURE0 + (GLenum)u);
+            glBindTexture(GL_TEXTURE_2D, unit_texture[u] >= 0 ? e->textures[unit_texture[u]] : 0);
+        }
         glActiveTexture(GL_TEXTURE0);
         if (cull_single_sided && !m->double_sided)
             glEnable(GL_CULL_FACE);

@@ -2,7 +2,7 @@
 #include "pt.h"
 
 #include "error.h"
-#include "tonemap.h"
+#include "material_sample.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -18,23 +18,15 @@
 typedef struct ref_tri {
     float p0[3], e1[3], e2[3]; /* corners p0, p0 + e1, p0 + e2 */
     float vn[3][3];            /* vertex normals (unit; the front normal where the file's was bad) */
-    float uv[3][2];
+    float uv[3][2], uv1[3][2]; /* TEXCOORD_0, TEXCOORD_1 */
     float front[3]; /* unit geometric normal of the front side (the emitting one, or the first of two) */
     int material;   /* -1 = none: black, not emissive */
 } ref_tri;
 
 typedef struct ref_material {
-    float albedo[3];
-    float emission[3];
     int emits;
     int sides;   /* emitting sides: 2 double-sided (glTF doubleSided: the back emits L_e too), else 1 */
-    int texture; /* -1 = none */
 } ref_material;
-
-typedef struct ref_texture {
-    int width, height;
-    float *rgb; /* linear (sRGB-decoded), width*height*3 */
-} ref_texture;
 
 struct lpv_ref {
     RTCDevice device;
@@ -43,8 +35,10 @@ struct lpv_ref {
     uint32_t tri_count;
     ref_material *materials;
     uint32_t material_count;
-    ref_texture *textures;
-    uint32_t texture_count;
+    /* copies of the scene's materials and textures (nothing else): a hit's
+     * albedo and emission follow core/material_sample.h, the rules lpvd's
+     * shaders and CPU samplers follow */
+    lpv_scene look;
     lpv_light *lights;
     uint32_t light_count;
     /* emissive triangles for next-event estimation, by emitted power */
@@ -174,8 +168,10 @@ static int make_tri(const lpv_scene *s, uint32_t first, int material, ref_tri *t
     for (int k = 0; k < 3; ++k) {
         if (!unit3(v[k]->normal, t->vn[k]))
             memcpy(t->vn[k], t->front, sizeof t->front);
-        for (int i = 0; i < 2; ++i)
+        for (int i = 0; i < 2; ++i) {
             t->uv[k][i] = isfinite(v[k]->uv[i]) ? v[k]->uv[i] : 0.0f;
+            t->uv1[k][i] = isfinite(v[k]->uv1[i]) ? v[k]->uv1[i] : 0.0f;
+        }
     }
     t->material = material;
     return 1;
@@ -185,49 +181,60 @@ static int copy_materials(lpv_ref *r, const lpv_scene *s)
 {
     if (s->material_count) {
         r->materials = calloc(s->material_count, sizeof *r->materials);
-        if (!r->materials)
+        r->look.materials = malloc(s->material_count * sizeof *r->look.materials);
+        if (!r->materials || !r->look.materials)
             return -1;
+        memcpy(r->look.materials, s->materials, s->material_count * sizeof *s->materials);
     }
-    r->material_count = s->material_count;
+    r->material_count = r->look.material_count = s->material_count;
     for (uint32_t m = 0; m < s->material_count; ++m) {
-        const lpv_material *src = &s->materials[m];
-        ref_material *dst = &r->materials[m];
-        for (int i = 0; i < 3; ++i) {
-            float a = src->base_color[i];
-            dst->albedo[i] = isfinite(a) ? fminf(fmaxf(a, 0.0f), 1.0f) : 0.0f;
-            float e = src->emission[i];
-            dst->emission[i] = (isfinite(e) && e > 0.0f) ? e : 0.0f;
-        }
-        dst->emits = dst->emission[0] > 0.0f || dst->emission[1] > 0.0f || dst->emission[2] > 0.0f;
-        dst->sides = lpv_material_emitting_sides(src);
-        int tex = src->base_color_texture;
-        dst->texture = (tex >= 0 && (uint32_t)tex < s->texture_count) ? tex : -1;
+        const float *e = s->materials[m].emission;
+        int emits = 0;
+        for (int i = 0; i < 3; ++i)
+            emits |= isfinite(e[i]) && e[i] > 0.0f;
+        r->materials[m].emits = emits;
+        r->materials[m].sides = lpv_material_emitting_sides(&s->materials[m]);
     }
     if (s->texture_count) {
-        r->textures = calloc(s->texture_count, sizeof *r->textures);
-        if (!r->textures)
+        r->look.textures = calloc(s->texture_count, sizeof *r->look.textures);
+        if (!r->look.textures)
             return -1;
     }
-    r->texture_count = s->texture_count;
-    float lut[256];
-    for (int i = 0; i < 256; ++i)
-        lut[i] = lpv_srgb_decode((float)i / 255.0f);
+    r->look.texture_count = s->texture_count;
     for (uint32_t t = 0; t < s->texture_count; ++t) {
         const lpv_texture *src = &s->textures[t];
+        lpv_texture *dst = &r->look.textures[t];
+        *dst = *src;
+        dst->rgba8 = NULL;
         if (!src->rgba8 || src->width < 1 || src->height < 1)
             continue;
-        size_t count = (size_t)src->width * (size_t)src->height;
-        float *rgb = malloc(count * 3 * sizeof *rgb);
-        if (!rgb)
+        const size_t bytes = (size_t)src->width * (size_t)src->height * 4;
+        if (!(dst->rgba8 = malloc(bytes)))
             return -1;
-        for (size_t i = 0; i < count; ++i)
-            for (int c = 0; c < 3; ++c)
-                rgb[3 * i + (size_t)c] = lut[src->rgba8[4 * i + (size_t)c]];
-        r->textures[t].width = src->width;
-        r->textures[t].height = src->height;
-        r->textures[t].rgb = rgb;
+        memcpy(dst->rgba8, src->rgba8, bytes);
     }
     return 0;
+}
+
+/* A triangle's corners as vertices with its uv sets (for core/material_sample.h). */
+static void tri_vertices(const ref_tri *t, lpv_vertex v[3])
+{
+    memset(v, 0, 3 * sizeof *v);
+    for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 2; ++i) {
+            v[k].uv[i] = t->uv[k][i];
+            v[k].uv1[i] = t->uv1[k][i];
+        }
+}
+
+/* The uv sets at barycentrics (1 - b1 - b2, b1, b2). */
+static void tri_uv(const ref_tri *t, float b1, float b2, float uv0[2], float uv1[2])
+{
+    const float w = 1.0f - b1 - b2;
+    for (int i = 0; i < 2; ++i) {
+        uv0[i] = w * t->uv[0][i] + b1 * t->uv[1][i] + b2 * t->uv[2][i];
+        uv1[i] = w * t->uv1[0][i] + b1 * t->uv1[1][i] + b2 * t->uv1[2][i];
+    }
 }
 
 static double tri_area(const ref_tri *t)
@@ -255,10 +262,14 @@ static int build_emitters(lpv_ref *r)
         if (tr->material < 0 || !r->materials[tr->material].emits)
             continue;
         const ref_material *m = &r->materials[tr->material];
-        const float *e = m->emission;
+        lpv_vertex v[3];
+        const lpv_vertex *pv[3] = {&v[0], &v[1], &v[2]};
+        float e[3];
+        tri_vertices(tr, v);
+        lpv_triangle_emission(&r->look, &r->look.materials[tr->material], pv, e); /* its emissiveTexture's mean */
+        const double le = isfinite((double)e[0] + e[1] + e[2]) ? fmax((double)e[0] + e[1] + e[2], 0.0) : 0.0;
         r->emitters[r->emitter_count] = t;
-        r->emitter_cdf[r->emitter_count + 1] =
-            r->emitter_cdf[r->emitter_count] + ((double)e[0] + e[1] + e[2]) * tri_area(tr) * m->sides;
+        r->emitter_cdf[r->emitter_count + 1] = r->emitter_cdf[r->emitter_count] + le * tri_area(tr) * m->sides;
         r->emitter_count++;
     }
     return 0;
@@ -408,9 +419,10 @@ void lpv_ref_destroy(lpv_ref *r)
         rtcReleaseScene(r->scene);
     if (r->device)
         rtcReleaseDevice(r->device);
-    for (uint32_t t = 0; t < r->texture_count; ++t)
-        free(r->textures[t].rgb);
-    free(r->textures);
+    for (uint32_t t = 0; t < r->look.texture_count; ++t)
+        free(r->look.textures[t].rgba8);
+    free(r->look.textures);
+    free(r->look.materials);
     free(r->materials);
     free(r->lights);
     free(r->emitters);
@@ -534,25 +546,8 @@ int lpv_ref_first_surface(const lpv_ref *r, const float org[3], const float dir[
 
 /* ---- materials ----------------------------------------------------------- */
 
-static void texture_sample(const ref_texture *t, float s, float tt, float out[3])
-{
-    float x = s * (float)t->width - 0.5f, y = tt * (float)t->height - 0.5f;
-    float fx = floorf(x), fy = floorf(y);
-    float ax = x - fx, ay = y - fy;
-    long ix = (long)fmodf(fx, (float)t->width), iy = (long)fmodf(fy, (float)t->height);
-    if (ix < 0)
-        ix += t->width;
-    if (iy < 0)
-        iy += t->height;
-    long ix1 = (ix + 1) % t->width, iy1 = (iy + 1) % t->height;
-    const float *a = &t->rgb[3 * ((size_t)iy * (size_t)t->width + (size_t)ix)];
-    const float *b = &t->rgb[3 * ((size_t)iy * (size_t)t->width + (size_t)ix1)];
-    const float *c = &t->rgb[3 * ((size_t)iy1 * (size_t)t->width + (size_t)ix)];
-    const float *d = &t->rgb[3 * ((size_t)iy1 * (size_t)t->width + (size_t)ix1)];
-    for (int i = 0; i < 3; ++i)
-        out[i] = (1.0f - ay) * ((1.0f - ax) * a[i] + ax * b[i]) + ay * ((1.0f - ax) * c[i] + ax * d[i]);
-}
-
+/* The diffuse albedo at a hit (core/material_sample.h: base colour x
+ * texture x (1 - metallic)); 0 without a material. */
 static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
 {
     const ref_tri *tr = &r->tris[h->tri];
@@ -560,27 +555,24 @@ static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
-    const ref_material *m = &r->materials[tr->material];
-    memcpy(out, m->albedo, 3 * sizeof(float));
-    if (m->texture >= 0 && r->textures[m->texture].rgb) {
-        float w = 1.0f - h->u - h->v, st[2];
-        for (int i = 0; i < 2; ++i)
-            st[i] = w * tr->uv[0][i] + h->u * tr->uv[1][i] + h->v * tr->uv[2][i];
-        if (isfinite(st[0]) && isfinite(st[1]) && fabsf(st[0]) < 1e6f && fabsf(st[1]) < 1e6f) {
-            float tex[3];
-            texture_sample(&r->textures[m->texture], st[0], st[1], tex);
-            for (int i = 0; i < 3; ++i)
-                out[i] *= tex[i];
-        }
-    }
+    float uv0[2], uv1[2];
+    tri_uv(tr, h->u, h->v, uv0, uv1);
+    lpv_material_albedo_at(&r->look, &r->look.materials[tr->material], uv0, uv1, out);
 }
 
-static const float *hit_emission(const lpv_ref *r, const hit *h)
+/* The radiance a hit's side emits (W/(m^2 sr), x its emissiveTexture): 0
+ * and no write where it emits none. */
+static int hit_emission(const lpv_ref *r, const hit *h, float out[3])
 {
     const ref_tri *tr = &r->tris[h->tri];
     if (tr->material < 0 || !r->materials[tr->material].emits || (!h->front && r->materials[tr->material].sides < 2))
-        return NULL;
-    return r->materials[tr->material].emission;
+        return 0;
+    float uv0[2], uv1[2];
+    tri_uv(tr, h->u, h->v, uv0, uv1);
+    lpv_material_emission_at(&r->look, &r->look.materials[tr->material], uv0, uv1, out);
+    for (int i = 0; i < 3; ++i)
+        out[i] = isfinite(out[i]) && out[i] > 0.0f ? out[i] : 0.0f;
+    return 1;
 }
 
 /* ---- punctual lights (shaders/lights.glsl) -------------------------------- */
@@ -665,9 +657,10 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
     }
     const ref_tri *tr = &r->tris[r->emitters[lo]];
     const ref_material *m = &r->materials[tr->material];
-    const float *le = m->emission;
     float s1 = sqrtf(pcg32_float(rng)), s2 = pcg32_float(rng);
-    float b1 = s1 * (1.0f - s2), b2 = s1 * s2, q[3], d[3];
+    float b1 = s1 * (1.0f - s2), b2 = s1 * s2, q[3], d[3], le[3], uv0[2], uv1[2];
+    tri_uv(tr, b1, b2, uv0, uv1);
+    lpv_material_emission_at(&r->look, &r->look.materials[tr->material], uv0, uv1, le); /* at q: its texture */
     for (int i = 0; i < 3; ++i) {
         q[i] = tr->p0[i] + b1 * tr->e1[i] + b2 * tr->e2[i];
         d[i] = q[i] - p[i];
@@ -699,11 +692,14 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
         to_q[i] /= len;
     if (occluded(r, org, to_q, len - 2.0f * r->eps))
         return;
-    /* pdf per unit area of the point: weight(tr) / total */
-    double weight = ((double)le[0] + le[1] + le[2]) * m->sides;
-    double g = (double)cos_r * cos_e / dist2 * total / weight;
+    /* pdf per unit area of q: the triangle's share of the CDF (its mean
+     * emission x area x sides) over its area, / total */
+    const double pdf_area = (r->emitter_cdf[lo + 1] - r->emitter_cdf[lo]) / (total * tri_area(tr));
+    if (!(pdf_area > 0.0))
+        return;
+    double g = (double)cos_r * cos_e / dist2 / pdf_area;
     for (int i = 0; i < 3; ++i)
-        out[i] = le[i] * g;
+        out[i] = (isfinite(le[i]) && le[i] > 0.0f ? le[i] : 0.0f) * g;
 }
 
 void lpv_ref_direct_irradiance(const lpv_ref *r, const float p[3], const float n[3], float out_rgb[3])
@@ -749,11 +745,12 @@ static void sample_path(const lpv_ref *r, pcg32 *rng, const float p_in[3], const
             break;
         float alb[3], ed[3] = {0.0f, 0.0f, 0.0f};
         hit_albedo(r, &h, alb);
-        const float *le = hit_emission(r, &h);
+        float le[3] = {0.0f, 0.0f, 0.0f};
+        hit_emission(r, &h, le);
         if (alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f)
             direct(r, h.p, h.ns, h.ng, ed);
         for (int i = 0; i < 3; ++i)
-            out[i] += (double)thr[i] * ((le ? (double)le[i] : 0.0) + (double)alb[i] / PT_PI * (double)ed[i]);
+            out[i] += (double)thr[i] * ((double)le[i] + (double)alb[i] / PT_PI * (double)ed[i]);
         if (depth == bounces)
             break;
         for (int i = 0; i < 3; ++i)
@@ -999,9 +996,11 @@ static void pixel_item(job *j, size_t i)
             estimate(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, e, se);
         }
     }
-    const float *le = j->full ? hit_emission(j->ref, &h) : NULL;
+    float le[3] = {0.0f, 0.0f, 0.0f};
+    if (j->full)
+        hit_emission(j->ref, &h, le);
     for (int c = 0; c < 3; ++c) {
-        px[c] = (float)(alb[c] / PT_PI) * (e[c] + ed[c]) + (le ? le[c] : 0.0f);
+        px[c] = (float)(alb[c] / PT_PI) * (e[c] + ed[c]) + le[c];
         if (pse)
             pse[c] = (float)(alb[c] / PT_PI) * se[c];
     }

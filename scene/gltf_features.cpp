@@ -143,7 +143,7 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
     }
 
     /* Materials lpvd approximates or reads only in part. */
-    Uses blend, occlusion, emissive, mr, far_uv;
+    Uses blend, occlusion, far_uv;
     std::set<int> far_sets;
     for (size_t i = 0; i < m.materials.size(); i++) {
         const tinygltf::Material &g = m.materials[i];
@@ -152,11 +152,8 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
             blend.add("material", k);
         if (g.occlusionTexture.index >= 0)
             occlusion.add("material", k);
-        if (g.emissiveTexture.index >= 0)
-            emissive.add("material", k);
-        if (g.pbrMetallicRoughness.metallicRoughnessTexture.index >= 0)
-            mr.add("material", k);
-        for (const auto *t : {&g.pbrMetallicRoughness.baseColorTexture})
+        for (const auto *t : {&g.pbrMetallicRoughness.baseColorTexture, &g.pbrMetallicRoughness.metallicRoughnessTexture,
+                              &g.emissiveTexture})
             if (t->index >= 0 && t->texCoord > 1)
                 far_uv.add("material", k), far_sets.insert(t->texCoord);
         if (g.normalTexture.index >= 0 && g.normalTexture.texCoord > 1)
@@ -169,12 +166,6 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
     if (occlusion.total)
         out.push_back("occlusionTexture (" + occlusion.describe() +
                       "): not used; lpvd computes occlusion from the scene's geometry");
-    if (emissive.total)
-        out.push_back("emissiveTexture (" + emissive.describe() +
-                      "): not used; the emissiveFactor is emitted uniformly over the surface");
-    if (mr.total)
-        out.push_back("metallicRoughnessTexture (" + mr.describe() +
-                      "): not used; metallicFactor and roughnessFactor are used");
     if (far_uv.total) {
         std::string sets;
         for (int s : far_sets)

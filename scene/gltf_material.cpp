@@ -104,17 +104,8 @@ int Builder::default_material()
 {
     if (default_material_ < 0) {
         lpv_material mat;
-        memset(&mat, 0, sizeof mat);
+        lpv_material_init(&mat);
         copy_name(mat.name, "default", "default");
-        mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = mat.base_color[3] = 1.0f;
-        mat.base_color_texture = -1;
-        mat.normal_texture = -1;
-        mat.metallic = 0.0f;
-        mat.roughness = 1.0f;
-        mat.double_sided = 0;
-        mat.alpha_cutoff = 0.5f;
-        mat.base_color_uv.scale[0] = mat.base_color_uv.scale[1] = 1.0f;
-        mat.normal_uv.scale[0] = mat.normal_uv.scale[1] = 1.0f;
         materials.push_back(mat);
         default_material_ = int(materials.size() - 1);
     }
@@ -189,7 +180,7 @@ void Builder::convert_materials()
         const tinygltf::Material &gm = m_.materials[i];
         const int mi = int(i);
         lpv_material mat;
-        memset(&mat, 0, sizeof mat);
+        lpv_material_init(&mat);
         copy_name(mat.name, gm.name, strf("material%d", mi));
         const auto &pbr = gm.pbrMetallicRoughness;
         if (pbr.baseColorFactor.size() != 4 || !finite_all(pbr.baseColorFactor))
@@ -199,6 +190,13 @@ void Builder::convert_materials()
         mat.base_color_texture = texture_for(mi, "baseColorTexture", pbr.baseColorTexture.index, false);
         texture_uv(mi, "baseColorTexture", pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
                    &mat.base_color_uv);
+        mat.metallic_roughness_texture =
+            texture_for(mi, "metallicRoughnessTexture", pbr.metallicRoughnessTexture.index, true);
+        texture_uv(mi, "metallicRoughnessTexture", pbr.metallicRoughnessTexture.texCoord,
+                   pbr.metallicRoughnessTexture.extensions, &mat.metallic_roughness_uv);
+        mat.emissive_texture = texture_for(mi, "emissiveTexture", gm.emissiveTexture.index, false);
+        texture_uv(mi, "emissiveTexture", gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions,
+                   &mat.emissive_uv);
         const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
         mat.normal_texture = texture_for(mi, "normalTexture", nt.index, true);
         texture_uv(mi, "normalTexture", nt.texCoord, nt.extensions, &mat.normal_uv);

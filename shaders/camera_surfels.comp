@@ -46,7 +46,7 @@ void main()
                 continue;
             vec3 x = p.xyz, n = nt.xyz;
             float w = p.w, tag = em.a; // tag: object size
-            vec3 val = p.w * texelFetch(u_gbuf_albedo, t, 0).rgb;
+            vec3 val = p.w * texelFetch(u_gbuf_albedo, t, 0).rgb * lpv_gbuffer_kd(nt.w); // diffuse
             uvec4 g = group_key(x, n, true, normal_bin(n)); // the bin: opposite faces never cancel
             BG_STEP
         }

@@ -15,7 +15,7 @@ uniform vec3 u_forward;
 
 layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0 = covered
 layout(location = 1) out vec4 o_normal;   // xyz unit shading normal, on the camera's side; w 1 + metallic where covered
-layout(location = 2) out vec4 o_albedo;   // rgb linear albedo; a roughness
+layout(location = 2) out vec4 o_albedo;   // rgb linear base colour (diffuse: x lpv_gbuffer_kd); a roughness
 layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr); a object size (m)
 
 void main()
@@ -45,8 +45,9 @@ void main()
     // after every derivative: cut-away texels leave no pixel (and no depth)
     if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff)
         discard;
+    vec2 mr = material_metallic_roughness(v_uv, v_uv1);
     o_position = vec4(p, area);
-    o_normal = vec4(n, 1.0 + clamp(u_metallic, 0.0, 1.0)); // w >= 1: covered; w - 1: metallic
-    o_albedo = vec4(base.rgb, u_roughness);
-    o_emission = vec4(u_emission, u_object_size);
+    o_normal = vec4(n, 1.0 + mr.x); // w >= 1: covered; w - 1: metallic (lpv_gbuffer_kd)
+    o_albedo = vec4(base.rgb, mr.y);
+    o_emission = vec4(material_emission(v_uv, v_uv1), u_object_size);
 }

@@ -53,7 +53,7 @@ void main()
             return; // background
         p = texelFetch(u_gbuf_position, t, 0).xyz;
         n = gn.xyz;
-        albedo = texelFetch(u_gbuf_albedo, t, 0).rgb;
+        albedo = texelFetch(u_gbuf_albedo, t, 0).rgb * lpv_gbuffer_kd(gn.w); // diffuse
         emission = texelFetch(u_gbuf_emission, t, 0).rgb;
     }
     float len = length(n);

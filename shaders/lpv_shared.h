@@ -549,6 +549,14 @@ LPV_INLINE int lpv_slab_index(int v, int slabs) { return v / slabs; }
 #endif
 LPV_INLINE int lpv_slab_y0(int v, int slabs, int dim_y) { return lpv_slab_index(v, slabs) * dim_y; }
 LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v - lpv_slab_index(v, slabs) * slabs) * dim_z; }
+/* The G-buffer's albedo is the base colour (glossy.frag's F0 needs it) and
+ * its normal's w 1 + metallic where covered: the diffuse albedo, which lights
+ * the frame and carries the bounces (iv's reprojected points, the camera's
+ * surfels), is base x (1 - metallic), as glTF's metallic-roughness model has
+ * it on a diffuse transport (core/material_sample.h for the CPU's side). */
+#ifdef LPV_GLSL
+float lpv_gbuffer_kd(float normal_w) { return 1.0 - clamp(normal_w - 1.0, 0.0, 1.0); }
+#endif
 #define LPV_LOOKUP_NORMAL_TEXELS 131072
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6
 

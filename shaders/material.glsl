@@ -1,8 +1,8 @@
 // material.glsl - the per-draw material and the surface normal, shared by the
 // RSM and G-buffer fragment shaders (docs/scenes.md, "Materials").
 // LPV_MATERIAL_PLAIN 1 compiles a scene pass's program for scenes whose
-// materials all have no base colour texture, no normal map and no alpha
-// cut (gpu/engine_scene.c, lpv_engine_material_program): llvmpipe runs the
+// materials all have no texture (base colour, normal, metallic-roughness,
+// emissive) and no alpha cut (gpu/engine_scene.c, lpv_engine_material_program): llvmpipe runs the
 // code of a branch under lane masks even when no lane takes it, so the
 // texture fetches and the normal map's frame cost every pixel, and a
 // discard keeps the depth-only shadow faces from its fast path.
@@ -26,8 +26,20 @@ uniform float u_normal_scale;     // glTF normalTexture.scale
 uniform int u_normal_uv_set;
 uniform vec3 u_normal_uv_row0;
 uniform vec3 u_normal_uv_row1;
+// metallicRoughnessTexture on unit 2 (linear: G x roughness, B x metallic),
+// emissiveTexture on unit 3 (sRGB, x the emission); their uv sets and rows
+uniform int u_has_mr_texture;
+uniform int u_mr_uv_set;
+uniform vec3 u_mr_uv_row0;
+uniform vec3 u_mr_uv_row1;
+uniform int u_has_emissive_texture;
+uniform int u_emissive_uv_set;
+uniform vec3 u_emissive_uv_row0;
+uniform vec3 u_emissive_uv_row1;
 layout(binding = 0) uniform sampler2D u_base_texture;
 layout(binding = 1) uniform sampler2D u_normal_texture;
+layout(binding = 2) uniform sampler2D u_mr_texture;
+layout(binding = 3) uniform sampler2D u_emissive_texture;
 
 vec2 texture_uv(int set, vec3 row0, vec3 row1, vec2 uv0, vec2 uv1)
 {
@@ -41,6 +53,27 @@ vec4 material_albedo(vec2 uv0, vec2 uv1)
     if (LPV_MATERIAL_PLAIN == 0 && u_has_texture != 0)
         c *= texture(u_base_texture, texture_uv(u_base_uv_set, u_base_uv_row0, u_base_uv_row1, uv0, uv1));
     return c;
+}
+
+// metallic (x) and roughness (y) at the surface: the factors x the
+// metallicRoughnessTexture's B and G (glTF), each in [0, 1]
+vec2 material_metallic_roughness(vec2 uv0, vec2 uv1)
+{
+    vec2 mr = vec2(u_metallic, u_roughness);
+    if (LPV_MATERIAL_PLAIN == 0 && u_has_mr_texture != 0)
+        mr *= texture(u_mr_texture, texture_uv(u_mr_uv_set, u_mr_uv_row0, u_mr_uv_row1, uv0, uv1)).bg;
+    return clamp(mr, 0.0, 1.0);
+}
+
+// the emitted radiance at the surface, W/(m^2 sr): the emission x the
+// emissiveTexture (glTF's emissiveFactor x emissiveTexture x strength)
+vec3 material_emission(vec2 uv0, vec2 uv1)
+{
+    vec3 e = u_emission;
+    if (LPV_MATERIAL_PLAIN == 0 && u_has_emissive_texture != 0)
+        e *= texture(u_emissive_texture,
+                     texture_uv(u_emissive_uv_set, u_emissive_uv_row0, u_emissive_uv_row1, uv0, uv1)).rgb;
+    return e;
 }
 
 #ifdef LPV_STAGE_FRAGMENT

@@ -50,7 +50,7 @@ void main()
     }
     vec3 power = e_perp * texel_area_perp;
     vec4 base = material_albedo(v_uv, v_uv1);
-    vec3 albedo = base.rgb;
+    vec3 albedo = base.rgb * (1.0 - material_metallic_roughness(v_uv, v_uv1).x); // diffuse
     if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff) // after every derivative
         discard;
 

@@ -217,15 +217,14 @@ layout(std430, binding = LPV_SSBO_AREA_REST) buffer AreaRest
 };
 #endif
 
-// kd x albedo / pi at pixel px (metallic_w: the G-buffer normal's w). With
-// the glossy pass on, a glossy surface's diffuse part gives way to its
-// specular part (glossy.frag adds F0 x the LPV's radiance along the
-// reflection): kd = (1 - metallic)(1 - 0.04).
+// The diffuse albedo / pi at pixel px (metallic_w: the G-buffer normal's
+// w): base x (1 - metallic) (lpv_gbuffer_kd). With the glossy pass on, a
+// glossy surface's diffuse part gives way to its specular part too
+// (glossy.frag adds F0 x the LPV's radiance along the reflection): x (1 - 0.04).
 vec3 diffuse_reflectance(ivec2 px, float metallic_w)
 {
     vec4 a = texelFetch(u_gbuf_albedo, px, 0);
-    float metallic = clamp(metallic_w - 1.0, 0.0, 1.0);
-    float kd = a.a < u_glossy_roughness ? (1.0 - metallic) * (1.0 - 0.04) : 1.0;
+    float kd = lpv_gbuffer_kd(metallic_w) * (a.a < u_glossy_roughness ? 1.0 - 0.04 : 1.0);
     return kd * a.rgb / LPV_PI;
 }
 

@@ -43,12 +43,10 @@ static int b_material(builder *b, float r, float g, float bl, float er, float eg
     b->s.materials = realloc(b->s.materials, (b->s.material_count + 1) * sizeof *b->s.materials);
     assert_non_null(b->s.materials);
     lpv_material *m = &b->s.materials[b->s.material_count];
-    memset(m, 0, sizeof *m);
+    lpv_material_init(m);
     m->base_color[0] = r;
     m->base_color[1] = g;
     m->base_color[2] = bl;
-    m->base_color[3] = 1.0f;
-    m->base_color_texture = -1;
     m->emission[0] = er;
     m->emission[1] = eg;
     m->emission[2] = eb;

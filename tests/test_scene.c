@@ -188,8 +188,7 @@ static void make_dark_scene(lpv_scene *s)
     const uint32_t idx[6] = {0, 2, 1, 0, 3, 2};
     memcpy(s->indices, idx, sizeof idx);
     s->draws[0].index_count = 6;
-    s->materials[0].base_color[0] = s->materials[0].base_color[1] = s->materials[0].base_color[2] = 1.0f;
-    s->materials[0].base_color_texture = -1;
+    lpv_material_init(&s->materials[0]);
     lpv_scene_compute_bounds(s);
 }
 
