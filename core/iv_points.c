@@ -27,6 +27,7 @@ typedef struct walk {
     int n;
     uint32_t seed;
     const lpv_material *m;
+    int vertex_color; /* the draw's lpv_draw.vertex_color */
     int emission;
 } walk;
 
@@ -153,14 +154,17 @@ static void emit_piece(walk *w, const double pb[3][3])
         double dot = n[0] * w->front[0] + n[1] * w->front[1] + n[2] * w->front[2];
         const int usable = isfinite(len2) && len2 > 1e-12 && dot > 0.0;
         /* the material at the point (its textures: core/material_sample.h) */
-        float uv0[2] = {0, 0}, uv1[2] = {0, 0}, albedo[3] = {1, 1, 1}, emission[3] = {0, 0, 0};
-        for (int j = 0; j < 3; ++j)
+        float uv0[2] = {0, 0}, uv1[2] = {0, 0}, col[4] = {0, 0, 0, 0}, albedo[3] = {1, 1, 1}, emission[3] = {0, 0, 0};
+        for (int j = 0; j < 3; ++j) {
             for (int c = 0; c < 2; ++c) {
                 uv0[c] += (float)b[j] * w->v[j]->uv[c];
                 uv1[c] += (float)b[j] * w->v[j]->uv1[c];
             }
+            for (int c = 0; c < 4; ++c)
+                col[c] += (float)b[j] * w->v[j]->color[c];
+        }
         if (w->m) {
-            lpv_material_albedo_at(w->scene, w->m, uv0, uv1, albedo);
+            lpv_material_albedo_at(w->scene, w->m, uv0, uv1, w->vertex_color ? col : NULL, albedo);
             if (w->emission)
                 lpv_material_emission_at(w->scene, w->m, uv0, uv1, emission);
         }
@@ -192,6 +196,7 @@ static void walk_scene(walk *w)
     for (uint32_t d = 0; d < s->draw_count; ++d) {
         const lpv_draw *dr = &s->draws[d];
         w->m = dr->material >= 0 && (uint32_t)dr->material < s->material_count ? &s->materials[dr->material] : NULL;
+        w->vertex_color = dr->vertex_color;
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
             double area;
             if (dr->first_index + t + 3 > s->index_count ||

@@ -84,13 +84,21 @@ float lpv_material_metallic_at(const lpv_scene *s, const lpv_material *m, const 
 }
 
 void lpv_material_albedo_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
-                            float out[3])
+                            const float *color, float out[3])
 {
     float t[4] = {1.0f, 1.0f, 1.0f, 1.0f};
     sample(s, m->base_color_texture, 0, &m->base_color_uv, uv0, uv1, t);
     const float kd = 1.0f - lpv_material_metallic_at(s, m, uv0, uv1);
     for (int c = 0; c < 3; ++c)
-        out[c] = unit(m->base_color[c] * t[c]) * kd;
+        out[c] = unit(m->base_color[c] * t[c] * (color ? color[c] : 1.0f)) * kd;
+}
+
+float lpv_material_occlusion_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2])
+{
+    float t[4];
+    if (!sample(s, m->occlusion_texture, 1, &m->occlusion_uv, uv0, uv1, t))
+        return 1.0f;
+    return unit(1.0f + m->occlusion_strength * (t[0] - 1.0f));
 }
 
 void lpv_material_emission_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],

@@ -34,10 +34,15 @@ void lpv_material_uv(const lpv_uv_transform *t, const float uv0[2], const float 
 /* Metallic at a surface point (factor x texture B), clamped to [0, 1]. */
 float lpv_material_metallic_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2]);
 
-/* The diffuse albedo at a surface point: base colour x (1 - metallic), each
- * channel clamped to [0, 1]. */
+/* The diffuse albedo at a surface point: base colour (x color, the point's
+ * COLOR_0, where not NULL) x (1 - metallic), each channel clamped to [0, 1]. */
 void lpv_material_albedo_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
-                            float out[3]);
+                            const float *color, float out[3]);
+
+/* The factor the frame's indirect (ambient) light takes at a surface point
+ * from the occlusionTexture: 1 + strength x (R - 1), in [0, 1]; 1 without
+ * one. Not applied to the GI (the bounces), only where a camera looks. */
+float lpv_material_occlusion_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2]);
 
 /* The emitted radiance at a surface point, W/(m^2 sr). */
 void lpv_material_emission_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],

@@ -27,7 +27,7 @@
 #define LPV_MEM_GV_POINT 80u      /* per geometry-volume point: the total (48, an LpvGvPoint) and atlas
                                      (2 x RGBA32F) */
 #define LPV_MEM_CELL_BUFFER 48u   /* the largest single grid buffer (one LpvCell per cell) */
-#define LPV_MEM_PIXEL 108u        /* G-buffer (RGBA32F x3, RGBA16F), depth, frame (RGBA32F) per pixel, the
+#define LPV_MEM_PIXEL 109u        /* G-buffer (RGBA32F x3, RGBA16F, R8), depth, frame (RGBA32F) per pixel, the
                                      lookup step's and the area shadow step's blocks (2 x RGBA32F each per
                                      block of >= 2 x 2 pixels) and the frame's two lists for second passes
                                      (an ivec2 per pixel each) */

@@ -149,7 +149,10 @@ void lpv_material_init(lpv_material *m)
     m->alpha_cutoff = 0.5f;
     m->normal_scale = 1.0f;
     m->base_color_texture = m->normal_texture = m->metallic_roughness_texture = m->emissive_texture = -1;
-    lpv_uv_transform *uv[] = {&m->base_color_uv, &m->normal_uv, &m->metallic_roughness_uv, &m->emissive_uv};
+    m->occlusion_texture = -1;
+    m->occlusion_strength = 1.0f;
+    lpv_uv_transform *uv[] = {&m->base_color_uv, &m->normal_uv, &m->metallic_roughness_uv, &m->emissive_uv,
+                              &m->occlusion_uv};
     for (size_t i = 0; i < sizeof uv / sizeof uv[0]; ++i)
         uv[i]->scale[0] = uv[i]->scale[1] = 1.0f;
 }

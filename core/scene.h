@@ -102,6 +102,9 @@ typedef struct lpv_material {
     lpv_uv_transform metallic_roughness_uv;
     int emissive_texture;   /* index into textures, -1 = none; sRGB colour x emission */
     lpv_uv_transform emissive_uv;
+    int occlusion_texture;  /* index into textures, -1 = none; linear: R darkens the frame's indirect light */
+    float occlusion_strength; /* glTF occlusionTexture.strength: 1 + strength x (R - 1) */
+    lpv_uv_transform occlusion_uv;
 } lpv_material;
 
 /* A material at glTF's defaults: white, opaque, metallic 0, roughness 1,
@@ -116,6 +119,7 @@ typedef struct lpv_vertex {
     float uv[2];       /* TEXCOORD_0 */
     float uv1[2];      /* TEXCOORD_1 (zero when absent) */
     float tangent[4];  /* world xyz unit and handedness w = +-1 (the file's TANGENT); all zero = none */
+    float color[4];    /* COLOR_0, linear RGBA (alpha 1 for a VEC3); read only where the draw's vertex_color is 1 */
 } lpv_vertex;
 
 /* A run of triangles (3 indices each) sharing one material. */
@@ -123,6 +127,7 @@ typedef struct lpv_draw {
     uint32_t first_index;
     uint32_t index_count;
     int material; /* index into materials */
+    int vertex_color; /* 1: the vertices' color (COLOR_0) multiplies the base colour and its alpha (glTF) */
 } lpv_draw;
 
 /* A participating medium (docs/scenes.md, "Media"): single scattering with an

@@ -22,6 +22,10 @@
 #include "technique.h"
 #include "timer.h"
 
+/* The G-buffer's targets (gbuffer.frag): position, normal, albedo,
+ * emission, occlusion. */
+#define LPV_GBUF_TARGETS 5
+
 typedef struct lpv_gpu_material {
     float base_color[4];
     float emission[3];
@@ -41,12 +45,17 @@ typedef struct lpv_gpu_material {
     int emissive_texture; /* emissiveTexture: index into lpv_engine.textures (sRGB), -1 none */
     int emissive_uv_set;
     float emissive_uv[6];
+    int occlusion_texture; /* occlusionTexture: index into lpv_engine.textures (linear), -1 none */
+    float occlusion_strength;
+    int occlusion_uv_set;
+    float occlusion_uv[6];
 } lpv_gpu_material;
 
 typedef struct lpv_gpu_draw {
     uint32_t first_index, index_count;
     int material;
     float size; /* m, longest side of the draw's bounding box (cascade fading) */
+    int vertex_color; /* lpv_draw.vertex_color */
 } lpv_gpu_draw;
 
 /* The frame's variants (shade.comp's defines, shading.glsl), a bit each. */
@@ -189,7 +198,7 @@ struct lpv_engine {
     int gbuf_w, gbuf_h;
     /* the camera's surfels: blocks of camera_surfel_step pixels, camera_surfel_slots surfels each */
     int camera_surfel_w, camera_surfel_h, camera_surfel_slots;
-    GLuint gbuf_tex[4], gbuf_depth, gbuf_fbo, camera_surfels;
+    GLuint gbuf_tex[LPV_GBUF_TARGETS], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
     GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
     GLuint area_rest;  /* the pixels left for area_shadow_rest.comp (the same layout) */

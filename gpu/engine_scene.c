@@ -292,7 +292,8 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         if ((uint64_t)d->first_index + d->index_count > scene->index_count)
             return lpv_error(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
         e->draws[e->draw_count++] =
-            (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, draw_size(scene, d)};
+            (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, draw_size(scene, d),
+                           d->vertex_color != 0};
         const lpv_material *m = (d->material >= 0 && (uint32_t)d->material < scene->material_count)
                                     ? &scene->materials[d->material]
                                     : NULL;
@@ -328,13 +329,17 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         g->emissive_texture = lpv_material_texture(scene, m->emissive_texture, 0);
         g->emissive_uv_set = m->emissive_uv.texcoord == 1;
         lpv_uv_transform_matrix(&m->emissive_uv, g->emissive_uv);
+        g->occlusion_texture = lpv_material_texture(scene, m->occlusion_texture, 1);
+        g->occlusion_strength = m->occlusion_strength;
+        g->occlusion_uv_set = m->occlusion_uv.texcoord == 1;
+        lpv_uv_transform_matrix(&m->occlusion_uv, g->occlusion_uv);
     }
     e->material_count = scene->material_count;
     e->materials_plain = 1;
     for (uint32_t i = 0; i < e->material_count; ++i) {
         const lpv_gpu_material *g = &e->materials[i];
         if (g->texture >= 0 || g->normal_texture >= 0 || g->mr_texture >= 0 || g->emissive_texture >= 0 ||
-            g->alpha_cutoff > 0.0f)
+            g->occlusion_texture >= 0 || g->alpha_cutoff > 0.0f)
             e->materials_plain = 0;
     }
     if (upload_textures(e, scene, err, err_size) != 0)
@@ -360,6 +365,8 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, uv1));
     glEnableVertexAttribArray(4);
     glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, tangent));
+    glEnableVertexAttribArray(5);
+    glVertexAttribPointer(5, 4, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, color));
     glBindVertexArray(0);
 
     /* before the lights: a light in a solid reach voxel is looked at closer
@@ -415,6 +422,7 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
     GLint loc_normal_set = glGetUniformLocation(prog, "u_normal_uv_set");
     GLint loc_normal_row0 = glGetUniformLocation(prog, "u_normal_uv_row0");
     GLint loc_normal_row1 = glGetUniformLocation(prog, "u_normal_uv_row1");
+    GLint loc_vertex_color = glGetUniformLocation(prog, "u_vertex_color");
     GLint loc_has_mr = glGetUniformLocation(prog, "u_has_mr_texture");
     GLint loc_mr_set = glGetUniformLocation(prog, "u_mr_uv_set");
     GLint loc_mr_row0 = glGetUniformLocation(prog, "u_mr_uv_row0");
@@ -423,6 +431,11 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
     GLint loc_emissive_set = glGetUniformLocation(prog, "u_emissive_uv_set");
     GLint loc_emissive_row0 = glGetUniformLocation(prog, "u_emissive_uv_row0");
     GLint loc_emissive_row1 = glGetUniformLocation(prog, "u_emissive_uv_row1");
+    GLint loc_has_occlusion = glGetUniformLocation(prog, "u_has_occlusion_texture");
+    GLint loc_occlusion_strength = glGetUniformLocation(prog, "u_occlusion_strength");
+    GLint loc_occlusion_set = glGetUniformLocation(prog, "u_occlusion_uv_set");
+    GLint loc_occlusion_row0 = glGetUniformLocation(prog, "u_occlusion_uv_row0");
+    GLint loc_occlusion_row1 = glGetUniformLocation(prog, "u_occlusion_uv_row1");
     glBindVertexArray(e->vao);
     glCullFace(GL_BACK);
     glFrontFace(GL_CCW); /* glTF's front faces; the loader rewinds mirrored nodes */
@@ -431,7 +444,8 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
         static const lpv_gpu_material fallback = {
             .base_color = {1, 1, 1, 1}, .roughness = 1.0f, .texture = -1, .double_sided = 1,
             .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0},
-            .mr_texture = -1, .mr_uv = {1, 0, 0, 0, 1, 0}, .emissive_texture = -1, .emissive_uv = {1, 0, 0, 0, 1, 0}};
+            .mr_texture = -1, .mr_uv = {1, 0, 0, 0, 1, 0}, .emissive_texture = -1, .emissive_uv = {1, 0, 0, 0, 1, 0},
+            .occlusion_texture = -1, .occlusion_strength = 1.0f, .occlusion_uv = {1, 0, 0, 0, 1, 0}};
         const lpv_gpu_material *m =
             (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
         glUniform4fv(loc_color, 1, m->base_color);
@@ -449,6 +463,7 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
         glUniform1i(loc_normal_set, m->normal_uv_set);
         glUniform3fv(loc_normal_row0, 1, &m->normal_uv[0]);
         glUniform3fv(loc_normal_row1, 1, &m->normal_uv[3]);
+        glUniform1i(loc_vertex_color, d->vertex_color);
         glUniform1i(loc_has_mr, m->mr_texture >= 0);
         glUniform1i(loc_mr_set, m->mr_uv_set);
         glUniform3fv(loc_mr_row0, 1, &m->mr_uv[0]);
@@ -457,9 +472,15 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
         glUniform1i(loc_emissive_set, m->emissive_uv_set);
         glUniform3fv(loc_emissive_row0, 1, &m->emissive_uv[0]);
         glUniform3fv(loc_emissive_row1, 1, &m->emissive_uv[3]);
-        /* material.glsl's units: base colour, normal, metallic-roughness, emissive */
-        const int unit_texture[4] = {m->texture, m->normal_texture, m->mr_texture, m->emissive_texture};
-        for (int u = 0; u < 4; ++u) {
+        glUniform1i(loc_has_occlusion, m->occlusion_texture >= 0);
+        glUniform1f(loc_occlusion_strength, m->occlusion_strength);
+        glUniform1i(loc_occlusion_set, m->occlusion_uv_set);
+        glUniform3fv(loc_occlusion_row0, 1, &m->occlusion_uv[0]);
+        glUniform3fv(loc_occlusion_row1, 1, &m->occlusion_uv[3]);
+        /* material.glsl's units: base colour, normal, metallic-roughness, emissive, occlusion */
+        const int unit_texture[5] = {m->texture, m->normal_texture, m->mr_texture, m->emissive_texture,
+                                     m->occlusion_texture};
+        for (int u = 0; u < 5; ++u) {
             glActiveTexture(GL_TEXTURE0 + (GLenum)u);
             glBindTexture(GL_TEXTURE_2D, unit_texture[u] >= 0 ? e->textures[unit_texture[u]] : 0);
         }

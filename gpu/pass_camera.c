@@ -16,7 +16,7 @@
  * this is the one list of them. */
 void lpv_pass_camera_free(lpv_engine *e)
 {
-    for (int i = 0; i < 4; ++i)
+    for (int i = 0; i < LPV_GBUF_TARGETS; ++i)
         lpv_gl_delete_texture(&e->gbuf_tex[i]);
     lpv_gl_delete_texture(&e->gbuf_depth);
     lpv_gl_delete_texture(&e->frame_tex);
@@ -39,18 +39,18 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     lpv_pass_camera_free(e);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
-    static const GLenum formats[4] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F};
+    static const GLenum formats[LPV_GBUF_TARGETS] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F, GL_R8};
     glGenFramebuffers(1, &e->gbuf_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
-    GLenum bufs[4];
-    for (int i = 0; i < 4; ++i) {
+    GLenum bufs[LPV_GBUF_TARGETS];
+    for (int i = 0; i < LPV_GBUF_TARGETS; ++i) {
         e->gbuf_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf_tex[i], 0);
         bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
     }
     e->gbuf_depth = lpv_gl_new_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf_depth, 0);
-    glDrawBuffers(4, bufs);
+    glDrawBuffers(LPV_GBUF_TARGETS, bufs);
 
     glGenFramebuffers(1, &e->frame_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->frame_fbo);
@@ -132,7 +132,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
     glViewport(0, 0, v->width, v->height);
     static const float zero[4] = {0, 0, 0, 0};
-    for (int i = 0; i < 4; ++i)
+    for (int i = 0; i < LPV_GBUF_TARGETS; ++i)
         glClearBufferfv(GL_COLOR, i, zero);
     glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
     glDisable(GL_BLEND);
@@ -276,6 +276,8 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
     }
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_GBUF_OCCLUSION);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[4]);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);

@@ -19,6 +19,7 @@ typedef struct ref_tri {
     float p0[3], e1[3], e2[3]; /* corners p0, p0 + e1, p0 + e2 */
     float vn[3][3];            /* vertex normals (unit; the front normal where the file's was bad) */
     float uv[3][2], uv1[3][2]; /* TEXCOORD_0, TEXCOORD_1 */
+    float color[3][3];         /* COLOR_0's rgb at the corners; 1 where the draw has none */
     float front[3]; /* unit geometric normal of the front side (the emitting one, or the first of two) */
     int material;   /* -1 = none: black, not emissive */
 } ref_tri;
@@ -153,7 +154,7 @@ static void sample_cosine(pcg32 *r, const float n[3], float out[3])
 
 
 /* Keeps triangle `first` of the scene if it is usable. */
-static int make_tri(const lpv_scene *s, uint32_t first, int material, ref_tri *t)
+static int make_tri(const lpv_scene *s, uint32_t first, int material, int vertex_color, ref_tri *t)
 {
     /* The front is the same side core/emissive.c emits from. */
     const lpv_vertex *v[3];
@@ -172,6 +173,8 @@ static int make_tri(const lpv_scene *s, uint32_t first, int material, ref_tri *t
             t->uv[k][i] = isfinite(v[k]->uv[i]) ? v[k]->uv[i] : 0.0f;
             t->uv1[k][i] = isfinite(v[k]->uv1[i]) ? v[k]->uv1[i] : 0.0f;
         }
+        for (int i = 0; i < 3; ++i)
+            t->color[k][i] = vertex_color && isfinite(v[k]->color[i]) ? v[k]->color[i] : 1.0f;
     }
     t->material = material;
     return 1;
@@ -323,7 +326,7 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
             uint64_t first = (uint64_t)dr->first_index + k;
             if (!scene->indices || first + 3 > scene->index_count)
                 break;
-            if (make_tri(scene, (uint32_t)first, mat, &r->tris[r->tri_count]))
+            if (make_tri(scene, (uint32_t)first, mat, dr->vertex_color, &r->tris[r->tri_count]))
                 r->tri_count++;
         }
     }
@@ -555,9 +558,25 @@ static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
+    float uv0[2], uv1[2], color[3];
+    tri_uv(tr, h->u, h->v, uv0, uv1);
+    const float w = 1.0f - h->u - h->v;
+    for (int i = 0; i < 3; ++i)
+        color[i] = w * tr->color[0][i] + h->u * tr->color[1][i] + h->v * tr->color[2][i];
+    lpv_material_albedo_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
+}
+
+/* The factor a hit's indirect light takes in the image: its material's
+ * occlusionTexture (core/material_sample.h), 1 without one: lpvd applies it
+ * to the frame's indirect term, so the reference's image does the same. */
+static float hit_occlusion(const lpv_ref *r, const hit *h)
+{
+    const ref_tri *tr = &r->tris[h->tri];
+    if (tr->material < 0)
+        return 1.0f;
     float uv0[2], uv1[2];
     tri_uv(tr, h->u, h->v, uv0, uv1);
-    lpv_material_albedo_at(&r->look, &r->look.materials[tr->material], uv0, uv1, out);
+    return lpv_material_occlusion_at(&r->look, &r->look.materials[tr->material], uv0, uv1);
 }
 
 /* The radiance a hit's side emits (W/(m^2 sr), x its emissiveTexture): 0
@@ -988,12 +1007,35 @@ static void pixel_item(job *j, size_t i)
         return;
     float alb[3], e[3] = {0, 0, 0}, se[3] = {0, 0, 0}, ed[3] = {0, 0, 0};
     hit_albedo(j->ref, &h, alb);
+    const float occ = hit_occlusion(j->ref, &h);
     if (alb[0] > 0.0f || alb[1] > 0.0f || alb[2] > 0.0f) {
-        if (j->full) { /* direct light (punctual exactly, emitters sampled) and the bounces */
+        if (j->full && occ < 1.0f) {
+            /* the bounces alone take the occlusion: the emitters' direct
+             * light apart (its own streams), then the bounces */
+            estimate_mode(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, 1, 0, e, se);
+            double em[3] = {0, 0, 0};
+            for (int s = 0; s < j->samples; ++s) {
+                pcg32 rng;
+                pcg32_seed(&rng, j->ref->seed ^ 0x9e3779b97f4a7c15ull, (uint64_t)i, (uint64_t)s);
+                double em_s[3];
+                emitter_direct(j->ref, &rng, h.p, h.ns, h.ng, em_s);
+                for (int c = 0; c < 3; ++c)
+                    em[c] += em_s[c] / j->samples;
+            }
+            for (int c = 0; c < 3; ++c) {
+                e[c] = occ * e[c] + (float)em[c];
+                se[c] *= occ;
+            }
+            direct(j->ref, h.p, h.ns, h.ng, ed);
+        } else if (j->full) { /* direct light (punctual exactly, emitters sampled) and the bounces */
             estimate_mode(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, 1, 1, e, se);
             direct(j->ref, h.p, h.ns, h.ng, ed);
         } else {
             estimate(j->ref, (uint64_t)i, h.p, h.ns, h.ng, j->bounces, j->samples, e, se);
+            for (int c = 0; c < 3; ++c) {
+                e[c] *= occ;
+                se[c] *= occ;
+            }
         }
     }
     float le[3] = {0.0f, 0.0f, 0.0f};

@@ -72,6 +72,8 @@ std::string draco_decode(const unsigned char *data, size_t len, const std::map<s
                        " has no value";
             for (int k = 0; k < n && k < a->num_components(); k++)
                 v[size_t(p.value()) * size_t(n) + size_t(k)] = tmp[k];
+            if (kv.first == "COLOR_0" && a->num_components() == 3 && n == 4)
+                v[size_t(p.value()) * 4 + 3] = 1.0f; /* an RGB colour is opaque */
         }
     }
     return "";

@@ -143,29 +143,27 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
     }
 
     /* Materials lpvd approximates or reads only in part. */
-    Uses blend, occlusion, far_uv;
+    Uses blend, far_uv;
     std::set<int> far_sets;
     for (size_t i = 0; i < m.materials.size(); i++) {
         const tinygltf::Material &g = m.materials[i];
         const int k = int(i);
         if (g.alphaMode == "BLEND")
             blend.add("material", k);
-        if (g.occlusionTexture.index >= 0)
-            occlusion.add("material", k);
-        for (const auto *t : {&g.pbrMetallicRoughness.baseColorTexture, &g.pbrMetallicRoughness.metallicRoughnessTexture,
-                              &g.emissiveTexture})
+        for (const tinygltf::TextureInfo *t :
+             {&g.pbrMetallicRoughness.baseColorTexture, &g.pbrMetallicRoughness.metallicRoughnessTexture,
+              &g.emissiveTexture})
             if (t->index >= 0 && t->texCoord > 1)
                 far_uv.add("material", k), far_sets.insert(t->texCoord);
         if (g.normalTexture.index >= 0 && g.normalTexture.texCoord > 1)
             far_uv.add("material", k), far_sets.insert(g.normalTexture.texCoord);
+        if (g.occlusionTexture.index >= 0 && g.occlusionTexture.texCoord > 1)
+            far_uv.add("material", k), far_sets.insert(g.occlusionTexture.texCoord);
     }
     if (blend.total)
         out.push_back("alphaMode BLEND (" + blend.describe() +
                       "): no blending; drawn as MASK with alphaCutoff 0.5 (alpha >= 0.5 opaque, the rest cut away) "
                       "for the camera and the lights alike");
-    if (occlusion.total)
-        out.push_back("occlusionTexture (" + occlusion.describe() +
-                      "): not used; lpvd computes occlusion from the scene's geometry");
     if (far_uv.total) {
         std::string sets;
         for (int s : far_sets)
@@ -190,7 +188,8 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
         for (const tinygltf::Primitive &p : m.meshes[i].primitives) {
             for (const auto &a : p.attributes) {
                 const std::string &n = a.first;
-                if (n == "POSITION" || n == "NORMAL" || n == "TANGENT" || n == "TEXCOORD_0" || n == "TEXCOORD_1")
+                if (n == "POSITION" || n == "NORMAL" || n == "TANGENT" || n == "TEXCOORD_0" || n == "TEXCOORD_1" ||
+                    n == "COLOR_0")
                     continue;
                 if (n.compare(0, 9, "TEXCOORD_") == 0)
                     continue; /* reported with the textures that ask for them */

@@ -197,6 +197,12 @@ void Builder::convert_materials()
         mat.emissive_texture = texture_for(mi, "emissiveTexture", gm.emissiveTexture.index, false);
         texture_uv(mi, "emissiveTexture", gm.emissiveTexture.texCoord, gm.emissiveTexture.extensions,
                    &mat.emissive_uv);
+        const tinygltf::OcclusionTextureInfo &ot = gm.occlusionTexture;
+        mat.occlusion_texture = texture_for(mi, "occlusionTexture", ot.index, true);
+        texture_uv(mi, "occlusionTexture", ot.texCoord, ot.extensions, &mat.occlusion_uv);
+        if (!std::isfinite(ot.strength) || ot.strength < 0.0 || ot.strength > 1.0)
+            fail("material %d: occlusionTexture.strength must be a number in [0, 1]", mi);
+        mat.occlusion_strength = float(ot.strength);
         const tinygltf::NormalTextureInfo &nt = gm.normalTexture;
         mat.normal_texture = texture_for(mi, "normalTexture", nt.index, true);
         texture_uv(mi, "normalTexture", nt.texCoord, nt.extensions, &mat.normal_uv);

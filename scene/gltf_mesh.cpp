@@ -7,6 +7,8 @@
  * world winding (its vertices un-shared).
  */
 #include "gltf_internal.hpp"
+
+#include <algorithm>
 #include "gltf_compressed.hpp"
 
 #include <climits>
@@ -42,7 +44,7 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         if (!bvv.IsNumber() || !attrs.IsObject())
             fail("mesh %d primitive %d: KHR_draco_mesh_compression needs a bufferView and attributes", mesh, prim);
         std::map<std::string, int> ids, comps = {{"POSITION", 3}, {"NORMAL", 3}, {"TEXCOORD_0", 2},
-                                                 {"TEXCOORD_1", 2}, {"TANGENT", 4}};
+                                                 {"TEXCOORD_1", 2}, {"TANGENT", 4}, {"COLOR_0", 4}};
         for (const std::string &k : attrs.Keys()) {
             const tinygltf::Value &id = attrs.Get(k);
             double v = id.IsNumber() ? id.GetNumberAsDouble() : -1.0;
@@ -100,6 +102,26 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         if (attribute(a.name, a.ncomp, *a.out) && a.out->size() / size_t(a.ncomp) != nv)
             fail("mesh %d primitive %d: %s has %zu elements but POSITION has %zu", mesh, prim, a.name,
                  a.out->size() / size_t(a.ncomp), nv);
+
+    /* COLOR_0: VEC3 or VEC4, float or normalized unsigned byte/short
+     * (read_accessor normalizes); linear RGB(A) multiplying the base colour */
+    std::vector<float> col;
+    int col_comps = 0;
+    {
+        auto it = p.attributes.find("COLOR_0");
+        const bool in_draco = is_draco && draco.attributes.count("COLOR_0");
+        if (in_draco) {
+            col = draco.attributes["COLOR_0"]; /* RGBA (gltf_compressed.cpp) */
+            col_comps = 4;
+        } else if (it != p.attributes.end() && it->second >= 0 && size_t(it->second) < m_.accessors.size()) {
+            col_comps = m_.accessors[size_t(it->second)].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+            snprintf(what, sizeof what, "mesh %d primitive %d COLOR_0", mesh, prim);
+            read_accessor(it->second, col_comps, what, col);
+        }
+        if (!col.empty() && col.size() != nv * size_t(col_comps))
+            fail("mesh %d primitive %d: COLOR_0 has %zu elements but POSITION has %zu", mesh, prim,
+                 col.size() / size_t(col_comps ? col_comps : 1), nv);
+    }
 
     std::vector<uint32_t> idx;
     if (is_draco) {
@@ -167,6 +189,10 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         out.uv[1] = uv.empty() ? 0.0f : uv[v * 2 + 1];
         if (!std::isfinite(out.uv[0]) || !std::isfinite(out.uv[1]))
             out.uv[0] = out.uv[1] = 0.0f;
+        for (int k = 0; k < 4; k++) {
+            const float c = col.empty() || k >= col_comps ? 1.0f : col[v * size_t(col_comps) + size_t(k)];
+            out.color[k] = std::isfinite(c) ? std::min(std::max(c, 0.0f), 1.0f) : 1.0f;
+        }
         out.uv1[0] = uv1.empty() ? 0.0f : uv1[v * 2];
         out.uv1[1] = uv1.empty() ? 0.0f : uv1[v * 2 + 1];
         if (!std::isfinite(out.uv1[0]) || !std::isfinite(out.uv1[1]))
@@ -195,6 +221,7 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
     draw.first_index = uint32_t(indices.size());
     draw.index_count = uint32_t(ntri * 3);
     draw.material = material;
+    draw.vertex_color = col.empty() ? 0 : 1;
 
     if (!nrm.empty()) {
         const uint32_t base = uint32_t(vertices.size());

@@ -7,6 +7,7 @@ in vec3 v_normal;
 in vec2 v_uv;
 in vec2 v_uv1;
 in vec4 v_tangent;
+in vec4 v_color;
 
 uniform vec3 u_eye;
 uniform float u_pixel_solid_angle; // sr per pixel at the image centre (perspective), 0 = orthographic
@@ -17,6 +18,7 @@ layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0
 layout(location = 1) out vec4 o_normal;   // xyz unit shading normal, on the camera's side; w 1 + metallic where covered
 layout(location = 2) out vec4 o_albedo;   // rgb linear base colour (diffuse: x lpv_gbuffer_kd); a roughness
 layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr); a object size (m)
+layout(location = 4) out float o_occlusion; // the frame's indirect light x this (occlusionTexture; 1 = open)
 
 void main()
 {
@@ -31,7 +33,7 @@ void main()
         // mapped on the front side, then turned with the side seen (glTF)
         n = side * normal_mapped(side * n, p, v_tangent, uvn);
     }
-    vec4 base = material_albedo(v_uv, v_uv1);
+    vec4 base = material_albedo(v_uv, v_uv1, v_color);
     float area;
     if (u_pixel_solid_angle > 0.0) {
         vec3 d = p - u_eye;
@@ -50,4 +52,5 @@ void main()
     o_normal = vec4(n, 1.0 + mr.x); // w >= 1: covered; w - 1: metallic (lpv_gbuffer_kd)
     o_albedo = vec4(base.rgb, mr.y);
     o_emission = vec4(material_emission(v_uv, v_uv1), u_object_size);
+    o_occlusion = material_occlusion(v_uv, v_uv1);
 }

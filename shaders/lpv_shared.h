@@ -576,6 +576,8 @@ float lpv_gbuffer_kd(float normal_w) { return 1.0 - clamp(normal_w - 1.0, 0.0, 1
  * the scene's voxels, each LPV_REACH_SOLID, _DARK (air no light reaches) or
  * _LIT; every pass that reads the technique's volume multiplies by it. */
 #define LPV_TEX_REACH 16
+/* The G-buffer's occlusion target (gbuffer.frag o_occlusion) in the frame. */
+#define LPV_TEX_GBUF_OCCLUSION 17
 #define LPV_REACH_SOLID 0
 #define LPV_REACH_DARK 1
 #define LPV_REACH_LIT 2

@@ -11,6 +11,7 @@
 #endif
 uniform vec4 u_base_color;      // linear RGBA factor
 uniform int u_has_texture;      // base colour texture bound to unit 0 (sRGB, decoded by GL)
+uniform int u_vertex_color;     // 1: the vertices' COLOR_0 multiplies the base colour (the draw's lpv_draw.vertex_color)
 uniform vec3 u_emission;        // W/(m^2 sr)
 uniform float u_roughness;      // glTF roughness (0 mirror .. 1 matte)
 uniform float u_metallic;       // glTF metallic (0 dielectric .. 1 metal)
@@ -40,6 +41,13 @@ layout(binding = 0) uniform sampler2D u_base_texture;
 layout(binding = 1) uniform sampler2D u_normal_texture;
 layout(binding = 2) uniform sampler2D u_mr_texture;
 layout(binding = 3) uniform sampler2D u_emissive_texture;
+// occlusionTexture on unit 4 (linear R), its strength, uv set and rows
+uniform int u_has_occlusion_texture;
+uniform float u_occlusion_strength;
+uniform int u_occlusion_uv_set;
+uniform vec3 u_occlusion_uv_row0;
+uniform vec3 u_occlusion_uv_row1;
+layout(binding = 4) uniform sampler2D u_occlusion_texture;
 
 vec2 texture_uv(int set, vec3 row0, vec3 row1, vec2 uv0, vec2 uv1)
 {
@@ -47,9 +55,13 @@ vec2 texture_uv(int set, vec3 row0, vec3 row1, vec2 uv0, vec2 uv1)
     return vec2(dot(row0, uv), dot(row1, uv));
 }
 
-vec4 material_albedo(vec2 uv0, vec2 uv1)
+// the base colour: factor x texture x COLOR_0 (color: the vertex's, read
+// where u_vertex_color is 1)
+vec4 material_albedo(vec2 uv0, vec2 uv1, vec4 color)
 {
     vec4 c = u_base_color;
+    if (u_vertex_color != 0)
+        c *= color;
     if (LPV_MATERIAL_PLAIN == 0 && u_has_texture != 0)
         c *= texture(u_base_texture, texture_uv(u_base_uv_set, u_base_uv_row0, u_base_uv_row1, uv0, uv1));
     return c;
@@ -74,6 +86,17 @@ vec3 material_emission(vec2 uv0, vec2 uv1)
         e *= texture(u_emissive_texture,
                      texture_uv(u_emissive_uv_set, u_emissive_uv_row0, u_emissive_uv_row1, uv0, uv1)).rgb;
     return e;
+}
+
+// the factor the frame's indirect light takes here: 1 + strength x (R - 1)
+// (glTF's occlusionTexture; core/material_sample.h lpv_material_occlusion_at)
+float material_occlusion(vec2 uv0, vec2 uv1)
+{
+    if (LPV_MATERIAL_PLAIN != 0 || u_has_occlusion_texture == 0)
+        return 1.0;
+    float r = texture(u_occlusion_texture,
+                      texture_uv(u_occlusion_uv_set, u_occlusion_uv_row0, u_occlusion_uv_row1, uv0, uv1)).r;
+    return clamp(1.0 + u_occlusion_strength * (r - 1.0), 0.0, 1.0);
 }
 
 #ifdef LPV_STAGE_FRAGMENT

@@ -10,6 +10,7 @@ in vec3 v_normal;
 in vec2 v_uv;
 in vec2 v_uv1;
 in vec4 v_tangent;
+in vec4 v_color;
 
 uniform int u_face;
 
@@ -49,7 +50,7 @@ void main()
         texel_area_perp = omega * dist2;
     }
     vec3 power = e_perp * texel_area_perp;
-    vec4 base = material_albedo(v_uv, v_uv1);
+    vec4 base = material_albedo(v_uv, v_uv1, v_color);
     vec3 albedo = base.rgb * (1.0 - material_metallic_roughness(v_uv, v_uv1).x); // diffuse
     if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff) // after every derivative
         discard;

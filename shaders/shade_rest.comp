@@ -18,6 +18,6 @@ void main()
         vec4 nrm = texelFetch(u_gbuf_normal, px, 0);
         vec3 e = V.shading.x * lpv_reach(pos.xyz, nrm.xyz) * lpv_irradiance(pos.xyz, nrm.xyz);
         vec4 c = imageLoad(u_frame, px);
-        imageStore(u_frame, px, vec4(c.rgb + diffuse_reflectance(px, nrm.w) * e, c.a));
+        imageStore(u_frame, px, vec4(c.rgb + diffuse_reflectance(px, nrm.w) * ambient_occlusion(px) * e, c.a));
     }
 }

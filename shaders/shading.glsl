@@ -9,6 +9,11 @@ layout(binding = 0) uniform sampler2D u_gbuf_position;
 layout(binding = 1) uniform sampler2D u_gbuf_normal;
 layout(binding = 2) uniform sampler2D u_gbuf_albedo;
 layout(binding = 3) uniform sampler2D u_gbuf_emission;
+layout(binding = LPV_TEX_GBUF_OCCLUSION) uniform sampler2D u_gbuf_occlusion; // the material's occlusionTexture
+
+// The factor the pixel's indirect light takes (glTF's occlusionTexture: an
+// ambient term of the frame, not of the GI the bounces carry).
+float ambient_occlusion(ivec2 px) { return texelFetch(u_gbuf_occlusion, px, 0).r; }
 
 layout(std140, binding = LPV_UBO_VIEW) uniform ViewUBO { LpvViewBlock V; };
 
@@ -294,7 +299,7 @@ vec4 shade_pixel(ivec2 px)
 #else
     vec3 e_indirect = V.shading.z != 0.0 ? V.shading.x * lpv_reach(p, n) * lpv_irradiance(p, n) : vec3(0.0);
 #endif
-    vec3 radiance = diffuse_reflectance(px, nrm.w) * (e_direct + e_indirect);
+    vec3 radiance = diffuse_reflectance(px, nrm.w) * (e_direct + ambient_occlusion(px) * e_indirect);
     if (V.shading.w != 0.0)
         radiance += emission;
     return vec4(radiance, 1.0);

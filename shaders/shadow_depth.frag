@@ -6,9 +6,10 @@ in vec3 v_normal;
 in vec2 v_uv;
 in vec2 v_uv1;
 in vec4 v_tangent;
+in vec4 v_color;
 
 void main()
 {
-    if (LPV_MATERIAL_PLAIN == 0 && u_alpha_cutoff > 0.0 && material_albedo(v_uv, v_uv1).a < u_alpha_cutoff)
+    if (LPV_MATERIAL_PLAIN == 0 && u_alpha_cutoff > 0.0 && material_albedo(v_uv, v_uv1, v_color).a < u_alpha_cutoff)
         discard;
 }

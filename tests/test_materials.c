@@ -30,6 +30,7 @@
 #include "gltf_load.h"
 #include "emissive.h"
 #include "image_io.h"
+#include "iv_points.h"
 #include "material_sample.h"
 #include "oracle.h"
 #include "pt.h"
@@ -92,6 +93,7 @@ typedef struct quad {
     float uv[4][2];     /* TEXCOORD_0 */
     const float *uv1;   /* 8 floats: TEXCOORD_1, or NULL */
     const float *tangent; /* 4 floats for every corner, or NULL */
+    const float *color;   /* 16 floats: COLOR_0 (VEC4) at the corners, or NULL */
     int material;
 } quad;
 
@@ -125,6 +127,9 @@ static void add_quad(glb *g, const quad *q)
             memcpy(t[c], q->tangent, sizeof t[c]);
         snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ",\"TANGENT\":%d", add_accessor(g, t, 4, 4, 5126));
     }
+    if (q->color)
+        snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ",\"COLOR_0\":%d",
+                 add_accessor(g, q->color, 4, 4, 5126));
     cat(g->meshes, sizeof g->meshes,
         "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d%s},\"indices\":%d,"
         "\"material\":%d}]}",
@@ -667,11 +672,11 @@ static const char *WARN_JSON =
     "'buffers':[{'byteLength':104,'uri':'data:application/octet-stream;base64,%s'}]}";
 
 /* The features above, each named by one line. */
-/* (emissiveTexture and metallicRoughnessTexture are read since issue 32:
- * test_material_textures) */
+/* (emissiveTexture, metallicRoughnessTexture, occlusionTexture and COLOR_0
+ * are read since issue 32: test_material_textures, test_vertex_colours,
+ * test_occlusion_texture) */
 static const char *const WARN_FEATURES[] = {
-    "KHR_materials_clearcoat", "EXT_lpvd_test_unknown", "occlusionTexture", "COLOR_0", "morph targets", "skin",
-    "animation", "2 scenes",
+    "KHR_materials_clearcoat", "EXT_lpvd_test_unknown", "morph targets", "skin", "animation", "2 scenes",
 };
 
 static const char *warn_gltf(void)
@@ -750,9 +755,9 @@ static void test_material_textures(void **state)
     float alb[3], e[3];
     const float metal_uv[2] = {0.2f, 0.5f}, plain_uv[2] = {0.8f, 0.5f}, lit_uv[2] = {0.5f, 0.2f},
                 dark_uv[2] = {0.5f, 0.8f};
-    lpv_material_albedo_at(&s, m, metal_uv, metal_uv, alb);
+    lpv_material_albedo_at(&s, m, metal_uv, metal_uv, NULL, alb);
     assert_true(alb[0] == 0.0f);
-    lpv_material_albedo_at(&s, m, plain_uv, plain_uv, alb);
+    lpv_material_albedo_at(&s, m, plain_uv, plain_uv, NULL, alb);
     assert_float_equal(alb[0], 0.8f, 1e-6f);
     lpv_material_emission_at(&s, m, lit_uv, lit_uv, e);
     assert_float_equal(e[1], 1.0f, 1e-5f);
@@ -801,6 +806,181 @@ static void test_material_textures(void **state)
     lpv_scene_free(&s);
 }
 
+/* COLOR_0 multiplies the base colour (issue 32, item 1): a white floor whose
+ * x < 0 corners are red and x > 0 corners green, lit straight down. The
+ * frame, iv's points and the reference's frame are red on the left and
+ * green on the right; before, COLOR_0 was dropped with a warning (white). */
+static void test_vertex_colours(void **state)
+{
+    (void)state;
+    glb g = {0};
+    quad f;
+    floor_quad(&f, 0);
+    float col[16];
+    for (int c = 0; c < 4; c++) {
+        const int left = f.c[c][0] < 0.0f;
+        col[4 * c + 0] = left ? 1.0f : 0.0f, col[4 * c + 1] = left ? 0.0f : 1.0f, col[4 * c + 2] = 0.0f;
+        col[4 * c + 3] = 1.0f;
+    }
+    f.color = col;
+    add_quad(&g, &f);
+    add_sun(&g, SUN_DOWN);
+    size_t len;
+    unsigned char *data = glb_finish(&g, "{'pbrMetallicRoughness':{'baseColorFactor':[0.8,0.8,0.8,1],'metallicFactor':0}}",
+                                     NULL, NULL, &len);
+    lpv_scene s;
+    lpv_gltf_warnings w;
+    load_glb(data, len, &s, &w);
+    free(data);
+    for (int i = 0; i < w.count; i++)
+        assert_null(strstr(w.line[i], "COLOR_0"));
+    assert_int_equal(s.draws[0].vertex_color, 1);
+    lpv_view v;
+    assert_int_equal(lpv_view_look_at((float[3]){0.0f, 6.0f, 0.01f}, (float[3]){0.0f, 0.0f, 0.0f}, 1.0f, W, H, &v), 0);
+    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
+    render(&s, &v, rgba);
+    double left[3], right[3];
+    patch(&v, rgba, (float[3]){-2.5f, 0.0f, 0.0f}, left);
+    patch(&v, rgba, (float[3]){2.5f, 0.0f, 0.0f}, right);
+    printf("frame: x = -2.5 (%.4f %.4f %.4f), x = +2.5 (%.4f %.4f %.4f)\n", left[0], left[1], left[2], right[0],
+           right[1], right[2]);
+    /* 5/6 of the way to the corner: 0.8 x (11/12 red + 1/12 green) / pi */
+    assert_true(fabs(left[0] - 0.8 * 11.0 / 12.0 / M_PI) < 0.02);
+    assert_true(fabs(left[1] - 0.8 * 1.0 / 12.0 / M_PI) < 0.02);
+    assert_true(fabs(right[1] - 0.8 * 11.0 / 12.0 / M_PI) < 0.02);
+    assert_true(left[2] < 1e-4 && right[2] < 1e-4);
+    /* the reference's frame */
+    lpv_ref *ref = NULL;
+    char err[512] = "";
+    lpv_ref_desc d = {.seed = 1};
+    assert_int_equal(lpv_ref_create(&s, &d, &ref, err, sizeof err), 0);
+    assert_int_equal(lpv_ref_render_full(ref, &v, 1, 4, rgba, NULL), 0);
+    lpv_ref_destroy(ref);
+    double rl[3], rr[3];
+    patch(&v, rgba, (float[3]){-2.5f, 0.0f, 0.0f}, rl);
+    patch(&v, rgba, (float[3]){2.5f, 0.0f, 0.0f}, rr);
+    printf("reference: x = -2.5 (%.4f %.4f %.4f), x = +2.5 (%.4f %.4f %.4f)\n", rl[0], rl[1], rl[2], rr[0], rr[1],
+           rr[2]);
+    assert_true(fabs(rl[0] - left[0]) < 0.02 && fabs(rr[1] - right[1]) < 0.02 && rl[2] < 1e-4);
+    free(rgba);
+    /* iv's points: red on the left, green on the right */
+    lpv_iv_point_params pp = {.voxel = 0.5f, .points = 1, .split = 0.5f, .max_points = 1 << 20};
+    struct IvPoint *pts = NULL;
+    size_t n = 0;
+    assert_int_equal(lpv_iv_points_make(&s, &pp, &pts, &n, NULL), 0);
+    assert_true(n > 100);
+    for (size_t i = 0; i < n; i++) {
+        const float x = pts[i].position[0], t = (x + 3.0f) / 6.0f; /* red share 1 - t */
+        assert_float_equal(pts[i].albedo[0], 0.8f * (1.0f - t), 1e-3f);
+        assert_float_equal(pts[i].albedo[1], 0.8f * t, 1e-3f);
+    }
+    free(pts);
+    lpv_scene_free(&s);
+}
+
+/* A floor with an occlusion texture 0 where z < 0 and 1 where z > 0 at
+ * `strength`, and a white wall at x = 1.5 that the diagonal sun lights and
+ * that throws light on the floor. */
+static void occlusion_scene(float strength, lpv_scene *s)
+{
+    glb g = {0};
+    quad f, wall;
+    floor_quad(&f, 0);
+    add_quad(&g, &f);
+    memset(&wall, 0, sizeof wall);
+    static const float WALL[4][3] = {{1.5f, 0, -3}, {1.5f, 0, 3}, {1.5f, 2, 3}, {1.5f, 2, -3}}; /* faces -x */
+    memcpy(wall.c, WALL, sizeof wall.c);
+    wall.material = 1;
+    add_quad(&g, &wall);
+    /* 64 x 64 texels: the mip levels the camera reads keep both halves pure */
+    static uint8_t occ[64 * 64 * 4];
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            uint8_t *p = &occ[(y * 64 + x) * 4];
+            p[0] = p[1] = p[2] = y < 32 ? 0 : 255, p[3] = 255;
+        }
+    add_png(&g, 64, 64, occ);
+    add_sun(&g, SUN_DIAGONAL);
+    size_t len;
+    unsigned char *data = glb_finish(
+        &g,
+        J("{'pbrMetallicRoughness':{'baseColorFactor':[0.8,0.8,0.8,1],'metallicFactor':0},"
+          "'occlusionTexture':{'index':0,'strength':%g}},"
+          "{'pbrMetallicRoughness':{'baseColorFactor':[0.9,0.9,0.9,1],'metallicFactor':0}}",
+          (double)strength),
+        J("{'source':0,'sampler':0}"), NULL, &len);
+    lpv_gltf_warnings w;
+    load_glb(data, len, s, &w);
+    free(data);
+    for (int i = 0; i < w.count; i++)
+        assert_null(strstr(w.line[i], "occlusionTexture"));
+}
+
+/* occlusionTexture (issue 32, item 1): the frame's indirect light, not its
+ * direct light and not the GI, takes 1 + strength (R - 1). The same scene at
+ * strength 0.5 and 0 (the texture then changes nothing): where R = 0 the
+ * indirect frame reads exactly half, where R = 1 the same; the direct frame
+ * the same everywhere; the reference's indirect image likewise. */
+static void test_occlusion_texture(void **state)
+{
+    (void)state;
+    lpv_scene s[2];
+    occlusion_scene(0.5f, &s[0]);
+    occlusion_scene(0.0f, &s[1]);
+    assert_true(s[0].materials[0].occlusion_texture >= 0);
+    assert_float_equal(s[0].materials[0].occlusion_strength, 0.5f, 0.0f);
+    const float in_uv[2] = {0.5f, 0.2f}, out_uv[2] = {0.5f, 0.8f};
+    assert_float_equal(lpv_material_occlusion_at(&s[0], &s[0].materials[0], in_uv, in_uv), 0.5f, 1e-6f);
+    assert_float_equal(lpv_material_occlusion_at(&s[0], &s[0].materials[0], out_uv, out_uv), 1.0f, 1e-6f);
+    assert_float_equal(lpv_material_occlusion_at(&s[1], &s[1].materials[0], in_uv, in_uv), 1.0f, 1e-6f);
+
+    lpv_view v;
+    assert_int_equal(lpv_view_look_at((float[3]){-2.0f, 5.0f, 0.01f}, (float[3]){0.5f, 0.0f, 0.0f}, 1.0f, W, H, &v), 0);
+    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
+    char err[1024] = "";
+    lpv_settings st = {.technique = LPV_TECHNIQUE_ID_LPV, .rsm_size = 256};
+    const float dark[3] = {0.5f, 0.0f, -1.5f}, open[3] = {0.5f, 0.0f, 1.5f}; /* v = 1/4, 3/4 */
+    double at[2][2][2]; /* [scene][terms][place] */
+    for (int k = 0; k < 2; ++k)
+        for (int terms = 0; terms < 2; ++terms) {
+            if (lpv_engine_set_settings(lpvt_engine, &st, err, sizeof err) ||
+                lpv_engine_set_scene(lpvt_engine, &s[k], err, sizeof err) ||
+                lpv_engine_set_view(lpvt_engine, &v, err, sizeof err) ||
+                lpv_engine_tick(lpvt_engine, err, sizeof err) ||
+                lpv_engine_render(lpvt_engine, terms ? LPV_TERMS_DIRECT_ONLY : LPV_TERMS_INDIRECT_ONLY, rgba, err,
+                                  sizeof err))
+                fail_msg("%s", err);
+            double a[3], b[3];
+            lpvt_patch(&v, rgba, W, H, dark, 2, a);
+            lpvt_patch(&v, rgba, W, H, open, 2, b);
+            at[k][terms][0] = lum(a);
+            at[k][terms][1] = lum(b);
+        }
+    printf("indirect: R = 0 %.5f vs %.5f without, R = 1 %.5f vs %.5f; direct %.5f vs %.5f\n", at[0][0][0], at[1][0][0],
+           at[0][0][1], at[1][0][1], at[0][1][0], at[1][1][0]);
+    assert_true(at[1][0][0] > 0.0 && at[1][1][0] > 0.0);
+    assert_true(fabs(at[0][0][0] / at[1][0][0] - 0.5) < 0.01);
+    assert_true(fabs(at[0][0][1] / at[1][0][1] - 1.0) < 0.01);
+    assert_true(fabs(at[0][1][0] / at[1][1][0] - 1.0) < 1e-4);
+    /* the reference's indirect image, its same streams with and without */
+    double ref_at[2];
+    for (int k = 0; k < 2; ++k) {
+        lpv_ref *ref = NULL;
+        lpv_ref_desc d = {.seed = 1};
+        assert_int_equal(lpv_ref_create(&s[k], &d, &ref, err, sizeof err), 0);
+        assert_int_equal(lpv_ref_render_indirect(ref, &v, 1, 16, rgba, NULL), 0);
+        lpv_ref_destroy(ref);
+        double a[3];
+        lpvt_patch(&v, rgba, W, H, dark, 2, a);
+        ref_at[k] = lum(a);
+    }
+    printf("reference indirect at R = 0: %.5f vs %.5f without\n", ref_at[0], ref_at[1]);
+    assert_true(ref_at[1] > 0.0 && fabs(ref_at[0] / ref_at[1] - 0.5) < 0.01);
+    free(rgba);
+    lpv_scene_free(&s[0]);
+    lpv_scene_free(&s[1]);
+}
+
 static void test_warnings_once_per_feature(void **state)
 {
     (void)state;
@@ -815,15 +995,15 @@ static void test_warnings_once_per_feature(void **state)
     for (size_t f = 0; f < sizeof WARN_FEATURES / sizeof WARN_FEATURES[0]; f++) {
         int n = 0;
         for (int i = 0; i < w.count; i++)
-            n += strstr(w.line[i], WARN_FEATURES[f]) != NULL && !(f == 5 && strstr(w.line[i], "skinning"));
+            n += strstr(w.line[i], WARN_FEATURES[f]) != NULL && !(f == 3 && strstr(w.line[i], "skinning"));
         if (n != 1)
             fail_msg("feature '%s' is named by %d warning lines, not 1", WARN_FEATURES[f], n);
     }
     assert_int_equal(w.dropped, 0);
-    /* occlusion is used by 3 materials and clearcoat by 2, yet each is one line naming them */
+    /* clearcoat is used by 2 materials, yet it is one line naming them */
     for (int i = 0; i < w.count; i++)
-        if (strstr(w.line[i], "occlusionTexture"))
-            assert_non_null(strstr(w.line[i], "materials 0, 1, 2"));
+        if (strstr(w.line[i], "KHR_materials_clearcoat"))
+            assert_non_null(strstr(w.line[i], "materials 0, 1"));
     lpv_scene_free(&s);
 
     /* the file loader prints the same lines on stderr, once each */
@@ -845,15 +1025,15 @@ static void test_warnings_once_per_feature(void **state)
     FILE *f = fopen(log, "r");
     assert_non_null(f);
     char line[1024];
-    int lines = 0, occlusion = 0;
+    int lines = 0, clearcoat = 0;
     while (fgets(line, sizeof line, f)) {
         assert_non_null(strstr(line, "warn.gltf: warning: "));
         lines++;
-        occlusion += strstr(line, "occlusionTexture") != NULL;
+        clearcoat += strstr(line, "KHR_materials_clearcoat") != NULL;
     }
     fclose(f);
     assert_int_equal(lines, w.count);
-    assert_int_equal(occlusion, 1);
+    assert_int_equal(clearcoat, 1);
 }
 
 /* Bad material values are refused with the field named. */
@@ -903,6 +1083,8 @@ int main(void)
         cmocka_unit_test(test_normal_map_direction),
         cmocka_unit_test(test_texture_transform),
         cmocka_unit_test(test_material_textures),
+        cmocka_unit_test(test_vertex_colours),
+        cmocka_unit_test(test_occlusion_texture),
         cmocka_unit_test(test_warnings_once_per_feature),
         cmocka_unit_test(test_bad_material_values_refused),
     };
