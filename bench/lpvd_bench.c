@@ -177,7 +177,7 @@ int main(int argc, char **argv)
     }
 
     lpv_scene scene;
-    if (lpv_scene_load_user(scene_path, &scene, err, sizeof err) != 0) {
+    if (lpv_scene_load_user(scene_path, NULL, &scene, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-bench: %s\n", err);
         return 1;
     }

@@ -104,7 +104,7 @@ static int g_nrows;
 static int load_view(const bench_scene *bs, const lpvd_options *opt, lpv_scene *scene, lpv_view *view, char *err,
                      size_t n)
 {
-    if (lpv_scene_load_user(bs->builtin ? NULL : bs->path, scene, err, n) != 0)
+    if (lpv_scene_load_user(bs->builtin ? NULL : bs->path, NULL, scene, err, n) != 0)
         return -1;
     lpv_view_choice cam = opt->cam;
     if (bs->has_cam) {

@@ -54,6 +54,7 @@ static const char *usage(void)
         lpv_flags_append(text, sizeof text, &len, "%s", USAGE_HEAD);
         lpv_flags_help(text, sizeof text, &len, FLAGS, F_COUNT);
         lpv_flags_append(text, sizeof text, &len, "%s", lpv_view_flags_help());
+        lpv_flags_append(text, sizeof text, &len, "%s", lpv_scene_pose_flags_help());
     }
     return text;
 }
@@ -189,9 +190,11 @@ int main(int argc, char **argv)
     memset(&cam, 0, sizeof cam);
     char err[512];
 
-    lpv_flag_group groups[2] = {{FLAGS, F_COUNT, NULL, NULL}, lpv_view_flag_group(&cam)};
+    lpv_scene_pose pose = {0};
+    lpv_flag_group groups[3] = {{FLAGS, F_COUNT, NULL, NULL}, lpv_view_flag_group(&cam),
+                                lpv_scene_pose_flag_group(&pose)};
     lpv_flags p;
-    if (lpv_flags_begin(&p, argc, argv, groups, 2, 1) != 0) {
+    if (lpv_flags_begin(&p, argc, argv, groups, 3, 1) != 0) {
         fprintf(stderr, "lpvd-reference: %s\n", p.err);
         return 2;
     }
@@ -285,7 +288,13 @@ int main(int argc, char **argv)
     }
 
     lpv_scene scene;
-    if (lpv_scene_load_user(scene_path, &scene, err, sizeof err) != 0) {
+    lpv_gltf_animation_time at_buf;
+    const lpv_gltf_animation_time *at = NULL;
+    if (lpv_scene_pose_at(&pose, &at_buf, &at, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd-reference: %s\n", err);
+        return 2;
+    }
+    if (lpv_scene_load_user(scene_path, at, &scene, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-reference: %s\n", err);
         return 1;
     }

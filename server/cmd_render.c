@@ -46,8 +46,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: lpvd render [SCENE.gltf|SCENE.glb] [-o OUT.png|OUT.exr] [flags]\n"
             "Renders SCENE (default: the built-in Cornell box) from its camera.\n"
-            "Output:\n%s%s",
-            help, LPVD_OPTIONS_HELP);
+            "Output:\n%s%s%s",
+            help, lpv_scene_pose_flags_help(), LPVD_OPTIONS_HELP);
 }
 
 /* The ambient occlusion term into path: linear grey, no exposure or tone
@@ -80,8 +80,9 @@ int lpvd_cmd_render(int argc, char **argv)
     int stats = 0;
     char err[1024] = "";
 
-    lpv_flag_group groups[4] = {{RENDER_FLAGS, R_COUNT, NULL, NULL}};
-    int ngroups = 1 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 1);
+    lpv_scene_pose pose = {0};
+    lpv_flag_group groups[5] = {{RENDER_FLAGS, R_COUNT, NULL, NULL}, lpv_scene_pose_flag_group(&pose)};
+    int ngroups = 2 + lpvd_options_groups(&opt, LPVD_GROUP_ALL, 1, groups + 2);
     lpv_flags p;
     if (lpv_flags_begin(&p, argc, argv, groups, ngroups, 0) != 0) {
         fprintf(stderr, "lpvd render: %s\n", p.err);
@@ -149,7 +150,13 @@ int lpvd_cmd_render(int argc, char **argv)
         opt.settings.iv.ao = LPV_SWITCH_ON;
     }
     lpv_scene scene;
-    if (lpv_scene_load_user(scene_path, &scene, err, sizeof err) != 0) {
+    lpv_gltf_animation_time at_buf;
+    const lpv_gltf_animation_time *at = NULL;
+    if (lpv_scene_pose_at(&pose, &at_buf, &at, err, sizeof err) != 0) {
+        fprintf(stderr, "lpvd render: %s\n", err);
+        return 2;
+    }
+    if (lpv_scene_load_user(scene_path, at, &scene, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd render: %s\n", err);
         return 1;
     }

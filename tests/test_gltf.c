@@ -732,7 +732,7 @@ static void test_user_paths_outside_the_folder(void **state)
         assert_int_equal(s.materials[0].base_color_texture, 0);
         lpv_scene_free(&s);
         /* the commands' call: lpv_scene_load_user */
-        assert_int_equal(lpv_scene_load_user(path, &s, err, sizeof err), 0);
+        assert_int_equal(lpv_scene_load_user(path, NULL, &s, err, sizeof err), 0);
         assert_int_equal(s.texture_count, 1);
         lpv_scene_free(&s);
         /* rooted: refused, the URI named */

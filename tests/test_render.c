@@ -371,6 +371,55 @@ static void test_render_command_rejects_bad_input(void **state)
     assert_int_equal(run(7, bad_out), 1);
 }
 
+/* --time and --animation (issue 32): a triangle that its animation moves
+ * 4 m along +x in 1 s, seen by a camera looking at where it starts. At
+ * --time 0 it fills the view's middle, at --time 1 it has left: the frames
+ * differ. --animation without --time, a negative time and an animation the
+ * file lacks are refused. */
+static void test_render_command_time(void **state)
+{
+    (void)state;
+    static const char *GLTF =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/"
+        "octet-stream;base64,AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIBAAAAA"
+        "AAAAAAA=\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,"
+        "\"byteLength\":8},{\"buffer\":0,\"byteOffset\":44,\"byteLength\":24}],\"accessors\":[{\"bufferView\":0,"
+        "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[-1,-1,0],\"max\":[1,1,0]},{\"bufferView\":1,"
+        "\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":2,"
+        "\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+        "{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0,\"animations\":"
+        "[{\"name\":\"slide\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}],"
+        "\"samplers\":[{\"input\":1,\"output\":2}]}]}";
+    const char *path = lpvt_write_file(lpvt_tmpdir(), "slide.gltf", GLTF, strlen(GLTF));
+    char scene[512], a_out[512], b_out[512], err[512];
+    snprintf(scene, sizeof scene, "%s", path);
+    snprintf(a_out, sizeof a_out, "%s/t0.exr", lpvt_tmpdir());
+    snprintf(b_out, sizeof b_out, "%s/t1.exr", lpvt_tmpdir());
+    const char *a[] = {"render", scene, "-o", a_out, "--size", "32x32", "--eye", "0,0,4", "--target", "0,0,0",
+                       "--time", "0", "--animation", "slide"};
+    assert_int_equal(run(14, a), 0);
+    const char *b[] = {"render", scene, "-o", b_out, "--size", "32x32", "--eye", "0,0,4", "--target", "0,0,0",
+                       "--time", "1"};
+    assert_int_equal(run(12, b), 0);
+    int w, h;
+    float *pa = NULL, *pb = NULL;
+    assert_int_equal(lpv_image_read_f32(a_out, 4, &w, &h, &pa, err, sizeof err), 0);
+    assert_int_equal(lpv_image_read_f32(b_out, 4, &w, &h, &pb, err, sizeof err), 0);
+    const size_t centre = 4 * ((size_t)(h / 2) * (size_t)w + (size_t)(w / 2));
+    printf("centre pixel at t = 0: %g (alpha %g); at t = 1: %g (alpha %g)\n", pa[centre], pa[centre + 3],
+           pb[centre], pb[centre + 3]);
+    assert_true(pa[centre + 3] > 0.5f); /* the triangle covers the centre at t = 0 */
+    assert_true(pb[centre + 3] < 0.5f); /* and has left it at t = 1 */
+    free(pa);
+    free(pb);
+    const char *no_time[] = {"render", scene, "--animation", "slide"};
+    assert_int_equal(run(4, no_time), 2);
+    const char *negative[] = {"render", scene, "--time", "-1"};
+    assert_int_equal(run(4, negative), 2);
+    const char *unknown[] = {"render", scene, "-o", a_out, "--size", "16x16", "--time", "0.5", "--animation", "walk"};
+    assert_int_equal(run(10, unknown), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -382,6 +431,7 @@ int main(void)
         cmocka_unit_test(test_shared_glb_matches_builtin),
         cmocka_unit_test(test_render_command_files),
         cmocka_unit_test(test_render_command_rejects_bad_input),
+        cmocka_unit_test(test_render_command_time),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

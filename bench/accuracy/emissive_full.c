@@ -284,7 +284,7 @@ int lpv_acc_emissive_run(lpv_engine *e, const lpv_acc_emissive_desc *d)
     FILE *probe = fopen(path, "rb");
     if (rc == 0 && probe) {
         fclose(probe);
-        if (lpv_scene_load_user(path, &s, err, sizeof err) != 0) {
+        if (lpv_scene_load_user(path, NULL, &s, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-accuracy: %s\n", err);
             rc = 1;
         } else {

@@ -218,7 +218,7 @@ int lpv_acc_iv_tables_run(lpv_engine *engine, const lpv_acc_iv_tables_desc *d)
         r->name = d->scenes[s].name;
         char err[1024];
         lpv_scene scene;
-        if (lpv_scene_load_user(d->scenes[s].path, &scene, err, sizeof err) != 0) {
+        if (lpv_scene_load_user(d->scenes[s].path, NULL, &scene, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-accuracy: --iv-tables: %s\n", err);
             rc = 1;
             continue;

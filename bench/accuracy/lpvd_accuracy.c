@@ -2201,7 +2201,7 @@ add_features:
     for (int s = 0; s < nscenes && rc == 0; ++s) {
         scene_entry *se = &scenes[s];
         lpv_scene scene;
-        if (lpv_scene_load_user(se->path, &scene, err, sizeof err) != 0) {
+        if (lpv_scene_load_user(se->path, NULL, &scene, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-accuracy: %s\n", err);
             rc = 1;
             break;
