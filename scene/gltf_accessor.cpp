@@ -43,6 +43,8 @@ int type_components(int type)
         return 3;
     case TINYGLTF_TYPE_VEC4:
         return 4;
+    case TINYGLTF_TYPE_MAT4: /* skins' inverse bind matrices; 4-byte components need no column padding */
+        return 16;
     default:
         return 0;
     }
@@ -84,7 +86,7 @@ double read_component(const unsigned char *p, int ctype, bool normalized)
 const char *type_name(int ncomp)
 {
     static const char *names[] = {"?", "SCALAR", "VEC2", "VEC3", "VEC4"};
-    return ncomp >= 0 && ncomp <= 4 ? names[ncomp] : "?";
+    return ncomp == 16 ? "MAT4" : ncomp >= 0 && ncomp <= 4 ? names[ncomp] : "?";
 }
 
 } // namespace

@@ -1,15 +1,16 @@
 /*
  * gltf_animation.cpp - the file's animations (gltf_internal.hpp, Builder):
- * their node translation / rotation / scale channels sampled at a time into
- * node overrides (lpv_gltf_load_file_animated), and their list
+ * their node translation / rotation / scale / weights channels sampled at a
+ * time into node overrides (lpv_gltf_load_file_animated), and their list
  * (lpv_gltf_animations). glTF 2.0, "Animations": LINEAR (rotations slerped
  * along the shortest path), STEP and CUBICSPLINE (Hermite, the tangents
  * scaled by the keyframe interval); before the first keyframe the first
  * value, after the last the last. Every channel, sampler and accessor an
  * animation plays is checked before anything is sampled, and a defect
  * refuses the file with "animation 2 ("Walk"): <problem>". Morph-target
- * "weights" channels and KHR_animation_pointer are skipped here and warned
- * by gltf_features.cpp.
+ * "weights" channels become the node's weights (gltf_mesh.cpp morphs with
+ * them); KHR_animation_pointer is skipped here and warned by
+ * gltf_features.cpp.
  */
 #include "gltf_internal.hpp"
 
@@ -23,7 +24,7 @@ namespace lpv_gltf {
 
 namespace {
 
-enum class Path { translation, rotation, scale };
+enum class Path { translation, rotation, scale, weights };
 enum class Interp { linear, step, cubic };
 
 /* One sampler's keyframes: times, and ncomp values per element (CUBICSPLINE:
@@ -76,7 +77,7 @@ void slerp(const double a[4], const double b[4], double u, double out[4])
 }
 
 /* Keys k sampled at time t into out[k.ncomp]; rotations come out unit length. */
-void sample(const Keys &k, double t, bool rotation, double out[4])
+void sample(const Keys &k, double t, bool rotation, double *out)
 {
     const size_t n = k.in.size();
     const size_t stride = k.interp == Interp::cubic ? 3 : 1; /* elements per keyframe */
@@ -175,7 +176,7 @@ struct Builder::Animation {
         Path path;
         int sampler;
     };
-    std::vector<Channel> channels; /* translation / rotation / scale only */
+    std::vector<Channel> channels; /* translation / rotation / scale / weights */
     std::vector<Keys> samplers;    /* by sampler index; outputs read for those channels use */
     double duration = 0.0;         /* the largest input time of all its samplers */
 };
@@ -233,10 +234,12 @@ void Builder::read_animation_parts(size_t index, Animation &out)
     /* The node channels, and the outputs of the samplers they use. */
     for (size_t c = 0; c < ga.channels.size(); c++) {
         const tinygltf::AnimationChannel &gc = ga.channels[c];
-        if (gc.target_path == "weights" || is_pointer_channel(gc))
+        if (is_pointer_channel(gc))
             continue; /* not supported: warned (gltf_features.cpp) */
         Path path;
-        if (gc.target_path == "translation")
+        if (gc.target_path == "weights")
+            path = Path::weights;
+        else if (gc.target_path == "translation")
             path = Path::translation;
         else if (gc.target_path == "rotation")
             path = Path::rotation;
@@ -251,10 +254,52 @@ void Builder::read_animation_parts(size_t index, Animation &out)
         if (gc.target_node < 0 || size_t(gc.target_node) >= m_.nodes.size())
             fail("channel %zu: target node %d does not exist (out of range; the file has %zu node%s)", c,
                  gc.target_node, m_.nodes.size(), m_.nodes.size() == 1 ? "" : "s");
-        if (!m_.nodes[size_t(gc.target_node)].matrix.empty())
+        if (path != Path::weights && !m_.nodes[size_t(gc.target_node)].matrix.empty())
             fail("channel %zu: target node %d is given as a matrix; an animated node must use translation, "
                  "rotation and scale",
                  c, gc.target_node);
+        if (path == Path::weights) {
+            /* one weight per morph target of the node's mesh, per keyframe */
+            const tinygltf::Node &tn = m_.nodes[size_t(gc.target_node)];
+            const size_t targets = tn.mesh >= 0 && size_t(tn.mesh) < m_.meshes.size() &&
+                                           !m_.meshes[size_t(tn.mesh)].primitives.empty()
+                                       ? m_.meshes[size_t(tn.mesh)].primitives[0].targets.size()
+                                       : 0;
+            if (!targets) { /* nothing to weigh: the rest of the animation plays */
+                ctx_.warn(strf("morph target weights channel (%s channel %zu): node %d's mesh has no morph targets; "
+                               "ignored",
+                               animation_label(m_, index).c_str(), c, gc.target_node));
+                continue;
+            }
+            if (gc.sampler < 0 || size_t(gc.sampler) >= ga.samplers.size())
+                fail("channel %zu: sampler %d does not exist", c, gc.sampler);
+            const int s = gc.sampler;
+            const tinygltf::AnimationSampler &gs = ga.samplers[size_t(s)];
+            Keys &k = out.samplers[size_t(s)];
+            if (gs.output < 0 || size_t(gs.output) >= m_.accessors.size())
+                fail("sampler %d: output accessor %d does not exist (out of range)", s, gs.output);
+            const tinygltf::Accessor &oa = m_.accessors[size_t(gs.output)];
+            if (oa.type != TINYGLTF_TYPE_SCALAR ||
+                !(oa.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || oa.normalized))
+                fail("channel %zu (weights): output accessor %d of sampler %d must be SCALAR FLOAT or normalized", c,
+                     gs.output, s);
+            out.channels.push_back({gc.target_node, path, s});
+            if (k.ncomp == int(targets))
+                continue;
+            const std::string what = strf("sampler %d: output", s);
+            std::vector<double> flat;
+            read_accessor(gs.output, 1, what.c_str(), flat);
+            const size_t keys = k.in.size(), per = k.interp == Interp::cubic ? 3 : 1;
+            if (flat.size() != keys * per * targets)
+                fail("sampler %d: output accessor %d holds %zu weights; %zu keyframes of %zu morph targets need %zu",
+                     s, gs.output, flat.size(), keys, targets, keys * per * targets);
+            for (size_t e = 0; e < flat.size(); e++)
+                if (!std::isfinite(flat[e]))
+                    fail("sampler %d: output weight %zu is not finite (output accessor %d)", s, e, gs.output);
+            k.ncomp = int(targets);
+            k.out = flat;
+            continue;
+        }
 
         const int s = gc.sampler;
         const tinygltf::AnimationSampler &gs = ga.samplers[size_t(s)];
@@ -303,7 +348,8 @@ void Builder::read_animation_parts(size_t index, Animation &out)
     }
 }
 
-std::vector<lpv_gltf_node_override> Builder::sample_animations(const lpv_gltf_animation_time &at)
+std::vector<lpv_gltf_node_override> Builder::sample_animations(const lpv_gltf_animation_time &at,
+                                                               std::vector<std::pair<int, std::vector<double>>> &weights)
 {
     const size_t n = m_.animations.size();
     const bool every = !at.animation || !at.animation[0];
@@ -337,6 +383,12 @@ std::vector<lpv_gltf_node_override> Builder::sample_animations(const lpv_gltf_an
         ctx_.played.push_back(int(a));
         for (const Animation::Channel &c : anim.channels) {
             const Keys &k = anim.samplers[size_t(c.sampler)];
+            if (c.path == Path::weights) {
+                std::vector<double> w(size_t(k.ncomp));
+                sample(k, at.time, false, w.data());
+                weights.push_back({c.node, w});
+                continue;
+            }
             double v[4];
             sample(k, at.time, c.path == Path::rotation, v);
             lpv_gltf_node_override o;

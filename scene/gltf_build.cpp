@@ -90,13 +90,82 @@ void Builder::check_node_graph()
     }
 }
 
-void Builder::add_mesh(int mesh, const Mat4 &world)
+void Builder::add_mesh(int mesh, const Mat4 &world, const Deform &d)
 {
     if (mesh < 0 || size_t(mesh) >= m_.meshes.size())
         fail("mesh %d does not exist (out of range)", mesh);
     const tinygltf::Mesh &gm = m_.meshes[size_t(mesh)];
     for (size_t i = 0; i < gm.primitives.size(); i++)
-        add_primitive(gm.primitives[i], mesh, int(i), world);
+        add_primitive(gm.primitives[i], mesh, int(i), world, d);
+}
+
+/* Every node's world transform, from the roots of the forest down
+ * (check_node_graph made it one), with the caller's and the animation's
+ * overrides already in the model. */
+void Builder::compute_node_worlds()
+{
+    const size_t n = m_.nodes.size();
+    node_world_.assign(n, identity());
+    std::vector<unsigned char> is_child(n, 0);
+    for (const auto &node : m_.nodes)
+        for (int c : node.children)
+            is_child[size_t(c)] = 1;
+    std::vector<std::pair<int, Mat4>> stack;
+    for (size_t i = 0; i < n; i++)
+        if (!is_child[i])
+            stack.push_back({int(i), identity()});
+    while (!stack.empty()) {
+        auto [node, parent] = stack.back();
+        stack.pop_back();
+        const Mat4 w = mul(parent, node_local(m_.nodes[size_t(node)], node));
+        node_world_[size_t(node)] = w;
+        for (int c : m_.nodes[size_t(node)].children)
+            stack.push_back({c, w});
+    }
+}
+
+/* Node `node`'s morph weights and skinning matrices (Deform). */
+Deform Builder::deform_of(int node)
+{
+    const tinygltf::Node &n = m_.nodes[size_t(node)];
+    Deform d;
+    const tinygltf::Mesh &gm = m_.meshes[size_t(n.mesh)];
+    d.weights = !n.weights.empty() ? n.weights : gm.weights;
+    for (size_t k = 0; k < d.weights.size(); k++)
+        if (!std::isfinite(d.weights[k]))
+            fail("node %d: morph weight %zu is not finite", node, k);
+    if (n.skin < 0)
+        return d;
+    if (size_t(n.skin) >= m_.skins.size())
+        fail("node %d: skin %d does not exist (out of range)", node, n.skin);
+    const tinygltf::Skin &sk = m_.skins[size_t(n.skin)];
+    if (sk.joints.empty())
+        fail("skin %d has no joints", n.skin);
+    std::vector<double> ibm;
+    if (sk.inverseBindMatrices >= 0) {
+        if (size_t(sk.inverseBindMatrices) < m_.accessors.size() &&
+            m_.accessors[size_t(sk.inverseBindMatrices)].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+            fail("skin %d: inverseBindMatrices must be MAT4 FLOAT", n.skin);
+        const std::string what = strf("skin %d inverseBindMatrices", n.skin);
+        read_accessor(sk.inverseBindMatrices, 16, what.c_str(), ibm);
+        if (ibm.size() < sk.joints.size() * 16)
+            fail("skin %d: inverseBindMatrices holds %zu matrices for %zu joints", n.skin, ibm.size() / 16,
+                 sk.joints.size());
+    }
+    for (size_t j = 0; j < sk.joints.size(); j++) {
+        const int joint = sk.joints[j];
+        if (joint < 0 || size_t(joint) >= m_.nodes.size())
+            fail("skin %d: joint %zu is node %d, which does not exist (out of range)", n.skin, j, joint);
+        Mat4 inv = identity();
+        if (!ibm.empty())
+            for (int k = 0; k < 16; k++) {
+                inv.m[k] = ibm[j * 16 + size_t(k)];
+                if (!std::isfinite(inv.m[k]))
+                    fail("skin %d: inverse bind matrix %zu is not finite", n.skin, j);
+            }
+        d.joints.push_back(mul(node_world_[size_t(joint)], inv));
+    }
+    return d;
 }
 
 void Builder::visit(int node, const Mat4 &parent, int depth)
@@ -114,9 +183,13 @@ void Builder::visit(int node, const Mat4 &parent, int depth)
         if (!std::isfinite(world.m[k]))
             fail("node %d: world transform is not finite (NaN or Inf)", node);
 
-    if (n.mesh >= 0)
-        add_mesh(n.mesh, world);
-    else if (n.mesh != -1)
+    if (n.mesh >= 0) {
+        if (size_t(n.mesh) >= m_.meshes.size())
+            fail("node %d: mesh %d does not exist (out of range)", node, n.mesh);
+        /* a skinned mesh moves with its joints alone (gltf_mesh.cpp): the
+         * node's own transform is not applied (glTF 2.0, "Skins") */
+        add_mesh(n.mesh, world, deform_of(node));
+    } else if (n.mesh != -1)
         fail("node %d: mesh %d does not exist (out of range)", node, n.mesh);
     if (n.camera >= 0)
         add_camera(node, n.camera, world);
@@ -165,6 +238,7 @@ void Builder::build()
             if (!is_child[i])
                 roots.push_back(int(i));
     }
+    compute_node_worlds();
     visited_.assign(m_.nodes.size(), 0);
     const Mat4 id = identity();
     for (int r : roots)

@@ -183,7 +183,7 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
 
     /* Mesh data lpvd does not draw. */
     std::map<std::string, Uses> attrs;
-    Uses morph, points_lines;
+    Uses points_lines;
     for (size_t i = 0; i < m.meshes.size(); i++) {
         for (const tinygltf::Primitive &p : m.meshes[i].primitives) {
             for (const auto &a : p.attributes) {
@@ -193,17 +193,15 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
                     continue;
                 if (n.compare(0, 9, "TEXCOORD_") == 0)
                     continue; /* reported with the textures that ask for them */
+                if (n.compare(0, 7, "JOINTS_") == 0 || n.compare(0, 8, "WEIGHTS_") == 0)
+                    continue; /* skinning: applied (gltf_mesh.cpp) */
                 std::string key;
                 if (n.compare(0, 6, "COLOR_") == 0)
                     key = "vertex colours (" + clean(n) + ")";
-                else if (n.compare(0, 7, "JOINTS_") == 0 || n.compare(0, 8, "WEIGHTS_") == 0)
-                    key = "skinning attributes (" + clean(n) + ")";
                 else
                     key = "vertex attribute " + clean(n);
                 attrs[key].add("mesh", int(i));
             }
-            if (!p.targets.empty())
-                morph.add("mesh", int(i));
             if (p.mode == TINYGLTF_MODE_POINTS || p.mode == TINYGLTF_MODE_LINE || p.mode == TINYGLTF_MODE_LINE_LOOP ||
                 p.mode == TINYGLTF_MODE_LINE_STRIP)
                 points_lines.add("mesh", int(i));
@@ -211,28 +209,12 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
     }
     for (const auto &kv : attrs)
         out.push_back(kv.first + " (" + kv.second.describe() + "): not used");
-    if (morph.total)
-        out.push_back("morph targets (" + morph.describe() + "): not applied; the base shape is drawn");
     if (points_lines.total)
         out.push_back("point and line primitives (" + points_lines.describe() +
                       "): not drawn (they carry no surface)");
-    if (!m.skins.empty())
-        out.push_back(std::to_string(m.skins.size()) + (m.skins.size() == 1 ? " skin" : " skins") +
-                      ": not applied; skinned meshes are drawn in their bind pose");
     if (played.empty() && !m.animations.empty())
         out.push_back(std::to_string(m.animations.size()) + (m.animations.size() == 1 ? " animation" : " animations") +
                       ": not played; the file's static pose is drawn");
-    if (!played.empty()) {
-        /* The played animations' channels lpvd cannot apply (gltf_animation.cpp skips them). */
-        Uses weights;
-        for (int a : played)
-            for (size_t c = 0; c < m.animations[size_t(a)].channels.size(); c++)
-                if (m.animations[size_t(a)].channels[c].target_path == "weights")
-                    weights.add(("animation " + std::to_string(a) + " channel").c_str(), int(c));
-        if (weights.total)
-            out.push_back("morph target weights channels (" + weights.describe() +
-                          "): not applied; the base shape is drawn");
-    }
     if (m.scenes.size() > 1)
         out.push_back("the file holds " + std::to_string(m.scenes.size()) + " scenes: only scene " +
                       std::to_string(scene < 0 ? 0 : scene) + " is loaded");

@@ -12,7 +12,7 @@
  *   gltf_animation.cpp  animations sampled at a time into node overrides
  *   gltf_transform.cpp  node transforms and the caller's node overrides
  *   gltf_accessor.cpp   buffer views and accessors, every range checked
- *   gltf_mesh.cpp       primitives into world-space triangles
+ *   gltf_mesh.cpp       primitives into world-space triangles (morphed, skinned)
  *   gltf_material.cpp   materials and their textures
  *   gltf_lights_cameras.cpp  KHR_lights_punctual and cameras
  *   gltf_medium.cpp     lpvd_medium from the raw JSON
@@ -170,6 +170,15 @@ void read_medium(const char *json, size_t len, const tinygltf::Model &model, Ctx
 /* A name from the file into a fixed-size scene name (gltf_build.cpp). */
 void copy_name(char *dst, const std::string &src, const std::string &fallback);
 
+/* How a mesh instance is deformed (glTF 2.0 "Skins", "Morph targets"): its
+ * morph weights (the node's, else the mesh's; missing ones 0) and, for a
+ * skinned node, each joint's skinning matrix world(joint) x its inverse bind
+ * matrix (a primitive with joints then ignores the node's own transform). */
+struct Deform {
+    std::vector<double> weights;
+    std::vector<Mat4> joints; /* empty: not skinned */
+};
+
 /* ---- the builder: tinygltf's model into the scene's arrays ------------------- */
 class Builder {
   public:
@@ -178,10 +187,12 @@ class Builder {
     void build(); /* gltf_build.cpp */
 
     /* gltf_animation.cpp: the node overrides that pose the model at `at`
-     * (every channel the chosen animations play checked first; the indices
-     * of those animations go to ctx.played), and the file's animations, each
-     * checked the same way. */
-    std::vector<lpv_gltf_node_override> sample_animations(const lpv_gltf_animation_time &at);
+     * and the morph weights its "weights" channels give nodes (every channel
+     * the chosen animations play checked first; the indices of those
+     * animations go to ctx.played), and the file's animations, each checked
+     * the same way. */
+    std::vector<lpv_gltf_node_override> sample_animations(const lpv_gltf_animation_time &at,
+                                                          std::vector<std::pair<int, std::vector<double>>> &weights);
     void list_animations(lpv_gltf_animation_list &out);
 
     std::vector<lpv_vertex> vertices;
@@ -203,6 +214,7 @@ class Builder {
     int default_material_ = -1;
     std::map<std::pair<int, int>, int> image_texture_; /* (glTF image, linear) -> index in textures (-1: unusable) */
     std::vector<unsigned char> visited_;
+    std::vector<Mat4> node_world_; /* every node's world transform (joints may lie outside the scene's tree) */
     std::map<int, std::vector<unsigned char>> meshopt_; /* bufferView -> its EXT_meshopt_compression data */
     std::vector<unsigned char> material_uv1_;            /* material index -> some texture reads TEXCOORD_1 */
 
@@ -225,7 +237,9 @@ class Builder {
     /* gltf_build.cpp */
     void check_node_graph();
     void visit(int node, const Mat4 &parent, int depth);
-    void add_mesh(int mesh, const Mat4 &world);
+    void compute_node_worlds();
+    Deform deform_of(int node);
+    void add_mesh(int mesh, const Mat4 &world, const Deform &d);
     /* gltf_material.cpp */
     void convert_materials();
     int texture_for(int material_index, const char *what, int index, bool linear);
@@ -233,7 +247,7 @@ class Builder {
                     lpv_uv_transform *out);
     int default_material();
     /* gltf_mesh.cpp */
-    void add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world);
+    void add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world, const Deform &d);
     /* gltf_lights_cameras.cpp */
     void add_light(int node, int light, const Mat4 &world);
     void add_camera(int node, int camera, const Mat4 &world);

@@ -136,8 +136,11 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
 
     /* The animation's pose first, then the caller's overrides (which win). */
     if (ctx.animation) {
-        std::vector<lpv_gltf_node_override> pose = b.sample_animations(*ctx.animation);
+        std::vector<std::pair<int, std::vector<double>>> weights;
+        std::vector<lpv_gltf_node_override> pose = b.sample_animations(*ctx.animation, weights);
         apply_node_overrides(model, pose.data(), pose.size());
+        for (const auto &w : weights) /* the node's weights win over its mesh's (glTF) */
+            model.nodes[size_t(w.first)].weights = w.second;
     }
     apply_node_overrides(model, ctx.overrides, ctx.override_count);
 

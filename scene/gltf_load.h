@@ -27,8 +27,8 @@
  * quote the file's bytes: only indices, sizes, URIs and identifier names.
  *
  * Everything else in the file that lpvd does not use (extensions it does not
- * implement, occlusion/emissive/metallic-roughness textures, vertex colours,
- * skins, morph targets, animations unless played (below), ...) is a
+ * implement, vertex colours beyond COLOR_0, animations unless played
+ * (below), ...) is a
  * warning, one line per feature
  * (docs/scenes.md, "Supported and warned"): printed on stderr as
  * "lpvd: <file>: warning: <line>", or handed to the caller through the _w
@@ -85,13 +85,14 @@ int lpv_gltf_load_memory_ex(const void *data, size_t size, const char *base_dir,
                             size_t err_size);
 
 /* ---- animations (docs/scenes.md, "Animations") -----------------------------
- * Node translation / rotation / scale channels of the file's animations,
+ * Node translation / rotation / scale / weights channels of the file's animations,
  * sampled at a time (LINEAR, with rotations slerped along the shortest path;
  * STEP; CUBICSPLINE), become node overrides (above) before the scene is
  * flattened, so meshes, cameras and lights below an animated node move with
  * it. Times before an animation's first keyframe take the first value, after
- * its last the last. Morph-target "weights" channels and KHR_animation_pointer
- * are not supported: warned, ignored. Defects (an unknown animation, a
+ * its last the last. Skins and morph targets deform the meshes at that pose
+ * (docs/scenes.md, "Animations"); KHR_animation_pointer is not supported:
+ * warned, ignored. Defects (an unknown animation, a
  * negative or non-finite time, sampler times not finite or not increasing,
  * an output count that does not fit the interpolation, a target node out of
  * range or given as a matrix, an accessor of the wrong type) refuse the

@@ -18,7 +18,7 @@
 
 namespace lpv_gltf {
 
-void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world)
+void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world, const Deform &deform)
 {
     const int mode = p.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
@@ -103,6 +103,88 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
             fail("mesh %d primitive %d: %s has %zu elements but POSITION has %zu", mesh, prim, a.name,
                  a.out->size() / size_t(a.ncomp), nv);
 
+    /* Morph targets (glTF 2.0): each target's POSITION, NORMAL and TANGENT
+     * displacements, weighted by the instance's weights, added to the base
+     * before any transform (a normal or tangent displacement is renormalized
+     * after). Draco-compressed primitives carry their targets in accessors
+     * too. */
+    for (size_t k = 0; k < p.targets.size() && k < deform.weights.size(); k++) {
+        const double wk = deform.weights[k];
+        if (wk == 0.0)
+            continue;
+        struct {
+            const char *name;
+            std::vector<float> *base;
+            int stride;
+        } parts[] = {{"POSITION", &pos, 3}, {"NORMAL", &nrm, 3}, {"TANGENT", &tan, 4}};
+        for (const auto &part : parts) {
+            auto it = p.targets[k].find(part.name);
+            if (it == p.targets[k].end() || part.base->empty())
+                continue;
+            std::vector<float> delta;
+            snprintf(what, sizeof what, "mesh %d primitive %d target %zu %s", mesh, prim, k, part.name);
+            read_accessor(it->second, 3, what, delta);
+            if (delta.size() / 3 != nv)
+                fail("mesh %d primitive %d: morph target %zu %s has %zu elements but POSITION has %zu", mesh, prim,
+                     k, part.name, delta.size() / 3, nv);
+            for (size_t v = 0; v < nv; v++)
+                for (int c = 0; c < 3; c++)
+                    (*part.base)[v * size_t(part.stride) + size_t(c)] += float(wk * delta[v * 3 + size_t(c)]);
+        }
+    }
+    for (size_t i = 0; i < pos.size(); i++)
+        if (!std::isfinite(pos[i]))
+            fail("mesh %d primitive %d: morphed POSITION of vertex %zu is not finite", mesh, prim, i / 3);
+
+    /* Skinning (glTF 2.0): each vertex moves with the weighted sum of its
+     * joints' matrices (JOINTS_n / WEIGHTS_n, every set the file has; the
+     * weights normalized to sum to 1), in place of the node's transform. */
+    std::vector<Mat4> skin_m;
+    if (!deform.joints.empty()) {
+        std::vector<double> acc(nv * 16, 0.0), wsum(nv, 0.0);
+        int sets = 0;
+        for (int set = 0;; set++) {
+            const std::string jn = "JOINTS_" + std::to_string(set), wn = "WEIGHTS_" + std::to_string(set);
+            auto jit = p.attributes.find(jn), wit = p.attributes.find(wn);
+            if (jit == p.attributes.end() || wit == p.attributes.end())
+                break;
+            std::vector<float> jv, wv;
+            snprintf(what, sizeof what, "mesh %d primitive %d %s", mesh, prim, jn.c_str());
+            read_accessor(jit->second, 4, what, jv);
+            snprintf(what, sizeof what, "mesh %d primitive %d %s", mesh, prim, wn.c_str());
+            read_accessor(wit->second, 4, what, wv);
+            if (jv.size() / 4 != nv || wv.size() / 4 != nv)
+                fail("mesh %d primitive %d: %s or %s does not have one element per vertex (%zu)", mesh, prim,
+                     jn.c_str(), wn.c_str(), nv);
+            for (size_t v = 0; v < nv; v++)
+                for (int c = 0; c < 4; c++) {
+                    const double w = wv[v * 4 + size_t(c)];
+                    if (!(w > 0.0))
+                        continue;
+                    const double j = jv[v * 4 + size_t(c)];
+                    if (!(j >= 0.0 && j < double(deform.joints.size())) || j != std::floor(j))
+                        fail("mesh %d primitive %d: %s of vertex %zu names joint %g; the skin has %zu", mesh, prim,
+                             jn.c_str(), v, j, deform.joints.size());
+                    const Mat4 &m = deform.joints[size_t(j)];
+                    for (int e = 0; e < 16; e++)
+                        acc[v * 16 + size_t(e)] += w * m.m[e];
+                    wsum[v] += w;
+                }
+            sets++;
+        }
+        if (!sets) /* (invalid glTF) drawn where its node stands */
+            ctx_.warn(strf("mesh %d: skinned, but without JOINTS_0 and WEIGHTS_0; drawn unskinned at its node",
+                           mesh));
+        else
+            skin_m.resize(nv);
+        for (size_t v = 0; v < skin_m.size(); v++) {
+            if (!(wsum[v] > 0.0))
+                fail("mesh %d primitive %d: vertex %zu has no joint weight (its WEIGHTS sum to 0)", mesh, prim, v);
+            for (int e = 0; e < 16; e++)
+                skin_m[v].m[e] = acc[v * 16 + size_t(e)] / wsum[v];
+        }
+    }
+
     /* COLOR_0: VEC3 or VEC4, float or normalized unsigned byte/short
      * (read_accessor normalizes); linear RGB(A) multiplying the base colour */
     std::vector<float> col;
@@ -173,13 +255,18 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         ctx_.warn(strf("material %d reads TEXCOORD_1, which mesh %d primitive %d lacks; (0, 0) is used there",
                        material, mesh, prim));
 
-    const bool flip = det3(world) < 0.0;
-    double nm[9];
-    normal_matrix(world, nm);
+    /* the transform of vertex v: the node's, or its skinning matrix */
+    auto mat_of = [&](size_t v) -> const Mat4 & { return skin_m.empty() ? world : skin_m[v]; };
+    const bool world_flip = det3(world) < 0.0;
+    /* a mirroring transform turns the winding: per triangle where skinned */
+    auto flips = [&](size_t corner) { return skin_m.empty() ? world_flip : det3(skin_m[corner]) < 0.0; };
+    double world_nm[9];
+    normal_matrix(world, world_nm);
 
     auto world_vertex = [&](size_t v, lpv_vertex &out) {
+        const Mat4 &mv = mat_of(v);
         double lp[3] = {pos[v * 3], pos[v * 3 + 1], pos[v * 3 + 2]}, wp[3];
-        xform_point(world, lp, wp);
+        xform_point(mv, lp, wp);
         for (int k = 0; k < 3; k++) {
             out.position[k] = float(wp[k]);
             if (!std::isfinite(out.position[k]))
@@ -203,12 +290,12 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         out.tangent[0] = out.tangent[1] = out.tangent[2] = out.tangent[3] = 0.0f;
         if (!tan.empty()) {
             double lt[3] = {tan[v * 4], tan[v * 4 + 1], tan[v * 4 + 2]}, wt[3];
-            xform_dir(world, lt, wt);
+            xform_dir(mv, lt, wt);
             const double w = tan[v * 4 + 3];
             if (normalize3(wt) && std::isfinite(w)) {
                 for (int k = 0; k < 3; k++)
                     out.tangent[k] = float(wt[k]);
-                out.tangent[3] = ((w < 0.0) != flip) ? -1.0f : 1.0f;
+                out.tangent[3] = ((w < 0.0) != (det3(mv) < 0.0)) ? -1.0f : 1.0f;
             }
         }
     };
@@ -229,6 +316,10 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         for (size_t v = 0; v < nv; v++) {
             lpv_vertex &out = vertices[base + v];
             world_vertex(v, out);
+            double vnm[9];
+            if (!skin_m.empty())
+                normal_matrix(skin_m[v], vnm);
+            const double *nm = skin_m.empty() ? world_nm : vnm;
             double ln[3] = {nrm[v * 3], nrm[v * 3 + 1], nrm[v * 3 + 2]}, wn[3];
             for (int r = 0; r < 3; r++)
                 wn[r] = nm[r * 3] * ln[0] + nm[r * 3 + 1] * ln[1] + nm[r * 3 + 2] * ln[2];
@@ -240,7 +331,7 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         indices.reserve(indices.size() + ntri * 3);
         for (size_t t = 0; t < ntri; t++) {
             uint32_t a = tri[t * 3], b = tri[t * 3 + 1], c = tri[t * 3 + 2];
-            if (flip)
+            if (flips(a))
                 std::swap(b, c);
             indices.insert(indices.end(), {base + a, base + b, base + c});
         }
@@ -250,7 +341,7 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         indices.reserve(indices.size() + ntri * 3);
         for (size_t t = 0; t < ntri; t++) {
             uint32_t corner[3] = {tri[t * 3], tri[t * 3 + 1], tri[t * 3 + 2]};
-            if (flip)
+            if (flips(corner[0]))
                 std::swap(corner[1], corner[2]);
             lpv_vertex vx[3];
             memset(vx, 0, sizeof vx);

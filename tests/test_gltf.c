@@ -1535,6 +1535,7 @@ static void expect_anim_fail(const char *path, const char *animation, double t, 
     lpv_scene_free(&s);
 }
 
+
 /* A file defect: refused when posed and when its animations are listed. */
 static void expect_anim_defect(const char *path, const char *w1, const char *w2)
 {
@@ -1550,6 +1551,95 @@ static void expect_anim_defect(const char *path, const char *w1, const char *w2)
 
 static const float T01[] = {0, 1};
 static const float T13[] = {1, 3};
+
+/* Skins and morph targets (issue 32, item 2), posed at a time. One
+ * triangle (0,0,0), (1,0,0), (0,1,0):
+ * - skinned: joint A at the origin, joint B its child at (0, 0.5, 0) (its
+ *   inverse bind matrix moves it back), vertex 0 on A, vertex 1 half on
+ *   each, vertex 2 on B; B turns 90 degrees about z over 1 s. The skinned
+ *   node's own translation (10, 0, 0) is not applied (glTF).
+ * - morphed: one target moving vertex 2 by (0, 0, 1); the mesh's weight
+ *   0.25, a node's 0.75, and a weights channel from 0 to 1 over 1 s.
+ * Before, both were drawn undeformed (bind pose, base shape) with a warning. */
+static void test_skins_and_morphs(void **state)
+{
+    (void)state;
+    anim_file f;
+    anim_init(&f);
+    /* JOINTS_0 as UNSIGNED_SHORT VEC4: vertex 0 (0,..), 1 (0,1,..), 2 (1,..) */
+    const size_t joff = f.b.n - 36;
+    const uint16_t joints[12] = {0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0};
+    for (int i = 0; i < 12; ++i)
+        put_u16(&f.b, joints[i]);
+    const int aj = anim_acc_json(&f, J("{'bufferView':1,'byteOffset':%zu,'componentType':5123,'count':3,"
+                                      "'type':'VEC4'}",
+                                      joff));
+    const float weights[12] = {1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0};
+    const int aw = anim_acc(&f, "VEC4", 3, weights);
+    const size_t moff = f.b.n - 36;
+    const float ibm[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
+                           1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -0.5f, 0, 1};
+    for (int i = 0; i < 32; ++i)
+        put_f32(&f.b, ibm[i]);
+    const int am = anim_acc_json(&f, J("{'bufferView':1,'byteOffset':%zu,'componentType':5126,'count':2,'type':'MAT4'}",
+                                      moff));
+    const int at = anim_acc(&f, "SCALAR", 2, T01);
+    const float quats[8] = {0, 0, 0, 1, 0, 0, 0.70710678f, 0.70710678f};
+    const int aq = anim_acc(&f, "VEC4", 2, quats);
+    const float delta[9] = {0, 0, 0, 0, 0, 0, 0, 0, 1};
+    const int ad = anim_acc(&f, "VEC3", 3, delta);
+    const float wkeys[2] = {0, 1};
+    const int awk = anim_acc(&f, "SCALAR", 2, wkeys);
+
+    char skin_path[512], morph_path[512], node_path[512];
+    const char *skin_json =
+        J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':%zu}],"
+          "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':%zu}],"
+          "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}%s],"
+          "'meshes':[{'primitives':[{'attributes':{'POSITION':0,'JOINTS_0':%d,'WEIGHTS_0':%d}}]}],"
+          "'skins':[{'joints':[1,2],'inverseBindMatrices':%d}],"
+          "'nodes':[{'mesh':0,'skin':0,'translation':[10,0,0]},{'children':[2]},{'translation':[0,0.5,0]}],"
+          "'scenes':[{'nodes':[0,1]}],'scene':0,"
+          "'animations':[{'name':'Bend','channels':[{'sampler':0,'target':{'node':2,'path':'rotation'}}],"
+          "'samplers':[{'input':%d,'output':%d}]}]}",
+          f.b.n, f.b.n - 36, f.accessors, aj, aw, am, at, aq);
+    write_glb(skin_path, "skinned.glb", skin_json, &f.b);
+    vertex_at(skin_path, "Bend", 0.0, 2, 0, 1, 0);
+    vertex_at(skin_path, "Bend", 1.0, 0, 0, 0, 0); /* on A: still, the node's (10,0,0) not applied */
+    vertex_at(skin_path, "Bend", 1.0, 2, -0.5f, 0.5f, 0); /* on B: turned about (0, 0.5, 0) */
+    vertex_at(skin_path, "Bend", 1.0, 1, 0.75f, 0.75f, 0); /* half each: (1,0,0) and (0.5,1.5,0) */
+    lpv_scene s;
+    load_ok(skin_path, &s); /* the static pose: the rest pose, no warning about skins */
+    assert_vec3(s.vertices[2].position, 0, 1, 0, 1e-6f);
+    lpv_scene_free(&s);
+
+    const char *morph_json =
+        J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':%zu}],"
+          "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':%zu}],"
+          "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}%s],"
+          "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'targets':[{'POSITION':%d}]}],'weights':[0.25]}],"
+          "'nodes':[{'mesh':0%s}],'scenes':[{'nodes':[0]}],'scene':0,"
+          "'animations':[{'name':'Grow','channels':[{'sampler':0,'target':{'node':0,'path':'weights'}}],"
+          "'samplers':[{'input':%d,'output':%d}]}]}",
+          f.b.n, f.b.n - 36, f.accessors, ad, "", at, awk);
+    write_glb(morph_path, "morphed.glb", morph_json, &f.b);
+    load_ok(morph_path, &s); /* the mesh's weight */
+    assert_vec3(s.vertices[2].position, 0, 1, 0.25f, 1e-6f);
+    lpv_scene_free(&s);
+    vertex_at(morph_path, "Grow", 0.5, 2, 0, 1, 0.5f); /* the channel's */
+    vertex_at(morph_path, "Grow", 2.0, 2, 0, 1, 1.0f);
+    const char *node_json =
+        J("{'asset':{'version':'2.0'},'buffers':[{'byteLength':%zu}],"
+          "'bufferViews':[{'buffer':0,'byteLength':36},{'buffer':0,'byteOffset':36,'byteLength':%zu}],"
+          "'accessors':[{'bufferView':0,'componentType':5126,'count':3,'type':'VEC3'}%s],"
+          "'meshes':[{'primitives':[{'attributes':{'POSITION':0},'targets':[{'POSITION':%d}]}],'weights':[0.25]}],"
+          "'nodes':[{'mesh':0,'weights':[0.75]}],'scenes':[{'nodes':[0]}],'scene':0}",
+          f.b.n, f.b.n - 36, f.accessors, ad);
+    write_glb(node_path, "node-weights.glb", node_json, &f.b);
+    load_ok(node_path, &s); /* the node's weight wins */
+    assert_vec3(s.vertices[2].position, 0, 1, 0.75f, 1e-6f);
+    lpv_scene_free(&s);
+}
 
 static void test_animation_linear_translation(void **state)
 {
@@ -1800,15 +1890,17 @@ static void test_animation_warnings(void **state)
     assert_vec3(s.vertices[0].position, 0, 0, 0, 1e-6f);
     lpv_scene_free(&s);
 
-    /* played: the translation is applied, the weights channel warned, and no
-     * line says the animation is not played */
+    /* played: the translation is applied, the weights channel (whose node
+     * has no morph targets) warned, and no line says the animation is not
+     * played */
     lpv_gltf_animation_time at = {"Walk", 0.5};
     if (lpv_gltf_load_file_animated_w(path, &at, &s, &w, err, sizeof err) != 0)
         fail_msg("%s", err);
     for (int i = 0; i < w.count; i++)
         print_message("    played: %s\n", w.line[i]);
     assert_vec3(s.vertices[0].position, 2, 0, 0, 1e-6f);
-    assert_true(warned(&w, "morph target weights channels (animation 0 channel 1): not applied"));
+    assert_true(warned(&w, "morph target weights channel (animation 0 (\"Walk\") channel 1): node 0's mesh has no "
+                           "morph targets; ignored"));
     assert_false(warned(&w, "not played"));
     lpv_scene_free(&s);
 
@@ -2057,6 +2149,7 @@ int main(void)
         cmocka_unit_test(test_animation_defects),
         cmocka_unit_test(test_animation_scene_load),
         cmocka_unit_test(test_schema_types),
+        cmocka_unit_test(test_skins_and_morphs),
         cmocka_unit_test(test_user_paths_outside_the_folder),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
