@@ -372,6 +372,15 @@ extern "C" int lpv_gltf_load_at(const void *data, size_t size, int base_fd, cons
                                 const lpv_gltf_node_override *nodes, size_t node_count, const lpv_gltf_limits *limits,
                                 lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size)
 {
+    return lpv_gltf_load_at_posed(data, size, base_fd, label, nullptr, nodes, node_count, limits, out, warnings, err,
+                                  err_size);
+}
+
+extern "C" int lpv_gltf_load_at_posed(const void *data, size_t size, int base_fd, const char *label,
+                                      const lpv_gltf_animation_time *at, const lpv_gltf_node_override *nodes,
+                                      size_t node_count, const lpv_gltf_limits *limits, lpv_scene *out,
+                                      lpv_gltf_warnings *warnings, char *err, size_t err_size)
+{
     const char *name = label && label[0] ? label : "<memory>";
     if (!begin_load(name, out, warnings, err, err_size))
         return LPV_GLTF_DEFECT;
@@ -386,6 +395,7 @@ extern "C" int lpv_gltf_load_at(const void *data, size_t size, int base_fd, cons
         ctx.sink = warnings;
         ctx.overrides = nodes;
         ctx.override_count = nodes ? node_count : 0;
+        ctx.animation = at;
         ctx.dir_fd = base_fd;
         ctx.allow_external = base_fd >= 0;
         if (limits) {

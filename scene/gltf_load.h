@@ -172,6 +172,15 @@ int lpv_gltf_load_at(const void *data, size_t size, int base_fd, const char *lab
                      const lpv_gltf_node_override *nodes, size_t node_count, const lpv_gltf_limits *limits,
                      lpv_scene *out, lpv_gltf_warnings *warnings, char *err, size_t err_size);
 
+/* lpv_gltf_load_at with the nodes posed by *at first (its animations at a
+ * time, skins and morph targets with them; lpv_gltf_load_file_animated),
+ * then the node overrides; at NULL is lpv_gltf_load_at. The daemon's
+ * SCENE_UPDATE "animation" (SPEC R4.4c). */
+int lpv_gltf_load_at_posed(const void *data, size_t size, int base_fd, const char *label,
+                           const lpv_gltf_animation_time *at, const lpv_gltf_node_override *nodes, size_t node_count,
+                           const lpv_gltf_limits *limits, lpv_scene *out, lpv_gltf_warnings *warnings, char *err,
+                           size_t err_size);
+
 /* The loaders above with the warnings stored in *warnings (zeroed first)
  * instead of printed on stderr; warnings NULL prints them as above. */
 int lpv_gltf_load_file_w(const char *path, lpv_scene *out, lpv_gltf_warnings *warnings, char *err,

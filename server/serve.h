@@ -186,15 +186,24 @@ void sv_net_preauth_leave(sv_conn *c);
 #define SV_PREAUTH_MAX_QUEUE (64u << 10)
 
 /* ---- scenes: parsed glTF, shared by every session that loaded the same bytes */
+/* A scene's pose: its animations at a time (SCENE_UPDATE "animation",
+ * SPEC R4.4c); unset: the file's static pose. */
+typedef struct sv_pose {
+    int set;
+    double time;                                 /* s */
+    char animation[LPV_GLTF_ANIMATION_NAME_LEN]; /* name or index; "" every animation */
+} sv_pose;
+
 typedef struct sv_scene {
     int refs;
-    uint64_t hash;          /* content hash (bytes + node overrides), 0 = built-in */
+    uint64_t hash;          /* content hash (bytes + node overrides + pose), 0 = built-in */
     lpv_scene scene;        /* parsed, default light ensured */
     uint8_t *glb;           /* the bytes (NULL for the built-in scene) */
     size_t glb_size;
     char *base_dir;         /* folder for external URIs, relative to the scene root (path loads), or NULL */
     lpv_gltf_node_override *nodes; /* SCENE_UPDATE node transforms applied at load */
     size_t node_count;
+    sv_pose pose;           /* SCENE_UPDATE animation time applied at load (before the nodes) */
     uint64_t bytes;         /* the file + lpv_scene_bytes: what it counts against --max-scenes-memory */
     struct sv_scene *next;  /* server's list of live scenes */
 } sv_scene;

@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdint.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +52,8 @@ typedef struct load_work {
                               the operator's --scene; or NULL */
     lpv_gltf_node_override *nodes;
     size_t node_count;
+    sv_pose pose;          /* the animation time to pose at (SCENE_UPDATE) */
+    int pose_given;        /* this request set it: its failures name "animation" */
     uint64_t base_hash;
     /* out */
     int status;
@@ -175,8 +178,9 @@ static void load_run(uv_work_t *req)
         return;
     }
     const char *label = w->sent ? w->sent : "attachment";
-    int rc = lpv_gltf_load_at(w->glb, w->glb_size, base_fd, label, w->nodes, w->node_count, &w->limits, &sc->scene,
-                              &w->warnings, w->err, sizeof w->err);
+    const lpv_gltf_animation_time at = {w->pose.animation, w->pose.time};
+    int rc = lpv_gltf_load_at_posed(w->glb, w->glb_size, base_fd, label, w->pose.set ? &at : NULL, w->nodes,
+                                    w->node_count, &w->limits, &sc->scene, &w->warnings, w->err, sizeof w->err);
     if (base_fd >= 0)
         close(base_fd);
     char why[256];
@@ -213,7 +217,10 @@ static void load_run(uv_work_t *req)
         h = lpv_hash_bytes(h, w->base_dir, strlen(w->base_dir));
     if (w->node_count)
         h = lpv_hash_bytes(h, w->nodes, sizeof *w->nodes * w->node_count);
+    if (w->pose.set)
+        h = lpv_hash_bytes(h, &w->pose, sizeof w->pose);
     sc->hash = h ? h : 1;
+    sc->pose = w->pose;
     sc->bytes = lpv_scene_bytes(&sc->scene) + w->glb_size;
     sc->glb = w->glb;
     sc->glb_size = w->glb_size;
@@ -269,8 +276,9 @@ static void load_done(uv_work_t *req, int status)
     if (!c->closing && !c->close_after_write) {
         char err[1024];
         if (w->status == LPVP_E_SCENE_INVALID && w->type == LPVP_SCENE_UPDATE) {
-            /* the file loaded before: the new node transforms are at fault */
-            sv_reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "nodes: %s", w->err);
+            /* the file loaded before: the new pose or node transforms are at fault */
+            sv_reply_err(c, w->request_id, LPVP_E_BAD_FIELD, 0, "%s: %s", w->pose_given ? "animation" : "nodes",
+                         w->err);
         } else if (w->status) {
             sv_reply_err(c, w->request_id, w->status, 0, "%s", w->err);
         } else if (scene_over_limits(s, &w->scene->scene, err, sizeof err) ||
@@ -497,13 +505,57 @@ void sv_do_scene_load(sv_conn *c, sv_request *r, json_t *j)
     }
 }
 
+/* SCENE_UPDATE "animation": {"name"?: string or index, "time": seconds}
+ * into *p; 0, 1 absent, -1 with a message (SPEC R4.4c). */
+static int parse_pose(const json_t *j, sv_pose *p, char *err, size_t n)
+{
+    const json_t *a = json_object_get(j, "animation");
+    if (!a)
+        return 1;
+    if (!json_is_object(a))
+        return snprintf(err, n, "animation: expected an object {\"name\"?, \"time\"}"), -1;
+    const char *k;
+    json_t *v;
+    json_object_foreach((json_t *)a, k, v) {
+        if (strcmp(k, "name") && strcmp(k, "time")) {
+            snprintf(err, n, "animation: unknown field (only \"name\" and \"time\")");
+            return -1;
+        }
+    }
+    memset(p, 0, sizeof *p);
+    const json_t *t = json_object_get(a, "time"), *name = json_object_get(a, "name");
+    if (!json_is_number(t) || !isfinite(json_number_value(t)) || json_number_value(t) < 0.0 ||
+        json_number_value(t) > 1e9)
+        return snprintf(err, n, "animation.time: expected seconds, a number in 0..1e9"), -1;
+    p->time = json_number_value(t);
+    if (json_is_string(name)) {
+        if (strlen(json_string_value(name)) >= sizeof p->animation)
+            return snprintf(err, n, "animation.name: longer than %zu bytes", sizeof p->animation - 1), -1;
+        snprintf(p->animation, sizeof p->animation, "%s", json_string_value(name));
+    } else if (json_is_integer(name) && json_integer_value(name) >= 0 && json_integer_value(name) <= 65535) {
+        snprintf(p->animation, sizeof p->animation, "%lld", (long long)json_integer_value(name));
+    } else if (name) {
+        return snprintf(err, n, "animation.name: expected the animation's name or index"), -1;
+    }
+    p->set = 1;
+    return 0;
+}
+
 void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
     const json_t *nodes = NULL, *mats = NULL;
+    sv_pose pose;
+    int pose_rc;
     if (lpvp_get_array(j, "nodes", 0, 65536, &nodes, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_array(j, "materials", 0, 65536, &mats, err, sizeof err) == LPVP_FIELD_BAD) {
+        lpvp_get_array(j, "materials", 0, 65536, &mats, err, sizeof err) == LPVP_FIELD_BAD ||
+        (pose_rc = parse_pose(j, &pose, err, sizeof err)) < 0) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
+        return;
+    }
+    if (pose_rc == 0 && !c->scene->glb) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                     "animation: the built-in scene has no animations; SCENE_LOAD a .glb first");
         return;
     }
     /* materials: validated into a copy, applied only if all are good */
@@ -602,7 +654,7 @@ void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j)
             return;
         }
     }
-    if (!ov) {
+    if (!ov && pose_rc != 0) {
         if (m) {
             free(c->materials);
             c->materials = m;
@@ -636,6 +688,9 @@ void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j)
     w->base_dir = bd;
     w->nodes = ov;
     w->node_count = nov;
+    /* the pose asked for, else the one the scene has (a node update keeps it) */
+    w->pose = pose_rc == 0 ? pose : c->scene->pose;
+    w->pose_given = pose_rc == 0;
     /* the overrides the scene already has come first (later ones win) */
     if (c->scene->node_count) {
         lpv_gltf_node_override *all = calloc(c->scene->node_count + nov, sizeof *all);
@@ -648,7 +703,8 @@ void sv_do_scene_update(sv_conn *c, sv_request *r, json_t *j)
             return;
         }
         memcpy(all, c->scene->nodes, sizeof *all * c->scene->node_count);
-        memcpy(all + c->scene->node_count, ov, sizeof *all * nov);
+        if (nov)
+            memcpy(all + c->scene->node_count, ov, sizeof *all * nov);
         free(w->nodes);
         w->nodes = all;
         w->node_count = c->scene->node_count + nov;

@@ -361,10 +361,11 @@ def make_glb(json_obj, bin_data=b"", *, lie_total=None, lie_json_len=None, magic
     return struct.pack("<4sII", magic, 2, total if lie_total is None else lie_total) + out
 
 
-def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=True, uri=None):
+def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=True, uri=None, animated=False):
     """A small open-front box, 2 m wide (x, z in [-1, 1], y in [0, 2]): white floor, ceiling and back wall,
     red left wall, green right wall, and a KHR_lights_punctual point light inside. 10 triangles.
-    uri: an external buffer URI instead of the BIN chunk (for the refusal cases)."""
+    uri: an external buffer URI instead of the BIN chunk (for the refusal cases).
+    animated: an animation "Swing" turns the box 90 degrees about y over its 1 s (R4.4c)."""
     quads = {
         "white": [
             [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)],      # floor, facing +y
@@ -401,6 +402,17 @@ def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=T
         accessors.append({"bufferView": len(views) - 1, "componentType": 5123, "count": len(idx), "type": "SCALAR"})
         prims.append({"attributes": {"POSITION": len(accessors) - 2}, "indices": len(accessors) - 1,
                       "material": mi})
+    animations = []
+    if animated:
+        keys = struct.pack("<2f", 0, 1) + struct.pack("<8f", 0, 0, 0, 1, 0, 0.70710678, 0, 0.70710678)
+        views.append({"buffer": 0, "byteOffset": len(binb), "byteLength": 8})
+        views.append({"buffer": 0, "byteOffset": len(binb) + 8, "byteLength": 32})
+        binb += keys
+        accessors.append({"bufferView": len(views) - 2, "componentType": 5126, "count": 2, "type": "SCALAR",
+                          "min": [0], "max": [1]})
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": 2, "type": "VEC4"})
+        animations = [{"name": "Swing", "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}],
+                       "samplers": [{"input": len(accessors) - 2, "output": len(accessors) - 1}]}]
     buf = {"byteLength": len(binb)}
     if uri is not None:
         buf["uri"] = uri
@@ -415,6 +427,8 @@ def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=T
         "bufferViews": views,
         "buffers": [buf],
     }
+    if animations:
+        doc["animations"] = animations
     if with_light:
         doc["extensionsUsed"] = ["KHR_lights_punctual"]
         doc["extensions"] = {"KHR_lights_punctual": {"lights": [
@@ -3033,6 +3047,33 @@ def c_scene_update(ctx):
             raise Fail("SCENE_UPDATE %s: %s" % (json.dumps(body), e))
     return "revisions %d < %d < %d < %d; material, mesh node and light node each changed the volume; " \
         "out-of-range refused" % (d, a, b, e)
+
+
+@case("R4.4c", "SCENE_UPDATE animation poses the scene at a time (the volume changes); a bad time or name, "
+      "or the built-in scene, gets BAD_FIELD naming animation")
+def c_scene_update_animation(ctx):
+    c = ctx.session()
+    expect_reply(c.request(SCENE_LOAD, {}, box_scene_glb(animated=True), timeout=ctx.tick_timeout), SCENE_LOAD)
+    expect_reply(c.request(CONFIG, dict(SMALL_CONFIG)), CONFIG)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v0 = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    r = expect_reply(c.request(SCENE_UPDATE, {"animation": {"name": "Swing", "time": 1.0}},
+                               timeout=ctx.tick_timeout), SCENE_UPDATE)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v1 = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    check(isinstance(r.body.get("revision"), int), "reply has no integer revision: %r" % r.body)
+    check(v1.att != v0.att, "posing the box at 1 s of \"Swing\" (turned 90 degrees) did not change the volume")
+    for body in ({"animation": {"time": -1}}, {"animation": {"time": "soon"}}, {"animation": 5},
+                 {"animation": {"name": "Nope", "time": 0.5}}, {"animation": {"time": 1, "speed": 2}}):
+        rid = c.send(SCENE_UPDATE, body)
+        try:
+            expect_error(c.recv_reply(rid, timeout=ctx.tick_timeout), "BAD_FIELD", rid, "animation")
+        except Fail as e:
+            raise Fail("SCENE_UPDATE %s: %s" % (json.dumps(body), e))
+    b = ctx.session()
+    rid = b.send(SCENE_UPDATE, {"animation": {"time": 1}})
+    expect_error(b.recv_reply(rid), "BAD_FIELD", rid, "animation")
+    return "posed at 1 s: the volume changed; 5 bad requests and the built-in scene refused"
 
 
 @case("R3.3", "CAMERA_SET with a scene camera (the default scene's) and with eye/target")

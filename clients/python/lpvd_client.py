@@ -896,12 +896,18 @@ class Client(object):
         """SCENE_LOAD with the .glb bytes as attachment."""
         return self.request(MSG["SCENE_LOAD"], {}, glb)[0]
 
-    def scene_update(self, nodes=None, materials=None):
+    def scene_update(self, nodes=None, materials=None, animation_time=None, animation=None):
+        """SCENE_UPDATE: node transforms, material edits, and/or the scene posed at animation_time seconds
+        of its animation (a name or index; None: every animation) (SPEC R4.4c)."""
         body = {}
         if nodes is not None:
             body["nodes"] = list(nodes)
         if materials is not None:
             body["materials"] = list(materials)
+        if animation_time is not None:
+            body["animation"] = {"time": float(animation_time)}
+            if animation is not None:
+                body["animation"]["name"] = animation
         return self.request(MSG["SCENE_UPDATE"], body)[0]
 
     def light_set(self, id, type, intensity, color=None, position=None, direction=None,
