@@ -88,9 +88,19 @@ void lpv_material_albedo_at(const lpv_scene *s, const lpv_material *m, const flo
 {
     float t[4] = {1.0f, 1.0f, 1.0f, 1.0f};
     sample(s, m->base_color_texture, 0, &m->base_color_uv, uv0, uv1, t);
-    const float kd = 1.0f - lpv_material_metallic_at(s, m, uv0, uv1);
+    const float kd = m->unlit ? 0.0f : 1.0f - lpv_material_metallic_at(s, m, uv0, uv1);
     for (int c = 0; c < 3; ++c)
         out[c] = unit(m->base_color[c] * t[c] * (color ? color[c] : 1.0f)) * kd;
+}
+
+void lpv_material_unlit_radiance_at(const lpv_scene *s, const lpv_material *m, const float uv0[2],
+                                    const float uv1[2], const float *color, float out[3])
+{
+    float t[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    if (m->unlit)
+        sample(s, m->base_color_texture, 0, &m->base_color_uv, uv0, uv1, t);
+    for (int c = 0; c < 3; ++c)
+        out[c] = m->unlit ? unit(m->base_color[c] * t[c] * (color ? color[c] : 1.0f)) / LPV_LUMENS_PER_WATT : 0.0f;
 }
 
 float lpv_material_occlusion_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2])

@@ -35,7 +35,8 @@ void lpv_material_uv(const lpv_uv_transform *t, const float uv0[2], const float 
 float lpv_material_metallic_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2]);
 
 /* The diffuse albedo at a surface point: base colour (x color, the point's
- * COLOR_0, where not NULL) x (1 - metallic), each channel clamped to [0, 1]. */
+ * COLOR_0, where not NULL) x (1 - metallic), each channel clamped to [0, 1];
+ * 0 for an unlit material (KHR_materials_unlit: it reflects no light). */
 void lpv_material_albedo_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
                             const float *color, float out[3]);
 
@@ -43,6 +44,14 @@ void lpv_material_albedo_at(const lpv_scene *s, const lpv_material *m, const flo
  * from the occlusionTexture: 1 + strength x (R - 1), in [0, 1]; 1 without
  * one. Not applied to the GI (the bounces), only where a camera looks. */
 float lpv_material_occlusion_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2]);
+
+/* What a camera sees of an unlit material (KHR_materials_unlit) at a
+ * surface point, W/(m^2 sr): its base colour (factor x texture x color
+ * where not NULL) as luminance in nits, / LPV_LUMENS_PER_WATT, which the
+ * display at EV 0 shows as the colour itself (docs/units.md), as three.js
+ * and the Khronos viewer show it. 0 for a lit material. */
+void lpv_material_unlit_radiance_at(const lpv_scene *s, const lpv_material *m, const float uv0[2],
+                                    const float uv1[2], const float *color, float out[3]);
 
 /* The emitted radiance at a surface point, W/(m^2 sr). */
 void lpv_material_emission_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],

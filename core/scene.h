@@ -14,8 +14,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "lpv_shared.h" /* LPV_LUMENS_PER_WATT */
+
 #define LPV_NAME_MAX 64
-#define LPV_LUMENS_PER_WATT 683.0f /* photometric -> radiometric, docs/units.md */
 
 /* The largest |coordinate| (m) lpvd computes with: scene vertices after node
  * transforms, lights' positions and ranges, the camera's eye and target,
@@ -102,6 +103,8 @@ typedef struct lpv_material {
     lpv_uv_transform metallic_roughness_uv;
     int emissive_texture;   /* index into textures, -1 = none; sRGB colour x emission */
     lpv_uv_transform emissive_uv;
+    int unlit;              /* KHR_materials_unlit: the frame shows the base colour as it is (1 = 1 nit); it
+                               neither reflects nor emits light (core/material_sample.h) */
     int occlusion_texture;  /* index into textures, -1 = none; linear: R darkens the frame's indirect light */
     float occlusion_strength; /* glTF occlusionTexture.strength: 1 + strength x (R - 1) */
     lpv_uv_transform occlusion_uv;

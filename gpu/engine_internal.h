@@ -45,6 +45,7 @@ typedef struct lpv_gpu_material {
     int emissive_texture; /* emissiveTexture: index into lpv_engine.textures (sRGB), -1 none */
     int emissive_uv_set;
     float emissive_uv[6];
+    int unlit;             /* KHR_materials_unlit */
     int occlusion_texture; /* occlusionTexture: index into lpv_engine.textures (linear), -1 none */
     float occlusion_strength;
     int occlusion_uv_set;

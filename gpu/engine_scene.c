@@ -329,6 +329,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         g->emissive_texture = lpv_material_texture(scene, m->emissive_texture, 0);
         g->emissive_uv_set = m->emissive_uv.texcoord == 1;
         lpv_uv_transform_matrix(&m->emissive_uv, g->emissive_uv);
+        g->unlit = m->unlit != 0;
         g->occlusion_texture = lpv_material_texture(scene, m->occlusion_texture, 1);
         g->occlusion_strength = m->occlusion_strength;
         g->occlusion_uv_set = m->occlusion_uv.texcoord == 1;
@@ -423,6 +424,7 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
     GLint loc_normal_row0 = glGetUniformLocation(prog, "u_normal_uv_row0");
     GLint loc_normal_row1 = glGetUniformLocation(prog, "u_normal_uv_row1");
     GLint loc_vertex_color = glGetUniformLocation(prog, "u_vertex_color");
+    GLint loc_unlit = glGetUniformLocation(prog, "u_unlit");
     GLint loc_has_mr = glGetUniformLocation(prog, "u_has_mr_texture");
     GLint loc_mr_set = glGetUniformLocation(prog, "u_mr_uv_set");
     GLint loc_mr_row0 = glGetUniformLocation(prog, "u_mr_uv_row0");
@@ -464,6 +466,7 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
         glUniform3fv(loc_normal_row0, 1, &m->normal_uv[0]);
         glUniform3fv(loc_normal_row1, 1, &m->normal_uv[3]);
         glUniform1i(loc_vertex_color, d->vertex_color);
+        glUniform1i(loc_unlit, m->unlit);
         glUniform1i(loc_has_mr, m->mr_texture >= 0);
         glUniform1i(loc_mr_set, m->mr_uv_set);
         glUniform3fv(loc_mr_row0, 1, &m->mr_uv[0]);

@@ -566,6 +566,23 @@ static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
     lpv_material_albedo_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
 }
 
+/* What the camera sees of an unlit material at a primary hit (its base
+ * colour as luminance, core/material_sample.h); 0 where lit. Never at a
+ * path's later hits: an unlit surface lights nothing. */
+static int hit_unlit(const lpv_ref *r, const hit *h, float out[3])
+{
+    const ref_tri *tr = &r->tris[h->tri];
+    if (tr->material < 0 || !r->look.materials[tr->material].unlit)
+        return 0;
+    float uv0[2], uv1[2], color[3];
+    tri_uv(tr, h->u, h->v, uv0, uv1);
+    const float w = 1.0f - h->u - h->v;
+    for (int i = 0; i < 3; ++i)
+        color[i] = w * tr->color[0][i] + h->u * tr->color[1][i] + h->v * tr->color[2][i];
+    lpv_material_unlit_radiance_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
+    return 1;
+}
+
 /* The factor a hit's indirect light takes in the image: its material's
  * occlusionTexture (core/material_sample.h), 1 without one: lpvd applies it
  * to the frame's indirect term, so the reference's image does the same. */
@@ -1039,7 +1056,7 @@ static void pixel_item(job *j, size_t i)
         }
     }
     float le[3] = {0.0f, 0.0f, 0.0f};
-    if (j->full)
+    if (j->full && !hit_unlit(j->ref, &h, le))
         hit_emission(j->ref, &h, le);
     for (int c = 0; c < 3; ++c) {
         px[c] = (float)(alb[c] / PT_PI) * (e[c] + ed[c]) + le[c];

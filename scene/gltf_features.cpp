@@ -15,6 +15,7 @@ namespace {
 const char *const kSupported[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_mesh_quantization",
     "KHR_texture_transform",      "KHR_draco_mesh_compression",      "EXT_meshopt_compression",
+    "KHR_materials_unlit",
 };
 
 /* Places a feature is used: "materials 0, 2, 5 and 3 more". */
@@ -71,8 +72,6 @@ void note_extensions(std::map<std::string, Uses> &ext, const tinygltf::Extension
 
 std::string what_instead(const std::string &name)
 {
-    if (name == "KHR_materials_unlit")
-        return "not supported; those materials are lit like any other";
     if (name.compare(0, 14, "KHR_materials_") == 0 || name == "KHR_materials_pbrSpecularGlossiness")
         return "not supported; the material's base colour, metallic and roughness are used";
     if (name == "KHR_texture_basisu" || name == "EXT_texture_webp" || name == "EXT_texture_avif")

@@ -231,6 +231,12 @@ void Builder::convert_materials()
         mat.metallic = float(pbr.metallicFactor);
         mat.roughness = float(pbr.roughnessFactor);
         mat.double_sided = gm.doubleSided ? 1 : 0;
+        if (gm.extensions.count("KHR_materials_unlit")) {
+            /* shown as its base colour, lit by nothing and lighting nothing:
+             * an emissive factor has no meaning on it (the extension) */
+            mat.unlit = 1;
+            mat.emission[0] = mat.emission[1] = mat.emission[2] = 0.0f;
+        }
         materials.push_back(mat);
     }
 }

@@ -41,7 +41,8 @@ void main()
             vec4 p = texelFetch(u_gbuf_position, t, 0);
             // emitters are light sources only: they do not block in the GV
             // (the planner counts only non-emissive triangles as occluders)
-            if (!(nt.w > 0.5) || any(greaterThan(em.rgb, vec3(0.0))) || !(p.w > 0.0) || isinf(p.w) ||
+            if (!(nt.w > 0.5) || (any(greaterThan(em.rgb, vec3(0.0))) && !lpv_gbuffer_unlit(nt.w)) || !(p.w > 0.0) ||
+                isinf(p.w) ||
                 !finite3(p.xyz) || !finite3(nt.xyz))
                 continue;
             vec3 x = p.xyz, n = nt.xyz;

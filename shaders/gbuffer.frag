@@ -49,8 +49,11 @@ void main()
         discard;
     vec2 mr = material_metallic_roughness(v_uv, v_uv1);
     o_position = vec4(p, area);
-    o_normal = vec4(n, 1.0 + mr.x); // w >= 1: covered; w - 1: metallic (lpv_gbuffer_kd)
+    // w >= 1: covered; w - 1: metallic (lpv_gbuffer_kd); LPV_GBUF_UNLIT_W: unlit
+    o_normal = vec4(n, u_unlit != 0 ? LPV_GBUF_UNLIT_W : 1.0 + mr.x);
     o_albedo = vec4(base.rgb, mr.y);
-    o_emission = vec4(material_emission(v_uv, v_uv1), u_object_size);
+    // an unlit pixel's emission target: what the camera sees (nits / 683, material_sample.h)
+    o_emission = vec4(u_unlit != 0 ? clamp(base.rgb, 0.0, 1.0) / LPV_LUMENS_PER_WATT : material_emission(v_uv, v_uv1),
+                      u_object_size);
     o_occlusion = material_occlusion(v_uv, v_uv1);
 }

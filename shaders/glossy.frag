@@ -26,7 +26,7 @@ void main()
     vec4 nrm = texelFetch(u_gbuf_normal, px, 0);
     vec4 alb = texelFetch(u_gbuf_albedo, px, 0);
     o_radiance = vec4(0.0);
-    if (nrm.w < 0.5 || !(alb.a < u_glossy_roughness))
+    if (nrm.w < 0.5 || lpv_gbuffer_unlit(nrm.w) || !(alb.a < u_glossy_roughness))
         return;
     vec3 p = texelFetch(u_gbuf_position, px, 0).xyz;
     vec3 n = normalize(nrm.xyz);

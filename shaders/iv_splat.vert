@@ -54,7 +54,8 @@ void main()
         p = texelFetch(u_gbuf_position, t, 0).xyz;
         n = gn.xyz;
         albedo = texelFetch(u_gbuf_albedo, t, 0).rgb * lpv_gbuffer_kd(gn.w); // diffuse
-        emission = texelFetch(u_gbuf_emission, t, 0).rgb;
+        // an unlit pixel's emission target is what the camera sees, not light
+        emission = lpv_gbuffer_unlit(gn.w) ? vec3(0.0) : texelFetch(u_gbuf_emission, t, 0).rgb;
     }
     float len = length(n);
     if (!finite3(p) || !(len > 1e-8) || isinf(len) || !finite3(albedo) || !finite3(emission))

@@ -554,8 +554,18 @@ LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v - lpv_slab_i
  * the frame and carries the bounces (iv's reprojected points, the camera's
  * surfels), is base x (1 - metallic), as glTF's metallic-roughness model has
  * it on a diffuse transport (core/material_sample.h for the CPU's side). */
+/* Photometric -> radiometric (docs/units.md): the loaders' lm/W, and an
+ * unlit material's base colour as luminance (nits) in the G-buffer. */
+#define LPV_LUMENS_PER_WATT 683.0f
+
+/* An unlit material's pixel (KHR_materials_unlit) has normal w
+ * LPV_GBUF_UNLIT_W: covered, no diffuse albedo (lpv_gbuffer_kd 0), and the
+ * emission target holds what the camera sees of it (its base colour as
+ * luminance, core/material_sample.h), which lights nothing. */
+#define LPV_GBUF_UNLIT_W 3.0
 #ifdef LPV_GLSL
 float lpv_gbuffer_kd(float normal_w) { return 1.0 - clamp(normal_w - 1.0, 0.0, 1.0); }
+bool lpv_gbuffer_unlit(float normal_w) { return normal_w > LPV_GBUF_UNLIT_W - 0.5; }
 #endif
 #define LPV_LOOKUP_NORMAL_TEXELS 131072
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6

@@ -15,6 +15,7 @@ uniform int u_vertex_color;     // 1: the vertices' COLOR_0 multiplies the base 
 uniform vec3 u_emission;        // W/(m^2 sr)
 uniform float u_roughness;      // glTF roughness (0 mirror .. 1 matte)
 uniform float u_metallic;       // glTF metallic (0 dielectric .. 1 metal)
+uniform int u_unlit;            // KHR_materials_unlit: shown as its base colour, lit by and lighting nothing
 uniform float u_object_size;    // m, the draw's longest bounding-box side (cascade fading)
 uniform float u_alpha_cutoff;   // alpha below it is cut away (MASK, BLEND as MASK at 0.5); 0 = opaque
 // A texture's uv: set (0 TEXCOORD_0, 1 TEXCOORD_1) and the rows of its

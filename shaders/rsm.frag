@@ -51,7 +51,8 @@ void main()
     }
     vec3 power = e_perp * texel_area_perp;
     vec4 base = material_albedo(v_uv, v_uv1, v_color);
-    vec3 albedo = base.rgb * (1.0 - material_metallic_roughness(v_uv, v_uv1).x); // diffuse
+    // diffuse (an unlit material reflects nothing)
+    vec3 albedo = u_unlit != 0 ? vec3(0.0) : base.rgb * (1.0 - material_metallic_roughness(v_uv, v_uv1).x);
     if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff) // after every derivative
         discard;
 

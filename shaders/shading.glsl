@@ -246,6 +246,8 @@ vec4 shade_pixel(ivec2 px)
         return vec4(vec3(lpv_ao(p, n)), 1.0);
 #endif
     vec3 emission = texelFetch(u_gbuf_emission, px, 0).rgb;
+    if (lpv_gbuffer_unlit(nrm.w)) // KHR_materials_unlit: its colour as it is, no light
+        return vec4(V.shading.w != 0.0 ? emission : vec3(0.0), 1.0);
 
     vec3 e_direct = vec3(0.0);
     if (V.shading.y != 0.0) {

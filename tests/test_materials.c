@@ -982,6 +982,105 @@ static void test_occlusion_texture(void **state)
     lpv_scene_free(&s[1]);
 }
 
+/* KHR_materials_unlit (issue 32, item 1): a floor of base colour
+ * (0.5, 0.25, 1) under a 1 W/m^2 sun shows that colour as it is, 1 = 1 nit
+ * = 1/683 W/(m^2 sr) (what three.js and the Khronos viewer show at exposure
+ * 1), in the full and direct frames, nothing in the indirect one; it
+ * reflects and emits nothing (iv's points, the RSM's light: a white wall
+ * beside it gets no bounce from it); the reference's image shows the same. */
+static void test_unlit(void **state)
+{
+    (void)state;
+    lpv_scene s[2];
+    for (int k = 0; k < 2; ++k) {
+        glb g = {0};
+        quad f, wall;
+        floor_quad(&f, 0);
+        add_quad(&g, &f);
+        memset(&wall, 0, sizeof wall);
+        static const float WALL[4][3] = {{1.5f, 0, -3}, {1.5f, 0, 3}, {1.5f, 2, 3}, {1.5f, 2, -3}}; /* faces -x */
+        memcpy(wall.c, WALL, sizeof wall.c);
+        wall.material = 1;
+        add_quad(&g, &wall);
+        add_sun(&g, SUN_DOWN);
+        size_t len;
+        unsigned char *data = glb_finish(
+            &g,
+            J("{'pbrMetallicRoughness':{'baseColorFactor':[0.5,0.25,1,1],'metallicFactor':0}%s},"
+              "{'pbrMetallicRoughness':{'baseColorFactor':[0.9,0.9,0.9,1],'metallicFactor':0}}",
+              k == 0 ? ",'extensions':{'KHR_materials_unlit':{}}" : ""),
+            NULL, k == 0 ? "\"KHR_materials_unlit\"" : NULL, &len);
+        lpv_gltf_warnings w;
+        load_glb(data, len, &s[k], &w);
+        free(data);
+        for (int i = 0; i < w.count; i++)
+            assert_null(strstr(w.line[i], "unlit"));
+    }
+    assert_int_equal(s[0].materials[0].unlit, 1);
+    assert_int_equal(s[1].materials[0].unlit, 0);
+    const float want[3] = {0.5f / 683.0f, 0.25f / 683.0f, 1.0f / 683.0f};
+    lpv_view v;
+    assert_int_equal(lpv_view_look_at((float[3]){-2.0f, 5.0f, 0.01f}, (float[3]){0.0f, 0.0f, 0.0f}, 1.0f, W, H, &v), 0);
+    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba);
+    char err[1024] = "";
+    lpv_settings st = {.technique = LPV_TECHNIQUE_ID_LPV, .rsm_size = 256};
+    const float on_floor[3] = {-1.0f, 0.0f, 0.0f}, on_wall[3] = {1.5f, 0.5f, 0.0f};
+    double wall_indirect[2];
+    for (int k = 0; k < 2; ++k)
+        for (int terms = 0; terms < 3; ++terms) {
+            static const lpv_frame_terms T[3] = {LPV_TERMS_FULL, LPV_TERMS_DIRECT_ONLY, LPV_TERMS_INDIRECT_ONLY};
+            if (lpv_engine_set_settings(lpvt_engine, &st, err, sizeof err) ||
+                lpv_engine_set_scene(lpvt_engine, &s[k], err, sizeof err) ||
+                lpv_engine_set_view(lpvt_engine, &v, err, sizeof err) ||
+                lpv_engine_tick(lpvt_engine, err, sizeof err) ||
+                lpv_engine_render(lpvt_engine, T[terms], rgba, err, sizeof err))
+                fail_msg("%s", err);
+            double a[3], b[3];
+            lpvt_patch(&v, rgba, W, H, on_floor, 1, a);
+            lpvt_patch(&v, rgba, W, H, on_wall, 1, b);
+            if (k == 0 && terms < 2)
+                for (int c = 0; c < 3; ++c)
+                    assert_float_equal(a[c], want[c], 1e-6);
+            if (k == 0 && terms == 2)
+                assert_true(lum(a) == 0.0);
+            if (k == 1 && terms == 0) /* lit: the sun's light, far more than 1 nit */
+                assert_true(a[1] > 0.05);
+            if (terms == 2)
+                wall_indirect[k] = lum(b);
+        }
+    printf("the wall's indirect light beside the unlit floor %.5f, beside the lit one %.5f\n", wall_indirect[0],
+           wall_indirect[1]);
+    assert_true(wall_indirect[1] > 0.0);
+    assert_true(wall_indirect[0] < 0.05 * wall_indirect[1]);
+    /* iv's points on the unlit floor: no albedo, no emission */
+    lpv_iv_point_params pp = {.voxel = 0.5f, .points = 1, .split = 0.5f, .max_points = 1 << 20, .emission = 1};
+    struct IvPoint *pts = NULL;
+    size_t n = 0;
+    assert_int_equal(lpv_iv_points_make(&s[0], &pp, &pts, &n, NULL), 0);
+    size_t floor_points = 0;
+    for (size_t i = 0; i < n; i++)
+        if (fabsf(pts[i].position[1]) < 1e-4f) {
+            floor_points++;
+            for (int c = 0; c < 3; c++)
+                assert_true(pts[i].albedo[c] == 0.0f && pts[i].emission[c] == 0.0f);
+        }
+    assert_true(floor_points > 10);
+    free(pts);
+    /* the reference's full image */
+    lpv_ref *ref = NULL;
+    lpv_ref_desc d = {.seed = 1};
+    assert_int_equal(lpv_ref_create(&s[0], &d, &ref, err, sizeof err), 0);
+    assert_int_equal(lpv_ref_render_full(ref, &v, 1, 4, rgba, NULL), 0);
+    lpv_ref_destroy(ref);
+    double r[3];
+    lpvt_patch(&v, rgba, W, H, on_floor, 1, r);
+    for (int c = 0; c < 3; ++c)
+        assert_float_equal(r[c], want[c], 1e-6);
+    free(rgba);
+    lpv_scene_free(&s[0]);
+    lpv_scene_free(&s[1]);
+}
+
 static void test_warnings_once_per_feature(void **state)
 {
     (void)state;
@@ -1086,6 +1185,7 @@ int main(void)
         cmocka_unit_test(test_material_textures),
         cmocka_unit_test(test_vertex_colours),
         cmocka_unit_test(test_occlusion_texture),
+        cmocka_unit_test(test_unlit),
         cmocka_unit_test(test_warnings_once_per_feature),
         cmocka_unit_test(test_bad_material_values_refused),
     };
