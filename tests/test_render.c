@@ -21,6 +21,7 @@
 #include "scene.h"
 #include "scene_load.h"
 #include "test_util.h"
+#include "view_choice.h"
 
 enum { W = 96, H = 96 };
 
@@ -376,10 +377,7 @@ static void test_render_command_rejects_bad_input(void **state)
  * --time 0 it fills the view's middle, at --time 1 it has left: the frames
  * differ. --animation without --time, a negative time and an animation the
  * file lacks are refused. */
-static void test_render_command_time(void **state)
-{
-    (void)state;
-    static const char *GLTF =
+static const char *SLIDE_GLTF =
         "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":68,\"uri\":\"data:application/"
         "octet-stream;base64,AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIBAAAAA"
         "AAAAAAA=\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,"
@@ -390,7 +388,11 @@ static void test_render_command_time(void **state)
         "{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0,\"animations\":"
         "[{\"name\":\"slide\",\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}],"
         "\"samplers\":[{\"input\":1,\"output\":2}]}]}";
-    const char *path = lpvt_write_file(lpvt_tmpdir(), "slide.gltf", GLTF, strlen(GLTF));
+
+static void test_render_command_time(void **state)
+{
+    (void)state;
+    const char *path = lpvt_write_file(lpvt_tmpdir(), "slide.gltf", SLIDE_GLTF, strlen(SLIDE_GLTF));
     char scene[512], a_out[512], b_out[512], err[512];
     snprintf(scene, sizeof scene, "%s", path);
     snprintf(a_out, sizeof a_out, "%s/t0.exr", lpvt_tmpdir());
@@ -420,6 +422,37 @@ static void test_render_command_time(void **state)
     assert_int_equal(run(10, unknown), 1);
 }
 
+/* A posed scene is sent to the GPU again only when the pose changed its
+ * geometry (issue 32): the triangle at 1 s and at 2 s (after the last
+ * keyframe: the same place) is one upload; at 0.5 s another. */
+static void test_pose_uploads_only_when_geometry_moves(void **state)
+{
+    (void)state;
+    const char *path = lpvt_write_file(lpvt_tmpdir(), "slide-uploads.gltf", SLIDE_GLTF, strlen(SLIDE_GLTF));
+    char p[512], err[512];
+    snprintf(p, sizeof p, "%s", path);
+    const double times[3] = {1.0, 2.0, 0.5};
+    unsigned long uploads[3];
+    lpv_settings st = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {8, 8, 8}};
+    assert_int_equal(lpv_engine_set_settings(lpvt_engine, &st, err, sizeof err), 0);
+    for (int i = 0; i < 3; ++i) {
+        lpv_gltf_animation_time at = {"slide", times[i]};
+        lpv_scene s;
+        assert_int_equal(lpv_scene_load_user(p, &at, &s, err, sizeof err), 0);
+        lpv_view v;
+        lpv_view_choice choice = {.width = 16, .height = 16};
+        assert_int_equal(lpv_view_resolve(&choice, &s, &v, err, sizeof err), 0);
+        if (lpv_engine_set_scene(lpvt_engine, &s, err, sizeof err) != 0 ||
+            lpv_engine_set_view(lpvt_engine, &v, err, sizeof err) != 0 || lpv_engine_tick(lpvt_engine, err, sizeof err))
+            fail_msg("%s", err);
+        uploads[i] = lpv_engine_get_counters(lpvt_engine).scene_uploads;
+        lpv_scene_free(&s);
+    }
+    printf("uploads after 1 s, 2 s, 0.5 s: %lu, %lu, %lu\n", uploads[0], uploads[1], uploads[2]);
+    assert_int_equal(uploads[1], uploads[0]);
+    assert_int_equal(uploads[2], uploads[1] + 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -432,6 +465,7 @@ int main(void)
         cmocka_unit_test(test_render_command_files),
         cmocka_unit_test(test_render_command_rejects_bad_input),
         cmocka_unit_test(test_render_command_time),
+        cmocka_unit_test(test_pose_uploads_only_when_geometry_moves),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
