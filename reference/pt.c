@@ -230,14 +230,17 @@ static void tri_vertices(const ref_tri *t, lpv_vertex v[3])
         }
 }
 
-/* The uv sets at barycentrics (1 - b1 - b2, b1, b2). */
-static void tri_uv(const ref_tri *t, float b1, float b2, float uv0[2], float uv1[2])
+/* The uv sets (and, color not NULL, COLOR_0's rgb) at barycentrics
+ * (1 - b1 - b2, b1, b2). */
+static void tri_uv(const ref_tri *t, float b1, float b2, float uv0[2], float uv1[2], float *color)
 {
     const float w = 1.0f - b1 - b2;
     for (int i = 0; i < 2; ++i) {
         uv0[i] = w * t->uv[0][i] + b1 * t->uv[1][i] + b2 * t->uv[2][i];
         uv1[i] = w * t->uv1[0][i] + b1 * t->uv1[1][i] + b2 * t->uv1[2][i];
     }
+    for (int i = 0; color && i < 3; ++i)
+        color[i] = w * t->color[0][i] + b1 * t->color[1][i] + b2 * t->color[2][i];
 }
 
 static double tri_area(const ref_tri *t)
@@ -559,10 +562,7 @@ static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
         return;
     }
     float uv0[2], uv1[2], color[3];
-    tri_uv(tr, h->u, h->v, uv0, uv1);
-    const float w = 1.0f - h->u - h->v;
-    for (int i = 0; i < 3; ++i)
-        color[i] = w * tr->color[0][i] + h->u * tr->color[1][i] + h->v * tr->color[2][i];
+    tri_uv(tr, h->u, h->v, uv0, uv1, color);
     lpv_material_albedo_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
 }
 
@@ -575,10 +575,7 @@ static int hit_unlit(const lpv_ref *r, const hit *h, float out[3])
     if (tr->material < 0 || !r->look.materials[tr->material].unlit)
         return 0;
     float uv0[2], uv1[2], color[3];
-    tri_uv(tr, h->u, h->v, uv0, uv1);
-    const float w = 1.0f - h->u - h->v;
-    for (int i = 0; i < 3; ++i)
-        color[i] = w * tr->color[0][i] + h->u * tr->color[1][i] + h->v * tr->color[2][i];
+    tri_uv(tr, h->u, h->v, uv0, uv1, color);
     lpv_material_unlit_radiance_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
     return 1;
 }
@@ -592,7 +589,7 @@ static float hit_occlusion(const lpv_ref *r, const hit *h)
     if (tr->material < 0)
         return 1.0f;
     float uv0[2], uv1[2];
-    tri_uv(tr, h->u, h->v, uv0, uv1);
+    tri_uv(tr, h->u, h->v, uv0, uv1, NULL);
     return lpv_material_occlusion_at(&r->look, &r->look.materials[tr->material], uv0, uv1);
 }
 
@@ -604,7 +601,7 @@ static int hit_emission(const lpv_ref *r, const hit *h, float out[3])
     if (tr->material < 0 || !r->materials[tr->material].emits || (!h->front && r->materials[tr->material].sides < 2))
         return 0;
     float uv0[2], uv1[2];
-    tri_uv(tr, h->u, h->v, uv0, uv1);
+    tri_uv(tr, h->u, h->v, uv0, uv1, NULL);
     lpv_material_emission_at(&r->look, &r->look.materials[tr->material], uv0, uv1, out);
     for (int i = 0; i < 3; ++i)
         out[i] = isfinite(out[i]) && out[i] > 0.0f ? out[i] : 0.0f;
@@ -695,7 +692,7 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
     const ref_material *m = &r->materials[tr->material];
     float s1 = sqrtf(pcg32_float(rng)), s2 = pcg32_float(rng);
     float b1 = s1 * (1.0f - s2), b2 = s1 * s2, q[3], d[3], le[3], uv0[2], uv1[2];
-    tri_uv(tr, b1, b2, uv0, uv1);
+    tri_uv(tr, b1, b2, uv0, uv1, NULL);
     lpv_material_emission_at(&r->look, &r->look.materials[tr->material], uv0, uv1, le); /* at q: its texture */
     for (int i = 0; i < 3; ++i) {
         q[i] = tr->p0[i] + b1 * tr->e1[i] + b2 * tr->e2[i];

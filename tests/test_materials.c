@@ -879,20 +879,27 @@ static void test_vertex_colours(void **state)
     lpv_scene_free(&s);
 }
 
+/* The floor (material 0) and, at x = 1.5, a 2 m white wall facing -x
+ * (material 1) that throws light on it. */
+static void floor_and_wall(glb *g)
+{
+    quad f, wall;
+    floor_quad(&f, 0);
+    add_quad(g, &f);
+    memset(&wall, 0, sizeof wall);
+    static const float WALL[4][3] = {{1.5f, 0, -3}, {1.5f, 0, 3}, {1.5f, 2, 3}, {1.5f, 2, -3}};
+    memcpy(wall.c, WALL, sizeof wall.c);
+    wall.material = 1;
+    add_quad(g, &wall);
+}
+
 /* A floor with an occlusion texture 0 where z < 0 and 1 where z > 0 at
  * `strength`, and a white wall at x = 1.5 that the diagonal sun lights and
  * that throws light on the floor. */
 static void occlusion_scene(float strength, lpv_scene *s)
 {
     glb g = {0};
-    quad f, wall;
-    floor_quad(&f, 0);
-    add_quad(&g, &f);
-    memset(&wall, 0, sizeof wall);
-    static const float WALL[4][3] = {{1.5f, 0, -3}, {1.5f, 0, 3}, {1.5f, 2, 3}, {1.5f, 2, -3}}; /* faces -x */
-    memcpy(wall.c, WALL, sizeof wall.c);
-    wall.material = 1;
-    add_quad(&g, &wall);
+    floor_and_wall(&g);
     /* 64 x 64 texels: the mip levels the camera reads keep both halves pure */
     static uint8_t occ[64 * 64 * 4];
     for (int y = 0; y < 64; y++)
@@ -994,14 +1001,7 @@ static void test_unlit(void **state)
     lpv_scene s[2];
     for (int k = 0; k < 2; ++k) {
         glb g = {0};
-        quad f, wall;
-        floor_quad(&f, 0);
-        add_quad(&g, &f);
-        memset(&wall, 0, sizeof wall);
-        static const float WALL[4][3] = {{1.5f, 0, -3}, {1.5f, 0, 3}, {1.5f, 2, 3}, {1.5f, 2, -3}}; /* faces -x */
-        memcpy(wall.c, WALL, sizeof wall.c);
-        wall.material = 1;
-        add_quad(&g, &wall);
+        floor_and_wall(&g);
         add_sun(&g, SUN_DOWN);
         size_t len;
         unsigned char *data = glb_finish(
