@@ -57,8 +57,8 @@ static int load(const char *path, const lpv_gltf_animation_time *at, int user, l
 }
 
 static const lpv_flag POSE_FLAGS[] = {
-    {"time", 0, "SECONDS", "pose the file at this time of its animations (node transforms;\n"
-                           "docs/scenes.md \"Animations\"); default: the file's static pose"},
+    {"time", 0, "SECONDS", "pose the file at this time of its animations (node transforms, skins,\n"
+                           "morph weights; docs/scenes.md \"Animations\"); default: the static pose"},
     {"animation", 0, "NAME|INDEX", "the animation --time plays (default: every animation of the file)"},
 };
 #define N_POSE_FLAGS (sizeof POSE_FLAGS / sizeof POSE_FLAGS[0])
