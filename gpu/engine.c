@@ -133,8 +133,10 @@ GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size
         lpv_error(err, err_size, "technique %s names too many lookup includes", e->tech->cls->name);
         return 0;
     }
-    char defines[256];
-    snprintf(defines, sizeof defines, "%s%s%s%s%s",
+    char defines[384];
+    snprintf(defines, sizeof defines, "%s%s%s%s%s%s%s",
+             variant & LPV_FRAME_OCCLUSION ? "" : "#define LPV_FRAME_OCCLUSION 0\n",
+             variant & LPV_FRAME_UNLIT ? "" : "#define LPV_FRAME_UNLIT 0\n",
              variant & LPV_FRAME_DIRECTIONAL ? "" : "#define LPV_SHADE_DIRECTIONAL 0\n",
              variant & LPV_FRAME_DAMPED ? "" : "#define LPV_LOOKUP_DAMPING 0\n",
              variant & LPV_FRAME_SPLIT ? "#define LPV_LOOKUP_SPLIT 1\n" : "",

@@ -66,7 +66,9 @@ enum {
     LPV_FRAME_SPLIT = 4,       /* the first of two passes (the technique's lookup_split) */
     LPV_FRAME_BLOCKS = 8,      /* the irradiance from the lookup step's blocks */
     LPV_FRAME_AREA_BLOCKS = 16, /* the area light samples' visibility from the area shadow step's blocks */
-    LPV_FRAME_VARIANTS = 32
+    LPV_FRAME_OCCLUSION = 32,   /* the G-buffer's occlusion target (scenes with an occlusionTexture) */
+    LPV_FRAME_UNLIT = 64,       /* unlit pixels (scenes with a KHR_materials_unlit material) */
+    LPV_FRAME_VARIANTS = 128
 };
 
 /* Textures of a pass per block of the frame's pixels (frame_blocks.c): a
@@ -123,6 +125,8 @@ struct lpv_engine {
     lpv_gpu_material *materials;
     uint32_t material_count;
     int materials_plain;      /* 1: no material has a texture, a normal map or an alpha cut */
+    int materials_occlusion;  /* 1: some material has an occlusionTexture (LPV_FRAME_OCCLUSION) */
+    int materials_unlit;      /* 1: some material is unlit (LPV_FRAME_UNLIT) */
     GLuint *textures;
     uint32_t texture_count;
     lpv_light lights[LPV_MAX_LIGHTS];

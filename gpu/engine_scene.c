@@ -337,11 +337,14 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     }
     e->material_count = scene->material_count;
     e->materials_plain = 1;
+    e->materials_occlusion = e->materials_unlit = 0;
     for (uint32_t i = 0; i < e->material_count; ++i) {
         const lpv_gpu_material *g = &e->materials[i];
         if (g->texture >= 0 || g->normal_texture >= 0 || g->mr_texture >= 0 || g->emissive_texture >= 0 ||
             g->occlusion_texture >= 0 || g->alpha_cutoff > 0.0f)
             e->materials_plain = 0;
+        e->materials_occlusion |= g->occlusion_texture >= 0;
+        e->materials_unlit |= g->unlit;
     }
     if (upload_textures(e, scene, err, err_size) != 0)
         return -1;

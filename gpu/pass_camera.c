@@ -258,7 +258,9 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
     const int split = !blocks && e->tech->cls->lookup_split && e->tech->cls->lookup_split(e->tech);
     const unsigned variant = (e->light_block.counts[3] > 0.0f ? LPV_FRAME_DIRECTIONAL : 0u) |
                              (damped ? LPV_FRAME_DAMPED : 0u) | (split ? LPV_FRAME_SPLIT : 0u) |
-                             (blocks ? LPV_FRAME_BLOCKS : 0u) | (area_blocks ? LPV_FRAME_AREA_BLOCKS : 0u);
+                             (blocks ? LPV_FRAME_BLOCKS : 0u) | (area_blocks ? LPV_FRAME_AREA_BLOCKS : 0u) |
+                             (e->materials_occlusion ? LPV_FRAME_OCCLUSION : 0u) |
+                             (e->materials_unlit ? LPV_FRAME_UNLIT : 0u);
     const GLuint prog = lpv_engine_frame_program(e, variant, err, err_size);
     if (!prog)
         return -1;

@@ -12,8 +12,16 @@ layout(binding = 3) uniform sampler2D u_gbuf_emission;
 layout(binding = LPV_TEX_GBUF_OCCLUSION) uniform sampler2D u_gbuf_occlusion; // the material's occlusionTexture
 
 // The factor the pixel's indirect light takes (glTF's occlusionTexture: an
-// ambient term of the frame, not of the GI the bounces carry).
-float ambient_occlusion(ivec2 px) { return texelFetch(u_gbuf_occlusion, px, 0).r; }
+// ambient term of the frame, not of the GI the bounces carry). Frames of
+// scenes without one (LPV_FRAME_OCCLUSION 0) read nothing: llvmpipe would
+// fetch for every pixel (gpu/pass_camera.c picks the variant).
+#ifndef LPV_FRAME_OCCLUSION
+#define LPV_FRAME_OCCLUSION 1
+#endif
+#ifndef LPV_FRAME_UNLIT
+#define LPV_FRAME_UNLIT 1
+#endif
+float ambient_occlusion(ivec2 px) { return LPV_FRAME_OCCLUSION != 0 ? texelFetch(u_gbuf_occlusion, px, 0).r : 1.0; }
 
 layout(std140, binding = LPV_UBO_VIEW) uniform ViewUBO { LpvViewBlock V; };
 
@@ -246,7 +254,7 @@ vec4 shade_pixel(ivec2 px)
         return vec4(vec3(lpv_ao(p, n)), 1.0);
 #endif
     vec3 emission = texelFetch(u_gbuf_emission, px, 0).rgb;
-    if (lpv_gbuffer_unlit(nrm.w)) // KHR_materials_unlit: its colour as it is, no light
+    if (LPV_FRAME_UNLIT != 0 && lpv_gbuffer_unlit(nrm.w)) // KHR_materials_unlit: its colour as it is, no light
         return vec4(V.shading.w != 0.0 ? emission : vec3(0.0), 1.0);
 
     vec3 e_direct = vec3(0.0);
