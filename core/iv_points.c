@@ -163,6 +163,10 @@ static void emit_piece(walk *w, const double pb[3][3])
             for (int c = 0; c < 4; ++c)
                 col[c] += (float)b[j] * w->v[j]->color[c];
         }
+        if (w->m && !lpv_material_covers_at(w->scene, w->m, uv0, uv1, w->vertex_color ? col[3] : 1.0f)) {
+            w->count--; /* a cut-away texel (alpha): no surface there */
+            continue;
+        }
         if (w->m) {
             lpv_material_albedo_at(w->scene, w->m, uv0, uv1, w->vertex_color ? col : NULL, albedo);
             if (w->emission)

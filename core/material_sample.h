@@ -31,6 +31,14 @@ void lpv_texture_sample(const lpv_texture *t, float u, float v, float out[4]);
  * then the transform. */
 void lpv_material_uv(const lpv_uv_transform *t, const float uv0[2], const float uv1[2], float out[2]);
 
+/* Whether a material's surface is there at a surface point: its alpha
+ * (baseColorFactor.a x the base colour texture's alpha x COLOR_0's alpha,
+ * color_alpha 1 without one) is at least lpv_material_alpha_cutoff (MASK,
+ * and BLEND drawn as MASK at 0.5; always for OPAQUE), as the shaders' cut
+ * (material.glsl): cut-away texels neither block, reflect nor show. */
+int lpv_material_covers_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
+                           float color_alpha);
+
 /* Metallic at a surface point (factor x texture B), clamped to [0, 1]. */
 float lpv_material_metallic_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2]);
 

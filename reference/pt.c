@@ -19,7 +19,7 @@ typedef struct ref_tri {
     float p0[3], e1[3], e2[3]; /* corners p0, p0 + e1, p0 + e2 */
     float vn[3][3];            /* vertex normals (unit; the front normal where the file's was bad) */
     float uv[3][2], uv1[3][2]; /* TEXCOORD_0, TEXCOORD_1 */
-    float color[3][3];         /* COLOR_0's rgb at the corners; 1 where the draw has none */
+    float color[3][4];         /* COLOR_0 (rgba) at the corners; 1 where the draw has none */
     float front[3]; /* unit geometric normal of the front side (the emitting one, or the first of two) */
     int material;   /* -1 = none: black, not emissive */
 } ref_tri;
@@ -173,7 +173,7 @@ static int make_tri(const lpv_scene *s, uint32_t first, int material, int vertex
             t->uv[k][i] = isfinite(v[k]->uv[i]) ? v[k]->uv[i] : 0.0f;
             t->uv1[k][i] = isfinite(v[k]->uv1[i]) ? v[k]->uv1[i] : 0.0f;
         }
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 4; ++i)
             t->color[k][i] = vertex_color && isfinite(v[k]->color[i]) ? v[k]->color[i] : 1.0f;
     }
     t->material = material;
@@ -230,7 +230,7 @@ static void tri_vertices(const ref_tri *t, lpv_vertex v[3])
         }
 }
 
-/* The uv sets (and, color not NULL, COLOR_0's rgb) at barycentrics
+/* The uv sets (and, color not NULL, COLOR_0's rgba) at barycentrics
  * (1 - b1 - b2, b1, b2). */
 static void tri_uv(const ref_tri *t, float b1, float b2, float uv0[2], float uv1[2], float *color)
 {
@@ -239,7 +239,7 @@ static void tri_uv(const ref_tri *t, float b1, float b2, float uv0[2], float uv1
         uv0[i] = w * t->uv[0][i] + b1 * t->uv[1][i] + b2 * t->uv[2][i];
         uv1[i] = w * t->uv1[0][i] + b1 * t->uv1[1][i] + b2 * t->uv1[2][i];
     }
-    for (int i = 0; color && i < 3; ++i)
+    for (int i = 0; color && i < 4; ++i)
         color[i] = w * t->color[0][i] + b1 * t->color[1][i] + b2 * t->color[2][i];
 }
 
@@ -248,6 +248,33 @@ static double tri_area(const ref_tri *t)
     float c[3];
     cross3(t->e1, t->e2, c);
     return 0.5 * sqrt((double)dot3(c, c));
+}
+
+/* Embree's filter for both ray kinds: a hit on a cut-away texel (alpha
+ * below the material's cutoff: MASK, BLEND drawn as MASK at 0.5) is no hit,
+ * as lpvd's shaders cut it (core/material_sample.h lpv_material_covers_at).
+ * Installed only when some material cuts. */
+static void alpha_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    /* RTCHitN's layout (rtcore_ray.h's RTCHitN_u/_v/_primID, C++ only): N
+     * floats each of Ng x, y, z, u, v, then N primIDs */
+    const float *hf = (const float *)args->hit;
+    const unsigned *hu = (const unsigned *)args->hit;
+    const lpv_ref *r = args->geometryUserPtr;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1)
+            continue;
+        const unsigned prim = hu[5 * args->N + i];
+        if (prim >= r->tri_count)
+            continue;
+        const ref_tri *tr = &r->tris[prim];
+        if (tr->material < 0)
+            continue;
+        float uv0[2], uv1[2], color[4];
+        tri_uv(tr, hf[3 * args->N + i], hf[4 * args->N + i], uv0, uv1, color);
+        if (!lpv_material_covers_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color[3]))
+            args->valid[i] = 0;
+    }
 }
 
 /* The emissive triangles and their power CDF, for next-event estimation. */
@@ -401,6 +428,14 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
             }
         }
         vb[9 * (size_t)r->tri_count] = vb[9 * (size_t)r->tri_count + 1] = vb[9 * (size_t)r->tri_count + 2] = 0.0f;
+        int cuts = 0;
+        for (uint32_t m = 0; m < r->look.material_count; ++m)
+            cuts |= lpv_material_alpha_cutoff(&r->look.materials[m]) > 0.0f;
+        if (cuts) {
+            rtcSetGeometryUserData(g, r);
+            rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+            rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+        }
         rtcCommitGeometry(g);
         rtcAttachGeometry(r->scene, g);
         rtcReleaseGeometry(g);
@@ -561,7 +596,7 @@ static void hit_albedo(const lpv_ref *r, const hit *h, float out[3])
         out[0] = out[1] = out[2] = 0.0f;
         return;
     }
-    float uv0[2], uv1[2], color[3];
+    float uv0[2], uv1[2], color[4];
     tri_uv(tr, h->u, h->v, uv0, uv1, color);
     lpv_material_albedo_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
 }
@@ -574,7 +609,7 @@ static int hit_unlit(const lpv_ref *r, const hit *h, float out[3])
     const ref_tri *tr = &r->tris[h->tri];
     if (tr->material < 0 || !r->look.materials[tr->material].unlit)
         return 0;
-    float uv0[2], uv1[2], color[3];
+    float uv0[2], uv1[2], color[4];
     tri_uv(tr, h->u, h->v, uv0, uv1, color);
     lpv_material_unlit_radiance_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color, out);
     return 1;

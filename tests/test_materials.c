@@ -1081,6 +1081,49 @@ static void test_unlit(void **state)
     lpv_scene_free(&s[1]);
 }
 
+/* A MASK cut-out is cut alike everywhere (issue 32: the same inputs in the
+ * reference): the occluder's z > 0 half (alpha 0) casts no shadow in the
+ * path tracer either, and iv's point cloud has no point there. Before, the
+ * reference's rays and iv's points ignored alpha: the whole occluder
+ * shadowed and carried light. */
+static void test_cut_outs_in_reference_and_points(void **state)
+{
+    (void)state;
+    lpv_scene s;
+    occluder_scene("{'alphaMode':'MASK','alphaCutoff':0.5,'pbrMetallicRoughness':{'baseColorTexture':{'index':0},"
+                   "'metallicFactor':0}}",
+                   OCC_UP, SUN_DOWN, &s, NULL);
+    lpv_ref *ref = NULL;
+    char err[512] = "";
+    assert_int_equal(lpv_ref_create(&s, NULL, &ref, err, sizeof err), 0);
+    const float up[3] = {0, 1, 0};
+    float under_opaque[3], under_cut[3], open[3];
+    lpv_ref_direct_irradiance(ref, (float[3]){0.0f, 0.0f, -0.5f}, up, under_opaque);
+    lpv_ref_direct_irradiance(ref, (float[3]){0.0f, 0.0f, 0.5f}, up, under_cut);
+    lpv_ref_direct_irradiance(ref, (float[3]){2.5f, 0.0f, 0.0f}, up, open);
+    lpv_ref_destroy(ref);
+    printf("reference direct irradiance (g): under the opaque half %.4f, under the cut half %.4f, open floor %.4f\n",
+           under_opaque[1], under_cut[1], open[1]);
+    assert_true(open[1] > 0.5f);
+    assert_true(under_opaque[1] < 0.01f * open[1]);
+    assert_float_equal(under_cut[1], open[1], 1e-4f * open[1]);
+    lpv_iv_point_params pp = {.voxel = 0.25f, .points = 1, .split = 0.5f, .max_points = 1 << 20};
+    struct IvPoint *pts = NULL;
+    size_t n = 0;
+    assert_int_equal(lpv_iv_points_make(&s, &pp, &pts, &n, NULL), 0);
+    size_t on_opaque = 0, on_cut = 0;
+    for (size_t i = 0; i < n; i++)
+        if (fabsf(pts[i].position[1] - 1.0f) < 1e-4f) {
+            on_opaque += pts[i].position[2] < -0.01f;
+            on_cut += pts[i].position[2] > 0.01f;
+        }
+    printf("iv points on the occluder: %zu on the opaque half, %zu on the cut half\n", on_opaque, on_cut);
+    assert_true(on_opaque > 10);
+    assert_int_equal(on_cut, 0);
+    free(pts);
+    lpv_scene_free(&s);
+}
+
 static void test_warnings_once_per_feature(void **state)
 {
     (void)state;
@@ -1186,6 +1229,7 @@ int main(void)
         cmocka_unit_test(test_vertex_colours),
         cmocka_unit_test(test_occlusion_texture),
         cmocka_unit_test(test_unlit),
+        cmocka_unit_test(test_cut_outs_in_reference_and_points),
         cmocka_unit_test(test_warnings_once_per_feature),
         cmocka_unit_test(test_bad_material_values_refused),
     };
