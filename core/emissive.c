@@ -3,6 +3,7 @@
 #include "material_sample.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static int material_emits(const lpv_scene *s, int m)
@@ -13,18 +14,39 @@ static int material_emits(const lpv_scene *s, int m)
     return (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) && isfinite(e[0] + e[1] + e[2]);
 }
 
-/* A usable triangle's corners, front normal, area (lpv_scene_triangle) and
- * mean emitted radiance (its emissiveTexture's mean, core/material_sample.h). */
-static int triangle(const lpv_scene *s, uint32_t first, const lpv_material *m, const float *p[3], float n[3],
-                    double *area, float e[3])
+/* The triangles' mean emitted radiance (their emissiveTexture's mean,
+ * core/material_sample.h: up to thousands of texture samples each), kept
+ * from a walk for the next one over the same scene. */
+typedef struct emission_memo {
+    float (*e)[3];
+    size_t n, cap, next;
+    int ready; /* filled: the next walk reads it */
+    int oom;
+} emission_memo;
+
+/* Triangle i's mean emitted radiance into e: from the memo once it is
+ * ready, else computed (and kept when there is a memo). */
+static void emission_of(const lpv_scene *s, const lpv_material *m, const lpv_vertex *const v[3],
+                        emission_memo *memo, float e[3])
 {
-    const lpv_vertex *v[3];
-    if (!lpv_scene_triangle(s, first, v, n, area))
-        return 0;
-    for (int k = 0; k < 3; ++k)
-        p[k] = v[k]->position;
+    if (memo && memo->ready && memo->next < memo->n) {
+        memcpy(e, memo->e[memo->next++], 3 * sizeof(float));
+        return;
+    }
     lpv_triangle_emission(s, m, v, e);
-    return 1;
+    if (!memo || memo->ready || memo->oom)
+        return;
+    if (memo->n == memo->cap) {
+        size_t cap = memo->cap ? 2 * memo->cap : 256;
+        float(*grown)[3] = realloc(memo->e, cap * sizeof *grown);
+        if (!grown) {
+            memo->oom = 1; /* the next walk computes again */
+            return;
+        }
+        memo->e = grown;
+        memo->cap = cap;
+    }
+    memcpy(memo->e[memo->n++], e, 3 * sizeof(float));
 }
 
 static double emission_weight(const float e[3])
@@ -38,8 +60,12 @@ static double emission_weight(const float e[3])
  * the first non-zero value fn returned (stop). */
 typedef int (*triangle_fn)(void *ud, const float *p[3], const float n[3], double area, const float e[3]);
 
-static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *ud)
+static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *ud, emission_memo *memo)
 {
+    if (memo && !memo->oom && memo->n) {
+        memo->ready = 1;
+        memo->next = 0;
+    }
     for (uint32_t d = 0; d < s->draw_count; ++d) {
         const lpv_draw *dr = &s->draws[d];
         if (!material_emits(s, dr->material))
@@ -47,11 +73,15 @@ static int for_each_emissive_triangle(const lpv_scene *s, triangle_fn fn, void *
         const lpv_material *m = &s->materials[dr->material];
         const int sides = lpv_material_emitting_sides(m);
         for (uint32_t t = 0; t + 3 <= dr->index_count; t += 3) {
+            const lpv_vertex *v[3];
             const float *p[3];
             float n[3], e[3];
             double area;
-            if (dr->first_index + t + 3 > s->index_count || !triangle(s, dr->first_index + t, m, p, n, &area, e))
+            if (dr->first_index + t + 3 > s->index_count || !lpv_scene_triangle(s, dr->first_index + t, v, n, &area))
                 continue;
+            for (int k = 0; k < 3; ++k)
+                p[k] = v[k]->position;
+            emission_of(s, m, v, memo, e);
             for (int side = 0; side < sides; ++side) {
                 if (side)
                     for (int i = 0; i < 3; ++i)
@@ -78,7 +108,7 @@ static int add_flux(void *ud, const float *p[3], const float n[3], double area, 
 void lpv_emissive_total_flux(const lpv_scene *s, double flux[3])
 {
     flux[0] = flux[1] = flux[2] = 0.0;
-    for_each_emissive_triangle(s, add_flux, flux);
+    for_each_emissive_triangle(s, add_flux, flux, NULL);
 }
 
 static int add_weight(void *ud, const float *p[3], const float n[3], double area, const float e[3])
@@ -128,9 +158,13 @@ static int sample_triangle(void *ud, const float *p[3], const float n[3], double
 size_t lpv_emissive_sample(const lpv_scene *s, size_t target, lpv_vpl *out, size_t max)
 {
     sampler sm = {.target = target, .max = max, .out = out};
-    for_each_emissive_triangle(s, add_weight, &sm.total_weight);
-    if (!(sm.total_weight > 0.0) || target == 0)
+    emission_memo memo = {0}; /* the weights' walk computes each triangle's emission, the samples' reads it */
+    for_each_emissive_triangle(s, add_weight, &sm.total_weight, &memo);
+    if (!(sm.total_weight > 0.0) || target == 0) {
+        free(memo.e);
         return 0;
-    for_each_emissive_triangle(s, sample_triangle, &sm);
+    }
+    for_each_emissive_triangle(s, sample_triangle, &sm, &memo);
+    free(memo.e);
     return sm.count;
 }

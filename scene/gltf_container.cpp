@@ -11,67 +11,9 @@
 
 #include <cstring>
 
-#include <nlohmann/json.hpp>
-
 namespace lpv_gltf {
 
 namespace {
-
-/* ---- JSON pre-scan: syntax and depth, without building anything ------------ */
-struct JsonScan : nlohmann::json_sax<nlohmann::json> {
-    int depth = 0;
-    bool too_deep = false;
-    std::string error;
-
-    bool push()
-    {
-        if (++depth > kMaxJsonDepth) {
-            too_deep = true;
-            return false;
-        }
-        return true;
-    }
-    bool null() override { return true; }
-    bool boolean(bool) override { return true; }
-    bool number_integer(number_integer_t) override { return true; }
-    bool number_unsigned(number_unsigned_t) override { return true; }
-    bool number_float(number_float_t, const string_t &) override { return true; }
-    bool string(string_t &) override { return true; }
-    bool binary(binary_t &) override { return true; }
-    bool start_object(std::size_t) override { return push(); }
-    bool key(string_t &) override { return true; }
-    bool end_object() override
-    {
-        --depth;
-        return true;
-    }
-    bool start_array(std::size_t) override { return push(); }
-    bool end_array() override
-    {
-        --depth;
-        return true;
-    }
-    bool parse_error(std::size_t, const std::string &, const nlohmann::detail::exception &ex) override
-    {
-        /* nlohmann's message ends with "; last read: '<the file's bytes>'...":
-         * cut there, so that no message quotes the file */
-        error = ex.what();
-        size_t cut = error.find("; last read:");
-        if (cut != std::string::npos)
-            error.resize(cut);
-        return false;
-    }
-};
-
-void scan_json(const char *text, size_t len)
-{
-    JsonScan scan;
-    bool ok = nlohmann::json::sax_parse(text, text + len, &scan);
-    if (scan.too_deep)
-        fail("JSON nested deeper than %d levels (refused)", kMaxJsonDepth);
-    if (!ok)
-        fail("invalid JSON: %s", scan.error.empty() ? "parse error" : scan.error.c_str());
-}
 
 /* ---- GLB container ------------------------------------------------------ */
 uint32_t le32(const unsigned char *p)
@@ -149,7 +91,6 @@ bool check_container(const unsigned char *data, size_t size, size_t *json_off, s
     *json_len = size;
     if (is_glb)
         check_glb(data, size, json_off, json_len);
-    scan_json(reinterpret_cast<const char *>(data) + *json_off, *json_len);
     return is_glb;
 }
 

@@ -5,8 +5,8 @@
  * One load runs through them in this order:
  *   gltf_load.cpp       the entry points, the tinygltf call, the hand-over
  *   gltf_files.cpp      the main file and every external URI (paths checked)
- *   gltf_container.cpp  .glb container and JSON pre-scan, before tinygltf
- *   gltf_schema.cpp     the JSON types of the fields lpvd reads, before tinygltf
+ *   gltf_container.cpp  size, format and the .glb container, before tinygltf
+ *   gltf_schema.cpp     the JSON's syntax, depth and types, before tinygltf
  *   gltf_images.cpp     image size caps and decoding, tinygltf's callback
  *   gltf_build.cpp      the Builder: the node forest walked into draws
  *   gltf_animation.cpp  animations sampled at a time into node overrides
@@ -121,12 +121,15 @@ bool take_bytes(Ctx &ctx, uint64_t n);
 std::string read_main_file(const char *path, std::vector<unsigned char> *data);
 
 /* ---- container and images (gltf_container.cpp, gltf_images.cpp) ------------- */
-/* Checks size, format (glb magic or JSON), the .glb container and the JSON's
- * syntax and depth; returns whether it is a .glb, and where its JSON lies. */
+/* Checks size, format (glb magic or JSON) and the .glb container; returns
+ * whether it is a .glb, and where its JSON lies. */
 bool check_container(const unsigned char *data, size_t size, size_t *json_off, size_t *json_len);
-/* Refuses a file whose fields lpvd reads have the wrong JSON type for the
- * glTF 2.0 schema, naming the JSON path (gltf_schema.cpp); a name that is not
- * a string is a warning. */
+/* One SAX pass over the JSON (no DOM) before tinygltf sees it
+ * (gltf_schema.cpp): refuses invalid syntax, nesting deeper than
+ * kMaxJsonDepth (tinygltf's recursive extras/extensions parser never sees a
+ * hostile depth), and fields lpvd reads whose JSON type is wrong for the
+ * glTF 2.0 schema, naming the JSON path; a name that is not a string is a
+ * warning. */
 void check_schema_types(const char *json, size_t len, Ctx &ctx);
 /* Compressed files as tinygltf 2.7 accepts them (gltf_compressed.hpp,
  * tinygltf_compat_json): when the file needs it, *rewritten gets the file with

@@ -14,7 +14,9 @@
  * are free-form and not looked at.
  *
  * One SAX pass (nlohmann-json, no DOM), the path matched against a tree built
- * once from the table: constant work per JSON value.
+ * once from the table: constant work per JSON value. The same pass refuses
+ * invalid syntax and a nesting deeper than kMaxJsonDepth, so that
+ * tinygltf's recursive extras/extensions parser never sees a hostile depth.
  */
 #include "gltf_internal.hpp"
 
@@ -272,6 +274,8 @@ struct Frame {
 struct SchemaScan : nlohmann::json_sax<nlohmann::json> {
     Ctx &ctx;
     std::vector<Frame> stack;
+    bool too_deep = false;
+    std::string error; /* the parser's, without the file's bytes */
     explicit SchemaScan(Ctx &c) : ctx(c) {}
 
     /* The path of the value being read, as JSON paths are written:
@@ -371,6 +375,10 @@ struct SchemaScan : nlohmann::json_sax<nlohmann::json> {
 
     bool open(bool array)
     {
+        if (stack.size() >= size_t(kMaxJsonDepth)) {
+            too_deep = true;
+            return false;
+        }
         const Node *n = here();
         if (n && n->has_type && n->type != (array ? kArray : kObject))
             check(n, array ? "an array" : "an object", false);
@@ -395,9 +403,15 @@ struct SchemaScan : nlohmann::json_sax<nlohmann::json> {
         stack.back().key = k;
         return true;
     }
-    bool parse_error(std::size_t, const std::string &, const nlohmann::detail::exception &) override
+    bool parse_error(std::size_t, const std::string &, const nlohmann::detail::exception &ex) override
     {
-        return false; /* check_container has refused a file that does not parse */
+        /* nlohmann's message ends with "; last read: '<the file's bytes>'...":
+         * cut there, so that no message quotes the file */
+        error = ex.what();
+        size_t cut = error.find("; last read:");
+        if (cut != std::string::npos)
+            error.resize(cut);
+        return false;
     }
 };
 
@@ -406,7 +420,11 @@ struct SchemaScan : nlohmann::json_sax<nlohmann::json> {
 void check_schema_types(const char *json, size_t len, Ctx &ctx)
 {
     SchemaScan scan(ctx);
-    nlohmann::json::sax_parse(json, json + len, &scan);
+    const bool ok = nlohmann::json::sax_parse(json, json + len, &scan);
+    if (scan.too_deep)
+        fail("JSON nested deeper than %d levels (refused)", kMaxJsonDepth);
+    if (!ok)
+        fail("invalid JSON: %s", scan.error.empty() ? "parse error" : scan.error.c_str());
 }
 
 } // namespace lpv_gltf
