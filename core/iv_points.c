@@ -29,7 +29,24 @@ typedef struct walk {
     const lpv_material *m;
     int vertex_color; /* the draw's lpv_draw.vertex_color */
     int emission;
+    float voxel;          /* m, the volume's voxel side (BLEND's draw per voxel) */
+    float origin[3];      /* m, a corner of the volume's voxels (the box's, else the world's origin) */
 } walk;
+
+/* The draw u for a BLEND surface's points in the voxel holding p (core/
+ * material_sample.h lpv_material_covers_at): one per voxel, so a voxel's
+ * points of a surface of alpha a all stay or all go, and the voxels a
+ * translucent pane passes through are occupied with probability a (iv's
+ * voxels block or not; a fraction 1 - a of them lets its rays through). */
+static float voxel_draw(const walk *w, const float p[3])
+{
+    uint32_t h = w->seed ^ 0xb5297a4du;
+    for (int i = 0; i < 3; ++i) {
+        const double c = w->voxel > 0.0f ? floor((double)(p[i] - w->origin[i]) / (double)w->voxel) : 0.0;
+        h = lpv_hash_u32(h ^ (uint32_t)(int32_t)(isfinite(c) && fabs(c) < 1e9 ? c : 0.0));
+    }
+    return lpv_hash_unit(h);
+}
 
 /* One triangle's splitting (lpv_iv_split_triangle). */
 typedef struct splitter {
@@ -163,8 +180,9 @@ static void emit_piece(walk *w, const double pb[3][3])
             for (int c = 0; c < 4; ++c)
                 col[c] += (float)b[j] * w->v[j]->color[c];
         }
-        if (w->m && !lpv_material_covers_at(w->scene, w->m, uv0, uv1, w->vertex_color ? col[3] : 1.0f)) {
-            w->count--; /* a cut-away texel (alpha): no surface there */
+        if (w->m && !lpv_material_covers_at(w->scene, w->m, uv0, uv1, w->vertex_color ? col[3] : 1.0f,
+                                            voxel_draw(w, o->position))) {
+            w->count--; /* a cut-away texel or a voxel BLEND's coverage left empty: no surface there */
             continue;
         }
         if (w->m) {
@@ -241,7 +259,10 @@ int lpv_iv_points_make(const lpv_scene *scene, const lpv_iv_point_params *p, str
     /* the pieces at this split; coarser splits until one point each fits */
     walk w = {.scene = scene,
               .box_min = p->has_box ? p->box_min : NULL,
-              .box_max = p->has_box ? p->box_max : NULL};
+              .box_max = p->has_box ? p->box_max : NULL,
+              .voxel = p->voxel};
+    for (int i = 0; p->has_box && i < 3; ++i)
+        w.origin[i] = p->box_min[i];
     for (;;) {
         w.limit = (double)st.split * (double)p->voxel;
         w.pieces = 0;

@@ -4,7 +4,8 @@
 #include <math.h>
 #include <pthread.h>
 
-#include "tonemap.h" /* lpv_srgb_decode */
+#include "lpv_shared.h" /* lpv_alpha_covers */
+#include "tonemap.h"    /* lpv_srgb_decode */
 
 static float srgb_lut[256];
 static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
@@ -74,15 +75,22 @@ static int sample(const lpv_scene *s, int index, int linear, const lpv_uv_transf
 
 static float unit(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; /* NaN: 0 */ }
 
-int lpv_material_covers_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
-                           float color_alpha)
+float lpv_material_alpha_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
+                            float color_alpha)
 {
-    const float cutoff = lpv_material_alpha_cutoff(m);
-    if (!(cutoff > 0.0f))
-        return 1;
     float t[4] = {1.0f, 1.0f, 1.0f, 1.0f};
     sample(s, m->base_color_texture, 0, &m->base_color_uv, uv0, uv1, t);
-    return m->base_color[3] * t[3] * color_alpha >= cutoff;
+    return m->base_color[3] * t[3] * color_alpha;
+}
+
+int lpv_material_covers_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
+                           float color_alpha, float u)
+{
+    const int blend = m->alpha_mode == LPV_ALPHA_BLEND;
+    const float cutoff = lpv_material_alpha_cutoff(m);
+    if (!blend && !(cutoff > 0.0f))
+        return 1; /* no texture read for an opaque surface */
+    return lpv_alpha_covers(lpv_material_alpha_at(s, m, uv0, uv1, color_alpha), cutoff, blend, u);
 }
 
 float lpv_material_metallic_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2])

@@ -31,13 +31,18 @@ void lpv_texture_sample(const lpv_texture *t, float u, float v, float out[4]);
  * then the transform. */
 void lpv_material_uv(const lpv_uv_transform *t, const float uv0[2], const float uv1[2], float out[2]);
 
-/* Whether a material's surface is there at a surface point: its alpha
- * (baseColorFactor.a x the base colour texture's alpha x COLOR_0's alpha,
- * color_alpha 1 without one) is at least lpv_material_alpha_cutoff (MASK,
- * and BLEND drawn as MASK at 0.5; always for OPAQUE), as the shaders' cut
- * (material.glsl): cut-away texels neither block, reflect nor show. */
+/* A material's alpha at a surface point: baseColorFactor.a x the base
+ * colour texture's alpha x color_alpha (COLOR_0's alpha, 1 without one). */
+float lpv_material_alpha_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
+                            float color_alpha);
+
+/* Whether a material's surface is there at a surface point for a draw u in
+ * [0, 1): lpv_alpha_covers (shaders/lpv_shared.h) of its alpha, as the
+ * shaders cut (material.glsl): always for OPAQUE, where alpha >= cutoff for
+ * MASK, for the fraction alpha of draws for BLEND (alpha is coverage).
+ * Where it is not there, it neither blocks, reflects nor shows. */
 int lpv_material_covers_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2],
-                           float color_alpha);
+                           float color_alpha, float u);
 
 /* Metallic at a surface point (factor x texture B), clamped to [0, 1]. */
 float lpv_material_metallic_at(const lpv_scene *s, const lpv_material *m, const float uv0[2], const float uv1[2]);

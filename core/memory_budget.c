@@ -44,7 +44,8 @@ uint64_t lpv_memory_rsm_bytes(const lpv_memory_need *n)
 
 uint64_t lpv_memory_shadow_bytes(const lpv_memory_need *n)
 {
-    return texels(n->shadow_size, n->shadow_faces) * LPV_MEM_SHADOW_TEXEL;
+    return texels(n->shadow_size, n->shadow_faces) *
+           (LPV_MEM_SHADOW_TEXEL + (n->translucent ? LPV_MEM_SHADOW_TRANSMIT_TEXEL : 0u));
 }
 
 uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
@@ -56,7 +57,8 @@ uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
 
 uint64_t lpv_memory_image_bytes(const lpv_memory_need *n)
 {
-    return pixels(n) * LPV_MEM_PIXEL + lpv_memory_block_samples(n->image_w, n->image_h) * LPV_MEM_SURFEL;
+    return pixels(n) * (LPV_MEM_PIXEL + (n->translucent ? LPV_MEM_LAYER_PIXEL : 0u)) +
+           lpv_memory_block_samples(n->image_w, n->image_h) * LPV_MEM_SURFEL;
 }
 
 uint64_t lpv_memory_total_bytes(const lpv_memory_need *n)

@@ -20,6 +20,8 @@
                                      uints per 32 for their live bits and places (gpu/compact.h; rounded up) */
 #define LPV_MEM_SURFEL 48u        /* one LpvSurfel per RSM texel or pixel */
 #define LPV_MEM_SHADOW_TEXEL 4u   /* DEPTH32F per shadow-map texel */
+#define LPV_MEM_SHADOW_TRANSMIT_TEXEL 8u /* RGBA16F per shadow-map texel: what BLEND surfaces let through
+                                            (scenes with one, lpv_memory_need.translucent) */
 #define LPV_MEM_CELL 504u         /* per cell: 4 LPV buffers (4 x 48), the lookup's 3D textures (48), transmittances (24), reflectances
                                      (96), what the cells send (2 x 48), the injection atlas (3 x RGBA32F) */
 #define LPV_MEM_LOOKUP_NORMAL_TEXEL 16u /* RGBA32F per texel of the lookup's normals (LPV_LOOKUP_NORMAL_TEXELS
@@ -31,6 +33,8 @@
                                      lookup step's and the area shadow step's blocks (2 x RGBA32F each per
                                      block of >= 2 x 2 pixels) and the frame's two lists for second passes
                                      (an ivec2 per pixel each) */
+#define LPV_MEM_LAYER_PIXEL 74u   /* the translucent layer per pixel (scenes with a BLEND material): its
+                                     G-buffer (RGBA32F x3, RGBA16F, R8), coverage (R8) and frame (RGBA32F) */
 
 /* What the device allows. */
 typedef struct lpv_memory_limits {
@@ -52,6 +56,8 @@ typedef struct lpv_memory_need {
     int cascades;                  /* for the message */
     int grid_dims[3];
     int image_w, image_h;          /* 0 x 0 = no camera */
+    int translucent;               /* 1: the scene has BLEND surfaces (the shadow maps' transmission, the
+                                      frame's translucent layer) */
 } lpv_memory_need;
 
 /* Bytes of each part, and of all. */

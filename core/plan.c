@@ -21,6 +21,7 @@ static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
     [LPV_PASS_BOUNCE] = "bounce",   [LPV_PASS_GLOSSY] = "glossy",     [LPV_PASS_MEDIA] = "media",
     [LPV_PASS_IV_POINTS] = "iv_points", [LPV_PASS_IV_REPROJECT] = "iv_reproject",
     [LPV_PASS_IV_GATHER] = "iv_gather", [LPV_PASS_IV_AO] = "iv_ao",
+    [LPV_PASS_TRANSLUCENT] = "translucent",
 };
 
 const char *lpv_pass_name(lpv_pass_id id)
@@ -166,7 +167,14 @@ static void render_passes(const lpv_settings *s, const lpv_plan_facts *f, lpv_pl
         decide(p, LPV_PASS_MEDIA, 0, "no medium in the scene and no fog set");
     else
         decide(p, LPV_PASS_MEDIA, 1, "the scene has a participating medium");
-
+    /* BLEND surfaces need their own layer in a frame; the light's passes
+     * take their alpha as coverage per texel without one */
+    if (all)
+        decide(p, LPV_PASS_TRANSLUCENT, 1, "planner off");
+    else if (!f->blend_draws)
+        decide(p, LPV_PASS_TRANSLUCENT, 0, "no material is alphaMode BLEND");
+    else
+        decide(p, LPV_PASS_TRANSLUCENT, 1, "%zu draws are alphaMode BLEND", f->blend_draws);
 }
 
 /* The lights' RSMs (the LPV's VPLs and surfels, the imperfect volume's
@@ -282,7 +290,7 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *
             decide(p, (lpv_pass_id)i, 0, "the LPV's (technique " LPV_TECHNIQUE_IV " gathers by ray marching)");
     if (!p->recompute) {
         for (int i = 0; i < LPV_PASS_COUNT; ++i)
-            if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA)
+            if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT)
                 decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
         return;
     }

@@ -30,6 +30,7 @@ typedef enum lpv_pass_id {
     LPV_PASS_IV_REPROJECT, /* imperfect volume: the camera's visible points refine the voxels */
     LPV_PASS_IV_GATHER,    /* imperfect volume: radiance gathered per voxel by ray marching, per bounce */
     LPV_PASS_IV_AO,        /* imperfect volume: ambient occlusion by ray marching */
+    LPV_PASS_TRANSLUCENT,  /* the BLEND surfaces' layer shaded and laid over the frame at render time */
     LPV_PASS_COUNT
 } lpv_pass_id;
 
@@ -43,6 +44,7 @@ typedef struct lpv_plan_facts {
                                   off or nothing emits */
     size_t occluder_triangles; /* triangles of non-emissive materials */
     size_t glossy_draws;       /* draws whose material is glossy under the settings */
+    size_t blend_draws;        /* draws whose material is alphaMode BLEND */
     int has_medium;            /* the scene or the fog settings give a medium */
     int has_view;              /* a camera is set */
     int camera_inside;         /* the camera stands inside the scene's bounds */
@@ -114,7 +116,8 @@ typedef struct lpv_plan {
 } lpv_plan;
 
 /* "rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce",
- * "glossy", "media", "iv_points", "iv_reproject", "iv_gather", "iv_ao"; NULL
+ * "glossy", "media", "iv_points", "iv_reproject", "iv_gather", "iv_ao",
+ * "translucent"; NULL
  * for an unknown id. */
 const char *lpv_pass_name(lpv_pass_id id);
 

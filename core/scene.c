@@ -164,8 +164,6 @@ float lpv_material_alpha_cutoff(const lpv_material *m)
     switch (m->alpha_mode) {
     case LPV_ALPHA_MASK:
         return m->alpha_cutoff > 0.0f ? m->alpha_cutoff : 0.0f; /* NaN: nothing is cut */
-    case LPV_ALPHA_BLEND:
-        return LPV_ALPHA_BLEND_THRESHOLD;
     default:
         return 0.0f;
     }

@@ -70,9 +70,8 @@ typedef struct lpv_texture {
 typedef enum lpv_alpha_mode {
     LPV_ALPHA_OPAQUE = 0, /* alpha ignored */
     LPV_ALPHA_MASK = 1,   /* cut away where alpha < alpha_cutoff */
-    LPV_ALPHA_BLEND = 2,  /* approximated: cut away where alpha < LPV_ALPHA_BLEND_THRESHOLD */
+    LPV_ALPHA_BLEND = 2,  /* alpha is coverage: the surface covers alpha, 1 - alpha of the light passes */
 } lpv_alpha_mode;
-#define LPV_ALPHA_BLEND_THRESHOLD 0.5f
 
 /* Which uv set a texture reads and its KHR_texture_transform:
  * uv' = T(offset) R(rotation) S(scale) uv, with R(a) = [cos a, sin a; -sin a, cos a]
@@ -202,8 +201,9 @@ int lpv_scene_check_ranges(const lpv_scene *scene, char *err, size_t err_size);
  * LPV_MAX_LIGHT_INTENSITY; else -1 with a message ("... = %g W/sr ..."). */
 int lpv_light_check_intensity(const lpv_light *light, char *err, size_t err_size);
 
-/* The alpha below which a material's surface is cut away (alpha_mode, the
- * cutoff, LPV_ALPHA_BLEND_THRESHOLD for BLEND); 0 (nothing is cut) for OPAQUE. */
+/* The alpha below which a MASK material's surface is cut away (its cutoff);
+ * 0 (nothing cut at a threshold) for OPAQUE and BLEND, whose alpha is
+ * coverage (lpv_alpha_covers in shaders/lpv_shared.h). */
 float lpv_material_alpha_cutoff(const lpv_material *m);
 
 /* The sides an emissive material emits from: 2 when double-sided (glTF's

@@ -188,6 +188,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         {&e->prog_shadow_plain, "scene.vert", "shadow_depth.frag", INC_MATERIAL, PLAIN},
         {&e->prog_compact[0], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 1"},
         {&e->prog_compact[1], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 2"},
+        {&e->prog_translucent, "translucent.comp", NULL, NULL},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog =
@@ -265,7 +266,8 @@ void lpv_engine_destroy(lpv_engine *e)
                        &e->prog_area_shadow_blocks,
                        &e->prog_area_shadow_rest,
                        &e->prog_compact[0],
-                       &e->prog_compact[1]};
+                       &e->prog_compact[1],
+                       &e->prog_translucent};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (*progs[i])
             glDeleteProgram(*progs[i]);

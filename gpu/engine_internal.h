@@ -31,7 +31,8 @@ typedef struct lpv_gpu_material {
     float emission[3];
     float roughness, metallic;
     int texture; /* index into lpv_engine.textures, -1 none */
-    float alpha_cutoff;   /* lpv_material_alpha_cutoff: 0 = opaque */
+    float alpha_cutoff;   /* lpv_material_alpha_cutoff: MASK's cutoff, else 0 */
+    int blend;            /* alphaMode BLEND: alpha is coverage, drawn in the translucent layer */
     int double_sided;     /* 0: the camera culls back faces */
     int base_uv_set;      /* 0 TEXCOORD_0, 1 TEXCOORD_1 */
     float base_uv[6];     /* lpv_uv_transform_matrix rows */
@@ -117,6 +118,7 @@ struct lpv_engine {
     GLuint prog_lookup_blocks, prog_lookup_blocks_damped, prog_area_shadow_blocks;
     GLuint prog_area_shadow_rest; /* the area light of the pixels no block is alike to (area_shadow_rest.comp) */
     GLuint prog_compact[2]; /* compact.comp's scan and copy */
+    GLuint prog_translucent; /* translucent.comp: the translucent layer laid over the frame */
 
     /* scene */
     GLuint vao, vbo, ibo, empty_vao;
@@ -127,6 +129,7 @@ struct lpv_engine {
     int materials_plain;      /* 1: no material has a texture, a normal map or an alpha cut */
     int materials_occlusion;  /* 1: some material has an occlusionTexture (LPV_FRAME_OCCLUSION) */
     int materials_unlit;      /* 1: some material is unlit (LPV_FRAME_UNLIT) */
+    size_t blend_draws;       /* draws whose material is BLEND (the translucent layer, LPV_PASS_TRANSLUCENT) */
     GLuint *textures;
     uint32_t texture_count;
     lpv_light lights[LPV_MAX_LIGHTS];
@@ -186,6 +189,10 @@ struct lpv_engine {
     /* shadow maps of direct light (pass_shadow.c), rendered at render time */
     struct LpvShadowBlock shadow_block; /* the faces the maps hold */
     GLuint shadow_ubo, shadow_tex, shadow_fbo;
+    /* the shadow maps' transmission (scenes with BLEND draws,
+     * LPV_TEX_SHADOW_TRANSMIT): an RGBA16F array like shadow_tex, drawn
+     * through shadow_transmit_fbo over shadow_tex's depth */
+    GLuint shadow_transmit_tex, shadow_transmit_fbo;
     int shadow_alloc_size, shadow_alloc_faces;
     int shadow_valid;     /* 0: the maps must be redrawn (scene, settings, invalidate) */
 
@@ -205,6 +212,12 @@ struct lpv_engine {
     int camera_surfel_w, camera_surfel_h, camera_surfel_slots;
     GLuint gbuf_tex[LPV_GBUF_TARGETS], gbuf_depth, gbuf_fbo, camera_surfels;
     GLuint frame_tex, frame_fbo;
+    /* The translucent layer (scenes with BLEND draws, LPV_PASS_TRANSLUCENT):
+     * the nearest BLEND surface in front of the G-buffer's, in a G-buffer of
+     * its own (the same targets, then its coverage: alpha) sharing the
+     * G-buffer's depth, shaded into layer_frame and laid over the frame. */
+    GLuint layer_tex[LPV_GBUF_TARGETS + 1], layer_fbo, layer_frame_tex;
+    int layer_w, layer_h;
     GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
     GLuint area_rest;  /* the pixels left for area_shadow_rest.comp (the same layout) */
     int shade_split;   /* the last frame was shaded in two passes */
@@ -223,10 +236,16 @@ struct lpv_engine {
     lpv_plan plan;
 };
 
-/* Draws every draw with its material's uniforms and textures. cull_single_sided:
- * back faces of materials that are not double-sided are culled (the camera's
- * view, as glTF says; light views pass 0 and see both sides). */
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided);
+/* Which draws lpv_engine_draw_scene draws: every one (the light views, where
+ * BLEND's alpha is coverage per texel), all but the BLEND ones (the camera's
+ * G-buffer), or only those (its translucent layer). */
+typedef enum lpv_draw_set { LPV_DRAWS_ALL = 0, LPV_DRAWS_NOT_BLEND, LPV_DRAWS_BLEND } lpv_draw_set;
+
+/* Draws the draws of `set` with their material's uniforms and textures.
+ * cull_single_sided: back faces of materials that are not double-sided are
+ * culled (the camera's view, as glTF says; light views pass 0 and see both
+ * sides). */
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set);
 /* The program a scene pass draws with: plain (built with LPV_MATERIAL_PLAIN)
  * when the scene's materials are all plain, else full. */
 GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plain);
@@ -287,6 +306,11 @@ size_t lpv_pass_shade_full_lookups(lpv_engine *e);
 /* Pixels of the last frame whose area light area_shadow_rest.comp added. */
 size_t lpv_pass_shade_area_rest_pixels(lpv_engine *e);
 void lpv_pass_glossy_run(lpv_engine *e);
+/* The translucent layer's frame laid over the frame (LPV_PASS_TRANSLUCENT;
+ * after the glossy pass, before media): adds its lists' pixels to *full_lookups
+ * and *area_rest_pixels. */
+int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_lookups, size_t *area_rest_pixels,
+                             char *err, size_t err_size);
 void lpv_pass_media_run(lpv_engine *e);
 
 /* Surfels [first, first + count) of the RSM surfel buffer that GV buffer
@@ -316,6 +340,9 @@ int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *
  * their size or count changed, and redraws them when anything they show
  * changed; records the "shadow" stage when it draws. Returns 0 or -1. */
 int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size);
+/* Binds what shadow.glsl reads: the shadow maps (unit 4), their
+ * transmission (LPV_TEX_SHADOW_TRANSMIT) and the shadow block. */
+void lpv_pass_shadow_bind(const lpv_engine *e);
 void lpv_pass_shadow_free(lpv_engine *e);
 /* Each producer deletes what it made (also what a failed allocation left):
  * the passes call these before remaking their storage, and

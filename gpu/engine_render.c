@@ -1,8 +1,8 @@
 /*
  * engine_render.c - after a tick: the camera's frame (G-buffer if stale,
- * shadow maps if stale, shading, glossy, media; read back top row first) and
- * irradiance queries at arbitrary points, both through the technique's
- * lookup.
+ * shadow maps if stale, shading, glossy, the translucent layer, media; read
+ * back top row first) and irradiance queries at arbitrary points, both
+ * through the technique's lookup.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +34,12 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return -1;
     if (e->plan.pass[LPV_PASS_GLOSSY].run && (terms == LPV_TERMS_FULL || terms == LPV_TERMS_INDIRECT_ONLY))
         lpv_pass_glossy_run(e);
+    /* the BLEND surfaces' layer over the frame (not over an ambient
+     * occlusion frame, which is the technique's term of the opaque surfaces) */
+    size_t full_lookups = 0, area_rest_pixels = 0;
+    if (e->plan.pass[LPV_PASS_TRANSLUCENT].run && e->blend_draws && terms != LPV_TERMS_AO &&
+        lpv_pass_translucent_run(e, terms, &full_lookups, &area_rest_pixels, err, err_size) != 0)
+        return -1;
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
         lpv_pass_media_run(e);
     const int w = e->gbuf_w, h = e->gbuf_h;
@@ -43,8 +49,8 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     /* read after the frame, which waited for the passes anyway */
-    e->stats.frame_full_lookups = lpv_pass_shade_full_lookups(e);
-    e->stats.frame_area_shadow_pixels = lpv_pass_shade_area_rest_pixels(e);
+    e->stats.frame_full_lookups = full_lookups + lpv_pass_shade_full_lookups(e);
+    e->stats.frame_area_shadow_pixels = area_rest_pixels + lpv_pass_shade_area_rest_pixels(e);
     /* GL rows run bottom-up; files and callers want the top row first. */
     size_t row = (size_t)w * 4;
     for (int y = 0; y < h / 2; ++y) {

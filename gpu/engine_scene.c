@@ -50,6 +50,7 @@ void lpv_engine_free_scene(lpv_engine *e)
     e->draws = NULL;
     e->materials = NULL;
     e->texture_count = e->draw_count = e->material_count = 0;
+    e->blend_draws = 0;
     e->light_count = 0;
     lpv_emitters_free(&e->emitters);
     lpv_engine_reach_free(e);
@@ -312,6 +313,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
                          ? m->base_color_texture
                          : -1;
         g->alpha_cutoff = lpv_material_alpha_cutoff(m);
+        g->blend = m->alpha_mode == LPV_ALPHA_BLEND;
         g->double_sided = m->double_sided;
         g->base_uv_set = m->base_color_uv.texcoord == 1;
         lpv_uv_transform_matrix(&m->base_color_uv, g->base_uv);
@@ -341,10 +343,15 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     for (uint32_t i = 0; i < e->material_count; ++i) {
         const lpv_gpu_material *g = &e->materials[i];
         if (g->texture >= 0 || g->normal_texture >= 0 || g->mr_texture >= 0 || g->emissive_texture >= 0 ||
-            g->occlusion_texture >= 0 || g->alpha_cutoff > 0.0f)
+            g->occlusion_texture >= 0 || g->alpha_cutoff > 0.0f || g->blend)
             e->materials_plain = 0;
         e->materials_occlusion |= g->occlusion_texture >= 0;
         e->materials_unlit |= g->unlit;
+    }
+    e->blend_draws = 0;
+    for (uint32_t i = 0; i < e->draw_count; ++i) {
+        const int k = e->draws[i].material;
+        e->blend_draws += k >= 0 && (uint32_t)k < e->material_count && e->materials[k].blend && e->draws[i].index_count;
     }
     if (upload_textures(e, scene, err, err_size) != 0)
         return -1;
@@ -409,7 +416,7 @@ GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plai
     return e->materials_plain ? plain : full;
 }
 
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set)
 {
     GLint loc_color = glGetUniformLocation(prog, "u_base_color");
     GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
@@ -418,6 +425,7 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
     GLint loc_metallic = glGetUniformLocation(prog, "u_metallic");
     GLint loc_size = glGetUniformLocation(prog, "u_object_size");
     GLint loc_cutoff = glGetUniformLocation(prog, "u_alpha_cutoff");
+    GLint loc_blend = glGetUniformLocation(prog, "u_alpha_blend");
     GLint loc_base_set = glGetUniformLocation(prog, "u_base_uv_set");
     GLint loc_base_row0 = glGetUniformLocation(prog, "u_base_uv_row0");
     GLint loc_base_row1 = glGetUniformLocation(prog, "u_base_uv_row1");
@@ -453,12 +461,15 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided)
             .occlusion_texture = -1, .occlusion_strength = 1.0f, .occlusion_uv = {1, 0, 0, 0, 1, 0}};
         const lpv_gpu_material *m =
             (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
+        if ((set == LPV_DRAWS_NOT_BLEND && m->blend) || (set == LPV_DRAWS_BLEND && !m->blend))
+            continue;
         glUniform4fv(loc_color, 1, m->base_color);
         glUniform3fv(loc_emission, 1, m->emission);
         glUniform1f(loc_roughness, m->roughness);
         glUniform1f(loc_metallic, m->metallic);
         glUniform1f(loc_size, d->size);
         glUniform1f(loc_cutoff, m->alpha_cutoff);
+        glUniform1i(loc_blend, m->blend);
         glUniform1i(loc_has_tex, m->texture >= 0);
         glUniform1i(loc_base_set, m->base_uv_set);
         glUniform3fv(loc_base_row0, 1, &m->base_uv[0]);

@@ -33,6 +33,7 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->area_light_samples = e->area_sample_count;
     f->occluder_triangles = e->occluder_triangles;
     f->glossy_draws = glossy_draws(e);
+    f->blend_draws = e->blend_draws;
     f->has_medium = e->medium.medium.present || e->settings.fog_sigma_s > 0.0f || e->settings.fog_sigma_a > 0.0f;
     f->has_view = e->has_view;
     f->camera_inside = e->has_view && lpv_point_in_bounds(e->view.eye, e->scene_min, e->scene_max);

@@ -25,9 +25,19 @@ void lpv_pass_camera_free(lpv_engine *e)
     lpv_gl_delete_buffer(&e->camera_surfels);
     lpv_gl_delete_buffer(&e->shade_rest);
     lpv_gl_delete_buffer(&e->area_rest);
+    for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
+        lpv_gl_delete_texture(&e->layer_tex[i]);
+    lpv_gl_delete_texture(&e->layer_frame_tex);
+    lpv_gl_delete_framebuffer(&e->layer_fbo);
+    e->layer_w = e->layer_h = 0;
     e->gbuf_w = e->gbuf_h = 0;
     e->camera_surfel_w = e->camera_surfel_h = e->camera_surfel_slots = 0;
 }
+
+/* The G-buffer's targets' formats (gbuffer.frag's outputs 0..4); the
+ * translucent layer's G-buffer adds its coverage. */
+#define GBUF_FORMATS GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F, GL_R8
+#define LAYER_COVERAGE_FORMAT GL_R8
 
 /* (Re)allocates the G-buffer, the frame and the camera's surfels for the
  * view's size (lpv_engine_set_view checked that they fit the budget). */
@@ -39,7 +49,7 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     lpv_pass_camera_free(e);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
-    static const GLenum formats[LPV_GBUF_TARGETS] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F, GL_R8};
+    static const GLenum formats[LPV_GBUF_TARGETS] = {GBUF_FORMATS};
     glGenFramebuffers(1, &e->gbuf_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
     GLenum bufs[LPV_GBUF_TARGETS];
@@ -80,6 +90,49 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     }
     e->gbuf_w = w;
     e->gbuf_h = h;
+    return 0;
+}
+
+/* (Re)allocates the translucent layer's G-buffer and frame for the
+ * G-buffer's size (scenes with BLEND draws; ensure_targets ran): its
+ * depth is the G-buffer's, so the layer keeps the nearest BLEND surface in
+ * front of the opaque one. Their memory is the G-buffer's and the frame's
+ * again (docs/memory.md counts it with them). */
+static int ensure_layer_targets(lpv_engine *e, char *err, size_t err_size)
+{
+    const int w = e->gbuf_w, h = e->gbuf_h;
+    if (e->layer_fbo && e->layer_w == w && e->layer_h == h)
+        return 0;
+    for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
+        lpv_gl_delete_texture(&e->layer_tex[i]);
+    lpv_gl_delete_texture(&e->layer_frame_tex);
+    lpv_gl_delete_framebuffer(&e->layer_fbo);
+    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
+    }
+    static const GLenum formats[LPV_GBUF_TARGETS + 1] = {GBUF_FORMATS, LAYER_COVERAGE_FORMAT};
+    glGenFramebuffers(1, &e->layer_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->layer_fbo);
+    GLenum bufs[LPV_GBUF_TARGETS + 1];
+    for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i) {
+        e->layer_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->layer_tex[i], 0);
+        bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
+    }
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf_depth, 0);
+    glDrawBuffers(LPV_GBUF_TARGETS + 1, bufs);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    e->layer_frame_tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
+    GLenum gl_err = glGetError();
+    if (gl_err != GL_NO_ERROR) {
+        for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
+            lpv_gl_delete_texture(&e->layer_tex[i]);
+        lpv_gl_delete_texture(&e->layer_frame_tex);
+        lpv_gl_delete_framebuffer(&e->layer_fbo);
+        return lpv_error(err, err_size, "could not allocate the %dx%d translucent layer (GL error 0x%04x)", w, h,
+                         gl_err);
+    }
+    e->layer_w = w;
+    e->layer_h = h;
     return 0;
 }
 
@@ -147,7 +200,21 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     float pixel = 2.0f * e->view_block.forward[3] / (float)v->height; /* tan-plane or metres per pixel */
     glUniform1f(glGetUniformLocation(p, "u_pixel_solid_angle"), v->orthographic ? 0.0f : pixel * pixel);
     glUniform1f(glGetUniformLocation(p, "u_pixel_area"), v->orthographic ? pixel * pixel : 0.0f);
-    lpv_engine_draw_scene(e, p, 1);
+    lpv_engine_draw_scene(e, p, 1, LPV_DRAWS_NOT_BLEND);
+    /* the translucent layer: the BLEND draws over the opaque depth, the
+     * nearest in front of it kept (the same program and uniforms) */
+    if (e->blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run) {
+        if (ensure_layer_targets(e, err, err_size) != 0) {
+            glDisable(GL_DEPTH_TEST);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            lpv_timer_end(&e->timer);
+            return -1;
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, e->layer_fbo);
+        for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
+            glClearBufferfv(GL_COLOR, i, zero);
+        lpv_engine_draw_scene(e, p, 1, LPV_DRAWS_BLEND);
+    }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
@@ -225,11 +292,11 @@ static void start_list(GLuint list, GLuint binding)
 /* A second pass over a list of the frame's pixels: prog (made current with
  * the shading's uniforms) adds to the frame, as many workgroups as the list
  * holds. */
-static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms terms)
+static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms terms, GLuint frame)
 {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     use_shading_program(e, prog, terms);
-    glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(LPV_IMG_FRAME, frame, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, list);
     glDispatchComputeIndirect(0);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
@@ -242,8 +309,11 @@ static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms te
  * llvmpipe it costs what the full-screen triangle did, and on a GPU whose
  * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
  * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
- * core. The glossy and media passes then blend into the same texture. */
-int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size)
+ * core. The glossy and media passes then blend into the same texture.
+ * gbuf: the G-buffer's targets to shade (the camera's or the translucent
+ * layer's), frame: the texture written, stage: the timer's name. */
+static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[LPV_GBUF_TARGETS], GLuint frame,
+                       const char *stage, char *err, size_t err_size)
 {
     /* the frame's variant: the lookup step's blocks (frames with the LPV
      * term), else the technique's two passes; the area shadow step's blocks
@@ -265,7 +335,7 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
     if (!prog)
         return -1;
 
-    lpv_timer_begin(&e->timer, "shade");
+    lpv_timer_begin(&e->timer, stage);
     struct LpvViewBlock *b = &e->view_block;
     b->shading[0] = e->settings.indirect_gain;
     b->shading[1] = terms != LPV_TERMS_INDIRECT_ONLY;
@@ -276,13 +346,11 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
+        glBindTexture(GL_TEXTURE_2D, gbuf[i]);
     }
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_GBUF_OCCLUSION);
-    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[4]);
-    glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
+    glBindTexture(GL_TEXTURE_2D, gbuf[4]);
+    lpv_pass_shadow_bind(e);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
     /* the passes per block first (frame_blocks.c) */
@@ -290,7 +358,7 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
         lpv_frame_lookup_blocks_run(e);
     if (area_blocks) {
         lpv_frame_area_shadow_blocks_run(e);
-        lpv_timer_begin(&e->timer, "shade");
+        lpv_timer_begin(&e->timer, stage);
     }
     /* the lists of pixels for the second passes start empty */
     if (split)
@@ -298,7 +366,7 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
     if (area_blocks)
         start_list(e->area_rest, LPV_SSBO_AREA_REST);
     use_shading_program(e, prog, terms);
-    glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(LPV_IMG_FRAME, frame, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     /* in bands of about LPV_SHADE_BAND_PIXELS, a yield point between them
      * (timer.h): a large view's one dispatch took seconds on llvmpipe; the
      * pixels are independent, so the frame is the same */
@@ -315,14 +383,46 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
     }
     /* the listed pixels' indirect light, then their area light */
     if (split)
-        run_list(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, e->shade_rest, terms);
+        run_list(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, e->shade_rest, terms, frame);
     if (area_blocks)
-        run_list(e, e->prog_area_shadow_rest, e->area_rest, terms);
+        run_list(e, e->prog_area_shadow_rest, e->area_rest, terms, frame);
     /* the glossy and media passes blend into the frame, which is then read back */
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     lpv_timer_count(&e->timer, (blocks ? 1 : 0) + 1 + (split ? 1 : 0) + (area_blocks ? 1 : 0));
     e->shade_split = split;
     e->shade_area_blocks = area_blocks;
+    lpv_timer_end(&e->timer);
+    return 0;
+}
+
+int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size)
+{
+    return shade_frame(e, terms, e->gbuf_tex, e->frame_tex, "shade", err, err_size);
+}
+
+int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_lookups, size_t *area_rest_pixels,
+                             char *err, size_t err_size)
+{
+    if (!e->layer_fbo || e->layer_w != e->gbuf_w || e->layer_h != e->gbuf_h)
+        return lpv_error(err, err_size, "the translucent layer was not drawn for this %dx%d frame", e->gbuf_w,
+                         e->gbuf_h);
+    /* the frame's pixels listed for second passes, before the layer's
+     * shading lists its own in the same buffers */
+    *full_lookups += lpv_pass_shade_full_lookups(e);
+    *area_rest_pixels += lpv_pass_shade_area_rest_pixels(e);
+    if (shade_frame(e, terms, e->layer_tex, e->layer_frame_tex, "translucent", err, err_size) != 0)
+        return -1;
+    lpv_timer_begin(&e->timer, "translucent");
+    glUseProgram(e->prog_translucent);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, e->layer_frame_tex);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, e->layer_tex[LPV_GBUF_TARGETS]);
+    glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
+    glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    lpv_timer_count(&e->timer, 1);
     lpv_timer_end(&e->timer);
     return 0;
 }

@@ -196,7 +196,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
         glViewport((int)lroundf(tile[0] * (float)size), (int)lroundf(tile[1] * (float)size), side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
         glUniform1i(loc_face, f);
-        lpv_engine_draw_scene(e, prog, 0); /* lights see both sides */
+        lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_ALL); /* lights see both sides */
     }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -5,7 +5,10 @@
  * into one layer of a DEPTH32F array texture of shadow_size^2 texels (an
  * area light sample's face: into one tile of a layer), which
  * shadow.glsl samples with hardware-compare PCF. Separate from the RSMs,
- * which stay the VPL source at rsm_size. Runs at render time, because the
+ * which stay the VPL source at rsm_size. In scenes with BLEND surfaces each
+ * face also gets a transmission map: those surfaces, drawn over the face's
+ * opaque depth, multiply in 1 - alpha and keep the nearest one's depth
+ * (docs/scenes.md, "Alpha"). Runs at render time, because the
  * directional cascades follow the camera, and only when the faces, the scene
  * or the settings changed.
  */
@@ -23,11 +26,13 @@ void lpv_pass_shadow_free(lpv_engine *e)
     if (e->shadow_fbo)
         glDeleteFramebuffers(1, &e->shadow_fbo);
     e->shadow_tex = e->shadow_fbo = 0;
+    lpv_gl_delete_texture(&e->shadow_transmit_tex);
+    lpv_gl_delete_framebuffer(&e->shadow_transmit_fbo);
     e->shadow_alloc_size = e->shadow_alloc_faces = 0;
     e->shadow_valid = 0;
 }
 
-static int allocate(lpv_engine *e, int size, int layers, char *err, size_t err_size)
+static int allocate(lpv_engine *e, int size, int layers, int translucent, char *err, size_t err_size)
 {
     lpv_memory_need need;
     lpv_engine_memory_need(e, &need);
@@ -55,6 +60,19 @@ static int allocate(lpv_engine *e, int size, int layers, char *err, size_t err_s
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (translucent && status == GL_FRAMEBUFFER_COMPLETE) {
+        glGenTextures(1, &e->shadow_transmit_tex);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_transmit_tex);
+        glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA16F, size, size, layers);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glGenFramebuffers(1, &e->shadow_transmit_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_transmit_fbo);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadow_transmit_tex, 0, 0);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, 0);
+        glDrawBuffer(GL_COLOR_ATTACHMENT0);
+        status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR || status != GL_FRAMEBUFFER_COMPLETE) {
@@ -67,6 +85,30 @@ static int allocate(lpv_engine *e, int size, int layers, char *err, size_t err_s
     e->shadow_alloc_size = size;
     e->shadow_alloc_faces = layers;
     return 0;
+}
+
+/* The BLEND draws into face f's transmission map (its tile's rect, over the
+ * opaque depth just drawn, within the caller's scissor): rgb multiplied by
+ * each texel's 1 - alpha, a the greatest reversed depth (the nearest
+ * surface); depth is read, not written. Leaves the depth pass's framebuffer
+ * and state bound again. */
+static void draw_transmission(lpv_engine *e, GLuint prog, int layer)
+{
+    static const float clear[4] = {1.0f, 1.0f, 1.0f, 0.0f}; /* all light passes; no surface (depth 0: infinitely far) */
+    glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_transmit_fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadow_transmit_tex, 0, layer);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, layer);
+    glClearBufferfv(GL_COLOR, 0, clear); /* within the face's rect: the caller's scissor */
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendEquationSeparate(GL_FUNC_ADD, GL_MAX);
+    glBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ONE, GL_ONE);
+    lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_BLEND);
+    glDisable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ZERO);
+    glDepthMask(GL_TRUE);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_fbo);
 }
 
 /* The cone of directions light l sends light into: a spot's outer cone, an
@@ -202,7 +244,9 @@ static void draw(lpv_engine *e)
         glClearBufferfv(GL_DEPTH, 0, &far_depth);
         glViewport(x, y, side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->shadow_block.faces[f].view_proj);
-        lpv_engine_draw_scene(e, prog, 0); /* lights see both sides */
+        lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_NOT_BLEND); /* lights see both sides */
+        if (e->shadow_transmit_fbo)
+            draw_transmission(e, prog, layer);
     }
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_DEPTH_TEST);
@@ -219,8 +263,10 @@ int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size)
         return -1;
     const int size = e->settings.shadow_size, faces = (int)b.counts[0];
     const int layers = b.counts[3] > 0.0f ? (int)b.counts[3] : 1;
-    if (e->shadow_alloc_size != size || e->shadow_alloc_faces != layers)
-        if (allocate(e, size, layers, err, err_size) != 0)
+    const int translucent = e->blend_draws > 0;
+    b.options[0] = (float)translucent;
+    if (e->shadow_alloc_size != size || e->shadow_alloc_faces != layers || !e->shadow_transmit_fbo != !translucent)
+        if (allocate(e, size, layers, translucent, err, err_size) != 0)
             return -1;
     if (e->shadow_valid && memcmp(&b, &e->shadow_block, sizeof b) == 0)
         return 0;
@@ -231,4 +277,14 @@ int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size)
         draw(e);
     e->shadow_valid = 1;
     return 0;
+}
+
+void lpv_pass_shadow_bind(const lpv_engine *e)
+{
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
+    glActiveTexture(GL_TEXTURE0 + LPV_TEX_SHADOW_TRANSMIT);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_transmit_tex);
+    glActiveTexture(GL_TEXTURE0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
 }

@@ -2,6 +2,7 @@
 #include "pt.h"
 
 #include "error.h"
+#include "lpv_shared.h" /* lpv_hash_u32 */
 #include "material_sample.h"
 
 #include <embree3/rtcore.h>
@@ -51,6 +52,7 @@ struct lpv_ref {
     int threads;
     uint64_t seed;
     float eps;
+    int has_blend; /* some material is alphaMode BLEND (its rays draw whether they pass) */
 };
 
 /* ---- small vector helpers ---------------------------------------------- */
@@ -250,10 +252,35 @@ static double tri_area(const ref_tri *t)
     return 0.5 * sqrt((double)dot3(c, c));
 }
 
-/* Embree's filter for both ray kinds: a hit on a cut-away texel (alpha
- * below the material's cutoff: MASK, BLEND drawn as MASK at 0.5) is no hit,
- * as lpvd's shaders cut it (core/material_sample.h lpv_material_covers_at).
- * Installed only when some material cuts. */
+/* How a ray treats BLEND surfaces (alpha is coverage: a fraction alpha of
+ * the surface is there, 1 - alpha of the light passes; docs/scenes.md
+ * "Alpha"). MASK cut-outs are cut in every mode. */
+typedef enum ref_blend {
+    REF_BLEND_DRAW = 0, /* a path's ray: it stops at the surface with probability alpha (its draw) */
+    REF_BLEND_HIT,      /* a camera ray that composites the layers itself: every BLEND texel of alpha > 0 is hit */
+    REF_BLEND_SKIP,     /* a query for the opaque surface behind (the points lpvd's G-buffer holds) */
+    REF_BLEND_TRANSMIT, /* a shadow ray: passes, taking the product of 1 - alpha along it */
+} ref_blend;
+
+#define REF_SEEN_MAX 16
+
+/* The context Embree hands the filter: its own first, then how the ray
+ * treats BLEND surfaces. */
+typedef struct ref_context {
+    struct RTCIntersectContext base;
+    ref_blend blend;
+    uint32_t salt;   /* REF_BLEND_DRAW: the path's draw for this ray */
+    float transmit;  /* REF_BLEND_TRANSMIT: the product of 1 - alpha of the BLEND texels passed */
+    /* REF_BLEND_TRANSMIT: the triangles counted (Embree may report a hit
+     * twice, e.g. a triangle split between nodes) */
+    unsigned seen[REF_SEEN_MAX];
+    int seen_count;
+} ref_context;
+
+/* Embree's filter for both ray kinds: a hit on a texel where the material
+ * is not there is no hit, as lpvd's shaders cut it (core/material_sample.h
+ * lpv_material_covers_at): alpha below a MASK cutoff; for BLEND as the
+ * ray's context says. Installed only when some material cuts or blends. */
 static void alpha_filter(const struct RTCFilterFunctionNArguments *args)
 {
     /* RTCHitN's layout (rtcore_ray.h's RTCHitN_u/_v/_primID, C++ only): N
@@ -261,18 +288,37 @@ static void alpha_filter(const struct RTCFilterFunctionNArguments *args)
     const float *hf = (const float *)args->hit;
     const unsigned *hu = (const unsigned *)args->hit;
     const lpv_ref *r = args->geometryUserPtr;
-    for (unsigned i = 0; i < args->N; ++i) {
+    ref_context *ctx = (ref_context *)args->context;
+    const unsigned N = args->N;
+    for (unsigned i = 0; i < N; ++i) {
         if (args->valid[i] != -1)
             continue;
-        const unsigned prim = hu[5 * args->N + i];
+        const unsigned prim = hu[5 * N + i];
         if (prim >= r->tri_count)
             continue;
         const ref_tri *tr = &r->tris[prim];
         if (tr->material < 0)
             continue;
+        const lpv_material *m = &r->look.materials[tr->material];
         float uv0[2], uv1[2], color[4];
-        tri_uv(tr, hf[3 * args->N + i], hf[4 * args->N + i], uv0, uv1, color);
-        if (!lpv_material_covers_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color[3]))
+        tri_uv(tr, hf[3 * N + i], hf[4 * N + i], uv0, uv1, color);
+        if (m->alpha_mode == LPV_ALPHA_BLEND && ctx->blend == REF_BLEND_TRANSMIT) {
+            int seen = 0;
+            for (int k = 0; k < ctx->seen_count; ++k)
+                seen |= ctx->seen[k] == prim;
+            if (!seen) {
+                const float a = lpv_material_alpha_at(&r->look, m, uv0, uv1, color[3]);
+                ctx->transmit *= a > 0.0f ? (a < 1.0f ? 1.0f - a : 0.0f) : 1.0f; /* NaN: passes */
+                if (ctx->seen_count < REF_SEEN_MAX)
+                    ctx->seen[ctx->seen_count++] = prim;
+            }
+            args->valid[i] = ctx->transmit > 0.0f ? 0 : -1; /* opaque where nothing passes any more */
+            continue;
+        }
+        const float u = ctx->blend == REF_BLEND_HIT    ? 0.0f
+                        : ctx->blend == REF_BLEND_SKIP ? INFINITY
+                                                       : lpv_hash_unit(lpv_hash_u32(ctx->salt ^ lpv_hash_u32(prim)));
+        if (!lpv_material_covers_at(&r->look, m, uv0, uv1, color[3], u))
             args->valid[i] = 0;
     }
 }
@@ -431,6 +477,9 @@ int lpv_ref_create(const lpv_scene *scene, const lpv_ref_desc *desc, lpv_ref **o
         int cuts = 0;
         for (uint32_t m = 0; m < r->look.material_count; ++m)
             cuts |= lpv_material_alpha_cutoff(&r->look.materials[m]) > 0.0f;
+        for (uint32_t m = 0; m < r->look.material_count; ++m)
+            r->has_blend |= r->look.materials[m].alpha_mode == LPV_ALPHA_BLEND;
+        cuts |= r->has_blend;
         if (cuts) {
             rtcSetGeometryUserData(g, r);
             rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
@@ -494,12 +543,15 @@ typedef struct hit {
     float t;
 } hit;
 
-static int intersect(const lpv_ref *r, const float org[3], const float dir[3], float tmin, float tmax, hit *h)
+/* The first surface along the ray in [tmin, tmax]; blend and salt: how it
+ * treats BLEND surfaces (ref_blend). */
+static int intersect(const lpv_ref *r, const float org[3], const float dir[3], float tmin, float tmax,
+                     ref_blend blend, uint32_t salt, hit *h)
 {
     if (!r->scene)
         return 0;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    ref_context ctx = {.blend = blend, .salt = salt, .transmit = 1.0f};
+    rtcInitIntersectContext(&ctx.base);
     struct RTCRayHit rh;
     memset(&rh, 0, sizeof rh);
     rh.ray.org_x = org[0];
@@ -513,7 +565,7 @@ static int intersect(const lpv_ref *r, const float org[3], const float dir[3], f
     rh.ray.mask = 0xFFFFFFFFu;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(r->scene, &ctx, &rh);
+    rtcIntersect1(r->scene, &ctx.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.primID >= r->tri_count)
         return 0;
     const ref_tri *tr = &r->tris[rh.hit.primID];
@@ -536,12 +588,15 @@ static int intersect(const lpv_ref *r, const float org[3], const float dir[3], f
     return 1;
 }
 
-static int occluded(const lpv_ref *r, const float org[3], const float dir[3], float tmax)
+/* The fraction of light that passes from org along dir to tmax: 0 behind
+ * an opaque surface, else the product of 1 - alpha of the BLEND surfaces
+ * between (1 with none). */
+static float transmitted(const lpv_ref *r, const float org[3], const float dir[3], float tmax)
 {
     if (!r->scene)
-        return 0;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+        return 1.0f;
+    ref_context ctx = {.blend = REF_BLEND_TRANSMIT, .transmit = 1.0f};
+    rtcInitIntersectContext(&ctx.base);
     struct RTCRay ray;
     memset(&ray, 0, sizeof ray);
     ray.org_x = org[0];
@@ -553,15 +608,15 @@ static int occluded(const lpv_ref *r, const float org[3], const float dir[3], fl
     ray.tnear = 0.0f;
     ray.tfar = tmax;
     ray.mask = 0xFFFFFFFFu;
-    rtcOccluded1(r->scene, &ctx, &ray);
-    return ray.tfar < 0.0f;
+    rtcOccluded1(r->scene, &ctx.base, &ray);
+    return ray.tfar < 0.0f ? 0.0f : ctx.transmit;
 }
 
 int lpv_ref_first_hit(const lpv_ref *r, const float org[3], const float dir[3], float tmin, float tmax, float *t,
                       float p[3])
 {
     hit h;
-    if (!r || !finite3(org) || !finite3(dir) || !intersect(r, org, dir, tmin, tmax, &h))
+    if (!r || !finite3(org) || !finite3(dir) || !intersect(r, org, dir, tmin, tmax, REF_BLEND_SKIP, 0u, &h))
         return 0;
     if (t)
         *t = h.t;
@@ -574,7 +629,7 @@ int lpv_ref_first_surface(const lpv_ref *r, const float org[3], const float dir[
                           float p[3], float n[3])
 {
     hit h;
-    if (!r || !finite3(org) || !finite3(dir) || !intersect(r, org, dir, tmin, tmax, &h))
+    if (!r || !finite3(org) || !finite3(dir) || !intersect(r, org, dir, tmin, tmax, REF_BLEND_SKIP, 0u, &h))
         return 0;
     if (t)
         *t = h.t;
@@ -696,10 +751,11 @@ static void direct(const lpv_ref *r, const float p[3], const float ns[3], const 
         float tmax = isfinite(dist) ? dist - 2.0f * r->eps : INFINITY;
         if (!(tmax > 0.0f))
             continue;
-        if (occluded(r, org, to_light, tmax))
+        const float pass = transmitted(r, org, to_light, tmax);
+        if (!(pass > 0.0f))
             continue;
         for (int i = 0; i < 3; ++i)
-            out[i] += li->color[i] * e * c;
+            out[i] += li->color[i] * e * c * pass;
     }
 }
 
@@ -758,14 +814,15 @@ static void emitter_direct(const lpv_ref *r, pcg32 *rng, const float p[3], const
         return;
     for (int i = 0; i < 3; ++i)
         to_q[i] /= len;
-    if (occluded(r, org, to_q, len - 2.0f * r->eps))
+    const float pass = transmitted(r, org, to_q, len - 2.0f * r->eps);
+    if (!(pass > 0.0f))
         return;
     /* pdf per unit area of q: the triangle's share of the CDF (its mean
      * emission x area x sides) over its area, / total */
     const double pdf_area = (r->emitter_cdf[lo + 1] - r->emitter_cdf[lo]) / (total * tri_area(tr));
     if (!(pdf_area > 0.0))
         return;
-    double g = (double)cos_r * cos_e / dist2 / pdf_area;
+    double g = (double)pass * cos_r * cos_e / dist2 / pdf_area;
     for (int i = 0; i < 3; ++i)
         out[i] = (isfinite(le[i]) && le[i] > 0.0f ? le[i] : 0.0f) * g;
 }
@@ -809,7 +866,7 @@ static void sample_path(const lpv_ref *r, pcg32 *rng, const float p_in[3], const
         for (int i = 0; i < 3; ++i)
             org[i] = p[i] + r->eps * ng[i];
         hit h;
-        if (!intersect(r, org, dir, 0.0f, INFINITY, &h))
+        if (!intersect(r, org, dir, 0.0f, INFINITY, REF_BLEND_DRAW, r->has_blend ? pcg32_next(rng) : 0u, &h))
             break;
         float alb[3], ed[3] = {0.0f, 0.0f, 0.0f};
         hit_albedo(r, &h, alb);
@@ -865,7 +922,7 @@ static void sample_path_lights(const lpv_ref *r, pcg32 *rng, const float p_in[3]
         for (int i = 0; i < 3; ++i)
             org[i] = p[i] + r->eps * ng[i];
         hit h;
-        if (!intersect(r, org, dir, 0.0f, INFINITY, &h))
+        if (!intersect(r, org, dir, 0.0f, INFINITY, REF_BLEND_DRAW, r->has_blend ? pcg32_next(rng) : 0u, &h))
             break;
         float alb[3], ed[3] = {0.0f, 0.0f, 0.0f};
         double ee[3] = {0.0, 0.0, 0.0};
@@ -1041,19 +1098,11 @@ void lpv_ref_pixel_ray(const lpv_view *v, int x, int y, float org[3], float dir[
     *tmax = zf / cz;
 }
 
-static void pixel_item(job *j, size_t i)
+/* The pixel's light from surface h, out (W/(m^2 sr)) and its standard
+ * error se, as lpvd's frame shows it (j->full) or its indirect term. */
+static void shade_hit(job *j, size_t i, const hit *hp, float out[3], float out_se[3])
 {
-    const lpv_view *v = j->view;
-    int x = (int)(i % (size_t)v->width), y = (int)(i / (size_t)v->width);
-    float org[3], dir[3], tmin, tmax;
-    float *px = &j->rgba[4 * i], *pse = j->rgba_se ? &j->rgba_se[4 * i] : NULL;
-    px[0] = px[1] = px[2] = px[3] = 0.0f;
-    if (pse)
-        pse[0] = pse[1] = pse[2] = pse[3] = 0.0f;
-    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
-    hit h;
-    if (!finite3(org) || !finite3(dir) || !intersect(j->ref, org, dir, tmin, tmax, &h))
-        return;
+    const hit h = *hp;
     float alb[3], e[3] = {0, 0, 0}, se[3] = {0, 0, 0}, ed[3] = {0, 0, 0};
     hit_albedo(j->ref, &h, alb);
     const float occ = hit_occlusion(j->ref, &h);
@@ -1091,13 +1140,61 @@ static void pixel_item(job *j, size_t i)
     if (j->full && !hit_unlit(j->ref, &h, le))
         hit_emission(j->ref, &h, le);
     for (int c = 0; c < 3; ++c) {
-        px[c] = (float)(alb[c] / PT_PI) * (e[c] + ed[c]) + le[c];
-        if (pse)
-            pse[c] = (float)(alb[c] / PT_PI) * se[c];
+        out[c] = (float)(alb[c] / PT_PI) * (e[c] + ed[c]) + le[c];
+        out_se[c] = (float)(alb[c] / PT_PI) * se[c];
     }
-    px[3] = 1.0f;
+}
+
+/* The share of the pixel a hit surface covers: its alpha for a BLEND
+ * material (coverage), else 1. */
+static float hit_coverage(const lpv_ref *r, const hit *h)
+{
+    const ref_tri *tr = &r->tris[h->tri];
+    if (tr->material < 0 || r->look.materials[tr->material].alpha_mode != LPV_ALPHA_BLEND)
+        return 1.0f;
+    float uv0[2], uv1[2], color[4];
+    tri_uv(tr, h->u, h->v, uv0, uv1, color);
+    const float a = lpv_material_alpha_at(&r->look, &r->look.materials[tr->material], uv0, uv1, color[3]);
+    return a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
+}
+
+/* Translucent layers a pixel composites before it takes the rest as hidden. */
+#define REF_MAX_LAYERS 16
+
+static void pixel_item(job *j, size_t i)
+{
+    const lpv_view *v = j->view;
+    int x = (int)(i % (size_t)v->width), y = (int)(i / (size_t)v->width);
+    float org[3], dir[3], tmin, tmax;
+    float *px = &j->rgba[4 * i], *pse = j->rgba_se ? &j->rgba_se[4 * i] : NULL;
+    px[0] = px[1] = px[2] = px[3] = 0.0f;
     if (pse)
-        pse[3] = 1.0f;
+        pse[0] = pse[1] = pse[2] = pse[3] = 0.0f;
+    lpv_ref_pixel_ray(v, x, y, org, dir, &tmin, &tmax);
+    if (!finite3(org) || !finite3(dir))
+        return;
+    /* Front to back through the BLEND surfaces, each weighing its alpha of
+     * what is left ("over", as lpvd's frame lays its translucent layer over
+     * the opaque one), to the first opaque surface. */
+    float left = 1.0f;
+    for (int layer = 0; layer < REF_MAX_LAYERS && left > 1e-6f; ++layer) {
+        hit h;
+        if (!intersect(j->ref, org, dir, tmin, tmax, REF_BLEND_HIT, 0u, &h))
+            break;
+        const float a = hit_coverage(j->ref, &h);
+        float c[3], cse[3];
+        shade_hit(j, i, &h, c, cse);
+        for (int k = 0; k < 3; ++k) {
+            px[k] += left * a * c[k];
+            if (pse)
+                pse[k] += left * a * cse[k];
+        }
+        left *= 1.0f - a;
+        tmin = h.t + j->ref->eps;
+    }
+    px[3] = 1.0f - left;
+    if (pse)
+        pse[3] = px[3];
 }
 
 int lpv_ref_render_indirect(const lpv_ref *r, const lpv_view *view, int bounces, int spp, float *rgba, float *rgba_se)

@@ -142,13 +142,11 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
     }
 
     /* Materials lpvd approximates or reads only in part. */
-    Uses blend, far_uv;
+    Uses far_uv;
     std::set<int> far_sets;
     for (size_t i = 0; i < m.materials.size(); i++) {
         const tinygltf::Material &g = m.materials[i];
         const int k = int(i);
-        if (g.alphaMode == "BLEND")
-            blend.add("material", k);
         for (const tinygltf::TextureInfo *t :
              {&g.pbrMetallicRoughness.baseColorTexture, &g.pbrMetallicRoughness.metallicRoughnessTexture,
               &g.emissiveTexture})
@@ -159,10 +157,6 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
         if (g.occlusionTexture.index >= 0 && g.occlusionTexture.texCoord > 1)
             far_uv.add("material", k), far_sets.insert(g.occlusionTexture.texCoord);
     }
-    if (blend.total)
-        out.push_back("alphaMode BLEND (" + blend.describe() +
-                      "): no blending; drawn as MASK with alphaCutoff 0.5 (alpha >= 0.5 opaque, the rest cut away) "
-                      "for the camera and the lights alike");
     if (far_uv.total) {
         std::string sets;
         for (int s : far_sets)

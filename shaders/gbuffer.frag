@@ -2,6 +2,8 @@
 // camera, albedo and emission per pixel (also the camera's surfels for the
 // geometry volume). Alpha-masked texels are cut away (no pixel, no surfel);
 // the shading normal follows the normal map (docs/scenes.md, "Materials").
+// BLEND draws are drawn apart, into the translucent layer's G-buffer
+// (pass_camera.c), which also keeps their alpha as coverage.
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
@@ -19,6 +21,7 @@ layout(location = 1) out vec4 o_normal;   // xyz unit shading normal, on the cam
 layout(location = 2) out vec4 o_albedo;   // rgb linear base colour (diffuse: x lpv_gbuffer_kd); a roughness
 layout(location = 3) out vec4 o_emission; // rgb W/(m^2 sr); a object size (m)
 layout(location = 4) out float o_occlusion; // the frame's indirect light x this (occlusionTexture; 1 = open)
+layout(location = 5) out float o_coverage;  // the translucent layer's: alpha (BLEND), 1 otherwise; the G-buffer has no such target
 
 void main()
 {
@@ -44,8 +47,9 @@ void main()
     } else {
         area = u_pixel_area / cos_s;
     }
-    // after every derivative: cut-away texels leave no pixel (and no depth)
-    if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff)
+    // after every derivative: cut-away texels leave no pixel (and no depth),
+    // nor do a translucent layer's texels of alpha 0
+    if (LPV_MATERIAL_PLAIN == 0 && (u_alpha_blend != 0 ? !(base.a > 0.0) : base.a < u_alpha_cutoff))
         discard;
     vec2 mr = material_metallic_roughness(v_uv, v_uv1);
     o_position = vec4(p, area);
@@ -56,4 +60,5 @@ void main()
     o_emission = vec4(u_unlit != 0 ? clamp(base.rgb, 0.0, 1.0) / LPV_LUMENS_PER_WATT : material_emission(v_uv, v_uv1),
                       u_object_size);
     o_occlusion = material_occlusion(v_uv, v_uv1);
+    o_coverage = u_alpha_blend != 0 ? min(base.a, 1.0) : 1.0;
 }

@@ -248,6 +248,7 @@ struct LpvShadowFaceGpu {
 
 struct LpvShadowBlock {
     vec4 counts;          /* x faces, y shadow_size (texels), z 1 / shadow_size, w layers */
+    vec4 options;         /* x 1 = the transmission maps (LPV_TEX_SHADOW_TRANSMIT) hold BLEND surfaces */
     vec4 lights[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* per light (as LpvLightBlock's): x first face,
                                                           y face count, z 1 = cascades, 2 = area sample */
     LPV_STRUCT(LpvShadowFaceGpu) faces[LPV_MAX_SHADOW_FACES];
@@ -468,6 +469,37 @@ LPV_INLINE LPV_U32 lpv_hash_u32(LPV_U32 x)
 
 LPV_INLINE float lpv_hash_unit(LPV_U32 x) { return (x >> 8u) * (1.0f / 16777216.0f); }
 
+/* Alpha as coverage (docs/scenes.md, "Alpha"): whether a surface of alpha
+ * `alpha` is there for a draw u in [0, 1). MASK (cutoff > 0): where alpha >=
+ * cutoff. BLEND (blend != 0): where alpha > u, so over uniform draws it
+ * covers the fraction alpha and lets 1 - alpha of the light through, as
+ * glTF defines alpha (the fraction of the pixel the surface covers).
+ * Otherwise (OPAQUE) always. The one rule of the shaders (material.glsl),
+ * the CPU's surface samples (core/material_sample.h) and the reference's
+ * rays; each draws u its own way (an ordered dither per texel, a hash per
+ * voxel, a hash per ray). NaN alpha: nothing there. */
+LPV_INLINE int lpv_alpha_covers(float alpha, float cutoff, int blend, float u)
+{
+    if (blend != 0)
+        return alpha > u ? 1 : 0;
+    if (cutoff > 0.0f)
+        return alpha >= cutoff ? 1 : 0;
+    return 1;
+}
+
+/* The draw u of texel (x, y) of a rasterised view for lpv_alpha_covers: an
+ * 8 x 8 ordered (Bayer) dither, (rank + 0.5) / 64. Every aligned 2^k block
+ * holds evenly spread ranks, so a shadow map's filter (4 x 4 texels at
+ * LPV_SHADOW_PCF_RADIUS 1) and an RSM's VPLs see a BLEND surface cover
+ * alpha of its texels to 1/32, the same texels every tick (no flicker). */
+LPV_INLINE float lpv_dither8(LPV_U32 x, LPV_U32 y)
+{
+    LPV_U32 xy = (x ^ y) & 7u, yy = y & 7u, rank = 0u;
+    for (LPV_U32 i = 0u; i < 3u; ++i)
+        rank = (rank << 2u) | (((xy >> i) & 1u) << 1u) | ((yy >> i) & 1u);
+    return (rank + 0.5f) / 64.0f;
+}
+
 /* Ray j of `rays` from voxel `voxel` under `seed` (paper section 3.3's
  * stratified directions): rays equal-area bands in z, one jittered ray per
  * band, azimuths on the golden-ratio sequence rotated per voxel. Writes the
@@ -588,6 +620,11 @@ bool lpv_gbuffer_unlit(float normal_w) { return normal_w > LPV_GBUF_UNLIT_W - 0.
 #define LPV_TEX_REACH 16
 /* The G-buffer's occlusion target (gbuffer.frag o_occlusion) in the frame. */
 #define LPV_TEX_GBUF_OCCLUSION 17
+/* The shadow maps' transmission (pass_shadow.c, shadow.glsl): per texel of
+ * a face, rgb the share of light the BLEND surfaces in front of its opaque
+ * depth let through (the product of 1 - alpha), a the reversed depth of the
+ * nearest of them. */
+#define LPV_TEX_SHADOW_TRANSMIT 18
 #define LPV_REACH_SOLID 0
 #define LPV_REACH_DARK 1
 #define LPV_REACH_LIT 2

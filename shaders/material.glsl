@@ -17,7 +17,8 @@ uniform float u_roughness;      // glTF roughness (0 mirror .. 1 matte)
 uniform float u_metallic;       // glTF metallic (0 dielectric .. 1 metal)
 uniform int u_unlit;            // KHR_materials_unlit: shown as its base colour, lit by and lighting nothing
 uniform float u_object_size;    // m, the draw's longest bounding-box side (cascade fading)
-uniform float u_alpha_cutoff;   // alpha below it is cut away (MASK, BLEND as MASK at 0.5); 0 = opaque
+uniform float u_alpha_cutoff;   // MASK: alpha below it is cut away; 0 = no cutoff
+uniform int u_alpha_blend;      // BLEND: alpha is coverage (lpv_alpha_covers)
 // A texture's uv: set (0 TEXCOORD_0, 1 TEXCOORD_1) and the rows of its
 // KHR_texture_transform matrix applied to (u, v, 1).
 uniform int u_base_uv_set;
@@ -101,6 +102,16 @@ float material_occlusion(vec2 uv0, vec2 uv1)
 }
 
 #ifdef LPV_STAGE_FRAGMENT
+// Whether the surface of alpha a is at this texel of a light's view (shadow
+// maps, RSMs): MASK where a >= the cutoff; BLEND at the fraction a of the
+// texels an ordered dither picks, so the light's filters and VPLs see 1 - a
+// of it let through (lpv_alpha_covers, lpv_dither8 in lpv_shared.h).
+bool material_covers_texel(float a)
+{
+    return lpv_alpha_covers(a, u_alpha_cutoff, u_alpha_blend,
+                            lpv_dither8(uint(gl_FragCoord.x), uint(gl_FragCoord.y))) != 0;
+}
+
 // The interpolated normal (the face normal when the file's normal is
 // zero-length or not finite), for the side of the surface seen from `toward`
 // (a unit direction from the surface to the viewer or light): the side is

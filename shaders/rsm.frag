@@ -2,7 +2,9 @@
 // surfel's position and area, its normal (facing the light) and the flux it
 // reflects (W), so each texel becomes one VPL and one blocking surfel.
 // Alpha-masked texels are cut away: they neither block light (no depth, so no
-// shadow) nor reflect it. Normal maps are not applied here: an RSM texel is
+// shadow) nor reflect it; a BLEND surface of alpha a keeps a of its texels
+// (material_covers_texel), so it reflects a of the light and the surfaces
+// behind it get the rest. Normal maps are not applied here: an RSM texel is
 // far larger than a normal map's detail, and the reflected flux below does
 // not depend on the normal (docs/scenes.md, "Materials").
 in vec3 v_position;
@@ -53,7 +55,7 @@ void main()
     vec4 base = material_albedo(v_uv, v_uv1, v_color);
     // diffuse (an unlit material reflects nothing)
     vec3 albedo = u_unlit != 0 ? vec3(0.0) : base.rgb * (1.0 - material_metallic_roughness(v_uv, v_uv1).x);
-    if (LPV_MATERIAL_PLAIN == 0 && base.a < u_alpha_cutoff) // after every derivative
+    if (LPV_MATERIAL_PLAIN == 0 && !material_covers_texel(base.a)) // after every derivative
         discard;
 
     o_position = vec4(p, texel_area_perp / cos_s);

@@ -3,6 +3,7 @@
 // in-scattering. Needs lights.glsl.
 layout(binding = 4) uniform sampler2DArrayShadow u_shadow;
 layout(std140, binding = LPV_UBO_SHADOW) uniform ShadowUBO { LpvShadowBlock S; };
+layout(binding = LPV_TEX_SHADOW_TRANSMIT) uniform sampler2DArray u_shadow_transmit;
 
 // Percentage-closer filtering: (2R + 1)^2 hardware-compare bilinear taps one
 // texel apart (a separable tent of 2R + 2 texels; R = 0: one bilinear
@@ -40,6 +41,29 @@ float shadow_pcf(int face, vec2 uv, float depth, int R)
         }
     }
     return sum / float((2 * R + 1) * (2 * R + 1));
+}
+
+// The share of the light that the BLEND surfaces of face `face` let through
+// to a receiver at reversed depth `depth` at the face's uv (1 where none lies
+// in front of it): bilinear over the four texels around uv, each passing its
+// product of 1 - alpha where the receiver lies behind its nearest BLEND
+// surface (a smaller reversed depth). A receiver between two of them takes
+// both (docs/scenes.md, "Alpha").
+float shadow_transmit(int face, vec2 uv, float depth)
+{
+    float texel = S.counts.z;
+    vec4 tile = S.faces[face].tile;
+    vec2 u = (tile.xy + uv * tile.z) / texel - 0.5; // texel-centre coordinates
+    vec2 i = floor(u), f = u - i;
+    ivec2 lo = ivec2(round(tile.xy / texel)), hi = ivec2(round((tile.xy + tile.z) / texel)) - 1;
+    float sum = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        vec4 t = texelFetch(u_shadow_transmit, ivec3(clamp(ivec2(i) + o, lo, hi), int(tile.w)), 0);
+        float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+        sum += w * (depth < t.a ? t.r : 1.0);
+    }
+    return sum;
 }
 
 // Which lights a caller passes (a constant, so that after inlining the
@@ -178,7 +202,10 @@ float shadow_visibility_of(int l, vec3 p, vec3 n, int taps, const int kind)
     if (any(greaterThan(abs(ndc.xy), vec2(1.0))))
         return S.faces[f].info.y == 0.0 ? 1.0 : 0.0; // outside a spot's face is outside its cone
     // the maps hold reversed depth in [0, 1] as it is (pass_shadow.c)
-    return shadow_pcf(f, ndc.xy * 0.5 + 0.5, ndc.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
+    float v = shadow_pcf(f, ndc.xy * 0.5 + 0.5, ndc.z, taps == 1 ? 0 : LPV_SHADOW_PCF_RADIUS);
+    if (S.options.x != 0.0 && v > 0.0)
+        v *= shadow_transmit(f, ndc.xy * 0.5 + 0.5, ndc.z);
+    return v;
 }
 
 float shadow_visibility_taps(int l, vec3 p, vec3 n, int taps)

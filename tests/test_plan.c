@@ -35,6 +35,7 @@ static lpv_plan_facts baseline(void)
     f.occluder_triangles = 12;
     f.glossy_draws = 1;
     f.has_medium = 1;
+    f.blend_draws = 1;
     f.has_view = 0;
     f.scene_extent = 4.0f;
     f.first_tick = 1;
@@ -63,7 +64,8 @@ static void test_baseline_runs_everything_but_bounce(void **state)
     for (int i = 0; i < LPV_PASS_COUNT; ++i) {
         assert_reason(p.pass[i].reason);
         /* no camera: no gbuffer; the imperfect volume's passes are not the LPV's */
-        assert_int_equal(p.pass[i].run, i != LPV_PASS_BOUNCE && i != LPV_PASS_GBUFFER && i < LPV_PASS_IV_POINTS);
+        assert_int_equal(p.pass[i].run, (i != LPV_PASS_BOUNCE && i != LPV_PASS_GBUFFER && i < LPV_PASS_IV_POINTS) ||
+                                            i == LPV_PASS_TRANSLUCENT);
     }
     assert_string_equal(lpv_pass_name(LPV_PASS_GV), "gv");
     assert_null(lpv_pass_name(LPV_PASS_COUNT));
@@ -115,6 +117,31 @@ static void test_no_medium_skips_media(void **state)
     f.has_medium = 1;
     assert_true(plan_of((lpv_settings){0}, f).pass[LPV_PASS_MEDIA].run);
     assert_false(plan_of((lpv_settings){.media = LPV_SWITCH_OFF}, f).pass[LPV_PASS_MEDIA].run);
+}
+
+/* The frame's translucent layer runs only for scenes with a BLEND draw,
+ * whatever the technique and even when the cached volume is served. */
+static void test_no_blend_skips_translucent(void **state)
+{
+    (void)state;
+    lpv_plan_facts f = baseline();
+    f.blend_draws = 0;
+    lpv_plan p = plan_of((lpv_settings){0}, f);
+    assert_false(p.pass[LPV_PASS_TRANSLUCENT].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_TRANSLUCENT].reason, "no material is alphaMode BLEND"));
+    f.blend_draws = 3;
+    p = plan_of((lpv_settings){0}, f);
+    assert_true(p.pass[LPV_PASS_TRANSLUCENT].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_TRANSLUCENT].reason, "3 draws are alphaMode BLEND"));
+    f.first_tick = 0; /* nothing changed: the volume is served again, the frame still needs the layer */
+    lpv_settings iv = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_IV});
+    lpv_plan_make_iv(&iv, &f, &p);
+    assert_false(p.recompute);
+    assert_true(p.pass[LPV_PASS_TRANSLUCENT].run);
+    p = plan_of((lpv_settings){0}, f);
+    assert_false(p.recompute);
+    assert_true(p.pass[LPV_PASS_TRANSLUCENT].run);
+    assert_string_equal(lpv_pass_name(LPV_PASS_TRANSLUCENT), "translucent");
 }
 
 static void test_no_emissive_skips_emissive(void **state)
@@ -423,7 +450,8 @@ static void test_planner_off_runs_everything(void **state)
     lpv_plan p = plan_of((lpv_settings){.planner = LPV_SWITCH_OFF, .lpv.bounces = LPV_SWITCH_ON}, f);
     assert_true(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i)
-        assert_int_equal(p.pass[i].run, i < LPV_PASS_IV_POINTS); /* every pass of the LPV's */
+        /* every pass of the LPV's, and the frame's translucent layer */
+        assert_int_equal(p.pass[i].run, i < LPV_PASS_IV_POINTS || i == LPV_PASS_TRANSLUCENT);
     /* planner on, same facts: almost nothing runs */
     p = plan_of((lpv_settings){.lpv.bounces = LPV_SWITCH_ON}, f);
     assert_false(p.recompute);
@@ -668,7 +696,7 @@ static void test_iv_plan(void **state)
     p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
     assert_false(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i)
-        if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA)
+        if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT) /* the frame's */
             assert_false(p.pass[i].run);
 }
 
@@ -771,6 +799,7 @@ int main(void)
         cmocka_unit_test(test_no_occluders_skips_gv_and_gbuffer),
         cmocka_unit_test(test_no_glossy_skips_glossy),
         cmocka_unit_test(test_no_medium_skips_media),
+        cmocka_unit_test(test_no_blend_skips_translucent),
         cmocka_unit_test(test_no_emissive_skips_emissive),
         cmocka_unit_test(test_no_lights_skips_rsm),
         cmocka_unit_test(test_area_lights_replace_emissive_vpls),

@@ -2805,8 +2805,8 @@ def c_plan_iv(ctx):
     passes = {p["name"]: p for p in plan["passes"]}
     names = [p["name"] for p in plan["passes"]]
     iv_names = ["iv_points", "iv_reproject", "iv_gather", "iv_ao"]
-    check(names[len(PLAN_PASSES):] == iv_names, "passes after R8.1's: %r, expected %r" % (
-        names[len(PLAN_PASSES):], iv_names))
+    after = names[len(PLAN_PASSES):len(PLAN_PASSES) + len(iv_names)]
+    check(after == iv_names, "passes after R8.1's: %r, expected %r first" % (after, iv_names))
     g = passes["iv_gather"]
     check(g["run"] and "iv: 3 bounces requested" in g["reason"], "iv_gather %r: expected it to run, naming "
           "\"iv: 3 bounces requested\"" % (g,))
