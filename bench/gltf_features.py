@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """gltf_features.py - lpvd's full frame against the path tracer's on files that use the glTF features
 issue 32 added (README "Scenes", docs/scenes.md): a skinned and a morphed file posed at a time, a file
-whose labels glow through an emissive texture, a textured box, and a vertex-coloured room this script
-writes (no file of Debian's corpus carries COLOR_0).
+whose labels glow through an emissive texture (and whose partial coating is alphaMode BLEND), a textured
+box, a vertex-coloured room this script writes (no file of Debian's corpus carries COLOR_0), and the
+accuracy set's translucent panes (scenes/glass.glb, alphaMode BLEND).
 
 For each: `lpvd render FILE [--time T] --size WxH -o lpvd.exr` and `lpvd-reference FILE [--time T] --full
 --bounces converged --spp N --size WxH -o ref.exr` (the same camera: both choose it alike), then over the
@@ -23,6 +24,7 @@ import numpy as np
 import OpenImageIO as oiio
 
 MODELS = os.environ.get("LPVD_ASSIMP_MODELS", "/usr/share/assimp/models") + "/glTF2"
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def vertex_coloured_room(path):
@@ -100,6 +102,7 @@ def main():
         ("emissive texture (ClearCoatTest's labels)", MODELS + "/ClearCoat-glTF/ClearCoatTest.gltf", []),
         ("base colour texture (BoxTextured)", MODELS + "/BoxTextured-glTF/BoxTextured.gltf", []),
         ("vertex colours (COLOR_0, this script's room)", room, []),
+        ("translucent panes (BLEND, scenes/glass.glb)", os.path.join(REPO, "scenes", "glass.glb"), []),
     ]
     lpvd = os.path.join(a.build, "server", "lpvd")
     ref = os.path.join(a.build, "reference", "lpvd-reference")

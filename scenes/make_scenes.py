@@ -65,6 +65,12 @@ as glTF 2.0 binary files next to this script. Python standard library only.
                  technique (the imperfect volume's first bounce: -0.105
                  against -0.017).
 
+  glass.glb      TRANSLUCENT (issue 32, docs/scenes.md "Alpha"): the room lit by a
+                 spot light shining down through a blue-green pane of alpha 0.4
+                 (alphaMode BLEND, double-sided) hanging 1.4 m over the floor,
+                 and a red pane of alpha 0.7 standing before the back wall:
+                 the floor under the first gets 60 % of the spot's light.
+
 Every object is an axis-aligned box (12 triangles), a quad (2 triangles, its
 front the side its corners run counter-clockwise around), or a UV sphere or
 upright cylinder with smooth vertex normals; each material is one mesh.
@@ -177,9 +183,12 @@ class Scene:
         self.lights = []
         self.cameras = []
         self.medium = None   # lpvd_medium object for the scene's extras, or None
+        self.alphas = {}     # material index -> None (opaque) or a BLEND alpha
 
-    def material(self, name, rgb, roughness=1.0, emission=None, double_sided=False):
+    def material(self, name, rgb, roughness=1.0, emission=None, double_sided=False, alpha=None):
+        """alpha: None for an opaque material, else alphaMode BLEND with this alpha (coverage)."""
         self.materials.append((name, rgb, roughness, emission, double_sided))
+        self.alphas[len(self.materials) - 1] = alpha
         self.boxes[len(self.materials) - 1] = []
         self.quads[len(self.materials) - 1] = []
         self.meshes[len(self.materials) - 1] = []
@@ -263,9 +272,12 @@ class Scene:
         if self.medium is not None:
             scene["extras"] = {"lpvd_medium": self.medium}
         materials = []
-        for n, c, r, e, two in self.materials:
-            mat = {"name": n, "pbrMetallicRoughness": {"baseColorFactor": list(c) + [1.0],
+        for k, (n, c, r, e, two) in enumerate(self.materials):
+            alpha = self.alphas[k]
+            mat = {"name": n, "pbrMetallicRoughness": {"baseColorFactor": list(c) + [1.0 if alpha is None else alpha],
                                                        "metallicFactor": 0.0, "roughnessFactor": r}}
+            if alpha is not None:
+                mat["alphaMode"] = "BLEND"
             if two:
                 mat["doubleSided"] = True
             if e is not None:
@@ -631,6 +643,23 @@ def walls_room(thin):
     return s
 
 
+def glass():
+    s = Scene()
+    room(s)
+    # a spot from the ceiling straight down through a tinted pane (alpha 0.4:
+    # 60 % of the light passes) hanging 1.4 m over the floor; an upright red
+    # pane (alpha 0.7) stands in front of the back wall, both in view
+    tinted = s.material("tinted_glass", (0.20, 0.55, 0.80), double_sided=True, alpha=0.4)
+    red = s.material("red_glass", (0.85, 0.15, 0.10), double_sided=True, alpha=0.7)
+    s.add_quad(tinted, [(-0.2, 1.4, 0.8), (1.4, 1.4, 0.8), (1.4, 1.4, -0.8), (-0.2, 1.4, -0.8)])
+    s.add_quad(red, [(-1.4, 0.0, -1.0), (0.0, 0.0, -1.0), (0.0, 1.6, -1.0), (-1.4, 1.6, -1.0)])
+    s.light("spot", {"type": "spot", "color": [1.0, 0.95, 0.9], "intensity": 12000.0,
+                     "spot": {"innerConeAngle": 0.35, "outerConeAngle": 0.55}},
+            (0.6, 2.9, 0.0), (0.6, 0.0, 0.0))
+    s.camera("Camera", (1.6, 1.7, 1.9), (-0.4, 0.5, -1.0), 65.0)
+    return s
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     for name, build in (("courtyard", courtyard), ("blinds", blinds), ("glossy", glossy), ("fog", fog),
@@ -641,7 +670,8 @@ def main():
                         ("two-rooms-lit", lambda: two_rooms(+1)), ("panel-room", panel_room), ("tunnel", tunnel),
                         ("tunnel-terrain", tunnel_terrain), ("tunnel-hill", tunnel_hill),
                         ("curved", curved), ("lamp-fixture", lamp_fixture),
-                        ("box-walls", lambda: walls_room(False)), ("thin-walls", lambda: walls_room(True))):
+                        ("box-walls", lambda: walls_room(False)), ("thin-walls", lambda: walls_room(True)),
+                        ("glass", glass)):
         data, tris = build().glb()
         if tris >= 2000:
             sys.exit("%s: %d triangles, over the 2000 budget" % (name, tris))
