@@ -58,6 +58,7 @@ typedef struct lpv_gpu_draw {
     int material;
     float size; /* m, longest side of the draw's bounding box (cascade fading) */
     int vertex_color; /* lpv_draw.vertex_color */
+    float box_min[3], box_max[3]; /* m, its bounding box (min > max: no finite vertex) */
 } lpv_gpu_draw;
 
 /* The frame's variants (shade.comp's defines, shading.glsl), a bit each. */

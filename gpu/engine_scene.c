@@ -100,9 +100,12 @@ static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, siz
 }
 
 /* Longest side of the bounding box of a draw's finite vertices (m). */
-static float draw_size(const lpv_scene *scene, const lpv_draw *d)
+/* Draw d's bounding box (lo > hi on an axis when it has no finite vertex)
+ * and its longest side (m; 0 then). */
+static float draw_box(const lpv_scene *scene, const lpv_draw *d, float lo[3], float hi[3])
 {
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < 3; ++k)
+        lo[k] = INFINITY, hi[k] = -INFINITY;
     for (uint32_t i = 0; i < d->index_count; ++i) {
         uint32_t v = scene->indices[d->first_index + i];
         if (v >= scene->vertex_count)
@@ -292,9 +295,10 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         const lpv_draw *d = &scene->draws[i];
         if ((uint64_t)d->first_index + d->index_count > scene->index_count)
             return lpv_error(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
-        e->draws[e->draw_count++] =
-            (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, draw_size(scene, d),
-                           d->vertex_color != 0};
+        lpv_gpu_draw *g = &e->draws[e->draw_count++];
+        *g = (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, 0.0f,
+                            d->vertex_color != 0};
+        g->size = draw_box(scene, d, g->box_min, g->box_max);
         const lpv_material *m = (d->material >= 0 && (uint32_t)d->material < scene->material_count)
                                     ? &scene->materials[d->material]
                                     : NULL;

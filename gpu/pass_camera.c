@@ -311,9 +311,10 @@ static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms te
  * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
  * core. The glossy and media passes then blend into the same texture.
  * gbuf: the G-buffer's targets to shade (the camera's or the translucent
- * layer's), frame: the texture written, stage: the timer's name. */
+ * layer's), frame: the texture written, rect: the pixels (x, y, w, h) to
+ * shade, stage: the timer's name. */
 static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[LPV_GBUF_TARGETS], GLuint frame,
-                       const char *stage, char *err, size_t err_size)
+                       const int rect[4], const char *stage, char *err, size_t err_size)
 {
     /* the frame's variant: the lookup step's blocks (frames with the LPV
      * term), else the technique's two passes; the area shadow step's blocks
@@ -371,14 +372,16 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
      * (timer.h): a large view's one dispatch took seconds on llvmpipe; the
      * pixels are independent, so the frame is the same */
     const GLint loc_row = glGetUniformLocation(prog, "u_row_first");
-    int rows = (int)(LPV_SHADE_BAND_PIXELS / (size_t)(e->gbuf_w > 0 ? e->gbuf_w : 1));
+    glUniform1i(glGetUniformLocation(prog, "u_col_first"), rect[0]);
+    int rows = (int)(LPV_SHADE_BAND_PIXELS / (size_t)(rect[2] > 0 ? rect[2] : 1));
     rows = rows < LPV_WG_2D ? LPV_WG_2D : rows / LPV_WG_2D * LPV_WG_2D;
-    for (int y = 0; y < e->gbuf_h;) {
-        const int n = e->gbuf_h - y < rows ? e->gbuf_h - y : rows;
+    const int y_end = rect[1] + rect[3];
+    for (int y = rect[1]; y < y_end;) {
+        const int n = y_end - y < rows ? y_end - y : rows;
         glUniform1i(loc_row, y);
-        glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)n, LPV_WG_2D), 1);
+        glDispatchCompute(lpv_div_up((size_t)rect[2], LPV_WG_2D), lpv_div_up((size_t)n, LPV_WG_2D), 1);
         y += n;
-        if (y < e->gbuf_h)
+        if (y < y_end)
             lpv_timer_yield(&e->timer);
     }
     /* the listed pixels' indirect light, then their area light */
@@ -397,7 +400,43 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
 
 int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size)
 {
-    return shade_frame(e, terms, e->gbuf_tex, e->frame_tex, "shade", err, err_size);
+    const int whole[4] = {0, 0, e->gbuf_w, e->gbuf_h};
+    return shade_frame(e, terms, e->gbuf_tex, e->frame_tex, whole, "shade", err, err_size);
+}
+
+/* The pixels the BLEND draws can cover: the bounding rectangle of their
+ * bounding boxes' corners projected by the G-buffer's camera, a pixel wider
+ * each way and clipped to the frame (the whole frame when a corner lies
+ * behind the eye). Returns 0 when none can be seen. */
+static int layer_rect(const lpv_engine *e, int rect[4])
+{
+    const float w = (float)e->gbuf_w, h = (float)e->gbuf_h;
+    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < e->draw_count; ++i) {
+        const lpv_gpu_draw *d = &e->draws[i];
+        if (d->material < 0 || (uint32_t)d->material >= e->material_count || !e->materials[d->material].blend ||
+            !(d->box_max[0] >= d->box_min[0]) || !d->index_count)
+            continue;
+        for (int c = 0; c < 8; ++c) {
+            vec4 p = {(c & 1) ? d->box_max[0] : d->box_min[0], (c & 2) ? d->box_max[1] : d->box_min[1],
+                      (c & 4) ? d->box_max[2] : d->box_min[2], 1.0f},
+                 clip;
+            glm_mat4_mulv((vec4 *)e->view_block.view_proj, p, clip);
+            if (!(clip[3] > 1e-6f)) { /* behind the eye (or on its plane): it may reach any pixel */
+                rect[0] = rect[1] = 0, rect[2] = e->gbuf_w, rect[3] = e->gbuf_h;
+                return 1;
+            }
+            const float x = (clip[0] / clip[3] * 0.5f + 0.5f) * w, y = (clip[1] / clip[3] * 0.5f + 0.5f) * h;
+            lo[0] = fminf(lo[0], x), hi[0] = fmaxf(hi[0], x);
+            lo[1] = fminf(lo[1], y), hi[1] = fmaxf(hi[1], y);
+        }
+    }
+    const float x0 = fmaxf(floorf(lo[0]) - 1.0f, 0.0f), y0 = fmaxf(floorf(lo[1]) - 1.0f, 0.0f);
+    const float x1 = fminf(ceilf(hi[0]) + 1.0f, w), y1 = fminf(ceilf(hi[1]) + 1.0f, h);
+    if (!(x1 > x0) || !(y1 > y0))
+        return 0;
+    rect[0] = (int)x0, rect[1] = (int)y0, rect[2] = (int)(x1 - x0), rect[3] = (int)(y1 - y0);
+    return 1;
 }
 
 int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_lookups, size_t *area_rest_pixels,
@@ -410,7 +449,13 @@ int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_
      * shading lists its own in the same buffers */
     *full_lookups += lpv_pass_shade_full_lookups(e);
     *area_rest_pixels += lpv_pass_shade_area_rest_pixels(e);
-    if (shade_frame(e, terms, e->layer_tex, e->layer_frame_tex, "translucent", err, err_size) != 0)
+    /* only the pixels its draws can cover: the layer's shading costs what
+     * the frame's does per pixel, and llvmpipe shades an uncovered pixel's
+     * lanes all the same */
+    int rect[4];
+    if (!layer_rect(e, rect))
+        return 0;
+    if (shade_frame(e, terms, e->layer_tex, e->layer_frame_tex, rect, "translucent", err, err_size) != 0)
         return -1;
     lpv_timer_begin(&e->timer, "translucent");
     glUseProgram(e->prog_translucent);
@@ -420,7 +465,8 @@ int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_
     glBindTexture(GL_TEXTURE_2D, e->layer_tex[LPV_GBUF_TARGETS]);
     glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
-    glDispatchCompute(lpv_div_up((size_t)e->gbuf_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf_h, LPV_WG_2D), 1);
+    glUniform2i(glGetUniformLocation(e->prog_translucent, "u_first"), rect[0], rect[1]);
+    glDispatchCompute(lpv_div_up((size_t)rect[2], LPV_WG_2D), lpv_div_up((size_t)rect[3], LPV_WG_2D), 1);
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     lpv_timer_count(&e->timer, 1);
     lpv_timer_end(&e->timer);

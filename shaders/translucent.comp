@@ -10,10 +10,11 @@ layout(local_size_x = LPV_WG_2D, local_size_y = LPV_WG_2D) in;
 layout(binding = LPV_IMG_FRAME, rgba32f) uniform image2D u_frame;
 layout(binding = 0) uniform sampler2D u_layer_frame;    // the layer's pixels shaded (shading.glsl)
 layout(binding = 1) uniform sampler2D u_layer_coverage; // the layer's alpha, 0 = no translucent surface
+uniform ivec2 u_first; // the dispatch's first pixel (the layer's rectangle, pass_camera.c)
 
 void main()
 {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = u_first + ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, imageSize(u_frame))))
         return;
     float a = texelFetch(u_layer_coverage, px, 0).r;
