@@ -17,6 +17,8 @@ void lpv_scene_free(lpv_scene *scene)
     free(scene->vertices);
     free(scene->indices);
     free(scene->draws);
+    free(scene->wire_indices);
+    free(scene->wire_draws);
     free(scene->materials);
     free(scene->textures);
     free(scene->lights);
@@ -42,14 +44,19 @@ int lpv_scene_copy_geometry(lpv_scene *dst, const lpv_scene *src)
     dst->indices = dup_array(src->indices, src->index_count, sizeof *src->indices);
     dst->draws = dup_array(src->draws, src->draw_count, sizeof *src->draws);
     dst->materials = dup_array(src->materials, src->material_count, sizeof *src->materials);
+    dst->wire_indices = dup_array(src->wire_indices, src->wire_index_count, sizeof *src->wire_indices);
+    dst->wire_draws = dup_array(src->wire_draws, src->wire_draw_count, sizeof *src->wire_draws);
     if ((src->vertex_count && !dst->vertices) || (src->index_count && !dst->indices) ||
-        (src->draw_count && !dst->draws) || (src->material_count && !dst->materials)) {
+        (src->draw_count && !dst->draws) || (src->material_count && !dst->materials) ||
+        (src->wire_index_count && !dst->wire_indices) || (src->wire_draw_count && !dst->wire_draws)) {
         lpv_scene_free(dst);
         return -1;
     }
     dst->vertex_count = src->vertex_count;
     dst->index_count = src->index_count;
     dst->draw_count = src->draw_count;
+    dst->wire_index_count = src->wire_index_count;
+    dst->wire_draw_count = src->wire_draw_count;
     dst->material_count = src->material_count;
     memcpy(dst->bounds_min, src->bounds_min, sizeof dst->bounds_min);
     memcpy(dst->bounds_max, src->bounds_max, sizeof dst->bounds_max);
@@ -62,7 +69,9 @@ uint64_t lpv_scene_bytes(const lpv_scene *s)
     uint64_t b = (uint64_t)s->vertex_count * sizeof *s->vertices + (uint64_t)s->index_count * sizeof *s->indices +
                  (uint64_t)s->draw_count * sizeof *s->draws + (uint64_t)s->material_count * sizeof *s->materials +
                  (uint64_t)s->light_count * sizeof *s->lights + (uint64_t)s->camera_count * sizeof *s->cameras +
-                 (uint64_t)s->texture_count * sizeof *s->textures;
+                 (uint64_t)s->texture_count * sizeof *s->textures +
+                 (uint64_t)s->wire_index_count * sizeof *s->wire_indices +
+                 (uint64_t)s->wire_draw_count * sizeof *s->wire_draws;
     for (uint32_t i = 0; i < s->texture_count; ++i)
         b += (uint64_t)s->textures[i].width * (uint64_t)s->textures[i].height * 4u;
     if (s->medium.density)

@@ -124,12 +124,18 @@ typedef struct lpv_vertex {
     float color[4];    /* COLOR_0, linear RGBA (alpha 1 for a VEC3); read only where the draw's vertex_color is 1 */
 } lpv_vertex;
 
-/* A run of triangles (3 indices each) sharing one material. */
+/* What a draw's indices are: triangles (3 each: every draw of
+ * lpv_scene.draws), or a wire draw's points (1 each) or line segments (2
+ * each, glTF's strips and loops unrolled): lpv_scene.wire_draws. */
+typedef enum lpv_draw_mode { LPV_DRAW_TRIANGLES = 0, LPV_DRAW_POINTS, LPV_DRAW_LINES } lpv_draw_mode;
+
+/* A run of primitives sharing one material. */
 typedef struct lpv_draw {
     uint32_t first_index;
     uint32_t index_count;
     int material; /* index into materials */
     int vertex_color; /* 1: the vertices' color (COLOR_0) multiplies the base colour and its alpha (glTF) */
+    int mode;         /* lpv_draw_mode */
 } lpv_draw;
 
 /* A participating medium (docs/scenes.md, "Media"): single scattering with an
@@ -158,6 +164,14 @@ typedef struct lpv_scene {
     uint32_t index_count;
     lpv_draw *draws;
     uint32_t draw_count;
+    /* glTF's points and lines (docs/scenes.md, "Points and lines"): their
+     * vertices are in `vertices`, their indices apart; they have no area, so
+     * only the camera's frame draws them (one pixel wide, in their colour),
+     * and nothing that carries light (the triangles' draws) sees them */
+    uint32_t *wire_indices;
+    uint32_t wire_index_count;
+    lpv_draw *wire_draws;
+    uint32_t wire_draw_count;
     lpv_material *materials;
     uint32_t material_count;
     lpv_texture *textures;
@@ -176,9 +190,9 @@ typedef struct lpv_scene {
 /* Frees everything the scene owns and zeroes it. Safe on a zeroed scene. */
 void lpv_scene_free(lpv_scene *scene);
 
-/* A deep copy of the scene's geometry: vertices, indices, draws and
- * materials, the bounds and the source; no textures, lights, cameras or
- * medium. What the engine keeps to
+/* A deep copy of the scene's geometry: vertices, indices, draws, wire
+ * draws and materials, the bounds and the source; no textures, lights,
+ * cameras or medium. What the engine keeps to
  * re-sample the scene when a knob changes without the scene being sent again.
  * Returns 0, or -1 out of memory (dst then zeroed; free it with
  * lpv_scene_free either way). */

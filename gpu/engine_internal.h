@@ -58,7 +58,8 @@ typedef struct lpv_gpu_draw {
     int material;
     float size; /* m, longest side of the draw's bounding box (cascade fading) */
     int vertex_color; /* lpv_draw.vertex_color */
-    float box_min[3], box_max[3]; /* m, its bounding box (min > max: no finite vertex) */
+    float box_min[3], box_max[3]; /* m, its bounding box (min > max: no finite vertex); triangles only */
+    int mode; /* lpv_draw_mode: LPV_DRAW_TRIANGLES, or a wire draw's POINTS or LINES */
 } lpv_gpu_draw;
 
 /* The frame's variants (shade.comp's defines, shading.glsl), a bit each. */
@@ -125,6 +126,8 @@ struct lpv_engine {
     GLuint vao, vbo, ibo, empty_vao;
     lpv_gpu_draw *draws;
     uint32_t draw_count;
+    lpv_gpu_draw *wire_draws; /* points and lines (lpv_scene.wire_draws), indices after the triangles' */
+    uint32_t wire_draw_count;
     lpv_gpu_material *materials;
     uint32_t material_count;
     int materials_plain;      /* 1: no material has a texture, a normal map or an alpha cut */
@@ -247,6 +250,9 @@ typedef enum lpv_draw_set { LPV_DRAWS_ALL = 0, LPV_DRAWS_NOT_BLEND, LPV_DRAWS_BL
  * culled (the camera's view, as glTF says; light views pass 0 and see both
  * sides). */
 void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set);
+/* Draws the points and lines (one pixel wide) with their materials'
+ * uniforms and u_wire 1: only the camera's G-buffer does. */
+void lpv_engine_draw_wires(lpv_engine *e, GLuint prog);
 /* The program a scene pass draws with: plain (built with LPV_MATERIAL_PLAIN)
  * when the scene's materials are all plain, else full. */
 GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plain);

@@ -45,11 +45,12 @@ void lpv_engine_free_scene(lpv_engine *e)
         glDeleteTextures((GLsizei)e->texture_count, e->textures);
     free(e->textures);
     free(e->draws);
+    free(e->wire_draws);
     free(e->materials);
     e->textures = NULL;
-    e->draws = NULL;
+    e->draws = e->wire_draws = NULL;
     e->materials = NULL;
-    e->texture_count = e->draw_count = e->material_count = 0;
+    e->texture_count = e->draw_count = e->wire_draw_count = e->material_count = 0;
     e->blend_draws = 0;
     e->light_count = 0;
     lpv_emitters_free(&e->emitters);
@@ -142,6 +143,8 @@ static uint64_t geometry_signature(const lpv_scene *s)
     h = lpv_hash_bytes(h, s->vertices, (size_t)s->vertex_count * sizeof *s->vertices);
     h = lpv_hash_bytes(h, s->indices, (size_t)s->index_count * sizeof *s->indices);
     h = lpv_hash_bytes(h, s->draws, (size_t)s->draw_count * sizeof *s->draws);
+    h = lpv_hash_bytes(h, s->wire_indices, (size_t)s->wire_index_count * sizeof *s->wire_indices);
+    h = lpv_hash_bytes(h, s->wire_draws, (size_t)s->wire_draw_count * sizeof *s->wire_draws);
     h = lpv_hash_bytes(h, s->materials, (size_t)s->material_count * sizeof *s->materials);
     h = lpv_hash_bytes(h, &s->medium, sizeof s->medium);
     return h;
@@ -263,12 +266,13 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
 {
     /* nothing to light or see: a frame of background and exit 0 would pass
      * for a render (issue 32); the file's loader has said what it dropped */
-    size_t triangles = 0;
+    size_t triangles = 0, wires = 0;
     for (uint32_t d = 0; d < scene->draw_count; ++d)
         triangles += scene->draws[d].index_count / 3;
-    if (!triangles)
-        return lpv_error(err, err_size, "%s: no triangles to draw (a scene needs a surface; points and lines carry "
-                         "none)", scene->source);
+    for (uint32_t d = 0; d < scene->wire_draw_count; ++d)
+        wires += scene->wire_draws[d].index_count;
+    if (!triangles && !wires)
+        return lpv_error(err, err_size, "%s: nothing to draw (no triangles, points or lines)", scene->source);
     uint64_t sig = geometry_signature(scene);
     e->shadow_valid = 0;
     e->ticked = 0;
@@ -305,6 +309,22 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         int emissive = m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
         if (!emissive)
             e->occluder_triangles += d->index_count / 3;
+    }
+    /* points and lines: drawn by the camera alone (pass_camera.c), from
+     * the index buffer's tail */
+    e->wire_draws = calloc(scene->wire_draw_count ? scene->wire_draw_count : 1, sizeof *e->wire_draws);
+    if (!e->wire_draws)
+        return lpv_error(err, err_size, "out of memory for the scene");
+    for (uint32_t i = 0; i < scene->wire_draw_count; ++i) {
+        const lpv_draw *d = &scene->wire_draws[i];
+        if ((uint64_t)d->first_index + d->index_count > scene->wire_index_count)
+            return lpv_error(err, err_size, "%s: point or line draw %u indexes past its index buffer", scene->source,
+                             i);
+        const uint32_t per = d->mode == LPV_DRAW_POINTS ? 1u : 2u;
+        lpv_gpu_draw *g = &e->wire_draws[e->wire_draw_count++];
+        *g = (lpv_gpu_draw){scene->index_count + d->first_index, d->index_count - d->index_count % per, d->material,
+                            0.0f, d->vertex_color != 0};
+        g->mode = d->mode == LPV_DRAW_POINTS ? LPV_DRAW_POINTS : LPV_DRAW_LINES;
     }
     for (uint32_t i = 0; i < scene->material_count; ++i) {
         const lpv_material *m = &scene->materials[i];
@@ -352,6 +372,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         e->materials_occlusion |= g->occlusion_texture >= 0;
         e->materials_unlit |= g->unlit;
     }
+    e->materials_unlit |= e->wire_draw_count > 0; /* points and lines show unlit (LPV_GBUF_WIRE_W) */
     e->blend_draws = 0;
     for (uint32_t i = 0; i < e->draw_count; ++i) {
         const int k = e->draws[i].material;
@@ -368,8 +389,13 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
                  GL_STATIC_DRAW);
     glGenBuffers(1, &e->ibo);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(scene->index_count * sizeof(uint32_t)), scene->indices,
+    /* the triangles' indices, then the wire draws' (their first_index moved past the triangles') */
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 (GLsizeiptr)(((size_t)scene->index_count + scene->wire_index_count) * sizeof(uint32_t)), NULL,
                  GL_STATIC_DRAW);
+    glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, (GLsizeiptr)(scene->index_count * sizeof(uint32_t)), scene->indices);
+    glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)(scene->index_count * sizeof(uint32_t)),
+                    (GLsizeiptr)(scene->wire_index_count * sizeof(uint32_t)), scene->wire_indices);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(lpv_vertex), (void *)offsetof(lpv_vertex, position));
     glEnableVertexAttribArray(1);
@@ -420,7 +446,11 @@ GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plai
     return e->materials_plain ? plain : full;
 }
 
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set)
+/* The draws of `list` in `set` with their materials' uniforms and textures
+ * (lpv_engine_draw_scene, lpv_engine_draw_wires); u_wire tells gbuffer.frag
+ * which kind it draws. */
+static void draw_list(lpv_engine *e, GLuint prog, const lpv_gpu_draw *list, uint32_t count, int cull_single_sided,
+                      lpv_draw_set set, int wire)
 {
     GLint loc_color = glGetUniformLocation(prog, "u_base_color");
     GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
@@ -430,6 +460,7 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lp
     GLint loc_size = glGetUniformLocation(prog, "u_object_size");
     GLint loc_cutoff = glGetUniformLocation(prog, "u_alpha_cutoff");
     GLint loc_blend = glGetUniformLocation(prog, "u_alpha_blend");
+    glUniform1i(glGetUniformLocation(prog, "u_wire"), wire);
     GLint loc_base_set = glGetUniformLocation(prog, "u_base_uv_set");
     GLint loc_base_row0 = glGetUniformLocation(prog, "u_base_uv_row0");
     GLint loc_base_row1 = glGetUniformLocation(prog, "u_base_uv_row1");
@@ -456,8 +487,8 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lp
     glBindVertexArray(e->vao);
     glCullFace(GL_BACK);
     glFrontFace(GL_CCW); /* glTF's front faces; the loader rewinds mirrored nodes */
-    for (uint32_t i = 0; i < e->draw_count; ++i) {
-        const lpv_gpu_draw *d = &e->draws[i];
+    for (uint32_t i = 0; i < count; ++i) {
+        const lpv_gpu_draw *d = &list[i];
         static const lpv_gpu_material fallback = {
             .base_color = {1, 1, 1, 1}, .roughness = 1.0f, .texture = -1, .double_sided = 1,
             .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0},
@@ -510,8 +541,9 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lp
             glEnable(GL_CULL_FACE);
         else
             glDisable(GL_CULL_FACE);
+        const GLenum mode = d->mode == LPV_DRAW_POINTS ? GL_POINTS : d->mode == LPV_DRAW_LINES ? GL_LINES : GL_TRIANGLES;
         if (d->index_count)
-            glDrawElements(GL_TRIANGLES, (GLsizei)d->index_count, GL_UNSIGNED_INT,
+            glDrawElements(mode, (GLsizei)d->index_count, GL_UNSIGNED_INT,
                            (void *)(uintptr_t)(d->first_index * sizeof(uint32_t)));
         lpv_timer_count(&e->timer, 1);
     }
@@ -519,3 +551,13 @@ void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lp
     glBindVertexArray(0);
 }
 
+void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set)
+{
+    draw_list(e, prog, e->draws, e->draw_count, cull_single_sided, set, 0);
+}
+
+void lpv_engine_draw_wires(lpv_engine *e, GLuint prog)
+{
+    if (e->wire_draw_count)
+        draw_list(e, prog, e->wire_draws, e->wire_draw_count, 0, LPV_DRAWS_ALL, 1);
+}

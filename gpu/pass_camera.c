@@ -201,6 +201,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     glUniform1f(glGetUniformLocation(p, "u_pixel_solid_angle"), v->orthographic ? 0.0f : pixel * pixel);
     glUniform1f(glGetUniformLocation(p, "u_pixel_area"), v->orthographic ? pixel * pixel : 0.0f);
     lpv_engine_draw_scene(e, p, 1, LPV_DRAWS_NOT_BLEND);
+    lpv_engine_draw_wires(e, p); /* points and lines: seen, one pixel wide, but no surfels (no area) */
     /* the translucent layer: the BLEND draws over the opaque depth, the
      * nearest in front of it kept (the same program and uniforms) */
     if (e->blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run) {

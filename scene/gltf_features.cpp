@@ -204,7 +204,8 @@ std::vector<std::string> unused_features(const tinygltf::Model &m, int scene, co
         out.push_back(kv.first + " (" + kv.second.describe() + "): not used");
     if (points_lines.total)
         out.push_back("point and line primitives (" + points_lines.describe() +
-                      "): not drawn (they carry no surface)");
+                      "): drawn one pixel wide in their colour, unlit; they carry no surface, so they neither block "
+                      "nor reflect light");
     if (played.empty() && !m.animations.empty())
         out.push_back(std::to_string(m.animations.size()) + (m.animations.size() == 1 ? " animation" : " animations") +
                       ": not played; the file's static pose is drawn");

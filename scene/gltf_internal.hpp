@@ -201,6 +201,8 @@ class Builder {
     std::vector<lpv_vertex> vertices;
     std::vector<uint32_t> indices;
     std::vector<lpv_draw> draws;
+    std::vector<uint32_t> wire_indices; /* points and lines (lpv_scene.wire_draws) */
+    std::vector<lpv_draw> wire_draws;
     std::vector<lpv_material> materials;
     std::vector<lpv_light> lights;
     std::vector<lpv_camera> cameras;

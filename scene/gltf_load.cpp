@@ -75,6 +75,7 @@ uint64_t model_bytes(const Builder &b, size_t density_count)
 {
     return uint64_t(b.vertices.size()) * sizeof(lpv_vertex) + uint64_t(b.indices.size()) * sizeof(uint32_t) +
            uint64_t(b.draws.size()) * sizeof(lpv_draw) + uint64_t(b.materials.size()) * sizeof(lpv_material) +
+           uint64_t(b.wire_indices.size()) * sizeof(uint32_t) + uint64_t(b.wire_draws.size()) * sizeof(lpv_draw) +
            uint64_t(b.lights.size()) * sizeof(lpv_light) + uint64_t(b.cameras.size()) * sizeof(lpv_camera) +
            uint64_t(b.textures.size()) * sizeof(lpv_texture) + uint64_t(density_count) * sizeof(float);
 }
@@ -149,7 +150,7 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     std::vector<float> density;
     read_medium(json_text, json_len, model, ctx, medium, density);
 
-    if (b.vertices.size() > UINT32_MAX || b.indices.size() > UINT32_MAX)
+    if (b.vertices.size() > UINT32_MAX || b.indices.size() > UINT32_MAX || b.wire_indices.size() > UINT32_MAX)
         fail("scene too large (absurd size)");
     if (!take_bytes(ctx, model_bytes(b, density.size())))
         fail_budget(ctx);
@@ -160,6 +161,10 @@ void load(const unsigned char *data, size_t size, Ctx &ctx, lpv_scene *out)
     out->index_count = uint32_t(b.indices.size());
     out->draws = c_array(b.draws);
     out->draw_count = uint32_t(b.draws.size());
+    out->wire_indices = c_array(b.wire_indices);
+    out->wire_index_count = uint32_t(b.wire_indices.size());
+    out->wire_draws = c_array(b.wire_draws);
+    out->wire_draw_count = uint32_t(b.wire_draws.size());
     out->materials = c_array(b.materials);
     out->material_count = uint32_t(b.materials.size());
     out->lights = c_array(b.lights);

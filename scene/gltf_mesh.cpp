@@ -2,7 +2,7 @@
  * gltf_mesh.cpp - the Builder's primitives (gltf_internal.hpp): a triangle,
  * strip or fan primitive, its attributes from the accessors or from
  * KHR_draco_mesh_compression (gltf_compressed.hpp), into world-space vertices
- * and one draw. Normals move with the normal matrix, a mirroring transform
+ * and one draw; a point or line primitive into one wire draw. Normals move with the normal matrix, a mirroring transform
  * flips the winding, and a primitive without normals gets flat ones from its
  * world winding (its vertices un-shared).
  */
@@ -21,11 +21,12 @@ namespace lpv_gltf {
 void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, const Mat4 &world, const Deform &deform)
 {
     const int mode = p.mode;
-    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-        if (mode < TINYGLTF_MODE_POINTS || mode > TINYGLTF_MODE_TRIANGLE_FAN)
-            ctx_.warn(strf("mesh %d primitive %d: unknown mode %d skipped", mesh, prim, mode));
-        return; /* points and lines carry no surface */
+    if (mode < TINYGLTF_MODE_POINTS || mode > TINYGLTF_MODE_TRIANGLE_FAN) {
+        ctx_.warn(strf("mesh %d primitive %d: unknown mode %d skipped", mesh, prim, mode));
+        return;
     }
+    const bool wire = mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE ||
+                      mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP;
     auto pos_it = p.attributes.find("POSITION");
     if (pos_it == p.attributes.end()) {
         ctx_.warn(strf("mesh %d primitive %d has no POSITION; skipped", mesh, prim));
@@ -220,10 +221,25 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
             fail("mesh %d primitive %d: index %u at position %zu is out of range (vertex count %zu)", mesh, prim,
                  idx[i], i, nv);
 
+    /* Points and lines: a point per index, or a segment per pair (strips
+     * and loops unrolled), drawn by the camera only (lpv_scene.wire_draws) */
+    const size_t ni = idx.size();
+    std::vector<uint32_t> seg;
+    if (mode == TINYGLTF_MODE_POINTS) {
+        seg = idx;
+    } else if (mode == TINYGLTF_MODE_LINE) {
+        seg.assign(idx.begin(), idx.begin() + ptrdiff_t(ni - ni % 2));
+    } else if (wire && ni >= 2) {
+        for (size_t i = 0; i + 1 < ni; i++)
+            seg.insert(seg.end(), {idx[i], idx[i + 1]});
+        if (mode == TINYGLTF_MODE_LINE_LOOP && ni > 2)
+            seg.insert(seg.end(), {idx[ni - 1], idx[0]});
+    }
     /* Triangle list in glTF's vertex order per mode. */
     std::vector<uint32_t> tri;
-    const size_t ni = idx.size();
-    if (mode == TINYGLTF_MODE_TRIANGLES) {
+    if (wire) {
+        /* none */
+    } else if (mode == TINYGLTF_MODE_TRIANGLES) {
         tri.assign(idx.begin(), idx.begin() + ptrdiff_t(ni - ni % 3));
     } else if (ni >= 3) {
         tri.reserve((ni - 2) * 3);
@@ -237,7 +253,7 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         }
     }
     const size_t ntri = tri.size() / 3;
-    if (ntri == 0)
+    if (ntri == 0 && seg.empty())
         return;
     if (uint64_t(indices.size()) / 3 + ntri > kMaxTriangles)
         fail("more than %llu triangles (absurd size)", (unsigned long long)kMaxTriangles);
@@ -300,6 +316,29 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
         }
     };
 
+    if (wire) {
+        if (uint64_t(wire_indices.size()) + seg.size() > kMaxTriangles * 3 ||
+            uint64_t(vertices.size()) + nv > kMaxVertices)
+            fail("more than %llu vertices or point and line indices (absurd size)", (unsigned long long)kMaxVertices);
+        lpv_draw w;
+        w.first_index = uint32_t(wire_indices.size());
+        w.index_count = uint32_t(seg.size());
+        w.material = material;
+        w.vertex_color = col.empty() ? 0 : 1;
+        w.mode = mode == TINYGLTF_MODE_POINTS ? LPV_DRAW_POINTS : LPV_DRAW_LINES;
+        const uint32_t base = uint32_t(vertices.size());
+        vertices.resize(vertices.size() + nv);
+        for (size_t v = 0; v < nv; v++) {
+            lpv_vertex &out = vertices[base + v];
+            world_vertex(v, out);
+            out.normal[0] = out.normal[1] = out.normal[2] = 0.0f; /* shown unlit: no normal needed */
+        }
+        for (uint32_t i : seg)
+            wire_indices.push_back(base + i);
+        wire_draws.push_back(w);
+        return;
+    }
+
     const uint64_t add_vertices = nrm.empty() ? uint64_t(ntri) * 3 : uint64_t(nv);
     if (uint64_t(vertices.size()) + add_vertices > kMaxVertices)
         fail("more than %llu vertices (absurd size)", (unsigned long long)kMaxVertices);
@@ -309,6 +348,7 @@ void Builder::add_primitive(const tinygltf::Primitive &p, int mesh, int prim, co
     draw.index_count = uint32_t(ntri * 3);
     draw.material = material;
     draw.vertex_color = col.empty() ? 0 : 1;
+    draw.mode = LPV_DRAW_TRIANGLES;
 
     if (!nrm.empty()) {
         const uint32_t base = uint32_t(vertices.size());

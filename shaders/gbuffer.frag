@@ -15,6 +15,7 @@ uniform vec3 u_eye;
 uniform float u_pixel_solid_angle; // sr per pixel at the image centre (perspective), 0 = orthographic
 uniform float u_pixel_area;        // m^2 per pixel (orthographic)
 uniform vec3 u_forward;
+uniform int u_wire; // 1: a point or line (lpv_engine_draw_wires): shown unlit, no surface (LPV_GBUF_WIRE_W)
 
 layout(location = 0) out vec4 o_position; // xyz world; w surfel area (m^2), > 0 = covered
 layout(location = 1) out vec4 o_normal;   // xyz unit shading normal, on the camera's side; w 1 + metallic where covered
@@ -51,6 +52,17 @@ void main()
     // nor do a translucent layer's texels of alpha 0
     if (LPV_MATERIAL_PLAIN == 0 && (u_alpha_blend != 0 ? !(base.a > 0.0) : base.a < u_alpha_cutoff))
         discard;
+    if (u_wire != 0) {
+        // its colour as the camera sees it, lit by nothing (three.js's line
+        // and point materials; docs/scenes.md "Points and lines"); no area
+        o_position = vec4(p, 0.0);
+        o_normal = vec4(to_eye, LPV_GBUF_WIRE_W);
+        o_albedo = vec4(base.rgb, 1.0);
+        o_emission = vec4(clamp(base.rgb, 0.0, 1.0) / LPV_LUMENS_PER_WATT + material_emission(v_uv, v_uv1), 0.0);
+        o_occlusion = 1.0;
+        o_coverage = 1.0;
+        return;
+    }
     vec2 mr = material_metallic_roughness(v_uv, v_uv1);
     o_position = vec4(p, area);
     // w >= 1: covered; w - 1: metallic (lpv_gbuffer_kd); LPV_GBUF_UNLIT_W: unlit

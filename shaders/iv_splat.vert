@@ -49,8 +49,8 @@ void main()
         int cols = (u_gbuf_size.x + u_stride - 1) / u_stride;
         ivec2 t = ivec2(gl_VertexID % cols, gl_VertexID / cols) * u_stride;
         vec4 gn = texelFetch(u_gbuf_normal, t, 0);
-        if (gn.w < 0.5)
-            return; // background
+        if (gn.w < 0.5 || lpv_gbuffer_wire(gn.w))
+            return; // background, or a point's or line's pixel (no surface)
         p = texelFetch(u_gbuf_position, t, 0).xyz;
         n = gn.xyz;
         albedo = texelFetch(u_gbuf_albedo, t, 0).rgb * lpv_gbuffer_kd(gn.w); // diffuse

@@ -595,9 +595,15 @@ LPV_INLINE int lpv_slab_z0(int v, int slabs, int dim_z) { return (v - lpv_slab_i
  * emission target holds what the camera sees of it (its base colour as
  * luminance, core/material_sample.h), which lights nothing. */
 #define LPV_GBUF_UNLIT_W 3.0
+/* A point's or line's pixel (glTF's points and lines, lpv_scene.wire_draws)
+ * has normal w LPV_GBUF_WIRE_W: shown as an unlit pixel is (lpv_gbuffer_unlit
+ * holds), but no surface: no surfel (its area is 0), no point of the
+ * imperfect volume's reprojection, no plane of the frame's blocks. */
+#define LPV_GBUF_WIRE_W 4.0
 #ifdef LPV_GLSL
 float lpv_gbuffer_kd(float normal_w) { return 1.0 - clamp(normal_w - 1.0, 0.0, 1.0); }
 bool lpv_gbuffer_unlit(float normal_w) { return normal_w > LPV_GBUF_UNLIT_W - 0.5; }
+bool lpv_gbuffer_wire(float normal_w) { return normal_w > LPV_GBUF_WIRE_W - 0.5; }
 #endif
 #define LPV_LOOKUP_NORMAL_TEXELS 131072
 #define LPV_LOOKUP_PLANE_TOLERANCE 1e-6

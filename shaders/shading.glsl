@@ -129,7 +129,7 @@ bool block_surface(ivec2 b, int step, out vec4 plane, out vec3 p_mean, out vec3 
         vec4 nrm = texelFetch(u_gbuf_normal, at, 0);
         vec3 p = texelFetch(u_gbuf_position, at, 0).xyz;
         vec3 nk = unit_or_zero(nrm.xyz);
-        bool covered = nrm.w >= 0.5 && all(lessThan(px, size));
+        bool covered = nrm.w >= 0.5 && !lpv_gbuffer_wire(nrm.w) && all(lessThan(px, size));
         if (covered && !seen) {
             plane = vec4(nk, dot(nk, p));
             seen = true;

@@ -434,7 +434,7 @@ static void test_strip_fan_points_lines(void **state)
     write_glb(path, "strip-fan.glb", json, &b);
     lpv_scene s;
     load_ok(path, &s);
-    assert_int_equal(s.draw_count, 2); /* points and lines give nothing */
+    assert_int_equal(s.draw_count, 2); /* points and lines are wire draws, apart */
     assert_int_equal(s.draws[0].index_count, 6);
     assert_int_equal(s.draws[1].index_count, 9);
     assert_int_equal(s.index_count, 15);
@@ -449,6 +449,33 @@ static void test_strip_fan_points_lines(void **state)
     /* every triangle of both faces +z (consistent winding) */
     for (uint32_t i = 0; i < s.index_count; i++)
         assert_vec3(s.vertices[s.indices[i]].normal, 0, 0, 1, 1e-6f);
+    /* the points (5), lines (5 vertices: 2 segments, the odd one dropped),
+     * the loop (5 segments, the last back to v0) and the strip (4) */
+    assert_int_equal(s.wire_draw_count, 4);
+    const int modes[4] = {LPV_DRAW_POINTS, LPV_DRAW_LINES, LPV_DRAW_LINES, LPV_DRAW_LINES};
+    const uint32_t counts[4] = {5, 4, 10, 8};
+    uint32_t at = 0;
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(s.wire_draws[k].mode, modes[k]);
+        assert_int_equal(s.wire_draws[k].first_index, at);
+        assert_int_equal(s.wire_draws[k].index_count, counts[k]);
+        at += counts[k];
+    }
+    assert_int_equal(s.wire_index_count, at);
+    const uint32_t *loop = s.wire_indices + s.wire_draws[2].first_index;
+    assert_vec3(s.vertices[loop[8]].position, -1, 1, 0, 0); /* v4 ... */
+    assert_vec3(s.vertices[loop[9]].position, 0, 0, 0, 0);  /* ... back to v0 */
+    const uint32_t *strip = s.wire_indices + s.wire_draws[3].first_index;
+    assert_vec3(s.vertices[strip[2]].position, 1, 0, 0, 0); /* segment 1 is (v1, v2) */
+    assert_vec3(s.vertices[strip[3]].position, 1, 1, 0, 0);
+    for (uint32_t i = 0; i < s.wire_index_count; i++)
+        assert_true(s.wire_indices[i] < s.vertex_count);
+    lpv_scene c; /* the engine's copy keeps them */
+    assert_int_equal(lpv_scene_copy_geometry(&c, &s), 0);
+    assert_int_equal(c.wire_draw_count, 4);
+    assert_int_equal(c.wire_index_count, at);
+    assert_memory_equal(c.wire_indices, s.wire_indices, at * sizeof *s.wire_indices);
+    lpv_scene_free(&c);
     lpv_scene_free(&s);
 }
 

@@ -139,6 +139,18 @@ static void add_quad(glb *g, const quad *q)
     g->node_count++;
 }
 
+/* n points as one mesh of glTF mode `mode` (0 points, 1 lines, 2 loop, 3
+ * strip), positions only, on one node. */
+static void add_wire(glb *g, const float (*p)[3], int n, int mode, int material)
+{
+    int ap = add_accessor(g, p, (size_t)n, 3, 5126);
+    cat(g->meshes, sizeof g->meshes, "%s{\"primitives\":[{\"attributes\":{\"POSITION\":%d},\"mode\":%d,\"material\":%d}]}",
+        g->mesh_count ? "," : "", ap, mode, material);
+    cat(g->nodes, sizeof g->nodes, "%s{\"mesh\":%d}", g->node_count ? "," : "", g->mesh_count);
+    g->mesh_count++;
+    g->node_count++;
+}
+
 /* An RGBA8 image as a PNG in the BIN chunk; returns its image index. */
 static int add_png(glb *g, int w, int h, const uint8_t *rgba)
 {
@@ -1205,6 +1217,69 @@ static void test_cut_outs_in_reference_and_points(void **state)
     lpv_scene_free(&s);
 }
 
+/* glTF's points and lines (docs/scenes.md, "Points and lines"): drawn one
+ * pixel wide in their colour, lit by nothing (1 = 1 nit, as an unlit
+ * material), and no surface: a red line 2 m over the floor casts no shadow
+ * under a sun straight down, leaves no camera surfel, and the floor's light
+ * is what it is without it. */
+static void test_points_and_lines(void **state)
+{
+    (void)state;
+    const float line[2][3] = {{-3.0f, 2.0f, 0.0f}, {3.0f, 2.0f, 0.0f}};
+    const float dots[3][3] = {{0.0f, 2.0f, 1.0f}, {1.0f, 2.0f, 1.0f}, {-1.0f, 2.0f, 1.0f}};
+    lpv_view v;
+    assert_int_equal(lpv_view_look_at((float[3]){4.5f, 5.0f, 0.3f}, (float[3]){0.0f, 0.5f, 0.0f}, 0.9f, W, H, &v), 0);
+    float *rgba[2];
+    double floor_under[2][3], floor_open[2][3];
+    for (int with = 0; with < 2; with++) {
+        glb g = {0};
+        quad f;
+        floor_quad(&f, 0);
+        add_quad(&g, &f);
+        if (with) {
+            add_wire(&g, line, 2, 1, 1);
+            add_wire(&g, dots, 3, 0, 1);
+        }
+        add_sun(&g, SUN_DOWN);
+        size_t len;
+        unsigned char *data = glb_finish(
+            &g, J("%s,{'pbrMetallicRoughness':{'baseColorFactor':[1,0,0,1],'metallicFactor':0}}", FLOOR_MAT), NULL,
+            NULL, &len);
+        lpv_scene s;
+        load_glb(data, len, &s, NULL);
+        free(data);
+        assert_int_equal(s.wire_draw_count, with ? 2u : 0u);
+        rgba[with] = calloc((size_t)W * H * 4, sizeof(float));
+        render(&s, &v, rgba[with]);
+        lpvt_patch(&v, rgba[with], W, H, (float[3]){1.0f, 0.0f, 0.0f}, 1, floor_under[with]);
+        lpvt_patch(&v, rgba[with], W, H, (float[3]){1.0f, 0.0f, -2.0f}, 1, floor_open[with]);
+        if (with) {
+            const size_t buffers = lpv_engine_gv_buffer_count(lpvt_engine);
+            assert_true(surfel_area_at_height(buffers - 2, 2.0f) == 0.0); /* no camera surfel on the line */
+        }
+        lpv_scene_free(&s);
+    }
+    /* the line's pixels: pure red at 1/683 W/(m^2 sr) (its colour as 1 nit);
+     * the frame without it has none */
+    int red[2] = {0, 0};
+    for (int with = 0; with < 2; with++)
+        for (int i = 0; i < W * H; i++) {
+            const float *px = &rgba[with][4 * i];
+            red[with] += px[0] > 0.0f && fabsf(px[0] - 1.0f / 683.0f) < 1e-5f && px[1] == 0.0f && px[2] == 0.0f;
+        }
+    printf("points and lines: %d pure red pixels (none without them); floor under the line %.4f, open %.4f "
+           "(without: %.4f, %.4f) W/(m^2 sr), green\n",
+           red[1], floor_under[1][1], floor_open[1][1], floor_under[0][1], floor_open[0][1]);
+    assert_int_equal(red[0], 0);
+    assert_true(red[1] >= W / 2); /* a line across the view, one pixel wide, and the points */
+    /* no shadow under the line, and the floor as without it */
+    assert_true(floor_under[1][1] > 0.1);
+    assert_float_equal(floor_under[1][1], floor_open[1][1], 1e-3 * floor_open[1][1]);
+    assert_float_equal(floor_under[1][1], floor_under[0][1], 1e-3 * floor_under[0][1]);
+    free(rgba[0]);
+    free(rgba[1]);
+}
+
 static void test_warnings_once_per_feature(void **state)
 {
     (void)state;
@@ -1313,6 +1388,7 @@ int main(void)
         cmocka_unit_test(test_occlusion_texture),
         cmocka_unit_test(test_unlit),
         cmocka_unit_test(test_cut_outs_in_reference_and_points),
+        cmocka_unit_test(test_points_and_lines),
         cmocka_unit_test(test_warnings_once_per_feature),
         cmocka_unit_test(test_bad_material_values_refused),
     };
