@@ -6,5 +6,6 @@ foreach(_case shards resume failures errors features schema links)
   add_test(NAME batch_${_case}
     COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${CMAKE_CURRENT_LIST_DIR}/batch/batch_cli.py"
             --lpvd "$<TARGET_FILE:lpvd>" --source "${PROJECT_SOURCE_DIR}" ${_case})
-  set_tests_properties(batch_${_case} PROPERTIES TIMEOUT 900 LABELS batch)
+  set_tests_properties(batch_${_case} PROPERTIES TIMEOUT 900)
+  lpv_label_tests(batch batch_${_case})
 endforeach()

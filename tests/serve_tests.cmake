@@ -44,6 +44,7 @@ foreach(_name midmessage slow_reader churn sigterm sighup fifo preauth sigterm_l
   list(APPEND _lpvd_serve_tests reliability_${_name})
 endforeach()
 
+lpv_label_tests(daemon ${_lpvd_serve_tests})
 set_tests_properties(${_lpvd_serve_tests} PROPERTIES
   TIMEOUT 300
   ENVIRONMENT "LPVD_SHARED_DIR=${_lpvd_serve_root}/../shared;LPVD_SOURCE_DIR=${_lpvd_serve_root};PYTHONDONTWRITEBYTECODE=1")
