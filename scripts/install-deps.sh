@@ -1,32 +1,68 @@
 #!/bin/sh
-# Installs every Debian 12 package lpvd needs to build, run, test and benchmark.
-# Run as root, or as a user with sudo. Safe to run repeatedly.
+# Installs the Debian 12 packages lpvd needs. Run as root, or as a user with
+# sudo. Safe to run repeatedly.
+#
+#   sh scripts/install-deps.sh             everything: build, run, test and benchmark
+#   sh scripts/install-deps.sh --runtime   what the built lpvd and lpvctl need to run (docker/Dockerfile's image)
+#   sh scripts/install-deps.sh --build     what building them needs
+#   sh scripts/install-deps.sh --print GROUP   prints a group's packages (runtime, build, test) and installs nothing
 set -eu
 
-PACKAGES="
-  build-essential cmake pkg-config clang libclang-rt-14-dev
+# Running lpvd and lpvctl: the shared libraries they link (the test
+# runtime_deps_cover_binaries checks the list against `ldd`), and what lpvd
+# opens at run time: Mesa's EGL and drivers (llvmpipe), OSMesa the last
+# fallback (docs/gl-backends.md).
+RUNTIME="
+  libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
+  libopenimageio2.4 libembree3-3 libjansson4 libuv1 libzstd1 libmeshoptimizer2d libtinygltf2d libstb0
+"
+# Building them (draco and cglm are linked statically or header-only).
+# khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
+# into gpu/gl_api.h at build time (docs/gl-backends.md); python3 runs it.
+# libcmocka-dev: the tests' framework, which the build configures with them.
+BUILD="
+  build-essential cmake pkg-config python3
   libegl-dev libgl-dev mesa-common-dev libegl-mesa0 libgl1-mesa-dri libosmesa6-dev
   khronos-api
   libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev libdraco-dev libmeshoptimizer-dev
   libopenimageio-dev
   libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
   libcmocka-dev
-  python3 python3-jsonschema python3-yaml gnuplot-nox
-  assimp-testmodels
-  chromium
 "
-# khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
-# into gpu/gl_api.h at build time (docs/gl-backends.md).
+# Testing and benchmarking (tests/README.md).
+# clang, libclang-rt-14-dev: the fuzzers (libFuzzer) scripts/test.sh runs.
 # python3-jsonschema: tests/batch/batch_cli.py checks job files against
 # docs/batch.schema.json.
 # python3-yaml: PyYAML, with which tests/test_k8s_manifests.py parses the
 # Kubernetes manifests of docker/k8s/.
+# gnuplot-nox: the accuracy sweep's plots.
 # assimp-testmodels: glTF 2.0 sample models (/usr/share/assimp/models) that
-# tests/test_realscene.c and the accuracy sweep render as scenes the project
-# did not write.
+# tests/test_realscene.c, tests/test_gltf_corpus.c and the accuracy sweep
+# render as scenes the project did not write.
 # chromium: the batch report test (tests/report_browser.py) opens report.html
 # in it, headless, to check the page's thumbnails load and its script logs no
 # error; the test fails without it.
+TEST="
+  clang libclang-rt-14-dev
+  python3-jsonschema python3-yaml gnuplot-nox
+  assimp-testmodels
+  chromium
+"
+
+case "${1:-}" in
+"") PACKAGES="$RUNTIME $BUILD $TEST" ;;
+--runtime) PACKAGES="$RUNTIME" ;;
+--build) PACKAGES="$BUILD" ;;
+--print)
+  case "${2:-}" in
+  runtime) echo $RUNTIME ;;
+  build) echo $BUILD ;;
+  test) echo $TEST ;;
+  *) echo "install-deps: --print runtime, build or test" >&2; exit 2 ;;
+  esac
+  exit 0 ;;
+*) echo "install-deps: unknown option '$1' (--runtime, --build, --print GROUP, or nothing for everything)" >&2; exit 2 ;;
+esac
 
 if [ "$(id -u)" -eq 0 ]; then
   SUDO=""
