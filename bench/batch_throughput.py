@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """batch_throughput.py - images per hour: one `lpvd batch` process against one
 `lpvd render` process per image, on the same items (issue 15, item 7;
-README "Batch rendering").
+docs/batch.md).
 
 The job: the built-in Cornell box and the repository's scenes (courtyard,
 blinds, glossy, emissive-room) x presets fast and balanced x the file's camera

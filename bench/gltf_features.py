@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """gltf_features.py - lpvd's full frame against the path tracer's on files that use the glTF features
-issue 32 added (README "Scenes", docs/scenes.md): a skinned and a morphed file posed at a time, a file
+issue 32 added (docs/render.md "Scenes", docs/scenes.md): a skinned and a morphed file posed at a time, a file
 whose labels glow through an emissive texture (and whose partial coating is alphaMode BLEND), a textured
 box, a vertex-coloured room this script writes (no file of Debian's corpus carries COLOR_0), the
-accuracy set's translucent panes (scenes/glass.glb, alphaMode BLEND), and the files the README's feature
+accuracy set's translucent panes (scenes/glass.glb, alphaMode BLEND), and the files docs/render.md's feature
 table names for triangles and node transforms, Draco, texture transforms, cameras, a double-sided emitter
 and lines.
 

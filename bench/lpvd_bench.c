@@ -11,7 +11,7 @@
  * throughput has been measured on since issue 3) and with 3 cascades of 32^3.
  * Prints a Markdown table per configuration: each stage's GPU ms, their sum,
  * and "wall": the whole tick and frame as the process sees it (CPU clock,
- * lpv_engine_tick + lpv_engine_render with its read-back). README.md records
+ * lpv_engine_tick + lpv_engine_render with its read-back). bench/README.md records
  * it with the machine; bench/compare_builds.py runs two builds' benches
  * alternately and prints the ratios. Each configuration's last frame is
  * summarised (mean radiance of the covered pixels, non-finite values) so a

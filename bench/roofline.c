@@ -1,6 +1,6 @@
 /*
  * roofline.c - `lpvd-roofline`: the machine's roofs for the propagation
- * kernel (README "Propagation throughput"): fp32 FMA rate, the rate of
+ * kernel (bench/README.md, "Engine"): fp32 FMA rate, the rate of
  * 8-wide AVX2 gathers (llvmpipe turns every texelFetch of a buffer texture
  * into one gather per channel), and memory bandwidth (a STREAM-like triad
  * over arrays far larger than the caches), each on every core at once (one

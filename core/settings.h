@@ -234,7 +234,7 @@ typedef struct lpv_settings {
  * texels into 8 slots: on the built-in Cornell box and the blinds room the
  * injected volumes equal those of one VPL per texel within float rounding
  * (tests/test_downsample.c), and the accuracy sweep's errors are the same to
- * four digits at grids 4 to 64 (README, "The down-sampling knobs"), for half
+ * four digits at grids 4 to 64 (docs/accuracy.md, "The down-sampling knobs and the lookup step on the front"), for half
  * the area lights' VPLs. The surfels stay at LPV_RSM_AUTO_STEP: at 4 the
  * Cornell box's geometry volume moved by 5 % of its peak. */
 #define LPV_RSM_AUTO_STEP 2

@@ -309,7 +309,7 @@ static void run_list(lpv_engine *e, GLuint prog, GLuint list, lpv_frame_terms te
 /* The frame (shading.glsl) as a compute pass writing the frame texture: on
  * llvmpipe it costs what the full-screen triangle did, and on a GPU whose
  * graphics units are few (an H100 shaded 1920x1080 in 6.5 ms through the
- * fragment path, 0.3 ms as compute; README "The GPU path") it runs on every
+ * fragment path, 0.3 ms as compute; bench/README.md "The GPU path") it runs on every
  * core. The glossy and media passes then blend into the same texture.
  * gbuf: the G-buffer's targets to shade (the camera's or the translucent
  * layer's), frame: the texture written, rect: the pixels (x, y, w, h) to

@@ -1,4 +1,4 @@
-/* stats_json.c - see stats_json.h. Field names are documented in README.md. */
+/* stats_json.c - see stats_json.h. Field names are documented in docs/render.md ("--stats") and protocol/SPEC.md. */
 #include "stats_json.h"
 
 #include <string.h>
