@@ -14,9 +14,10 @@ set -eu
 # fallback (docs/gl-backends.md).
 RUNTIME="
   libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
-  libopenimageio2.4 libembree3-3 libjansson4 libuv1 libzstd1 libmeshoptimizer2d libtinygltf2d libstb0
+  libopenimageio2.4 libembree3-3 libjansson4 libuv1 libzstd1 libmeshoptimizer2d libtinygltf2d libstb0 libcglm0
 "
-# Building them (draco and cglm are linked statically or header-only).
+# Building them (draco is linked statically; cglm's functions are mostly
+# inlined, but a build that does not inline them links libcglm0).
 # khronos-api: the OpenGL registry (gl.xml) that cmake/gen_gl_api.py turns
 # into gpu/gl_api.h at build time (docs/gl-backends.md); python3 runs it.
 # libcmocka-dev: the tests' framework, which the build configures with them.

@@ -18,6 +18,10 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
+# The sanitizers' own runtimes: the test suite's second build links them (scripts/test.sh), the
+# image's build never does.
+SANITIZER_RUNTIMES = re.compile(r"/lib(asan|ubsan|lsan|tsan)\.so")
+
 # What lpvd dlopens (gpu/context.c): a file of each, and so its package, must be installed.
 OPENED = ["libEGL_mesa.so.0", "swrast_dri.so", "libOSMesa.so.8"]
 
@@ -55,7 +59,7 @@ def main():
     for binary in (a.lpvd, a.lpvctl):
         for line in run("ldd", binary).splitlines():
             m = re.search(r"=>\s+(/\S+)", line) or re.match(r"\s*(/\S+)", line)
-            if m:
+            if m and not SANITIZER_RUNTIMES.search(m.group(1)):
                 loaded.setdefault(m.group(1), binary)
     opened = {}
     for name in OPENED:
