@@ -181,3 +181,14 @@ int lpv_flag_parse_floats(const char *v, float *out, int n)
     }
     return *p ? -1 : 0;
 }
+
+const char *lpv_flags_section_help(char *buf, size_t size, const char *heading, const lpv_flag *flags,
+                                   size_t count)
+{
+    if (!buf[0]) {
+        size_t len = 0;
+        lpv_flags_append(buf, size, &len, "%s:\n", heading);
+        lpv_flags_help(buf, size, &len, flags, count);
+    }
+    return buf;
+}

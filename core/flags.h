@@ -90,4 +90,10 @@ void lpv_flags_append(char *buf, size_t size, size_t *len, const char *fmt, ...)
  * help column. */
 void lpv_flags_help(char *buf, size_t size, size_t *len, const lpv_flag *flags, size_t count);
 
+/* A flag group's help section, "HEADING:\n" then the table's lines, written
+ * into buf the first time (buf starts zeroed: a static buffer) and returned
+ * as it is after. */
+const char *lpv_flags_section_help(char *buf, size_t size, const char *heading, const lpv_flag *flags,
+                                   size_t count);
+
 #endif /* LPV_FLAGS_H */

@@ -70,12 +70,7 @@ lpv_flag_group lpv_view_flag_group(lpv_view_choice *c)
 const char *lpv_view_flags_help(void)
 {
     static char help[2048];
-    if (!help[0]) {
-        size_t len = 0;
-        lpv_flags_append(help, sizeof help, &len, "Camera:\n");
-        lpv_flags_help(help, sizeof help, &len, FLAGS, N_FLAGS);
-    }
-    return help;
+    return lpv_flags_section_help(help, sizeof help, "Camera", FLAGS, N_FLAGS);
 }
 
 int lpv_view_resolve(const lpv_view_choice *c, const lpv_scene *scene, lpv_view *view, char *err, size_t n)

@@ -89,12 +89,7 @@ lpv_flag_group lpv_scene_pose_flag_group(lpv_scene_pose *p)
 const char *lpv_scene_pose_flags_help(void)
 {
     static char help[1024];
-    if (!help[0]) {
-        size_t len = 0;
-        lpv_flags_append(help, sizeof help, &len, "Pose:\n");
-        lpv_flags_help(help, sizeof help, &len, POSE_FLAGS, N_POSE_FLAGS);
-    }
-    return help;
+    return lpv_flags_section_help(help, sizeof help, "Pose", POSE_FLAGS, N_POSE_FLAGS);
 }
 
 int lpv_scene_pose_at(const lpv_scene_pose *p, lpv_gltf_animation_time *buf, const lpv_gltf_animation_time **at,
