@@ -64,6 +64,9 @@ typedef struct lpv_volume_desc {
     lpv_levels_kind kind;         /* what the levels are and how they are looked up */
     const char *units;            /* of the values (static): "W/sr" (cascades), "W/(m^2 sr)" (iv voxels) */
     int iv_neighbours;            /* LPV_LEVELS_IV_VOXELS: the lookup's voxels (settings iv.neighbours); else 0 */
+    int index_levels;             /* the merged grid comes from levels the technique can also give whole, with
+                                     an index volume over level 0 (the octree: lpv_engine_read_volumes,
+                                     lpv_engine_read_index; SPEC R5.13's content "levels"); else 0 */
 } lpv_volume_desc;
 
 typedef struct lpv_engine_stats {

@@ -234,10 +234,10 @@ typedef struct sv_result {
     lpv_grid cascades[LPVP_MAX_CASCADES]; /* finest first; every cascade has grid.dims */
     float *cells;           /* cells * 12 floats: every cascade's, cascade 0 first */
     size_t cell_count;      /* all cascades' cells */
-    /* GET_VOLUME content "levels" (SPEC R5.13): a technique with an index
-     * volume (the octree) keeps every level's cells (level_cells x 12 floats,
-     * level 0 first, as lpv_engine_read_volumes gives them) and the index (one
-     * per cell of cascade 0); NULL / 0 for a technique without levels. */
+    /* GET_VOLUME content "levels" (SPEC R5.13), in a result of
+     * sv_result_take_levels only: every level's cells (level_cells x 12
+     * floats, level 0 first, as lpv_engine_read_volumes gives them) and the
+     * index (one per cell of cascade 0); NULL / 0 in a tick's result. */
     float *levels;
     size_t level_cells;
     uint32_t *index;
@@ -301,6 +301,7 @@ struct sv_world {
 typedef enum sv_job_kind {
     SV_JOB_TICK = 1,
     SV_JOB_RENDER,
+    SV_JOB_LEVELS,          /* GET_VOLUME content "levels": read back on request, not every tick */
     SV_JOB_QUERY,
     SV_JOB_DESTROY,
     SV_JOB_QUIT,
@@ -335,7 +336,7 @@ struct sv_job {
     /* results */
     int status;             /* 0 ok, else an LPVP_E_ code */
     char err[512];
-    sv_result *result;      /* tick */
+    sv_result *result;      /* tick, levels */
     float *rgba;            /* render */
     int width, height;
     float *out;             /* query: 3n floats */
@@ -585,12 +586,15 @@ void sv_world_detach(sv_conn *c);
 void sv_world_unref(sv_world *w);
 void sv_result_unref(sv_result *r);
 /* The engine's last tick read back (serve_tick_result.c): every cascade's
- * accumulated volume, the octree's levels and index or the imperfect
- * volume's occupancy when the technique has them, the frames of terms_mask
- * (bit t: lpv_frame_terms t) at width x height, stats and plan; refs 1, tick
- * and gen 0 (the caller's). NULL with a message in err. On the GL context's
- * thread. */
+ * accumulated volume, the imperfect volume's occupancy when the technique
+ * has it, the frames of terms_mask (bit t: lpv_frame_terms t) at width x
+ * height, stats and plan; refs 1, tick and gen 0 (the caller's). NULL with a
+ * message in err. On the GL context's thread. */
 sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n);
+/* The octree's levels and index of the engine's last tick, for GET_VOLUME
+ * content "levels" (SPEC R5.13) only (no merged cells, no frames), with the
+ * grid, stats and plan; NULL with err for a technique without them. */
+sv_result *sv_result_take_levels(lpv_engine *e, char *err, size_t n);
 sv_result *sv_result_ref(sv_result *r);
 void sv_scene_unref(sv_server *s, sv_scene *sc);
 sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */

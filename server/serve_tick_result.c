@@ -1,9 +1,11 @@
 /*
  * serve_tick_result.c - a tick's result read back from the engine on the GL
- * thread (sv_result: the accumulated volume of every cascade, the octree's
- * levels and index, the imperfect volume's occupancy, the frames asked for,
- * the stats and plan), what GET_VOLUME, GET_FRAME and the streams encode.
- * The daemon's GL thread and lpvd batch's volume output take it here.
+ * thread (sv_result: the accumulated volume of every cascade, the imperfect
+ * volume's occupancy, the frames asked for, the stats and plan), what
+ * GET_VOLUME, GET_FRAME and the streams encode. The daemon's GL thread and
+ * lpvd batch's volume output take it here. The octree's levels and index
+ * (GET_VOLUME content "levels") are read only for a request that asks for
+ * them (sv_result_take_levels): a tick does not pay for them (issue 33).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,23 +15,23 @@
 
 /* GET_VOLUME content "levels" (SPEC R5.13): with a technique that has an
  * index volume (the octree), its levels and index, read now on the GL thread.
- * 0 (nothing kept for a technique without one) or -1 with err. */
+ * 0, or -1 with err (also for a technique or grid without them). */
 static int keep_levels(lpv_engine *e, sv_result *r, char *err, size_t n)
 {
     size_t cells0 = lpv_grid_cell_count(&r->grid);
     int count = lpvp_octree_level_count(r->grid.dims[0]);
-    if (count < 1) /* no octree over this grid */
-        return 0;
+    const lpv_volume_desc *d = &r->stats.volume;
+    if (!d->index_levels || count < 1) {
+        snprintf(err, n, "technique \"%s\" has no levels and index volume over its %dx%dx%d grid to send",
+                 d->technique ? d->technique : "?", r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]);
+        return -1;
+    }
     int32_t *index = malloc((cells0 ? cells0 : 1) * sizeof *index);
     if (!index) {
         snprintf(err, n, "out of memory for a %zu-cell index volume", cells0);
         return -1;
     }
     size_t got = lpv_engine_read_index(e, index, cells0);
-    if (got == 0) { /* no index volume: no levels to send */
-        free(index);
-        return 0;
-    }
     lpvp_cascade_info c0 = {.dims = {r->grid.dims[0], r->grid.dims[1], r->grid.dims[2]}, .cells = cells0};
     size_t total = 0;
     for (int i = 0; i < count; ++i) {
@@ -81,7 +83,9 @@ static int keep_iv_held(lpv_engine *e, sv_result *r, long long *occupied, char *
     return 0;
 }
 
-sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n)
+/* What every result holds: the grid and cascades, the stats and the plan of
+ * the engine's last tick. NULL with err when out of memory. */
+static sv_result *result_new(lpv_engine *e, char *err, size_t n)
 {
     sv_result *r = calloc(1, sizeof *r);
     if (!r) {
@@ -95,12 +99,23 @@ sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_m
         r->cascade_count = 1;
     if (r->cascade_count > LPVP_MAX_CASCADES)
         r->cascade_count = LPVP_MAX_CASCADES;
-    r->cell_count = 0;
     for (int k = 0; k < r->cascade_count; ++k) {
         const lpv_grid *g = lpv_engine_cascade(e, k);
         r->cascades[k] = g ? *g : r->grid;
-        r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
     }
+    r->stats = *lpv_engine_last_stats(e);
+    r->plan = *lpv_engine_last_plan(e);
+    return r;
+}
+
+sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n)
+{
+    sv_result *r = result_new(e, err, n);
+    if (!r)
+        return NULL;
+    r->cell_count = 0;
+    for (int k = 0; k < r->cascade_count; ++k)
+        r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
     r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
     if (!r->cells) {
         snprintf(err, n, "out of memory for %zu cells", r->cell_count);
@@ -111,7 +126,7 @@ sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_m
     if (got < r->cell_count)
         memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
     long long occupied = -1;
-    if (keep_levels(e, r, err, n) != 0 || keep_iv_held(e, r, &occupied, err, n) != 0) {
+    if (keep_iv_held(e, r, &occupied, err, n) != 0) {
         sv_result_unref(r);
         return NULL;
     }
@@ -127,9 +142,19 @@ sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_m
             r->frames[t] = NULL;
         }
     }
-    r->stats = *lpv_engine_last_stats(e);
+    r->stats = *lpv_engine_last_stats(e); /* again: the frames' render stages join them */
+    r->plan = *lpv_engine_last_plan(e);
     if (r->iv_held)
         r->stats.iv.occupied = occupied; /* counted from the index the volume carries */
-    r->plan = *lpv_engine_last_plan(e);
     return r;
+}
+
+sv_result *sv_result_take_levels(lpv_engine *e, char *err, size_t n)
+{
+    sv_result *r = result_new(e, err, n);
+    if (r && keep_levels(e, r, err, n) != 0) {
+        sv_result_unref(r);
+        return NULL;
+    }
+    return r; /* no merged cells: it answers content "levels" only */
 }

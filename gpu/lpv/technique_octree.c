@@ -326,6 +326,7 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     d->values_per_cell = 12;
     d->kind = LPV_LEVELS_CASCADES; /* the merged grid reads as one cascade */
     d->units = "W/sr";
+    d->index_levels = 1; /* read back only when a request asks for them (read below) */
 }
 
 static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part, lpv_grid_which which, void *out,
