@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "options.h"
 #include "scene_load.h"
+#include "serve_limits.h"
 
 uint64_t sv_now_ms(void)
 {
@@ -27,82 +28,42 @@ uint64_t sv_now_ms(void)
     return (uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u;
 }
 
+enum { S_SOCKET, S_LISTEN, S_TOKEN_FILE, S_SCENE_ROOT, S_SCENE, S_HELP, S_COUNT };
+
+/* The flags that are no limit: where the daemon listens and what it serves. */
+static const lpv_flag SERVE_FLAGS[S_COUNT] = {
+    [S_SOCKET] = {"socket", 0, "PATH", "Unix socket (mode 0600; default $XDG_RUNTIME_DIR/lpvd.sock,\n"
+                                       "else /tmp/lpvd-$UID.sock); a stale socket file is replaced"},
+    [S_LISTEN] = {"listen", 0, "HOST:PORT", "also (or only, without --socket) listen on TCP; default host\n"
+                                            "127.0.0.1; a non-loopback host requires --token-file"},
+    [S_TOKEN_FILE] = {"token-file", 0, "FILE", "every client must present this token in HELLO"},
+    [S_SCENE_ROOT] = {"scene-root", 0, "DIR", "SCENE_LOAD paths resolve under DIR (none: paths are refused)"},
+    [S_SCENE] = {"scene", 0, "FILE.glb", "the scene every session starts with (default: built-in Cornell box)"},
+    [S_HELP] = {"help", 'h', NULL, "this text"},
+};
+
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: lpvd serve [flags]\n"
-            "Runs the lpvd daemon: clients speak the wire protocol (protocol/SPEC.md) over a Unix socket\n"
-            "(default) or TCP, load scenes, set lights, cameras and settings, tick, and stream volumes\n"
-            "and frames. See docs/server.md.\n"
-            "Listening:\n"
-            "  --socket PATH           Unix socket (mode 0600; default $XDG_RUNTIME_DIR/lpvd.sock,\n"
-            "                          else /tmp/lpvd-$UID.sock); a stale socket file is replaced\n"
-            "  --listen HOST:PORT      also (or only, without --socket) listen on TCP; default host\n"
-            "                          127.0.0.1; a non-loopback host requires --token-file\n"
-            "  --token-file FILE       every client must present this token in HELLO\n"
-            "Scenes:\n"
-            "  --scene-root DIR        SCENE_LOAD paths resolve under DIR (none: paths are refused)\n"
-            "  --scene FILE.glb        the scene every session starts with (default: built-in Cornell box)\n"
-            "Limits:\n"
-            "  --max-clients N         connections at once (default 64)\n"
-            "  --max-message BYTES     json + attachment of one message (default 268435456)\n"
-            "  --max-body BYTES        json of one message (default 1048576)\n"
-            "  --max-queue BYTES       reply bytes queued for one client before it is dropped (default 67108864)\n"
-            "  --max-world-memory BYTES  GPU storage one world (one computation) may take (default %llu)\n"
-            "  --max-memory BYTES      all worlds' storage, live scenes, requests and replies together (default:\n"
-            "                          half of the machine's memory, or of its cgroup's limit; the worlds also\n"
-            "                          stay within half of the video memory)\n"
-            "  --max-request-memory BYTES  request bytes held for all clients together; a frame that does not\n"
-            "                          fit waits, unread (default %llu, at least --max-message)\n"
-            "  --max-triangles N       per scene (default 10000000)\n"
-            "  --max-texture N         texels per texture side, and the largest rsm_size and shadow_size (default 8192)\n"
-            "  --max-scene-texels N    decoded texels of one scene's images, from their headers (default %llu)\n"
-            "  --max-scene-bytes BYTES memory one parsed scene may take: file, buffers, texels, model (default %llu)\n"
-            "  --max-scenes-memory BYTES  all live scenes together, each counted once (default %llu, at least\n"
-            "                          --max-scene-bytes)\n"
-            "  --max-grid N            LPV cells per axis (default 128, at most 256; lowered at start to the grid\n"
-            "                          one world holds under --max-world-memory: 120 at its default)\n"
-            "  --max-tick-rate HZ      CONFIG tick_rate_hz (default 60)\n"
-            "  --max-tick-cost N       cell-steps one tick may cost: CONFIG over it gets LIMIT (default "
-            SV_STR(SV_DEFAULT_MAX_TICK_COST) ")\n"
-            "  --max-tick-ms MS        a world whose tick after a change took longer on the GL thread is refused\n"
-            "                          such ticks (LIMIT) until its settings or camera size change (default "
-            SV_STR(SV_DEFAULT_MAX_TICK_MS) ";\n                          0 = no limit)\n"
-            "  --idle-timeout S        a session with no complete frame for S s is sent BYE and closed\n"
-            "                          (default 300)\n"
-            "Before HELLO (a connection that has not yet said HELLO with the token):\n"
-            "  --max-preauth-body BYTES  JSON of a frame; any attachment is refused (default %u)\n"
-            "  --handshake-timeout S   no HELLO within S s of connecting: ERROR LIMIT, closed (default %g;\n"
-            "                          0 = none)\n"
-            "  --max-preauth N         such connections at once, apart from --max-clients (default %d)\n"
-            "Default CONFIG of every session:\n"
-            "  --tick-rate HZ          periodic ticks per second (default 0: only TICK requests)\n"
-            "%s",
-            (unsigned long long)SV_DEFAULT_MAX_WORLD_MEMORY, (unsigned long long)SV_DEFAULT_MAX_REQUEST_MEMORY, (unsigned long long)SV_DEFAULT_MAX_SCENE_TEXELS,
-            (unsigned long long)SV_DEFAULT_MAX_SCENE_BYTES, (unsigned long long)SV_DEFAULT_MAX_SCENES_MEMORY,
-            SV_DEFAULT_MAX_PREAUTH_BODY, SV_DEFAULT_HANDSHAKE_TIMEOUT,
-            SV_DEFAULT_MAX_PREAUTH, LPVD_OPTIONS_HELP);
-}
-
-static int parse_u64(const char *v, uint64_t lo, uint64_t hi, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long long x = strtoull(v, &end, 10);
-    if (!v[0] || v[0] == '-' || end == v || *end || errno || x < lo || x > hi)
-        return -1;
-    *out = x;
-    return 0;
-}
-
-static int parse_num(const char *v, double lo, double hi, double *out)
-{
-    char *end;
-    double x = strtod(v, &end);
-    if (end == v || *end || !(x >= lo && x <= hi))
-        return -1;
-    *out = x;
-    return 0;
+    static char help[16384];
+    if (!help[0]) {
+        size_t len = 0, n = sizeof help;
+        lpv_flags_append(help, n, &len, "usage: lpvd serve [flags]\n"
+                         "Runs the lpvd daemon: clients speak the wire protocol (protocol/SPEC.md) over a Unix socket\n"
+                         "(default) or TCP, load scenes, set lights, cameras and settings, tick, and stream volumes\n"
+                         "and frames. See docs/server.md.\nListening:\n");
+        lpv_flags_help(help, n, &len, &SERVE_FLAGS[S_SOCKET], 3);
+        lpv_flags_append(help, n, &len, "Scenes:\n");
+        lpv_flags_help(help, n, &len, &SERVE_FLAGS[S_SCENE_ROOT], 2);
+        const char *section = NULL;
+        for (size_t i = 0; i < sv_limit_count; ++i) /* the limits' sections, in the table's order */
+            if (!section || strcmp(section, sv_limits[i].section) != 0) {
+                section = sv_limits[i].section;
+                lpv_flags_append(help, n, &len, "%s:\n", section);
+                sv_limits_help(help, n, &len, section);
+            }
+        lpv_flags_append(help, n, &len, "%s", LPVD_OPTIONS_HELP);
+    }
+    fputs(help, f);
 }
 
 static int read_token(const char *path, sv_config *cfg, char *err, size_t n)
@@ -372,12 +333,6 @@ static void close_walk(uv_handle_t *h, void *arg)
         uv_close(h, NULL);
 }
 
-static const char *const SERVE_VALUE_FLAGS[] = {
-    "socket", "listen", "token-file", "scene-root", "scene", "max-clients", "max-message", "max-body", "max-queue",
-    "max-triangles", "max-texture", "max-scene-texels", "max-scene-bytes", "max-scenes-memory", "max-world-memory", "max-memory", "max-tick-ms", "max-grid",
-    "max-tick-rate", "max-tick-cost", "idle-timeout", "tick-rate", "max-preauth-body", "max-request-memory",
-    "handshake-timeout", "max-preauth", NULL};
-
 int lpvd_cmd_serve(int argc, char **argv)
 {
     static sv_server srv; /* one per process; its address is stable for the handles */
@@ -391,77 +346,55 @@ int lpvd_cmd_serve(int argc, char **argv)
     mallopt(M_MMAP_THRESHOLD, SV_MMAP_THRESHOLD);
     memset(s, 0, sizeof *s);
     sv_config *cfg = &s->cfg;
-    cfg->max_body = LPVP_DEFAULT_MAX_BODY;
-    cfg->max_message = LPVP_DEFAULT_MAX_MESSAGE;
-    cfg->max_queue = 64u << 20;
-    cfg->max_request_memory = SV_DEFAULT_MAX_REQUEST_MEMORY;
-    cfg->max_scenes_memory = SV_DEFAULT_MAX_SCENES_MEMORY;
-    cfg->max_world_memory = SV_DEFAULT_MAX_WORLD_MEMORY;
-    cfg->max_tick_ms = (double)SV_DEFAULT_MAX_TICK_MS;
-    cfg->max_clients = 64;
-    cfg->max_triangles = 10000000;
-    cfg->max_texture = 8192;
-    cfg->max_scene_texels = SV_DEFAULT_MAX_SCENE_TEXELS;
-    cfg->max_scene_bytes = SV_DEFAULT_MAX_SCENE_BYTES;
+    sv_limits_defaults(cfg);
     s->root_fd = -1;
-    cfg->max_grid = 128;
-    cfg->max_tick_rate = 60.0;
-    cfg->max_tick_cost = SV_DEFAULT_MAX_TICK_COST;
-    cfg->idle_timeout = 300.0;
-    cfg->max_preauth_body = SV_DEFAULT_MAX_PREAUTH_BODY;
-    cfg->handshake_timeout = SV_DEFAULT_HANDSHAKE_TIMEOUT;
-    cfg->max_preauth = SV_DEFAULT_MAX_PREAUTH;
     lpvd_options opt;
     memset(&opt, 0, sizeof opt);
     char err[2048] = "";
     int have_socket = 0;
     const char *token_file = NULL;
 
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage(stdout);
-            return 0;
+    /* the daemon's own flags, its limits (serve_limits.c), the engine's
+     * settings and backend (parsed there), and the camera's, refused: a
+     * client sends CAMERA_SET */
+    lpv_flag_group groups[6] = {{SERVE_FLAGS, S_COUNT, NULL, NULL}, sv_limits_flag_group(cfg)};
+    int ngroups = 2 + lpvd_options_groups(&opt, LPVD_GROUP_SETTINGS | LPVD_GROUP_BACKEND, 1, groups + 2);
+    const int camera_group = ngroups;
+    ngroups += lpvd_options_groups(&opt, LPVD_GROUP_CAMERA, 0, groups + ngroups);
+    lpv_flags p;
+    if (lpv_flags_begin(&p, argc, argv, groups, ngroups, 0) != 0) {
+        fprintf(stderr, "lpvd serve: %s\n", p.err);
+        return 2;
+    }
+    int g;
+    const lpv_flag *fl;
+    const char *v;
+    for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
+        switch (it) {
+        case LPV_FLAGS_UNKNOWN: fprintf(stderr, "lpvd serve: unknown flag %s (see lpvd serve --help)\n", p.arg); return 2;
+        case LPV_FLAGS_NO_VALUE: fprintf(stderr, "lpvd serve: %s needs a value\n", p.arg); return 2;
+        case LPV_FLAGS_BAD_VALUE: fprintf(stderr, "lpvd serve: %s\n", p.err); return 2;
+        case LPV_FLAGS_POSITIONAL:
+            fprintf(stderr, "lpvd serve: unexpected argument %s (see lpvd serve --help)\n", v);
+            return 2;
+        case LPV_FLAGS_FLAG:
+        case LPV_FLAGS_END: break;
         }
-        if (a[0] != '-' || a[1] != '-') {
-            fprintf(stderr, "lpvd serve: unexpected argument %s (see lpvd serve --help)\n", a);
+        if (g == camera_group) {
+            fprintf(stderr, "lpvd serve: --%s is not used by the daemon (clients send CAMERA_SET)\n", fl->name);
             return 2;
         }
-        const char *name = a + 2;
-        int known = 0;
-        for (int k = 0; SERVE_VALUE_FLAGS[k]; ++k)
-            if (strcmp(name, SERVE_VALUE_FLAGS[k]) == 0)
-                known = 1;
-        if (!known && lpvd_option_takes_value(name) < 0) {
-            fprintf(stderr, "lpvd serve: unknown flag %s (see lpvd serve --help)\n", a);
-            return 2;
-        }
-        if (i + 1 >= argc) {
-            fprintf(stderr, "lpvd serve: %s needs a value\n", a);
-            return 2;
-        }
-        const char *v = argv[++i];
-        uint64_t u = 0;
-        double d = 0.0;
-        int bad = 0;
-        if (!known) {
-            if (!strcmp(name, "camera") || !strcmp(name, "eye") || !strcmp(name, "target") || !strcmp(name, "fov") ||
-                !strcmp(name, "size")) {
-                fprintf(stderr, "lpvd serve: %s is not used by the daemon (clients send CAMERA_SET)\n", a);
-                return 2;
-            }
-            if (lpvd_option_parse(&opt, name, v, err, sizeof err) < 0) {
-                fprintf(stderr, "lpvd serve: %s\n", err);
-                return 2;
-            }
-        } else if (!strcmp(name, "socket")) {
+        switch (fl - SERVE_FLAGS) {
+        case S_HELP: usage(stdout); return 0;
+        case S_SOCKET:
             if (!v[0] || strlen(v) >= sizeof cfg->socket_path) {
                 fprintf(stderr, "lpvd serve: --socket: bad path\n");
                 return 2;
             }
             snprintf(cfg->socket_path, sizeof cfg->socket_path, "%s", v);
             have_socket = 1;
-        } else if (!strcmp(name, "listen")) {
+            break;
+        case S_LISTEN: {
             unsigned port;
             char perr[256];
             if (lpvp_split_host_port(v, cfg->listen_host, sizeof cfg->listen_host, &port, perr, sizeof perr) != 0) {
@@ -469,9 +402,10 @@ int lpvd_cmd_serve(int argc, char **argv)
                 return 2;
             }
             cfg->listen_port = (int)port;
-        } else if (!strcmp(name, "token-file")) {
-            token_file = v;
-        } else if (!strcmp(name, "scene-root")) {
+            break;
+        }
+        case S_TOKEN_FILE: token_file = v; break;
+        case S_SCENE_ROOT: {
             char *real = realpath(v, NULL);
             struct stat st;
             if (!real || stat(real, &st) != 0 || !S_ISDIR(st.st_mode) || strlen(real) >= sizeof cfg->scene_root) {
@@ -481,77 +415,9 @@ int lpvd_cmd_serve(int argc, char **argv)
             }
             snprintf(cfg->scene_root, sizeof cfg->scene_root, "%s", real);
             free(real);
-        } else if (!strcmp(name, "scene")) {
-            cfg->scene_file = v;
-        } else if (!strcmp(name, "max-clients")) {
-            bad = parse_u64(v, 1, 100000, &u);
-            cfg->max_clients = (int)u;
-        } else if (!strcmp(name, "max-message")) {
-            bad = parse_u64(v, 64, (uint64_t)1 << 40, &u);
-            cfg->max_message = u;
-        } else if (!strcmp(name, "max-body")) {
-            bad = parse_u64(v, 64, UINT32_MAX, &u);
-            cfg->max_body = u;
-        } else if (!strcmp(name, "max-queue")) {
-            /* at least 64 KiB: no reply over it is sent (R3.5), and HELLO's,
-             * which describes every knob, takes ~15 KiB */
-            bad = parse_u64(v, 65536, (uint64_t)1 << 40, &u);
-            cfg->max_queue = u;
-        } else if (!strcmp(name, "max-triangles")) {
-            bad = parse_u64(v, 1, (uint64_t)1 << 40, &u);
-            cfg->max_triangles = u;
-        } else if (!strcmp(name, "max-texture")) {
-            bad = parse_u64(v, 16, 1 << 20, &u);
-            cfg->max_texture = (int)u;
-        } else if (!strcmp(name, "max-scene-texels")) {
-            bad = parse_u64(v, 1, (uint64_t)1 << 40, &u);
-            cfg->max_scene_texels = u;
-        } else if (!strcmp(name, "max-scene-bytes")) {
-            bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
-            cfg->max_scene_bytes = u;
-        } else if (!strcmp(name, "max-grid")) {
-            bad = parse_u64(v, 1, LPV_MAX_GRID_DIM, &u);
-            cfg->max_grid = (int)u;
-        } else if (!strcmp(name, "max-tick-rate")) {
-            bad = parse_num(v, 0.0, 10000.0, &d);
-            cfg->max_tick_rate = d;
-        } else if (!strcmp(name, "max-tick-cost")) {
-            bad = parse_u64(v, 1, (uint64_t)1 << 50, &u);
-            cfg->max_tick_cost = u;
-        } else if (!strcmp(name, "idle-timeout")) {
-            bad = parse_num(v, 0.0, 1e9, &d);
-            cfg->idle_timeout = d;
-        } else if (!strcmp(name, "max-preauth-body")) {
-            bad = parse_u64(v, 64, UINT32_MAX, &u);
-            cfg->max_preauth_body = u;
-        } else if (!strcmp(name, "handshake-timeout")) {
-            bad = parse_num(v, 0.0, 1e9, &d);
-            cfg->handshake_timeout = d;
-        } else if (!strcmp(name, "max-world-memory")) {
-            bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 44, &u);
-            cfg->max_world_memory = u;
-        } else if (!strcmp(name, "max-tick-ms")) {
-            bad = parse_num(v, 0.0, 1e9, &d);
-            cfg->max_tick_ms = d;
-        } else if (!strcmp(name, "max-memory")) {
-            bad = parse_u64(v, (uint64_t)1 << 20, (uint64_t)1 << 48, &u);
-            cfg->max_memory = u;
-        } else if (!strcmp(name, "max-scenes-memory")) {
-            bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
-            cfg->max_scenes_memory = u;
-        } else if (!strcmp(name, "max-request-memory")) {
-            bad = parse_u64(v, 1024, (uint64_t)1 << 44, &u);
-            cfg->max_request_memory = u;
-        } else if (!strcmp(name, "max-preauth")) {
-            bad = parse_u64(v, 1, 100000, &u);
-            cfg->max_preauth = (int)u;
-        } else if (!strcmp(name, "tick-rate")) {
-            bad = parse_num(v, 0.0, 10000.0, &d);
-            cfg->tick_rate = d;
+            break;
         }
-        if (bad) {
-            fprintf(stderr, "lpvd serve: %s %s: bad value (see lpvd serve --help)\n", a, v);
-            return 2;
+        case S_SCENE: cfg->scene_file = v; break;
         }
     }
     if (cfg->max_body > cfg->max_message)
@@ -613,6 +479,7 @@ int lpvd_cmd_serve(int argc, char **argv)
         fprintf(stderr, "lpvd serve: %s\n", err);
         return 2;
     }
+    cfg->max_memory = s->mem.budget; /* 0 meant "from the machine": HELLO says what it came to */
     signal(SIGPIPE, SIG_IGN);
 
     int rc = 1;

@@ -55,18 +55,11 @@ typedef struct sv_world sv_world;
 typedef struct sv_job sv_job;
 
 /* ---- configuration ------------------------------------------------------ */
-/* Per-scene budgets (docs/server.md, "Limits"): 64 Mi texels is 256 MiB of
- * RGBA8, eight 4096² or one 8192² texture; 2 GiB of RAM holds a scene at the
- * other defaults (a 256 MiB file, 256 MiB of texels and the model of
- * 10 M indexed triangles, ~1 GB), with room to spare. */
-#define SV_DEFAULT_MAX_SCENE_TEXELS ((uint64_t)64 << 20)
-#define SV_DEFAULT_MAX_SCENE_BYTES ((uint64_t)2 << 30)
 /* --max-tick-cost's default, in cell-steps (core/tick_cost.h): about 4 s of
  * propagation on llvmpipe with 2 cores (25,165,824 cell-steps took 2 s). */
 #define SV_DEFAULT_MAX_TICK_COST 40000000
-#define SV_STR_(x) #x
-#define SV_STR(x) SV_STR_(x)
 
+/* The limits' defaults, ranges and help are rows of serve_limits.c. */
 typedef struct sv_config {
     char socket_path[256];   /* "" = no Unix socket */
     int want_unix;
@@ -107,8 +100,6 @@ typedef struct sv_config {
     double tick_rate;        /* default tick_rate_hz */
 } sv_config;
 
-#define SV_DEFAULT_MAX_PREAUTH_BODY 4096u
-#define SV_DEFAULT_MAX_REQUEST_MEMORY ((uint64_t)1 << 30)
 /* QUERY_IRRADIANCE's largest count (HELLO limits.max_query_points): the
  * request's count x 24 bytes plus its JSON within --max-message, and the
  * reply's count x 12 bytes plus its header and JSON within --max-queue.
@@ -176,10 +167,6 @@ void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms);
 void sv_net_preauth_leave(sv_conn *c);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
-#define SV_DEFAULT_MAX_SCENES_MEMORY ((uint64_t)4 << 30)
-#define SV_DEFAULT_MAX_WORLD_MEMORY ((uint64_t)1 << 30)
-#define SV_DEFAULT_HANDSHAKE_TIMEOUT 10.0
-#define SV_DEFAULT_MAX_PREAUTH 16
 /* Reply bytes a connection may have queued before HELLO: its replies are a
  * few ERRORs of ~100 bytes each, so a peer that sends small frames and never
  * reads is dropped here instead of at --max-queue (R2.5a). */

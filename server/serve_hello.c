@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "settings_json.h"
+#include "serve_limits.h"
 
 static int token_equal(const char *a, size_t alen, const char *b, size_t blen)
 {
@@ -63,27 +64,11 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
     sv_net_preauth_leave(c);
     char server[64];
     snprintf(server, sizeof server, "lpvd %s", LPVD_VERSION);
-    json_t *lim = json_pack("{s:I, s:I, s:i, s:I, s:i, s:i, s:f, s:f, s:I, s:I, s:f, s:i}", "max_body",
-                            (json_int_t)s->cfg.max_body, "max_message", (json_int_t)s->cfg.max_message,
-                            "max_clients", s->cfg.max_clients, "max_triangles", (json_int_t)s->cfg.max_triangles,
-                            "max_texture", s->cfg.max_texture, "max_grid", s->cfg.max_grid, "max_tick_rate",
-                            s->cfg.max_tick_rate, "idle_timeout", s->cfg.idle_timeout, "max_queue",
-                            (json_int_t)s->cfg.max_queue, "max_preauth_body", (json_int_t)s->cfg.max_preauth_body,
-                            "handshake_timeout", s->cfg.handshake_timeout, "max_preauth", s->cfg.max_preauth);
+    json_t *lim = json_object(); /* every limit of serve_limits.c's table, and what follows from them */
     if (lim) {
-        json_object_set_new(lim, "max_request_memory", json_integer((json_int_t)s->cfg.max_request_memory));
+        sv_limits_hello(&s->cfg, lim);
         json_object_set_new(lim, "max_query_points", json_integer((json_int_t)sv_max_query_points(&s->cfg)));
-        json_object_set_new(lim, "max_memory", json_integer((json_int_t)s->mem.budget));
-        json_object_set_new(lim, "max_tick_ms", json_real(s->cfg.max_tick_ms));
     }
-    if (lim) { /* the per-scene budgets (R4.5) */
-        json_object_set_new(lim, "max_scene_texels", json_integer((json_int_t)s->cfg.max_scene_texels));
-        json_object_set_new(lim, "max_scene_bytes", json_integer((json_int_t)s->cfg.max_scene_bytes));
-        json_object_set_new(lim, "max_scenes_memory", json_integer((json_int_t)s->cfg.max_scenes_memory));
-        json_object_set_new(lim, "max_world_memory", json_integer((json_int_t)s->cfg.max_world_memory));
-    }
-    if (lim)
-        json_object_set_new(lim, "max_tick_cost", json_integer((json_int_t)s->cfg.max_tick_cost));
     json_t *b = json_pack("{s:i, s:s, s:I, s:o, s:s, s:s, s:I}", "version", LPVP_VERSION, "server", server, "session",
                           (json_int_t)c->id, "limits", lim, "backend", s->gl_backend, "gl_renderer", s->gl_renderer,
                           "revision", (json_int_t)c->revision);
