@@ -5,6 +5,8 @@
 #ifndef LPV_SETTINGS_H
 #define LPV_SETTINGS_H
 
+#include <stddef.h>
+
 /* The GI techniques' names (gpu/technique.h's class names; the wire's and the
  * knob description's "technique"; --technique and CONFIG's "technique"). */
 #define LPV_TECHNIQUE_LPV "lpv"       /* cascaded light propagation volumes (gpu/lpv/) */
@@ -297,6 +299,18 @@ int lpv_technique_from_name(const char *name, lpv_technique_id *out);
 const char *lpv_technique_name(lpv_technique_id t);
 /* The technique names, comma separated, for help and errors. */
 const char *lpv_technique_names(void);
+
+/* What a technique can give beyond irradiance (core/settings.c's table). */
+typedef enum lpv_technique_cap {
+    LPV_CAP_AO = 1u << 0, /* an ambient occlusion term (frame terms "ao", its iv_ao knob) */
+} lpv_technique_cap;
+/* Whether technique t (DEFAULT: LPV_TECHNIQUE_ID_DEFAULT_IS; auto: none
+ * until resolved) has cap. */
+int lpv_technique_has(lpv_technique_id t, lpv_technique_cap cap);
+/* 0 when settings s running technique `running` give an ambient occlusion
+ * term (a technique with LPV_CAP_AO, its ao knob on); else -1 with why in
+ * err, naming the technique and the knob. The one place of that rule. */
+int lpv_ao_check(const lpv_settings *s, lpv_technique_id running, char *err, size_t n);
 
 /* The preset's name ("balanced" for DEFAULT), or NULL for an unknown value. */
 const char *lpv_preset_name(lpv_preset p);

@@ -17,10 +17,8 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return lpv_error(err, err_size, "render before a tick");
     if (!e->has_view)
         return lpv_error(err, err_size, "render needs a view (camera)");
-    if (terms == LPV_TERMS_AO && !(e->tech_id == LPV_TECHNIQUE_ID_IV && e->settings.iv.ao == LPV_SWITCH_ON))
-        return lpv_error(err, err_size, "the ao term needs technique %s with iv_ao on (technique %s, iv_ao %s)",
-                         LPV_TECHNIQUE_IV, lpv_technique_name(e->tech_id),
-                         e->settings.iv.ao == LPV_SWITCH_ON ? "on" : "off");
+    if (terms == LPV_TERMS_AO && lpv_ao_check(&e->settings, e->tech_id, err, err_size) != 0)
+        return -1;
     if (e->gbuf_stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
         if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
             return -1;

@@ -416,8 +416,8 @@ json_t *lpvd_batch_render_item(lpvd_batch_renderer *r, const lpvd_batch_item *it
     double t0 = now_ms(), t_load = 0.0, t_tick = 0.0, t_render = 0.0, t_write = 0.0;
     int ok = 0;
     lpv_settings s = se->settings;
-    if ((job->outputs & LPVD_OUT_AO) && s.technique != LPV_TECHNIQUE_ID_IV) {
-        snprintf(err, sizeof err, "the ao output needs technique iv (settings \"%s\")", se->name);
+    if ((job->outputs & LPVD_OUT_AO) && !lpv_technique_has(s.technique, LPV_CAP_AO)) { /* its knob is set below */
+        snprintf(err, sizeof err, "the ao output needs technique %s (settings \"%s\")", LPV_TECHNIQUE_IV, se->name);
         goto done;
     }
     if (job->outputs & LPVD_OUT_AO)

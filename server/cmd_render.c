@@ -142,7 +142,7 @@ int lpvd_cmd_render(int argc, char **argv)
     }
 
     if (ao_path) {
-        if (opt.settings.technique != LPV_TECHNIQUE_ID_IV) {
+        if (!lpv_technique_has(opt.settings.technique, LPV_CAP_AO)) { /* its knob is set below */
             fprintf(stderr, "lpvd render: --ao needs --technique %s (ambient occlusion comes from the imperfect "
                             "volume)\n", LPV_TECHNIQUE_IV);
             return 2;

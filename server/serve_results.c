@@ -79,12 +79,10 @@ int sv_terms_check(const sv_conn *c, int terms, char *err, size_t n)
         return 0;
     lpv_settings s = c->settings;
     lpv_settings_resolve(&s);
-    if (s.technique == LPV_TECHNIQUE_ID_IV && s.iv.ao == LPV_SWITCH_ON)
+    char why[256];
+    if (lpv_ao_check(&s, s.technique, why, sizeof why) == 0)
         return 0;
-    const char *t = lpv_technique_name(s.technique);
-    snprintf(err, n, "terms: \"%s\" (ambient occlusion) needs technique \"%s\" with iv_ao on; this session has "
-             "technique \"%s\" and iv_ao %s (CONFIG them first)", lpvp_frame_terms_names[LPVP_TERMS_AO],
-             LPV_TECHNIQUE_IV, t ? t : "?", s.iv.ao == LPV_SWITCH_ON ? "on" : "off");
+    snprintf(err, n, "terms: \"%s\": %s (CONFIG them first)", lpvp_frame_terms_names[LPVP_TERMS_AO], why);
     return -1;
 }
 

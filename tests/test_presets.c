@@ -234,6 +234,26 @@ static void test_flags_override_in_any_order(void **state)
     assert_non_null(strstr(LPVD_OPTIONS_HELP, "--preset"));
 }
 
+/* The techniques' capabilities (core/settings.c's table): ambient occlusion
+ * is iv's alone, and needs its knob; the one rule names both when refused. */
+static void test_ao_is_a_capability(void **state)
+{
+    (void)state;
+    assert_true(lpv_technique_has(LPV_TECHNIQUE_ID_IV, LPV_CAP_AO));
+    assert_false(lpv_technique_has(LPV_TECHNIQUE_ID_LPV, LPV_CAP_AO));
+    assert_false(lpv_technique_has(LPV_TECHNIQUE_ID_OCTREE, LPV_CAP_AO));
+    assert_false(lpv_technique_has(LPV_TECHNIQUE_ID_AUTO, LPV_CAP_AO)); /* not until the engine chose */
+    assert_false(lpv_technique_has((lpv_technique_id)99, LPV_CAP_AO));
+    lpv_settings s = {0};
+    char err[256] = "";
+    assert_int_equal(lpv_ao_check(&s, LPV_TECHNIQUE_ID_IV, err, sizeof err), -1);
+    assert_non_null(strstr(err, "technique iv and iv_ao off"));
+    s.iv.ao = LPV_SWITCH_ON;
+    assert_int_equal(lpv_ao_check(&s, LPV_TECHNIQUE_ID_IV, err, sizeof err), 0);
+    assert_int_equal(lpv_ao_check(&s, LPV_TECHNIQUE_ID_OCTREE, err, sizeof err), -1);
+    assert_non_null(strstr(err, "needs technique iv with iv_ao on; this has technique octree and iv_ao on"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -243,6 +263,7 @@ int main(void)
         cmocka_unit_test(test_flags_override_in_any_order),
         cmocka_unit_test(test_iterations_follow_grid),
         cmocka_unit_test(test_iterations_note),
+        cmocka_unit_test(test_ao_is_a_capability),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
