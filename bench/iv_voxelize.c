@@ -167,7 +167,7 @@ int main(int argc, char **argv)
     printf("%d random triangles per size (seed %llu: corners uniform in a cube, scaled to the longest edge, "
            "centroid uniform in a voxel; area >= 1 %% of longest edge^2), the same triangles for every N. "
            "Conservative voxelization: triangle/box overlap by the separating axis theorem "
-           "(core/iv_voxelize.c). Points: Turk's formula (core/iv_points.c), N per piece. "
+           "(techniques/iv/core/iv_voxelize.c). Points: Turk's formula (techniques/iv/core/iv_points.c), N per piece. "
            "Ratios of sums over the triangles.\n\n",
            triangles, (unsigned long long)seed);
     printf("Conservative voxels per triangle:");

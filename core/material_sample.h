@@ -3,7 +3,7 @@
  * point of a surface, read from its textures as the GPU reads them (uv set
  * and KHR_texture_transform, REPEAT, bilinear, sRGB colour decoded): the
  * emissive VPLs and area lights (core/emissive.c, core/area_lights.c), the
- * imperfect volume's point cloud (core/iv_points.c) and the reference path
+ * imperfect volume's point cloud (techniques/iv/core/iv_points.c) and the reference path
  * tracer use the same rules as the G-buffer and RSM shaders
  * (shaders/material.glsl), so the accuracy comparison stays like for like.
  *

@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "cascades.h"
-#include "iv_points.h"
+#include "iv_points.h" /* lpv_iv_place: where auto asks what iv would place */
 #include "lpv_shared.h"
 
 static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
@@ -108,8 +108,7 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
     return LPV_DEFAULT_CASCADES;
 }
 
-/* Sets pass id to run (1) or skip (0) with a reason. */
-static void decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)
+void lpv_plan_decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)
 {
     p->pass[id].run = run;
     va_list ap;
@@ -118,10 +117,7 @@ static void decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)
     va_end(ap);
 }
 
-/* Whether the tick must recompute the volume, with the reason. */
-/* camera_use: what the camera's view feeds (a recompute when it moves a
- * cell), NULL when nothing computed depends on it. */
-static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, const char *camera_use, char *why,
+int lpv_plan_needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, const char *camera_use, char *why,
                            size_t n)
 {
     if (s->planner == LPV_SWITCH_OFF)
@@ -148,194 +144,46 @@ static int needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, const
     return say(why, n, "nothing changed: cached volume served"), 0;
 }
 
-/* Render-time passes: decided first, they do not depend on a recompute. */
-static void render_passes(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p, int all)
+void lpv_plan_render_passes(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p, int all)
 {
     if (all)
-        decide(p, LPV_PASS_GLOSSY, 1, "planner off");
+        lpv_plan_decide(p, LPV_PASS_GLOSSY, 1, "planner off");
     else if (s->glossy == LPV_SWITCH_OFF)
-        decide(p, LPV_PASS_GLOSSY, 0, "glossy off");
+        lpv_plan_decide(p, LPV_PASS_GLOSSY, 0, "glossy off");
     else if (!f->glossy_draws)
-        decide(p, LPV_PASS_GLOSSY, 0, "no material has roughness below %.2f", (double)s->glossy_roughness);
+        lpv_plan_decide(p, LPV_PASS_GLOSSY, 0, "no material has roughness below %.2f", (double)s->glossy_roughness);
     else
-        decide(p, LPV_PASS_GLOSSY, 1, "%zu draws are glossy", f->glossy_draws);
+        lpv_plan_decide(p, LPV_PASS_GLOSSY, 1, "%zu draws are glossy", f->glossy_draws);
     if (all)
-        decide(p, LPV_PASS_MEDIA, 1, "planner off");
+        lpv_plan_decide(p, LPV_PASS_MEDIA, 1, "planner off");
     else if (s->media == LPV_SWITCH_OFF)
-        decide(p, LPV_PASS_MEDIA, 0, "media off");
+        lpv_plan_decide(p, LPV_PASS_MEDIA, 0, "media off");
     else if (!f->has_medium)
-        decide(p, LPV_PASS_MEDIA, 0, "no medium in the scene and no fog set");
+        lpv_plan_decide(p, LPV_PASS_MEDIA, 0, "no medium in the scene and no fog set");
     else
-        decide(p, LPV_PASS_MEDIA, 1, "the scene has a participating medium");
+        lpv_plan_decide(p, LPV_PASS_MEDIA, 1, "the scene has a participating medium");
     /* BLEND surfaces need their own layer in a frame; the light's passes
      * take their alpha as coverage per texel without one */
     if (all)
-        decide(p, LPV_PASS_TRANSLUCENT, 1, "planner off");
+        lpv_plan_decide(p, LPV_PASS_TRANSLUCENT, 1, "planner off");
     else if (!f->blend_draws)
-        decide(p, LPV_PASS_TRANSLUCENT, 0, "no material is alphaMode BLEND");
+        lpv_plan_decide(p, LPV_PASS_TRANSLUCENT, 0, "no material is alphaMode BLEND");
     else
-        decide(p, LPV_PASS_TRANSLUCENT, 1, "%zu draws are alphaMode BLEND", f->blend_draws);
+        lpv_plan_decide(p, LPV_PASS_TRANSLUCENT, 1, "%zu draws are alphaMode BLEND", f->blend_draws);
 }
 
-/* The lights' RSMs (the LPV's VPLs and surfels, the imperfect volume's
- * shadows); area: the area lights' summary, for other reasons. */
-static void rsm_pass(const lpv_plan_facts *f, lpv_plan *p, int all, char *area, size_t area_size)
+void lpv_plan_rsm_pass(const lpv_plan_facts *f, lpv_plan *p, int all, char *area, size_t area_size)
 {
     say(area, area_size, "area lights: %u emissive surfaces -> %zu samples", f->emissive_surfaces,
         f->area_light_samples);
     if (f->lights && f->area_light_samples)
-        decide(p, LPV_PASS_RSM, 1, "%u punctual lights; %s", f->lights, area);
+        lpv_plan_decide(p, LPV_PASS_RSM, 1, "%u punctual lights; %s", f->lights, area);
     else if (f->area_light_samples)
-        decide(p, LPV_PASS_RSM, 1, "%s", area);
+        lpv_plan_decide(p, LPV_PASS_RSM, 1, "%s", area);
     else if (all || f->lights)
-        decide(p, LPV_PASS_RSM, 1, "%u punctual lights", f->lights);
+        lpv_plan_decide(p, LPV_PASS_RSM, 1, "%u punctual lights", f->lights);
     else
-        decide(p, LPV_PASS_RSM, 0, "no punctual lights");
-}
-
-void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
-{
-    memset(p, 0, sizeof *p);
-    const int all = s->planner == LPV_SWITCH_OFF;
-    p->cascades = lpv_plan_cascades(s, f, p->cascades_reason, sizeof p->cascades_reason);
-    const int in_use = lpv_cascades_count(s, p->cascades);
-    if (in_use > p->cascades) {
-        size_t len = strlen(p->cascades_reason);
-        say(p->cascades_reason + len, sizeof p->cascades_reason - len, "; far field: %d coarser levels",
-            in_use - p->cascades);
-        p->cascades = in_use;
-    }
-
-    p->iterations_warning = lpv_settings_iterations_note(s, p->iterations_reason, sizeof p->iterations_reason);
-
-    render_passes(s, f, p, all);
-
-    const int occlusion = s->lpv.occlusion == LPV_SWITCH_ON;
-    const int gv = occlusion && (all || f->occluder_triangles > 0);
-    const int camera_in_gv = gv && f->has_view;
-    p->recompute = needs_recompute(s, f, camera_in_gv ? "its surfels feed the geometry volume" : NULL,
-                                   p->recompute_reason, sizeof p->recompute_reason);
-    for (int i = LPV_PASS_IV_POINTS; i <= LPV_PASS_IV_AO; ++i)
-        decide(p, (lpv_pass_id)i, 0, "the imperfect volume's (technique " LPV_TECHNIQUE_IV ")");
-    if (!p->recompute) {
-        for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
-            decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
-        return;
-    }
-
-    char area[LPV_PLAN_REASON_MAX];
-    rsm_pass(f, p, all, area, sizeof area);
-    /* Not a saving but correctness, so also with the planner off: emitters
-     * that light the scene directly must not enter the LPV a second time. */
-    if (f->area_light_samples)
-        decide(p, LPV_PASS_EMISSIVE, 0, "%s light the scene directly (their VPLs would count it twice)", area);
-    else if (all || f->emissive_vpls)
-        decide(p, LPV_PASS_EMISSIVE, 1, "%zu emissive VPLs%s", f->emissive_vpls,
-               s->area_lights == LPV_SWITCH_OFF && f->emissive_vpls ? " (area lights off)" : "");
-    else
-        decide(p, LPV_PASS_EMISSIVE, 0, "no emissive surfaces");
-    const int inject = all || p->pass[LPV_PASS_RSM].run || p->pass[LPV_PASS_EMISSIVE].run;
-    if (inject)
-        decide(p, LPV_PASS_INJECT, 1, "%d cascades receive the VPLs", p->cascades);
-    else
-        decide(p, LPV_PASS_INJECT, 0, "no light sources");
-
-    if (!occlusion)
-        decide(p, LPV_PASS_GV, 0, "occlusion off");
-    else if (!gv)
-        decide(p, LPV_PASS_GV, 0, "no occluders (no non-emissive triangles)");
-    else
-        decide(p, LPV_PASS_GV, 1, "%zu occluder triangles", f->occluder_triangles);
-    if (!f->has_view)
-        decide(p, LPV_PASS_GBUFFER, 0, "no camera");
-    else if (!gv)
-        decide(p, LPV_PASS_GBUFFER, 0, "the geometry volume does not run (render draws its own)");
-    else
-        decide(p, LPV_PASS_GBUFFER, 1, "camera surfels for the geometry volume");
-
-    if (s->lpv.iterations == 0)
-        decide(p, LPV_PASS_PROPAGATE, 0, "iterations = 0");
-    else if (!inject)
-        decide(p, LPV_PASS_PROPAGATE, 0, "nothing injected");
-    else
-        decide(p, LPV_PASS_PROPAGATE, 1, "%d steps in %d cascades", s->lpv.iterations, p->cascades);
-
-    if (s->lpv.bounces != LPV_SWITCH_ON)
-        decide(p, LPV_PASS_BOUNCE, 0, "bounces off");
-    else if (!p->pass[LPV_PASS_GV].run)
-        decide(p, LPV_PASS_BOUNCE, 0, "needs the geometry volume, which does not run");
-    else if (!p->pass[LPV_PASS_PROPAGATE].run)
-        decide(p, LPV_PASS_BOUNCE, 0, "propagation does not run");
-    else
-        decide(p, LPV_PASS_BOUNCE, 1, "bounces on, intensity %.2f", (double)s->lpv.bounce_intensity);
-
-    p->consumes.emissive_vpls = p->pass[LPV_PASS_EMISSIVE].run;
-    p->consumes.surfels = p->pass[LPV_PASS_GV].run;
-    p->consumes.camera_surfels = p->pass[LPV_PASS_GV].run && p->pass[LPV_PASS_GBUFFER].run;
-}
-
-void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
-{
-    memset(p, 0, sizeof *p);
-    const int all = s->planner == LPV_SWITCH_OFF;
-    p->cascades = 1;
-    say(p->cascades_reason, sizeof p->cascades_reason, "%s: one volume, %d voxels along the scene's longest side",
-        LPV_TECHNIQUE_IV, s->iv.resolution);
-    render_passes(s, f, p, all);
-    const int reproject = s->iv.reprojection == LPV_SWITCH_ON && f->has_view;
-    p->recompute = needs_recompute(s, f, reproject ? "its visible points refine the imperfect volume" : NULL,
-                                   p->recompute_reason, sizeof p->recompute_reason);
-    for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
-        if (i != LPV_PASS_RSM && i != LPV_PASS_GBUFFER)
-            decide(p, (lpv_pass_id)i, 0, "the LPV's (technique " LPV_TECHNIQUE_IV " gathers by ray marching)");
-    if (!p->recompute) {
-        for (int i = 0; i < LPV_PASS_COUNT; ++i)
-            if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT)
-                decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);
-        return;
-    }
-    char area[LPV_PLAN_REASON_MAX];
-    rsm_pass(f, p, all, area, sizeof area);
-    if (p->pass[LPV_PASS_RSM].run) {
-        size_t len = strlen(p->pass[LPV_PASS_RSM].reason);
-        say(p->pass[LPV_PASS_RSM].reason + len, sizeof p->pass[LPV_PASS_RSM].reason - len,
-            " (shadows of the points' direct light)");
-    }
-    if (!f->iv_points)
-        decide(p, LPV_PASS_IV_POINTS, 0, "no triangles to sample");
-    else if (f->iv_budget_cut)
-        decide(p, LPV_PASS_IV_POINTS, 1, "%zu points (%d per piece: the %d-point budget cut %d)", f->iv_points,
-               f->iv_points_per_piece, s->iv.max_points, s->iv.points);
-    else
-        decide(p, LPV_PASS_IV_POINTS, 1, "%zu points, %d per triangle piece", f->iv_points, f->iv_points_per_piece);
-    if (s->iv.reprojection == LPV_SWITCH_OFF)
-        decide(p, LPV_PASS_IV_REPROJECT, 0, "reprojection off");
-    else if (!f->has_view)
-        decide(p, LPV_PASS_IV_REPROJECT, 0, "reprojection skipped: no camera");
-    else
-        decide(p, LPV_PASS_IV_REPROJECT, 1, "the camera's visible points refine the volume");
-    if (p->pass[LPV_PASS_IV_REPROJECT].run)
-        decide(p, LPV_PASS_GBUFFER, 1, "the camera's visible points for reprojection");
-    else
-        decide(p, LPV_PASS_GBUFFER, 0, "reprojection does not run (render draws its own)");
-    const int filled = p->pass[LPV_PASS_IV_POINTS].run || p->pass[LPV_PASS_IV_REPROJECT].run;
-    const int lit = all || p->pass[LPV_PASS_RSM].run || (f->emissive_surfaces && !f->area_light_samples);
-    if (!filled)
-        decide(p, LPV_PASS_IV_GATHER, 0, "the volume is empty");
-    else if (!lit)
-        decide(p, LPV_PASS_IV_GATHER, 0, "no light sources");
-    else
-        decide(p, LPV_PASS_IV_GATHER, 1, "%s: %d bounces requested, %d rays per voxel%s", LPV_TECHNIQUE_IV,
-               s->iv.bounces, s->iv.rays,
-               s->iv.tail != LPV_SWITCH_ON ? ", no tail (iv_tail off)"
-               : s->iv.bounces < 3         ? ", no tail (fewer than 3 bounces set no ratio)"
-                                           : ", the bounces after them as the series they set");
-    if (s->iv.ao != LPV_SWITCH_ON)
-        decide(p, LPV_PASS_IV_AO, 0, "ambient occlusion off");
-    else if (!filled)
-        decide(p, LPV_PASS_IV_AO, 0, "the volume is empty");
-    else
-        decide(p, LPV_PASS_IV_AO, 1, "ambient occlusion on, %d rays per voxel", s->iv.rays);
+        lpv_plan_decide(p, LPV_PASS_RSM, 0, "no punctual lights");
 }
 
 lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_facts *f, char *why, size_t n)

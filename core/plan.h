@@ -74,7 +74,7 @@ typedef struct lpv_plan_facts {
     int forced;                /* the caller asked for a recompute (lpv_engine_invalidate) */
     int placement_changed;     /* a cascade's snapped placement differs */
     float camera_move_cells;   /* camera travel since the last computed tick, in finest cells */
-    /* the imperfect volume's point cloud (core/iv_points.h), 0 for other techniques */
+    /* the imperfect volume's point cloud (techniques/iv/core/iv_points.h), 0 for other techniques */
     size_t iv_points;
     int iv_points_per_piece;
     int iv_budget_cut;         /* the budget lowered the points per piece or coarsened the split */
@@ -127,15 +127,24 @@ const char *lpv_pass_name(lpv_pass_id id);
  * be resolved. */
 int lpv_plan_cascades(const lpv_settings *s, const lpv_plan_facts *f, char *reason, size_t reason_size);
 
-/* The whole plan for one tick. s must be resolved. */
-void lpv_plan_make(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
+/* The rules every technique's plan shares (techniques/NAME/core/NAME_plan.c
+ * call them; a technique's plan function is in its rules header). */
+/* Sets pass id to run (1) or skip (0) with a reason. */
+void lpv_plan_decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+/* Whether the tick must recompute the volume, with the reason. camera_use:
+ * what the camera's view feeds (a recompute when it moves a cell), NULL when
+ * nothing computed depends on it. */
+int lpv_plan_needs_recompute(const lpv_settings *s, const lpv_plan_facts *f, const char *camera_use, char *why,
+                             size_t n);
+/* Render-time passes: decided first, they do not depend on a recompute. */
+void lpv_plan_render_passes(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p, int all);
+/* The lights' RSMs (the LPV's VPLs and surfels, the imperfect volume's
+ * shadows); area: the area lights' summary, for other reasons. */
+void lpv_plan_rsm_pass(const lpv_plan_facts *f, lpv_plan *p, int all, char *area, size_t area_size);
 /* The technique for technique auto, from the preset and the scene's facts
  * (never LPV_TECHNIQUE_ID_AUTO), with the reason in why. Any other request
  * is returned as it is ("requested"). */
 lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_facts *f, char *why, size_t why_size);
-
-/* The imperfect volume's plan (technique iv): the shared producers it reads
- * (the RSMs for shadows, the G-buffer for reprojection) and its passes. */
-void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
 
 #endif /* LPV_PLAN_H */

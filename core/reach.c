@@ -1,6 +1,6 @@
 /*
  * reach.c - the scene's air spaces and which of them a light reaches
- * (reach.h). Voxelization by core/iv_voxelize.h's triangle/box test, the
+ * (reach.h). Voxelization by techniques/iv/core/iv_voxelize.h's triangle/box test, the
  * components by a breadth-first flood fill over 6-connected air voxels.
  */
 #include "reach.h"

@@ -10,7 +10,7 @@
  * (lpv; octree 37 %, iv 2.7 %). The path tracer says 0: no path leaves a
  * closed surface. This module finds the closed spaces exactly enough to
  * tell: the scene's opaque triangles are voxelized conservatively (every
- * voxel a triangle touches is solid, core/iv_voxelize.h's overlap test) on a
+ * voxel a triangle touches is solid, techniques/iv/core/iv_voxelize.h's overlap test) on a
  * fine grid of cubic voxels, the air between them is split into its
  * 6-connected components, and a component is lit when a light can put light
  * into it: a point or spot light's voxel, both sides of an emissive

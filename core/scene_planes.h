@@ -1,6 +1,6 @@
 /*
  * scene_planes.h - the normals of the scene's largest flat surfaces, for the
- * lookup's per-normal irradiance (shaders/lookup.glsl, "planes"): a pixel
+ * lookup's per-normal irradiance (techniques/lpv/shaders/lookup.glsl, "planes"): a pixel
  * of a flat triangle has its vertices' normal up to rounding, so the lookup
  * can read that normal's irradiance, summed over the normal bins once per
  * cell, with one fetch per cascade instead of three per volume.

@@ -119,44 +119,7 @@ const char *lpv_preset_names(void)
     return NAME_FAST ", " NAME_BALANCED ", " NAME_ACCURATE; /* the table's names, in its order */
 }
 
-/* The techniques' names and what each can give, indexed by
- * lpv_technique_id: ONE table. */
-static const struct {
-    const char *name;
-    unsigned caps; /* lpv_technique_cap */
-} TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
-    [LPV_TECHNIQUE_ID_DEFAULT] = {NULL, 0}, /* not a row: resolves to LPV_TECHNIQUE_ID_DEFAULT_IS */
-    [LPV_TECHNIQUE_ID_LPV] = {LPV_TECHNIQUE_LPV, 0},
-    [LPV_TECHNIQUE_ID_OCTREE] = {LPV_TECHNIQUE_OCTREE, 0},
-    [LPV_TECHNIQUE_ID_IV] = {LPV_TECHNIQUE_IV, LPV_CAP_AO},
-    [LPV_TECHNIQUE_ID_AUTO] = {LPV_TECHNIQUE_AUTO, 0}, /* none until the engine has chosen */
-};
-
-int lpv_technique_from_name(const char *name, lpv_technique_id *out)
-{
-    for (int t = LPV_TECHNIQUE_ID_DEFAULT + 1; name && t < LPV_TECHNIQUE_ID_COUNT_; ++t)
-        if (strcmp(name, TECHNIQUES[t].name) == 0) {
-            *out = (lpv_technique_id)t;
-            return 0;
-        }
-    return -1;
-}
-
-const char *lpv_technique_name(lpv_technique_id t)
-{
-    if (t == LPV_TECHNIQUE_ID_DEFAULT)
-        t = LPV_TECHNIQUE_ID_DEFAULT_IS;
-    return (int)t > (int)LPV_TECHNIQUE_ID_DEFAULT && (int)t < (int)LPV_TECHNIQUE_ID_COUNT_ ? TECHNIQUES[t].name
-                                                                                            : NULL;
-}
-
-int lpv_technique_has(lpv_technique_id t, lpv_technique_cap cap)
-{
-    if (t == LPV_TECHNIQUE_ID_DEFAULT)
-        t = LPV_TECHNIQUE_ID_DEFAULT_IS;
-    return (int)t > (int)LPV_TECHNIQUE_ID_DEFAULT && (int)t < (int)LPV_TECHNIQUE_ID_COUNT_ &&
-           (TECHNIQUES[t].caps & cap) != 0;
-}
+/* The techniques' names and capabilities: techniques/registry.c. */
 
 int lpv_ao_check(const lpv_settings *s, lpv_technique_id running, char *err, size_t n)
 {
@@ -165,11 +128,6 @@ int lpv_ao_check(const lpv_settings *s, lpv_technique_id running, char *err, siz
     const char *t = lpv_technique_name(running);
     return lpv_error(err, n, "ambient occlusion needs technique %s with iv_ao on; this has technique %s and iv_ao %s",
                      LPV_TECHNIQUE_IV, t ? t : "?", s->iv.ao == LPV_SWITCH_ON ? "on" : "off");
-}
-
-const char *lpv_technique_names(void)
-{
-    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV ", " LPV_TECHNIQUE_AUTO; /* the table's names, in its order */
 }
 
 lpv_preset lpv_preset_match(const lpv_settings *s)

@@ -9,14 +9,14 @@
 
 /* The GI techniques' names (gpu/technique.h's class names; the wire's and the
  * knob description's "technique"; --technique and CONFIG's "technique"). */
-#define LPV_TECHNIQUE_LPV "lpv"       /* cascaded light propagation volumes (gpu/lpv/) */
-#define LPV_TECHNIQUE_OCTREE "octree" /* octree light propagation volumes (gpu/lpv/technique_octree.c) */
-#define LPV_TECHNIQUE_IV "iv"         /* imperfect volumes (gpu/iv/) */
+#define LPV_TECHNIQUE_LPV "lpv"       /* cascaded light propagation volumes (techniques/lpv/gpu/) */
+#define LPV_TECHNIQUE_OCTREE "octree" /* octree light propagation volumes (techniques/octree/gpu/technique_octree.c) */
+#define LPV_TECHNIQUE_IV "iv"         /* imperfect volumes (techniques/iv/gpu/) */
 #define LPV_TECHNIQUE_AUTO "auto"     /* the planner chooses from the scene and the preset (core/plan.c) */
 
 /* Which technique computes the volume; 0 means "the default"
- * (LPV_TECHNIQUE_ID_DEFAULT_IS, below). The names are core/settings.c's
- * technique table, the classes gpu/technique.c's. */
+ * (LPV_TECHNIQUE_ID_DEFAULT_IS, below). The names, capabilities and tick
+ * costs are techniques/registry.c's table, the classes techniques/classes.c's. */
 typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_DEFAULT = 0,
     LPV_TECHNIQUE_ID_LPV = 1,
@@ -28,7 +28,7 @@ typedef enum lpv_technique_id {
 
 /* The technique when none is named (lpvd render, serve, batch and the
  * library): written here once; lpv_settings_resolve, lpv_technique_name,
- * lpv_technique_choose and gpu/technique.c read it; lpv, octree, iv or
+ * lpv_technique_choose and techniques/classes.c read it; lpv, octree, iv or
  * auto (then lpv_technique_choose's rules decide). Why it is auto (the
  * best light for the time on the accuracy set against converged light):
  * docs/accuracy.md, "Which technique by default (issue 30)". */
@@ -54,7 +54,7 @@ typedef enum lpv_preset {
     LPV_PRESET_COUNT_ /* one past the last; not a preset */
 } lpv_preset;
 
-/* The cascaded LPV's own knobs (LPV_TECHNIQUE_LPV, gpu/lpv/; the first
+/* The cascaded LPV's own knobs (LPV_TECHNIQUE_LPV, techniques/lpv/gpu/; the first
  * seed): how its volume propagates, occludes, cascades and is read. Every
  * technique gets a struct like this one inside lpv_settings, zero meaning
  * "the default" as everywhere. */

@@ -45,7 +45,7 @@ typedef enum lpv_levels_kind {
     LPV_LEVELS_CASCADES = 0,  /* an LPV's cascades (or far-field levels): radiant intensity per cell, W/sr,
                                  read by the trilinear lookup / cell_size^2 (R5.7) */
     LPV_LEVELS_IV_VOXELS = 1, /* technique iv's one level of voxels: the radiance arriving at each voxel centre,
-                                 W/(m^2 sr), read by the imperfect volume's reconstruction (core/oracle_iv.h
+                                 W/(m^2 sr), read by the imperfect volume's reconstruction (techniques/iv/core/oracle_iv.h
                                  lpv_iv_irradiance, R5.14), which also needs which voxels hold a surface
                                  (lpv_engine_read_iv_voxels) and iv_neighbours below */
 } lpv_levels_kind;
@@ -99,7 +99,7 @@ typedef struct lpv_engine_stats {
      * was made of */
     struct {
         int on;                /* the volume is an imperfect volume (volume.kind LPV_LEVELS_IV_VOXELS) */
-        size_t points;         /* the scene's point cloud (core/iv_points.h) */
+        size_t points;         /* the scene's point cloud (techniques/iv/core/iv_points.h) */
         int points_per_piece;  /* points per triangle piece (below iv_points when the budget cut it) */
         size_t voxels;         /* of the grid */
         long long occupied;    /* voxels holding a surface; -1: not counted (the engine reads no voxels back for

@@ -150,7 +150,7 @@ static uint64_t geometry_signature(const lpv_scene *s)
     return h;
 }
 
-/* The imperfect volume's point cloud at its voxel size (core/iv_points.h). */
+/* The imperfect volume's point cloud at its voxel size (techniques/iv/core/iv_points.h). */
 static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
 {
     const lpv_settings *s = &e->settings;

@@ -30,7 +30,7 @@
  *
  * A technique sees none of the engine: what it needs comes in the structs
  * below. docs/architecture.md, "Adding a technique", walks through writing
- * one; gpu/lpv/ is the cascaded LPV on this seam.
+ * one; techniques/lpv/gpu/ is the cascaded LPV on this seam.
  */
 #ifndef LPV_TECHNIQUE_H
 #define LPV_TECHNIQUE_H
@@ -85,7 +85,7 @@ typedef struct lpv_technique_inputs {
     /* For a technique that lights surfaces itself (the imperfect volume):
      * the lights' block and their RSMs' position and albedo layers as
      * shadow maps, the camera's G-buffer (0 when it did not run this tick),
-     * and the scene's point cloud (core/iv_points.h). */
+     * and the scene's point cloud (techniques/iv/core/iv_points.h). */
     GLuint light_ubo;
     GLuint rsm_position, rsm_albedo;        /* 2D array textures (rsm.frag's targets) */
     GLuint gbuffer[4];                      /* position, normal, albedo, emission (gbuffer.frag) */
@@ -157,11 +157,11 @@ struct lpv_technique_class {
     void (*stats)(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats *s);
 };
 
-/* The cascaded light propagation volume (gpu/lpv/). */
+/* The cascaded light propagation volume (techniques/lpv/gpu/). */
 extern const lpv_technique_class lpv_technique_cascaded_lpv;
-/* The octree light propagation volume (gpu/lpv/technique_octree.c). */
+/* The octree light propagation volume (techniques/octree/gpu/technique_octree.c). */
 extern const lpv_technique_class lpv_technique_octree;
-/* Imperfect volumes (gpu/iv/). */
+/* Imperfect volumes (techniques/iv/gpu/). */
 extern const lpv_technique_class lpv_technique_iv;
 
 /* The class of a technique (core/settings.h's ids; technique.c's table), or

@@ -3,13 +3,13 @@
  *
  * R5.7 (the LPV's cascades): the cascade to read at a point and the blend
  * across cascade borders. The SH lookup inside one cascade is core's
- * reference lookup (core/oracle.h lpv_oracle_irradiance: the half-cell
+ * reference lookup (techniques/lpv/core/oracle.h lpv_oracle_irradiance: the half-cell
  * offset, trilinear filtering clamped at the edge, the cosine lobe, /
  * cell_size^2), so the client's answer and the oracle tests' are the same
  * code; this file adds only what the SPEC defines on top of it.
  *
  * R5.14 (technique iv's voxels): the imperfect volume's reconstruction, core's
- * reference (core/oracle_iv.h lpv_iv_irradiance_held) on the volume and its
+ * reference (techniques/iv/core/oracle_iv.h lpv_iv_irradiance_held) on the volume and its
  * index of surface-holding voxels.
  *
  * Part of the lpv_protocol library, which therefore links lpv_core

@@ -56,7 +56,7 @@
  *   (solid_angle_f / pi) * lobe(n_f) * Y(w_f)^T
  * with w_f the direction from the source centre to the centre of face f.
  * A is exactly 1/6: the six neighbours share the source's total flux.
- * tests/test_propagation.c rebuilds the matrices from the face table. */
+ * techniques/lpv/tests/test_propagation.c rebuilds the matrices from the face table. */
 #define LPV_PROP_A 0.16666666666666666f
 #define LPV_PROP_B 0.26402916857008096f
 #define LPV_PROP_E 0.03681679577750147f
@@ -264,7 +264,7 @@ struct LpvViewBlock {
                              w include emission (0/1) */
 };
 
-/* ---- Imperfect volumes (gpu/iv/, docs/imperfect-volumes.md) ---------------
+/* ---- Imperfect volumes (techniques/iv/gpu/, docs/imperfect-volumes.md) ---------------
  * The volume is a grid of cubic voxels over the scene (the LpvGridParams UBO
  * with one cascade). Every SH here is 2-band RGB in LpvCell layout and, as
  * the LPV's, a function of the direction light TRAVELS: a voxel's outgoing
@@ -272,7 +272,7 @@ struct LpvViewBlock {
  * irradiance is the same lobe(-n) product as the LPV's, without its /cell^2).
  * Units: radiance W/(m^2 sr), irradiance W/m^2. */
 
-/* A point of the cloud (core/iv_points.c): Turk's uniform points, N per
+/* A point of the cloud (techniques/iv/core/iv_points.c): Turk's uniform points, N per
  * triangle; the GPU lights it every tick. */
 struct IvPoint {
     vec4 position; /* xyz world (m); w 1 = a point, 0 = skip */
@@ -414,12 +414,12 @@ struct IvVoxel {
 #define LPV_IV_HELD_WEIGHT 0.015625f
 /* Luminance weights (Rec. 709, summing to 1) of the lookup's rule for a
  * reconstructed irradiance with a channel below 0 (iv_lookup.glsl,
- * iv_physical; core/oracle_iv.c). */
+ * iv_physical; techniques/iv/core/oracle_iv.c). */
 #define LPV_IV_LUMA_R 0.2126f
 #define LPV_IV_LUMA_G 0.7152f
 #define LPV_IV_LUMA_B 0.0722f
 /* The bounces after the gathered ones as a series (iv_tail.comp,
- * core/oracle_iv.c lpv_iv_add_tail): the per-bounce ratio is at most this
+ * techniques/iv/core/oracle_iv.c lpv_iv_add_tail): the per-bounce ratio is at most this
  * (the share two bounces keep at most its square, a factor q / (1 - q) of
  * 4.3 on the last two bounces); the totals S_k sit in slots 1..K of a float
  * buffer, the per-bounce ratios used in LPV_IV_TAIL_RATIO_SLOT, three
@@ -549,7 +549,7 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_TEX_TRANSMIT  3
 #define LPV_TEX_REFLECT   4
 #define LPV_TEX_DENSITY   7 /* the medium's 3D density (units 0..6 are the shading's) */
-/* The accumulated LPV as 3D textures for the lookup (lookup.glsl, gpu/lpv/lpv_lookup_volume.c). */
+/* The accumulated LPV as 3D textures for the lookup (lookup.glsl, techniques/lpv/gpu/lpv_lookup_volume.c). */
 #define LPV_TEX_LOOKUP_R  8
 #define LPV_TEX_LOOKUP_G  9
 #define LPV_TEX_LOOKUP_B  10

@@ -146,7 +146,7 @@ static void test_placement_and_volumes(void **state)
     assert_int_equal(r->lpv.normal_bins, LPV_SWITCH_ON);
 }
 
-/* E (red) at p facing n from cascade k alone, on the CPU (core/oracle_lookup.c: the same lookup as lookup.glsl's
+/* E (red) at p facing n from cascade k alone, on the CPU (techniques/lpv/core/oracle_lookup.c: the same lookup as lookup.glsl's
  * cascade_irradiance without damping). */
 static float cascade_e(const lpv_cell *acc, int k, const float p[3], const float n[3])
 {

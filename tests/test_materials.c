@@ -802,7 +802,7 @@ static const char *warn_gltf(void)
  *   diffuse albedo is base colour x (1 - metallic)) and 0 where x > 0;
  * - emission x an emissive texture white where z < 0, black where z > 0.
  * The G-buffer's frame, the emitters' flux (core/emissive.c), the imperfect
- * volume's points (core/iv_points.c) and the reference's frame all follow
+ * volume's points (techniques/iv/core/iv_points.c) and the reference's frame all follow
  * the textures; before, the texture was ignored (the whole floor metal-free
  * grey, the whole floor glowing). */
 static void test_material_textures(void **state)

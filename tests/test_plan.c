@@ -17,6 +17,8 @@
 
 #include "cascades.h"
 #include "plan.h"
+#include "iv_rules.h"
+#include "lpv_rules.h"
 #include "settings.h"
 
 static lpv_settings resolved(lpv_settings s)
@@ -46,7 +48,7 @@ static lpv_plan plan_of(lpv_settings s, lpv_plan_facts f)
 {
     lpv_plan p;
     s = resolved(s);
-    lpv_plan_make(&s, &f, &p);
+    lpv_plan_make_lpv(&s, &f, &p);
     return p;
 }
 
@@ -753,7 +755,7 @@ static void test_technique_auto_never_the_worst(void **state)
         {"cornell", 2.03f, 2.02f, 1.99f, 1, 1, 32, 1, {0.831, 0.954, 0.246}},
         {"courtyard", 24.0f, 24.0f, 12.2f, 1, 0, 96, 1, {0.689, 0.785, 0.507}},
         {"blinds", 6.2f, 4.1f, 3.2f, 1, 0, 276, 1, {1.569, 1.565, 1.117}},
-        /* iv's voxels from the free path (2.6 m: 0.94 m voxels, core/iv_points.h) */
+        /* iv's voxels from the free path (2.6 m: 0.94 m voxels, techniques/iv/core/iv_points.h) */
         {"tunnel", 240.4f, 3.4f, 3.0f, 6, 0, 72, 1, {0.948, 1.240, 0.500}, 2.62f},
         /* the same tunnel with iv's voxels 15 m (the longest side / 16, as before
          * they followed the free path): iv is black and the worst */

@@ -4,7 +4,7 @@
  * lpvd's scenes.
  *
  *   Table 1  volume creation vs points per triangle N = 3, 7, 12, 19: the CPU
- *            time to make the point cloud (core/iv_points.h,
+ *            time to make the point cloud (techniques/iv/core/iv_points.h,
  *            lpv_iv_points_make, what lpv_engine_set_settings re-samples)
  *            plus the iv_points stage's GPU ms (lighting and splatting the
  *            points), and the reprojection (iv_reproject) of the view's

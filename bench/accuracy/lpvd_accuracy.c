@@ -255,7 +255,7 @@ typedef struct result {
 
 /* The thesis' correctness metric (section 6.2) on the octree the GPU
  * computed: every level's accumulation read back into the oracle's octree,
- * each level above 0 against the mean of its children (core/oracle_octree.h). */
+ * each level above 0 against the mean of its children (techniques/octree/core/oracle_octree.h). */
 static void octree_metric(lpv_engine *engine, lpv_octree_error *out)
 {
     memset(out, 0, sizeof *out);

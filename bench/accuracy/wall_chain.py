@@ -7,7 +7,7 @@ what a cell sends to its four side neighbours comes straight back from them:
 each layer is one coefficient vector and only the +z/-z transfers move light
 between layers. The step is the full sparse 4x4 transfer of lpv_shared.h (the
 lateral band-1 slots stay 0 by symmetry, and the model checks that they do),
-with the same flux limiter as core/oracle_propagate.c; no occlusion. For the
+with the same flux limiter as techniques/lpv/core/oracle_propagate.c; no occlusion. For the
 paper's transport and the central one (docs/propagation.md section 4b) it
 prints, in units of the wall's exitance M (the truth is 1 everywhere for a
 surface facing the wall, 0 for the wall itself):

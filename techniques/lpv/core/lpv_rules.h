@@ -1,0 +1,19 @@
+/*
+ * lpv_rules.h - the cascaded LPV's CPU half beside its oracle (oracle.h):
+ * its plan and its tick cost bound, which techniques/registry.c lists.
+ */
+#ifndef LPV_LPV_RULES_H
+#define LPV_LPV_RULES_H
+
+#include "plan.h"
+#include "tick_cost.h"
+
+/* The plan of one tick of the cascaded LPV (the octree's too): the shared
+ * producers it reads and its passes, each with its reason. s resolved. */
+void lpv_plan_make_lpv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
+
+/* Cells x cascades (auto: the most the planner may place, the far field's
+ * levels included) x normal bins x iterations. */
+void lpv_lpv_tick_cost(const lpv_settings *s, lpv_tick_cost *out);
+
+#endif /* LPV_LPV_RULES_H */
