@@ -74,10 +74,6 @@ typedef struct lpv_plan_facts {
     int forced;                /* the caller asked for a recompute (lpv_engine_invalidate) */
     int placement_changed;     /* a cascade's snapped placement differs */
     float camera_move_cells;   /* camera travel since the last computed tick, in finest cells */
-    /* the imperfect volume's point cloud (techniques/iv/core/iv_points.h), 0 for other techniques */
-    size_t iv_points;
-    int iv_points_per_piece;
-    int iv_budget_cut;         /* the budget lowered the points per piece or coarsened the split */
 } lpv_plan_facts;
 
 /* Technique auto (LPV_TECHNIQUE_ID_AUTO): what the planner runs instead. */

@@ -313,7 +313,7 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
     lpv_engine_update_area_samples(e);
     if (!e->has_scene)
         return 0;
-    if (((touches & LPV_TOUCH_SAMPLES) || lpv_engine_iv_points_stale(e)) && lpv_engine_sample_scene(e, err, err_size) != 0)
+    if (((touches & LPV_TOUCH_SAMPLES) || lpv_engine_samples_stale(e)) && lpv_engine_sample_scene(e, err, err_size) != 0)
         return -1;
     return lpv_engine_place_volume(e, err, err_size);
 }

@@ -11,7 +11,6 @@
 #include "cascades.h"
 #include "engine.h"
 #include "error.h"
-#include "iv_points.h"
 #include "gl.h"
 #include "gl_util.h"
 #include "lpv_shared.h"
@@ -148,13 +147,9 @@ struct lpv_engine {
     lpv_surfel *scene_surfel_samples; /* the samples themselves, regrouped when the cascades move */
     size_t scene_surfel_sample_count;
     uint64_t scene_surfel_grid_sig; /* the cascades the buffer's groups are for; 0 = none yet */
-    GLuint iv_points;         /* the imperfect volume's point cloud (technique iv only), 0 = none */
-    size_t iv_point_count;
-    lpv_grid iv_points_grid;  /* the volume the cloud was made for (its pieces split by its voxel, kept in its box) */
     /* the scene's flat surfaces' normals for the lookup (core/scene_planes.h) */
     float lookup_planes[LPV_MAX_LOOKUP_PLANES][3];
     int lookup_plane_count;
-    lpv_iv_point_stats iv_point_stats;
     lpv_emitter_list emitters;                          /* emissive triangles (area lights) */
     lpv_area_sample area_samples[LPV_MAX_AREA_LIGHTS];  /* the emitters as area light samples */
     size_t area_sample_count;                           /* 0: area lights off or no emitter */
@@ -285,10 +280,10 @@ void lpv_engine_update_area_samples(lpv_engine *e);
 /* The emissive VPLs and scene surfels under the current settings, from
  * e->geometry (engine_scene.c). */
 int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size);
-/* 1 when the imperfect volume's point cloud was made for another voxel size
- * than the current settings place (iv_resolution, the bounds, the free path):
- * it must be made again, its pieces being split by the voxel. */
-int lpv_engine_iv_points_stale(const lpv_engine *e);
+/* 1 when the technique's own samples of the scene (iv's point cloud) were
+ * made for another volume than the current settings and lit space place:
+ * they must be made again (lpv_technique_class.samples_stale). */
+int lpv_engine_samples_stale(const lpv_engine *e);
 
 /* The frame program of a variant (LPV_FRAME_* bits), built on first use and
  * kept until the technique changes; 0 with err set if it does not build. */

@@ -15,15 +15,11 @@
 #include "hash.h"
 #include "scene_planes.h"
 #include "scene_surfels.h"
-#include "iv_points.h"
 
 static void free_samples(lpv_engine *e)
 {
     lpv_gl_delete_buffer(&e->emissive_vpls);
     lpv_gl_delete_buffer(&e->scene_surfels);
-    lpv_gl_delete_buffer(&e->iv_points);
-    e->iv_point_count = 0;
-    memset(&e->iv_point_stats, 0, sizeof e->iv_point_stats);
     e->emissive_vpl_count = 0;
     e->scene_surfel_count = 0;
     free(e->scene_surfel_samples);
@@ -150,44 +146,20 @@ static uint64_t geometry_signature(const lpv_scene *s)
     return h;
 }
 
-/* The imperfect volume's point cloud at its voxel size (techniques/iv/core/iv_points.h). */
-static int sample_iv_points(lpv_engine *e, char *err, size_t err_size)
+/* The scene as a technique that samples it itself sees it. */
+static lpv_technique_scene technique_scene(const lpv_engine *e)
 {
-    const lpv_settings *s = &e->settings;
-    lpv_grid g;
-    float lo[3], hi[3], free_path;
-    lpv_engine_lit_region(e, lo, hi, &free_path);
-    if (lpv_iv_place(s, lo, hi, free_path, &g) != 0)
-        return lpv_error(err, err_size, "%s: cannot place the imperfect volume over the scene's bounds",
-                         e->geometry.source);
-    const lpv_iv_point_params p = lpv_iv_point_params_of(s, &g);
-    struct IvPoint *pts = NULL;
-    size_t n = 0;
-    if (lpv_iv_points_make(&e->geometry, &p, &pts, &n, &e->iv_point_stats) != 0)
-        return lpv_error(err, err_size, "out of memory for the imperfect volume's points (iv_max_points %d)",
-                         s->iv.max_points);
-    e->iv_points = lpv_gl_new_ssbo(n * sizeof *pts);
-    if (n)
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *pts), pts);
-    e->iv_point_count = n;
-    e->iv_points_grid = g;
-    free(pts);
-    if (glGetError() != GL_NO_ERROR)
-        return lpv_error(err, err_size, "%s: GL error while storing %zu imperfect-volume points", e->geometry.source,
-                         n);
-    return 0;
+    lpv_technique_scene sc = {.geometry = &e->geometry, .settings = &e->settings};
+    lpv_engine_lit_region(e, sc.lit_min, sc.lit_max, &sc.free_path);
+    return sc;
 }
 
-int lpv_engine_iv_points_stale(const lpv_engine *e)
+int lpv_engine_samples_stale(const lpv_engine *e)
 {
-    lpv_grid g;
-    if (e->tech_id != LPV_TECHNIQUE_ID_IV || !e->iv_points)
+    if (!e->tech || !e->tech->cls->samples_stale)
         return 0;
-    float lo[3], hi[3], free_path;
-    lpv_engine_lit_region(e, lo, hi, &free_path);
-    if (lpv_iv_place(&e->settings, lo, hi, free_path, &g) != 0)
-        return 0;
-    return memcmp(&g, &e->iv_points_grid, sizeof g) != 0; /* its pieces were split by its voxel, kept in its box */
+    const lpv_technique_scene sc = technique_scene(e);
+    return e->tech->cls->samples_stale(e->tech, &sc);
 }
 
 /* The scene's samples under the current settings, from the engine's copy of
@@ -200,11 +172,13 @@ int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size)
     free_samples(e);
     e->counters.scene_samplings++;
 
-    /* The imperfect volume samples its own point cloud; the LPV's samples
-     * (emissive VPLs, scene surfels) would go unused. */
-    const int iv = e->tech_id == LPV_TECHNIQUE_ID_IV;
-    if (iv)
-        return sample_iv_points(e, err, err_size);
+    /* A technique that samples the scene itself (the imperfect volume's
+     * point cloud) would leave the engine's samples (emissive VPLs, scene
+     * surfels) unused. */
+    if (e->tech && e->tech->cls->sample_scene) {
+        const lpv_technique_scene sc = technique_scene(e);
+        return e->tech->cls->sample_scene(e->tech, &sc, err, err_size);
+    }
     size_t target = (size_t)e->settings.emissive_vpls;
     lpv_vpl *vpls = target ? calloc(target * 2 + 1024, sizeof *vpls) : NULL;
     size_t n = vpls ? lpv_emissive_sample(scene, target, vpls, target * 2 + 1024) : 0;
@@ -282,7 +256,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
          * is kept in the box of the lit ones */
         e->lights_dirty = 1;
         set_lights(e, scene);
-        if (lpv_engine_iv_points_stale(e) && lpv_engine_sample_scene(e, err, err_size) != 0)
+        if (lpv_engine_samples_stale(e) && lpv_engine_sample_scene(e, err, err_size) != 0)
             return -1;
         return lpv_engine_place_volume(e, err, err_size);
     }

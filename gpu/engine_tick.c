@@ -61,9 +61,6 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->settings_changed = e->settings_dirty;
     memcpy(f->settings_knob, e->settings_knob, sizeof f->settings_knob);
     f->forced = e->forced;
-    f->iv_points = e->iv_point_count;
-    f->iv_points_per_piece = e->iv_point_stats.points_per_piece;
-    f->iv_budget_cut = e->iv_point_stats.budget_cut;
     if (e->has_view != e->computed_has_view) {
         f->camera_move_cells = INFINITY;
     } else if (e->has_view) {
@@ -121,8 +118,6 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
         in->gbuffer_w = e->gbuf_w;
         in->gbuffer_h = e->gbuf_h;
     }
-    in->iv_points = e->iv_points;
-    in->iv_point_count = e->iv_point_count;
     in->lookup_planes = (const float (*)[3])e->lookup_planes;
     in->lookup_plane_count = e->lookup_plane_count;
 }
@@ -165,18 +160,6 @@ static void record_stats(lpv_engine *e)
     s->scene_samplings = e->counters.scene_samplings;
     e->tech->cls->stats(e->tech, &e->plan, s);
     s->volume = e->desc;
-    if (e->desc.kind == LPV_LEVELS_IV_VOXELS) {
-        s->iv.on = 1;
-        s->iv.points = e->iv_point_count;
-        s->iv.points_per_piece = e->iv_point_stats.points_per_piece;
-        s->iv.voxels = s->cells;
-        s->iv.occupied = -1;
-        s->iv.bounces = e->plan.pass[LPV_PASS_IV_GATHER].run ? s->iterations : 0;
-        s->iv.bounces_requested = e->settings.iv.bounces;
-        s->iv.rays = e->settings.iv.rays;
-        s->iv.reprojected = e->plan.pass[LPV_PASS_IV_REPROJECT].run;
-        s->iv.ao = e->plan.pass[LPV_PASS_IV_AO].run;
-    }
 }
 
 void lpv_engine_set_yield(lpv_engine *e, int (*fn)(void *arg), void *arg, double every_ms)

@@ -44,6 +44,7 @@
 #include "medium.h"
 #include "memory_budget.h"
 #include "plan.h"
+#include "scene.h"
 #include "settings.h"
 #include "timer.h"
 
@@ -84,19 +85,25 @@ typedef struct lpv_technique_inputs {
     const lpv_medium_gpu *medium; /* attenuation during transport */
     /* For a technique that lights surfaces itself (the imperfect volume):
      * the lights' block and their RSMs' position and albedo layers as
-     * shadow maps, the camera's G-buffer (0 when it did not run this tick),
-     * and the scene's point cloud (techniques/iv/core/iv_points.h). */
+     * shadow maps, and the camera's G-buffer (0 when it did not run this
+     * tick). */
     GLuint light_ubo;
     GLuint rsm_position, rsm_albedo;        /* 2D array textures (rsm.frag's targets) */
     GLuint gbuffer[4];                      /* position, normal, albedo, emission (gbuffer.frag) */
     int gbuffer_w, gbuffer_h;
-    GLuint iv_points;                       /* IvPoint */
-    size_t iv_point_count;
     /* The normals of the scene's largest flat surfaces (core/scene_planes.h),
      * for a lookup that keeps their irradiance per cell. */
     const float (*lookup_planes)[3];
     int lookup_plane_count;
 } lpv_technique_inputs;
+
+/* The scene, for a technique that samples it itself (sample_scene). */
+typedef struct lpv_technique_scene {
+    const lpv_scene *geometry;    /* the engine's copy: triangles, draws, materials, textures */
+    const lpv_settings *settings; /* resolved and valid */
+    float lit_min[3], lit_max[3]; /* where light can go (the engine's reach), else the scene's box */
+    float free_path;              /* of that space (m) */
+} lpv_technique_scene;
 
 /* What the volume is: lpv_volume_desc (engine.h, where the tick's stats
  * carry it to readers on other threads). */
@@ -129,6 +136,14 @@ struct lpv_technique_class {
     void (*destroy)(lpv_technique *t);
     /* Takes new (resolved, valid) settings. */
     void (*configure)(lpv_technique *t, const lpv_settings *s);
+    /* Optional: a technique that samples the scene itself (iv's point
+     * cloud) does it here, on a new scene, a new technique or a change of a
+     * knob that touches the samples (LPV_TOUCH_SAMPLES); the engine then
+     * makes none of its own samples (emissive VPLs, scene surfels). */
+    int (*sample_scene)(lpv_technique *t, const lpv_technique_scene *sc, char *err, size_t err_size);
+    /* Optional: 1 when the samples no longer fit sc (the lit space moved
+     * the volume they were made for); the engine samples again. */
+    int (*samples_stale)(const lpv_technique *t, const lpv_technique_scene *sc);
     /* Where the volume goes now (no GL); *moved: it differs from where the
      * last commit put it. */
     int (*place)(lpv_technique *t, const lpv_technique_where *w, int *moved, char *err, size_t err_size);

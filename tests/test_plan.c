@@ -137,7 +137,7 @@ static void test_no_blend_skips_translucent(void **state)
     assert_non_null(strstr(p.pass[LPV_PASS_TRANSLUCENT].reason, "3 draws are alphaMode BLEND"));
     f.first_tick = 0; /* nothing changed: the volume is served again, the frame still needs the layer */
     lpv_settings iv = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_IV});
-    lpv_plan_make_iv(&iv, &f, &p);
+    lpv_plan_make_iv(&iv, &f, &(lpv_iv_point_stats){0}, &p);
     assert_false(p.recompute);
     assert_true(p.pass[LPV_PASS_TRANSLUCENT].run);
     p = plan_of((lpv_settings){0}, f);
@@ -621,12 +621,12 @@ static void test_place_temporal(void **state)
 }
 
 
-static lpv_plan plan_iv(lpv_settings s, lpv_plan_facts f)
+static lpv_plan plan_iv(lpv_settings s, lpv_plan_facts f, lpv_iv_point_stats cloud)
 {
     lpv_plan p;
     s.technique = LPV_TECHNIQUE_ID_IV;
     s = resolved(s);
-    lpv_plan_make_iv(&s, &f, &p);
+    lpv_plan_make_iv(&s, &f, &cloud, &p);
     return p;
 }
 
@@ -637,9 +637,8 @@ static void test_iv_plan(void **state)
 {
     (void)state;
     lpv_plan_facts f = baseline(); /* no camera */
-    f.iv_points = 1000;
-    f.iv_points_per_piece = 8;
-    lpv_plan p = plan_iv((lpv_settings){0}, f);
+    lpv_iv_point_stats cloud = {.points = 1000, .points_per_piece = 8};
+    lpv_plan p = plan_iv((lpv_settings){0}, f, cloud);
     assert_true(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i)
         assert_reason(p.pass[i].reason);
@@ -659,12 +658,12 @@ static void test_iv_plan(void **state)
 
     /* a camera: reprojection and its G-buffer; AO on request */
     f.has_view = 1;
-    p = plan_iv((lpv_settings){.iv.ao = LPV_SWITCH_ON, .iv.bounces = 1}, f);
+    p = plan_iv((lpv_settings){.iv.ao = LPV_SWITCH_ON, .iv.bounces = 1}, f, cloud);
     assert_true(p.pass[LPV_PASS_IV_REPROJECT].run);
     assert_true(p.pass[LPV_PASS_GBUFFER].run);
     assert_true(p.pass[LPV_PASS_IV_AO].run);
     assert_non_null(strstr(p.pass[LPV_PASS_IV_GATHER].reason, "iv: 1 bounces requested"));
-    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
+    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f, cloud);
     assert_false(p.pass[LPV_PASS_IV_REPROJECT].run);
     assert_string_equal(p.pass[LPV_PASS_IV_REPROJECT].reason, "reprojection off");
     assert_false(p.pass[LPV_PASS_GBUFFER].run);
@@ -672,30 +671,28 @@ static void test_iv_plan(void **state)
     /* nothing lights the volume: no gather; nothing in it: neither */
     f.lights = 0;
     f.emissive_surfaces = 0;
-    p = plan_iv((lpv_settings){0}, f);
+    p = plan_iv((lpv_settings){0}, f, cloud);
     assert_false(p.pass[LPV_PASS_IV_GATHER].run);
     assert_string_equal(p.pass[LPV_PASS_IV_GATHER].reason, "no light sources");
     f.lights = 1;
-    f.iv_points = 0;
-    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
+    cloud.points = 0;
+    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f, cloud);
     assert_false(p.pass[LPV_PASS_IV_POINTS].run);
     assert_false(p.pass[LPV_PASS_IV_GATHER].run);
 
     /* the budget says so */
-    f.iv_points = 500;
-    f.iv_points_per_piece = 2;
-    f.iv_budget_cut = 1;
-    p = plan_iv((lpv_settings){0}, f);
+    cloud = (lpv_iv_point_stats){.points = 500, .points_per_piece = 2, .budget_cut = 1};
+    p = plan_iv((lpv_settings){0}, f, cloud);
     assert_non_null(strstr(p.pass[LPV_PASS_IV_POINTS].reason, "budget"));
 
     /* steady: a camera move of a voxel recomputes only because reprojection feeds the volume */
     f = steady();
-    f.iv_points = 1000;
+    cloud = (lpv_iv_point_stats){.points = 1000, .points_per_piece = 8};
     f.camera_move_cells = 2.0f;
-    p = plan_iv((lpv_settings){0}, f);
+    p = plan_iv((lpv_settings){0}, f, cloud);
     assert_true(p.recompute);
     assert_non_null(strstr(p.recompute_reason, "refine the imperfect volume"));
-    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f);
+    p = plan_iv((lpv_settings){.iv.reprojection = LPV_SWITCH_OFF}, f, cloud);
     assert_false(p.recompute);
     for (int i = 0; i < LPV_PASS_COUNT; ++i)
         if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT) /* the frame's */

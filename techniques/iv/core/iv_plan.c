@@ -10,7 +10,8 @@
 
 #include "lpv_shared.h"
 
-void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, const lpv_iv_point_stats *cloud,
+                      lpv_plan *p)
 {
     memset(p, 0, sizeof *p);
     const int all = s->planner == LPV_SWITCH_OFF;
@@ -37,13 +38,13 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *
         snprintf(p->pass[LPV_PASS_RSM].reason + len, sizeof p->pass[LPV_PASS_RSM].reason - len,
             " (shadows of the points' direct light)");
     }
-    if (!f->iv_points)
+    if (!cloud->points)
         lpv_plan_decide(p, LPV_PASS_IV_POINTS, 0, "no triangles to sample");
-    else if (f->iv_budget_cut)
-        lpv_plan_decide(p, LPV_PASS_IV_POINTS, 1, "%zu points (%d per piece: the %d-point budget cut %d)", f->iv_points,
-               f->iv_points_per_piece, s->iv.max_points, s->iv.points);
+    else if (cloud->budget_cut)
+        lpv_plan_decide(p, LPV_PASS_IV_POINTS, 1, "%zu points (%d per piece: the %d-point budget cut %d)", cloud->points,
+               cloud->points_per_piece, s->iv.max_points, s->iv.points);
     else
-        lpv_plan_decide(p, LPV_PASS_IV_POINTS, 1, "%zu points, %d per triangle piece", f->iv_points, f->iv_points_per_piece);
+        lpv_plan_decide(p, LPV_PASS_IV_POINTS, 1, "%zu points, %d per triangle piece", cloud->points, cloud->points_per_piece);
     if (s->iv.reprojection == LPV_SWITCH_OFF)
         lpv_plan_decide(p, LPV_PASS_IV_REPROJECT, 0, "reprojection off");
     else if (!f->has_view)

@@ -1,7 +1,7 @@
 /*
  * iv_internal.h - the imperfect volume's state, shared by its files
  * (technique_iv.c: the lpv_technique_class, placement and storage;
- * iv_passes.c: the tick's passes). Not seen outside techniques/iv/gpu/; like the LPV's
+ * iv_cloud.c: the scene's point cloud; iv_passes.c: the tick's passes). Not seen outside techniques/iv/gpu/; like the LPV's
  * passes, these take the technique's state and the tick's inputs, never the
  * engine.
  */
@@ -10,6 +10,7 @@
 
 #include "atlas.h"
 #include "gl_util.h"
+#include "iv_points.h"
 #include "technique.h"
 
 /* The atlas's attachments: r, g, b SH sums, normal + count, albedo + area,
@@ -36,7 +37,17 @@ typedef struct lpv_iv_gpu {
     int alloc_dims[3];
     int bounces_run;  /* by the last computed tick */
     int tail_run;     /* the last computed tick added the tail (iv_tail.comp) */
+    /* the scene's point cloud (iv_cloud.c; techniques/iv/core/iv_points.h) */
+    GLuint points;            /* IvPoint, 0 = not sampled */
+    lpv_iv_point_stats cloud; /* what sampling it gave (cloud.points: its count) */
+    lpv_grid cloud_grid;      /* the volume it was made for (its pieces split by its voxel, kept in its box) */
 } lpv_iv_gpu;
+
+/* The class's sample_scene and samples_stale (iv_cloud.c): the point cloud
+ * at the voxel size the settings place over the lit space. */
+int lpv_iv_sample_scene(lpv_technique *t, const lpv_technique_scene *sc, char *err, size_t err_size);
+int lpv_iv_samples_stale(const lpv_technique *t, const lpv_technique_scene *sc);
+void lpv_iv_free_cloud(lpv_iv_gpu *v);
 
 /* Zeroes a buffer (floats or bits alike). */
 void lpv_iv_clear_buffer(GLuint b);

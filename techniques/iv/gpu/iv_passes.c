@@ -32,10 +32,10 @@ void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
     glActiveTexture(GL_TEXTURE0 + 6);
     glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
     glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
-    if (p->pass[LPV_PASS_IV_POINTS].run && in->iv_point_count) {
+    if (p->pass[LPV_PASS_IV_POINTS].run && v->cloud.points) {
         lpv_timer_begin(in->timer, "iv_points");
         glUniform1i(glGetUniformLocation(prog, "u_source"), 0);
-        lpv_atlas_splat(prog, LPV_SSBO_IV_POINTS, in->iv_points, 0, in->iv_point_count, 1, in->timer);
+        lpv_atlas_splat(prog, LPV_SSBO_IV_POINTS, v->points, 0, v->cloud.points, 1, in->timer);
         lpv_timer_end(in->timer);
     }
     if (p->pass[LPV_PASS_IV_REPROJECT].run && in->gbuffer_w > 0 && in->gbuffer_h > 0) {

@@ -58,6 +58,7 @@ static void destroy(lpv_technique *t)
     if (!v)
         return;
     free_storage(v);
+    lpv_iv_free_cloud(v);
     GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (progs[i])
@@ -182,8 +183,8 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
 
 static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
 {
-    (void)t;
-    lpv_plan_make_iv(s, f, p);
+    const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
+    lpv_plan_make_iv(s, f, &v->cloud, p);
 }
 
 static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
@@ -283,6 +284,16 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     s->iterations = last->pass[LPV_PASS_IV_GATHER].run ? v->bounces_run : 0;
     s->cell_steps = 0.0;
     s->occlusion = 1; /* the march stops at occupied voxels */
+    s->iv.on = 1;
+    s->iv.points = v->cloud.points;
+    s->iv.points_per_piece = v->cloud.points_per_piece;
+    s->iv.voxels = s->cells;
+    s->iv.occupied = -1;
+    s->iv.bounces = s->iterations;
+    s->iv.bounces_requested = v->settings.iv.bounces;
+    s->iv.rays = v->settings.iv.rays;
+    s->iv.reprojected = last->pass[LPV_PASS_IV_REPROJECT].run;
+    s->iv.ao = last->pass[LPV_PASS_IV_AO].run;
     s->iv.tail = last->pass[LPV_PASS_IV_GATHER].run && v->tail_run;
     memset(s->iv.tail_ratio, 0, sizeof s->iv.tail_ratio);
     if (s->iv.tail)
@@ -295,6 +306,8 @@ const lpv_technique_class lpv_technique_iv = {
     .create = create,
     .destroy = destroy,
     .configure = configure,
+    .sample_scene = lpv_iv_sample_scene,
+    .samples_stale = lpv_iv_samples_stale,
     .place = place,
     .commit = commit,
     .plan = plan,
