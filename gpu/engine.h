@@ -69,6 +69,19 @@ typedef struct lpv_volume_desc {
                                      lpv_engine_read_index; SPEC R5.13's content "levels"); else 0 */
 } lpv_volume_desc;
 
+/* One of a technique's own counts in the stats. */
+typedef enum lpv_stat_kind {
+    LPV_STAT_INT = 0,  /* v[0], a whole number */
+    LPV_STAT_BOOL,     /* v[0], 0 or 1 */
+    LPV_STAT_REAL3,    /* v[0..2], e.g. per channel */
+} lpv_stat_kind;
+typedef struct lpv_stat {
+    const char *name;  /* static; a JSON key */
+    lpv_stat_kind kind;
+    double v[3];
+} lpv_stat;
+#define LPV_TECHNIQUE_STATS_MAX 16
+
 typedef struct lpv_engine_stats {
     int stage_count;
     struct {
@@ -95,24 +108,12 @@ typedef struct lpv_engine_stats {
      * map (area_shadow_rest.comp) because no block of the area shadow step
      * around them lies on their surface (0 at step 1, or before a frame) */
     size_t frame_area_shadow_pixels;
-    /* technique iv (all 0 for the others): what the tick's imperfect volume
-     * was made of */
-    struct {
-        int on;                /* the volume is an imperfect volume (volume.kind LPV_LEVELS_IV_VOXELS) */
-        size_t points;         /* the scene's point cloud (techniques/iv/core/iv_points.h) */
-        int points_per_piece;  /* points per triangle piece (below iv_points when the budget cut it) */
-        size_t voxels;         /* of the grid */
-        long long occupied;    /* voxels holding a surface; -1: not counted (the engine reads no voxels back for
-                                  its stats; the daemon counts them from the index it sends, SPEC R5.14) */
-        int bounces;           /* gathered (0 when iv_gather did not run) */
-        int bounces_requested; /* settings iv.bounces */
-        int tail;              /* the bounces after these were added as a series (iv_tail) */
-        float tail_ratio[3];   /* its per-bounce ratio per channel (the square root of the share q two
-                                  bounces keep; iv_tail.comp); 0 without */
-        int rays;              /* marched per voxel and bounce */
-        int reprojected;       /* iv_reproject ran (the camera's pixels refined the volume) */
-        int ao;                /* iv_ao ran (the ao frame term has a volume) */
-    } iv;
+    /* The technique's own counts, by name (its class's stats fills them;
+     * the stats JSON puts them in an object named after the technique):
+     * technique iv's are what the tick's imperfect volume was made of
+     * (docs/imperfect-volumes.md). lpv_stats_put, lpv_stats_get. */
+    int technique_stat_count;
+    lpv_stat technique_stats[LPV_TECHNIQUE_STATS_MAX];
     /* where light can reach (core/reach.h, docs/propagation.md 6d): the
      * scene's voxels of air and which a light reaches; the frame multiplies
      * the technique's light by it */
@@ -216,6 +217,11 @@ const lpv_grid *lpv_engine_cascade(const lpv_engine *e, int k);
 const lpv_plan *lpv_engine_last_plan(const lpv_engine *e);
 const lpv_settings *lpv_engine_settings(const lpv_engine *e);
 const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e);
+/* Sets the technique's count `name` (static) in s, replacing one of that
+ * name, else appending it (dropped past LPV_TECHNIQUE_STATS_MAX). */
+void lpv_stats_put(lpv_engine_stats *s, const char *name, lpv_stat_kind kind, double a, double b, double c);
+/* The technique's count `name` in s, or NULL. */
+const lpv_stat *lpv_stats_get(const lpv_engine_stats *s, const char *name);
 
 /* Read-backs for tests and the daemon. Each returns the element count written
  * (at most max), or 0 if nothing exists yet. */

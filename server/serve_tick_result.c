@@ -145,7 +145,7 @@ sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_m
     r->stats = *lpv_engine_last_stats(e); /* again: the frames' render stages join them */
     r->plan = *lpv_engine_last_plan(e);
     if (r->iv_held)
-        r->stats.iv.occupied = occupied; /* counted from the index the volume carries */
+        lpv_stats_put(&r->stats, "occupied", LPV_STAT_INT, (double)occupied, 0, 0); /* from the index it carries */
     return r;
 }
 

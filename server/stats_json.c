@@ -54,24 +54,19 @@ json_t *lpvd_plan_json(const lpv_plan *p)
                      reason_len(p->recompute_reason), "passes", passes);
 }
 
-/* Technique iv's counts (lpv_engine_stats.iv): what the tick's imperfect
- * volume was made of. */
-static json_t *iv_json(const lpv_engine_stats *st)
+/* The technique's own counts (lpv_engine_stats.technique_stats), by name. */
+static json_t *technique_json(const lpv_engine_stats *st)
 {
-    json_t *o = json_pack("{s:I, s:i, s:I, s:i, s:i, s:i, s:b, s:b}", "points", (json_int_t)st->iv.points,
-                          "points_per_piece", st->iv.points_per_piece, "voxels", (json_int_t)st->iv.voxels, "bounces",
-                          st->iv.bounces, "bounces_requested", st->iv.bounces_requested, "rays", st->iv.rays,
-                          "reprojected", st->iv.reprojected != 0, "ao", st->iv.ao != 0);
-    if (o && (json_object_set_new(o, "tail", json_boolean(st->iv.tail != 0)) != 0 ||
-              json_object_set_new(o, "tail_ratio",
-                                  json_pack("[f, f, f]", (double)st->iv.tail_ratio[0], (double)st->iv.tail_ratio[1],
-                                            (double)st->iv.tail_ratio[2])) != 0)) {
-        json_decref(o);
-        return NULL;
-    }
-    if (o && st->iv.occupied >= 0 && json_object_set_new(o, "occupied", json_integer(st->iv.occupied)) != 0) {
-        json_decref(o);
-        return NULL;
+    json_t *o = json_object();
+    for (int i = 0; o && i < st->technique_stat_count; ++i) {
+        const lpv_stat *v = &st->technique_stats[i];
+        json_t *j = v->kind == LPV_STAT_BOOL    ? json_boolean(v->v[0] != 0.0)
+                    : v->kind == LPV_STAT_REAL3 ? json_pack("[f, f, f]", v->v[0], v->v[1], v->v[2])
+                                                : json_integer((json_int_t)v->v[0]);
+        if (json_object_set_new(o, v->name, j) != 0) {
+            json_decref(o);
+            return NULL;
+        }
     }
     return o;
 }
@@ -113,7 +108,8 @@ json_t *lpvd_tick_stats_json(const lpv_engine_stats *st, const lpv_plan *plan, c
         json_decref(o);
         return NULL;
     }
-    if (o && st->iv.on && json_object_set_new(o, "iv", iv_json(st)) != 0) {
+    if (o && st->technique_stat_count && st->volume.technique &&
+        json_object_set_new(o, st->volume.technique, technique_json(st)) != 0) {
         json_decref(o);
         return NULL;
     }

@@ -284,20 +284,22 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     s->iterations = last->pass[LPV_PASS_IV_GATHER].run ? v->bounces_run : 0;
     s->cell_steps = 0.0;
     s->occlusion = 1; /* the march stops at occupied voxels */
-    s->iv.on = 1;
-    s->iv.points = v->cloud.points;
-    s->iv.points_per_piece = v->cloud.points_per_piece;
-    s->iv.voxels = s->cells;
-    s->iv.occupied = -1;
-    s->iv.bounces = s->iterations;
-    s->iv.bounces_requested = v->settings.iv.bounces;
-    s->iv.rays = v->settings.iv.rays;
-    s->iv.reprojected = last->pass[LPV_PASS_IV_REPROJECT].run;
-    s->iv.ao = last->pass[LPV_PASS_IV_AO].run;
-    s->iv.tail = last->pass[LPV_PASS_IV_GATHER].run && v->tail_run;
-    memset(s->iv.tail_ratio, 0, sizeof s->iv.tail_ratio);
-    if (s->iv.tail)
-        lpv_iv_gpu_tail_ratio(v, s->iv.tail_ratio);
+    /* what the tick's volume was made of (the stats JSON's "iv"; the daemon
+     * adds "occupied", counted from the index it sends, SPEC R5.14) */
+    const int tail = last->pass[LPV_PASS_IV_GATHER].run && v->tail_run;
+    float ratio[3] = {0.0f, 0.0f, 0.0f}; /* the tail's per-bounce ratio per channel (iv_tail.comp); 0 without */
+    if (tail)
+        lpv_iv_gpu_tail_ratio(v, ratio);
+    lpv_stats_put(s, "points", LPV_STAT_INT, (double)v->cloud.points, 0, 0); /* the scene's point cloud */
+    lpv_stats_put(s, "points_per_piece", LPV_STAT_INT, v->cloud.points_per_piece, 0, 0); /* after the budget */
+    lpv_stats_put(s, "voxels", LPV_STAT_INT, (double)s->cells, 0, 0);
+    lpv_stats_put(s, "bounces", LPV_STAT_INT, s->iterations, 0, 0); /* gathered: 0 when iv_gather did not run */
+    lpv_stats_put(s, "bounces_requested", LPV_STAT_INT, v->settings.iv.bounces, 0, 0);
+    lpv_stats_put(s, "rays", LPV_STAT_INT, v->settings.iv.rays, 0, 0); /* per voxel and bounce */
+    lpv_stats_put(s, "reprojected", LPV_STAT_BOOL, last->pass[LPV_PASS_IV_REPROJECT].run, 0, 0);
+    lpv_stats_put(s, "ao", LPV_STAT_BOOL, last->pass[LPV_PASS_IV_AO].run, 0, 0); /* the ao term has a volume */
+    lpv_stats_put(s, "tail", LPV_STAT_BOOL, tail, 0, 0); /* the bounces after these added as a series */
+    lpv_stats_put(s, "tail_ratio", LPV_STAT_REAL3, ratio[0], ratio[1], ratio[2]);
 }
 
 const lpv_technique_class lpv_technique_iv = {

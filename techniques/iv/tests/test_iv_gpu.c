@@ -354,13 +354,13 @@ static void test_thick_walls_match_oracle(void **state)
     lpv_iv_tail_share((const double(*)[3])totals, bounces, q);
     lpv_iv_add_tail(cells, base, q, cpu);
     print_message("thick walls: per-bounce tail ratio (red) GPU %.6f, oracle %.6f (red per bounce %.4g %.4g %.4g)\n",
-                  (double)st->iv.tail_ratio[0], sqrt((double)q[0]), totals[1][0], totals[2][0] - totals[1][0],
+                  lpv_stats_get(st, "tail_ratio")->v[0], sqrt((double)q[0]), totals[1][0], totals[2][0] - totals[1][0],
                   totals[3][0] - totals[2][0]);
-    assert_true(st->iv.tail);
+    assert_true(lpv_stats_get(st, "tail")->v[0] != 0.0);
     for (int ch = 0; ch < 3; ++ch) {
         const float per_bounce = sqrtf(q[ch]);
         assert_true(per_bounce > 0.3f && per_bounce < LPV_IV_TAIL_MAX_RATIO);
-        assert_true(fabsf(st->iv.tail_ratio[ch] - per_bounce) <= 1e-4f * per_bounce);
+        assert_true(fabs(lpv_stats_get(st, "tail_ratio")->v[ch] - per_bounce) <= 1e-4 * per_bounce);
     }
     print_message("thick walls: %zu two-sided voxels\n", two_sided);
     assert_true(two_sided > 20);
@@ -386,12 +386,12 @@ static void test_resolution_change_remakes_cloud(void **state)
     lpv_scene scene = cornell();
     lpv_settings s = iv_settings(8, 16, 1);
     tick(&scene, &s, NULL);
-    const size_t coarse = lpv_engine_last_stats(lpvt_engine)->iv.points;
+    const size_t coarse = (size_t)lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "points")->v[0];
     char err[256];
     s.iv.resolution = 24;
     assert_int_equal(lpv_engine_set_settings(lpvt_engine, &s, err, sizeof err), 0);
     assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
-    const size_t changed = lpv_engine_last_stats(lpvt_engine)->iv.points;
+    const size_t changed = (size_t)lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "points")->v[0];
     const lpv_iv_point_params pp =
         lpv_iv_point_params_of(lpv_engine_settings(lpvt_engine), lpv_engine_grid(lpvt_engine));
     struct IvPoint *pts = NULL;
@@ -627,11 +627,11 @@ static void test_hard_cases(void **state)
             tick(&h.scene, &s, &v);
             const double most = (double)LPV_IV_TAIL_MAX_RATIO * LPV_IV_TAIL_MAX_RATIO, cap = most / (1.0 - most);
             const double et = total_dc();
-            const float *r = lpv_engine_last_stats(lpvt_engine)->iv.tail_ratio;
+            const double *r = lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "tail_ratio")->v;
             print_message("%-28s tail ratio %.4f %.4f %.4f adds %.4g\n", info->name, (double)r[0], (double)r[1],
                           (double)r[2], et - e[3]);
             for (int ch = 0; ch < 3; ++ch)
-                assert_true(r[ch] >= 0.0f && r[ch] <= LPV_IV_TAIL_MAX_RATIO);
+                assert_true(r[ch] >= 0.0 && r[ch] <= LPV_IV_TAIL_MAX_RATIO);
             assert_true(isfinite(et));
             assert_true(et >= e[3] * (1.0 - 1e-6) - 1e-30);
             assert_true(et - e[3] <= cap * (e[3] - e[1]) * (1.0 + 1e-3) + 1e-6 * e[3] + 1e-30);
