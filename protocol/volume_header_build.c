@@ -1,0 +1,212 @@
+/*
+ * volume_header_build.c - the VOLUME header's JSON from an
+ * lpvp_volume_info (SPEC R5.1, R5.9 - R5.14): placement, cascades or
+ * levels, the description object, the index. See volume_codec.h.
+ */
+#include "volume_codec.h"
+#include "proto.h"
+#include "volume_codec_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The description object (R5.9): levels from the cascades, values from the
+ * SH names (the only values this library builds). */
+static json_t *placement_json(const lpvp_cascade_info *c);
+static json_t *index_json(const lpvp_volume_info *vi);
+
+static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
+{
+    const lpvp_volume_layout *l = &vi->layout;
+    json_t *levels = NULL, *values = json_array();
+    if (l->content == LPVP_CONTENT_LEVELS) { /* R5.13: the octree's levels */
+        levels = json_array();
+        for (int k = 0; levels && k < l->level_count && k < LPVP_MAX_LEVELS; k++) {
+            if (json_array_append_new(levels, placement_json(&l->level[k])) != 0) {
+                json_decref(levels);
+                levels = NULL;
+            }
+        }
+    } else {
+        levels = json_deep_copy(cascades);
+    }
+    json_t *o = json_object();
+    int bad = !levels || !values || !o || !l->sh_values || l->values_per_cell != LPVP_VALUES_PER_CELL;
+    for (size_t k = 0; !bad && k < json_array_size(levels); k++) {
+        int r = l->role[k] >= 0 && l->role[k] < LPVP_ROLE_COUNT ? (int)l->role[k] : LPVP_ROLE_CASCADE;
+        bad |= json_object_set_new(json_array_get(levels, k), "role", json_string(lpvp_level_role_names[r])) != 0;
+    }
+    for (int i = 0; !bad && i < LPVP_VALUES_PER_CELL; i++)
+        bad |= json_array_append_new(values, json_string(lpvp_sh_value_names[i])) != 0;
+    if (!bad) {
+        bad |= json_object_set_new(o, "layout_version", json_integer(l->layout_version)) != 0;
+        bad |= json_object_set_new(o, "technique", json_string(l->technique)) != 0;
+        bad |= json_object_set_new(o, "levels", levels) != 0;
+        levels = NULL;
+        bad |= json_object_set_new(o, "far_field", json_boolean(l->far_field)) != 0;
+        bad |= json_object_set_new(o, "volumes_per_level", json_integer(l->volumes_per_level)) != 0;
+        bad |= json_object_set_new(o, "values_per_cell", json_integer(l->values_per_cell)) != 0;
+        bad |= json_object_set_new(o, "values", values) != 0;
+        values = NULL;
+        bad |= json_object_set_new(o, "units", json_string(lpvp_volume_layout_units(l))) != 0;
+        bad |= json_object_set_new(o, "index", l->has_index ? index_json(vi) : json_null()) != 0;
+        if (lpvp_volume_layout_is_iv(l)) /* R5.14 */
+            bad |= json_object_set_new(o, LPVP_IV_NEIGHBOURS_KEY, json_integer(l->iv_neighbours)) != 0;
+    }
+    json_decref(levels);
+    json_decref(values);
+    if (bad) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* ---- Volume header -------------------------------------------------------- */
+
+static json_t *vec_json(const double *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < n; i++) {
+        if (json_array_append_new(a, json_real(isfinite(v[i]) ? v[i] : 0.0)) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+int lpvp_cascades_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
+{
+    if (vi->cascade_count == 0) {
+        memset(out, 0, sizeof *out);
+        out->cells = 1;
+        for (int i = 0; i < 3; i++) {
+            out->dims[i] = vi->dims[i];
+            out->origin[i] = vi->origin[i];
+            out->cells *= (uint64_t)(vi->dims[i] > 0 ? vi->dims[i] : 0);
+        }
+        out->cell_size = vi->cell_size;
+        return 1;
+    }
+    if (vi->cascade_count < 0 || vi->cascade_count > LPVP_MAX_CASCADES)
+        return -1;
+    for (int k = 0; k < vi->cascade_count; k++)
+        out[k] = vi->cascades[k];
+    return vi->cascade_count;
+}
+
+/* The levels the raw volume holds: the octree's (R5.13) or the cascades. */
+static int levels_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
+{
+    if (vi->layout.content != LPVP_CONTENT_LEVELS)
+        return lpvp_cascades_of(vi, out);
+    if (vi->layout.level_count < 1 || vi->layout.level_count > LPVP_MAX_LEVELS)
+        return -1;
+    for (int k = 0; k < vi->layout.level_count; k++)
+        out[k] = vi->layout.level[k];
+    return vi->layout.level_count;
+}
+
+uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi)
+{
+    lpvp_cascade_info c[LPVP_MAX_LEVELS];
+    int n = levels_of(vi, c);
+    uint64_t total = 0;
+    for (int k = 0; k < n; k++)
+        total += c[k].cells;
+    return n < 0 ? 0 : total;
+}
+
+uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k)
+{
+    lpvp_cascade_info c[LPVP_MAX_LEVELS];
+    int n = levels_of(vi, c);
+    uint64_t first = 0;
+    for (int i = 0; i < k && i < n; i++)
+        first += c[i].cells;
+    return first;
+}
+
+/* One level's (cascade's) placement: dims, origin, cell_size, cells. */
+static json_t *placement_json(const lpvp_cascade_info *c)
+{
+    return json_pack("{s:[I,I,I], s:o, s:f, s:I}", "dims", (json_int_t)c->dims[0], (json_int_t)c->dims[1],
+                     (json_int_t)c->dims[2], "origin", vec_json(c->origin, 3), "cell_size",
+                     isfinite(c->cell_size) ? c->cell_size : 0.0, "cells", (json_int_t)c->cells);
+}
+
+/* The index object (R5.12), right after the levels' values. */
+static json_t *index_json(const lpvp_volume_info *vi)
+{
+    const lpvp_index_info *ix = &vi->layout.index;
+    uint64_t length = ix->cells * (uint64_t)ix->values_per_cell * LPVP_INDEX_VALUE_SIZE;
+    return json_pack("{s:i, s:[I,I,I], s:i, s:s, s:I, s:I}", "level", ix->level, "dims", (json_int_t)ix->dims[0],
+                     (json_int_t)ix->dims[1], (json_int_t)ix->dims[2], "values_per_cell", ix->values_per_cell,
+                     "value_type", LPVP_INDEX_VALUE_TYPE, "raw_offset", (json_int_t)lpvp_volume_values_bytes(vi),
+                     "raw_length", (json_int_t)length);
+}
+
+static json_t *cascades_json(const lpvp_volume_info *vi)
+{
+    lpvp_cascade_info c[LPVP_MAX_CASCADES];
+    int n = lpvp_cascades_of(vi, c);
+    json_t *a = json_array();
+    if (!a || n < 0) {
+        json_decref(a);
+        return NULL;
+    }
+    for (int k = 0; k < n; k++) {
+        json_t *e = placement_json(&c[k]);
+        if (!e || json_array_append_new(a, e) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
+{
+    json_t *o = json_object();
+    json_t *grid = json_object();
+    json_t *dims = json_array();
+    int bad = !o || !grid || !dims;
+    for (int i = 0; !bad && i < 3; i++)
+        bad |= json_array_append_new(dims, json_integer(vi->dims[i])) != 0;
+    if (!bad) {
+        bad |= json_object_set_new(grid, "dims", dims) != 0;
+        dims = NULL;
+        bad |= json_object_set_new(grid, "origin", vec_json(vi->origin, 3)) != 0;
+        bad |= json_object_set_new(grid, "cell_size",
+                                   json_real(isfinite(vi->cell_size) ? vi->cell_size : 0.0)) != 0;
+    }
+    if (!bad) {
+        bad |= json_object_set_new(o, "revision", json_integer(vi->revision)) != 0;
+        bad |= json_object_set_new(o, "tick", json_integer(vi->tick)) != 0;
+        bad |= json_object_set_new(o, "format",
+                                   json_string(lpvp_volume_format_name(vi->format))) != 0;
+        bad |= json_object_set_new(o, "compression",
+                                   json_string(lpvp_compression_name(vi->compression))) != 0;
+        bad |= json_object_set_new(o, "keyframe", json_boolean(vi->keyframe)) != 0;
+        if (!vi->keyframe)
+            bad |= json_object_set_new(o, "base_tick", json_integer(vi->base_tick)) != 0;
+        bad |= json_object_set_new(o, "grid", grid) != 0;
+        grid = NULL;
+        json_t *cascades = cascades_json(vi);
+        bad |= json_object_set_new(o, "cascades", cascades) != 0;
+        bad |= json_object_set_new(o, "units", json_string(lpvp_volume_layout_units(&vi->layout))) != 0;
+        bad |= json_object_set_new(o, "layout", json_string(LPVP_VOLUME_LAYOUT)) != 0;
+        bad |= json_object_set_new(o, "sh", json_string(LPVP_VOLUME_SH)) != 0;
+        bad |= json_object_set_new(o, "raw_length", json_integer((json_int_t)vi->raw_length)) != 0;
+        if (!bad && vi->layout.present)
+            bad |= json_object_set_new(o, LPVP_VOLUME_DESC_KEY, layout_json(vi, cascades)) != 0;
+    }
+    json_decref(dims);
+    json_decref(grid);
+    if (bad) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
