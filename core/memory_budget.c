@@ -167,13 +167,14 @@ void lpv_memory_need_floor(const lpv_settings *s, int light_faces, lpv_memory_ne
     n->rsm_faces = faces;
     n->shadow_size = s->shadow_size;
     n->shadow_faces = faces;
-    if (s->technique != LPV_TECHNIQUE_ID_LPV && s->technique != LPV_TECHNIQUE_ID_OCTREE)
-        return;
-    /* the cascades asked for, and the far field's levels the LPV adds to one */
-    const int asked = s->lpv.cascades > 0 ? s->lpv.cascades : 1;
-    const size_t k = (size_t)(s->technique == LPV_TECHNIQUE_ID_LPV ? lpv_cascades_count(s, asked) : 1);
+    lpv_technique_memory_floor(s, n);
+}
+
+void lpv_memory_need_grid(const struct lpv_settings *s, int levels, lpv_memory_need *n)
+{
+    const size_t k = (size_t)levels;
     n->cells = (size_t)s->grid_dims[0] * (size_t)s->grid_dims[1] * (size_t)s->grid_dims[2] * k;
     n->gv_points = (size_t)(s->grid_dims[0] + 1) * (size_t)(s->grid_dims[1] + 1) * (size_t)(s->grid_dims[2] + 1) * k;
-    n->cascades = (int)k;
+    n->cascades = levels;
     memcpy(n->grid_dims, s->grid_dims, sizeof n->grid_dims);
 }

@@ -82,11 +82,18 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
 
 /* The least any scene needs under settings s (resolved, core/settings.h):
  * one light face of RSM and of shadow map at their sizes times light_faces
- * (at least 1), and for the LPV and the octree their grid at the cascades
- * asked for (at least one, and the LPV's far-field levels); nothing for the imperfect volume or auto, whose
- * grids the scene places. What fails lpv_memory_check here can never run, so
- * the daemon refuses it at CONFIG (issue 31, item 11). */
+ * (at least 1), and the technique's own floor (lpv_technique_memory_floor:
+ * for the LPV and the octree their grid at the cascades asked for; nothing
+ * for the imperfect volume or auto, whose grids the scene places). What
+ * fails lpv_memory_check here can never run, so the daemon refuses it at
+ * CONFIG (issue 31, item 11). */
 struct lpv_settings;
 void lpv_memory_need_floor(const struct lpv_settings *s, int light_faces, lpv_memory_need *n);
+/* Sets n's grid to `levels` grids of s's grid_dims cells (and their
+ * geometry-volume points): the LPVs' floor. */
+void lpv_memory_need_grid(const struct lpv_settings *s, int levels, lpv_memory_need *n);
+/* Adds the technique's own least storage under s to n (its row of
+ * techniques/registry.c; none for a technique without one). */
+void lpv_technique_memory_floor(const struct lpv_settings *s, lpv_memory_need *n);
 
 #endif /* LPV_MEMORY_BUDGET_H */

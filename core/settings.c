@@ -346,13 +346,8 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
     if (s->technique != LPV_TECHNIQUE_ID_DEFAULT && !lpv_technique_name(s->technique))
         return fail(err, err_size, "technique = %d is out of range (allowed: %s)", (int)s->technique,
                     lpv_technique_names());
-    if (s->technique == LPV_TECHNIQUE_ID_OCTREE) { /* a full octree halves one cube down to one cell */
-        const int n = s->grid_dims[0];
-        if (n != s->grid_dims[1] || n != s->grid_dims[2] || n < 1 || (n & (n - 1)) != 0)
-            return fail(err, err_size,
-                        "technique octree needs a cubic grid of a power of two cells per axis (grid %dx%dx%d)",
-                        s->grid_dims[0], s->grid_dims[1], s->grid_dims[2]);
-    }
+    if (lpv_technique_validate(s, err, err_size) != 0) /* its own rules (techniques/registry.c) */
+        return -1;
     for (int i = 0; i < 3; i++) {
         if (s->grid_dims[i] < 1 || s->grid_dims[i] > LPV_MAX_GRID_DIM)
             return fail(err, err_size, "grid_dims[%d] = %d is out of range (allowed 1..%d)", i, s->grid_dims[i],

@@ -311,6 +311,10 @@ int lpv_technique_has(lpv_technique_id t, lpv_technique_cap cap);
  * term (a technique with LPV_CAP_AO, its ao knob on); else -1 with why in
  * err, naming the technique and the knob. The one place of that rule. */
 int lpv_ao_check(const lpv_settings *s, lpv_technique_id running, char *err, size_t n);
+/* The technique's own rules on s beyond each knob's range (its row of
+ * techniques/registry.c; the octree: a cubic power-of-two grid): 0, or -1
+ * with why in err. lpv_settings_validate calls it. */
+int lpv_technique_validate(const lpv_settings *s, char *err, size_t n);
 
 /* The preset's name ("balanced" for DEFAULT), or NULL for an unknown value. */
 const char *lpv_preset_name(lpv_preset p);

@@ -21,7 +21,7 @@ void lpv_tick_cost_estimate(const lpv_settings *s, lpv_tick_cost *out)
         r->tick_cost(s, out);
         return;
     }
-    /* auto: the dearest of the techniques the planner may choose (core/plan.c) */
+    /* auto: the dearest of the techniques auto may choose (techniques/auto_choose.c) */
     memset(out, 0, sizeof *out);
     for (int t = 0; t < LPV_TECHNIQUE_ID_COUNT_; ++t) {
         r = lpv_technique_rules_of((lpv_technique_id)t);

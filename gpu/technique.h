@@ -172,15 +172,9 @@ struct lpv_technique_class {
     void (*stats)(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats *s);
 };
 
-/* The cascaded light propagation volume (techniques/lpv/gpu/). */
-extern const lpv_technique_class lpv_technique_cascaded_lpv;
-/* The octree light propagation volume (techniques/octree/gpu/technique_octree.c). */
-extern const lpv_technique_class lpv_technique_octree;
-/* Imperfect volumes (techniques/iv/gpu/). */
-extern const lpv_technique_class lpv_technique_iv;
-
-/* The class of a technique (core/settings.h's ids; technique.c's table), or
- * NULL for an id without one. */
+/* The class of a technique (core/settings.h's ids; the table of
+ * techniques/classes.c, which names each module's class), or NULL for an id
+ * without one. */
 const lpv_technique_class *lpv_technique_class_of(lpv_technique_id id);
 
 #endif /* LPV_TECHNIQUE_H */

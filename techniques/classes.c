@@ -4,6 +4,11 @@
  */
 #include "technique.h"
 
+/* Each module's class (techniques/NAME/gpu/technique_NAME.c). */
+extern const lpv_technique_class lpv_technique_cascaded_lpv;
+extern const lpv_technique_class lpv_technique_octree;
+extern const lpv_technique_class lpv_technique_iv;
+
 static const lpv_technique_class *const CLASSES[LPV_TECHNIQUE_ID_COUNT_] = {
     [LPV_TECHNIQUE_ID_LPV] = &lpv_technique_cascaded_lpv,
     [LPV_TECHNIQUE_ID_OCTREE] = &lpv_technique_octree,

@@ -12,11 +12,12 @@
 #include "octree_rules.h"
 
 static const lpv_technique_rules TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
-    [LPV_TECHNIQUE_ID_DEFAULT] = {NULL, 0, 0, NULL}, /* not a row: resolves to LPV_TECHNIQUE_ID_DEFAULT_IS */
-    [LPV_TECHNIQUE_ID_LPV] = {LPV_TECHNIQUE_LPV, 0, 1, lpv_lpv_tick_cost},
-    [LPV_TECHNIQUE_ID_OCTREE] = {LPV_TECHNIQUE_OCTREE, 0, 0, lpv_octree_tick_cost},
-    [LPV_TECHNIQUE_ID_IV] = {LPV_TECHNIQUE_IV, LPV_CAP_AO, 1, lpv_iv_tick_cost},
-    [LPV_TECHNIQUE_ID_AUTO] = {LPV_TECHNIQUE_AUTO, 0, 0, NULL}, /* no capability until the engine has chosen */
+    [LPV_TECHNIQUE_ID_DEFAULT] = {0}, /* not a row: resolves to LPV_TECHNIQUE_ID_DEFAULT_IS */
+    [LPV_TECHNIQUE_ID_LPV] = {LPV_TECHNIQUE_LPV, 0, 1, lpv_lpv_tick_cost, NULL, lpv_lpv_memory_floor},
+    [LPV_TECHNIQUE_ID_OCTREE] = {LPV_TECHNIQUE_OCTREE, 0, 0, lpv_octree_tick_cost, lpv_octree_validate,
+                                 lpv_octree_memory_floor},
+    [LPV_TECHNIQUE_ID_IV] = {LPV_TECHNIQUE_IV, LPV_CAP_AO, 1, lpv_iv_tick_cost, NULL, NULL},
+    [LPV_TECHNIQUE_ID_AUTO] = {LPV_TECHNIQUE_AUTO, 0, 0, NULL, NULL, NULL}, /* nothing until the engine chose */
 };
 
 const lpv_technique_rules *lpv_technique_rules_of(lpv_technique_id t)
@@ -45,6 +46,19 @@ const char *lpv_technique_name(lpv_technique_id t)
 const char *lpv_technique_names(void)
 {
     return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV ", " LPV_TECHNIQUE_AUTO; /* the table's names, in its order */
+}
+
+int lpv_technique_validate(const lpv_settings *s, char *err, size_t err_size)
+{
+    const lpv_technique_rules *r = lpv_technique_rules_of(s->technique);
+    return r && r->validate ? r->validate(s, err, err_size) : 0;
+}
+
+void lpv_technique_memory_floor(const lpv_settings *s, lpv_memory_need *n)
+{
+    const lpv_technique_rules *r = lpv_technique_rules_of(s->technique);
+    if (r && r->memory_floor)
+        r->memory_floor(s, n);
 }
 
 int lpv_technique_has(lpv_technique_id t, lpv_technique_cap cap)

@@ -43,6 +43,9 @@ typedef struct lpv_iv_gpu {
     lpv_grid cloud_grid;      /* the volume it was made for (its pieces split by its voxel, kept in its box) */
 } lpv_iv_gpu;
 
+/* The class (technique_iv.c), listed in techniques/classes.c. */
+extern const lpv_technique_class lpv_technique_iv;
+
 /* The class's sample_scene and samples_stale (iv_cloud.c): the point cloud
  * at the voxel size the settings place over the lit space. */
 int lpv_iv_sample_scene(lpv_technique *t, const lpv_technique_scene *sc, char *err, size_t err_size);

@@ -1,5 +1,6 @@
 /*
- * lpv_cost.c - the cascaded LPV's tick cost bound (core/tick_cost.h).
+ * lpv_cost.c - the cascaded LPV's tick cost bound (core/tick_cost.h) and
+ * its least storage (core/memory_budget.h).
  */
 #include "lpv_rules.h"
 
@@ -21,4 +22,11 @@ void lpv_lpv_tick_cost(const lpv_settings *s, lpv_tick_cost *out)
              s->grid_dims[0], s->grid_dims[1], s->grid_dims[2], cascades, cascades == 1 ? "" : "s", bins,
              bins == 1 ? "" : "s", s->lpv.iterations);
     out->lower = "grid, iterations, cascades or normal_bins";
+}
+
+void lpv_lpv_memory_floor(const lpv_settings *s, lpv_memory_need *n)
+{
+    /* the cascades asked for, and the far field's levels the LPV adds to one */
+    const int asked = s->lpv.cascades > 0 ? s->lpv.cascades : 1;
+    lpv_memory_need_grid(s, lpv_cascades_count(s, asked), n);
 }

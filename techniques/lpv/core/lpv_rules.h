@@ -5,6 +5,7 @@
 #ifndef LPV_LPV_RULES_H
 #define LPV_LPV_RULES_H
 
+#include "memory_budget.h"
 #include "plan.h"
 #include "tick_cost.h"
 
@@ -15,5 +16,9 @@ void lpv_plan_make_lpv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan 
 /* Cells x cascades (auto: the most the planner may place, the far field's
  * levels included) x normal bins x iterations. */
 void lpv_lpv_tick_cost(const lpv_settings *s, lpv_tick_cost *out);
+
+/* Its least storage whatever the scene: the grid at the cascades asked for
+ * (at least one) and the far field's levels. */
+void lpv_lpv_memory_floor(const lpv_settings *s, lpv_memory_need *n);
 
 #endif /* LPV_LPV_RULES_H */

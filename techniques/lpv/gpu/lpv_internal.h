@@ -43,6 +43,9 @@ typedef struct lpv_cascaded {
     int grid_alloc_dims[3], grid_alloc_cascades, grid_alloc_bins;
 } lpv_cascaded;
 
+/* The cascaded LPV's class (technique_lpv.c), listed in techniques/classes.c. */
+extern const lpv_technique_class lpv_technique_cascaded_lpv;
+
 /* Cells of one cascade, and of all cascades in use. */
 static inline size_t lpv_cascade_cells(const lpv_cascaded *c) { return lpv_grid_cell_count(&c->grid); }
 static inline size_t lpv_all_cells(const lpv_cascaded *c)

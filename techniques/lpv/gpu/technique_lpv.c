@@ -1,7 +1,7 @@
 /*
  * technique_lpv.c - the cascaded light propagation volume (Kaplanyan &
- * Dachsbacher) as an lpv_technique: its programs, its plan (core/plan.c's
- * rules), its tick (inject -> geometry volume -> propagation with the
+ * Dachsbacher) as an lpv_technique: its programs, its plan (lpv_plan.c's
+ * rules, techniques/lpv/core), its tick (inject -> geometry volume -> propagation with the
  * far-field hand-off), its lookup (techniques/lpv/shaders/lookup.glsl over grid.glsl) and
  * what it says about its volume. The passes are in lpv_*.c beside it.
  */
@@ -125,7 +125,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     return lpv_cascaded_commit((lpv_cascaded *)t, w, reset, err, err_size);
 }
 
-/* The LPV's rules are core/plan.c's: they also decide which of the shared
+/* The LPV's rules (techniques/lpv/core/lpv_plan.c): they also decide which of the shared
  * producers run (the RSMs feed injection, the camera's surfels the GV). */
 static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
 {

@@ -11,4 +11,11 @@
 /* Every level propagates: level 0's cells x 8/7 x iterations. */
 void lpv_octree_tick_cost(const lpv_settings *s, lpv_tick_cost *out);
 
+/* Its least storage whatever the scene: level 0's grid. */
+void lpv_octree_memory_floor(const lpv_settings *s, lpv_memory_need *n);
+
+/* A full octree halves one cube down to one cell: a cubic grid of a power
+ * of two cells per axis. 0, or -1 with why in err. */
+int lpv_octree_validate(const lpv_settings *s, char *err, size_t err_size);
+
 #endif /* LPV_OCTREE_RULES_H */

@@ -35,6 +35,9 @@
 #include "oracle_octree.h"
 #include "shader.h"
 
+/* The class (below), listed in techniques/classes.c. */
+extern const lpv_technique_class lpv_technique_octree;
+
 typedef struct lpv_octree_gpu {
     lpv_technique base;
     lpv_settings settings;
@@ -215,7 +218,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     return 0;
 }
 
-/* The LPV's rules (core/plan.c), and the octree's levels with the reason the
+/* The LPV's rules (techniques/lpv/core/lpv_plan.c), and the octree's levels with the reason the
  * thesis gives: after k steps, levels l-1-floor(log2 k) .. l-1 are covered
  * completely (section 4.2). */
 static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
