@@ -26,17 +26,26 @@ static const char *const INC_VPL_BLOCKS8[] = {"grid.glsl", "block_slots8.glsl", 
                                               NULL};
 static const char *const INC_COMPACT[] = {"compact.glsl", NULL};
 
-/* out = the technique's lookup includes, reach.glsl (the enclosed-light
+/* out = grid.glsl (the SH basis and grid block every reader of a volume
+ * uses, whatever the technique), the technique's lookup includes (a name
+ * already in the list is not pasted twice), reach.glsl (the enclosed-light
  * mask every reader of the volume multiplies by), then the pass's own (both
  * NULL-terminated; own may be NULL). Returns -1 when they do not fit. */
 static int includes(const char **out, size_t cap, const char *const *own, const char *const *lookup)
 {
     size_t n = 0;
-    for (const char *const *i = lookup; i && *i; ++i)
+    out[n++] = "grid.glsl";
+    for (const char *const *i = lookup; i && *i; ++i) {
+        int dup = 0;
+        for (size_t k = 0; k < n; ++k)
+            dup |= strcmp(out[k], *i) == 0;
+        if (dup)
+            continue;
         if (n + 1 < cap)
             out[n++] = *i;
         else
             return -1;
+    }
     if (n + 1 < cap)
         out[n++] = "reach.glsl";
     else

@@ -26,7 +26,9 @@
  *               uniform float u_damping;              0 = off
  *             and whatever they bind (bind_lookup binds it). The engine
  *             pastes them into shade.comp, glossy.frag, media.frag and
- *             query.comp when it builds those programs.
+ *             query.comp when it builds those programs, after grid.glsl
+ *             (the SH basis and grid block, which those shaders use too:
+ *             a technique may name it, it is pasted once).
  *
  * A technique sees none of the engine: what it needs comes in the structs
  * below. docs/architecture.md, "Adding a technique", walks through writing
