@@ -138,12 +138,9 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_BAD_VALUE) {
-            fprintf(stderr, "lpvd-bench: %s\n", p.err);
-            return 2;
-        } else if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_NO_VALUE) {
-            fprintf(stderr, "lpvd-bench: %s %s (see --help)\n", p.arg,
-                    it == LPV_FLAGS_UNKNOWN ? "is unknown" : "needs a value");
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem) {
+            fprintf(stderr, "lpvd-bench: %s (see --help)\n", problem);
             return 2;
         } else if (it == LPV_FLAGS_POSITIONAL) {
             scene_path = v; /* the last one given */

@@ -355,12 +355,10 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_BAD_VALUE) {
-            fprintf(stderr, "lpvd-bench-features: %s\n", p.err);
-            return 2;
-        } else if (it != LPV_FLAGS_FLAG) {
-            fprintf(stderr, "lpvd-bench-features: %s %s (see --help)\n", it == LPV_FLAGS_POSITIONAL ? v : p.arg,
-                    it == LPV_FLAGS_NO_VALUE ? "needs a value" : it == LPV_FLAGS_POSITIONAL ? "is no flag" : "is unknown");
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem || it == LPV_FLAGS_POSITIONAL) {
+            fprintf(stderr, "lpvd-bench-features: %s%s (see --help)\n", problem ? "" : "unexpected argument ",
+                    problem ? problem : v);
             return 2;
         } else if (fl == &FLAGS[B_HELP]) {
             usage(stdout);

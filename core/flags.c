@@ -22,6 +22,19 @@ void lpv_flags_append(char *buf, size_t size, size_t *len, const char *fmt, ...)
         *len = *len + (size_t)n < size ? *len + (size_t)n : size;
 }
 
+const char *lpv_flags_problem(lpv_flags *p, lpv_flags_item it)
+{
+    switch (it) {
+    case LPV_FLAGS_UNKNOWN: snprintf(p->err, sizeof p->err, "unknown flag %s", p->arg); return p->err;
+    case LPV_FLAGS_NO_VALUE: snprintf(p->err, sizeof p->err, "%s needs a value", p->arg); return p->err;
+    case LPV_FLAGS_BAD_VALUE: return p->err;
+    case LPV_FLAGS_END:
+    case LPV_FLAGS_FLAG:
+    case LPV_FLAGS_POSITIONAL: break;
+    }
+    return NULL;
+}
+
 const lpv_flag *lpv_flag_find(const lpv_flag *flags, size_t count, const char *name)
 {
     for (size_t i = 0; name && i < count; ++i)

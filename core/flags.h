@@ -74,6 +74,12 @@ int lpv_flags_begin(lpv_flags *p, int argc, char **argv, const lpv_flag_group *g
  * parsed here and not returned. */
 lpv_flags_item lpv_flags_next(lpv_flags *p, int *group, const lpv_flag **flag, const char **value);
 
+/* What is wrong with an item lpv_flags_next returned, in words, for a
+ * program's "PROG: %s (see PROG --help)": "unknown flag --x", "--x needs a
+ * value" or the group's own message (written into p->err); NULL for a flag
+ * or a positional argument, which only the program can judge. */
+const char *lpv_flags_problem(lpv_flags *p, lpv_flags_item it);
+
 /* The flag named name (without dashes) in a table, or NULL. */
 const lpv_flag *lpv_flag_find(const lpv_flag *flags, size_t count, const char *name);
 

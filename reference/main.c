@@ -202,16 +202,9 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *val;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &val)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_UNKNOWN) {
-            fprintf(stderr, "lpvd-reference: unknown flag %s\n%s", p.arg, usage());
-            return 2;
-        }
-        if (it == LPV_FLAGS_NO_VALUE) {
-            fprintf(stderr, "lpvd-reference: %s needs a value\n", p.arg);
-            return 2;
-        }
-        if (it == LPV_FLAGS_BAD_VALUE) {
-            fprintf(stderr, "lpvd-reference: %s\n", p.err);
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem) {
+            fprintf(stderr, "lpvd-reference: %s (see lpvd-reference --help)\n", problem);
             return 2;
         }
         if (it == LPV_FLAGS_POSITIONAL) {

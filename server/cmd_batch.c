@@ -212,10 +212,9 @@ int lpvd_cmd_batch(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_NO_VALUE || it == LPV_FLAGS_BAD_VALUE) {
-            fprintf(stderr, "lpvd batch: %s%s (see lpvd batch --help)\n",
-                    it == LPV_FLAGS_UNKNOWN ? "unknown flag " : it == LPV_FLAGS_NO_VALUE ? "a value is missing: " : "",
-                    it == LPV_FLAGS_BAD_VALUE ? p.err : p.arg);
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem) {
+            fprintf(stderr, "lpvd batch: %s (see lpvd batch --help)\n", problem);
             return 2;
         }
         if (it == LPV_FLAGS_POSITIONAL) {

@@ -92,17 +92,9 @@ int lpvd_cmd_render(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_UNKNOWN) {
-            fprintf(stderr, "lpvd render: unknown flag %s (see lpvd render --help)\n", p.arg);
-            return 2;
-        }
-        if (it == LPV_FLAGS_NO_VALUE) {
-            fprintf(stderr, "lpvd render: %s needs a %s\n", p.arg,
-                    strcmp(p.arg, "-o") == 0 || strcmp(p.arg, "--output") == 0 ? "path" : "value");
-            return 2;
-        }
-        if (it == LPV_FLAGS_BAD_VALUE) {
-            fprintf(stderr, "lpvd render: %s\n", p.err);
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem) {
+            fprintf(stderr, "lpvd render: %s (see lpvd render --help)\n", problem);
             return 2;
         }
         if (it == LPV_FLAGS_POSITIONAL) {

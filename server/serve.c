@@ -370,15 +370,11 @@ int lpvd_cmd_serve(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        switch (it) {
-        case LPV_FLAGS_UNKNOWN: fprintf(stderr, "lpvd serve: unknown flag %s (see lpvd serve --help)\n", p.arg); return 2;
-        case LPV_FLAGS_NO_VALUE: fprintf(stderr, "lpvd serve: %s needs a value\n", p.arg); return 2;
-        case LPV_FLAGS_BAD_VALUE: fprintf(stderr, "lpvd serve: %s\n", p.err); return 2;
-        case LPV_FLAGS_POSITIONAL:
-            fprintf(stderr, "lpvd serve: unexpected argument %s (see lpvd serve --help)\n", v);
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem || it == LPV_FLAGS_POSITIONAL) {
+            fprintf(stderr, "lpvd serve: %s%s (see lpvd serve --help)\n", problem ? "" : "unexpected argument ",
+                    problem ? problem : v);
             return 2;
-        case LPV_FLAGS_FLAG:
-        case LPV_FLAGS_END: break;
         }
         if (g == camera_group) {
             fprintf(stderr, "lpvd serve: --%s is not used by the daemon (clients send CAMERA_SET)\n", fl->name);

@@ -85,18 +85,23 @@ static void test_errors_name_the_flag(void **state)
     assert_int_equal(parse(4, unknown, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_UNKNOWN);
     assert_string_equal(p.arg, "--nope");
     assert_string_equal(log, "full ");
+    assert_string_equal(lpv_flags_problem(&p, LPV_FLAGS_UNKNOWN), "unknown flag --nope");
+    assert_null(lpv_flags_problem(&p, LPV_FLAGS_POSITIONAL));
+    assert_null(lpv_flags_problem(&p, LPV_FLAGS_FLAG));
     char *short_unknown[] = {"prog", "-x"};
     assert_int_equal(parse(2, short_unknown, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_UNKNOWN);
     assert_string_equal(p.arg, "-x");
     char *no_value[] = {"prog", "--grid"};
     assert_int_equal(parse(2, no_value, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_NO_VALUE);
     assert_string_equal(p.arg, "--grid");
+    assert_string_equal(lpv_flags_problem(&p, LPV_FLAGS_NO_VALUE), "--grid needs a value");
     char *no_value_short[] = {"prog", "-o"};
     assert_int_equal(parse(2, no_value_short, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_NO_VALUE);
     assert_string_equal(p.arg, "-o");
     char *bad[] = {"prog", "--occlusion", "maybe"};
     assert_int_equal(parse(3, bad, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_BAD_VALUE);
     assert_non_null(strstr(p.err, "--occlusion maybe: expected on or off"));
+    assert_ptr_equal(lpv_flags_problem(&p, LPV_FLAGS_BAD_VALUE), p.err); /* the group's own message */
     char *bad_size[] = {"prog", "--size=12"};
     assert_int_equal(parse(2, bad_size, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_BAD_VALUE);
     assert_non_null(strstr(p.err, "--size 12: expected WxH"));

@@ -1885,12 +1885,10 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&cli, &cg, &fl, &v)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_NO_VALUE) {
-            fprintf(stderr, "lpvd-accuracy: %s needs a value (or is unknown; see --help)\n", cli.arg);
-            return 2;
-        }
-        if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_POSITIONAL) {
-            fprintf(stderr, "lpvd-accuracy: unknown argument %s (see --help)\n", it == LPV_FLAGS_UNKNOWN ? cli.arg : v);
+        const char *problem = lpv_flags_problem(&cli, it);
+        if (problem || it == LPV_FLAGS_POSITIONAL) {
+            fprintf(stderr, "lpvd-accuracy: %s%s (see --help)\n", problem ? "" : "unexpected argument ",
+                    problem ? problem : v);
             return 2;
         }
         if (cg > 0) { /* a shared flag */

@@ -384,14 +384,10 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        if (it == LPV_FLAGS_NO_VALUE) {
-            fprintf(stderr, "lpvd-hard-cases: %s needs a value (or is unknown; see --help)\n", p.arg);
-            return 2;
-        } else if (it == LPV_FLAGS_UNKNOWN || it == LPV_FLAGS_POSITIONAL) {
-            fprintf(stderr, "lpvd-hard-cases: unknown argument %s (see --help)\n", it == LPV_FLAGS_UNKNOWN ? p.arg : v);
-            return 2;
-        } else if (it == LPV_FLAGS_BAD_VALUE) {
-            fprintf(stderr, "lpvd-hard-cases: %s\n", p.err);
+        const char *problem = lpv_flags_problem(&p, it);
+        if (problem || it == LPV_FLAGS_POSITIONAL) {
+            fprintf(stderr, "lpvd-hard-cases: %s%s (see --help)\n", problem ? "" : "unexpected argument ",
+                    problem ? problem : v);
             return 2;
         } else if (fl == &FLAGS[H_HELP]) {
             usage(stdout, groups[1].flags, &groups[2]);
