@@ -20,7 +20,7 @@
 #include "points_csv.h"
 
 #include "scene_load.h"
-#include "serve.h"
+#include "export.h"
 #include "stats_json.h"
 #include "tonemap.h"
 #include "write_beneath.h"

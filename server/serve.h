@@ -11,8 +11,12 @@
  *                    their jobs; they report to sessions through
  *                    sv_world_listener
  *   serve_gl.c       the GL thread and its job queue
- *   serve_encode.c   VOLUME / FRAME payloads (fp16, XOR delta, zstd, PNG, EXR)
- *   serve_encode_work.c  runs them on libuv's work threads, sends on the loop
+ *   serve_encode_work.c  runs export.h's payload encoders (VOLUME / FRAME:
+ *                    fp16, XOR delta, zstd, PNG, EXR) on libuv's work
+ *                    threads, sends on the loop
+ *   serve_limits.c   the daemon's limits, one row each
+ * What a tick's result is and how it becomes a payload is export.h's
+ * (export_result.c, export_encode.c), shared with lpvd batch.
  *
  * Threads: the libuv loop runs on the main thread and owns every structure
  * here except the fields marked "GL thread". One GL thread owns the GL context
@@ -34,6 +38,7 @@
 #include "context.h"
 #include "proto.h"
 #include "engine.h"
+#include "export.h"
 #include "gltf_load.h"
 #include "hash.h"
 #include "serve_memory.h"
@@ -211,38 +216,6 @@ typedef struct sv_inputs {
     uint64_t key_hash;
 } sv_inputs;
 
-/* The product of one tick: immutable once handed to the main thread. */
-typedef struct sv_result {
-    int refs;
-    uint64_t tick;          /* world tick number, 1.. */
-    uint64_t gen;           /* world generation it was computed for */
-    lpv_grid grid;          /* cascade 0 (the finest) */
-    int cascade_count;      /* 1..LPVP_MAX_CASCADES */
-    lpv_grid cascades[LPVP_MAX_CASCADES]; /* finest first; every cascade has grid.dims */
-    float *cells;           /* cells * 12 floats: every cascade's, cascade 0 first */
-    size_t cell_count;      /* all cascades' cells */
-    /* GET_VOLUME content "levels" (SPEC R5.13), in a result of
-     * sv_result_take_levels only: every level's cells (level_cells x 12
-     * floats, level 0 first, as lpv_engine_read_volumes gives them) and the
-     * index (one per cell of cascade 0); NULL / 0 in a tick's result. */
-    float *levels;
-    size_t level_cells;
-    uint32_t *index;
-    size_t index_count;
-    /* Technique iv (SPEC R5.14): per voxel of the grid, 1 when it holds a
-     * surface (IvVoxel.normal[3] > 0), the index every iv volume carries;
-     * NULL / 0 for the other techniques. */
-    uint32_t *iv_held;
-    size_t iv_held_count;
-    float *frames[LPVP_TERMS_COUNT]; /* rgba float per lpv_frame_terms, NULL if not rendered */
-    int width, height;
-    lpv_engine_stats stats;
-    lpv_plan plan;          /* the plan of this tick, snapshotted with stats */
-    double tick_ms;         /* wall time of the tick on the GL thread */
-    /* main thread: keyframe attachments already encoded, [fp16][zstd] */
-    uint8_t *enc[2][2];
-    size_t enc_len[2][2];
-} sv_result;
 
 struct sv_world {
     int refs;               /* sessions attached */
@@ -342,13 +315,6 @@ typedef struct sv_request {
     struct sv_request *next;
 } sv_request;
 
-typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */
-    uint64_t tick;
-    int dims[3];
-    int fp16;
-    uint8_t *raw;
-    size_t raw_len;
-} sv_sent;
 
 #define SV_SENT_KEEP 4
 
@@ -571,18 +537,6 @@ void sv_world_jobs_done(uv_async_t *a);  /* done_async: finished jobs, on the lo
 void sv_world_attach(sv_conn *c, sv_inputs *in); /* consumes in */
 void sv_world_detach(sv_conn *c);
 void sv_world_unref(sv_world *w);
-void sv_result_unref(sv_result *r);
-/* The engine's last tick read back (serve_tick_result.c): every cascade's
- * accumulated volume, the imperfect volume's occupancy when the technique
- * has it, the frames of terms_mask (bit t: lpv_frame_terms t) at width x
- * height, stats and plan; refs 1, tick and gen 0 (the caller's). NULL with a
- * message in err. On the GL context's thread. */
-sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n);
-/* The octree's levels and index of the engine's last tick, for GET_VOLUME
- * content "levels" (SPEC R5.13) only (no merged cells, no frames), with the
- * grid, stats and plan; NULL with err for a technique without them. */
-sv_result *sv_result_take_levels(lpv_engine *e, char *err, size_t n);
-sv_result *sv_result_ref(sv_result *r);
 void sv_scene_unref(sv_server *s, sv_scene *sc);
 sv_scene *sv_scene_intern(sv_server *s, sv_scene *sc); /* dedupe by hash */
 /* 1 when sc is already live or fits in --max-scenes-memory next to the live
@@ -597,19 +551,7 @@ int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: join
  * lower (CONFIG's LIMIT, and the default CONFIG at start). */
 int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, size_t n);
 
-/* serve_encode.c: thread-safe, run on libuv's work threads */
-/* Volume reply/stream body + attachment. A delta subscriber's encoding passes
- * keep_raw: it gets the raw volume (for sv_sub_remember), and a delta against
- * base (its ACKed volume) when base fits; else keep_raw and base are NULL. */
-int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
-                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
-                     size_t n);
-/* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
-int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
-                    uint64_t revision,
-                    uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len,
-                    char *err, size_t n);
-/* the loop's side of a subscription */
+/* the loop's side of a subscription (serve_streams.c) */
 void sv_sub_clear(sv_sub *sub);
 void sv_sub_ack(sv_sub *sub, uint64_t tick);
 void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len);

@@ -2,7 +2,7 @@
  * serve_encode_work.c - nothing heavy on the event loop (issue 14, item 4):
  * the payloads of GET_VOLUME, GET_FRAME, QUERY_IRRADIANCE and of the VOLUME /
  * FRAME streams are packed, compressed and encoded (fp16, XOR, zstd, PNG,
- * EXR: serve_encode.c) on libuv's work threads; the loop only sends what
+ * EXR: export_encode.c) on libuv's work threads; the loop only sends what
  * comes back. A 4096x4096 EXR took 14 s on the loop and held every other
  * client's STATS for seconds.
  *

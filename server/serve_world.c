@@ -20,34 +20,6 @@
 #include <time.h>
 
 /* ---- small helpers ------------------------------------------------------ */
-sv_result *sv_result_ref(sv_result *r)
-{
-    if (r)
-        r->refs++;
-    return r;
-}
-
-static void result_free(sv_result *r)
-{
-    if (!r)
-        return;
-    free(r->cells);
-    free(r->levels);
-    free(r->index);
-    free(r->iv_held);
-    for (int i = 0; i < LPVP_TERMS_COUNT; ++i)
-        free(r->frames[i]);
-    for (int i = 0; i < 4; ++i)
-        free(r->enc[i / 2][i % 2]);
-    free(r);
-}
-
-void sv_result_unref(sv_result *r)
-{
-    if (r && --r->refs <= 0)
-        result_free(r);
-}
-
 void sv_scene_unref(sv_server *s, sv_scene *sc)
 {
     if (!sc || --sc->refs > 0)

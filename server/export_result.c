@@ -1,9 +1,9 @@
 /*
- * serve_tick_result.c - a tick's result read back from the engine on the GL
- * thread (sv_result: the accumulated volume of every cascade, the imperfect
- * volume's occupancy, the frames asked for, the stats and plan), what
- * GET_VOLUME, GET_FRAME and the streams encode. The daemon's GL thread and
- * lpvd batch's volume output take it here. The octree's levels and index
+ * export_result.c - a tick's result read back from the engine on the GL
+ * context's thread (sv_result: the accumulated volume of every cascade, the
+ * imperfect volume's occupancy, the frames asked for, the stats and plan),
+ * what GET_VOLUME, GET_FRAME and the streams encode (export.h). The
+ * daemon's GL thread and lpvd batch's volume output take it here. The octree's levels and index
  * (GET_VOLUME content "levels") are read only for a request that asks for
  * them (sv_result_take_levels): a tick does not pay for them (issue 33).
  */
@@ -11,7 +11,35 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "serve.h"
+#include "export.h"
+
+sv_result *sv_result_ref(sv_result *r)
+{
+    if (r)
+        r->refs++;
+    return r;
+}
+
+static void result_free(sv_result *r)
+{
+    if (!r)
+        return;
+    free(r->cells);
+    free(r->levels);
+    free(r->index);
+    free(r->iv_held);
+    for (int i = 0; i < LPVP_TERMS_COUNT; ++i)
+        free(r->frames[i]);
+    for (int i = 0; i < 4; ++i)
+        free(r->enc[i / 2][i % 2]);
+    free(r);
+}
+
+void sv_result_unref(sv_result *r)
+{
+    if (r && --r->refs <= 0)
+        result_free(r);
+}
 
 /* GET_VOLUME content "levels" (SPEC R5.13): with a technique that has an
  * index volume (the octree), its levels and index, read now on the GL thread.

@@ -1,5 +1,5 @@
 /*
- * serve_encode.c - the payloads of VOLUME / GET_VOLUME (SPEC section 5) and
+ * export_encode.c - the payloads of VOLUME / GET_VOLUME (SPEC section 5) and
  * FRAME / GET_FRAME (section 6), through protocol/volume_codec.h: fp16/fp32
  * packing, XOR deltas against the last volume a subscriber ACKed, zstd; and
  * frames as tone-mapped rgba8, PNG or EXR (in-memory, image/image_io.h), the
@@ -7,13 +7,14 @@
  * cascade 0 first), or technique iv's voxels and their index (R5.14), and
  * both headers the tick's "plan" (lpvd_plan_json).
  *
- * The encoders run on libuv's work threads (serve_encode_work.c): they read
- * only immutable results and what they are given, and the one shared thing
- * they write, a result's keyframe cache, is under enc_mu. A subscriber's
- * state (its ACKed base, the volumes it may ACK) is the loop's: the caller
- * hands the base in and remembers the raw volume that comes out.
+ * The daemon runs the encoders on libuv's work threads (serve_encode_work.c):
+ * they read only immutable results and what they are given, and the one
+ * shared thing they write, a result's keyframe cache, is under enc_mu. A
+ * subscriber's state (its ACKed base, the volumes it may ACK) is the
+ * daemon's (serve_streams.c): the caller hands the base in and remembers the
+ * raw volume that comes out.
  */
-#include "serve.h"
+#include "export.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -29,55 +30,6 @@
 /* Guards every sv_result's enc / enc_len (the keyframe cache): encoders of
  * one result run on several work threads at once. */
 static pthread_mutex_t enc_mu = PTHREAD_MUTEX_INITIALIZER;
-
-void sv_sub_clear(sv_sub *sub)
-{
-    sub->epoch++; /* an encoding in flight no longer hands its base back (sv_sub_restore_base) */
-    for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        free(sub->sent[i].raw);
-        sub->sent[i].raw = NULL;
-    }
-    free(sub->acked.raw);
-    sub->acked.raw = NULL;
-}
-
-void sv_sub_ack(sv_sub *sub, uint64_t tick)
-{
-    for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        if (sub->sent[i].raw && sub->sent[i].tick == tick) {
-            free(sub->acked.raw);
-            sub->acked = sub->sent[i];
-            sub->sent[i].raw = NULL;
-            /* older unacknowledged volumes can never become a base now */
-            for (int k = 0; k < SV_SENT_KEEP; ++k)
-                if (sub->sent[k].raw && sub->sent[k].tick < tick) {
-                    free(sub->sent[k].raw);
-                    sub->sent[k].raw = NULL;
-                }
-            return;
-        }
-    }
-}
-
-/* Keeps raw (taken, not copied) as a volume sent to sub that it may ACK. */
-void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len)
-{
-    int slot = 0;
-    for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        if (!sub->sent[i].raw) {
-            slot = i;
-            break;
-        }
-        if (sub->sent[i].tick < sub->sent[slot].tick)
-            slot = i;
-    }
-    free(sub->sent[slot].raw);
-    sub->sent[slot].raw = raw;
-    sub->sent[slot].raw_len = len;
-    sub->sent[slot].tick = tick;
-    sub->sent[slot].fp16 = fp16;
-    memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
-}
 
 _Static_assert((int)LPVP_TERMS_AO == (int)LPV_TERMS_AO && (int)LPVP_TERMS_DIRECT == (int)LPV_TERMS_DIRECT_ONLY,
                "the protocol's frame terms are the engine's");

@@ -1,0 +1,92 @@
+/*
+ * export.h - a tick's result as the wire sees it: read back from the engine
+ * on the GL context's thread (sv_result, export_result.c) and encoded as a
+ * VOLUME / GET_VOLUME or FRAME / GET_FRAME payload (SPEC sections 5 and 6,
+ * export_encode.c). The daemon (serve_*.c) and lpvd batch's volume output
+ * (batch_render.c) both export through it; it knows nothing of sessions,
+ * sockets or jobs.
+ */
+#ifndef LPVD_EXPORT_H
+#define LPVD_EXPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <jansson.h>
+
+#include "engine.h"
+#include "plan.h"
+#include "proto.h"
+#include "tonemap.h"
+#include "volume_codec.h"
+
+/* The product of one tick: immutable once handed to the main thread. */
+typedef struct sv_result {
+    int refs;
+    uint64_t tick;          /* world tick number, 1.. */
+    uint64_t gen;           /* world generation it was computed for */
+    lpv_grid grid;          /* cascade 0 (the finest) */
+    int cascade_count;      /* 1..LPVP_MAX_CASCADES */
+    lpv_grid cascades[LPVP_MAX_CASCADES]; /* finest first; every cascade has grid.dims */
+    float *cells;           /* cells * 12 floats: every cascade's, cascade 0 first */
+    size_t cell_count;      /* all cascades' cells */
+    /* GET_VOLUME content "levels" (SPEC R5.13), in a result of
+     * sv_result_take_levels only: every level's cells (level_cells x 12
+     * floats, level 0 first, as lpv_engine_read_volumes gives them) and the
+     * index (one per cell of cascade 0); NULL / 0 in a tick's result. */
+    float *levels;
+    size_t level_cells;
+    uint32_t *index;
+    size_t index_count;
+    /* Technique iv (SPEC R5.14): per voxel of the grid, 1 when it holds a
+     * surface (IvVoxel.normal[3] > 0), the index every iv volume carries;
+     * NULL / 0 for the other techniques. */
+    uint32_t *iv_held;
+    size_t iv_held_count;
+    float *frames[LPVP_TERMS_COUNT]; /* rgba float per lpv_frame_terms, NULL if not rendered */
+    int width, height;
+    lpv_engine_stats stats;
+    lpv_plan plan;          /* the plan of this tick, snapshotted with stats */
+    double tick_ms;         /* wall time of the tick on the GL thread */
+    /* main thread: keyframe attachments already encoded, [fp16][zstd] */
+    uint8_t *enc[2][2];
+    size_t enc_len[2][2];
+} sv_result;
+
+sv_result *sv_result_ref(sv_result *r);
+void sv_result_unref(sv_result *r);
+/* The engine's last tick read back (export_result.c): every cascade's
+ * accumulated volume, the imperfect volume's occupancy when the technique
+ * has it, the frames of terms_mask (bit t: lpv_frame_terms t) at width x
+ * height, stats and plan; refs 1, tick and gen 0 (the caller's). NULL with a
+ * message in err. On the GL context's thread. */
+sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n);
+/* The octree's levels and index of the engine's last tick, for GET_VOLUME
+ * content "levels" (SPEC R5.13) only (no merged cells, no frames), with the
+ * grid, stats and plan; NULL with err for a technique without them. */
+sv_result *sv_result_take_levels(lpv_engine *e, char *err, size_t n);
+
+/* A VOLUME sent to a delta subscriber, not yet ACKed: the base of a delta. */
+typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */
+    uint64_t tick;
+    int dims[3];
+    int fp16;
+    uint8_t *raw;
+    size_t raw_len;
+} sv_sent;
+
+/* Thread-safe (export_encode.c): the daemon runs them on libuv's work
+ * threads, lpvd batch on its own. */
+/* Volume reply/stream body + attachment. A delta subscriber's encoding passes
+ * keep_raw: it gets the raw volume (for sv_sub_remember), and a delta against
+ * base (its ACKed volume) when base fits; else keep_raw and base are NULL. */
+int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
+                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
+                     size_t n);
+/* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
+int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
+                    uint64_t revision,
+                    uint64_t tick, const lpv_plan *plan, json_t **body, uint8_t **att, size_t *att_len,
+                    char *err, size_t n);
+
+#endif /* LPVD_EXPORT_H */
