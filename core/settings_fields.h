@@ -1,7 +1,7 @@
 /*
  * settings_fields.h - one table describing the tunable scalar fields of
  * lpv_settings, so the CLI (server/options.c), the daemon's CONFIG
- * (server/serve_controls.c) and the clients expose every knob without each
+ * (server/serve/serve_controls.c) and the clients expose every knob without each
  * writing the same code again.
  *
  * Not in the table (they have their own syntax): grid_dims (N | NxMxK, or a

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""report_browser.py - the batch report's page (batch/report_html.h) in a real
+"""report_browser.py - the batch report's page (report/report_html.h) in a real
 browser: Debian's chromium, headless.
 
 Writes the job folder of tests/report_fixture.h (--fixture), runs lpvd-report

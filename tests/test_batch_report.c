@@ -1,4 +1,4 @@
-/* test_batch_report.c - the report of a batch job (batch/report.h): manifests
+/* test_batch_report.c - the report of a batch job (report/report.h): manifests
  * with a superseded and a torn line, escaping, totals, thumbnails and the
  * contact sheet; the merged manifest first; one id in two shards; items
  * without a thumbnail; no items; clean failures; the manifests' times. */

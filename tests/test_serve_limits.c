@@ -1,5 +1,5 @@
 /*
- * test_serve_limits.c - the daemon's limits table (server/serve_limits.c;
+ * test_serve_limits.c - the daemon's limits table (server/serve/serve_limits.c;
  * issue 33, item 3): each row's default lies in its range, the flag sets
  * its field of sv_config and refuses a value outside the range naming the
  * flag and the range, --help shows the default, HELLO's limits carry the

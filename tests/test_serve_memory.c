@@ -1,5 +1,5 @@
 /*
- * test_serve_memory.c - the daemon's one memory budget (server/serve_memory.h;
+ * test_serve_memory.c - the daemon's one memory budget (server/serve/serve_memory.h;
  * issue 31, daemon-wide memory; R7.6a): every term counts against one
  * budget, the terms but requests leave one message of headroom, and the
  * sums do not wrap.

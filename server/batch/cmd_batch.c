@@ -1,10 +1,10 @@
 /*
  * cmd_batch.c - `lpvd batch JOB.json --out DIR`: every work item of a job
- * file (server/batch_job.h) in one process with one GL context, scenes
+ * file (server/batch/batch_job.h) in one process with one GL context, scenes
  * loaded once and their items run back to back, so the engine recomputes
  * only what changed between two items. Resumable: outputs are written under
  * a temporary name and renamed when complete, then the item's manifest line
- * is appended (server/batch_manifest.h); a re-run skips every item whose
+ * is appended (server/batch/batch_manifest.h); a re-run skips every item whose
  * line says ok and whose outputs exist. SIGTERM / SIGINT finish the item in
  * flight and exit. Sharded with --shard I/N or Kubernetes' Indexed Job
  * environment (docs/batch.md).
@@ -156,7 +156,7 @@ static int entry_done(const char *dir, const json_t *e)
     return json_array_size(outs) > 0;
 }
 
-/* The report of DIR's manifests (batch/report.h). */
+/* The report of DIR's manifests (report/report.h). */
 static int write_report(const char *dir)
 {
     char err[1024];

@@ -2,7 +2,7 @@
  * batch_manifest.h - writing lpvd batch's manifests (docs/batch.md): JSON
  * Lines, one object per finished item, appended by each shard to
  * OUT/manifest-I-of-N.jsonl and combined by --merge into OUT/manifest.jsonl.
- * Reading them (which line of an id counts, torn lines) is batch/manifest.h's,
+ * Reading them (which line of an id counts, torn lines) is report/manifest.h's,
  * shared with the report.
  */
 #ifndef LPVD_BATCH_MANIFEST_H

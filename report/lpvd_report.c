@@ -1,5 +1,5 @@
 /* lpvd_report.c - `lpvd-report DIR`: the report of an `lpvd batch` job's
- * output folder (batch/report.h, docs/batch.md "Report"). */
+ * output folder (report/report.h, docs/batch.md "Report"). */
 #include "report.h"
 
 #include <stdio.h>
