@@ -138,9 +138,7 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem) {
-            fprintf(stderr, "lpvd-bench: %s (see --help)\n", problem);
+        if (lpv_flags_refuse(&p, it, v, "lpvd-bench", 1)) {
             return 2;
         } else if (it == LPV_FLAGS_POSITIONAL) {
             scene_path = v; /* the last one given */

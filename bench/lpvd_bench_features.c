@@ -355,10 +355,7 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem || it == LPV_FLAGS_POSITIONAL) {
-            fprintf(stderr, "lpvd-bench-features: %s%s (see --help)\n", problem ? "" : "unexpected argument ",
-                    problem ? problem : v);
+        if (lpv_flags_refuse(&p, it, v, "lpvd-bench-features", 0)) {
             return 2;
         } else if (fl == &FLAGS[B_HELP]) {
             usage(stdout);

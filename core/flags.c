@@ -35,6 +35,16 @@ const char *lpv_flags_problem(lpv_flags *p, lpv_flags_item it)
     return NULL;
 }
 
+int lpv_flags_refuse(lpv_flags *p, lpv_flags_item it, const char *value, const char *prog, int positional_ok)
+{
+    const char *problem = lpv_flags_problem(p, it);
+    if (!problem && (positional_ok || it != LPV_FLAGS_POSITIONAL))
+        return 0;
+    fprintf(stderr, "%s: %s%s (see %s --help)\n", prog, problem ? "" : "unexpected argument ", problem ? problem : value,
+            prog);
+    return 1;
+}
+
 const lpv_flag *lpv_flag_find(const lpv_flag *flags, size_t count, const char *name)
 {
     for (size_t i = 0; name && i < count; ++i)

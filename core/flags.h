@@ -80,6 +80,13 @@ lpv_flags_item lpv_flags_next(lpv_flags *p, int *group, const lpv_flag **flag, c
  * or a positional argument, which only the program can judge. */
 const char *lpv_flags_problem(lpv_flags *p, lpv_flags_item it);
 
+/* A program's refusal of an item of lpv_flags_next: for a problem
+ * (lpv_flags_problem), and for a positional argument when the program takes
+ * none (positional_ok 0: "unexpected argument VALUE"), prints
+ * "PROG: ... (see PROG --help)" on stderr and returns 1 (the program exits
+ * 2); else 0. */
+int lpv_flags_refuse(lpv_flags *p, lpv_flags_item it, const char *value, const char *prog, int positional_ok);
+
 /* The flag named name (without dashes) in a table, or NULL. */
 const lpv_flag *lpv_flag_find(const lpv_flag *flags, size_t count, const char *name);
 

@@ -202,11 +202,8 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *val;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &val)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem) {
-            fprintf(stderr, "lpvd-reference: %s (see lpvd-reference --help)\n", problem);
+        if (lpv_flags_refuse(&p, it, val, "lpvd-reference", 1))
             return 2;
-        }
         if (it == LPV_FLAGS_POSITIONAL) {
             if (scene_path) {
                 fprintf(stderr, "lpvd-reference: more than one scene given (%s, %s)\n", scene_path, val);

@@ -88,6 +88,10 @@ static void test_errors_name_the_flag(void **state)
     assert_string_equal(lpv_flags_problem(&p, LPV_FLAGS_UNKNOWN), "unknown flag --nope");
     assert_null(lpv_flags_problem(&p, LPV_FLAGS_POSITIONAL));
     assert_null(lpv_flags_problem(&p, LPV_FLAGS_FLAG));
+    assert_int_equal(lpv_flags_refuse(&p, LPV_FLAGS_POSITIONAL, "x", "prog", 1), 0); /* taken */
+    assert_int_equal(lpv_flags_refuse(&p, LPV_FLAGS_POSITIONAL, "x", "prog", 0), 1); /* refused */
+    assert_int_equal(lpv_flags_refuse(&p, LPV_FLAGS_FLAG, NULL, "prog", 0), 0);
+    assert_int_equal(lpv_flags_refuse(&p, LPV_FLAGS_UNKNOWN, NULL, "prog", 1), 1);
     char *short_unknown[] = {"prog", "-x"};
     assert_int_equal(parse(2, short_unknown, 0, &s, &c, log, sizeof log, &p), LPV_FLAGS_UNKNOWN);
     assert_string_equal(p.arg, "-x");

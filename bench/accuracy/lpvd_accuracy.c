@@ -1885,12 +1885,8 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&cli, &cg, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&cli, it);
-        if (problem || it == LPV_FLAGS_POSITIONAL) {
-            fprintf(stderr, "lpvd-accuracy: %s%s (see --help)\n", problem ? "" : "unexpected argument ",
-                    problem ? problem : v);
+        if (lpv_flags_refuse(&cli, it, v, "lpvd-accuracy", 0))
             return 2;
-        }
         if (cg > 0) { /* a shared flag */
             if (is_swept(fl->name)) {
                 fprintf(stderr, "lpvd-accuracy: --%s is a swept knob; use --knobs, --points or --presets\n",

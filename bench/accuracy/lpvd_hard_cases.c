@@ -384,10 +384,7 @@ int main(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem || it == LPV_FLAGS_POSITIONAL) {
-            fprintf(stderr, "lpvd-hard-cases: %s%s (see --help)\n", problem ? "" : "unexpected argument ",
-                    problem ? problem : v);
+        if (lpv_flags_refuse(&p, it, v, "lpvd-hard-cases", 0)) {
             return 2;
         } else if (fl == &FLAGS[H_HELP]) {
             usage(stdout, groups[1].flags, &groups[2]);

@@ -212,11 +212,8 @@ int lpvd_cmd_batch(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem) {
-            fprintf(stderr, "lpvd batch: %s (see lpvd batch --help)\n", problem);
+        if (lpv_flags_refuse(&p, it, v, "lpvd batch", 1))
             return 2;
-        }
         if (it == LPV_FLAGS_POSITIONAL) {
             if (job_path) {
                 fprintf(stderr, "lpvd batch: more than one job file given (%s, %s)\n", job_path, v);

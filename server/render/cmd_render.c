@@ -92,11 +92,8 @@ int lpvd_cmd_render(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem) {
-            fprintf(stderr, "lpvd render: %s (see lpvd render --help)\n", problem);
+        if (lpv_flags_refuse(&p, it, v, "lpvd render", 1))
             return 2;
-        }
         if (it == LPV_FLAGS_POSITIONAL) {
             if (scene_path) {
                 fprintf(stderr, "lpvd render: more than one scene given (%s, %s)\n", scene_path, v);

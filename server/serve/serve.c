@@ -370,12 +370,8 @@ int lpvd_cmd_serve(int argc, char **argv)
     const lpv_flag *fl;
     const char *v;
     for (lpv_flags_item it; (it = lpv_flags_next(&p, &g, &fl, &v)) != LPV_FLAGS_END;) {
-        const char *problem = lpv_flags_problem(&p, it);
-        if (problem || it == LPV_FLAGS_POSITIONAL) {
-            fprintf(stderr, "lpvd serve: %s%s (see lpvd serve --help)\n", problem ? "" : "unexpected argument ",
-                    problem ? problem : v);
+        if (lpv_flags_refuse(&p, it, v, "lpvd serve", 0))
             return 2;
-        }
         if (g == camera_group) {
             fprintf(stderr, "lpvd serve: --%s is not used by the daemon (clients send CAMERA_SET)\n", fl->name);
             return 2;
