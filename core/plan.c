@@ -60,8 +60,8 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
         return s->lpv.cascades;
     }
     if (s->planner == LPV_SWITCH_OFF) {
-        say(reason, n, "planner off: the default %d cascades", LPV_DEFAULT_CASCADES);
-        return LPV_DEFAULT_CASCADES;
+        say(reason, n, "planner off: the default %d cascades", LPV_AUTO_CASCADES);
+        return LPV_AUTO_CASCADES;
     }
     if (s->lpv.cascade_size > 0.0f) { /* an explicit size in m: the scene fits in it or not */
         if (f->scene_extent <= s->lpv.cascade_size) {
@@ -71,7 +71,7 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
         }
         say(reason, n, "the scene (%.3g m) is larger than the finest cascade (%.3g m)", (double)f->scene_extent,
             (double)s->lpv.cascade_size);
-        return LPV_DEFAULT_CASCADES;
+        return LPV_AUTO_CASCADES;
     }
     /* cascade_size auto (relative to the scene): cascades pay where the camera
      * sees parts of the scene up close, i.e. stands inside it */
@@ -90,7 +90,7 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
         f->cascade_finest < LPV_CASCADE_AUTO_FRACTION * f->scene_extent * 0.999f) {
         say(reason, n, "the camera's space is %.3g m across (median chord) in a %.3g m scene: cascades from %.3g m",
             (double)f->view_chord, (double)f->scene_extent, (double)f->cascade_finest);
-        return LPV_DEFAULT_CASCADES;
+        return LPV_AUTO_CASCADES;
     }
     if (f->scene_extent < LPV_CASCADE_WIDE_RATIO * f->scene_shortest) {
         say(reason, n, "the camera is inside a scene of similar sides (%.3g m, shortest %.3g m): one grid over it",
@@ -100,11 +100,11 @@ static int plan_cascades_wanted(const lpv_settings *s, const lpv_plan_facts *f, 
     if (f->scene_cross > 0.0f && f->cascade_finest < LPV_CASCADE_AUTO_FRACTION * f->scene_extent * 0.999f) {
         say(reason, n, "the camera is inside a long scene (%.3g m, %.3g m across): cascades from %.3g m, cells "
             "about as wide as it", (double)f->scene_extent, (double)f->scene_cross, (double)f->cascade_finest);
-        return LPV_DEFAULT_CASCADES;
+        return LPV_AUTO_CASCADES;
     }
     say(reason, n, "the camera is inside a wide scene (%.3g m, shortest side %.3g m): cascades from a quarter of it",
         (double)f->scene_extent, (double)f->scene_shortest);
-    return LPV_DEFAULT_CASCADES;
+    return LPV_AUTO_CASCADES;
 }
 
 void lpv_plan_decide(lpv_plan *p, lpv_pass_id id, int run, const char *fmt, ...)

@@ -1,5 +1,7 @@
 /*
- * settings.c - defaults and range checks for lpv_settings (see settings.h).
+ * settings.c - the presets, and lpv_settings' two rules: resolve (the
+ * defaults) and validate (the ranges), both read from the tables that hold
+ * them: the preset table below and the knob table (settings_fields.c).
  *
  * Zero means "default" for every field, so a zero-initialised struct is a
  * valid configuration after lpv_settings_resolve(). The one consequence to
@@ -20,11 +22,8 @@
 #include "error.h"
 #include "grid.h"
 #include "scene.h"
+#include "settings_fields.h"
 #include "lpv_shared.h"
-
-#define LPV_MIN_RSM_SIZE 16
-#define LPV_MIN_SHADOW_SIZE 16
-#define LPV_MAX_EMISSIVE_VPLS (1 << 20)
 
 /* The named presets: ONE table, indexed by lpv_preset. The values are points
  * on the accuracy sweep's Pareto front (bench/accuracy, docs/accuracy.md);
@@ -54,7 +53,7 @@ static const preset_row PRESETS[LPV_PRESET_COUNT_] = {
                          LPV_SWITCH_ON},
     /* balanced, the default: all four departures on, the front's knee (8 steps cost 2 % more
      * than 4 and buy 0.04 on the Cornell box: the far field's coarse level carries them) */
-    [LPV_PRESET_BALANCED] = {NAME_BALANCED, LPV_DEFAULT_GRID_DIM, LPV_DEFAULT_ITERATIONS, LPV_DEFAULT_RSM_SIZE,
+    [LPV_PRESET_BALANCED] = {NAME_BALANCED, 8, 8, 128,
                              LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON},
     /* accurate: the front's lowest error */
     [LPV_PRESET_ACCURATE] = {NAME_ACCURATE, 16, 16, 128, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON, LPV_SWITCH_ON,
@@ -209,93 +208,18 @@ void lpv_settings_resolve(lpv_settings *s)
             if (s->grid_dims[i] == 0)
                 s->grid_dims[i] = p.grid_dims[i];
         }
-        if (s->lpv.iterations == 0) /* after grid_dims: the count follows the grid */
-            s->lpv.iterations = lpv_settings_scaled_iterations(s, NULL);
-        if (s->rsm_size == 0)
-            s->rsm_size = p.rsm_size;
-        if (s->lpv.occlusion == LPV_SWITCH_DEFAULT)
-            s->lpv.occlusion = p.lpv.occlusion;
-        if (s->lpv.central_transport == LPV_SWITCH_DEFAULT)
-            s->lpv.central_transport = p.lpv.central_transport;
-        if (s->lpv.normal_bins == LPV_SWITCH_DEFAULT)
-            s->lpv.normal_bins = p.lpv.normal_bins;
-        if (s->lpv.far_field == LPV_SWITCH_DEFAULT)
-            s->lpv.far_field = p.lpv.far_field;
-        if (s->scene_surfels == LPV_SWITCH_DEFAULT)
-            s->scene_surfels = p.scene_surfels;
+        /* after grid_dims: the count follows the grid */
+        p.lpv.iterations = lpv_settings_scaled_iterations(s, NULL);
+        size_t n;
+        const lpv_field *fields = lpv_fields(&n);
+        for (size_t i = 0; i < n; ++i) /* the preset's knobs: each a 4-byte int or switch */
+            if (fields[i].dflt_rule == LPV_DEFAULT_PRESET && lpv_field_is_default(s, &fields[i]))
+                memcpy((char *)s + fields[i].offset, (const char *)&p + fields[i].offset, sizeof(int));
     }
     if (s->technique == LPV_TECHNIQUE_ID_DEFAULT)
         s->technique = LPV_TECHNIQUE_ID_DEFAULT_IS;
-    if (s->shadow_size == 0)
-        s->shadow_size = LPV_DEFAULT_SHADOW_SIZE;
-    if (s->indirect_gain == 0.0f)
-        s->indirect_gain = 1.0f;
-    if (s->emissive_vpls == 0)
-        s->emissive_vpls = LPV_DEFAULT_EMISSIVE_VPLS;
-    /* cascade_size 0 stays 0: auto, relative to the scene (lpv_cascade_finest_size) */
-    if (s->lpv.cascade_ratio == 0.0f)
-        s->lpv.cascade_ratio = LPV_DEFAULT_CASCADE_RATIO;
-    if (s->lpv.cascade_offset == 0.0f)
-        s->lpv.cascade_offset = LPV_DEFAULT_CASCADE_OFFSET; /* a negative value stays: it means 0 (none) */
-    if (s->lpv.bounces == LPV_SWITCH_DEFAULT)
-        s->lpv.bounces = LPV_SWITCH_OFF;
-    if (s->lpv.bounce_intensity == 0.0f)
-        s->lpv.bounce_intensity = 1.0f;
-    if (s->glossy == LPV_SWITCH_DEFAULT)
-        s->glossy = LPV_SWITCH_ON;
-    if (s->glossy_roughness == 0.0f)
-        s->glossy_roughness = LPV_DEFAULT_GLOSSY_ROUGHNESS;
-    if (s->media == LPV_SWITCH_DEFAULT)
-        s->media = LPV_SWITCH_ON;
-    if (s->media_step == 0.0f)
-        s->media_step = LPV_DEFAULT_MEDIA_STEP;
-    if (s->planner == LPV_SWITCH_DEFAULT)
-        s->planner = LPV_SWITCH_ON;
-    if (s->lpv.far_field_levels == 0)
-        s->lpv.far_field_levels = LPV_DEFAULT_FAR_FIELD_LEVELS;
-    if (s->lpv.far_field_steps == 0)
-        s->lpv.far_field_steps = LPV_DEFAULT_FAR_FIELD_STEPS;
-    if (s->scene_surfel_count == 0)
-        s->scene_surfel_count = LPV_DEFAULT_SCENE_SURFEL_COUNT;
-    if (s->area_lights == LPV_SWITCH_DEFAULT)
-        s->area_lights = LPV_SWITCH_ON;
-    if (s->reach == LPV_SWITCH_DEFAULT)
-        s->reach = LPV_SWITCH_ON;
-    if (s->area_light_samples == 0)
-        s->area_light_samples = LPV_DEFAULT_AREA_LIGHT_SAMPLES;
-    if (s->lookup_step == 0)
-        s->lookup_step = LPV_DEFAULT_LOOKUP_STEP;
-    if (s->area_shadow_step == 0)
-        s->area_shadow_step = LPV_DEFAULT_AREA_SHADOW_STEP;
-    lpv_iv_settings *iv = &s->iv;
-    if (iv->resolution == 0)
-        iv->resolution = LPV_IV_DEFAULT_RESOLUTION;
-    if (iv->points == 0)
-        iv->points = LPV_IV_DEFAULT_POINTS;
-    if (iv->split == 0.0f)
-        iv->split = LPV_IV_DEFAULT_SPLIT;
-    if (iv->seed == 0)
-        iv->seed = LPV_IV_DEFAULT_SEED;
-    if (iv->rays == 0)
-        iv->rays = LPV_IV_DEFAULT_RAYS;
-    if (iv->bounces == 0)
-        iv->bounces = LPV_IV_DEFAULT_BOUNCES;
-    if (iv->reprojection == LPV_SWITCH_DEFAULT)
-        iv->reprojection = LPV_SWITCH_ON;
-    if (iv->tail == LPV_SWITCH_DEFAULT)
-        iv->tail = LPV_SWITCH_ON;
-    if (iv->neighbours == 0)
-        iv->neighbours = LPV_IV_DEFAULT_NEIGHBOURS;
-    if (iv->ao == LPV_SWITCH_DEFAULT)
-        iv->ao = LPV_SWITCH_OFF;
-    /* ao_distance 0 stays 0: auto, LPV_IV_AO_VOXELS voxels */
-    if (iv->max_points == 0)
-        iv->max_points = LPV_IV_DEFAULT_MAX_POINTS;
+    lpv_fields_resolve(s); /* every other knob's default: its row in settings_fields.c */
 }
-
-/* The imperfect volume's knobs (zero = default everywhere but validate sees
- * resolved settings). */
-static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_size);
 
 /* Writes a formatted message into err (when there is room) and returns -1. */
 static int fail(char *err, unsigned long err_size, const char *fmt, ...)
@@ -353,121 +277,12 @@ int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_si
             return fail(err, err_size, "grid_dims[%d] = %d is out of range (allowed 1..%d)", i, s->grid_dims[i],
                         LPV_MAX_GRID_DIM);
     }
-    if (s->lpv.iterations < 0 || s->lpv.iterations > LPV_MAX_ITERATIONS)
-        return fail(err, err_size, "iterations = %d is out of range (allowed 0..%d; 0 = injection only)",
-                    s->lpv.iterations, LPV_MAX_ITERATIONS);
-    if (s->rsm_size < LPV_MIN_RSM_SIZE || s->rsm_size > LPV_MAX_RSM_SIZE)
-        return fail(err, err_size, "rsm_size = %d is out of range (allowed %d..%d)", s->rsm_size, LPV_MIN_RSM_SIZE,
-                    LPV_MAX_RSM_SIZE);
-    if (s->shadow_size < LPV_MIN_SHADOW_SIZE || s->shadow_size > LPV_MAX_SHADOW_SIZE)
-        return fail(err, err_size, "shadow_size = %d is out of range (allowed %d..%d)", s->shadow_size,
-                    LPV_MIN_SHADOW_SIZE, LPV_MAX_SHADOW_SIZE);
-    if (s->lpv.occlusion != LPV_SWITCH_DEFAULT && s->lpv.occlusion != LPV_SWITCH_ON &&
-        s->lpv.occlusion != LPV_SWITCH_OFF)
-        return fail(err, err_size, "occlusion = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
-                    (int)s->lpv.occlusion);
-    if (!isfinite(s->indirect_gain) || s->indirect_gain < 0.0f)
-        return fail(err, err_size, "indirect_gain = %g is out of range (allowed finite and >= 0)",
-                    (double)s->indirect_gain);
-    if (s->emissive_vpls < 0 || s->emissive_vpls > LPV_MAX_EMISSIVE_VPLS)
-        return fail(err, err_size, "emissive_vpls = %d is out of range (allowed 0..%d)", s->emissive_vpls,
-                    LPV_MAX_EMISSIVE_VPLS);
-    if (s->camera_surfel_step < 0 || s->camera_surfel_step > LPV_MAX_CAMERA_SURFEL_STEP)
-        return fail(err, err_size, "camera_surfel_step = %d is out of range (allowed 0 = auto, 1..%d)",
-                    s->camera_surfel_step, LPV_MAX_CAMERA_SURFEL_STEP);
-    if (s->rsm_vpl_step < 0 || s->rsm_vpl_step > LPV_MAX_RSM_VPL_STEP)
-        return fail(err, err_size, "rsm_vpl_step = %d is out of range (allowed 0 = auto, 1..%d)", s->rsm_vpl_step,
-                    LPV_MAX_RSM_VPL_STEP);
-    if (s->scene_surfel_count < 1 || s->scene_surfel_count > (1 << 22))
-        return fail(err, err_size, "scene_surfel_count = %d is out of range (allowed 1..%d)", s->scene_surfel_count,
-                    1 << 22);
-    if (s->lpv.far_field_levels < 1 || s->lpv.far_field_levels > LPV_MAX_CASCADES - 1)
-        return fail(err, err_size, "far_field_levels = %d is out of range (allowed 1..%d)", s->lpv.far_field_levels,
-                    LPV_MAX_CASCADES - 1);
-    if (s->lpv.far_field_steps < 1 || s->lpv.far_field_steps > LPV_MAX_ITERATIONS)
-        return fail(err, err_size, "far_field_steps = %d is out of range (allowed 1..%d)", s->lpv.far_field_steps,
-                    LPV_MAX_ITERATIONS);
-    if (s->lpv.cascades < 0 || s->lpv.cascades > LPV_MAX_CASCADES)
-        return fail(err, err_size, "cascades = %d is out of range (allowed 0 = auto, 1..%d)", s->lpv.cascades,
-                    LPV_MAX_CASCADES);
-    if (!isfinite(s->lpv.cascade_size) || s->lpv.cascade_size < 0.0f || s->lpv.cascade_size > 1e6f)
-        return fail(err, err_size, "cascade_size = %g m is out of range (allowed 0 = auto, or > 0 and <= 1e6)",
-                    (double)s->lpv.cascade_size);
-    if (!isfinite(s->lpv.cascade_ratio) || s->lpv.cascade_ratio < 1.25f || s->lpv.cascade_ratio > 8.0f)
-        return fail(err, err_size, "cascade_ratio = %g is out of range (allowed 1.25..8)",
-                    (double)s->lpv.cascade_ratio);
-    if (!isfinite(s->lpv.cascade_offset) || s->lpv.cascade_offset > 0.5f)
-        return fail(err, err_size, "cascade_offset = %g is out of range (allowed <= 0.5; negative = 0)",
-                    (double)s->lpv.cascade_offset);
-    const struct {
-        const char *name;
-        lpv_switch v;
-    } switches[] = {{"bounces", s->lpv.bounces}, {"glossy", s->glossy}, {"media", s->media}, {"planner", s->planner},
-                    {"central_transport", s->lpv.central_transport}, {"normal_bins", s->lpv.normal_bins},
-                    {"far_field", s->lpv.far_field}, {"scene_surfels", s->scene_surfels},
-                    {"area_lights", s->area_lights}, {"reach", s->reach}, {"iv_reprojection", s->iv.reprojection},
-                    {"iv_tail", s->iv.tail}, {"iv_ao", s->iv.ao}};
-    for (size_t i = 0; i < sizeof switches / sizeof switches[0]; ++i)
-        if (switches[i].v != LPV_SWITCH_DEFAULT && switches[i].v != LPV_SWITCH_ON && switches[i].v != LPV_SWITCH_OFF)
-            return fail(err, err_size, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)",
-                        switches[i].name, (int)switches[i].v);
-    if (!isfinite(s->lpv.bounce_intensity) || s->lpv.bounce_intensity < 0.0f || s->lpv.bounce_intensity > 1.0f)
-        return fail(err, err_size, "bounce_intensity = %g is out of range (allowed 0..1; above 1 would create "
-                    "energy)", (double)s->lpv.bounce_intensity);
-    if (!isfinite(s->lpv.damping) || s->lpv.damping < 0.0f || s->lpv.damping > 1.0f)
-        return fail(err, err_size, "damping = %g is out of range (allowed 0..1; 0 = off)", (double)s->lpv.damping);
-    if (!isfinite(s->glossy_roughness) || s->glossy_roughness < 0.0f || s->glossy_roughness > 1.0f)
-        return fail(err, err_size, "glossy_roughness = %g is out of range (allowed 0..1)",
-                    (double)s->glossy_roughness);
-    if (!isfinite(s->fog_sigma_s) || s->fog_sigma_s < 0.0f || s->fog_sigma_s > 1e3f ||
-        !isfinite(s->fog_sigma_a) || s->fog_sigma_a < 0.0f || s->fog_sigma_a > 1e3f)
-        return fail(err, err_size, "fog_sigma_s = %g, fog_sigma_a = %g per m are out of range (allowed 0..1000)",
-                    (double)s->fog_sigma_s, (double)s->fog_sigma_a);
-    if (!isfinite(s->media_step) || s->media_step < 0.05f || s->media_step > 4.0f)
-        return fail(err, err_size, "media_step = %g is out of range (allowed 0.05..4 cells)", (double)s->media_step);
-    if (s->area_light_samples < 0 || s->area_light_samples > LPV_MAX_AREA_SAMPLES)
-        return fail(err, err_size, "area_light_samples = %d is out of range (allowed 1..%d; 0 = the default %d)",
-                    s->area_light_samples, LPV_MAX_AREA_SAMPLES, LPV_DEFAULT_AREA_LIGHT_SAMPLES);
-    if (s->lookup_step < 0 || s->lookup_step > LPV_MAX_LOOKUP_STEP)
-        return fail(err, err_size, "lookup_step = %d is out of range (allowed 1..%d; 0 = the default %d)",
-                    s->lookup_step, LPV_MAX_LOOKUP_STEP, LPV_DEFAULT_LOOKUP_STEP);
-    if (s->area_shadow_step < 0 || s->area_shadow_step > LPV_MAX_AREA_SHADOW_STEP)
-        return fail(err, err_size, "area_shadow_step = %d is out of range (allowed 1..%d; 0 = the default %d)",
-                    s->area_shadow_step, LPV_MAX_AREA_SHADOW_STEP, LPV_DEFAULT_AREA_SHADOW_STEP);
-    if (validate_iv(&s->iv, err, err_size) != 0)
-        return -1;
+    size_t n;
+    const lpv_field *fields = lpv_fields(&n);
+    for (size_t i = 0; i < n; ++i) /* every knob's range: its row in settings_fields.c */
+        if (lpv_field_check(s, &fields[i], err, (size_t)err_size) != 0)
+            return -1;
     return validate_bounds(s, err, err_size);
-}
-
-static int validate_iv(const lpv_iv_settings *iv, char *err, unsigned long err_size)
-{
-    if (iv->resolution < 0 || iv->resolution > LPV_MAX_GRID_DIM)
-        return fail(err, err_size, "iv_resolution = %d is out of range (allowed 1..%d voxels; 0 = the default %d)",
-                    iv->resolution, LPV_MAX_GRID_DIM, LPV_IV_DEFAULT_RESOLUTION);
-    if (iv->points < 0 || iv->points > LPV_IV_MAX_POINTS_PER_TRIANGLE)
-        return fail(err, err_size, "iv_points = %d is out of range (allowed 1..%d per triangle)", iv->points,
-                    LPV_IV_MAX_POINTS_PER_TRIANGLE);
-    if (!isfinite(iv->split) || iv->split < 0.0f || iv->split > 1e6f)
-        return fail(err, err_size, "iv_split = %g is out of range (allowed > 0 and <= 1e6 voxels)",
-                    (double)iv->split);
-    if (iv->seed < 0 || iv->seed > LPV_IV_MAX_SEED)
-        return fail(err, err_size, "iv_seed = %d is out of range (allowed 1..%d)", iv->seed, LPV_IV_MAX_SEED);
-    if (iv->rays < 0 || iv->rays > LPV_IV_MAX_RAYS)
-        return fail(err, err_size, "iv_rays = %d is out of range (allowed 1..%d per voxel)", iv->rays,
-                    LPV_IV_MAX_RAYS);
-    if (iv->bounces < 0 || iv->bounces > LPV_IV_MAX_BOUNCES)
-        return fail(err, err_size, "iv_bounces = %d is out of range (allowed 1..%d)", iv->bounces,
-                    LPV_IV_MAX_BOUNCES);
-    if (iv->neighbours < 0 || iv->neighbours > 8)
-        return fail(err, err_size, "iv_neighbours = %d is out of range (allowed 1..8 of the 8 voxels around the "
-                    "shifted point)", iv->neighbours);
-    if (!isfinite(iv->ao_distance) || iv->ao_distance < 0.0f || iv->ao_distance > 1e6f)
-        return fail(err, err_size, "iv_ao_distance = %g m is out of range (allowed 0 = auto, or > 0 and <= 1e6)",
-                    (double)iv->ao_distance);
-    if (iv->max_points < 0 || iv->max_points > LPV_IV_MAX_POINTS)
-        return fail(err, err_size, "iv_max_points = %d is out of range (allowed 1..%d)", iv->max_points,
-                    LPV_IV_MAX_POINTS);
-    return 0;
 }
 
 int lpv_settings_camera_surfel_step(const lpv_settings *s, int image_h)

@@ -1,6 +1,8 @@
 /*
  * settings.h - engine settings, sokol style: zero-initialise, set what you
  * care about, and lpv_settings_resolve() fills every zero with its default.
+ * Each knob's default and range is written once, as its row of the knob
+ * table (settings_fields.c); the comments below say what a field means.
  */
 #ifndef LPV_SETTINGS_H
 #define LPV_SETTINGS_H
@@ -67,8 +69,8 @@ typedef struct lpv_lpv_settings {
      * has grid_dims cells; cascade k's cells are cascade_ratio^k times the
      * finest cascade's. */
     int cascades;           /* 0 = auto (core/plan.c): with an explicit cascade_size, one grid when
-                               the scene fits in it, else LPV_DEFAULT_CASCADES; with cascade_size
-                               auto, LPV_DEFAULT_CASCADES only when the camera stands inside a wide
+                               the scene fits in it, else LPV_AUTO_CASCADES; with cascade_size
+                               auto, LPV_AUTO_CASCADES only when the camera stands inside a wide
                                scene (LPV_CASCADE_WIDE_RATIO) or in a space narrower than a quarter
                                of the scene's cascades (lpv_plan_facts.view_chord), else one grid;
                                N = exactly N */
@@ -76,14 +78,14 @@ typedef struct lpv_lpv_settings {
                                = auto: LPV_CASCADE_AUTO_FRACTION of the scene's longest side, or
                                cells as wide as the space around the camera where that is
                                narrower (lpv_cascade_finest_size) */
-    float cascade_ratio;    /* cell size ratio of consecutive cascades; default 2 */
+    float cascade_ratio;    /* cell size ratio of consecutive cascades */
     float cascade_offset;   /* how far each cascade's centre sits ahead of the camera along
                                the view direction, as a fraction of its extent; default 0.25,
                                negative = 0 (centred on the camera) */
 
     /* Section 7's multiple bounces and section 3.4's damping; docs/effects.md. */
-    lpv_switch bounces;     /* multiple bounces off the geometry volume's blockers; default off */
-    float bounce_intensity; /* factor on the blockers' albedo (1 = physical); default 1 */
+    lpv_switch bounces;     /* multiple bounces off the geometry volume's blockers */
+    float bounce_intensity; /* factor on the blockers' albedo (1 = physical) */
     float damping;          /* directional-derivative damping strength; 0 = off (default) */
 
     /* Transport and lookup (docs/propagation.md sections 4b, 5b and 6b):
@@ -97,10 +99,10 @@ typedef struct lpv_lpv_settings {
                                      over the scene gets far_field_levels of them; camera-following
                                      cascades hand light from each to the next) */
     int far_field_levels;         /* coarser levels for one grid over the scene, each doubling the cell
-                                     size; default 1 */
+                                     size */
     int far_field_steps;          /* steps each level but the coarsest takes before handing its light
                                      on; the coarsest takes the rest of the iterations, so more
-                                     iterations only add steps there; default 1 */
+                                     iterations only add steps there */
 } lpv_lpv_settings;
 
 /* Everything the engine is told: the volume's resolution and bounds, the
@@ -108,26 +110,25 @@ typedef struct lpv_lpv_settings {
  * effects, the planner, and one nested struct per GI technique. */
 /* Imperfect volumes (Mavridis & Papaioannou, the third seed; docs/imperfect-volumes.md):
  * a voxel copy of the whole scene from a point cloud, radiance gathered per
- * voxel by ray marching it. A zero field takes its default. */
+ * voxel by ray marching it. A zero field takes its default (every knob's
+ * default and range: its row in settings_fields.c). */
 typedef struct lpv_iv_settings {
-    int resolution;         /* voxels along the scene's longest side (voxels are cubes); default
-                               LPV_IV_DEFAULT_RESOLUTION */
-    int points;             /* random points per triangle (Turk's formula); default LPV_IV_DEFAULT_POINTS */
+    int resolution;         /* voxels along the scene's longest side (voxels are cubes) */
+    int points;             /* random points per triangle (Turk's formula) */
     float split;            /* voxels: a triangle with a longer edge is split before sampling (the
-                               paper's load-time tessellation); default 1 */
-    int seed;               /* the points' and the rays' random seed; default 1 */
-    int rays;               /* stratified rays per voxel; default LPV_IV_DEFAULT_RAYS */
-    int bounces;            /* diffuse bounces (ping-pong passes); default LPV_IV_DEFAULT_BOUNCES */
+                               paper's load-time tessellation) */
+    int seed;               /* the points' and the rays' random seed */
+    int rays;               /* stratified rays per voxel */
+    int bounces;            /* diffuse bounces (ping-pong passes) */
     lpv_switch tail;        /* the bounces after these (3 or more) as the series the last ones set
-                               (iv_tail.comp); default on */
-    lpv_switch reprojection; /* the camera's visible points refine the volume; default on */
+                               (iv_tail.comp) */
+    lpv_switch reprojection; /* the camera's visible points refine the volume */
     int neighbours;         /* the reconstruction blends the nearest this many of the 8 voxels around
-                               the shifted point: 6 (the paper's text) .. 8 (its figure 2);
-                               default LPV_IV_DEFAULT_NEIGHBOURS */
-    lpv_switch ao;          /* ambient occlusion volume; default off */
+                               the shifted point: 6 (the paper's text) .. 8 (its figure 2) */
+    lpv_switch ao;          /* ambient occlusion volume */
     float ao_distance;      /* m, the AO rays' reach; 0 (default) = LPV_IV_AO_VOXELS voxels */
     int max_points;         /* the point cloud's budget: more triangles x points get fewer points per
-                               triangle (the plan says so); default LPV_IV_DEFAULT_MAX_POINTS */
+                               triangle (the plan says so) */
 } lpv_iv_settings;
 
 typedef struct lpv_settings {
@@ -135,23 +136,23 @@ typedef struct lpv_settings {
     float bounds_min[3];    /* grid bounds, m; all-zero min and max = the scene's */
     float bounds_max[3];    /*   bounds grown by half a cell on every side */
     int rsm_size;           /* reflective shadow map side, texels; default: the preset's */
-    int shadow_size;        /* side of each light face's shadow map for direct light, texels;
-                               default LPV_DEFAULT_SHADOW_SIZE (docs/shadows.md) */
-    float indirect_gain;    /* artistic factor on the indirect term; default 1 (0 = default) */
-    int emissive_vpls;      /* VPLs sampled on emissive surfaces; default 4096 */
+    int shadow_size;        /* side of each light face's shadow map for direct light, texels
+                               (docs/shadows.md) */
+    float indirect_gain;    /* artistic factor on the indirect term */
+    int emissive_vpls;      /* VPLs sampled on emissive surfaces */
     lpv_preset preset;      /* supplies the defaults marked "the preset's"; default balanced */
     lpv_technique_id technique; /* the GI technique; default LPV_TECHNIQUE_ID_DEFAULT_IS */
 
     /* Effects read at render time (docs/effects.md). */
     lpv_switch glossy;      /* glossy reflections by marching the volume; default on (run
                                only when the scene has a glossy material) */
-    float glossy_roughness; /* materials with roughness below this are glossy; default 0.3 */
+    float glossy_roughness; /* materials with roughness below this are glossy */
     lpv_switch media;       /* participating media single scattering; default on (run only
                                when the scene or the fog settings give a medium) */
     float fog_sigma_s;      /* 1/m, homogeneous fog scattering coefficient; 0 = none (the
                                scene's own medium, if any) */
     float fog_sigma_a;      /* 1/m, homogeneous fog absorption coefficient; 0 = none */
-    float media_step;       /* ray-march step as a fraction of the volume's cell; default 0.5 */
+    float media_step;       /* ray-march step as a fraction of the volume's cell */
 
     lpv_switch planner;     /* on (default): run only the passes the scene needs and reuse an
                                unchanged volume; off: run every pass every tick */
@@ -159,7 +160,7 @@ typedef struct lpv_settings {
     /* Samples of the scene for occlusion (docs/propagation.md section 3b). */
     lpv_switch scene_surfels;     /* surfels sampled over every triangle join the geometry volume, so
                                      walls no view sees still block; default: the preset's */
-    int scene_surfel_count;       /* how many; default 65536 */
+    int scene_surfel_count;       /* how many */
     int camera_surfel_step;       /* G-buffer pixels per camera surfel along each axis (a block of
                                      step x step pixels becomes one surfel); 0 (default) = auto,
                                      lpv_settings_camera_surfel_step() */
@@ -174,7 +175,7 @@ typedef struct lpv_settings {
                                area_light_samples shadow-mapped samples and stop injecting
                                their own VPLs; off: emitters reach the scene only as
                                emissive_vpls VPLs in the volume */
-    int area_light_samples; /* samples the emitters are reduced to; default 8 */
+    int area_light_samples; /* samples the emitters are reduced to */
     /* The frame's irradiance lookup (docs/accuracy.md, "The lookup step"). */
     int lookup_step;        /* pixels per lookup of the technique's irradiance along each axis: 1
                                (default) every pixel; N > 1 once per N x N block, spread to the
@@ -189,15 +190,11 @@ typedef struct lpv_settings {
     lpv_iv_settings iv;     /* the imperfect volume's knobs (LPV_TECHNIQUE_IV) */
 } lpv_settings;
 
-/* The balanced preset's values, i.e. the engine's defaults. They mirror the
- * preset table in settings.c (a test checks that they agree). */
-#define LPV_DEFAULT_GRID_DIM 8
-#define LPV_DEFAULT_ITERATIONS 8
-#define LPV_DEFAULT_RSM_SIZE 128
-#define LPV_DEFAULT_SHADOW_SIZE 1024
-#define LPV_DEFAULT_EMISSIVE_VPLS 4096
-#define LPV_DEFAULT_CASCADES 3
-#define LPV_DEFAULT_CASCADE_SIZE 0.0f     /* auto, relative to the scene (any unit scale) */
+/* The knobs' defaults and ranges are rows of the knob table
+ * (settings_fields.c); the preset's knobs, rows of the preset table
+ * (settings.c). What follows are the rules' constants the tables and the
+ * planner share. */
+#define LPV_AUTO_CASCADES 3            /* auto cascades, when the camera stands inside a wide scene */
 #define LPV_CASCADE_WIDE_RATIO 4.0f    /* auto cascades: only for a scene whose longest side is at least
                                             this x its shortest (a level, not a room), seen from inside */
 #define LPV_CASCADE_AUTO_FRACTION 0.25f  /* auto cascade_size: this x the scene's longest side, so
@@ -212,13 +209,6 @@ typedef struct lpv_settings {
                                             x 2.6 m tunnel): the auto cascades' cells (lpv_cascade_finest_size).
                                             The long scene's LPV_CASCADE_LONG_CELL of its cross-section,
                                             measured instead */
-#define LPV_DEFAULT_CASCADE_RATIO 2.0f
-#define LPV_DEFAULT_CASCADE_OFFSET 0.25f
-#define LPV_DEFAULT_GLOSSY_ROUGHNESS 0.3f
-#define LPV_DEFAULT_MEDIA_STEP 0.5f
-#define LPV_DEFAULT_FAR_FIELD_LEVELS 1
-#define LPV_DEFAULT_FAR_FIELD_STEPS 1
-#define LPV_DEFAULT_SCENE_SURFEL_COUNT 65536
 /* Auto camera surfel step: this many surfels per finest cell along the
  * image's height when the grid spans it (seed 000: the camera's buffers are
  * down-sampled before surfel injection). */
@@ -242,20 +232,9 @@ typedef struct lpv_settings {
 #define LPV_RSM_AUTO_STEP 2
 #define LPV_RSM_AUTO_VPL_STEP 4
 #define LPV_MAX_RSM_VPL_STEP 64
-#define LPV_DEFAULT_AREA_LIGHT_SAMPLES 8
-#define LPV_DEFAULT_LOOKUP_STEP 1
 #define LPV_MAX_LOOKUP_STEP 4
-#define LPV_DEFAULT_AREA_SHADOW_STEP 2
 #define LPV_MAX_AREA_SHADOW_STEP 4
-#define LPV_IV_DEFAULT_RESOLUTION 16
-#define LPV_IV_DEFAULT_POINTS 1
-#define LPV_IV_DEFAULT_SPLIT 0.5f
-#define LPV_IV_DEFAULT_SEED 1
-#define LPV_IV_DEFAULT_RAYS 128
-#define LPV_IV_DEFAULT_BOUNCES 4
-#define LPV_IV_DEFAULT_NEIGHBOURS 8
 #define LPV_IV_AO_VOXELS 4.0f
-#define LPV_IV_DEFAULT_MAX_POINTS (1 << 20)
 #define LPV_IV_MAX_POINTS (1 << 24)
 #define LPV_IV_MAX_POINTS_PER_TRIANGLE 64
 #define LPV_IV_MAX_RAYS 1024

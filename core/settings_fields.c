@@ -1,8 +1,7 @@
 /*
- * settings_fields.c - the lpv_settings field table (see settings_fields.h).
- * The ranges mirror lpv_settings_validate() in settings.c, narrowed where a
- * zero would silently resolve to a non-zero default; tests/test_settings_fields.c
- * checks that the two agree.
+ * settings_fields.c - the lpv_settings field table (see settings_fields.h):
+ * each knob's range and default written once, and what reads them (resolve's
+ * defaults, validate's ranges, help's words).
  */
 #include "settings_fields.h"
 
@@ -23,121 +22,125 @@
 #define T_SAMPLES LPV_TOUCH_SAMPLES
 #define T_SHADOWS LPV_TOUCH_SHADOWS
 #define T_SHADE LPV_TOUCH_SHADING
+/* The default columns (settings_fields.h, lpv_default_rule). */
+#define D(value) LPV_DEFAULT_VALUE, (value), NULL
+#define D_ZERO(words) LPV_DEFAULT_ZERO, 0, (words)
+#define D_PRESET(words) LPV_DEFAULT_PRESET, 0, (words)
 
 static const lpv_field FIELDS[] = {
     /* The older knobs (the preset supplies the defaults of three of them). */
     {"iterations", "iterations", LPV_FIELD_INT, F(lpv.iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
-     "the preset's x grid / its grid", "", "propagation steps (light moves about a cell a step)", T_VOL,
+     D_PRESET("the preset's x grid / its grid"), "", "propagation steps (light moves about a cell a step)", T_VOL,
      LPV_TECHNIQUE_LPV},
     {"rsm_size", "rsm-size", LPV_FIELD_INT, F(rsm_size), 16, LPV_MAX_RSM_SIZE, 0, "texels",
-     "the preset's", "", "reflective shadow map side", T_VOL, ""},
-    {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", "1024", "",
+     D_PRESET("the preset's"), "", "reflective shadow map side", T_VOL, ""},
+    {"shadow_size", "shadow-size", LPV_FIELD_INT, F(shadow_size), 16, LPV_MAX_SHADOW_SIZE, 0, "texels", D(1024), "",
      "shadow map side per light face, for direct light (docs/shadows.md)", T_SHADOWS, ""},
-    {"occlusion", "occlusion", LPV_FIELD_SWITCH, F(lpv.occlusion), 0, 1, 0, "", "the preset's (on)", "",
+    {"occlusion", "occlusion", LPV_FIELD_SWITCH, F(lpv.occlusion), 0, 1, 0, "", D_PRESET("the preset's (on)"), "",
      "fuzzy occlusion from the geometry volume", T_VOL, LPV_TECHNIQUE_LPV},
-    {"indirect_gain", "indirect-gain", LPV_FIELD_FLOAT, F(indirect_gain), 0, 1e30, 1, "", "1", "",
+    {"indirect_gain", "indirect-gain", LPV_FIELD_FLOAT, F(indirect_gain), 0, 1e30, 1, "", D(1), "",
      "artistic factor on the LPV term", T_SHADE, ""},
-    {"emissive_vpls", "emissive-vpls", LPV_FIELD_INT, F(emissive_vpls), 1, 1 << 20, 0, "", "4096", "",
+    {"emissive_vpls", "emissive-vpls", LPV_FIELD_INT, F(emissive_vpls), 1, 1 << 20, 0, "", D(4096), "",
      "VPLs sampled on emissive surfaces", T_VOL | T_SAMPLES, ""},
 
     /* Cascades (docs/cascades.md). */
-    {"cascades", "cascades", LPV_FIELD_INT, F(lpv.cascades), 0, LPV_MAX_CASCADES, 0, "", "auto", "0 = auto",
+    {"cascades", "cascades", LPV_FIELD_INT, F(lpv.cascades), 0, LPV_MAX_CASCADES, 0, "", D_ZERO("auto"), "0 = auto",
      "cascade count (auto: one grid unless the camera is inside the scene, else 3)", T_VOL, LPV_TECHNIQUE_LPV},
-    {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(lpv.cascade_size), 0, 1e6, 0, "m", "auto",
+    {"cascade_size", "cascade-size", LPV_FIELD_FLOAT, F(lpv.cascade_size), 0, 1e6, 0, "m", D_ZERO("auto"),
      "0 = auto: a quarter of the scene's longest side, or cells about as wide as the camera's space",
      "the finest cascade's extent along its longest axis", T_VOL, LPV_TECHNIQUE_LPV},
-    {"cascade_ratio", "cascade-ratio", LPV_FIELD_FLOAT, F(lpv.cascade_ratio), 1.25, 8, 0, "", "2", "",
+    {"cascade_ratio", "cascade-ratio", LPV_FIELD_FLOAT, F(lpv.cascade_ratio), 1.25, 8, 0, "", D(2), "",
      "cell size ratio of consecutive cascades", T_VOL, LPV_TECHNIQUE_LPV},
-    {"cascade_offset", "cascade-offset", LPV_FIELD_FLOAT, F(lpv.cascade_offset), -1, 0.5, 0, "", "0.25",
+    {"cascade_offset", "cascade-offset", LPV_FIELD_FLOAT, F(lpv.cascade_offset), -1, 0.5, 0, "", D(0.25),
      "negative = centred on the camera",
      "cascade centre ahead of the camera, as a fraction of its extent", T_VOL, LPV_TECHNIQUE_LPV},
 
     /* Effects and damping (docs/effects.md). */
-    {"bounces", "bounces", LPV_FIELD_SWITCH, F(lpv.bounces), 0, 1, 0, "", "off", "",
+    {"bounces", "bounces", LPV_FIELD_SWITCH, F(lpv.bounces), 0, 1, 0, "", D(0), "",
      "multiple bounces off the geometry volume's blockers", T_VOL, LPV_TECHNIQUE_LPV},
-    {"bounce_intensity", "bounce-intensity", LPV_FIELD_FLOAT, F(lpv.bounce_intensity), 0, 1, 1, "", "1", "",
+    {"bounce_intensity", "bounce-intensity", LPV_FIELD_FLOAT, F(lpv.bounce_intensity), 0, 1, 1, "", D(1), "",
      "factor on the blockers' albedo for bounces", T_VOL, LPV_TECHNIQUE_LPV},
-    {"damping", "damping", LPV_FIELD_FLOAT, F(lpv.damping), 0, 1, 0, "", "0", "0 = off",
+    {"damping", "damping", LPV_FIELD_FLOAT, F(lpv.damping), 0, 1, 0, "", D_ZERO("0"), "0 = off",
      "directional-derivative damping strength", T_SHADE, LPV_TECHNIQUE_LPV},
-    {"glossy", "glossy", LPV_FIELD_SWITCH, F(glossy), 0, 1, 0, "", "on", "",
+    {"glossy", "glossy", LPV_FIELD_SWITCH, F(glossy), 0, 1, 0, "", D(1), "",
      "glossy reflections by marching the LPV (if a material is glossy)", T_SHADE, ""},
-    {"glossy_roughness", "glossy-roughness", LPV_FIELD_FLOAT, F(glossy_roughness), 0, 1, 1, "", "0.3", "",
+    {"glossy_roughness", "glossy-roughness", LPV_FIELD_FLOAT, F(glossy_roughness), 0, 1, 1, "", D(0.3), "",
      "materials with roughness below this are glossy", T_SHADE, ""},
-    {"media", "media", LPV_FIELD_SWITCH, F(media), 0, 1, 0, "", "on", "",
+    {"media", "media", LPV_FIELD_SWITCH, F(media), 0, 1, 0, "", D(1), "",
      "participating media single scattering (if there is a medium)", T_VOL | T_SHADE, ""},
-    {"fog_sigma_s", "fog-sigma-s", LPV_FIELD_FLOAT, F(fog_sigma_s), 0, 1000, 0, "1/m", "0", "0 = none",
+    {"fog_sigma_s", "fog-sigma-s", LPV_FIELD_FLOAT, F(fog_sigma_s), 0, 1000, 0, "1/m", D_ZERO("0"), "0 = none",
      "homogeneous fog scattering coefficient", T_VOL | T_SHADE, ""},
-    {"fog_sigma_a", "fog-sigma-a", LPV_FIELD_FLOAT, F(fog_sigma_a), 0, 1000, 0, "1/m", "0", "0 = none",
+    {"fog_sigma_a", "fog-sigma-a", LPV_FIELD_FLOAT, F(fog_sigma_a), 0, 1000, 0, "1/m", D_ZERO("0"), "0 = none",
      "homogeneous fog absorption coefficient", T_VOL | T_SHADE, ""},
-    {"media_step", "media-step", LPV_FIELD_FLOAT, F(media_step), 0.05, 4, 0, "cells", "0.5", "",
+    {"media_step", "media-step", LPV_FIELD_FLOAT, F(media_step), 0.05, 4, 0, "cells", D(0.5), "",
      "media ray-march step", T_SHADE, ""},
-    {"planner", "planner", LPV_FIELD_SWITCH, F(planner), 0, 1, 0, "", "on", "",
+    {"planner", "planner", LPV_FIELD_SWITCH, F(planner), 0, 1, 0, "", D(1), "",
      "run only the passes the scene needs (off: every pass every tick)", T_VOL, ""},
 
     /* Transport, occlusion and lookup (docs/propagation.md). */
     {"central_transport", "central-transport", LPV_FIELD_SWITCH, F(lpv.central_transport), 0, 1, 0, "",
-     "the preset's", "", "re-emit each face's flux along its central direction (less diffusive than the paper)", T_VOL, LPV_TECHNIQUE_LPV},
-    {"normal_bins", "normal-bins", LPV_FIELD_SWITCH, F(lpv.normal_bins), 0, 1, 0, "", "the preset's", "",
+     D_PRESET("the preset's"), "", "re-emit each face's flux along its central direction (less diffusive than the paper)", T_VOL, LPV_TECHNIQUE_LPV},
+    {"normal_bins", "normal-bins", LPV_FIELD_SWITCH, F(lpv.normal_bins), 0, 1, 0, "", D_PRESET("the preset's"), "",
      "one volume per emitter normal axis: surfaces never read back their own light", T_VOL, LPV_TECHNIQUE_LPV},
-    {"far_field", "far-field", LPV_FIELD_SWITCH, F(lpv.far_field), 0, 1, 0, "", "the preset's", "",
+    {"far_field", "far-field", LPV_FIELD_SWITCH, F(lpv.far_field), 0, 1, 0, "", D_PRESET("the preset's"), "",
      "coarser levels carry the light on (reach grows with 2^levels)", T_VOL, LPV_TECHNIQUE_LPV},
     {"far_field_levels", "far-field-levels", LPV_FIELD_INT, F(lpv.far_field_levels), 1, LPV_MAX_CASCADES - 1, 0,
-     "levels", "1", "", "coarser levels (2x the cells each) over one grid", T_VOL, LPV_TECHNIQUE_LPV},
+     "levels", D(1), "", "coarser levels (2x the cells each) over one grid", T_VOL, LPV_TECHNIQUE_LPV},
     {"far_field_steps", "far-field-steps", LPV_FIELD_INT, F(lpv.far_field_steps), 1, LPV_MAX_ITERATIONS, 0, "steps",
-     "1", "", "steps each far-field level but the coarsest takes before handing its light on", T_VOL, LPV_TECHNIQUE_LPV},
-    {"scene_surfels", "scene-surfels", LPV_FIELD_SWITCH, F(scene_surfels), 0, 1, 0, "", "the preset's", "",
+     D(1), "", "steps each far-field level but the coarsest takes before handing its light on", T_VOL, LPV_TECHNIQUE_LPV},
+    {"scene_surfels", "scene-surfels", LPV_FIELD_SWITCH, F(scene_surfels), 0, 1, 0, "", D_PRESET("the preset's"), "",
      "surfels over every triangle join the geometry volume (walls no view sees block)", T_VOL | T_SAMPLES, ""},
     {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",
-     "65536", "", "surfels sampled over the scene's triangles", T_VOL | T_SAMPLES, ""},
+     D(65536), "", "surfels sampled over the scene's triangles", T_VOL | T_SAMPLES, ""},
     {"camera_surfel_step", "camera-surfel-step", LPV_FIELD_INT, F(camera_surfel_step), 0,
-     LPV_MAX_CAMERA_SURFEL_STEP, 0, "pixels", "auto", "0 = auto: 4 surfels per finest cell along the image's height",
+     LPV_MAX_CAMERA_SURFEL_STEP, 0, "pixels", D_ZERO("auto"), "0 = auto: 4 surfels per finest cell along the image's height",
      "G-buffer pixels per camera surfel along each axis (geometry volume)", T_VOL, ""},
-    {"rsm_vpl_step", "rsm-vpl-step", LPV_FIELD_INT, F(rsm_vpl_step), 0, LPV_MAX_RSM_VPL_STEP, 0, "texels", "auto",
+    {"rsm_vpl_step", "rsm-vpl-step", LPV_FIELD_INT, F(rsm_vpl_step), 0, LPV_MAX_RSM_VPL_STEP, 0, "texels", D_ZERO("auto"),
      "0 = auto: 2 (exact: a block never has more cells than slots), 4 in the layers that give VPLs only (the "
      "area light samples after the first); a power of two dividing the face",
      "RSM texels per VPL and surfel along each axis (injection, geometry volume)", T_VOL, ""},
     /* Enclosed lights (docs/propagation.md, "Enclosed lights"). */
-    {"reach", "reach", LPV_FIELD_SWITCH, F(reach), 0, 1, 0, "", "on", "",
+    {"reach", "reach", LPV_FIELD_SWITCH, F(reach), 0, 1, 0, "", D(1), "",
      "indirect light only in the air spaces a light reaches (closed walls keep it in)", T_SHADE, ""},
     /* Emissive surfaces as direct area lights (docs/area-lights.md). */
-    {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", "on", "",
+    {"area_lights", "area-lights", LPV_FIELD_SWITCH, F(area_lights), 0, 1, 0, "", D(1), "",
      "emitters light the scene directly as shadow-mapped samples (off: only as LPV VPLs)", T_VOL | T_SHADOWS, ""},
     {"area_light_samples", "area-light-samples", LPV_FIELD_INT, F(area_light_samples), 1, LPV_MAX_AREA_SAMPLES, 0,
-     "", "8", "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)", T_VOL | T_SHADOWS, ""},
-    {"lookup_step", "lookup-step", LPV_FIELD_INT, F(lookup_step), 1, LPV_MAX_LOOKUP_STEP, 0, "pixels", "1", "",
+     "", D(8), "", "shadow-mapped samples the emitters are reduced to (accuracy vs time)", T_VOL | T_SHADOWS, ""},
+    {"lookup_step", "lookup-step", LPV_FIELD_INT, F(lookup_step), 1, LPV_MAX_LOOKUP_STEP, 0, "pixels", D(1), "",
      "pixels per irradiance lookup along each axis in the frame (N > 1: once per N x N block, upsampled "
      "along planes; accuracy vs time)", T_SHADE, ""},
     {"area_shadow_step", "area-shadow-step", LPV_FIELD_INT, F(area_shadow_step), 1, LPV_MAX_AREA_SHADOW_STEP, 0,
-     "pixels", "2", "",
+     "pixels", D(2), "",
      "pixels per evaluation of the area lights' shadow maps along each axis in the frame (N > 1: once per "
      "N x N block as a visibility ratio, upsampled along planes; accuracy vs time)", T_SHADE, ""},
 
     /* Imperfect volumes (docs/imperfect-volumes.md). */
-    {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", "16", "",
+    {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", D(16), "",
      "voxels along the scene's longest side (more in long scenes: a quarter of the free path each, within this cube's count)",
      T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", "1", "",
+    {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", D(1), "",
      "random points per triangle (Turk's formula)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", "0.5", "",
+    {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", D(0.5), "",
      "triangles with a longer edge are split before sampling", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, LPV_IV_MAX_SEED, 0, "", "1", "",
+    {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, LPV_IV_MAX_SEED, 0, "", D(1), "",
      "random seed of the points and the rays", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", "128", "",
+    {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", D(128), "",
      "stratified rays marched per voxel", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", "4", "",
+    {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", D(4), "",
      "diffuse bounces (ping-pong passes over two volumes)", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_tail", "iv-tail", LPV_FIELD_SWITCH, F(iv.tail), 0, 1, 0, "", "on", "",
+    {"iv_tail", "iv-tail", LPV_FIELD_SWITCH, F(iv.tail), 0, 1, 0, "", D(1), "",
      "the bounces after iv_bounces (3 or more) as the series the last ones set", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_reprojection", "iv-reprojection", LPV_FIELD_SWITCH, F(iv.reprojection), 0, 1, 0, "", "on", "",
+    {"iv_reprojection", "iv-reprojection", LPV_FIELD_SWITCH, F(iv.reprojection), 0, 1, 0, "", D(1), "",
      "the camera's visible points refine the volume", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_neighbours", "iv-neighbours", LPV_FIELD_INT, F(iv.neighbours), 1, 8, 0, "", "8", "the paper's text: 6",
+    {"iv_neighbours", "iv-neighbours", LPV_FIELD_INT, F(iv.neighbours), 1, 8, 0, "", D(8), "the paper's text: 6",
      "nearest of the 8 voxels around the shifted point the reconstruction blends", T_VOL | T_SHADE,
      LPV_TECHNIQUE_IV},
-    {"iv_ao", "iv-ao", LPV_FIELD_SWITCH, F(iv.ao), 0, 1, 0, "", "off", "",
+    {"iv_ao", "iv-ao", LPV_FIELD_SWITCH, F(iv.ao), 0, 1, 0, "", D(0), "",
      "ambient occlusion volume (the ao frame term)", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_ao_distance", "iv-ao-distance", LPV_FIELD_FLOAT, F(iv.ao_distance), 0, 1e6, 0, "m", "auto",
+    {"iv_ao_distance", "iv-ao-distance", LPV_FIELD_FLOAT, F(iv.ao_distance), 0, 1e6, 0, "m", D_ZERO("auto"),
      "0 = auto: 4 voxels", "reach of the ambient occlusion rays", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_max_points", "iv-max-points", LPV_FIELD_INT, F(iv.max_points), 1, LPV_IV_MAX_POINTS, 0, "", "1048576", "",
+    {"iv_max_points", "iv-max-points", LPV_FIELD_INT, F(iv.max_points), 1, LPV_IV_MAX_POINTS, 0, "", D(1 << 20), "",
      "point cloud budget (more triangles get fewer points each)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
 };
 
@@ -146,6 +149,9 @@ static const lpv_field FIELDS[] = {
 #undef T_SAMPLES
 #undef T_SHADOWS
 #undef T_SHADE
+#undef D
+#undef D_ZERO
+#undef D_PRESET
 
 const lpv_field *lpv_fields(size_t *count)
 {
@@ -295,6 +301,62 @@ int lpv_field_is_default(const lpv_settings *s, const lpv_field *f)
     case LPV_FIELD_SWITCH: return *(const lpv_switch *)p == LPV_SWITCH_DEFAULT;
     default: return *(const float *)p == 0.0f;
     }
+}
+
+const char *lpv_field_default_words(const lpv_field *f, char *buf, size_t n)
+{
+    if (f->dflt_rule != LPV_DEFAULT_VALUE)
+        snprintf(buf, n, "%s", f->dflt_words);
+    else if (f->kind == LPV_FIELD_SWITCH)
+        snprintf(buf, n, "%s", f->dflt != 0.0 ? "on" : "off");
+    else if (f->kind == LPV_FIELD_INT)
+        snprintf(buf, n, "%.0f", f->dflt);
+    else
+        snprintf(buf, n, "%g", f->dflt);
+    return buf;
+}
+
+void lpv_fields_resolve(lpv_settings *s)
+{
+    for (size_t i = 0; i < sizeof FIELDS / sizeof FIELDS[0]; ++i) {
+        const lpv_field *f = &FIELDS[i];
+        if (f->dflt_rule != LPV_DEFAULT_VALUE || !lpv_field_is_default(s, f))
+            continue;
+        char *p = (char *)s + f->offset;
+        if (f->kind == LPV_FIELD_SWITCH)
+            *(lpv_switch *)p = f->dflt != 0.0 ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
+        else if (f->kind == LPV_FIELD_INT)
+            *(int *)p = (int)f->dflt;
+        else
+            *(float *)p = (float)f->dflt;
+    }
+}
+
+int lpv_field_check(const lpv_settings *s, const lpv_field *f, char *err, size_t n)
+{
+    char want[96];
+    const char *p = (const char *)s + f->offset;
+    if (f->kind == LPV_FIELD_SWITCH) {
+        const lpv_switch w = *(const lpv_switch *)p;
+        if (w == LPV_SWITCH_DEFAULT || w == LPV_SWITCH_ON || w == LPV_SWITCH_OFF)
+            return 0;
+        if (err && n)
+            snprintf(err, n, "%s = %d is out of range (allowed 0 = default, 1 = on, 2 = off)", f->key, (int)w);
+        return -1;
+    }
+    if (lpv_field_is_default(s, f))
+        return 0; /* zero: the default (resolved away unless the row's rule keeps it) */
+    const double v = f->kind == LPV_FIELD_INT ? (double)*(const int *)p : (double)*(const float *)p;
+    /* a float holds the range's ends as floats: 1e30 is stored as 1.0000000150e30 */
+    const lpv_field stored = {.kind = f->kind, .min_exclusive = f->min_exclusive,
+                              .min = f->kind == LPV_FIELD_FLOAT ? (double)(float)f->min : f->min,
+                              .max = f->kind == LPV_FIELD_FLOAT ? (double)(float)f->max : f->max};
+    if (in_range(&stored, v))
+        return 0;
+    if (err && n)
+        snprintf(err, n, "%s = %g%s%s is out of range (allowed: %s%s%s)", f->key, v, f->unit[0] ? " " : "", f->unit,
+                 lpv_field_expect(f, want, sizeof want), f->note[0] ? "; " : "", f->note);
+    return -1;
 }
 
 /* A field's value as stored: ints, floats and switches are each 4 bytes, so

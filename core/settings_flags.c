@@ -147,16 +147,17 @@ const char *lpv_settings_flags_help(void)
     const lpv_field *fields = lpv_fields(&count);
     for (size_t i = 0; i < count; ++i) {
         const lpv_field *f = &fields[i];
-        char left[64], range[64];
+        char left[64], range[64], dflt[32];
         snprintf(left, sizeof left, "%s %s", f->flag, lpv_field_metavar(f));
+        lpv_field_default_words(f, dflt, sizeof dflt);
         help_range(f, range, sizeof range);
         /* a flag too long for its column puts the help on the next line */
         const char *gap = strlen(left) >= 22 ? "\n                          " : "";
         if (f->kind == LPV_FIELD_SWITCH) /* "  --glossy on|off   help\n   (default on)" */
-            lpv_flags_append(help, sz, &len, "  --%-22s%s%s\n%26s(default %s)\n", left, gap, f->help, "", f->deflt);
+            lpv_flags_append(help, sz, &len, "  --%-22s%s%s\n%26s(default %s)\n", left, gap, f->help, "", dflt);
         else /* "  --cascade-size X   help\n   (m; > 0, <= 1e+06; default 8)" */
             lpv_flags_append(help, sz, &len, "  --%-22s%s%s\n%26s(%s%s%s%s%s; default %s)\n", left, gap, f->help, "",
-                             f->unit, f->unit[0] ? "; " : "", range, f->note[0] ? ", " : "", f->note, f->deflt);
+                             f->unit, f->unit[0] ? "; " : "", range, f->note[0] ? ", " : "", f->note, dflt);
     }
     return help;
 }

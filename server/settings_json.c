@@ -52,11 +52,13 @@ json_t *lpvd_knobs_json(const lpv_settings *defaults, int max_texture)
     json_t *a = json_array();
     for (size_t i = 0; a && i < n; ++i) {
         const lpv_field *f = &fields[i];
+        char dflt[32];
         double max = f->max;
         if (strcmp(f->unit, "texels") == 0 && max > (double)max_texture) /* CONFIG refuses more with LIMIT */
             max = (double)max_texture;
         json_t *o = json_pack("{s:s, s:s, s:o, s:s, s:s, s:s, s:s, s:s, s:o}", "name", f->key, "type",
-                              type_name(f->kind), "default", typed(f, lpv_field_get(&d, f)), "default_text", f->deflt,
+                              type_name(f->kind), "default", typed(f, lpv_field_get(&d, f)), "default_text",
+                              lpv_field_default_words(f, dflt, sizeof dflt),
                               "unit", f->unit, "note", f->note, "help", f->help, "technique", f->technique, "touches",
                               touches_json(f->touches));
         if (o && f->kind != LPV_FIELD_SWITCH &&

@@ -31,7 +31,9 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
             f->occluder_triangles, LPV_AUTO_IV_MAX_TRIANGLES);
         return LPV_TECHNIQUE_ID_LPV;
     }
-    const int res = s->iv.resolution > 0 ? s->iv.resolution : LPV_IV_DEFAULT_RESOLUTION;
+    lpv_settings resolved = *s;
+    lpv_settings_resolve(&resolved);
+    const int res = resolved.iv.resolution;
     if (f && f->scene_extent > 0.0f && f->scene_middle > 0.0f && !f->bounds_given) {
         /* the voxels iv would place with these settings (lpv_iv_place: over
          * where light can go, finer in long scenes from the free path), and

@@ -47,6 +47,7 @@
 #define HEIGHT 1.0f    /* m, the emitter above the floor */
 #define FLOOR_HALF 4.0f
 #define RHO 0.5f
+#define SAMPLES 8 /* the area_light_samples knob's default */
 
 /* A grey floor (y = 0) under a black square emitter facing down; with plate,
  * an opaque 0.8 m plate at y = 0.5 between them. */
@@ -281,10 +282,10 @@ static void test_double_sided_emits_both_ways(void **state)
     assert_int_equal(lpv_emitters_collect(&s, &l), 0);
     assert_int_equal(l.count, 4);
     assert_int_equal(l.surfaces, 1);
-    lpv_area_sample smp[LPV_DEFAULT_AREA_LIGHT_SAMPLES];
-    assert_int_equal(lpv_area_lights_sample(&l, LPV_DEFAULT_AREA_LIGHT_SAMPLES, smp), LPV_DEFAULT_AREA_LIGHT_SAMPLES);
+    lpv_area_sample smp[SAMPLES];
+    assert_int_equal(lpv_area_lights_sample(&l, SAMPLES, smp), SAMPLES);
     double up = 0.0, down = 0.0;
-    for (int k = 0; k < LPV_DEFAULT_AREA_LIGHT_SAMPLES; ++k)
+    for (int k = 0; k < SAMPLES; ++k)
         *(smp[k].normal[1] > 0.99f ? &up : &down) += M_PI * smp[k].intensity[1];
     const double side_flux = M_PI * LE * 4.0 * HALF * HALF;
     assert_true(fabs(up - side_flux) < 1e-5 * side_flux);
@@ -395,10 +396,10 @@ static void test_energy_no_double_count(void **state)
     /* the samples: exactly pi L A */
     lpv_emitter_list l;
     assert_int_equal(lpv_emitters_collect(&s, &l), 0);
-    lpv_area_sample smp[LPV_DEFAULT_AREA_LIGHT_SAMPLES];
-    assert_int_equal(lpv_area_lights_sample(&l, LPV_DEFAULT_AREA_LIGHT_SAMPLES, smp), LPV_DEFAULT_AREA_LIGHT_SAMPLES);
+    lpv_area_sample smp[SAMPLES];
+    assert_int_equal(lpv_area_lights_sample(&l, SAMPLES, smp), SAMPLES);
     double sum = 0.0;
-    for (int k = 0; k < LPV_DEFAULT_AREA_LIGHT_SAMPLES; ++k)
+    for (int k = 0; k < SAMPLES; ++k)
         sum += M_PI * smp[k].intensity[1];
     assert_true(fabs(sum - emitted) < 1e-6 * emitted);
     lpv_emitters_free(&l);

@@ -208,7 +208,9 @@ static void test_wall_injected_flux_and_exitance(void **state)
      * (gpu/light_faces.c): texels of side 2R/N, R the half diagonal. A texel
      * counts when its centre is on the wall, so each edge is exact to within
      * one texel row: |error| <= M (perimeter * texel + 4 texel^2). */
-    double radius = sqrt(2.0) * WALL_HALF, texel = 2.0 * radius / LPV_DEFAULT_RSM_SIZE;
+    lpv_settings resolved = set; /* the RSM size the engine used */
+    lpv_settings_resolve(&resolved);
+    double radius = sqrt(2.0) * WALL_HALF, texel = 2.0 * radius / resolved.rsm_size;
     double rim = WALL_ALBEDO * SUN_E * (8.0 * WALL_HALF * texel + 4.0 * texel * texel);
     printf("calibration: injected flux error %.4f W, rim bound %.4f W (%.2f %%)\n", flux[1] - want, rim,
            100.0 * rim / want);

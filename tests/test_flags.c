@@ -149,8 +149,8 @@ static void test_tables(void **state)
     for (size_t i = 0; i < nf; ++i) {
         assert_string_equal(flags[4 + i].name, fields[i].flag);
         assert_non_null(flags[4 + i].metavar);
-        char line[96];
-        snprintf(line, sizeof line, "default %s)", fields[i].deflt);
+        char line[96], dflt[32];
+        snprintf(line, sizeof line, "default %s)", lpv_field_default_words(&fields[i], dflt, sizeof dflt));
         if (!strstr(lpv_settings_flags_help(), line))
             fail_msg("help gives no default for --%s", fields[i].flag);
     }

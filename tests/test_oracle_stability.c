@@ -651,8 +651,10 @@ static void test_settings_ranges(void **state)
     lpv_settings s = {0};
     lpv_settings_resolve(&s);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
-    assert_int_equal(s.grid_dims[0], LPV_DEFAULT_GRID_DIM);
-    assert_int_equal(s.lpv.iterations, LPV_DEFAULT_ITERATIONS);
+    lpv_settings balanced;
+    assert_int_equal(lpv_preset_settings(LPV_PRESET_BALANCED, &balanced), 0);
+    assert_int_equal(s.grid_dims[0], balanced.grid_dims[0]);
+    assert_int_equal(s.lpv.iterations, balanced.lpv.iterations);
     assert_int_equal(s.lpv.occlusion, LPV_SWITCH_ON);
     assert_true(s.indirect_gain == 1.0f);
 

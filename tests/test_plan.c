@@ -218,14 +218,14 @@ static void test_cascade_count(void **state)
     assert_non_null(strstr(why, "outside"));
     f.camera_inside = 1;
     f.scene_shortest = 743.0f / 4.0f; /* a wide scene: longest >= 4 x shortest */
-    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
-    assert_int_equal(LPV_DEFAULT_CASCADES, 3);
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_AUTO_CASCADES);
+    assert_int_equal(LPV_AUTO_CASCADES, 3);
     f.scene_shortest = 743.0f / 3.9f; /* a room-like one: one grid */
     assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), 1);
     assert_non_null(strstr(why, "similar sides"));
     f.scene_extent = 0.5f; /* the same in millimetres or in kilometres */
     f.scene_shortest = 0.1f;
-    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_int_equal(lpv_plan_cascades(&s, &f, why, sizeof why), LPV_AUTO_CASCADES);
     assert_reason(why);
     /* an explicit cascade_size: fits (extent <= cascade_size; equality fits) or not, camera anywhere */
     lpv_settings eight = resolved((lpv_settings){.lpv.cascade_size = 8.0f});
@@ -233,7 +233,7 @@ static void test_cascade_count(void **state)
     f.scene_extent = 8.0f;
     assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), 1);
     f.scene_extent = 8.01f;
-    assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_int_equal(lpv_plan_cascades(&eight, &f, why, sizeof why), LPV_AUTO_CASCADES);
     /* the threshold follows cascade_size */
     lpv_settings small = resolved((lpv_settings){.lpv.cascade_size = 2.0f});
     f.scene_extent = 4.0f;
@@ -260,7 +260,7 @@ static void test_cascade_count(void **state)
     /* one grid over the scene: the plan counts the grids in use, the far field's levels too (on by default) */
     f = baseline();
     lpv_plan p1 = plan_of((lpv_settings){0}, f);
-    assert_int_equal(p1.cascades, 1 + LPV_DEFAULT_FAR_FIELD_LEVELS);
+    assert_int_equal(p1.cascades, 1 + 1); /* far_field_levels 1 */
     assert_non_null(strstr(p1.cascades_reason, "far field"));
     assert_int_equal(plan_of((lpv_settings){.lpv.far_field = LPV_SWITCH_OFF}, f).cascades, 1);
     assert_int_equal(plan_of((lpv_settings){.lpv.far_field_levels = 2}, f).cascades, 3);
@@ -303,7 +303,7 @@ static void test_long_scene_finest_cascade(void **state)
     f.scene_shortest = 3.0f;
     f.scene_cross = lpv_cascade_cross_section(tmin, tmax);
     f.cascade_finest = lpv_cascade_finest_size(&s8, tmin, tmax, 0.0f);
-    assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_AUTO_CASCADES);
     assert_non_null(strstr(why, "long scene"));
     assert_reason(why);
 }
@@ -342,7 +342,7 @@ static void test_finest_cascade_from_the_camera_space(void **state)
     f.scene_shortest = 13.0f;
     f.view_chord = 2.41f;
     f.cascade_finest = lpv_cascade_finest_size(&s8, hmin, hmax, f.view_chord);
-    assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_DEFAULT_CASCADES);
+    assert_int_equal(lpv_plan_cascades(&s8, &f, why, sizeof why), LPV_AUTO_CASCADES);
     assert_non_null(strstr(why, "median chord"));
     assert_reason(why);
 }

@@ -62,11 +62,13 @@ static void test_zero_resolves_to_balanced(void **state)
     assert_knobs(&s, PRESETS[1].grid, PRESETS[1].iterations, PRESETS[1].rsm_size, PRESETS[1].occlusion);
     assert_departures(&s, &PRESETS[1]);
     assert_int_equal(lpv_settings_validate(&s, err, sizeof err), 0);
-    /* the LPV_DEFAULT_* macros are the balanced preset */
-    assert_int_equal(s.grid_dims[0], LPV_DEFAULT_GRID_DIM);
-    assert_int_equal(s.lpv.iterations, LPV_DEFAULT_ITERATIONS);
-    assert_int_equal(s.rsm_size, LPV_DEFAULT_RSM_SIZE);
-    assert_int_equal(s.emissive_vpls, LPV_DEFAULT_EMISSIVE_VPLS);
+    /* the balanced preset's row, and the knob table's defaults */
+    lpv_settings b;
+    assert_int_equal(lpv_preset_settings(LPV_PRESET_BALANCED, &b), 0);
+    assert_int_equal(s.grid_dims[0], b.grid_dims[0]);
+    assert_int_equal(s.lpv.iterations, b.lpv.iterations);
+    assert_int_equal(s.rsm_size, b.rsm_size);
+    assert_int_equal(s.emissive_vpls, 4096);
     assert_true(s.indirect_gain == 1.0f);
 }
 

@@ -26,6 +26,7 @@
 
 static const float LEVEL_MIN[3] = {-32.0f, -0.2f, -32.0f}, LEVEL_MAX[3] = {32.0f, 12.0f, 32.0f};
 static const float SUN[3] = {0.45f, -0.8f, 0.4f};
+#define SHADOW_SIZE 1024 /* texels per cascade (the shadow_size knob's default) */
 
 static lpv_view camera(const float eye[3], const float target[3])
 {
@@ -36,7 +37,7 @@ static lpv_view camera(const float eye[3], const float target[3])
 
 static void fit(const lpv_view *v, lpv_shadow_cascade c[LPV_SHADOW_CASCADES])
 {
-    assert_int_equal(lpv_shadow_cascades_fit(v, SUN, LEVEL_MIN, LEVEL_MAX, LPV_DEFAULT_SHADOW_SIZE,
+    assert_int_equal(lpv_shadow_cascades_fit(v, SUN, LEVEL_MIN, LEVEL_MAX, SHADOW_SIZE,
                                              LPV_SHADOW_BORDER_TEXELS, LPV_SHADOW_CASCADES, c),
                      0);
 }
@@ -66,7 +67,7 @@ static void test_texels_near_the_camera_are_centimetres(void **state)
     /* No cascade is coarser than one map over the level's bounding sphere
      * (its radius rounded up by at most 1/64, the border added). */
     float radius = 0.5f * sqrtf(64.0f * 64.0f + 12.2f * 12.2f + 64.0f * 64.0f);
-    float n = (float)LPV_DEFAULT_SHADOW_SIZE;
+    float n = (float)SHADOW_SIZE;
     float whole = 2.0f * radius * (1.0f + 1.0f / 64.0f) / (n - 2.0f * LPV_SHADOW_BORDER_TEXELS);
     for (int k = 0; k < LPV_SHADOW_CASCADES; ++k)
         assert_true(c[k].texel <= whole);
@@ -83,7 +84,7 @@ static void test_cascades_cover_the_view(void **state)
     /* Points across the frustum at depths through every slice: each that
      * lies in the scene lies in the inner square (border kept free) of the
      * cascade of its slice. */
-    const float inner = 1.0f - 2.0f * LPV_SHADOW_BORDER_TEXELS / (float)LPV_DEFAULT_SHADOW_SIZE;
+    const float inner = 1.0f - 2.0f * LPV_SHADOW_BORDER_TEXELS / (float)SHADOW_SIZE;
     const float aspect = (float)v.width / (float)v.height, t = tanf(0.5f * v.yfov);
     vec3 fwd = {v.forward[0], v.forward[1], v.forward[2]}, up = {v.up[0], v.up[1], v.up[2]}, right;
     glm_vec3_cross(fwd, up, right);
@@ -121,7 +122,7 @@ static void texel_phase(const lpv_shadow_cascade *c, const float p[3], float pha
     float xy[2];
     project(c, p, xy);
     for (int a = 0; a < 2; ++a) {
-        float u = (xy[a] * 0.5f + 0.5f) * (float)LPV_DEFAULT_SHADOW_SIZE;
+        float u = (xy[a] * 0.5f + 0.5f) * (float)SHADOW_SIZE;
         phase[a] = u - floorf(u);
     }
 }

@@ -19,7 +19,7 @@
 
 /* The points: area lights off (before issue 10), then on with K samples at
  * the settings' area shadow step (0: the given settings', by default
- * LPV_DEFAULT_AREA_SHADOW_STEP), and at 4, 8 and 16 samples also at the
+ * the area_shadow_step row's), and at 4, 8 and 16 samples also at the
  * steps 1 and 4 (docs/area-lights.md, "The area shadow step"). */
 static const struct {
     int samples; /* 0 = area lights off */

@@ -14,8 +14,8 @@
 void lpv_lpv_tick_cost(const lpv_settings *s, lpv_tick_cost *out)
 {
     int cascades = s->lpv.cascades > 0 ? lpv_cascades_count(s, s->lpv.cascades) : lpv_cascades_count(s, 1);
-    if (s->lpv.cascades <= 0 && cascades < LPV_DEFAULT_CASCADES)
-        cascades = LPV_DEFAULT_CASCADES;
+    if (s->lpv.cascades <= 0 && cascades < LPV_AUTO_CASCADES)
+        cascades = LPV_AUTO_CASCADES;
     int bins = s->lpv.normal_bins == LPV_SWITCH_ON ? LPV_NORMAL_BINS : 1;
     out->cell_steps = lpv_settings_grid_cells(s) * cascades * bins * s->lpv.iterations;
     snprintf(out->terms, sizeof out->terms, "grid %dx%dx%d x %d cascade%s x %d normal bin%s x %d iterations",
