@@ -3,6 +3,7 @@
  *   lpvd render ...   one frame of a scene to an image (offline, batch jobs)
  *   lpvd batch ...    many items of a job file in one process (docs/batch.md)
  *   lpvd serve ...    the daemon: clients over a Unix socket or TCP (docs/server.md)
+ *   lpvd knobs ...    every knob's range and default, from the table (docs/knobs.md)
  */
 #include <stdio.h>
 #include <string.h>
@@ -17,6 +18,7 @@ static void usage(FILE *f)
             "  render [SCENE] -o OUT.png|OUT.exr   render a glTF scene (default: built-in Cornell box)\n"
             "  batch JOB.json --out DIR            render every item of a job file, resumable (docs/batch.md)\n"
             "  serve [flags]                       run the daemon (Unix socket / TCP, protocol/SPEC.md)\n"
+            "  knobs [--markdown|--json]           every knob's range and default (docs/knobs.md)\n"
             "  version                             print the version\n"
             "Run 'lpvd <command> --help' for a command's flags.\n");
 }
@@ -34,6 +36,8 @@ int main(int argc, char **argv)
         return lpvd_cmd_batch(argc - 1, argv + 1);
     if (strcmp(cmd, "serve") == 0)
         return lpvd_cmd_serve(argc - 1, argv + 1);
+    if (strcmp(cmd, "knobs") == 0)
+        return lpvd_cmd_knobs(argc - 1, argv + 1);
     if (strcmp(cmd, "version") == 0 || strcmp(cmd, "--version") == 0) {
         printf("lpvd %s\n", LPVD_VERSION);
         return 0;
