@@ -286,8 +286,15 @@ int lpv_engine_sample_scene(lpv_engine *e, char *err, size_t err_size);
 int lpv_engine_samples_stale(const lpv_engine *e);
 
 /* The frame program of a variant (LPV_FRAME_* bits), built on first use and
- * kept until the technique changes; 0 with err set if it does not build. */
+ * kept until the technique changes; 0 with err set if it does not build
+ * (engine_technique.c). */
 GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size_t err_size);
+/* Deletes the frame programs built so far. */
+void lpv_engine_free_frame_programs(lpv_engine *e);
+/* Makes technique id the engine's: creates its instance and builds the
+ * passes that read its volume with its lookup includes. On failure the
+ * current technique stays. */
+int lpv_engine_use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t err_size);
 
 /* The frame's passes per block of pixels (frame_blocks.c), each before the
  * frame that reads its blocks, with the G-buffer and view block bound: the
@@ -361,11 +368,11 @@ void lpv_engine_memory_need(const lpv_engine *e, lpv_memory_need *n);
 int lpv_engine_memory_check(const lpv_engine *e, char *err, size_t err_size);
 
 /* The planner's facts about the scene, the settings and what changed
- * (engine_tick.c). */
+ * (engine_facts.c). */
 void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f);
 /* Where the technique's volume must go now, under facts f. */
 void lpv_engine_where(const lpv_engine *e, const lpv_plan_facts *f, lpv_technique_where *w);
-/* Switches to the technique settings s call for (technique auto: chosen from
+/* engine_technique.c: switches to the technique settings s call for (technique auto: chosen from
  * the scene's facts, lpv_technique_choose) and configures it with s. */
 int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err, size_t err_size);
 /* Places and commits the technique's volume for the current inputs without a

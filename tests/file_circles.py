@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""file_circles.py - circles of files that call each other, read from a build's object files.
+
+A file A depends on B when A's object file uses a symbol (function or
+variable) that B's object defines. Strongly connected components of that
+graph with more than one file are circles: none of their files can be
+understood or changed alone. Usage:
+
+  python3 file_circles.py BUILD_DIR SOURCE_DIR [SOURCE_DIR...]
+
+e.g. `file_circles.py build gpu server`: the circles among the files of gpu/
+and server/ (each directory's files with the files of its subdirectories).
+Exit status 1 when there is a circle, 0 when none.
+"""
+import os
+import subprocess
+import sys
+
+
+def objects(build, dirs):
+    """{source path relative to the repo: object path} for the sources under dirs."""
+    out = {}
+    for root, _, files in os.walk(build):
+        for f in files:
+            if not (f.endswith('.c.o') or f.endswith('.cpp.o')):
+                continue
+            path = os.path.join(root, f)
+            # CMake: build/<dir>/CMakeFiles/<target>.dir/<source relative to dir>.o
+            rel = os.path.relpath(path, build)
+            parts = rel.split(os.sep)
+            if 'CMakeFiles' not in parts:
+                continue
+            i = parts.index('CMakeFiles')
+            # a source outside the target's folder is spelled with '__' for '..'
+            src = os.path.normpath(os.path.join(*(parts[:i] + ['..' if p == '__' else p for p in parts[i + 2:]])))[:-2]
+            if any(src == d or src.startswith(d.rstrip('/') + '/') for d in dirs):
+                out.setdefault(src, path)
+    return out
+
+
+def symbols(obj):
+    defined, used = set(), set()
+    text = subprocess.run(['nm', obj], capture_output=True, text=True, check=True).stdout
+    for line in text.splitlines():
+        p = line.split()
+        if len(p) == 2 and p[0] == 'U':
+            used.add(p[1])
+        elif len(p) == 3 and p[1] in 'TDBRGSC':
+            defined.add(p[2])
+    return defined, used
+
+
+def sccs(graph):
+    index, low, stack, on, out, n = {}, {}, [], set(), [], [0]
+
+    def visit(v):
+        index[v] = low[v] = n[0]
+        n[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            out.append(sorted(comp))
+
+    sys.setrecursionlimit(10000)
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def main():
+    if len(sys.argv) < 3:
+        print(__doc__.strip(), file=sys.stderr)
+        return 2
+    build, dirs = sys.argv[1], [d.rstrip('/') for d in sys.argv[2:]]
+    objs = objects(build, dirs)
+    if not objs:
+        print('file_circles: no object files for %s under %s (build first)' % (', '.join(dirs), build),
+              file=sys.stderr)
+        return 2
+    owner, uses = {}, {}
+    for src, obj in objs.items():
+        d, u = symbols(obj)
+        uses[src] = u
+        for s in d:
+            owner[s] = src
+    graph = {src: {owner[s] for s in uses[src] if s in owner and owner[s] != src} for src in objs}
+    circles = [c for c in sccs(graph) if len(c) > 1]
+    print('file_circles: %d files in %s, %d circle(s)' % (len(objs), ', '.join(dirs), len(circles)))
+    for c in circles:
+        print('  circle of %d: %s' % (len(c), ' '.join(c)))
+        for a in c:
+            calls = sorted(b for b in graph[a] if b in c)
+            print('    %s -> %s' % (a, ', '.join(calls)))
+    return 1 if circles else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
