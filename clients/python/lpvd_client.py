@@ -228,7 +228,7 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
     n from an iv volume: ``dims``, ``origin``, ``cell_size`` its one level,
     ``cell(x, y, z)`` a voxel's 12 values, ``held(x, y, z)`` its index entry
     (non-zero: the voxel holds a surface), ``neighbours`` the description's
-    iv_neighbours. Step by step in binary32 as techniques/iv/core/oracle_iv.c computes it
+    iv_neighbours. Step by step in binary32 as techniques/iv/core/oracle_iv_reconstruct.c computes it
     (lpv_iv_irradiance; the sums of step 6 in double, as there)."""
     f32 = _f32
     # 1. a finite p, a unit-able n
