@@ -414,7 +414,7 @@ struct IvVoxel {
 #define LPV_IV_HELD_WEIGHT 0.015625f
 /* Luminance weights (Rec. 709, summing to 1) of the lookup's rule for a
  * reconstructed irradiance with a channel below 0 (iv_lookup.glsl,
- * iv_physical; techniques/iv/core/oracle_iv.c). */
+ * iv_physical; techniques/iv/core/oracle_iv_reconstruct.c). */
 #define LPV_IV_LUMA_R 0.2126f
 #define LPV_IV_LUMA_G 0.7152f
 #define LPV_IV_LUMA_B 0.0722f
