@@ -140,7 +140,7 @@ class LayoutError(ValueError):
 def default_address():
     """The daemon's default socket (SPEC R1.1)."""
     run = os.environ.get("XDG_RUNTIME_DIR")
-    if run and os.path.isabs(run) and os.path.isdir(run):  # the daemon's rule (protocol/proto.c)
+    if run and os.path.isabs(run) and os.path.isdir(run):  # the daemon's rule (protocol/proto_address.c)
         return os.path.join(run, "lpvd.sock")
     return "/tmp/lpvd-%d.sock" % os.getuid()
 
