@@ -2,7 +2,8 @@
  * serve.h - the internals of `lpvd serve` (the daemon), shared by its files:
  *
  *   serve.c          the command: flags, start-up, signals, shutdown
- *   serve_net.c      libuv listeners, connections, frame reading, bounded writes
+ *   serve_net_*.c    libuv listeners, connections, frame reading, bounded writes
+ *                    (one file per job: serve_net_internal.h lists them)
  *   serve_session.c  per-connection state, request dispatch, revisions; its
  *                    handlers are in serve_hello.c, serve_scene.c,
  *                    serve_controls.c, serve_results.c and serve_streams.c
@@ -166,9 +167,9 @@ int sv_grid_that_fits(const struct sv_server *s, int n);
  * answered SHUTTING_DOWN): at shutdown. */
 void sv_scene_loads_drop(struct sv_server *s);
 #define SV_PREAUTH_HARD_FACTOR 4
-void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms);
+void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms); /* serve_net_reserve.c */
 /* Takes c out of the server's pre-HELLO list (HELLO succeeded, or c is
- * closing); no-op when it is not in it. */
+ * closing); no-op when it is not in it (serve_net_accept.c). */
 void sv_net_preauth_leave(sv_conn *c);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
@@ -331,7 +332,7 @@ typedef struct sv_sub {
     uint32_t epoch;         /* bumped by sv_sub_clear: a lent base is no longer this subscription's */
 } sv_sub;
 
-struct sv_wreq; /* one frame being written (serve_net.c) */
+struct sv_wreq; /* one frame being written (serve_net_write.c) */
 
 /* How a world reports back to the sessions that use it, so the world layer
  * (serve_world.c) never calls up into the session layer: the session layer
@@ -480,9 +481,11 @@ struct sv_server {
 /* serve.c */
 uint64_t sv_now_ms(void);
 
-/* serve_net.c */
+/* the network layer (serve_net_*.c) */
+/* serve_net_listen.c */
 int sv_net_listen(sv_server *s, char *err, size_t n);
 void sv_net_stop_listening(sv_server *s);
+/* serve_net_write.c */
 /* Sends one frame. stream: SV_STREAM_* (a stream message replaces an unsent
  * older one of its stream). Returns 0, or -1 when the connection was closed
  * (over its write cap, or already closing). body is consumed (decref'd),
@@ -491,13 +494,17 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
             int stream); /* att_owned: malloc'd, freed by sv_send */
 int sv_send_error(sv_conn *c, uint32_t request_id, int code, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
+void sv_conn_unref(sv_conn *c);
+/* serve_net_conn.c */
 void sv_conn_close(sv_conn *c);
 void sv_conn_close_after_write(sv_conn *c);
-void sv_conn_unref(sv_conn *c);
+/* serve_net_read.c */
 void sv_net_resume_reading(sv_conn *c);
+/* serve_net_reserve.c */
 /* A pending request of c (bytes = json + attachment) is taken to be handled:
  * its bytes leave --max-request-memory and waiting connections may go on. */
 void sv_net_request_handled(sv_conn *c, uint64_t bytes);
+/* serve_net_accept.c */
 /* A HELLO that passed the version and token checks: admits c as one of
  * --max-clients sessions (0), or sends ERROR LIMIT for request_id, closes c
  * and returns -1 (R4.1a). */
