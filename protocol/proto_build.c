@@ -1,10 +1,11 @@
 /*
  * proto_build.c - frames to send: header + JSON body + attachment in one
  * malloc'd buffer, or header and body only for a large attachment written
- * from its own buffer (writev, no copy). See proto.h.
+ * from its own buffer (writev, no copy), and ERROR frames. See proto.h.
  */
 #include "proto.h"
 
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -69,5 +70,21 @@ uint8_t *lpvp_frame_build_json(uint16_t type, uint32_t request_id, const json_t 
         return NULL;
     out = lpvp_frame_build(type, request_id, s, strlen(s), attachment, att_len, out_len);
     free(s);
+    return out;
+}
+
+/* An ERROR frame (its body: proto_error.c). */
+uint8_t *lpvp_error_build(uint32_t request_id, int code, size_t *out_len, const char *fmt, ...)
+{
+    va_list ap;
+    json_t *o;
+    uint8_t *out;
+    va_start(ap, fmt);
+    o = lpvp_error_vbody(code, fmt, ap);
+    va_end(ap);
+    if (!o)
+        return NULL;
+    out = lpvp_frame_build_json(LPVP_ERROR, request_id, o, NULL, 0, out_len);
+    json_decref(o);
     return out;
 }

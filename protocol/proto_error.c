@@ -1,6 +1,7 @@
 /*
  * proto_error.c - the protocol's errors (SPEC section 3): the codes' names,
- * which codes close the connection (R3.4), the ERROR body and frame, and
+ * which codes close the connection (R3.4), the ERROR body (its frame:
+ * proto_build.c), and
  * lpvp_set_error, the one way every function of this library reports what
  * was wrong (a message naming the field or value, ready to be an ERROR's
  * "message"). See proto.h.
@@ -88,19 +89,4 @@ json_t *lpvp_error_body(int code, const char *fmt, ...)
     o = lpvp_error_vbody(code, fmt, ap);
     va_end(ap);
     return o;
-}
-
-uint8_t *lpvp_error_build(uint32_t request_id, int code, size_t *out_len, const char *fmt, ...)
-{
-    va_list ap;
-    json_t *o;
-    uint8_t *out;
-    va_start(ap, fmt);
-    o = lpvp_error_vbody(code, fmt, ap);
-    va_end(ap);
-    if (!o)
-        return NULL;
-    out = lpvp_frame_build_json(LPVP_ERROR, request_id, o, NULL, 0, out_len);
-    json_decref(o);
-    return out;
 }

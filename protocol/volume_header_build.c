@@ -76,58 +76,6 @@ static json_t *vec_json(const double *v, size_t n)
     return a;
 }
 
-int lpvp_cascades_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
-{
-    if (vi->cascade_count == 0) {
-        memset(out, 0, sizeof *out);
-        out->cells = 1;
-        for (int i = 0; i < 3; i++) {
-            out->dims[i] = vi->dims[i];
-            out->origin[i] = vi->origin[i];
-            out->cells *= (uint64_t)(vi->dims[i] > 0 ? vi->dims[i] : 0);
-        }
-        out->cell_size = vi->cell_size;
-        return 1;
-    }
-    if (vi->cascade_count < 0 || vi->cascade_count > LPVP_MAX_CASCADES)
-        return -1;
-    for (int k = 0; k < vi->cascade_count; k++)
-        out[k] = vi->cascades[k];
-    return vi->cascade_count;
-}
-
-/* The levels the raw volume holds: the octree's (R5.13) or the cascades. */
-static int levels_of(const lpvp_volume_info *vi, lpvp_cascade_info *out)
-{
-    if (vi->layout.content != LPVP_CONTENT_LEVELS)
-        return lpvp_cascades_of(vi, out);
-    if (vi->layout.level_count < 1 || vi->layout.level_count > LPVP_MAX_LEVELS)
-        return -1;
-    for (int k = 0; k < vi->layout.level_count; k++)
-        out[k] = vi->layout.level[k];
-    return vi->layout.level_count;
-}
-
-uint64_t lpvp_volume_total_cells(const lpvp_volume_info *vi)
-{
-    lpvp_cascade_info c[LPVP_MAX_LEVELS];
-    int n = levels_of(vi, c);
-    uint64_t total = 0;
-    for (int k = 0; k < n; k++)
-        total += c[k].cells;
-    return n < 0 ? 0 : total;
-}
-
-uint64_t lpvp_volume_cascade_first_cell(const lpvp_volume_info *vi, int k)
-{
-    lpvp_cascade_info c[LPVP_MAX_LEVELS];
-    int n = levels_of(vi, c);
-    uint64_t first = 0;
-    for (int i = 0; i < k && i < n; i++)
-        first += c[i].cells;
-    return first;
-}
-
 /* One level's (cascade's) placement: dims, origin, cell_size, cells. */
 static json_t *placement_json(const lpvp_cascade_info *c)
 {

@@ -17,14 +17,28 @@ import subprocess
 import sys
 
 
+def source_root(build):
+    """The source tree the build was configured from (CMakeCache.txt), or None."""
+    try:
+        with open(os.path.join(build, 'CMakeCache.txt'), encoding='utf-8') as f:
+            for line in f:
+                if line.startswith('CMAKE_HOME_DIRECTORY:'):
+                    return line.split('=', 1)[1].strip()
+    except OSError:
+        pass
+    return None
+
+
 def objects(build, dirs):
-    """{source path relative to the repo: object path} for the sources under dirs."""
+    """{source path relative to the repo: object path} for the sources under dirs
+    (an object whose source is gone, left by an earlier build, is not read)."""
+    top = source_root(build)
     out = {}
-    for root, _, files in os.walk(build):
+    for folder, _, files in os.walk(build):
         for f in files:
             if not (f.endswith('.c.o') or f.endswith('.cpp.o')):
                 continue
-            path = os.path.join(root, f)
+            path = os.path.join(folder, f)
             # CMake: build/<dir>/CMakeFiles/<target>.dir/<source relative to dir>.o
             rel = os.path.relpath(path, build)
             parts = rel.split(os.sep)
@@ -33,6 +47,8 @@ def objects(build, dirs):
             i = parts.index('CMakeFiles')
             # a source outside the target's folder is spelled with '__' for '..'
             src = os.path.normpath(os.path.join(*(parts[:i] + ['..' if p == '__' else p for p in parts[i + 2:]])))[:-2]
+            if top and not os.path.exists(os.path.join(top, src)):
+                continue
             if any(src == d or src.startswith(d.rstrip('/') + '/') for d in dirs):
                 out.setdefault(src, path)
     return out
