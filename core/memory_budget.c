@@ -159,17 +159,6 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
                 gb(lim->budget), lim->budget_source);
 }
 
-void lpv_memory_need_floor(const lpv_settings *s, int light_faces, lpv_memory_need *n)
-{
-    memset(n, 0, sizeof *n);
-    const int faces = light_faces > 1 ? light_faces : 1;
-    n->rsm_size = s->rsm_size;
-    n->rsm_faces = faces;
-    n->shadow_size = s->shadow_size;
-    n->shadow_faces = faces;
-    lpv_technique_memory_floor(s, n);
-}
-
 void lpv_memory_need_grid(const struct lpv_settings *s, int levels, lpv_memory_need *n)
 {
     const size_t k = (size_t)levels;

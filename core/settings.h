@@ -317,6 +317,9 @@ const char *lpv_settings_departures(const lpv_settings *s, char buf[5]);
  * all six zero means "the scene's bounds". */
 int lpv_settings_bounds_given(const lpv_settings *s);
 
+/* Cells of the settings' grid (grid_dims multiplied). */
+double lpv_settings_grid_cells(const lpv_settings *s);
+
 /* Checks ranges after resolve; on failure writes a message naming the setting
  * into err and returns -1. */
 int lpv_settings_validate(const lpv_settings *s, char *err, unsigned long err_size);

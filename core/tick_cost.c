@@ -9,11 +9,6 @@
 
 #include "registry.h"
 
-double lpv_settings_grid_cells(const lpv_settings *s)
-{
-    return (double)s->grid_dims[0] * (double)s->grid_dims[1] * (double)s->grid_dims[2];
-}
-
 void lpv_tick_cost_estimate(const lpv_settings *s, lpv_tick_cost *out)
 {
     const lpv_technique_rules *r = lpv_technique_rules_of(s->technique);

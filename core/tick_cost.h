@@ -28,8 +28,6 @@ typedef struct lpv_tick_cost {
     const char *lower;  /* the CONFIG knobs that lower it, e.g. "grid, iterations, cascades or normal_bins" */
 } lpv_tick_cost;
 
-/* Cells of the settings' grid (grid_dims multiplied). */
-double lpv_settings_grid_cells(const lpv_settings *s);
 
 /* The bound for resolved settings s (lpv_settings_resolve); technique auto
  * takes the dearest of the techniques the planner may choose. */
