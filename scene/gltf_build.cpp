@@ -16,21 +16,6 @@
 
 namespace lpv_gltf {
 
-void copy_name(char *dst, const std::string &src, const std::string &fallback)
-{
-    const std::string &s = src.empty() ? fallback : src;
-    size_t n = std::min(s.size(), size_t(LPV_NAME_MAX - 1));
-    /* Do not cut a UTF-8 sequence in half, and stop at an embedded NUL. */
-    if (n < s.size())
-        while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80)
-            n--;
-    size_t z = s.find('\0');
-    if (z != std::string::npos && z < n)
-        n = z;
-    memcpy(dst, s.data(), n);
-    dst[n] = '\0';
-}
-
 Builder::~Builder()
 {
     for (lpv_texture &t : textures)

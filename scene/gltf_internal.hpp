@@ -170,7 +170,7 @@ void apply_node_overrides(tinygltf::Model &model, const lpv_gltf_node_override *
 void read_medium(const char *json, size_t len, const tinygltf::Model &model, Ctx &ctx, lpv_medium &m,
                  std::vector<float> &values);
 
-/* A name from the file into a fixed-size scene name (gltf_build.cpp). */
+/* A name from the file into a fixed-size scene name (gltf_messages.cpp). */
 void copy_name(char *dst, const std::string &src, const std::string &fallback);
 
 /* How a mesh instance is deformed (glTF 2.0 "Skins", "Morph targets"): its

@@ -1,13 +1,15 @@
 /*
  * gltf_messages.cpp - how the glTF adapter words its problems (gltf_internal.hpp):
  * printf-style formatting, the Failure that refuses a file, names and URIs
- * from the file for a message (never other file contents), and the warnings, each line once.
+ * from the file for a message (never other file contents), the warnings, each line once,
+ * and a name from the file cut to fit the scene's fixed-size names.
  */
 #include "gltf_internal.hpp"
 
 #include <algorithm>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 
 namespace lpv_gltf {
 
@@ -120,6 +122,21 @@ void Ctx::warn(const std::string &w)
         warnings.push_back(w);
     else
         warnings_dropped++;
+}
+
+void copy_name(char *dst, const std::string &src, const std::string &fallback)
+{
+    const std::string &s = src.empty() ? fallback : src;
+    size_t n = std::min(s.size(), size_t(LPV_NAME_MAX - 1));
+    /* Do not cut a UTF-8 sequence in half, and stop at an embedded NUL. */
+    if (n < s.size())
+        while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80)
+            n--;
+    size_t z = s.find('\0');
+    if (z != std::string::npos && z < n)
+        n = z;
+    memcpy(dst, s.data(), n);
+    dst[n] = '\0';
 }
 
 } // namespace lpv_gltf

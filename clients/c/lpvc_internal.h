@@ -89,6 +89,23 @@ int lpvci_request(lpvc *c, uint16_t type, const json_t *body, const void *att, s
  * takes the body (NULL: out of memory). */
 int lpvci_simple(lpvc *c, uint16_t type, json_t *body_stolen);
 
+/* One received frame (lpvci_recv_frame). */
+typedef struct lpvci_rx {
+    lpvp_header h;
+    json_t *body;
+    uint8_t *att;
+    size_t att_len;
+} lpvci_rx;
+/* Receives one frame. timeout_ms: -1 the connection's reply timeout, < -1
+ * forever, >= 0 that many ms before the first byte. 0, or -1 with the error set. */
+int lpvci_recv_frame(lpvc *c, lpvci_rx *out, int timeout_ms);
+void lpvci_rx_free(lpvci_rx *r);
+/* Keeps body as the last reply (lpvc_last_reply) and its revision. */
+void lpvci_set_last_reply(lpvc *c, const json_t *body);
+/* An ERROR frame: records its code, name and message; closes if it closes
+ * (request_type: the request it answers, 0 for none). */
+int lpvci_take_error(lpvc *c, const json_t *body, uint16_t request_type);
+
 /* ---- lpvc_requests.c ----------------------------------------------------- */
 
 /* text (NULL: "{}") as a JSON object, or NULL with a USAGE error naming what. */

@@ -2,7 +2,8 @@
  * lpvc_transport.c - the C client's transport (see lpvc_internal.h):
  * sockets, framing (protocol/proto.h builds and checks the frames), sending
  * and receiving, request/reply matching, the stream queue, connect / close
- * and the error state every call reports through.
+ * and the error state every call reports through. Decoding what a stream
+ * brings is above it, in lpvc_stream.c.
  */
 #include <errno.h>
 #include <netdb.h>
@@ -233,15 +234,7 @@ uint32_t lpvci_send_frame(lpvc *c, uint16_t type, const json_t *body, const void
     return rc == 0 ? id : 0;
 }
 
-/* One received frame. */
-typedef struct rx {
-    lpvp_header h;
-    json_t *body;
-    uint8_t *att;
-    size_t att_len;
-} rx;
-
-static void rx_free(rx *r)
+void lpvci_rx_free(lpvci_rx *r)
 {
     json_decref(r->body);
     free(r->att);
@@ -250,7 +243,7 @@ static void rx_free(rx *r)
 
 /* Receives one frame. timeout_ms: -1 the connection's reply timeout, < -1
  * forever, >= 0 that many ms before the first byte. */
-static int recv_frame(lpvc *c, rx *out, int timeout_ms)
+int lpvci_recv_frame(lpvc *c, lpvci_rx *out, int timeout_ms)
 {
     memset(out, 0, sizeof *out);
     if (c->fd < 0)
@@ -310,7 +303,7 @@ static int recv_frame(lpvc *c, rx *out, int timeout_ms)
     return 0;
 }
 
-static void set_last_reply(lpvc *c, const json_t *body)
+void lpvci_set_last_reply(lpvc *c, const json_t *body)
 {
     free(c->last_reply);
     c->last_reply = json_dumps(body, JSON_COMPACT);
@@ -320,13 +313,13 @@ static void set_last_reply(lpvc *c, const json_t *body)
 }
 
 /* An ERROR frame: record its code, name and message; close if it closes. */
-static int take_error(lpvc *c, const json_t *body, uint16_t request_type)
+int lpvci_take_error(lpvc *c, const json_t *body, uint16_t request_type)
 {
     json_t *code = json_object_get(body, "code");
     json_t *name = json_object_get(body, "name");
     json_t *msg = json_object_get(body, "message");
     int k = json_is_integer(code) ? (int)json_integer_value(code) : LPVC_ERR_PROTOCOL;
-    set_last_reply(c, body);
+    lpvci_set_last_reply(c, body);
     lpvci_fail(c, k, "%s", json_is_string(msg) ? json_string_value(msg) : "");
     if (json_is_string(name))
         snprintf(c->err_name, sizeof c->err_name, "%s", json_string_value(name));
@@ -336,11 +329,11 @@ static int take_error(lpvc *c, const json_t *body, uint16_t request_type)
     return -1;
 }
 
-static void enqueue(lpvc *c, rx *r)
+static void enqueue(lpvc *c, lpvci_rx *r)
 {
     lpvc_queued *q = calloc(1, sizeof *q);
     if (!q) {
-        rx_free(r);
+        lpvci_rx_free(r);
         return;
     }
     q->type = r->h.type;
@@ -369,12 +362,12 @@ int lpvci_request(lpvc *c, uint16_t type, const json_t *body, const void *att, s
     if (!id)
         return -1;
     for (;;) {
-        rx r;
-        if (recv_frame(c, &r, -1) != 0)
+        lpvci_rx r;
+        if (lpvci_recv_frame(c, &r, -1) != 0)
             return -1;
         uint16_t t = r.h.type;
         if (t == LPVP_REPLY(type) && r.h.request_id == id) {
-            set_last_reply(c, r.body);
+            lpvci_set_last_reply(c, r.body);
             if (reply)
                 *reply = json_incref(r.body);
             if (ratt) {
@@ -383,14 +376,14 @@ int lpvci_request(lpvc *c, uint16_t type, const json_t *body, const void *att, s
             }
             if (ratt_len)
                 *ratt_len = r.att_len;
-            rx_free(&r);
+            lpvci_rx_free(&r);
             return 0;
         }
         if (t == LPVP_ERROR && (r.h.request_id == id || r.h.request_id == 0)) {
-            take_error(c, r.body, type);
+            lpvci_take_error(c, r.body, type);
             if (r.h.request_id == 0)
                 lpvci_close_fd(c); /* unsolicited: SHUTTING_DOWN and the like */
-            rx_free(&r);
+            lpvci_rx_free(&r);
             return -1;
         }
         if (t == LPVP_VOLUME || t == LPVP_FRAME) {
@@ -398,13 +391,13 @@ int lpvci_request(lpvc *c, uint16_t type, const json_t *body, const void *att, s
             continue;
         }
         if (t == LPVP_BYE_REPLY && r.h.request_id == 0) {
-            rx_free(&r);
+            lpvci_rx_free(&r);
             lpvci_close_fd(c);
             return lpvci_fail(c, LPVC_ERR_CLOSED, "the server said BYE");
         }
         lpvci_fail(c, LPVC_ERR_PROTOCOL, "unexpected %s (type 0x%04x, request_id %u) while waiting for the reply to %s #%u",
              lpvp_type_name(t), t, r.h.request_id, lpvp_type_name(type), id);
-        rx_free(&r);
+        lpvci_rx_free(&r);
         lpvci_close_fd(c);
         return -1;
     }
@@ -499,84 +492,4 @@ void lpvc_close(lpvc *c)
     free(c->hello);
     lpvc_knobset_free(&c->knobs);
     free(c);
-}
-
-/* ---- streams ---------------------------------------------------------------- */
-
-void lpvc_message_free(lpvc_message *m)
-{
-    if (!m)
-        return;
-    lpvc_volume_free(&m->volume);
-    lpvc_frame_free(&m->frame);
-    m->type = LPVC_MSG_NONE;
-}
-
-int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms)
-{
-    if (!c)
-        return -1;
-    if (!out)
-        return lpvci_fail(c, LPVC_ERR_USAGE, "out is NULL");
-    memset(out, 0, sizeof *out);
-    lpvci_clear_error(c);
-    uint16_t type;
-    json_t *body;
-    uint8_t *att;
-    size_t att_len;
-    if (c->q_head) {
-        lpvc_queued *q = c->q_head;
-        c->q_head = q->next;
-        if (!c->q_head)
-            c->q_tail = NULL;
-        type = q->type;
-        body = q->body;
-        att = q->att;
-        att_len = q->att_len;
-        free(q);
-    } else {
-        for (;;) {
-            rx r;
-            if (recv_frame(c, &r, timeout_ms < 0 ? -2 : timeout_ms) != 0)
-                return -1;
-            if (r.h.type == LPVP_VOLUME || r.h.type == LPVP_FRAME) {
-                type = r.h.type;
-                body = r.body;
-                att = r.att;
-                att_len = r.att_len;
-                break;
-            }
-            if (r.h.type == LPVP_BYE_REPLY) {
-                rx_free(&r);
-                lpvci_close_fd(c);
-                out->type = LPVC_MSG_BYE;
-                return 0;
-            }
-            if (r.h.type == LPVP_ERROR) {
-                take_error(c, r.body, 0);
-                if (r.h.request_id == 0 && c->err_code == LPVP_E_SHUTTING_DOWN)
-                    lpvci_close_fd(c);
-                rx_free(&r);
-                return -1;
-            }
-            lpvci_fail(c, LPVC_ERR_PROTOCOL, "unexpected %s (type 0x%04x, request_id %u) in the stream",
-                 lpvp_type_name(r.h.type), r.h.type, r.h.request_id);
-            rx_free(&r);
-            return -1;
-        }
-    }
-    set_last_reply(c, body);
-    int rc;
-    if (type == LPVP_VOLUME) {
-        out->type = LPVC_MSG_VOLUME;
-        rc = lpvci_decode_volume(c, body, att, att_len, true, &out->volume);
-        free(att);
-    } else {
-        out->type = LPVC_MSG_FRAME;
-        rc = lpvci_decode_frame(c, body, att, att_len, &out->frame);
-    }
-    json_decref(body);
-    if (rc != 0)
-        lpvc_message_free(out);
-    return rc;
 }
