@@ -24,7 +24,7 @@
 #define LPV_ACC_KEY 15
 #define LPV_ACC_KEY_TECHNIQUE 5
 #define LPV_ACC_KEY_IV 6 /* .. 11 */
-#define LPV_ACC_KEY_STEPS 12 /* camera surfel step, RSM VPL step, lookup step (lpvd_accuracy.c point.cstep, rstep, lstep) */
+#define LPV_ACC_KEY_STEPS 12 /* camera surfel step, RSM VPL step, lookup step (accuracy_internal.h point.cstep, rstep, lstep) */
 typedef struct lpv_acc_row {
     int scene; /* 0 .. nscenes-1 */
     int key[LPV_ACC_KEY];
