@@ -80,8 +80,8 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     glGenVertexArrays(1, &e->empty_vao);
     glGenBuffers(1, &e->light_ubo);
     glGenBuffers(1, &e->view_ubo);
-    glGenBuffers(1, &e->shadow_ubo);
-    glBindBuffer(GL_UNIFORM_BUFFER, e->shadow_ubo);
+    glGenBuffers(1, &e->shadows.ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, e->shadows.ubo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvShadowBlock), NULL, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_UNIFORM_BUFFER, e->light_ubo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvLightBlock), NULL, GL_DYNAMIC_DRAW);
@@ -141,7 +141,7 @@ void lpv_engine_destroy(lpv_engine *e)
         glDeleteVertexArrays(1, &e->empty_vao);
     lpv_gl_delete_buffer(&e->light_ubo);
     lpv_gl_delete_buffer(&e->view_ubo);
-    lpv_gl_delete_buffer(&e->shadow_ubo);
+    lpv_gl_delete_buffer(&e->shadows.ubo);
     lpv_timer_destroy(&e->timer);
     free(e);
 }
@@ -175,7 +175,7 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
         e->gbuf_stale = 1;
     }
     if (touches & LPV_TOUCH_SHADOWS)
-        e->shadow_valid = 0;
+        e->shadows.valid = 0;
     lpv_engine_update_area_samples(e);
     if (!e->has_scene)
         return 0;
@@ -215,7 +215,7 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
 void lpv_engine_invalidate(lpv_engine *e)
 {
     e->forced = 1;
-    e->shadow_valid = 0;
+    e->shadows.valid = 0;
 }
 
 const lpv_grid *lpv_engine_grid(const lpv_engine *e) { return &e->desc.level[0]; }

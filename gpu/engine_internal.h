@@ -80,6 +80,39 @@ typedef struct lpv_frame_blocks {
     int w, h, step;
 } lpv_frame_blocks;
 
+/* The lights' reflective shadow maps and what pass_rsm.c makes of them:
+ * the VPLs the technique injects and the surfels of the geometry volume
+ * (lpv_technique_inputs takes them). Faces are laid out by light_faces.c. */
+typedef struct lpv_rsms {
+    int size, face_count, alloc_size, alloc_faces;
+    int punctual_faces;   /* faces (= layers) of the punctual lights; area faces follow */
+    int layers;           /* layers in use: punctual faces + those the area faces' tiles fill */
+    int area_face_side;   /* texels of an area light face's tile */
+    GLuint position, normal, flux, albedo, depth, fbo;
+    GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
+    /* the VPLs that carry light, in order, and their draw command (compact.h):
+     * the injection draws only them */
+    GLuint vpls_live, vpls_draw;
+    /* VPLs (and surfels) per layer, blocks^2 x slots: the punctual lights',
+     * the area lights' layers whose surfels the GV takes
+     * (lpv_engine_area_gv_layers), the other area layers' (pass_rsm.c) */
+    size_t per_layer[3];
+    size_t vpl_count; /* the three kinds of layers x their per_layer */
+} lpv_rsms;
+
+/* The shadow maps of direct light: what pass_shadow.c owns and gives the
+ * frame (lpv_pass_shadow_bind binds them); rendered at render time. */
+typedef struct lpv_shadow_maps {
+    struct LpvShadowBlock block; /* the faces the maps hold */
+    GLuint ubo, tex, fbo;        /* the block's buffer; the DEPTH32F array and its framebuffer */
+    /* the maps' transmission (scenes with BLEND draws,
+     * LPV_TEX_SHADOW_TRANSMIT): an RGBA16F array like tex, drawn through
+     * transmit_fbo over tex's depth */
+    GLuint transmit_tex, transmit_fbo;
+    int alloc_size, alloc_faces;
+    int valid;                   /* 0: the maps must be redrawn (scene, settings, invalidate) */
+} lpv_shadow_maps;
+
 struct lpv_engine {
     lpv_settings settings;
     lpv_technique *tech;      /* the GI technique (gpu/technique.h) */
@@ -161,10 +194,6 @@ struct lpv_engine {
     /* lights and RSMs */
     struct LpvLightBlock light_block;
     GLuint light_ubo;
-    int rsm_size, face_count, rsm_alloc_size, rsm_alloc_faces;
-    int punctual_faces;   /* faces (= layers) of the punctual lights; area faces follow */
-    int rsm_layers;       /* layers in use: punctual faces + those the area faces' tiles fill */
-    int area_face_side;   /* texels of an area light face's tile */
     /* each light's clearance (light_faces.c: the distance from its eye to
      * the nearest surface that can shadow what it lights, for its faces'
      * near planes), per light of light_block, and what it was found for:
@@ -174,26 +203,9 @@ struct lpv_engine {
     float light_clearance_key[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS][8];
     int light_clearance_pending[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* lights whose triangles are to scan */
     int light_clearance_pending_count;
-    GLuint rsm_position, rsm_normal, rsm_flux, rsm_albedo, rsm_depth, rsm_fbo;
-    GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
-    /* the VPLs that carry light, in order, and their draw command (compact.h):
-     * the injection draws only them */
-    GLuint vpls_live, vpls_draw;
-    /* VPLs (and surfels) per layer, blocks^2 x slots: the punctual lights',
-     * the area lights' layers whose surfels the GV takes
-     * (lpv_engine_area_gv_layers), the other area layers' (pass_rsm.c) */
-    size_t rsm_per_layer[3];
-    size_t rsm_vpl_count; /* the three kinds of layers x their rsm_per_layer */
+    lpv_rsms rsm; /* the lights' RSMs and the VPLs and surfels made from them (pass_rsm.c) */
 
-    /* shadow maps of direct light (pass_shadow.c), rendered at render time */
-    struct LpvShadowBlock shadow_block; /* the faces the maps hold */
-    GLuint shadow_ubo, shadow_tex, shadow_fbo;
-    /* the shadow maps' transmission (scenes with BLEND draws,
-     * LPV_TEX_SHADOW_TRANSMIT): an RGBA16F array like shadow_tex, drawn
-     * through shadow_transmit_fbo over shadow_tex's depth */
-    GLuint shadow_transmit_tex, shadow_transmit_fbo;
-    int shadow_alloc_size, shadow_alloc_faces;
-    int shadow_valid;     /* 0: the maps must be redrawn (scene, settings, invalidate) */
+    lpv_shadow_maps shadows; /* direct light's shadow maps (pass_shadow.c) */
 
     lpv_memory_limits mem_limits; /* of the context, read at create; the budget lowered by caps */
     uint64_t mem_device_budget;    /* the budget as read at create */
@@ -327,7 +339,7 @@ void lpv_pass_media_run(lpv_engine *e);
 void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *first, size_t *count);
 
 /* Light faces (RSM views) for the scene's lights and area light samples:
- * fills e->light_block, face_count, punctual_faces, rsm_layers. */
+ * fills e->light_block and e->rsm's face_count, punctual_faces, layers. */
 void lpv_light_faces_build(lpv_engine *e);
 
 /* RSM layers and shadow-map layers the scene's lights and area light samples

@@ -62,7 +62,7 @@ size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 {
     if (!e->ticked)
         return 0;
-    size_t n = lpv_gl_read_buffer(e->vpls, sizeof(lpv_vpl), e->rsm_vpl_count, out, max);
+    size_t n = lpv_gl_read_buffer(e->rsm.vpls, sizeof(lpv_vpl), e->rsm.vpl_count, out, max);
     if (n < max && e->plan.consumes.emissive_vpls) /* what the technique got */
         n += lpv_gl_read_buffer(e->emissive_vpls, sizeof(lpv_vpl), e->emissive_vpl_count, out + n, max - n);
     return n;
@@ -70,11 +70,11 @@ size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 
 size_t lpv_engine_read_injected_vpls(lpv_engine *e, lpv_vpl *out, size_t max)
 {
-    if (!e->ticked || !e->vpls_draw)
+    if (!e->ticked || !e->rsm.vpls_draw)
         return 0;
     GLuint count = 0;
-    lpv_gl_read_buffer(e->vpls_draw, sizeof count, 1, &count, 1);
-    lpv_gl_read_buffer(e->vpls_live, sizeof(lpv_vpl), count, out, max);
+    lpv_gl_read_buffer(e->rsm.vpls_draw, sizeof count, 1, &count, 1);
+    lpv_gl_read_buffer(e->rsm.vpls_live, sizeof(lpv_vpl), count, out, max);
     return count;
 }
 
@@ -94,7 +94,7 @@ size_t lpv_engine_gv_buffer_count(const lpv_engine *e)
 
 void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *first, size_t *count)
 {
-    const size_t per_layer = e->rsm_per_layer[0], per_area_layer = e->rsm_per_layer[1];
+    const size_t per_layer = e->rsm.per_layer[0], per_area_layer = e->rsm.per_layer[1];
     const size_t lights = (size_t)e->light_block.counts[2];
     *first = *count = 0;
     if (buffer < lights) {
@@ -105,7 +105,7 @@ void lpv_engine_gv_buffer_range(const lpv_engine *e, size_t buffer, size_t *firs
         /* only the layers holding the first sample's faces: the other
          * samples' surfels are left out of the GV anyway (rsm.frag) */
         const int layers = lpv_engine_area_gv_layers(e);
-        *first = (size_t)e->punctual_faces * per_layer;
+        *first = (size_t)e->rsm.punctual_faces * per_layer;
         *count = (size_t)layers * per_area_layer;
     }
 }
@@ -120,7 +120,7 @@ size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, si
         lpv_engine_gv_buffer_range(e, buffer, &first, &count);
         size_t n = count < max ? count : max;
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->rsm.surfels);
         glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, (GLintptr)(first * sizeof(lpv_surfel)),
                            (GLsizeiptr)(n * sizeof(lpv_surfel)), out);
         return n;

@@ -248,7 +248,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     if (!triangles && !wires)
         return lpv_error(err, err_size, "%s: nothing to draw (no triangles, points or lines)", scene->source);
     uint64_t sig = geometry_signature(scene);
-    e->shadow_valid = 0;
+    e->shadows.valid = 0;
     e->ticked = 0;
     if (e->has_scene && sig == e->geometry_sig) {
         /* the same geometry, materials and textures: only the lights are new,

@@ -21,16 +21,16 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
     in->settings = &e->settings;
     in->plan = &e->plan;
     in->timer = &e->timer;
-    in->rsm_vpls = e->vpls_live;
-    in->rsm_vpl_draw = e->vpls_draw;
-    in->rsm_vpl_count = e->rsm_vpl_count;
+    in->rsm_vpls = e->rsm.vpls_live;
+    in->rsm_vpl_draw = e->rsm.vpls_draw;
+    in->rsm_vpl_count = e->rsm.vpl_count;
     in->emissive_vpls = e->emissive_vpls;
     in->emissive_vpl_count = e->emissive_vpl_count;
     in->medium = &e->medium;
     size_t n = 0;
     for (size_t b = 0, first, count;
          n < LPV_MAX_SURFEL_SETS && (lpv_engine_gv_buffer_range(e, b, &first, &count), count > 0); ++b)
-        in->surfel_sets[n++] = (lpv_surfel_set){e->surfels, first, count};
+        in->surfel_sets[n++] = (lpv_surfel_set){e->rsm.surfels, first, count};
     if (e->plan.pass[LPV_PASS_GBUFFER].run && n < LPV_MAX_SURFEL_SETS)
         in->surfel_sets[n++] =
             (lpv_surfel_set){e->camera_surfels, 0, lpv_engine_camera_surfel_count(e)};
@@ -38,8 +38,8 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
         in->surfel_sets[n++] = (lpv_surfel_set){e->scene_surfels, 0, e->scene_surfel_count};
     in->surfel_set_count = n;
     in->light_ubo = e->light_ubo;
-    in->rsm_position = e->rsm_position;
-    in->rsm_albedo = e->rsm_albedo;
+    in->rsm_position = e->rsm.position;
+    in->rsm_albedo = e->rsm.albedo;
     if (e->plan.pass[LPV_PASS_GBUFFER].run) {
         memcpy(in->gbuffer, e->gbuf_tex, sizeof in->gbuffer);
         in->gbuffer_w = e->gbuf_w;
@@ -65,7 +65,7 @@ static void record_stats(lpv_engine *e)
     }
     s->lights = (unsigned)e->light_block.counts[2];
     s->area_lights = (unsigned)(e->light_block.counts[0] - e->light_block.counts[2]);
-    s->rsm_faces = (unsigned)e->face_count;
+    s->rsm_faces = (unsigned)e->rsm.face_count;
     s->rsm_size = (unsigned)e->settings.rsm_size;
     s->reach.on = lpv_engine_reach_in_use(e);
     s->reach.per_pixel = lpv_engine_reach_per_pixel(e);
@@ -76,7 +76,7 @@ static void record_stats(lpv_engine *e)
     s->reach.lit_components = e->reach.lit_components;
     s->reach.dark_voxels = e->reach.dark_voxels;
     s->reach.lit_voxels = e->reach.lit_voxels;
-    s->vpls_rsm = e->rsm_vpl_count;
+    s->vpls_rsm = e->rsm.vpl_count;
     s->vpls_emissive = e->plan.consumes.emissive_vpls ? e->emissive_vpl_count : 0;
     const int gv = e->plan.consumes.surfels;
     s->surfels_rsm = 0;

@@ -408,8 +408,8 @@ static int add_area_lights(lpv_engine *e, int lights, int faces, int layer, floa
         }
         ++added;
     }
-    e->area_face_side = side;
-    e->rsm_layers = layer + area_layers(n, added * LPV_AREA_FACES);
+    e->rsm.area_face_side = side;
+    e->rsm.layers = layer + area_layers(n, added * LPV_AREA_FACES);
     return added;
 }
 
@@ -501,13 +501,13 @@ static void build_faces(lpv_engine *e)
     }
     b->counts[2] = (float)lights;
     b->counts[3] = (float)directional;
-    e->punctual_faces = faces;
+    e->rsm.punctual_faces = faces;
     const int area = add_area_lights(e, lights, faces, faces, radius);
     lights += area;
     faces += area * LPV_AREA_FACES;
     b->counts[0] = (float)lights;
     b->counts[1] = (float)faces;
-    e->face_count = faces;
+    e->rsm.face_count = faces;
 }
 
 void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers)

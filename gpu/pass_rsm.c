@@ -27,17 +27,17 @@ static GLuint array_texture(GLenum format, int size, int layers)
  * the engine's destroy calls it too, so this is the one list of them. */
 void lpv_pass_rsm_free(lpv_engine *e)
 {
-    lpv_gl_delete_texture(&e->rsm_position);
-    lpv_gl_delete_texture(&e->rsm_normal);
-    lpv_gl_delete_texture(&e->rsm_flux);
-    lpv_gl_delete_texture(&e->rsm_albedo);
-    lpv_gl_delete_texture(&e->rsm_depth);
-    lpv_gl_delete_framebuffer(&e->rsm_fbo);
-    lpv_gl_delete_buffer(&e->vpls);
-    lpv_gl_delete_buffer(&e->surfels);
-    lpv_gl_delete_buffer(&e->vpls_live);
-    lpv_gl_delete_buffer(&e->vpls_draw);
-    e->rsm_alloc_size = e->rsm_alloc_faces = 0;
+    lpv_gl_delete_texture(&e->rsm.position);
+    lpv_gl_delete_texture(&e->rsm.normal);
+    lpv_gl_delete_texture(&e->rsm.flux);
+    lpv_gl_delete_texture(&e->rsm.albedo);
+    lpv_gl_delete_texture(&e->rsm.depth);
+    lpv_gl_delete_framebuffer(&e->rsm.fbo);
+    lpv_gl_delete_buffer(&e->rsm.vpls);
+    lpv_gl_delete_buffer(&e->rsm.surfels);
+    lpv_gl_delete_buffer(&e->rsm.vpls_live);
+    lpv_gl_delete_buffer(&e->rsm.vpls_draw);
+    e->rsm.alloc_size = e->rsm.alloc_faces = 0;
 }
 
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
@@ -47,13 +47,13 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof e->light_block, &e->light_block);
 
     const int size = e->settings.rsm_size;
-    const int layers = e->rsm_layers > 0 ? e->rsm_layers : 1;
-    if (e->rsm_alloc_size == size && e->rsm_alloc_faces == layers) {
-        e->rsm_size = size;
+    const int layers = e->rsm.layers > 0 ? e->rsm.layers : 1;
+    if (e->rsm.alloc_size == size && e->rsm.alloc_faces == layers) {
+        e->rsm.size = size;
         return 0;
     }
-    e->rsm_size = 0;
-    e->rsm_vpl_count = 0;
+    e->rsm.size = 0;
+    e->rsm.vpl_count = 0;
     /* Estimate before allocating: past what the device holds, drivers fail
      * in ways that crash (llvmpipe segfaults on shader storage past 2 GiB). */
     lpv_memory_need need;
@@ -64,26 +64,26 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
     }
 
     lpv_pass_rsm_free(e);
-    e->rsm_position = array_texture(GL_RGBA32F, size, layers);
-    e->rsm_normal = array_texture(GL_RGBA32F, size, layers);
-    e->rsm_flux = array_texture(GL_RGBA32F, size, layers);
-    e->rsm_albedo = array_texture(GL_RGBA8, size, layers);
-    e->rsm_depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
-    glGenFramebuffers(1, &e->rsm_fbo);
+    e->rsm.position = array_texture(GL_RGBA32F, size, layers);
+    e->rsm.normal = array_texture(GL_RGBA32F, size, layers);
+    e->rsm.flux = array_texture(GL_RGBA32F, size, layers);
+    e->rsm.albedo = array_texture(GL_RGBA8, size, layers);
+    e->rsm.depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
+    glGenFramebuffers(1, &e->rsm.fbo);
 
     /* the most VPLs (and surfels) any step makes: see lpv_memory_block_samples */
     size_t texels = (size_t)layers * (size_t)lpv_memory_block_samples(size, size);
-    glGenBuffers(1, &e->vpls);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls);
+    glGenBuffers(1, &e->rsm.vpls);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->rsm.vpls);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_vpl)), NULL, GL_DYNAMIC_COPY);
-    glGenBuffers(1, &e->surfels);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->surfels);
+    glGenBuffers(1, &e->rsm.surfels);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->rsm.surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_surfel)), NULL, GL_DYNAMIC_COPY);
-    glGenBuffers(1, &e->vpls_live);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls_live);
+    glGenBuffers(1, &e->rsm.vpls_live);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->rsm.vpls_live);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(texels * sizeof(lpv_vpl)), NULL, GL_DYNAMIC_COPY);
-    glGenBuffers(1, &e->vpls_draw);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->vpls_draw);
+    glGenBuffers(1, &e->rsm.vpls_draw);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->rsm.vpls_draw);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)lpv_compact_head_bytes(texels), NULL, GL_DYNAMIC_COPY);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
@@ -91,10 +91,10 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
         return lpv_error(err, err_size, "could not allocate the RSMs: rsm_size %d x %d layers = %.2f GB (GL error "
                          "0x%04x)", size, layers, (double)lpv_memory_rsm_bytes(&need) / 1e9, gl_err);
     }
-    e->rsm_alloc_size = size;
-    e->rsm_alloc_faces = layers;
-    e->rsm_size = size;
-    e->rsm_vpl_count = 0;
+    e->rsm.alloc_size = size;
+    e->rsm.alloc_faces = layers;
+    e->rsm.size = size;
+    e->rsm.vpl_count = 0;
     return 0;
 }
 
@@ -107,7 +107,7 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
  * lpv_settings_rsm_vpl_step). Returns the elements per layer. */
 static size_t extract_layers(lpv_engine *e, int first, int count, int side, size_t base, int surfels)
 {
-    const int size = e->rsm_size;
+    const int size = e->rsm.size;
     const int step = lpv_settings_rsm_vpl_step(&e->settings, side, surfels);
     const int blocks = (size + step - 1) / step;
     const int slots = lpv_block_slots(step);
@@ -128,7 +128,7 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
         glUniform1i(glGetUniformLocation(prog, "u_blocks"), blocks);
         glUniform1i(glGetUniformLocation(prog, "u_slots"), slots);
     }
-    GLuint tex[4] = {e->rsm_position, e->rsm_normal, e->rsm_flux, e->rsm_albedo};
+    GLuint tex[4] = {e->rsm.position, e->rsm.normal, e->rsm.flux, e->rsm.albedo};
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
@@ -136,8 +136,8 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
     glUniform1i(glGetUniformLocation(prog, "u_size"), size);
     glUniform1i(glGetUniformLocation(prog, "u_layer0"), first);
     glUniform1i(glGetUniformLocation(prog, "u_base"), (GLint)base);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->vpls);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->surfels);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->rsm.vpls);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->rsm.surfels);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D), (GLuint)count);
     lpv_timer_count(&e->timer, 1);
@@ -146,20 +146,20 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
 
 int lpv_engine_area_gv_layers(const lpv_engine *e)
 {
-    const int area = e->rsm_layers - e->punctual_faces;
-    if (area <= 0 || e->rsm_size <= 0)
+    const int area = e->rsm.layers - e->rsm.punctual_faces;
+    if (area <= 0 || e->rsm.size <= 0)
         return 0;
-    const int side = e->area_face_side > 0 ? e->area_face_side : e->rsm_size;
-    const int per_row = e->rsm_size / side, faces_per_layer = per_row * per_row;
+    const int side = e->rsm.area_face_side > 0 ? e->rsm.area_face_side : e->rsm.size;
+    const int per_row = e->rsm.size / side, faces_per_layer = per_row * per_row;
     const int layers = (LPV_AREA_FACES + faces_per_layer - 1) / faces_per_layer;
     return layers < area ? layers : area;
 }
 
 void lpv_pass_rsm_run(lpv_engine *e)
 {
-    const int size = e->rsm_size;
+    const int size = e->rsm.size;
     lpv_timer_begin(&e->timer, "rsm");
-    glBindFramebuffer(GL_FRAMEBUFFER, e->rsm_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->rsm.fbo);
     static const GLenum bufs[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                                    GL_COLOR_ATTACHMENT3};
     glDrawBuffers(4, bufs);
@@ -175,17 +175,17 @@ void lpv_pass_rsm_run(lpv_engine *e)
     GLint loc_vp = glGetUniformLocation(prog, "u_view_proj");
     GLint loc_face = glGetUniformLocation(prog, "u_face");
     int bound_layer = -1;
-    for (int f = 0; f < e->face_count; ++f) {
+    for (int f = 0; f < e->rsm.face_count; ++f) {
         /* A face fills its layer, or (area lights) one tile of it: a layer is
          * attached and cleared once, before its first face draws. */
         const float *tile = e->light_block.faces[f].tile;
         const int layer = (int)tile[3];
         if (layer != bound_layer) {
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->rsm_position, 0, layer);
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, e->rsm_normal, 0, layer);
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, e->rsm_flux, 0, layer);
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, e->rsm_albedo, 0, layer);
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->rsm_depth, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->rsm.position, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, e->rsm.normal, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, e->rsm.flux, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, e->rsm.albedo, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->rsm.depth, 0, layer);
             static const float zero[4] = {0, 0, 0, 0};
             for (int i = 0; i < 4; ++i)
                 glClearBufferfv(GL_COLOR, i, zero);
@@ -209,26 +209,26 @@ void lpv_pass_rsm_run(lpv_engine *e)
         return;
     lpv_timer_begin(&e->timer, "vpl_extract");
     /* the producers mark the VPLs that carry light (compact.h) */
-    lpv_compact_clear(e->vpls_draw);
-    lpv_compact_bind(e->vpls_draw);
+    lpv_compact_clear(e->rsm.vpls_draw);
+    lpv_compact_bind(e->rsm.vpls_draw);
     /* the punctual lights' layers (one face a layer), then the area lights'
      * (faces tiled four to a layer): those holding the first sample's faces,
      * whose surfels the geometry volume takes, then the others, which give
      * VPLs only (rsm.frag); each at the step of its faces' side, one after
      * the other in the buffers */
-    const int punctual = e->punctual_faces < e->rsm_layers ? e->punctual_faces : e->rsm_layers;
-    const int area_side = e->area_face_side > 0 ? e->area_face_side : size;
-    const int area = e->rsm_layers - punctual, area_gv = lpv_engine_area_gv_layers(e);
+    const int punctual = e->rsm.punctual_faces < e->rsm.layers ? e->rsm.punctual_faces : e->rsm.layers;
+    const int area_side = e->rsm.area_face_side > 0 ? e->rsm.area_face_side : size;
+    const int area = e->rsm.layers - punctual, area_gv = lpv_engine_area_gv_layers(e);
     size_t base = 0;
-    e->rsm_per_layer[0] = extract_layers(e, 0, punctual, size, base, 1);
-    base += (size_t)punctual * e->rsm_per_layer[0];
-    e->rsm_per_layer[1] = extract_layers(e, punctual, area_gv, area_side, base, 1);
-    base += (size_t)area_gv * e->rsm_per_layer[1];
-    e->rsm_per_layer[2] = extract_layers(e, punctual + area_gv, area - area_gv, area_side, base, 0);
-    e->rsm_vpl_count = base + (size_t)(area - area_gv) * e->rsm_per_layer[2];
+    e->rsm.per_layer[0] = extract_layers(e, 0, punctual, size, base, 1);
+    base += (size_t)punctual * e->rsm.per_layer[0];
+    e->rsm.per_layer[1] = extract_layers(e, punctual, area_gv, area_side, base, 1);
+    base += (size_t)area_gv * e->rsm.per_layer[1];
+    e->rsm.per_layer[2] = extract_layers(e, punctual + area_gv, area - area_gv, area_side, base, 0);
+    e->rsm.vpl_count = base + (size_t)(area - area_gv) * e->rsm.per_layer[2];
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     /* the injection draws only the VPLs that carry light (most of the
      * blocks' slots are empty) */
-    lpv_compact_run(e->prog_compact, e->vpls, e->rsm_vpl_count, e->vpls_live, e->vpls_draw);
+    lpv_compact_run(e->prog_compact, e->rsm.vpls, e->rsm.vpl_count, e->rsm.vpls_live, e->rsm.vpls_draw);
     lpv_timer_end(&e->timer);
 }

@@ -21,15 +21,15 @@
 
 void lpv_pass_shadow_free(lpv_engine *e)
 {
-    if (e->shadow_tex)
-        glDeleteTextures(1, &e->shadow_tex);
-    if (e->shadow_fbo)
-        glDeleteFramebuffers(1, &e->shadow_fbo);
-    e->shadow_tex = e->shadow_fbo = 0;
-    lpv_gl_delete_texture(&e->shadow_transmit_tex);
-    lpv_gl_delete_framebuffer(&e->shadow_transmit_fbo);
-    e->shadow_alloc_size = e->shadow_alloc_faces = 0;
-    e->shadow_valid = 0;
+    if (e->shadows.tex)
+        glDeleteTextures(1, &e->shadows.tex);
+    if (e->shadows.fbo)
+        glDeleteFramebuffers(1, &e->shadows.fbo);
+    e->shadows.tex = e->shadows.fbo = 0;
+    lpv_gl_delete_texture(&e->shadows.transmit_tex);
+    lpv_gl_delete_framebuffer(&e->shadows.transmit_fbo);
+    e->shadows.alloc_size = e->shadows.alloc_faces = 0;
+    e->shadows.valid = 0;
 }
 
 static int allocate(lpv_engine *e, int size, int layers, int translucent, char *err, size_t err_size)
@@ -41,8 +41,8 @@ static int allocate(lpv_engine *e, int size, int layers, int translucent, char *
     lpv_pass_shadow_free(e);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
-    glGenTextures(1, &e->shadow_tex);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
+    glGenTextures(1, &e->shadows.tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.tex);
     glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
     /* Hardware compare with bilinear filtering: each tap of the PCF kernel
      * is already a 2x2 weighted comparison. */
@@ -54,22 +54,22 @@ static int allocate(lpv_engine *e, int size, int layers, int translucent, char *
     /* reversed depth (docs/shadows.md "Near planes"): nearer is larger, so
      * a receiver is lit where its depth is at least the map's */
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
-    glGenFramebuffers(1, &e->shadow_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_fbo);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, 0);
+    glGenFramebuffers(1, &e->shadows.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, 0);
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (translucent && status == GL_FRAMEBUFFER_COMPLETE) {
-        glGenTextures(1, &e->shadow_transmit_tex);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_transmit_tex);
+        glGenTextures(1, &e->shadows.transmit_tex);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.transmit_tex);
         glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA16F, size, size, layers);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        glGenFramebuffers(1, &e->shadow_transmit_fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_transmit_fbo);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadow_transmit_tex, 0, 0);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, 0);
+        glGenFramebuffers(1, &e->shadows.transmit_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.transmit_fbo);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadows.transmit_tex, 0, 0);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, 0);
         glDrawBuffer(GL_COLOR_ATTACHMENT0);
         status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     }
@@ -82,8 +82,8 @@ static int allocate(lpv_engine *e, int size, int layers, int translucent, char *
                          "framebuffer 0x%04x)",
                          size, layers, (double)lpv_memory_shadow_bytes(&need) / 1e9, gl_err, status);
     }
-    e->shadow_alloc_size = size;
-    e->shadow_alloc_faces = layers;
+    e->shadows.alloc_size = size;
+    e->shadows.alloc_faces = layers;
     return 0;
 }
 
@@ -95,9 +95,9 @@ static int allocate(lpv_engine *e, int size, int layers, int translucent, char *
 static void draw_transmission(lpv_engine *e, GLuint prog, int layer)
 {
     static const float clear[4] = {1.0f, 1.0f, 1.0f, 0.0f}; /* all light passes; no surface (depth 0: infinitely far) */
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_transmit_fbo);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadow_transmit_tex, 0, layer);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, layer);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.transmit_fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadows.transmit_tex, 0, layer);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, layer);
     glClearBufferfv(GL_COLOR, 0, clear); /* within the face's rect: the caller's scissor */
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
@@ -108,7 +108,7 @@ static void draw_transmission(lpv_engine *e, GLuint prog, int layer)
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ZERO);
     glDepthMask(GL_TRUE);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.fbo);
 }
 
 /* The cone of directions light l sends light into: a spot's outer cone, an
@@ -144,7 +144,7 @@ static int light_cone(const lpv_engine *e, int l, vec3 apex, vec3 axis, float *h
 #define EDGE_SAMPLES 64
 static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int rect[4])
 {
-    const struct LpvShadowFaceGpu *F = &e->shadow_block.faces[f];
+    const struct LpvShadowFaceGpu *F = &e->shadows.block.faces[f];
     rect[0] = x, rect[1] = y, rect[2] = side, rect[3] = side;
     vec3 apex, axis;
     float half;
@@ -206,10 +206,10 @@ static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int
 
 static void draw(lpv_engine *e)
 {
-    const int size = e->shadow_alloc_size, faces = (int)e->shadow_block.counts[0];
+    const int size = e->shadows.alloc_size, faces = (int)e->shadows.block.counts[0];
     int bound_layer = -1;
     lpv_timer_begin(&e->timer, "shadow");
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadow_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.fbo);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE); /* both sides cast: single-sided walls still block */
     glEnable(GL_DEPTH_TEST);
@@ -229,10 +229,10 @@ static void draw(lpv_engine *e)
         /* A face fills its layer, or (area light samples) one tile of it, or
          * the lit half of that tile: only what it draws is cleared (the
          * clear costs as much as the drawing on llvmpipe). */
-        const float *tile = e->shadow_block.faces[f].tile;
+        const float *tile = e->shadows.block.faces[f].tile;
         const int layer = (int)tile[3];
         if (layer != bound_layer) {
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadow_tex, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, layer);
             bound_layer = layer;
         }
         const int side = (int)lroundf(tile[2] * (float)size);
@@ -243,9 +243,9 @@ static void draw(lpv_engine *e)
         glScissor(rect[0], rect[1], rect[2], rect[3]);
         glClearBufferfv(GL_DEPTH, 0, &far_depth);
         glViewport(x, y, side, side);
-        glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->shadow_block.faces[f].view_proj);
+        glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->shadows.block.faces[f].view_proj);
         lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_NOT_BLEND); /* lights see both sides */
-        if (e->shadow_transmit_fbo)
+        if (e->shadows.transmit_fbo)
             draw_transmission(e, prog, layer);
     }
     glDisable(GL_SCISSOR_TEST);
@@ -265,26 +265,26 @@ int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size)
     const int layers = b.counts[3] > 0.0f ? (int)b.counts[3] : 1;
     const int translucent = e->blend_draws > 0;
     b.options[0] = (float)translucent;
-    if (e->shadow_alloc_size != size || e->shadow_alloc_faces != layers || !e->shadow_transmit_fbo != !translucent)
+    if (e->shadows.alloc_size != size || e->shadows.alloc_faces != layers || !e->shadows.transmit_fbo != !translucent)
         if (allocate(e, size, layers, translucent, err, err_size) != 0)
             return -1;
-    if (e->shadow_valid && memcmp(&b, &e->shadow_block, sizeof b) == 0)
+    if (e->shadows.valid && memcmp(&b, &e->shadows.block, sizeof b) == 0)
         return 0;
-    e->shadow_block = b;
-    glBindBuffer(GL_UNIFORM_BUFFER, e->shadow_ubo);
+    e->shadows.block = b;
+    glBindBuffer(GL_UNIFORM_BUFFER, e->shadows.ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof b, &b);
     if (faces > 0)
         draw(e);
-    e->shadow_valid = 1;
+    e->shadows.valid = 1;
     return 0;
 }
 
 void lpv_pass_shadow_bind(const lpv_engine *e)
 {
     glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.tex);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_SHADOW_TRANSMIT);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadow_transmit_tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.transmit_tex);
     glActiveTexture(GL_TEXTURE0);
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadow_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadows.ubo);
 }
