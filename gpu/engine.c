@@ -172,7 +172,7 @@ int lpv_engine_set_settings(lpv_engine *e, const lpv_settings *settings, char *e
         if (!e->settings_dirty)
             memcpy(e->settings_knob, knob, sizeof knob);
         e->settings_dirty = 1;
-        e->gbuf_stale = 1;
+        e->gbuf.stale = 1;
     }
     if (touches & LPV_TOUCH_SHADOWS)
         e->shadows.valid = 0;
@@ -190,7 +190,7 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
 {
     if (!view) {
         e->has_view = 0;
-        e->gbuf_stale = 1;
+        e->gbuf.stale = 1;
         return 0;
     }
     if (view->width < 1 || view->height < 1 || view->width > 16384 || view->height > 16384)
@@ -205,7 +205,7 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
             return -1;
     }
     if (!e->has_view || memcmp(&e->view, view, sizeof *view) != 0)
-        e->gbuf_stale = 1;
+        e->gbuf.stale = 1;
     e->view = *view;
     e->has_view = 1;
     lpv_engine_reach_view(e);

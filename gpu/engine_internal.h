@@ -80,6 +80,36 @@ typedef struct lpv_frame_blocks {
     int w, h, step;
 } lpv_frame_blocks;
 
+/* The camera's G-buffer, its surfels for the geometry volume and the
+ * translucent layer: what pass_camera.c's G-buffer pass owns and gives the
+ * technique (camera surfels) and the frame (the targets). */
+typedef struct lpv_gbuffer {
+    int w, h;
+    /* the camera's surfels: blocks of camera_surfel_step pixels, surfel_slots surfels each */
+    int surfel_w, surfel_h, surfel_slots;
+    GLuint tex[LPV_GBUF_TARGETS], depth, fbo, surfels;
+    /* The translucent layer (scenes with BLEND draws, LPV_PASS_TRANSLUCENT):
+     * the nearest BLEND surface in front of the G-buffer's, in a G-buffer of
+     * its own (the same targets, then its coverage: alpha) sharing the
+     * G-buffer's depth, shaded into layer_frame_tex and laid over the frame. */
+    GLuint layer_tex[LPV_GBUF_TARGETS + 1], layer_fbo, layer_frame_tex;
+    int layer_w, layer_h;
+    int stale;           /* the G-buffer does not show the current view and scene */
+} lpv_gbuffer;
+
+/* The shaded frame and what its passes keep between them. */
+typedef struct lpv_frame_buffers {
+    GLuint tex, fbo;
+    GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
+    GLuint area_rest;  /* the pixels left for area_shadow_rest.comp (the same layout) */
+    int shade_split;   /* the last frame was shaded in two passes */
+    int shade_area_blocks; /* the last frame took the area light's shadows from the area shadow step's blocks */
+    /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp)
+     * and the blocks' area light visibility and planes of the area shadow
+     * step (area_shadow_blocks.comp); empty until a step above 1 */
+    lpv_frame_blocks lookup_blocks, area_shadow_blocks;
+} lpv_frame_buffers;
+
 /* The lights' reflective shadow maps and what pass_rsm.c makes of them:
  * the VPLs the technique injects and the surfels of the geometry volume
  * (lpv_technique_inputs takes them). Faces are laid out by light_faces.c. */
@@ -130,7 +160,6 @@ struct lpv_engine {
     int computed_has_view;
     size_t occluder_triangles;
     lpv_medium_gpu medium;    /* the scene's participating medium (medium.present), if any */
-    int gbuf_stale;           /* the G-buffer does not show the current view and scene */
 
     /* programs */
     GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
@@ -218,25 +247,8 @@ struct lpv_engine {
     lpv_view view;
     GLuint view_ubo;
     struct LpvViewBlock view_block;
-    int gbuf_w, gbuf_h;
-    /* the camera's surfels: blocks of camera_surfel_step pixels, camera_surfel_slots surfels each */
-    int camera_surfel_w, camera_surfel_h, camera_surfel_slots;
-    GLuint gbuf_tex[LPV_GBUF_TARGETS], gbuf_depth, gbuf_fbo, camera_surfels;
-    GLuint frame_tex, frame_fbo;
-    /* The translucent layer (scenes with BLEND draws, LPV_PASS_TRANSLUCENT):
-     * the nearest BLEND surface in front of the G-buffer's, in a G-buffer of
-     * its own (the same targets, then its coverage: alpha) sharing the
-     * G-buffer's depth, shaded into layer_frame and laid over the frame. */
-    GLuint layer_tex[LPV_GBUF_TARGETS + 1], layer_fbo, layer_frame_tex;
-    int layer_w, layer_h;
-    GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
-    GLuint area_rest;  /* the pixels left for area_shadow_rest.comp (the same layout) */
-    int shade_split;   /* the last frame was shaded in two passes */
-    int shade_area_blocks; /* the last frame took the area light's shadows from the area shadow step's blocks */
-    /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp)
-     * and the blocks' area light visibility and planes of the area shadow
-     * step (area_shadow_blocks.comp); empty until a step above 1 */
-    lpv_frame_blocks lookup_blocks, area_shadow_blocks;
+    lpv_gbuffer gbuf;      /* the camera's G-buffer and surfels (pass_camera.c) */
+    lpv_frame_buffers frame; /* the shaded frame and its passes' buffers (pass_camera.c, frame_blocks.c) */
 
     GLuint query_in, query_out; /* irradiance queries */
     size_t query_capacity;
@@ -413,7 +425,7 @@ int lpv_block_slots(int step);
 /* The camera's surfels the last G-buffer pass made (pass_camera.c). */
 static inline size_t lpv_engine_camera_surfel_count(const lpv_engine *e)
 {
-    return (size_t)e->camera_surfel_w * (size_t)e->camera_surfel_h * (size_t)e->camera_surfel_slots;
+    return (size_t)e->gbuf.surfel_w * (size_t)e->gbuf.surfel_h * (size_t)e->gbuf.surfel_slots;
 }
 
 #endif /* LPV_ENGINE_INTERNAL_H */

@@ -126,7 +126,7 @@ size_t lpv_engine_read_surfels(lpv_engine *e, size_t buffer, lpv_surfel *out, si
         return n;
     }
     if (buffer == rsm_buffers && e->has_view)
-        return lpv_gl_read_buffer(e->camera_surfels, sizeof(lpv_surfel), lpv_engine_camera_surfel_count(e), out, max);
+        return lpv_gl_read_buffer(e->gbuf.surfels, sizeof(lpv_surfel), lpv_engine_camera_surfel_count(e), out, max);
     if (buffer == rsm_buffers + (e->has_view ? 1 : 0) && e->scene_surfel_count)
         return lpv_gl_read_buffer(e->scene_surfels, sizeof(lpv_surfel), e->scene_surfel_count, out, max);
     return 0;

@@ -19,10 +19,10 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return lpv_error(err, err_size, "render needs a view (camera)");
     if (terms == LPV_TERMS_AO && lpv_ao_check(&e->settings, e->tech_id, err, err_size) != 0)
         return -1;
-    if (e->gbuf_stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
+    if (e->gbuf.stale) { /* the tick did not need the camera's G-buffer, or the camera moved since */
         if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
             return -1;
-        e->gbuf_stale = 0;
+        e->gbuf.stale = 0;
     }
     /* Direct light needs the shadow maps (media's in-scattering too, which
      * only a full frame has); they are redrawn only when what they show changed. */
@@ -40,8 +40,8 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return -1;
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
         lpv_pass_media_run(e);
-    const int w = e->gbuf_w, h = e->gbuf_h;
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame_fbo);
+    const int w = e->gbuf.w, h = e->gbuf.h;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame.fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);

@@ -262,7 +262,7 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     }
     e->scene_dirty = 1;
     e->geometry_sig = sig;
-    e->gbuf_stale = 1;
+    e->gbuf.stale = 1;
     lpv_engine_free_scene(e);
     e->counters.scene_uploads++;
     e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);

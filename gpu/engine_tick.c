@@ -33,7 +33,7 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
         in->surfel_sets[n++] = (lpv_surfel_set){e->rsm.surfels, first, count};
     if (e->plan.pass[LPV_PASS_GBUFFER].run && n < LPV_MAX_SURFEL_SETS)
         in->surfel_sets[n++] =
-            (lpv_surfel_set){e->camera_surfels, 0, lpv_engine_camera_surfel_count(e)};
+            (lpv_surfel_set){e->gbuf.surfels, 0, lpv_engine_camera_surfel_count(e)};
     if (e->scene_surfel_count && n < LPV_MAX_SURFEL_SETS)
         in->surfel_sets[n++] = (lpv_surfel_set){e->scene_surfels, 0, e->scene_surfel_count};
     in->surfel_set_count = n;
@@ -41,9 +41,9 @@ static void technique_inputs(lpv_engine *e, lpv_technique_inputs *in)
     in->rsm_position = e->rsm.position;
     in->rsm_albedo = e->rsm.albedo;
     if (e->plan.pass[LPV_PASS_GBUFFER].run) {
-        memcpy(in->gbuffer, e->gbuf_tex, sizeof in->gbuffer);
-        in->gbuffer_w = e->gbuf_w;
-        in->gbuffer_h = e->gbuf_h;
+        memcpy(in->gbuffer, e->gbuf.tex, sizeof in->gbuffer);
+        in->gbuffer_w = e->gbuf.w;
+        in->gbuffer_h = e->gbuf.h;
     }
     in->lookup_planes = (const float (*)[3])e->lookup_planes;
     in->lookup_plane_count = e->lookup_plane_count;
@@ -148,7 +148,7 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
     if (p->pass[LPV_PASS_GBUFFER].run) {
         if (lpv_pass_gbuffer_run(e, err, err_size) != 0)
             return -1;
-        e->gbuf_stale = 0;
+        e->gbuf.stale = 0;
     }
     if (lpv_timer_abandoned(&e->timer))
         return abandoned(e, err, err_size);

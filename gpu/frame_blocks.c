@@ -22,7 +22,7 @@
 static void run_blocks(lpv_engine *e, lpv_frame_blocks *b, int step, GLuint img_value, GLuint img_plane,
                        GLenum tex_value, GLenum tex_plane)
 {
-    const int w = (e->gbuf_w + step - 1) / step, h = (e->gbuf_h + step - 1) / step;
+    const int w = (e->gbuf.w + step - 1) / step, h = (e->gbuf.h + step - 1) / step;
     if (b->step != step || b->w != w || b->h != h) {
         glActiveTexture(GL_TEXTURE0 + tex_value);
         for (int i = 0; i < 2; ++i) {
@@ -51,7 +51,7 @@ void lpv_frame_lookup_blocks_run(lpv_engine *e)
     glUseProgram(prog);
     lpv_engine_bind_lookup(e, prog, damping);
     glUniform1i(glGetUniformLocation(prog, "u_lookup_step"), step);
-    run_blocks(e, &e->lookup_blocks, step, LPV_IMG_BLOCK_IRRADIANCE, LPV_IMG_BLOCK_PLANE, LPV_TEX_BLOCK_IRRADIANCE,
+    run_blocks(e, &e->frame.lookup_blocks, step, LPV_IMG_BLOCK_IRRADIANCE, LPV_IMG_BLOCK_PLANE, LPV_TEX_BLOCK_IRRADIANCE,
                LPV_TEX_BLOCK_PLANE);
 }
 
@@ -62,7 +62,7 @@ void lpv_frame_area_shadow_blocks_run(lpv_engine *e)
     const GLuint prog = e->prog_area_shadow_blocks;
     glUseProgram(prog);
     glUniform1i(glGetUniformLocation(prog, "u_area_shadow_step"), step);
-    run_blocks(e, &e->area_shadow_blocks, step, LPV_IMG_AREA_SHADOW, LPV_IMG_AREA_SHADOW_PLANE, LPV_TEX_AREA_SHADOW,
+    run_blocks(e, &e->frame.area_shadow_blocks, step, LPV_IMG_AREA_SHADOW, LPV_IMG_AREA_SHADOW_PLANE, LPV_TEX_AREA_SHADOW,
                LPV_TEX_AREA_SHADOW_PLANE);
     lpv_timer_count(&e->timer, 1);
     lpv_timer_end(&e->timer);
@@ -70,7 +70,7 @@ void lpv_frame_area_shadow_blocks_run(lpv_engine *e)
 
 void lpv_frame_blocks_free(lpv_engine *e)
 {
-    lpv_frame_blocks *all[] = {&e->lookup_blocks, &e->area_shadow_blocks};
+    lpv_frame_blocks *all[] = {&e->frame.lookup_blocks, &e->frame.area_shadow_blocks};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; ++k) {
         for (int i = 0; i < 2; ++i)
             lpv_gl_delete_texture(&all[k]->tex[i]);

@@ -17,21 +17,21 @@
 void lpv_pass_camera_free(lpv_engine *e)
 {
     for (int i = 0; i < LPV_GBUF_TARGETS; ++i)
-        lpv_gl_delete_texture(&e->gbuf_tex[i]);
-    lpv_gl_delete_texture(&e->gbuf_depth);
-    lpv_gl_delete_texture(&e->frame_tex);
-    lpv_gl_delete_framebuffer(&e->gbuf_fbo);
-    lpv_gl_delete_framebuffer(&e->frame_fbo);
-    lpv_gl_delete_buffer(&e->camera_surfels);
-    lpv_gl_delete_buffer(&e->shade_rest);
-    lpv_gl_delete_buffer(&e->area_rest);
+        lpv_gl_delete_texture(&e->gbuf.tex[i]);
+    lpv_gl_delete_texture(&e->gbuf.depth);
+    lpv_gl_delete_texture(&e->frame.tex);
+    lpv_gl_delete_framebuffer(&e->gbuf.fbo);
+    lpv_gl_delete_framebuffer(&e->frame.fbo);
+    lpv_gl_delete_buffer(&e->gbuf.surfels);
+    lpv_gl_delete_buffer(&e->frame.shade_rest);
+    lpv_gl_delete_buffer(&e->frame.area_rest);
     for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-        lpv_gl_delete_texture(&e->layer_tex[i]);
-    lpv_gl_delete_texture(&e->layer_frame_tex);
-    lpv_gl_delete_framebuffer(&e->layer_fbo);
-    e->layer_w = e->layer_h = 0;
-    e->gbuf_w = e->gbuf_h = 0;
-    e->camera_surfel_w = e->camera_surfel_h = e->camera_surfel_slots = 0;
+        lpv_gl_delete_texture(&e->gbuf.layer_tex[i]);
+    lpv_gl_delete_texture(&e->gbuf.layer_frame_tex);
+    lpv_gl_delete_framebuffer(&e->gbuf.layer_fbo);
+    e->gbuf.layer_w = e->gbuf.layer_h = 0;
+    e->gbuf.w = e->gbuf.h = 0;
+    e->gbuf.surfel_w = e->gbuf.surfel_h = e->gbuf.surfel_slots = 0;
 }
 
 /* The G-buffer's targets' formats (gbuffer.frag's outputs 0..4); the
@@ -44,37 +44,37 @@ void lpv_pass_camera_free(lpv_engine *e)
 static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
 {
     const int w = e->view.width, h = e->view.height;
-    if (e->gbuf_w == w && e->gbuf_h == h)
+    if (e->gbuf.w == w && e->gbuf.h == h)
         return 0;
     lpv_pass_camera_free(e);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
     static const GLenum formats[LPV_GBUF_TARGETS] = {GBUF_FORMATS};
-    glGenFramebuffers(1, &e->gbuf_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
+    glGenFramebuffers(1, &e->gbuf.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.fbo);
     GLenum bufs[LPV_GBUF_TARGETS];
     for (int i = 0; i < LPV_GBUF_TARGETS; ++i) {
-        e->gbuf_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf_tex[i], 0);
+        e->gbuf.tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf.tex[i], 0);
         bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
     }
-    e->gbuf_depth = lpv_gl_new_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf_depth, 0);
+    e->gbuf.depth = lpv_gl_new_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf.depth, 0);
     glDrawBuffers(LPV_GBUF_TARGETS, bufs);
 
-    glGenFramebuffers(1, &e->frame_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->frame_fbo);
-    e->frame_tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->frame_tex, 0);
+    glGenFramebuffers(1, &e->frame.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->frame.fbo);
+    e->frame.tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->frame.tex, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
-    glGenBuffers(1, &e->camera_surfels);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->camera_surfels);
+    glGenBuffers(1, &e->gbuf.surfels);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->gbuf.surfels);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lpv_memory_block_samples(w, h) * sizeof(lpv_surfel)), NULL,
                  GL_DYNAMIC_COPY);
     /* the frame's two lists of pixels for a second pass: the lookup's
      * (shade_rest.comp) and the area shadow step's (area_shadow_rest.comp) */
-    GLuint *lists[2] = {&e->shade_rest, &e->area_rest};
+    GLuint *lists[2] = {&e->frame.shade_rest, &e->frame.area_rest};
     for (int i = 0; i < 2; ++i) {
         glGenBuffers(1, lists[i]);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, *lists[i]);
@@ -88,8 +88,8 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
         return lpv_error(err, err_size, "could not allocate the %dx%d G-buffer, frame and surfels (GL error 0x%04x)", w,
                          h, gl_err);
     }
-    e->gbuf_w = w;
-    e->gbuf_h = h;
+    e->gbuf.w = w;
+    e->gbuf.h = h;
     return 0;
 }
 
@@ -100,39 +100,39 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
  * again (docs/memory.md counts it with them). */
 static int ensure_layer_targets(lpv_engine *e, char *err, size_t err_size)
 {
-    const int w = e->gbuf_w, h = e->gbuf_h;
-    if (e->layer_fbo && e->layer_w == w && e->layer_h == h)
+    const int w = e->gbuf.w, h = e->gbuf.h;
+    if (e->gbuf.layer_fbo && e->gbuf.layer_w == w && e->gbuf.layer_h == h)
         return 0;
     for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-        lpv_gl_delete_texture(&e->layer_tex[i]);
-    lpv_gl_delete_texture(&e->layer_frame_tex);
-    lpv_gl_delete_framebuffer(&e->layer_fbo);
+        lpv_gl_delete_texture(&e->gbuf.layer_tex[i]);
+    lpv_gl_delete_texture(&e->gbuf.layer_frame_tex);
+    lpv_gl_delete_framebuffer(&e->gbuf.layer_fbo);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
     static const GLenum formats[LPV_GBUF_TARGETS + 1] = {GBUF_FORMATS, LAYER_COVERAGE_FORMAT};
-    glGenFramebuffers(1, &e->layer_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->layer_fbo);
+    glGenFramebuffers(1, &e->gbuf.layer_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.layer_fbo);
     GLenum bufs[LPV_GBUF_TARGETS + 1];
     for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i) {
-        e->layer_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->layer_tex[i], 0);
+        e->gbuf.layer_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf.layer_tex[i], 0);
         bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
     }
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf_depth, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf.depth, 0);
     glDrawBuffers(LPV_GBUF_TARGETS + 1, bufs);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    e->layer_frame_tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
+    e->gbuf.layer_frame_tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
         for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-            lpv_gl_delete_texture(&e->layer_tex[i]);
-        lpv_gl_delete_texture(&e->layer_frame_tex);
-        lpv_gl_delete_framebuffer(&e->layer_fbo);
+            lpv_gl_delete_texture(&e->gbuf.layer_tex[i]);
+        lpv_gl_delete_texture(&e->gbuf.layer_frame_tex);
+        lpv_gl_delete_framebuffer(&e->gbuf.layer_fbo);
         return lpv_error(err, err_size, "could not allocate the %dx%d translucent layer (GL error 0x%04x)", w, h,
                          gl_err);
     }
-    e->layer_w = w;
-    e->layer_h = h;
+    e->gbuf.layer_w = w;
+    e->gbuf.layer_h = h;
     return 0;
 }
 
@@ -182,7 +182,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     lpv_timer_begin(&e->timer, "gbuffer");
     build_view_block(e);
     const lpv_view *v = &e->view;
-    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.fbo);
     glViewport(0, 0, v->width, v->height);
     static const float zero[4] = {0, 0, 0, 0};
     for (int i = 0; i < LPV_GBUF_TARGETS; ++i)
@@ -211,7 +211,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
             lpv_timer_end(&e->timer);
             return -1;
         }
-        glBindFramebuffer(GL_FRAMEBUFFER, e->layer_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.layer_fbo);
         for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
             glClearBufferfv(GL_COLOR, i, zero);
         lpv_engine_draw_scene(e, p, 1, LPV_DRAWS_BLEND);
@@ -221,26 +221,26 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
 
     glUseProgram(e->prog_camera_surfels);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[0]);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf.tex[0]);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[1]);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf.tex[1]);
     glActiveTexture(GL_TEXTURE2);
-    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[2]);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf.tex[2]);
     glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[3]);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf.tex[3]);
     const int step = lpv_settings_camera_surfel_step(&e->settings, v->height);
-    e->camera_surfel_w = (v->width + step - 1) / step;
-    e->camera_surfel_h = (v->height + step - 1) / step;
-    e->camera_surfel_slots = lpv_block_slots(step);
+    e->gbuf.surfel_w = (v->width + step - 1) / step;
+    e->gbuf.surfel_h = (v->height + step - 1) / step;
+    e->gbuf.surfel_slots = lpv_block_slots(step);
     GLuint cs = e->prog_camera_surfels;
     glUniform2i(glGetUniformLocation(cs, "u_size"), v->width, v->height);
     glUniform1i(glGetUniformLocation(cs, "u_step"), step);
-    glUniform2i(glGetUniformLocation(cs, "u_out_size"), e->camera_surfel_w, e->camera_surfel_h);
-    glUniform1i(glGetUniformLocation(cs, "u_slots"), e->camera_surfel_slots);
+    glUniform2i(glGetUniformLocation(cs, "u_out_size"), e->gbuf.surfel_w, e->gbuf.surfel_h);
+    glUniform1i(glGetUniformLocation(cs, "u_slots"), e->gbuf.surfel_slots);
     lpv_engine_bind_block_groups(e, cs);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->camera_surfels);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->gbuf.surfels);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    glDispatchCompute(lpv_div_up((size_t)e->camera_surfel_w, LPV_WG_2D), lpv_div_up((size_t)e->camera_surfel_h, LPV_WG_2D),
+    glDispatchCompute(lpv_div_up((size_t)e->gbuf.surfel_w, LPV_WG_2D), lpv_div_up((size_t)e->gbuf.surfel_h, LPV_WG_2D),
                       1);
     lpv_timer_count(&e->timer, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -272,12 +272,12 @@ static size_t listed_pixels(GLuint list)
 
 size_t lpv_pass_shade_full_lookups(lpv_engine *e)
 {
-    return e->shade_split && e->shade_rest ? listed_pixels(e->shade_rest) : 0;
+    return e->frame.shade_split && e->frame.shade_rest ? listed_pixels(e->frame.shade_rest) : 0;
 }
 
 size_t lpv_pass_shade_area_rest_pixels(lpv_engine *e)
 {
-    return e->shade_area_blocks && e->area_rest ? listed_pixels(e->area_rest) : 0;
+    return e->frame.shade_area_blocks && e->frame.area_rest ? listed_pixels(e->frame.area_rest) : 0;
 }
 
 /* Empties a list of the frame's (0 x 1 x 1 workgroups, 0 pixels) and binds
@@ -364,9 +364,9 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
     }
     /* the lists of pixels for the second passes start empty */
     if (split)
-        start_list(e->shade_rest, LPV_SSBO_SHADE_REST);
+        start_list(e->frame.shade_rest, LPV_SSBO_SHADE_REST);
     if (area_blocks)
-        start_list(e->area_rest, LPV_SSBO_AREA_REST);
+        start_list(e->frame.area_rest, LPV_SSBO_AREA_REST);
     use_shading_program(e, prog, terms);
     glBindImageTexture(LPV_IMG_FRAME, frame, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     /* in bands of about LPV_SHADE_BAND_PIXELS, a yield point between them
@@ -387,22 +387,22 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
     }
     /* the listed pixels' indirect light, then their area light */
     if (split)
-        run_list(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, e->shade_rest, terms, frame);
+        run_list(e, damped ? e->prog_shade_rest_damped : e->prog_shade_rest, e->frame.shade_rest, terms, frame);
     if (area_blocks)
-        run_list(e, e->prog_area_shadow_rest, e->area_rest, terms, frame);
+        run_list(e, e->prog_area_shadow_rest, e->frame.area_rest, terms, frame);
     /* the glossy and media passes blend into the frame, which is then read back */
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     lpv_timer_count(&e->timer, (blocks ? 1 : 0) + 1 + (split ? 1 : 0) + (area_blocks ? 1 : 0));
-    e->shade_split = split;
-    e->shade_area_blocks = area_blocks;
+    e->frame.shade_split = split;
+    e->frame.shade_area_blocks = area_blocks;
     lpv_timer_end(&e->timer);
     return 0;
 }
 
 int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size)
 {
-    const int whole[4] = {0, 0, e->gbuf_w, e->gbuf_h};
-    return shade_frame(e, terms, e->gbuf_tex, e->frame_tex, whole, "shade", err, err_size);
+    const int whole[4] = {0, 0, e->gbuf.w, e->gbuf.h};
+    return shade_frame(e, terms, e->gbuf.tex, e->frame.tex, whole, "shade", err, err_size);
 }
 
 /* The pixels the BLEND draws can cover: the bounding rectangle of their
@@ -411,7 +411,7 @@ int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t e
  * behind the eye). Returns 0 when none can be seen. */
 static int layer_rect(const lpv_engine *e, int rect[4])
 {
-    const float w = (float)e->gbuf_w, h = (float)e->gbuf_h;
+    const float w = (float)e->gbuf.w, h = (float)e->gbuf.h;
     float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     for (uint32_t i = 0; i < e->draw_count; ++i) {
         const lpv_gpu_draw *d = &e->draws[i];
@@ -424,7 +424,7 @@ static int layer_rect(const lpv_engine *e, int rect[4])
                  clip;
             glm_mat4_mulv((vec4 *)e->view_block.view_proj, p, clip);
             if (!(clip[3] > 1e-6f)) { /* behind the eye (or on its plane): it may reach any pixel */
-                rect[0] = rect[1] = 0, rect[2] = e->gbuf_w, rect[3] = e->gbuf_h;
+                rect[0] = rect[1] = 0, rect[2] = e->gbuf.w, rect[3] = e->gbuf.h;
                 return 1;
             }
             const float x = (clip[0] / clip[3] * 0.5f + 0.5f) * w, y = (clip[1] / clip[3] * 0.5f + 0.5f) * h;
@@ -443,9 +443,9 @@ static int layer_rect(const lpv_engine *e, int rect[4])
 int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_lookups, size_t *area_rest_pixels,
                              char *err, size_t err_size)
 {
-    if (!e->layer_fbo || e->layer_w != e->gbuf_w || e->layer_h != e->gbuf_h)
-        return lpv_error(err, err_size, "the translucent layer was not drawn for this %dx%d frame", e->gbuf_w,
-                         e->gbuf_h);
+    if (!e->gbuf.layer_fbo || e->gbuf.layer_w != e->gbuf.w || e->gbuf.layer_h != e->gbuf.h)
+        return lpv_error(err, err_size, "the translucent layer was not drawn for this %dx%d frame", e->gbuf.w,
+                         e->gbuf.h);
     /* the frame's pixels listed for second passes, before the layer's
      * shading lists its own in the same buffers */
     *full_lookups += lpv_pass_shade_full_lookups(e);
@@ -456,15 +456,15 @@ int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_
     int rect[4];
     if (!layer_rect(e, rect))
         return 0;
-    if (shade_frame(e, terms, e->layer_tex, e->layer_frame_tex, rect, "translucent", err, err_size) != 0)
+    if (shade_frame(e, terms, e->gbuf.layer_tex, e->gbuf.layer_frame_tex, rect, "translucent", err, err_size) != 0)
         return -1;
     lpv_timer_begin(&e->timer, "translucent");
     glUseProgram(e->prog_translucent);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, e->layer_frame_tex);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf.layer_frame_tex);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, e->layer_tex[LPV_GBUF_TARGETS]);
-    glBindImageTexture(LPV_IMG_FRAME, e->frame_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindTexture(GL_TEXTURE_2D, e->gbuf.layer_tex[LPV_GBUF_TARGETS]);
+    glBindImageTexture(LPV_IMG_FRAME, e->frame.tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
     glUniform2i(glGetUniformLocation(e->prog_translucent, "u_first"), rect[0], rect[1]);
     glDispatchCompute(lpv_div_up((size_t)rect[2], LPV_WG_2D), lpv_div_up((size_t)rect[3], LPV_WG_2D), 1);

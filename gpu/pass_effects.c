@@ -16,12 +16,12 @@ static void bind_frame_inputs(lpv_engine *e)
 {
     for (int i = 0; i < 4; ++i) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        glBindTexture(GL_TEXTURE_2D, e->gbuf_tex[i]);
+        glBindTexture(GL_TEXTURE_2D, e->gbuf.tex[i]);
     }
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->frame_fbo);
-    glViewport(0, 0, e->gbuf_w, e->gbuf_h);
+    glBindFramebuffer(GL_FRAMEBUFFER, e->frame.fbo);
+    glViewport(0, 0, e->gbuf.w, e->gbuf.h);
     glDisable(GL_DEPTH_TEST);
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
