@@ -21,13 +21,6 @@
 #include "scene_load.h"
 #include "serve_limits.h"
 
-uint64_t sv_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u;
-}
-
 enum { S_SOCKET, S_LISTEN, S_TOKEN_FILE, S_SCENE_ROOT, S_SCENE, S_HELP, S_COUNT };
 
 /* The flags that are no limit: where the daemon listens and what it serves. */
@@ -483,11 +476,13 @@ int lpvd_cmd_serve(int argc, char **argv)
     }
     pthread_mutex_init(&s->mu, NULL);
     pthread_cond_init(&s->cv, NULL);
+    /* what the network layer and the handlers call of the sessions (serve.h) */
+    s->session = (sv_session_hooks){.open = sv_session_open, .free = sv_session_free, .pump = sv_session_pump};
     if (load_default_scene(s, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd serve: %s\n", err);
         goto out;
     }
-    if (sv_gl_start(s, err, sizeof err) != 0) {
+    if (sv_gl_start(s, sv_world_jobs_done, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd serve: %s\n", err);
         goto out;
     }

@@ -1,13 +1,18 @@
 /*
  * serve.h - the internals of `lpvd serve` (the daemon), shared by its files:
  *
- *   serve.c          the command: flags, start-up, signals, shutdown
+ *   serve.c          the command: flags, start-up, signals, shutdown; it
+ *                    registers the session hooks (sv_session_hooks)
+ *   serve_clock.c    sv_now_ms
  *   serve_net_*.c    libuv listeners, connections, frame reading, bounded writes
  *                    (one file per job: serve_net_internal.h lists them)
- *   serve_session.c  per-connection state, request dispatch, revisions; its
- *                    handlers are in serve_hello.c, serve_scene.c,
+ *   serve_session.c  per-connection state and revisions; the replies are
+ *                    serve_reply.c's, the dispatch serve_dispatch.c's, the
+ *                    handlers in serve_hello.c, serve_scene.c,
  *                    serve_controls.c, serve_results.c and serve_streams.c
- *                    (serve_session_internal.h)
+ *                    (serve_session_internal.h); serve_sub.c a delta
+ *                    subscriber's bases
+ *   serve_inputs.c   live scenes and the inputs snapshots that key worlds
  *   serve_world.c    worlds (shared computations) and the completions of
  *                    their jobs; they report to sessions through
  *                    sv_world_listener
@@ -16,6 +21,10 @@
  *                    fp16, XOR delta, zstd, PNG, EXR) on libuv's work
  *                    threads, sends on the loop
  *   serve_limits.c   the daemon's limits, one row each
+ * No circle of files (a file calls only files below it; docs/server.md,
+ * "Files", has the order): where a lower layer must reach a higher one it
+ * calls a function pointer the higher one registered (sv_session_hooks,
+ * sv_server.net_resume_reading, sv_gl_start's jobs_done, sv_world_listener).
  * What a tick's result is and how it becomes a payload is export.h's
  * (export_result.c, export_encode.c), shared with lpvd batch.
  *
@@ -114,7 +123,7 @@ typedef struct sv_config {
 #define SV_QUERY_REPLY_ROOM 256u
 uint64_t sv_query_points_by_message(const sv_config *cfg);
 uint64_t sv_query_points_by_queue(const sv_config *cfg);
-uint64_t sv_max_query_points(const sv_config *cfg);
+uint64_t sv_max_query_points(const sv_config *cfg); /* serve_limits.c */
 /* 0 when the least any scene needs under settings s (resolved) with
  * light_faces light faces fits one world (core/memory_budget.h,
  * lpv_memory_need_floor); else -1 with err (CONFIG's ERROR LIMIT). */
@@ -169,7 +178,7 @@ void sv_scene_loads_drop(struct sv_server *s);
 #define SV_PREAUTH_HARD_FACTOR 4
 void sv_net_shrink_stalled(sv_conn *c, uint64_t now_ms); /* serve_net_reserve.c */
 /* Takes c out of the server's pre-HELLO list (HELLO succeeded, or c is
- * closing); no-op when it is not in it (serve_net_accept.c). */
+ * closing); no-op when it is not in it (serve_net_conn.c). */
 void sv_net_preauth_leave(sv_conn *c);
 /* Blocks over this come from their own mapping, given back when freed (serve.c). */
 #define SV_MMAP_THRESHOLD (256 * 1024)
@@ -337,7 +346,7 @@ struct sv_wreq; /* one frame being written (serve_net_write.c) */
 /* How a world reports back to the sessions that use it, so the world layer
  * (serve_world.c) never calls up into the session layer: the session layer
  * points each connection's listener at its callbacks when the session starts
- * (sv_session_init). Both run on the loop thread: from done_async, or from
+ * (sv_session_open). Both run on the loop thread: from done_async, or from
  * sv_gl_stop for the jobs it drops at shutdown. */
 typedef struct sv_world_listener {
     /* c's request request_id, answered by job j (the job's own request, then
@@ -350,6 +359,18 @@ typedef struct sv_world_listener {
 } sv_world_listener;
 
 enum { SV_STREAM_NONE = -1, SV_STREAM_VOLUME = 0, SV_STREAM_FRAME = 1 };
+
+/* What the network layer (serve_net_*.c) and the request handlers call of
+ * the session layer above them: the daemon registers them at start
+ * (serve.c) before it listens, so that no file below the dispatcher calls
+ * up into it by name (docs/architecture.md: no circle of files). */
+typedef struct sv_session_hooks {
+    void (*open)(sv_conn *c); /* accepted: its session starts (sv_session_open) */
+    void (*free)(sv_conn *c); /* closed: its session's state goes (sv_session_free) */
+    /* requests pending, or a busy request answered: handle the next ones,
+     * in order (sv_session_pump) */
+    void (*pump)(sv_conn *c);
+} sv_session_hooks;
 
 struct sv_conn {
     int refs;
@@ -424,6 +445,7 @@ struct sv_server {
     uv_timer_t idle_timer;
     uv_timer_t stop_timer;
     uv_async_t done_async;
+    uv_async_cb gl_jobs_done; /* done_async's callback (sv_gl_start) */
     int stopping;
     uv_timer_t exit_timer;  /* SIGTERM: the most it waits for worker threads (SV_SHUTDOWN_WAIT_MS) */
     int works_inflight;     /* requests running on libuv workers, all sessions */
@@ -439,6 +461,11 @@ struct sv_server {
     int loads_running;
     struct load_work *loads_wait_head, *loads_wait_tail;
     uint64_t memory_waits;  /* turns handed out to connections waiting for request memory */
+    sv_session_hooks session; /* set at start (serve.c) */
+    /* serve_net_read.c's sv_net_resume_reading, set by sv_net_listen: the
+     * requests' memory (serve_net_reserve.c, below reading) resumes a
+     * connection whose frame now fits through it */
+    void (*net_resume_reading)(sv_conn *c);
     uint64_t next_conn_id;
     sv_world *worlds;
     int world_count;
@@ -478,7 +505,7 @@ struct sv_server {
     int exit_code;
 };
 
-/* serve.c */
+/* serve_clock.c */
 uint64_t sv_now_ms(void);
 
 /* the network layer (serve_net_*.c) */
@@ -511,8 +538,10 @@ void sv_net_request_handled(sv_conn *c, uint64_t bytes);
 int sv_net_admit_session(sv_conn *c, uint32_t request_id);
 
 /* serve_session.c */
-void sv_session_init(sv_conn *c);
+void sv_session_init(sv_conn *c);        /* the session's state, its world */
 void sv_session_free(sv_conn *c);        /* on close: detach, free state */
+/* serve_dispatch.c: what the daemon registers as its sv_session_hooks */
+void sv_session_open(sv_conn *c);        /* its world's listener, then sv_session_init */
 void sv_session_pump(sv_conn *c);        /* processes pending requests in order */
 /* A request of c (request_id) starts / ends running on a libuv worker. */
 void sv_session_work_begin(sv_conn *c, uint32_t request_id);
@@ -523,12 +552,16 @@ void sv_session_work_end(sv_conn *c);
 void sv_session_shutdown(sv_conn *c);
 
 /* serve_gl.c */
-int sv_gl_start(sv_server *s, char *err, size_t n);
+/* jobs_done: what done_async runs on the loop for the finished jobs (the
+ * world layer's sv_world_jobs_done, above this one), and sv_gl_stop at the
+ * end. */
+int sv_gl_start(sv_server *s, uv_async_cb jobs_done, char *err, size_t n);
 void sv_gl_stop(sv_server *s);
 void sv_job_submit(sv_server *s, sv_job *j);
 sv_job *sv_job_new(sv_job_kind kind, sv_world *w);
 void sv_job_free(sv_job *j);
 size_t sv_jobs_queued(sv_server *s);
+void sv_job_reply_all(sv_job *j);        /* the job's request and every one that joined it */
 /* Marks w's jobs that wanted(j, arg) says nobody wants any more: the GL
  * thread skips those not started (no GL time), abandons a running tick at
  * its next yield point, and they complete with no result. Destroy jobs are
@@ -539,7 +572,6 @@ void sv_gl_cancel(sv_server *s, sv_world *w, int (*wanted)(const sv_job *j, void
 sv_inputs *sv_inputs_build(sv_conn *c);
 void sv_inputs_unref(sv_inputs *in);
 void sv_inputs_release(sv_server *s, sv_inputs *in); /* unref; the scene too with the last ref */
-void sv_job_reply_all(sv_job *j);        /* the job's request and every one that joined it */
 void sv_world_jobs_done(uv_async_t *a);  /* done_async: finished jobs, on the loop */
 void sv_world_attach(sv_conn *c, sv_inputs *in); /* consumes in */
 void sv_world_detach(sv_conn *c);
@@ -558,7 +590,7 @@ int sv_world_join_tick(sv_world *w, sv_conn *c, uint32_t request_id); /* 1: join
  * lower (CONFIG's LIMIT, and the default CONFIG at start). */
 int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, size_t n);
 
-/* the loop's side of a subscription (serve_streams.c) */
+/* the loop's side of a subscription (serve_sub.c) */
 void sv_sub_clear(sv_sub *sub);
 void sv_sub_ack(sv_sub *sub, uint64_t tick);
 void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len);

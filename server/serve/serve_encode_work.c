@@ -182,7 +182,7 @@ static void after_work_cb(uv_work_t *w, int status)
     sv_result_unref(t->r);
     if (reply) {
         if (!c->closing && !c->close_after_write)
-            sv_session_pump(c);
+            sv_session_go_on(c);
     } else {
         c->enc_busy[t->stream] = 0;
         stream_next(c, t->stream);

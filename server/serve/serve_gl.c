@@ -3,7 +3,8 @@
  * is the only thread that touches GL: it creates the context, owns every
  * world's engine, and runs jobs (tick, render, query, destroy) one at a time;
  * finished jobs go back to the loop through done_async, where the world layer
- * (serve_world.c, sv_world_jobs_done) replies and streams.
+ * (serve_world.c, sv_world_jobs_done, handed to sv_gl_start: this file is
+ * below it and never calls it by name) replies and streams.
  */
 #include "serve.h"
 #include "memory_limits.h"
@@ -38,6 +39,16 @@ sv_job *sv_job_new(sv_job_kind kind, sv_world *w)
         w->jobs++;
     }
     return j;
+}
+
+/* Replies to the request of a job and to every request that joined it,
+ * through each connection's sv_world_listener. */
+void sv_job_reply_all(sv_job *j)
+{
+    if (j->conn)
+        j->conn->listener->job_done(j, j->conn, j->request_id);
+    for (sv_waiter *wt = j->joined; wt; wt = wt->next)
+        wt->conn->listener->job_done(j, wt->conn, wt->request_id);
 }
 
 void sv_job_free(sv_job *j)
@@ -567,9 +578,10 @@ static void *gl_main(void *arg)
 }
 
 
-int sv_gl_start(sv_server *s, char *err, size_t n)
+int sv_gl_start(sv_server *s, uv_async_cb jobs_done, char *err, size_t n)
 {
-    if (uv_async_init(s->loop, &s->done_async, sv_world_jobs_done) != 0) {
+    s->gl_jobs_done = jobs_done;
+    if (uv_async_init(s->loop, &s->done_async, jobs_done) != 0) {
         snprintf(err, n, "uv_async_init failed");
         return -1;
     }
@@ -627,6 +639,6 @@ void sv_gl_stop(sv_server *s)
         pthread_join(s->gl_thread, NULL);
     }
     s->gl_started = 0;
-    sv_world_jobs_done(&s->done_async);
+    s->gl_jobs_done(&s->done_async);
 }
 

@@ -2,7 +2,7 @@
  * serve_hello.c - HELLO, the first request of every session: the protocol
  * version (SPEC R4.1), the --token check (R4.2), and the reply that tells the
  * client the server's limits, knobs and presets (R4.12). Until it succeeds,
- * dispatch (serve_session.c) answers every other request with
+ * dispatch (serve_dispatch.c) answers every other request with
  * HELLO_REQUIRED. A HELLO that passes the token check takes one of the
  * --max-clients slots, or gets LIMIT and the connection closes (R4.1a).
  */

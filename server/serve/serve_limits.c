@@ -178,3 +178,21 @@ void sv_limits_hello(const struct sv_config *cfg, json_t *lim)
         json_object_set_new(lim, l->hello, l->type == SV_LIMIT_REAL ? json_real(v) : json_integer((json_int_t)v));
     }
 }
+
+/* QUERY_IRRADIANCE's largest count (serve.h): here with the limits it
+ * follows from, for HELLO's limits and the query's check alike. */
+uint64_t sv_query_points_by_message(const sv_config *cfg)
+{
+    return cfg->max_message > SV_QUERY_BODY_ROOM ? (cfg->max_message - SV_QUERY_BODY_ROOM) / 24 : 0;
+}
+
+uint64_t sv_query_points_by_queue(const sv_config *cfg)
+{
+    return cfg->max_queue > SV_QUERY_REPLY_ROOM ? (cfg->max_queue - SV_QUERY_REPLY_ROOM) / 12 : 0;
+}
+
+uint64_t sv_max_query_points(const sv_config *cfg)
+{
+    const uint64_t a = sv_query_points_by_message(cfg), b = sv_query_points_by_queue(cfg);
+    return a < b ? a : b;
+}

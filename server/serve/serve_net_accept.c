@@ -4,7 +4,8 @@
  * pre-HELLO list and --max-preauth (R4.1a; when it is full the oldest
  * connection of the peer holding the most goes, not the newcomer), and
  * --max-clients for the connections whose HELLO succeeded. The network
- * layer's design is in serve_net_internal.h.
+ * layer's design is in serve_net_internal.h; the pre-HELLO list itself is
+ * serve_net_conn.c's (a closing connection leaves it).
  */
 #include "serve.h"
 #include "serve_net_internal.h"
@@ -14,35 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
-
-/* ---- the pre-HELLO list ------------------------------------------------- */
-void sv_net_preauth_leave(sv_conn *c)
-{
-    if (!c->in_preauth)
-        return;
-    sv_server *s = c->srv;
-    if (c->pre_prev)
-        c->pre_prev->pre_next = c->pre_next;
-    else
-        s->preauth = c->pre_next;
-    if (c->pre_next)
-        c->pre_next->pre_prev = c->pre_prev;
-    c->pre_prev = c->pre_next = NULL;
-    c->in_preauth = 0;
-    s->preauth_count--;
-}
-
-static void preauth_join(sv_conn *c)
-{
-    sv_server *s = c->srv;
-    c->pre_prev = NULL;
-    c->pre_next = s->preauth;
-    if (s->preauth)
-        s->preauth->pre_prev = c;
-    s->preauth = c;
-    c->in_preauth = 1;
-    s->preauth_count++;
-}
 
 /* ---- accepting ---------------------------------------------------------- */
 /* Open connections (not closing) that have said HELLO (authenticated = 1:
@@ -190,8 +162,8 @@ void sv_net_on_connection(uv_stream_t *server, int status)
         snprintf(c->peer, sizeof c->peer, "unix");
     }
     c->last_rx_ms = c->accepted_ms = sv_now_ms();
-    sv_session_init(c);
-    preauth_join(c);
+    s->session.open(c);
+    sv_net_preauth_join(c);
     peer_key_of(c, is_tcp);
     /* R4.1a: connections that have not said HELLO have their own small
      * quota and never take a --max-clients slot. When it is full, one of them

@@ -2,7 +2,10 @@
  * serve_net_conn.c - closing connections: at once (sv_conn_close), or once
  * what is queued has been written (sv_conn_close_after_write, for an ERROR
  * that closes, R3.4), and what a closed connection gives back: its pending
- * requests' memory, its session, its place in the server's list. The network
+ * requests' memory, its session, its place in the server's list. Also its
+ * last reference (sv_conn_unref, which frees its unsent stream frames) and
+ * the pre-HELLO list it leaves on HELLO or close: both are used by every
+ * file of the network layer, so they are here at its bottom. The network
  * layer's design is in serve_net_internal.h.
  */
 #include "serve.h"
@@ -10,6 +13,58 @@
 
 #include <stdlib.h>
 
+/* ---- references ------------------------------------------------------------ */
+void sv_net_wreq_free(sv_wreq *w)
+{
+    if (!w)
+        return;
+    if (w->mem)
+        sv_memory_sub(w->mem, SV_MEM_REPLIES, w->counted);
+    free(w->head);
+    free(w->att);
+    free(w);
+}
+
+void sv_conn_unref(sv_conn *c)
+{
+    if (!c || --c->refs > 0)
+        return;
+    for (int i = 0; i < 2; ++i)
+        sv_net_wreq_free(c->stream_pending[i]);
+    lpvp_parser_free(&c->parser);
+    free(c);
+}
+
+/* ---- the pre-HELLO list ------------------------------------------------- */
+void sv_net_preauth_leave(sv_conn *c)
+{
+    if (!c->in_preauth)
+        return;
+    sv_server *s = c->srv;
+    if (c->pre_prev)
+        c->pre_prev->pre_next = c->pre_next;
+    else
+        s->preauth = c->pre_next;
+    if (c->pre_next)
+        c->pre_next->pre_prev = c->pre_prev;
+    c->pre_prev = c->pre_next = NULL;
+    c->in_preauth = 0;
+    s->preauth_count--;
+}
+
+void sv_net_preauth_join(sv_conn *c)
+{
+    sv_server *s = c->srv;
+    c->pre_prev = NULL;
+    c->pre_next = s->preauth;
+    if (s->preauth)
+        s->preauth->pre_prev = c;
+    s->preauth = c;
+    c->in_preauth = 1;
+    s->preauth_count++;
+}
+
+/* ---- closing ------------------------------------------------------------ */
 static void free_pending_requests(sv_conn *c)
 {
     sv_request *r = c->pending_head;
@@ -42,7 +97,7 @@ static void on_closed(uv_handle_t *h)
         c->next->prev = c->prev;
     s->conn_count--;
     free_pending_requests(c);
-    sv_session_free(c);
+    s->session.free(c);
     sv_conn_unref(c);
 }
 

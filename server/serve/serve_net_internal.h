@@ -8,8 +8,14 @@
  *                        --max-preauth and --max-clients quotas
  *   serve_net_read.c     frame reading into pending requests
  *   serve_net_reserve.c  the requests' memory (--max-request-memory)
- *   serve_net_write.c    bounded writes (sv_send) and sv_conn_unref
- *   serve_net_conn.c     closing connections
+ *   serve_net_write.c    bounded writes (sv_send)
+ *   serve_net_conn.c     closing connections, the last reference
+ *                        (sv_conn_unref) and the pre-HELLO list
+ *
+ * Each file uses only those listed below it (no circle of files); what the
+ * layer calls up into, the sessions above it and the reading of a
+ * connection whose frame now fits, it calls through function pointers set
+ * at start (sv_session_hooks in serve.h, sv_server.net_resume_reading).
  *
  * The network side of `lpvd serve`, all on the libuv loop: listeners (Unix
  * socket, TCP), connections, frame reading through the protocol's
@@ -42,6 +48,27 @@
 #define LPVD_SERVE_NET_INTERNAL_H
 
 #include "serve.h"
+
+/* ---- connections (serve_net_conn.c) ---- */
+/* One frame being written (serve_net_write.c); its struct is here because
+ * a connection's last reference frees its unsent stream frames
+ * (sv_conn_unref). */
+typedef struct sv_wreq {
+    uv_write_t req;
+    sv_conn *c;
+    uint8_t *head;
+    size_t head_len;
+    uint8_t *att;
+    size_t att_len;
+    int stream;
+    sv_memory *mem;   /* the daemon's budget, once the frame counts in its replies' term */
+    uint64_t counted;
+} sv_wreq;
+
+/* Frees w and takes it out of the daemon's replies' memory. */
+void sv_net_wreq_free(sv_wreq *w);
+/* Puts c in the server's pre-HELLO list (sv_net_preauth_leave takes it out). */
+void sv_net_preauth_join(sv_conn *c);
 
 /* ---- reading (serve_net_read.c) ---- */
 /* The frame limits of a connection, before and after HELLO (R2.5a). */

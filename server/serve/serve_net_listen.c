@@ -45,6 +45,9 @@ static int is_loopback(const struct sockaddr *sa)
 int sv_net_listen(sv_server *s, char *err, size_t n)
 {
     sv_config *cfg = &s->cfg;
+    /* before any connection: the requests' memory resumes the reading of
+     * a connection whose frame now fits through it */
+    s->net_resume_reading = sv_net_resume_reading;
     if (cfg->want_unix) {
         struct stat st;
         if (strlen(cfg->socket_path) >= sizeof(((struct sockaddr_un *)0)->sun_path)) {

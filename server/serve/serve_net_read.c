@@ -120,7 +120,7 @@ void sv_net_on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
                  * that succeeds the configured limits apply (R2.5a). Before
                  * HELLO nothing makes a session busy, so this empties the
                  * queue. */
-                sv_session_pump(c);
+                c->srv->session.pump(c);
                 if (c->hello && !c->closing)
                     c->parser.limits = sv_net_conn_limits(c->srv, 1);
             }
@@ -142,7 +142,7 @@ void sv_net_on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
             uv_read_stop(&c->h.stream);
             c->reading = 0;
         }
-        sv_session_pump(c);
+        c->srv->session.pump(c);
     }
     sv_conn_unref(c);
 }

@@ -62,7 +62,7 @@ void sv_net_release_request_bytes(sv_conn *c, uint64_t bytes)
         if (!first || sv_net_reserve_frame(first) != 0)
             return;
         first->wait_memory = 0;
-        sv_net_resume_reading(first);
+        s->net_resume_reading(first); /* sv_net_resume_reading, set by sv_net_listen */
     }
 }
 

@@ -4,9 +4,8 @@
  * memory budget (R7.6a) and the connection's write cap (--max-queue, or
  * SV_PREAUTH_MAX_QUEUE before HELLO; R3.5), and keeps at most one stream
  * message in flight and one unsent per stream (R5.5). The writes in flight
- * hold references to their connection, so its last reference is dropped
- * here too (sv_conn_unref). The network layer's design is in
- * serve_net_internal.h.
+ * hold references to their connection (sv_conn_unref, serve_net_conn.c).
+ * The network layer's design is in serve_net_internal.h.
  */
 #include "serve.h"
 #include "serve_net_internal.h"
@@ -15,39 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct sv_wreq {
-    uv_write_t req;
-    sv_conn *c;
-    uint8_t *head;
-    size_t head_len;
-    uint8_t *att;
-    size_t att_len;
-    int stream;
-    sv_memory *mem;   /* the daemon's budget, once the frame counts in its replies' term */
-    uint64_t counted;
-} sv_wreq;
-
-static void wreq_free(sv_wreq *w)
-{
-    if (!w)
-        return;
-    if (w->mem)
-        sv_memory_sub(w->mem, SV_MEM_REPLIES, w->counted);
-    free(w->head);
-    free(w->att);
-    free(w);
-}
-
-void sv_conn_unref(sv_conn *c)
-{
-    if (!c || --c->refs > 0)
-        return;
-    for (int i = 0; i < 2; ++i)
-        wreq_free(c->stream_pending[i]);
-    lpvp_parser_free(&c->parser);
-    free(c);
-}
 
 static void write_start(sv_conn *c, sv_wreq *w);
 
@@ -62,7 +28,7 @@ static void on_written(uv_write_t *req, int status)
         c->srv->bytes_sent += w->head_len + w->att_len;
     }
     int stream = w->stream;
-    wreq_free(w);
+    sv_net_wreq_free(w);
     if (stream != SV_STREAM_NONE) {
         c->stream_inflight[stream] = 0;
         if (!c->closing && !c->close_after_write && status == 0 && c->stream_pending[stream]) {
@@ -97,7 +63,7 @@ static void write_start(sv_conn *c, sv_wreq *w)
         c->wq_count--;
         if (w->stream != SV_STREAM_NONE)
             c->stream_inflight[w->stream] = 0;
-        wreq_free(w);
+        sv_net_wreq_free(w);
         sv_conn_close(c);
         sv_conn_unref(c);
     }
@@ -128,7 +94,7 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
     w->att_len = att_len;
     w->stream = stream;
     if (!w->head) {
-        wreq_free(w);
+        sv_net_wreq_free(w);
         sv_conn_close(c);
         return -1;
     }
@@ -136,7 +102,7 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
     if (type != LPVP_ERROR && type != LPVP_BYE_REPLY && !sv_memory_fits(&c->srv->mem, SV_MEM_REPLIES, bytes)) {
         /* R7.6a: over the daemon's budget. A stream message is dropped, as
          * one a newer replaces would be; a reply becomes an ERROR */
-        wreq_free(w);
+        sv_net_wreq_free(w);
         if (stream != SV_STREAM_NONE) {
             c->stream_dropped++;
             return 0;
@@ -153,7 +119,7 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
         if (c->stream_inflight[stream]) { /* R5.5: newest replaces the unsent one */
             if (c->stream_pending[stream])
                 c->stream_dropped++;
-            wreq_free(c->stream_pending[stream]);
+            sv_net_wreq_free(c->stream_pending[stream]);
             c->stream_pending[stream] = w;
             return 0;
         }
@@ -165,7 +131,7 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
     if (len > cap && type != LPVP_ERROR && type != LPVP_BYE_REPLY) {
         /* R3.5 for every reply, the small ones too (a STATS under a tiny
          * --max-queue): never sent, an ERROR instead, the connection stays */
-        wreq_free(w);
+        sv_net_wreq_free(w);
         return sv_send_error(c, request_id, LPVP_E_LIMIT,
                              "the %s reply is %zu bytes, over this server's per-client queue limit of %llu bytes "
                              "(--max-queue): not sent", lpvp_type_name((uint16_t)(type & ~LPVP_REPLY_BIT)), len,
@@ -176,7 +142,7 @@ int sv_send(sv_conn *c, uint16_t type, uint32_t request_id, json_t *body, uint8_
                         "disconnecting it\n",
                 (unsigned long long)c->id, c->peer, c->wq_bytes, (unsigned long long)cap,
                 c->hello ? "" : " before HELLO");
-        wreq_free(w);
+        sv_net_wreq_free(w);
         sv_conn_close(c);
         return -1;
     }

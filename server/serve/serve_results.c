@@ -163,22 +163,6 @@ void sv_do_get_frame(sv_conn *c, sv_request *r, json_t *j)
     submit(c, jb);
 }
 
-uint64_t sv_query_points_by_message(const sv_config *cfg)
-{
-    return cfg->max_message > SV_QUERY_BODY_ROOM ? (cfg->max_message - SV_QUERY_BODY_ROOM) / 24 : 0;
-}
-
-uint64_t sv_query_points_by_queue(const sv_config *cfg)
-{
-    return cfg->max_queue > SV_QUERY_REPLY_ROOM ? (cfg->max_queue - SV_QUERY_REPLY_ROOM) / 12 : 0;
-}
-
-uint64_t sv_max_query_points(const sv_config *cfg)
-{
-    const uint64_t a = sv_query_points_by_message(cfg), b = sv_query_points_by_queue(cfg);
-    return a < b ? a : b;
-}
-
 void sv_do_query(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
@@ -322,5 +306,5 @@ void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
         j->out = NULL;
         sv_reply_query(c, request_id, out, j->count, j->tick);
     }
-    sv_session_pump(c); /* a reply encoding keeps the session busy: nothing is taken before it is queued */
+    sv_session_go_on(c); /* a reply encoding keeps the session busy: nothing is taken before it is queued */
 }

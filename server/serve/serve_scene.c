@@ -361,7 +361,7 @@ static void load_done(uv_work_t *req, int status)
     c->busy = 0;
     sv_session_work_end(c);
     free(w);
-    sv_session_pump(c);
+    sv_session_go_on(c);
     sv_conn_unref(c);
     start_waiting_loads(s);
 }

@@ -2,7 +2,9 @@
  * serve_session_internal.h - what the files of the session layer share, and
  * nothing outside it includes (serve.h is the daemon's common header):
  *
- *   serve_session.c   session state, replies, dispatch, the request pump
+ *   serve_reply.c     REPLY and ERROR, the revision body
+ *   serve_session.c   session state and what changes it
+ *   serve_sub.c       a delta subscriber's bases (sv_sub_*, serve.h)
  *   serve_hello.c     HELLO and the token check
  *   serve_scene.c     SCENE_LOAD, SCENE_UPDATE and their load worker
  *   serve_controls.c  LIGHT_SET, LIGHT_REMOVE, CAMERA_SET, CONFIG
@@ -11,9 +13,16 @@
  *   serve_streams.c   SUBSCRIBE, UNSUBSCRIBE, ACK and the VOLUME / FRAME
  *                     streams after each tick
  *   serve_encode_work.c  their payloads encoded on libuv's work threads
+ *   serve_dispatch.c  dispatch to the handlers, the request pump
+ *
+ * Each file uses only those listed below it in serve.h's layering (no
+ * circle of files): the handlers use the replies and the session state,
+ * the dispatcher uses the handlers, and a handler that answers a busy
+ * request later goes on with the session's next requests through
+ * sv_session_go_on (the pump registered in sv_server.session).
  *
  * Everything here runs on the loop thread. Each sv_do_* handles one request
- * type for dispatch (serve_session.c): it either replies before it returns or
+ * type for dispatch (serve_dispatch.c): it either replies before it returns or
  * marks the session busy and replies later (R3.2).
  */
 #ifndef LPVD_SERVE_SESSION_INTERNAL_H
@@ -27,7 +36,7 @@
 /* the side of the default view, used until CAMERA_SET gives a size */
 #define SV_DEFAULT_VIEW_SIDE 256
 
-/* ---- replies (serve_session.c) ---- */
+/* ---- replies (serve_reply.c) ---- */
 /* ERROR reply; closes the connection when the code does (R3.4), unless
  * noclose (HELLO's BAD_VERSION, R4.1). */
 void sv_reply_err(sv_conn *c, uint32_t rid, int code, int noclose, const char *fmt, ...)
@@ -36,6 +45,13 @@ void sv_reply(sv_conn *c, uint16_t type, uint32_t rid, json_t *body); /* body NU
 json_t *sv_rev_body(sv_conn *c); /* {"revision": the session's} */
 
 /* ---- session state (serve_session.c) ---- */
+/* A busy request of c has been answered (or c may go on): handle its next
+ * requests, through the pump the daemon registered (serve_dispatch.c's
+ * sv_session_pump): the handlers are below the dispatcher. */
+static inline void sv_session_go_on(sv_conn *c)
+{
+    c->srv->session.pump(c);
+}
 /* The scene's lights with clean names (their ids). NULL when it has none. */
 lpv_light *sv_named_lights(const lpv_scene *sc, int *fail);
 /* Takes the scene (a reference) as the session's, with its materials and

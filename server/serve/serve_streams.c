@@ -3,8 +3,8 @@
  * SUBSCRIBE and UNSUBSCRIBE of the volume and frame streams, ACK of delta
  * volumes, and the delivery of VOLUME / FRAME messages after each tick of the
  * session's world (sv_session_stream, which the world calls through its
- * listener after the tick's replies), and a delta subscriber's bases: the
- * volumes it may ACK and the one it did (sv_sub_*).
+ * listener after the tick's replies). A delta subscriber's bases (sv_sub_*)
+ * are serve_sub.c's.
  */
 #include "serve_session_internal.h"
 
@@ -84,54 +84,4 @@ void sv_session_stream(sv_conn *c, sv_result *r)
     sv_sub *fs = &c->subs[SV_STREAM_FRAME];
     if (fs->on && r->frames[fs->terms] && !c->closing)
         sv_stream_result(c, SV_STREAM_FRAME, r);
-}
-
-/* ---- a subscriber's delta bases (its side of export_encode.c's deltas) ---- */
-void sv_sub_clear(sv_sub *sub)
-{
-    sub->epoch++; /* an encoding in flight no longer hands its base back (sv_sub_restore_base) */
-    for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        free(sub->sent[i].raw);
-        sub->sent[i].raw = NULL;
-    }
-    free(sub->acked.raw);
-    sub->acked.raw = NULL;
-}
-
-void sv_sub_ack(sv_sub *sub, uint64_t tick)
-{
-    for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        if (sub->sent[i].raw && sub->sent[i].tick == tick) {
-            free(sub->acked.raw);
-            sub->acked = sub->sent[i];
-            sub->sent[i].raw = NULL;
-            /* older unacknowledged volumes can never become a base now */
-            for (int k = 0; k < SV_SENT_KEEP; ++k)
-                if (sub->sent[k].raw && sub->sent[k].tick < tick) {
-                    free(sub->sent[k].raw);
-                    sub->sent[k].raw = NULL;
-                }
-            return;
-        }
-    }
-}
-
-/* Keeps raw (taken, not copied) as a volume sent to sub that it may ACK. */
-void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len)
-{
-    int slot = 0;
-    for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        if (!sub->sent[i].raw) {
-            slot = i;
-            break;
-        }
-        if (sub->sent[i].tick < sub->sent[slot].tick)
-            slot = i;
-    }
-    free(sub->sent[slot].raw);
-    sub->sent[slot].raw = raw;
-    sub->sent[slot].raw_len = len;
-    sub->sent[slot].tick = tick;
-    sub->sent[slot].fp16 = fp16;
-    memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
 }

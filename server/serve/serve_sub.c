@@ -1,0 +1,60 @@
+/*
+ * serve_sub.c - a delta subscriber's bases (the loop's side of
+ * export_encode.c's deltas): the volumes sent that it may ACK and the one it
+ * did. A file of its own below the streams (serve_streams.c), the encodings
+ * (serve_encode_work.c) and the session state (serve_session.c), which all
+ * keep or drop them, so none of those calls another for it.
+ */
+#include "serve.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void sv_sub_clear(sv_sub *sub)
+{
+    sub->epoch++; /* an encoding in flight no longer hands its base back (sv_sub_restore_base) */
+    for (int i = 0; i < SV_SENT_KEEP; ++i) {
+        free(sub->sent[i].raw);
+        sub->sent[i].raw = NULL;
+    }
+    free(sub->acked.raw);
+    sub->acked.raw = NULL;
+}
+
+void sv_sub_ack(sv_sub *sub, uint64_t tick)
+{
+    for (int i = 0; i < SV_SENT_KEEP; ++i) {
+        if (sub->sent[i].raw && sub->sent[i].tick == tick) {
+            free(sub->acked.raw);
+            sub->acked = sub->sent[i];
+            sub->sent[i].raw = NULL;
+            /* older unacknowledged volumes can never become a base now */
+            for (int k = 0; k < SV_SENT_KEEP; ++k)
+                if (sub->sent[k].raw && sub->sent[k].tick < tick) {
+                    free(sub->sent[k].raw);
+                    sub->sent[k].raw = NULL;
+                }
+            return;
+        }
+    }
+}
+
+/* Keeps raw (taken, not copied) as a volume sent to sub that it may ACK. */
+void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len)
+{
+    int slot = 0;
+    for (int i = 0; i < SV_SENT_KEEP; ++i) {
+        if (!sub->sent[i].raw) {
+            slot = i;
+            break;
+        }
+        if (sub->sent[i].tick < sub->sent[slot].tick)
+            slot = i;
+    }
+    free(sub->sent[slot].raw);
+    sub->sent[slot].raw = raw;
+    sub->sent[slot].raw_len = len;
+    sub->sent[slot].tick = tick;
+    sub->sent[slot].fp16 = fp16;
+    memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
+}
