@@ -54,16 +54,22 @@ def objects(build, dirs):
     return out
 
 
-def symbols(obj):
-    defined, used = set(), set()
-    text = subprocess.run(['nm', obj], capture_output=True, text=True, check=True).stdout
+def symbols(objs):
+    """{object: (defined, used)} for every object, from one `nm -A` run (one
+    process for all: the test runs on every CI build)."""
+    out = {o: (set(), set()) for o in objs}
+    text = subprocess.run(['nm', '-A'] + list(objs), capture_output=True, text=True, check=True).stdout
     for line in text.splitlines():
-        p = line.split()
+        head, sep, rest = line.partition('.o:')  # "OBJECT.o:ADDRESS TYPE NAME" or "OBJECT.o:  U NAME"
+        name = head + '.o'
+        if not sep or name not in out:
+            continue
+        p = rest.split()
         if len(p) == 2 and p[0] == 'U':
-            used.add(p[1])
+            out[name][1].add(p[1])
         elif len(p) == 3 and p[1] in 'TDBRGSC':
-            defined.add(p[2])
-    return defined, used
+            out[name][0].add(p[2])
+    return out
 
 
 def sccs(graph):
@@ -108,8 +114,9 @@ def main():
               file=sys.stderr)
         return 2
     owner, uses = {}, {}
+    syms = symbols(objs.values())
     for src, obj in objs.items():
-        d, u = symbols(obj)
+        d, u = syms[obj]
         uses[src] = u
         for s in d:
             owner[s] = src
