@@ -9,9 +9,11 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <stdio.h>
 #include <string.h>
 
 #include "iv_knobs.h"
+#include "knob_rows.h"
 #include "overall.h"
 #include "settings.h"
 
@@ -95,6 +97,44 @@ static void test_knob_lists(void **state)
     assert_int_equal(lpv_acc_iv_parse_list(LPV_ACC_IV_RAYS, "1/2/3", v, 2), -1);
 }
 
+/* The sweep's knobs are rows of lpvd's knob table: a swept value is
+ * accepted exactly when the row's range takes it, and the sweep's short
+ * names stand for the rows (bench/accuracy/knob_rows.h). */
+static void test_ranges_from_rows(void **state)
+{
+    (void)state;
+    for (int k = 0; k < LPV_ACC_IV_KNOBS; ++k) {
+        const lpv_field *f = lpv_field_by_key(lpv_acc_iv_knob_name(k));
+        assert_non_null(f);
+        if (f->kind == LPV_FIELD_SWITCH)
+            continue;
+        char tok[32];
+        int v = 0;
+        snprintf(tok, sizeof tok, "%d", (int)f->max);
+        assert_int_equal(lpv_acc_iv_parse_value(k, tok, &v), 0);
+        assert_int_equal(v, (int)f->max);
+        snprintf(tok, sizeof tok, "%d", (int)f->max + 1);
+        assert_int_equal(lpv_acc_iv_parse_value(k, tok, &v), -1);
+    }
+    assert_ptr_equal(acc_knob_row("rsm"), lpv_field_by_key("rsm_size"));
+    assert_ptr_equal(acc_knob_row("rsm_size"), lpv_field_by_key("rsm_size"));
+    assert_ptr_equal(acc_knob_row("bins"), lpv_field_by_key("normal_bins"));
+    assert_null(acc_knob_row("bogus"));
+    assert_string_equal(acc_knob_alias("camera_surfel_step"), "camera_step");
+    double x;
+    const lpv_field *rsm = acc_knob_row("rsm");
+    char tok[32];
+    snprintf(tok, sizeof tok, "%d", (int)rsm->max);
+    assert_int_equal(acc_knob_value(rsm, tok, &x, NULL, 0), 0);
+    snprintf(tok, sizeof tok, "%d", (int)rsm->max * 2);
+    assert_int_equal(acc_knob_value(rsm, tok, &x, NULL, 0), -1);
+    assert_int_equal(acc_knob_value(acc_knob_row("camera_step"), "auto", &x, NULL, 0), 0);
+    assert_true(x == 0.0);
+    assert_int_equal(acc_knob_value(acc_knob_row("occlusion"), "off", &x, NULL, 0), 0);
+    assert_true(x == 0.0);
+    assert_int_equal(acc_knob_value(acc_knob_row("occlusion"), "maybe", &x, NULL, 0), -1);
+}
+
 /* The overall front keys iv points by their iv knobs: two iv points that
  * differ only there are two points, and an LPV point is a third. */
 static void test_overall_iv_keys(void **state)
@@ -122,6 +162,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_full),  cmocka_unit_test(test_point_partial),
         cmocka_unit_test(test_point_errors), cmocka_unit_test(test_knob_lists),
+        cmocka_unit_test(test_ranges_from_rows),
         cmocka_unit_test(test_overall_iv_keys),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "accuracy_internal.h"
+#include "knob_rows.h"
 
 enum {
     A_OUT, A_REF_SPP, A_CONV_SPP, A_SCENES, A_QUICK, A_PRESETS, A_FEATURES, A_MULTI_BOUNCES, A_KNOBS, A_POINTS,
@@ -88,16 +89,20 @@ static void usage(FILE *f)
     static char help[8192];
     size_t len = 0;
     lpv_flags_help(help, sizeof help, &len, FLAGS, A_COUNT);
+    static char rows[2048];
+    acc_knob_rows_help(rows, sizeof rows);
     fprintf(f,
             "usage: lpvd-accuracy [--out DIR] [--size WxH] [--ref-spp N] [--conv-spp N] [--scenes LIST] [--quick] [--presets]\n"
             "                     [--knobs SPEC] [--points LIST] [--ticks N] [--warmup N]\n"
             "                     [--reference PATH] [--no-plot] [--iv-tables] [lpvd flags: --backend, --camera, ...]\n"
             "Sweeps lpvd's quality knobs against a path-traced reference (docs/accuracy.md).\n"
             "%s(--quick: %d points; --size: default 128x128 here)\n"
+            "--knobs names: grid (1..%d), technique, each iv_* row, and these aliases of rows of lpvd's\n"
+            "knob table (docs/knobs.md), whose values and ranges they take:\n%s"
             "lpvd flags (all but the swept knobs: --preset, --grid, --iterations, --rsm-size, --occlusion,\n"
             "--central-transport, --normal-bins, --far-field, --scene-surfels; an --iv-* knob only while\n"
             "--knobs or --points does not sweep it):\n%s",
-            help, (int)(sizeof QUICK / sizeof QUICK[0]), LPVD_OPTIONS_HELP);
+            help, (int)(sizeof QUICK / sizeof QUICK[0]), LPV_MAX_GRID_DIM, rows, LPVD_OPTIONS_HELP);
 }
 
 int acc_parse_args(acc_args *a, int argc, char **argv)

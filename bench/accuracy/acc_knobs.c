@@ -8,46 +8,45 @@
 #include <string.h>
 
 #include "accuracy_internal.h"
+#include "knob_rows.h"
 
-/* Parses "16/32" style value lists into out; returns the count or -1. */
-static int parse_values(const char *s, int *out, int max, int is_switch)
+/* A "16/32" list of the row's values into out[max]; returns the count or
+ * -1. Switches give 1 (on) and 0 (off); auto_as replaces a zero value (the
+ * steps keep "auto" as -1, point.cstep / rstep). */
+static int parse_row_list(const lpv_field *f, const char *s, int *out, int max, int auto_as)
 {
     int n = 0;
     char buf[256];
-    snprintf(buf, sizeof buf, "%s", s);
+    if (snprintf(buf, sizeof buf, "%s", s) >= (int)sizeof buf)
+        return -1;
     for (char *save = NULL, *tok = strtok_r(buf, "/", &save); tok; tok = strtok_r(NULL, "/", &save)) {
+        double v;
+        char err[256];
         if (n >= max)
             return -1;
-        if (is_switch) {
-            if (strcmp(tok, "on") == 0 || strcmp(tok, "1") == 0)
-                out[n++] = 1;
-            else if (strcmp(tok, "off") == 0 || strcmp(tok, "0") == 0)
-                out[n++] = 0;
-            else
-                return -1;
-        } else {
-            char *end = NULL;
-            long v = strtol(tok, &end, 10);
-            if (!end || *end || v < 1 || v > 4096)
-                return -1;
-            out[n++] = (int)v;
+        if (acc_knob_value(f, tok, &v, err, sizeof err) != 0) {
+            fprintf(stderr, "lpvd-accuracy: --knobs %s\n", err);
+            return -1;
         }
+        out[n++] = v == 0.0 && f->kind != LPV_FIELD_SWITCH ? auto_as : (int)v;
     }
     return n > 0 ? n : -1;
 }
 
-/* "auto/1/4": the steps' list, auto as -1. */
-static int parse_steps(const char *v, int *out, int max)
+/* The grid is not a row (three sizes, grid_dims): 1..LPV_MAX_GRID_DIM, as
+ * lpv_settings_validate checks it. */
+static int parse_grid(const char *s, int *out, int max)
 {
-    char buf[128];
-    snprintf(buf, sizeof buf, "%s", v);
     int n = 0;
-    for (char *save = NULL, *t = strtok_r(buf, "/", &save); t; t = strtok_r(NULL, "/", &save)) {
-        char *end;
-        long x = strcmp(t, "auto") == 0 ? -1 : strtol(t, &end, 10);
-        if (n >= max || (x != -1 && (*end || x < 1 || x > LPV_MAX_CAMERA_SURFEL_STEP)))
+    char buf[256];
+    if (snprintf(buf, sizeof buf, "%s", s) >= (int)sizeof buf)
+        return -1;
+    for (char *save = NULL, *tok = strtok_r(buf, "/", &save); tok; tok = strtok_r(NULL, "/", &save)) {
+        char *end = NULL;
+        long v = strtol(tok, &end, 10);
+        if (n >= max || !end || *end || v < 1 || v > LPV_MAX_GRID_DIM)
             return -1;
-        out[n++] = (int)x;
+        out[n++] = (int)v;
     }
     return n > 0 ? n : -1;
 }
@@ -67,7 +66,16 @@ int acc_names_iv_knob(const knob_filter *kf)
     return 0;
 }
 
-static const char *const MOD_KNOBS[4] = {"central", "bins", "far", "surfels"};
+/* The mods' rows, in the point's mods bit order (c, b, f, s). */
+static const char *const MOD_KEYS[4] = {"central_transport", "normal_bins", "far_field", "scene_surfels"};
+
+static int m_not_swept(const char *key)
+{
+    for (int m = 0; m < 4; ++m)
+        if (strcmp(key, MOD_KEYS[m]) == 0)
+            return 0;
+    return 1;
+}
 
 int acc_parse_knobs(const char *spec, knob_filter *kf)
 {
@@ -80,24 +88,10 @@ int acc_parse_knobs(const char *spec, knob_filter *kf)
         *eq = '\0';
         const char *v = eq + 1;
         int r;
+        const lpv_field *f = acc_knob_row(tok);
+        const char *key = f ? f->key : tok;
         if (strcmp(tok, "grid") == 0)
-            r = kf->ngrid = parse_values(v, kf->grid, 16, 0);
-        else if (strcmp(tok, "iterations") == 0)
-            r = kf->niter = parse_values(v, kf->iter, 16, 0);
-        else if (strcmp(tok, "rsm") == 0)
-            r = kf->nrsm = parse_values(v, kf->rsm, 16, 0);
-        else if (strcmp(tok, "occlusion") == 0)
-            r = kf->nocc = parse_values(v, kf->occ, 2, 1);
-        else if (strcmp(tok, "camera_step") == 0)
-            r = kf->ncs = parse_steps(v, kf->cs, 16);
-        else if (strcmp(tok, "rsm_step") == 0)
-            r = kf->nrs = parse_steps(v, kf->rs, 16);
-        else if (strcmp(tok, "lookup_step") == 0) {
-            r = kf->nls = parse_values(v, kf->ls, 16, 0);
-            for (int i = 0; i < kf->nls; ++i)
-                if (kf->ls[i] < 1 || kf->ls[i] > LPV_MAX_LOOKUP_STEP)
-                    r = -1;
-        }
+            r = kf->ngrid = parse_grid(v, kf->grid, 16);
         else if (strcmp(tok, "technique") == 0) {
             char names[128];
             snprintf(names, sizeof names, "%s", v);
@@ -109,21 +103,45 @@ int acc_parse_knobs(const char *spec, knob_filter *kf)
                 kf->tech[kf->ntech++] = (int)id;
             }
             r = kf->ntech > 0 ? kf->ntech : -1;
-        } else if (lpv_acc_iv_knob_from_name(tok) >= 0) {
-            const int ik = lpv_acc_iv_knob_from_name(tok);
+        } else if (!f) {
+            fprintf(stderr, "lpvd-accuracy: --knobs %s: not a swept knob\n", tok);
+            return -1;
+        } else if (strcmp(key, "iterations") == 0)
+            r = kf->niter = parse_row_list(f, v, kf->iter, 16, 0);
+        else if (strcmp(key, "rsm_size") == 0)
+            r = kf->nrsm = parse_row_list(f, v, kf->rsm, 16, 0);
+        else if (strcmp(key, "occlusion") == 0)
+            r = kf->nocc = parse_row_list(f, v, kf->occ, 2, 0);
+        else if (strcmp(key, "camera_surfel_step") == 0)
+            r = kf->ncs = parse_row_list(f, v, kf->cs, 16, -1);
+        else if (strcmp(key, "rsm_vpl_step") == 0)
+            r = kf->nrs = parse_row_list(f, v, kf->rs, 16, -1);
+        else if (strcmp(key, "lookup_step") == 0)
+            r = kf->nls = parse_row_list(f, v, kf->ls, 16, 0);
+        else if (lpv_acc_iv_knob_from_name(key) >= 0) {
+            const int ik = lpv_acc_iv_knob_from_name(key);
             r = kf->niv[ik] = lpv_acc_iv_parse_list(ik, v, kf->iv[ik], 16);
         } else {
             r = -1;
             for (int m = 0; m < 4; ++m)
-                if (strcmp(tok, MOD_KNOBS[m]) == 0)
-                    r = kf->nsw[m] = parse_values(v, kf->sw[m], 2, 1);
-            if (r < 0)
-                return -1;
+                if (strcmp(key, MOD_KEYS[m]) == 0)
+                    r = kf->nsw[m] = parse_row_list(f, v, kf->sw[m], 2, 0);
+            if (r < 0 && m_not_swept(key))
+                fprintf(stderr, "lpvd-accuracy: --knobs %s: a knob of lpvd (%s) the sweep does not vary\n", tok, key);
         }
         if (r < 0)
             return -1;
     }
     return 0;
+}
+
+/* Whether the row with this key accepts the integer v. */
+static int row_accepts(const char *key, int v)
+{
+    char tok[24];
+    double out;
+    snprintf(tok, sizeof tok, "%d", v);
+    return acc_knob_value(lpv_field_by_key(key), tok, &out, NULL, 0) == 0;
 }
 
 /* --points: "GRID:ITER:RSM:on|off[:MODS[:TECHNIQUE]][@CAM/VPL]" (the steps,
@@ -142,8 +160,12 @@ int acc_parse_points(const char *list, point *pts, int max, char *err, size_t er
         if (steps) {
             int st[2];
             *steps = '\0';
-            if (parse_steps(steps + 1, st, 2) != 2) {
-                snprintf(err, err_size, "%s: @CAM/VPL expects two steps, each a number or auto", steps + 1);
+            char *vpl = strchr(steps + 1, '/');
+            if (vpl)
+                *vpl++ = '\0';
+            if (!vpl || parse_row_list(lpv_field_by_key("camera_surfel_step"), steps + 1, &st[0], 1, -1) != 1 ||
+                parse_row_list(lpv_field_by_key("rsm_vpl_step"), vpl, &st[1], 1, -1) != 1) {
+                snprintf(err, err_size, "@CAM/VPL expects two steps, each a number or auto");
                 return -1;
             }
             p.cstep = st[0];
@@ -184,8 +206,8 @@ int acc_parse_points(const char *list, point *pts, int max, char *err, size_t er
             if (*c != '-')
                 p.mods |= 1 << (at - acc_mod_letters());
         }
-        if (p.grid < 1 || p.grid > 256 || p.iterations < 0 || p.iterations > 4096 || p.rsm < 16 || p.rsm > 8192 ||
-            !acc_technique_runs(&p))
+        if (p.grid < 1 || p.grid > LPV_MAX_GRID_DIM || (p.iterations != 0 && !row_accepts("iterations", p.iterations)) ||
+            !row_accepts("rsm_size", p.rsm) || !acc_technique_runs(&p))
             return -1;
         if (is_iv(&p)) /* the old form with technique iv: its RSM, the iv knobs' defaults */
             p = (point){.rsm = p.rsm, .technique = LPV_TECHNIQUE_ID_IV, .cstep = p.cstep, .rstep = p.rstep};

@@ -5,19 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "knob_rows.h"
 #include "lpv_shared.h"
 
 static const char *const NAMES[LPV_ACC_IV_KNOBS] = {
     [LPV_ACC_IV_RESOLUTION] = "iv_resolution", [LPV_ACC_IV_POINTS] = "iv_points",
     [LPV_ACC_IV_RAYS] = "iv_rays",             [LPV_ACC_IV_BOUNCES] = "iv_bounces",
     [LPV_ACC_IV_REPROJECTION] = "iv_reprojection", [LPV_ACC_IV_NEIGHBOURS] = "iv_neighbours",
-};
-
-/* The settings' ranges (core/settings.c, validate_iv). */
-static const int MAXV[LPV_ACC_IV_KNOBS] = {
-    [LPV_ACC_IV_RESOLUTION] = LPV_MAX_GRID_DIM, [LPV_ACC_IV_POINTS] = LPV_IV_MAX_POINTS_PER_TRIANGLE,
-    [LPV_ACC_IV_RAYS] = LPV_IV_MAX_RAYS,        [LPV_ACC_IV_BOUNCES] = LPV_IV_MAX_BOUNCES,
-    [LPV_ACC_IV_REPROJECTION] = 2,              [LPV_ACC_IV_NEIGHBOURS] = 8,
 };
 
 const char *lpv_acc_iv_knob_name(int knob)
@@ -37,18 +31,15 @@ int lpv_acc_iv_parse_value(int knob, const char *s, int *out)
 {
     if (knob < 0 || knob >= LPV_ACC_IV_KNOBS || !s)
         return -1;
-    if (knob == LPV_ACC_IV_REPROJECTION) {
-        if (strcmp(s, "on") == 0 || strcmp(s, "1") == 0)
-            *out = LPV_SWITCH_ON;
-        else if (strcmp(s, "off") == 0 || strcmp(s, "0") == 0)
-            *out = LPV_SWITCH_OFF;
-        else
-            return -1;
+    double v;
+    const lpv_field *f = lpv_field_by_key(NAMES[knob]);
+    if (acc_knob_value(f, s, &v, NULL, 0) != 0)
+        return -1;
+    if (f->kind == LPV_FIELD_SWITCH) {
+        *out = v != 0.0 ? LPV_SWITCH_ON : LPV_SWITCH_OFF;
         return 0;
     }
-    char *end = NULL;
-    long v = strtol(s, &end, 10);
-    if (!*s || !end || *end || v < 1 || v > MAXV[knob])
+    if (v < 1.0) /* 0 is "not set" in a point (lpv_acc_iv_knobs) */
         return -1;
     *out = (int)v;
     return 0;
@@ -90,10 +81,9 @@ int lpv_acc_iv_parse_point(const char *tok, lpv_acc_iv_knobs *out, char *err, si
         memcpy(field, at, len);
         field[len] = '\0';
         if (len > 0 && strcmp(field, "-") != 0 && lpv_acc_iv_parse_value(k, field, &out->v[k]) != 0) {
-            if (k == LPV_ACC_IV_REPROJECTION)
-                snprintf(err, err_size, "%s: %s must be on or off, not '%s'", tok, NAMES[k], field);
-            else
-                snprintf(err, err_size, "%s: %s must be 1..%d, not '%s'", tok, NAMES[k], MAXV[k], field);
+            char want[96];
+            snprintf(err, err_size, "%s: %s expects %s, not '%s'", tok, NAMES[k],
+                     lpv_field_expect(lpv_field_by_key(NAMES[k]), want, sizeof want), field);
             return -1;
         }
         at = colon ? colon + 1 : NULL;
