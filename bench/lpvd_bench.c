@@ -211,8 +211,8 @@ int main(int argc, char **argv)
         if (configs[c].paper)
             s.lpv.central_transport = s.lpv.normal_bins = s.lpv.far_field = s.scene_surfels = LPV_SWITCH_OFF;
         lpv_settings_resolve(&s);
-        if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0 || lpv_engine_set_scene(e, &scene, err, sizeof err) ||
-            lpv_engine_set_view(e, &view, err, sizeof err) != 0) {
+        const lpv_engine_item item = {.settings = &s, .scene = &scene, .view = &view};
+        if (lpv_engine_run_item(e, &item, err, sizeof err) != 0) {
             fprintf(stderr, "lpvd-bench: %s\n", err);
             rc = 1;
             break;

@@ -236,8 +236,8 @@ static int run_planner(lpv_engine *e, const lpv_scene *scene, const lpv_view *vi
     /* the count auto picks with the planner on: planner off would force the
      * default 3 when auto, so it gets this count explicitly */
     lpv_settings on = opt->settings;
-    if (lpv_engine_set_settings(e, &on, err, sizeof err) != 0 || lpv_engine_set_scene(e, scene, err, sizeof err) ||
-        lpv_engine_set_view(e, view, err, sizeof err) != 0 || lpv_engine_tick(e, err, sizeof err) != 0)
+    const lpv_engine_item first = {.settings = &on, .scene = scene, .view = view, .tick = 1};
+    if (lpv_engine_run_item(e, &first, err, sizeof err) != 0)
         goto fail;
     const int cascades = lpv_engine_cascade_count(e);
     int failed[4] = {0};
@@ -246,8 +246,8 @@ static int run_planner(lpv_engine *e, const lpv_scene *scene, const lpv_view *vi
         s.planner = m == 0 ? LPV_SWITCH_OFF : LPV_SWITCH_ON;
         if (m == 0)
             s.lpv.cascades = cascades;
-        if (lpv_engine_set_settings(e, &s, err, sizeof err) != 0 || lpv_engine_set_scene(e, scene, err, sizeof err) ||
-            lpv_engine_set_view(e, view, err, sizeof err) != 0)
+        const lpv_engine_item item = {.settings = &s, .scene = scene, .view = view};
+        if (lpv_engine_run_item(e, &item, err, sizeof err) != 0)
             goto mode_fail;
         double wall[MAX_REPEAT], gpu[MAX_REPEAT], frame[MAX_REPEAT];
         recomputed[m] = 0;

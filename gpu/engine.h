@@ -181,6 +181,26 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
  * plan says "recompute requested"): for benchmarks that time full ticks. */
 void lpv_engine_invalidate(lpv_engine *e);
 
+/* One item of work, as `lpvd render`, a batch item and a daemon world's tick
+ * all run it: what changed since the engine's last item (NULL: unchanged),
+ * applied in the one order every program uses, settings, then scene, then
+ * view (a scene set after the settings is sampled once, with the knobs it
+ * will be ticked with), then, when tick is set, one tick. recompute: the tick
+ * recomputes even when the planner would serve the cached volume
+ * (lpv_engine_invalidate). What an item outputs (a frame, a volume, points'
+ * irradiance) is the caller's: each program wants different ones. */
+typedef struct lpv_engine_item {
+    const lpv_settings *settings;
+    const lpv_scene *scene;
+    const lpv_view *view;
+    int recompute;
+    int tick;
+} lpv_engine_item;
+
+/* Applies the item and ticks when it asks; 0, or -1 with err from the step
+ * that failed (lpv_engine_set_settings, _set_scene, _set_view, _tick). */
+int lpv_engine_run_item(lpv_engine *e, const lpv_engine_item *item, char *err, size_t err_size);
+
 /* Runs one tick: RSMs through propagation. A tick whose yield hook asked it
  * to stop (lpv_engine_set_yield) returns -1 with err starting with
  * LPV_TICK_ABANDONED; the next tick recomputes everything. */

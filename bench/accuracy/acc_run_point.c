@@ -77,9 +77,8 @@ int acc_run_point(acc_run *c, const acc_scene_run *x, int p)
         st.lpv.damping = c->pts[p].damping;
     }
 settings_made:
-    if (lpv_engine_set_settings(c->engine, &st, c->err, sizeof c->err) != 0 ||
-        lpv_engine_set_scene(c->engine, x->scene, c->err, sizeof c->err) != 0 ||
-        lpv_engine_set_view(c->engine, x->view, c->err, sizeof c->err) != 0) {
+    const lpv_engine_item item = {.settings = &st, .scene = x->scene, .view = x->view};
+    if (lpv_engine_run_item(c->engine, &item, c->err, sizeof c->err) != 0) {
         fprintf(stderr, "lpvd-accuracy: %s\n", c->err);
         return 1;
     }

@@ -111,8 +111,8 @@ static int lpvd_point(lpv_engine *e, const lpv_scene *scene, const lpv_view *vie
 {
     char err[1024] = "";
     static double frames[MAX_TICKS], tick_ms[MAX_TICKS];
-    if (lpv_engine_set_settings(e, &st, err, sizeof err) != 0 || lpv_engine_set_scene(e, scene, err, sizeof err) != 0 ||
-        lpv_engine_set_view(e, view, err, sizeof err) != 0) {
+    const lpv_engine_item item = {.settings = &st, .scene = scene, .view = view};
+    if (lpv_engine_run_item(e, &item, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-accuracy: %s\n", err);
         return -1;
     }

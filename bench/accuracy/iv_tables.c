@@ -42,8 +42,8 @@ static int run_ticks(lpv_engine *e, const lpv_settings *st, const lpv_scene *sce
 {
     char err[1024];
     static double v[S_COUNT + 1][IV_MAX_TICKS];
-    if (lpv_engine_set_settings(e, st, err, sizeof err) != 0 || lpv_engine_set_scene(e, scene, err, sizeof err) != 0 ||
-        lpv_engine_set_view(e, view, err, sizeof err) != 0) {
+    const lpv_engine_item item = {.settings = st, .scene = scene, .view = view};
+    if (lpv_engine_run_item(e, &item, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd-accuracy: --iv-tables: %s\n", err);
         return -1;
     }

@@ -98,10 +98,8 @@ static int read_grid(lpv_engine *e, lpv_grid_which w, lpv_cell *cells, size_t n)
 static int tick(lpv_engine *e, const lpv_hard_scene *h, const lpv_settings *s, const lpv_view *v, char *err,
                 size_t n)
 {
-    if (lpv_engine_set_settings(e, s, err, n) != 0 || lpv_engine_set_scene(e, &h->scene, err, n) != 0 ||
-        lpv_engine_set_view(e, v, err, n) != 0)
-        return -1;
-    return lpv_engine_tick(e, err, n);
+    const lpv_engine_item item = {.settings = s, .scene = &h->scene, .view = v, .tick = 1};
+    return lpv_engine_run_item(e, &item, err, n);
 }
 
 static void describe_settings(const lpv_settings *s, float cell_size, char *out, size_t n)

@@ -443,29 +443,27 @@ json_t *lpvd_batch_render_item(lpvd_batch_renderer *r, const lpvd_batch_item *it
         view.height = job->height;
     }
     double t1 = now_ms();
-    if (r->engine_scene != it->scene || r->engine_lights != it->lights) {
-        lpv_scene given = r->scene; /* shallow: the lights replaced for this item */
-        if (!li->use_file) {
-            given.lights = li->lights;
-            given.light_count = (uint32_t)li->count;
-        }
-        if (lpv_engine_set_scene(r->engine, &given, err, sizeof err) != 0)
-            goto done;
-        r->engine_scene = it->scene;
-        r->engine_lights = it->lights;
+    /* the item's scene only when it is not the engine's already */
+    lpv_scene given = r->scene; /* shallow: the lights replaced for this item */
+    if (!li->use_file) {
+        given.lights = li->lights;
+        given.light_count = (uint32_t)li->count;
     }
+    const int new_scene = r->engine_scene != it->scene || r->engine_lights != it->lights;
     /* An item's image must not depend on the item before it: the planner
      * serves a cached volume when the camera moved less than a cell (the
      * daemon's trade), which here would keep the previous item's camera
      * surfels; a new view recomputes, so every image is what `lpvd render`
      * makes of its item alone (bench/batch_throughput.py checks it). */
-    if (!r->has_view || memcmp(&view, &r->last_view, sizeof view) != 0)
-        lpv_engine_invalidate(r->engine);
+    const int new_view = !r->has_view || memcmp(&view, &r->last_view, sizeof view) != 0;
+    const lpv_engine_item item = {
+        .settings = &s, .scene = new_scene ? &given : NULL, .view = &view, .recompute = new_view, .tick = 1};
+    if (lpv_engine_run_item(r->engine, &item, err, sizeof err) != 0)
+        goto done;
+    r->engine_scene = it->scene;
+    r->engine_lights = it->lights;
     r->last_view = view;
     r->has_view = 1;
-    if (lpv_engine_set_settings(r->engine, &s, err, sizeof err) != 0 ||
-        lpv_engine_set_view(r->engine, &view, err, sizeof err) != 0 || lpv_engine_tick(r->engine, err, sizeof err) != 0)
-        goto done;
     double t2 = now_ms();
     t_tick = t2 - t1;
     if ((job->outputs & (LPVD_OUT_PNG | LPVD_OUT_EXR)) &&

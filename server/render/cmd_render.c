@@ -169,9 +169,8 @@ int lpvd_cmd_render(int argc, char **argv)
     fprintf(stderr, "lpvd render: backend %s, GL_RENDERER %s\n", lpv_backend_name(lpv_gl_context_backend(ctx)),
             lpv_gl_context_renderer(ctx));
     engine = lpv_engine_create(err, sizeof err);
-    if (!engine || lpv_engine_set_settings(engine, &opt.settings, err, sizeof err) != 0 ||
-        lpv_engine_set_scene(engine, &scene, err, sizeof err) != 0 ||
-        lpv_engine_set_view(engine, &view, err, sizeof err) != 0 || lpv_engine_tick(engine, err, sizeof err) != 0) {
+    const lpv_engine_item item = {.settings = &opt.settings, .scene = &scene, .view = &view, .tick = 1};
+    if (!engine || lpv_engine_run_item(engine, &item, err, sizeof err) != 0) {
         fprintf(stderr, "lpvd render: %s\n", err);
         goto done;
     }

@@ -237,20 +237,22 @@ static int gl_apply(sv_world *w, const sv_inputs *in, uint64_t gen, char *err, s
     int scene_changed = !w->gl_has_applied || w->gl_scene_sig != sig;
     int view_changed = !w->gl_has_applied || memcmp(&w->gl_view, &in->view, sizeof in->view) != 0;
     w->gl_has_applied = 0;
-    if (settings_changed && lpv_engine_set_settings(w->engine, &in->settings, err, n) != 0)
-        return -1;
     /* the engine re-samples the scene itself when a knob needs it: a CONFIG
-     * sends no geometry again (lpv_engine_set_settings) */
+     * sends no geometry again (lpv_engine_set_settings). The tick runs in
+     * gl_tick, after this world's applied state is recorded: an abandoned
+     * tick does not make the next one apply its inputs again. */
+    lpv_scene sc;
     if (scene_changed) {
-        lpv_scene sc = in->scene->scene;
+        sc = in->scene->scene;
         sc.materials = in->materials;
         sc.material_count = in->material_count;
         sc.lights = in->lights;
         sc.light_count = in->light_count;
-        if (lpv_engine_set_scene(w->engine, &sc, err, n) != 0)
-            return -1;
     }
-    if (view_changed && lpv_engine_set_view(w->engine, &in->view, err, n) != 0)
+    const lpv_engine_item item = {.settings = settings_changed ? &in->settings : NULL,
+                                  .scene = scene_changed ? &sc : NULL,
+                                  .view = view_changed ? &in->view : NULL};
+    if (lpv_engine_run_item(w->engine, &item, err, n) != 0)
         return -1;
     w->gl_settings = in->settings;
     w->gl_view = in->view;
@@ -490,10 +492,8 @@ static int self_test(sv_server *s, char *err, size_t n)
     lpv_gl_context *ctx = lpv_gl_context_create(&desc, why, sizeof why);
     float *rgba = ctx ? malloc(sizeof(float) * 4 * W * H) : NULL;
     lpv_engine *e = rgba ? lpv_engine_create(why, sizeof why) : NULL;
-    int rc = !e || lpv_engine_set_settings(e, &s->cfg.settings, why, sizeof why) != 0 ||
-                     lpv_engine_set_scene(e, &box, why, sizeof why) != 0 ||
-                     lpv_engine_set_view(e, &view, why, sizeof why) != 0 ||
-                     lpv_engine_tick(e, why, sizeof why) != 0 ||
+    const lpv_engine_item item = {.settings = &s->cfg.settings, .scene = &box, .view = &view, .tick = 1};
+    int rc = !e || lpv_engine_run_item(e, &item, why, sizeof why) != 0 ||
                      lpv_engine_render(e, LPV_TERMS_FULL, rgba, why, sizeof why) != 0
                  ? -1
                  : 0;
