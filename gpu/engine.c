@@ -80,9 +80,7 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
     glGenVertexArrays(1, &e->empty_vao);
     glGenBuffers(1, &e->light_ubo);
     glGenBuffers(1, &e->view_ubo);
-    glGenBuffers(1, &e->shadows.ubo);
-    glBindBuffer(GL_UNIFORM_BUFFER, e->shadows.ubo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvShadowBlock), NULL, GL_DYNAMIC_DRAW);
+    lpv_shadow_maps_create(&e->shadows);
     glBindBuffer(GL_UNIFORM_BUFFER, e->light_ubo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvLightBlock), NULL, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_UNIFORM_BUFFER, e->view_ubo);
@@ -104,7 +102,7 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_pass_rsm_free(e);
     lpv_pass_camera_free(e);
     lpv_frame_blocks_free(e);
-    lpv_pass_shadow_free(e);
+    lpv_shadow_maps_destroy(&e->shadows);
     lpv_medium_free(&e->medium);
     lpv_gl_delete_buffer(&e->query_in);
     lpv_gl_delete_buffer(&e->query_out);
@@ -141,7 +139,6 @@ void lpv_engine_destroy(lpv_engine *e)
         glDeleteVertexArrays(1, &e->empty_vao);
     lpv_gl_delete_buffer(&e->light_ubo);
     lpv_gl_delete_buffer(&e->view_ubo);
-    lpv_gl_delete_buffer(&e->shadows.ubo);
     lpv_timer_destroy(&e->timer);
     free(e);
 }

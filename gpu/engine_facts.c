@@ -13,9 +13,9 @@
 static size_t glossy_draws(const lpv_engine *e)
 {
     size_t n = 0;
-    for (uint32_t i = 0; i < e->draw_count; ++i) {
-        int m = e->draws[i].material;
-        if (m >= 0 && (uint32_t)m < e->material_count && e->materials[m].roughness < e->settings.glossy_roughness)
+    for (uint32_t i = 0; i < e->geo.draw_count; ++i) {
+        int m = e->geo.draws[i].material;
+        if (m >= 0 && (uint32_t)m < e->geo.material_count && e->geo.materials[m].roughness < e->settings.glossy_roughness)
             ++n;
     }
     return n;
@@ -31,7 +31,7 @@ void lpv_engine_gather_facts(const lpv_engine *e, lpv_plan_facts *f)
     f->area_light_samples = e->area_sample_count;
     f->occluder_triangles = e->occluder_triangles;
     f->glossy_draws = glossy_draws(e);
-    f->blend_draws = e->blend_draws;
+    f->blend_draws = e->geo.blend_draws;
     f->has_medium = e->medium.medium.present || e->settings.fog_sigma_s > 0.0f || e->settings.fog_sigma_a > 0.0f;
     f->has_view = e->has_view;
     f->camera_inside = e->has_view && lpv_point_in_bounds(e->view.eye, e->scene_min, e->scene_max);

@@ -16,6 +16,8 @@
 #include "lpv_shared.h"
 #include "medium.h"
 #include "reach.h"
+#include "scene_gpu.h"
+#include "shadow_maps.h"
 #include "memory_budget.h"
 #include "surfel_groups.h"
 #include "technique.h"
@@ -24,42 +26,6 @@
 /* The G-buffer's targets (gbuffer.frag): position, normal, albedo,
  * emission, occlusion. */
 #define LPV_GBUF_TARGETS 5
-
-typedef struct lpv_gpu_material {
-    float base_color[4];
-    float emission[3];
-    float roughness, metallic;
-    int texture; /* index into lpv_engine.textures, -1 none */
-    float alpha_cutoff;   /* lpv_material_alpha_cutoff: MASK's cutoff, else 0 */
-    int blend;            /* alphaMode BLEND: alpha is coverage, drawn in the translucent layer */
-    int double_sided;     /* 0: the camera culls back faces */
-    int base_uv_set;      /* 0 TEXCOORD_0, 1 TEXCOORD_1 */
-    float base_uv[6];     /* lpv_uv_transform_matrix rows */
-    int normal_texture;   /* index into lpv_engine.textures (linear), -1 none */
-    float normal_scale;
-    int normal_uv_set;
-    float normal_uv[6];
-    int mr_texture;       /* metallicRoughnessTexture: index into lpv_engine.textures (linear), -1 none */
-    int mr_uv_set;
-    float mr_uv[6];
-    int emissive_texture; /* emissiveTexture: index into lpv_engine.textures (sRGB), -1 none */
-    int emissive_uv_set;
-    float emissive_uv[6];
-    int unlit;             /* KHR_materials_unlit */
-    int occlusion_texture; /* occlusionTexture: index into lpv_engine.textures (linear), -1 none */
-    float occlusion_strength;
-    int occlusion_uv_set;
-    float occlusion_uv[6];
-} lpv_gpu_material;
-
-typedef struct lpv_gpu_draw {
-    uint32_t first_index, index_count;
-    int material;
-    float size; /* m, longest side of the draw's bounding box (cascade fading) */
-    int vertex_color; /* lpv_draw.vertex_color */
-    float box_min[3], box_max[3]; /* m, its bounding box (min > max: no finite vertex); triangles only */
-    int mode; /* lpv_draw_mode: LPV_DRAW_TRIANGLES, or a wire draw's POINTS or LINES */
-} lpv_gpu_draw;
 
 /* The frame's variants (shade.comp's defines, shading.glsl), a bit each. */
 enum {
@@ -130,18 +96,6 @@ typedef struct lpv_rsms {
     size_t vpl_count; /* the three kinds of layers x their per_layer */
 } lpv_rsms;
 
-/* The shadow maps of direct light: what pass_shadow.c owns and gives the
- * frame (lpv_pass_shadow_bind binds them); rendered at render time. */
-typedef struct lpv_shadow_maps {
-    struct LpvShadowBlock block; /* the faces the maps hold */
-    GLuint ubo, tex, fbo;        /* the block's buffer; the DEPTH32F array and its framebuffer */
-    /* the maps' transmission (scenes with BLEND draws,
-     * LPV_TEX_SHADOW_TRANSMIT): an RGBA16F array like tex, drawn through
-     * transmit_fbo over tex's depth */
-    GLuint transmit_tex, transmit_fbo;
-    int alloc_size, alloc_faces;
-    int valid;                   /* 0: the maps must be redrawn (scene, settings, invalidate) */
-} lpv_shadow_maps;
 
 struct lpv_engine {
     lpv_settings settings;
@@ -172,7 +126,7 @@ struct lpv_engine {
      * shade_rest.comp adds the indirect light of the pixels the first listed */
     GLuint prog_shade_rest, prog_shade_rest_damped;
     /* the scene passes' programs without textures, normal maps and alpha cuts
-     * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_engine_material_program) */
+     * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_scene_gpu_program) */
     GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
     /* the lookup step (settings.lookup_step > 1): the blocks' lookup without
      * and with damping (lookup_blocks.comp); the area shadow step
@@ -184,19 +138,8 @@ struct lpv_engine {
     GLuint prog_translucent; /* translucent.comp: the translucent layer laid over the frame */
 
     /* scene */
-    GLuint vao, vbo, ibo, empty_vao;
-    lpv_gpu_draw *draws;
-    uint32_t draw_count;
-    lpv_gpu_draw *wire_draws; /* points and lines (lpv_scene.wire_draws), indices after the triangles' */
-    uint32_t wire_draw_count;
-    lpv_gpu_material *materials;
-    uint32_t material_count;
-    int materials_plain;      /* 1: no material has a texture, a normal map or an alpha cut */
-    int materials_occlusion;  /* 1: some material has an occlusionTexture (LPV_FRAME_OCCLUSION) */
-    int materials_unlit;      /* 1: some material is unlit (LPV_FRAME_UNLIT) */
-    size_t blend_draws;       /* draws whose material is BLEND (the translucent layer, LPV_PASS_TRANSLUCENT) */
-    GLuint *textures;
-    uint32_t texture_count;
+    lpv_scene_gpu geo;        /* its draws, materials and textures on the GPU (scene_gpu.h) */
+    GLuint empty_vao;
     lpv_light lights[LPV_MAX_LIGHTS];
     uint32_t light_count;
     float scene_min[3], scene_max[3];
@@ -234,7 +177,7 @@ struct lpv_engine {
     int light_clearance_pending_count;
     lpv_rsms rsm; /* the lights' RSMs and the VPLs and surfels made from them (pass_rsm.c) */
 
-    lpv_shadow_maps shadows; /* direct light's shadow maps (pass_shadow.c) */
+    lpv_shadow_maps shadows; /* direct light's shadow maps (shadow_maps.h) */
 
     lpv_memory_limits mem_limits; /* of the context, read at create; the budget lowered by caps */
     uint64_t mem_device_budget;    /* the budget as read at create */
@@ -258,23 +201,6 @@ struct lpv_engine {
     lpv_engine_stats stats;
     lpv_plan plan;
 };
-
-/* Which draws lpv_engine_draw_scene draws: every one (the light views, where
- * BLEND's alpha is coverage per texel), all but the BLEND ones (the camera's
- * G-buffer), or only those (its translucent layer). */
-typedef enum lpv_draw_set { LPV_DRAWS_ALL = 0, LPV_DRAWS_NOT_BLEND, LPV_DRAWS_BLEND } lpv_draw_set;
-
-/* Draws the draws of `set` with their material's uniforms and textures.
- * cull_single_sided: back faces of materials that are not double-sided are
- * culled (the camera's view, as glTF says; light views pass 0 and see both
- * sides). */
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set);
-/* Draws the points and lines (one pixel wide) with their materials'
- * uniforms and u_wire 1: only the camera's G-buffer does. */
-void lpv_engine_draw_wires(lpv_engine *e, GLuint prog);
-/* The program a scene pass draws with: plain (built with LPV_MATERIAL_PLAIN)
- * when the scene's materials are all plain, else full. */
-GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plain);
 
 /* The scene's GPU objects (engine_scene.c): freed, and the emitters as area
  * light samples under the current settings (none when area lights are off). */
@@ -360,23 +286,17 @@ void lpv_light_faces_build(lpv_engine *e);
  * faces are tiles, four to a layer. */
 void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_layers);
 
-/* A spot's outer cone half angle (rad) from its GPU record (cos stored in
- * cone_faces[1]): what its shadow faces cover and what it lights. */
-float lpv_spot_outer_angle(const struct LpvLightGpu *g);
 
 /* The shadow-map faces for e->light_block's lights (punctual lights and area
  * light samples) at shadow_size, the directional cascades fitted to e->view.
  * Returns 0 or -1 with err. */
 int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *err, size_t err_size);
 
-/* Shadow maps (pass_shadow.c): builds the faces, (re)allocates the maps when
- * their size or count changed, and redraws them when anything they show
- * changed; records the "shadow" stage when it draws. Returns 0 or -1. */
-int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size);
-/* Binds what shadow.glsl reads: the shadow maps (unit 4), their
- * transmission (LPV_TEX_SHADOW_TRANSMIT) and the shadow block. */
-void lpv_pass_shadow_bind(const lpv_engine *e);
-void lpv_pass_shadow_free(lpv_engine *e);
+/* The engine's shadow maps brought to its lights, scene and view
+ * (engine_render.c): builds the faces, checks the memory budget before the
+ * maps (re)allocate, and has them redraw what changed (shadow_maps.h).
+ * Returns 0 or -1. */
+int lpv_engine_shadows_update(lpv_engine *e, char *err, size_t err_size);
 /* Each producer deletes what it made (also what a failed allocation left):
  * the passes call these before remaking their storage, and
  * lpv_engine_destroy calls them, so each list of objects is written once. */

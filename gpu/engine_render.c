@@ -11,6 +11,29 @@
 #include "engine_internal.h"
 #include "error.h"
 
+int lpv_engine_shadows_update(lpv_engine *e, char *err, size_t err_size)
+{
+    struct LpvShadowBlock b;
+    if (lpv_shadow_faces_build(e, &b, err, err_size) != 0)
+        return -1;
+    const int size = e->settings.shadow_size;
+    const int layers = b.counts[3] > 0.0f ? (int)b.counts[3] : 1;
+    const int translucent = e->geo.blend_draws > 0;
+    b.options[0] = (float)translucent;
+    if (!lpv_shadow_maps_fit(&e->shadows, size, layers, translucent)) {
+        lpv_memory_need need;
+        lpv_engine_memory_need(e, &need);
+        if (lpv_engine_memory_check(e, err, err_size) != 0 ||
+            lpv_shadow_maps_allocate(&e->shadows, size, layers, translucent, lpv_memory_shadow_bytes(&need), err,
+                                     err_size) != 0)
+            return -1;
+    }
+    const lpv_shadow_draw d = {.geo = &e->geo, .lights = e->light_block.lights, .prog = e->prog_shadow,
+                               .prog_plain = e->prog_shadow_plain, .timer = &e->timer};
+    lpv_shadow_maps_draw(&e->shadows, &b, &d);
+    return 0;
+}
+
 int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *err, size_t err_size)
 {
     if (!e->ticked)
@@ -26,7 +49,7 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     }
     /* Direct light needs the shadow maps (media's in-scattering too, which
      * only a full frame has); they are redrawn only when what they show changed. */
-    if (terms != LPV_TERMS_INDIRECT_ONLY && terms != LPV_TERMS_AO && lpv_pass_shadow_update(e, err, err_size) != 0)
+    if (terms != LPV_TERMS_INDIRECT_ONLY && terms != LPV_TERMS_AO && lpv_engine_shadows_update(e, err, err_size) != 0)
         return -1;
     if (lpv_pass_shade_run(e, terms, err, err_size) != 0)
         return -1;
@@ -35,7 +58,7 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
     /* the BLEND surfaces' layer over the frame (not over an ambient
      * occlusion frame, which is the technique's term of the opaque surfaces) */
     size_t full_lookups = 0, area_rest_pixels = 0;
-    if (e->plan.pass[LPV_PASS_TRANSLUCENT].run && e->blend_draws && terms != LPV_TERMS_AO &&
+    if (e->plan.pass[LPV_PASS_TRANSLUCENT].run && e->geo.blend_draws && terms != LPV_TERMS_AO &&
         lpv_pass_translucent_run(e, terms, &full_lookups, &area_rest_pixels, err, err_size) != 0)
         return -1;
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)

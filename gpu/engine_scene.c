@@ -30,24 +30,24 @@ static void free_samples(lpv_engine *e)
 
 void lpv_engine_free_scene(lpv_engine *e)
 {
-    if (e->vao)
-        glDeleteVertexArrays(1, &e->vao);
-    e->vao = 0;
-    lpv_gl_delete_buffer(&e->vbo);
-    lpv_gl_delete_buffer(&e->ibo);
+    if (e->geo.vao)
+        glDeleteVertexArrays(1, &e->geo.vao);
+    e->geo.vao = 0;
+    lpv_gl_delete_buffer(&e->geo.vbo);
+    lpv_gl_delete_buffer(&e->geo.ibo);
     free_samples(e);
     lpv_scene_free(&e->geometry);
-    if (e->texture_count)
-        glDeleteTextures((GLsizei)e->texture_count, e->textures);
-    free(e->textures);
-    free(e->draws);
-    free(e->wire_draws);
-    free(e->materials);
-    e->textures = NULL;
-    e->draws = e->wire_draws = NULL;
-    e->materials = NULL;
-    e->texture_count = e->draw_count = e->wire_draw_count = e->material_count = 0;
-    e->blend_draws = 0;
+    if (e->geo.texture_count)
+        glDeleteTextures((GLsizei)e->geo.texture_count, e->geo.textures);
+    free(e->geo.textures);
+    free(e->geo.draws);
+    free(e->geo.wire_draws);
+    free(e->geo.materials);
+    e->geo.textures = NULL;
+    e->geo.draws = e->geo.wire_draws = NULL;
+    e->geo.materials = NULL;
+    e->geo.texture_count = e->geo.draw_count = e->geo.wire_draw_count = e->geo.material_count = 0;
+    e->geo.blend_draws = 0;
     e->light_count = 0;
     lpv_emitters_free(&e->emitters);
     lpv_engine_reach_free(e);
@@ -70,14 +70,14 @@ static int upload_textures(lpv_engine *e, const lpv_scene *scene, char *err, siz
 {
     if (!scene->texture_count)
         return 0;
-    e->textures = calloc(scene->texture_count, sizeof(GLuint));
-    if (!e->textures)
+    e->geo.textures = calloc(scene->texture_count, sizeof(GLuint));
+    if (!e->geo.textures)
         return lpv_error(err, err_size, "out of memory for textures");
-    e->texture_count = scene->texture_count;
-    glGenTextures((GLsizei)scene->texture_count, e->textures);
+    e->geo.texture_count = scene->texture_count;
+    glGenTextures((GLsizei)scene->texture_count, e->geo.textures);
     for (uint32_t i = 0; i < scene->texture_count; ++i) {
         const lpv_texture *t = &scene->textures[i];
-        glBindTexture(GL_TEXTURE_2D, e->textures[i]);
+        glBindTexture(GL_TEXTURE_2D, e->geo.textures[i]);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         /* colour is sRGB-encoded (GL decodes it); normal maps are linear data */
         const GLint format = t->linear ? GL_RGBA8 : GL_SRGB8_ALPHA8;
@@ -265,15 +265,15 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     e->gbuf.stale = 1;
     lpv_engine_free_scene(e);
     e->counters.scene_uploads++;
-    e->draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->draws);
-    e->materials = calloc(scene->material_count ? scene->material_count : 1, sizeof *e->materials);
-    if (!e->draws || !e->materials)
+    e->geo.draws = calloc(scene->draw_count ? scene->draw_count : 1, sizeof *e->geo.draws);
+    e->geo.materials = calloc(scene->material_count ? scene->material_count : 1, sizeof *e->geo.materials);
+    if (!e->geo.draws || !e->geo.materials)
         return lpv_error(err, err_size, "out of memory for the scene");
     for (uint32_t i = 0; i < scene->draw_count; ++i) {
         const lpv_draw *d = &scene->draws[i];
         if ((uint64_t)d->first_index + d->index_count > scene->index_count)
             return lpv_error(err, err_size, "%s: draw %u indexes past the index buffer", scene->source, i);
-        lpv_gpu_draw *g = &e->draws[e->draw_count++];
+        lpv_gpu_draw *g = &e->geo.draws[e->geo.draw_count++];
         *g = (lpv_gpu_draw){d->first_index, d->index_count - d->index_count % 3, d->material, 0.0f,
                             d->vertex_color != 0};
         g->size = draw_box(scene, d, g->box_min, g->box_max);
@@ -286,8 +286,8 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     }
     /* points and lines: drawn by the camera alone (pass_camera.c), from
      * the index buffer's tail */
-    e->wire_draws = calloc(scene->wire_draw_count ? scene->wire_draw_count : 1, sizeof *e->wire_draws);
-    if (!e->wire_draws)
+    e->geo.wire_draws = calloc(scene->wire_draw_count ? scene->wire_draw_count : 1, sizeof *e->geo.wire_draws);
+    if (!e->geo.wire_draws)
         return lpv_error(err, err_size, "out of memory for the scene");
     for (uint32_t i = 0; i < scene->wire_draw_count; ++i) {
         const lpv_draw *d = &scene->wire_draws[i];
@@ -295,14 +295,14 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
             return lpv_error(err, err_size, "%s: point or line draw %u indexes past its index buffer", scene->source,
                              i);
         const uint32_t per = d->mode == LPV_DRAW_POINTS ? 1u : 2u;
-        lpv_gpu_draw *g = &e->wire_draws[e->wire_draw_count++];
+        lpv_gpu_draw *g = &e->geo.wire_draws[e->geo.wire_draw_count++];
         *g = (lpv_gpu_draw){scene->index_count + d->first_index, d->index_count - d->index_count % per, d->material,
                             0.0f, d->vertex_color != 0};
         g->mode = d->mode == LPV_DRAW_POINTS ? LPV_DRAW_POINTS : LPV_DRAW_LINES;
     }
     for (uint32_t i = 0; i < scene->material_count; ++i) {
         const lpv_material *m = &scene->materials[i];
-        lpv_gpu_material *g = &e->materials[i];
+        lpv_gpu_material *g = &e->geo.materials[i];
         memcpy(g->base_color, m->base_color, sizeof g->base_color);
         memcpy(g->emission, m->emission, sizeof g->emission);
         g->roughness = m->roughness;
@@ -335,34 +335,34 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
         g->occlusion_uv_set = m->occlusion_uv.texcoord == 1;
         lpv_uv_transform_matrix(&m->occlusion_uv, g->occlusion_uv);
     }
-    e->material_count = scene->material_count;
-    e->materials_plain = 1;
-    e->materials_occlusion = e->materials_unlit = 0;
-    for (uint32_t i = 0; i < e->material_count; ++i) {
-        const lpv_gpu_material *g = &e->materials[i];
+    e->geo.material_count = scene->material_count;
+    e->geo.materials_plain = 1;
+    e->geo.materials_occlusion = e->geo.materials_unlit = 0;
+    for (uint32_t i = 0; i < e->geo.material_count; ++i) {
+        const lpv_gpu_material *g = &e->geo.materials[i];
         if (g->texture >= 0 || g->normal_texture >= 0 || g->mr_texture >= 0 || g->emissive_texture >= 0 ||
             g->occlusion_texture >= 0 || g->alpha_cutoff > 0.0f || g->blend)
-            e->materials_plain = 0;
-        e->materials_occlusion |= g->occlusion_texture >= 0;
-        e->materials_unlit |= g->unlit;
+            e->geo.materials_plain = 0;
+        e->geo.materials_occlusion |= g->occlusion_texture >= 0;
+        e->geo.materials_unlit |= g->unlit;
     }
-    e->materials_unlit |= e->wire_draw_count > 0; /* points and lines show unlit (LPV_GBUF_WIRE_W) */
-    e->blend_draws = 0;
-    for (uint32_t i = 0; i < e->draw_count; ++i) {
-        const int k = e->draws[i].material;
-        e->blend_draws += k >= 0 && (uint32_t)k < e->material_count && e->materials[k].blend && e->draws[i].index_count;
+    e->geo.materials_unlit |= e->geo.wire_draw_count > 0; /* points and lines show unlit (LPV_GBUF_WIRE_W) */
+    e->geo.blend_draws = 0;
+    for (uint32_t i = 0; i < e->geo.draw_count; ++i) {
+        const int k = e->geo.draws[i].material;
+        e->geo.blend_draws += k >= 0 && (uint32_t)k < e->geo.material_count && e->geo.materials[k].blend && e->geo.draws[i].index_count;
     }
     if (upload_textures(e, scene, err, err_size) != 0)
         return -1;
 
-    glGenVertexArrays(1, &e->vao);
-    glBindVertexArray(e->vao);
-    glGenBuffers(1, &e->vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
+    glGenVertexArrays(1, &e->geo.vao);
+    glBindVertexArray(e->geo.vao);
+    glGenBuffers(1, &e->geo.vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, e->geo.vbo);
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(scene->vertex_count * sizeof(lpv_vertex)), scene->vertices,
                  GL_STATIC_DRAW);
-    glGenBuffers(1, &e->ibo);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
+    glGenBuffers(1, &e->geo.ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->geo.ibo);
     /* the triangles' indices, then the wire draws' (their first_index moved past the triangles') */
     glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                  (GLsizeiptr)(((size_t)scene->index_count + scene->wire_index_count) * sizeof(uint32_t)), NULL,
@@ -415,123 +415,3 @@ int lpv_engine_set_scene(lpv_engine *e, const lpv_scene *scene, char *err, size_
     return lpv_engine_place_volume(e, err, err_size);
 }
 
-GLuint lpv_engine_material_program(const lpv_engine *e, GLuint full, GLuint plain)
-{
-    return e->materials_plain ? plain : full;
-}
-
-/* The draws of `list` in `set` with their materials' uniforms and textures
- * (lpv_engine_draw_scene, lpv_engine_draw_wires); u_wire tells gbuffer.frag
- * which kind it draws. */
-static void draw_list(lpv_engine *e, GLuint prog, const lpv_gpu_draw *list, uint32_t count, int cull_single_sided,
-                      lpv_draw_set set, int wire)
-{
-    GLint loc_color = glGetUniformLocation(prog, "u_base_color");
-    GLint loc_has_tex = glGetUniformLocation(prog, "u_has_texture");
-    GLint loc_emission = glGetUniformLocation(prog, "u_emission");
-    GLint loc_roughness = glGetUniformLocation(prog, "u_roughness");
-    GLint loc_metallic = glGetUniformLocation(prog, "u_metallic");
-    GLint loc_size = glGetUniformLocation(prog, "u_object_size");
-    GLint loc_cutoff = glGetUniformLocation(prog, "u_alpha_cutoff");
-    GLint loc_blend = glGetUniformLocation(prog, "u_alpha_blend");
-    glUniform1i(glGetUniformLocation(prog, "u_wire"), wire);
-    GLint loc_base_set = glGetUniformLocation(prog, "u_base_uv_set");
-    GLint loc_base_row0 = glGetUniformLocation(prog, "u_base_uv_row0");
-    GLint loc_base_row1 = glGetUniformLocation(prog, "u_base_uv_row1");
-    GLint loc_has_normal = glGetUniformLocation(prog, "u_has_normal_texture");
-    GLint loc_normal_scale = glGetUniformLocation(prog, "u_normal_scale");
-    GLint loc_normal_set = glGetUniformLocation(prog, "u_normal_uv_set");
-    GLint loc_normal_row0 = glGetUniformLocation(prog, "u_normal_uv_row0");
-    GLint loc_normal_row1 = glGetUniformLocation(prog, "u_normal_uv_row1");
-    GLint loc_vertex_color = glGetUniformLocation(prog, "u_vertex_color");
-    GLint loc_unlit = glGetUniformLocation(prog, "u_unlit");
-    GLint loc_has_mr = glGetUniformLocation(prog, "u_has_mr_texture");
-    GLint loc_mr_set = glGetUniformLocation(prog, "u_mr_uv_set");
-    GLint loc_mr_row0 = glGetUniformLocation(prog, "u_mr_uv_row0");
-    GLint loc_mr_row1 = glGetUniformLocation(prog, "u_mr_uv_row1");
-    GLint loc_has_emissive = glGetUniformLocation(prog, "u_has_emissive_texture");
-    GLint loc_emissive_set = glGetUniformLocation(prog, "u_emissive_uv_set");
-    GLint loc_emissive_row0 = glGetUniformLocation(prog, "u_emissive_uv_row0");
-    GLint loc_emissive_row1 = glGetUniformLocation(prog, "u_emissive_uv_row1");
-    GLint loc_has_occlusion = glGetUniformLocation(prog, "u_has_occlusion_texture");
-    GLint loc_occlusion_strength = glGetUniformLocation(prog, "u_occlusion_strength");
-    GLint loc_occlusion_set = glGetUniformLocation(prog, "u_occlusion_uv_set");
-    GLint loc_occlusion_row0 = glGetUniformLocation(prog, "u_occlusion_uv_row0");
-    GLint loc_occlusion_row1 = glGetUniformLocation(prog, "u_occlusion_uv_row1");
-    glBindVertexArray(e->vao);
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW); /* glTF's front faces; the loader rewinds mirrored nodes */
-    for (uint32_t i = 0; i < count; ++i) {
-        const lpv_gpu_draw *d = &list[i];
-        static const lpv_gpu_material fallback = {
-            .base_color = {1, 1, 1, 1}, .roughness = 1.0f, .texture = -1, .double_sided = 1,
-            .base_uv = {1, 0, 0, 0, 1, 0}, .normal_texture = -1, .normal_uv = {1, 0, 0, 0, 1, 0},
-            .mr_texture = -1, .mr_uv = {1, 0, 0, 0, 1, 0}, .emissive_texture = -1, .emissive_uv = {1, 0, 0, 0, 1, 0},
-            .occlusion_texture = -1, .occlusion_strength = 1.0f, .occlusion_uv = {1, 0, 0, 0, 1, 0}};
-        const lpv_gpu_material *m =
-            (d->material >= 0 && (uint32_t)d->material < e->material_count) ? &e->materials[d->material] : &fallback;
-        if ((set == LPV_DRAWS_NOT_BLEND && m->blend) || (set == LPV_DRAWS_BLEND && !m->blend))
-            continue;
-        glUniform4fv(loc_color, 1, m->base_color);
-        glUniform3fv(loc_emission, 1, m->emission);
-        glUniform1f(loc_roughness, m->roughness);
-        glUniform1f(loc_metallic, m->metallic);
-        glUniform1f(loc_size, d->size);
-        glUniform1f(loc_cutoff, m->alpha_cutoff);
-        glUniform1i(loc_blend, m->blend);
-        glUniform1i(loc_has_tex, m->texture >= 0);
-        glUniform1i(loc_base_set, m->base_uv_set);
-        glUniform3fv(loc_base_row0, 1, &m->base_uv[0]);
-        glUniform3fv(loc_base_row1, 1, &m->base_uv[3]);
-        glUniform1i(loc_has_normal, m->normal_texture >= 0);
-        glUniform1f(loc_normal_scale, m->normal_scale);
-        glUniform1i(loc_normal_set, m->normal_uv_set);
-        glUniform3fv(loc_normal_row0, 1, &m->normal_uv[0]);
-        glUniform3fv(loc_normal_row1, 1, &m->normal_uv[3]);
-        glUniform1i(loc_vertex_color, d->vertex_color);
-        glUniform1i(loc_unlit, m->unlit);
-        glUniform1i(loc_has_mr, m->mr_texture >= 0);
-        glUniform1i(loc_mr_set, m->mr_uv_set);
-        glUniform3fv(loc_mr_row0, 1, &m->mr_uv[0]);
-        glUniform3fv(loc_mr_row1, 1, &m->mr_uv[3]);
-        glUniform1i(loc_has_emissive, m->emissive_texture >= 0);
-        glUniform1i(loc_emissive_set, m->emissive_uv_set);
-        glUniform3fv(loc_emissive_row0, 1, &m->emissive_uv[0]);
-        glUniform3fv(loc_emissive_row1, 1, &m->emissive_uv[3]);
-        glUniform1i(loc_has_occlusion, m->occlusion_texture >= 0);
-        glUniform1f(loc_occlusion_strength, m->occlusion_strength);
-        glUniform1i(loc_occlusion_set, m->occlusion_uv_set);
-        glUniform3fv(loc_occlusion_row0, 1, &m->occlusion_uv[0]);
-        glUniform3fv(loc_occlusion_row1, 1, &m->occlusion_uv[3]);
-        /* material.glsl's units: base colour, normal, metallic-roughness, emissive, occlusion */
-        const int unit_texture[5] = {m->texture, m->normal_texture, m->mr_texture, m->emissive_texture,
-                                     m->occlusion_texture};
-        for (int u = 0; u < 5; ++u) {
-            glActiveTexture(GL_TEXTURE0 + (GLenum)u);
-            glBindTexture(GL_TEXTURE_2D, unit_texture[u] >= 0 ? e->textures[unit_texture[u]] : 0);
-        }
-        glActiveTexture(GL_TEXTURE0);
-        if (cull_single_sided && !m->double_sided)
-            glEnable(GL_CULL_FACE);
-        else
-            glDisable(GL_CULL_FACE);
-        const GLenum mode = d->mode == LPV_DRAW_POINTS ? GL_POINTS : d->mode == LPV_DRAW_LINES ? GL_LINES : GL_TRIANGLES;
-        if (d->index_count)
-            glDrawElements(mode, (GLsizei)d->index_count, GL_UNSIGNED_INT,
-                           (void *)(uintptr_t)(d->first_index * sizeof(uint32_t)));
-        lpv_timer_count(&e->timer, 1);
-    }
-    glDisable(GL_CULL_FACE);
-    glBindVertexArray(0);
-}
-
-void lpv_engine_draw_scene(lpv_engine *e, GLuint prog, int cull_single_sided, lpv_draw_set set)
-{
-    draw_list(e, prog, e->draws, e->draw_count, cull_single_sided, set, 0);
-}
-
-void lpv_engine_draw_wires(lpv_engine *e, GLuint prog)
-{
-    if (e->wire_draw_count)
-        draw_list(e, prog, e->wire_draws, e->wire_draw_count, 0, LPV_DRAWS_ALL, 1);
-}

@@ -84,7 +84,7 @@ static float far_from(const lpv_engine *e, const vec3 p)
  * distance d can lie at depth d / sqrt(3) along a 90-degree face's axis (the
  * face's corner), so 0.5 d keeps everything at distance >= d in front of the
  * near plane. The floor keeps the depth precision. The shadow maps hold
- * reversed depth (pass_shadow.c: near / depth, float precision relative at
+ * reversed depth (shadow_maps.c: near / depth, float precision relative at
  * every depth), so theirs is only NEAR_REVERSED_FLOOR x the radius. The
  * RSMs keep the standard projection: a depth stored as
  * GL_DEPTH_COMPONENT32F (pass_rsm.c) near 1 has a step of 2^-24, so a
@@ -532,11 +532,6 @@ void lpv_light_face_counts(const lpv_engine *e, int *rsm_layers, int *shadow_lay
     *shadow_layers = shadows + area_layers(e->settings.shadow_size, area_faces);
 }
 
-float lpv_spot_outer_angle(const struct LpvLightGpu *g)
-{
-    return acosf(fminf(fmaxf(g->cone_faces[1], -1.0f), 1.0f));
-}
-
 /* d: the light's clearance (light_clearance), for the near plane. */
 static void shadow_perspective_face(const lpv_engine *e, struct LpvShadowFaceGpu *f, const vec3 eye, const vec3 dir,
                                     float tan_half, float d, float radius, int light, int size)
@@ -550,7 +545,7 @@ static void shadow_perspective_face(const lpv_engine *e, struct LpvShadowFaceGpu
     glm_vec3_add((float *)eye, (float *)dir, centre);
     any_up(dir, up);
     glm_lookat((float *)eye, centre, up, view);
-    /* Reversed depth with no far plane (pass_shadow.c draws with clip z in
+    /* Reversed depth with no far plane (shadow_maps.c draws with clip z in
      * [0, w]): clip z = near, w = depth, so the map holds near / depth. */
     glm_mat4_zero(proj);
     proj[0][0] = proj[1][1] = 1.0f / t;

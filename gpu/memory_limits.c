@@ -83,7 +83,7 @@ void lpv_engine_memory_need(const lpv_engine *e, lpv_memory_need *n)
     lpv_light_face_counts(e, &n->rsm_faces, &n->shadow_faces);
     n->rsm_size = e->settings.rsm_size;
     n->shadow_size = e->settings.shadow_size;
-    n->translucent = e->blend_draws > 0;
+    n->translucent = e->geo.blend_draws > 0;
     if (e->has_view) {
         n->image_w = e->view.width;
         n->image_h = e->view.height;

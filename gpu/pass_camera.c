@@ -1,7 +1,7 @@
 /*
  * pass_camera.c - the camera's passes: the G-buffer (position/surfel area,
  * normal, albedo, emission) with its pixels as GV surfels, and the final
- * shading of direct light (through the shadow maps of pass_shadow.c) plus the
+ * shading of direct light (through the shadow maps of shadow_maps.c) plus the
  * technique's irradiance (its lookup, technique.h) into a linear-radiance frame.
  */
 #include <math.h>
@@ -192,7 +192,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     glDisable(GL_CULL_FACE);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    GLuint p = lpv_engine_material_program(e, e->prog_gbuffer, e->prog_gbuffer_plain);
+    GLuint p = lpv_scene_gpu_program(&e->geo, e->prog_gbuffer, e->prog_gbuffer_plain);
     glUseProgram(p);
     glUniformMatrix4fv(glGetUniformLocation(p, "u_view_proj"), 1, GL_FALSE, (const float *)e->view_block.view_proj);
     glUniform3fv(glGetUniformLocation(p, "u_eye"), 1, e->view_block.eye);
@@ -200,11 +200,11 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     float pixel = 2.0f * e->view_block.forward[3] / (float)v->height; /* tan-plane or metres per pixel */
     glUniform1f(glGetUniformLocation(p, "u_pixel_solid_angle"), v->orthographic ? 0.0f : pixel * pixel);
     glUniform1f(glGetUniformLocation(p, "u_pixel_area"), v->orthographic ? pixel * pixel : 0.0f);
-    lpv_engine_draw_scene(e, p, 1, LPV_DRAWS_NOT_BLEND);
-    lpv_engine_draw_wires(e, p); /* points and lines: seen, one pixel wide, but no surfels (no area) */
+    lpv_scene_gpu_draw(&e->geo, p, 1, LPV_DRAWS_NOT_BLEND, &e->timer);
+    lpv_scene_gpu_draw_wires(&e->geo, p, &e->timer); /* points and lines: seen, one pixel wide, but no surfels (no area) */
     /* the translucent layer: the BLEND draws over the opaque depth, the
      * nearest in front of it kept (the same program and uniforms) */
-    if (e->blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run) {
+    if (e->geo.blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run) {
         if (ensure_layer_targets(e, err, err_size) != 0) {
             glDisable(GL_DEPTH_TEST);
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -214,7 +214,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
         glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.layer_fbo);
         for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
             glClearBufferfv(GL_COLOR, i, zero);
-        lpv_engine_draw_scene(e, p, 1, LPV_DRAWS_BLEND);
+        lpv_scene_gpu_draw(&e->geo, p, 1, LPV_DRAWS_BLEND, &e->timer);
     }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -331,8 +331,8 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
     const unsigned variant = (e->light_block.counts[3] > 0.0f ? LPV_FRAME_DIRECTIONAL : 0u) |
                              (damped ? LPV_FRAME_DAMPED : 0u) | (split ? LPV_FRAME_SPLIT : 0u) |
                              (blocks ? LPV_FRAME_BLOCKS : 0u) | (area_blocks ? LPV_FRAME_AREA_BLOCKS : 0u) |
-                             (e->materials_occlusion ? LPV_FRAME_OCCLUSION : 0u) |
-                             (e->materials_unlit ? LPV_FRAME_UNLIT : 0u);
+                             (e->geo.materials_occlusion ? LPV_FRAME_OCCLUSION : 0u) |
+                             (e->geo.materials_unlit ? LPV_FRAME_UNLIT : 0u);
     const GLuint prog = lpv_engine_frame_program(e, variant, err, err_size);
     if (!prog)
         return -1;
@@ -352,7 +352,7 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
     }
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_GBUF_OCCLUSION);
     glBindTexture(GL_TEXTURE_2D, gbuf[4]);
-    lpv_pass_shadow_bind(e);
+    lpv_shadow_maps_bind(&e->shadows);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_VIEW, e->view_ubo);
     /* the passes per block first (frame_blocks.c) */
@@ -413,9 +413,9 @@ static int layer_rect(const lpv_engine *e, int rect[4])
 {
     const float w = (float)e->gbuf.w, h = (float)e->gbuf.h;
     float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-    for (uint32_t i = 0; i < e->draw_count; ++i) {
-        const lpv_gpu_draw *d = &e->draws[i];
-        if (d->material < 0 || (uint32_t)d->material >= e->material_count || !e->materials[d->material].blend ||
+    for (uint32_t i = 0; i < e->geo.draw_count; ++i) {
+        const lpv_gpu_draw *d = &e->geo.draws[i];
+        if (d->material < 0 || (uint32_t)d->material >= e->geo.material_count || !e->geo.materials[d->material].blend ||
             !(d->box_max[0] >= d->box_min[0]) || !d->index_count)
             continue;
         for (int c = 0; c < 8; ++c) {

@@ -60,7 +60,7 @@ void lpv_pass_media_run(lpv_engine *e)
     glBlendFuncSeparate(GL_ONE, GL_SRC1_COLOR, GL_ZERO, GL_ONE);
     GLuint p = e->prog_media;
     glUseProgram(p);
-    lpv_pass_shadow_bind(e);
+    lpv_shadow_maps_bind(&e->shadows);
     lpv_medium_bind(&e->medium, &e->settings, p, 1);
     glUniform1f(glGetUniformLocation(p, "u_media_step"), e->settings.media_step);
     lpv_engine_bind_lookup(e, p, 0.0f);

@@ -2,7 +2,7 @@
  * pass_rsm.c - reflective shadow maps: every light face renders the scene's
  * position/area, normal and reflected flux into one layer (an area light's
  * face: one tile of a layer) of three 2D array textures (plus the depth its
- * own depth test needs; direct light has its own shadow maps, pass_shadow.c);
+ * own depth test needs; direct light has its own shadow maps, shadow_maps.c);
  * a compute pass then turns every texel into one VPL and one surfel.
  */
 #include <math.h>
@@ -169,7 +169,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    const GLuint prog = lpv_engine_material_program(e, e->prog_rsm, e->prog_rsm_plain);
+    const GLuint prog = lpv_scene_gpu_program(&e->geo, e->prog_rsm, e->prog_rsm_plain);
     glUseProgram(prog);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, e->light_ubo);
     GLint loc_vp = glGetUniformLocation(prog, "u_view_proj");
@@ -196,7 +196,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
         glViewport((int)lroundf(tile[0] * (float)size), (int)lroundf(tile[1] * (float)size), side, side);
         glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->light_block.faces[f].view_proj);
         glUniform1i(loc_face, f);
-        lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_ALL); /* lights see both sides */
+        lpv_scene_gpu_draw(&e->geo, prog, 0, LPV_DRAWS_ALL, &e->timer); /* lights see both sides */
     }
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -626,7 +626,7 @@ bool lpv_gbuffer_wire(float normal_w) { return normal_w > LPV_GBUF_WIRE_W - 0.5;
 #define LPV_TEX_REACH 16
 /* The G-buffer's occlusion target (gbuffer.frag o_occlusion) in the frame. */
 #define LPV_TEX_GBUF_OCCLUSION 17
-/* The shadow maps' transmission (pass_shadow.c, shadow.glsl): per texel of
+/* The shadow maps' transmission (shadow_maps.c, shadow.glsl): per texel of
  * a face, rgb the share of light the BLEND surfaces in front of its opaque
  * depth let through (the product of 1 - alpha), a the reversed depth of the
  * nearest of them. */

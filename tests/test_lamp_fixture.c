@@ -19,7 +19,7 @@
  *      degrees to its face's axis 10, 40 and 150 m away without acne (with
  *      the standard depth mapping a near plane that small loses the depth
  *      precision at such distances; the shadow maps hold reversed depth,
- *      pass_shadow.c): the direct frame over I cos / r^2 is 1.
+ *      shadow_maps.c): the direct frame over I cos / r^2 is 1.
  */
 #include <math.h>
 #include <setjmp.h>

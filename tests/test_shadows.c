@@ -16,7 +16,7 @@
  *     anywhere on the plane is darkened (no acne at grazing incidence), with
  *     the cascades' texels (core/shadow_cascades.c) as the tolerance.
  *  3. A spot wider than 45 degrees (a cube of shadow-map faces, of which
- *     pass_shadow.c draws only what the cone reaches: not the face behind
+ *     shadow_maps.c draws only what the cone reaches: not the face behind
  *     it, a band of each side face) over a plane, with a small box on each
  *     side near the cone's rim and one under the light: every box's shadow
  *     is there and nothing lit is darkened, against the path tracer's direct

@@ -1,5 +1,5 @@
 /*
- * pass_shadow.c - the shadow maps of direct light (docs/shadows.md): every
+ * shadow_maps.c - the shadow maps of direct light (docs/shadows.md): every
  * shadow-map face (lpv_shadow_faces_build) renders the scene's depth alone,
  * reversed (near / depth, docs/shadows.md "Near planes"),
  * into one layer of a DEPTH32F array texture of shadow_size^2 texels (an
@@ -17,32 +17,53 @@
 
 #include <cglm/cglm.h>
 
-#include "engine_internal.h"
+#include "shadow_maps.h"
 
-void lpv_pass_shadow_free(lpv_engine *e)
+#include "error.h"
+#include "gl_util.h"
+
+void lpv_shadow_maps_create(lpv_shadow_maps *sm)
 {
-    if (e->shadows.tex)
-        glDeleteTextures(1, &e->shadows.tex);
-    if (e->shadows.fbo)
-        glDeleteFramebuffers(1, &e->shadows.fbo);
-    e->shadows.tex = e->shadows.fbo = 0;
-    lpv_gl_delete_texture(&e->shadows.transmit_tex);
-    lpv_gl_delete_framebuffer(&e->shadows.transmit_fbo);
-    e->shadows.alloc_size = e->shadows.alloc_faces = 0;
-    e->shadows.valid = 0;
+    memset(sm, 0, sizeof *sm);
+    glGenBuffers(1, &sm->ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, sm->ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvShadowBlock), NULL, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
 }
 
-static int allocate(lpv_engine *e, int size, int layers, int translucent, char *err, size_t err_size)
+/* The maps' textures and framebuffers, not the block's buffer. */
+static void release(lpv_shadow_maps *sm)
 {
-    lpv_memory_need need;
-    lpv_engine_memory_need(e, &need);
-    if (lpv_engine_memory_check(e, err, err_size) != 0)
-        return -1;
-    lpv_pass_shadow_free(e);
+    if (sm->tex)
+        glDeleteTextures(1, &sm->tex);
+    if (sm->fbo)
+        glDeleteFramebuffers(1, &sm->fbo);
+    sm->tex = sm->fbo = 0;
+    lpv_gl_delete_texture(&sm->transmit_tex);
+    lpv_gl_delete_framebuffer(&sm->transmit_fbo);
+    sm->alloc_size = sm->alloc_faces = 0;
+    sm->valid = 0;
+}
+
+void lpv_shadow_maps_destroy(lpv_shadow_maps *sm)
+{
+    release(sm);
+    lpv_gl_delete_buffer(&sm->ubo);
+}
+
+int lpv_shadow_maps_fit(const lpv_shadow_maps *sm, int size, int layers, int translucent)
+{
+    return sm->alloc_size == size && sm->alloc_faces == layers && !sm->transmit_fbo == !translucent;
+}
+
+int lpv_shadow_maps_allocate(lpv_shadow_maps *sm, int size, int layers, int translucent, uint64_t bytes, char *err,
+                             size_t err_size)
+{
+    release(sm);
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
-    glGenTextures(1, &e->shadows.tex);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.tex);
+    glGenTextures(1, &sm->tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, sm->tex);
     glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
     /* Hardware compare with bilinear filtering: each tap of the PCF kernel
      * is already a 2x2 weighted comparison. */
@@ -54,36 +75,36 @@ static int allocate(lpv_engine *e, int size, int layers, int translucent, char *
     /* reversed depth (docs/shadows.md "Near planes"): nearer is larger, so
      * a receiver is lit where its depth is at least the map's */
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
-    glGenFramebuffers(1, &e->shadows.fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.fbo);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, 0);
+    glGenFramebuffers(1, &sm->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, sm->fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sm->tex, 0, 0);
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (translucent && status == GL_FRAMEBUFFER_COMPLETE) {
-        glGenTextures(1, &e->shadows.transmit_tex);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.transmit_tex);
+        glGenTextures(1, &sm->transmit_tex);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, sm->transmit_tex);
         glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA16F, size, size, layers);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        glGenFramebuffers(1, &e->shadows.transmit_fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.transmit_fbo);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadows.transmit_tex, 0, 0);
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, 0);
+        glGenFramebuffers(1, &sm->transmit_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, sm->transmit_fbo);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, sm->transmit_tex, 0, 0);
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sm->tex, 0, 0);
         glDrawBuffer(GL_COLOR_ATTACHMENT0);
         status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR || status != GL_FRAMEBUFFER_COMPLETE) {
-        lpv_pass_shadow_free(e);
+        release(sm);
         return lpv_error(err, err_size,
                          "could not allocate the shadow maps: shadow_size %d x %d layers = %.2f GB (GL error 0x%04x, "
                          "framebuffer 0x%04x)",
-                         size, layers, (double)lpv_memory_shadow_bytes(&need) / 1e9, gl_err, status);
+                         size, layers, (double)bytes / 1e9, gl_err, status);
     }
-    e->shadows.alloc_size = size;
-    e->shadows.alloc_faces = layers;
+    sm->alloc_size = size;
+    sm->alloc_faces = layers;
     return 0;
 }
 
@@ -92,31 +113,31 @@ static int allocate(lpv_engine *e, int size, int layers, int translucent, char *
  * each texel's 1 - alpha, a the greatest reversed depth (the nearest
  * surface); depth is read, not written. Leaves the depth pass's framebuffer
  * and state bound again. */
-static void draw_transmission(lpv_engine *e, GLuint prog, int layer)
+static void draw_transmission(lpv_shadow_maps *sm, const lpv_shadow_draw *d, GLuint prog, int layer)
 {
     static const float clear[4] = {1.0f, 1.0f, 1.0f, 0.0f}; /* all light passes; no surface (depth 0: infinitely far) */
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.transmit_fbo);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, e->shadows.transmit_tex, 0, layer);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, layer);
+    glBindFramebuffer(GL_FRAMEBUFFER, sm->transmit_fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, sm->transmit_tex, 0, layer);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sm->tex, 0, layer);
     glClearBufferfv(GL_COLOR, 0, clear); /* within the face's rect: the caller's scissor */
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendEquationSeparate(GL_FUNC_ADD, GL_MAX);
     glBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ONE, GL_ONE);
-    lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_BLEND);
+    lpv_scene_gpu_draw(d->geo, prog, 0, LPV_DRAWS_BLEND, d->timer);
     glDisable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ZERO);
     glDepthMask(GL_TRUE);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, sm->fbo);
 }
 
 /* The cone of directions light l sends light into: a spot's outer cone, an
  * area light sample's hemisphere (cosine emission); 0 for lights that light
  * every direction (points, directional cascades). */
-static int light_cone(const lpv_engine *e, int l, vec3 apex, vec3 axis, float *half_angle)
+static int light_cone(const struct LpvLightGpu *lights, int l, vec3 apex, vec3 axis, float *half_angle)
 {
-    const struct LpvLightGpu *g = &e->light_block.lights[l];
+    const struct LpvLightGpu *g = &lights[l];
     const int type = (int)g->position_type[3];
     if (type != LPV_LIGHT_TYPE_SPOT && type != LPV_LIGHT_TYPE_AREA)
         return 0;
@@ -142,13 +163,14 @@ static int light_cone(const lpv_engine *e, int l, vec3 apex, vec3 axis, float *h
  * Returns 0 when no direction of the face is lit (the face is not drawn). */
 #define RIM_SAMPLES 256
 #define EDGE_SAMPLES 64
-static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int rect[4])
+static int face_lit_rect(const lpv_shadow_maps *sm, const struct LpvLightGpu *lights, int f, int x, int y, int side,
+                         int rect[4])
 {
-    const struct LpvShadowFaceGpu *F = &e->shadows.block.faces[f];
+    const struct LpvShadowFaceGpu *F = &sm->block.faces[f];
     rect[0] = x, rect[1] = y, rect[2] = side, rect[3] = side;
     vec3 apex, axis;
     float half;
-    if (F->info[1] != 1.0f || !light_cone(e, (int)F->info[2], apex, axis, &half))
+    if (F->info[1] != 1.0f || !light_cone(lights, (int)F->info[2], apex, axis, &half))
         return 1;
     const float open = half + 0.02f, cos_open = cosf(open), sin_open = sinf(open);
     float lo[2] = {2.0f, 2.0f}, hi[2] = {-2.0f, -2.0f};
@@ -204,12 +226,12 @@ static int face_lit_rect(const lpv_engine *e, int f, int x, int y, int side, int
     return r[2] > 0 && r[3] > 0;
 }
 
-static void draw(lpv_engine *e)
+static void draw(lpv_shadow_maps *sm, const lpv_shadow_draw *d)
 {
-    const int size = e->shadows.alloc_size, faces = (int)e->shadows.block.counts[0];
+    const int size = sm->alloc_size, faces = (int)sm->block.counts[0];
     int bound_layer = -1;
-    lpv_timer_begin(&e->timer, "shadow");
-    glBindFramebuffer(GL_FRAMEBUFFER, e->shadows.fbo);
+    lpv_timer_begin(d->timer, "shadow");
+    glBindFramebuffer(GL_FRAMEBUFFER, sm->fbo);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE); /* both sides cast: single-sided walls still block */
     glEnable(GL_DEPTH_TEST);
@@ -220,7 +242,7 @@ static void draw(lpv_engine *e)
     glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_TRUE);
-    const GLuint prog = lpv_engine_material_program(e, e->prog_shadow, e->prog_shadow_plain);
+    const GLuint prog = lpv_scene_gpu_program(d->geo, d->prog, d->prog_plain);
     glUseProgram(prog);
     GLint loc_vp = glGetUniformLocation(prog, "u_view_proj");
     const float far_depth = 0.0f;
@@ -229,62 +251,51 @@ static void draw(lpv_engine *e)
         /* A face fills its layer, or (area light samples) one tile of it, or
          * the lit half of that tile: only what it draws is cleared (the
          * clear costs as much as the drawing on llvmpipe). */
-        const float *tile = e->shadows.block.faces[f].tile;
+        const float *tile = sm->block.faces[f].tile;
         const int layer = (int)tile[3];
         if (layer != bound_layer) {
-            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, e->shadows.tex, 0, layer);
+            glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sm->tex, 0, layer);
             bound_layer = layer;
         }
         const int side = (int)lroundf(tile[2] * (float)size);
         const int x = (int)lroundf(tile[0] * (float)size), y = (int)lroundf(tile[1] * (float)size);
         int rect[4];
-        if (!face_lit_rect(e, f, x, y, side, rect))
+        if (!face_lit_rect(sm, d->lights, f, x, y, side, rect))
             continue;
         glScissor(rect[0], rect[1], rect[2], rect[3]);
         glClearBufferfv(GL_DEPTH, 0, &far_depth);
         glViewport(x, y, side, side);
-        glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)e->shadows.block.faces[f].view_proj);
-        lpv_engine_draw_scene(e, prog, 0, LPV_DRAWS_NOT_BLEND); /* lights see both sides */
-        if (e->shadows.transmit_fbo)
-            draw_transmission(e, prog, layer);
+        glUniformMatrix4fv(loc_vp, 1, GL_FALSE, (const float *)sm->block.faces[f].view_proj);
+        lpv_scene_gpu_draw(d->geo, prog, 0, LPV_DRAWS_NOT_BLEND, d->timer); /* lights see both sides */
+        if (sm->transmit_fbo)
+            draw_transmission(sm, d, prog, layer);
     }
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    lpv_timer_end(&e->timer);
+    lpv_timer_end(d->timer);
 }
 
-int lpv_pass_shadow_update(lpv_engine *e, char *err, size_t err_size)
+void lpv_shadow_maps_draw(lpv_shadow_maps *sm, const struct LpvShadowBlock *b, const lpv_shadow_draw *d)
 {
-    struct LpvShadowBlock b;
-    if (lpv_shadow_faces_build(e, &b, err, err_size) != 0)
-        return -1;
-    const int size = e->settings.shadow_size, faces = (int)b.counts[0];
-    const int layers = b.counts[3] > 0.0f ? (int)b.counts[3] : 1;
-    const int translucent = e->blend_draws > 0;
-    b.options[0] = (float)translucent;
-    if (e->shadows.alloc_size != size || e->shadows.alloc_faces != layers || !e->shadows.transmit_fbo != !translucent)
-        if (allocate(e, size, layers, translucent, err, err_size) != 0)
-            return -1;
-    if (e->shadows.valid && memcmp(&b, &e->shadows.block, sizeof b) == 0)
-        return 0;
-    e->shadows.block = b;
-    glBindBuffer(GL_UNIFORM_BUFFER, e->shadows.ubo);
-    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof b, &b);
-    if (faces > 0)
-        draw(e);
-    e->shadows.valid = 1;
-    return 0;
+    if (sm->valid && memcmp(b, &sm->block, sizeof *b) == 0)
+        return;
+    sm->block = *b;
+    glBindBuffer(GL_UNIFORM_BUFFER, sm->ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof *b, b);
+    if (b->counts[0] > 0.0f)
+        draw(sm, d);
+    sm->valid = 1;
 }
 
-void lpv_pass_shadow_bind(const lpv_engine *e)
+void lpv_shadow_maps_bind(const lpv_shadow_maps *sm)
 {
     glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, sm->tex);
     glActiveTexture(GL_TEXTURE0 + LPV_TEX_SHADOW_TRANSMIT);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, e->shadows.transmit_tex);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, sm->transmit_tex);
     glActiveTexture(GL_TEXTURE0);
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, e->shadows.ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_SHADOW, sm->ubo);
 }
