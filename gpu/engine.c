@@ -99,7 +99,7 @@ void lpv_engine_destroy(lpv_engine *e)
     if (!e)
         return;
     lpv_engine_free_scene(e);
-    lpv_pass_rsm_free(e);
+    lpv_rsms_free(&e->rsm);
     lpv_pass_camera_free(e);
     lpv_frame_blocks_free(e);
     lpv_shadow_maps_destroy(&e->shadows);

@@ -17,6 +17,7 @@
 #include "medium.h"
 #include "reach.h"
 #include "scene_gpu.h"
+#include "rsm_maps.h"
 #include "shadow_maps.h"
 #include "memory_budget.h"
 #include "surfel_groups.h"
@@ -76,25 +77,6 @@ typedef struct lpv_frame_buffers {
     lpv_frame_blocks lookup_blocks, area_shadow_blocks;
 } lpv_frame_buffers;
 
-/* The lights' reflective shadow maps and what pass_rsm.c makes of them:
- * the VPLs the technique injects and the surfels of the geometry volume
- * (lpv_technique_inputs takes them). Faces are laid out by light_faces.c. */
-typedef struct lpv_rsms {
-    int size, face_count, alloc_size, alloc_faces;
-    int punctual_faces;   /* faces (= layers) of the punctual lights; area faces follow */
-    int layers;           /* layers in use: punctual faces + those the area faces' tiles fill */
-    int area_face_side;   /* texels of an area light face's tile */
-    GLuint position, normal, flux, albedo, depth, fbo;
-    GLuint vpls, surfels; /* blocks of RSM texels, lpv_block_slots each (vpl_blocks.comp; vpl_extract.comp at step 1) */
-    /* the VPLs that carry light, in order, and their draw command (compact.h):
-     * the injection draws only them */
-    GLuint vpls_live, vpls_draw;
-    /* VPLs (and surfels) per layer, blocks^2 x slots: the punctual lights',
-     * the area lights' layers whose surfels the GV takes
-     * (lpv_engine_area_gv_layers), the other area layers' (pass_rsm.c) */
-    size_t per_layer[3];
-    size_t vpl_count; /* the three kinds of layers x their per_layer */
-} lpv_rsms;
 
 
 struct lpv_engine {
@@ -300,7 +282,6 @@ int lpv_engine_shadows_update(lpv_engine *e, char *err, size_t err_size);
 /* Each producer deletes what it made (also what a failed allocation left):
  * the passes call these before remaking their storage, and
  * lpv_engine_destroy calls them, so each list of objects is written once. */
-void lpv_pass_rsm_free(lpv_engine *e);
 void lpv_pass_camera_free(lpv_engine *e);
 
 /* The storage the engine's own producers call for (RSMs, shadow maps, the
