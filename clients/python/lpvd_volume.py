@@ -1,0 +1,586 @@
+"""lpvd_volume.py - volumes of the lpvd Python client: decoding a VOLUME or
+GET_VOLUME reply's values (fp16/fp32, XOR deltas, the layout description)
+into ``Volume`` and ``Cascade`` objects, and their local lookups (SPEC R5.7,
+and R5.14's ``iv_irradiance`` for technique iv).
+
+Standard library only (array, math, struct, sys); numpy is used when it is
+importable (values then come back as float32 arrays). One of the modules of
+the client; import ``lpvd_client``, which re-exports every name.
+
+The protocol is protocol/SPEC.md; section numbers below refer to it.
+"""
+
+import array
+import math
+import struct
+import sys
+
+try:  # optional
+    import numpy as _np
+except ImportError:  # pragma: no cover - depends on the machine
+    _np = None
+
+from lpvd_protocol import ProtocolError
+
+HAVE_NUMPY = _np is not None
+
+# Two-band SH constants of docs/propagation.md section 1.
+SH_LOBE0 = 0.886226925452758    # sqrt(pi) / 2
+SH_LOBE1 = 1.0233267079464885   # sqrt(pi / 3)
+
+MAX_CASCADES = 4  # entries of a volume header's "cascades" (SPEC R5.6)
+# The description's layout version this client reads (SPEC R5.9); what a
+# volume carries is read from the description itself.
+VOLUME_LAYOUT_VERSION = 1
+OCTREE_LEVEL_ROLE = "octree_level"  # the role of an octree's levels (SPEC R5.13, GET_VOLUME content "levels")
+IV_VOXELS_ROLE = "iv_voxels"  # the role of technique iv's one level of voxels (SPEC R5.14)
+IV_UNITS = "W/(m^2 sr)"  # an iv volume's values: the radiance arriving at each voxel centre (SPEC R5.14)
+LPV_UNITS = "W/sr"  # an LPV's values: radiant intensity per cell, what R5.7's lookup reads
+# The values, in order, that this client's lookup (Cascade.irradiance: the
+# cosine lobe on SH bands 0-1 per channel) reads; a volume whose description
+# names other values is decoded but not looked up (SPEC R5.11).
+LOOKUP_VALUES = tuple("%s.%s" % (ch, y) for ch in "rgb" for y in ("Y00", "Y1-1", "Y10", "Y11"))
+
+
+class LayoutError(ValueError):
+    """A lookup on a volume whose described layout (SPEC R5.11) it does not read;
+    the message names the layout."""
+
+
+def _xor(a, b):
+    """Byte-wise XOR of two equally long byte strings (SPEC R5.3)."""
+    if len(a) != len(b):
+        raise ProtocolError("XOR delta of %d bytes against a base of %d bytes" % (len(a), len(b)))
+    n = len(a)
+    return (int.from_bytes(a, "little") ^ int.from_bytes(b, "little")).to_bytes(n, "little")
+
+
+def _floats(raw, fmt):
+    """Raw little-endian fp16/fp32 bytes -> float32 numpy array or array('f')."""
+    if fmt == "fp32":
+        if len(raw) % 4:
+            raise ProtocolError("fp32 volume of %d bytes" % len(raw))
+        if _np is not None:
+            return _np.frombuffer(raw, dtype="<f4").copy()
+        out = array.array("f")
+        out.frombytes(raw)
+        if sys.byteorder != "little":
+            out.byteswap()
+        return out
+    if fmt == "fp16":
+        if len(raw) % 2:
+            raise ProtocolError("fp16 volume of %d bytes" % len(raw))
+        if _np is not None:
+            return _np.frombuffer(raw, dtype="<f2").astype(_np.float32)
+        return array.array("f", struct.unpack("<%de" % (len(raw) // 2), raw))
+    raise ProtocolError("unknown volume format %r" % fmt)
+
+
+_F32 = struct.Struct("<f")
+
+
+def _f32(x):
+    """x rounded to the nearest binary32 (each step of SPEC R5.14's lookup is
+    a binary32 operation; rounding the double result of one +, -, *, / or
+    sqrt gives the binary32 result exactly)."""
+    try:
+        return _F32.unpack(_F32.pack(x))[0]
+    except OverflowError:  # beyond the largest binary32: what a binary32 operation gives
+        return math.copysign(float("inf"), x)
+
+
+# R5.14's constants as the binary32 values the server and core use
+_IV_HELD_WEIGHT = 1.0 / 64.0
+_LOBE0 = _f32(SH_LOBE0)
+_LOBE1 = _f32(SH_LOBE1)
+
+
+def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
+    """SPEC R5.14's lookup: E (W/m^2, r, g, b) at surface point p with normal
+    n from an iv volume: ``dims``, ``origin``, ``cell_size`` its one level,
+    ``cell(x, y, z)`` a voxel's 12 values, ``held(x, y, z)`` its index entry
+    (non-zero: the voxel holds a surface), ``neighbours`` the description's
+    iv_neighbours. Step by step in binary32 as techniques/iv/core/oracle_iv_reconstruct.c computes it
+    (lpv_iv_irradiance; the sums of step 6 in double, as there)."""
+    f32 = _f32
+    # 1. a finite p, a unit-able n
+    p = [f32(float(v)) for v in p]
+    n = [f32(float(v)) for v in n]
+    if not all(math.isfinite(v) for v in p + n):
+        return (0.0, 0.0, 0.0)
+    ln = f32(math.sqrt(f32(f32(f32(n[0] * n[0]) + f32(n[1] * n[1])) + f32(n[2] * n[2]))))
+    if not (ln > f32(1e-8)) or ln == float("inf"):
+        return (0.0, 0.0, 0.0)
+    nh = [f32(v / ln) for v in n]
+    s = f32(cell_size)
+    o = [f32(v) for v in origin]
+    # 2. half a voxel in front of the surface, the 8 voxel centres around it
+    base, f = [0, 0, 0], [0.0, 0.0, 0.0]
+    for a in range(3):
+        q = f32(p[a] + f32(f32(0.5 * s) * nh[a]))
+        u = f32(f32(f32(q - o[a]) / s) - 0.5)
+        if not (-1.0 <= u < dims[a]):
+            return (0.0, 0.0, 0.0)
+        b = float(int(u // 1))
+        base[a] = int(b)
+        f[a] = f32(u - b)
+    # 3. + 4. the corners by distance to q (ties: the lower number), the nearest `neighbours`
+    d2 = []
+    for c in range(8):
+        acc = 0.0
+        for a in range(3):
+            e = f32(f[a] - ((c >> a) & 1))
+            acc = f32(acc + f32(e * e))
+        d2.append(acc)
+    order = sorted(range(8), key=lambda c: (d2[c], c))
+    neighbours = min(max(int(neighbours), 1), 8)
+    idx, weight = [], []
+    for c in order[:neighbours]:
+        v = [base[a] + ((c >> a) & 1) for a in range(3)]
+        if not all(0 <= v[a] < dims[a] for a in range(3)):
+            continue
+        # 5. trilinear weight x the cosine towards the voxel's centre, 1/64 for a voxel holding a surface
+        t = 1.0
+        for a in range(3):
+            t = f32(t * (f[a] if (c >> a) & 1 else f32(1.0 - f[a])))
+        d = [f32(f32(o[a] + f32(f32(v[a] + 0.5) * s)) - p[a]) for a in range(3)]
+        ln2 = f32(math.sqrt(f32(f32(f32(d[0] * d[0]) + f32(d[1] * d[1])) + f32(d[2] * d[2]))))
+        cosine = 0.0
+        if ln2 > 0.0:
+            c = [f32(nh[a] * f32(d[a] / ln2)) for a in range(3)]
+            cosine = f32(f32(c[0] + c[1]) + c[2])
+        w = f32(t * (cosine if cosine > 0.0 else 0.0))
+        if held(v[0], v[1], v[2]):
+            w = f32(w * _IV_HELD_WEIGHT)
+        if not (w > 0.0):
+            continue
+        idx.append(v)
+        weight.append(w)
+    # 6. the blend, then the cosine lobe around -n (radiance: no / s^2)
+    total = sum(weight)
+    if not (total > 0.0):
+        return (0.0, 0.0, 0.0)
+    acc = [0.0] * 12
+    for v, w in zip(idx, weight):
+        vals = cell(v[0], v[1], v[2])
+        for k in range(12):
+            acc[k] += w * float(vals[k])
+    lobe = (_LOBE0, f32(_LOBE1 * -nh[1]), f32(_LOBE1 * -nh[2]), f32(_LOBE1 * -nh[0]))
+    e3 = []
+    for ch in range(3):
+        L = [f32(acc[4 * ch + k] / total) for k in range(4)]
+        e3.append(f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3])))
+    # 7. made light as a whole colour: luminance y <= 0 gives 0; else y is
+    # kept and, where the most negative channel m < 0, the chroma scales
+    # by y / (y - 2 m)
+    y = f32(f32(f32(e3[0] * f32(0.2126)) + f32(e3[1] * f32(0.7152))) + f32(e3[2] * f32(0.0722)))
+    if not y > 0.0:
+        return (0.0, 0.0, 0.0)
+    m = min(e3)
+    if m >= 0.0:
+        return tuple(e3)
+    s = f32(y / f32(y - f32(2.0 * m)))
+    return tuple(f32(y + f32(f32(c - y) * s)) for c in e3)
+
+
+class Cascade(object):
+    """One cascade (level) of a volume (SPEC R5.6, R5.10): ``dims``,
+    ``origin`` (m, lower corner), ``cell_size`` (m), ``values_per_cell`` and
+    ``volumes`` (the description's volumes_per_level; 1 and 12 for R5.1's
+    layout) and ``data``: ``volumes * cells * values_per_cell`` float32
+    values, cell-major, x fastest (``index = x + nx * (y + ny * z)``); for
+    R5.1's layout per cell r0..r3 g0..g3 b0..b3 in radiant intensity W/sr. A
+    numpy array of shape (nz, ny, nx, values_per_cell) (one volume) or
+    (volumes, nz, ny, nx, values_per_cell) when numpy is available, else a
+    flat ``array('f')``. ``role`` is "cascade" or "far_field" (or
+    "octree_level", R5.13, or "iv_voxels", R5.14: technique iv's voxels,
+    radiance W/(m^2 sr) at their centres, which R5.7's ``irradiance`` and
+    ``total_flux`` refuse; ``Volume.irradiance`` reads them by R5.14).
+    """
+
+    def __init__(self, dims, origin, cell_size, values, values_per_cell=12, volumes=1, role="cascade",
+                 lookup_refusal=None):
+        self.dims = tuple(int(v) for v in dims)
+        self.origin = tuple(float(v) for v in origin)
+        self.cell_size = float(cell_size)
+        self.values_per_cell = int(values_per_cell)
+        self.volumes = int(volumes)
+        self.role = role
+        self._lookup_refusal = lookup_refusal
+        cells = self.dims[0] * self.dims[1] * self.dims[2]
+        if len(values) != cells * self.values_per_cell * self.volumes:
+            raise ProtocolError("cascade of %d values for %d cells x %d volumes x %d values" % (
+                len(values), cells, self.volumes, self.values_per_cell))
+        if _np is not None:
+            shape = (self.dims[2], self.dims[1], self.dims[0], self.values_per_cell)
+            values = values.reshape(shape if self.volumes == 1 else (self.volumes,) + shape)
+        self.data = values
+
+    def _check_lookup(self):
+        if self._lookup_refusal:
+            raise LayoutError(self._lookup_refusal)
+
+    def contains(self, p):
+        """Whether world point p lies inside this cascade's box."""
+        for a in range(3):
+            u = (p[a] - self.origin[a]) / self.cell_size
+            if not (0.0 <= u <= self.dims[a]):
+                return False
+        return True
+
+    def border_cells(self, p):
+        """Distance from p to the box's border in this cascade's cells (the
+        smallest over the six faces; negative outside)."""
+        d = None
+        for a in range(3):
+            u = (p[a] - self.origin[a]) / self.cell_size
+            m = min(u, self.dims[a] - u)
+            d = m if d is None else min(d, m)
+        return d
+
+    @property
+    def cells(self):
+        return self.dims[0] * self.dims[1] * self.dims[2]
+
+    def cell(self, x, y, z):
+        """The 12 coefficients of cell (x, y, z) as a list."""
+        self._check_lookup()
+        if _np is not None:
+            return [float(v) for v in self.data[z, y, x]]
+        i = (x + self.dims[0] * (y + self.dims[1] * z)) * 12
+        return list(self.data[i:i + 12])
+
+    def _check_r57(self):
+        self._check_lookup()
+        if self.role == IV_VOXELS_ROLE:
+            raise LayoutError("technique iv's voxels (role %r) hold radiance (%s) at their centres, not the intensity "
+                              "per cell R5.7's lookup reads: use Volume.irradiance (SPEC R5.14)"
+                              % (IV_VOXELS_ROLE, IV_UNITS))
+
+    def total_flux(self):
+        """Sum over cells of c0 * sqrt(4 pi) per channel, in W."""
+        self._check_r57()
+        k = (4.0 * 3.141592653589793) ** 0.5
+        if _np is not None:
+            d = self.data.reshape(-1, 12)
+            return [float(d[:, 0].sum() * k), float(d[:, 4].sum() * k), float(d[:, 8].sum() * k)]
+        r = g = b = 0.0
+        for i in range(0, len(self.data), 12):
+            r += self.data[i]
+            g += self.data[i + 4]
+            b += self.data[i + 8]
+        return [r * k, g * k, b * k]
+
+    def sh_at(self, p):
+        """Trilinear interpolation of the 12 coefficients at world point p,
+        between cell centres, clamped to the outermost centres (GL_CLAMP_TO_EDGE),
+        as docs/propagation.md section 6. Returns None for a NaN coordinate."""
+        i0, i1, f = [0, 0, 0], [0, 0, 0], [0.0, 0.0, 0.0]
+        for a in range(3):
+            u = (p[a] - self.origin[a]) / self.cell_size
+            if u != u:
+                return None
+            n = self.dims[a]
+            u = min(max(u, 0.5), n - 0.5) - 0.5
+            base = float(int(u // 1))
+            if base > n - 2:
+                base = float(n - 2)
+            if base < 0:
+                base = 0.0
+            i0[a] = int(base)
+            i1[a] = i0[a] + 1 if i0[a] + 1 < n else i0[a]
+            f[a] = u - base
+        out = [0.0] * 12
+        for corner in range(8):
+            w = 1.0
+            idx = [0, 0, 0]
+            for a in range(3):
+                if corner >> a & 1:
+                    idx[a] = i1[a]
+                    w *= f[a]
+                else:
+                    idx[a] = i0[a]
+                    w *= 1.0 - f[a]
+            if w == 0.0:
+                continue
+            c = self.cell(idx[0], idx[1], idx[2])
+            for k in range(12):
+                out[k] += w * c[k]
+        return out
+
+    def irradiance(self, p, n):
+        """E(n) in W/m^2 (r, g, b) at surface point p with normal n from this
+        cascade alone (propagation.md §6): sample half a cell in front of the
+        surface, E = max(0, c . lobe(-n)) / s^2. Raises LayoutError for a
+        volume whose values are not LOOKUP_VALUES in one volume per level (or
+        are technique iv's voxels, SPEC R5.14)."""
+        self._check_r57()
+        ln = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) ** 0.5
+        if not (ln > 1e-8) or ln == float("inf") or any(v != v for v in n):
+            return (0.0, 0.0, 0.0)
+        un = [v / ln for v in n]
+        q = [p[a] + 0.5 * self.cell_size * un[a] for a in range(3)]
+        c = self.sh_at(q)
+        if c is None:
+            return (0.0, 0.0, 0.0)
+        lobe = (SH_LOBE0, -SH_LOBE1 * un[1], -SH_LOBE1 * un[2], -SH_LOBE1 * un[0])
+        inv = 1.0 / (self.cell_size * self.cell_size)
+        rgb = []
+        for ch in range(3):
+            d = sum(c[4 * ch + k] * lobe[k] for k in range(4))
+            rgb.append(max(0.0, d * inv))
+        return tuple(rgb)
+
+
+class Volume(Cascade):
+    """A decoded LPV (SPEC section 5) with every cascade (R5.6).
+
+    ``cascades`` lists the ``Cascade`` objects, finest first. The volume's
+    own ``dims``, ``origin``, ``cell_size``, ``data``, ``cell()`` and
+    ``total_flux()`` are cascade 0's (the finest; the whole volume when there
+    is one cascade); ``irradiance()`` blends the cascades as R5.7 (and the
+    server's QUERY_IRRADIANCE) do. ``plan`` is the tick's plan (SPEC section
+    8) or None. ``units`` are the values' units.
+
+    Technique iv's volume (SPEC R5.14; ``iv`` true): one level of voxels
+    holding the radiance arriving at their centres (``units`` W/(m^2 sr)),
+    ``index`` one flag per voxel (1: it holds a surface) and
+    ``iv_neighbours``; ``irradiance()`` is then R5.14's lookup
+    (``iv_irradiance``).
+    """
+
+    def __init__(self, header, raw):
+        self.header = header
+        self.raw = raw  # the raw (decompressed, delta-resolved) bytes
+        self.tick = header.get("tick")
+        self.revision = header.get("revision")
+        self.format = header.get("format")
+        self.keyframe = bool(header.get("keyframe", True))
+        self.base_tick = header.get("base_tick")
+        self.plan = header.get("plan")
+        grid = header.get("grid") or {}
+        specs = header.get("cascades")
+        if specs is None:  # a server before cascades: the grid is the volume
+            specs = [dict(grid, cells=None)]
+        if not isinstance(specs, list) or not 1 <= len(specs) <= MAX_CASCADES:
+            raise ProtocolError("cascades: expected 1 to %d entries" % MAX_CASCADES)
+        self.description = self._describe(header, specs)
+        desc = self.description
+        # SPEC R5.13: GET_VOLUME content "levels" describes an octree's levels
+        # (the cascades then are level 0 alone); else the levels are the cascades
+        octree = self._octree_levels(desc)
+        self.iv = self._iv_levels(desc)
+        self.iv_neighbours = desc.get("iv_neighbours") if self.iv else None
+        self.units = desc.get("units") or header.get("units") or LPV_UNITS
+        self.content = "levels" if octree else "merged"
+        vpc, vpl = desc["values_per_cell"], desc["volumes_per_level"]
+        self.values_per_cell, self.volumes_per_level = vpc, vpl
+        self.technique, self.far_field = desc["technique"], desc["far_field"]
+        refusal = None
+        if octree:
+            refusal = ("volume of content \"levels\" (technique %r: its %d octree levels and index volume) is not "
+                       "the merged grid the lookup reads (SPEC R5.7, R5.13): ask get_volume(content=\"merged\")" % (
+                           desc["technique"], len(desc["levels"])))
+        elif self.iv:
+            pass  # R5.14: read by its own lookup (Volume.irradiance)
+        elif vpl != 1 or desc["index"] is not None or self.units != LPV_UNITS or (
+                desc["values"] is not None and tuple(desc["values"]) != LOOKUP_VALUES):
+            refusal = ("volume layout of technique %r (layout_version %d, %d values per cell %s, %d volumes per "
+                       "level%s, units %s) is not the 12 SH values %s in %s in one volume per level, the only layout "
+                       "this client's lookup reads (SPEC R5.7, R5.11)" % (
+                           desc["technique"], desc["layout_version"], vpc, desc["values"], vpl,
+                           ", with an index volume" if desc["index"] is not None else "", self.units,
+                           list(LOOKUP_VALUES), LPV_UNITS))
+        self.lookup_refusal = refusal
+        size = 2 if self.format == "fp16" else 4
+        index = desc["index"]
+        values_end = int(index["raw_offset"]) if index is not None else len(raw)
+        values = _floats(raw[:values_end], self.format)
+        self.index = None
+        if index is not None:  # R5.12: little-endian u32 after the levels' values
+            ib = raw[values_end:values_end + int(index["raw_length"])]
+            self.index = array.array("I", struct.unpack("<%dI" % (len(ib) // 4), ib))
+        self.cascades = []
+        first = 0
+        for k, c in enumerate(desc["levels"] if octree else specs):
+            dims = [int(v) for v in c.get("dims", (0, 0, 0))]
+            if len(dims) != 3 or min(dims) < 1:
+                raise ProtocolError("cascades[%d].dims: expected 3 integers >= 1" % k)
+            cells = dims[0] * dims[1] * dims[2]
+            if c.get("cells") is not None and int(c["cells"]) != cells:
+                raise ProtocolError("cascades[%d].cells: %r, its dims give %d" % (k, c["cells"], cells))
+            cs = float(c.get("cell_size", 0.0))
+            if not cs > 0.0:
+                raise ProtocolError("cascades[%d].cell_size: expected a positive number" % k)
+            n = cells * vpc * vpl
+            if first + n > len(values):
+                raise ProtocolError("volume of %d values, the cascades need more" % len(values))
+            self.cascades.append(Cascade(dims, c.get("origin", (0.0, 0.0, 0.0)), cs, values[first:first + n],
+                                         vpc, vpl, desc["levels"][k].get("role", "cascade"), refusal))
+            first += n
+        if first != len(values):
+            raise ProtocolError("volume of %d values (%d bytes of %s) for %d values as described" % (
+                len(values), len(values) * size, self.format, first))
+        # the description's levels: every octree level for content "levels",
+        # else the cascades; the cascades are what the legacy keys describe
+        self.levels = list(self.cascades)
+        if octree:
+            self.cascades = self.cascades[:1]
+        c0 = self.cascades[0]
+        if grid and (tuple(int(v) for v in grid.get("dims", ())) != c0.dims
+                     or abs(float(grid.get("cell_size", 0.0)) - c0.cell_size) > 1e-9 * c0.cell_size):
+            raise ProtocolError("grid: differs from cascades[0]")
+        self.dims, self.origin, self.cell_size, self.data = c0.dims, c0.origin, c0.cell_size, c0.data
+        self.role, self.values_per_cell, self.volumes = c0.role, c0.values_per_cell, c0.volumes
+        self._lookup_refusal = refusal
+
+    @staticmethod
+    def _describe(header, specs):
+        """The header's description (SPEC R5.9 - R5.12), checked; or, from a
+        server without one, R5.1's layout from the legacy keys (layout_version
+        0, values None: named by the "layout" string)."""
+        d = header.get("volume")
+        if d is None:
+            return {"layout_version": 0, "technique": "", "far_field": False, "volumes_per_level": 1,
+                    "values_per_cell": 12, "values": None, "units": header.get("units"), "index": None,
+                    "levels": [dict(c, role="cascade") for c in specs]}
+        if not isinstance(d, dict):
+            raise ProtocolError("volume: expected an object")
+        if d.get("layout_version") != VOLUME_LAYOUT_VERSION:
+            raise ProtocolError("volume.layout_version: %r is not a layout this client reads (it reads %d)" % (
+                d.get("layout_version"), VOLUME_LAYOUT_VERSION))
+        vpc, vpl = d.get("values_per_cell"), d.get("volumes_per_level")
+        if not isinstance(vpc, int) or vpc < 1:
+            raise ProtocolError("volume.values_per_cell: expected an integer >= 1, got %r" % (vpc,))
+        if not isinstance(vpl, int) or vpl < 1:
+            raise ProtocolError("volume.volumes_per_level: expected an integer >= 1, got %r" % (vpl,))
+        vals = d.get("values")
+        if not isinstance(vals, list) or len(vals) != vpc or len(set(vals)) != vpc:
+            raise ProtocolError("volume.values: expected %d distinct names (values_per_cell), got %r" % (vpc, vals))
+        levels = d.get("levels")
+        if Volume._octree_levels(d):
+            Volume._check_octree_levels(d, specs)
+            return d
+        if Volume._iv_levels(d):
+            Volume._check_iv_levels(d, specs, header)
+            return d
+        if not isinstance(levels, list) or len(levels) != len(specs):
+            raise ProtocolError("volume.levels: expected %d levels (one per cascade)" % len(specs))
+        for k, (lv, c) in enumerate(zip(levels, specs)):
+            if any(lv.get(key) != c.get(key) for key in ("dims", "origin", "cell_size", "cells")):
+                raise ProtocolError("volume.levels[%d]: differs from cascades[%d]" % (k, k))
+        if d.get("index") is not None:
+            ix = d["index"]
+            if not isinstance(ix, dict) or not isinstance(ix.get("raw_offset"), int) \
+                    or not isinstance(ix.get("raw_length"), int):
+                raise ProtocolError("volume.index: expected null or an object with raw_offset and raw_length")
+        return d
+    @staticmethod
+    def _octree_levels(d):
+        """Whether description d's levels are an octree's (SPEC R5.13)."""
+        levels = d.get("levels") if isinstance(d, dict) else None
+        return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+            and levels[0].get("role") == OCTREE_LEVEL_ROLE
+
+    @staticmethod
+    def _iv_levels(d):
+        """Whether description d's levels are technique iv's voxels (SPEC R5.14)."""
+        levels = d.get("levels") if isinstance(d, dict) else None
+        return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+            and levels[0].get("role") == IV_VOXELS_ROLE
+
+    @staticmethod
+    def _check_iv_levels(d, specs, header):
+        """R5.14: one cascade and one "iv_voxels" level equal to it, far field
+        false, the 12 SH values in one volume, radiance units, the index over
+        level 0 (one u32 per voxel) and iv_neighbours in 1..8."""
+        levels = d["levels"]
+        if len(specs) != 1 or len(levels) != 1:
+            raise ProtocolError("volume.levels: %d levels over %d cascades, but %r is exactly one level over one "
+                                "cascade (SPEC R5.14)" % (len(levels), len(specs), IV_VOXELS_ROLE))
+        c0, lv = specs[0], levels[0]
+        if any(lv.get(key) != c0.get(key) for key in ("dims", "origin", "cell_size", "cells")):
+            raise ProtocolError("volume.levels[0]: differs from cascades[0]")
+        if d.get("far_field") is not False:
+            raise ProtocolError("volume.far_field: %r with %r levels, expected false" % (d.get("far_field"),
+                                                                                         IV_VOXELS_ROLE))
+        if d.get("volumes_per_level") != 1 or tuple(d.get("values") or ()) != LOOKUP_VALUES:
+            raise ProtocolError("volume.values: %r levels hold the 12 SH values %s in one volume (got %r, %r "
+                                "volumes)" % (IV_VOXELS_ROLE, list(LOOKUP_VALUES), d.get("values"),
+                                              d.get("volumes_per_level")))
+        if d.get("units") != IV_UNITS or header.get("units") != IV_UNITS:
+            raise ProtocolError("volume.units: %r (header %r) with %r levels, expected %r" % (
+                d.get("units"), header.get("units"), IV_VOXELS_ROLE, IV_UNITS))
+        dims = c0.get("dims")
+        cells = dims[0] * dims[1] * dims[2] if isinstance(dims, list) and len(dims) == 3 else None
+        ix = d.get("index")
+        if not isinstance(ix, dict) or ix.get("level") != 0 or ix.get("dims") != dims \
+                or ix.get("values_per_cell") != 1 or ix.get("value_type") != "u32" \
+                or not isinstance(ix.get("raw_offset"), int) or ix.get("raw_length") != (cells or 0) * 4:
+            raise ProtocolError("volume.index: %r levels need the index over level 0 (level 0, dims %r, "
+                                "values_per_cell 1, u32)" % (IV_VOXELS_ROLE, dims))
+        nb = d.get("iv_neighbours")
+        if not isinstance(nb, int) or isinstance(nb, bool) or not 1 <= nb <= 8:
+            raise ProtocolError("volume.iv_neighbours: %r, expected an integer in [1, 8] with %r levels"
+                                % (nb, IV_VOXELS_ROLE))
+
+    @staticmethod
+    def _check_octree_levels(d, specs):
+        """R5.13: one cascade (level 0), l = log2(n) + 1 levels, level i at
+        level 0's origin with dims n >> i and cell size 2^i x level 0's, and
+        the index over level 0 (one u32 per cell)."""
+        levels = d["levels"]
+        if len(specs) != 1:
+            raise ProtocolError("cascades: %d entries, but octree levels need exactly one, level 0" % len(specs))
+        c0 = specs[0]
+        n = c0.get("dims", [0])[0]
+        if list(c0.get("dims", ())) != [n, n, n] or not isinstance(n, int) or n < 1 or n & (n - 1):
+            raise ProtocolError("volume.levels: octree levels over level 0 of dims %r (not a cube of a power of two)"
+                                % (c0.get("dims"),))
+        count = n.bit_length()
+        if len(levels) != count:
+            raise ProtocolError("volume.levels: %d octree levels, an octree over %d^3 cells has %d" % (
+                len(levels), n, count))
+        if d.get("far_field"):
+            raise ProtocolError("volume.far_field: true with octree levels")
+        for i, lv in enumerate(levels):
+            m = n >> i
+            cs = float(c0.get("cell_size", 0.0)) * (1 << i)
+            if not isinstance(lv, dict) or lv.get("role") != OCTREE_LEVEL_ROLE or lv.get("dims") != [m, m, m] \
+                    or lv.get("cells") != m * m * m or lv.get("origin") != c0.get("origin") \
+                    or abs(float(lv.get("cell_size", 0.0)) - cs) > 1e-9 * cs:
+                raise ProtocolError("volume.levels[%d]: not octree level %d (role %r, level 0's origin, dims "
+                                    "n >> %d, cell size 2^%d x level 0's)" % (i, i, OCTREE_LEVEL_ROLE, i, i))
+        ix = d.get("index")
+        if not isinstance(ix, dict) or ix.get("level") != 0 or ix.get("dims") != [n, n, n] \
+                or ix.get("values_per_cell") != 1 or not isinstance(ix.get("raw_offset"), int) \
+                or ix.get("raw_length") != n * n * n * 4:
+            raise ProtocolError("volume.index: octree levels need the index over level 0 (level 0, dims %r, "
+                                "values_per_cell 1, %d bytes)" % ([n, n, n], n * n * n * 4))
+
+    def irradiance(self, p, n):
+        """E(n) in W/m^2 (r, g, b) at surface point p with normal n, computed
+        locally as the server's QUERY_IRRADIANCE (SPEC R5.7): the finest
+        cascade containing p, blended towards the next coarser one within the
+        last 3 cells of its border, w = clamp((d - 1) / 2, 0, 1); each
+        cascade's lookup as propagation.md §6. Technique iv's voxels (``iv``):
+        R5.14's lookup instead (``iv_irradiance`` with the index and
+        iv_neighbours). Raises LayoutError (naming the layout) for a volume
+        neither lookup reads."""
+        self._check_lookup()
+        if self.iv:
+            nx, ny = self.dims[0], self.dims[1]
+            index = self.index
+            return iv_irradiance(self.dims, self.origin, self.cell_size, self.cell,
+                                 lambda x, y, z: index[x + nx * (y + ny * z)], self.iv_neighbours, p, n)
+        cs = self.cascades
+        k = next((i for i, c in enumerate(cs) if c.contains(p)), len(cs) - 1)
+        fine = Cascade.irradiance(cs[k], p, n)
+        if k + 1 >= len(cs) or not cs[k + 1].contains(p):
+            return fine
+        d = cs[k].border_cells(p)
+        w = min(max((d - 1.0) / 2.0, 0.0), 1.0)
+        if w >= 1.0:
+            return fine
+        coarse = Cascade.irradiance(cs[k + 1], p, n)
+        return tuple(w * f + (1.0 - w) * c for f, c in zip(fine, coarse))
