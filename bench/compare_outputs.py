@@ -11,7 +11,7 @@ GET_VOLUME fp32 payload, its header (less the tick number) and TICK's stats
 others. A refactor that should change nothing (issue 33) is checked with it;
 an earlier build: `git worktree add --detach ../old REV` and
 `cmake -S ../old -B ../old/build && cmake --build ../old/build --target lpvd`.
-Standard library and clients/python/lpvd_client.py only.
+Standard library and the Python client (clients/python/lpvd_client.py) only.
 """
 import argparse
 import hashlib
