@@ -1,0 +1,330 @@
+"""conf_volume_checks.py - checks shared by the volume, stream and plan cases: a volume header
+(R5.1, R5.6), its "volume" description (R5.9 - R5.14), the tick plan (SPEC section 8),
+R5.14's irradiance lookup written from the SPEC, and technique iv's small CONFIG."""
+
+import math
+import struct
+
+from conf_core import check
+
+
+def _vol_header_checks(h, fmt, comp, dims=None):
+    for k in ("revision", "tick", "format", "compression", "keyframe", "grid", "units", "layout", "sh",
+              "raw_length"):
+        check(k in h, "volume header has no %r: %r" % (k, h))
+    check(h["format"] == fmt, "format %r, expected %r" % (h["format"], fmt))
+    check(h["compression"] == comp, "compression %r, expected %r" % (h["compression"], comp))
+    want_units = IV_UNITS if _iv_levels(h.get("volume") or {}) else "W/sr"  # R5.14: an iv volume holds radiance
+    check(h["units"] == want_units, "units %r, expected %s" % (h["units"], want_units))
+    g = h["grid"]
+    check(isinstance(g, dict) and isinstance(g.get("dims"), list) and len(g["dims"]) == 3
+          and all(isinstance(x, int) and x > 0 for x in g["dims"]), "grid.dims %r" % g)
+    check(isinstance(g.get("origin"), list) and len(g["origin"]) == 3, "grid.origin %r" % g.get("origin"))
+    check(isinstance(g.get("cell_size"), (int, float)) and g["cell_size"] > 0, "grid.cell_size %r"
+          % g.get("cell_size"))
+    if dims is not None:
+        check(g["dims"] == list(dims), "grid.dims %r, expected the configured %r" % (g["dims"], list(dims)))
+    cells = _cascades_checks(h)
+    _description_checks(h)
+    _plan_checks(h.get("plan"), "volume header")
+    return cells
+
+
+INDEX_VALUE_SIZE = 4  # R5.12: index values are little-endian u32
+
+
+def _description_checks(h):
+    """R5.9 - R5.12: the header's "volume" description, checked against the
+    legacy keys, the cascades and raw_length. Everything it says is read
+    from the header, so a technique with other values passes as long as it is
+    consistent. Returns the description."""
+    d = h.get("volume")
+    check(isinstance(d, dict), "volume header has no \"volume\" description object (R5.9): %r" % (d,))
+    check(isinstance(d.get("layout_version"), int) and not isinstance(d.get("layout_version"), bool)
+          and d["layout_version"] >= 1, "volume.layout_version %r: expected an integer >= 1 (R5.9)"
+          % (d.get("layout_version"),))
+    check(isinstance(d.get("technique"), str) and d["technique"], "volume.technique %r: expected a name (R5.9)"
+          % (d.get("technique"),))
+    check(d.get("units") == h.get("units"), "volume.units %r differs from the header's units %r (R5.11)"
+          % (d.get("units"), h.get("units")))
+    check(isinstance(d.get("far_field"), bool), "volume.far_field %r: expected a boolean (R5.10)"
+          % (d.get("far_field"),))
+    levels, cs = d.get("levels"), h["cascades"]
+    octree, iv = _octree_levels(d), _iv_levels(d)
+    if octree:  # R5.13: content "levels", the octree's levels over cascades[0]
+        _octree_level_checks(d, cs)
+    elif iv:  # R5.14: technique iv's one level of voxels
+        _iv_level_checks(d, cs, h)
+    else:
+        check(isinstance(levels, list) and len(levels) == len(cs), "volume.levels %r: expected %d levels, one "
+              "per cascade (R5.10)" % (levels, len(cs)))
+    for k, (lv, c) in enumerate(zip(levels, cs) if not (octree or iv) else ()):
+        for key in ("dims", "origin", "cell_size", "cells"):
+            check(isinstance(lv, dict) and lv.get(key) == c.get(key), "volume.levels[%d].%s %r differs from "
+                  "cascades[%d].%s %r (R5.10)" % (k, key, lv.get(key) if isinstance(lv, dict) else lv, k, key,
+                                                  c.get(key)))
+        want = "far_field" if d["far_field"] and k > 0 else "cascade"
+        check(lv.get("role") == want, "volume.levels[%d].role %r with far_field %r, expected %r (R5.10)"
+              % (k, lv.get("role"), d["far_field"], want))
+    vpc, vpl = d.get("values_per_cell"), d.get("volumes_per_level")
+    for key, v in (("values_per_cell", vpc), ("volumes_per_level", vpl)):
+        check(isinstance(v, int) and not isinstance(v, bool) and v >= 1, "volume.%s %r: expected an integer "
+              ">= 1 (R5.11)" % (key, v))
+    vals = d.get("values")
+    check(isinstance(vals, list) and len(vals) == vpc, "volume.values has %s names, values_per_cell is %d (R5.11)"
+          % (len(vals) if isinstance(vals, list) else repr(vals), vpc))
+    check(all(isinstance(v, str) and v for v in vals) and len(set(vals)) == len(vals),
+          "volume.values %r: expected distinct non-empty names (R5.11)" % (vals,))
+    size = 2 if h["format"] == "fp16" else 4
+    cells = sum(c["cells"] for c in (levels if octree else cs))
+    values_bytes = cells * vpl * vpc * size
+    index, index_bytes = d.get("index", None), 0
+    check("index" in d, "volume has no \"index\" key (null when there is none, R5.12)")
+    if index is not None:
+        check(isinstance(index, dict), "volume.index %r: expected null or an object (R5.12)" % (index,))
+        n = 1
+        for x in index.get("dims", []):
+            n *= x
+        index_bytes = n * index.get("values_per_cell", 0) * INDEX_VALUE_SIZE
+        check(index.get("raw_offset") == values_bytes, "volume.index.raw_offset %r, the levels' values end at %d "
+              "(R5.12)" % (index.get("raw_offset"), values_bytes))
+        check(index.get("raw_length") == index_bytes, "volume.index.raw_length %r, expected %d (R5.12)"
+              % (index.get("raw_length"), index_bytes))
+    check(h["raw_length"] == values_bytes + index_bytes, "raw_length %r, expected cells(%d, all levels) x %d "
+          "volume(s) x %d values x %d bytes%s = %d (R5.6, R5.11)" % (
+              h["raw_length"], cells, vpl, vpc, size, " + index %d" % index_bytes if index_bytes else "",
+              values_bytes + index_bytes))
+    return d
+
+
+OCTREE_LEVEL_ROLE = "octree_level"  # R5.13: the role of an octree's levels
+
+
+def _octree_levels(d):
+    """Whether a description's levels are an octree's (R5.13)."""
+    levels = d.get("levels")
+    return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+        and levels[0].get("role") == OCTREE_LEVEL_ROLE
+
+
+def _octree_level_checks(d, cs):
+    """R5.13: the cascades are level 0 alone; l = log2(n) + 1 levels, level i
+    at level 0's origin with dims n >> i and cell size 2^i x level 0's; far
+    field false; an index over level 0, one u32 per cell."""
+    levels = d["levels"]
+    check(len(cs) == 1, "octree levels with %d cascades; the legacy keys describe level 0 alone (R5.13)" % len(cs))
+    n = cs[0]["dims"][0]
+    check(cs[0]["dims"] == [n, n, n] and n & (n - 1) == 0, "octree levels over level 0 of dims %r: not a cube of a "
+          "power of two (R5.13)" % (cs[0]["dims"],))
+    check(len(levels) == n.bit_length(), "%d octree levels over %d^3 cells, expected log2(n) + 1 = %d (R5.13)"
+          % (len(levels), n, n.bit_length()))
+    check(d.get("far_field") is False, "volume.far_field %r with octree levels, expected false (R5.13)"
+          % (d.get("far_field"),))
+    for i, lv in enumerate(levels):
+        m, cell = n >> i, cs[0]["cell_size"] * (1 << i)
+        check(isinstance(lv, dict) and lv.get("role") == OCTREE_LEVEL_ROLE and lv.get("dims") == [m, m, m]
+              and lv.get("cells") == m ** 3 and lv.get("origin") == cs[0]["origin"]
+              and abs(lv.get("cell_size", 0) - cell) <= 1e-9 * cell,
+              "volume.levels[%d] %r: expected role %r, dims %r, cells %d, origin %r (level 0's), cell_size %g "
+              "(R5.13)" % (i, lv, OCTREE_LEVEL_ROLE, [m, m, m], m ** 3, cs[0]["origin"], cell))
+    ix = d.get("index")
+    check(isinstance(ix, dict) and ix.get("level") == 0 and ix.get("dims") == [n, n, n]
+          and ix.get("values_per_cell") == 1 and ix.get("value_type") == "u32",
+          "volume.index %r: octree levels need the index over level 0 (level 0, dims %r, values_per_cell 1, u32; "
+          "R5.13)" % (ix, [n, n, n]))
+
+
+IV_VOXELS_ROLE = "iv_voxels"  # R5.14: the role of technique iv's one level
+IV_UNITS = "W/(m^2 sr)"  # R5.14: its values are radiance
+SH_NAMES = ["%s.%s" % (ch, y) for ch in "rgb" for y in ("Y00", "Y1-1", "Y10", "Y11")]
+
+
+def _iv_levels(d):
+    """Whether a description's levels are technique iv's voxels (R5.14)."""
+    levels = d.get("levels")
+    return isinstance(levels, list) and bool(levels) and isinstance(levels[0], dict) \
+        and levels[0].get("role") == IV_VOXELS_ROLE
+
+
+def _iv_level_checks(d, cs, h):
+    """R5.14: one cascade and one "iv_voxels" level equal to it, far_field
+    false, the 12 SH values in one volume, units W/(m^2 sr) (header too), the
+    index over level 0 with level 0's dims and one u32 per voxel, and
+    iv_neighbours an integer in 1..8."""
+    levels = d["levels"]
+    check(len(cs) == 1 and len(levels) == 1, "%d levels over %d cascades, R5.14 has one %r level over one cascade"
+          % (len(levels), len(cs), IV_VOXELS_ROLE))
+    for key in ("dims", "origin", "cell_size", "cells"):
+        check(levels[0].get(key) == cs[0].get(key), "volume.levels[0].%s %r differs from cascades[0].%s %r (R5.14)"
+              % (key, levels[0].get(key), key, cs[0].get(key)))
+    check(d.get("far_field") is False, "volume.far_field %r with %r, expected false (R5.14)"
+          % (d.get("far_field"), IV_VOXELS_ROLE))
+    check(d.get("volumes_per_level") == 1 and d.get("values") == SH_NAMES, "volume values %r x %r volumes, R5.14 "
+          "has the 12 SH values %r in one volume" % (d.get("values"), d.get("volumes_per_level"), SH_NAMES))
+    check(d.get("units") == IV_UNITS and h.get("units") == IV_UNITS, "units %r (header %r), R5.14 says %r"
+          % (d.get("units"), h.get("units"), IV_UNITS))
+    ix = d.get("index")
+    check(isinstance(ix, dict) and ix.get("level") == 0 and ix.get("dims") == cs[0]["dims"]
+          and ix.get("values_per_cell") == 1 and ix.get("value_type") == "u32",
+          "volume.index %r: R5.14 has the index over level 0 (level 0, dims %r, values_per_cell 1, u32)"
+          % (ix, cs[0]["dims"]))
+    nb = d.get("iv_neighbours")
+    check(isinstance(nb, int) and not isinstance(nb, bool) and 1 <= nb <= 8,
+          "volume.iv_neighbours %r: expected an integer in 1..8 (R5.14)" % (nb,))
+
+
+SH_LOBE0 = math.sqrt(math.pi) / 2.0
+SH_LOBE1 = math.sqrt(math.pi / 3.0)
+
+
+_F32 = struct.Struct("<f")
+
+
+def _f32(x):
+    """x rounded to binary32 (R5.14 computes in binary32)."""
+    try:
+        return _F32.unpack(_F32.pack(x))[0]
+    except OverflowError:
+        return math.copysign(float("inf"), x)
+
+
+def _iv_lookup(d, vals, held, p, n):
+    """R5.14's lookup written from the SPEC's seven steps: E (r, g, b) at p
+    with normal n from the voxels (vals: 12 floats per voxel, x fastest; held:
+    the index) of description d's one level."""
+    lv = d["levels"][0]
+    dims, o, s, N = lv["dims"], [_f32(v) for v in lv["origin"]], _f32(lv["cell_size"]), d["iv_neighbours"]
+    f32 = _f32
+    p, n = [f32(v) for v in p], [f32(v) for v in n]
+    # 1
+    if not all(math.isfinite(v) for v in p + n):
+        return [0.0, 0.0, 0.0]
+    ln = f32(math.sqrt(f32(f32(f32(n[0] * n[0]) + f32(n[1] * n[1])) + f32(n[2] * n[2]))))
+    if not (math.isfinite(ln) and ln > f32(1e-8)):
+        return [0.0, 0.0, 0.0]
+    nh = [f32(v / ln) for v in n]
+    b, f = [0] * 3, [0.0] * 3
+    for a in range(3):
+        # 2
+        q = f32(p[a] + f32(f32(0.5 * s) * nh[a]))
+        u = f32(f32(f32(q - o[a]) / s) - 0.5)
+        if not (-1.0 <= u < dims[a]):
+            return [0.0, 0.0, 0.0]
+        b[a] = math.floor(u)
+        f[a] = f32(u - b[a])
+    # 3
+    corners = []
+    for c in range(8):
+        bits = [(c >> a) & 1 for a in range(3)]
+        t, dd = 1.0, 0.0
+        for a in range(3):
+            t = f32(t * (f[a] if bits[a] else f32(1.0 - f[a])))
+            e = f32(f[a] - bits[a])
+            dd = f32(dd + f32(e * e))
+        corners.append((dd, c, [b[a] + bits[a] for a in range(3)], t))
+    # 4
+    corners.sort(key=lambda e: (e[0], e[1]))
+    total, acc = 0.0, [0.0] * 12
+    for _, _, v, t in corners[:N]:
+        if not all(0 <= v[a] < dims[a] for a in range(3)):
+            continue
+        # 5
+        dv = [f32(f32(o[a] + f32(f32(v[a] + 0.5) * s)) - p[a]) for a in range(3)]
+        dl = f32(math.sqrt(f32(f32(f32(dv[0] * dv[0]) + f32(dv[1] * dv[1])) + f32(dv[2] * dv[2]))))
+        cos = 0.0
+        if dl > 0.0:
+            cs = [f32(nh[a] * f32(dv[a] / dl)) for a in range(3)]
+            cos = f32(f32(cs[0] + cs[1]) + cs[2])
+        wc = f32(t * max(0.0, cos))
+        i = v[0] + dims[0] * (v[1] + dims[1] * v[2])
+        if held[i]:
+            wc = f32(wc / 64.0)
+        if not wc > 0.0:
+            continue
+        total += wc
+        for k in range(12):
+            acc[k] += wc * vals[12 * i + k]
+    if not total > 0.0:
+        return [0.0, 0.0, 0.0]
+    # 6
+    lobe = [f32(SH_LOBE0), f32(f32(SH_LOBE1) * -nh[1]), f32(f32(SH_LOBE1) * -nh[2]), f32(f32(SH_LOBE1) * -nh[0])]
+    e3 = []
+    for ch in range(3):
+        L = [f32(acc[4 * ch + k] / total) for k in range(4)]
+        e3.append(f32(f32(f32(f32(L[0] * lobe[0]) + f32(L[1] * lobe[1])) + f32(L[2] * lobe[2])) + f32(L[3] * lobe[3])))
+    # 7. made light as a whole colour: luminance y <= 0 gives 0; else y is
+    # kept and, where the most negative channel m < 0, the chroma scales
+    # by y / (y - 2 m)
+    y = f32(f32(f32(e3[0] * f32(0.2126)) + f32(e3[1] * f32(0.7152))) + f32(e3[2] * f32(0.0722)))
+    if not y > 0.0:
+        return [0.0, 0.0, 0.0]
+    m = min(e3)
+    if m >= 0.0:
+        return list(e3)
+    s = f32(y / f32(y - f32(2.0 * m)))
+    return list(f32(y + f32(f32(c - y) * s)) for c in e3)
+
+
+def _cascades_checks(h):
+    """R5.6: "cascades" present, 1..4 entries, each consistent, cascade 0 ==
+    grid. Returns the cells of all cascades."""
+    cs = h.get("cascades")
+    check(isinstance(cs, list) and 1 <= len(cs) <= 4, "volume header cascades %r: expected 1 to 4 entries" % (cs,))
+    total = 0
+    for k, e in enumerate(cs):
+        check(isinstance(e, dict), "cascades[%d] %r is not an object" % (k, e))
+        d = e.get("dims")
+        check(isinstance(d, list) and len(d) == 3 and all(isinstance(x, int) and x > 0 for x in d),
+              "cascades[%d].dims %r" % (k, d))
+        check(isinstance(e.get("origin"), list) and len(e["origin"]) == 3
+              and all(isinstance(x, (int, float)) for x in e["origin"]), "cascades[%d].origin %r" % (k, e.get("origin")))
+        check(isinstance(e.get("cell_size"), (int, float)) and e["cell_size"] > 0,
+              "cascades[%d].cell_size %r" % (k, e.get("cell_size")))
+        n = d[0] * d[1] * d[2]
+        check(e.get("cells") == n, "cascades[%d].cells %r, its dims give %d" % (k, e.get("cells"), n))
+        if k > 0:
+            check(e["cell_size"] > cs[k - 1]["cell_size"], "cascades[%d].cell_size %r is not coarser than "
+                  "cascades[%d]'s %r (finest first)" % (k, e["cell_size"], k - 1, cs[k - 1]["cell_size"]))
+        total += n
+    g = h["grid"]
+    check(cs[0]["dims"] == g["dims"], "cascades[0].dims %r != grid.dims %r" % (cs[0]["dims"], g["dims"]))
+    check(abs(cs[0]["cell_size"] - g["cell_size"]) <= 1e-9 * g["cell_size"]
+          and all(abs(a - b) <= 1e-9 * max(1.0, abs(b)) for a, b in zip(cs[0]["origin"], g["origin"])),
+          "cascades[0] %r differs from grid %r" % (cs[0], g))
+    return total
+
+
+PLAN_PASSES = ("rsm", "emissive", "inject", "gbuffer", "gv", "propagate", "bounce", "glossy", "media")
+
+
+def _plan_checks(plan, where, cascades=None):
+    """SPEC section 8: the plan object names every pass with run and a reason."""
+    check(isinstance(plan, dict), "%s has no plan object: %r" % (where, plan))
+    check(isinstance(plan.get("cascades"), int) and not isinstance(plan.get("cascades"), bool),
+          "%s plan.cascades %r" % (where, plan.get("cascades")))
+    check(isinstance(plan.get("cascades_reason"), str), "%s plan.cascades_reason %r"
+          % (where, plan.get("cascades_reason")))
+    check(isinstance(plan.get("recompute"), bool), "%s plan.recompute %r" % (where, plan.get("recompute")))
+    check(isinstance(plan.get("recompute_reason"), str), "%s plan.recompute_reason %r"
+          % (where, plan.get("recompute_reason")))
+    passes = plan.get("passes")
+    check(isinstance(passes, list), "%s plan.passes %r" % (where, passes))
+    names = [p.get("name") if isinstance(p, dict) else None for p in passes]
+    check(tuple(names[:len(PLAN_PASSES)]) == PLAN_PASSES, "%s plan passes %r, expected %r first (R8.1)"
+          % (where, names, list(PLAN_PASSES)))
+    for p in passes:
+        check(isinstance(p.get("run"), bool) and isinstance(p.get("reason"), str),
+              "%s plan pass %r: expected a boolean run and a reason string" % (where, p))
+    if cascades is not None:
+        check(plan["cascades"] == cascades, "%s plan.cascades %r, the volume has %d cascades (R8.2)"
+              % (where, plan["cascades"], cascades))
+
+
+# technique iv kept small for llvmpipe: ~12 voxels along the box, 16 rays, 2 bounces
+IV_CONFIG = {"technique": "iv", "iv_resolution": 12, "iv_rays": 16, "iv_bounces": 2}
+
+
+def _iv_techniques(ctx):
+    """The techniques HELLO lists (a fresh session's)."""
+    ctx.session().close()
+    return (ctx.hello_reply or {}).get("techniques") or []

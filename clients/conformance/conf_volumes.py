@@ -1,0 +1,375 @@
+"""conf_volumes.py - conformance cases: volumes from GET_VOLUME: the description, octree levels,
+technique iv, layout, fp16, zstd, dims (R5.1 - R5.14)."""
+
+import math
+import os
+import random
+import struct
+
+from conf_wire import CONFIG, GET_VOLUME, QUERY_IRRADIANCE, SUBSCRIBE, TICK, UNSUBSCRIBE, VOLUME
+from conf_payloads import SMALL_CONFIG, f16_list, f32_list, zstd_decompress_cli, zstd_frame_content_size
+from conf_core import Fail, case, check, expect_error, expect_reply, is_finite_list, unique_light
+from conf_volume_checks import (
+    IV_CONFIG, IV_VOXELS_ROLE, SH_LOBE0, SH_LOBE1, _description_checks, _iv_levels, _iv_lookup, _iv_techniques,
+    _octree_levels, _vol_header_checks)
+
+
+# ---------------------------------------------------------------------------
+# Cases: volumes
+
+
+@case("R5.9", "GET_VOLUME and VOLUME headers carry a versioned \"volume\" description naming the technique")
+def c_volume_description(ctx):
+    c, cfg, t = ctx.scene_session()
+    seen = []
+    for fmt in ("fp32", "fp16"):
+        f = expect_reply(c.request(GET_VOLUME, {"format": fmt, "compression": "none"}), GET_VOLUME)
+        _vol_header_checks(f.body, fmt, "none")
+        check(len(f.att) == f.body["raw_length"], "attachment %d bytes, raw_length %d" % (len(f.att),
+                                                                                        f.body["raw_length"]))
+        seen.append(f.body["volume"])
+    expect_reply(c.request(SUBSCRIBE, {"stream": "volume", "format": "fp32", "compression": "none"}), SUBSCRIBE)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v = c.recv_stream(VOLUME, timeout=ctx.tick_timeout)
+    _vol_header_checks(v.body, "fp32", "none")
+    # the description says what the cells are, not how they are sent
+    check(v.body["volume"] == seen[0] == seen[1], "the description differs between fp32, fp16 and the stream: %r"
+          % ([seen[0], seen[1], v.body["volume"]],))
+    d = seen[0]
+    return "layout %d, technique %s, %d values x %d volume(s) per cell" % (
+        d["layout_version"], d["technique"], d["values_per_cell"], d["volumes_per_level"])
+
+
+@case("R5.10", "the description's levels are the cascades (placement) with roles that agree with far_field")
+def c_volume_description_levels(ctx):
+    out = []
+    for ff in (False, True):
+        c, cfg, t = ctx.scene_session(config=dict(SMALL_CONFIG, far_field=ff))
+        f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+        _vol_header_checks(f.body, "fp32", "none")
+        d = f.body["volume"]
+        check(d["far_field"] == ff, "CONFIG far_field %r, the description says far_field %r" % (ff, d["far_field"]))
+        out.append("far_field %s: %s" % (ff, [lv["role"] for lv in d["levels"]]))
+        c.close()
+    return "; ".join(out)
+
+
+@case("R5.11 R5.1", "values per cell are named (values_per_cell names) and drive raw_length; the 12 SH values "
+      "agree with the legacy layout")
+def c_volume_description_values(ctx):
+    c, cfg, t = ctx.scene_session()
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    d = _description_checks(f.body)
+    vpc, vpl = d["values_per_cell"], d["volumes_per_level"]
+    cells = sum(cc["cells"] for cc in f.body["cascades"])
+    check(len(f.att) == cells * vpl * vpc * 4, "attachment %d bytes, the description gives %d cells x %d x %d x 4"
+          % (len(f.att), cells, vpl, vpc))
+    # R5.1's legacy keys describe 12 values per cell r0..r3 g0..g3 b0..b3 in
+    # one volume per level: a description of them must say the same count
+    # with one name per channel and coefficient, channel-major.
+    if "layout" in f.body:
+        check(vpc == 12 and vpl == 1, "legacy \"layout\" %r sent, but the description has %d values x %d volumes"
+              % (f.body["layout"], vpc, vpl))
+        chans = [v.split(".", 1)[0] for v in d["values"]]
+        check(chans == [chans[0]] * 4 + [chans[4]] * 4 + [chans[8]] * 4 and len(set(chans)) == 3,
+              "values %r are not 4 per channel, channel-major, as the layout %r" % (d["values"], f.body["layout"]))
+    return "%d values: %s" % (vpc, ", ".join(d["values"]))
+
+
+@case("R5.13 R5.12", "GET_VOLUME content levels with technique octree: every octree level placed as described, an "
+      "index of one level per cell, and the merged volume is the indexed levels (eq. 10); refused for lpv")
+def c_volume_octree_levels(ctx):
+    ctx.session().close()  # its HELLO reply lists the techniques
+    techniques = (ctx.hello_reply or {}).get("techniques") or []
+    if "octree" not in techniques:  # no technique with levels: "levels" is refused (R5.13)
+        c, cfg, t = ctx.scene_session(light=unique_light("no-octree-levels"))
+        rid = c.send(GET_VOLUME, {"format": "fp32", "content": "levels"})
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+        return "HELLO lists no \"octree\" (%r): content \"levels\" refused naming content" % (techniques,)
+    n = 8
+    # one step: light spreads a cell on level 0, so coarser levels fill the rest (eq. 10 picks them)
+    config = dict(SMALL_CONFIG, grid=[n, n, n], technique="octree", iterations=1)
+    c, cfg, t = ctx.scene_session(config=config, light=unique_light("octree-levels"))
+    for body in ({"content": "everything"}, {"content": 1}):
+        rid = c.send(GET_VOLUME, dict(body, format="fp32"))
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    m = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none", "content": "merged"}),
+                     GET_VOLUME)
+    plain = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    check(m.att == plain.att, "content \"merged\" differs from GET_VOLUME without content (the default)")
+    _vol_header_checks(m.body, "fp32", "none", [n, n, n])
+    check(not _octree_levels(m.body["volume"]), "content \"merged\" describes octree levels")
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none", "content": "levels"}),
+                     GET_VOLUME)
+    _vol_header_checks(f.body, "fp32", "none", [n, n, n])
+    d = f.body["volume"]
+    check(d["technique"] == "octree", "content levels from technique %r" % (d["technique"],))
+    check(_octree_levels(d), "content \"levels\" with technique octree: levels %r are not octree levels"
+          % ([lv.get("role") for lv in d["levels"]],))
+    check(len(f.att) == f.body["raw_length"], "attachment %d bytes, raw_length %d" % (len(f.att),
+                                                                                    f.body["raw_length"]))
+    check(f.body["tick"] == m.body["tick"], "levels of tick %r, merged of tick %r" % (f.body["tick"],
+                                                                                      m.body["tick"]))
+    z = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "zstd", "content": "levels"}),
+                     GET_VOLUME)
+    zs = zstd_frame_content_size(z.att)
+    check(zs[0] and zs[1] == f.body["raw_length"], "zstd levels: content size %r (%s), raw_length %d"
+          % (zs[1], zs[2], f.body["raw_length"]))
+    l = len(d["levels"])
+    ix = d["index"]
+    index = struct.unpack("<%dI" % (n ** 3), f.att[ix["raw_offset"]:ix["raw_offset"] + ix["raw_length"]])
+    vals = f32_list(f.att[:ix["raw_offset"]])
+    check(is_finite_list(vals), "non-finite values in the levels")
+    first, at = [], 0
+    for lv in d["levels"]:
+        first.append(at)
+        at += lv["cells"] * 12
+    merged = f32_list(m.att)
+    used = [0] * l
+    for z_ in range(n):
+        for y in range(n):
+            for x in range(n):
+                cell = x + n * (y + n * z_)
+                i = index[cell]
+                check(0 <= i < l, "index[%d] = %d, not a level in 0..%d" % (cell, i, l - 1))
+                used[i] += 1
+                k = n >> i
+                src = first[i] + 12 * ((x >> i) + k * ((y >> i) + k * (z_ >> i)))
+                got, want = merged[12 * cell:12 * cell + 12], vals[src:src + 12]
+                check(got == want, "merged cell (%d, %d, %d) %r is not level %d's cell at x >> %d %r (eq. 10)"
+                      % (x, y, z_, got[:4], i, i, want[:4]))
+                if i < l - 1:
+                    check(any(v != 0.0 for v in want), "index[%d] = %d names a level with no light there" % (cell, i))
+    check(any(v != 0.0 for v in merged[0::4]), "the merged volume of a lit box is all zero")
+    check(sum(used[1:]) > 0, "after one step every cell's light is level 0's (%r): eq. 10 is not exercised" % (used,))
+    # a technique without levels: content "levels" is refused naming content
+    expect_reply(c.request(CONFIG, {"technique": "lpv"}), CONFIG)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    rid = c.send(GET_VOLUME, {"format": "fp32", "content": "levels"})
+    expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    return "%d levels (%s), %d bytes; cells per index level %r; merged = the indexed levels; lpv refused" % (
+        l, ", ".join("%d^3" % lv["dims"][0] for lv in d["levels"]), len(f.att), used)
+
+
+@case("R5.14 R5.12 R4.7", "technique iv: GET_VOLUME and VOLUME describe one \"iv_voxels\" level in W/(m^2 sr) with "
+      "the occupancy index and the effective iv_neighbours; R5.14's lookup on it agrees with QUERY_IRRADIANCE")
+def c_volume_iv(ctx):
+    if "iv" not in _iv_techniques(ctx):
+        c = ctx.session()
+        rid = c.send(CONFIG, {"technique": "iv"})
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "technique")
+        return "HELLO lists no \"iv\": CONFIG technique iv refused naming technique (R4.14)"
+    c, cfg, t = ctx.scene_session(config=dict(IV_CONFIG, iv_neighbours=6), light=unique_light("iv-volume"))
+    nb = (cfg.body.get("config") or {}).get("iv_neighbours")
+    check(nb == 6, "CONFIG iv_neighbours 6: the effective config says %r" % (nb,))
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    h = f.body
+    _vol_header_checks(h, "fp32", "none")
+    d = h["volume"]
+    check(_iv_levels(d), "technique iv's volume has levels %r, expected one %r level (R5.14)"
+          % ([lv.get("role") for lv in d.get("levels") or []], IV_VOXELS_ROLE))
+    check(d["technique"] == "iv", "volume.technique %r, expected iv" % (d["technique"],))
+    check(d["iv_neighbours"] == nb, "volume.iv_neighbours %r, the effective config's is %r (R5.14)"
+          % (d["iv_neighbours"], nb))
+    cells = h["cascades"][0]["cells"]
+    ix = d["index"]
+    check(ix["raw_offset"] == cells * 12 * 4 and ix["raw_length"] == cells * 4
+          and h["raw_length"] == cells * 12 * 4 + cells * 4 == len(f.att),
+          "raw_length %r, index at %r of %r bytes, attachment %d: expected %d voxels x 48 + %d x 4 (R5.14)"
+          % (h["raw_length"], ix["raw_offset"], ix["raw_length"], len(f.att), cells, cells))
+    vals = f32_list(f.att[:ix["raw_offset"]])
+    held = struct.unpack("<%dI" % cells, f.att[ix["raw_offset"]:])
+    check(is_finite_list(vals), "non-finite values in the iv volume")
+    check(set(held) <= {0, 1}, "index entries %r: R5.14 has 1 (holds a surface) or 0" % (sorted(set(held)),))
+    check(0 < sum(held) < cells, "%d of %d voxels hold a surface in a box" % (sum(held), cells))
+    check(any(v != 0.0 for v in vals[0::4]), "the iv volume of a lit box is all zero")
+    st = (t.body.get("stats") or {}).get("iv")
+    if isinstance(st, dict) and "occupied" in st:  # R4.13 (informative)
+        check(st["occupied"] == sum(held), "TICK stats iv.occupied %r, the index has %d" % (st["occupied"], sum(held)))
+    # the same description and index in fp16, zstd and the stream; no "levels" content
+    z = expect_reply(c.request(GET_VOLUME, {"format": "fp16", "compression": "zstd"}), GET_VOLUME)
+    _vol_header_checks(z.body, "fp16", "zstd")
+    check(z.body["volume"]["levels"] == d["levels"] and z.body["volume"]["iv_neighbours"] == nb,
+          "fp16/zstd describes other levels than fp32")
+    rid = c.send(GET_VOLUME, {"format": "fp32", "content": "levels"})
+    expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    expect_reply(c.request(SUBSCRIBE, {"stream": "volume", "format": "fp32", "compression": "none"}), SUBSCRIBE)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v = c.recv_stream(VOLUME, timeout=ctx.tick_timeout)
+    _vol_header_checks(v.body, "fp32", "none")
+    check(v.body["volume"] == d, "the VOLUME stream describes the iv volume otherwise than GET_VOLUME")
+    check(v.att[ix["raw_offset"]:] == f.att[ix["raw_offset"]:], "the streamed index differs (same inputs)")
+    expect_reply(c.request(UNSUBSCRIBE, {"stream": "volume"}), UNSUBSCRIBE)
+    # R5.14's lookup here against the server's QUERY_IRRADIANCE, at seeded random points (no exact corner ties)
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    vals = f32_list(f.att[:ix["raw_offset"]])
+    held = struct.unpack("<%dI" % cells, f.att[ix["raw_offset"]:])
+    lv = d["levels"][0]
+    rnd = random.Random(14)
+    probes = []
+    for i in range(90):
+        p = [lv["origin"][a] + rnd.uniform(0.03, 0.97) * lv["dims"][a] * lv["cell_size"] for a in range(3)]
+        n = [(0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (-1.0, 0.0, 0.0)][i % 3] if i % 2 else \
+            [rnd.uniform(-1.0, 1.0) for _ in range(3)]
+        probes.append((p, n))
+    att = b"".join(struct.pack("<6f", *(p + list(n))) for p, n in probes)
+    q = expect_reply(c.request(QUERY_IRRADIANCE, {"count": len(probes)}, att), QUERY_IRRADIANCE)
+    check(q.body.get("tick") == f.body.get("tick"), "query tick %r != volume tick %r" % (q.body.get("tick"),
+                                                                                       f.body.get("tick")))
+    got = f32_list(q.att)
+    want = []
+    for p, n in probes:
+        want.extend(_iv_lookup(d, vals, held, p, n))
+    peak = max(max(want), max(got))
+    check(peak > 0.0, "every irradiance is zero (the light does not reach the probes?)")
+    tol = 1e-4 * peak  # R5.14: about 1e-6 of the peak where no two corners tie
+    bad = [(i, a, b) for i, (a, b) in enumerate(zip(want, got)) if abs(a - b) > tol]
+    check(not bad, "%d of %d channel values differ by more than %.3g W/m^2, e.g. probe %d channel %d: R5.14's "
+          "lookup %.6g, QUERY_IRRADIANCE %.6g" % (len(bad), len(want), tol, bad[0][0] // 3, bad[0][0] % 3,
+                                                  bad[0][1], bad[0][2]) if bad else "")
+    worst = max(abs(a - b) for a, b in zip(want, got))
+    return "%s voxels, %d hold a surface, iv_neighbours %d; %d probes agree with QUERY_IRRADIANCE to %.2e of the " \
+        "peak %.4g W/m^2" % ("x".join(str(x) for x in lv["dims"]), sum(held), nb, len(probes), worst / peak, peak)
+
+
+@case("R5.1", "GET_VOLUME fp32/none: sizes match the grid dims; values finite")
+def c_volume_fp32(ctx):
+    c, cfg, t = ctx.scene_session()
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    cells = _vol_header_checks(f.body, "fp32", "none", SMALL_CONFIG["grid"])
+    check(f.body["keyframe"] is True, "GET_VOLUME keyframe %r, expected true" % f.body["keyframe"])
+    check(f.body["tick"] == t.body.get("tick"), "volume tick %r, expected %r" % (f.body["tick"], t.body.get("tick")))
+    check(len(f.att) == f.body["raw_length"], "attachment %d bytes, raw_length %d" % (len(f.att),
+                                                                                    f.body["raw_length"]))
+    vals = f32_list(f.att)
+    check(is_finite_list(vals), "non-finite values in the volume")
+    dc = vals[0::4]
+    check(any(x != 0.0 for x in dc), "the volume of a lit box is all zero")
+    return "%d cells, %d bytes" % (cells, len(f.att))
+
+
+@case("R5.1 R4.7", "volume layout (x fastest, r0..r3 g0..g3 b0..b3, Y00 Y1-1 Y10 Y11) agrees with the "
+      "server's own irradiance lookup at cell centres")
+def c_volume_layout(ctx):
+    c, cfg, t = ctx.scene_session(config={"technique": "lpv", "grid": [12, 10, 8], "iterations": 4, "rsm_size": 64,
+                                          "normal_bins": False, "far_field": False},  # see SMALL_CONFIG
+                                  light={"id": "lay-%d" % os.getpid(), "type": "point", "color": [1.0, 0.6, 0.3],
+                                         "intensity": 30.0, "position": [0.55, 0.6, -0.35]})
+    v = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    g = v.body.get("grid", {})
+    dims, origin, cell = g.get("dims"), g.get("origin"), g.get("cell_size")
+    check(dims == [12, 10, 8], "dims %r, expected [12, 10, 8]" % dims)
+    vals = f32_list(v.att)
+    nx, ny, nz = dims
+    rnd = random.Random(11)
+    normals = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1),
+               (1 / math.sqrt(3), 1 / math.sqrt(3), -1 / math.sqrt(3))]
+    probes = []
+    # With several cascades the server blends cascade 0 with the next within
+    # 3 cells of its border (R5.7): probe only deeper than that.
+    m = 3 if len(v.body.get("cascades") or [1]) > 1 else 1
+    for _ in range(60):
+        i, j, k = rnd.randrange(m, nx - m), rnd.randrange(m, ny - m), rnd.randrange(m, nz - m)
+        n = normals[rnd.randrange(len(normals))]
+        q = [origin[a] + ((i, j, k)[a] + 0.5) * cell for a in range(3)]
+        p = [q[a] - 0.5 * cell * n[a] for a in range(3)]
+        probes.append(((i, j, k), n, p))
+    att = b"".join(struct.pack("<6f", *(pr[2] + list(pr[1]))) for pr in probes)
+    f = expect_reply(c.request(QUERY_IRRADIANCE, {"count": len(probes)}, att), QUERY_IRRADIANCE)
+    check(f.body.get("tick") == v.body.get("tick"), "query tick %r != volume tick %r" % (f.body.get("tick"),
+                                                                                       v.body.get("tick")))
+    got = f32_list(f.att)
+    want = []
+    for (i, j, k), n, _ in probes:
+        base = (i + nx * (j + ny * k)) * 12
+        lobe = (SH_LOBE0, -SH_LOBE1 * n[1], -SH_LOBE1 * n[2], -SH_LOBE1 * n[0])  # lobe(-n)
+        for ch in range(3):
+            cc = vals[base + ch * 4:base + ch * 4 + 4]
+            want.append(max(0.0, sum(a * b for a, b in zip(cc, lobe)) / (cell * cell)))
+    scale = max(max(want), 1e-30)
+    check(max(want) > 0, "all expected irradiances are zero (the light does not reach the probes?)")
+    bad = [(idx, w, x) for idx, (w, x) in enumerate(zip(want, got)) if abs(w - x) > 2e-3 * abs(w) + 1e-5 * scale]
+    check(not bad, "%d of %d channel values differ, e.g. probe %d channel %d: from the volume %.6g, queried %.6g "
+          "(layout or coefficient order differs from SPEC section 5)" % (len(bad), len(want), bad[0][0] // 3,
+                                                                         bad[0][0] % 3, bad[0][1], bad[0][2])
+          if bad else "")
+    return "%d probes x 3 channels agree (max %.4g W/m^2)" % (len(probes), max(want))
+
+
+@case("R5.1 R5.4", "GET_VOLUME fp16 agrees with fp32 within fp16 precision; no Inf/NaN")
+def c_volume_fp16(ctx):
+    c, cfg, t = ctx.scene_session()
+    a = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    h = expect_reply(c.request(GET_VOLUME, {"format": "fp16", "compression": "none"}), GET_VOLUME)
+    _vol_header_checks(h.body, "fp16", "none", SMALL_CONFIG["grid"])
+    check(h.body["tick"] == a.body["tick"], "fp16 and fp32 volumes from different ticks")
+    check(len(h.att) == h.body["raw_length"], "attachment %d bytes, raw_length %d" % (len(h.att),
+                                                                                    h.body["raw_length"]))
+    fa, fh = f32_list(a.att), f16_list(h.att)
+    check(len(fa) == len(fh), "value counts differ: fp32 %d, fp16 %d" % (len(fa), len(fh)))
+    worst = 0.0
+    for i, (x, y) in enumerate(zip(fa, fh)):
+        if not math.isfinite(y):
+            raise Fail("fp16 value %d is %r (R5.4: never Inf or NaN)" % (i, y))
+        if abs(x) > 65504:
+            check(y == math.copysign(65504.0, x), "value %d: fp32 %g should clamp to +-65504, got %g" % (i, x, y))
+            continue
+        tol = max(abs(x) * 2.0 ** -11, 2.0 ** -25) * 1.001
+        err = abs(x - y)
+        if err > tol:
+            raise Fail("value %d: fp32 %.9g vs fp16 %.9g (error %.3g > %.3g)" % (i, x, y, err, tol))
+        if abs(x) >= 2.0 ** -14:
+            worst = max(worst, err / abs(x))
+    return "%d values agree (worst relative error %.2g over the normal fp16 range)" % (len(fa), worst)
+
+
+@case("R5.2", "GET_VOLUME zstd: one zstd frame whose content is raw_length bytes (fp16 and fp32)")
+def c_volume_zstd(ctx):
+    c, cfg, t = ctx.scene_session()
+    notes = []
+    for fmt in ("fp32", "fp16"):
+        raw = expect_reply(c.request(GET_VOLUME, {"format": fmt, "compression": "none"}), GET_VOLUME)
+        z = expect_reply(c.request(GET_VOLUME, {"format": fmt, "compression": "zstd"}), GET_VOLUME)
+        _vol_header_checks(z.body, fmt, "zstd", SMALL_CONFIG["grid"])
+        check(z.body["raw_length"] == len(raw.att), "%s zstd raw_length %r, uncompressed volume is %d bytes"
+              % (fmt, z.body["raw_length"], len(raw.att)))
+        ok, size, why = zstd_frame_content_size(z.att)
+        check(ok, "%s: %s" % (fmt, why))
+        if size is not None:
+            check(size == z.body["raw_length"], "%s: zstd frame content size %d != raw_length %d"
+                  % (fmt, size, z.body["raw_length"]))
+        dec = zstd_decompress_cli(z.att)
+        if dec is not None:
+            check(dec == raw.att, "%s: decompressed zstd volume differs from the uncompressed one" % fmt)
+            notes.append("%s %d->%d B, decoded and equal" % (fmt, len(raw.att), len(z.att)))
+        else:
+            notes.append("%s %d->%d B (magic/size only)" % (fmt, len(raw.att), len(z.att)))
+    return "; ".join(notes)
+
+
+@case("R5.1", "GET_VOLUME defaults (no format/compression given) are a valid volume")
+def c_volume_defaults(ctx):
+    c, cfg, t = ctx.scene_session()
+    f = expect_reply(c.request(GET_VOLUME, {}), GET_VOLUME)
+    fmt, comp = f.body.get("format"), f.body.get("compression")
+    check(fmt in ("fp16", "fp32") and comp in ("zstd", "none"), "format/compression %r/%r" % (fmt, comp))
+    _vol_header_checks(f.body, fmt, comp, SMALL_CONFIG["grid"])
+    if comp == "none":
+        check(len(f.att) == f.body["raw_length"], "attachment %d != raw_length" % len(f.att))
+    else:
+        ok, size, why = zstd_frame_content_size(f.att)
+        check(ok, why)
+    return "%s/%s" % (fmt, comp)
+
+
+@case("R5.1", "CONFIG grid change is reflected in the volume dims (non-cubic grid, x fastest size)")
+def c_volume_dims(ctx):
+    # the LPV's grid (see SMALL_CONFIG: auto, the default since issue 30, places iv's voxels by iv_resolution)
+    c, cfg, t = ctx.scene_session(config={"technique": "lpv", "grid": [8, 12, 6], "iterations": 4, "rsm_size": 64})
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    cells = _vol_header_checks(f.body, "fp32", "none", [8, 12, 6])
+    check(all(e["dims"] == [8, 12, 6] for e in f.body["cascades"]), "cascade dims %r, expected [8, 12, 6] each"
+          % [e["dims"] for e in f.body["cascades"]])
+    check(len(f.att) == cells * 48 == 8 * 12 * 6 * 48 * len(f.body["cascades"]),
+          "attachment %d bytes, expected %d" % (len(f.att), cells * 48))
+    return "8x12x6 x %d cascade(s) = %d cells" % (len(f.body["cascades"]), cells)
