@@ -17,6 +17,7 @@
 #include "medium.h"
 #include "reach.h"
 #include "scene_gpu.h"
+#include "gbuffer.h"
 #include "rsm_maps.h"
 #include "shadow_maps.h"
 #include "memory_budget.h"
@@ -24,9 +25,6 @@
 #include "technique.h"
 #include "timer.h"
 
-/* The G-buffer's targets (gbuffer.frag): position, normal, albedo,
- * emission, occlusion. */
-#define LPV_GBUF_TARGETS 5
 
 /* The frame's variants (shade.comp's defines, shading.glsl), a bit each. */
 enum {
@@ -47,22 +45,6 @@ typedef struct lpv_frame_blocks {
     int w, h, step;
 } lpv_frame_blocks;
 
-/* The camera's G-buffer, its surfels for the geometry volume and the
- * translucent layer: what pass_camera.c's G-buffer pass owns and gives the
- * technique (camera surfels) and the frame (the targets). */
-typedef struct lpv_gbuffer {
-    int w, h;
-    /* the camera's surfels: blocks of camera_surfel_step pixels, surfel_slots surfels each */
-    int surfel_w, surfel_h, surfel_slots;
-    GLuint tex[LPV_GBUF_TARGETS], depth, fbo, surfels;
-    /* The translucent layer (scenes with BLEND draws, LPV_PASS_TRANSLUCENT):
-     * the nearest BLEND surface in front of the G-buffer's, in a G-buffer of
-     * its own (the same targets, then its coverage: alpha) sharing the
-     * G-buffer's depth, shaded into layer_frame_tex and laid over the frame. */
-    GLuint layer_tex[LPV_GBUF_TARGETS + 1], layer_fbo, layer_frame_tex;
-    int layer_w, layer_h;
-    int stale;           /* the G-buffer does not show the current view and scene */
-} lpv_gbuffer;
 
 /* The shaded frame and what its passes keep between them. */
 typedef struct lpv_frame_buffers {

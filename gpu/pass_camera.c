@@ -1,6 +1,6 @@
 /*
- * pass_camera.c - the camera's passes: the G-buffer (position/surfel area,
- * normal, albedo, emission) with its pixels as GV surfels, and the final
+ * pass_camera.c - the camera's passes: the G-buffer (gbuffer.c: position/
+ * surfel area, normal, albedo, emission) with its pixels as GV surfels, and the final
  * shading of direct light (through the shadow maps of shadow_maps.c) plus the
  * technique's irradiance (its lookup, technique.h) into a linear-radiance frame.
  */
@@ -11,35 +11,19 @@
 
 #include "engine_internal.h"
 
-/* Deletes the G-buffer, the frame and the camera's surfels and pixel lists
- * (a partly failed allocation too); the engine's destroy calls it too, so
- * this is the one list of them. */
+/* Deletes the G-buffer (gbuffer.c), the frame and its pixel lists (a
+ * partly failed allocation too); the engine's destroy calls it too, so this
+ * is the one list of them. */
 void lpv_pass_camera_free(lpv_engine *e)
 {
-    for (int i = 0; i < LPV_GBUF_TARGETS; ++i)
-        lpv_gl_delete_texture(&e->gbuf.tex[i]);
-    lpv_gl_delete_texture(&e->gbuf.depth);
+    lpv_gbuffer_free(&e->gbuf);
     lpv_gl_delete_texture(&e->frame.tex);
-    lpv_gl_delete_framebuffer(&e->gbuf.fbo);
     lpv_gl_delete_framebuffer(&e->frame.fbo);
-    lpv_gl_delete_buffer(&e->gbuf.surfels);
     lpv_gl_delete_buffer(&e->frame.shade_rest);
     lpv_gl_delete_buffer(&e->frame.area_rest);
-    for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-        lpv_gl_delete_texture(&e->gbuf.layer_tex[i]);
-    lpv_gl_delete_texture(&e->gbuf.layer_frame_tex);
-    lpv_gl_delete_framebuffer(&e->gbuf.layer_fbo);
-    e->gbuf.layer_w = e->gbuf.layer_h = 0;
-    e->gbuf.w = e->gbuf.h = 0;
-    e->gbuf.surfel_w = e->gbuf.surfel_h = e->gbuf.surfel_slots = 0;
 }
 
-/* The G-buffer's targets' formats (gbuffer.frag's outputs 0..4); the
- * translucent layer's G-buffer adds its coverage. */
-#define GBUF_FORMATS GL_RGBA32F, GL_RGBA32F, GL_RGBA16F, GL_RGBA32F, GL_R8
-#define LAYER_COVERAGE_FORMAT GL_R8
-
-/* (Re)allocates the G-buffer, the frame and the camera's surfels for the
+/* (Re)allocates the G-buffer, the camera's surfels and the frame for the
  * view's size (lpv_engine_set_view checked that they fit the budget). */
 static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
 {
@@ -47,31 +31,13 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     if (e->gbuf.w == w && e->gbuf.h == h)
         return 0;
     lpv_pass_camera_free(e);
-    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
-    }
-    static const GLenum formats[LPV_GBUF_TARGETS] = {GBUF_FORMATS};
-    glGenFramebuffers(1, &e->gbuf.fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.fbo);
-    GLenum bufs[LPV_GBUF_TARGETS];
-    for (int i = 0; i < LPV_GBUF_TARGETS; ++i) {
-        e->gbuf.tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf.tex[i], 0);
-        bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
-    }
-    e->gbuf.depth = lpv_gl_new_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf.depth, 0);
-    glDrawBuffers(LPV_GBUF_TARGETS, bufs);
-
+    if (lpv_gbuffer_ensure(&e->gbuf, w, h, err, err_size) != 0)
+        return -1;
     glGenFramebuffers(1, &e->frame.fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, e->frame.fbo);
     e->frame.tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, e->frame.tex, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-
-    glGenBuffers(1, &e->gbuf.surfels);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->gbuf.surfels);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lpv_memory_block_samples(w, h) * sizeof(lpv_surfel)), NULL,
-                 GL_DYNAMIC_COPY);
     /* the frame's two lists of pixels for a second pass: the lookup's
      * (shade_rest.comp) and the area shadow step's (area_shadow_rest.comp) */
     GLuint *lists[2] = {&e->frame.shade_rest, &e->frame.area_rest};
@@ -85,54 +51,8 @@ static int ensure_targets(lpv_engine *e, char *err, size_t err_size)
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
         lpv_pass_camera_free(e);
-        return lpv_error(err, err_size, "could not allocate the %dx%d G-buffer, frame and surfels (GL error 0x%04x)", w,
-                         h, gl_err);
+        return lpv_error(err, err_size, "could not allocate the %dx%d frame (GL error 0x%04x)", w, h, gl_err);
     }
-    e->gbuf.w = w;
-    e->gbuf.h = h;
-    return 0;
-}
-
-/* (Re)allocates the translucent layer's G-buffer and frame for the
- * G-buffer's size (scenes with BLEND draws; ensure_targets ran): its
- * depth is the G-buffer's, so the layer keeps the nearest BLEND surface in
- * front of the opaque one. Their memory is the G-buffer's and the frame's
- * again (docs/memory.md counts it with them). */
-static int ensure_layer_targets(lpv_engine *e, char *err, size_t err_size)
-{
-    const int w = e->gbuf.w, h = e->gbuf.h;
-    if (e->gbuf.layer_fbo && e->gbuf.layer_w == w && e->gbuf.layer_h == h)
-        return 0;
-    for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-        lpv_gl_delete_texture(&e->gbuf.layer_tex[i]);
-    lpv_gl_delete_texture(&e->gbuf.layer_frame_tex);
-    lpv_gl_delete_framebuffer(&e->gbuf.layer_fbo);
-    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
-    }
-    static const GLenum formats[LPV_GBUF_TARGETS + 1] = {GBUF_FORMATS, LAYER_COVERAGE_FORMAT};
-    glGenFramebuffers(1, &e->gbuf.layer_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.layer_fbo);
-    GLenum bufs[LPV_GBUF_TARGETS + 1];
-    for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i) {
-        e->gbuf.layer_tex[i] = lpv_gl_new_texture_2d(formats[i], w, h);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D, e->gbuf.layer_tex[i], 0);
-        bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
-    }
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, e->gbuf.depth, 0);
-    glDrawBuffers(LPV_GBUF_TARGETS + 1, bufs);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    e->gbuf.layer_frame_tex = lpv_gl_new_texture_2d(GL_RGBA32F, w, h);
-    GLenum gl_err = glGetError();
-    if (gl_err != GL_NO_ERROR) {
-        for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-            lpv_gl_delete_texture(&e->gbuf.layer_tex[i]);
-        lpv_gl_delete_texture(&e->gbuf.layer_frame_tex);
-        lpv_gl_delete_framebuffer(&e->gbuf.layer_fbo);
-        return lpv_error(err, err_size, "could not allocate the %dx%d translucent layer (GL error 0x%04x)", w, h,
-                         gl_err);
-    }
-    e->gbuf.layer_w = w;
-    e->gbuf.layer_h = h;
     return 0;
 }
 
@@ -182,42 +102,15 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     lpv_timer_begin(&e->timer, "gbuffer");
     build_view_block(e);
     const lpv_view *v = &e->view;
-    glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.fbo);
-    glViewport(0, 0, v->width, v->height);
-    static const float zero[4] = {0, 0, 0, 0};
-    for (int i = 0; i < LPV_GBUF_TARGETS; ++i)
-        glClearBufferfv(GL_COLOR, i, zero);
-    glClearBufferfi(GL_DEPTH_STENCIL, 0, 1.0f, 0);
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    GLuint p = lpv_scene_gpu_program(&e->geo, e->prog_gbuffer, e->prog_gbuffer_plain);
-    glUseProgram(p);
-    glUniformMatrix4fv(glGetUniformLocation(p, "u_view_proj"), 1, GL_FALSE, (const float *)e->view_block.view_proj);
-    glUniform3fv(glGetUniformLocation(p, "u_eye"), 1, e->view_block.eye);
-    glUniform3fv(glGetUniformLocation(p, "u_forward"), 1, e->view_block.forward);
-    float pixel = 2.0f * e->view_block.forward[3] / (float)v->height; /* tan-plane or metres per pixel */
-    glUniform1f(glGetUniformLocation(p, "u_pixel_solid_angle"), v->orthographic ? 0.0f : pixel * pixel);
-    glUniform1f(glGetUniformLocation(p, "u_pixel_area"), v->orthographic ? pixel * pixel : 0.0f);
-    lpv_scene_gpu_draw(&e->geo, p, 1, LPV_DRAWS_NOT_BLEND, &e->timer);
-    lpv_scene_gpu_draw_wires(&e->geo, p, &e->timer); /* points and lines: seen, one pixel wide, but no surfels (no area) */
-    /* the translucent layer: the BLEND draws over the opaque depth, the
-     * nearest in front of it kept (the same program and uniforms) */
-    if (e->geo.blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run) {
-        if (ensure_layer_targets(e, err, err_size) != 0) {
-            glDisable(GL_DEPTH_TEST);
-            glBindFramebuffer(GL_FRAMEBUFFER, 0);
-            lpv_timer_end(&e->timer);
-            return -1;
-        }
-        glBindFramebuffer(GL_FRAMEBUFFER, e->gbuf.layer_fbo);
-        for (int i = 0; i < LPV_GBUF_TARGETS + 1; ++i)
-            glClearBufferfv(GL_COLOR, i, zero);
-        lpv_scene_gpu_draw(&e->geo, p, 1, LPV_DRAWS_BLEND, &e->timer);
+    const lpv_gbuffer_draw d = {.geo = &e->geo, .view = &e->view_block, .width = v->width, .height = v->height,
+                                .orthographic = v->orthographic, .prog = e->prog_gbuffer,
+                                .prog_plain = e->prog_gbuffer_plain,
+                                .translucent = e->geo.blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run,
+                                .timer = &e->timer};
+    if (lpv_gbuffer_draw_scene(&e->gbuf, &d, err, err_size) != 0) {
+        lpv_timer_end(&e->timer);
+        return -1;
     }
-    glDisable(GL_DEPTH_TEST);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
     glUseProgram(e->prog_camera_surfels);
     glActiveTexture(GL_TEXTURE0);
