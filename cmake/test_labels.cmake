@@ -10,15 +10,21 @@
 # tests; each labels its own (CMake sets a test's properties only in the
 # directory that added it).
 
-# 10 s or more each on the 2-core CI machine (Intel Xeon, llvmpipe,
-# 2026-11-29, a release build's `ctest -j 2`), and the checks that need one
-# of them first (ctest would run a fixture's setup for them): without them
-# the rest ran in about two minutes there. The one list of them.
+# 10 s or more each on a 2-core machine (Intel Xeon, llvmpipe, 2026-11-29,
+# and AMD EPYC, 2026-11-29: a release build's `ctest -LE slow -j 2`, where
+# the 17 from reliability_loads_and_encodes on took 10.7-23.9 s each, most
+# of it starting daemons: `lpvd serve` takes 2.8 s to listen, its self-test
+# tick and frame included), and the checks that need one of them first
+# (ctest would run a fixture's setup for them). The one list of them.
 set(LPV_SLOW_TESTS
     accuracy_knobs_sweep accuracy_knobs_check accuracy_knobs_check_open reliability_world_churn conformance test_grid_reach test_gltf_corpus test_bounces
     reliability_slow_reader reliability_preauth test_iv_voxelize test_k8s_manifests test_client test_enclosure
     test_render reliability_fair_gl reliability_yield_points test_materials test_realscene batch_shards
-    test_gpu_stability reliability_preauth_burst test_yield_points)
+    test_gpu_stability reliability_preauth_burst test_yield_points
+    reliability_loads_and_encodes batch_resume reliability_sigterm_frame reliability_encode_offloop
+    reliability_settings_that_run batch_errors reliability_measured_ticks reliability_root_race reliability_sigterm
+    reliability_all_worlds_memory reliability_daemon_memory report_browser reliability_query_limits
+    reliability_sigterm_load test_iv_gpu test_planner_gpu test_area_lights)
 
 set(LPV_TEST_KINDS unit gpu daemon batch accuracy)
 
