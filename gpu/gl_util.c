@@ -29,17 +29,33 @@ void lpv_gl_delete_buffer(GLuint *b)
     *b = 0;
 }
 
-GLuint lpv_gl_new_texture_2d(GLenum format, int w, int h)
+/* A texture of one level, nearest filtering, clamped: a 2D texture
+ * (layers 0) or a 2D array of `layers` layers. */
+static GLuint new_texture(GLenum format, int w, int h, int layers)
 {
+    const GLenum target = layers > 0 ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D;
     GLuint t;
     glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(target, t);
+    if (layers > 0)
+        glTexStorage3D(target, 1, format, w, h, layers);
+    else
+        glTexStorage2D(target, 1, format, w, h);
+    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     return t;
+}
+
+GLuint lpv_gl_new_texture_2d(GLenum format, int w, int h)
+{
+    return new_texture(format, w, h, 0);
+}
+
+GLuint lpv_gl_new_texture_2d_array(GLenum format, int w, int h, int layers)
+{
+    return new_texture(format, w, h, layers);
 }
 
 void lpv_gl_delete_texture(GLuint *t)

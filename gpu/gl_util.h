@@ -20,6 +20,8 @@ void lpv_gl_delete_buffer(GLuint *b);
 /* A w x h 2D texture of one level in `format`, nearest filtering, clamped
  * to its edges, left bound to the active unit. */
 GLuint lpv_gl_new_texture_2d(GLenum format, int w, int h);
+/* The same as a 2D array of `layers` layers (layers >= 1). */
+GLuint lpv_gl_new_texture_2d_array(GLenum format, int w, int h, int layers);
 void lpv_gl_delete_texture(GLuint *t);
 void lpv_gl_delete_framebuffer(GLuint *f);
 /* Copies min(available, max) elements from the start of buf into out after

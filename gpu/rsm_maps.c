@@ -8,19 +8,6 @@
 #include "gl_util.h"
 #include "memory_budget.h"
 
-static GLuint array_texture(GLenum format, int size, int layers)
-{
-    GLuint t;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, t);
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, format, size, size, layers);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
-}
-
 void lpv_rsms_free(lpv_rsms *r)
 {
     lpv_gl_delete_texture(&r->position);
@@ -46,11 +33,11 @@ int lpv_rsms_allocate(lpv_rsms *r, int size, int layers, uint64_t bytes, char *e
     for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) { /* start from a clean error state */
     }
     lpv_rsms_free(r);
-    r->position = array_texture(GL_RGBA32F, size, layers);
-    r->normal = array_texture(GL_RGBA32F, size, layers);
-    r->flux = array_texture(GL_RGBA32F, size, layers);
-    r->albedo = array_texture(GL_RGBA8, size, layers);
-    r->depth = array_texture(GL_DEPTH_COMPONENT32F, size, layers);
+    r->position = lpv_gl_new_texture_2d_array(GL_RGBA32F, size, size, layers);
+    r->normal = lpv_gl_new_texture_2d_array(GL_RGBA32F, size, size, layers);
+    r->flux = lpv_gl_new_texture_2d_array(GL_RGBA32F, size, size, layers);
+    r->albedo = lpv_gl_new_texture_2d_array(GL_RGBA8, size, size, layers);
+    r->depth = lpv_gl_new_texture_2d_array(GL_DEPTH_COMPONENT32F, size, size, layers);
     glGenFramebuffers(1, &r->fbo);
 
     /* the most VPLs (and surfels) any step makes: see lpv_memory_block_samples */
