@@ -1,11 +1,12 @@
 /*
- * block_groups.c - the uniforms of shaders/block_groups.glsl, with which the
- * camera's surfels (pass_camera.c) and the RSMs' VPLs and surfels
- * (pass_rsm.c) are down-sampled in blocks grouped by the cells and
- * geometry-volume points of the volume's cascades.
+ * block_groups.c - block_groups.h's uniforms, and the engine's cascades as
+ * the groups' keys see them (lpv_engine_group_grids), with which the
+ * camera's surfels (gbuffer.c) and the RSMs' VPLs and surfels (rsm_maps.c)
+ * are grouped.
  */
 #include <string.h>
 
+#include "block_groups.h"
 #include "engine_internal.h"
 
 int lpv_engine_group_grids(const lpv_engine *e, lpv_group_grid g[LPV_MAX_CASCADES])
@@ -30,12 +31,11 @@ int lpv_block_slots(int step)
     return step * step < LPV_BLOCK_SLOTS ? step * step : LPV_BLOCK_SLOTS;
 }
 
-void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog)
+void lpv_block_groups_bind(GLuint prog, const lpv_group_grid *g, int levels)
 {
-    lpv_group_grid g[LPV_MAX_CASCADES];
-    const int levels = lpv_engine_group_grids(e, g);
     float grids[LPV_MAX_CASCADES][4];
-    for (int k = 0; k < LPV_MAX_CASCADES; ++k) {
+    memset(grids, 0, sizeof grids);
+    for (int k = 0; k < levels && k < LPV_MAX_CASCADES; ++k) {
         memcpy(grids[k], g[k].origin_cells, sizeof g[k].origin_cells);
         grids[k][3] = g[k].cell_size;
     }

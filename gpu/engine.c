@@ -101,7 +101,6 @@ void lpv_engine_destroy(lpv_engine *e)
     lpv_engine_free_scene(e);
     lpv_rsms_free(&e->rsm);
     lpv_pass_camera_free(e);
-    lpv_frame_blocks_free(e);
     lpv_shadow_maps_destroy(&e->shadows);
     lpv_medium_free(&e->medium);
     lpv_gl_delete_buffer(&e->query_in);

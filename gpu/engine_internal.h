@@ -17,6 +17,8 @@
 #include "medium.h"
 #include "reach.h"
 #include "scene_gpu.h"
+#include "block_groups.h"
+#include "frame.h"
 #include "gbuffer.h"
 #include "rsm_maps.h"
 #include "shadow_maps.h"
@@ -38,26 +40,6 @@ enum {
     LPV_FRAME_VARIANTS = 128
 };
 
-/* Textures of a pass per block of the frame's pixels (frame_blocks.c): a
- * value and a plane per block, w x h blocks of step x step pixels. */
-typedef struct lpv_frame_blocks {
-    GLuint tex[2];
-    int w, h, step;
-} lpv_frame_blocks;
-
-
-/* The shaded frame and what its passes keep between them. */
-typedef struct lpv_frame_buffers {
-    GLuint tex, fbo;
-    GLuint shade_rest; /* the pixels left for shade_rest.comp (a uvec4 head, then an ivec2 per pixel) */
-    GLuint area_rest;  /* the pixels left for area_shadow_rest.comp (the same layout) */
-    int shade_split;   /* the last frame was shaded in two passes */
-    int shade_area_blocks; /* the last frame took the area light's shadows from the area shadow step's blocks */
-    /* the blocks' irradiance and planes of the lookup step (lookup_blocks.comp)
-     * and the blocks' area light visibility and planes of the area shadow
-     * step (area_shadow_blocks.comp); empty until a step above 1 */
-    lpv_frame_blocks lookup_blocks, area_shadow_blocks;
-} lpv_frame_buffers;
 
 
 
@@ -155,7 +137,7 @@ struct lpv_engine {
     GLuint view_ubo;
     struct LpvViewBlock view_block;
     lpv_gbuffer gbuf;      /* the camera's G-buffer and surfels (pass_camera.c) */
-    lpv_frame_buffers frame; /* the shaded frame and its passes' buffers (pass_camera.c, frame_blocks.c) */
+    lpv_frame frame;       /* the shaded frame and its passes' buffers (frame.c) */
 
     GLuint query_in, query_out; /* irradiance queries */
     size_t query_capacity;
@@ -210,24 +192,11 @@ void lpv_engine_free_frame_programs(lpv_engine *e);
  * current technique stays. */
 int lpv_engine_use_technique(lpv_engine *e, lpv_technique_id id, char *err, size_t err_size);
 
-/* The frame's passes per block of pixels (frame_blocks.c), each before the
- * frame that reads its blocks, with the G-buffer and view block bound: the
- * lookup step's irradiance (settings.lookup_step > 1) and the area shadow
- * step's visibility (settings.area_shadow_step > 1; scenes with area light
- * samples, frames with direct light). Each records a timer stage. */
-void lpv_frame_lookup_blocks_run(lpv_engine *e);
-void lpv_frame_area_shadow_blocks_run(lpv_engine *e);
-void lpv_frame_blocks_free(lpv_engine *e);
-
 /* Per-pass set-up and work; each _run records its own timer stage. */
 int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size); /* light faces, RSM storage */
 void lpv_pass_rsm_run(lpv_engine *e);
 int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size); /* -1: the targets could not be allocated */
 int lpv_pass_shade_run(lpv_engine *e, lpv_frame_terms terms, char *err, size_t err_size);
-/* Pixels of the last frame the second pass looked up in full (shade_rest.comp). */
-size_t lpv_pass_shade_full_lookups(lpv_engine *e);
-/* Pixels of the last frame whose area light area_shadow_rest.comp added. */
-size_t lpv_pass_shade_area_rest_pixels(lpv_engine *e);
 void lpv_pass_glossy_run(lpv_engine *e);
 /* The translucent layer's frame laid over the frame (LPV_PASS_TRANSLUCENT;
  * after the glossy pass, before media): adds its lists' pixels to *full_lookups
@@ -296,14 +265,10 @@ void lpv_engine_group_scene_surfels(lpv_engine *e);
  * (block_groups.glsl, core/surfel_groups.h): fills g and returns how many
  * (0 for a technique without cascades: one group per block). block_groups.c. */
 int lpv_engine_group_grids(const lpv_engine *e, lpv_group_grid g[LPV_MAX_CASCADES]);
-/* Sets prog's (in use) block_groups.glsl uniforms from those cascades. */
-void lpv_engine_bind_block_groups(const lpv_engine *e, GLuint prog);
 /* The area lights' RSM layers (after the punctual lights') that hold the
  * first sample's faces: the only ones whose surfels the geometry volume
  * takes (rsm.frag); pass_rsm.c. */
 int lpv_engine_area_gv_layers(const lpv_engine *e);
-/* Samples a block of step x step keeps: min(step^2, LPV_BLOCK_SLOTS). */
-int lpv_block_slots(int step);
 
 /* The camera's surfels the last G-buffer pass made (pass_camera.c). */
 static inline size_t lpv_engine_camera_surfel_count(const lpv_engine *e)

@@ -63,25 +63,10 @@ int lpv_engine_render(lpv_engine *e, lpv_frame_terms terms, float *rgba, char *e
         return -1;
     if (e->plan.pass[LPV_PASS_MEDIA].run && terms == LPV_TERMS_FULL)
         lpv_pass_media_run(e);
-    const int w = e->gbuf.w, h = e->gbuf.h;
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, e->frame.fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    lpv_frame_read(&e->frame, rgba);
     /* read after the frame, which waited for the passes anyway */
-    e->stats.frame_full_lookups = full_lookups + lpv_pass_shade_full_lookups(e);
-    e->stats.frame_area_shadow_pixels = area_rest_pixels + lpv_pass_shade_area_rest_pixels(e);
-    /* GL rows run bottom-up; files and callers want the top row first. */
-    size_t row = (size_t)w * 4;
-    for (int y = 0; y < h / 2; ++y) {
-        float *a = rgba + (size_t)y * row, *b = rgba + (size_t)(h - 1 - y) * row;
-        for (size_t i = 0; i < row; ++i) {
-            float t = a[i];
-            a[i] = b[i];
-            b[i] = t;
-        }
-    }
+    e->stats.frame_full_lookups = full_lookups + lpv_frame_full_lookups(&e->frame);
+    e->stats.frame_area_shadow_pixels = area_rest_pixels + lpv_frame_area_rest_pixels(&e->frame);
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR)
         return lpv_error(err, err_size, "GL error 0x%04x during rendering", gl_err);

@@ -1,6 +1,7 @@
 /* gbuffer.c - see gbuffer.h. */
 #include "gbuffer.h"
 
+#include "block_groups.h"
 #include "error.h"
 #include "gl_util.h"
 #include "memory_budget.h"
@@ -143,4 +144,28 @@ int lpv_gbuffer_draw_scene(lpv_gbuffer *g, const lpv_gbuffer_draw *d, char *err,
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return 0;
+}
+
+void lpv_gbuffer_extract_surfels(lpv_gbuffer *g, const lpv_gbuffer_surfels *d)
+{
+    const GLuint cs = d->prog;
+    glUseProgram(cs);
+    for (int i = 0; i < 4; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, g->tex[i]);
+    }
+    const int step = d->step;
+    g->surfel_w = (g->w + step - 1) / step;
+    g->surfel_h = (g->h + step - 1) / step;
+    g->surfel_slots = lpv_block_slots(step);
+    glUniform2i(glGetUniformLocation(cs, "u_size"), g->w, g->h);
+    glUniform1i(glGetUniformLocation(cs, "u_step"), step);
+    glUniform2i(glGetUniformLocation(cs, "u_out_size"), g->surfel_w, g->surfel_h);
+    glUniform1i(glGetUniformLocation(cs, "u_slots"), g->surfel_slots);
+    lpv_block_groups_bind(cs, d->groups, d->group_levels);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, g->surfels);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up((size_t)g->surfel_w, LPV_WG_2D), lpv_div_up((size_t)g->surfel_h, LPV_WG_2D), 1);
+    lpv_timer_count(d->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }

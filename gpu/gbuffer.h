@@ -2,9 +2,9 @@
  * gbuffer.h - the camera's G-buffer as an object: its targets, the buffer
  * of the camera's surfels and the translucent layer, allocated for a size,
  * and the scene drawn into them from explicit inputs (the scene on the GPU,
- * the view block, the programs). Knows no engine: pass_camera.c turns its
- * pixels into surfels grouped by the cascades' cells and shades the frame
- * from it.
+ * the view block, the programs), and its pixels turned into surfels
+ * grouped by the cascades given. Knows no engine: pass_camera.c gives it
+ * the inputs and shades the frame (frame.h) from it.
  */
 #ifndef LPV_GBUFFER_H
 #define LPV_GBUFFER_H
@@ -14,6 +14,7 @@
 #include "gl.h"
 #include "lpv_shared.h"
 #include "scene_gpu.h"
+#include "surfel_groups.h"
 #include "timer.h"
 
 /* The G-buffer's targets (gbuffer.frag): position, normal, albedo,
@@ -63,5 +64,21 @@ typedef struct lpv_gbuffer_draw {
  * the BLEND draws into the translucent layer (allocated here). Returns 0,
  * or -1 with err (the layer could not be allocated). */
 int lpv_gbuffer_draw_scene(lpv_gbuffer *g, const lpv_gbuffer_draw *d, char *err, size_t err_size);
+
+/* What the camera's surfels are made with: camera_surfels.comp, the block
+ * side in pixels (lpv_settings_camera_surfel_step), the cascades whose
+ * cells and GV points group them (block_groups.h; 0 levels: one group per
+ * block), the timer whose current stage counts the dispatch. */
+typedef struct lpv_gbuffer_surfels {
+    GLuint prog;
+    int step;
+    const lpv_group_grid *groups;
+    int group_levels;
+    lpv_timer *timer;
+} lpv_gbuffer_surfels;
+
+/* Turns the targets' blocks of d->step pixels into the surfels buffer
+ * (surfel_w x surfel_h blocks, surfel_slots each). */
+void lpv_gbuffer_extract_surfels(lpv_gbuffer *g, const lpv_gbuffer_surfels *d);
 
 #endif

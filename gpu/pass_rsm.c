@@ -4,8 +4,9 @@
  * (rsm_maps.c: every light face renders the scene's position/area, normal
  * and reflected flux into one layer, or an area light's tile, of array
  * textures; direct light has its own shadow maps, shadow_maps.c) allocate,
- * and turns every texel block into VPLs and surfels grouped by the
- * cascades' cells (a compute pass) for the technique.
+ * and has rsm_maps.c turn every texel block into VPLs and surfels grouped
+ * by the cascades' cells (a compute pass) at the step each kind of layer
+ * takes, for the technique.
  */
 #include <math.h>
 
@@ -40,19 +41,13 @@ int lpv_pass_rsm_prepare(lpv_engine *e, char *err, size_t err_size)
 
 /* Layers [first, first + count) of the RSMs, whose faces are `side` texels
  * (a whole layer, or an area light's tile), into VPLs and surfels from
- * element `base` on: blocks of step x step texels, grouped by the cells
- * (VPLs) and GV points (surfels) of the cascades they reach
- * (block_groups.glsl), the step dividing side; surfels: whether the
- * geometry volume takes these layers' surfels (the step depends on it,
- * lpv_settings_rsm_vpl_step). Returns the elements per layer. */
+ * element `base` on (rsm_maps.c), at the step of the settings for that
+ * side; surfels: whether the geometry volume takes these layers' surfels
+ * (the step depends on it, lpv_settings_rsm_vpl_step). Returns the elements
+ * per layer. */
 static size_t extract_layers(lpv_engine *e, int first, int count, int side, size_t base, int surfels)
 {
-    const int size = e->rsm.size;
     const int step = lpv_settings_rsm_vpl_step(&e->settings, side, surfels);
-    const int blocks = (size + step - 1) / step;
-    const int slots = lpv_block_slots(step);
-    if (count <= 0)
-        return (size_t)blocks * (size_t)blocks * (size_t)slots;
     /* step 1: a VPL per texel (a program without the grouping: llvmpipe
      * would run its code for every texel even where it is not needed);
      * step 2: four slots (block_groups.glsl), as many as texels; larger: 8,
@@ -61,27 +56,16 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
     const GLuint prog = step == 1   ? e->prog_vpl_extract
                         : step == 2 ? e->prog_vpl_blocks
                                     : (surfels ? e->prog_vpl_blocks8 : e->prog_vpl_blocks8_vpls);
-    glUseProgram(prog);
-    if (step > 1) {
-        lpv_engine_bind_block_groups(e, prog);
-        glUniform1i(glGetUniformLocation(prog, "u_step"), step);
-        glUniform1i(glGetUniformLocation(prog, "u_blocks"), blocks);
-        glUniform1i(glGetUniformLocation(prog, "u_slots"), slots);
-    }
-    GLuint tex[4] = {e->rsm.position, e->rsm.normal, e->rsm.flux, e->rsm.albedo};
-    for (int i = 0; i < 4; ++i) {
-        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
-    }
-    glUniform1i(glGetUniformLocation(prog, "u_size"), size);
-    glUniform1i(glGetUniformLocation(prog, "u_layer0"), first);
-    glUniform1i(glGetUniformLocation(prog, "u_base"), (GLint)base);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->rsm.vpls);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->rsm.surfels);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D), (GLuint)count);
-    lpv_timer_count(&e->timer, 1);
-    return (size_t)blocks * (size_t)blocks * (size_t)slots;
+    lpv_group_grid groups[LPV_MAX_CASCADES];
+    const lpv_rsm_extract d = {.first = first,
+                               .count = count,
+                               .step = step,
+                               .base = base,
+                               .prog = prog,
+                               .groups = groups,
+                               .group_levels = step > 1 ? lpv_engine_group_grids(e, groups) : 0,
+                               .timer = &e->timer};
+    return lpv_rsms_extract(&e->rsm, &d);
 }
 
 int lpv_engine_area_gv_layers(const lpv_engine *e)

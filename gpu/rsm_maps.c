@@ -3,6 +3,7 @@
 
 #include <math.h>
 
+#include "block_groups.h"
 #include "compact.h"
 #include "error.h"
 #include "gl_util.h"
@@ -111,4 +112,35 @@ void lpv_rsms_draw(lpv_rsms *r, const lpv_rsm_draw *d)
     glDisable(GL_DEPTH_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     lpv_timer_end(d->timer);
+}
+
+size_t lpv_rsms_extract(lpv_rsms *r, const lpv_rsm_extract *d)
+{
+    const int size = r->size, step = d->step;
+    const int blocks = (size + step - 1) / step;
+    const int slots = lpv_block_slots(step);
+    if (d->count <= 0)
+        return (size_t)blocks * (size_t)blocks * (size_t)slots;
+    const GLuint prog = d->prog;
+    glUseProgram(prog);
+    if (step > 1) {
+        lpv_block_groups_bind(prog, d->groups, d->group_levels);
+        glUniform1i(glGetUniformLocation(prog, "u_step"), step);
+        glUniform1i(glGetUniformLocation(prog, "u_blocks"), blocks);
+        glUniform1i(glGetUniformLocation(prog, "u_slots"), slots);
+    }
+    const GLuint tex[4] = {r->position, r->normal, r->flux, r->albedo};
+    for (int i = 0; i < 4; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, tex[i]);
+    }
+    glUniform1i(glGetUniformLocation(prog, "u_size"), size);
+    glUniform1i(glGetUniformLocation(prog, "u_layer0"), d->first);
+    glUniform1i(glGetUniformLocation(prog, "u_base"), (GLint)d->base);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, r->vpls);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, r->surfels);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up((size_t)blocks, LPV_WG_2D), lpv_div_up((size_t)blocks, LPV_WG_2D), (GLuint)d->count);
+    lpv_timer_count(d->timer, 1);
+    return (size_t)blocks * (size_t)blocks * (size_t)slots;
 }

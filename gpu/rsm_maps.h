@@ -3,9 +3,9 @@
  * textures and the VPL and surfel buffers made from them, allocated for a
  * size and a layer count, and the light views drawn into them from explicit
  * inputs (the faces, the scene on the GPU, the light block's buffer, the
- * programs). Knows no engine: pass_rsm.c lays out the faces, checks the
- * memory budget before they allocate and turns the texels into VPLs and
- * surfels for the technique.
+ * programs), and their texels turned into VPLs and surfels grouped by the
+ * cascades given. Knows no engine: pass_rsm.c lays out the faces, checks
+ * the memory budget before they allocate and chooses each layer's step.
  */
 #ifndef LPV_RSM_MAPS_H
 #define LPV_RSM_MAPS_H
@@ -16,6 +16,7 @@
 #include "gl.h"
 #include "lpv_shared.h"
 #include "scene_gpu.h"
+#include "surfel_groups.h"
 #include "timer.h"
 
 /* The lights' reflective shadow maps and what pass_rsm.c makes of them:
@@ -65,5 +66,24 @@ typedef struct lpv_rsm_draw {
 /* Draws every face into its layer (or tile): position, normal, flux and
  * albedo, cleared once per layer. */
 void lpv_rsms_draw(lpv_rsms *r, const lpv_rsm_draw *d);
+
+/* What the VPLs and surfels of layers [first, first + count) are made
+ * with: blocks of step x step texels (the step divides the faces' side;
+ * lpv_block_slots samples each), written from element `base` on, by prog
+ * (vpl_extract.comp at step 1, a vpl_blocks.comp variant above), grouped by
+ * the cells (VPLs) and GV points (surfels) of `group_levels` cascades
+ * (block_groups.h), the timer's current stage counting the dispatch. */
+typedef struct lpv_rsm_extract {
+    int first, count, step;
+    size_t base;
+    GLuint prog;
+    const lpv_group_grid *groups;
+    int group_levels;
+    lpv_timer *timer;
+} lpv_rsm_extract;
+
+/* Makes those VPLs and surfels (nothing when count is 0). Returns the
+ * elements per layer: blocks^2 x slots. */
+size_t lpv_rsms_extract(lpv_rsms *r, const lpv_rsm_extract *d);
 
 #endif

@@ -635,7 +635,7 @@ bool lpv_gbuffer_wire(float normal_w) { return normal_w > LPV_GBUF_WIRE_W - 0.5;
 #define LPV_REACH_DARK 1
 #define LPV_REACH_LIT 2
 
-/* Image units of the frame that shade.comp writes (pass_camera.c), of the
+/* Image units of the frame that shade.comp writes (frame.c), of the
  * blocks' irradiance and planes that lookup_blocks.comp writes and of the
  * blocks' area light visibility that area_shadow_blocks.comp writes. */
 #define LPV_IMG_FRAME 0
