@@ -41,20 +41,20 @@ lpv_engine *lpv_engine_create(char *err, size_t err_size)
         const char *const *inc;
         const char *defines;
     } progs[] = {
-        {&e->prog_rsm, "scene.vert", "rsm.frag", INC_RSM},
-        {&e->prog_rsm_plain, "scene.vert", "rsm.frag", INC_RSM, PLAIN},
-        {&e->prog_vpl_extract, "vpl_extract.comp", NULL, INC_COMPACT},
-        {&e->prog_vpl_blocks, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS},
-        {&e->prog_vpl_blocks8, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8},
-        {&e->prog_vpl_blocks8_vpls, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8, "#define LPV_BLOCKS_VPLS_ONLY 1"},
-        {&e->prog_gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
-        {&e->prog_gbuffer_plain, "scene.vert", "gbuffer.frag", INC_MATERIAL, PLAIN},
-        {&e->prog_camera_surfels, "camera_surfels.comp", NULL, INC_BLOCKS8},
-        {&e->prog_shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
-        {&e->prog_shadow_plain, "scene.vert", "shadow_depth.frag", INC_MATERIAL, PLAIN},
-        {&e->prog_compact[0], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 1"},
-        {&e->prog_compact[1], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 2"},
-        {&e->prog_translucent, "translucent.comp", NULL, NULL},
+        {&e->progs.rsm, "scene.vert", "rsm.frag", INC_RSM},
+        {&e->progs.rsm_plain, "scene.vert", "rsm.frag", INC_RSM, PLAIN},
+        {&e->progs.vpl_extract, "vpl_extract.comp", NULL, INC_COMPACT},
+        {&e->progs.vpl_blocks, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS},
+        {&e->progs.vpl_blocks8, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8},
+        {&e->progs.vpl_blocks8_vpls, "vpl_blocks.comp", NULL, INC_VPL_BLOCKS8, "#define LPV_BLOCKS_VPLS_ONLY 1"},
+        {&e->progs.gbuffer, "scene.vert", "gbuffer.frag", INC_MATERIAL},
+        {&e->progs.gbuffer_plain, "scene.vert", "gbuffer.frag", INC_MATERIAL, PLAIN},
+        {&e->progs.camera_surfels, "camera_surfels.comp", NULL, INC_BLOCKS8},
+        {&e->progs.shadow, "scene.vert", "shadow_depth.frag", INC_MATERIAL},
+        {&e->progs.shadow_plain, "scene.vert", "shadow_depth.frag", INC_MATERIAL, PLAIN},
+        {&e->progs.compact[0], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 1"},
+        {&e->progs.compact[1], "compact.comp", NULL, INC_COMPACT, "#define LPV_COMPACT_PHASE 2"},
+        {&e->progs.translucent, "translucent.comp", NULL, NULL},
     };
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i) {
         *progs[i].prog =
@@ -108,32 +108,10 @@ void lpv_engine_destroy(lpv_engine *e)
     if (e->tech)
         e->tech->cls->destroy(e->tech);
     lpv_engine_free_frame_programs(e);
-    GLuint *progs[] = {&e->prog_rsm,
-                       &e->prog_rsm_plain,
-                       &e->prog_vpl_extract,
-                       &e->prog_vpl_blocks,
-                       &e->prog_vpl_blocks8,
-                       &e->prog_vpl_blocks8_vpls,
-                       &e->prog_gbuffer,
-                       &e->prog_gbuffer_plain,
-                       &e->prog_camera_surfels,
-                       &e->prog_query,
-                       &e->prog_glossy,
-                       &e->prog_media,
-                       &e->prog_shadow,
-                       &e->prog_shadow_plain,
-                       &e->prog_lookup_blocks,
-                       &e->prog_lookup_blocks_damped,
-                       &e->prog_shade_rest,
-                       &e->prog_shade_rest_damped,
-                       &e->prog_area_shadow_blocks,
-                       &e->prog_area_shadow_rest,
-                       &e->prog_compact[0],
-                       &e->prog_compact[1],
-                       &e->prog_translucent};
-    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
-        if (*progs[i])
-            glDeleteProgram(*progs[i]);
+    GLuint *progs = (GLuint *)&e->progs;
+    for (size_t i = 0; i < sizeof e->progs / sizeof(GLuint); ++i)
+        if (progs[i])
+            glDeleteProgram(progs[i]);
     if (e->empty_vao)
         glDeleteVertexArrays(1, &e->empty_vao);
     lpv_gl_delete_buffer(&e->light_ubo);

@@ -43,6 +43,33 @@ enum {
 
 
 
+/* The engine's programs: the shared producers' (built at create, engine.c)
+ * and those that read the technique's volume through its lookup (rebuilt
+ * with each technique, engine_technique.c). GLuints only: destroy deletes
+ * them as one array, so a program added here is freed without another list. */
+typedef struct lpv_engine_programs {
+    GLuint rsm, vpl_extract, vpl_blocks, vpl_blocks8, gbuffer, camera_surfels, query, glossy, media, shadow;
+    /* the frame programs (shade.comp), one per variant (LPV_FRAME_*), built
+     * when first used (lpv_engine_frame_program) */
+    GLuint frame[LPV_FRAME_VARIANTS];
+    GLuint vpl_blocks8_vpls; /* vpl_blocks.comp without the surfels (LPV_BLOCKS_VPLS_ONLY) */
+    /* the second pass of a frame in two passes (LPV_FRAME_SPLIT):
+     * shade_rest.comp adds the indirect light of the pixels the first listed */
+    GLuint shade_rest, shade_rest_damped;
+    /* the scene passes' programs without textures, normal maps and alpha cuts
+     * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_scene_gpu_program) */
+    GLuint rsm_plain, gbuffer_plain, shadow_plain;
+    /* the lookup step (settings.lookup_step > 1): the blocks' lookup without
+     * and with damping (lookup_blocks.comp); the area shadow step
+     * (settings.area_shadow_step > 1): the blocks' area light visibility
+     * (area_shadow_blocks.comp) */
+    GLuint lookup_blocks, lookup_blocks_damped, area_shadow_blocks;
+    GLuint area_shadow_rest; /* the area light of the pixels no block is alike to (area_shadow_rest.comp) */
+    GLuint compact[2];       /* compact.comp's scan and copy */
+    GLuint translucent;      /* translucent.comp: the translucent layer laid over the frame */
+} lpv_engine_programs;
+_Static_assert(sizeof(lpv_engine_programs) % sizeof(GLuint) == 0, "lpv_engine_programs holds GLuints only");
+
 struct lpv_engine {
     lpv_settings settings;
     lpv_technique *tech;      /* the GI technique (gpu/technique.h) */
@@ -61,27 +88,7 @@ struct lpv_engine {
     size_t occluder_triangles;
     lpv_medium_gpu medium;    /* the scene's participating medium (medium.present), if any */
 
-    /* programs */
-    GLuint prog_rsm, prog_vpl_extract, prog_vpl_blocks, prog_vpl_blocks8, prog_gbuffer, prog_camera_surfels,
-        prog_query, prog_glossy, prog_media, prog_shadow;
-    /* the frame programs (shade.comp), one per variant (LPV_FRAME_*), built
-     * when first used (lpv_engine_frame_program) */
-    GLuint prog_frame[LPV_FRAME_VARIANTS];
-    GLuint prog_vpl_blocks8_vpls; /* vpl_blocks.comp without the surfels (LPV_BLOCKS_VPLS_ONLY) */
-    /* the second pass of a frame in two passes (LPV_FRAME_SPLIT):
-     * shade_rest.comp adds the indirect light of the pixels the first listed */
-    GLuint prog_shade_rest, prog_shade_rest_damped;
-    /* the scene passes' programs without textures, normal maps and alpha cuts
-     * (LPV_MATERIAL_PLAIN), for scenes with none (lpv_scene_gpu_program) */
-    GLuint prog_rsm_plain, prog_gbuffer_plain, prog_shadow_plain;
-    /* the lookup step (settings.lookup_step > 1): the blocks' lookup without
-     * and with damping (lookup_blocks.comp); the area shadow step
-     * (settings.area_shadow_step > 1): the blocks' area light visibility
-     * (area_shadow_blocks.comp) */
-    GLuint prog_lookup_blocks, prog_lookup_blocks_damped, prog_area_shadow_blocks;
-    GLuint prog_area_shadow_rest; /* the area light of the pixels no block is alike to (area_shadow_rest.comp) */
-    GLuint prog_compact[2]; /* compact.comp's scan and copy */
-    GLuint prog_translucent; /* translucent.comp: the translucent layer laid over the frame */
+    lpv_engine_programs progs; /* the shared producers' and the lookup's programs */
 
     /* scene */
     lpv_scene_gpu geo;        /* its draws, materials and textures on the GPU (scene_gpu.h) */
@@ -117,10 +124,12 @@ struct lpv_engine {
      * near planes), per light of light_block, and what it was found for:
      * position, normal (an area light sample's; 0 for a punctual light),
      * search radius, geometry_sig */
-    float light_clearance[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
-    float light_clearance_key[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS][8];
-    int light_clearance_pending[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* lights whose triangles are to scan */
-    int light_clearance_pending_count;
+    struct {
+        float distance[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
+        float key[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS][8];
+        int pending[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS]; /* lights whose triangles are to scan */
+        int pending_count;
+    } clearance;
     lpv_rsms rsm; /* the lights' RSMs and the VPLs and surfels made from them (pass_rsm.c) */
 
     lpv_shadow_maps shadows; /* direct light's shadow maps (shadow_maps.h) */

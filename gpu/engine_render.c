@@ -28,8 +28,8 @@ int lpv_engine_shadows_update(lpv_engine *e, char *err, size_t err_size)
                                      err_size) != 0)
             return -1;
     }
-    const lpv_shadow_draw d = {.geo = &e->geo, .lights = e->light_block.lights, .prog = e->prog_shadow,
-                               .prog_plain = e->prog_shadow_plain, .timer = &e->timer};
+    const lpv_shadow_draw d = {.geo = &e->geo, .lights = e->light_block.lights, .prog = e->progs.shadow,
+                               .prog_plain = e->progs.shadow_plain, .timer = &e->timer};
     lpv_shadow_maps_draw(&e->shadows, &b, &d);
     return 0;
 }
@@ -105,9 +105,9 @@ static void irradiance_chunk(lpv_engine *e, const float *points, const float *no
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, e->query_in);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 8 * sizeof(float)), in);
-    glUseProgram(e->prog_query);
-    glUniform1i(glGetUniformLocation(e->prog_query, "u_count"), (GLint)n);
-    lpv_engine_bind_lookup(e, e->prog_query, e->settings.lpv.damping);
+    glUseProgram(e->progs.query);
+    glUniform1i(glGetUniformLocation(e->progs.query, "u_count"), (GLint)n);
+    lpv_engine_bind_lookup(e, e->progs.query, e->settings.lpv.damping);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_VPLS, e->query_in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_SURFELS, e->query_out);
     glDispatchCompute(lpv_div_up(n, QUERY_GROUP), 1, 1);

@@ -54,9 +54,9 @@ static int includes(const char **out, size_t cap, const char *const *own, const 
 void lpv_engine_free_frame_programs(lpv_engine *e)
 {
     for (int v = 0; v < LPV_FRAME_VARIANTS; ++v)
-        if (e->prog_frame[v]) {
-            glDeleteProgram(e->prog_frame[v]);
-            e->prog_frame[v] = 0;
+        if (e->progs.frame[v]) {
+            glDeleteProgram(e->progs.frame[v]);
+            e->progs.frame[v] = 0;
         }
 }
 
@@ -80,17 +80,17 @@ int lpv_engine_use_technique(lpv_engine *e, lpv_technique_id id, char *err, size
         const char *defines;
     } progs[] = {
         /* the frame's programs are built when first used (lpv_engine_frame_program) */
-        {&e->prog_shade_rest, "shade_rest.comp", NULL, inc_shade,
+        {&e->progs.shade_rest, "shade_rest.comp", NULL, inc_shade,
          "#define LPV_LOOKUP_DAMPING 0\n#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
-        {&e->prog_area_shadow_blocks, "area_shadow_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
-        {&e->prog_area_shadow_rest, "area_shadow_rest.comp", NULL, inc_shade,
+        {&e->progs.shade_rest_damped, "shade_rest.comp", NULL, inc_shade, "#define LPV_LOOKUP_SPLIT 1"},
+        {&e->progs.area_shadow_blocks, "area_shadow_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->progs.area_shadow_rest, "area_shadow_rest.comp", NULL, inc_shade,
          "#define LPV_LOOKUP_DAMPING 0\n#define LPV_AREA_SHADOW_BLOCKS 1"},
-        {&e->prog_lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
-        {&e->prog_lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
-        {&e->prog_query, "query.comp", NULL, inc_lookup},
-        {&e->prog_glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
-        {&e->prog_media, "fullscreen.vert", "media.frag", inc_media},
+        {&e->progs.lookup_blocks, "lookup_blocks.comp", NULL, inc_shade, "#define LPV_LOOKUP_DAMPING 0"},
+        {&e->progs.lookup_blocks_damped, "lookup_blocks.comp", NULL, inc_shade, NULL},
+        {&e->progs.query, "query.comp", NULL, inc_lookup},
+        {&e->progs.glossy, "fullscreen.vert", "glossy.frag", inc_lookup},
+        {&e->progs.media, "fullscreen.vert", "media.frag", inc_media},
     };
     enum { N = sizeof progs / sizeof progs[0] };
     GLuint built[N] = {0};
@@ -126,8 +126,8 @@ GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size
 {
     if (variant & LPV_FRAME_BLOCKS) /* the frame reads the blocks' irradiance: it looks nothing up */
         variant &= ~(unsigned)(LPV_FRAME_DAMPED | LPV_FRAME_SPLIT);
-    if (e->prog_frame[variant])
-        return e->prog_frame[variant];
+    if (e->progs.frame[variant])
+        return e->progs.frame[variant];
     const char *inc_shade[16];
     if (includes(inc_shade, 16, INC_SHADE, e->tech->cls->lookup_includes)) {
         lpv_error(err, err_size, "technique %s names too many lookup includes", e->tech->cls->name);
@@ -142,8 +142,8 @@ GLuint lpv_engine_frame_program(lpv_engine *e, unsigned variant, char *err, size
              variant & LPV_FRAME_SPLIT ? "#define LPV_LOOKUP_SPLIT 1\n" : "",
              variant & LPV_FRAME_BLOCKS ? "#define LPV_LOOKUP_BLOCKS 1\n" : "",
              variant & LPV_FRAME_AREA_BLOCKS ? "#define LPV_AREA_SHADOW_BLOCKS 1\n" : "");
-    e->prog_frame[variant] = lpv_program_build_defines("shade.comp", NULL, NULL, defines, inc_shade, err, err_size);
-    return e->prog_frame[variant];
+    e->progs.frame[variant] = lpv_program_build_defines("shade.comp", NULL, NULL, defines, inc_shade, err, err_size);
+    return e->progs.frame[variant];
 }
 
 int lpv_engine_resolve_technique(lpv_engine *e, const lpv_settings *s, char *err, size_t err_size)

@@ -174,10 +174,10 @@ static float face_near(const lpv_engine *e, const vec3 eye, const vec3 axis, flo
     return near_z < cap ? near_z : cap;
 }
 
-/* The distances (m) from the lights pending in e->light_clearance_pending
- * (their position, normal and search radius in light_clearance_key) to the
+/* The distances (m) from the lights pending in e->clearance.pending
+ * (their position, normal and search radius in clearance.key) to the
  * nearest of the scene's triangles, up to the search radius (the answer
- * when nothing is closer), into e->light_clearance: one pass over the
+ * when nothing is closer), into e->clearance.distance: one pass over the
  * triangles for all of them (a triangle's vertices are read once). For an
  * area light sample (a non-zero normal n: its emitting side) only what lies
  * in front of its plane can shadow a receiver it lights, and its own
@@ -186,11 +186,11 @@ static float face_near(const lpv_engine *e, const vec3 eye, const vec3 axis, flo
 static void scan_triangles(lpv_engine *e)
 {
     const lpv_scene *g = &e->geometry;
-    const int count = e->light_clearance_pending_count;
+    const int count = e->clearance.pending_count;
     float best2[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS], eps[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
     int has_n[LPV_MAX_LIGHTS + LPV_MAX_AREA_LIGHTS];
     for (int j = 0; j < count; ++j) {
-        const float *k = e->light_clearance_key[e->light_clearance_pending[j]];
+        const float *k = e->clearance.key[e->clearance.pending[j]];
         best2[j] = k[6] * k[6];
         has_n[j] = k[3] != 0.0f || k[4] != 0.0f || k[5] != 0.0f;
         /* off the plane: past the float error of the sample's position */
@@ -212,7 +212,7 @@ static void scan_triangles(lpv_engine *e)
             hi[i] = fmaxf(v[0][i], fmaxf(v[1][i], v[2][i]));
         }
         for (int j = 0; j < count; ++j) {
-            const float *k = e->light_clearance_key[e->light_clearance_pending[j]];
+            const float *k = e->clearance.key[e->clearance.pending[j]];
             float box2 = 0.0f; /* the triangle's box farther than the best: skip */
             for (int i = 0; i < 3; ++i) {
                 const float out = k[i] < lo[i] ? lo[i] - k[i] : (k[i] > hi[i] ? k[i] - hi[i] : 0.0f);
@@ -233,8 +233,8 @@ static void scan_triangles(lpv_engine *e)
         }
     }
     for (int j = 0; j < count; ++j)
-        e->light_clearance[e->light_clearance_pending[j]] = sqrtf(best2[j]);
-    e->light_clearance_pending_count = 0;
+        e->clearance.distance[e->clearance.pending[j]] = sqrtf(best2[j]);
+    e->clearance.pending_count = 0;
 }
 
 /* The d of face_near for light l of the light block at p (n: an area light
@@ -250,16 +250,16 @@ static float light_clearance(lpv_engine *e, int l, const vec3 p, const float *n,
     const float within = NEAR_OLD_FRACTION * radius / NEAR_FRACTION;
     float key[8] = {p[0], p[1], p[2], n ? n[0] : 0.0f, n ? n[1] : 0.0f, n ? n[2] : 0.0f, within, 0.0f};
     memcpy(&key[7], &e->geometry_sig, sizeof key[7]); /* the low half of the signature */
-    if (memcmp(key, e->light_clearance_key[l], sizeof key) != 0) {
-        memcpy(e->light_clearance_key[l], key, sizeof key);
+    if (memcmp(key, e->clearance.key[l], sizeof key) != 0) {
+        memcpy(e->clearance.key[l], key, sizeof key);
         if (e->reach.all_opaque && !lpv_reach_solid_within(&e->reach, p, within))
-            e->light_clearance[l] = within;
+            e->clearance.distance[l] = within;
         else {
-            e->light_clearance[l] = 0.0f;
-            e->light_clearance_pending[e->light_clearance_pending_count++] = l;
+            e->clearance.distance[l] = 0.0f;
+            e->clearance.pending[e->clearance.pending_count++] = l;
         }
     }
-    return e->light_clearance[l];
+    return e->clearance.distance[l];
 }
 
 /* The first LPV_MAX_LIGHTS of the scene's punctual lights in the light
@@ -417,9 +417,9 @@ static void build_faces(lpv_engine *e);
 
 void lpv_light_faces_build(lpv_engine *e)
 {
-    e->light_clearance_pending_count = 0;
+    e->clearance.pending_count = 0;
     build_faces(e);
-    if (e->light_clearance_pending_count > 0) { /* lights near surfaces: their distances, then their faces */
+    if (e->clearance.pending_count > 0) { /* lights near surfaces: their distances, then their faces */
         scan_triangles(e);
         build_faces(e);
     }
@@ -577,7 +577,7 @@ int lpv_shadow_faces_build(const lpv_engine *e, struct LpvShadowBlock *b, char *
         vec3 dir = {g->direction_range[0], g->direction_range[1], g->direction_range[2]};
         const int first = faces;
         /* an area light sample's clearance is in front of its emitter */
-        const float d = e->light_clearance[l]; /* found by lpv_light_faces_build */
+        const float d = e->clearance.distance[l]; /* found by lpv_light_faces_build */
         if (type == LPV_LIGHT_TYPE_AREA) {
             /* The RSM's five faces (front, four sides), each a tile in the
              * layers after the punctual lights' (whose count is known once

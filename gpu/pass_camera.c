@@ -81,8 +81,8 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     build_view_block(e);
     const lpv_view *v = &e->view;
     const lpv_gbuffer_draw d = {.geo = &e->geo, .view = &e->view_block, .width = v->width, .height = v->height,
-                                .orthographic = v->orthographic, .prog = e->prog_gbuffer,
-                                .prog_plain = e->prog_gbuffer_plain,
+                                .orthographic = v->orthographic, .prog = e->progs.gbuffer,
+                                .prog_plain = e->progs.gbuffer_plain,
                                 .translucent = e->geo.blend_draws && e->plan.pass[LPV_PASS_TRANSLUCENT].run,
                                 .timer = &e->timer};
     if (lpv_gbuffer_draw_scene(&e->gbuf, &d, err, err_size) != 0) {
@@ -91,7 +91,7 @@ int lpv_pass_gbuffer_run(lpv_engine *e, char *err, size_t err_size)
     }
 
     lpv_group_grid groups[LPV_MAX_CASCADES];
-    const lpv_gbuffer_surfels sd = {.prog = e->prog_camera_surfels,
+    const lpv_gbuffer_surfels sd = {.prog = e->progs.camera_surfels,
                                     .step = lpv_settings_camera_surfel_step(&e->settings, v->height),
                                     .groups = groups,
                                     .group_levels = lpv_engine_group_grids(e, groups),
@@ -156,10 +156,10 @@ static int shade_frame(lpv_engine *e, lpv_frame_terms terms, const GLuint gbuf[L
                                 ? e->settings.glossy_roughness
                                 : 0.0f,
         .prog = prog,
-        .prog_rest = damped ? e->prog_shade_rest_damped : e->prog_shade_rest,
-        .prog_area_rest = e->prog_area_shadow_rest,
-        .prog_lookup_blocks = damped ? e->prog_lookup_blocks_damped : e->prog_lookup_blocks,
-        .prog_area_shadow_blocks = e->prog_area_shadow_blocks,
+        .prog_rest = damped ? e->progs.shade_rest_damped : e->progs.shade_rest,
+        .prog_area_rest = e->progs.area_shadow_rest,
+        .prog_lookup_blocks = damped ? e->progs.lookup_blocks_damped : e->progs.lookup_blocks,
+        .prog_area_shadow_blocks = e->progs.area_shadow_blocks,
         .lookup = {bind_lookup, e},
         .shadows = &e->shadows,
         .light_ubo = e->light_ubo,
@@ -230,7 +230,7 @@ int lpv_pass_translucent_run(lpv_engine *e, lpv_frame_terms terms, size_t *full_
     if (shade_frame(e, terms, e->gbuf.layer_tex, e->gbuf.layer_frame_tex, rect, "translucent", err, err_size) != 0)
         return -1;
     lpv_timer_begin(&e->timer, "translucent");
-    lpv_frame_overlay(&e->frame, e->prog_translucent, e->gbuf.layer_frame_tex, e->gbuf.layer_tex[LPV_GBUF_TARGETS],
+    lpv_frame_overlay(&e->frame, e->progs.translucent, e->gbuf.layer_frame_tex, e->gbuf.layer_tex[LPV_GBUF_TARGETS],
                       rect, &e->timer);
     lpv_timer_end(&e->timer);
     return 0;

@@ -45,9 +45,9 @@ void lpv_pass_glossy_run(lpv_engine *e)
     lpv_timer_begin(&e->timer, "glossy");
     bind_frame_inputs(e);
     glBlendFunc(GL_ONE, GL_ONE);
-    glUseProgram(e->prog_glossy);
-    glUniform1f(glGetUniformLocation(e->prog_glossy, "u_glossy_roughness"), e->settings.glossy_roughness);
-    lpv_engine_bind_lookup(e, e->prog_glossy, e->settings.lpv.damping);
+    glUseProgram(e->progs.glossy);
+    glUniform1f(glGetUniformLocation(e->progs.glossy, "u_glossy_roughness"), e->settings.glossy_roughness);
+    lpv_engine_bind_lookup(e, e->progs.glossy, e->settings.lpv.damping);
     draw_fullscreen(e);
     lpv_timer_end(&e->timer);
 }
@@ -58,7 +58,7 @@ void lpv_pass_media_run(lpv_engine *e)
     bind_frame_inputs(e);
     /* frame = scattered + transmittance x frame, per channel; alpha kept */
     glBlendFuncSeparate(GL_ONE, GL_SRC1_COLOR, GL_ZERO, GL_ONE);
-    GLuint p = e->prog_media;
+    GLuint p = e->progs.media;
     glUseProgram(p);
     lpv_shadow_maps_bind(&e->shadows);
     lpv_medium_bind(&e->medium, &e->settings, p, 1);

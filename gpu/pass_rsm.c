@@ -53,9 +53,9 @@ static size_t extract_layers(lpv_engine *e, int first, int count, int side, size
      * step 2: four slots (block_groups.glsl), as many as texels; larger: 8,
      * without the surfels' grouping where the GV leaves them out (their
      * slots are then not written) */
-    const GLuint prog = step == 1   ? e->prog_vpl_extract
-                        : step == 2 ? e->prog_vpl_blocks
-                                    : (surfels ? e->prog_vpl_blocks8 : e->prog_vpl_blocks8_vpls);
+    const GLuint prog = step == 1   ? e->progs.vpl_extract
+                        : step == 2 ? e->progs.vpl_blocks
+                                    : (surfels ? e->progs.vpl_blocks8 : e->progs.vpl_blocks8_vpls);
     lpv_group_grid groups[LPV_MAX_CASCADES];
     const lpv_rsm_extract d = {.first = first,
                                .count = count,
@@ -83,7 +83,7 @@ void lpv_pass_rsm_run(lpv_engine *e)
 {
     const int size = e->rsm.size;
     const lpv_rsm_draw d = {.geo = &e->geo, .lights = &e->light_block, .light_ubo = e->light_ubo,
-                            .prog = e->prog_rsm, .prog_plain = e->prog_rsm_plain, .timer = &e->timer};
+                            .prog = e->progs.rsm, .prog_plain = e->progs.rsm_plain, .timer = &e->timer};
     lpv_rsms_draw(&e->rsm, &d);
 
     /* VPLs and surfels only for a technique whose passes read them (the
@@ -113,6 +113,6 @@ void lpv_pass_rsm_run(lpv_engine *e)
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     /* the injection draws only the VPLs that carry light (most of the
      * blocks' slots are empty) */
-    lpv_compact_run(e->prog_compact, e->rsm.vpls, e->rsm.vpl_count, e->rsm.vpls_live, e->rsm.vpls_draw);
+    lpv_compact_run(e->progs.compact, e->rsm.vpls, e->rsm.vpl_count, e->rsm.vpls_live, e->rsm.vpls_draw);
     lpv_timer_end(&e->timer);
 }
