@@ -13,12 +13,7 @@
  * named: the registry's header (techniques/technique_ids.h). */
 #include "technique_ids.h"
 
-/* Tri-state switch: 0 means "the default". */
-typedef enum lpv_switch {
-    LPV_SWITCH_DEFAULT = 0,
-    LPV_SWITCH_ON = 1,
-    LPV_SWITCH_OFF = 2,
-} lpv_switch;
+#include "settings_switch.h"
 
 /* Named quality presets: points on the accuracy sweep's Pareto front
  * (docs/accuracy.md). A preset supplies grid_dims, iterations, rsm_size,
@@ -85,28 +80,8 @@ typedef struct lpv_lpv_settings {
 /* Everything the engine is told: the volume's resolution and bounds, the
  * shared producers (RSMs, shadow maps, samples of the scene), the shading's
  * effects, the planner, and one nested struct per GI technique. */
-/* Imperfect volumes (Mavridis & Papaioannou, the third seed; docs/imperfect-volumes.md):
- * a voxel copy of the whole scene from a point cloud, radiance gathered per
- * voxel by ray marching it. A zero field takes its default (every knob's
- * default and range: its row in settings_fields.c). */
-typedef struct lpv_iv_settings {
-    int resolution;         /* voxels along the scene's longest side (voxels are cubes) */
-    int points;             /* random points per triangle (Turk's formula) */
-    float split;            /* voxels: a triangle with a longer edge is split before sampling (the
-                               paper's load-time tessellation) */
-    int seed;               /* the points' and the rays' random seed */
-    int rays;               /* stratified rays per voxel */
-    int bounces;            /* diffuse bounces (ping-pong passes) */
-    lpv_switch tail;        /* the bounces after these (3 or more) as the series the last ones set
-                               (iv_tail.comp) */
-    lpv_switch reprojection; /* the camera's visible points refine the volume */
-    int neighbours;         /* the reconstruction blends the nearest this many of the 8 voxels around
-                               the shifted point: 6 (the paper's text) .. 8 (its figure 2) */
-    lpv_switch ao;          /* ambient occlusion volume */
-    float ao_distance;      /* m, the AO rays' reach; 0 (default) = LPV_IV_AO_VOXELS voxels */
-    int max_points;         /* the point cloud's budget: more triangles x points get fewer points per
-                               triangle (the plan says so) */
-} lpv_iv_settings;
+/* Imperfect volumes' knobs (lpv_iv_settings): the technique's own header. */
+#include "iv_settings.h"
 
 typedef struct lpv_settings {
     int grid_dims[3];       /* cells per axis; default: the preset's */
@@ -168,7 +143,7 @@ typedef struct lpv_settings {
 } lpv_settings;
 
 /* The knobs' defaults and ranges are rows of the knob table
- * (settings_fields.c); the preset's knobs, rows of the preset table
+ * (settings_fields.c, and each technique's NAME_fields.c); the preset's knobs, rows of the preset table
  * (settings.c). What follows are the rules' constants the tables and the
  * planner share. */
 #define LPV_AUTO_CASCADES 3            /* auto cascades, when the camera stands inside a wide scene */
@@ -211,12 +186,6 @@ typedef struct lpv_settings {
 #define LPV_MAX_RSM_VPL_STEP 64
 #define LPV_MAX_LOOKUP_STEP 4
 #define LPV_MAX_AREA_SHADOW_STEP 4
-#define LPV_IV_AO_VOXELS 4.0f
-#define LPV_IV_MAX_POINTS (1 << 24)
-#define LPV_IV_MAX_POINTS_PER_TRIANGLE 64
-#define LPV_IV_MAX_RAYS 1024
-#define LPV_IV_MAX_BOUNCES 8
-#define LPV_IV_MAX_SEED 99999999
 
 /* Fills defaults into zero fields: preset 0 becomes BALANCED, then zero
  * grid_dims / rsm_size / occlusion take the preset's values, zero iterations

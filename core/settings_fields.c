@@ -9,6 +9,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,18 +17,12 @@
 #include "area_lights.h"
 #include "lpv_shared.h"
 
-#define F(name) offsetof(lpv_settings, name)
-/* The touches column (settings_fields.h, lpv_touch). */
-#define T_VOL LPV_TOUCH_VOLUME
-#define T_SAMPLES LPV_TOUCH_SAMPLES
-#define T_SHADOWS LPV_TOUCH_SHADOWS
-#define T_SHADE LPV_TOUCH_SHADING
-/* The default columns (settings_fields.h, lpv_default_rule). */
-#define D(value) LPV_DEFAULT_VALUE, (value), NULL
-#define D_ZERO(words) LPV_DEFAULT_ZERO, 0, (words)
-#define D_PRESET(words) LPV_DEFAULT_PRESET, 0, (words)
+#include "settings_rows.h"
 
-static const lpv_field FIELDS[] = {
+/* core's rows: the shared producers', the shading's and the cascaded LPV's
+ * (the presets set them); each technique's own follow
+ * (techniques/technique_fields.c). */
+static const lpv_field CORE_FIELDS[] = {
     /* The older knobs (the preset supplies the defaults of three of them). */
     {"iterations", "iterations", LPV_FIELD_INT, F(lpv.iterations), 1, LPV_MAX_ITERATIONS, 0, "steps",
      D_PRESET("the preset's x grid / its grid"), "", "propagation steps (light moves about a cell a step)", T_VOL,
@@ -115,54 +110,50 @@ static const lpv_field FIELDS[] = {
      "pixels per evaluation of the area lights' shadow maps along each axis in the frame (N > 1: once per "
      "N x N block as a visibility ratio, upsampled along planes; accuracy vs time)", T_SHADE, ""},
 
-    /* Imperfect volumes (docs/imperfect-volumes.md). */
-    {"iv_resolution", "iv-resolution", LPV_FIELD_INT, F(iv.resolution), 1, LPV_MAX_GRID_DIM, 0, "voxels", D(16), "",
-     "voxels along the scene's longest side (more in long scenes: a quarter of the free path each, within this cube's count)",
-     T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_points", "iv-points", LPV_FIELD_INT, F(iv.points), 1, LPV_IV_MAX_POINTS_PER_TRIANGLE, 0, "", D(1), "",
-     "random points per triangle (Turk's formula)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_split", "iv-split", LPV_FIELD_FLOAT, F(iv.split), 0, 1e6, 1, "voxels", D(0.5), "",
-     "triangles with a longer edge are split before sampling", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_seed", "iv-seed", LPV_FIELD_INT, F(iv.seed), 1, LPV_IV_MAX_SEED, 0, "", D(1), "",
-     "random seed of the points and the rays", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
-    {"iv_rays", "iv-rays", LPV_FIELD_INT, F(iv.rays), 1, LPV_IV_MAX_RAYS, 0, "", D(128), "",
-     "stratified rays marched per voxel", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_bounces", "iv-bounces", LPV_FIELD_INT, F(iv.bounces), 1, LPV_IV_MAX_BOUNCES, 0, "", D(4), "",
-     "diffuse bounces (ping-pong passes over two volumes)", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_tail", "iv-tail", LPV_FIELD_SWITCH, F(iv.tail), 0, 1, 0, "", D(1), "",
-     "the bounces after iv_bounces (3 or more) as the series the last ones set", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_reprojection", "iv-reprojection", LPV_FIELD_SWITCH, F(iv.reprojection), 0, 1, 0, "", D(1), "",
-     "the camera's visible points refine the volume", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_neighbours", "iv-neighbours", LPV_FIELD_INT, F(iv.neighbours), 1, 8, 0, "", D(8), "the paper's text: 6",
-     "nearest of the 8 voxels around the shifted point the reconstruction blends", T_VOL | T_SHADE,
-     LPV_TECHNIQUE_IV},
-    {"iv_ao", "iv-ao", LPV_FIELD_SWITCH, F(iv.ao), 0, 1, 0, "", D(0), "",
-     "ambient occlusion volume (the ao frame term)", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_ao_distance", "iv-ao-distance", LPV_FIELD_FLOAT, F(iv.ao_distance), 0, 1e6, 0, "m", D_ZERO("auto"),
-     "0 = auto: 4 voxels", "reach of the ambient occlusion rays", T_VOL, LPV_TECHNIQUE_IV},
-    {"iv_max_points", "iv-max-points", LPV_FIELD_INT, F(iv.max_points), 1, LPV_IV_MAX_POINTS, 0, "", D(1 << 20), "",
-     "point cloud budget (more triangles get fewer points each)", T_VOL | T_SAMPLES, LPV_TECHNIQUE_IV},
 };
 
-#undef F
-#undef T_VOL
-#undef T_SAMPLES
-#undef T_SHADOWS
-#undef T_SHADE
-#undef D
-#undef D_ZERO
-#undef D_PRESET
+#include "settings_rows_end.h"
+
+/* The knob table: core's rows, then each technique's, put together once
+ * (the daemon's threads all read it). */
+#define LPV_FIELDS_MAX 128
+static lpv_field FIELDS[LPV_FIELDS_MAX];
+static size_t FIELD_COUNT;
+static pthread_once_t FIELDS_ONCE = PTHREAD_ONCE_INIT;
+
+static void fields_join(void)
+{
+    size_t n = sizeof CORE_FIELDS / sizeof CORE_FIELDS[0];
+    memcpy(FIELDS, CORE_FIELDS, sizeof CORE_FIELDS);
+    size_t k = 0;
+    for (size_t t = 0; lpv_technique_fields(t, &k); ++t) {
+        if (n + k > LPV_FIELDS_MAX) { /* a build with more rows than this: raise LPV_FIELDS_MAX */
+            fprintf(stderr, "lpvd: %zu knob rows, the table holds %d\n", n + k, LPV_FIELDS_MAX);
+            abort();
+        }
+        memcpy(FIELDS + n, lpv_technique_fields(t, &k), k * sizeof *FIELDS);
+        n += k;
+    }
+    FIELD_COUNT = n;
+}
+
+static void fields_ready(void)
+{
+    pthread_once(&FIELDS_ONCE, fields_join);
+}
 
 const lpv_field *lpv_fields(size_t *count)
 {
+    fields_ready();
     if (count)
-        *count = sizeof FIELDS / sizeof FIELDS[0];
+        *count = FIELD_COUNT;
     return FIELDS;
 }
 
 const lpv_field *lpv_field_by_key(const char *key)
 {
-    for (size_t i = 0; key && i < sizeof FIELDS / sizeof FIELDS[0]; ++i)
+    fields_ready();
+    for (size_t i = 0; key && i < FIELD_COUNT; ++i)
         if (strcmp(FIELDS[i].key, key) == 0)
             return &FIELDS[i];
     return NULL;
@@ -170,7 +161,8 @@ const lpv_field *lpv_field_by_key(const char *key)
 
 const lpv_field *lpv_field_by_flag(const char *flag)
 {
-    for (size_t i = 0; flag && i < sizeof FIELDS / sizeof FIELDS[0]; ++i)
+    fields_ready();
+    for (size_t i = 0; flag && i < FIELD_COUNT; ++i)
         if (strcmp(FIELDS[i].flag, flag) == 0)
             return &FIELDS[i];
     return NULL;
@@ -318,7 +310,8 @@ const char *lpv_field_default_words(const lpv_field *f, char *buf, size_t n)
 
 void lpv_fields_resolve(lpv_settings *s)
 {
-    for (size_t i = 0; i < sizeof FIELDS / sizeof FIELDS[0]; ++i) {
+    fields_ready();
+    for (size_t i = 0; i < FIELD_COUNT; ++i) {
         const lpv_field *f = &FIELDS[i];
         if (f->dflt_rule != LPV_DEFAULT_VALUE || !lpv_field_is_default(s, f))
             continue;
@@ -398,7 +391,8 @@ unsigned lpv_settings_touches(const lpv_settings *a, const lpv_settings *b, char
         touches |= LPV_TOUCH_VOLUME | LPV_TOUCH_SAMPLES | LPV_TOUCH_SHADOWS | LPV_TOUCH_SHADING;
         note_first(first, first_size, "technique");
     }
-    for (size_t i = 0; i < sizeof FIELDS / sizeof FIELDS[0]; ++i) {
+    fields_ready();
+    for (size_t i = 0; i < FIELD_COUNT; ++i) {
         if (!field_differs(a, b, &FIELDS[i]))
             continue;
         touches |= FIELDS[i].touches;

@@ -7,6 +7,10 @@
  * Not in the table (they have their own syntax): grid_dims (N | NxMxK, or a
  * JSON [3]), bounds (six numbers) and preset (a name).
  *
+ * The table is core's rows (settings_fields.c) followed by each technique's
+ * own (techniques/NAME/core/NAME_fields.c, listed by
+ * techniques/technique_fields.c).
+ *
  * One fact, one place: each row holds its knob's range and default, and
  * everything else is derived from the rows: lpv_settings_resolve() writes the
  * defaults, lpv_settings_validate() checks the ranges, the CLI's --help, the
@@ -65,6 +69,10 @@ typedef struct lpv_field {
     const char *technique; /* the GI technique the knob tunes (its class name, LPV_TECHNIQUE_LPV), or
                               "" for the engine's shared producers and shading */
 } lpv_field;
+
+/* The k-th technique's own rows and *count of them, NULL past the last
+ * (techniques/technique_fields.c). */
+const lpv_field *lpv_technique_fields(size_t k, size_t *count);
 
 /* The table, and its length in *count (may be NULL). */
 const lpv_field *lpv_fields(size_t *count);
