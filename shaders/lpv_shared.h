@@ -675,4 +675,27 @@ bool lpv_gbuffer_wire(float normal_w) { return normal_w > LPV_GBUF_WIRE_W - 0.5;
 #define LPV_MAX_SHADOW_SIZE  8192 /* texels per side of a shadow map */
 #define LPV_FP16_MAX         65504.0f
 
+/* ---- Probes (techniques/probes, issue 34): the scene's BVH as the shaders
+ * read it (techniques/probes/core/probes_bvh.h builds it; probes_trace.glsl
+ * traverses it). A node is two vec4: lo.xyz and hi.xyz its box, the w's
+ * uints (floatBitsToUint in GLSL; probes_bvh.h's lpv_probes_bvh_node names
+ * them a and b). Inner node: b == 0, left child the next node, right child
+ * node a. Leaf: b has LPV_PROBES_BVH_LEAF set, its triangles are
+ * leaf_tris[a .. a + (b & LPV_PROBES_BVH_COUNT_MASK)). */
+struct LpvBvhNode {
+    vec4 lo;
+    vec4 hi;
+};
+#define LPV_PROBES_BVH_LEAF 0x80000000u
+#define LPV_PROBES_BVH_COUNT_MASK 0x7fffffffu
+#define LPV_PROBES_BVH_STACK 64 /* the traversal's stack: the tree is at most LPV_PROBES_BVH_MAX_DEPTH deep */
+#define LPV_PROBES_WG 64        /* one-dimensional workgroups of the probes' compute passes */
+/* Its buffers (the probes' passes share 10..14 with iv's, which none of
+ * theirs binds). */
+#define LPV_SSBO_PROBES_NODES 10     /* LpvBvhNode, node 0 the root */
+#define LPV_SSBO_PROBES_LEAF_TRIS 11 /* uint: triangle ids, each leaf's run */
+#define LPV_SSBO_PROBES_VERTS 12     /* vec4: triangle t's corners at 3t, 3t + 1, 3t + 2 */
+#define LPV_SSBO_PROBES_RAYS 13      /* probes_rays.comp: vec4 origin (w: tmax), vec4 direction per ray */
+#define LPV_SSBO_PROBES_HITS 14      /* probes_rays.comp: uvec4 per ray: t (bits), triangle id, hit, 0 */
+
 #endif /* LPV_SHARED_H */

@@ -21,14 +21,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* One node, exactly two vec4 in std430, so the shader declares it as
- *
- *   struct Node { vec3 lo; uint a; vec3 hi; uint b; };
- *   layout(std430, binding = N) readonly buffer Nodes { Node nodes[]; };
- *
- * (a vec3 followed by a 4-byte scalar packs into one 16-byte slot; the
- * array's stride is 32). lo, hi: the node's own box, tight around its
- * triangles' vertices.
+#include "lpv_shared.h"
+
+/* One node, exactly two vec4 in std430: lpv_shared.h's struct LpvBvhNode
+ * (vec4 lo, hi), whose w's are the uints a and b here, as the shaders read
+ * them (probes_trace.glsl: floatBitsToUint). lo, hi: the node's own box,
+ * tight around its triangles' vertices.
  *
  *   inner node: b == 0; its left child is the next node (index + 1), its
  *               right child is node a.
@@ -49,8 +47,10 @@ _Static_assert(offsetof(lpv_probes_bvh_node, a) == 12 && offsetof(lpv_probes_bvh
                    offsetof(lpv_probes_bvh_node, b) == 28,
                "lpv_probes_bvh_node must match std430's { vec3 lo; uint a; vec3 hi; uint b; }");
 
-#define LPV_PROBES_BVH_LEAF 0x80000000u
-#define LPV_PROBES_BVH_COUNT_MASK 0x7fffffffu
+/* lpv_shared.h's struct LpvBvhNode, whose w's these name: the layout and
+ * its leaf bit (LPV_PROBES_BVH_LEAF, LPV_PROBES_BVH_COUNT_MASK) are written
+ * there once, for C and GLSL. */
+_Static_assert(sizeof(lpv_probes_bvh_node) == sizeof(struct LpvBvhNode), "lpv_probes_bvh_node is an LpvBvhNode");
 
 /* Most triangles a leaf holds (Embree's maxLeafSize): small, because the
  * shader tests a leaf's triangles one after another in one invocation. */
@@ -64,7 +64,6 @@ _Static_assert(offsetof(lpv_probes_bvh_node, a) == 12 && offsetof(lpv_probes_bvh
  * its stack of LPV_PROBES_BVH_STACK entries cannot overflow. (SAH trees of
  * 10^5 and 10^6 random triangles are 21 and 25 levels deep.) */
 #define LPV_PROBES_BVH_MAX_DEPTH 48
-#define LPV_PROBES_BVH_STACK 64
 _Static_assert(LPV_PROBES_BVH_MAX_DEPTH <= LPV_PROBES_BVH_STACK, "the traversal's stack must hold the deepest tree");
 
 /* Most triangles: their ids, and 3 * id as a vertex index, fit a GLSL uint. */
