@@ -54,6 +54,16 @@ static void shade_front(void *ctx, uint32_t tri, const float p[3], const float d
         l[c] = front ? e->l[c] : 0.0f;
 }
 
+/* The BVH of the box from (-1, -1, -1) to (1, 1, 1), walls facing in or out. */
+static void unit_box(int inward, lpv_probes_bvh *b)
+{
+    float pos[24];
+    uint32_t idx[36];
+    box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, inward, pos, idx);
+    char err[128];
+    assert_int_equal(lpv_probes_bvh_build(b, pos, 8, idx, 12, err, sizeof err), 0);
+}
+
 static lpv_probes_update_desc desc_for(const lpv_probes_bvh *b, const float *probes, size_t n, emitter *e)
 {
     return (lpv_probes_update_desc){.bvh = b, .positions = probes, .probe_count = n, .rays = 2048, .tick = 1,
@@ -68,12 +78,8 @@ static lpv_probes_update_desc desc_for(const lpv_probes_bvh *b, const float *pro
 static void test_inside_a_glowing_box(void **state)
 {
     (void)state;
-    float pos[24];
-    uint32_t idx[36];
-    box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, 1, pos, idx);
     lpv_probes_bvh b;
-    char err[128];
-    assert_int_equal(lpv_probes_bvh_build(&b, pos, 8, idx, 12, err, sizeof err), 0);
+    unit_box(1, &b);
     emitter e = {&b, {1.0f, 0.5f, 0.25f}};
     const float probe[3] = {0.0f, 0.0f, 0.0f};
     float moments[2 * 64];
@@ -107,12 +113,8 @@ static void test_inside_a_glowing_box(void **state)
 static void test_outside_and_inside_a_wall(void **state)
 {
     (void)state;
-    float pos[24];
-    uint32_t idx[36];
-    box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, 1, pos, idx);
     lpv_probes_bvh b;
-    char err[128];
-    assert_int_equal(lpv_probes_bvh_build(&b, pos, 8, idx, 12, err, sizeof err), 0);
+    unit_box(1, &b);
     emitter e = {&b, {1.0f, 1.0f, 1.0f}};
     const float probe[3] = {3.0f, 0.0f, 0.0f};
     float moments[2 * 64];
@@ -148,8 +150,7 @@ static void test_outside_and_inside_a_wall(void **state)
     lpv_probes_bvh_free(&b);
 
     /* a solid block: its walls face out, a probe inside it sees their backs */
-    box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, 0, pos, idx);
-    assert_int_equal(lpv_probes_bvh_build(&b, pos, 8, idx, 12, err, sizeof err), 0);
+    unit_box(0, &b);
     e.bvh = &b;
     const float inside[3] = {0.2f, -0.1f, 0.3f};
     const lpv_probes_update_desc d2 = desc_for(&b, inside, 1, &e);
