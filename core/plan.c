@@ -20,7 +20,7 @@ static const char *const PASS_NAMES[LPV_PASS_COUNT] = {
     [LPV_PASS_BOUNCE] = "bounce",   [LPV_PASS_GLOSSY] = "glossy",     [LPV_PASS_MEDIA] = "media",
     [LPV_PASS_IV_POINTS] = "iv_points", [LPV_PASS_IV_REPROJECT] = "iv_reproject",
     [LPV_PASS_IV_GATHER] = "iv_gather", [LPV_PASS_IV_AO] = "iv_ao",
-    [LPV_PASS_TRANSLUCENT] = "translucent",
+    [LPV_PASS_TRANSLUCENT] = "translucent", [LPV_PASS_PROBES] = "probes",
 };
 
 const char *lpv_pass_name(lpv_pass_id id)

@@ -31,6 +31,7 @@ typedef enum lpv_pass_id {
     LPV_PASS_IV_GATHER,    /* imperfect volume: radiance gathered per voxel by ray marching, per bounce */
     LPV_PASS_IV_AO,        /* imperfect volume: ambient occlusion by ray marching */
     LPV_PASS_TRANSLUCENT,  /* the BLEND surfaces' layer shaded and laid over the frame at render time */
+    LPV_PASS_PROBES,       /* probes: a budget of probes traced through the scene's BVH and blended in */
     LPV_PASS_COUNT
 } lpv_pass_id;
 

@@ -82,6 +82,8 @@ typedef struct lpv_lpv_settings {
  * effects, the planner, and one nested struct per GI technique. */
 /* Imperfect volumes' knobs (lpv_iv_settings): the technique's own header. */
 #include "iv_settings.h"
+/* Probes' knobs (lpv_probes_settings): the technique's own header. */
+#include "probes_settings.h"
 
 typedef struct lpv_settings {
     int grid_dims[3];       /* cells per axis; default: the preset's */
@@ -140,6 +142,7 @@ typedef struct lpv_settings {
 
     lpv_lpv_settings lpv;   /* the cascaded LPV's knobs (LPV_TECHNIQUE_LPV) */
     lpv_iv_settings iv;     /* the imperfect volume's knobs (LPV_TECHNIQUE_IV) */
+    lpv_probes_settings probes; /* the probes' knobs (LPV_TECHNIQUE_PROBES) */
 } lpv_settings;
 
 /* The knobs' defaults and ranges are rows of the knob table

@@ -13,8 +13,9 @@
 static const lpv_flag OWN_SYNTAX[] = {
     {"technique", 0, "NAME",
      "GI technique: " LPV_TECHNIQUE_LPV " (cascaded LPV), " LPV_TECHNIQUE_OCTREE
-     " (octree LPV: a cubic power-of-two\ngrid), " LPV_TECHNIQUE_IV " (imperfect volumes: the --iv-* knobs) or "
-     LPV_TECHNIQUE_AUTO " (the default: the planner\nchooses from the scene and the preset, and says why)"},
+     " (octree LPV: a cubic power-of-two\ngrid), " LPV_TECHNIQUE_IV " (imperfect volumes: the --iv-* knobs), "
+     LPV_TECHNIQUE_PROBES " (ray-traced\nirradiance probes, a probe per grid cell: the --probes-* knobs) or " LPV_TECHNIQUE_AUTO
+     " (the default: the\nplanner chooses from the scene and the preset, and says why)"},
     {"preset", 0, "NAME", "quality preset (default balanced; docs/accuracy.md):"},
     {"grid", 0, "N | NxMxK", "LPV cells per axis (default: the preset's)"},
     {"bounds", 0, "x0,y0,z0,x1,y1,z1", "grid bounds in m (default: the scene's bounds)"},
@@ -125,7 +126,7 @@ static void help_range(const lpv_field *f, char *buf, size_t n)
 
 const char *lpv_settings_flags_help(void)
 {
-    static char help[8192];
+    static char help[12288]; /* the knob table's lines: room to grow */
     if (help[0])
         return help;
     size_t len = 0, sz = sizeof help;
@@ -142,7 +143,7 @@ const char *lpv_settings_flags_help(void)
     lpv_flags_help(help, sz, &len, &OWN_SYNTAX[2], N_OWN - 2);
     lpv_flags_append(help, sz, &len,
                      "Knobs (docs/propagation.md, docs/shadows.md, docs/cascades.md, docs/effects.md,\n"
-                     "docs/area-lights.md, docs/imperfect-volumes.md):\n");
+                     "docs/area-lights.md, docs/imperfect-volumes.md, techniques/probes/README.md):\n");
     size_t count;
     const lpv_field *fields = lpv_fields(&count);
     for (size_t i = 0; i < count; ++i) {

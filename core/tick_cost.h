@@ -22,6 +22,11 @@
  * 33^3 LPV cells x 6 bins x 2 levels x 64 steps in 2 s). */
 #define LPV_TICK_COST_IV_RAYS_PER_STEP 4.0
 
+/* The probes trace about as many rays in the time as iv marches (one
+ * traversal of the BVH against one march through the voxels); a first
+ * figure until the front measures it (techniques/probes/README.md). */
+#define LPV_TICK_COST_PROBES_RAYS_PER_STEP 4.0
+
 typedef struct lpv_tick_cost {
     double cell_steps;  /* the bound */
     char terms[224];    /* how it is made, e.g. "grid 64x64x64 x 3 cascades x 6 normal bins x 16 iterations" */

@@ -59,7 +59,7 @@ int lpvd_option_takes_value(const char *name)
 
 const char *lpvd_options_help(void)
 {
-    static char help[12288];
+    static char help[20480];
     if (!help[0]) {
         size_t len = 0;
         lpv_flags_append(help, sizeof help, &len, "%sGL:\n", lpv_settings_flags_help());

@@ -697,5 +697,14 @@ struct LpvBvhNode {
 #define LPV_SSBO_PROBES_VERTS 12     /* vec4: triangle t's corners at 3t, 3t + 1, 3t + 2 */
 #define LPV_SSBO_PROBES_RAYS 13      /* probes_rays.comp: vec4 origin (w: tmax), vec4 direction per ray */
 #define LPV_SSBO_PROBES_HITS 14      /* probes_rays.comp: uvec4 per ray: t (bits), triangle id, hit, 0 */
+/* The technique's own (techniques/probes/gpu): the update's per-ray results
+ * (vec4: radiance rgb, w the hit distance, negative for a back face) share
+ * 13 with the test's rays; the lookup reads the last three, which no pass
+ * of the frame or the queries binds otherwise. */
+#define LPV_SSBO_PROBES_RAY_OUT 13
+#define LPV_SSBO_PROBES_MATERIALS 16 /* vec4 albedo (w: double-sided), vec4 emission per triangle */
+#define LPV_SSBO_PROBES_SH 17        /* LpvCell per probe: cell^2 x the L1 SH of the radiance by travel direction */
+#define LPV_SSBO_PROBES_MOMENTS 18   /* vec2 per texel of each probe's distance map: mean, mean square (m, m^2) */
+#define LPV_SSBO_PROBES_STATE 19     /* vec4 per probe: x back-face share of its last rays, y 1 = active */
 
 #endif /* LPV_SHARED_H */

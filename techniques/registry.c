@@ -10,6 +10,7 @@
 #include "iv_rules.h"
 #include "lpv_rules.h"
 #include "octree_rules.h"
+#include "probes_rules.h"
 
 static const lpv_technique_rules TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
     [LPV_TECHNIQUE_ID_DEFAULT] = {0}, /* not a row: resolves to LPV_TECHNIQUE_ID_DEFAULT_IS */
@@ -18,6 +19,7 @@ static const lpv_technique_rules TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
                                  lpv_octree_memory_floor},
     [LPV_TECHNIQUE_ID_IV] = {LPV_TECHNIQUE_IV, LPV_CAP_AO, 1, lpv_iv_tick_cost, NULL, NULL},
     [LPV_TECHNIQUE_ID_AUTO] = {LPV_TECHNIQUE_AUTO, 0, 0, NULL, NULL, NULL}, /* nothing until the engine chose */
+    [LPV_TECHNIQUE_ID_PROBES] = {LPV_TECHNIQUE_PROBES, 0, 0, lpv_probes_tick_cost, NULL, NULL},
 };
 
 const lpv_technique_rules *lpv_technique_rules_of(lpv_technique_id t)
@@ -45,7 +47,7 @@ const char *lpv_technique_name(lpv_technique_id t)
 
 const char *lpv_technique_names(void)
 {
-    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV ", " LPV_TECHNIQUE_AUTO; /* the table's names, in its order */
+    return LPV_TECHNIQUE_LPV ", " LPV_TECHNIQUE_OCTREE ", " LPV_TECHNIQUE_IV ", " LPV_TECHNIQUE_AUTO ", " LPV_TECHNIQUE_PROBES; /* the table's names, in its order */
 }
 
 int lpv_technique_validate(const lpv_settings *s, char *err, size_t err_size)

@@ -7,11 +7,12 @@
  * rows depend on nothing but headers.
  */
 #include "iv_rules.h"
+#include "probes_rules.h"
 #include "settings_fields.h"
 
 typedef const lpv_field *(*rows_fn)(size_t *count);
 
-static const rows_fn ROWS[] = {lpv_iv_fields};
+static const rows_fn ROWS[] = {lpv_iv_fields, lpv_probes_fields};
 
 const lpv_field *lpv_technique_fields(size_t k, size_t *count)
 {

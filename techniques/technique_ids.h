@@ -13,6 +13,7 @@
 #define LPV_TECHNIQUE_OCTREE "octree" /* octree light propagation volumes (techniques/octree/gpu/technique_octree.c) */
 #define LPV_TECHNIQUE_IV "iv"         /* imperfect volumes (techniques/iv/gpu/) */
 #define LPV_TECHNIQUE_AUTO "auto"     /* the planner chooses from the scene and the preset (core/plan.c) */
+#define LPV_TECHNIQUE_PROBES "probes" /* ray-traced irradiance probes with visibility (techniques/probes/) */
 
 /* Which technique computes the volume; 0 means "the default"
  * (LPV_TECHNIQUE_ID_DEFAULT_IS, below). The names, capabilities and tick
@@ -23,6 +24,7 @@ typedef enum lpv_technique_id {
     LPV_TECHNIQUE_ID_OCTREE = 2,
     LPV_TECHNIQUE_ID_IV = 3,
     LPV_TECHNIQUE_ID_AUTO = 4, /* not a class: the engine resolves it (lpv_technique_choose) */
+    LPV_TECHNIQUE_ID_PROBES = 5,
     LPV_TECHNIQUE_ID_COUNT_ /* one past the last; not a technique */
 } lpv_technique_id;
 

@@ -25,6 +25,7 @@ void lpv_plan_make_iv(const lpv_settings *s, const lpv_plan_facts *f, const lpv_
     for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
         if (i != LPV_PASS_RSM && i != LPV_PASS_GBUFFER)
             lpv_plan_decide(p, (lpv_pass_id)i, 0, "the LPV's (technique " LPV_TECHNIQUE_IV " gathers by ray marching)");
+    lpv_plan_decide(p, LPV_PASS_PROBES, 0, "the probes' (technique " LPV_TECHNIQUE_PROBES ")");
     if (!p->recompute) {
         for (int i = 0; i < LPV_PASS_COUNT; ++i)
             if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT)

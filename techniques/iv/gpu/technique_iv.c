@@ -271,6 +271,7 @@ static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part,
     case LPV_VOLUME_GEOMETRY:
     case LPV_VOLUME_TRANSMIT:
     case LPV_VOLUME_INDEX:
+    case LPV_VOLUME_VISIBILITY:
         return 0;
     }
     return 0;

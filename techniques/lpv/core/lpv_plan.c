@@ -34,6 +34,7 @@ void lpv_plan_make_lpv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan 
                                    p->recompute_reason, sizeof p->recompute_reason);
     for (int i = LPV_PASS_IV_POINTS; i <= LPV_PASS_IV_AO; ++i)
         lpv_plan_decide(p, (lpv_pass_id)i, 0, "the imperfect volume's (technique " LPV_TECHNIQUE_IV ")");
+    lpv_plan_decide(p, LPV_PASS_PROBES, 0, "the probes' (technique " LPV_TECHNIQUE_PROBES ")");
     if (!p->recompute) {
         for (int i = 0; i <= LPV_PASS_BOUNCE; ++i)
             lpv_plan_decide(p, (lpv_pass_id)i, 0, "%s", p->recompute_reason);

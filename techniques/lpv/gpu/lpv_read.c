@@ -68,6 +68,7 @@ size_t lpv_cascaded_read(lpv_cascaded *c, const lpv_plan *last, lpv_volume_part 
     case LPV_VOLUME_INDEX: /* one grid per cascade: no index volume */
     case LPV_VOLUME_IV_VOXELS:
     case LPV_VOLUME_AO:
+    case LPV_VOLUME_VISIBILITY:
         return 0;
     }
     return 0;

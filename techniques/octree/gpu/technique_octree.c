@@ -350,6 +350,7 @@ static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part,
     }
     case LPV_VOLUME_IV_VOXELS:
     case LPV_VOLUME_AO:
+    case LPV_VOLUME_VISIBILITY:
         return 0;
     case LPV_VOLUME_INDEX:
         return lpv_gl_read_buffer(o->index, sizeof(int32_t), o->merged_cells, out, max);

@@ -1,0 +1,60 @@
+/*
+ * probes_plan.c - the probes' plan and tick cost bound (probes_rules.h).
+ */
+#include "probes_rules.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "cascades.h"
+#include "lpv_shared.h"
+
+void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const lpv_probes_progress *g,
+                          lpv_plan *p)
+{
+    memset(p, 0, sizeof *p);
+    const int all = s->planner == LPV_SWITCH_OFF;
+    char why[LPV_PLAN_REASON_MAX];
+    p->cascades = lpv_plan_cascades(s, f, why, sizeof why);
+    snprintf(p->cascades_reason, sizeof p->cascades_reason, "%s: a probe per cell; %.90s", LPV_TECHNIQUE_PROBES, why);
+    lpv_plan_render_passes(s, f, p, all);
+    p->recompute = lpv_plan_needs_recompute(s, f, NULL, p->recompute_reason, sizeof p->recompute_reason);
+    /* the probes read none of the shared producers but the light block,
+     * which every tick fills: their rays see the scene itself */
+    for (int i = 0; i < LPV_PASS_PROBES; ++i)
+        if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT)
+            lpv_plan_decide(p, (lpv_pass_id)i, 0, "the probes trace the scene's triangles (technique %s)",
+                            LPV_TECHNIQUE_PROBES);
+    const int fresh = !g || !g->history;
+    if (all)
+        lpv_plan_decide(p, LPV_PASS_PROBES, 1, "planner off");
+    else if (p->recompute || fresh)
+        lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute ? p->recompute_reason : "no history",
+                        fresh ? "every probe, warmup passes" : "a budget of probes");
+    else if (g->sweeps < LPV_PROBES_SETTLE_SWEEPS) {
+        p->recompute = 1;
+        snprintf(p->recompute_reason, sizeof p->recompute_reason, LPV_PROBES_SETTLE_REASON " (%d of %d sweeps)", g->sweeps,
+                 LPV_PROBES_SETTLE_SWEEPS);
+        lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s", p->recompute_reason);
+    } else
+        lpv_plan_decide(p, LPV_PASS_PROBES, 0, "%s; the probes settled (%d sweeps since the last change)",
+                        p->recompute_reason, g->sweeps);
+}
+
+void lpv_probes_tick_cost(const lpv_settings *s, lpv_tick_cost *out)
+{
+    /* the cascades the planner may place (auto: the most it places) */
+    int cascades = s->lpv.cascades > 0 ? lpv_cascades_count(s, s->lpv.cascades) : lpv_cascades_count(s, 1);
+    if (s->lpv.cascades <= 0 && cascades < LPV_AUTO_CASCADES)
+        cascades = LPV_AUTO_CASCADES;
+    const double cells = lpv_settings_grid_cells(s) * (double)cascades;
+    const double per_pass = cells < (double)s->probes.budget ? cells : (double)s->probes.budget;
+    const double first = cells * (double)s->probes.warmup;
+    const double probes = first > per_pass ? first : per_pass;
+    out->cell_steps = probes * s->probes.rays / LPV_TICK_COST_PROBES_RAYS_PER_STEP;
+    snprintf(out->terms, sizeof out->terms,
+             "%.0f probes (the first tick: %d warmup passes over %.0f; then probes_budget %d) x %d rays / %g rays a "
+             "cell-step",
+             probes, s->probes.warmup, cells, s->probes.budget, s->probes.rays, LPV_TICK_COST_PROBES_RAYS_PER_STEP);
+    out->lower = "grid, probes_rays, probes_warmup or probes_budget";
+}

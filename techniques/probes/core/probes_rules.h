@@ -1,0 +1,47 @@
+/*
+ * probes_rules.h - the probes' CPU half beside their BVH (probes_bvh.h),
+ * ray math (probes_math.h) and CPU update (probes_update.h): the plan, the
+ * tick cost bound and the knob rows, which techniques/registry.c and
+ * technique_fields.c list.
+ */
+#ifndef LPV_PROBES_RULES_H
+#define LPV_PROBES_RULES_H
+
+#include "plan.h"
+#include "settings_fields.h"
+#include "tick_cost.h"
+
+/* The update's fixed shape (techniques/probes/README.md "The update"). */
+#define LPV_PROBES_SHARPNESS 50.0f   /* a ray's weight in a distance texel: max(0, cos)^this (the paper's) */
+#define LPV_PROBES_MOMENT_CELLS 2.0f /* the distance moments clamp hits at this many cells */
+#define LPV_PROBES_BACKFACE_OFF 0.25f /* a probe whose rays hit back faces more often is off */
+#define LPV_PROBES_BIAS_CELLS 0.25f  /* the lookup's point moves this far along the normal (cells) */
+#define LPV_PROBES_SEED 1u           /* the ray set's rotations (lpv_probes_rotation) */
+/* Updates of every probe after the last change before a static scene stops
+ * tracing: the old value's weight falls to hysteresis^this. */
+#define LPV_PROBES_SETTLE_SWEEPS 24
+/* The plan's recompute reason while they settle (the tick tells it from a change). */
+#define LPV_PROBES_SETTLE_REASON "the probes settle"
+
+/* The state the plan reads from the technique (the GPU class keeps it). */
+typedef struct lpv_probes_progress {
+    int history;  /* 1: the probes hold light from earlier ticks */
+    int sweeps;   /* full sweeps over every probe since the last change */
+    size_t probes;
+} lpv_probes_progress;
+
+/* The probes' plan: the shared producers (none but the frame's: the light
+ * block comes with every tick) and their pass, which runs on a change and
+ * until the probes settled. */
+void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const lpv_probes_progress *g,
+                          lpv_plan *out);
+
+/* Probes a tick (budget, or every probe of the grid's cascades on the
+ * first tick's warmup) x rays, at LPV_TICK_COST_PROBES_RAYS_PER_STEP a
+ * cell-step. */
+void lpv_probes_tick_cost(const lpv_settings *s, lpv_tick_cost *out);
+
+/* Its knob rows (probes_fields.c), *count of them. */
+const lpv_field *lpv_probes_fields(size_t *count);
+
+#endif

@@ -1,0 +1,559 @@
+/*
+ * technique_probes.c - ray-traced irradiance probes (issue 34; Majercik et
+ * al., "Dynamic Diffuse Global Illumination with Ray-Traced Irradiance
+ * Fields", JCGT 2019) on the technique seam (gpu/technique.h). Every pass is
+ * a compute shader:
+ *
+ *   sample_scene   the scene's triangles into a BVH (Embree's builder,
+ *                  core/probes_bvh.c) and each triangle's albedo and
+ *                  emission, uploaded as storage buffers
+ *   place/commit   a probe at the centre of every cell of the cascades the
+ *                  LPV would place (core/cascades.c, without the far
+ *                  field's hand-off: every cascade holds all its light)
+ *   tick           probes_update.comp traces a batch of probes' rays and
+ *                  shades the hits (direct light by shadow rays, the
+ *                  probes' own light for the next bounce), probes_blend.comp
+ *                  folds them into each probe's SH, distance moments and
+ *                  back-face share with the hysteresis. A volume without
+ *                  history runs probes_warmup passes over every probe (the
+ *                  bounces a single tick, e.g. lpvd render, sees); after
+ *                  that a tick updates probes_budget probes, round robin.
+ *   lookup         probes_lookup.glsl: 8 probes, visibility-weighted
+ *
+ * The volume is an LpvCell per probe in the cascades' layout, so the wire's
+ * volume and the clients' lookup are the LPV's (without the visibility).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cascades.h"
+#include "error.h"
+#include "gl_util.h"
+#include "material_sample.h"
+#include "probes_bvh.h"
+#include "probes_math.h"
+#include "probes_rules.h"
+#include "shader.h"
+#include "technique.h"
+
+extern const lpv_technique_class lpv_technique_probes;
+
+typedef struct lpv_probes_gpu {
+    lpv_technique base;
+    lpv_settings settings;
+    lpv_cascade_set cascades, pending;
+    GLuint prog_update, prog_blend;
+    GLuint grid_ubo;
+    /* the scene (sample_scene) */
+    GLuint nodes, leaf_tris, verts, materials;
+    size_t triangles;
+    float scene_size; /* m, the bounds' diagonal: the rays' reach */
+    /* the probes (commit) */
+    GLuint sh, moments, state, ray_out;
+    size_t probes, ray_out_rays;
+    int oct;
+    /* progress */
+    uint32_t tick_no;
+    size_t cursor;
+    lpv_probes_progress progress;
+    size_t updated, rays_traced; /* the last tick's */
+    size_t off;                  /* probes off (inside geometry) after the last warmup */
+} lpv_probes_gpu;
+
+static const char *const LOOKUP[] = {"probes_lookup.glsl", NULL};
+static const char *const INC_UPDATE[] = {"grid.glsl", "lights.glsl", "probes_trace.glsl", "probes_rays.glsl",
+                                         "probes_lookup.glsl", NULL};
+static const char *const INC_BLEND[] = {"grid.glsl", "probes_rays.glsl", NULL};
+
+static void free_scene(lpv_probes_gpu *g)
+{
+    GLuint *b[] = {&g->nodes, &g->leaf_tris, &g->verts, &g->materials};
+    for (size_t i = 0; i < sizeof b / sizeof b[0]; ++i)
+        lpv_gl_delete_buffer(b[i]);
+    g->triangles = 0;
+}
+
+static void free_probes(lpv_probes_gpu *g)
+{
+    GLuint *b[] = {&g->sh, &g->moments, &g->state, &g->ray_out};
+    for (size_t i = 0; i < sizeof b / sizeof b[0]; ++i)
+        lpv_gl_delete_buffer(b[i]);
+    g->probes = g->ray_out_rays = 0;
+    g->progress = (lpv_probes_progress){0};
+}
+
+static void destroy(lpv_technique *t)
+{
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    if (!g)
+        return;
+    free_scene(g);
+    free_probes(g);
+    if (g->prog_update)
+        glDeleteProgram(g->prog_update);
+    if (g->prog_blend)
+        glDeleteProgram(g->prog_blend);
+    lpv_gl_delete_buffer(&g->grid_ubo);
+    free(g);
+}
+
+static lpv_technique *create(char *err, size_t err_size)
+{
+    lpv_probes_gpu *g = calloc(1, sizeof *g);
+    if (!g)
+        return lpv_error(err, err_size, "out of memory"), NULL;
+    g->base.cls = &lpv_technique_probes;
+    g->prog_update = lpv_program_build("probes_update.comp", NULL, NULL, INC_UPDATE, err, err_size);
+    g->prog_blend = g->prog_update ? lpv_program_build("probes_blend.comp", NULL, NULL, INC_BLEND, err, err_size) : 0;
+    if (!g->prog_blend) {
+        destroy(&g->base);
+        return NULL;
+    }
+    glGenBuffers(1, &g->grid_ubo);
+    glBindBuffer(GL_UNIFORM_BUFFER, g->grid_ubo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(struct LpvGridParams), NULL, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
+    lpv_settings_resolve(&g->settings);
+    return &g->base;
+}
+
+static void configure(lpv_technique *t, const lpv_settings *s)
+{
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    g->settings = *s;
+}
+
+static void clear_zero(GLuint b)
+{
+    static const float zero = 0.0f;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
+    glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, &zero);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+}
+
+/* A storage buffer of n elements of `size` bytes from data (NULL: zeros);
+ * one element of padding when n is 0 (a bound buffer must not be empty). */
+static GLuint upload(const void *data, size_t n, size_t size)
+{
+    GLuint b = lpv_gl_new_ssbo((n ? n : 1) * size);
+    if (data && n) {
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * size), data);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    }
+    return b;
+}
+
+/* Each triangle's albedo (w: 1 = double-sided) and emission (W/(m^2 sr)) at
+ * its centroid's texture coordinates, in the order of the BVH's ids. */
+static void triangle_material(const lpv_scene *sc, const lpv_draw *d, const uint32_t *idx, float out[8])
+{
+    const lpv_material *m = &sc->materials[d->material];
+    float uv0[2] = {0, 0}, uv1[2] = {0, 0}, color[4] = {0, 0, 0, 0};
+    for (int v = 0; v < 3; ++v) {
+        const lpv_vertex *x = &sc->vertices[idx[v]];
+        for (int i = 0; i < 2; ++i) {
+            uv0[i] += x->uv[i] / 3.0f;
+            uv1[i] += x->uv1[i] / 3.0f;
+        }
+        for (int i = 0; i < 4; ++i)
+            color[i] += x->color[i] / 3.0f;
+    }
+    memset(out, 0, 8 * sizeof *out);
+    if (m->unlit) /* neither reflects nor emits (core/material_sample.h) */
+        return;
+    lpv_material_albedo_at(sc, m, uv0, uv1, d->vertex_color ? color : NULL, out);
+    out[3] = m->double_sided ? 1.0f : 0.0f;
+    lpv_material_emission_at(sc, m, uv0, uv1, out + 4);
+}
+
+static int sample_scene(lpv_technique *t, const lpv_technique_scene *in, char *err, size_t err_size)
+{
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    const lpv_scene *sc = in->geometry;
+    size_t tris = 0;
+    for (uint32_t k = 0; k < sc->draw_count; ++k)
+        if (sc->draws[k].mode == LPV_DRAW_TRIANGLES)
+            tris += sc->draws[k].index_count / 3;
+    float *pos = malloc((sc->vertex_count ? sc->vertex_count : 1) * 3 * sizeof *pos);
+    uint32_t *idx = malloc((tris ? tris : 1) * 3 * sizeof *idx);
+    float *mat = malloc((tris ? tris : 1) * 8 * sizeof *mat);
+    if (!pos || !idx || !mat) {
+        free(pos), free(idx), free(mat);
+        return lpv_error(err, err_size, "%s: out of memory for %zu triangles", LPV_TECHNIQUE_PROBES, tris);
+    }
+    for (uint32_t v = 0; v < sc->vertex_count; ++v)
+        memcpy(pos + 3 * v, sc->vertices[v].position, 3 * sizeof *pos);
+    size_t n = 0;
+    for (uint32_t k = 0; k < sc->draw_count; ++k) {
+        const lpv_draw *d = &sc->draws[k];
+        if (d->mode != LPV_DRAW_TRIANGLES)
+            continue;
+        for (uint32_t i = 0; i + 2 < d->index_count; i += 3, ++n) {
+            memcpy(idx + 3 * n, sc->indices + d->first_index + i, 3 * sizeof *idx);
+            triangle_material(sc, d, idx + 3 * n, mat + 8 * n);
+        }
+    }
+    lpv_probes_bvh bvh;
+    const int rc = lpv_probes_bvh_build(&bvh, pos, sc->vertex_count, idx, n, err, err_size);
+    free(pos);
+    free(idx);
+    if (rc != 0) {
+        free(mat);
+        return -1;
+    }
+    free_scene(g);
+    g->nodes = upload(bvh.nodes, bvh.node_count, sizeof *bvh.nodes);
+    g->leaf_tris = upload(bvh.leaf_tris, bvh.leaf_tri_count, sizeof *bvh.leaf_tris);
+    g->verts = upload(bvh.vertices, bvh.triangle_count * 3, 4 * sizeof(float));
+    g->materials = upload(mat, n, 8 * sizeof(float));
+    g->triangles = n;
+    free(mat);
+    lpv_probes_bvh_free(&bvh);
+    float d2 = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+        const float e = sc->bounds_max[i] - sc->bounds_min[i];
+        d2 += e > 0.0f ? e * e : 0.0f;
+    }
+    g->scene_size = sqrtf(d2) > 1e-3f ? sqrtf(d2) : 1e-3f;
+    g->progress.history = 0; /* a new scene: no light is right any more */
+    return 0;
+}
+
+/* The settings the cascades are placed with: the far field's hand-off
+ * splits one light between cascades, and every probe holds all of its. */
+static lpv_settings cascade_settings(const lpv_settings *s)
+{
+    lpv_settings c = *s;
+    c.lpv.far_field = LPV_SWITCH_OFF;
+    return c;
+}
+
+/* One grid over the bounds puts its first and last cell centres on the
+ * bounds (the LPV's cells straddle the walls): a probe there sits in the
+ * wall's plane and sees half of nothing. Shrinking the cells by (n - 1) / n
+ * about the grid's centre puts the outer probes half a cell inside. A
+ * camera-following cascade lands anywhere; relocating the probes it puts in
+ * walls is the README's "what is not here yet". */
+static void inset_grid(lpv_cascade_set *c)
+{
+    lpv_grid *g = &c->grid[0];
+    int n = g->dims[0] > g->dims[1] ? g->dims[0] : g->dims[1];
+    n = n > g->dims[2] ? n : g->dims[2];
+    if (n < 2)
+        return;
+    const float cell = g->cell_size * (float)(n - 1) / (float)n;
+    for (int i = 0; i < 3; ++i) {
+        const float centre = g->origin[i] + 0.5f * (float)g->dims[i] * g->cell_size;
+        g->origin[i] = centre - 0.5f * (float)g->dims[i] * cell;
+        c->origin_cells[0][i] = g->origin[i] / cell;
+    }
+    g->cell_size = cell;
+}
+
+static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, char *err, size_t err_size)
+{
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    const lpv_settings s = cascade_settings(w->settings);
+    char why[LPV_PLAN_REASON_MAX];
+    const int count = lpv_plan_cascades(&s, w->facts, why, sizeof why);
+    float f[3];
+    const float *fwd = w->forward;
+    if (fwd) {
+        const float len = sqrtf(fwd[0] * fwd[0] + fwd[1] * fwd[1] + fwd[2] * fwd[2]);
+        for (int i = 0; i < 3; ++i)
+            f[i] = len > 0.0f ? fwd[i] / len : 0.0f;
+        fwd = f;
+    }
+    if (lpv_cascades_place(&s, count, w->bounds_min, w->bounds_max, w->eye, fwd, w->facts->view_chord,
+                           &g->pending) != 0)
+        return lpv_error(err, err_size, "%s: %d cascades of %dx%dx%d probes cannot be placed", LPV_TECHNIQUE_PROBES,
+                         count, s.grid_dims[0], s.grid_dims[1], s.grid_dims[2]);
+    if (!g->pending.snapped && g->pending.count == 1)
+        inset_grid(&g->pending);
+    if (moved)
+        *moved = !lpv_cascades_equal(&g->pending, &g->cascades);
+    return 0;
+}
+
+static size_t probe_count(const lpv_cascade_set *c)
+{
+    return lpv_grid_cell_count(&c->grid[0]) * (size_t)(c->count > 0 ? c->count : 1);
+}
+
+static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, char *err, size_t err_size)
+{
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    const lpv_cascade_set *set = &g->pending;
+    const lpv_grid *grid = &set->grid[0];
+    const int moved = !lpv_cascades_equal(set, &g->cascades);
+    g->cascades = *set;
+    struct LpvGridParams params = {
+        .dims = {(float)grid->dims[0], (float)grid->dims[1], (float)grid->dims[2], (float)lpv_grid_cell_count(grid)},
+        .info = {(float)set->count, 0.0f, 1.0f, 0.0f},
+    };
+    for (int k = 0; k < set->count; ++k) {
+        for (int i = 0; i < 3; ++i)
+            params.cascade[k][i] = set->origin_cells[k][i];
+        params.cascade[k][3] = set->grid[k].cell_size;
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, g->grid_ubo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
+    const size_t n = probe_count(set);
+    const int oct = g->settings.probes.oct;
+    const size_t batch = (size_t)g->settings.probes.budget < n ? (size_t)g->settings.probes.budget : n;
+    const size_t rays = batch * (size_t)g->settings.probes.rays;
+    *reset = 0;
+    if (n == g->probes && oct == g->oct && rays == g->ray_out_rays) {
+        /* probes that moved with the camera hold another place's light:
+         * their history is gone (a whole-cell shift keeps most of it, which
+         * a later change may keep by moving the probes' data along) */
+        if (moved)
+            g->progress.history = 0;
+        return 0;
+    }
+    lpv_memory_need need = w->others;
+    need.cells += n;
+    if (lpv_memory_check(&need, w->limits, err, err_size) != 0)
+        return -1;
+    free_probes(g);
+    *reset = 1;
+    g->sh = lpv_gl_new_ssbo(n * sizeof(struct LpvCell));
+    g->moments = lpv_gl_new_ssbo(n * (size_t)oct * (size_t)oct * 2 * sizeof(float));
+    g->state = lpv_gl_new_ssbo(n * 4 * sizeof(float));
+    g->ray_out = lpv_gl_new_ssbo((rays ? rays : 1) * 4 * sizeof(float));
+    clear_zero(g->sh);
+    clear_zero(g->moments);
+    clear_zero(g->state);
+    g->probes = n;
+    g->oct = oct;
+    g->ray_out_rays = rays;
+    g->cursor = 0;
+    g->progress = (lpv_probes_progress){.probes = n};
+    return 0;
+}
+
+static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p)
+{
+    const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
+    const lpv_settings c = cascade_settings(s);
+    lpv_plan_make_probes(&c, f, &g->progress, p);
+}
+
+static void bind_scene(const lpv_probes_gpu *g)
+{
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_NODES, g->nodes);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_LEAF_TRIS, g->leaf_tris);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_VERTS, g->verts);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_MATERIALS, g->materials);
+}
+
+static void bind_probes(const lpv_probes_gpu *g)
+{
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, g->grid_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_SH, g->sh);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_MOMENTS, g->moments);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_STATE, g->state);
+}
+
+static void set_rotation(GLuint prog, uint32_t tick)
+{
+    float m[9];
+    lpv_probes_rotation(tick, LPV_PROBES_SEED, m);
+    glUniformMatrix3fv(glGetUniformLocation(prog, "u_rotation"), 1, GL_TRUE, m);
+}
+
+static void set_batch(GLuint prog, size_t first, size_t batch, size_t total, int rays)
+{
+    glUniform1ui(glGetUniformLocation(prog, "u_first"), (GLuint)first);
+    glUniform1ui(glGetUniformLocation(prog, "u_batch"), (GLuint)batch);
+    glUniform1ui(glGetUniformLocation(prog, "u_total"), (GLuint)total);
+    glUniform1ui(glGetUniformLocation(prog, "u_rays"), (GLuint)rays);
+}
+
+/* One batch: probes [first, first + batch) (mod the count) trace and blend. */
+static void run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t first, size_t batch, int feedback,
+                      float hysteresis, float moment_hysteresis)
+{
+    const lpv_probes_settings *ps = &g->settings.probes;
+    const size_t rays = batch * (size_t)ps->rays;
+    const uint32_t tick = g->tick_no++;
+    lpv_timer_begin(in->timer, "probes_trace");
+    glUseProgram(g->prog_update);
+    bind_scene(g);
+    bind_probes(g);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_RAY_OUT, g->ray_out);
+    set_batch(g->prog_update, first, batch, g->probes, ps->rays);
+    set_rotation(g->prog_update, tick);
+    glUniform1ui(glGetUniformLocation(g->prog_update, "u_tick"), tick);
+    glUniform1f(glGetUniformLocation(g->prog_update, "u_max_distance"), 2.0f * g->scene_size);
+    glUniform1f(glGetUniformLocation(g->prog_update, "u_eps"), 1e-4f * g->scene_size);
+    glUniform1f(glGetUniformLocation(g->prog_update, "u_emission"),
+                in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
+    glUniform1f(glGetUniformLocation(g->prog_update, "u_feedback"), feedback ? 1.0f : 0.0f);
+    static const float sky[3] = {0.0f, 0.0f, 0.0f}; /* no environment light yet */
+    glUniform3fv(glGetUniformLocation(g->prog_update, "u_sky"), 1, sky);
+    glUniform1i(glGetUniformLocation(g->prog_update, "u_probes_oct"), g->oct);
+    glUniform1f(glGetUniformLocation(g->prog_update, "u_probes_bias"), LPV_PROBES_BIAS_CELLS);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up(rays, LPV_PROBES_WG), 1, 1);
+    lpv_timer_count(in->timer, 1);
+    lpv_timer_end(in->timer);
+
+    lpv_timer_begin(in->timer, "probes_blend");
+    glUseProgram(g->prog_blend);
+    set_batch(g->prog_blend, first, batch, g->probes, ps->rays);
+    set_rotation(g->prog_blend, tick);
+    glUniform1i(glGetUniformLocation(g->prog_blend, "u_oct"), g->oct);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_hysteresis"), hysteresis);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_hysteresis"), moment_hysteresis);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_sharpness"), LPV_PROBES_SHARPNESS);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_cells"), LPV_PROBES_MOMENT_CELLS);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_backface_off"), LPV_PROBES_BACKFACE_OFF);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glDispatchCompute(lpv_div_up(batch, LPV_PROBES_WG), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    lpv_timer_count(in->timer, 1);
+    lpv_timer_end(in->timer);
+    g->updated += batch;
+    g->rays_traced += rays;
+}
+
+/* Probes the last blend turned off (state.y 0): read back once a warmup. */
+static size_t count_off(const lpv_probes_gpu *g)
+{
+    float *st = malloc(g->probes * 4 * sizeof *st);
+    size_t off = 0;
+    if (!st)
+        return 0;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    const size_t n = lpv_gl_read_buffer(g->state, 4 * sizeof(float), g->probes, st, g->probes);
+    for (size_t i = 0; i < n; ++i)
+        off += st[4 * i + 1] == 0.0f;
+    free(st);
+    return off;
+}
+
+static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
+{
+    (void)err;
+    (void)err_size;
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    const lpv_plan *p = in->plan;
+    g->updated = g->rays_traced = 0;
+    if (!p->pass[LPV_PASS_PROBES].run || !g->probes)
+        return 0;
+    const lpv_probes_settings *ps = &g->settings.probes;
+    const size_t batch = g->ray_out_rays / (size_t)ps->rays;
+    if (!g->progress.history) {
+        /* every probe, warmup passes: pass b's hits read pass b - 1's
+         * probes; the rotations start over, so a fresh volume's light does
+         * not depend on what the technique did before */
+        g->tick_no = 0;
+        for (int pass = 0; pass < ps->warmup; ++pass)
+            for (size_t first = 0; first < g->probes; first += batch)
+                run_batch(g, in, first, g->probes - first < batch ? g->probes - first : batch, pass > 0, 0.0f,
+                          (float)pass / (float)(pass + 1));
+        g->off = count_off(g);
+        g->cursor = 0;
+        g->progress.history = 1;
+        g->progress.sweeps = 0;
+    } else {
+        if (p->recompute && strncmp(p->recompute_reason, LPV_PROBES_SETTLE_REASON,
+                                    sizeof LPV_PROBES_SETTLE_REASON - 1) != 0)
+            g->progress.sweeps = 0; /* a change: settle again */
+        run_batch(g, in, g->cursor, batch, 1, ps->hysteresis, ps->hysteresis);
+        g->cursor += batch;
+        if (g->cursor >= g->probes) {
+            g->cursor %= g->probes;
+            ++g->progress.sweeps;
+        }
+    }
+    glUseProgram(0);
+    return 0;
+}
+
+static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
+{
+    const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
+    glUniform1f(glGetUniformLocation(prog, "u_damping"), damping);
+    glUniform1i(glGetUniformLocation(prog, "u_probes_oct"), g->oct > 0 ? g->oct : 1);
+    glUniform1f(glGetUniformLocation(prog, "u_probes_bias"), LPV_PROBES_BIAS_CELLS);
+    bind_probes(g);
+}
+
+static void describe(const lpv_technique *t, lpv_volume_desc *d)
+{
+    const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
+    memset(d, 0, sizeof *d);
+    d->technique = lpv_technique_probes.name;
+    d->levels = g->cascades.count > 0 ? g->cascades.count : 1;
+    for (int k = 0; k < d->levels && k < g->cascades.count; ++k) {
+        d->level[k] = g->cascades.grid[k];
+        memcpy(d->origin_cells[k], g->cascades.origin_cells[k], sizeof d->origin_cells[k]);
+    }
+    d->volumes_per_level = 1;
+    d->values_per_cell = 12;
+    d->kind = LPV_LEVELS_CASCADES;
+    d->units = "W/sr";
+    d->visibility_side = g->oct;
+}
+
+static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part, lpv_grid_which which, void *out,
+                   size_t max)
+{
+    (void)last;
+    (void)which;
+    lpv_probes_gpu *g = (lpv_probes_gpu *)t;
+    if (!g->sh)
+        return 0;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (part == LPV_VOLUME_VISIBILITY)
+        return lpv_gl_read_buffer(g->moments, sizeof(float), g->probes * (size_t)g->oct * (size_t)g->oct * 2, out, max);
+    if (part != LPV_VOLUME_SUMMED && part != LPV_VOLUME_STORED)
+        return 0;
+    return lpv_gl_read_buffer(g->sh, sizeof(struct LpvCell), g->probes, out, max);
+}
+
+static void memory_need(const lpv_technique *t, lpv_memory_need *n)
+{
+    const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
+    n->cells += g->probes;
+    n->cascades = g->cascades.count;
+    memcpy(n->grid_dims, g->cascades.grid[0].dims, sizeof n->grid_dims);
+}
+
+static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats *s)
+{
+    (void)last;
+    const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
+    s->cascades = g->cascades.count;
+    s->cells = g->probes;
+    s->cell_steps = (double)g->rays_traced / LPV_TICK_COST_PROBES_RAYS_PER_STEP;
+    lpv_stats_put(s, "probes_updated", LPV_STAT_INT, (double)g->updated, 0, 0);
+    lpv_stats_put(s, "probes_rays", LPV_STAT_INT, (double)g->rays_traced, 0, 0);
+    lpv_stats_put(s, "probes_off", LPV_STAT_INT, (double)g->off, 0, 0);
+    lpv_stats_put(s, "probes_sweeps", LPV_STAT_INT, (double)g->progress.sweeps, 0, 0);
+    lpv_stats_put(s, "probes_triangles", LPV_STAT_INT, (double)g->triangles, 0, 0);
+}
+
+const lpv_technique_class lpv_technique_probes = {
+    .name = LPV_TECHNIQUE_PROBES,
+    .lookup_includes = LOOKUP,
+    .create = create,
+    .destroy = destroy,
+    .configure = configure,
+    .sample_scene = sample_scene,
+    .place = place,
+    .commit = commit,
+    .plan = plan,
+    .tick = tick,
+    .bind_lookup = bind_lookup,
+    .describe = describe,
+    .read = read,
+    .memory_need = memory_need,
+    .stats = stats,
+};

