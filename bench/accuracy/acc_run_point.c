@@ -40,6 +40,10 @@ static void octree_metric(lpv_engine *engine, lpv_octree_error *out)
     lpv_octree_free(&o);
 }
 
+/* Techniques whose error images name them (lpv's and the presets' do not:
+ * their names predate the others). */
+static int named_file(lpv_technique_id t) { return t == LPV_TECHNIQUE_ID_OCTREE || t == LPV_TECHNIQUE_ID_PROBES; }
+
 int acc_run_point(acc_run *c, const acc_scene_run *x, int p)
 {
     const acc_args *a = c->a;
@@ -161,7 +165,8 @@ settings_made:
     if (lpv_acc_compare(x->rgba, x->cref, x->cref_se, x->view->width, x->view->height, &res->m) != 0)
         fprintf(stderr, "lpvd-accuracy: %s: warning: no pixel seen by both the converged reference and "
                         "lpvd\n", x->se->name);
-    if (iv_all) {
+    /* the probes' feedback carries every bounce too (techniques/probes/README.md) */
+    if (iv_all || c->pts[p].technique == LPV_TECHNIQUE_ID_PROBES) {
         res->own = res->m;
         res->ref_bounces = 0;
     }
@@ -183,8 +188,8 @@ settings_made:
     else
         snprintf(ep, sizeof ep, "%s/g%d-i%d-r%d-occ%s-%s%s%s%s.png", x->sub, c->pts[p].grid, c->pts[p].iterations,
                  c->pts[p].rsm, acc_occ_name(c->pts[p].occlusion), acc_mods_name(c->pts[p].mods, (char[5]){0}),
-                 c->pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? "-" : "",
-                 c->pts[p].technique == LPV_TECHNIQUE_ID_OCTREE ? acc_tech_name(c->pts[p].technique) : "",
+                 named_file(c->pts[p].technique) ? "-" : "",
+                 named_file(c->pts[p].technique) ? acc_tech_name(c->pts[p].technique) : "",
                  acc_steps_text(&c->pts[p], 1, (char[48]){0}));
     if (lpv_acc_write_error_png(ep, x->rgba, cmp_ref, x->view->width, x->view->height, res->m.mean_ref, c->err,
                                 sizeof c->err) != 0)
@@ -217,13 +222,13 @@ settings_made:
         fprintf(stderr,
                 "lpvd-accuracy: %s %d/%d: %s, grid %d, iterations %d, rsm %d, occlusion %s, mods %s%s: "
                 "%.2f ms/tick, rel_rmse %.4f, rel_bias %+.4f vs converged%s (ref_noise2 %.4f); %.4f %+.4f vs "
-                "%d bounce(s)%s%s\n",
+                "%s%s%s\n",
                 x->se->name, p + 1, c->npts, acc_tech_name(c->pts[p].technique), c->pts[p].grid, c->pts[p].iterations, c->pts[p].rsm,
                 acc_occ_name(c->pts[p].occlusion), acc_mods_name(c->pts[p].mods, (char[5]){0}),
                 acc_steps_text(&c->pts[p], 0, (char[48]){0}),
                 res->ms_total, res->m.rel_rmse, res->m.rel_bias,
                 res->at_noise ? " (at the reference's noise)" : "", x->se->ref_noise2, res->own.rel_rmse,
-                res->own.rel_bias, res->ref_bounces, c->pts[p].feat ? "; " : "",
+                res->own.rel_bias, acc_own_text(res->ref_bounces, (char[32]){0}), c->pts[p].feat ? "; " : "",
                 c->pts[p].label);
     ++c->nres;
     return 0;
