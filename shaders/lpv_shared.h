@@ -706,5 +706,18 @@ struct LpvBvhNode {
 #define LPV_SSBO_PROBES_SH 17        /* LpvCell per probe: cell^2 x the L1 SH of the radiance by travel direction */
 #define LPV_SSBO_PROBES_MOMENTS 18   /* vec2 per texel of each probe's distance map: mean, mean square (m, m^2) */
 #define LPV_SSBO_PROBES_STATE 19     /* vec4 per probe: x back-face share of its last rays, y 1 = active */
+/* A batch's ray table (the same for every probe of the batch; the CPU makes
+ * it with probes_math.h's functions): each ray's direction, then for the
+ * distance moments each texel's (first, count) of taps and the taps (ray,
+ * weight bits), the weights max(0, cos)^sharpness normalised per texel. */
+#define LPV_SSBO_PROBES_RAY_DIRS 20  /* vec4 per ray: xyz its unit direction */
+#define LPV_SSBO_PROBES_TAPS 21      /* uvec2: the distance map's oct^2 texel ranges, the irradiance map's
+                                        LPV_PROBES_IRR_OCT^2, then the taps */
+/* Each probe's irradiance map (Majercik et al. 2019: irradiance per
+ * direction, not L1 SH, is what the server's lookup reads: L1 loses a
+ * quarter of a small bright source's light and lights surfaces that face
+ * darkness). The volume on the wire keeps the SH. */
+#define LPV_SSBO_PROBES_IRRADIANCE 22 /* float: rgb (W/m^2) per texel of each probe's irradiance map */
+#define LPV_PROBES_IRR_OCT 6          /* its texels per side (the paper's) */
 
 #endif /* LPV_SHARED_H */

@@ -14,7 +14,7 @@ static const lpv_field PROBES_FIELDS[] = {
     {"probes_rays", "probes-rays", LPV_FIELD_INT, F(probes.rays), 1, LPV_PROBES_MAX_RAYS, 0, "", D(64), "",
      "rays a probe traces per update (stratified, turned every tick)", T_VOL, LPV_TECHNIQUE_PROBES},
     {"probes_budget", "probes-budget", LPV_FIELD_INT, F(probes.budget), 1, LPV_PROBES_MAX_BUDGET, 0, "probes",
-     D(4096), "", "probes updated per tick once the volume has history (a cheaper tick, slower to follow a change)",
+     D(1024), "", "probes updated per tick once the volume has history (a cheaper tick, slower to follow a change)",
      T_VOL, LPV_TECHNIQUE_PROBES},
     {"probes_hysteresis", "probes-hysteresis", LPV_FIELD_FLOAT, F(probes.hysteresis), 0, 0.99, 1, "", D(0.9), "",
      "weight of a probe's old light in an update (lowered where the light changed)", T_VOL, LPV_TECHNIQUE_PROBES},

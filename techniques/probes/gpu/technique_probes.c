@@ -34,6 +34,7 @@
 #include "probes_bvh.h"
 #include "probes_math.h"
 #include "probes_rules.h"
+#include "probes_table.h"
 #include "shader.h"
 #include "technique.h"
 
@@ -50,7 +51,9 @@ typedef struct lpv_probes_gpu {
     size_t triangles;
     float scene_size; /* m, the bounds' diagonal: the rays' reach */
     /* the probes (commit) */
-    GLuint sh, moments, state, ray_out;
+    GLuint sh, moments, state, ray_out, irradiance;
+    GLuint ray_dirs, taps; /* the batch's ray table */
+    lpv_probes_table table;
     size_t probes, ray_out_rays;
     int oct;
     /* progress */
@@ -62,9 +65,8 @@ typedef struct lpv_probes_gpu {
 } lpv_probes_gpu;
 
 static const char *const LOOKUP[] = {"probes_lookup.glsl", NULL};
-static const char *const INC_UPDATE[] = {"grid.glsl", "lights.glsl", "probes_trace.glsl", "probes_rays.glsl",
-                                         "probes_lookup.glsl", NULL};
-static const char *const INC_BLEND[] = {"grid.glsl", "probes_rays.glsl", NULL};
+static const char *const INC_UPDATE[] = {"grid.glsl", "lights.glsl", "probes_trace.glsl", "probes_lookup.glsl", NULL};
+static const char *const INC_BLEND[] = {"grid.glsl", NULL};
 
 static void free_scene(lpv_probes_gpu *g)
 {
@@ -76,7 +78,7 @@ static void free_scene(lpv_probes_gpu *g)
 
 static void free_probes(lpv_probes_gpu *g)
 {
-    GLuint *b[] = {&g->sh, &g->moments, &g->state, &g->ray_out};
+    GLuint *b[] = {&g->sh, &g->moments, &g->state, &g->ray_out, &g->ray_dirs, &g->taps, &g->irradiance};
     for (size_t i = 0; i < sizeof b / sizeof b[0]; ++i)
         lpv_gl_delete_buffer(b[i]);
     g->probes = g->ray_out_rays = 0;
@@ -95,6 +97,7 @@ static void destroy(lpv_technique *t)
     if (g->prog_blend)
         glDeleteProgram(g->prog_blend);
     lpv_gl_delete_buffer(&g->grid_ubo);
+    lpv_probes_table_free(&g->table);
     free(g);
 }
 
@@ -323,10 +326,12 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     g->sh = lpv_gl_new_ssbo(n * sizeof(struct LpvCell));
     g->moments = lpv_gl_new_ssbo(n * (size_t)oct * (size_t)oct * 2 * sizeof(float));
     g->state = lpv_gl_new_ssbo(n * 4 * sizeof(float));
+    g->irradiance = lpv_gl_new_ssbo(n * LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT * 3 * sizeof(float));
     g->ray_out = lpv_gl_new_ssbo((rays ? rays : 1) * 4 * sizeof(float));
     clear_zero(g->sh);
     clear_zero(g->moments);
     clear_zero(g->state);
+    clear_zero(g->irradiance);
     g->probes = n;
     g->oct = oct;
     g->ray_out_rays = rays;
@@ -356,13 +361,21 @@ static void bind_probes(const lpv_probes_gpu *g)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_SH, g->sh);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_MOMENTS, g->moments);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_STATE, g->state);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_IRRADIANCE, g->irradiance);
 }
 
-static void set_rotation(GLuint prog, uint32_t tick)
+/* The batch's ray table (probes_table.h) into its two buffers. */
+static int upload_table(lpv_probes_gpu *g, uint32_t tick)
 {
-    float m[9];
-    lpv_probes_rotation(tick, LPV_PROBES_SEED, m);
-    glUniformMatrix3fv(glGetUniformLocation(prog, "u_rotation"), 1, GL_TRUE, m);
+    const lpv_probes_settings *ps = &g->settings.probes;
+    if (lpv_probes_table_make(&g->table, tick, LPV_PROBES_SEED, (uint32_t)ps->rays, g->oct, LPV_PROBES_SHARPNESS,
+                              LPV_PROBES_IRR_OCT) != 0)
+        return -1;
+    lpv_gl_delete_buffer(&g->ray_dirs);
+    lpv_gl_delete_buffer(&g->taps);
+    g->ray_dirs = upload(g->table.dirs, (size_t)ps->rays, 4 * sizeof(float));
+    g->taps = upload(g->table.taps, g->table.tap_words, sizeof(uint32_t));
+    return 0;
 }
 
 static void set_batch(GLuint prog, size_t first, size_t batch, size_t total, int rays)
@@ -374,12 +387,14 @@ static void set_batch(GLuint prog, size_t first, size_t batch, size_t total, int
 }
 
 /* One batch: probes [first, first + batch) (mod the count) trace and blend. */
-static void run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t first, size_t batch, int feedback,
-                      float hysteresis, float moment_hysteresis)
+static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t first, size_t batch, int feedback,
+                     float hysteresis, float moment_hysteresis)
 {
     const lpv_probes_settings *ps = &g->settings.probes;
     const size_t rays = batch * (size_t)ps->rays;
     const uint32_t tick = g->tick_no++;
+    if (upload_table(g, tick) != 0)
+        return -1;
     lpv_timer_begin(in->timer, "probes_trace");
     glUseProgram(g->prog_update);
     bind_scene(g);
@@ -387,7 +402,8 @@ static void run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t 
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_RAY_OUT, g->ray_out);
     set_batch(g->prog_update, first, batch, g->probes, ps->rays);
-    set_rotation(g->prog_update, tick);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_RAY_DIRS, g->ray_dirs);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_TAPS, g->taps);
     glUniform1ui(glGetUniformLocation(g->prog_update, "u_tick"), tick);
     glUniform1f(glGetUniformLocation(g->prog_update, "u_max_distance"), 2.0f * g->scene_size);
     glUniform1f(glGetUniformLocation(g->prog_update, "u_eps"), 1e-4f * g->scene_size);
@@ -406,11 +422,9 @@ static void run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t 
     lpv_timer_begin(in->timer, "probes_blend");
     glUseProgram(g->prog_blend);
     set_batch(g->prog_blend, first, batch, g->probes, ps->rays);
-    set_rotation(g->prog_blend, tick);
     glUniform1i(glGetUniformLocation(g->prog_blend, "u_oct"), g->oct);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_hysteresis"), hysteresis);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_hysteresis"), moment_hysteresis);
-    glUniform1f(glGetUniformLocation(g->prog_blend, "u_sharpness"), LPV_PROBES_SHARPNESS);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_cells"), LPV_PROBES_MOMENT_CELLS);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_backface_off"), LPV_PROBES_BACKFACE_OFF);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -420,6 +434,7 @@ static void run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t 
     lpv_timer_end(in->timer);
     g->updated += batch;
     g->rays_traced += rays;
+    return 0;
 }
 
 /* Probes the last blend turned off (state.y 0): read back once a warmup. */
@@ -439,8 +454,6 @@ static size_t count_off(const lpv_probes_gpu *g)
 
 static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
 {
-    (void)err;
-    (void)err_size;
     lpv_probes_gpu *g = (lpv_probes_gpu *)t;
     const lpv_plan *p = in->plan;
     g->updated = g->rays_traced = 0;
@@ -455,8 +468,9 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         g->tick_no = 0;
         for (int pass = 0; pass < ps->warmup; ++pass)
             for (size_t first = 0; first < g->probes; first += batch)
-                run_batch(g, in, first, g->probes - first < batch ? g->probes - first : batch, pass > 0, 0.0f,
-                          (float)pass / (float)(pass + 1));
+                if (run_batch(g, in, first, g->probes - first < batch ? g->probes - first : batch, pass > 0, 0.0f,
+                              (float)pass / (float)(pass + 1)) != 0)
+                    return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->off = count_off(g);
         g->cursor = 0;
         g->progress.history = 1;
@@ -465,7 +479,8 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         if (p->recompute && strncmp(p->recompute_reason, LPV_PROBES_SETTLE_REASON,
                                     sizeof LPV_PROBES_SETTLE_REASON - 1) != 0)
             g->progress.sweeps = 0; /* a change: settle again */
-        run_batch(g, in, g->cursor, batch, 1, ps->hysteresis, ps->hysteresis);
+        if (run_batch(g, in, g->cursor, batch, 1, ps->hysteresis, ps->hysteresis) != 0)
+            return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->cursor += batch;
         if (g->cursor >= g->probes) {
             g->cursor %= g->probes;

@@ -3,7 +3,9 @@
 // of a uniform set), times cell^2 by travel direction as the lookup reads
 // it; the mean and mean square of the hit distance per texel of the
 // octahedral map, each ray weighted max(0, cos)^sharpness about the texel's
-// direction and clamped at a few cells; and the share of rays that met a
+// direction (the batch's taps: the weights are the same for every probe, so
+// the CPU lists each texel's rays that count and their normalised weights)
+// and clamped at a few cells; and the share of rays that met a
 // back face, which turns the probe off past a threshold. The light is
 // blended into the probe's old value with the hysteresis, lowered where the
 // light changed by much (Majercik et al. 2021: fast where light changed,
@@ -16,23 +18,16 @@ layout(std430, binding = LPV_SSBO_PROBES_RAY_OUT) readonly buffer ProbesRayOut {
 layout(std430, binding = LPV_SSBO_PROBES_SH) buffer ProbesSH { LpvCell probes_sh[]; };
 layout(std430, binding = LPV_SSBO_PROBES_MOMENTS) buffer ProbesMoments { vec2 probes_moments[]; };
 layout(std430, binding = LPV_SSBO_PROBES_STATE) buffer ProbesState { vec4 probes_state[]; };
+layout(std430, binding = LPV_SSBO_PROBES_RAY_DIRS) readonly buffer ProbesRayDirs { vec4 probes_ray_dirs[]; };
+layout(std430, binding = LPV_SSBO_PROBES_TAPS) readonly buffer ProbesTaps { uvec2 probes_taps[]; };
+layout(std430, binding = LPV_SSBO_PROBES_IRRADIANCE) buffer ProbesIrradiance { float probes_irradiance[]; };
 
 uniform uint u_first, u_batch, u_total, u_rays;
 uniform int u_oct;
 uniform float u_hysteresis;    // 0: the rays replace the old value
 uniform float u_moment_hysteresis; // the same for the distances, which only moving geometry changes
-uniform float u_sharpness;
 uniform float u_moment_cells;  // the moments clamp distances at this many of the probe's cells
 uniform float u_backface_off;  // a probe whose share of back faces exceeds it is off
-
-vec3 probes_texel_dir(int x, int y, int s)
-{
-    vec2 uv = (vec2(x, y) + 0.5) / float(s) * 2.0 - 1.0;
-    vec3 d = vec3(uv, 1.0 - abs(uv.x) - abs(uv.y));
-    if (d.z < 0.0)
-        d.xy = (1.0 - abs(d.yx)) * vec2(d.x >= 0.0 ? 1.0 : -1.0, d.y >= 0.0 ? 1.0 : -1.0);
-    return normalize(d);
-}
 
 void main()
 {
@@ -48,7 +43,7 @@ void main()
     for (uint i = 0u; i < u_rays; ++i) {
         vec4 o = ray_out[first + i];
         back += o.w < 0.0 ? 1u : 0u;
-        vec4 y = sh_basis(-probes_ray_dir(i, u_rays)); // travel direction: from the hit to the probe
+        vec4 y = sh_basis(-probes_ray_dirs[i].xyz); // travel direction: from the hit to the probe
         r += o.r * y;
         g += o.g * y;
         b += o.b * y;
@@ -67,22 +62,35 @@ void main()
     }
     probes_sh[probe] = LpvCell(mix(r, old.r, h), mix(g, old.g, h), mix(b, old.b, h));
 
-    int s = u_oct;
-    for (int ty = 0; ty < s; ++ty)
-        for (int tx = 0; tx < s; ++tx) {
-            vec3 td = probes_texel_dir(tx, ty, s);
-            vec3 m = vec3(0.0); // weighted t, t^2, weight
-            for (uint i = 0u; i < u_rays; ++i) {
-                float c = dot(td, probes_ray_dir(i, u_rays));
-                if (c <= 0.0)
-                    continue;
-                float wt = pow(c, u_sharpness), t = min(abs(ray_out[first + i].w), mmax);
-                m += wt * vec3(t, t * t, 1.0);
-            }
-            vec2 fresh = m.z > 0.0 ? m.xy / m.z : vec2(mmax, mmax * mmax);
-            uint at = probe * uint(s * s) + uint(ty * s + tx);
-            probes_moments[at] = mix(fresh, probes_moments[at], u_moment_hysteresis);
+    int texels = u_oct * u_oct;
+    for (int t = 0; t < texels; ++t) {
+        uvec2 range = probes_taps[t];
+        vec2 m = vec2(0.0), fresh = vec2(mmax, mmax * mmax); // a texel no ray weighs: as far as the clamp
+        for (uint k = range.x; k < range.x + range.y; ++k) {
+            uvec2 tap = probes_taps[k];
+            float d = min(abs(ray_out[first + tap.x].w), mmax);
+            m += uintBitsToFloat(tap.y) * vec2(d, d * d);
         }
+        if (range.y > 0u)
+            fresh = m;
+        uint at = probe * uint(texels) + uint(t);
+        probes_moments[at] = mix(fresh, probes_moments[at], u_moment_hysteresis);
+    }
+    // the irradiance map: each texel's rays (cos > 0) weighted pi cos / sum cos
+    const int irr = LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT;
+    for (int t = 0; t < irr; ++t) {
+        uvec2 range = probes_taps[texels + t];
+        vec3 e = vec3(0.0);
+        for (uint k = range.x; k < range.x + range.y; ++k) {
+            uvec2 tap = probes_taps[k];
+            e += uintBitsToFloat(tap.y) * ray_out[first + tap.x].rgb;
+        }
+        uint at = 3u * (probe * uint(irr) + uint(t));
+        vec3 v = mix(e, vec3(probes_irradiance[at], probes_irradiance[at + 1u], probes_irradiance[at + 2u]), h);
+        probes_irradiance[at] = v.r;
+        probes_irradiance[at + 1u] = v.g;
+        probes_irradiance[at + 2u] = v.b;
+    }
     float share = float(back) / float(u_rays);
     probes_state[probe] = vec4(share, share > u_backface_off ? 0.0 : 1.0, 0.0, 0.0);
 }

@@ -5,9 +5,11 @@
 // a ray's hit reads the probes' light of the pass before (more bounces).
 //
 // A probe sits at the centre of every cell of every cascade (grid.glsl's
-// placement). Its light is cell^2 x the L1 SH of the radiance it saw, by
-// travel direction: an LpvCell in the cascaded LPV's convention, so the
-// volume on the wire and the clients' lookup are the LPV's. A surface at p
+// placement). It keeps its irradiance per texel of an octahedral map
+// (LPV_PROBES_IRR_OCT a side), which this lookup reads, and cell^2 x the L1
+// SH of the radiance it saw, by travel direction: an LpvCell in the
+// cascaded LPV's convention, the volume on the wire, whose lookup by the
+// clients is the LPV's, and lpv_project's here. A surface at p
 // facing n blends the 8 probes around p + bias n (Majercik et al. 2019,
 // section 4): trilinear weights, times a smooth back-face term (a probe
 // behind the surface counts less), times the Chebyshev bound from the
@@ -19,6 +21,7 @@
 layout(std430, binding = LPV_SSBO_PROBES_SH) readonly buffer ProbesSH { LpvCell probes_sh[]; };
 layout(std430, binding = LPV_SSBO_PROBES_MOMENTS) readonly buffer ProbesMoments { vec2 probes_moments[]; };
 layout(std430, binding = LPV_SSBO_PROBES_STATE) readonly buffer ProbesState { vec4 probes_state[]; };
+layout(std430, binding = LPV_SSBO_PROBES_IRRADIANCE) readonly buffer ProbesIrradiance { float probes_irradiance[]; };
 uniform int u_probes_oct;       // texels per side of a probe's distance map
 uniform float u_probes_bias;    // cells: how far along n the surface's point moves before it looks up
 uniform float u_damping;        // the seam's; the probes' visibility takes its place (unused)
@@ -41,19 +44,40 @@ vec3 probes_oct_decode(vec2 uv)
     return normalize(d);
 }
 
-// Probe `probe`'s distance moments toward unit d: bilinear between the
-// four texel centres around d's place on the map, clamped at its edge.
+// Bilinear weights over the four texel centres around unit d's place on
+// a side x side octahedral map, clamped at its edge: texel indices in i.
+vec4 probes_oct_bilinear(int side, vec3 d, out ivec4 i)
+{
+    vec2 st = clamp((probes_oct_encode(d) * 0.5 + 0.5) * float(side) - 0.5, vec2(0.0), vec2(float(side - 1)));
+    ivec2 b = min(ivec2(floor(st)), ivec2(max(side - 2, 0)));
+    vec2 f = st - vec2(b);
+    ivec2 b1 = min(b + 1, ivec2(side - 1));
+    i = ivec4(b.y * side + b.x, b.y * side + b1.x, b1.y * side + b.x, b1.y * side + b1.x);
+    return vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+}
+
+// Probe `probe`'s distance moments toward unit d.
 vec2 probes_moments_toward(int probe, vec3 d)
 {
-    int s = u_probes_oct;
-    vec2 st = clamp((probes_oct_encode(d) * 0.5 + 0.5) * float(s) - 0.5, vec2(0.0), vec2(float(s - 1)));
-    ivec2 b = min(ivec2(floor(st)), ivec2(max(s - 2, 0)));
-    vec2 f = st - vec2(b);
-    int base = probe * s * s;
-    ivec2 b1 = min(b + 1, ivec2(s - 1));
-    vec2 m00 = probes_moments[base + b.y * s + b.x], m10 = probes_moments[base + b.y * s + b1.x];
-    vec2 m01 = probes_moments[base + b1.y * s + b.x], m11 = probes_moments[base + b1.y * s + b1.x];
-    return mix(mix(m00, m10, f.x), mix(m01, m11, f.x), f.y);
+    ivec4 i;
+    vec4 w = probes_oct_bilinear(u_probes_oct, d, i);
+    int base = probe * u_probes_oct * u_probes_oct;
+    return w.x * probes_moments[base + i.x] + w.y * probes_moments[base + i.y] + w.z * probes_moments[base + i.z] +
+           w.w * probes_moments[base + i.w];
+}
+
+// Probe `probe`'s irradiance (W/m^2) on a surface facing unit n.
+vec3 probes_irradiance_toward(int probe, vec3 n)
+{
+    ivec4 i;
+    vec4 w = probes_oct_bilinear(LPV_PROBES_IRR_OCT, n, i);
+    int base = probe * LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT;
+    vec3 e = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {
+        int at = 3 * (base + i[k]);
+        e += w[k] * vec3(probes_irradiance[at], probes_irradiance[at + 1], probes_irradiance[at + 2]);
+    }
+    return e;
 }
 
 // probes_math.c's lpv_probes_chebyshev: 1 when the point is no farther than
@@ -80,7 +104,6 @@ vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
     vec3 q = clamp(cascade_coords(k, ps) - 0.5, vec3(0.0), vec3(dims - 1));
     ivec3 b = min(ivec3(floor(q)), max(dims - 2, ivec3(0)));
     vec3 f = q - vec3(b);
-    vec4 lobe = sh_lobe(-n);
     vec3 sum = vec3(0.0);
     float wsum = 0.0, min_var = 0.0001 * cell * cell;
     for (int i = 0; i < 8; ++i) {
@@ -101,11 +124,10 @@ vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
         if (w < 0.2)
             w *= w * w / 0.04; // the paper's crush of small weights: less light through walls
         w = max(w, 1e-6) * tri.x * tri.y * tri.z;
-        LpvCell s = probes_sh[probe];
-        sum += w * max(vec3(dot(s.r, lobe), dot(s.g, lobe), dot(s.b, lobe)), 0.0);
+        sum += w * probes_irradiance_toward(probe, n);
         wsum += w;
     }
-    return wsum > 0.0 ? sum / (wsum * cell * cell) : vec3(0.0);
+    return wsum > 0.0 ? sum / wsum : vec3(0.0);
 }
 
 // How far p lies inside cascade k's probes, in its cells (< 0.5: outside

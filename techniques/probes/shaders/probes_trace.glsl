@@ -65,8 +65,10 @@ bool probes_triangle(vec3 o, vec3 d, uint tri, float tmax, out float t)
 }
 
 // The closest hit along o + t d, 0 < t < tmax: true with t_hit and the
-// input's triangle id, false when nothing is hit (or d is 0).
-bool probes_closest_hit(vec3 o, vec3 d, float tmax, out float t_hit, out uint tri_hit)
+// input's triangle id, false when nothing is hit (or d is 0). any: stop at
+// the first triangle hit (a shadow ray's question), t_hit and tri_hit then
+// that one's.
+bool probes_trace_ray(vec3 o, vec3 d, float tmax, bool any, out float t_hit, out uint tri_hit)
 {
     t_hit = 0.0;
     tri_hit = 0u;
@@ -96,6 +98,11 @@ bool probes_closest_hit(vec3 o, vec3 d, float tmax, out float t_hit, out uint tr
                     best = t;
                     best_tri = tri;
                     hit = true;
+                    if (any) {
+                        t_hit = best;
+                        tri_hit = best_tri;
+                        return true;
+                    }
                 }
             }
         } else {
@@ -134,4 +141,17 @@ bool probes_closest_hit(vec3 o, vec3 d, float tmax, out float t_hit, out uint tr
     t_hit = best;
     tri_hit = best_tri;
     return hit;
+}
+
+bool probes_closest_hit(vec3 o, vec3 d, float tmax, out float t_hit, out uint tri_hit)
+{
+    return probes_trace_ray(o, d, tmax, false, t_hit, tri_hit);
+}
+
+// Whether anything lies on o + t d, 0 < t < tmax.
+bool probes_any_hit(vec3 o, vec3 d, float tmax)
+{
+    float t;
+    uint tri;
+    return probes_trace_ray(o, d, tmax, true, t, tri);
 }

@@ -7,11 +7,14 @@
 // indirect from the probes of the pass before (probes_lookup.glsl: every
 // pass adds a bounce). A ray that meets the back of a one-sided triangle
 // sends nothing and reports its distance negative (the blend counts them).
-// The CPU oracle of the rays and statistics is probes_update.c.
+// The rays' directions are the batch's table (the CPU turns the spherical
+// Fibonacci set by the tick's rotation, probes_math.c). The CPU oracle of
+// the rays and statistics is probes_update.c.
 layout(local_size_x = LPV_PROBES_WG) in;
 
 layout(std430, binding = LPV_SSBO_PROBES_RAY_OUT) writeonly buffer ProbesRayOut { vec4 ray_out[]; };
 layout(std430, binding = LPV_SSBO_PROBES_MATERIALS) readonly buffer ProbesMaterials { vec4 probes_materials[]; };
+layout(std430, binding = LPV_SSBO_PROBES_RAY_DIRS) readonly buffer ProbesRayDirs { vec4 probes_ray_dirs[]; };
 
 uniform uint u_first;         // the batch's first probe (it wraps at u_total)
 uniform uint u_batch;         // probes in the batch
@@ -36,9 +39,7 @@ uint probes_hash(uint x)
 
 bool probes_visible(vec3 p, vec3 n, vec3 to_light, float dist)
 {
-    float t;
-    uint tri;
-    return !probes_closest_hit(p + n * u_eps, to_light, dist - 2.0 * u_eps, t, tri);
+    return !probes_any_hit(p + n * u_eps, to_light, dist - 2.0 * u_eps);
 }
 
 // Direct irradiance (W/m^2) on a surface at p facing n.
@@ -78,7 +79,7 @@ void main()
     ivec3 dims = grid_dims();
     ivec3 c = ivec3(cell % dims.x, (cell / dims.x) % dims.y, cell / (dims.x * dims.y));
     vec3 o = probes_position(k, c);
-    vec3 d = probes_ray_dir(r, u_rays);
+    vec3 d = probes_ray_dirs[r].xyz;
     float t;
     uint tri;
     if (!probes_closest_hit(o, d, u_max_distance, t, tri)) {

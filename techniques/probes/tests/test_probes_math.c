@@ -8,11 +8,14 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
 #include "lpv_shared.h"
 #include "probes_math.h"
+#include "probes_table.h"
+#include "probes_update.h"
 
 static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -179,6 +182,53 @@ static void test_chebyshev(void **state)
     assert_float_equal(lpv_probes_chebyshev(1.0f, INFINITY, 2.0f, 1e-4f), 0.0f, 0.0f);
 }
 
+/* The batch's ray table: its directions are lpv_probes_ray's; every
+ * distance texel's weights sum to 1 and keep to its direction; every
+ * irradiance texel's sum to pi (uniform radiance L gives pi L) and weigh
+ * its hemisphere as the cosine does (their mean cosine is 2/3). */
+static void test_ray_table(void **state)
+{
+    (void)state;
+    lpv_probes_table t = {0};
+    const int oct = 8, irr = 6;
+    const uint32_t rays = 256;
+    assert_int_equal(lpv_probes_table_make(&t, 3, 7, rays, oct, 50.0f, irr), 0);
+    float m[9], d[3];
+    lpv_probes_rotation(3, 7, m);
+    for (uint32_t i = 0; i < rays; ++i) {
+        lpv_probes_ray(i, rays, m, d);
+        for (int k = 0; k < 3; ++k)
+            assert_float_equal(t.dirs[4 * i + k], d[k], 1e-7);
+    }
+    const size_t texels = (size_t)(oct * oct + irr * irr);
+    for (size_t k = 0; k < texels; ++k) {
+        const int is_irr = k >= (size_t)(oct * oct);
+        const int side = is_irr ? irr : oct, j = (int)(is_irr ? k - (size_t)(oct * oct) : k);
+        float td[3];
+        lpv_probes_texel_dir(j % side, j / side, side, td);
+        const uint32_t first = t.taps[2 * k], count = t.taps[2 * k + 1];
+        assert_true(count >= 1 && count <= rays);
+        double sum = 0.0, cos_mean = 0.0;
+        for (uint32_t q = first; q < first + count; ++q) {
+            float w;
+            memcpy(&w, &t.taps[2 * q + 1], sizeof w);
+            const float *r = t.dirs + 4 * t.taps[2 * q];
+            assert_true(w > 0.0f);
+            sum += w;
+            cos_mean += w * (td[0] * r[0] + td[1] * r[1] + td[2] * r[2]);
+        }
+        assert_float_equal(sum, is_irr ? LPV_PI : 1.0, 1e-4);
+        if (!is_irr) /* the paper's sharpness: the rays within ~37 degrees, a tenth of them */
+            assert_true(count <= rays / 8 && cos_mean > 0.9);
+        else /* int cos^2 / int cos over the hemisphere = 2/3 */
+            assert_true(cos_mean / LPV_PI > 0.6 && cos_mean / LPV_PI < 0.72);
+    }
+    lpv_probes_table_free(&t);
+    assert_null(t.dirs);
+    assert_int_equal(lpv_probes_table_make(&t, 0, 0, 0, oct, 50.0f, irr), -1);
+    assert_int_equal(lpv_probes_table_make(&t, 0, 0, rays, 0, 50.0f, irr), -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -188,6 +238,7 @@ int main(void)
         cmocka_unit_test(test_octahedral_round_trip),
         cmocka_unit_test(test_sh_irradiance),
         cmocka_unit_test(test_chebyshev),
+        cmocka_unit_test(test_ray_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
