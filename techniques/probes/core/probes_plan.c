@@ -3,6 +3,7 @@
  */
 #include "probes_rules.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -31,14 +32,21 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
     else if (p->recompute || fresh)
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute ? p->recompute_reason : "no history",
                         fresh ? "every probe, warmup passes" : "a budget of probes");
-    else if (g->sweeps < LPV_PROBES_SETTLE_SWEEPS) {
+    else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis)) {
         p->recompute = 1;
         snprintf(p->recompute_reason, sizeof p->recompute_reason, LPV_PROBES_SETTLE_REASON " (%d of %d sweeps)", g->sweeps,
-                 LPV_PROBES_SETTLE_SWEEPS);
+                 lpv_probes_settle_sweeps(s->probes.hysteresis));
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s", p->recompute_reason);
     } else
         lpv_plan_decide(p, LPV_PASS_PROBES, 0, "%s; the probes settled (%d sweeps since the last change)",
                         p->recompute_reason, g->sweeps);
+}
+
+int lpv_probes_settle_sweeps(float hysteresis)
+{
+    if (!(hysteresis > 0.0f) || !(hysteresis < 1.0f))
+        return 1;
+    return (int)ceil(log(LPV_PROBES_SETTLE_RESIDUE) / log((double)hysteresis));
 }
 
 void lpv_probes_tick_cost(const lpv_settings *s, lpv_tick_cost *out)

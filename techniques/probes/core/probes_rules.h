@@ -17,9 +17,10 @@
 #define LPV_PROBES_BACKFACE_OFF 0.25f /* a probe whose rays hit back faces more often is off */
 #define LPV_PROBES_BIAS_CELLS 0.25f  /* the lookup's point moves this far along the normal (cells) */
 #define LPV_PROBES_SEED 1u           /* the ray set's rotations (lpv_probes_rotation) */
-/* Updates of every probe after the last change before a static scene stops
- * tracing: the old value's weight falls to hysteresis^this. */
-#define LPV_PROBES_SETTLE_SWEEPS 24
+/* A static scene stops tracing once every probe was updated often enough
+ * after the last change for the light from before it to weigh at most this
+ * (hysteresis^sweeps, lpv_probes_settle_sweeps). */
+#define LPV_PROBES_SETTLE_RESIDUE 0.01
 /* The plan's recompute reason while they settle (the tick tells it from a change). */
 #define LPV_PROBES_SETTLE_REASON "the probes settle"
 
@@ -35,6 +36,10 @@ typedef struct lpv_probes_progress {
  * until the probes settled. */
 void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const lpv_probes_progress *g,
                           lpv_plan *out);
+
+/* Sweeps over every probe after a change until the probes settled: the
+ * least n with hysteresis^n <= LPV_PROBES_SETTLE_RESIDUE (44 at 0.9). */
+int lpv_probes_settle_sweeps(float hysteresis);
 
 /* Probes a tick (budget, or every probe of the grid's cascades on the
  * first tick's warmup) x rays, at LPV_TICK_COST_PROBES_RAYS_PER_STEP a

@@ -543,13 +543,14 @@ static void memory_need(const lpv_technique *t, lpv_memory_need *n)
 
 static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats *s)
 {
-    (void)last;
     const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
+    /* a tick the plan served from the cache does not reach tick() */
+    const int ran = last->pass[LPV_PASS_PROBES].run;
     s->cascades = g->cascades.count;
     s->cells = g->probes;
-    s->cell_steps = (double)g->rays_traced / LPV_TICK_COST_PROBES_RAYS_PER_STEP;
-    lpv_stats_put(s, "probes_updated", LPV_STAT_INT, (double)g->updated, 0, 0);
-    lpv_stats_put(s, "probes_rays", LPV_STAT_INT, (double)g->rays_traced, 0, 0);
+    s->cell_steps = ran ? (double)g->rays_traced / LPV_TICK_COST_PROBES_RAYS_PER_STEP : 0.0;
+    lpv_stats_put(s, "probes_updated", LPV_STAT_INT, ran ? (double)g->updated : 0.0, 0, 0);
+    lpv_stats_put(s, "probes_rays", LPV_STAT_INT, ran ? (double)g->rays_traced : 0.0, 0, 0);
     lpv_stats_put(s, "probes_off", LPV_STAT_INT, (double)g->off, 0, 0);
     lpv_stats_put(s, "probes_sweeps", LPV_STAT_INT, (double)g->progress.sweeps, 0, 0);
     lpv_stats_put(s, "probes_triangles", LPV_STAT_INT, (double)g->triangles, 0, 0);

@@ -58,7 +58,7 @@ void main()
         // band 0 is the mean radiance: its relative change, over the channels
         vec3 a = vec3(old.r.x, old.g.x, old.b.x), c = vec3(r.x, g.x, b.x);
         vec3 rel = abs(c - a) / max(max(abs(a), abs(c)), vec3(1e-30));
-        h *= 1.0 - smoothstep(0.25, 0.75, max(rel.x, max(rel.y, rel.z)));
+        h *= 1.0 - smoothstep(0.5, 1.0, max(rel.x, max(rel.y, rel.z)));
     }
     probes_sh[probe] = LpvCell(mix(r, old.r, h), mix(g, old.g, h), mix(b, old.b, h));
 
