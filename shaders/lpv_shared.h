@@ -705,7 +705,9 @@ struct LpvBvhNode {
 #define LPV_SSBO_PROBES_MATERIALS 16 /* vec4 albedo (w: double-sided), vec4 emission per triangle */
 #define LPV_SSBO_PROBES_SH 17        /* LpvCell per probe: cell^2 x the L1 SH of the radiance by travel direction */
 #define LPV_SSBO_PROBES_MOMENTS 18   /* vec2 per texel of each probe's distance map: mean, mean square (m, m^2) */
-#define LPV_SSBO_PROBES_STATE 19     /* vec4 per probe: x back-face share of its last rays, y 1 = active */
+#define LPV_SSBO_PROBES_STATE 19     /* 2 vec4 per probe: (back-face share of its last rays, 1 = active,
+                                        1 = moved by the last relocation, 0), (offset from its cell's centre
+                                        xyz (m), 0) */
 /* A batch's ray table (the same for every probe of the batch; the CPU makes
  * it with probes_math.h's functions): each ray's direction, then for the
  * distance moments each texel's (first, count) of taps and the taps (ray,

@@ -16,6 +16,12 @@
 #define LPV_PROBES_MOMENT_CELLS 2.0f /* the distance moments clamp hits at this many cells */
 #define LPV_PROBES_BACKFACE_OFF 0.25f /* a probe whose rays hit back faces more often is off */
 #define LPV_PROBES_BIAS_CELLS 0.25f  /* the lookup's point moves this far along the normal (cells) */
+/* Relocation (Majercik et al. 2021), on a fresh volume's first pass: a probe
+ * that is off moves out through its closest back face, one nearer a surface
+ * than this many cells moves away from it, neither beyond
+ * LPV_PROBES_MAX_OFFSET_CELLS of its cell's centre on any axis. */
+#define LPV_PROBES_MIN_FRONT_CELLS 0.2f
+#define LPV_PROBES_MAX_OFFSET_CELLS 0.45f
 #define LPV_PROBES_SEED 1u           /* the ray set's rotations (lpv_probes_rotation) */
 /* A static scene stops tracing once every probe was updated often enough
  * after the last change for the light from before it to weigh at most this

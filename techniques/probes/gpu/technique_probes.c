@@ -61,7 +61,7 @@ typedef struct lpv_probes_gpu {
     size_t cursor;
     lpv_probes_progress progress;
     size_t updated, rays_traced; /* the last tick's */
-    size_t off;                  /* probes off (inside geometry) after the last warmup */
+    size_t off, moved;           /* probes off (inside geometry) and relocated after the last warmup */
 } lpv_probes_gpu;
 
 static const char *const LOOKUP[] = {"probes_lookup.glsl", NULL};
@@ -325,7 +325,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     *reset = 1;
     g->sh = lpv_gl_new_ssbo(n * sizeof(struct LpvCell));
     g->moments = lpv_gl_new_ssbo(n * (size_t)oct * (size_t)oct * 2 * sizeof(float));
-    g->state = lpv_gl_new_ssbo(n * 4 * sizeof(float));
+    g->state = lpv_gl_new_ssbo(n * 8 * sizeof(float));
     g->irradiance = lpv_gl_new_ssbo(n * LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT * 3 * sizeof(float));
     g->ray_out = lpv_gl_new_ssbo((rays ? rays : 1) * 4 * sizeof(float));
     clear_zero(g->sh);
@@ -388,7 +388,7 @@ static void set_batch(GLuint prog, size_t first, size_t batch, size_t total, int
 
 /* One batch: probes [first, first + batch) (mod the count) trace and blend. */
 static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t first, size_t batch, int feedback,
-                     float hysteresis, float moment_hysteresis)
+                     float hysteresis, float moment_hysteresis, int relocate)
 {
     const lpv_probes_settings *ps = &g->settings.probes;
     const size_t rays = batch * (size_t)ps->rays;
@@ -427,6 +427,10 @@ static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t f
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_hysteresis"), moment_hysteresis);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_cells"), LPV_PROBES_MOMENT_CELLS);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_backface_off"), LPV_PROBES_BACKFACE_OFF);
+    glUniform1i(glGetUniformLocation(g->prog_blend, "u_relocate"), relocate);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_min_front"), LPV_PROBES_MIN_FRONT_CELLS);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_max_offset"), LPV_PROBES_MAX_OFFSET_CELLS);
+    glUniform1f(glGetUniformLocation(g->prog_blend, "u_max_distance"), 2.0f * g->scene_size);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glDispatchCompute(lpv_div_up(batch, LPV_PROBES_WG), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -437,19 +441,21 @@ static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t f
     return 0;
 }
 
-/* Probes the last blend turned off (state.y 0): read back once a warmup. */
-static size_t count_off(const lpv_probes_gpu *g)
+/* Probes the last blend turned off (state.y 0) and moved (state.z 1):
+ * read back once a warmup. */
+static void count_state(lpv_probes_gpu *g)
 {
-    float *st = malloc(g->probes * 4 * sizeof *st);
-    size_t off = 0;
+    float *st = malloc(g->probes * 8 * sizeof *st);
+    g->off = g->moved = 0;
     if (!st)
-        return 0;
+        return;
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    const size_t n = lpv_gl_read_buffer(g->state, 4 * sizeof(float), g->probes, st, g->probes);
-    for (size_t i = 0; i < n; ++i)
-        off += st[4 * i + 1] == 0.0f;
+    const size_t n = lpv_gl_read_buffer(g->state, 8 * sizeof(float), g->probes, st, g->probes);
+    for (size_t i = 0; i < n; ++i) {
+        g->off += st[8 * i + 1] == 0.0f;
+        g->moved += st[8 * i + 4] != 0.0f || st[8 * i + 5] != 0.0f || st[8 * i + 6] != 0.0f;
+    }
     free(st);
-    return off;
 }
 
 static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
@@ -466,12 +472,14 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
          * probes; the rotations start over, so a fresh volume's light does
          * not depend on what the technique did before */
         g->tick_no = 0;
+        clear_zero(g->state); /* no offsets: pass 0 places the probes again */
         for (int pass = 0; pass < ps->warmup; ++pass)
             for (size_t first = 0; first < g->probes; first += batch)
+                /* pass 0 relocates; the distances average from pass 1 on, where the probes stay */
                 if (run_batch(g, in, first, g->probes - first < batch ? g->probes - first : batch, pass > 0, 0.0f,
-                              (float)pass / (float)(pass + 1)) != 0)
+                              pass < 2 ? 0.0f : (float)(pass - 1) / (float)pass, pass == 0 && ps->warmup > 1) != 0)
                     return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
-        g->off = count_off(g);
+        count_state(g);
         g->cursor = 0;
         g->progress.history = 1;
         g->progress.sweeps = 0;
@@ -479,7 +487,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         if (p->recompute && strncmp(p->recompute_reason, LPV_PROBES_SETTLE_REASON,
                                     sizeof LPV_PROBES_SETTLE_REASON - 1) != 0)
             g->progress.sweeps = 0; /* a change: settle again */
-        if (run_batch(g, in, g->cursor, batch, 1, ps->hysteresis, ps->hysteresis) != 0)
+        if (run_batch(g, in, g->cursor, batch, 1, ps->hysteresis, ps->hysteresis, 0) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->cursor += batch;
         if (g->cursor >= g->probes) {
@@ -552,6 +560,7 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     lpv_stats_put(s, "probes_updated", LPV_STAT_INT, ran ? (double)g->updated : 0.0, 0, 0);
     lpv_stats_put(s, "probes_rays", LPV_STAT_INT, ran ? (double)g->rays_traced : 0.0, 0, 0);
     lpv_stats_put(s, "probes_off", LPV_STAT_INT, (double)g->off, 0, 0);
+    lpv_stats_put(s, "probes_moved", LPV_STAT_INT, (double)g->moved, 0, 0);
     lpv_stats_put(s, "probes_sweeps", LPV_STAT_INT, (double)g->progress.sweeps, 0, 0);
     lpv_stats_put(s, "probes_triangles", LPV_STAT_INT, (double)g->triangles, 0, 0);
 }

@@ -6,7 +6,9 @@
 // direction (the batch's taps: the weights are the same for every probe, so
 // the CPU lists each texel's rays that count and their normalised weights)
 // and clamped at a few cells; and the share of rays that met a
-// back face, which turns the probe off past a threshold. The light is
+// back face, which turns the probe off past a threshold, and on a fresh
+// volume's first pass moves probes out of geometry and off surfaces
+// (relocation; the next passes trace from where they moved to). The light is
 // blended into the probe's old value with the hysteresis, lowered where the
 // light changed by much (Majercik et al. 2021: fast where light changed,
 // slow where it is noise); the distances with their own weight (a running
@@ -28,6 +30,10 @@ uniform float u_hysteresis;    // 0: the rays replace the old value
 uniform float u_moment_hysteresis; // the same for the distances, which only moving geometry changes
 uniform float u_moment_cells;  // the moments clamp distances at this many of the probe's cells
 uniform float u_backface_off;  // a probe whose share of back faces exceeds it is off
+uniform int u_relocate;        // 1: move the probe (see the end of main)
+uniform float u_min_front;     // cells
+uniform float u_max_offset;    // cells
+uniform float u_max_distance;  // m: a miss's distance
 
 void main()
 {
@@ -40,9 +46,18 @@ void main()
     uint first = j * u_rays;
     vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
     uint back = 0u;
+    float t_back = 1e30, t_front = 1e30; // the closest back and front faces' distances, and directions
+    vec3 d_back = vec3(0.0), d_front = vec3(0.0);
     for (uint i = 0u; i < u_rays; ++i) {
         vec4 o = ray_out[first + i];
         back += o.w < 0.0 ? 1u : 0u;
+        if (o.w < 0.0 && -o.w < t_back) {
+            t_back = -o.w;
+            d_back = probes_ray_dirs[i].xyz;
+        } else if (o.w >= 0.0 && o.w < u_max_distance && o.w < t_front) {
+            t_front = o.w;
+            d_front = probes_ray_dirs[i].xyz;
+        }
         vec4 y = sh_basis(-probes_ray_dirs[i].xyz); // travel direction: from the hit to the probe
         r += o.r * y;
         g += o.g * y;
@@ -92,5 +107,19 @@ void main()
         probes_irradiance[at + 2u] = v.b;
     }
     float share = float(back) / float(u_rays);
-    probes_state[probe] = vec4(share, share > u_backface_off ? 0.0 : 1.0, 0.0, 0.0);
+    vec3 offset = probes_state[2u * probe + 1u].xyz, moved = offset;
+    if (u_relocate != 0) {
+        // Relocation (Majercik et al. 2021): out through the closest back
+        // face of what the probe is inside, or away from a surface too
+        // near; only within its cell, else where it was
+        float min_front = u_min_front * cell;
+        if (share > u_backface_off)
+            moved = offset + d_back * (t_back + 0.5 * min_front);
+        else if (t_front < min_front)
+            moved = offset - d_front * (min_front - t_front);
+        if (any(greaterThan(abs(moved), vec3(u_max_offset * cell))))
+            moved = offset;
+    }
+    probes_state[2u * probe] = vec4(share, share > u_backface_off ? 0.0 : 1.0, moved != offset ? 1.0 : 0.0, 0.0);
+    probes_state[2u * probe + 1u] = vec4(moved, 0.0);
 }

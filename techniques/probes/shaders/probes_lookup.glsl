@@ -91,9 +91,13 @@ float probes_chebyshev(vec2 m, float d, float min_var)
     return w * w * w;
 }
 
-// The probe of cascade k at cell c: its index and world position (m).
+// The probe of cascade k at cell c: its index and world position (m): the
+// cell's centre and the offset relocation gave it.
 int probes_index(int k, ivec3 c) { return k * grid_cells() + cell_index(c); }
-vec3 probes_position(int k, ivec3 c) { return (vec3(c) + 0.5 + cascade_origin_cells(k)) * cascade_cell(k); }
+vec3 probes_position(int k, ivec3 c)
+{
+    return (vec3(c) + 0.5 + cascade_origin_cells(k)) * cascade_cell(k) + probes_state[2 * probes_index(k, c) + 1].xyz;
+}
 
 // The irradiance (W/m^2) of a surface at p facing unit n from cascade k's probes.
 vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
@@ -110,7 +114,7 @@ vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
         ivec3 o = ivec3(i & 1, (i >> 1) & 1, i >> 2);
         ivec3 c = min(b + o, dims - 1);
         int probe = probes_index(k, c);
-        if (probes_state[probe].y == 0.0)
+        if (probes_state[2 * probe].y == 0.0)
             continue; // off: inside geometry
         vec3 pp = probes_position(k, c);
         vec3 tri = mix(1.0 - f, f, vec3(o));

@@ -256,6 +256,36 @@ static void test_probes_in_a_block_are_off(void **state)
     lpv_scene_free(&scene);
 }
 
+/* Relocation: probes in a solid slab whose top lies within their cell
+ * move out through it on the first warmup pass and are on; those deeper
+ * stay off; one too near a wall moves away from it. */
+static void test_probes_relocate(void **state)
+{
+    (void)state;
+    lpv_scene scene = {0};
+    const float grey[3] = {0.5f, 0.5f, 0.5f};
+    const int m = lpv_scene_add_material(&scene, "grey", grey, NULL);
+    scene.materials[m].double_sided = 0;
+    inward_box(&scene, 2.0f, m, m);
+    /* probe centres at -1.5, -0.5, 0.5, 1.5 (cells of 1 m): the slab's top
+     * at y = -0.2 is 0.3 m above the probes at y = -0.5 (moved up to
+     * -0.5 + 0.3 + 0.1 = -0.1) and 1.3 m above those at y = -1.5 (too far:
+     * off); x, z in (-1, 1): the 4 middle columns */
+    assert_true(lpv_scene_add_box(&scene, m, (const float[3]){-1.0f, -2.0f, -1.0f}, (const float[3]){1.0f, -0.2f, 1.0f}) >= 0);
+    lpv_scene_add_point_light(&scene, (const float[3]){0.0f, 1.5f, 0.0f}, 20.0f);
+    lpv_scene_compute_bounds(&scene);
+    lpv_settings st = probe_settings(4);
+    st.area_lights = LPV_SWITCH_DEFAULT;
+    st.probes.warmup = 2;
+    run(&scene, &st);
+    const lpv_engine_stats *s = lpv_engine_last_stats(lpvt_engine);
+    /* the 8 in the slab: 4 moved out and on, 4 off; none other is nearer
+     * than 0.2 cells to a surface */
+    assert_int_equal((int)lpv_stats_get(s, "probes_off")->v[0], 4);
+    assert_int_equal((int)lpv_stats_get(s, "probes_moved")->v[0], 4);
+    lpv_scene_free(&scene);
+}
+
 /* A room lit by a point light at `at`: one-sided grey walls facing in. */
 static void lit_room(lpv_scene *scene, const float at[3])
 {
@@ -351,6 +381,7 @@ int main(void)
         cmocka_unit_test(test_glowing_box_gives_pi_l),
         cmocka_unit_test(test_update_matches_cpu_oracle),
         cmocka_unit_test(test_probes_in_a_block_are_off),
+        cmocka_unit_test(test_probes_relocate),
         cmocka_unit_test(test_probes_follow_a_moved_light),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
