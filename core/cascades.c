@@ -190,3 +190,19 @@ int lpv_cascades_equal(const lpv_cascade_set *a, const lpv_cascade_set *b)
     }
     return 1;
 }
+
+void lpv_cascades_grid_params(const lpv_cascade_set *set, struct LpvGridParams *out)
+{
+    const lpv_grid *g = &set->grid[0];
+    memset(out, 0, sizeof *out);
+    out->dims[0] = (float)g->dims[0];
+    out->dims[1] = (float)g->dims[1];
+    out->dims[2] = (float)g->dims[2];
+    out->dims[3] = (float)lpv_grid_cell_count(g);
+    out->info[0] = (float)set->count;
+    for (int k = 0; k < set->count; ++k) {
+        for (int i = 0; i < 3; ++i)
+            out->cascade[k][i] = set->origin_cells[k][i];
+        out->cascade[k][3] = set->grid[k].cell_size;
+    }
+}

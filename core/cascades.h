@@ -61,6 +61,13 @@ int lpv_cascades_place(const lpv_settings *s, int count, const float bmin[3], co
 int lpv_cascades_fit(const lpv_settings *s, const float bmin[3], const float bmax[3], float view_chord, char *why,
                      size_t n);
 
+/* The grid block the shaders read (lpv_shared.h's LpvGridParams, grid.glsl)
+ * for the cascades `set`: dims, cell count, cascade count (info.x) and each
+ * cascade's origin in cells and cell size; the rest zero, the technique's
+ * own to fill. */
+struct LpvGridParams;
+void lpv_cascades_grid_params(const lpv_cascade_set *set, struct LpvGridParams *out);
+
 /* How many grids lpv_cascades_place(s, count, ...) places: count, or for one
  * grid over the bounds with the far field on 1 + far_field_levels (at most
  * LPV_MAX_CASCADES). */

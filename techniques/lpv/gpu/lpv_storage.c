@@ -86,18 +86,13 @@ int lpv_cascaded_commit(lpv_cascaded *c, const lpv_technique_where *w, int *rese
     c->cascades = *set;
     c->grid = *g;
     c->bins = c->settings.lpv.normal_bins == LPV_SWITCH_ON ? LPV_NORMAL_BINS : 1;
-    struct LpvGridParams params = {
-        .dims = {(float)g->dims[0], (float)g->dims[1], (float)g->dims[2], (float)lpv_grid_cell_count(g)},
-        .info = {(float)set->count, set->count > 1 && !set->handoff ? 1.0f : 0.0f, (float)c->bins,
-                 c->settings.lpv.central_transport == LPV_SWITCH_ON ? (float)LPV_TRANSPORT_CENTRAL
-                                                                : (float)LPV_TRANSPORT_PAPER},
-    };
+    struct LpvGridParams params;
+    lpv_cascades_grid_params(set, &params);
+    params.info[1] = set->count > 1 && !set->handoff ? 1.0f : 0.0f;
+    params.info[2] = (float)c->bins;
+    params.info[3] = c->settings.lpv.central_transport == LPV_SWITCH_ON ? (float)LPV_TRANSPORT_CENTRAL
+                                                                       : (float)LPV_TRANSPORT_PAPER;
     params.mode[0] = set->handoff ? 1.0f : 0.0f;
-    for (int k = 0; k < set->count; ++k) {
-        for (int i = 0; i < 3; ++i)
-            params.cascade[k][i] = set->origin_cells[k][i];
-        params.cascade[k][3] = set->grid[k].cell_size;
-    }
     glBindBuffer(GL_UNIFORM_BUFFER, c->grid_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
     if (c->grid_alloc_cells && memcmp(g->dims, c->grid_alloc_dims, sizeof g->dims) == 0 &&

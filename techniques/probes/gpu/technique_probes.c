@@ -289,18 +289,11 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
 {
     lpv_probes_gpu *g = (lpv_probes_gpu *)t;
     const lpv_cascade_set *set = &g->pending;
-    const lpv_grid *grid = &set->grid[0];
     const int moved = !lpv_cascades_equal(set, &g->cascades);
     g->cascades = *set;
-    struct LpvGridParams params = {
-        .dims = {(float)grid->dims[0], (float)grid->dims[1], (float)grid->dims[2], (float)lpv_grid_cell_count(grid)},
-        .info = {(float)set->count, 0.0f, 1.0f, 0.0f},
-    };
-    for (int k = 0; k < set->count; ++k) {
-        for (int i = 0; i < 3; ++i)
-            params.cascade[k][i] = set->origin_cells[k][i];
-        params.cascade[k][3] = set->grid[k].cell_size;
-    }
+    struct LpvGridParams params;
+    lpv_cascades_grid_params(set, &params);
+    params.info[2] = 1.0f; /* one volume a cascade (grid.glsl's bin_count) */
     glBindBuffer(GL_UNIFORM_BUFFER, g->grid_ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof params, &params);
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
