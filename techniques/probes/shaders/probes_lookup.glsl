@@ -99,8 +99,11 @@ vec3 probes_position(int k, ivec3 c)
     return (vec3(c) + 0.5 + cascade_origin_cells(k)) * cascade_cell(k) + probes_state[2 * probes_index(k, c) + 1].xyz;
 }
 
-// The irradiance (W/m^2) of a surface at p facing unit n from cascade k's probes.
-vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
+// The irradiance (W/m^2) of a surface at p facing unit n from cascade k's
+// probes (rgb), and how much of them sees it (a: the trilinear, back-face
+// and visibility weights' sum before the floor that keeps the division
+// defined; 0 when every probe around p is off or hidden from it).
+vec4 probes_irradiance_in(int k, vec3 p, vec3 n)
 {
     float cell = cascade_cell(k);
     ivec3 dims = grid_dims();
@@ -109,7 +112,7 @@ vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
     ivec3 b = min(ivec3(floor(q)), max(dims - 2, ivec3(0)));
     vec3 f = q - vec3(b);
     vec3 sum = vec3(0.0);
-    float wsum = 0.0, min_var = 0.0001 * cell * cell;
+    float wsum = 0.0, seen = 0.0, min_var = 0.0001 * cell * cell;
     for (int i = 0; i < 8; ++i) {
         ivec3 o = ivec3(i & 1, (i >> 1) & 1, i >> 2);
         ivec3 c = min(b + o, dims - 1);
@@ -127,12 +130,18 @@ vec3 probes_irradiance_in(int k, vec3 p, vec3 n)
         w *= probes_chebyshev(probes_moments_toward(probe, d > 0.0 ? v / d : n), d, min_var);
         if (w < 0.2)
             w *= w * w / 0.04; // the paper's crush of small weights: less light through walls
-        w = max(w, 1e-6) * tri.x * tri.y * tri.z;
+        float t = tri.x * tri.y * tri.z;
+        seen += w * t;
+        w = max(w, 1e-6) * t;
         sum += w * probes_irradiance_toward(probe, n);
         wsum += w;
     }
-    return wsum > 0.0 ? sum / wsum : vec3(0.0);
+    return vec4(wsum > 0.0 ? sum / wsum : vec3(0.0), seen);
 }
+
+// Below this share of full weight, a cascade's probes around p do not see
+// it (all off, or all behind walls): the next coarser cascade answers.
+const float PROBES_UNSEEN = 1e-3;
 
 // How far p lies inside cascade k's probes, in its cells (< 0.5: outside
 // the last probes).
@@ -155,11 +164,18 @@ int probes_cascade_at(vec3 p)
 vec3 lpv_irradiance(vec3 p, vec3 n)
 {
     int k = probes_cascade_at(p);
-    vec3 e = probes_irradiance_in(k, p, n);
+    vec4 e = probes_irradiance_in(k, p, n);
+    // a fine cascade's probes may all sit in the geometry around p (a
+    // camera-following cascade in terrain): a coarser one's may not
+    while (e.a < PROBES_UNSEEN && k + 1 < cascade_count())
+        e = probes_irradiance_in(++k, p, n);
     float w = clamp((probes_inside(k, p) - 0.5) * 0.5, 0.0, 1.0);
-    if (w < 1.0 && k + 1 < cascade_count())
-        e = mix(probes_irradiance_in(k + 1, p, n), e, w);
-    return e;
+    if (w < 1.0 && k + 1 < cascade_count()) {
+        vec4 c = probes_irradiance_in(k + 1, p, n);
+        if (c.a >= PROBES_UNSEEN)
+            e.rgb = mix(c.rgb, e.rgb, w);
+    }
+    return e.rgb;
 }
 
 vec3 lpv_irradiance_listed(vec3 p, vec3 n, out bool done)
