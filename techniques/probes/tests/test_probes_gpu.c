@@ -229,14 +229,22 @@ static void test_update_matches_cpu_oracle(void **state)
     lpv_scene_free(&scene);
 }
 
+/* A room [-h, h]^3 of one-sided grey walls facing in (a back face is a
+ * back face); returns its material, for more geometry. */
+static int grey_room(lpv_scene *scene, float h)
+{
+    const float grey[3] = {0.5f, 0.5f, 0.5f};
+    const int m = lpv_scene_add_material(scene, "grey", grey, NULL);
+    scene->materials[m].double_sided = 0;
+    inward_box(scene, h, m, m);
+    return m;
+}
+
 static void test_probes_in_a_block_are_off(void **state)
 {
     (void)state;
     lpv_scene scene = {0};
-    const float grey[3] = {0.5f, 0.5f, 0.5f};
-    const int m = lpv_scene_add_material(&scene, "grey", grey, NULL);
-    scene.materials[m].double_sided = 0; /* a back face is a back face */
-    inward_box(&scene, 2.0f, m, m);
+    const int m = grey_room(&scene, 2.0f);
     /* a solid block (outward faces, one-sided) over the lower middle */
     assert_true(lpv_scene_add_box(&scene, m, (const float[3]){-1.0f, -2.0f, -1.0f}, (const float[3]){1.0f, 0.0f, 1.0f}) >= 0);
     lpv_scene_add_point_light(&scene, (const float[3]){0.0f, 1.5f, 0.0f}, 20.0f);
@@ -258,15 +266,12 @@ static void test_probes_in_a_block_are_off(void **state)
 
 /* Relocation: probes in a solid slab whose top lies within their cell
  * move out through it on the first warmup pass and are on; those deeper
- * stay off; one too near a wall moves away from it. */
+ * stay off; no other probe is near enough a surface to move. */
 static void test_probes_relocate(void **state)
 {
     (void)state;
     lpv_scene scene = {0};
-    const float grey[3] = {0.5f, 0.5f, 0.5f};
-    const int m = lpv_scene_add_material(&scene, "grey", grey, NULL);
-    scene.materials[m].double_sided = 0;
-    inward_box(&scene, 2.0f, m, m);
+    const int m = grey_room(&scene, 2.0f);
     /* probe centres at -1.5, -0.5, 0.5, 1.5 (cells of 1 m): the slab's top
      * at y = -0.2 is 0.3 m above the probes at y = -0.5 (moved up to
      * -0.5 + 0.3 + 0.1 = -0.1) and 1.3 m above those at y = -1.5 (too far:
@@ -289,10 +294,7 @@ static void test_probes_relocate(void **state)
 /* A room lit by a point light at `at`: one-sided grey walls facing in. */
 static void lit_room(lpv_scene *scene, const float at[3])
 {
-    const float grey[3] = {0.6f, 0.6f, 0.6f};
-    const int m = lpv_scene_add_material(scene, "grey", grey, NULL);
-    scene->materials[m].double_sided = 0;
-    inward_box(scene, 2.0f, m, m);
+    grey_room(scene, 2.0f);
     lpv_scene_add_point_light(scene, at, 40.0f);
     lpv_scene_compute_bounds(scene);
 }
