@@ -64,8 +64,11 @@ typedef struct lpv_volume_desc {
     lpv_levels_kind kind;         /* what the levels are and how they are looked up */
     const char *units;            /* of the values (static): "W/sr" (cascades), "W/(m^2 sr)" (iv voxels) */
     int iv_neighbours;            /* LPV_LEVELS_IV_VOXELS: the lookup's voxels (settings iv.neighbours); else 0 */
-    int visibility_side;          /* > 0: each cell's probe also has a distance map of this many texels a side
-                                     (technique probes; lpv_engine_read_visibility); else 0 */
+    /* Technique probes: each cell's probe also has visibility
+     * (lpv_engine_read_visibility, SPEC R5.15); 0 for the others. */
+    int visibility_side;          /* > 0: texels a side of each probe's distance map */
+    int irradiance_side;          /* texels a side of each probe's irradiance map */
+    float visibility_bias_cells;  /* the lookup's point moves this far along the normal (cells) */
     int index_levels;             /* the merged grid comes from levels the technique can also give whole, with
                                      an index volume over level 0 (the octree: lpv_engine_read_volumes,
                                      lpv_engine_read_index; SPEC R5.13's content "levels"); else 0 */
@@ -277,11 +280,13 @@ size_t lpv_engine_read_index(lpv_engine *e, int32_t *out, size_t max);
  * (W/(m^2 sr)), read_grid(INJECTED) its voxels' direct light. */
 size_t lpv_engine_read_iv_voxels(lpv_engine *e, struct IvVoxel *out, size_t max);
 size_t lpv_engine_read_ao(lpv_engine *e, float *out, size_t max_floats);
-/* The probes' visibility (technique probes): per probe, in read_grid's
- * order, its distance map's texels (row by row, the octahedral map of
- * techniques/probes/README.md) of 2 floats, the mean and mean square hit
- * distance (m, m^2); *side the map's texels per side. 0 for the others. */
-size_t lpv_engine_read_visibility(lpv_engine *e, float *out, size_t max_floats, int *side);
+/* The probes' visibility (technique probes; SPEC R5.15 sends it as is):
+ * per probe, in read_grid's order, its record
+ * (techniques/probes/core/probes_lookup.h: offset, active, irradiance map,
+ * distance map), lpv_probes_record_values(volume.irradiance_side,
+ * volume.visibility_side) floats. Returns the floats written (whole probes
+ * only), 0 for the other techniques. */
+size_t lpv_engine_read_visibility(lpv_engine *e, float *out, size_t max_floats);
 /* RSM VPLs (punctual lights' and area light samples'), then the emissive VPLs
  * when the last tick injected them (area lights off). */
 size_t lpv_engine_read_vpls(lpv_engine *e, lpv_vpl *out, size_t max);

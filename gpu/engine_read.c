@@ -58,16 +58,14 @@ size_t lpv_engine_read_ao(lpv_engine *e, float *out, size_t max_floats)
     return 4 * e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_AO, LPV_GRID_ACCUMULATED, out, max_floats / 4);
 }
 
-size_t lpv_engine_read_visibility(lpv_engine *e, float *out, size_t max_floats, int *side)
+size_t lpv_engine_read_visibility(lpv_engine *e, float *out, size_t max_floats)
 {
-    *side = 0;
     if (!e->ticked)
         return 0;
     lpv_volume_desc d;
     e->tech->cls->describe(e->tech, &d);
     if (d.visibility_side <= 0)
         return 0;
-    *side = d.visibility_side;
     return e->tech->cls->read(e->tech, &e->plan, LPV_VOLUME_VISIBILITY, LPV_GRID_ACCUMULATED, out, max_floats);
 }
 

@@ -119,7 +119,7 @@ typedef enum lpv_volume_part {
     LPV_VOLUME_INDEX,      /* int32 per level-0 cell: the octree level its light comes from (0 if none) */
     LPV_VOLUME_IV_VOXELS,  /* lpv_iv_voxel per voxel: the imperfect volume's voxels (0 if none) */
     LPV_VOLUME_AO,         /* 4 floats per voxel: SH of the visible directions (0 if none) */
-    LPV_VOLUME_VISIBILITY, /* float per probe, texel and moment: the distance maps (0 if none) */
+    LPV_VOLUME_VISIBILITY, /* floats: lpv_visibility_values per probe (engine.h; 0 if none) */
 } lpv_volume_part;
 
 typedef struct lpv_technique_class lpv_technique_class;

@@ -721,5 +721,15 @@ struct LpvBvhNode {
  * darkness). The volume on the wire keeps the SH. */
 #define LPV_SSBO_PROBES_IRRADIANCE 22 /* float: rgb (W/m^2) per texel of each probe's irradiance map */
 #define LPV_PROBES_IRR_OCT 6          /* its texels per side (the paper's) */
+/* The lookup's weights (probes_lookup.glsl and its CPU oracle,
+ * techniques/probes/core/probes_lookup.c; SPEC R5.15 states them): a
+ * probe's weight is (facing^2 + LPV_PROBES_FACING_FLOOR) x the Chebyshev
+ * bound (variance at least LPV_PROBES_MIN_VAR cells^2), crushed to
+ * w^3 / LPV_PROBES_CRUSH^2 below LPV_PROBES_CRUSH; a level whose probes
+ * see less than LPV_PROBES_UNSEEN of the point hands it to the next. */
+#define LPV_PROBES_FACING_FLOOR 0.2f
+#define LPV_PROBES_CRUSH 0.2f
+#define LPV_PROBES_MIN_VAR 1e-4f
+#define LPV_PROBES_UNSEEN 1e-3f
 
 #endif /* LPV_SHARED_H */

@@ -32,6 +32,7 @@
 #include "gl_util.h"
 #include "material_sample.h"
 #include "probes_bvh.h"
+#include "probes_lookup.h"
 #include "probes_math.h"
 #include "probes_rules.h"
 #include "probes_table.h"
@@ -516,6 +517,38 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     d->kind = LPV_LEVELS_CASCADES;
     d->units = "W/sr";
     d->visibility_side = g->oct;
+    d->irradiance_side = LPV_PROBES_IRR_OCT;
+    d->visibility_bias_cells = LPV_PROBES_BIAS_CELLS;
+}
+
+/* The probes' visibility as lpv_engine_read_visibility reads it: each
+ * probe's record (probes_lookup.h) gathered from the state, irradiance and
+ * distance buffers. Whole probes only; returns the floats written. */
+static size_t read_visibility(const lpv_probes_gpu *g, float *out, size_t max)
+{
+    const size_t per = lpv_probes_record_values(LPV_PROBES_IRR_OCT, g->oct),
+                 at = lpv_probes_record_distance_at(LPV_PROBES_IRR_OCT);
+    const size_t irr = 3 * (size_t)LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT, dist = 2 * (size_t)g->oct * g->oct;
+    const size_t n = per ? (max / per < g->probes ? max / per : g->probes) : 0;
+    float *state = malloc((n ? n : 1) * 8 * sizeof *state), *e = malloc((n ? n : 1) * irr * sizeof *e),
+          *m = malloc((n ? n : 1) * dist * sizeof *m);
+    size_t done = 0;
+    if (state && e && m && lpv_gl_read_buffer(g->state, 8 * sizeof(float), g->probes, state, n) == n &&
+        lpv_gl_read_buffer(g->irradiance, irr * sizeof(float), g->probes, e, n) == n &&
+        lpv_gl_read_buffer(g->moments, dist * sizeof(float), g->probes, m, n) == n) {
+        for (size_t p = 0; p < n; ++p) {
+            float *r = out + p * per;
+            memcpy(r + LPV_PROBES_RECORD_OFFSET, state + 8 * p + 4, 3 * sizeof(float)); /* vec4 (offset, 0) */
+            r[LPV_PROBES_RECORD_ACTIVE] = state[8 * p + 1] != 0.0f ? 1.0f : 0.0f;  /* vec4 (share, active, moved, 0) */
+            memcpy(r + LPV_PROBES_RECORD_IRRADIANCE, e + p * irr, irr * sizeof(float));
+            memcpy(r + at, m + p * dist, dist * sizeof(float));
+        }
+        done = n * per;
+    }
+    free(state);
+    free(e);
+    free(m);
+    return done;
 }
 
 static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part, lpv_grid_which which, void *out,
@@ -528,7 +561,7 @@ static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part,
         return 0;
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     if (part == LPV_VOLUME_VISIBILITY)
-        return lpv_gl_read_buffer(g->moments, sizeof(float), g->probes * (size_t)g->oct * (size_t)g->oct * 2, out, max);
+        return read_visibility(g, out, max);
     if (part != LPV_VOLUME_SUMMED && part != LPV_VOLUME_STORED)
         return 0;
     return lpv_gl_read_buffer(g->sh, sizeof(struct LpvCell), g->probes, out, max);

@@ -112,7 +112,7 @@ vec4 probes_irradiance_in(int k, vec3 p, vec3 n)
     ivec3 b = min(ivec3(floor(q)), max(dims - 2, ivec3(0)));
     vec3 f = q - vec3(b);
     vec3 sum = vec3(0.0);
-    float wsum = 0.0, seen = 0.0, min_var = 0.0001 * cell * cell;
+    float wsum = 0.0, seen = 0.0, min_var = LPV_PROBES_MIN_VAR * cell * cell;
     for (int i = 0; i < 8; ++i) {
         ivec3 o = ivec3(i & 1, (i >> 1) & 1, i >> 2);
         ivec3 c = min(b + o, dims - 1);
@@ -124,12 +124,12 @@ vec4 probes_irradiance_in(int k, vec3 p, vec3 n)
         vec3 to_probe = pp - p;
         float dl = length(to_probe);
         float facing = dl > 0.0 ? (dot(to_probe / dl, n) + 1.0) * 0.5 : 1.0;
-        float w = facing * facing + 0.2;
+        float w = facing * facing + LPV_PROBES_FACING_FLOOR;
         vec3 v = ps - pp;
         float d = length(v);
         w *= probes_chebyshev(probes_moments_toward(probe, d > 0.0 ? v / d : n), d, min_var);
-        if (w < 0.2)
-            w *= w * w / 0.04; // the paper's crush of small weights: less light through walls
+        if (w < LPV_PROBES_CRUSH) // the paper's crush of small weights: less light through walls
+            w *= w * w / (LPV_PROBES_CRUSH * LPV_PROBES_CRUSH);
         float t = tri.x * tri.y * tri.z;
         seen += w * t;
         w = max(w, 1e-6) * t;
@@ -138,10 +138,6 @@ vec4 probes_irradiance_in(int k, vec3 p, vec3 n)
     }
     return vec4(wsum > 0.0 ? sum / wsum : vec3(0.0), seen);
 }
-
-// Below this share of full weight, a cascade's probes around p do not see
-// it (all off, or all behind walls): the next coarser cascade answers.
-const float PROBES_UNSEEN = 1e-3;
 
 // How far p lies inside cascade k's probes, in its cells (< 0.5: outside
 // the last probes).
@@ -163,16 +159,20 @@ int probes_cascade_at(vec3 p)
 
 vec3 lpv_irradiance(vec3 p, vec3 n)
 {
+    float ln = length(n); // SPEC R5.15: a unit normal, no light without one
+    if (!(ln > 1e-8))
+        return vec3(0.0);
+    n /= ln;
     int k = probes_cascade_at(p);
     vec4 e = probes_irradiance_in(k, p, n);
     // a fine cascade's probes may all sit in the geometry around p (a
     // camera-following cascade in terrain): a coarser one's may not
-    while (e.a < PROBES_UNSEEN && k + 1 < cascade_count())
+    while (e.a < LPV_PROBES_UNSEEN && k + 1 < cascade_count())
         e = probes_irradiance_in(++k, p, n);
     float w = clamp((probes_inside(k, p) - 0.5) * 0.5, 0.0, 1.0);
     if (w < 1.0 && k + 1 < cascade_count()) {
         vec4 c = probes_irradiance_in(k + 1, p, n);
-        if (c.a >= PROBES_UNSEEN)
+        if (c.a >= LPV_PROBES_UNSEEN)
             e.rgb = mix(c.rgb, e.rgb, w);
     }
     return e.rgb;

@@ -25,6 +25,7 @@
 
 #include "engine.h"
 #include "probes_bvh.h"
+#include "probes_lookup.h"
 #include "probes_rules.h"
 #include "probes_update.h"
 #include "scene.h"
@@ -155,11 +156,18 @@ static void test_update_matches_cpu_oracle(void **state)
     const size_t n = 27;
     lpv_cell cells[27];
     assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, cells, n), n);
-    int side = 0;
     const size_t texels = 36;
-    float *moments = malloc(n * texels * 2 * sizeof *moments);
-    assert_int_equal(lpv_engine_read_visibility(lpvt_engine, moments, n * texels * 2, &side), n * texels * 2);
-    assert_int_equal(side, 6);
+    assert_int_equal(d->visibility_side, 6);
+    const size_t per = lpv_probes_record_values(d->irradiance_side, d->visibility_side),
+                 at = lpv_probes_record_distance_at(d->irradiance_side);
+    assert_int_equal(per, 4 + 3 * LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT + 2 * texels);
+    float *records = malloc(n * per * sizeof *records), *moments = malloc(n * texels * 2 * sizeof *moments);
+    assert_int_equal(lpv_engine_read_visibility(lpvt_engine, records, n * per), n * per);
+    for (size_t p = 0; p < n; ++p) {
+        memcpy(moments + p * texels * 2, records + p * per + at, texels * 2 * sizeof *moments);
+        assert_true(records[p * per + LPV_PROBES_RECORD_ACTIVE] == 1.0f); /* an open box: every probe on */
+    }
+    free(records);
 
     /* the same rays on the CPU: the triangles in draw order, each quad two */
     float pos[3 * 24];
@@ -291,6 +299,119 @@ static void test_probes_relocate(void **state)
     lpv_scene_free(&scene);
 }
 
+/* The lookup (SPEC R5.15): the server's (probes_lookup.glsl, through
+ * lpv_engine_irradiance) equals the CPU oracle's on the read-back records
+ * (probes_lookup.c, the clients' code) at points on every surface of a
+ * room with a slab, whose probes are moved, off or near walls; and the
+ * distance maps matter: without them (every probe sees every point) the
+ * answer differs at many of those points. */
+static void test_lookup_matches_cpu_oracle(void **state)
+{
+    (void)state;
+    lpv_scene scene = {0};
+    const int m = grey_room(&scene, 2.0f);
+    assert_true(lpv_scene_add_box(&scene, m, (const float[3]){-1.0f, -2.0f, -1.0f}, (const float[3]){1.0f, -0.2f, 1.0f}) >= 0);
+    /* a thin partition: the far side of x = 1.3 is lit only around it */
+    quad(&scene, m, (const float[3]){1.3f, 0.0f, -0.5f}, (const float[3]){0, 2.0f, 0}, (const float[3]){0, 0, 1.5f});
+    quad(&scene, m, (const float[3]){1.3f, 0.0f, -0.5f}, (const float[3]){0, 0, 1.5f}, (const float[3]){0, 2.0f, 0});
+    lpv_scene_add_point_light(&scene, (const float[3]){-0.5f, 1.5f, 0.5f}, 20.0f);
+    lpv_scene_compute_bounds(&scene);
+    lpv_settings st = probe_settings(5);
+    st.area_lights = LPV_SWITCH_DEFAULT;
+    st.probes.warmup = 2;
+    run(&scene, &st);
+    const lpv_volume_desc *d = &lpv_engine_last_stats(lpvt_engine)->volume;
+    const size_t per = lpv_probes_record_values(d->irradiance_side, d->visibility_side);
+    size_t probes = 0;
+    for (int k = 0; k < d->levels; ++k)
+        probes += (size_t)d->level[k].dims[0] * d->level[k].dims[1] * d->level[k].dims[2];
+    float *rec = malloc(probes * per * sizeof *rec), *blind = malloc(probes * per * sizeof *blind);
+    assert_int_equal(lpv_engine_read_visibility(lpvt_engine, rec, probes * per), probes * per);
+    lpv_probes_field f = {.levels = d->levels, .irradiance_side = d->irradiance_side,
+                          .distance_side = d->visibility_side, .bias_cells = d->visibility_bias_cells};
+    size_t first = 0;
+    for (int k = 0; k < d->levels; ++k) {
+        const lpv_grid *g = &d->level[k];
+        lpv_probes_level *l = &f.level[k];
+        memcpy(l->dims, g->dims, sizeof l->dims);
+        for (int a = 0; a < 3; ++a)
+            l->origin[a] = d->origin_cells[k][a] * g->cell_size;
+        l->cell_size = g->cell_size;
+        l->records = rec + first * per;
+        first += (size_t)g->dims[0] * g->dims[1] * g->dims[2];
+    }
+    lpv_probes_field open = f;
+    memcpy(blind, rec, probes * per * sizeof *rec);
+    const size_t at = lpv_probes_record_distance_at(d->irradiance_side);
+    for (size_t i = 0; i < probes; ++i)
+        for (size_t t = at; t < per; t += 2) {
+            blind[i * per + t] = 1e6f;
+            blind[i * per + t + 1] = 1e12f;
+        }
+    for (int k = 0; k < d->levels; ++k)
+        open.level[k].records = blind + (f.level[k].records - rec);
+
+    /* points on the walls, the slab's faces and both sides of the partition */
+    enum { N = 600 };
+    float *p = malloc(N * 3 * sizeof *p), *n = malloc(N * 3 * sizeof *n), *gpu = malloc(N * 3 * sizeof *gpu);
+    uint32_t h = 12345u;
+    for (int i = 0; i < N; ++i) {
+        float u[2];
+        for (int j = 0; j < 2; ++j) {
+            h = h * 1664525u + 1013904223u;
+            u[j] = (float)(h >> 8) / 16777216.0f * 2.0f - 1.0f;
+        }
+        float *q = p + 3 * i, *nn = n + 3 * i;
+        const int kind = i % 6;
+        if (kind < 3) { /* a room wall, facing in */
+            const int a = (i / 6) % 3, sign = (i / 18) % 2 ? 1 : -1;
+            q[a] = 1.99f * (float)sign;
+            q[(a + 1) % 3] = 1.9f * u[0];
+            q[(a + 2) % 3] = 1.9f * u[1];
+            nn[0] = nn[1] = nn[2] = 0.0f;
+            nn[a] = (float)-sign;
+        } else if (kind == 3) { /* the slab's top */
+            q[0] = 0.95f * u[0], q[1] = -0.19f, q[2] = 0.95f * u[1];
+            nn[0] = 0, nn[1] = 1, nn[2] = 0;
+        } else { /* the partition, one side or the other */
+            const float side = kind == 4 ? -1.0f : 1.0f;
+            q[0] = 1.3f + 0.01f * side, q[1] = 1.9f * u[0], q[2] = -0.5f + 1.45f * u[1];
+            nn[0] = side, nn[1] = 0, nn[2] = 0;
+        }
+    }
+    char err[256];
+    assert_int_equal(lpv_engine_irradiance(lpvt_engine, p, n, N, gpu, err, sizeof err), 0);
+    float emax = 0.0f;
+    for (int i = 0; i < 3 * N; ++i)
+        emax = fmaxf(emax, gpu[i]);
+    assert_true(emax > 0.0f);
+    int off = 0, seen_changes = 0;
+    double worst = 0.0;
+    for (int i = 0; i < N; ++i) {
+        float e[3], o[3];
+        assert_int_equal(lpv_probes_irradiance(&f, p + 3 * i, n + 3 * i, e), 0);
+        assert_int_equal(lpv_probes_irradiance(&open, p + 3 * i, n + 3 * i, o), 0);
+        double diff = 0.0, change = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            diff = fmax(diff, fabs(e[c] - gpu[3 * i + c]) / emax);
+            change = fmax(change, fabs(o[c] - e[c]) / emax);
+        }
+        worst = fmax(worst, diff);
+        off += diff > 1e-4;
+        seen_changes += change > 0.01;
+    }
+    printf("lookup: %d of %d points differ from the oracle by more than 1e-4 of the brightest (worst %.3g); "
+           "the distance maps change %d by more than 1 %%\n", off, N, worst, seen_changes);
+    assert_true(off <= N / 50); /* the thresholds, where float rounding may fall either way */
+    assert_true(seen_changes >= N / 20);
+    free(p);
+    free(n);
+    free(gpu);
+    free(rec);
+    free(blind);
+    lpv_scene_free(&scene);
+}
+
 /* A room lit by a point light at `at`: one-sided grey walls facing in. */
 static void lit_room(lpv_scene *scene, const float at[3])
 {
@@ -384,6 +505,7 @@ int main(void)
         cmocka_unit_test(test_update_matches_cpu_oracle),
         cmocka_unit_test(test_probes_in_a_block_are_off),
         cmocka_unit_test(test_probes_relocate),
+        cmocka_unit_test(test_lookup_matches_cpu_oracle),
         cmocka_unit_test(test_probes_follow_a_moved_light),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
