@@ -200,13 +200,15 @@ typedef enum lpvp_level_role {
 #define LPVP_IV_NEIGHBOURS_MAX 8
 
 /* What GET_VOLUME's optional "content" asks for (R5.13): "merged" (the
- * default: the volume R5.1 - R5.12 describe) or "levels" (a technique's
- * levels and index volume, e.g. the octree's). */
+ * default: the volume R5.1 - R5.12 describe), "levels" (a technique's
+ * levels and index volume, e.g. the octree's) or "visibility" (R5.15: the
+ * merged volume and the probes' visibility). */
 #define LPVP_VOLUME_CONTENT_KEY "content"
 typedef enum lpvp_volume_content {
     LPVP_CONTENT_MERGED = 0,
     LPVP_CONTENT_LEVELS = 1,
-    LPVP_CONTENT_COUNT = 2
+    LPVP_CONTENT_VISIBILITY = 2, /* R5.15: the merged volume and the probes' visibility */
+    LPVP_CONTENT_COUNT = 3
 } lpvp_volume_content;
 extern const char *const lpvp_volume_content_names[LPVP_CONTENT_COUNT];
 extern const char *const lpvp_level_role_names[LPVP_ROLE_COUNT];
@@ -214,6 +216,23 @@ extern const char *const lpvp_level_role_names[LPVP_ROLE_COUNT];
 /* An index volume (R5.12): value type and its size. */
 #define LPVP_INDEX_VALUE_TYPE "u32"
 #define LPVP_INDEX_VALUE_SIZE 4
+
+/* The probes' visibility (R5.15): after the levels' values, a record of
+ * values_per_probe f32 per probe (a probe a cell of every level). */
+#define LPVP_VISIBILITY_KEY "visibility"
+#define LPVP_VISIBILITY_VALUE_TYPE "f32"
+#define LPVP_VISIBILITY_VALUE_SIZE 4
+#define LPVP_VISIBILITY_MAX_IRRADIANCE_SIDE 16
+#define LPVP_VISIBILITY_MAX_DISTANCE_SIDE 32
+typedef struct lpvp_visibility_info {
+    uint64_t probes;             /* the levels' cells together */
+    int irradiance_side;         /* 1..LPVP_VISIBILITY_MAX_IRRADIANCE_SIDE */
+    int distance_side;           /* 1..LPVP_VISIBILITY_MAX_DISTANCE_SIDE */
+    uint64_t values_per_probe;   /* 4 + 3 irradiance_side^2 + 2 distance_side^2 */
+    double bias_cells;           /* >= 0: the lookup's step along the normal, in cells */
+    uint64_t raw_offset;         /* bytes into the raw volume: right after the levels' values */
+    uint64_t raw_length;         /* probes x values_per_probe x 4 */
+} lpvp_visibility_info;
 
 typedef struct lpvp_index_info {
     int level;                   /* the level whose box it covers */
@@ -249,6 +268,9 @@ typedef struct lpvp_volume_layout {
     lpvp_index_info index;       /* when has_index */
     /* R5.14 (role[0] LPVP_ROLE_IV_VOXELS): the reconstruction's voxels, 1..8 */
     int iv_neighbours;
+    /* R5.15 (content LPVP_CONTENT_VISIBILITY): the probes' visibility */
+    int has_visibility;
+    lpvp_visibility_info visibility;
 } lpvp_volume_layout;
 
 typedef struct lpvp_volume_info {
@@ -298,6 +320,22 @@ int lpvp_volume_layout_octree(lpvp_volume_layout *l, const char *technique, cons
  * iv_neighbours. Returns 0, or -1 with err set for neighbours outside 1..8. */
 int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lpvp_cascade_info *level0,
                           int neighbours, char *err, size_t err_n);
+
+/* R5.15's layout: the SH layout of lpvp_volume_layout_sh (cascades, no
+ * far field) with the probes' visibility after it, content
+ * LPVP_CONTENT_VISIBILITY; its probe count and raw_offset are filled by
+ * lpvp_volume_header_build. Returns 0, or -1 with err set for sides or a
+ * bias out of range. */
+int lpvp_volume_layout_visibility(lpvp_volume_layout *l, const char *technique, int levels, int irradiance_side,
+                                  int distance_side, double bias_cells, char *err, size_t err_n);
+
+/* R5.15's values per probe, 4 + 3 irradiance_side^2 + 2 distance_side^2
+ * (techniques/probes/core/probes_lookup.h's record). */
+uint64_t lpvp_visibility_values_per_probe(int irradiance_side, int distance_side);
+
+/* Bytes after the levels' values: the index's (R5.12) or the visibility's
+ * (R5.15), 0 when the layout has neither. */
+uint64_t lpvp_volume_extra_bytes(const lpvp_volume_info *vi);
 
 /* 1 when the layout is R5.14's (level 0 has the role "iv_voxels"). */
 int lpvp_volume_layout_is_iv(const lpvp_volume_layout *l);

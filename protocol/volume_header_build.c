@@ -1,7 +1,7 @@
 /*
  * volume_header_build.c - the VOLUME header's JSON from an
- * lpvp_volume_info (SPEC R5.1, R5.9 - R5.14): placement, cascades or
- * levels, the description object, the index. See volume_codec.h.
+ * lpvp_volume_info (SPEC R5.1, R5.9 - R5.15): placement, cascades or
+ * levels, the description object, the index or the probes' visibility. See volume_codec.h.
  */
 #include "volume_codec.h"
 #include "proto.h"
@@ -14,6 +14,7 @@
  * SH names (the only values this library builds). */
 static json_t *placement_json(const lpvp_cascade_info *c);
 static json_t *index_json(const lpvp_volume_info *vi);
+static json_t *visibility_json(const lpvp_volume_info *vi);
 
 static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
 {
@@ -52,6 +53,8 @@ static json_t *layout_json(const lpvp_volume_info *vi, json_t *cascades)
         bad |= json_object_set_new(o, "index", l->has_index ? index_json(vi) : json_null()) != 0;
         if (lpvp_volume_layout_is_iv(l)) /* R5.14 */
             bad |= json_object_set_new(o, LPVP_IV_NEIGHBOURS_KEY, json_integer(l->iv_neighbours)) != 0;
+        if (l->has_visibility) /* R5.15 */
+            bad |= json_object_set_new(o, LPVP_VISIBILITY_KEY, visibility_json(vi)) != 0;
     }
     json_decref(levels);
     json_decref(values);
@@ -93,6 +96,19 @@ static json_t *index_json(const lpvp_volume_info *vi)
                      (json_int_t)ix->dims[1], (json_int_t)ix->dims[2], "values_per_cell", ix->values_per_cell,
                      "value_type", LPVP_INDEX_VALUE_TYPE, "raw_offset", (json_int_t)lpvp_volume_values_bytes(vi),
                      "raw_length", (json_int_t)length);
+}
+
+/* The probes' visibility (R5.15), right after the levels' values: a probe
+ * per cell of every level. */
+static json_t *visibility_json(const lpvp_volume_info *vi)
+{
+    const lpvp_visibility_info *v = &vi->layout.visibility;
+    const uint64_t probes = lpvp_volume_total_cells(vi);
+    return json_pack("{s:I, s:i, s:i, s:I, s:s, s:f, s:I, s:I}", "probes", (json_int_t)probes, "irradiance_side",
+                     v->irradiance_side, "distance_side", v->distance_side, "values_per_probe",
+                     (json_int_t)v->values_per_probe, "value_type", LPVP_VISIBILITY_VALUE_TYPE, "bias_cells",
+                     isfinite(v->bias_cells) ? v->bias_cells : 0.0, "raw_offset",
+                     (json_int_t)lpvp_volume_values_bytes(vi), "raw_length", (json_int_t)lpvp_volume_extra_bytes(vi));
 }
 
 static json_t *cascades_json(const lpvp_volume_info *vi)

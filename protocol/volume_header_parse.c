@@ -274,6 +274,7 @@ static int parse_cells(const json_t *obj, const json_t *d, lpvp_volume_info *vi,
 /* The description (R5.9 - R5.12) into vi->layout; the cascades are already
  * read. Absent: R5.1's 12 values (layout.present 0). Each MUST-reject rule of
  * R5.9 - R5.12 is one check here, its message naming the field. */
+static int parse_visibility(const json_t *v, lpvp_volume_info *vi, char *err, size_t err_n);
 static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size_t err_n)
 {
     lpvp_volume_layout *l = &vi->layout;
@@ -319,6 +320,13 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
     l->far_field = json_is_true(v);
 
     a = json_object_get(d, "levels");
+    if (json_object_get(d, LPVP_VISIBILITY_KEY) &&
+        (levels_have_role(a, LPVP_ROLE_OCTREE_LEVEL) || levels_have_role(a, LPVP_ROLE_IV_VOXELS))) {
+        lpvp_set_error(err, err_n, "%s.%s: only a probes' volume of cascades has visibility (R5.15), not \"%s\" or "
+                       "\"%s\" levels", K, LPVP_VISIBILITY_KEY, lpvp_level_role_names[LPVP_ROLE_OCTREE_LEVEL],
+                       lpvp_level_role_names[LPVP_ROLE_IV_VOXELS]);
+        return -1;
+    }
     if (levels_have_role(a, LPVP_ROLE_OCTREE_LEVEL))
         return parse_octree_levels(d, vi, err, err_n) != 0 ? -1 : parse_cells(obj, d, vi, err, err_n);
     if (levels_have_role(a, LPVP_ROLE_IV_VOXELS))
@@ -364,7 +372,85 @@ static int parse_layout(const json_t *obj, lpvp_volume_info *vi, char *err, size
         }
         l->role[k] = (lpvp_level_role)role;
     }
-    return parse_cells(obj, d, vi, err, err_n);
+    if (parse_cells(obj, d, vi, err, err_n) != 0)
+        return -1;
+    v = json_object_get(d, LPVP_VISIBILITY_KEY);
+    return v ? parse_visibility(v, vi, err, err_n) : 0;
+}
+
+/* R5.15: the probes' visibility after the cascades' SH values. */
+static int parse_visibility(const json_t *v, lpvp_volume_info *vi, char *err, size_t err_n)
+{
+    lpvp_volume_layout *l = &vi->layout;
+    lpvp_visibility_info *vis = &l->visibility;
+    const char *K = LPVP_VOLUME_DESC_KEY "." LPVP_VISIBILITY_KEY;
+    char key[96];
+    long long x;
+    if (!json_is_object(v)) {
+        lpvp_set_error(err, err_n, "%s: expected an object", K);
+        return -1;
+    }
+    if (l->far_field || !l->sh_values || l->volumes_per_level != 1 || l->has_index) {
+        lpvp_set_error(err, err_n, "%s: the probes' visibility goes with cascades of R5.1's 12 values in one volume "
+                       "a level, no far field and no index", K);
+        return -1;
+    }
+    snprintf(key, sizeof key, "%s.irradiance_side", K);
+    if (need_int(v, "irradiance_side", 1, &x, err, err_n) != 0 || x > LPVP_VISIBILITY_MAX_IRRADIANCE_SIDE) {
+        lpvp_set_error(err, err_n, "%s: expected an integer in [1, %d]", key, LPVP_VISIBILITY_MAX_IRRADIANCE_SIDE);
+        return -1;
+    }
+    vis->irradiance_side = (int)x;
+    snprintf(key, sizeof key, "%s.distance_side", K);
+    if (need_int(v, "distance_side", 1, &x, err, err_n) != 0 || x > LPVP_VISIBILITY_MAX_DISTANCE_SIDE) {
+        lpvp_set_error(err, err_n, "%s: expected an integer in [1, %d]", key, LPVP_VISIBILITY_MAX_DISTANCE_SIDE);
+        return -1;
+    }
+    vis->distance_side = (int)x;
+    vis->values_per_probe = lpvp_visibility_values_per_probe(vis->irradiance_side, vis->distance_side);
+    snprintf(key, sizeof key, "%s.values_per_probe", K);
+    if (need_int(v, "values_per_probe", 1, &x, err, err_n) != 0 || (uint64_t)x != vis->values_per_probe) {
+        lpvp_set_error(err, err_n, "%s: expected %llu (4 + 3 irradiance_side^2 + 2 distance_side^2)", key,
+                       (unsigned long long)vis->values_per_probe);
+        return -1;
+    }
+    vis->probes = lpvp_volume_total_cells(vi);
+    snprintf(key, sizeof key, "%s.probes", K);
+    if (need_int(v, "probes", 1, &x, err, err_n) != 0 || (uint64_t)x != vis->probes) {
+        lpvp_set_error(err, err_n, "%s: expected %llu (a probe per cell of every level)", key,
+                       (unsigned long long)vis->probes);
+        return -1;
+    }
+    const json_t *t = json_object_get(v, "value_type");
+    if (!json_is_string(t) || strcmp(json_string_value(t), LPVP_VISIBILITY_VALUE_TYPE) != 0) {
+        lpvp_set_error(err, err_n, "%s.value_type: expected \"%s\"", K, LPVP_VISIBILITY_VALUE_TYPE);
+        return -1;
+    }
+    t = json_object_get(v, "bias_cells");
+    if (!json_is_number(t) || !(json_number_value(t) >= 0.0) || !isfinite(json_number_value(t))) {
+        lpvp_set_error(err, err_n, "%s.bias_cells: expected a finite number >= 0", K);
+        return -1;
+    }
+    vis->bias_cells = json_number_value(t);
+    const uint64_t values = lpvp_volume_values_bytes(vi);
+    snprintf(key, sizeof key, "%s.raw_offset", K);
+    if (need_int(v, "raw_offset", 0, &x, err, err_n) != 0 || (uint64_t)x != values) {
+        lpvp_set_error(err, err_n, "%s: expected %llu (right after the levels' values)", key,
+                       (unsigned long long)values);
+        return -1;
+    }
+    vis->raw_offset = values;
+    l->has_visibility = 1;
+    l->content = LPVP_CONTENT_VISIBILITY;
+    const uint64_t want = lpvp_volume_extra_bytes(vi);
+    snprintf(key, sizeof key, "%s.raw_length", K);
+    if (need_int(v, "raw_length", 0, &x, err, err_n) != 0 || (uint64_t)x != want) {
+        lpvp_set_error(err, err_n, "%s: expected %llu (probes x values_per_probe x %d bytes)", key,
+                       (unsigned long long)want, LPVP_VISIBILITY_VALUE_SIZE);
+        return -1;
+    }
+    vis->raw_length = want;
+    return 0;
 }
 
 /* R5.11, R5.12: what a cell holds, units, the index. */
@@ -587,13 +673,13 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
     {
         /* R5.6 / R5.11: the levels' values as described, then the index (R5.12) */
         uint64_t values = lpvp_volume_values_bytes(vi);
-        uint64_t index = vi->layout.has_index ? vi->layout.index.raw_length : 0;
+        uint64_t index = lpvp_volume_extra_bytes(vi); /* the index (R5.12) or the visibility (R5.15) */
         uint64_t expect = values + index;
         if (values == 0 || (uint64_t)(size_t)expect != expect || expect != vi->raw_length) {
             lpvp_set_error(err, err_n,
                            "raw_length: %llu, but %zu cells x %d volumes x %d values of %s%s need %llu bytes", x,
                            cells, vi->layout.volumes_per_level, vi->layout.values_per_cell,
-                           lpvp_volume_format_name(vi->format), index ? " + the index" : "",
+                           lpvp_volume_format_name(vi->format), index ? " + the index or visibility" : "",
                            (unsigned long long)expect);
             return -1;
         }

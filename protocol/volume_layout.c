@@ -1,8 +1,9 @@
 /*
- * volume_layout.c - what a volume carries (SPEC R5.9 - R5.14): the value
+ * volume_layout.c - what a volume carries (SPEC R5.9 - R5.15): the value
  * and role names, the layout of each kind of volume (SH cascades, the
- * octree's levels with an index, iv's voxels with an index), its units,
- * its byte sizes and the checks a lookup needs. See volume_codec.h.
+ * octree's levels with an index, iv's voxels with an index, the probes'
+ * cascades with their visibility), its units, its byte sizes and the
+ * checks a lookup needs. See volume_codec.h.
  */
 #include "volume_codec.h"
 #include "proto.h"
@@ -25,7 +26,8 @@ const char *const lpvp_level_role_names[LPVP_ROLE_COUNT] = {[LPVP_ROLE_CASCADE] 
                                                             [LPVP_ROLE_OCTREE_LEVEL] = "octree_level",
                                                             [LPVP_ROLE_IV_VOXELS] = "iv_voxels"};
 const char *const lpvp_volume_content_names[LPVP_CONTENT_COUNT] = {[LPVP_CONTENT_MERGED] = "merged",
-                                                                   [LPVP_CONTENT_LEVELS] = "levels"};
+                                                                   [LPVP_CONTENT_LEVELS] = "levels",
+                                                                   [LPVP_CONTENT_VISIBILITY] = "visibility"};
 
 void lpvp_volume_layout_sh(lpvp_volume_layout *l, const char *technique, int far_field, int levels)
 {
@@ -108,6 +110,42 @@ int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lp
     snprintf(l->units, sizeof l->units, "%s", LPVP_VOLUME_UNITS_RADIANCE);
     layout_index_over(l, level0);
     l->iv_neighbours = neighbours;
+    return 0;
+}
+
+uint64_t lpvp_visibility_values_per_probe(int irradiance_side, int distance_side)
+{
+    return 4 + 3 * (uint64_t)irradiance_side * (uint64_t)irradiance_side +
+           2 * (uint64_t)distance_side * (uint64_t)distance_side;
+}
+
+int lpvp_volume_layout_visibility(lpvp_volume_layout *l, const char *technique, int levels, int irradiance_side,
+                                  int distance_side, double bias_cells, char *err, size_t err_n)
+{
+    if (irradiance_side < 1 || irradiance_side > LPVP_VISIBILITY_MAX_IRRADIANCE_SIDE || distance_side < 1 ||
+        distance_side > LPVP_VISIBILITY_MAX_DISTANCE_SIDE || !(bias_cells >= 0.0) || !isfinite(bias_cells)) {
+        lpvp_set_error(err, err_n, "probes' visibility with maps of %d and %d texels a side and a bias of %g cells: "
+                       "the sides must be in 1..%d and 1..%d, the bias finite and >= 0", irradiance_side,
+                       distance_side, bias_cells, LPVP_VISIBILITY_MAX_IRRADIANCE_SIDE,
+                       LPVP_VISIBILITY_MAX_DISTANCE_SIDE);
+        return -1;
+    }
+    lpvp_volume_layout_sh(l, technique, 0, levels);
+    l->content = LPVP_CONTENT_VISIBILITY;
+    l->has_visibility = 1;
+    l->visibility.irradiance_side = irradiance_side;
+    l->visibility.distance_side = distance_side;
+    l->visibility.values_per_probe = lpvp_visibility_values_per_probe(irradiance_side, distance_side);
+    l->visibility.bias_cells = bias_cells;
+    return 0;
+}
+
+uint64_t lpvp_volume_extra_bytes(const lpvp_volume_info *vi)
+{
+    if (vi->layout.has_index)
+        return vi->layout.index.raw_length;
+    if (vi->layout.has_visibility)
+        return lpvp_volume_total_cells(vi) * vi->layout.visibility.values_per_probe * LPVP_VISIBILITY_VALUE_SIZE;
     return 0;
 }
 

@@ -1,7 +1,8 @@
 /*
- * volume_lookup.c - SPEC R5.7 and R5.14 on a decoded volume (see
- * volume_lookup.h): the cascade choice and border blend here, the SH lookup
- * and the imperfect volume's reconstruction from core's oracles.
+ * volume_lookup.c - SPEC R5.7, R5.14 and R5.15 on a decoded volume (see
+ * volume_lookup.h): the cascade choice and border blend here, the SH lookup,
+ * the imperfect volume's reconstruction and the probes' weighted lookup
+ * from core's oracles.
  */
 #include "volume_lookup.h"
 
@@ -11,6 +12,7 @@
 
 #include "oracle.h"
 #include "oracle_iv.h"
+#include "probes_lookup.h"
 
 /* The wire's 12 values per cell are core's lpv_cell, r g b vec4 each (R5.1). */
 _Static_assert(sizeof(lpv_cell) == 12 * sizeof(float), "lpv_cell is the wire's 12 floats");
@@ -91,4 +93,29 @@ int lpvp_iv_irradiance(const lpvp_lookup_iv *v, const float p[3], const float n[
                   .cell_size = v->cell_size};
     lpv_iv_irradiance_held(&g, v->held, (const lpv_cell *)(const void *)v->cells, p, n, v->neighbours, rgb);
     return 0;
+}
+
+int lpvp_probes_irradiance(const lpvp_lookup_probes *v, const float p[3], const float n[3], float rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!v || !v->records || v->count < 1 || v->count > 4)
+        return -1;
+    lpv_probes_field f = {.levels = v->count, .irradiance_side = v->irradiance_side,
+                          .distance_side = v->distance_side, .bias_cells = v->bias_cells};
+    const size_t per = lpv_probes_record_values(v->irradiance_side, v->distance_side);
+    size_t first = 0;
+    for (int k = 0; k < v->count; ++k) {
+        const lpvp_lookup_cascade *c = &v->levels[k];
+        lpv_probes_level *l = &f.level[k];
+        for (int a = 0; a < 3; ++a) {
+            if (c->dims[a] < 1)
+                return -1;
+            l->dims[a] = c->dims[a];
+            l->origin[a] = c->origin[a];
+        }
+        l->cell_size = c->cell_size;
+        l->records = v->records + first * per;
+        first += (size_t)c->dims[0] * (size_t)c->dims[1] * (size_t)c->dims[2];
+    }
+    return lpv_probes_irradiance(&f, p, n, rgb);
 }

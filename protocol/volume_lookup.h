@@ -12,6 +12,10 @@
  * reference (techniques/iv/core/oracle_iv.h lpv_iv_irradiance_held) on the volume and its
  * index of surface-holding voxels.
  *
+ * R5.15 (technique probes with their visibility): the probes' weighted
+ * lookup, core's reference (techniques/probes/core/probes_lookup.h
+ * lpv_probes_irradiance) on the records the visibility carries.
+ *
  * Part of the lpv_protocol library, which therefore links lpv_core
  * (protocol -> core; core never includes protocol).
  */
@@ -63,6 +67,24 @@ typedef struct lpvp_lookup_iv {
  * volume that is not usable: no cells or flags, misaligned cells, dims < 1, a
  * cell size <= 0, neighbours outside 1..8. */
 int lpvp_iv_irradiance(const lpvp_lookup_iv *v, const float p[3], const float n[3], float rgb[3]);
+
+/* A probes' volume with its visibility (SPEC R5.15): the levels'
+ * placement and every probe's record (the description's values_per_probe
+ * floats each, level 0's probes first, x fastest). */
+typedef struct lpvp_lookup_probes {
+    int count;                         /* levels, 1..4, finest first */
+    lpvp_lookup_cascade levels[4];     /* dims, origin, cell_size (cells unused) */
+    const float *records;              /* the visibility's probes x values_per_probe floats */
+    int irradiance_side, distance_side; /* the description's */
+    float bias_cells;
+} lpvp_lookup_probes;
+
+/* Irradiance (W/m^2, rgb) at p for a surface with normal n by R5.15's
+ * visibility-weighted lookup (techniques/probes/core/probes_lookup.c
+ * lpv_probes_irradiance, the oracle of the server's). Returns 0, or -1
+ * (rgb zero) for a volume that is not usable: no records, levels outside
+ * 1..4, dims < 1, a cell size <= 0, a map side < 1. */
+int lpvp_probes_irradiance(const lpvp_lookup_probes *v, const float p[3], const float n[3], float rgb[3]);
 
 #ifdef __cplusplus
 }

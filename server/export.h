@@ -31,13 +31,18 @@ typedef struct sv_result {
     float *cells;           /* cells * 12 floats: every cascade's, cascade 0 first */
     size_t cell_count;      /* all cascades' cells */
     /* GET_VOLUME content "levels" (SPEC R5.13), in a result of
-     * sv_result_take_levels only: every level's cells (level_cells x 12
+     * sv_result_take_content (levels) only: every level's cells (level_cells x 12
      * floats, level 0 first, as lpv_engine_read_volumes gives them) and the
      * index (one per cell of cascade 0); NULL / 0 in a tick's result. */
     float *levels;
     size_t level_cells;
     uint32_t *index;
     size_t index_count;
+    /* GET_VOLUME content "visibility" (SPEC R5.15), in a result of
+     * sv_result_take_content only: every probe's record
+     * (lpv_engine_read_visibility), beside the merged cells. */
+    float *visibility;
+    size_t visibility_floats;
     /* Technique iv (SPEC R5.14): per voxel of the grid, 1 when it holds a
      * surface (IvVoxel.normal[3] > 0), the index every iv volume carries;
      * NULL / 0 for the other techniques. */
@@ -61,10 +66,12 @@ void sv_result_unref(sv_result *r);
  * height, stats and plan; refs 1, tick and gen 0 (the caller's). NULL with a
  * message in err. On the GL context's thread. */
 sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n);
-/* The octree's levels and index of the engine's last tick, for GET_VOLUME
- * content "levels" (SPEC R5.13) only (no merged cells, no frames), with the
- * grid, stats and plan; NULL with err for a technique without them. */
-sv_result *sv_result_take_levels(lpv_engine *e, char *err, size_t n);
+/* What GET_VOLUME's content (SPEC R5.13, R5.15) needs beyond a tick's
+ * result, read on request only, with the grid, stats and plan (no frames):
+ * LPVP_CONTENT_LEVELS the octree's levels and index (no merged cells),
+ * LPVP_CONTENT_VISIBILITY the merged cells and the probes' visibility. NULL
+ * with err for a technique without them. */
+sv_result *sv_result_take_content(lpv_engine *e, int content, char *err, size_t n);
 
 /* A VOLUME sent to a delta subscriber, not yet ACKed: the base of a delta. */
 typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */

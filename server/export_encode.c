@@ -5,7 +5,8 @@
  * frames as tone-mapped rgba8, PNG or EXR (in-memory, image/image_io.h), the
  * ao term as a linear fraction. A volume carries every cascade (R5.6,
  * cascade 0 first), or technique iv's voxels and their index (R5.14), and
- * both headers the tick's "plan" (lpvd_plan_json).
+ * on request the octree's levels (R5.13) or the probes' visibility (R5.15);
+ * both headers carry the tick's "plan" (lpvd_plan_json).
  *
  * The daemon runs the encoders on libuv's work threads (serve_encode_work.c):
  * they read only immutable results and what they are given, and the one
@@ -47,6 +48,16 @@ static void pack_levels(const sv_result *r, const lpvp_volume_info *vi, uint8_t 
 {
     lpvp_volume_pack(r->levels, r->level_cells, vi->format, raw);
     pack_index(raw + lpvp_volume_values_bytes(vi), r->index, r->index_count);
+}
+
+/* The probes' visibility (SPEC R5.15) as little-endian f32 at at. */
+static void pack_visibility(uint8_t *at, const float *v, size_t count)
+{
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t u;
+        memcpy(&u, &v[i], sizeof u);
+        lpvp_put_u32(at + LPVP_VISIBILITY_VALUE_SIZE * i, u);
+    }
 }
 
 /* A copy of r's cached keyframe attachment [fp16][zstd] in *att, or 0
@@ -93,6 +104,8 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
         *keep_raw = NULL;
     lpvp_volume_format fmt = fp16 ? LPVP_FMT_FP16 : LPVP_FMT_FP32;
     const int levels = content == LPVP_CONTENT_LEVELS;
+    const int visibility = content == LPVP_CONTENT_VISIBILITY;
+    const int merged = !levels && !visibility; /* the keyframe cache and deltas hold it alone */
     lpvp_volume_info vi;
     memset(&vi, 0, sizeof vi);
     vi.revision = (int64_t)revision;
@@ -142,6 +155,22 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
                      (unsigned long long)vi.layout.index.cells);
             return -1;
         }
+    } else if (visibility) { /* R5.15: the probes' SH, then their visibility */
+        if (!r->visibility || d->visibility_side <= 0 ||
+            lpvp_volume_layout_visibility(&vi.layout, d->technique, vi.cascade_count, d->irradiance_side,
+                                          d->visibility_side, d->visibility_bias_cells, err, n) != 0) {
+            if (!r->visibility || d->visibility_side <= 0)
+                snprintf(err, n, "%s: technique \"%s\" has no visibility to send", LPVP_VOLUME_CONTENT_KEY,
+                         d->technique);
+            return -1;
+        }
+        if (lpvp_volume_total_cells(&vi) != r->cell_count ||
+            r->visibility_floats != r->cell_count * vi.layout.visibility.values_per_probe) {
+            snprintf(err, n, "the tick kept %zu visibility values for %zu probes of %llu values", r->visibility_floats,
+                     r->cell_count, (unsigned long long)vi.layout.visibility.values_per_probe);
+            return -1;
+        }
+        raw_len = (size_t)(lpvp_volume_values_bytes(&vi) + lpvp_volume_extra_bytes(&vi));
     } else if (d->kind == LPV_LEVELS_IV_VOXELS) { /* R5.14: the voxels' radiance, then which hold a surface */
         if (vi.cascade_count != 1 || !r->iv_held || r->iv_held_count != r->cell_count) {
             snprintf(err, n, "technique \"%s\": the tick kept %zu of the %zu voxels' occupancy over %d levels",
@@ -158,9 +187,9 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
     vi.raw_length = raw_len;
 
     /* the keyframe cache and XOR deltas (R5.3) hold the merged content only */
-    if (levels)
+    if (!merged)
         keep_raw = NULL;
-    if (!levels && !keep_raw && cache_copy(r, fp16, zstd, att, att_len)) /* another session had it encoded */
+    if (merged && !keep_raw && cache_copy(r, fp16, zstd, att, att_len)) /* another session had it encoded */
         goto header;
     uint8_t *raw = malloc(raw_len ? raw_len : 1);
     if (!raw) {
@@ -173,6 +202,8 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
         lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
         if (vi.layout.has_index) /* R5.14 */
             pack_index(raw + lpvp_volume_values_bytes(&vi), r->iv_held, r->iv_held_count);
+        if (visibility) /* R5.15 */
+            pack_visibility(raw + lpvp_volume_values_bytes(&vi), r->visibility, r->visibility_floats);
     }
 
     uint8_t *payload = raw; /* what gets compressed / sent */
@@ -187,7 +218,7 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
             vi.base_tick = (int64_t)base->tick;
         }
     }
-    if (vi.keyframe && !levels && cache_copy(r, fp16, zstd, att, att_len)) {
+    if (vi.keyframe && merged && cache_copy(r, fp16, zstd, att, att_len)) {
         /* cached meanwhile */
     } else if (zstd) {
         uint8_t *z = NULL;
@@ -224,7 +255,7 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
     } else {
         free(raw);
     }
-    if (vi.keyframe && !levels && *att)
+    if (vi.keyframe && merged && *att)
         cache_put(r, fp16, zstd, *att, *att_len);
 header:
     *body = lpvp_volume_header_build(&vi);

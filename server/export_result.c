@@ -3,9 +3,11 @@
  * context's thread (sv_result: the accumulated volume of every cascade, the
  * imperfect volume's occupancy, the frames asked for, the stats and plan),
  * what GET_VOLUME, GET_FRAME and the streams encode (export.h). The
- * daemon's GL thread and lpvd batch's volume output take it here. The octree's levels and index
- * (GET_VOLUME content "levels") are read only for a request that asks for
- * them (sv_result_take_levels): a tick does not pay for them (issue 33).
+ * daemon's GL thread and lpvd batch's volume output take it here. The
+ * octree's levels and index (GET_VOLUME content "levels") and the probes'
+ * visibility (content "visibility") are read only for a request that asks
+ * for them (sv_result_take_content): a tick does not pay for them (issue
+ * 33).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,6 +29,7 @@ static void result_free(sv_result *r)
     free(r->cells);
     free(r->levels);
     free(r->index);
+    free(r->visibility);
     free(r->iv_held);
     for (int i = 0; i < LPVP_TERMS_COUNT; ++i)
         free(r->frames[i]);
@@ -136,23 +139,56 @@ static sv_result *result_new(lpv_engine *e, char *err, size_t n)
     return r;
 }
 
-sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n)
+/* Every cascade's accumulated cells. 0, or -1 with err. */
+static int keep_cells(lpv_engine *e, sv_result *r, char *err, size_t n)
 {
-    sv_result *r = result_new(e, err, n);
-    if (!r)
-        return NULL;
     r->cell_count = 0;
     for (int k = 0; k < r->cascade_count; ++k)
         r->cell_count += lpv_grid_cell_count(&r->cascades[k]);
     r->cells = malloc((r->cell_count ? r->cell_count : 1) * sizeof(lpv_cell));
     if (!r->cells) {
         snprintf(err, n, "out of memory for %zu cells", r->cell_count);
-        sv_result_unref(r);
-        return NULL;
+        return -1;
     }
     size_t got = lpv_engine_read_grid(e, LPV_GRID_ACCUMULATED, (lpv_cell *)r->cells, r->cell_count);
     if (got < r->cell_count)
         memset(r->cells + got * 12, 0, (r->cell_count - got) * sizeof(lpv_cell));
+    return 0;
+}
+
+/* GET_VOLUME content "visibility" (SPEC R5.15): the probes' records, a
+ * probe per cell kept. 0, or -1 with err (also for a technique without). */
+static int keep_visibility(lpv_engine *e, sv_result *r, char *err, size_t n)
+{
+    const lpv_volume_desc *d = &r->stats.volume;
+    if (d->visibility_side <= 0) {
+        snprintf(err, n, "technique \"%s\" has no probes' visibility to send", d->technique ? d->technique : "?");
+        return -1;
+    }
+    const size_t per = (size_t)lpvp_visibility_values_per_probe(d->irradiance_side, d->visibility_side);
+    const size_t want = r->cell_count * per;
+    r->visibility = malloc((want ? want : 1) * sizeof *r->visibility);
+    if (!r->visibility) {
+        snprintf(err, n, "out of memory for the visibility of %zu probes", r->cell_count);
+        return -1;
+    }
+    if (lpv_engine_read_visibility(e, r->visibility, want) != want) {
+        snprintf(err, n, "the visibility of %zu probes could not be read back", r->cell_count);
+        return -1;
+    }
+    r->visibility_floats = want;
+    return 0;
+}
+
+sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_mask, char *err, size_t n)
+{
+    sv_result *r = result_new(e, err, n);
+    if (!r)
+        return NULL;
+    if (keep_cells(e, r, err, n) != 0) {
+        sv_result_unref(r);
+        return NULL;
+    }
     long long occupied = -1;
     if (keep_iv_held(e, r, &occupied, err, n) != 0) {
         sv_result_unref(r);
@@ -177,12 +213,21 @@ sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_m
     return r;
 }
 
-sv_result *sv_result_take_levels(lpv_engine *e, char *err, size_t n)
+sv_result *sv_result_take_content(lpv_engine *e, int content, char *err, size_t n)
 {
     sv_result *r = result_new(e, err, n);
-    if (r && keep_levels(e, r, err, n) != 0) {
+    if (!r)
+        return NULL;
+    int bad;
+    if (content == LPVP_CONTENT_LEVELS)
+        bad = keep_levels(e, r, err, n); /* no merged cells: it answers content "levels" only */
+    else if (content == LPVP_CONTENT_VISIBILITY)
+        bad = keep_cells(e, r, err, n) != 0 || keep_visibility(e, r, err, n) != 0;
+    else
+        bad = snprintf(err, n, "content %d is read with every tick", content) > 0;
+    if (bad) {
         sv_result_unref(r);
         return NULL;
     }
-    return r; /* no merged cells: it answers content "levels" only */
+    return r;
 }

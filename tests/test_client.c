@@ -695,6 +695,93 @@ static void test_iv_volume(void **state)
     lpvc_close(c);
 }
 
+/* Technique probes with content "visibility" (SPEC R5.15): the merged SH
+ * volume plus every probe's record, f32 whatever the format, looked up
+ * locally (lpvc_volume_irradiance: the probes weighted by their distance
+ * maps) as the server's QUERY_IRRADIANCE answers; refused with BAD_FIELD
+ * naming content for a technique without probes. */
+static void test_probes_visibility(void **state)
+{
+    (void)state;
+    REQUIRE_DAEMON();
+    lpvc *c = open_client();
+    OK(c, lpvc_config_json(c, "{\"technique\": \"lpv\"}"));
+    OK(c, lpvc_tick(c, NULL));
+    lpvc_volume v, v16, merged;
+    assert_int_equal(lpvc_get_volume(c, &(lpvc_volume_desc){.content = "visibility"}, &v), -1);
+    assert_string_equal(lpvc_error_name(c), "BAD_FIELD");
+    assert_non_null(strstr(lpvc_error_message(c), "content"));
+    OK(c, lpvc_config_json(c, "{\"technique\": \"probes\", \"grid\": 8, \"probes_rays\": 32}"));
+    int64_t tick = -1;
+    OK(c, lpvc_tick(c, &tick));
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp32", .content = "visibility"}, &v));
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp16", .compression = "none", .content = "visibility"},
+                          &v16));
+    OK(c, lpvc_get_volume(c, &(lpvc_volume_desc){.format = "fp32"}, &merged));
+    assert_int_equal(v.tick, tick);
+    assert_string_equal(v.technique, "probes");
+    assert_string_equal(v.content, "visibility");
+    assert_string_equal(merged.content, "merged");
+    assert_null(merged.visibility);
+    assert_int_equal(v.irradiance_side, 6);
+    assert_int_equal(v.distance_side, 8);
+    assert_int_equal(v.values_per_probe, 4 + 3 * 36 + 2 * 64);
+    assert_int_equal(v.visibility_floats, v.total_cells * (size_t)v.values_per_probe);
+    assert_int_equal(v.total_cells, merged.total_cells);
+    /* the SH part is the merged volume; the visibility is f32 in either format */
+    assert_memory_equal(v.data, merged.data, merged.total_cells * 12 * sizeof(float));
+    assert_int_equal(v16.visibility_floats, v.visibility_floats);
+    assert_memory_equal(v16.visibility, v.visibility, v.visibility_floats * sizeof(float));
+    size_t active = 0;
+    for (size_t i = 0; i < v.total_cells; i++) {
+        const float *r = v.visibility + i * (size_t)v.values_per_probe;
+        assert_true(r[3] == 0.0f || r[3] == 1.0f);
+        active += r[3] == 1.0f;
+        for (int a = 0; a < 3; a++)
+            assert_true(fabsf(r[a]) < 0.5f * v.cell_size);
+        for (int k = 4; k < v.values_per_probe; k++)
+            assert_true(isfinite(r[k]) && r[k] >= 0.0f);
+    }
+    assert_true(active > 0);
+
+    /* QUERY_IRRADIANCE = R5.15's lookup on the volume of the same tick */
+    enum { N = 7 * 64 };
+    float pts[N * 3], nrm[N * 3], rgb[N * 3], local[N * 3];
+    static const float dirs[7][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}};
+    size_t n = 0;
+    for (int i = 0; i < 64; i++)
+        for (int k = 0; k < 7; k++, n++) {
+            int g[3] = {i % 4, (i / 4) % 4, i / 16};
+            for (int a = 0; a < 3; a++) {
+                static const float at[3] = {0.07f, 0.11f, 0.05f}, step[3] = {0.29f, 0.27f, 0.31f};
+                pts[3 * n + a] = v.origin[a] + (at[a] + step[a] * (float)g[a]) * (float)v.dims[a] * v.cell_size;
+                nrm[3 * n + a] = dirs[k][a];
+            }
+        }
+    OK(c, lpvc_query_irradiance(c, pts, nrm, N, rgb));
+    for (size_t i = 0; i < N; i++)
+        assert_int_equal(lpvc_volume_irradiance(&v, pts + 3 * i, nrm + 3 * i, local + 3 * i), 0);
+    float emax = fmaxf(max_abs(local, N * 3), max_abs(rgb, N * 3));
+    assert_true(emax > 0.0f);
+    size_t off = 0, lit = 0;
+    float worst = 0.0f;
+    for (size_t i = 0; i < N * 3; i++) {
+        assert_true(isfinite(rgb[i]) && rgb[i] >= 0.0f);
+        lit += local[i] > 1e-3f * emax;
+        worst = fmaxf(worst, fabsf(rgb[i] - local[i]) / emax);
+        off += !(fabsf(rgb[i] - local[i]) <= 1e-4f * emax);
+    }
+    fprintf(stderr, "probes: %zu of %d values differ from the server's by more than 1e-4 of the largest (worst %g)\n",
+            off, N * 3, (double)worst);
+    assert_true(off <= N * 3 / 50); /* the thresholds, where the GPU's rounding may fall the other way */
+    assert_true(lit > N);
+    lpvc_volume_free(&v);
+    lpvc_volume_free(&v16);
+    lpvc_volume_free(&merged);
+    OK(c, lpvc_bye(c));
+    lpvc_close(c);
+}
+
 static void test_frames(void **state)
 {
     (void)state;
@@ -1024,6 +1111,7 @@ int main(void)
         cmocka_unit_test(test_tick_volume_query),
         cmocka_unit_test(test_octree_levels),
         cmocka_unit_test(test_iv_volume),
+        cmocka_unit_test(test_probes_visibility),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_state_changes_bump_revision),
         cmocka_unit_test(test_config_recomputes_only_what_it_touches),

@@ -1658,6 +1658,171 @@ static void test_volume_iv(void **state)
     json_decref(h);
 }
 
+/* R5.15: a probes' volume with its visibility (GET_VOLUME content
+ * "visibility"): built, read back (still R5.7's SH), and every inconsistent
+ * variant refused naming the field. */
+static void test_volume_visibility(void **state)
+{
+    (void)state;
+    char err[256];
+    lpvp_volume_info vi, back;
+    memset(&vi, 0, sizeof vi);
+    vi.revision = 3;
+    vi.tick = 4;
+    vi.format = LPVP_FMT_FP16;
+    vi.keyframe = 1;
+    vi.base_tick = -1;
+    vi.cascade_count = 2;
+    for (int k = 0; k < 2; k++) {
+        lpvp_cascade_info *c = &vi.cascades[k];
+        for (int a = 0; a < 3; a++) {
+            c->dims[a] = 2;
+            c->origin[a] = -1.0 * (k + 1);
+        }
+        c->cell_size = k + 1.0;
+        c->cells = 8;
+    }
+    for (int a = 0; a < 3; a++) {
+        vi.dims[a] = 2;
+        vi.origin[a] = -1.0;
+    }
+    vi.cell_size = 1.0;
+    assert_int_equal(lpvp_volume_layout_visibility(&vi.layout, "probes", 2, 0, 8, 0.25, err, sizeof err), -1);
+    assert_int_equal(lpvp_volume_layout_visibility(&vi.layout, "probes", 2, 6, 33, 0.25, err, sizeof err), -1);
+    assert_int_equal(lpvp_volume_layout_visibility(&vi.layout, "probes", 2, 6, 8, -1.0, err, sizeof err), -1);
+    assert_int_equal(lpvp_volume_layout_visibility(&vi.layout, "probes", 2, 6, 8, 0.25, err, sizeof err), 0);
+    assert_int_equal(vi.layout.visibility.values_per_probe, 240);
+    /* 16 probes x 12 fp16 values, then 16 x 240 f32 */
+    assert_int_equal(lpvp_volume_values_bytes(&vi), 16 * 12 * 2);
+    assert_int_equal(lpvp_volume_extra_bytes(&vi), 16 * 240 * 4);
+    vi.raw_length = 16 * 12 * 2 + 16 * 240 * 4;
+    json_t *h = lpvp_volume_header_build(&vi);
+    assert_non_null(h);
+    json_t *d = json_object_get(h, LPVP_VOLUME_DESC_KEY), *v = json_object_get(d, LPVP_VISIBILITY_KEY);
+    assert_non_null(v);
+    assert_int_equal(json_integer_value(json_object_get(v, "probes")), 16);
+    assert_int_equal(json_integer_value(json_object_get(v, "irradiance_side")), 6);
+    assert_int_equal(json_integer_value(json_object_get(v, "distance_side")), 8);
+    assert_int_equal(json_integer_value(json_object_get(v, "values_per_probe")), 240);
+    assert_string_equal(json_string_value(json_object_get(v, "value_type")), "f32");
+    assert_true(json_real_value(json_object_get(v, "bias_cells")) == 0.25);
+    assert_int_equal(json_integer_value(json_object_get(v, "raw_offset")), 16 * 12 * 2);
+    assert_int_equal(json_integer_value(json_object_get(v, "raw_length")), 16 * 240 * 4);
+    assert_true(json_is_null(json_object_get(d, "index")));
+    assert_true(json_is_false(json_object_get(d, "far_field")));
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_int_equal(back.layout.content, LPVP_CONTENT_VISIBILITY);
+    assert_true(back.layout.has_visibility);
+    assert_int_equal(back.layout.visibility.probes, 16);
+    assert_int_equal(back.layout.visibility.values_per_probe, 240);
+    assert_int_equal(back.layout.visibility.raw_offset, 16 * 12 * 2);
+    assert_int_equal(back.layout.visibility.raw_length, 16 * 240 * 4);
+    assert_true(back.layout.visibility.bias_cells == 0.25);
+    assert_int_equal(lpvp_volume_layout_lookup_check(&back.layout, err, sizeof err), 0); /* R5.7 reads its SH */
+
+#define BAD(edit, what)                                                                                       \
+    do {                                                                                                      \
+        json_t *b = json_deep_copy(h), *bd = json_object_get(b, LPVP_VOLUME_DESC_KEY);                        \
+        json_t *bv = json_object_get(bd, LPVP_VISIBILITY_KEY);                                                \
+        (void)bv;                                                                                             \
+        edit;                                                                                                 \
+        expect_refused(b, what);                                                                              \
+    } while (0)
+    BAD(json_object_set_new(bd, LPVP_VISIBILITY_KEY, json_integer(1)), "visibility: expected an object");
+    BAD(json_object_set_new(bv, "irradiance_side", json_integer(0)), "visibility.irradiance_side");
+    BAD(json_object_set_new(bv, "irradiance_side", json_integer(17)), "visibility.irradiance_side");
+    BAD(json_object_set_new(bv, "distance_side", json_integer(33)), "visibility.distance_side");
+    BAD(json_object_set_new(bv, "distance_side", json_integer(7)), "visibility.values_per_probe");
+    BAD(json_object_set_new(bv, "values_per_probe", json_integer(239)), "visibility.values_per_probe");
+    BAD(json_object_set_new(bv, "probes", json_integer(8)), "visibility.probes");
+    BAD(json_object_set_new(bv, "value_type", json_string("f16")), "visibility.value_type");
+    BAD(json_object_set_new(bv, "bias_cells", json_real(-0.5)), "visibility.bias_cells");
+    BAD(json_object_set_new(bv, "bias_cells", json_string("0.25")), "visibility.bias_cells");
+    BAD(json_object_set_new(bv, "raw_offset", json_integer(0)), "visibility.raw_offset");
+    BAD(json_object_set_new(bv, "raw_length", json_integer(16 * 240 * 2)), "visibility.raw_length");
+    BAD(json_object_set_new(b, "raw_length", json_integer(16 * 12 * 2)), "raw_length");
+    /* only with cascades of the SH in one volume, no far field, no index */
+    BAD((json_object_set_new(bd, "far_field", json_true()),
+         json_object_set_new(json_array_get(json_object_get(bd, "levels"), 1), "role", json_string("far_field"))),
+        "visibility");
+    BAD(json_object_set_new(bd, "index", json_pack("{s:i, s:[i,i,i], s:i, s:s, s:I, s:I}", "level", 0, "dims", 2, 2,
+                                                  2, "values_per_cell", 1, "value_type", "u32", "raw_offset",
+                                                  (json_int_t)(16 * 12 * 2), "raw_length", (json_int_t)32)),
+        "visibility");
+#undef BAD
+    json_decref(h);
+
+    /* on an iv volume it is refused too */
+    lpvp_volume_info iv = vi;
+    iv.cascade_count = 1;
+    assert_int_equal(lpvp_volume_layout_iv(&iv.layout, "iv", &iv.cascades[0], 6, err, sizeof err), 0);
+    iv.raw_length = 8 * 12 * 2 + 8 * 4;
+    json_t *hi = lpvp_volume_header_build(&iv);
+    json_object_set_new(json_object_get(hi, LPVP_VOLUME_DESC_KEY), LPVP_VISIBILITY_KEY, json_object());
+    expect_refused(hi, "only a probes' volume");
+}
+
+/* R5.15's lookup on hand-made records: probes that all hold the same
+ * irradiance give it wherever the point is; a probe whose distance map says
+ * a wall stands between it and the point counts (almost) nothing; off probes
+ * count nothing. */
+static void test_probes_lookup(void **state)
+{
+    (void)state;
+    enum { I = 2, D = 2, PER = 4 + 3 * I * I + 2 * D * D };
+    float rec[8 * PER];
+    memset(rec, 0, sizeof rec);
+    for (int p = 0; p < 8; p++) {
+        float *r = rec + p * PER;
+        r[3] = 1.0f;
+        for (int t = 0; t < I * I; t++) {
+            r[4 + 3 * t] = 3.0f, r[5 + 3 * t] = 2.0f, r[6 + 3 * t] = 1.0f;
+        }
+        for (int t = 0; t < D * D; t++) {
+            r[4 + 3 * I * I + 2 * t] = 10.0f; /* far walls: every probe sees every point */
+            r[5 + 3 * I * I + 2 * t] = 100.0f;
+        }
+    }
+    lpvp_lookup_probes pr = {.count = 1, .records = rec, .irradiance_side = I, .distance_side = D, .bias_cells = 0.25f};
+    pr.levels[0] = (lpvp_lookup_cascade){.dims = {2, 2, 2}, .origin = {0, 0, 0}, .cell_size = 1.0f};
+    const float pts[3][3] = {{1.0f, 1.0f, 1.0f}, {0.6f, 1.3f, 0.9f}, {5.0f, -3.0f, 1.0f}};
+    const float n[3] = {0.0f, 0.0f, 2.0f};
+    for (int i = 0; i < 3; i++) {
+        float e[3];
+        assert_int_equal(lpvp_probes_irradiance(&pr, pts[i], n, e), 0);
+        assert_float_equal(e[0], 3.0f, 1e-5f);
+        assert_float_equal(e[1], 2.0f, 1e-5f);
+        assert_float_equal(e[2], 1.0f, 1e-5f);
+    }
+    /* the x = 1 probes (odd indices) light 6 times as bright; at x = 0.5 the two halves weigh the same */
+    for (int p = 1; p < 8; p += 2)
+        for (int t = 0; t < I * I; t++)
+            rec[p * PER + 4 + 3 * t] = 18.0f;
+    const float mid[3] = {1.0f, 1.0f, 1.0f}, up[3] = {0.0f, 0.0f, 1.0f};
+    float e[3];
+    assert_int_equal(lpvp_probes_irradiance(&pr, mid, up, e), 0);
+    assert_float_equal(e[0], 10.5f, 1e-4f);
+    /* the bright probes see a wall 0.1 m away in every direction: the point (0.5 m off) is hidden from them */
+    for (int p = 1; p < 8; p += 2)
+        for (int t = 0; t < D * D; t++) {
+            rec[p * PER + 4 + 3 * I * I + 2 * t] = 0.1f;
+            rec[p * PER + 5 + 3 * I * I + 2 * t] = 0.0101f;
+        }
+    assert_int_equal(lpvp_probes_irradiance(&pr, mid, up, e), 0);
+    assert_true(e[0] > 3.0f && e[0] < 3.01f);
+    /* off, the dim probes count nothing: only the hidden bright ones are left, by the floor of their weights */
+    for (int p = 0; p < 8; p += 2)
+        rec[p * PER + 3] = 0.0f;
+    assert_int_equal(lpvp_probes_irradiance(&pr, mid, up, e), 0);
+    assert_float_equal(e[0], 18.0f, 1e-3f);
+    /* no normal, no light; a field that is not usable refuses */
+    const float zero[3] = {0, 0, 0};
+    assert_int_equal(lpvp_probes_irradiance(&pr, mid, zero, e), 0);
+    assert_true(e[0] == 0.0f && e[1] == 0.0f && e[2] == 0.0f);
+    pr.count = 0;
+    assert_int_equal(lpvp_probes_irradiance(&pr, mid, up, e), -1);
+}
+
 /* R5.14's lookup (volume_lookup.h) is core's reconstruction on the flags:
  * bit for bit what lpv_iv_irradiance gives from the voxels the flags come
  * from, at random points and normals (inside, on faces, outside the grid). */
@@ -1894,6 +2059,8 @@ int main(void)
         cmocka_unit_test(test_volume_octree_levels),
         cmocka_unit_test(test_volume_iv),
         cmocka_unit_test(test_iv_lookup),
+        cmocka_unit_test(test_volume_visibility),
+        cmocka_unit_test(test_probes_lookup),
         cmocka_unit_test(test_addresses),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

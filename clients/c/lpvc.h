@@ -249,7 +249,7 @@ typedef struct lpvc_volume {
      * the header says and pointing into data; cascades[0] is level 0) and the
      * index volume above (per level-0 cell, the level its merged light comes
      * from). R5.7's lookup refuses a "levels" volume. */
-    char content[8];
+    char content[16];          /* "merged", "levels" or "visibility" */
     int level_count;           /* "levels": 1..LPVC_MAX_LEVELS; "merged": 0 */
     lpvc_cascade levels[LPVC_MAX_LEVELS];
     /* The values' units ("W/sr": an LPV's intensity per cell; "W/(m^2 sr)":
@@ -260,13 +260,25 @@ typedef struct lpvc_volume {
     char units[32];
     bool iv_voxels;
     int iv_neighbours;         /* 1..8 with iv_voxels, else 0 */
+    /* Content "visibility" (SPEC R5.15, technique probes): beside the
+     * cascades' SH, every probe's record (a probe per cell, cascade 0's
+     * first, x fastest), values_per_probe floats each: offset from the
+     * cell's centre (m, 3), active (1 or 0), the irradiance map
+     * (irradiance_side^2 texels of rgb, W/m^2), the distance map
+     * (distance_side^2 texels of mean and mean square distance, m and
+     * m^2). lpvc_volume_irradiance then weighs the probes as the server
+     * does. NULL / 0 for any other volume. */
+    float *visibility;
+    size_t visibility_floats;
+    int irradiance_side, distance_side, values_per_probe;
+    float bias_cells;          /* the lookup's step along the normal, in cells */
 } lpvc_volume;
 void lpvc_volume_free(lpvc_volume *v);
 
 typedef struct lpvc_volume_desc {
     const char *format;        /* "fp16" | "fp32"; NULL: "fp32" */
     const char *compression;   /* "zstd" | "none"; NULL: "zstd" */
-    const char *content;       /* "merged" | "levels" (SPEC R5.13); NULL: "merged" */
+    const char *content;       /* "merged" | "levels" (SPEC R5.13) | "visibility" (R5.15); NULL: "merged" */
 } lpvc_volume_desc;
 int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out);
 
@@ -336,13 +348,15 @@ void lpvc_message_free(lpvc_message *m);
  * LPVC_ERR_TIMEOUT. */
 int lpvc_next_stream_message(lpvc *c, lpvc_message *out, int timeout_ms);
 
-/* ---- Local lookup (SPEC R5.7, R5.14; protocol/volume_lookup.h over core's oracles) ---- */
+/* ---- Local lookup (SPEC R5.7, R5.14, R5.15; protocol/volume_lookup.h over core's oracles) ---- */
 
 /* E(n) in W/m^2 at point p with normal n from a decoded volume, as the
  * server's QUERY_IRRADIANCE computes it: with several cascades, the finest
  * containing p, blended to the next coarser within the last 3 cells of its
  * border (SPEC R5.7); for technique iv's voxels (iv_voxels), R5.14's
- * reconstruction from the voxels around p and the index. Returns 0, or -1
+ * reconstruction from the voxels around p and the index; for a probes'
+ * volume with its visibility (content "visibility"), R5.15's lookup: the 8
+ * probes around p weighted by their distance maps. Returns 0, or -1
  * with rgb zero for a volume whose layout neither lookup reads
  * (lpvc_volume_lookup_check says why). */
 int lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n[3], float rgb[3]);

@@ -2,8 +2,8 @@
  * lpvc_volume.c - the C client's volumes (SPEC section 5): decoding a
  * VOLUME / GET_VOLUME header and attachment (zstd, fp16 and XOR deltas come
  * from protocol/volume_codec.h), the acknowledged volumes kept as delta bases
- * (R5.3), GET_VOLUME, and the local lookup (R5.7, or R5.14 for technique iv's
- * voxels; protocol/volume_lookup.h).
+ * (R5.3), GET_VOLUME, and the local lookup (R5.7, R5.14 for technique iv's
+ * voxels, R5.15 for the probes with their visibility; protocol/volume_lookup.h).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,6 +23,7 @@ void lpvc_volume_free(lpvc_volume *v)
         return;
     free(v->data);
     free(v->index);
+    free(v->visibility);
     free(v->header_json);
     free(v->plan_json);
     memset(v, 0, sizeof *v);
@@ -88,21 +89,38 @@ int lpvci_decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t a
     uint8_t *raw = malloc(vi.raw_length ? (size_t)vi.raw_length : 1);
     float *data = malloc((values ? values : 1) * sizeof(float));
     uint32_t *index = ix ? malloc((index_count ? index_count : 1) * sizeof(uint32_t)) : NULL;
-    if (!raw || !data || (ix && !index)) {
+    const lpvp_visibility_info *vis = lay->has_visibility ? &lay->visibility : NULL;
+    size_t vis_count = vis ? (size_t)(vis->raw_length / LPVP_VISIBILITY_VALUE_SIZE) : 0;
+    float *visibility = vis ? malloc((vis_count ? vis_count : 1) * sizeof(float)) : NULL;
+    if (!raw || !data || (ix && !index) || (vis && !visibility)) {
         free(raw);
         free(data);
         free(index);
+        free(visibility);
         return lpvci_fail(c, LPVC_ERR_IO, "out of memory for a %zu-cell volume", cells);
     }
     if (lpvp_volume_decode(&vi, att, att_len, base ? base->raw : NULL, base ? base->len : 0, raw, err, sizeof err) != 0) {
         free(raw);
         free(data);
         free(index);
+        free(visibility);
         return lpvci_fail(c, LPVC_ERR_PROTOCOL, "cannot decode the volume: %s", err);
     }
     lpvp_values_unpack(raw, values, vi.format, data);
     for (size_t i = 0; i < index_count; i++) /* R5.12: little-endian u32 whatever the format */
         index[i] = lpvp_get_u32(raw + ix->raw_offset + LPVP_INDEX_VALUE_SIZE * i);
+    for (size_t i = 0; i < vis_count; i++) { /* R5.15: little-endian f32 whatever the format */
+        const uint32_t u = lpvp_get_u32(raw + vis->raw_offset + LPVP_VISIBILITY_VALUE_SIZE * i);
+        memcpy(&visibility[i], &u, sizeof u);
+    }
+    if (vis) {
+        out->visibility = visibility;
+        out->visibility_floats = vis_count;
+        out->irradiance_side = vis->irradiance_side;
+        out->distance_side = vis->distance_side;
+        out->values_per_probe = (int)vis->values_per_probe;
+        out->bias_cells = (float)vis->bias_cells;
+    }
 
     out->revision = vi.revision;
     out->tick = vi.tick;
@@ -202,7 +220,7 @@ int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out)
     return rc;
 }
 
-/* ---- local lookup: SPEC R5.7 and R5.14, the protocol library's (volume_lookup.h) ----- */
+/* ---- local lookup: SPEC R5.7, R5.14 and R5.15, the protocol library's (volume_lookup.h) ----- */
 
 static lpvp_lookup_cascade lookup_cascade(const lpvc_cascade *cs)
 {
@@ -235,8 +253,11 @@ static lpvp_volume_layout layout_of(const lpvc_volume *v)
     l.volumes_per_level = v->volumes_per_level;
     l.sh_values = v->sh_values;
     l.has_index = v->index != NULL;
-    l.content = strcmp(v->content, lpvp_volume_content_names[LPVP_CONTENT_LEVELS]) == 0 ? LPVP_CONTENT_LEVELS
-                                                                                          : LPVP_CONTENT_MERGED;
+    l.content = LPVP_CONTENT_MERGED;
+    for (int k = 0; k < LPVP_CONTENT_COUNT; k++)
+        if (strcmp(v->content, lpvp_volume_content_names[k]) == 0)
+            l.content = (lpvp_volume_content)k;
+    l.has_visibility = v->visibility != NULL;
     l.level_count = v->level_count;
     snprintf(l.units, sizeof l.units, "%s", v->units);
     if (v->iv_voxels) { /* R5.14: its one level and the index over it */
@@ -274,6 +295,17 @@ int lpvc_volume_irradiance(const lpvc_volume *v, const float p[3], const float n
     char err[8];
     if (lpvc_volume_lookup_check(v, err, sizeof err) != 0)
         return -1;
+    if (v->visibility) { /* R5.15 */
+        lpvp_lookup_probes pr = {.count = v->cascade_count, .records = v->visibility,
+                                 .irradiance_side = v->irradiance_side, .distance_side = v->distance_side,
+                                 .bias_cells = v->bias_cells};
+        if (pr.count < 1 || pr.count > LPVC_MAX_CASCADES ||
+            v->visibility_floats != v->total_cells * (size_t)v->values_per_probe)
+            return -1;
+        for (int k = 0; k < pr.count; k++)
+            pr.levels[k] = lookup_cascade(&v->cascades[k]);
+        return lpvp_probes_irradiance(&pr, p, n, rgb);
+    }
     if (v->iv_voxels) { /* R5.14 */
         const lpvc_cascade *cs = &v->cascades[0];
         const lpvp_lookup_iv iv = {.dims = {cs->dims[0], cs->dims[1], cs->dims[2]},

@@ -46,6 +46,7 @@ static const char *g_usage =
     "                                          --tick sends a TICK before each wait\n"
     "  unsubscribe [volume|frame]\n"
     "  volume [-o FILE.bin|FILE.json] [--format fp16|fp32] [--compression zstd|none]\n"
+    "         [--content merged|levels|visibility]\n"
     "                                          .bin: raw float32 (all cascades' cells x 12, finest first)\n"
     "                                          + FILE.bin.json sidecar (with each cascade's placement);\n"
     "                                          .json: a summary; no -o: summary on stdout\n"

@@ -119,6 +119,20 @@ static json_t *volume_summary(const lpvc_volume *v)
                           (json_int_t)nonfinite, "negative_c0", (json_int_t)negative_c0, "header",
                           hdr ? hdr : json_object());
     json_object_set_new(o, "cascades", cascades);
+    json_object_set_new(o, "content", json_string(v->content[0] ? v->content : "merged"));
+    if (v->visibility && v->values_per_probe > 0) { /* SPEC R5.15: how many probes are on, how far they moved */
+        size_t probes = v->visibility_floats / (size_t)v->values_per_probe, active = 0;
+        double moved = 0.0;
+        for (size_t i = 0; i < probes; i++) {
+            const float *r = v->visibility + i * (size_t)v->values_per_probe;
+            active += r[3] != 0.0f;
+            moved = fmax(moved, sqrt((double)r[0] * r[0] + (double)r[1] * r[1] + (double)r[2] * r[2]));
+        }
+        json_object_set_new(o, "visibility",
+                            json_pack("{s:I, s:I, s:i, s:i, s:f}", "probes", (json_int_t)probes, "active",
+                                      (json_int_t)active, "irradiance_side", v->irradiance_side, "distance_side",
+                                      v->distance_side, "max_offset_m", moved));
+    }
     if (v->plan_json)
         json_object_set_new(o, "plan", json_loads(v->plan_json, 0, NULL));
     return o;
@@ -190,11 +204,12 @@ int save_volume(const lpvc_volume *v, const char *path)
     return rc;
 }
 
-enum { VOL_OUTPUT, VOL_FORMAT, VOL_COMPRESSION, VOL_COUNT };
+enum { VOL_OUTPUT, VOL_FORMAT, VOL_COMPRESSION, VOL_CONTENT, VOL_COUNT };
 static const lpv_flag VOLUME_FLAGS[VOL_COUNT] = {
     [VOL_OUTPUT] = {"output", 'o', "FILE.bin|FILE.json", ""},
     [VOL_FORMAT] = {"format", 0, "fp16|fp32", ""},
     [VOL_COMPRESSION] = {"compression", 0, "zstd|none", ""},
+    [VOL_CONTENT] = {"content", 0, "merged|levels|visibility", ""},
 };
 
 int cmd_volume(int argc, char **argv)
@@ -212,6 +227,7 @@ int cmd_volume(int argc, char **argv)
         case VOL_OUTPUT: out = v; break;
         case VOL_FORMAT: d.format = v; break;
         case VOL_COMPRESSION: d.compression = v; break;
+        case VOL_CONTENT: d.content = v; break;
         }
     }
     if (r < 0)

@@ -271,7 +271,7 @@ struct sv_world {
 typedef enum sv_job_kind {
     SV_JOB_TICK = 1,
     SV_JOB_RENDER,
-    SV_JOB_LEVELS,          /* GET_VOLUME content "levels": read back on request, not every tick */
+    SV_JOB_CONTENT,         /* GET_VOLUME content "levels" or "visibility": read back on request, not every tick */
     SV_JOB_QUERY,
     SV_JOB_DESTROY,
     SV_JOB_QUIT,

@@ -340,14 +340,15 @@ static void gl_render(sv_job *j)
     j->tick = w->gl_ticks;
 }
 
-/* GET_VOLUME content "levels": the octree's levels and index of the tick the
- * world last computed, read now (a tick reads only its merged volume). */
-static void gl_levels(sv_job *j)
+/* GET_VOLUME content "levels" or "visibility" (j->count >> 8): the octree's
+ * levels and index, or the probes' visibility, of the tick the world last
+ * computed, read now (a tick reads only its merged volume). */
+static void gl_content(sv_job *j)
 {
     sv_world *w = j->world;
     if (!gl_ready_for(w, j))
         return;
-    j->result = sv_result_take_levels(w->engine, j->err, sizeof j->err);
+    j->result = sv_result_take_content(w->engine, (int)(j->count >> 8), j->err, sizeof j->err);
     if (!j->result) {
         j->status = strstr(j->err, "out of memory") ? LPVP_E_INTERNAL : LPVP_E_BAD_FIELD;
         return;
@@ -408,7 +409,7 @@ static void run_job(sv_server *s, sv_job *j)
         switch (j->kind) {
         case SV_JOB_TICK: gl_tick(s, j); break;
         case SV_JOB_RENDER: gl_render(j); break;
-        case SV_JOB_LEVELS: gl_levels(j); break;
+        case SV_JOB_CONTENT: gl_content(j); break;
         case SV_JOB_QUERY: gl_query(j); break;
         case SV_JOB_DESTROY:
             lpv_engine_destroy(w->engine);

@@ -103,13 +103,13 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
         return;
     }
     const sv_result *latest = c->world->latest;
-    if (content != LPVP_CONTENT_LEVELS) { /* packed and compressed on a work thread; the session is busy until
+    if (content == LPVP_CONTENT_MERGED) { /* packed and compressed on a work thread; the session is busy until
                                              the reply is queued */
         sv_reply_volume(c, r->request_id, c->world->latest, content, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD);
         return;
     }
-    if (!latest->stats.volume.index_levels) { /* R5.13: only a technique with levels */
-        const char *t = latest->stats.volume.technique;
+    const char *t = latest->stats.volume.technique;
+    if (content == LPVP_CONTENT_LEVELS && !latest->stats.volume.index_levels) { /* R5.13: only a technique with levels */
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
                      "%s: \"%s\" needs a technique with levels and an index volume; this session's "
                      "volume comes from technique \"%s\", whose volume is its merged content \"%s\" only",
@@ -117,14 +117,22 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
                      lpvp_volume_content_names[LPVP_CONTENT_MERGED]);
         return;
     }
-    /* the levels are read back on the GL thread for this request alone (a tick does not read them) */
-    sv_job *jb = sv_job_new(SV_JOB_LEVELS, c->world);
+    if (content == LPVP_CONTENT_VISIBILITY && latest->stats.volume.visibility_side <= 0) { /* R5.15: probes only */
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                     "%s: \"%s\" needs a technique whose probes have visibility (\"probes\"); this session's "
+                     "volume comes from technique \"%s\", which has none",
+                     LPVP_VOLUME_CONTENT_KEY, lpvp_volume_content_names[LPVP_CONTENT_VISIBILITY], t ? t : "?");
+        return;
+    }
+    /* read back on the GL thread for this request alone (a tick does not read them) */
+    sv_job *jb = sv_job_new(SV_JOB_CONTENT, c->world);
     if (!jb) {
         sv_reply_err(c, r->request_id, LPVP_E_INTERNAL, 0, "out of memory");
         return;
     }
     jb->request_id = r->request_id;
-    jb->count = (size_t)(fmt == LPVP_FMT_FP16) | ((size_t)(comp == LPVP_COMP_ZSTD) << 4); /* read in job_done */
+    jb->count = (size_t)(fmt == LPVP_FMT_FP16) | ((size_t)(comp == LPVP_COMP_ZSTD) << 4) |
+                ((size_t)content << 8); /* read in gl_content and job_done */
     submit(c, jb);
 }
 
@@ -299,8 +307,9 @@ void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
         j->rgba = NULL;
         sv_reply_frame(c, request_id, NULL, rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
                        j->terms, &j->display, j->tick);
-    } else if (j->kind == SV_JOB_LEVELS) { /* so do the levels */
-        sv_reply_volume(c, request_id, j->result, LPVP_CONTENT_LEVELS, (int)(j->count & 15), (int)(j->count >> 4));
+    } else if (j->kind == SV_JOB_CONTENT) { /* so do the levels or the visibility */
+        sv_reply_volume(c, request_id, j->result, (int)(j->count >> 8), (int)(j->count & 15),
+                        (int)((j->count >> 4) & 15));
     } else if (j->kind == SV_JOB_QUERY) { /* so do the answers, packed there */
         float *out = j->out;
         j->out = NULL;

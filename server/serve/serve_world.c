@@ -81,7 +81,7 @@ void sv_world_jobs_done(uv_async_t *a)
         switch (j->kind) {
         case SV_JOB_TICK: tick_done(s, j); break;
         case SV_JOB_RENDER:
-        case SV_JOB_LEVELS:
+        case SV_JOB_CONTENT:
         case SV_JOB_QUERY: sv_job_reply_all(j); break;
         case SV_JOB_DESTROY: {
             sv_world *w = j->world;
