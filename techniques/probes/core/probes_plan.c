@@ -42,6 +42,13 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
                         p->recompute_reason, g->sweeps);
 }
 
+float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g)
+{
+    if (!g || !g->changed)
+        return hysteresis;
+    return hysteresis * (1.0f - powf(LPV_PROBES_CHANGE_RAMP, (float)(g->sweeps + 1)));
+}
+
 int lpv_probes_settle_sweeps(float hysteresis)
 {
     if (!(hysteresis > 0.0f) || !(hysteresis < 1.0f))

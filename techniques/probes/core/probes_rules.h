@@ -34,8 +34,18 @@
 typedef struct lpv_probes_progress {
     int history;  /* 1: the probes hold light from earlier ticks */
     int sweeps;   /* full sweeps over every probe since the last change */
+    int changed;  /* 1: sweeps counts from a change of the scene or lights (0: from a warmup) */
     size_t probes;
 } lpv_probes_progress;
+
+/* The hysteresis of the sweeps after a change (a light moved, a knob of
+ * the volume): h x (1 - LPV_PROBES_CHANGE_RAMP^(sweeps + 1)), so the first
+ * sweep after it keeps half as much of the old light and the weight climbs
+ * back to h over a few sweeps; a light that moves every tick keeps the
+ * probes at the low end (fast and noisier), a still one lets them average.
+ * After a warmup (no old light to forget) h itself. */
+#define LPV_PROBES_CHANGE_RAMP 0.5f
+float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g);
 
 /* The probes' plan: the shared producers (none but the frame's: the light
  * block comes with every tick) and their pass, which runs on a change and

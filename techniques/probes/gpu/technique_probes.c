@@ -477,11 +477,15 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         g->cursor = 0;
         g->progress.history = 1;
         g->progress.sweeps = 0;
+        g->progress.changed = 0;
     } else {
         if (p->recompute && strncmp(p->recompute_reason, LPV_PROBES_SETTLE_REASON,
-                                    sizeof LPV_PROBES_SETTLE_REASON - 1) != 0)
-            g->progress.sweeps = 0; /* a change: settle again */
-        if (run_batch(g, in, g->cursor, batch, 1, ps->hysteresis, ps->hysteresis, 0) != 0)
+                                    sizeof LPV_PROBES_SETTLE_REASON - 1) != 0) {
+            g->progress.sweeps = 0; /* a change: settle again, forgetting the old light faster */
+            g->progress.changed = 1;
+        }
+        if (run_batch(g, in, g->cursor, batch, 1, lpv_probes_hysteresis_now(ps->hysteresis, &g->progress),
+                      ps->hysteresis, 0) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->cursor += batch;
         if (g->cursor >= g->probes) {
