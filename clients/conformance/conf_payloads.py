@@ -73,11 +73,14 @@ def make_glb(json_obj, bin_data=b"", *, lie_total=None, lie_json_len=None, magic
     return struct.pack("<4sII", magic, 2, total if lie_total is None else lie_total) + out
 
 
-def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=True, uri=None, animated=False):
+def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=True, uri=None, animated=False,
+                  block=None):
     """A small open-front box, 2 m wide (x, z in [-1, 1], y in [0, 2]): white floor, ceiling and back wall,
     red left wall, green right wall, and a KHR_lights_punctual point light inside. 10 triangles.
     uri: an external buffer URI instead of the BIN chunk (for the refusal cases).
-    animated: an animation "Swing" turns the box 90 degrees about y over its 1 s (R4.4c)."""
+    animated: an animation "Swing" turns the box 90 degrees about y over its 1 s (R4.4c).
+    block: ((x0, y0, z0), (x1, y1, z1)), a closed white block between those corners, faces outward (12
+    triangles more)."""
     quads = {
         "white": [
             [(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)],      # floor, facing +y
@@ -87,6 +90,16 @@ def box_scene_glb(light_intensity=500.0, light_pos=(0.0, 1.6, 0.0), with_light=T
         "red": [[(-1, 0, 1), (-1, 2, 1), (-1, 2, -1), (-1, 0, -1)]],   # left wall, facing +x
         "green": [[(1, 0, -1), (1, 2, -1), (1, 2, 1), (1, 0, 1)]],     # right wall, facing -x
     }
+    if block is not None:
+        (x0, y0, z0), (x1, y1, z1) = block
+        quads["white"] += [  # counter-clockwise seen from outside
+            [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)][::-1],   # bottom, facing -y
+            [(x0, y1, z1), (x1, y1, z1), (x1, y1, z0), (x0, y1, z0)][::-1],   # top, facing +y
+            [(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)][::-1],   # back, facing -z
+            [(x0, y0, z1), (x0, y1, z1), (x1, y1, z1), (x1, y0, z1)],         # front, facing +z
+            [(x0, y0, z1), (x0, y1, z1), (x0, y1, z0), (x0, y0, z0)][::-1],   # left, facing -x
+            [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)][::-1],   # right, facing +x
+        ]
     colours = {"white": [0.8, 0.8, 0.8, 1], "red": [0.8, 0.1, 0.1, 1], "green": [0.1, 0.8, 0.1, 1]}
     binb = bytearray()
     accessors, views, prims, materials = [], [], [], []

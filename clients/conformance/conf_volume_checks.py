@@ -1,6 +1,7 @@
 """conf_volume_checks.py - checks shared by the volume, stream and plan cases: a volume header
-(R5.1, R5.6), its "volume" description (R5.9 - R5.14), the tick plan (SPEC section 8),
-R5.14's irradiance lookup written from the SPEC, and technique iv's small CONFIG."""
+(R5.1, R5.6), its "volume" description (R5.9 - R5.15), the tick plan (SPEC section 8),
+R5.14's and R5.15's irradiance lookups written from the SPEC, and technique iv's and probes'
+small CONFIGs."""
 
 import math
 import struct
@@ -8,7 +9,11 @@ import struct
 from conf_core import check
 
 
-def _vol_header_checks(h, fmt, comp, dims=None):
+def _vol_header_checks(h, fmt, comp, dims=None, visibility=False):
+    """A volume header (R5.1, R5.6) and its description (R5.9 - R5.15); with
+    visibility False (every reply but GET_VOLUME content "visibility") the
+    description must not have R5.15's "visibility", with True it must.
+    Returns the cells of all cascades."""
     for k in ("revision", "tick", "format", "compression", "keyframe", "grid", "units", "layout", "sh",
               "raw_length"):
         check(k in h, "volume header has no %r: %r" % (k, h))
@@ -25,7 +30,12 @@ def _vol_header_checks(h, fmt, comp, dims=None):
     if dims is not None:
         check(g["dims"] == list(dims), "grid.dims %r, expected the configured %r" % (g["dims"], list(dims)))
     cells = _cascades_checks(h)
-    _description_checks(h)
+    d = _description_checks(h)
+    if visibility:
+        check("visibility" in d, "GET_VOLUME content \"visibility\": the description has no \"visibility\" (R5.15)")
+    else:
+        check("visibility" not in d, "volume.visibility %r in a reply that is not GET_VOLUME content \"visibility\" "
+              "(R5.15: present only there)" % (d.get("visibility"),))
     _plan_checks(h.get("plan"), "volume header")
     return cells
 
@@ -90,11 +100,57 @@ def _description_checks(h):
               "(R5.12)" % (index.get("raw_offset"), values_bytes))
         check(index.get("raw_length") == index_bytes, "volume.index.raw_length %r, expected %d (R5.12)"
               % (index.get("raw_length"), index_bytes))
-    check(h["raw_length"] == values_bytes + index_bytes, "raw_length %r, expected cells(%d, all levels) x %d "
-          "volume(s) x %d values x %d bytes%s = %d (R5.6, R5.11)" % (
+    vis_bytes = _visibility_checks(d, cells, values_bytes) if "visibility" in d else 0
+    check(h["raw_length"] == values_bytes + index_bytes + vis_bytes, "raw_length %r, expected cells(%d, all levels) "
+          "x %d volume(s) x %d values x %d bytes%s%s = %d (R5.6, R5.11, R5.15)" % (
               h["raw_length"], cells, vpl, vpc, size, " + index %d" % index_bytes if index_bytes else "",
-              values_bytes + index_bytes))
+              " + visibility %d" % vis_bytes if vis_bytes else "", values_bytes + index_bytes + vis_bytes))
     return d
+
+
+PROBES_VALUE_TYPE = "f32"  # R5.15: the visibility is binary32 whatever the format
+
+
+def _is_int(v):
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _visibility_checks(d, cells, values_bytes):
+    """R5.15: the description's "visibility": P = the levels' cells, I in
+    1..16, D in 1..32, V = 4 + 3 I^2 + 2 D^2, value_type "f32", bias_cells a
+    number >= 0, raw_offset = the levels' values' bytes, raw_length = P x V x
+    4; over the merged levels (role "cascade", far_field false, no index).
+    Returns raw_length."""
+    v = d["visibility"]
+    check(isinstance(v, dict), "volume.visibility %r: expected an object (R5.15)" % (v,))
+    for key in ("probes", "irradiance_side", "distance_side", "values_per_probe", "value_type", "bias_cells",
+                "raw_offset", "raw_length"):
+        check(key in v, "volume.visibility has no %r: %r (R5.15)" % (key, v))
+    check(_is_int(v["probes"]) and v["probes"] == cells, "volume.visibility.probes %r, the levels have %d cells (a "
+          "probe a cell, R5.15)" % (v["probes"], cells))
+    I, D = v["irradiance_side"], v["distance_side"]
+    check(_is_int(I) and 1 <= I <= 16, "volume.visibility.irradiance_side %r: expected an integer in 1..16 (R5.15)"
+          % (I,))
+    check(_is_int(D) and 1 <= D <= 32, "volume.visibility.distance_side %r: expected an integer in 1..32 (R5.15)"
+          % (D,))
+    V = 4 + 3 * I * I + 2 * D * D
+    check(_is_int(v["values_per_probe"]) and v["values_per_probe"] == V, "volume.visibility.values_per_probe %r, "
+          "expected 4 + 3 x %d^2 + 2 x %d^2 = %d (R5.15)" % (v["values_per_probe"], I, D, V))
+    check(v["value_type"] == PROBES_VALUE_TYPE, "volume.visibility.value_type %r, expected %r whatever the format "
+          "(R5.15)" % (v["value_type"], PROBES_VALUE_TYPE))
+    b = v["bias_cells"]
+    check(isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b) and b >= 0,
+          "volume.visibility.bias_cells %r: expected a number >= 0 (R5.15)" % (b,))
+    check(_is_int(v["raw_offset"]) and v["raw_offset"] == values_bytes, "volume.visibility.raw_offset %r, the "
+          "levels' values end at %d (R5.15)" % (v["raw_offset"], values_bytes))
+    check(_is_int(v["raw_length"]) and v["raw_length"] == cells * V * 4, "volume.visibility.raw_length %r, expected "
+          "%d probes x %d values x 4 = %d (R5.15)" % (v["raw_length"], cells, V, cells * V * 4))
+    check(d.get("index") is None and d.get("far_field") is False
+          and all(lv.get("role") == "cascade" for lv in d["levels"]),
+          "volume.visibility with index %r, far_field %r, roles %r: R5.15's volume is the merged one (role "
+          "\"cascade\", far_field false, no index)" % (d.get("index"), d.get("far_field"),
+                                                        [lv.get("role") for lv in d["levels"]]))
+    return v["raw_length"]
 
 
 OCTREE_LEVEL_ROLE = "octree_level"  # R5.13: the role of an octree's levels
@@ -328,3 +384,121 @@ def _iv_techniques(ctx):
     """The techniques HELLO lists (a fresh session's)."""
     ctx.session().close()
     return (ctx.hello_reply or {}).get("techniques") or []
+
+
+# technique probes kept small for llvmpipe: 8 probes a side (R5.15)
+PROBES_CONFIG = {"technique": "probes", "grid": [8, 8, 8]}
+PROBES_UNSEEN = 1e-3  # R5.15 step 3
+
+
+def _probes_oct(w):
+    """R5.15: the octahedral encoding of direction w."""
+    l1 = abs(w[0]) + abs(w[1]) + abs(w[2])
+    u = [w[0] / l1, w[1] / l1] if l1 > 0 else [0.0, 0.0]
+    if w[2] < 0:
+        sx = 1.0 if u[0] >= 0 else -1.0
+        sy = 1.0 if u[1] >= 0 else -1.0
+        u = [(1.0 - abs(u[1])) * sx, (1.0 - abs(u[0])) * sy]
+    return u
+
+
+def _probes_read(vals, at, side, width, w):
+    """R5.15: a side x side map of `width` values a texel, starting at
+    vals[at], read toward w bilinearly: the `width` values."""
+    u = _probes_oct(w)
+    b, b1, f = [0, 0], [0, 0], [0.0, 0.0]
+    for a in range(2):
+        s = min(max((u[a] * 0.5 + 0.5) * side - 0.5, 0.0), side - 1.0)
+        b[a] = min(math.floor(s), max(side - 2, 0))
+        f[a] = s - b[a]
+        b1[a] = min(b[a] + 1, side - 1)
+    out = [0.0] * width
+    for (col, row), wt in (((b[0], b[1]), (1 - f[0]) * (1 - f[1])), ((b1[0], b[1]), f[0] * (1 - f[1])),
+                           ((b[0], b1[1]), (1 - f[0]) * f[1]), ((b1[0], b1[1]), f[0] * f[1])):
+        t = at + width * (row * side + col)
+        for i in range(width):
+            out[i] += wt * vals[t + i]
+    return out
+
+
+def _probes_lookup(d, vis, p, n, stats=None):
+    """R5.15's lookup written from the SPEC's four steps: E (r, g, b) at p with
+    normal n from description d's levels and vis, the visibility's P x V
+    floats. In double precision (binary32 or better) from p and n as sent
+    (binary32). stats, a dict, counts what the lookup went through: "crushed"
+    probes (w < 0.2), "chebyshev" (delta > mu), "fallback" (step 3 moved to a
+    coarser level), "blend" (step 4 blended two levels)."""
+    v = d["visibility"]
+    I, D, V, bias = v["irradiance_side"], v["distance_side"], v["values_per_probe"], v["bias_cells"]
+    levels = d["levels"]
+    K = len(levels)
+    if not all(math.isfinite(x) for x in list(p) + list(n)):
+        return [0.0, 0.0, 0.0]
+    ln = math.sqrt(sum(x * x for x in n))
+    if not 1e-8 < ln < 1e18:
+        return [0.0, 0.0, 0.0]
+    nh = [x / ln for x in n]
+    first, at = [], 0
+    for lv in levels:
+        first.append(at)
+        at += lv["cells"]
+    stats = stats if stats is not None else {}
+
+    def inside(k, x):
+        lv = levels[k]
+        u = [(x[a] - lv["origin"][a]) / lv["cell_size"] for a in range(3)]
+        return min(min(u[a], lv["dims"][a] - u[a]) for a in range(3))
+
+    def level(k):  # step 2: (E(k), h(k))
+        lv = levels[k]
+        o, s, dims = lv["origin"], lv["cell_size"], lv["dims"]
+        x = [p[a] + bias * s * nh[a] for a in range(3)]
+        q = [min(max((x[a] - o[a]) / s - 0.5, 0.0), dims[a] - 1.0) for a in range(3)]
+        c0 = [min(math.floor(q[a]), max(dims[a] - 2, 0)) for a in range(3)]
+        f = [q[a] - c0[a] for a in range(3)]
+        h, W, S = 0.0, 0.0, [0.0, 0.0, 0.0]
+        for j in range(8):
+            e = [j & 1, (j >> 1) & 1, (j >> 2) & 1]
+            c = [min(c0[a] + e[a], dims[a] - 1) for a in range(3)]
+            base = (first[k] + c[0] + dims[0] * (c[1] + dims[1] * c[2])) * V
+            if vis[base + 3] == 0:
+                continue
+            m = [o[a] + (c[a] + 0.5) * s + vis[base + a] for a in range(3)]
+            t = 1.0
+            for a in range(3):
+                t *= f[a] if e[a] else 1.0 - f[a]
+            r = [m[a] - p[a] for a in range(3)]
+            rl = math.sqrt(sum(y * y for y in r))
+            phi = (sum(r[a] / rl * nh[a] for a in range(3)) + 1.0) / 2.0 if rl > 0 else 1.0
+            w = phi * phi + 0.2
+            vv = [x[a] - m[a] for a in range(3)]
+            delta = math.sqrt(sum(y * y for y in vv))
+            mu, mu2 = _probes_read(vis, base + 4 + 3 * I * I, D, 2, [y / delta for y in vv] if delta > 0 else nh)
+            if delta > mu:
+                stats["chebyshev"] = stats.get("chebyshev", 0) + 1
+                var = max(mu2 - mu * mu, 1e-4 * s * s)
+                w *= (var / (var + (delta - mu) ** 2)) ** 3
+            if w < 0.2:
+                stats["crushed"] = stats.get("crushed", 0) + 1
+                w = w ** 3 / 0.04
+            h += w * t
+            w2 = max(w, 1e-6) * t
+            irr = _probes_read(vis, base + 4, I, 3, nh)
+            for i in range(3):
+                S[i] += w2 * irr[i]
+            W += w2
+        return ([S[i] / W for i in range(3)] if W > 0 else [0.0, 0.0, 0.0]), h
+
+    k = next((i for i in range(K - 1) if inside(i, p) >= 0.5), K - 1)  # step 1
+    E, h = level(k)
+    while h < PROBES_UNSEEN and k + 1 < K:  # step 3
+        stats["fallback"] = stats.get("fallback", 0) + 1
+        k += 1
+        E, h = level(k)
+    om = min(max((inside(k, p) - 0.5) / 2.0, 0.0), 1.0)  # step 4
+    if om < 1 and k + 1 < K:
+        E1, h1 = level(k + 1)
+        if h1 >= PROBES_UNSEEN:
+            stats["blend"] = stats.get("blend", 0) + 1
+            E = [E1[i] + (E[i] - E1[i]) * om for i in range(3)]
+    return E

@@ -1,17 +1,19 @@
 """conf_volumes.py - conformance cases: volumes from GET_VOLUME: the description, octree levels,
-technique iv, layout, fp16, zstd, dims (R5.1 - R5.14)."""
+technique iv, technique probes' visibility, layout, fp16, zstd, dims (R5.1 - R5.15)."""
 
 import math
 import os
 import random
 import struct
 
-from conf_wire import CONFIG, GET_VOLUME, QUERY_IRRADIANCE, SUBSCRIBE, TICK, UNSUBSCRIBE, VOLUME
-from conf_payloads import SMALL_CONFIG, f16_list, f32_list, zstd_decompress_cli, zstd_frame_content_size
+from conf_wire import (
+    CONFIG, GET_VOLUME, LIGHT_SET, QUERY_IRRADIANCE, SCENE_LOAD, SUBSCRIBE, TICK, UNSUBSCRIBE, VOLUME)
+from conf_payloads import (
+    SMALL_CONFIG, box_scene_glb, f16_list, f32_list, zstd_decompress_cli, zstd_frame_content_size)
 from conf_core import Fail, case, check, expect_error, expect_reply, is_finite_list, unique_light
 from conf_volume_checks import (
-    IV_CONFIG, IV_VOXELS_ROLE, SH_LOBE0, SH_LOBE1, _description_checks, _iv_levels, _iv_lookup, _iv_techniques,
-    _octree_levels, _vol_header_checks)
+    IV_CONFIG, IV_VOXELS_ROLE, PROBES_CONFIG, SH_LOBE0, SH_LOBE1, _description_checks, _iv_levels, _iv_lookup,
+    _iv_techniques, _octree_levels, _probes_lookup, _vol_header_checks)
 
 
 # ---------------------------------------------------------------------------
@@ -230,6 +232,254 @@ def c_volume_iv(ctx):
     worst = max(abs(a - b) for a, b in zip(want, got))
     return "%s voxels, %d hold a surface, iv_neighbours %d; %d probes agree with QUERY_IRRADIANCE to %.2e of the " \
         "peak %.4g W/m^2" % ("x".join(str(x) for x in lv["dims"]), sum(held), nb, len(probes), worst / peak, peak)
+
+
+# the test box's surfaces (conf_payloads.box_scene_glb): a point's range per axis and the surface's normal
+BOX_SURFACES = (("floor", ((-1, 1), (0, 0), (-1, 1)), (0.0, 1.0, 0.0)),
+                ("ceiling", ((-1, 1), (2, 2), (-1, 1)), (0.0, -1.0, 0.0)),
+                ("back wall", ((-1, 1), (0, 2), (-1, -1)), (0.0, 0.0, 1.0)),
+                ("left wall", ((-1, -1), (0, 2), (-1, 1)), (1.0, 0.0, 0.0)),
+                ("right wall", ((1, 1), (0, 2), (-1, 1)), (-1.0, 0.0, 0.0)))
+
+
+def _f32_round(x):
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+BOX_AIR = ((-0.95, 0.95), (0.05, 1.95), (-0.95, 0.95))  # inside the test box, 5 cm from its walls
+
+
+def _level_air(lv):
+    """The part of a level's box inside BOX_AIR (per axis (lo, hi))."""
+    return tuple((max(lo, lv["origin"][a]), min(hi, lv["origin"][a] + lv["dims"][a] * lv["cell_size"]))
+                 for a, (lo, hi) in enumerate(BOX_AIR))
+
+
+def _block_surfaces(block):
+    """A closed block's faces as BOX_SURFACES has the box's."""
+    (x0, y0, z0), (x1, y1, z1) = block
+    return (("block top", ((x0, x1), (y1, y1), (z0, z1)), (0.0, 1.0, 0.0)),
+            ("block bottom", ((x0, x1), (y0, y0), (z0, z1)), (0.0, -1.0, 0.0)),
+            ("block front", ((x0, x1), (y0, y1), (z1, z1)), (0.0, 0.0, 1.0)),
+            ("block back", ((x0, x1), (y0, y1), (z0, z0)), (0.0, 0.0, -1.0)),
+            ("block left", ((x0, x0), (y0, y1), (z0, z1)), (-1.0, 0.0, 0.0)),
+            ("block right", ((x1, x1), (y0, y1), (z0, z1)), (1.0, 0.0, 0.0)))
+
+
+def _probes_points(seed, surface_points, air, surfaces=BOX_SURFACES):
+    """Seeded points on the surfaces (by default the box's) with their
+    normals, and points in the air with random unit normals (air: [(count,
+    box per axis (lo, hi))]), as binary32 (what QUERY_IRRADIANCE carries)."""
+    rnd = random.Random(seed)
+    out = []
+    for i in range(surface_points):
+        _, rng, n = surfaces[i % len(surfaces)]
+        p = [lo if lo == hi else rnd.uniform(lo + 0.02 * (hi - lo), hi - 0.02 * (hi - lo)) for lo, hi in rng]
+        out.append(([_f32_round(x) for x in p], list(n)))
+    for count, box in air:
+        for _ in range(count):
+            out.append(([_f32_round(rnd.uniform(lo, hi)) for lo, hi in box], _random_unit(rnd)))
+    return out
+
+
+def _random_unit(rnd):
+    """A random unit normal, in binary32."""
+    while True:
+        n = [rnd.gauss(0.0, 1.0) for _ in range(3)]
+        ln = math.sqrt(sum(x * x for x in n))
+        if ln > 0.1:
+            return [_f32_round(x / ln) for x in n]
+
+
+def _probes_lookup_vs_query(ctx, c, seed, surface_points=60, air_points=30, more_surfaces=()):
+    """R5.15's lookup (the suite's, from the SPEC) on a GET_VOLUME content
+    "visibility" against QUERY_IRRADIANCE of the same tick, at points on the
+    box's surfaces and in its air (as many in each level's box): at least
+    90 % of the points within 1e-4 of the largest irradiance (the SPEC's
+    "about 1e-4, except near the thresholds"), every point within 2e-2 of
+    it. Returns a summary."""
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none", "content": "visibility"}),
+                     GET_VOLUME, what="GET_VOLUME content visibility")
+    _vol_header_checks(f.body, "fp32", "none", visibility=True)
+    d = f.body["volume"]
+    vis = f32_list(f.att[d["visibility"]["raw_offset"]:])
+    boxes = [b for b in (_level_air(lv) for lv in d["levels"]) if all(lo < hi for lo, hi in b)]
+    air = [(air_points // len(boxes), b) for b in boxes] if boxes else [(air_points, BOX_AIR)]
+    pts = _probes_points(seed, surface_points, air, BOX_SURFACES + tuple(more_surfaces))
+    # R5.15: n / |n| whatever its length, and E = 0 without one (|n| <= 1e-8)
+    pts += [(p, [_f32_round(x * k) for x in n]) for (p, n), k in zip(pts[:8], (3.0, 0.25) * 4)]
+    pts += [(pts[0][0], [0.0, 0.0, 0.0]), (pts[1][0], [0.0, 1e-9, 0.0])]
+    att = b"".join(struct.pack("<6f", *(p + n)) for p, n in pts)
+    q = expect_reply(c.request(QUERY_IRRADIANCE, {"count": len(pts)}, att), QUERY_IRRADIANCE)
+    check(q.body.get("tick") == f.body.get("tick"), "query tick %r != volume tick %r" % (q.body.get("tick"),
+                                                                                       f.body.get("tick")))
+    got = f32_list(q.att)
+    stats = {}
+    want = []
+    for p, n in pts:
+        want.extend(_probes_lookup(d, vis, p, n, stats))
+    check(is_finite_list(want), "R5.15's lookup gave a non-finite irradiance")
+    peak = max(max(want), max(got))
+    check(peak > 0.0, "every irradiance is zero (the light does not reach the points?)")
+    errs = [max(abs(want[3 * i + ch] - got[3 * i + ch]) for ch in range(3)) for i in range(len(pts))]
+    close = sum(1 for e in errs if e <= 1e-4 * peak)
+    worst = max(range(len(pts)), key=lambda i: errs[i])
+    detail = "the worst, point %d %r facing %r: R5.15's lookup %r, QUERY_IRRADIANCE %r" % (
+        worst, pts[worst][0], pts[worst][1], ["%.6g" % x for x in want[3 * worst:3 * worst + 3]],
+        ["%.6g" % x for x in got[3 * worst:3 * worst + 3]])
+    check(got[-6:] == (0.0,) * 6, "QUERY_IRRADIANCE %r at normals (0, 0, 0) and (0, 1e-9, 0): R5.15 says 0"
+          % (got[-6:],))
+    check(close >= 0.9 * len(pts), "%d of %d points agree with QUERY_IRRADIANCE within 1e-4 of the peak %.4g W/m^2 "
+          "(R5.15: about 1e-4 except near the thresholds; 90 %% asked); %s" % (close, len(pts), peak, detail))
+    check(errs[worst] <= 2e-2 * peak, "a point differs by %.3g of the peak %.4g W/m^2 (more than a threshold's "
+          "flip explains; 2e-2 allowed); %s" % (errs[worst] / peak, peak, detail))
+    return "%d of %d points within 1e-4 of the peak %.4g W/m^2, the worst %.2e (the lookup met %s)" % (
+        close, len(pts), peak, errs[worst] / peak, ", ".join("%s %d" % kv for kv in sorted(stats.items())) or
+        "no threshold")
+
+
+@case("R5.15 R5.2 R4.7", "technique probes: GET_VOLUME content visibility (fp32, fp16, zstd) is the merged "
+      "volume plus the probes' visibility as described; its values in range; not on the stream; R5.15's lookup "
+      "agrees with QUERY_IRRADIANCE; refused for lpv")
+def c_volume_probes_visibility(ctx):
+    if "probes" not in _iv_techniques(ctx):  # no technique probes: content "visibility" is refused (R5.15)
+        c, cfg, t = ctx.scene_session(light=unique_light("no-probes"))
+        rid = c.send(GET_VOLUME, {"format": "fp32", "content": "visibility"})
+        expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+        return "HELLO lists no \"probes\": content \"visibility\" refused naming content"
+    c, cfg, t = ctx.scene_session(config=PROBES_CONFIG, light=unique_light("probes-visibility"))
+    check((cfg.body.get("config") or {}).get("technique") == "probes", "CONFIG technique probes: the effective "
+          "config says %r" % ((cfg.body.get("config") or {}).get("technique"),))
+    seen, notes = {}, []
+    for fmt in ("fp32", "fp16"):
+        f = expect_reply(c.request(GET_VOLUME, {"format": fmt, "compression": "none", "content": "visibility"}),
+                         GET_VOLUME, what="GET_VOLUME %s content visibility" % fmt)
+        m = expect_reply(c.request(GET_VOLUME, {"format": fmt, "compression": "none"}), GET_VOLUME)
+        h = f.body
+        _vol_header_checks(h, fmt, "none", PROBES_CONFIG["grid"], visibility=True)
+        _vol_header_checks(m.body, fmt, "none", PROBES_CONFIG["grid"])
+        d = h["volume"]
+        vd = d["visibility"]
+        check(d["technique"] == "probes", "volume.technique %r, expected probes" % (d["technique"],))
+        check(h["keyframe"] is True, "content visibility keyframe %r (R5.15: always a keyframe)" % (h["keyframe"],))
+        check(h["tick"] == m.body["tick"] == t.body.get("tick"), "ticks: visibility %r, merged %r, TICK %r"
+              % (h["tick"], m.body["tick"], t.body.get("tick")))
+        check(len(f.att) == h["raw_length"], "attachment %d bytes, raw_length %d" % (len(f.att), h["raw_length"]))
+        # the merged part: the plain GET_VOLUME of the same tick, header and values
+        check(f.att[:vd["raw_offset"]] == m.att, "%s: the %d bytes before the visibility differ from GET_VOLUME's "
+              "merged volume of the same tick (%d bytes)" % (fmt, vd["raw_offset"], len(m.att)))
+        mine = dict(h, raw_length=None, volume=dict((k, v) for k, v in d.items() if k != "visibility"))
+        theirs = dict(m.body, raw_length=None)
+        diff = sorted(k for k in set(mine) | set(theirs) if mine.get(k) != theirs.get(k))
+        check(not diff, "%s: the content visibility header differs from the merged one in %r, not only in "
+              "raw_length and volume.visibility (R5.15)" % (fmt, diff))
+        check(h["raw_length"] == m.body["raw_length"] + vd["raw_length"], "raw_length %r, the merged volume's %r + "
+              "the visibility's %r (R5.15)" % (h["raw_length"], m.body["raw_length"], vd["raw_length"]))
+        vis = f32_list(f.att[vd["raw_offset"]:])
+        check(is_finite_list(vis), "%s: non-finite values in the visibility" % fmt)
+        seen[fmt] = (vd, f.att[vd["raw_offset"]:])
+        if fmt == "fp32":
+            notes.append(_probes_values_checks(d, vis))
+    same = [k for k in seen["fp32"][0] if k != "raw_offset"]  # the levels' values are half as long in fp16
+    check([seen["fp32"][0].get(k) for k in same] == [seen["fp16"][0].get(k) for k in same]
+          and sorted(seen["fp32"][0]) == sorted(seen["fp16"][0]),
+          "the visibility is described otherwise in fp32 %r and fp16 %r" % (seen["fp32"][0], seen["fp16"][0]))
+    check(seen["fp32"][1] == seen["fp16"][1], "the visibility of the same tick differs between fp32 and fp16 "
+          "(R5.15: binary32 whatever the format)")
+    z = expect_reply(c.request(GET_VOLUME, {"format": "fp16", "compression": "zstd", "content": "visibility"}),
+                     GET_VOLUME)
+    _vol_header_checks(z.body, "fp16", "zstd", PROBES_CONFIG["grid"], visibility=True)
+    zs = zstd_frame_content_size(z.att)
+    check(zs[0] and zs[1] in (None, z.body["raw_length"]), "zstd visibility: content size %r (%s), raw_length %d"
+          % (zs[1], zs[2], z.body["raw_length"]))
+    dec = zstd_decompress_cli(z.att)
+    if dec is not None:
+        check(len(dec) == z.body["raw_length"] and dec[z.body["volume"]["visibility"]["raw_offset"]:] ==
+              seen["fp16"][1], "zstd fp16 visibility decompresses to other bytes than the uncompressed one")
+    # the VOLUME stream carries the merged volume (no "visibility": _vol_header_checks)
+    expect_reply(c.request(SUBSCRIBE, {"stream": "volume", "format": "fp32", "compression": "none"}), SUBSCRIBE)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    v = c.recv_stream(VOLUME, timeout=ctx.tick_timeout)
+    _vol_header_checks(v.body, "fp32", "none", PROBES_CONFIG["grid"])
+    check(v.body["volume"]["technique"] == "probes", "the stream's volume names technique %r"
+          % (v.body["volume"]["technique"],))
+    expect_reply(c.request(UNSUBSCRIBE, {"stream": "volume"}), UNSUBSCRIBE)
+    notes.append(_probes_lookup_vs_query(ctx, c, 15))
+    # another technique: content "visibility" is refused naming content
+    expect_reply(c.request(CONFIG, {"technique": "lpv"}), CONFIG)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    rid = c.send(GET_VOLUME, {"format": "fp32", "content": "visibility"})
+    expect_error(c.recv_reply(rid), "BAD_FIELD", rid, "content")
+    return "%s; %s; lpv refused" % tuple(notes)
+
+
+def _probes_values_checks(d, vis):
+    """R5.15: each probe's values in range: active 0 or 1 (some on), each
+    offset component under half its level's cell, the distance moments
+    mean >= 0 and mean square >= mean^2 (up to binary32 rounding), both
+    within the 2 cells they are clamped at, the irradiance >= 0 (some > 0).
+    Returns a summary."""
+    v = d["visibility"]
+    I, D, V = v["irradiance_side"], v["distance_side"], v["values_per_probe"]
+    eps = 1e-5
+    on, lit, moved, worst_off, at = 0, 0, 0, 0.0, 0
+    for k, lv in enumerate(d["levels"]):
+        s = lv["cell_size"]
+        for i in range(lv["cells"]):
+            base = (at + i) * V
+            pv = vis[base:base + V]
+            where = "level %d probe %d" % (k, i)
+            check(pv[3] in (0.0, 1.0), "%s: active %r, R5.15 has 1 or 0" % (where, pv[3]))
+            on += pv[3] == 1.0
+            off = max(abs(x) for x in pv[0:3])
+            moved += off > 0.0
+            worst_off = max(worst_off, off / s)
+            check(off < 0.5 * s, "%s: offset %r, a component not under half the cell %g m (R5.15)"
+                  % (where, pv[0:3], s))
+            irr = pv[4:4 + 3 * I * I]
+            check(min(irr) >= 0.0, "%s: an irradiance texel %g < 0 W/m^2" % (where, min(irr)))
+            lit += max(irr) > 0.0
+            for t in range(D * D):
+                mu, mu2 = pv[4 + 3 * I * I + 2 * t], pv[4 + 3 * I * I + 2 * t + 1]
+                check(mu >= 0.0 and mu2 >= mu * mu * (1.0 - eps) - eps * s * s,
+                      "%s distance texel %d: mean %r, mean square %r (R5.15: mean >= 0, mean square >= mean^2)"
+                      % (where, t, mu, mu2))
+                check(mu <= 2.0 * s * (1.0 + eps) and mu2 <= 4.0 * s * s * (1.0 + eps),
+                      "%s distance texel %d: mean %r m, mean square %r m^2 beyond the 2 cells (%g m) the distances "
+                      "are clamped at (R5.15)" % (where, t, mu, mu2, 2.0 * s))
+        at += lv["cells"]
+    check(at == v["probes"], "the levels have %d probes, the visibility %d" % (at, v["probes"]))
+    check(on > 0, "every probe of a box scene is off")
+    check(lit > 0, "no probe's irradiance map holds light in a lit box")
+    return "%d probes (%d on, %d lit, %d moved, up to %.3f cells), maps %d^2 and %d^2, bias %g cells" % (
+        at, on, lit, moved, worst_off, I, D, v["bias_cells"])
+
+
+# a closed block in the test box (R5.15's levels case): probes inside it are off or moved out of it
+PROBES_BLOCK = ((-0.45, 0.1, -0.45), (0.33, 0.8, 0.3))
+
+
+@case("R5.15 R4.7", "technique probes with three cascades, a block in the box: R5.15's lookup (level choice, "
+      "fallback, blend, probes off or moved) on content visibility agrees with QUERY_IRRADIANCE")
+def c_volume_probes_levels(ctx):
+    if "probes" not in _iv_techniques(ctx):
+        return "HELLO lists no \"probes\" (R4.14): nothing to look up"
+    c = ctx.session()
+    expect_reply(c.request(SCENE_LOAD, {}, box_scene_glb(block=PROBES_BLOCK), timeout=ctx.tick_timeout), SCENE_LOAD,
+                 what="SCENE_LOAD (the test box with a block)")
+    expect_reply(c.request(CONFIG, dict(PROBES_CONFIG, cascades=3)), CONFIG)
+    expect_reply(c.request(LIGHT_SET, unique_light("probes-levels")), LIGHT_SET)
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    f = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none", "content": "visibility"}),
+                     GET_VOLUME)
+    _vol_header_checks(f.body, "fp32", "none", PROBES_CONFIG["grid"], visibility=True)
+    levels = f.body["volume"]["levels"]
+    # (the cascades knob is described as the LPV's, R4.12; lpvd's probes sit in the LPV's cascades, R4.14)
+    values = _probes_values_checks(f.body["volume"], f32_list(f.att[f.body["volume"]["visibility"]["raw_offset"]:]))
+    return "%d level(s) of %s m%s; %s; %s" % (
+        len(levels), "/".join("%.3g" % lv["cell_size"] for lv in levels),
+        "" if len(levels) > 1 else " (CONFIG cascades 3 gave one: steps 3 and 4 across levels not exercised)",
+        values, _probes_lookup_vs_query(ctx, c, 16, 60, 90, _block_surfaces(PROBES_BLOCK)))
 
 
 @case("R5.1", "GET_VOLUME fp32/none: sizes match the grid dims; values finite")

@@ -24,7 +24,7 @@ writer. The rest lives in the modules next to it (standard library only):
     conf_wire           message types, error codes, frames, Conn (the client)
     conf_payloads       volume/frame bytes, zstd headers, glb and PNG builders, SMALL_CONFIG
     conf_core           the case registry (@case, CASES), Fail/Skip, reply checks, Ctx
-    conf_volume_checks  volume header, "volume" description and plan checks, R5.14's lookup
+    conf_volume_checks  volume header, "volume" description and plan checks, R5.14's and R5.15's lookups
 
 and the cases, imported below in the order they run:
 
@@ -35,7 +35,7 @@ and the cases, imported below in the order they run:
     conf_scenes         scene paths, glb attachments, images (R4.3 - R4.5b)
     conf_config         CONFIG limits, presets, techniques, knobs (R4.6, R4.10 - R4.15)
     conf_queries        QUERY_IRRADIANCE (R4.7), settings at the limits (R7.6)
-    conf_volumes        GET_VOLUME (R5.1 - R5.14)
+    conf_volumes        GET_VOLUME (R5.1 - R5.15)
     conf_streams        VOLUME streams and deltas (R5.1 - R5.3)
     conf_frame_stats    GET_FRAME, STATS, the tick plan (R6.1, R6.2, R3.1, R7.6a, R8)
     conf_limits         BYE, idle and handshake timeouts, server limits (R4.8, R4.9, R4.1a, R4.5)

@@ -26,7 +26,8 @@ code lives in the modules beside it, one job each (copy all five together):
     lpvd_selftest.py  the self-test and the command line (main)
 
 Run ``python3 lpvd_client.py --self-test ADDRESS`` for a short end-to-end
-check against a running daemon (exit status 0 on success).
+check against a running daemon (exit status 0 on success), and
+``python3 lpvd_client.py --offline-self-test`` for the checks that need none.
 """
 
 import sys
@@ -37,11 +38,14 @@ from lpvd_protocol import (  # noqa: F401
     ERROR_NAMES, HAVE_ZSTD, HEADER, MAGIC, MSG, PLAN_PASSES, REPLY_BIT, SERVER_BYE, VERSION, LpvdError,
     ProtocolError, _decompress, _default_compression, _parse_address, _zstd, default_address, plan_lines)
 from lpvd_volume import (  # noqa: F401
-    HAVE_NUMPY, IV_UNITS, IV_VOXELS_ROLE, LOOKUP_VALUES, LPV_UNITS, MAX_CASCADES, OCTREE_LEVEL_ROLE, SH_LOBE0,
-    SH_LOBE1, VOLUME_LAYOUT_VERSION, _F32, _IV_HELD_WEIGHT, _LOBE0, _LOBE1, Cascade, LayoutError, Volume, _f32,
-    _floats, _np, _xor, iv_irradiance)
+    HAVE_NUMPY, IV_UNITS, IV_VOXELS_ROLE, LOOKUP_VALUES, LPV_UNITS, MAX_CASCADES, MAX_DISTANCE_SIDE,
+    MAX_IRRADIANCE_SIDE, OCTREE_LEVEL_ROLE, PROBES_TECHNIQUE, PROBES_UNSEEN, SH_LOBE0, SH_LOBE1, VISIBILITY_CONTENT,
+    VISIBILITY_VALUE_TYPE, VOLUME_LAYOUT_VERSION, _F32, _IV_HELD_WEIGHT, _LOBE0, _LOBE1, Cascade, LayoutError,
+    Visibility, Volume, _f32, _floats, _is_int, _np, _oct_bilinear, _oct_encode, _xor, iv_irradiance,
+    probes_irradiance)
 from lpvd_session import Client, Frame  # noqa: F401
-from lpvd_selftest import _minimal_glb, _self_test_iv, main, self_test  # noqa: F401
+from lpvd_selftest import (  # noqa: F401
+    _minimal_glb, _probe, _probes_reply, _self_test_iv, _self_test_probes, main, offline_self_test, self_test)
 
 __all__ = [
     "Client", "LpvdError", "ProtocolError", "Volume", "Frame",

@@ -317,15 +317,19 @@ class Client(object):
 
     def get_volume(self, format="fp32", compression=None, content=None):
         """GET_VOLUME, decoded to a ``Volume`` (a keyframe). content: "merged"
-        (None: the server's default, the merged volume) or "levels" (SPEC
+        (None: the server's default, the merged volume), "levels" (SPEC
         R5.13: an octree technique's levels, ``Volume.levels``, and its index
-        volume, ``Volume.index``). Technique iv's volume (SPEC R5.14) comes
-        as ``Volume.iv``, its occupancy as ``Volume.index``."""
+        volume, ``Volume.index``) or "visibility" (SPEC R5.15: technique
+        probes' merged volume and the probes' visibility,
+        ``Volume.visibility``, which ``Volume.irradiance`` then weighs the
+        probes with as the server does; binary32 whatever the format).
+        Technique iv's volume (SPEC R5.14) comes as ``Volume.iv``, its
+        occupancy as ``Volume.index``."""
         body = {"format": format, "compression": compression or _default_compression()}
         if content is not None:
             body["content"] = content
         hdr, att = self.request(MSG["GET_VOLUME"], body)
-        return self._decode_volume(hdr, att, ack=False)
+        return self._decode_volume(hdr, att, ack=False, content=content)
 
     def get_frame(self, format="rgba8", compression=None, terms="full", exposure=None, transparent=None):
         """GET_FRAME -> ``Frame`` (rgba8 pixels are decompressed). terms:
@@ -396,7 +400,7 @@ class Client(object):
         while len(self._acked_order) > self.keep_acked:
             self._acked.pop(self._acked_order.pop(0), None)
 
-    def _decode_volume(self, hdr, att, ack):
+    def _decode_volume(self, hdr, att, ack, content=None):
         raw = _decompress(att, hdr.get("compression", "none"), hdr.get("raw_length", len(att)))
         if "raw_length" in hdr and len(raw) != hdr["raw_length"]:
             raise ProtocolError("volume of %d bytes, header says raw_length %d" % (len(raw), hdr["raw_length"]))
@@ -405,7 +409,7 @@ class Client(object):
             if base not in self._acked:
                 raise ProtocolError("delta against tick %r which this client does not hold" % (base,))
             raw = _xor(raw, self._acked[base])
-        vol = Volume(hdr, raw)
+        vol = Volume(hdr, raw, content)
         if ack and vol.tick is not None:
             self._remember(vol.tick, raw)
             self.ack(vol.tick)

@@ -1,7 +1,9 @@
 """lpvd_volume.py - volumes of the lpvd Python client: decoding a VOLUME or
 GET_VOLUME reply's values (fp16/fp32, XOR deltas, the layout description)
-into ``Volume`` and ``Cascade`` objects, and their local lookups (SPEC R5.7,
-and R5.14's ``iv_irradiance`` for technique iv).
+into ``Volume`` and ``Cascade`` objects (and, for GET_VOLUME content
+"visibility", the probes' ``Visibility``), and their local lookups (SPEC
+R5.7, R5.14's ``iv_irradiance`` for technique iv and R5.15's
+``probes_irradiance`` for technique probes' visibility).
 
 Standard library only (array, math, struct, sys); numpy is used when it is
 importable (values then come back as float32 arrays). One of the modules of
@@ -36,6 +38,11 @@ OCTREE_LEVEL_ROLE = "octree_level"  # the role of an octree's levels (SPEC R5.13
 IV_VOXELS_ROLE = "iv_voxels"  # the role of technique iv's one level of voxels (SPEC R5.14)
 IV_UNITS = "W/(m^2 sr)"  # an iv volume's values: the radiance arriving at each voxel centre (SPEC R5.14)
 LPV_UNITS = "W/sr"  # an LPV's values: radiant intensity per cell, what R5.7's lookup reads
+PROBES_TECHNIQUE = "probes"  # ray-traced irradiance probes (SPEC R5.15): an LPV's layout, and on request visibility
+VISIBILITY_CONTENT = "visibility"  # GET_VOLUME content that adds the probes' visibility block (SPEC R5.15)
+VISIBILITY_VALUE_TYPE = "f32"  # the visibility's values, whatever the volume's format (SPEC R5.15)
+MAX_IRRADIANCE_SIDE = 16  # the sides of a probe's two octahedral maps (SPEC R5.15: I in 1..16, D in 1..32)
+MAX_DISTANCE_SIDE = 32
 # The values, in order, that this client's lookup (Cascade.irradiance: the
 # cosine lobe on SH bands 0-1 per channel) reads; a volume whose description
 # names other values is decoded but not looked up (SPEC R5.11).
@@ -77,6 +84,11 @@ def _floats(raw, fmt):
 
 
 _F32 = struct.Struct("<f")
+
+
+def _is_int(v):
+    """A JSON integer (not a bool, not 4.0)."""
+    return isinstance(v, int) and not isinstance(v, bool)
 
 
 def _f32(x):
@@ -181,6 +193,191 @@ def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
         return tuple(e3)
     s = f32(y / f32(y - f32(2.0 * m)))
     return tuple(f32(y + f32(f32(c - y) * s)) for c in e3)
+
+
+# R5.15's constants (shaders/lpv_shared.h's LPV_PROBES_*, read by techniques/probes/shaders/probes_lookup.glsl)
+_PROBES_FACING_FLOOR = 0.2     # w = phi^2 + 0.2
+_PROBES_CRUSH = 0.2            # a weight below it is crushed to w^3 / 0.2^2
+_PROBES_MIN_VAR = 1e-4         # sigma^2 at least 1e-4 s_k^2
+_PROBES_MIN_WEIGHT = 1e-6      # w' = max(w, 1e-6) t: keeps the division defined
+PROBES_UNSEEN = 1e-3           # a level whose probes around p see less of it passes p to the next coarser one
+
+
+def _oct_encode(w):
+    """SPEC R5.15's octahedral encoding of a direction: (w_x, w_y) / l with
+    l = |w_x| + |w_y| + |w_z| (0 when l is 0), folded over the corners for
+    w_z < 0 (sgn 0 = +1)."""
+    l1 = abs(w[0]) + abs(w[1]) + abs(w[2])
+    u = (w[0] / l1, w[1] / l1) if l1 > 0.0 else (0.0, 0.0)
+    if w[2] < 0.0:
+        u = ((1.0 - abs(u[1])) * (1.0 if u[0] >= 0.0 else -1.0), (1.0 - abs(u[0])) * (1.0 if u[1] >= 0.0 else -1.0))
+    return u
+
+
+def _oct_bilinear(side, w):
+    """The four texels (row * side + column) around direction w's place on a
+    side x side octahedral map and their bilinear weights (SPEC R5.15)."""
+    b, b1, f = [0, 0], [0, 0], [0.0, 0.0]
+    u = _oct_encode(w)
+    for a in range(2):  # a = 0: the column, a = 1: the row
+        s = min(max((u[a] * 0.5 + 0.5) * side - 0.5, 0.0), float(side - 1))
+        b[a] = min(int(math.floor(s)), max(side - 2, 0))
+        f[a] = s - b[a]
+        b1[a] = min(b[a] + 1, side - 1)
+    return ((b[1] * side + b[0], (1.0 - f[0]) * (1.0 - f[1])), (b[1] * side + b1[0], f[0] * (1.0 - f[1])),
+            (b1[1] * side + b[0], (1.0 - f[0]) * f[1]), (b1[1] * side + b1[0], f[0] * f[1]))
+
+
+def _probes_inside(level, x):
+    """SPEC R5.15 step 1: how far x lies inside a level's box, in its cells
+    (the least over the six faces; < 1/2: outside its last probes)."""
+    dims, o, s = level[0], level[1], level[2]
+    d = None
+    for a in range(3):
+        u = (x[a] - o[a]) / s
+        m = min(u, dims[a] - u)
+        d = m if d is None else min(d, m)
+    return d
+
+
+def _probes_level(level, k, probe, irradiance_side, distance_side, bias_cells, p, nh):
+    """SPEC R5.15 step 2: (E(k) as [r, g, b], h(k)) from level k's 8 probes
+    around p + b s_k n (probe(k, x, y, z): the probe's values)."""
+    dims, o, s = level[0], level[1], level[2]
+    x = [p[a] + bias_cells * s * nh[a] for a in range(3)]
+    c0, f = [0, 0, 0], [0.0, 0.0, 0.0]
+    for a in range(3):
+        q = min(max((x[a] - o[a]) / s - 0.5, 0.0), float(dims[a] - 1))
+        c0[a] = min(int(math.floor(q)), max(dims[a] - 2, 0))
+        f[a] = q - c0[a]
+    irr_at = 4
+    dist_at = 4 + 3 * irradiance_side * irradiance_side
+    min_var = _PROBES_MIN_VAR * s * s
+    irr_texels = _oct_bilinear(irradiance_side, nh)  # every probe's irradiance is read toward n
+    total, seen, acc = 0.0, 0.0, [0.0, 0.0, 0.0]
+    for j in range(8):
+        e = (j & 1, (j >> 1) & 1, j >> 2)
+        c = [min(c0[a] + e[a], dims[a] - 1) for a in range(3)]
+        v = probe(k, c[0], c[1], c[2])
+        if v[3] == 0.0:
+            continue  # off: inside geometry
+        m = [o[a] + (c[a] + 0.5) * s + v[a] for a in range(3)]
+        t = 1.0
+        for a in range(3):
+            t *= f[a] if e[a] else 1.0 - f[a]
+        r = [m[a] - p[a] for a in range(3)]
+        rl = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+        phi = (sum(r[a] / rl * nh[a] for a in range(3)) + 1.0) * 0.5 if rl > 0.0 else 1.0
+        w = phi * phi + _PROBES_FACING_FLOOR
+        d = [x[a] - m[a] for a in range(3)]
+        dl = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        toward = [d[a] / dl for a in range(3)] if dl > 0.0 else nh
+        mu = mu2 = 0.0
+        for texel, tw in _oct_bilinear(distance_side, toward):
+            mu += tw * v[dist_at + 2 * texel]
+            mu2 += tw * v[dist_at + 2 * texel + 1]
+        if dl > mu:  # the one-sided Chebyshev bound, cubed
+            var = max(mu2 - mu * mu, min_var)
+            cheb = var / (var + (dl - mu) * (dl - mu))
+            w *= cheb * cheb * cheb
+        if w < _PROBES_CRUSH:
+            w = w * w * w / (_PROBES_CRUSH * _PROBES_CRUSH)
+        seen += w * t
+        w = max(w, _PROBES_MIN_WEIGHT) * t
+        for texel, tw in irr_texels:
+            for ch in range(3):
+                acc[ch] += w * tw * v[irr_at + 3 * texel + ch]
+        total += w
+    if not total > 0.0:
+        return [0.0, 0.0, 0.0], seen
+    return [a / total for a in acc], seen
+
+
+def probes_irradiance(levels, probe, irradiance_side, distance_side, bias_cells, p, n):
+    """SPEC R5.15's lookup: E (W/m^2, r, g, b) at surface point p with normal
+    n from technique probes' visibility: ``levels`` the volume's levels,
+    finest first, each (dims, origin, cell_size); ``probe(k, x, y, z)`` the
+    V values of level k's probe at cell (x, y, z) (offset x y z, active, the
+    irradiance map, the distance map); ``irradiance_side``,
+    ``distance_side`` and ``bias_cells`` the description's. As
+    techniques/probes/shaders/probes_lookup.glsl (lpv_irradiance; its CPU
+    oracle techniques/probes/core/probes_lookup.c) computes it, in double
+    precision (R5.15: binary32 or better) from p and n rounded to binary32
+    (what QUERY_IRRADIANCE carries): the level k0 whose probes
+    surround p, each level's 8 probes weighed trilinear x the back-face term
+    x the Chebyshev bound of their distance moments (small weights crushed),
+    a coarser level where the probes around p do not see it (h < 1e-3), and
+    the blend into the next coarser level over the last two cells."""
+    p = [_f32(float(v)) for v in p]
+    n = [_f32(float(v)) for v in n]
+    if not all(math.isfinite(v) for v in p + n):
+        return (0.0, 0.0, 0.0)
+    ln = math.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+    if not 1e-8 < ln < 1e18:  # R5.15: no direction, or one binary32 cannot normalise
+        return (0.0, 0.0, 0.0)
+    nh = [v / ln for v in n]
+    K = len(levels)
+
+    def at(k):
+        return _probes_level(levels[k], k, probe, irradiance_side, distance_side, bias_cells, p, nh)
+    # 1. the level first asked: the first whose last probes surround p
+    k = next((i for i in range(K - 1) if _probes_inside(levels[i], p) >= 0.5), K - 1)
+    # 2. + 3. its light, or a coarser level's where its probes around p do not see p
+    e, h = at(k)
+    while h < PROBES_UNSEEN and k + 1 < K:
+        k += 1
+        e, h = at(k)
+    # 4. blended into the next coarser level over the last two cells
+    w = min(max((_probes_inside(levels[k], p) - 0.5) * 0.5, 0.0), 1.0)
+    if w < 1.0 and k + 1 < K:
+        c, hc = at(k + 1)
+        if hc >= PROBES_UNSEEN:
+            e = [c[i] + (e[i] - c[i]) * w for i in range(3)]
+    return tuple(e)
+
+
+class Visibility(object):
+    """The probes' visibility of a GET_VOLUME content "visibility" reply
+    (SPEC R5.15): ``probes`` (P, a probe per cell of every level, in the
+    levels' cell order), ``irradiance_side`` (I), ``distance_side`` (D),
+    ``values_per_probe`` (V = 4 + 3 I^2 + 2 D^2), ``bias_cells`` and
+    ``first`` (each level's first probe). ``data``: the P x V binary32
+    values, a float32 numpy array of shape (P, V) when numpy is available
+    (``offsets`` (P, 3), ``active`` (P,), ``irradiance`` (P, I*I, 3) and
+    ``distance`` (P, D*D, 2) are views of it), else a flat ``array('f')``.
+    ``probe(i)`` is probe i's V values as a list in any case."""
+
+    def __init__(self, desc, values, levels):
+        self.probes = int(desc["probes"])
+        self.irradiance_side = int(desc["irradiance_side"])
+        self.distance_side = int(desc["distance_side"])
+        self.values_per_probe = int(desc["values_per_probe"])
+        self.bias_cells = float(desc["bias_cells"])
+        self.description = desc
+        self.first, at = [], 0
+        for lv in levels:
+            self.first.append(at)
+            at += lv.cells
+        P, V, I, D = self.probes, self.values_per_probe, self.irradiance_side, self.distance_side
+        if len(values) != P * V or at != P:
+            raise ProtocolError("visibility of %d values for %d probes x %d values (the levels have %d cells)" % (
+                len(values), P, V, at))
+        self.offsets = self.active = self.irradiance = self.distance = None
+        if _np is not None:
+            values = values.reshape(P, V)
+            self.offsets = values[:, 0:3]
+            self.active = values[:, 3]
+            self.irradiance = values[:, 4:4 + 3 * I * I].reshape(P, I * I, 3)
+            self.distance = values[:, 4 + 3 * I * I:].reshape(P, D * D, 2)
+        self.data = values
+
+    def probe(self, i):
+        """Probe i's V values (offset x y z, active, I^2 x r g b, D^2 x mean
+        mean-square) as a list of floats."""
+        if _np is not None:
+            return self.data[i].tolist()
+        V = self.values_per_probe
+        return list(self.data[i * V:(i + 1) * V])
 
 
 class Cascade(object):
@@ -347,9 +544,22 @@ class Volume(Cascade):
     ``index`` one flag per voxel (1: it holds a surface) and
     ``iv_neighbours``; ``irradiance()`` is then R5.14's lookup
     (``iv_irradiance``).
+
+    Technique probes' GET_VOLUME content "visibility" (SPEC R5.15;
+    ``content`` "visibility"): the merged volume plus ``visibility``, a
+    ``Visibility`` (the probes' offsets, switches and octahedral maps);
+    ``irradiance()`` and ``probes_irradiance()`` are then R5.15's lookup
+    (``probes_irradiance``). Every other volume has ``visibility`` None.
+
+    ``content`` is what the request asked for: None for a VOLUME stream
+    message or a GET_VOLUME without content (or "merged" / "levels", read
+    from the description), "visibility" for GET_VOLUME content
+    "visibility". A description with a ``visibility`` key is refused unless
+    ``content`` is "visibility", and a "visibility" reply without one is
+    refused too (SPEC R5.15).
     """
 
-    def __init__(self, header, raw):
+    def __init__(self, header, raw, content=None):
         self.header = header
         self.raw = raw  # the raw (decompressed, delta-resolved) bytes
         self.tick = header.get("tick")
@@ -366,13 +576,26 @@ class Volume(Cascade):
             raise ProtocolError("cascades: expected 1 to %d entries" % MAX_CASCADES)
         self.description = self._describe(header, specs)
         desc = self.description
+        vis = desc.get("visibility")
+        if vis is not None and content != VISIBILITY_CONTENT:
+            raise ProtocolError("volume.visibility in a reply to %s: the probes' visibility comes only with "
+                                "GET_VOLUME content %r (SPEC R5.15)" % (
+                                    "GET_VOLUME content %r" % content if content is not None else
+                                    "a VOLUME stream message or GET_VOLUME without content (merged)",
+                                    VISIBILITY_CONTENT))
+        if content == VISIBILITY_CONTENT and vis is None:
+            raise ProtocolError("GET_VOLUME content %r answered without volume.visibility (technique %r; SPEC R5.15)"
+                                % (VISIBILITY_CONTENT, desc.get("technique")))
+        if vis is not None and not self.keyframe:
+            raise ProtocolError("a content %r volume that is not a keyframe (SPEC R5.15: always a keyframe)"
+                                % VISIBILITY_CONTENT)
         # SPEC R5.13: GET_VOLUME content "levels" describes an octree's levels
         # (the cascades then are level 0 alone); else the levels are the cascades
         octree = self._octree_levels(desc)
         self.iv = self._iv_levels(desc)
         self.iv_neighbours = desc.get("iv_neighbours") if self.iv else None
         self.units = desc.get("units") or header.get("units") or LPV_UNITS
-        self.content = "levels" if octree else "merged"
+        self.content = "levels" if octree else VISIBILITY_CONTENT if vis is not None else "merged"
         vpc, vpl = desc["values_per_cell"], desc["volumes_per_level"]
         self.values_per_cell, self.volumes_per_level = vpc, vpl
         self.technique, self.far_field = desc["technique"], desc["far_field"]
@@ -394,7 +617,11 @@ class Volume(Cascade):
         self.lookup_refusal = refusal
         size = 2 if self.format == "fp16" else 4
         index = desc["index"]
-        values_end = int(index["raw_offset"]) if index is not None else len(raw)
+        values_end = int(index["raw_offset"]) if index is not None else \
+            int(vis["raw_offset"]) if vis is not None else len(raw)
+        if vis is not None and len(raw) != values_end + int(vis["raw_length"]):
+            raise ProtocolError("volume of %d bytes, the description has %d bytes of values and %d of visibility" % (
+                len(raw), values_end, int(vis["raw_length"])))
         values = _floats(raw[:values_end], self.format)
         self.index = None
         if index is not None:  # R5.12: little-endian u32 after the levels' values
@@ -433,6 +660,10 @@ class Volume(Cascade):
         self.dims, self.origin, self.cell_size, self.data = c0.dims, c0.origin, c0.cell_size, c0.data
         self.role, self.values_per_cell, self.volumes = c0.role, c0.values_per_cell, c0.volumes
         self._lookup_refusal = refusal
+        # SPEC R5.15: the probes' visibility, binary32 whatever the format, after the levels' values
+        self.visibility = None
+        if vis is not None:
+            self.visibility = Visibility(vis, _floats(raw[values_end:], "fp32"), self.levels)
 
     @staticmethod
     def _describe(header, specs):
@@ -458,6 +689,9 @@ class Volume(Cascade):
         if not isinstance(vals, list) or len(vals) != vpc or len(set(vals)) != vpc:
             raise ProtocolError("volume.values: expected %d distinct names (values_per_cell), got %r" % (vpc, vals))
         levels = d.get("levels")
+        if "visibility" in d and (Volume._octree_levels(d) or Volume._iv_levels(d)):
+            raise ProtocolError("volume.visibility with %r levels: the probes' visibility goes with the merged "
+                                "cascades' volume only (SPEC R5.15)" % (levels[0].get("role"),))
         if Volume._octree_levels(d):
             Volume._check_octree_levels(d, specs)
             return d
@@ -474,7 +708,69 @@ class Volume(Cascade):
             if not isinstance(ix, dict) or not isinstance(ix.get("raw_offset"), int) \
                     or not isinstance(ix.get("raw_length"), int):
                 raise ProtocolError("volume.index: expected null or an object with raw_offset and raw_length")
+        if "visibility" in d:
+            Volume._check_visibility(d, specs, header)
         return d
+
+    @staticmethod
+    def _check_visibility(d, specs, header):
+        """R5.15: the probes' visibility (GET_VOLUME content "visibility"): P =
+        the levels' cells together, I in 1..16, D in 1..32, V = 4 + 3 I^2 +
+        2 D^2, value_type "f32", bias_cells >= 0, raw_offset = the levels'
+        values' bytes, raw_length = P x V x 4 and the header's raw_length
+        their sum; over the merged levels (role "cascade", far field off, the
+        12 SH values in one volume, no index)."""
+        vis = d["visibility"]
+        if not isinstance(vis, dict):
+            raise ProtocolError("volume.visibility: expected an object, got %r (SPEC R5.15)" % (vis,))
+
+        def integer(key, lo, hi):
+            v = vis.get(key)
+            if not _is_int(v) or not lo <= v <= hi:
+                raise ProtocolError("volume.visibility.%s: %r, expected an integer in [%d, %d] (SPEC R5.15)"
+                                    % (key, v, lo, hi))
+            return v
+        levels = d["levels"]
+        if d.get("far_field") is not False or any(lv.get("role") != "cascade" for lv in levels) \
+                or d.get("index") is not None or d.get("volumes_per_level") != 1 \
+                or tuple(d.get("values") or ()) != LOOKUP_VALUES or d.get("units") != LPV_UNITS:
+            raise ProtocolError("volume.visibility over levels of roles %r, far_field %r, index %r, %r volume(s) of "
+                                "%r in %r: the probes' visibility goes with their merged volume (role \"cascade\", "
+                                "far_field false, no index, the 12 SH values in one volume, %s; SPEC R5.15)" % (
+                                    [lv.get("role") for lv in levels], d.get("far_field"), d.get("index"),
+                                    d.get("volumes_per_level"), d.get("values"), d.get("units"), LPV_UNITS))
+        cells = sum(int(c.get("cells") or 0) for c in specs)
+        P = vis.get("probes")
+        if not _is_int(P) or P != cells:
+            raise ProtocolError("volume.visibility.probes: %r, the levels have %d cells (a probe a cell; SPEC R5.15)"
+                                % (P, cells))
+        I = integer("irradiance_side", 1, MAX_IRRADIANCE_SIDE)
+        D = integer("distance_side", 1, MAX_DISTANCE_SIDE)
+        V = 4 + 3 * I * I + 2 * D * D
+        if not _is_int(vis.get("values_per_probe")) or vis["values_per_probe"] != V:
+            raise ProtocolError("volume.visibility.values_per_probe: %r, sides %d and %d give 4 + 3 x %d^2 + 2 x "
+                                "%d^2 = %d (SPEC R5.15)" % (vis.get("values_per_probe"), I, D, I, D, V))
+        if vis.get("value_type") != VISIBILITY_VALUE_TYPE:
+            raise ProtocolError("volume.visibility.value_type: %r, expected %r whatever the format (SPEC R5.15)"
+                                % (vis.get("value_type"), VISIBILITY_VALUE_TYPE))
+        b = vis.get("bias_cells")
+        if not isinstance(b, (int, float)) or isinstance(b, bool) or not (math.isfinite(b) and b >= 0.0):
+            raise ProtocolError("volume.visibility.bias_cells: %r, expected a finite number >= 0 (SPEC R5.15)"
+                                % (b,))
+        fmt = header.get("format")
+        if fmt not in ("fp16", "fp32"):
+            raise ProtocolError("unknown volume format %r" % (fmt,))
+        values_bytes = cells * 12 * (2 if fmt == "fp16" else 4)
+        if not _is_int(vis.get("raw_offset")) or vis["raw_offset"] != values_bytes:
+            raise ProtocolError("volume.visibility.raw_offset: %r, the levels' values (%d cells x 12 %s) end at "
+                                "byte %d (SPEC R5.15)" % (vis.get("raw_offset"), cells, fmt, values_bytes))
+        if not _is_int(vis.get("raw_length")) or vis["raw_length"] != P * V * 4:
+            raise ProtocolError("volume.visibility.raw_length: %r, expected %d probes x %d values x 4 = %d "
+                                "(SPEC R5.15)" % (vis.get("raw_length"), P, V, P * V * 4))
+        if "raw_length" in header and header["raw_length"] != values_bytes + P * V * 4:
+            raise ProtocolError("raw_length: %r, the levels' values (%d bytes) and the visibility (%d) make %d "
+                                "(SPEC R5.15)" % (header["raw_length"], values_bytes, P * V * 4,
+                                                  values_bytes + P * V * 4))
     @staticmethod
     def _octree_levels(d):
         """Whether description d's levels are an octree's (SPEC R5.13)."""
@@ -565,9 +861,12 @@ class Volume(Cascade):
         last 3 cells of its border, w = clamp((d - 1) / 2, 0, 1); each
         cascade's lookup as propagation.md §6. Technique iv's voxels (``iv``):
         R5.14's lookup instead (``iv_irradiance`` with the index and
-        iv_neighbours). Raises LayoutError (naming the layout) for a volume
-        neither lookup reads."""
+        iv_neighbours); technique probes' content "visibility"
+        (``visibility``): R5.15's (``probes_irradiance``). Raises LayoutError
+        (naming the layout) for a volume none of the lookups reads."""
         self._check_lookup()
+        if self.visibility is not None:
+            return self.probes_irradiance(p, n)
         if self.iv:
             nx, ny = self.dims[0], self.dims[1]
             index = self.index
@@ -584,3 +883,28 @@ class Volume(Cascade):
             return fine
         coarse = Cascade.irradiance(cs[k + 1], p, n)
         return tuple(w * f + (1.0 - w) * c for f, c in zip(fine, coarse))
+
+    def probes_irradiance(self, p, n):
+        """E(n) in W/m^2 (r, g, b) at surface point p with normal n by SPEC
+        R5.15's lookup, the one the server's QUERY_IRRADIANCE uses for
+        technique probes: the probes' visibility weighs each of the 8 probes
+        around p (``probes_irradiance``). Raises LayoutError naming the
+        technique and content for a volume without the visibility (ask
+        ``Client.get_volume(content="visibility")`` of a probes session)."""
+        vis = self.visibility
+        if vis is None:
+            raise LayoutError("R5.15's lookup reads the probes' visibility, which this volume (technique %r, content "
+                              "%r) does not carry: it comes only with GET_VOLUME content %r from a session of "
+                              "technique %r (SPEC R5.15)" % (self.technique, self.content, VISIBILITY_CONTENT,
+                                                             PROBES_TECHNIQUE))
+        levels = [(lv.dims, lv.origin, lv.cell_size) for lv in self.levels]
+        first, dims = vis.first, [lv.dims for lv in self.levels]
+        cache = {}
+
+        def probe(k, x, y, z):
+            i = first[k] + x + dims[k][0] * (y + dims[k][1] * z)
+            v = cache.get(i)
+            if v is None:
+                v = cache[i] = vis.probe(i)
+            return v
+        return probes_irradiance(levels, probe, vis.irradiance_side, vis.distance_side, vis.bias_cells, p, n)

@@ -86,7 +86,7 @@ static int unit_normal(const float p[3], const float n[3], float u[3])
         if (!isfinite(p[a]) || !isfinite(n[a]))
             return 0;
     const float l = len3(n);
-    if (!(l > 1e-8f) || !isfinite(l))
+    if (!(l > 1e-8f && l < 1e18f)) /* SPEC R5.15: no direction, or one a float cannot normalise */
         return 0;
     for (int a = 0; a < 3; ++a)
         u[a] = n[a] / l;

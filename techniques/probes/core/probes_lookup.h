@@ -44,8 +44,9 @@ typedef struct lpv_probes_field {
  * (row * side + column). */
 void lpv_probes_oct_bilinear(int side, const float d[3], int i[4], float w[4]);
 
-/* The irradiance (W/m^2, rgb) at p on a surface of normal n (any length >
- * 1e-8; zero light for a non-finite p or n) from level k's probes alone;
+/* The irradiance (W/m^2, rgb) at p on a surface of normal n (of a length
+ * in (1e-8, 1e18); else, or for a non-finite p or n, no light) from level
+ * k's probes alone;
  * returns how much of them sees p (0 when every probe around it is off or
  * hidden from it). */
 float lpv_probes_irradiance_in(const lpv_probes_field *f, int k, const float p[3], const float n[3], float e[3]);

@@ -159,8 +159,8 @@ int probes_cascade_at(vec3 p)
 
 vec3 lpv_irradiance(vec3 p, vec3 n)
 {
-    float ln = length(n); // SPEC R5.15: a unit normal, no light without one
-    if (!(ln > 1e-8))
+    float ln = length(n); // SPEC R5.15: a unit normal, no light without one (or one a float cannot normalise)
+    if (!(ln > 1e-8 && ln < 1e18))
         return vec3(0.0);
     n /= ln;
     int k = probes_cascade_at(p);
