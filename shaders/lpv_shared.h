@@ -731,5 +731,10 @@ struct LpvBvhNode {
 #define LPV_PROBES_CRUSH 0.2f
 #define LPV_PROBES_MIN_VAR 1e-4f
 #define LPV_PROBES_UNSEEN 1e-3f
+/* The blend's hysteresis drops to none as a probe's band 0 changes by
+ * LPV_PROBES_CHANGE_Z0 .. Z1 standard errors of the batch's own estimate
+ * (probes_blend.comp): a change its rays' noise does not explain. */
+#define LPV_PROBES_CHANGE_Z0 3.0f
+#define LPV_PROBES_CHANGE_Z1 6.0f
 
 #endif /* LPV_SHARED_H */

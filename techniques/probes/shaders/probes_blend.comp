@@ -10,8 +10,8 @@
 // volume's first pass moves probes out of geometry and off surfaces
 // (relocation; the next passes trace from where they moved to). The light is
 // blended into the probe's old value with the hysteresis, lowered where the
-// light changed by much (Majercik et al. 2021: fast where light changed,
-// slow where it is noise); the distances with their own weight (a running
+// light changed by much, or by more than the batch's noise explains
+// (Majercik et al. 2021: fast where light changed, slow where it is noise); the distances with their own weight (a running
 // mean over the warmup's passes, then the hysteresis: only geometry moves
 // them, and a new scene starts the probes afresh). probes_update.c is the CPU oracle of the statistics.
 layout(local_size_x = LPV_PROBES_WG) in;
@@ -45,11 +45,13 @@ void main()
     float cell = cascade_cell(k), mmax = u_moment_cells * cell;
     uint first = j * u_rays;
     vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
+    vec3 s2 = vec3(0.0); // the rays' radiance squared: the batch's own noise
     uint back = 0u;
     float t_back = 1e30, t_front = 1e30; // the closest back and front faces' distances, and directions
     vec3 d_back = vec3(0.0), d_front = vec3(0.0);
     for (uint i = 0u; i < u_rays; ++i) {
         vec4 o = ray_out[first + i];
+        s2 += o.rgb * o.rgb;
         back += o.w < 0.0 ? 1u : 0u;
         if (o.w < 0.0 && -o.w < t_back) {
             t_back = -o.w;
@@ -70,10 +72,19 @@ void main()
     LpvCell old = probes_sh[probe];
     float h = u_hysteresis;
     if (h > 0.0) {
-        // band 0 is the mean radiance: its relative change, over the channels
+        // band 0 is w C0 x the sum of the rays' radiance: its change against
+        // the old value, relative (over half of it) and in standard errors of
+        // this batch's estimate (the rays' sample variance): a change the
+        // rays' noise does not explain lowers the hysteresis
         vec3 a = vec3(old.r.x, old.g.x, old.b.x), c = vec3(r.x, g.x, b.x);
         vec3 rel = abs(c - a) / max(max(abs(a), abs(c)), vec3(1e-30));
-        h *= 1.0 - smoothstep(0.5, 1.0, max(rel.x, max(rel.y, rel.z)));
+        float n = float(u_rays), c0 = sh_basis(vec3(0.0, 0.0, 1.0)).x;
+        vec3 s1 = c / max(w * c0, 1e-30); // the rays' radiance summed
+        vec3 se = w * c0 * sqrt(n * max(s2 - s1 * s1 / n, vec3(0.0)) / max(n - 1.0, 1.0));
+        vec3 z = abs(c - a) / max(se, max(max(abs(a), abs(c)) * 1e-3, vec3(1e-30)));
+        float changed = max(smoothstep(0.5, 1.0, max(rel.x, max(rel.y, rel.z))),
+                            smoothstep(LPV_PROBES_CHANGE_Z0, LPV_PROBES_CHANGE_Z1, max(z.x, max(z.y, z.z))));
+        h *= 1.0 - changed;
     }
     probes_sh[probe] = LpvCell(mix(r, old.r, h), mix(g, old.g, h), mix(b, old.b, h));
 
