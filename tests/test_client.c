@@ -569,6 +569,35 @@ static void test_octree_levels(void **state)
     lpvc_close(c);
 }
 
+/* The points where a volume's local lookup is held to QUERY_IRRADIANCE:
+ * 4 x 4 x 4 places across its box, each with the 6 axes and a diagonal as
+ * normals. The server's answers go to rgb, the local ones to local (each
+ * LOOKUP_POINTS x 3); returns the largest value of either. */
+enum { LOOKUP_POINTS = 7 * 64 };
+static float query_and_look_up(lpvc *c, const lpvc_volume *v, float *rgb, float *local)
+{
+    float pts[LOOKUP_POINTS * 3], nrm[LOOKUP_POINTS * 3];
+    static const float dirs[7][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}};
+    size_t n = 0;
+    for (int i = 0; i < 64; i++)
+        for (int k = 0; k < 7; k++, n++) {
+            int g[3] = {i % 4, (i / 4) % 4, i / 16};
+            for (int a = 0; a < 3; a++) {
+                /* other fractions per axis: no two corners exactly as far from the shifted point (a tie that the
+                 * GPU's float distances may break the other way; R5.14 keeps the lower corner) */
+                static const float at[3] = {0.07f, 0.11f, 0.05f}, step[3] = {0.29f, 0.27f, 0.31f};
+                pts[3 * n + a] = v->origin[a] + (at[a] + step[a] * (float)g[a]) * (float)v->dims[a] * v->cell_size;
+                nrm[3 * n + a] = dirs[k][a];
+            }
+        }
+    OK(c, lpvc_query_irradiance(c, pts, nrm, LOOKUP_POINTS, rgb));
+    for (size_t i = 0; i < LOOKUP_POINTS; i++)
+        assert_int_equal(lpvc_volume_irradiance(v, pts + 3 * i, nrm + 3 * i, local + 3 * i), 0);
+    const float emax = fmaxf(max_abs(local, LOOKUP_POINTS * 3), max_abs(rgb, LOOKUP_POINTS * 3));
+    assert_true(emax > 0.0f);
+    return emax;
+}
+
 /* Technique iv (SPEC R5.14): the volume of voxels with its occupancy index
  * and iv_neighbours, looked up locally (lpvc_volume_irradiance) as the
  * server's QUERY_IRRADIANCE answers; the "ao" frame term is refused with
@@ -635,26 +664,9 @@ static void test_iv_volume(void **state)
     }
 
     /* QUERY_IRRADIANCE = R5.14's lookup on the fp32 volume of the same tick */
-    enum { N = 7 * 64 };
-    float pts[N * 3], nrm[N * 3], rgb[N * 3], local[N * 3];
-    static const float dirs[7][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}};
-    size_t n = 0;
-    for (int i = 0; i < 64; i++)
-        for (int k = 0; k < 7; k++, n++) {
-            int g[3] = {i % 4, (i / 4) % 4, i / 16};
-            for (int a = 0; a < 3; a++) {
-                /* other fractions per axis: no two corners exactly as far from the shifted point (a tie that the
-                 * GPU's float distances may break the other way; R5.14 keeps the lower corner) */
-                static const float at[3] = {0.07f, 0.11f, 0.05f}, step[3] = {0.29f, 0.27f, 0.31f};
-                pts[3 * n + a] = v.origin[a] + (at[a] + step[a] * (float)g[a]) * (float)v.dims[a] * v.cell_size;
-                nrm[3 * n + a] = dirs[k][a];
-            }
-        }
-    OK(c, lpvc_query_irradiance(c, pts, nrm, N, rgb));
-    for (size_t i = 0; i < N; i++)
-        assert_int_equal(lpvc_volume_irradiance(&v, pts + 3 * i, nrm + 3 * i, local + 3 * i), 0);
-    float emax = fmaxf(max_abs(local, N * 3), max_abs(rgb, N * 3));
-    assert_true(emax > 0.0f);
+    enum { N = LOOKUP_POINTS };
+    float rgb[N * 3], local[N * 3];
+    const float emax = query_and_look_up(c, &v, rgb, local);
     size_t lit = 0;
     for (size_t i = 0; i < N * 3; i++) {
         assert_true(isfinite(rgb[i]) && rgb[i] >= 0.0f);
@@ -745,24 +757,9 @@ static void test_probes_visibility(void **state)
     assert_true(active > 0);
 
     /* QUERY_IRRADIANCE = R5.15's lookup on the volume of the same tick */
-    enum { N = 7 * 64 };
-    float pts[N * 3], nrm[N * 3], rgb[N * 3], local[N * 3];
-    static const float dirs[7][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 1, 1}};
-    size_t n = 0;
-    for (int i = 0; i < 64; i++)
-        for (int k = 0; k < 7; k++, n++) {
-            int g[3] = {i % 4, (i / 4) % 4, i / 16};
-            for (int a = 0; a < 3; a++) {
-                static const float at[3] = {0.07f, 0.11f, 0.05f}, step[3] = {0.29f, 0.27f, 0.31f};
-                pts[3 * n + a] = v.origin[a] + (at[a] + step[a] * (float)g[a]) * (float)v.dims[a] * v.cell_size;
-                nrm[3 * n + a] = dirs[k][a];
-            }
-        }
-    OK(c, lpvc_query_irradiance(c, pts, nrm, N, rgb));
-    for (size_t i = 0; i < N; i++)
-        assert_int_equal(lpvc_volume_irradiance(&v, pts + 3 * i, nrm + 3 * i, local + 3 * i), 0);
-    float emax = fmaxf(max_abs(local, N * 3), max_abs(rgb, N * 3));
-    assert_true(emax > 0.0f);
+    enum { N = LOOKUP_POINTS };
+    float rgb[N * 3], local[N * 3];
+    const float emax = query_and_look_up(c, &v, rgb, local);
     size_t off = 0, lit = 0;
     float worst = 0.0f;
     for (size_t i = 0; i < N * 3; i++) {
