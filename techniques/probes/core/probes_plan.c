@@ -32,10 +32,10 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
     else if (p->recompute || fresh)
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute ? p->recompute_reason : "no history",
                         fresh ? "every probe, warmup passes" : "a budget of probes");
-    else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis)) {
+    else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed)) {
         p->recompute = 1;
         snprintf(p->recompute_reason, sizeof p->recompute_reason, LPV_PROBES_SETTLE_REASON " (%d of %d sweeps)", g->sweeps,
-                 lpv_probes_settle_sweeps(s->probes.hysteresis));
+                 lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed));
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s", p->recompute_reason);
     } else
         lpv_plan_decide(p, LPV_PASS_PROBES, 0, "%s; the probes settled (%d sweeps since the last change)",
@@ -49,11 +49,17 @@ float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g)
     return hysteresis * (1.0f - powf(LPV_PROBES_CHANGE_RAMP, (float)(g->sweeps + 1)));
 }
 
-int lpv_probes_settle_sweeps(float hysteresis)
+int lpv_probes_settle_sweeps(float hysteresis, int changed)
 {
     if (!(hysteresis > 0.0f) || !(hysteresis < 1.0f))
         return 1;
-    return (int)ceil(log(LPV_PROBES_SETTLE_RESIDUE) / log((double)hysteresis));
+    if (!changed)
+        return (int)ceil(log(LPV_PROBES_SETTLE_RESIDUE) / log((double)hysteresis));
+    lpv_probes_progress g = {.history = 1, .changed = 1};
+    double left = 1.0;
+    for (g.sweeps = 0; left > LPV_PROBES_SETTLE_RESIDUE; ++g.sweeps)
+        left *= (double)lpv_probes_hysteresis_now(hysteresis, &g);
+    return g.sweeps;
 }
 
 void lpv_probes_tick_cost(const lpv_settings *s, lpv_tick_cost *out)

@@ -25,7 +25,7 @@
 #define LPV_PROBES_SEED 1u           /* the ray set's rotations (lpv_probes_rotation) */
 /* A static scene stops tracing once every probe was updated often enough
  * after the last change for the light from before it to weigh at most this
- * (hysteresis^sweeps, lpv_probes_settle_sweeps). */
+ * (the product of the sweeps' hysteresis, lpv_probes_settle_sweeps). */
 #define LPV_PROBES_SETTLE_RESIDUE 0.01
 /* The plan's recompute reason while they settle (the tick tells it from a change). */
 #define LPV_PROBES_SETTLE_REASON "the probes settle"
@@ -53,9 +53,13 @@ float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g);
 void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const lpv_probes_progress *g,
                           lpv_plan *out);
 
-/* Sweeps over every probe after a change until the probes settled: the
- * least n with hysteresis^n <= LPV_PROBES_SETTLE_RESIDUE (44 at 0.9). */
-int lpv_probes_settle_sweeps(float hysteresis);
+/* Sweeps over every probe after a change (changed 1) or a warmup (0)
+ * until the probes settled: the least n for which the product of the n
+ * sweeps' hysteresis (lpv_probes_hysteresis_now) is at most
+ * LPV_PROBES_SETTLE_RESIDUE: at 0.9, 44 after a warmup (0.9^n), 32 after a
+ * change (the ramp forgets faster). An upper bound: the blend lowers the
+ * hysteresis further where a probe's light changed. */
+int lpv_probes_settle_sweeps(float hysteresis, int changed);
 
 /* Probes a tick (budget, or every probe of the grid's cascades on the
  * first tick's warmup) x rays, at LPV_TICK_COST_PROBES_RAYS_PER_STEP a

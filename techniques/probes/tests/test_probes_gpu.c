@@ -459,8 +459,9 @@ static void test_probes_follow_a_moved_light(void **state)
     lpv_scene at_b = {0}, at_a = {0}, back = {0};
     lit_room(&at_b, b);
     run(&at_b, &st); /* a new scene: a fresh volume, every probe 4 passes */
-    const int sweeps = lpv_probes_settle_sweeps(0.9f);
+    const int sweeps = lpv_probes_settle_sweeps(0.9f, 0); /* after a warmup */
     assert_int_equal(sweeps, 44);
+    assert_int_equal(lpv_probes_settle_sweeps(0.9f, 1), 32); /* after a change: the ramp forgets faster */
     const int first = settle(4 * sweeps + 8);
     assert_int_equal(first, 4 * sweeps); /* then the plan stops the probes */
     float want[18], got[18];
