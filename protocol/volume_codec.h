@@ -329,10 +329,6 @@ int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lp
 int lpvp_volume_layout_visibility(lpvp_volume_layout *l, const char *technique, int levels, int irradiance_side,
                                   int distance_side, double bias_cells, char *err, size_t err_n);
 
-/* R5.15's values per probe, 4 + 3 irradiance_side^2 + 2 distance_side^2
- * (techniques/probes/core/probes_lookup.h's record). */
-uint64_t lpvp_visibility_values_per_probe(int irradiance_side, int distance_side);
-
 /* Bytes after the levels' values: the index's (R5.12) or the visibility's
  * (R5.15), 0 when the layout has neither. */
 uint64_t lpvp_volume_extra_bytes(const lpvp_volume_info *vi);

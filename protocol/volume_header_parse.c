@@ -7,6 +7,7 @@
 #include "volume_codec.h"
 #include "proto.h"
 #include "volume_codec_internal.h"
+#include "probes_record.h" /* R5.15's record is the engine's */
 
 #include <math.h>
 #include <stdarg.h>
@@ -407,7 +408,7 @@ static int parse_visibility(const json_t *v, lpvp_volume_info *vi, char *err, si
         return -1;
     }
     vis->distance_side = (int)x;
-    vis->values_per_probe = lpvp_visibility_values_per_probe(vis->irradiance_side, vis->distance_side);
+    vis->values_per_probe = lpv_probes_record_values(vis->irradiance_side, vis->distance_side);
     snprintf(key, sizeof key, "%s.values_per_probe", K);
     if (need_int(v, "values_per_probe", 1, &x, err, err_n) != 0 || (uint64_t)x != vis->values_per_probe) {
         lpvp_set_error(err, err_n, "%s: expected %llu (4 + 3 irradiance_side^2 + 2 distance_side^2)", key,

@@ -8,6 +8,7 @@
 #include "volume_codec.h"
 #include "proto.h"
 #include "volume_codec_internal.h"
+#include "probes_record.h" /* R5.15's record is the engine's */
 
 #include <math.h>
 #include <stdarg.h>
@@ -113,12 +114,6 @@ int lpvp_volume_layout_iv(lpvp_volume_layout *l, const char *technique, const lp
     return 0;
 }
 
-uint64_t lpvp_visibility_values_per_probe(int irradiance_side, int distance_side)
-{
-    return 4 + 3 * (uint64_t)irradiance_side * (uint64_t)irradiance_side +
-           2 * (uint64_t)distance_side * (uint64_t)distance_side;
-}
-
 int lpvp_volume_layout_visibility(lpvp_volume_layout *l, const char *technique, int levels, int irradiance_side,
                                   int distance_side, double bias_cells, char *err, size_t err_n)
 {
@@ -135,7 +130,7 @@ int lpvp_volume_layout_visibility(lpvp_volume_layout *l, const char *technique, 
     l->has_visibility = 1;
     l->visibility.irradiance_side = irradiance_side;
     l->visibility.distance_side = distance_side;
-    l->visibility.values_per_probe = lpvp_visibility_values_per_probe(irradiance_side, distance_side);
+    l->visibility.values_per_probe = lpv_probes_record_values(irradiance_side, distance_side);
     l->visibility.bias_cells = bias_cells;
     return 0;
 }

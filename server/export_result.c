@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "export.h"
+#include "probes_record.h" /* a probe's record: its size */
 
 sv_result *sv_result_ref(sv_result *r)
 {
@@ -165,7 +166,7 @@ static int keep_visibility(lpv_engine *e, sv_result *r, char *err, size_t n)
         snprintf(err, n, "technique \"%s\" has no probes' visibility to send", d->technique ? d->technique : "?");
         return -1;
     }
-    const size_t per = (size_t)lpvp_visibility_values_per_probe(d->irradiance_side, d->visibility_side);
+    const size_t per = lpv_probes_record_values(d->irradiance_side, d->visibility_side);
     const size_t want = r->cell_count * per;
     r->visibility = malloc((want ? want : 1) * sizeof *r->visibility);
     if (!r->visibility) {

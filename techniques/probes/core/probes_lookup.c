@@ -6,16 +6,6 @@
 
 #include "probes_math.h"
 
-size_t lpv_probes_record_distance_at(int irradiance_side)
-{
-    return LPV_PROBES_RECORD_IRRADIANCE + 3 * (size_t)irradiance_side * (size_t)irradiance_side;
-}
-
-size_t lpv_probes_record_values(int irradiance_side, int distance_side)
-{
-    return lpv_probes_record_distance_at(irradiance_side) + 2 * (size_t)distance_side * (size_t)distance_side;
-}
-
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
 static int mini(int a, int b) { return a < b ? a : b; }
 static int maxi(int a, int b) { return a > b ? a : b; }

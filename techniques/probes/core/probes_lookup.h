@@ -12,17 +12,7 @@
 #include <stddef.h>
 
 #include "lpv_shared.h" /* the lookup's weights, LPV_PROBES_FACING_FLOOR .. LPV_PROBES_UNSEEN */
-
-/* A probe's record, floats: its offset from its cell's centre (m, 3),
- * active (1, or 0: off), the irradiance map (irradiance_side^2 texels of
- * rgb, W/m^2), then the distance map (distance_side^2 texels of mean and
- * mean square hit distance, m and m^2); each map row by row on the
- * octahedral map (probes_math.h). */
-#define LPV_PROBES_RECORD_OFFSET 0
-#define LPV_PROBES_RECORD_ACTIVE 3
-#define LPV_PROBES_RECORD_IRRADIANCE 4
-size_t lpv_probes_record_distance_at(int irradiance_side);
-size_t lpv_probes_record_values(int irradiance_side, int distance_side);
+#include "probes_record.h" /* a probe's record: its layout and size */
 
 /* One level of probes (a cascade): a probe at each cell's centre. */
 typedef struct lpv_probes_level {
