@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "probes_record.h" /* R5.15: a probe's record, its size */
 #include "stats_json.h"
 
 /* The tick's stats in the one shape of lpvd_tick_stats_json (stats_json.h). */
@@ -86,6 +87,34 @@ int sv_terms_check(const sv_conn *c, int terms, char *err, size_t n)
     return -1;
 }
 
+/* R5.15: the probes' records alone over max_queue, or over the memory
+ * budget's room for replies, are answered LIMIT before the read-back, which
+ * would hold them twice (the records, then the frame). 1 when answered. */
+static int visibility_too_big(sv_conn *c, sv_request *r, const sv_result *latest)
+{
+    const lpv_volume_desc *d = &latest->stats.volume;
+    const uint64_t bytes =
+        (uint64_t)latest->cell_count * lpv_probes_record_values(d->irradiance_side, d->visibility_side) * 4u;
+    if (bytes > c->srv->cfg.max_queue) {
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                     "%s \"%s\": %zu probes' records are %llu bytes, over this server's per-client queue limit of "
+                     "%llu bytes (--max-queue); not read back: ask for a smaller grid or fewer cascades",
+                     LPVP_VOLUME_CONTENT_KEY, lpvp_volume_content_names[LPVP_CONTENT_VISIBILITY], latest->cell_count,
+                     (unsigned long long)bytes, (unsigned long long)c->srv->cfg.max_queue);
+        return 1;
+    }
+    if (!sv_memory_fits(&c->srv->mem, SV_MEM_REPLIES, bytes)) {
+        char mem[SV_MEMORY_DESCRIBE_SIZE];
+        sv_memory_describe(&c->srv->mem, mem, sizeof mem);
+        sv_reply_err(c, r->request_id, LPVP_E_LIMIT, 0,
+                     "%s \"%s\": %zu probes' records are %llu bytes, more than %s has room for; not read back",
+                     LPVP_VOLUME_CONTENT_KEY, lpvp_volume_content_names[LPVP_CONTENT_VISIBILITY], latest->cell_count,
+                     (unsigned long long)bytes, mem);
+        return 1;
+    }
+    return 0;
+}
+
 void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
@@ -124,6 +153,8 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
                      LPVP_VOLUME_CONTENT_KEY, lpvp_volume_content_names[LPVP_CONTENT_VISIBILITY], t ? t : "?");
         return;
     }
+    if (content == LPVP_CONTENT_VISIBILITY && visibility_too_big(c, r, latest))
+        return;
     /* read back on the GL thread for this request alone (a tick does not read them) */
     sv_job *jb = sv_job_new(SV_JOB_CONTENT, c->world);
     if (!jb) {

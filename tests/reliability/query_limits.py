@@ -13,6 +13,10 @@ only then refused. Two daemons with small limits:
      before it is computed (the refusal says the reply "would be" over the
      limit; after an encoding it says it "is" over and was not sent), and
      the session goes on.
+  3. The same daemon, technique probes (R5.15): GET_VOLUME content
+     "visibility" at grid 8 (512 probes' records, 492 KB) is answered; at
+     grid 12 (1728 probes, 1.66 MB of records) it gets LIMIT naming
+     --max-queue before anything is read back, and the session goes on.
 """
 
 import struct
@@ -65,8 +69,30 @@ def run(rep, lpvd, flag):
                       "%.3f s (the full query took %.3f s)" % (dt, dt_full))
         f = c.request(lc.QUERY_IRRADIANCE, {"count": 1}, points(1), timeout=60)
         rep.check(f.type == (lc.QUERY_IRRADIANCE | lc.REPLY), "%s: the session goes on" % flag, repr(f.type))
+        if flag == "--max-queue":
+            visibility(rep, c)
         c.close()
         return d
+
+
+def visibility(rep, c):
+    """R5.15: the probes' records over max_queue are refused before the read-back."""
+    ask = {"format": "fp32", "compression": "none", "content": "visibility"}
+    ok(c.request(lc.CONFIG, {"technique": "probes", "grid": 8, "cascades": 1, "probes_rays": 16}, timeout=60),
+       lc.CONFIG)
+    ok(c.request(lc.TICK, {}, timeout=120), lc.TICK)
+    f = c.request(lc.GET_VOLUME, ask, timeout=120)
+    vis = (f.body.get("volume") or {}).get("visibility", {}) if f.type == (lc.GET_VOLUME | lc.REPLY) else {}
+    rep.check(vis.get("probes") == 512 and vis.get("raw_length") == 512 * vis.get("values_per_probe", 0) * 4,
+              "--max-queue: 512 probes' visibility (under 1 MiB) is answered", repr((f.type, vis)))
+    ok(c.request(lc.CONFIG, {"grid": 12}, timeout=60), lc.CONFIG)
+    ok(c.request(lc.TICK, {}, timeout=120), lc.TICK)
+    f = c.request(lc.GET_VOLUME, ask, timeout=120)
+    msg = str(f.body.get("message", "")) if f.type == lc.ERROR else ""
+    rep.check(f.type == lc.ERROR and f.err_name == "LIMIT" and "--max-queue" in msg and "not read back" in msg,
+              "--max-queue: 1728 probes' visibility gets LIMIT naming --max-queue before the read-back", repr(f))
+    f = c.request(lc.GET_VOLUME, {"format": "fp16"}, timeout=120)
+    rep.check(f.type == (lc.GET_VOLUME | lc.REPLY), "--max-queue: the merged volume still comes", repr(f.type))
 
 
 def main():
