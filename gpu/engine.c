@@ -192,6 +192,12 @@ void lpv_engine_invalidate(lpv_engine *e)
     e->shadows.valid = 0;
 }
 
+void lpv_engine_forget(lpv_engine *e)
+{
+    if (e->tech && e->tech->cls->forget)
+        e->tech->cls->forget(e->tech);
+}
+
 const lpv_grid *lpv_engine_grid(const lpv_engine *e) { return &e->desc.level[0]; }
 const lpv_settings *lpv_engine_settings(const lpv_engine *e) { return &e->settings; }
 const lpv_engine_stats *lpv_engine_last_stats(const lpv_engine *e) { return &e->stats; }

@@ -186,19 +186,28 @@ int lpv_engine_set_view(lpv_engine *e, const lpv_view *view, char *err, size_t e
  * plan says "recompute requested"): for benchmarks that time full ticks. */
 void lpv_engine_invalidate(lpv_engine *e);
 
+/* Drops what the technique carries from tick to tick (the probes'
+ * history; the others carry nothing), so the next tick computes what a
+ * fresh engine makes of the same inputs: for an item whose output must not
+ * depend on the items before it (a batch's). The benchmarks' full ticks
+ * (lpv_engine_invalidate) keep it. */
+void lpv_engine_forget(lpv_engine *e);
+
 /* One item of work, as `lpvd render`, a batch item and a daemon world's tick
  * all run it: what changed since the engine's last item (NULL: unchanged),
  * applied in the one order every program uses, settings, then scene, then
  * view (a scene set after the settings is sampled once, with the knobs it
  * will be ticked with), then, when tick is set, one tick. recompute: the tick
  * recomputes even when the planner would serve the cached volume
- * (lpv_engine_invalidate). What an item outputs (a frame, a volume, points'
+ * (lpv_engine_invalidate); forget: the technique's history is dropped
+ * first, so the tick is a fresh engine's (lpv_engine_forget). What an item outputs (a frame, a volume, points'
  * irradiance) is the caller's: each program wants different ones. */
 typedef struct lpv_engine_item {
     const lpv_settings *settings;
     const lpv_scene *scene;
     const lpv_view *view;
     int recompute;
+    int forget;
     int tick;
 } lpv_engine_item;
 

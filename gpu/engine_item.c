@@ -17,5 +17,7 @@ int lpv_engine_run_item(lpv_engine *e, const lpv_engine_item *it, char *err, siz
         return -1;
     if (it->recompute)
         lpv_engine_invalidate(e);
+    if (it->forget)
+        lpv_engine_forget(e);
     return it->tick ? lpv_engine_tick(e, err, err_size) : 0;
 }

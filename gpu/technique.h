@@ -158,6 +158,10 @@ struct lpv_technique_class {
     void (*plan)(const lpv_technique *t, const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *p);
     /* Runs the plan's technique passes on this tick's inputs. */
     int (*tick)(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size);
+    /* Optional: a technique whose volume carries light from tick to tick
+     * (the probes' hysteresis) drops it, so the next tick computes what a
+     * fresh engine would (lpv_engine_forget); NULL: nothing is carried. */
+    void (*forget)(lpv_technique *t);
     /* Binds what lookup_includes read for prog (in use). */
     void (*bind_lookup)(const lpv_technique *t, GLuint prog, float damping);
     /* Optional: 1 when lpv_irradiance_listed serves most pixels cheaply, so

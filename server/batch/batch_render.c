@@ -453,11 +453,17 @@ json_t *lpvd_batch_render_item(lpvd_batch_renderer *r, const lpvd_batch_item *it
     /* An item's image must not depend on the item before it: the planner
      * serves a cached volume when the camera moved less than a cell (the
      * daemon's trade), which here would keep the previous item's camera
-     * surfels; a new view recomputes, so every image is what `lpvd render`
-     * makes of its item alone (bench/batch_throughput.py checks it). */
+     * surfels; a new view recomputes, and no item inherits the probes'
+     * history (lpv_engine_forget), so every image is what `lpvd render`
+     * makes of its item alone (bench/batch_throughput.py and
+     * tests/batch/batch_cli.py check it). */
     const int new_view = !r->has_view || memcmp(&view, &r->last_view, sizeof view) != 0;
-    const lpv_engine_item item = {
-        .settings = &s, .scene = new_scene ? &given : NULL, .view = &view, .recompute = new_view, .tick = 1};
+    const lpv_engine_item item = {.settings = &s,
+                                  .scene = new_scene ? &given : NULL,
+                                  .view = &view,
+                                  .recompute = new_view,
+                                  .forget = 1,
+                                  .tick = 1};
     if (lpv_engine_run_item(r->engine, &item, err, sizeof err) != 0)
         goto done;
     r->engine_scene = it->scene;

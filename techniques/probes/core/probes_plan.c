@@ -27,10 +27,14 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
             lpv_plan_decide(p, (lpv_pass_id)i, 0, "the probes trace the scene's triangles (technique %s)",
                             LPV_TECHNIQUE_PROBES);
     const int fresh = !g || !g->history;
+    if (fresh && !p->recompute) { /* dropped (lpv_engine_forget) with nothing else changed */
+        p->recompute = 1;
+        snprintf(p->recompute_reason, sizeof p->recompute_reason, "no history");
+    }
     if (all)
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "planner off");
     else if (p->recompute || fresh)
-        lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute ? p->recompute_reason : "no history",
+        lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute_reason,
                         fresh ? "every probe, warmup passes" : "a budget of probes");
     else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed)) {
         p->recompute = 1;

@@ -497,6 +497,10 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
     return 0;
 }
 
+/* lpv_engine_forget: the next tick warms up from nothing, its rotations
+ * from the first, as a fresh engine's. */
+static void forget(lpv_technique *t) { ((lpv_probes_gpu *)t)->progress.history = 0; }
+
 static void bind_lookup(const lpv_technique *t, GLuint prog, float damping)
 {
     const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
@@ -606,6 +610,7 @@ const lpv_technique_class lpv_technique_probes = {
     .commit = commit,
     .plan = plan,
     .tick = tick,
+    .forget = forget,
     .bind_lookup = bind_lookup,
     .describe = describe,
     .read = read,

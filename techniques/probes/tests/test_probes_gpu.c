@@ -499,6 +499,39 @@ static void test_probes_follow_a_moved_light(void **state)
     lpv_scene_free(&back);
 }
 
+/* lpv_engine_forget: after ticks that carried light forward, the next tick
+ * is the first tick's again, bit for bit (a batch's items must not depend
+ * on the items before them), and says why it ran. */
+static void test_forget_gives_a_fresh_tick(void **state)
+{
+    (void)state;
+    const float b[3] = {1.5f, 1.3f, 1.5f};
+    lpv_settings st = probe_settings(4);
+    st.probes.warmup = 4;
+    st.probes.budget = 16;
+    lpv_scene room = {0};
+    grey_room(&room, 1.8f); /* not the last test's room: a new scene, so the first tick is a fresh one */
+    lpv_scene_add_point_light(&room, b, 40.0f);
+    lpv_scene_compute_bounds(&room);
+    run(&room, &st);
+    assert_non_null(strstr(lpv_engine_last_plan(lpvt_engine)->pass[LPV_PASS_PROBES].reason, "warmup passes"));
+    lpv_cell first[64], later[64];
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, first, 64), 64);
+    char err[512];
+    for (int i = 0; i < 8; ++i)
+        assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, later, 64), 64);
+    assert_memory_not_equal(first, later, sizeof first); /* the history changed the light */
+    lpv_engine_forget(lpvt_engine);
+    assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+    const lpv_plan *p = lpv_engine_last_plan(lpvt_engine);
+    assert_true(p->pass[LPV_PASS_PROBES].run);
+    assert_non_null(strstr(p->pass[LPV_PASS_PROBES].reason, "every probe, warmup passes"));
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, later, 64), 64);
+    assert_memory_equal(first, later, sizeof first);
+    lpv_scene_free(&room);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -508,6 +541,7 @@ int main(void)
         cmocka_unit_test(test_probes_relocate),
         cmocka_unit_test(test_lookup_matches_cpu_oracle),
         cmocka_unit_test(test_probes_follow_a_moved_light),
+        cmocka_unit_test(test_forget_gives_a_fresh_tick),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }
