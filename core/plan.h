@@ -81,9 +81,11 @@ typedef struct lpv_plan_facts {
 #define LPV_AUTO_IV_MAX_TRIANGLES 1000000 /* above: the imperfect volume's point cloud costs seconds per change */
 /* The imperfect volume's cubic voxels (the longest axis over iv_resolution)
  * must fit this many times across the scene's middle axis, else auto runs
- * the cascaded LPV, whose cascades follow a long scene's cross-section: the
+ * the probes, whose cascades follow a long scene's cross-section: the
  * 240 m tunnel's 15 m voxels over its 3.4 m width left iv the worst of the
- * three there (docs/accuracy.md, "Which technique by default (issue 30)"). */
+ * three there (docs/accuracy.md, "Which technique by default (issue 30)"),
+ * and the probes beat the cascaded LPV on the tunnels ("auto and the
+ * probes (issue 34)"). */
 #define LPV_AUTO_IV_MIN_VOXELS_ACROSS 2.0f
 
 typedef struct lpv_plan {

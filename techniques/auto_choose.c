@@ -18,13 +18,18 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
         return asked;
     }
     /* The rules follow the front of the accuracy set against converged light
-     * (docs/accuracy.md, "Which technique by default (issue 30)"): the
-     * imperfect volume is the most accurate on every scene whose cross-section
-     * its voxels resolve, the cascaded LPV the cheaper, and the better where
-     * they do not (a tunnel); the octree is best on none. */
+     * (docs/accuracy.md, "Which technique by default (issue 30)" and "auto
+     * and the probes (issue 34)"): the imperfect volume is the most accurate
+     * at the one tick a render computes on every scene whose cross-section
+     * its voxels resolve; the probes beat the cascaded LPV on all thirteen
+     * scenes, at the first tick and after, for about the LPV's tick once
+     * their first is done, so they are the cheap choice and the one where
+     * iv's voxels do not resolve the scene (a tunnel); the octree is best on
+     * none. */
     if (s->preset == LPV_PRESET_FAST) {
-        snprintf(why, n, "auto: preset fast asks for the cheapest technique, the cascaded LPV");
-        return LPV_TECHNIQUE_ID_LPV;
+        snprintf(why, n, "auto: preset fast: the probes, more accurate than the cascaded LPV on every scene of the "
+                         "accuracy set at about its tick");
+        return LPV_TECHNIQUE_ID_PROBES;
     }
     if (f && f->occluder_triangles > LPV_AUTO_IV_MAX_TRIANGLES) {
         snprintf(why, n, "auto: %zu triangles (over %d): the cascaded LPV; the imperfect volume's cloud takes seconds",
@@ -54,9 +59,9 @@ lpv_technique_id lpv_technique_choose(const lpv_settings *s, const lpv_plan_fact
         const float across = ext[1] / voxel;
         const char *whose = lit ? "lit space" : "scene";
         if (across < LPV_AUTO_IV_MIN_VOXELS_ACROSS) {
-            snprintf(why, n, "auto: the cascaded LPV: iv's %.3g m voxels (iv_resolution %d) fit %.2g times across the %s "
+            snprintf(why, n, "auto: the probes: iv's %.3g m voxels (iv_resolution %d) fit %.2g times across the %s "
                 "(%.3g m), under %.3g", voxel, res, across, whose, ext[1], LPV_AUTO_IV_MIN_VOXELS_ACROSS);
-            return LPV_TECHNIQUE_ID_LPV;
+            return LPV_TECHNIQUE_ID_PROBES;
         }
         snprintf(why, n, "auto: the imperfect volume: its %.3g m voxels fit %.3g times across the %s (%.3g m; preset %s)",
             voxel, across, whose, ext[1], lpv_preset_name(s->preset));

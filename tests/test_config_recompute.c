@@ -274,9 +274,10 @@ static void test_sampling_knob_resamples_without_upload(void **state)
     lpv_scene_free(&room);
 }
 
-/* auto's choice changing with a knob (the fast preset: the cascaded LPV) is a
- * change of technique: the scene is sampled again for the chosen one (iv
- * samples a point cloud, the LPV emissive VPLs and surfels), so the frame is
+/* auto's choice changing with a knob (the fast preset: the probes, the
+ * cascaded LPV before issue 34) is a change of technique: the scene is
+ * sampled again for the chosen one (iv samples a point cloud, the probes
+ * build their BVH, the LPV emissive VPLs and surfels), so the frame is
  * the one of the same settings on a scene uploaded afresh (issue 30: auto
  * being the default, `lpvd batch` items whose preset is fast after a scene
  * set under balanced read iv's samples with the LPV) */
@@ -293,7 +294,7 @@ static void test_auto_choice_change_resamples(void **state)
     s.preset = LPV_PRESET_FAST;
     settings(&s);
     const lpv_plan *p = tick();
-    assert_string_equal(p->technique, LPV_TECHNIQUE_LPV);
+    assert_string_equal(p->technique, LPV_TECHNIQUE_PROBES);
     assert_true(p->recompute);
     assert_int_equal(counters().scene_uploads, c0.scene_uploads);
     assert_int_equal(counters().scene_samplings, c0.scene_samplings + 1);
