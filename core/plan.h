@@ -100,6 +100,10 @@ typedef struct lpv_plan {
                                                count under half its longest axis, or the clamp cut) */
     int recompute;                          /* 0: the cached volume is served, no tick pass runs */
     char recompute_reason[LPV_PLAN_REASON_MAX];
+    int light_stale;                        /* set by a technique that carries light from tick to tick
+                                               (the probes): the scene, its lights or a knob that shapes
+                                               the volume changed, so what it carries is stale; not a
+                                               forced recompute, not a camera move */
     struct {
         int run;
         char reason[LPV_PLAN_REASON_MAX];   /* why it runs or why it is skipped */

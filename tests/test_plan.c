@@ -19,6 +19,7 @@
 #include "plan.h"
 #include "iv_rules.h"
 #include "lpv_rules.h"
+#include "probes_rules.h"
 #include "settings.h"
 
 static lpv_settings resolved(lpv_settings s)
@@ -699,6 +700,48 @@ static void test_iv_plan(void **state)
             assert_false(p.pass[i].run);
 }
 
+/* The probes' plan: light from earlier ticks goes stale (the hysteresis
+ * ramps, settling starts over) when the scene, its lights or a volume knob
+ * change, not when a caller forces a full tick (the benchmarks' every tick)
+ * or the camera alone moves; settled probes stop until something changes. */
+static void test_probes_plan_light_stale(void **state)
+{
+    (void)state;
+    const lpv_settings s = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_PROBES});
+    const lpv_probes_progress settled = {.history = 1, .sweeps = 1000, .changed = 0, .probes = 512};
+    lpv_plan p;
+    lpv_plan_facts f = steady();
+    lpv_plan_make_probes(&s, &f, &settled, &p);
+    assert_false(p.recompute);
+    assert_false(p.light_stale);
+    assert_false(p.pass[LPV_PASS_PROBES].run);
+    f.forced = 1;
+    lpv_plan_make_probes(&s, &f, &settled, &p);
+    assert_true(p.recompute);
+    assert_true(p.pass[LPV_PASS_PROBES].run);
+    assert_false(p.light_stale);
+    f = steady();
+    f.camera_move_cells = 3.0f;
+    lpv_plan_make_probes(&s, &f, &settled, &p);
+    assert_false(p.light_stale);
+    f = steady();
+    f.lights_changed = 1;
+    lpv_plan_make_probes(&s, &f, &settled, &p);
+    assert_true(p.light_stale);
+    assert_true(p.pass[LPV_PASS_PROBES].run);
+    f = steady();
+    f.settings_changed = 1;
+    lpv_plan_make_probes(&s, &f, &settled, &p);
+    assert_true(p.light_stale);
+    /* no history (lpv_engine_forget): a warmup, whatever else changed */
+    const lpv_probes_progress none = {0};
+    f = steady();
+    lpv_plan_make_probes(&s, &f, &none, &p);
+    assert_true(p.recompute);
+    assert_string_equal(p.recompute_reason, "no history");
+    assert_non_null(strstr(p.pass[LPV_PASS_PROBES].reason, "warmup passes"));
+}
+
 /* Technique auto: the planner's choice, with its reason; any other request is kept. */
 static void test_technique_choose(void **state)
 {
@@ -827,6 +870,7 @@ int main(void)
         cmocka_unit_test(test_iv_plan),
         cmocka_unit_test(test_technique_choose),
         cmocka_unit_test(test_technique_auto_never_the_worst),
+        cmocka_unit_test(test_probes_plan_light_stale),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -26,6 +26,7 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
         if (i != LPV_PASS_GLOSSY && i != LPV_PASS_MEDIA && i != LPV_PASS_TRANSLUCENT)
             lpv_plan_decide(p, (lpv_pass_id)i, 0, "the probes trace the scene's triangles (technique %s)",
                             LPV_TECHNIQUE_PROBES);
+    p->light_stale = f->first_tick || f->scene_changed || f->lights_changed || f->settings_changed;
     const int fresh = !g || !g->history;
     if (fresh && !p->recompute) { /* dropped (lpv_engine_forget) with nothing else changed */
         p->recompute = 1;

@@ -27,7 +27,8 @@
  * after the last change for the light from before it to weigh at most this
  * (the product of the sweeps' hysteresis, lpv_probes_settle_sweeps). */
 #define LPV_PROBES_SETTLE_RESIDUE 0.01
-/* The plan's recompute reason while they settle (the tick tells it from a change). */
+/* The plan's recompute reason while they settle (the tick tells a change
+ * by the plan's light_stale, not by the reason). */
 #define LPV_PROBES_SETTLE_REASON "the probes settle"
 
 /* The state the plan reads from the technique (the GPU class keeps it). */

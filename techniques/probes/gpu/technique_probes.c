@@ -479,8 +479,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         g->progress.sweeps = 0;
         g->progress.changed = 0;
     } else {
-        if (p->recompute && strncmp(p->recompute_reason, LPV_PROBES_SETTLE_REASON,
-                                    sizeof LPV_PROBES_SETTLE_REASON - 1) != 0) {
+        if (p->light_stale) {
             g->progress.sweeps = 0; /* a change: settle again, forgetting the old light faster */
             g->progress.changed = 1;
         }
