@@ -187,9 +187,12 @@ int acc_parse_args(acc_args *a, int argc, char **argv)
         case A_WARMUP: {
             char *end = NULL;
             long x = strtol(v, &end, 10);
-            if (!end || *end || x < (id == A_WARMUP ? 0 : 1) ||
-                x > (id == A_REF_SPP || id == A_CONV_SPP ? 1000000 : MAX_TICKS)) {
-                fprintf(stderr, "lpvd-accuracy: bad value for --%s: %s\n", fl->name, v);
+            /* warmup ticks are not kept (a large probe grid settles in 1000s); timed ones are */
+            const long lo = id == A_WARMUP ? 0 : 1,
+                       hi = id == A_REF_SPP || id == A_CONV_SPP ? 1000000 : id == A_WARMUP ? 100000 : MAX_TICKS;
+            if (!end || *end || x < lo || x > hi) {
+                fprintf(stderr, "lpvd-accuracy: bad value for --%s: %s (an integer in %ld..%ld)\n", fl->name, v, lo,
+                        hi);
                 return 2;
             }
             if (id == A_REF_SPP)
