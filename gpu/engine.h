@@ -200,8 +200,9 @@ void lpv_engine_forget(lpv_engine *e);
  * will be ticked with), then, when tick is set, one tick. recompute: the tick
  * recomputes even when the planner would serve the cached volume
  * (lpv_engine_invalidate); forget: the technique's history is dropped
- * first, so the tick is a fresh engine's (lpv_engine_forget). What an item outputs (a frame, a volume, points'
- * irradiance) is the caller's: each program wants different ones. */
+ * first, so the tick is a fresh engine's (lpv_engine_forget). What an
+ * item outputs (a frame, a volume, points' irradiance) is the caller's:
+ * each program wants different ones. */
 typedef struct lpv_engine_item {
     const lpv_settings *settings;
     const lpv_scene *scene;

@@ -34,7 +34,7 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
     }
     if (all)
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "planner off");
-    else if (p->recompute || fresh)
+    else if (p->recompute) /* also with no history: set above */
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute_reason,
                         fresh ? "every probe, warmup passes" : "a budget of probes");
     else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed)) {
