@@ -54,6 +54,11 @@ float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g)
     return hysteresis * (1.0f - powf(LPV_PROBES_CHANGE_RAMP, (float)(g->sweeps + 1)));
 }
 
+int lpv_probes_change_test_on(const lpv_probes_progress *g)
+{
+    return g && g->changed && g->sweeps < LPV_PROBES_CHANGE_TEST_SWEEPS;
+}
+
 int lpv_probes_settle_sweeps(float hysteresis, int changed)
 {
     if (!(hysteresis > 0.0f) || !(hysteresis < 1.0f))

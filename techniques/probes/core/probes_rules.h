@@ -48,6 +48,16 @@ typedef struct lpv_probes_progress {
 #define LPV_PROBES_CHANGE_RAMP 0.5f
 float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g);
 
+/* Whether the blend's per-probe change test (probes_blend.comp) runs: only
+ * in the first LPV_PROBES_CHANGE_TEST_SWEEPS sweeps after a change, to
+ * follow it fast. Not after a warmup nor once the light has been still that
+ * long: it resets a probe toward any batch far from its old value, by ratio
+ * either way, which tracks a skewed radiance (a few rays through the blinds'
+ * slats) in the log and settles it dark (blinds at 32^3: bias -0.27 after
+ * five sweeps with the test always on, docs/accuracy.md). */
+#define LPV_PROBES_CHANGE_TEST_SWEEPS 4
+int lpv_probes_change_test_on(const lpv_probes_progress *g);
+
 /* The probes' plan: the shared producers (none but the frame's: the light
  * block comes with every tick) and their pass, which runs on a change and
  * until the probes settled. */

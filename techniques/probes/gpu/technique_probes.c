@@ -418,6 +418,7 @@ static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t f
     set_batch(g->prog_blend, first, batch, g->probes, ps->rays);
     glUniform1i(glGetUniformLocation(g->prog_blend, "u_oct"), g->oct);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_hysteresis"), hysteresis);
+    glUniform1i(glGetUniformLocation(g->prog_blend, "u_change_test"), lpv_probes_change_test_on(&g->progress));
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_hysteresis"), moment_hysteresis);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_cells"), LPV_PROBES_MOMENT_CELLS);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_backface_off"), LPV_PROBES_BACKFACE_OFF);

@@ -9,9 +9,10 @@
 // back face, which turns the probe off past a threshold, and on a fresh
 // volume's first pass moves probes out of geometry and off surfaces
 // (relocation; the next passes trace from where they moved to). The light is
-// blended into the probe's old value with the hysteresis, lowered where the
-// light changed by much, or by more than the batch's noise explains
-// (Majercik et al. 2021: fast where light changed, slow where it is noise); the distances with their own weight (a running
+// blended into the probe's old value with the hysteresis, lowered in the
+// first sweeps after a change where the light changed by much, or by more
+// than the batch's noise explains (Majercik et al. 2021: fast where light
+// changed, slow where it is noise; lpv_probes_change_test_on); the distances with their own weight (a running
 // mean over the warmup's passes, then the hysteresis: only geometry moves
 // them, and a new scene starts the probes afresh). probes_update.c is the CPU oracle of the statistics.
 layout(local_size_x = LPV_PROBES_WG) in;
@@ -27,6 +28,7 @@ layout(std430, binding = LPV_SSBO_PROBES_IRRADIANCE) buffer ProbesIrradiance { f
 uniform uint u_first, u_batch, u_total, u_rays;
 uniform int u_oct;
 uniform float u_hysteresis;    // 0: the rays replace the old value
+uniform int u_change_test;     // 1: lower it where the light changed (the first sweeps after a change only)
 uniform float u_moment_hysteresis; // the same for the distances, which only moving geometry changes
 uniform float u_moment_cells;  // the moments clamp distances at this many of the probe's cells
 uniform float u_backface_off;  // a probe whose share of back faces exceeds it is off
@@ -71,7 +73,7 @@ void main()
     b *= w;
     LpvCell old = probes_sh[probe];
     float h = u_hysteresis;
-    if (h > 0.0) {
+    if (h > 0.0 && u_change_test != 0) {
         // band 0 is w C0 x the sum of the rays' radiance: its change against
         // the old value, relative (over half of it) and in standard errors of
         // this batch's estimate (the rays' sample variance): a change the
