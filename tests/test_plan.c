@@ -733,6 +733,16 @@ static void test_probes_plan_light_stale(void **state)
     f.settings_changed = 1;
     lpv_plan_make_probes(&s, &f, &settled, &p);
     assert_true(p.light_stale);
+    /* the blend's change test: only in the first sweeps after a change,
+     * never after a warmup nor once the light has been still (always on, it
+     * settled the blinds room dark, docs/accuracy.md "The probes") */
+    lpv_probes_progress g = {.history = 1, .sweeps = 0, .changed = 0, .probes = 512};
+    assert_false(lpv_probes_change_test_on(&g));
+    g.changed = 1;
+    for (g.sweeps = 0; g.sweeps < LPV_PROBES_CHANGE_TEST_SWEEPS; ++g.sweeps)
+        assert_true(lpv_probes_change_test_on(&g));
+    assert_false(lpv_probes_change_test_on(&g));
+    assert_true(LPV_PROBES_CHANGE_TEST_SWEEPS < lpv_probes_settle_sweeps(0.9f, 1)); /* the settled sweeps average */
     /* no history (lpv_engine_forget): a warmup, whatever else changed */
     const lpv_probes_progress none = {0};
     f = steady();
