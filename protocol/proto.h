@@ -22,6 +22,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 #include <jansson.h>
 
 #ifdef __cplusplus
@@ -409,6 +410,24 @@ static inline uint32_t lpvp_get_u32(const uint8_t *p)
 {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
            ((uint32_t)p[3] << 24);
+}
+/* 1 when the host stores numbers as the wire does (R1.3): a raw volume's
+ * bytes are then its floats in memory. */
+static inline int lpvp_host_little_endian(void)
+{
+    const uint16_t one = 1;
+    uint8_t b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+static inline void lpvp_put_u64(uint8_t *p, uint64_t v)
+{
+    lpvp_put_u32(p, (uint32_t)v);
+    lpvp_put_u32(p + 4, (uint32_t)(v >> 32));
+}
+static inline uint64_t lpvp_get_u64(const uint8_t *p)
+{
+    return (uint64_t)lpvp_get_u32(p) | ((uint64_t)lpvp_get_u32(p + 4) << 32);
 }
 
 #ifdef __cplusplus

@@ -49,13 +49,14 @@ typedef enum lpvp_volume_format {
 
 typedef enum lpvp_compression {
     LPVP_COMP_NONE = 0, /* "none" */
-    LPVP_COMP_ZSTD = 1  /* "zstd" (R5.2) */
+    LPVP_COMP_ZSTD = 1, /* "zstd" (R5.2) */
+    LPVP_COMP_SHQ = 2   /* "shq": quantised SH to an error bound, format fp32 (R5.16) */
 } lpvp_compression;
 
 /* The SPEC's names, indexed by the enums above (lpvp_get_enum takes them as its
- * choices): "fp16", "fp32"; "none", "zstd". */
+ * choices): "fp16", "fp32"; "none", "zstd", "shq". */
 extern const char *const lpvp_volume_format_names[2];
-extern const char *const lpvp_compression_names[2];
+extern const char *const lpvp_compression_names[3];
 
 /* Frame terms and formats (SPEC section 6). The terms' order is the engine's
  * lpv_frame_terms (full, indirect only, direct only). */
@@ -145,6 +146,45 @@ int lpvp_zstd_decompress(const void *src, size_t n, size_t max_out, uint8_t **ou
  * (e.g. the header's raw_length); returns 0 or -1 with err set. */
 int lpvp_zstd_decompress_exact(const void *src, size_t n, void *dst, size_t expect, char *err,
                                size_t err_n);
+
+/* ---- Quantised SH, "shq" (R5.16) ------------------------------------------ */
+
+/* The client's error bound (SUBSCRIBE / GET_VOLUME "error_bound", echoed in
+ * the header): the largest change of a cell's lookup E_c(n), any normal n,
+ * any channel c, as a fraction of the cell's magnitude
+ * (lpvp_shq_cell_magnitude). */
+#define LPVP_SHQ_BOUND_KEY "error_bound"
+#define LPVP_SHQ_BOUND_MIN 0.001
+#define LPVP_SHQ_BOUND_MAX 0.25
+#define LPVP_SHQ_BOUND_DEFAULT 0.01
+
+/* A cell's magnitude: max over channels of LOBE0 |c0| + LOBE1 |(c1, c2, c3)|,
+ * the largest |E_c(n)| of R5.7's cosine-lobe lookup over all normals (in
+ * the lookup's units before its 1 / cell_size^2). */
+double lpvp_shq_cell_magnitude(const float v[LPVP_VALUES_PER_CELL]);
+
+/* The largest |E_c(n)| of the difference of two cells, over all normals and
+ * channels: what a client's lookup at the cell moves by from a to b. */
+double lpvp_shq_cell_error(const float a[LPVP_VALUES_PER_CELL], const float b[LPVP_VALUES_PER_CELL]);
+
+/* Encodes raw (a raw fp32 volume of raw_len bytes: `cells` cells of R5.1's
+ * 12 values, then any bytes that follow them, e.g. an index) as one zstd
+ * frame in a malloc'd *out. base NULL: a keyframe, every cell quantised.
+ * base (the client's volume, raw_len bytes): a delta that re-sends only the
+ * cells whose base is off raw's by more than bound x the cell's magnitude
+ * (lpvp_shq_cell_error). recon (raw_len bytes; may be base) gets the
+ * volume the client rebuilds. *sent: the cells sent (0 on a delta: nothing
+ * changed beyond the bound). NaN is sent as 0, values beyond +-1e30 clamp.
+ * Returns 0, or -1 with err set (bound outside its range, no memory). */
+int lpvp_shq_encode(const uint8_t *raw, size_t raw_len, size_t cells, const uint8_t *base, double bound,
+                    uint8_t *recon, uint8_t **out, size_t *out_len, size_t *sent, char *err, size_t err_n);
+
+/* The inverse into raw_out (raw_len bytes; may equal base, a delta's base
+ * of raw_len bytes; NULL for a keyframe). Checks every count against
+ * cells and raw_len. *sent (may be NULL): the cells the message carried.
+ * Returns 0 or -1 with err set. */
+int lpvp_shq_decode(const void *att, size_t att_len, size_t raw_len, size_t cells, const uint8_t *base,
+                    uint8_t *raw_out, size_t *sent, char *err, size_t err_n);
 
 /* ---- Volume header JSON (SPEC section 5) ---------------------------------- */
 
@@ -280,6 +320,7 @@ typedef struct lpvp_volume_info {
     lpvp_compression compression;
     int keyframe;                /* 1: raw is the volume; 0: XOR delta vs base_tick (R5.3) */
     int64_t base_tick;           /* meaningful when keyframe == 0; -1 when absent */
+    double error_bound;          /* compression LPVP_COMP_SHQ: the bound the message holds (R5.16) */
     int64_t dims[3];             /* cells per axis, each >= 1 */
     double origin[3];            /* m, lower corner */
     double cell_size;            /* m, > 0 */

@@ -153,6 +153,8 @@ json_t *lpvp_volume_header_build(const lpvp_volume_info *vi)
         bad |= json_object_set_new(o, "compression",
                                    json_string(lpvp_compression_name(vi->compression))) != 0;
         bad |= json_object_set_new(o, "keyframe", json_boolean(vi->keyframe)) != 0;
+        if (vi->compression == LPVP_COMP_SHQ) /* R5.16 */
+            bad |= json_object_set_new(o, LPVP_SHQ_BOUND_KEY, json_real(vi->error_bound)) != 0;
         if (!vi->keyframe)
             bad |= json_object_set_new(o, "base_tick", json_integer(vi->base_tick)) != 0;
         bad |= json_object_set_new(o, "grid", grid) != 0;

@@ -608,8 +608,23 @@ int lpvp_volume_header_parse(const json_t *obj, lpvp_volume_info *vi, char *err,
     }
     if (lpvp_compression_parse(json_string_value(json_object_get(obj, "compression")),
                                &vi->compression) != 0) {
-        lpvp_set_error(err, err_n, "compression: expected \"zstd\" or \"none\"");
+        lpvp_set_error(err, err_n, "compression: expected \"zstd\", \"shq\" or \"none\"");
         return -1;
+    }
+    if (vi->compression == LPVP_COMP_SHQ) { /* R5.16 */
+        if (vi->format != LPVP_FMT_FP32) {
+            lpvp_set_error(err, err_n, "format: \"shq\" decodes to \"fp32\", the header says \"%s\"",
+                           lpvp_volume_format_name(vi->format));
+            return -1;
+        }
+        v = json_object_get(obj, LPVP_SHQ_BOUND_KEY);
+        if (!json_is_number(v) || !(json_number_value(v) >= LPVP_SHQ_BOUND_MIN) ||
+            !(json_number_value(v) <= LPVP_SHQ_BOUND_MAX)) {
+            lpvp_set_error(err, err_n, "%s: expected a number in %g..%g with compression \"shq\"",
+                           LPVP_SHQ_BOUND_KEY, LPVP_SHQ_BOUND_MIN, LPVP_SHQ_BOUND_MAX);
+            return -1;
+        }
+        vi->error_bound = json_number_value(v);
     }
     v = json_object_get(obj, "keyframe");
     if (!json_is_boolean(v)) {
@@ -702,6 +717,17 @@ int lpvp_volume_decode(const lpvp_volume_info *vi, const void *attachment, size_
         lpvp_set_error(err, err_n, "delta against tick %lld without a base volume of %zu bytes",
                 (long long)vi->base_tick, raw_len);
         return -1;
+    }
+    if (vi->compression == LPVP_COMP_SHQ) { /* R5.16: the levels' SH values quantised, then the rest */
+        uint64_t values = lpvp_volume_values_bytes(vi);
+        int vpc = vi->layout.present ? vi->layout.values_per_cell : LPVP_VALUES_PER_CELL;
+        if (vpc != LPVP_VALUES_PER_CELL || vi->format != LPVP_FMT_FP32 || values > raw_len) {
+            lpvp_set_error(err, err_n, "shq carries R5.1's %d fp32 values per cell; the header has %d in %s",
+                           LPVP_VALUES_PER_CELL, vpc, lpvp_volume_format_name(vi->format));
+            return -1;
+        }
+        return lpvp_shq_decode(attachment, att_len, raw_len, (size_t)(values / (LPVP_VALUES_PER_CELL * 4)),
+                               vi->keyframe ? NULL : base_raw, raw_out, NULL, err, err_n);
     }
     if (vi->compression == LPVP_COMP_ZSTD) {
         if (!vi->keyframe && raw_out == base_raw) {

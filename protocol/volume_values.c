@@ -85,7 +85,8 @@ float lpvp_f16_to_f32(uint16_t h)
 /* ---- Names ---------------------------------------------------------------- */
 
 const char *const lpvp_volume_format_names[2] = {[LPVP_FMT_FP16] = "fp16", [LPVP_FMT_FP32] = "fp32"};
-const char *const lpvp_compression_names[2] = {[LPVP_COMP_NONE] = "none", [LPVP_COMP_ZSTD] = "zstd"};
+const char *const lpvp_compression_names[3] = {[LPVP_COMP_NONE] = "none", [LPVP_COMP_ZSTD] = "zstd",
+                                               [LPVP_COMP_SHQ] = "shq"};
 const char *const lpvp_frame_terms_names[LPVP_TERMS_COUNT] = {
     [LPVP_TERMS_FULL] = "full", [LPVP_TERMS_INDIRECT] = "indirect", [LPVP_TERMS_DIRECT] = "direct",
     [LPVP_TERMS_AO] = "ao"};
@@ -119,12 +120,12 @@ int lpvp_volume_format_parse(const char *s, lpvp_volume_format *out)
 
 const char *lpvp_compression_name(lpvp_compression c)
 {
-    return lpvp_compression_names[c == LPVP_COMP_ZSTD ? LPVP_COMP_ZSTD : LPVP_COMP_NONE];
+    return lpvp_compression_names[c == LPVP_COMP_ZSTD || c == LPVP_COMP_SHQ ? c : LPVP_COMP_NONE];
 }
 
 int lpvp_compression_parse(const char *s, lpvp_compression *out)
 {
-    int i = name_index(lpvp_compression_names, 2, s);
+    int i = name_index(lpvp_compression_names, 3, s);
     if (i < 0)
         return -1;
     *out = (lpvp_compression)i;

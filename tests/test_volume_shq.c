@@ -1,0 +1,350 @@
+/*
+ * test_volume_shq.c - the "shq" volume codec (protocol/volume_shq.c, SPEC
+ * R5.16): the bound held on every cell of keyframes and of a chain of
+ * deltas, unchanged cells cost nothing, a static volume sends no cell, the
+ * bytes after the values travel exactly, hostile values stay finite, and
+ * the decoder refuses every malformed payload the SPEC names.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "proto.h"
+#include "volume_codec.h"
+
+#define CELL_BYTES (LPVP_VALUES_PER_CELL * 4)
+
+static uint64_t rng = 0x9E3779B97F4A7C15ull;
+static double uniform(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+/* A physically shaped cell: a non-negative lobe of each channel (|v| <= c0
+ * sqrt(3)), scaled over many decades so every exponent range is tried. */
+static void make_cell(float v[LPVP_VALUES_PER_CELL], double scale)
+{
+    for (int c = 0; c < 3; ++c) {
+        double c0 = scale * (0.2 + uniform());
+        v[4 * c] = (float)c0;
+        for (int k = 1; k < 4; ++k)
+            v[4 * c + k] = (float)(c0 * (uniform() * 2.0 - 1.0));
+    }
+}
+
+static void get_cell(const uint8_t *raw, size_t i, float v[LPVP_VALUES_PER_CELL])
+{
+    for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k) {
+        uint32_t u = lpvp_get_u32(raw + i * CELL_BYTES + 4 * (size_t)k);
+        memcpy(&v[k], &u, 4);
+    }
+}
+
+static void put_cell(uint8_t *raw, size_t i, const float v[LPVP_VALUES_PER_CELL])
+{
+    for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k) {
+        uint32_t u;
+        memcpy(&u, &v[k], 4);
+        lpvp_put_u32(raw + i * CELL_BYTES + 4 * (size_t)k, u);
+    }
+}
+
+/* The largest D(held, exact) / M(exact) over the cells (0 for equal zero cells). */
+static double worst_ratio(const uint8_t *held, const uint8_t *exact, size_t cells)
+{
+    double worst = 0.0;
+    for (size_t i = 0; i < cells; ++i) {
+        float a[LPVP_VALUES_PER_CELL], b[LPVP_VALUES_PER_CELL];
+        get_cell(held, i, a);
+        get_cell(exact, i, b);
+        double d = lpvp_shq_cell_error(a, b), m = lpvp_shq_cell_magnitude(b);
+        double r = m > 0.0 ? d / m : (d > 0.0 ? INFINITY : 0.0);
+        worst = r > worst ? r : worst;
+    }
+    return worst;
+}
+
+/* Encode, decode (in place on the client's copy), check both sides agree. */
+static size_t round_trip(const uint8_t *raw, size_t len, size_t cells, uint8_t *server_held, uint8_t *client,
+                         int delta, double bound)
+{
+    char err[256];
+    uint8_t *att = NULL, *recon = malloc(len);
+    size_t att_len = 0, sent = 9999, got = 7777;
+    assert_non_null(recon);
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, delta ? server_held : NULL, bound, recon, &att, &att_len, &sent,
+                                     err, sizeof err),
+                     0);
+    assert_int_equal(lpvp_shq_decode(att, att_len, len, cells, delta ? client : NULL, client, &got, err, sizeof err), 0);
+    assert_int_equal(got, sent);
+    assert_memory_equal(recon, client, len); /* the server knows what the client holds, bit for bit */
+    memcpy(server_held, recon, len);
+    free(recon);
+    free(att);
+    return sent;
+}
+
+static void test_keyframe_holds_the_bound(void **state)
+{
+    (void)state;
+    const size_t cells = 4096;
+    const double bounds[] = {LPVP_SHQ_BOUND_MIN, 0.01, 0.1, LPVP_SHQ_BOUND_MAX};
+    uint8_t *raw = malloc(cells * CELL_BYTES), *held = malloc(cells * CELL_BYTES), *client = malloc(cells * CELL_BYTES);
+    for (size_t i = 0; i < cells; ++i) {
+        float v[LPVP_VALUES_PER_CELL];
+        make_cell(v, pow(10.0, -25.0 + 50.0 * uniform()));
+        put_cell(raw, i, v);
+    }
+    for (size_t b = 0; b < sizeof bounds / sizeof bounds[0]; ++b) {
+        assert_int_equal(round_trip(raw, cells * CELL_BYTES, cells, held, client, 0, bounds[b]), cells);
+        double worst = worst_ratio(client, raw, cells);
+        assert_true(worst <= bounds[b] * (1.0 + 1e-6)); /* rounding spends a share of the bound */
+        assert_true(worst > bounds[b] * 0.05); /* and it is a quantisation, not a copy */
+    }
+    free(raw);
+    free(held);
+    free(client);
+}
+
+/* A light that keeps moving: each step changes every cell a little and a
+ * few cells a lot; every delta holds the bound on every cell, unchanged
+ * cells are not re-sent, and the drift is caught before it passes the bound. */
+static void test_deltas_hold_the_bound(void **state)
+{
+    (void)state;
+    const size_t cells = 2048;
+    const double bound = 0.01;
+    uint8_t *raw = malloc(cells * CELL_BYTES), *held = malloc(cells * CELL_BYTES), *client = malloc(cells * CELL_BYTES);
+    for (size_t i = 0; i < cells; ++i) {
+        float v[LPVP_VALUES_PER_CELL];
+        make_cell(v, 1.0 + 10.0 * uniform());
+        put_cell(raw, i, v);
+    }
+    round_trip(raw, cells * CELL_BYTES, cells, held, client, 0, bound);
+    size_t total = 0;
+    for (int step = 0; step < 40; ++step) {
+        for (size_t i = 0; i < cells; ++i) {
+            float v[LPVP_VALUES_PER_CELL];
+            get_cell(raw, i, v);
+            double f = (i % 97 == (size_t)step) ? 1.5 : 1.0 + 0.002 * (uniform() - 0.3); /* a slow drift up */
+            for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k)
+                v[k] = (float)(v[k] * f);
+            put_cell(raw, i, v);
+        }
+        size_t sent = round_trip(raw, cells * CELL_BYTES, cells, held, client, 1, bound);
+        total += sent;
+        assert_true(worst_ratio(client, raw, cells) <= bound * (1.0 + 1e-6));
+        assert_true(sent < cells / 2); /* most cells stand */
+    }
+    /* the 1.5x cells are re-sent each time they jump (about 21 per step) and the drift
+     * re-sends the rest every few steps; far fewer than 40 keyframes */
+    assert_true(total > 40 * 21);
+    assert_true(total < 40 * cells / 4);
+    free(raw);
+    free(held);
+    free(client);
+}
+
+static void test_static_volume_sends_nothing(void **state)
+{
+    (void)state;
+    const size_t cells = 1000, extra = 37, len = cells * CELL_BYTES + extra;
+    uint8_t *raw = malloc(len), *held = malloc(len), *client = malloc(len);
+    for (size_t i = 0; i < cells; ++i) {
+        float v[LPVP_VALUES_PER_CELL];
+        make_cell(v, (i % 3) ? 1.0 : 0.0); /* a third of the cells black */
+        put_cell(raw, i, v);
+    }
+    for (size_t i = 0; i < extra; ++i)
+        raw[cells * CELL_BYTES + i] = (uint8_t)(i * 7 + 1);
+    round_trip(raw, len, cells, held, client, 0, 0.01);
+    assert_memory_equal(client + cells * CELL_BYTES, raw + cells * CELL_BYTES, extra); /* the index exactly */
+    for (int step = 0; step < 3; ++step)
+        assert_int_equal(round_trip(raw, len, cells, held, client, 1, 0.01), 0);
+    raw[cells * CELL_BYTES + 5] ^= 0x40; /* the index changed: it travels, exactly */
+    assert_int_equal(round_trip(raw, len, cells, held, client, 1, 0.01), 0);
+    assert_memory_equal(client + cells * CELL_BYTES, raw + cells * CELL_BYTES, extra);
+    /* a black cell lit, a lit cell black: both re-sent */
+    float v[LPVP_VALUES_PER_CELL], z[LPVP_VALUES_PER_CELL] = {0};
+    make_cell(v, 1.0);
+    put_cell(raw, 0, v);
+    put_cell(raw, 1, z);
+    assert_int_equal(round_trip(raw, len, cells, held, client, 1, 0.01), 2);
+    assert_true(worst_ratio(client, raw, cells) <= 0.01);
+    free(raw);
+    free(held);
+    free(client);
+}
+
+/* NaN, Inf, huge and subnormal values decode finite, and the bound holds
+ * wherever the cell is in the codec's range. */
+static void test_hostile_values(void **state)
+{
+    (void)state;
+    const size_t cells = 4, len = cells * CELL_BYTES;
+    uint8_t raw[4 * CELL_BYTES], held[4 * CELL_BYTES], client[4 * CELL_BYTES];
+    float v[4][LPVP_VALUES_PER_CELL];
+    for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k) {
+        v[0][k] = k == 3 ? NAN : 1.0f;
+        v[1][k] = k == 0 ? INFINITY : (k == 5 ? -INFINITY : 2.0f);
+        v[2][k] = k % 4 == 0 ? FLT_MAX : 0.0f;
+        v[3][k] = k % 4 == 0 ? 1e-40f : 0.0f; /* subnormal: below the codec's 1e-30, sent as zero */
+    }
+    for (size_t i = 0; i < cells; ++i)
+        put_cell(raw, i, v[i]);
+    round_trip(raw, len, cells, held, client, 0, 0.01);
+    for (size_t i = 0; i < cells; ++i) {
+        float a[LPVP_VALUES_PER_CELL];
+        get_cell(client, i, a);
+        for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k)
+            assert_true(isfinite(a[k]));
+        if (i == 3)
+            for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k)
+                assert_true(a[k] == 0.0f);
+    }
+    float a[LPVP_VALUES_PER_CELL];
+    get_cell(client, 0, a);
+    assert_true(fabsf(a[3]) < 0.02f && fabsf(a[0] - 1.0f) < 0.02f); /* NaN went as 0 */
+    get_cell(client, 2, a);
+    assert_true(a[0] > 0.99e30f && a[0] < 1.01e30f); /* clamped to 1e30 */
+}
+
+static void test_bad_bound_and_payloads(void **state)
+{
+    (void)state;
+    char err[256];
+    const size_t cells = 20, len = cells * CELL_BYTES;
+    uint8_t raw[20 * CELL_BYTES], held[20 * CELL_BYTES], client[20 * CELL_BYTES];
+    for (size_t i = 0; i < cells; ++i) {
+        float v[LPVP_VALUES_PER_CELL];
+        make_cell(v, 1.0);
+        put_cell(raw, i, v);
+    }
+    uint8_t *att = NULL;
+    size_t att_len = 0, sent = 0;
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, NULL, 0.0005, held, &att, &att_len, &sent, err, sizeof err), -1);
+    assert_non_null(strstr(err, LPVP_SHQ_BOUND_KEY));
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, NULL, NAN, held, &att, &att_len, &sent, err, sizeof err), -1);
+
+    /* a good delta's payload, then each field broken in turn */
+    round_trip(raw, len, cells, held, client, 0, 0.01);
+    float v[LPVP_VALUES_PER_CELL];
+    make_cell(v, 3.0);
+    put_cell(raw, 3, v);
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, held, 0.01, held, &att, &att_len, &sent, err, sizeof err), 0);
+    assert_int_equal(sent, 1);
+    uint8_t *p = NULL;
+    size_t plen = 0;
+    assert_int_equal(lpvp_zstd_decompress(att, att_len, 1 << 20, &p, &plen, err, sizeof err), 0);
+    free(att);
+    struct {
+        size_t at;
+        uint8_t value;
+        const char *what;
+    } breaks[] = {
+        {0, 'X', "magic"},        {4, 2, "flags"},           {8, 21, "cell count"}, {16, 2, "sent count"},
+        {24, 1, "extra bytes"},  {32, 0x09, "bit map count"}, {34, 0x80, "bit past C"}, {36, 2, "mode"},
+    };
+    for (size_t b = 0; b < sizeof breaks / sizeof breaks[0]; ++b) {
+        uint8_t *q = malloc(plen);
+        memcpy(q, p, plen);
+        q[breaks[b].at] = breaks[b].value;
+        uint8_t *z = NULL;
+        size_t zlen = 0;
+        assert_int_equal(lpvp_zstd_compress(q, plen, 1, &z, &zlen, err, sizeof err), 0);
+        memcpy(client + len - CELL_BYTES, held + len - CELL_BYTES, CELL_BYTES);
+        err[0] = 0;
+        int rc = lpvp_shq_decode(z, zlen, len, cells, client, client, NULL, err, sizeof err);
+        if (rc == 0)
+            print_error("accepted a payload with a broken %s\n", breaks[b].what);
+        assert_int_equal(rc, -1);
+        assert_true(strlen(err) > 0);
+        free(z);
+        free(q);
+    }
+    /* truncated and lengthened payloads */
+    for (int d = -1; d <= 1; d += 2) {
+        uint8_t *q = calloc(plen + 1, 1);
+        memcpy(q, p, plen);
+        uint8_t *z = NULL;
+        size_t zlen = 0;
+        assert_int_equal(lpvp_zstd_compress(q, plen + (size_t)d, 1, &z, &zlen, err, sizeof err), 0);
+        assert_int_equal(lpvp_shq_decode(z, zlen, len, cells, client, client, NULL, err, sizeof err), -1);
+        free(z);
+        free(q);
+    }
+    /* a delta without a base, a payload for another size, and not zstd at all */
+    uint8_t *z = NULL;
+    size_t zlen = 0;
+    assert_int_equal(lpvp_zstd_compress(p, plen, 1, &z, &zlen, err, sizeof err), 0);
+    assert_int_equal(lpvp_shq_decode(z, zlen, len, cells, NULL, client, NULL, err, sizeof err), -1);
+    assert_int_equal(lpvp_shq_decode(z, zlen, len - CELL_BYTES, cells - 1, client, client, NULL, err, sizeof err), -1);
+    assert_int_equal(lpvp_shq_decode(p, plen, len, cells, client, client, NULL, err, sizeof err), -1);
+    assert_int_equal(lpvp_shq_decode(z, zlen, len, cells, client, client, NULL, err, sizeof err), 0); /* intact */
+    free(z);
+    free(p);
+}
+
+/* The header: "shq" needs fp32 and a bound in range; decode goes through it. */
+static void test_header(void **state)
+{
+    (void)state;
+    char err[256];
+    const size_t cells = 8;
+    lpvp_volume_info vi = {.revision = 1, .tick = 2, .format = LPVP_FMT_FP32, .compression = LPVP_COMP_SHQ,
+                           .error_bound = 0.02, .keyframe = 1, .base_tick = -1, .dims = {2, 2, 2},
+                           .cell_size = 0.5, .raw_length = cells * CELL_BYTES};
+    json_t *h = lpvp_volume_header_build(&vi);
+    assert_non_null(h);
+    assert_string_equal(json_string_value(json_object_get(h, "compression")), "shq");
+    lpvp_volume_info back;
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), 0);
+    assert_int_equal(back.compression, LPVP_COMP_SHQ);
+    assert_true(back.error_bound == 0.02);
+
+    uint8_t raw[8 * CELL_BYTES], held[8 * CELL_BYTES], out[8 * CELL_BYTES];
+    for (size_t i = 0; i < cells; ++i) {
+        float v[LPVP_VALUES_PER_CELL];
+        make_cell(v, 1.0);
+        put_cell(raw, i, v);
+    }
+    uint8_t *att = NULL;
+    size_t att_len = 0, sent = 0;
+    assert_int_equal(lpvp_shq_encode(raw, sizeof raw, cells, NULL, 0.02, held, &att, &att_len, &sent, err, sizeof err),
+                     0);
+    assert_int_equal(lpvp_volume_decode(&back, att, att_len, NULL, 0, out, err, sizeof err), 0);
+    assert_memory_equal(out, held, sizeof out);
+    free(att);
+
+    json_object_set_new(h, "error_bound", json_real(0.5));
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), -1);
+    assert_non_null(strstr(err, "error_bound"));
+    json_object_del(h, "error_bound");
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), -1);
+    json_object_set_new(h, "error_bound", json_real(0.02));
+    json_object_set_new(h, "format", json_string("fp16"));
+    json_object_set_new(h, "raw_length", json_integer((json_int_t)(cells * 24)));
+    assert_int_equal(lpvp_volume_header_parse(h, &back, err, sizeof err), -1);
+    assert_non_null(strstr(err, "fp32"));
+    json_decref(h);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_keyframe_holds_the_bound), cmocka_unit_test(test_deltas_hold_the_bound),
+        cmocka_unit_test(test_static_volume_sends_nothing), cmocka_unit_test(test_hostile_values),
+        cmocka_unit_test(test_bad_bound_and_payloads), cmocka_unit_test(test_header),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
