@@ -14,7 +14,8 @@ set -eu
 # fallback (docs/gl-backends.md).
 RUNTIME="
   libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
-  libopenimageio2.4 libembree3-3 libjansson4 libuv1 libzstd1 libmeshoptimizer2d libtinygltf2d libstb0 libcglm0
+  libopenimageio2.4 libembree3-3 libjansson4 libuv1 libzstd1 libxxhash0 libmeshoptimizer2d libtinygltf2d libstb0
+  libcglm0
 "
 # Building them (draco is linked statically; cglm's functions are mostly
 # inlined, but a build that does not inline them links libcglm0).
@@ -27,7 +28,7 @@ BUILD="
   khronos-api
   libtinygltf-dev nlohmann-json3-dev libstb-dev libglm-dev libdraco-dev libmeshoptimizer-dev
   libopenimageio-dev
-  libcglm-dev libuv1-dev libzstd-dev zstd libjansson-dev libembree-dev
+  libcglm-dev libuv1-dev libzstd-dev zstd libxxhash-dev libjansson-dev libembree-dev
   libcmocka-dev
 "
 # Testing and benchmarking (tests/README.md).

@@ -20,6 +20,39 @@
 #include "tonemap.h"
 #include "volume_codec.h"
 
+/* How a volume goes on the wire (SPEC section 5): zero-initialised is fp32,
+ * uncompressed. */
+typedef struct sv_volume_coding {
+    int fp16;               /* format fp16, else fp32 (shq is always fp32) */
+    int comp;               /* lpvp_compression: none, zstd, shq */
+    double bound;           /* shq: the client's error bound (R5.16) */
+} sv_volume_coding;
+
+typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */
+    uint64_t tick;
+    int dims[3];
+    sv_volume_coding how;   /* a base serves only a volume coded the same way */
+    uint8_t *raw;           /* the raw volume the client holds (shq: its reconstruction) */
+    size_t raw_len;
+    uint64_t lineage;       /* shq: equal lineages, equal raw bytes (export_encode.c) */
+} sv_sent;
+
+/* An shq encoding kept for the next subscriber that holds the same volume
+ * (R5.16; export_encode.c): a world's subscribers in step share one. */
+#define SV_SHQ_SHARED 2
+typedef struct sv_shq_shared {
+    int used;
+    uint64_t from;          /* the base's lineage; 0: a keyframe */
+    double bound;
+    int outcome;            /* 0: sent; 1: nothing to send */
+    int keyframe;
+    uint64_t lineage;       /* the client's volume after it */
+    uint8_t *att;
+    size_t att_len;
+    uint8_t *recon;         /* the client's volume after it */
+    size_t recon_len;
+} sv_shq_shared;
+
 /* The product of one tick: immutable once handed to the main thread. */
 typedef struct sv_result {
     int refs;
@@ -56,6 +89,8 @@ typedef struct sv_result {
     /* main thread: keyframe attachments already encoded, [fp16][zstd] */
     uint8_t *enc[2][2];
     size_t enc_len[2][2];
+    sv_shq_shared shq[SV_SHQ_SHARED]; /* under export_encode.c's lock, as enc */
+    int shq_next;
 } sv_result;
 
 sv_result *sv_result_ref(sv_result *r);
@@ -73,23 +108,21 @@ sv_result *sv_result_take(lpv_engine *e, int width, int height, unsigned terms_m
  * with err for a technique without them. */
 sv_result *sv_result_take_content(lpv_engine *e, int content, char *err, size_t n);
 
-/* A VOLUME sent to a delta subscriber, not yet ACKed: the base of a delta. */
-typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */
-    uint64_t tick;
-    int dims[3];
-    int fp16;
-    uint8_t *raw;
-    size_t raw_len;
-} sv_sent;
+/* GET_VOLUME's and SUBSCRIBE's "format", "compression" and "error_bound"
+ * (SPEC R5.16) into how (default fp16 + zstd); 0, or -1 with err set
+ * ("<key>: <what>", for BAD_FIELD). */
+int sv_volume_coding_parse(const json_t *j, sv_volume_coding *how, char *err, size_t n);
 
 /* Thread-safe (export_encode.c): the daemon runs them on libuv's work
  * threads, lpvd batch on its own. */
 /* Volume reply/stream body + attachment. A delta subscriber's encoding passes
- * keep_raw: it gets the raw volume (for sv_sub_remember), and a delta against
- * base (its ACKed volume) when base fits; else keep_raw and base are NULL. */
-int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
-                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
-                     size_t n);
+ * keep: it gets the volume the client will hold (raw, its tick, coding and
+ * lineage, for sv_sub_remember), and a delta against base (its ACKed
+ * volume) when base fits; else keep and base are NULL. Returns 0, -1 with
+ * err set, or 1 for an shq delta with nothing beyond the bound to send
+ * (R5.16: nothing is sent; *body, *att and keep->raw are NULL). */
+int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, const sv_sent *base, sv_sent *keep,
+                     uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
                     uint64_t revision,

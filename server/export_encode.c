@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <xxhash.h>
 
 #include "image_io.h"
 #include "stats_json.h"
@@ -96,12 +97,181 @@ static void cache_put(sv_result *r, int fp16, int zstd, const uint8_t *att, size
     pthread_mutex_unlock(&enc_mu);
 }
 
-int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sent *base, uint8_t **keep_raw,
-                     size_t *keep_len, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err,
-                     size_t n)
+int sv_volume_coding_parse(const json_t *j, sv_volume_coding *how, char *err, size_t n)
 {
-    if (keep_raw)
-        *keep_raw = NULL;
+    int fmt = -1, comp = LPVP_COMP_ZSTD;
+    double bound = LPVP_SHQ_BOUND_DEFAULT;
+    if (lpvp_get_enum(j, "format", 0, lpvp_volume_format_names, 2, &fmt, err, n) == LPVP_FIELD_BAD ||
+        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 3, &comp, err, n) == LPVP_FIELD_BAD)
+        return -1;
+    int has_bound = lpvp_get_number(j, LPVP_SHQ_BOUND_KEY, 0, LPVP_SHQ_BOUND_MIN, LPVP_SHQ_BOUND_MAX, &bound, err, n);
+    if (has_bound == LPVP_FIELD_BAD)
+        return -1;
+    if (comp == LPVP_COMP_SHQ && fmt == LPVP_FMT_FP16) {
+        snprintf(err, n, "format: compression \"shq\" decodes to \"fp32\" (R5.16); omit format or ask \"fp32\"");
+        return -1;
+    }
+    if (comp != LPVP_COMP_SHQ && has_bound == LPVP_FIELD_OK) {
+        snprintf(err, n, "%s: only compression \"shq\" takes an error bound (R5.16)", LPVP_SHQ_BOUND_KEY);
+        return -1;
+    }
+    how->comp = comp;
+    how->fp16 = comp != LPVP_COMP_SHQ && fmt != LPVP_FMT_FP32; /* default fp16 */
+    how->bound = comp == LPVP_COMP_SHQ ? bound : 0.0;
+    return 0;
+}
+
+/* ---- shq (R5.16) ---------------------------------------------------------- */
+
+/* A lineage names the volume a subscriber holds: the hash of its bytes
+ * (XXH3, 64 bits; 0 is kept for "a keyframe"). Subscribers of a world that
+ * hold the same volume (they got the same keyframe, from whichever tick,
+ * and the same deltas since) share one encoding of the next tick: a hundred
+ * subscribers in step cost one encoding and a hundred copies. */
+static uint64_t lineage_of(const uint8_t *raw, size_t len)
+{
+    uint64_t h = XXH3_64bits(raw, len);
+    return h ? h : 1;
+}
+
+/* A copy of what an encoding of r against lineage `from` at bound made, when
+ * one is cached; 1 when found (the outcome in *outcome). A delta's header
+ * names this subscriber's base tick (base_tick), which may differ from the
+ * one the encoding had: the same volume, acknowledged as another tick. */
+static int shared_copy(sv_result *r, uint64_t from, int64_t base_tick, double bound, lpvp_volume_info *vi,
+                       sv_sent *keep, uint8_t **att, size_t *att_len, int *outcome)
+{
+    int got = 0;
+    pthread_mutex_lock(&enc_mu);
+    for (int i = 0; i < SV_SHQ_SHARED && !got; ++i) {
+        const sv_shq_shared *s = &r->shq[i];
+        if (!s->used || s->from != from || s->bound != bound || (keep && s->outcome == 0 && !s->recon))
+            continue; /* (a reply's keyframe kept no client volume for a subscriber to hold) */
+        uint8_t *a = s->att_len ? malloc(s->att_len) : NULL;
+        uint8_t *k = keep && s->recon ? malloc(s->recon_len) : NULL;
+        if ((s->att_len && !a) || (keep && s->recon && !k)) {
+            free(a);
+            free(k);
+            break;
+        }
+        if (a)
+            memcpy(a, s->att, s->att_len);
+        if (k) {
+            memcpy(k, s->recon, s->recon_len);
+            keep->raw = k;
+            keep->raw_len = s->recon_len;
+            keep->lineage = s->lineage;
+        }
+        *att = a;
+        *att_len = s->att_len;
+        vi->keyframe = s->keyframe;
+        vi->base_tick = s->keyframe ? -1 : base_tick;
+        *outcome = s->outcome;
+        got = 1;
+    }
+    pthread_mutex_unlock(&enc_mu);
+    return got;
+}
+
+/* Keeps a copy of an encoding for the subscribers that hold the same volume
+ * (the oldest entry makes room). */
+static void shared_put(sv_result *r, uint64_t from, double bound, const lpvp_volume_info *vi, const sv_sent *keep,
+                       const uint8_t *att, size_t att_len, int outcome)
+{
+    uint8_t *a = att_len ? malloc(att_len) : NULL, *k = keep && keep->raw ? malloc(keep->raw_len) : NULL;
+    if ((att_len && !a) || (keep && keep->raw && !k)) {
+        free(a);
+        free(k);
+        return;
+    }
+    if (a)
+        memcpy(a, att, att_len);
+    if (k)
+        memcpy(k, keep->raw, keep->raw_len);
+    pthread_mutex_lock(&enc_mu);
+    sv_shq_shared *s = &r->shq[r->shq_next];
+    r->shq_next = (r->shq_next + 1) % SV_SHQ_SHARED;
+    free(s->att);
+    free(s->recon);
+    *s = (sv_shq_shared){.used = 1, .from = from, .bound = bound, .outcome = outcome, .keyframe = vi->keyframe,
+                         .lineage = keep ? keep->lineage : 0, .att = a, .att_len = att_len,
+                         .recon = k, .recon_len = k ? keep->raw_len : 0};
+    pthread_mutex_unlock(&enc_mu);
+}
+
+/* The base a delta may use: coded the same way, of the same layout, another
+ * tick (not necessarily an older one: a session that moves to another
+ * world, R7.2, meets that world's tick numbers, and the client rebuilds
+ * from whichever tick it acknowledged). */
+static const sv_sent *shq_base(const sv_result *r, const sv_sent *base, double bound, size_t raw_len)
+{
+    if (base && base->raw && base->how.comp == LPVP_COMP_SHQ && base->how.bound == bound &&
+        base->raw_len == raw_len && memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick != r->tick)
+        return base;
+    return NULL;
+}
+
+/* raw (fp32) as shq: a delta against base when shq_base allows it, else a
+ * keyframe; the client's volume and its lineage in keep (NULL: a reply).
+ * Returns 0, 1 for a delta with nothing to send, -1 with err. */
+static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, double bound,
+                      const sv_sent *base, sv_sent *keep, uint8_t **att, size_t *att_len, char *err, size_t n)
+{
+    const size_t cells = (size_t)(lpvp_volume_values_bytes(vi) / (LPVP_VALUES_PER_CELL * 4));
+    const uint8_t *b = base ? base->raw : NULL;
+    uint8_t *recon = malloc(raw_len ? raw_len : 1);
+    size_t sent = 0;
+    if (!recon || lpvp_shq_encode(raw, raw_len, cells, b, bound, recon, att, att_len, &sent, err, n) != 0) {
+        if (!recon)
+            snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
+        free(recon);
+        return -1;
+    }
+    /* almost every cell re-sent: a keyframe costs no more and drops the map */
+    if (b && sent > cells - cells / 16) {
+        free(*att);
+        *att = NULL;
+        b = NULL;
+        if (lpvp_shq_encode(raw, raw_len, cells, NULL, bound, recon, att, att_len, &sent, err, n) != 0) {
+            free(recon);
+            return -1;
+        }
+    }
+    const size_t values = cells * LPVP_VALUES_PER_CELL * 4;
+    if (b && sent == 0 && memcmp(recon + values, b + values, raw_len - values) == 0) {
+        free(*att); /* nothing beyond the bound: nothing sent, the client's base stands */
+        *att = NULL;
+        *att_len = 0;
+        free(recon);
+        return 1;
+    }
+    if (b) {
+        vi->keyframe = 0;
+        vi->base_tick = (int64_t)base->tick;
+    }
+    if (keep) {
+        keep->raw = recon;
+        keep->raw_len = raw_len;
+        keep->lineage = lineage_of(recon, raw_len);
+    } else {
+        free(recon);
+    }
+    return 0;
+}
+
+int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, const sv_sent *base, sv_sent *keep,
+                     uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
+{
+    if (keep) {
+        memset(keep, 0, sizeof *keep);
+        keep->tick = r->tick;
+        memcpy(keep->dims, r->grid.dims, sizeof keep->dims);
+        keep->how = *how;
+    }
+    *att = NULL;
+    *att_len = 0;
+    const int shq = how->comp == LPVP_COMP_SHQ;
+    const int fp16 = !shq && how->fp16, zstd = how->comp == LPVP_COMP_ZSTD;
     lpvp_volume_format fmt = fp16 ? LPVP_FMT_FP16 : LPVP_FMT_FP32;
     const int levels = content == LPVP_CONTENT_LEVELS;
     const int visibility = content == LPVP_CONTENT_VISIBILITY;
@@ -111,7 +281,8 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
     vi.revision = (int64_t)revision;
     vi.tick = (int64_t)r->tick;
     vi.format = fmt;
-    vi.compression = zstd ? LPVP_COMP_ZSTD : LPVP_COMP_NONE;
+    vi.compression = shq ? LPVP_COMP_SHQ : zstd ? LPVP_COMP_ZSTD : LPVP_COMP_NONE;
+    vi.error_bound = shq ? how->bound : 0.0;
     vi.keyframe = 1;
     vi.base_tick = -1;
     for (int i = 0; i < 3; ++i) {
@@ -188,9 +359,29 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
 
     /* the keyframe cache and XOR deltas (R5.3) hold the merged content only */
     if (!merged)
-        keep_raw = NULL;
-    if (merged && !keep_raw && cache_copy(r, fp16, zstd, att, att_len)) /* another session had it encoded */
+        keep = NULL;
+    if (merged && !shq && !keep && cache_copy(r, fp16, zstd, att, att_len)) /* another session had it encoded */
         goto header;
+    /* shq: another subscriber that holds the same volume had it encoded */
+    const sv_sent *shq_from = shq && keep ? shq_base(r, base, how->bound, raw_len) : NULL;
+    const uint64_t from = shq_from ? shq_from->lineage : 0;
+    int outcome = 0;
+    if (shq && merged &&
+        shared_copy(r, from, shq_from ? (int64_t)shq_from->tick : -1, how->bound, &vi, keep, att, att_len, &outcome)) {
+        if (outcome == 1)
+            return 1;
+        goto header;
+    }
+    if (shq && merged && raw_len == r->cell_count * LPVP_VALUES_PER_CELL * 4 && lpvp_host_little_endian()) {
+        /* the cells as they are in memory are the raw fp32 volume (the codec
+         * sends NaN as 0 itself): 4.7 MB less to write at 3 x 32^3 */
+        int rc = encode_shq(&vi, (const uint8_t *)r->cells, raw_len, how->bound, shq_from, keep, att, att_len, err, n);
+        if (rc >= 0)
+            shared_put(r, from, how->bound, &vi, keep, *att, *att_len, rc);
+        if (rc != 0)
+            return rc;
+        goto header;
+    }
     uint8_t *raw = malloc(raw_len ? raw_len : 1);
     if (!raw) {
         snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
@@ -206,10 +397,20 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
             pack_visibility(raw + lpvp_volume_values_bytes(&vi), r->visibility, r->visibility_floats);
     }
 
+    if (shq) {
+        int rc = encode_shq(&vi, raw, raw_len, how->bound, shq_from, keep, att, att_len, err, n);
+        free(raw);
+        if (rc >= 0 && merged)
+            shared_put(r, from, how->bound, &vi, keep, *att, *att_len, rc);
+        if (rc != 0)
+            return rc;
+        goto header;
+    }
     uint8_t *payload = raw; /* what gets compressed / sent */
     uint8_t *delta = NULL;
-    if (keep_raw && base && base->raw && base->fp16 == fp16 && base->raw_len == raw_len &&
-        memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick < r->tick) {
+    if (keep && base && base->raw && base->how.comp != LPVP_COMP_SHQ && base->how.fp16 == fp16 &&
+        base->raw_len == raw_len &&
+        memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick != r->tick) {
         delta = malloc(raw_len ? raw_len : 1);
         if (delta) {
             lpvp_xor(delta, raw, base->raw, raw_len);
@@ -234,7 +435,7 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
         *att = delta;
         delta = NULL;
         *att_len = raw_len;
-    } else if (!keep_raw) {
+    } else if (!keep) {
         *att = raw;
         raw = NULL;
         *att_len = raw_len;
@@ -249,9 +450,9 @@ int sv_encode_volume(sv_result *r, int content, int fp16, int zstd, const sv_sen
         *att_len = raw_len;
     }
     free(delta);
-    if (keep_raw) { /* the subscriber remembers it (sv_sub_remember) */
-        *keep_raw = raw;
-        *keep_len = raw_len;
+    if (keep) { /* the subscriber remembers it (sv_sub_remember) */
+        keep->raw = raw;
+        keep->raw_len = raw_len;
     } else {
         free(raw);
     }

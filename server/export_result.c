@@ -36,6 +36,10 @@ static void result_free(sv_result *r)
         free(r->frames[i]);
     for (int i = 0; i < 4; ++i)
         free(r->enc[i / 2][i % 2]);
+    for (int i = 0; i < SV_SHQ_SHARED; ++i) {
+        free(r->shq[i].att);
+        free(r->shq[i].recon);
+    }
     free(r);
 }
 

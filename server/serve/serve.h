@@ -262,7 +262,7 @@ struct sv_world {
     lpv_settings gl_settings;
     lpv_view gl_view;
     uint64_t gl_scene_sig;
-    uint64_t gl_ticks;
+    uint64_t gl_ticks;      /* its latest tick's number (serve_gl.c: server-wide, increasing) */
     uint64_t gl_ticked_gen;
     int gl_ticked;
 };
@@ -330,8 +330,8 @@ typedef struct sv_request {
 
 typedef struct sv_sub {
     int on;
-    int fp16;               /* volume: fp16 (default) or fp32 */
-    int zstd;               /* compression */
+    sv_volume_coding vol;   /* volume: format, compression, bound (default fp16 + zstd) */
+    int zstd;               /* frame: compression */
     int delta;              /* volume only */
     int fmt;                /* frame: 0 rgba8, 1 png, 2 exr */
     int terms;              /* frame terms */
@@ -408,6 +408,7 @@ struct sv_conn {
     struct sv_wreq *stream_pending[2]; /* newest unsent stream message */
     uint64_t bytes_sent;
     uint64_t stream_dropped;
+    uint64_t stream_unchanged; /* VOLUMEs not sent: an shq delta with nothing beyond the bound (R5.16) */
     /* encoding on the work threads (serve_encode_work.c), per stream: one in
      * flight, and the newest result waiting for it (a newer replaces it) */
     int enc_busy[2];
@@ -499,6 +500,8 @@ struct sv_server {
     /* counters */
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */
+    uint64_t volumes_encoded; /* volume encodings on the work threads (STATS "encode") */
+    uint64_t volume_encode_ns; /* their CPU time on the work threads */
     uint64_t ticks_coalesced; /* TICK requests answered by another request's tick */
     uint64_t ticks_cancelled; /* ticks skipped or abandoned because every requester had gone */
     uint64_t requests;
@@ -593,6 +596,6 @@ int sv_tick_cost_check(const sv_config *cfg, const lpv_settings *s, char *err, s
 /* the loop's side of a subscription (serve_sub.c) */
 void sv_sub_clear(sv_sub *sub);
 void sv_sub_ack(sv_sub *sub, uint64_t tick);
-void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len);
+void sv_sub_remember(sv_sub *sub, const sv_sent *sent);
 
 #endif

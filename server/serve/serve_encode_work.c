@@ -27,6 +27,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef enum enc_kind { ENC_VOLUME, ENC_FRAME, ENC_QUERY } enc_kind;
 
@@ -41,12 +42,15 @@ typedef struct enc_task {
     uint64_t revision;      /* the session's when the request was handled */
     sv_result *r;           /* ref: the volume, or the frame (r->frames) */
     /* volume */
-    int content, fp16, zstd;
-    int keep;               /* a delta subscriber: the raw volume comes back in kept */
+    int content;
+    sv_volume_coding how;
+    int zstd;               /* frame */
+    int unchanged;          /* an shq delta with nothing to send (R5.16) */
+    uint64_t encode_ns;     /* the work thread's CPU time on a volume */
+    int keep;               /* a delta subscriber: the client's volume comes back in kept */
     sv_sent base;           /* lent by the subscription (raw NULL: none) */
     uint32_t epoch;         /* the subscription's when the base was lent */
-    uint8_t *kept;
-    size_t kept_len;
+    sv_sent kept;
     /* frame */
     const float *rgba;      /* in r->frames or rgba_owned */
     float *rgba_owned;
@@ -66,13 +70,26 @@ typedef struct enc_task {
     char err[512];
 } enc_task;
 
+/* The calling thread's CPU time: an encoding's cost, whatever else (the GL
+ * thread, a client on the same machine) competes for the cores meanwhile. */
+static uint64_t thread_cpu_ns(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
+        return 0;
+    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
+}
+
 static void work_cb(uv_work_t *w)
 {
     enc_task *t = w->data;
     if (t->kind == ENC_VOLUME) {
-        t->failed = sv_encode_volume(t->r, t->content, t->fp16, t->zstd, t->base.raw ? &t->base : NULL,
-                                     t->keep ? &t->kept : NULL, &t->kept_len, t->revision, &t->body, &t->att,
-                                     &t->att_len, t->err, sizeof t->err) != 0;
+        uint64_t t0 = thread_cpu_ns();
+        int rc = sv_encode_volume(t->r, t->content, &t->how, t->base.raw ? &t->base : NULL, t->keep ? &t->kept : NULL,
+                                  t->revision, &t->body, &t->att, &t->att_len, t->err, sizeof t->err);
+        t->failed = rc < 0;
+        t->unchanged = rc == 1;
+        t->encode_ns = thread_cpu_ns() - t0;
     } else if (t->kind == ENC_FRAME) {
         t->failed = sv_encode_frame(t->rgba, t->w, t->h, t->fmt, t->zstd, t->terms, &t->display, t->revision, t->tick,
                                     t->has_plan ? &t->plan : NULL, &t->body, &t->att, &t->att_len, t->err,
@@ -130,11 +147,11 @@ static void volume_stream_state(sv_conn *c, enc_task *t, int sent)
     }
     free(t->base.raw);
     t->base.raw = NULL;
-    if (same && sent && t->kept)
-        sv_sub_remember(sub, t->r->tick, t->r->grid.dims, t->fp16, t->kept, t->kept_len);
+    if (same && sent && t->kept.raw)
+        sv_sub_remember(sub, &t->kept);
     else
-        free(t->kept);
-    t->kept = NULL;
+        free(t->kept.raw);
+    t->kept.raw = NULL;
 }
 
 static void after_work_cb(uv_work_t *w, int status)
@@ -150,6 +167,8 @@ static void after_work_cb(uv_work_t *w, int status)
     if (reply && !c->closing && c->close_after_write && c->srv->stopping) {
         /* SIGTERM came while this encoded on a worker: sv_session_shutdown
          * has answered it SHUTTING_DOWN already (R7.4), the reply is dropped */
+    } else if (t->unchanged) {
+        c->stream_unchanged++; /* R5.16: nothing moved beyond the bound, nothing is sent; the base stands */
     } else if (!c->closing && !c->close_after_write) {
         size_t json_len = t->body ? json_dumpb(t->body, NULL, 0, JSON_COMPACT) : 2;
         size_t frame = LPVP_HEADER_SIZE + json_len + t->att_len;
@@ -171,6 +190,10 @@ static void after_work_cb(uv_work_t *w, int status)
             t->att = NULL;
         }
     }
+    if (t->kind == ENC_VOLUME) {
+        c->srv->volumes_encoded++;
+        c->srv->volume_encode_ns += t->encode_ns;
+    }
     if (t->stream == SV_STREAM_VOLUME)
         volume_stream_state(c, t, sent);
     json_decref(t->body);
@@ -178,7 +201,7 @@ static void after_work_cb(uv_work_t *w, int status)
     free(t->rgba_owned);
     free(t->out);
     free(t->base.raw);
-    free(t->kept);
+    free(t->kept.raw);
     sv_result_unref(t->r);
     if (reply) {
         if (!c->closing && !c->close_after_write)
@@ -231,7 +254,7 @@ static void no_task(sv_conn *c, uint32_t rid)
     sv_reply_err(c, rid, LPVP_E_INTERNAL, 0, "out of memory");
 }
 
-void sv_reply_volume(sv_conn *c, uint32_t rid, sv_result *r, int content, int fp16, int zstd)
+void sv_reply_volume(sv_conn *c, uint32_t rid, sv_result *r, int content, const sv_volume_coding *how)
 {
     enc_task *t = task_new(c, ENC_VOLUME, LPVP_REPLY(LPVP_GET_VOLUME), rid, SV_STREAM_NONE);
     if (!t) {
@@ -240,8 +263,7 @@ void sv_reply_volume(sv_conn *c, uint32_t rid, sv_result *r, int content, int fp
     }
     t->r = sv_result_ref(r);
     t->content = content;
-    t->fp16 = fp16;
-    t->zstd = zstd;
+    t->how = *how;
     start(t);
 }
 
@@ -310,7 +332,7 @@ static void stream_next(sv_conn *c, int stream)
     t->zstd = sub->zstd;
     if (stream == SV_STREAM_VOLUME) {
         t->content = LPVP_CONTENT_MERGED;
-        t->fp16 = sub->fp16;
+        t->how = sub->vol;
         t->keep = sub->delta;
         t->epoch = sub->epoch;
         if (sub->delta) { /* lent for the XOR; back in volume_stream_state */

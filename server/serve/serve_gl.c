@@ -11,10 +11,21 @@
 
 #include <malloc.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+/* Tick numbers come from one counter for the whole server, not one per
+ * world: a session that moves to another world (its lights changed while
+ * others share its world, R7.2) never meets a tick number it has seen, so
+ * a delta's base_tick (R5.3, R5.16) names one volume. */
+static uint64_t next_tick_number(void)
+{
+    static atomic_uint_fast64_t last = 0;
+    return (uint64_t)atomic_fetch_add(&last, 1) + 1;
+}
 
 static double wall_ms(void)
 {
@@ -301,7 +312,7 @@ static void gl_tick(sv_server *s, sv_job *j)
         return;
     }
     r->gen = j->gen;
-    r->tick = ++w->gl_ticks;
+    r->tick = w->gl_ticks = next_tick_number();
     r->tick_ms = wall_ms() - t0 - j->yielded_ms; /* its own GL time, not other worlds' */
     j->result = r;
     if (changed && w->gl_seen_sig == sig) { /* not its first with these settings: that one does one-time work */

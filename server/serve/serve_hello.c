@@ -26,6 +26,17 @@ static int token_equal(const char *a, size_t alen, const char *b, size_t blen)
     return diff == 0;
 }
 
+/* R5.16: the volume compressions this server sends and shq's error bounds,
+ * for a client to choose from in SUBSCRIBE / GET_VOLUME. */
+static json_t *volume_codecs(void)
+{
+    json_t *names = json_array();
+    for (int i = 0; names && i < 3; ++i)
+        json_array_append_new(names, json_string(lpvp_compression_names[i]));
+    return json_pack("{s:o, s:{s:f, s:f, s:f}}", "compression", names, LPVP_SHQ_BOUND_KEY, "min", LPVP_SHQ_BOUND_MIN,
+                     "max", LPVP_SHQ_BOUND_MAX, "default", LPVP_SHQ_BOUND_DEFAULT);
+}
+
 void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
 {
     sv_server *s = c->srv;
@@ -76,7 +87,8 @@ void sv_do_hello(sv_conn *c, sv_request *r, json_t *j)
      * copy */
     if (b && (json_object_set_new(b, "knobs", lpvd_knobs_json(&s->cfg.settings, s->cfg.max_texture)) != 0 ||
               json_object_set_new(b, "presets", lpvd_presets_json()) != 0 ||
-              json_object_set_new(b, "techniques", lpvd_techniques_json()) != 0)) {
+              json_object_set_new(b, "techniques", lpvd_techniques_json()) != 0 ||
+              json_object_set_new(b, "volume_codecs", volume_codecs()) != 0)) {
         json_decref(b);
         b = NULL;
     }

@@ -118,9 +118,9 @@ static int visibility_too_big(sv_conn *c, sv_request *r, const sv_result *latest
 void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
 {
     char err[512];
-    int fmt = LPVP_FMT_FP16, comp = LPVP_COMP_ZSTD, content = LPVP_CONTENT_MERGED;
-    if (lpvp_get_enum(j, "format", 0, lpvp_volume_format_names, 2, &fmt, err, sizeof err) == LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+    int content = LPVP_CONTENT_MERGED;
+    sv_volume_coding how = {0};
+    if (sv_volume_coding_parse(j, &how, err, sizeof err) != 0 ||
         lpvp_get_enum(j, LPVP_VOLUME_CONTENT_KEY, 0, lpvp_volume_content_names, LPVP_CONTENT_COUNT, &content, err,
                       sizeof err) == LPVP_FIELD_BAD) {
         sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0, "%s", err);
@@ -134,7 +134,13 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
     const sv_result *latest = c->world->latest;
     if (content == LPVP_CONTENT_MERGED) { /* packed and compressed on a work thread; the session is busy until
                                              the reply is queued */
-        sv_reply_volume(c, r->request_id, c->world->latest, content, fmt == LPVP_FMT_FP16, comp == LPVP_COMP_ZSTD);
+        sv_reply_volume(c, r->request_id, c->world->latest, content, &how);
+        return;
+    }
+    if (how.comp == LPVP_COMP_SHQ) {
+        sv_reply_err(c, r->request_id, LPVP_E_BAD_FIELD, 0,
+                     "compression: \"shq\" codes the merged volume only (R5.16); ask \"zstd\" for content \"%s\"",
+                     lpvp_volume_content_names[content]);
         return;
     }
     const char *t = latest->stats.volume.technique;
@@ -162,7 +168,7 @@ void sv_do_get_volume(sv_conn *c, sv_request *r, json_t *j)
         return;
     }
     jb->request_id = r->request_id;
-    jb->count = (size_t)(fmt == LPVP_FMT_FP16) | ((size_t)(comp == LPVP_COMP_ZSTD) << 4) |
+    jb->count = (size_t)how.fp16 | ((size_t)how.comp << 4) |
                 ((size_t)content << 8); /* read in gl_content and job_done */
     submit(c, jb);
 }
@@ -273,12 +279,13 @@ void sv_do_stats(sv_conn *c, sv_request *r)
     json_object_set_new(plan, "backend", json_string(s->gl_backend));
     json_object_set_new(plan, "gl_renderer", json_string(s->gl_renderer));
     json_object_set_new(plan, "config", sv_config_json(c));
-    size_t pend = 0, wq = 0, drops = 0;
+    size_t pend = 0, wq = 0, drops = 0, unchanged = 0;
     int sessions = 0;
     for (sv_conn *o = s->conns; o; o = o->next) {
         pend += o->pending_count;
         wq += o->wq_bytes;
         drops += o->stream_dropped;
+        unchanged += o->stream_unchanged;
         if (o->hello)
             sessions++;
     }
@@ -294,6 +301,10 @@ void sv_do_stats(sv_conn *c, sv_request *r)
         (json_int_t)c->bytes_sent, "ticks", (json_int_t)s->ticks, "world_ticks",
         (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
         "revision", (json_int_t)c->revision);
+    json_object_set_new(b, "stream_unchanged", json_integer((json_int_t)unchanged)); /* R5.16 */
+    json_object_set_new(b, "encode", json_pack("{s:I, s:f}", "volumes", (json_int_t)s->volumes_encoded, "volume_cpu_ms",
+                                               (double)s->volume_encode_ns / 1e6));
+    json_object_set_new(b, "session_stream_unchanged", json_integer((json_int_t)c->stream_unchanged));
     /* R7.5: request bytes held for all connections, against --max-request-memory */
     json_object_set_new(json_object_get(b, "queues"), "request_bytes",
                         json_integer((json_int_t)sv_memory_held(&s->mem, SV_MEM_REQUESTS)));
@@ -339,8 +350,8 @@ void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
         sv_reply_frame(c, request_id, NULL, rgba, j->width, j->height, (int)(j->count & 15), (int)(j->count >> 4),
                        j->terms, &j->display, j->tick);
     } else if (j->kind == SV_JOB_CONTENT) { /* so do the levels or the visibility */
-        sv_reply_volume(c, request_id, j->result, (int)(j->count >> 8), (int)(j->count & 15),
-                        (int)((j->count >> 4) & 15));
+        const sv_volume_coding how = {.fp16 = (int)(j->count & 15), .comp = (int)((j->count >> 4) & 15)};
+        sv_reply_volume(c, request_id, j->result, (int)(j->count >> 8), &how);
     } else if (j->kind == SV_JOB_QUERY) { /* so do the answers, packed there */
         float *out = j->out;
         j->out = NULL;

@@ -106,7 +106,7 @@ void sv_session_init(sv_conn *c)
     c->view_camera = -1;
     c->settings = s->cfg.settings;
     c->tick_rate = s->cfg.tick_rate;
-    c->subs[0].fp16 = 1;
+    c->subs[SV_STREAM_VOLUME].vol = (sv_volume_coding){.fp16 = 1, .comp = LPVP_COMP_ZSTD};
     s->builtin->refs++;
     if (sv_session_set_scene(c, s->builtin) != 0) {
         sv_conn_close(c);

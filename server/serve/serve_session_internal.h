@@ -75,7 +75,7 @@ int sv_terms_check(const sv_conn *c, int terms, char *err, size_t n);
  * A reply keeps the session busy until it is queued (R3.2) and carries the
  * revision of when the request was handled (R3.3); a frame over --max-queue
  * is not sent: ERROR LIMIT instead (R3.5). */
-void sv_reply_volume(sv_conn *c, uint32_t rid, sv_result *r, int content, int fp16, int zstd);
+void sv_reply_volume(sv_conn *c, uint32_t rid, sv_result *r, int content, const sv_volume_coding *how);
 /* rgba_owned: a rendered frame, taken; NULL: r's frames[terms], r referenced */
 void sv_reply_frame(sv_conn *c, uint32_t rid, sv_result *r, float *rgba_owned, int w, int h, int fmt, int zstd,
                     int terms, const lpv_display *display, uint64_t tick);

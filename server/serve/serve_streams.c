@@ -17,6 +17,7 @@ void sv_do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
 {
     char err[512];
     int stream = 0, fmt = -1, comp = -1, delta = 0, terms = 0;
+    sv_volume_coding vol = {0};
     lpv_display display;
     lpv_display_default(&display);
     if (lpvp_get_enum(j, "stream", 1, lpvp_stream_names, LPVP_STREAM_COUNT, &stream, err, sizeof err) != LPVP_FIELD_OK)
@@ -28,10 +29,11 @@ void sv_do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
         sv_reply(c, LPVP_UNSUBSCRIBE, r->request_id, json_object());
         return;
     }
-    if (lpvp_get_enum(j, "format", 0, stream ? lpvp_frame_format_names : lpvp_volume_format_names,
-                      stream ? LPVP_FRAME_FORMAT_COUNT : 2, &fmt, err, sizeof err) ==
-            LPVP_FIELD_BAD ||
-        lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) == LPVP_FIELD_BAD ||
+    if ((!stream && sv_volume_coding_parse(j, &vol, err, sizeof err) != 0) ||
+        (stream && lpvp_get_enum(j, "format", 0, lpvp_frame_format_names, LPVP_FRAME_FORMAT_COUNT, &fmt, err,
+                                 sizeof err) == LPVP_FIELD_BAD) ||
+        (stream && lpvp_get_enum(j, "compression", 0, lpvp_compression_names, 2, &comp, err, sizeof err) ==
+                       LPVP_FIELD_BAD) ||
         lpvp_get_bool(j, "delta", 0, &delta, err, sizeof err) == LPVP_FIELD_BAD ||
         (stream && lpvp_get_enum(j, "terms", 0, lpvp_frame_terms_names, LPVP_TERMS_COUNT, &terms, err, sizeof err) == LPVP_FIELD_BAD) ||
         (stream && sv_get_display(j, &display, err, sizeof err) == LPVP_FIELD_BAD) ||
@@ -44,8 +46,7 @@ void sv_do_subscribe(sv_conn *c, sv_request *r, json_t *j, int on)
     sv_sub_clear(sub);
     sub->on = 1;
     if (stream == SV_STREAM_VOLUME) {
-        sub->fp16 = fmt != LPVP_FMT_FP32;
-        sub->zstd = comp != LPVP_COMP_NONE; /* default zstd */
+        sub->vol = vol;
         sub->delta = delta;
     } else {
         sub->fmt = fmt < 0 ? LPVP_FRAME_PNG : fmt; /* default png */

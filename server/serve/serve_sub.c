@@ -39,8 +39,8 @@ void sv_sub_ack(sv_sub *sub, uint64_t tick)
     }
 }
 
-/* Keeps raw (taken, not copied) as a volume sent to sub that it may ACK. */
-void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, uint8_t *raw, size_t len)
+/* Keeps sent (its raw taken, not copied) as a volume sent to sub that it may ACK. */
+void sv_sub_remember(sv_sub *sub, const sv_sent *sent)
 {
     int slot = 0;
     for (int i = 0; i < SV_SENT_KEEP; ++i) {
@@ -52,9 +52,5 @@ void sv_sub_remember(sv_sub *sub, uint64_t tick, const int dims[3], int fp16, ui
             slot = i;
     }
     free(sub->sent[slot].raw);
-    sub->sent[slot].raw = raw;
-    sub->sent[slot].raw_len = len;
-    sub->sent[slot].tick = tick;
-    sub->sent[slot].fp16 = fp16;
-    memcpy(sub->sent[slot].dims, dims, sizeof sub->sent[slot].dims);
+    sub->sent[slot] = *sent;
 }
