@@ -189,8 +189,9 @@ enum lpvc_stream { LPVC_STREAM_VOLUME = 0, LPVC_STREAM_FRAME = 1 };
 typedef struct lpvc_subscribe_desc {
     enum lpvc_stream stream;
     const char *format;        /* volume: "fp16"|"fp32"; frame: "rgba8"|"png"|"exr"; NULL: server default */
-    const char *compression;   /* "zstd"|"none"; NULL: server default */
-    bool delta;                /* volume XOR deltas (R5.3); this library undoes them */
+    const char *compression;   /* "zstd"|"none", volume also "shq" (R5.16); NULL: server default */
+    double error_bound;        /* "shq": the bound (R5.16, 0.001..0.25); 0: the server's default */
+    bool delta;                /* volume deltas (R5.3, R5.16); this library undoes them */
 } lpvc_subscribe_desc;
 int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc);
 int lpvc_unsubscribe(lpvc *c, enum lpvc_stream stream);
@@ -220,8 +221,9 @@ typedef struct lpvc_volume {
     float *data;               /* total_cells * volumes_per_level * values_per_cell floats; for R5.1's
                                   layout (sh_values) per cell r0..r3 g0..g3 b0..b3, x fastest, in units */
     char format[8];            /* wire format: "fp16" or "fp32" */
-    char compression[8];       /* wire compression */
-    bool keyframe;             /* false: was an XOR delta, already undone */
+    char compression[8];       /* wire compression: "none", "zstd" or "shq" */
+    double error_bound;        /* "shq": the bound every cell holds (R5.16); 0 otherwise */
+    bool keyframe;             /* false: was a delta, already undone */
     int64_t base_tick;         /* delta base (-1 for keyframes) */
     char *header_json;         /* the header as received */
     int cascade_count;         /* 1..LPVC_MAX_CASCADES */
@@ -277,7 +279,8 @@ void lpvc_volume_free(lpvc_volume *v);
 
 typedef struct lpvc_volume_desc {
     const char *format;        /* "fp16" | "fp32"; NULL: "fp32" */
-    const char *compression;   /* "zstd" | "none"; NULL: "zstd" */
+    const char *compression;   /* "zstd" | "none" | "shq" (R5.16, decoded to fp32); NULL: "zstd" */
+    double error_bound;        /* "shq": the bound (R5.16); 0: the server's default */
     const char *content;       /* "merged" | "levels" (SPEC R5.13) | "visibility" (R5.15); NULL: "merged" */
 } lpvc_volume_desc;
 int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out);

@@ -213,6 +213,8 @@ int lpvc_subscribe(lpvc *c, const lpvc_subscribe_desc *desc)
         json_object_set_new(o, "format", json_string(d.format));
     if (d.compression)
         json_object_set_new(o, "compression", json_string(d.compression));
+    if (d.error_bound > 0.0)
+        json_object_set_new(o, LPVP_SHQ_BOUND_KEY, json_real(d.error_bound));
     if (d.delta)
         json_object_set_new(o, "delta", json_true());
     return lpvci_simple(c, LPVP_SUBSCRIBE, o);

@@ -176,6 +176,7 @@ int lpvci_decode_volume(lpvc *c, const json_t *hdr, const uint8_t *att, size_t a
         out->plan_json = json_dumps(json_object_get(hdr, "plan"), JSON_COMPACT);
     snprintf(out->format, sizeof out->format, "%s", lpvp_volume_format_name(vi.format));
     snprintf(out->compression, sizeof out->compression, "%s", lpvp_compression_name(vi.compression));
+    out->error_bound = vi.compression == LPVP_COMP_SHQ ? vi.error_bound : 0.0;
     out->keyframe = vi.keyframe != 0;
     out->base_tick = vi.keyframe ? -1 : vi.base_tick;
     out->header_json = json_dumps(hdr, JSON_COMPACT);
@@ -202,6 +203,10 @@ int lpvc_get_volume(lpvc *c, const lpvc_volume_desc *desc, lpvc_volume *out)
         d = *desc;
     json_t *o = json_pack("{s:s, s:s}", "format", d.format ? d.format : lpvp_volume_format_names[LPVP_FMT_FP32],
                           "compression", d.compression ? d.compression : lpvp_compression_names[LPVP_COMP_ZSTD]);
+    if (o && d.error_bound > 0.0 && json_object_set_new(o, LPVP_SHQ_BOUND_KEY, json_real(d.error_bound)) != 0) {
+        json_decref(o);
+        o = NULL;
+    }
     if (o && d.content && json_object_set_new(o, LPVP_VOLUME_CONTENT_KEY, json_string(d.content)) != 0) {
         json_decref(o);
         o = NULL;

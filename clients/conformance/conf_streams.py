@@ -1,13 +1,15 @@
-"""conf_streams.py - conformance cases: VOLUME streams, ACK and deltas (R5.1, R5.2, R5.3), and
-hostile QUERY_IRRADIANCE points (R4.7)."""
+"""conf_streams.py - conformance cases: VOLUME streams, ACK and deltas (R5.1, R5.2, R5.3), shq's
+delta stream (R5.16), and hostile QUERY_IRRADIANCE points (R4.7)."""
 
 import math
 import struct
+import time
 
-from conf_wire import ACK, CONFIG, ERROR, GET_VOLUME, LIGHT_SET, QUERY_IRRADIANCE, SUBSCRIBE, TICK, UNSUBSCRIBE, VOLUME
+from conf_wire import (
+    ACK, CONFIG, ERROR, GET_VOLUME, LIGHT_SET, QUERY_IRRADIANCE, STATS, SUBSCRIBE, TICK, UNSUBSCRIBE, VOLUME)
 from conf_payloads import SMALL_CONFIG, f32_list, xor_bytes, zstd_decompress_cli, zstd_frame_content_size
 from conf_core import case, check, expect_error, expect_reply, unique_light
-from conf_volume_checks import _vol_header_checks
+from conf_volume_checks import _shq_bound_checks, _shq_decode, _vol_header_checks
 
 
 # ---------------------------------------------------------------------------
@@ -154,3 +156,80 @@ def c_delta_zstd(ctx):
         check(xor_bytes(d1, d2) == g.att, "decoded keyframe XOR decoded delta differs from GET_VOLUME fp16")
         return "keyframe %d B, delta %d B, decoded and rebuilt" % (len(v1.att), len(v2.att))
     return "keyframe %d B, delta %d B (magic/size only)" % (len(v1.att), len(v2.att))
+
+
+def _shq_answer(ctx, c, wait):
+    """TICK on an shq delta subscription, then its answer: (the TICK reply, the
+    VOLUME or None, how "none" was seen). R5.16: a tick that moved no cell
+    beyond the bound sends no VOLUME and counts in STATS
+    "session_stream_unchanged" (a VOLUME sent before a STATS reply arrives
+    before it); a server that skips such a tick altogether (R7.3a) counts
+    nothing, so "none" is also no VOLUME within ``wait`` seconds."""
+    before = expect_reply(c.request(STATS, {}), STATS).body.get("session_stream_unchanged")
+    check(isinstance(before, int), "STATS has no integer \"session_stream_unchanged\" (R5.16): %r" % (before,))
+    t = expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    deadline = time.monotonic() + wait
+    while True:
+        vols = [s for s in c.streams if s.type == VOLUME]
+        if vols:
+            c.streams.remove(vols[0])
+            return t, vols[0], None
+        st = expect_reply(c.request(STATS, {}), STATS).body
+        if st.get("session_stream_unchanged", 0) > before:
+            check(st.get("stream_unchanged", 0) >= st["session_stream_unchanged"], "STATS stream_unchanged %r < "
+                  "session_stream_unchanged %r" % (st.get("stream_unchanged"), st["session_stream_unchanged"]))
+            return t, None, "counted in session_stream_unchanged"
+        if time.monotonic() > deadline:
+            return t, None, "no VOLUME within %g s" % wait
+        time.sleep(0.02)
+
+
+@case("R5.16 R5.3", "shq delta stream (bound 0.01): a keyframe, then per 1 cm light move a delta of the cells "
+      "moved beyond the bound (or nothing), each rebuilt volume within the bound of GET_VOLUME fp32 of the newest "
+      "tick; a TICK without a change sends no VOLUME")
+def c_delta_shq(ctx):
+    lt = unique_light("shq")
+    c, cfg, _ = ctx.scene_session(tick=False, light=lt)
+    expect_reply(c.request(SUBSCRIBE, {"stream": "volume", "compression": "shq", "delta": True,
+                                       "error_bound": 0.01}), SUBSCRIBE)
+    held, acked, kinds, worst = None, None, [], 0.0
+    for step in range(7):
+        moved = 1 <= step <= 4
+        if moved:
+            lt["position"] = [lt["position"][0] + 0.01] + lt["position"][1:]
+            expect_reply(c.request(LIGHT_SET, lt), LIGHT_SET)
+        t, v, none = _shq_answer(ctx, c, ctx.tick_timeout if step < 5 else 2.0)
+        if v is None:
+            check(held is not None, "no VOLUME for the first TICK of the subscription (%s)" % none)
+            kinds.append("none")
+        else:
+            check(step < 5, "a VOLUME (tick %r, %s) for a TICK that changed nothing (R5.16)" % (
+                v.body.get("tick"), "keyframe" if v.body.get("keyframe") else "delta"))
+            _vol_header_checks(v.body, "fp32", "shq", SMALL_CONFIG["grid"])
+            check(v.body.get("error_bound") == 0.01, "VOLUME error_bound %r, subscribed 0.01"
+                  % (v.body.get("error_bound"),))
+            check(v.body["tick"] == t.body.get("tick"), "VOLUME tick %r, TICK reply tick %r" % (
+                v.body["tick"], t.body.get("tick")))
+            if held is None:
+                check(v.body["keyframe"] is True, "the first VOLUME is not a keyframe")
+            elif not v.body["keyframe"]:
+                check(v.body.get("base_tick") == acked, "delta against tick %r, the client acknowledged %r"
+                      % (v.body.get("base_tick"), acked))
+            payload = zstd_decompress_cli(v.att)
+            if payload is None:
+                return "no zstd tool: the stream's payloads cannot be checked (%d B keyframe)" % len(v.att)
+            held, sent = _shq_decode(v.body, payload, held)
+            kinds.append("keyframe" if v.body["keyframe"] else "delta/%d of %d cells" % (sent, len(held) // 48))
+            acked = v.body["tick"]
+            c.send(ACK, {"stream": "volume", "tick": acked})
+        g = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+        check(g.body["tick"] == t.body.get("tick"), "GET_VOLUME tick %r, the newest TICK %r" % (
+            g.body["tick"], t.body.get("tick")))
+        worst = max(worst, _shq_bound_checks(held, g.att, 0.01, len(held) // 48, "the stream after tick %r"
+                                             % g.body["tick"]))
+        if not moved and step:
+            kinds[-1] += " (%s)" % none
+    check(any(k.startswith("delta") for k in kinds[1:5]), "no delta for a light moved 1 cm: %s" % ", ".join(kinds))
+    ctx.ping(c)
+    check(not [s for s in c.streams if s.type == VOLUME], "a VOLUME after the unchanged TICKs")
+    return "%s; every cell within %.2f of the bound" % (", ".join(kinds), worst)

@@ -1,7 +1,7 @@
 """conf_volume_checks.py - checks shared by the volume, stream and plan cases: a volume header
 (R5.1, R5.6), its "volume" description (R5.9 - R5.15), the tick plan (SPEC section 8),
-R5.14's and R5.15's irradiance lookups written from the SPEC, and technique iv's and probes'
-small CONFIGs."""
+R5.14's and R5.15's irradiance lookups and R5.16's shq decoding and bound written from the
+SPEC, and technique iv's and probes' small CONFIGs."""
 
 import math
 import struct
@@ -502,3 +502,110 @@ def _probes_lookup(d, vis, p, n, stats=None):
             stats["blend"] = stats.get("blend", 0) + 1
             E = [E1[i] + (E[i] - E1[i]) * om for i in range(3)]
     return E
+
+
+# R5.16: compression "shq", written from the SPEC (protocol/volume_shq.c is the server's)
+SHQ_CODECS = {"compression": ["none", "zstd", "shq"], "error_bound": {"min": 0.001, "max": 0.25, "default": 0.01}}
+SHQ_VALUE_LIMIT = _f32(1e30)  # exact values beyond it are clamped (binary32 1e30), NaN is 0, before the bound
+SHQ_TINY = 1e-30        # a cell of smaller magnitude is held as zero
+
+
+def _shq_steps(b, x):
+    """round(b x 2^-x), half to even, of a binary32 b, in exact integers
+    (R5.16's mode 1: the base's value in the new steps)."""
+    n, d = b.as_integer_ratio()  # d a power of two
+    num, den = (n << -x, d) if x <= 0 else (n, d << x)
+    q, r = divmod(num, den)  # q = floor
+    return q + 1 if 2 * r > den or (2 * r == den and q % 2) else q
+
+
+def _shq_decode(h, payload, base=None):
+    """R5.16's payload (the zstd frame's content) checked against header h
+    and decoded: (the raw fp32 volume of raw_length bytes, S the cells
+    sent). A delta's cells not flagged keep base's bytes (the volume rebuilt
+    for the acknowledged tick) and its bytes after the values are XOR'd with
+    the base's; a delta's cell of mode 1 sends the change from the base's
+    cell in its steps."""
+    raw_length = h["raw_length"]
+    ix = (h.get("volume") or {}).get("index")
+    values = ix["raw_offset"] if ix else raw_length
+    check(values % 48 == 0, "R5.16: %d bytes of values are not whole cells of 12 fp32 values" % values)
+    C, X = values // 48, raw_length - values
+    check(len(payload) >= 32 and payload[:4] == b"SHQ1", "R5.16: the payload (%d bytes) starts %r, not \"SHQ1\""
+          % (len(payload), bytes(payload[:4])))
+    flags, c, s, x = struct.unpack_from("<IQQQ", payload, 4)
+    key = flags == 1
+    check(flags in (0, 1), "R5.16: payload flags 0x%x (bit 0 alone is defined)" % flags)
+    check(key == h["keyframe"], "R5.16: payload flags say keyframe %r, the header %r" % (key, h["keyframe"]))
+    check(c == C and x == X, "R5.16: payload counts C %d, X %d; the header's volume has %d cells and %d bytes after "
+          "them" % (c, x, C, X))
+    check(s <= C and (not key or s == C), "R5.16: %d cells sent of %d in a %s" % (s, C, "keyframe" if key else
+                                                                                  "delta"))
+    map_len = 0 if key else (C + 7) // 8
+    per = 25 if key else 26  # exponent, a delta's mode, 12 two-byte mantissas
+    check(len(payload) == 32 + map_len + per * s + X, "R5.16: payload of %d bytes, 32 + %d + %d x %d + %d = %d "
+          "expected" % (len(payload), map_len, per, s, X, 32 + map_len + per * s + X))
+    if key:
+        sent = range(C)
+    else:
+        check(base is not None and len(base) == raw_length, "a delta without the acknowledged base of %d bytes"
+              % raw_length)
+        sent = [i for i in range(C) if payload[32 + i // 8] >> (i % 8) & 1]
+        past = [b for b in range(C, 8 * map_len) if payload[32 + b // 8] >> (b % 8) & 1]
+        check(len(sent) == s and not past, "R5.16: the bit map flags %d cells (%d past C), S is %d"
+              % (len(sent), len(past), s))
+    at = 32 + map_len
+    modes = [0] * s if key else payload[at + s:at + 2 * s]
+    lo = at + (1 if key else 2) * s
+    hi = lo + 12 * s
+    out = bytearray(values) if key else bytearray(base[:values])
+    for j, i in enumerate(sent):
+        x = struct.unpack_from("<b", payload, at + j)[0]
+        check(modes[j] in (0, 1) and not (modes[j] == 1 and x == -128), "R5.16: sent cell %d (cell %d) has mode %d "
+              "with exponent %d" % (j, i, modes[j], x))
+        b = struct.unpack_from("<12f", base, 48 * i) if modes[j] == 1 else None
+        cell = []
+        for k in range(12):
+            z = payload[lo + k * s + j] + 256 * payload[hi + k * s + j]
+            q = z // 2 if z % 2 == 0 else -(z + 1) // 2
+            if b is not None:
+                q += _shq_steps(b[k], x)
+            cell.append(0.0 if x == -128 else math.ldexp(q, x))
+            check(x == -128 or (abs(q) < 2 ** 53 and abs(cell[-1]) < 2.0 ** 128
+                                and struct.unpack("<f", struct.pack("<f", cell[-1]))[0] == cell[-1]),
+                  "R5.16: cell %d's value %d is %d x 2^%d (mode %d), not exact in binary32" % (i, k, q, x, modes[j]))
+        struct.pack_into("<12f", out, 48 * i, *cell)
+    tail = bytes(payload[hi + 12 * s:])
+    if not key:
+        tail = bytes(a ^ b for a, b in zip(tail, base[values:]))
+    return bytes(out) + tail, s
+
+
+def _shq_magnitude(c):
+    """R5.16's M of 12 values: max over channels of L0 |c0| + L1 |(c1, c2, c3)|."""
+    return max(SH_LOBE0 * abs(c[4 * ch]) + SH_LOBE1 * math.sqrt(sum(v * v for v in c[4 * ch + 1:4 * ch + 4]))
+               for ch in range(3))
+
+
+def _shq_bound_checks(held, exact, bound, n, what):
+    """R5.16's bound: each of the n cells c~ of held (raw fp32 bytes)
+    satisfies D(c~, c) <= bound x M(c), c exact's cell (NaN 0, clamped to
+    1e30), to float rounding (1e-6 M + 1e-30; below 1e-30 a cell is held as
+    zero). The bytes after the values (an index) must be exact's. Returns
+    the largest D / (bound M) over the cells with M > 0."""
+    check(len(held) == len(exact), "%s: %d bytes, the exact volume %d" % (what, len(held), len(exact)))
+    check(held[48 * n:] == exact[48 * n:], "R5.16: %s: the %d bytes after the values differ from the exact volume's"
+          % (what, len(exact) - 48 * n))
+    a = struct.unpack_from("<%df" % (12 * n), held)
+    e = [0.0 if v != v else min(max(v, -SHQ_VALUE_LIMIT), SHQ_VALUE_LIMIT)
+         for v in struct.unpack_from("<%df" % (12 * n), exact)]
+    worst = 0.0
+    for i in range(n):
+        c = e[12 * i:12 * i + 12]
+        M = _shq_magnitude(c)
+        D = _shq_magnitude([x - y for x, y in zip(a[12 * i:12 * i + 12], c)])
+        check(D <= bound * M + 1e-6 * M + SHQ_TINY, "R5.16: %s: cell %d is D = %.6g from the exact volume's, over "
+              "the bound %g x M = %g x %.6g" % (what, i, D, bound, bound, M))
+        if M > 0.0:
+            worst = max(worst, D / (bound * M))
+    return worst

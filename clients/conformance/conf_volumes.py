@@ -1,5 +1,6 @@
 """conf_volumes.py - conformance cases: volumes from GET_VOLUME: the description, octree levels,
-technique iv, technique probes' visibility, layout, fp16, zstd, dims (R5.1 - R5.15)."""
+technique iv, technique probes' visibility, layout, fp16, zstd, dims, and compression shq's
+codecs, bound and refusals (R5.1 - R5.16)."""
 
 import math
 import os
@@ -12,8 +13,8 @@ from conf_payloads import (
     SMALL_CONFIG, box_scene_glb, f16_list, f32_list, zstd_decompress_cli, zstd_frame_content_size)
 from conf_core import Fail, case, check, expect_error, expect_reply, is_finite_list, unique_light
 from conf_volume_checks import (
-    IV_CONFIG, IV_VOXELS_ROLE, PROBES_CONFIG, SH_LOBE0, SH_LOBE1, _description_checks, _iv_levels, _iv_lookup,
-    _iv_techniques, _octree_levels, _probes_lookup, _vol_header_checks)
+    IV_CONFIG, IV_VOXELS_ROLE, PROBES_CONFIG, SH_LOBE0, SH_LOBE1, SHQ_CODECS, _description_checks, _iv_levels,
+    _iv_lookup, _iv_techniques, _octree_levels, _probes_lookup, _shq_bound_checks, _shq_decode, _vol_header_checks)
 
 
 # ---------------------------------------------------------------------------
@@ -623,3 +624,86 @@ def c_volume_dims(ctx):
     check(len(f.att) == cells * 48 == 8 * 12 * 6 * 48 * len(f.body["cascades"]),
           "attachment %d bytes, expected %d" % (len(f.att), cells * 48))
     return "8x12x6 x %d cascade(s) = %d cells" % (len(f.body["cascades"]), cells)
+
+
+@case("R5.16 R4.12", "HELLO lists volume_codecs: the compressions none, zstd, shq and shq's error bounds")
+def c_volume_codecs(ctx):
+    ctx.session().close()
+    codecs = (ctx.hello_reply or {}).get("volume_codecs")
+    check(isinstance(codecs, dict), "HELLO reply has no object \"volume_codecs\": %r" % (codecs,))
+    check(codecs == SHQ_CODECS, "HELLO volume_codecs %r, R5.16 says %r" % (codecs, SHQ_CODECS))
+    return "volume_codecs %r" % (codecs,)
+
+
+def _shq_get_volume(c, bound, dims=None):
+    """GET_VOLUME compression "shq" (bound None: the default), then fp32 and
+    "none" of the same tick: the header, the zstd frame and the payload
+    checked, every cell within the bound of the exact volume. Returns a
+    note."""
+    body = {"compression": "shq"}
+    if bound is not None:
+        body["error_bound"] = bound
+    q = expect_reply(c.request(GET_VOLUME, body), GET_VOLUME)
+    x = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
+    _vol_header_checks(q.body, "fp32", "shq", dims)
+    want = SHQ_CODECS["error_bound"]["default"] if bound is None else bound
+    check(q.body.get("error_bound") == want, "header error_bound %r, asked %r" % (q.body.get("error_bound"), bound))
+    check(q.body["keyframe"] is True, "GET_VOLUME shq is not a keyframe")
+    check(q.body["tick"] == x.body["tick"] and q.body["revision"] == x.body["revision"],
+          "shq of tick %r (revision %r), fp32 of tick %r (revision %r)" % (
+              q.body["tick"], q.body["revision"], x.body["tick"], x.body["revision"]))
+    check(q.body["raw_length"] == x.body["raw_length"] == len(x.att), "raw_length %r, the fp32 volume's %r (%d bytes)"
+          % (q.body["raw_length"], x.body["raw_length"], len(x.att)))
+    ok, size, why = zstd_frame_content_size(q.att)
+    check(ok, "R5.16 (R5.2): %s" % why)
+    payload = zstd_decompress_cli(q.att)
+    label = "bound %g%s" % (want, " (the default)" if bound is None else "")
+    if payload is None:
+        return "%s: %d B (zstd frame only: no zstd tool)" % (label, len(q.att))
+    check(size is None or size == len(payload), "zstd frame content size %r, the payload is %d bytes"
+          % (size, len(payload)))
+    raw, cells = _shq_decode(q.body, payload)  # a keyframe: every cell sent
+    worst = _shq_bound_checks(raw, x.att, want, cells, "GET_VOLUME shq %g" % want)
+    return "%s: %d B for %d B of fp32, %d cells within %.2f of the bound" % (label, len(q.att), len(x.att), cells,
+                                                                              worst)
+
+
+@case("R5.16 R5.2", "GET_VOLUME compression shq at bounds 0.01, 0.1 and the default: format fp32, error_bound, "
+      "every cell within the bound of GET_VOLUME fp32 of the same tick; an iv volume's index as is")
+def c_volume_shq(ctx):
+    c, cfg, t = ctx.scene_session(light=unique_light("shq-get"))
+    notes = [_shq_get_volume(c, b, SMALL_CONFIG["grid"]) for b in (0.01, 0.1, None)]
+    if "iv" in _iv_techniques(ctx):  # a volume with an index after its values (R5.12, R5.14): X bytes
+        c, cfg, t = ctx.scene_session(config=IV_CONFIG, light=unique_light("shq-iv"))
+        notes.append("iv " + _shq_get_volume(c, 0.05))
+    return "; ".join(notes)
+
+
+@case("R5.16 R2.9", "BAD_FIELD for error_bound out of range or not a number, error_bound without shq, fp16 with "
+      "shq, shq with content levels (GET_VOLUME and SUBSCRIBE); nothing is subscribed")
+def c_volume_shq_refused(ctx):
+    octree = "octree" in _iv_techniques(ctx)  # content "levels" is valid there: the refusal is shq's
+    config = dict(SMALL_CONFIG, grid=[8, 8, 8], technique="octree") if octree else None
+    c, cfg, t = ctx.scene_session(config=config, light=unique_light("shq-bad"))
+    bad = [({"compression": "shq", "error_bound": 0.0005}, "error_bound"),
+           ({"compression": "shq", "error_bound": 0.5}, "error_bound"),
+           ({"compression": "shq", "error_bound": "x"}, "error_bound"),
+           ({"compression": "zstd", "error_bound": 0.01}, "error_bound"),
+           ({"compression": "shq", "format": "fp16"}, "format")]
+    for body, field in bad:
+        for req, extra in ((GET_VOLUME, {}), (SUBSCRIBE, {"stream": "volume"})):
+            rid = c.send(req, dict(body, **extra))
+            expect_error(c.recv_reply(rid), "BAD_FIELD", rid, field)
+    if octree:
+        expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "zstd", "content": "levels"}),
+                     GET_VOLUME, what="content levels of an octree session with zstd")
+    rid = c.send(GET_VOLUME, {"compression": "shq", "content": "levels"})
+    f = c.recv_reply(rid)
+    expect_error(f, "BAD_FIELD", rid)
+    check("shq" in f.body["message"] or "compression" in f.body["message"] or "content" in f.body["message"],
+          "shq with content levels refused with %r, naming neither compression nor content" % f.body["message"])
+    expect_reply(c.request(TICK, {}, timeout=ctx.tick_timeout), TICK)
+    ctx.ping(c)
+    check(not [s for s in c.streams if s.type == VOLUME], "a refused SUBSCRIBE subscribed: a VOLUME came")
+    return "%d refusals each for GET_VOLUME and SUBSCRIBE, and shq with content levels (%s): %s" % (
+        len(bad), "octree" if octree else "lpv", f.body["message"])

@@ -204,11 +204,12 @@ int save_volume(const lpvc_volume *v, const char *path)
     return rc;
 }
 
-enum { VOL_OUTPUT, VOL_FORMAT, VOL_COMPRESSION, VOL_CONTENT, VOL_COUNT };
+enum { VOL_OUTPUT, VOL_FORMAT, VOL_COMPRESSION, VOL_BOUND, VOL_CONTENT, VOL_COUNT };
 static const lpv_flag VOLUME_FLAGS[VOL_COUNT] = {
     [VOL_OUTPUT] = {"output", 'o', "FILE.bin|FILE.json", ""},
     [VOL_FORMAT] = {"format", 0, "fp16|fp32", ""},
-    [VOL_COMPRESSION] = {"compression", 0, "zstd|none", ""},
+    [VOL_COMPRESSION] = {"compression", 0, "zstd|none|shq", ""},
+    [VOL_BOUND] = {"error-bound", 0, "E", ""},
     [VOL_CONTENT] = {"content", 0, "merged|levels|visibility", ""},
 };
 
@@ -227,6 +228,13 @@ int cmd_volume(int argc, char **argv)
         case VOL_OUTPUT: out = v; break;
         case VOL_FORMAT: d.format = v; break;
         case VOL_COMPRESSION: d.compression = v; break;
+        case VOL_BOUND: {
+            float e;
+            if (parse_float(v, &e) != 0 || !(e > 0.0f))
+                return usage_error("bad --error-bound '%s' (a fraction, e.g. 0.01)", v);
+            d.error_bound = e;
+            break;
+        }
         case VOL_CONTENT: d.content = v; break;
         }
     }

@@ -18,12 +18,13 @@ static int stream_of(const char *s, enum lpvc_stream *out)
     return 0;
 }
 
-enum { SUB_DELTA, SUB_TICK, SUB_FORMAT, SUB_COMPRESSION, SUB_N, SUB_WAIT, SUB_OUTPUT, SUB_COUNT };
+enum { SUB_DELTA, SUB_TICK, SUB_FORMAT, SUB_COMPRESSION, SUB_BOUND, SUB_N, SUB_WAIT, SUB_OUTPUT, SUB_COUNT };
 static const lpv_flag SUB_FLAGS[SUB_COUNT] = {
     [SUB_DELTA] = {"delta", 0, NULL, ""},
     [SUB_TICK] = {"tick", 0, NULL, ""},
     [SUB_FORMAT] = {"format", 0, "F", ""},
-    [SUB_COMPRESSION] = {"compression", 0, "zstd|none", ""},
+    [SUB_COMPRESSION] = {"compression", 0, "zstd|none|shq", ""},
+    [SUB_BOUND] = {"error-bound", 0, "E", ""},
     [SUB_N] = {"count", 'n', "COUNT", ""},
     [SUB_WAIT] = {"wait", 0, "MS", ""},
     [SUB_OUTPUT] = {"output", 'o', "PREFIX", ""},
@@ -50,6 +51,13 @@ int cmd_subscribe(int argc, char **argv)
         case SUB_TICK: tick = 1; break;
         case SUB_FORMAT: d.format = v; break;
         case SUB_COMPRESSION: d.compression = v; break;
+        case SUB_BOUND: {
+            float e;
+            if (parse_float(v, &e) != 0 || !(e > 0.0f))
+                return usage_error("bad --error-bound '%s' (a fraction, e.g. 0.01)", v);
+            d.error_bound = e;
+            break;
+        }
         case SUB_N:
             if (parse_int(v, 1, 1L << 30, &count) != 0)
                 return usage_error("bad count '%s'", v);
@@ -63,6 +71,11 @@ int cmd_subscribe(int argc, char **argv)
     }
     if (r < 0)
         return 2;
+    /* R5.16: an shq delta subscriber gets no VOLUME for a tick that moved
+     * nothing beyond its bound, so a TICK is not always answered by one */
+    const int quiet_ticks = tick && d.delta && d.compression && strcmp(d.compression, "shq") == 0;
+    if (quiet_ticks && wait_ms < 0)
+        wait_ms = 5000;
     if (lpvc_subscribe(g_c, &d) != 0)
         return server_error();
     print_reply();
@@ -70,8 +83,13 @@ int cmd_subscribe(int argc, char **argv)
         if (tick && lpvc_tick(g_c, NULL) != 0)
             return server_error();
         lpvc_message m;
-        if (lpvc_next_stream_message(g_c, &m, (int)wait_ms) != 0)
+        if (lpvc_next_stream_message(g_c, &m, (int)wait_ms) != 0) {
+            if (quiet_ticks && lpvc_error_code(g_c) == LPVC_ERR_TIMEOUT) {
+                printf("VOLUME: none within %ld ms of the TICK (shq: nothing moved beyond the bound)\n", wait_ms);
+                continue;
+            }
             return server_error();
+        }
         if (m.type == LPVC_MSG_BYE) {
             printf("subscribe: the server said BYE\n");
             return 0;

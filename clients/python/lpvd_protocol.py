@@ -4,12 +4,17 @@ attachments' compression and the tick plan's passes.
 
 Standard library only (os, struct); the ``zstandard`` module is used when
 importable, otherwise the client asks the server for ``"compression":
-"none"`` (the standard library has no zstd). One of the modules of the
-client; import ``lpvd_client``, which re-exports every name.
+"none"`` (the standard library has no zstd). Attachments that are zstd
+whatever the client asks (a volume of compression "shq", SPEC R5.16) are
+decompressed, without ``zstandard``, by the system's libzstd through ctypes
+(the library lpvd itself links). One of the modules of the client; import
+``lpvd_client``, which re-exports every name.
 
 The protocol is protocol/SPEC.md; section numbers below refer to it.
 """
 
+import ctypes
+import ctypes.util
 import os
 import struct
 
@@ -116,13 +121,73 @@ def _parse_address(address):
     return ("tcp", (host or "127.0.0.1", int(port)))
 
 
+_libzstd = []  # [the loaded library or None] once looked for
+
+
+def _load_libzstd():
+    """The system's libzstd (ctypes.CDLL) or None, looked for once, on the first
+    zstd attachment that arrives without the ``zstandard`` module: a client
+    that never sees one never runs ldconfig to find it."""
+    if not _libzstd:
+        lib = None
+        for name in (ctypes.util.find_library("zstd"), "libzstd.so.1", "libzstd.1.dylib"):
+            if not name:
+                continue
+            try:
+                lib = ctypes.CDLL(name)
+            except OSError:
+                continue
+            lib.ZSTD_decompress.restype = ctypes.c_size_t
+            lib.ZSTD_decompress.argtypes = (ctypes.c_void_p, ctypes.c_size_t, ctypes.c_char_p, ctypes.c_size_t)
+            lib.ZSTD_isError.restype = ctypes.c_uint
+            lib.ZSTD_isError.argtypes = (ctypes.c_size_t,)
+            lib.ZSTD_getErrorName.restype = ctypes.c_char_p
+            lib.ZSTD_getErrorName.argtypes = (ctypes.c_size_t,)
+            break
+        _libzstd.append(lib)
+    return _libzstd[0]
+
+
+def zstd_decoder():
+    """What decompresses zstd attachments here: "zstandard" (the module),
+    "libzstd" (the system library through ctypes) or None (neither: a zstd
+    attachment, e.g. every "shq" volume, raises ProtocolError)."""
+    if _zstd is not None:
+        return "zstandard"
+    return "libzstd" if _load_libzstd() is not None else None
+
+
+def _zstd_decompress(data, max_output):
+    """One zstd frame (SPEC R5.2) decompressed to at most max_output bytes;
+    ProtocolError when it is not one or holds more."""
+    if _zstd is not None:
+        try:
+            # decompress() trusts a frame's declared size over max_output_size
+            size = _zstd.frame_content_size(data)
+            if size > max_output:
+                raise ProtocolError("zstd attachment of %d bytes whose frame holds %d, more than the %d expected"
+                                    % (len(data), size, max_output))
+            return _zstd.ZstdDecompressor().decompress(data, max_output_size=max(max_output, 1))
+        except _zstd.ZstdError as e:
+            raise ProtocolError("zstd attachment of %d bytes: %s" % (len(data), e))
+    lib = _load_libzstd()
+    if lib is None:
+        raise ProtocolError("zstd-compressed attachment, but neither the 'zstandard' module nor the system's "
+                            "libzstd is there to decompress it")
+    data = bytes(data)
+    out = ctypes.create_string_buffer(max(max_output, 1))
+    n = lib.ZSTD_decompress(out, len(out), data, len(data))
+    if lib.ZSTD_isError(n):
+        raise ProtocolError("zstd attachment of %d bytes (at most %d decompressed): %s" % (
+            len(data), max_output, lib.ZSTD_getErrorName(n).decode("ascii", "replace")))
+    return out.raw[:n]
+
+
 def _decompress(data, compression, raw_length):
     if compression in (None, "none"):
         return bytes(data)
     if compression == "zstd":
-        if _zstd is None:
-            raise ProtocolError("zstd-compressed attachment but the 'zstandard' module is not installed")
-        return _zstd.ZstdDecompressor().decompress(data, max_output_size=max(raw_length, 1))
+        return _zstd_decompress(data, raw_length)
     raise ProtocolError("unknown compression %r" % compression)
 
 

@@ -2,7 +2,8 @@
 ``python3 lpvd_client.py --self-test ADDRESS`` runs ``main``, a short
 end-to-end check against a running daemon (exit status 0 on success), after
 the checks that need none; ``python3 lpvd_client.py --offline-self-test``
-runs only those (SPEC R5.15's decoding and lookup on hand-made payloads).
+runs only those (SPEC R5.15's decoding and lookup, R5.16's shq decoding,
+on hand-made payloads).
 
 Standard library only. One of the modules of the client; import
 ``lpvd_client``, which re-exports every name.
@@ -15,9 +16,11 @@ import math
 import struct
 import sys
 
-from lpvd_protocol import HAVE_ZSTD, LpvdError, ProtocolError, default_address, plan_lines
+from lpvd_protocol import HAVE_ZSTD, LpvdError, ProtocolError, default_address, plan_lines, zstd_decoder
 from lpvd_session import Client
-from lpvd_volume import HAVE_NUMPY, IV_UNITS, LOOKUP_VALUES, LPV_UNITS, LayoutError, Volume
+from lpvd_volume import (HAVE_NUMPY, IV_UNITS, LOOKUP_VALUES, LPV_UNITS, SH_LOBE0, SH_LOBE1, SHQ_BOUND_MAX, LayoutError,
+                         Volume, shq_bound_excess, shq_cell_distance, shq_cell_magnitude, shq_decode,
+                         shq_decode_payload, shq_distances)
 
 
 def _minimal_glb():
@@ -375,22 +378,271 @@ def _offline_probes(say):
         "green)" % (lpvd_volume._np is not None, len(wrong) + 3, wall[0], wall[1]))
 
 
+# -- offline: compression "shq" (SPEC R5.16) on hand-made payloads -----------
+
+def _shq_payload(sent, extra=b"", bitmap=None, cells=None, flags=None, counts=None, magic=b"SHQ1", modes=None):
+    """An R5.16 payload built by hand: ``sent`` the cells sent, in cell order,
+    each (x, [12 mantissas r]); ``bitmap`` a delta's bit map (None: a
+    keyframe); ``modes`` a delta's mode per cell sent (default: all 0, the
+    mantissas are the values' steps; a keyframe has none); ``cells`` C
+    (default: the cells sent); ``flags`` and ``counts`` (C, S, X) replace
+    what the rest says, for the refusals."""
+    S = len(sent)
+    C, S_, X = counts or (S if cells is None else cells, S, len(extra))
+    head = struct.pack("<4sIQQQ", magic, (1 if bitmap is None else 0) if flags is None else flags, C, S_, X)
+    zz = [[2 * q if q >= 0 else -2 * q - 1 for q in qs] for _, qs in sent]
+    lo = bytes(zz[j][k] & 0xFF for k in range(12) for j in range(S))
+    hi = bytes(zz[j][k] >> 8 for k in range(12) for j in range(S))
+    mode_bytes = b"" if bitmap is None else bytes([0] * S if modes is None else modes)
+    return (head + (bitmap or b"") + struct.pack("<%db" % S, *[x for x, _ in sent]) + mode_bytes + lo + hi
+            + extra)
+
+
+def _shq_value(x, q, b=None):
+    """Value q x 2^x as R5.16 says, in binary32 bytes: 0 for x = -128, infinity
+    past the largest binary32 (worked out with ** and struct, not as the
+    decoders do). ``b``: a delta's mode 1, the base's value (a binary32,
+    finite): q is then the mantissa plus b x 2^-x rounded half to even."""
+    if x == -128:
+        return struct.pack("<f", 0.0)
+    if b is not None:
+        steps = b * 2.0 ** -x  # exact: |b| < 2^128, 2^-x <= 2^127
+        near = math.floor(steps)
+        near += 1 if steps - near > 0.5 or (steps - near == 0.5 and near % 2) else 0
+        q += near
+    try:
+        return struct.pack("<f", q * 2.0 ** x)
+    except OverflowError:
+        return struct.pack("<f", math.copysign(float("inf"), q))
+
+
+def _zstd_raw_frame(data):
+    """``data`` as one zstd frame of raw (stored) blocks (RFC 8878 3.1.1): what
+    the server's zstd frames decode to, built without a compressor."""
+    out = struct.pack("<IB", 0xFD2FB528, 0xE0) + struct.pack("<Q", len(data))  # single segment, 8-byte size
+    at = 0
+    while True:
+        block = data[at:at + 65536]
+        at += len(block)
+        out += struct.pack("<I", (len(block) << 3) | (1 if at >= len(data) else 0))[:3] + block
+        if at >= len(data):
+            return out
+
+
+def _offline_shq(say):
+    """SPEC R5.16 without a daemon: a hand-made keyframe and delta decoded to
+    the values worked out by hand (through the session's delta bases and
+    zstd when a zstd decoder is there), a seeded payload of every exponent
+    against values computed another way, each rejection the SPEC names, and
+    D and M against values worked out by hand. Returns the seeded payload's
+    decoded bytes, which must not depend on numpy."""
+    import random
+    import lpvd_volume
+    # -- a keyframe of 3 cells and an 8-byte index: a zero cell (x = -128), the extreme mantissas, a
+    # subnormal (2^-127 x 1), a normal just above (3 x 2^-127), overflow to infinity (x = 127)
+    q1 = [5, -3, 0, 1, 32767, -32768, 7, -1, 2, 0, 0, 9]
+    key_cells = [(-3, q1), (-128, [1] * 12), (-127, [1, 3, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0]),
+                 (127, [0, 1, -1, 2, -3] + [0] * 7)]
+    index = b"\x01\x00\x00\x00\x00\x00\x00\x00"
+    want = b"".join(_shq_value(x, q) for x, qs in key_cells for q in qs) + index
+    got = shq_decode_payload(_shq_payload(key_cells, index), len(want), 4, True)
+    if got != want:
+        raise AssertionError("shq keyframe decoded as %r, by hand %r" % (got[:48], want[:48]))
+    if struct.unpack_from("<6f", got, 0)[::4] != (0.625, 32767 * 0.125) or struct.unpack_from("<f", got, 20) != (
+            -4096.0,) or struct.unpack_from("<4f", got, 148) != (2.0 ** 127, -2.0 ** 127, math.inf, -math.inf):
+        raise AssertionError("shq keyframe: q x 2^x is not 5/8, 32767/8, -32768/8, +-2^127, +-inf: %r, %r"
+                             % (struct.unpack_from("<6f", got), struct.unpack_from("<4f", got, 148)))
+    # -- a delta of 10 cells (a 2-byte bit map) re-sending cells 1, 3, 5, 6, 8 and 9 against a base of values
+    # i - 60 (value i of the volume); the index XOR'd. Cells 1, 6 (x = -128: zero), 8 and 9 are mode 0, the
+    # values' steps; cells 3 and 5 mode 1, the change from the base's cell in steps of 2^x: cell 3's base
+    # -24..-13 at x = 1 has the negative ties -11.5, -10.5, ..., -6.5 (to -12, -10, -10, -8, -8, -6), cell 5's
+    # 0..11 at x = 2 the ties 0.5, 1.5, 2.5 (to 0, 2, 2)
+    base = struct.pack("<120f", *[float(i - 60) for i in range(120)]) + b"\x0f\x00\xf0\x00"
+    resent = [(0, [1] * 12), (1, [0] * 10 + [1, -1]), (2, [0] * 11 + [3]), (-128, [5] * 12), (-2, [-2] * 12),
+              (4, list(range(12)))]
+    resent_at, modes, bitmap_d = (1, 3, 5, 6, 8, 9), [0, 1, 1, 0, 0, 0], b"\x6a\x03"
+    delta = _shq_payload(resent, b"\x01\x01\x01\x01", bitmap=bitmap_d, cells=10, modes=modes)
+    want = bytearray(base[:480])
+    for i, (x, qs), m in zip(resent_at, resent, modes):
+        want[48 * i:48 * i + 48] = b"".join(_shq_value(x, q, struct.unpack_from("<f", base, 48 * i + 4 * k)[0]
+                                                       if m else None) for k, q in enumerate(qs))
+    want = bytes(want) + b"\x0e\x01\xf1\x01"
+    got = shq_decode_payload(delta, len(base), 10, False, base)
+    if got != want:
+        raise AssertionError("shq delta: cells %r differ from the values by hand" % (
+            [i for i in range(10) if got[48 * i:48 * i + 48] != want[48 * i:48 * i + 48]],))
+    ties = (struct.unpack_from("<12f", got, 3 * 48), struct.unpack_from("<12f", got, 5 * 48),
+            struct.unpack_from("<12f", got, 6 * 48))
+    if ties != ((-24.0, -24.0, -22.0, -20.0, -20.0, -20.0, -18.0, -16.0, -16.0, -16.0, -12.0, -14.0),
+                (0.0, 0.0, 0.0, 4.0, 4.0, 4.0, 8.0, 8.0, 8.0, 8.0, 8.0, 24.0), (0.0,) * 12):
+        raise AssertionError("shq delta's mode 1: (r + round(b 2^-x)) 2^x, ties to even, is not %r" % (ties,))
+    # -- the same messages through a header, zstd and the session's delta bases (the ACKed tick's bytes)
+    header = {"revision": 1, "tick": 1, "format": "fp32", "compression": "shq", "error_bound": 0.01,
+              "keyframe": True, "grid": {"dims": [5, 2, 1], "origin": [0.0, 0.0, 0.0], "cell_size": 0.5},
+              "cascades": [{"dims": [5, 2, 1], "origin": [0.0, 0.0, 0.0], "cell_size": 0.5, "cells": 10}],
+              "units": LPV_UNITS, "raw_length": 480}
+    through = "payloads only (no zstd decoder)"
+    if zstd_decoder() is not None:
+        c = Client(connect=False)
+        vol = c._decode_volume(header, _zstd_raw_frame(_shq_payload(resent[:1] * 10)), ack=False)
+        if vol.error_bound != 0.01 or vol.compression != "shq" or vol.raw != b"".join(
+                _shq_value(0, 1) for _ in range(120)):
+            raise AssertionError("shq keyframe through zstd: bound %r, compression %r, %r" % (
+                vol.error_bound, vol.compression, vol.raw[:16]))
+        c._remember(1, base[:480])
+        vol = c._decode_volume(dict(header, tick=2, keyframe=False, base_tick=1),
+                               _zstd_raw_frame(_shq_payload(resent, bitmap=bitmap_d, cells=10, modes=modes)),
+                               ack=False)
+        if vol.raw != want[:480] or vol.keyframe or vol.base_tick != 1:
+            raise AssertionError("shq delta through zstd and the session's base differs from the values by hand")
+        for what, att in (("a payload that is not zstd", _shq_payload(resent[:1] * 10)),
+                          ("a zstd frame of more than the largest payload", _zstd_raw_frame(
+                              _shq_payload(resent[:1] * 10) + bytes(10 ** 4)))):
+            try:
+                shq_decode(att, header)
+                raise AssertionError("shq: %s was read" % what)
+            except ProtocolError as e:
+                if "zstd" not in str(e):
+                    raise AssertionError("shq: %s refused without naming zstd: %s" % (what, e))
+        through = "also through zstd (%s) and the session's delta bases" % zstd_decoder()
+    # -- a seeded keyframe of 300 cells of every exponent and mantissa range, and a delta of it
+    rnd = random.Random(16)
+    cells = [(rnd.choice([-128, -127, 127, 126]) if i % 7 == 0 else rnd.randint(-128, 127),
+              [rnd.randint(-32768, 32767) if k % 3 else rnd.randint(-3, 3) for k in range(12)]) for i in range(300)]
+    seeded = shq_decode_payload(_shq_payload(cells), 300 * 48, 300, True)
+    if seeded != b"".join(_shq_value(x, q) for x, qs in cells for q in qs):
+        raise AssertionError("shq: the seeded keyframe differs from q x 2^x worked out with ** (numpy: %s)"
+                             % (lpvd_volume._np is not None))
+    flags = [rnd.random() < 0.3 for _ in range(300)]
+    bitmap = bytes(sum(1 << b for b in range(8) if 8 * i + b < 300 and flags[8 * i + b]) for i in range(38))
+    seeded_delta = shq_decode_payload(_shq_payload([c for c, f in zip(cells, flags) if f], bitmap=bitmap, cells=300),
+                                      300 * 48, 300, False, seeded[::-1])
+    if seeded_delta != b"".join(seeded[48 * i:48 * i + 48] if f else seeded[::-1][48 * i:48 * i + 48]
+                                for i, f in enumerate(flags)):
+        raise AssertionError("shq: the seeded delta is not the cells sent over the base's")
+    # -- a seeded delta of modes 0 and 1 against a finite base of every range (ties at every exponent,
+    # subnormals, values near the largest binary32, so that some sums overflow to infinity, negative ones)
+    based = []
+    for i in range(300 * 12):
+        x, pick = cells[i // 12][0], rnd.random()  # ties: the base's b x 2^-x at k + 1/2 in the cell's own steps
+        based.append(rnd.choice([0.0, -0.0, 1e-45, -1e-45, 3.4e38, -3.4e38]) if pick < 0.05 else
+                     (rnd.randint(-4096, 4096) + 0.5) * 2.0 ** x if pick < 0.5 else
+                     rnd.randint(-2 ** 24, 2 ** 24) * 2.0 ** rnd.randint(-149, 103))
+    finite = struct.pack("<%df" % len(based), *[max(-3.4e38, min(3.4e38, v)) for v in based])
+    modes_s = [rnd.randint(0, 1) if x != -128 else 0 for x, _ in cells]
+    sent_s = [(c, m) for c, m, f in zip(cells, modes_s, flags) if f]
+    seeded_mixed = shq_decode_payload(_shq_payload([c for c, _ in sent_s], bitmap=bitmap, cells=300,
+                                                   modes=[m for _, m in sent_s]), 300 * 48, 300, False, finite)
+    want = []
+    for i, ((x, qs), m, f) in enumerate(zip(cells, modes_s, flags)):
+        want.append(b"".join(_shq_value(x, q, struct.unpack_from("<f", finite, 48 * i + 4 * k)[0] if m else None)
+                             for k, q in enumerate(qs)) if f else finite[48 * i:48 * i + 48])
+    if seeded_mixed != b"".join(want) or sum(m for m, f in zip(modes_s, flags) if f) < 20:
+        raise AssertionError("shq: the seeded delta of modes 0 and 1 differs from (r + round(b 2^-x)) 2^x worked "
+                             "out with ** (numpy: %s) in cells %r" % (lpvd_volume._np is not None, [
+                                 i for i in range(300) if seeded_mixed[48 * i:48 * i + 48] != want[i]][:10]))
+    # -- what a client MUST refuse (R5.16): header, magic, flags, counts, bit map, length
+    k3 = key_cells[:3]
+    refusals = [
+        ("the magic", lambda: shq_decode_payload(_shq_payload(k3, magic=b"SHQ2"), 144, 3, True), "SHQ1"),
+        ("an unknown flag", lambda: shq_decode_payload(_shq_payload(k3, flags=3), 144, 3, True), "flags"),
+        ("a keyframe flag where the header has a delta",
+         lambda: shq_decode_payload(_shq_payload(k3), 144, 3, False, bytes(144)), "keyframe"),
+        ("a delta flag where the header has a keyframe",
+         lambda: shq_decode_payload(_shq_payload(k3, bitmap=b"\x07", cells=3), 144, 3, True), "delta"),
+        ("C other than the header's", lambda: shq_decode_payload(_shq_payload(k3, index), 152, 4, True), "cells"),
+        ("X other than the header's", lambda: shq_decode_payload(_shq_payload(k3, index), 148, 3, True), "after"),
+        ("S over C", lambda: shq_decode_payload(_shq_payload(k3, bitmap=b"\x03", counts=(2, 3, 0)), 96, 2, False,
+                                                bytes(96)), "sent"),
+        ("a keyframe's S under C", lambda: shq_decode_payload(_shq_payload(k3[:2], counts=(3, 2, 0)), 144, 3, True),
+         "every cell"),
+        ("a bit map of other than S bits",
+         lambda: shq_decode_payload(_shq_payload(resent, bitmap=b"\x6a\x01", cells=10), 480, 10, False,
+                                    base[:480]), "bit map"),
+        ("a bit past C", lambda: shq_decode_payload(_shq_payload(resent, bitmap=b"\x6a\x06", cells=10), 480, 10,
+                                                    False, base[:480]), "past"),
+        ("a mode 2", lambda: shq_decode_payload(_shq_payload(resent, bitmap=bitmap_d, cells=10,
+                                                             modes=[0, 1, 2, 0, 0, 0]), 480, 10, False,
+                                                base[:480]), "mode 2"),
+        ("a mode 255", lambda: shq_decode_payload(_shq_payload(resent, bitmap=bitmap_d, cells=10,
+                                                               modes=[255, 1, 1, 0, 0, 0]), 480, 10, False,
+                                                  base[:480]), "mode 255"),
+        ("mode 1 with the zero exponent -128",
+         lambda: shq_decode_payload(_shq_payload(resent, bitmap=bitmap_d, cells=10, modes=[0, 1, 1, 1, 0, 0]),
+                                    480, 10, False, base[:480]), "zero exponent"),
+        ("a delta without its modes", lambda: shq_decode_payload(_shq_payload(resent, bitmap=bitmap_d, cells=10)[
+            :32 + 2 + 6] + _shq_payload(resent, bitmap=bitmap_d, cells=10)[32 + 2 + 12:], 480, 10, False,
+                                                                 base[:480]), "counts need"),
+        ("a byte more", lambda: shq_decode_payload(_shq_payload(k3) + b"\0", 144, 3, True), "counts need"),
+        ("a byte less", lambda: shq_decode_payload(_shq_payload(k3)[:-1], 144, 3, True), "counts need"),
+        ("a short head", lambda: shq_decode_payload(b"SHQ1" + bytes(20), 144, 3, True), "SHQ1"),
+        ("a delta without its base", lambda: shq_decode_payload(delta, len(base), 10, False), "base"),
+        ("a base of another length", lambda: shq_decode_payload(delta, len(base), 10, False, base[:-4]), "base"),
+    ]
+    for key, value, word in (("format", "fp16", "format"), ("error_bound", None, "error_bound"),
+                             ("error_bound", SHQ_BOUND_MAX * 2, "error_bound"), ("error_bound", 0.0005, "error_bound"),
+                             ("error_bound", "0.01", "error_bound"), ("error_bound", True, "error_bound"),
+                             ("volume", {"values_per_cell": 13, "index": None}, "merged"),
+                             ("volume", {"values_per_cell": 12, "index": None, "visibility": {}}, "visibility"),
+                             ("raw_length", 481, "whole cells")):
+        h = dict(header)
+        if value is None:
+            del h[key]
+        else:
+            h[key] = value
+        refusals.append(("a header's %s %r" % (key, value), lambda h=h: shq_decode(b"", h), word))
+    refusals.append(("a Volume of compression shq in fp16", lambda: Volume(dict(header, format="fp16"),
+                                                                           bytes(240)), "fp32"))
+    for what, decode, word in refusals:
+        try:
+            decode()
+            raise AssertionError("shq: %s was read" % what)
+        except ProtocolError as e:
+            if word not in str(e):
+                raise AssertionError("shq: %s refused without saying %r: %s" % (what, word, e))
+    # -- D and M (R5.16) by hand: exact (1, 0, 0, 0) per channel has M = L0; held (1, 0.01, 0, 0) in red is
+    # L1 x 0.01 off, over the bound 0.011 (L0 x 0.011 < L1 x 0.01) and within 0.012; a NaN counts as 0
+    exact = [1.0, 0.0, 0.0, 0.0] * 3
+    held = [1.0, 0.01, 0.0, 0.0] + [1.0, 0.0, 0.0, 0.0] * 2
+    if not _close([shq_cell_magnitude(exact), shq_cell_magnitude([0, 3, 4, 0] + [0] * 8),
+                   shq_cell_distance(held, exact)], [SH_LOBE0, 5 * SH_LOBE1, 0.01 * SH_LOBE1], 1e-12):
+        raise AssertionError("shq: M and D differ from L0, 5 L1 and 0.01 L1")
+    pack = struct.Struct("<12f").pack
+    D, M = shq_distances(pack(*held) + pack(*[0.0] * 12), pack(*exact) + pack(float("nan"), *[0.0] * 11))
+    over, cell = shq_bound_excess(pack(*held), pack(*exact), 0.011)
+    within = shq_bound_excess(pack(*held), pack(*exact), 0.012)[0]
+    if not (_close([float(v) for v in D] + [float(v) for v in M], [0.01 * SH_LOBE1, 0.0, SH_LOBE0, 0.0], 1e-6)
+            and over > 0 and cell == 0 and within <= 0):
+        raise AssertionError("shq: D %r, M %r, excess %r at cell %r over 0.011, %r within 0.012" % (
+            list(D), list(M), over, cell, within))
+    say("offline R5.16 (numpy: %s): a hand-made keyframe (zero, subnormal, infinite values) and delta decoded to the "
+        "values by hand (mode 1: ties to even, negative), %s; seeded payloads of 300 cells as q x 2^x and (r + "
+        "round(b 2^-x)) 2^x; %d malformed payloads and headers refused; "
+        "D and M by hand" % (lpvd_volume._np is not None, through, len(refusals)))
+    return seeded + seeded_delta + seeded_mixed
+
+
 def offline_self_test(out=sys.stdout):
     """The client's checks that need no daemon (SPEC R5.15's decoding and
-    lookup on hand-made payloads), with numpy when it is importable and
-    again without it. Returns 0 on success, raises AssertionError."""
+    lookup and R5.16's shq decoding on hand-made payloads), with numpy when
+    it is importable and again without it (the two shq decoders must give
+    the same bytes). Returns 0 on success, raises AssertionError."""
     import lpvd_volume
 
     def say(msg):
         out.write("self-test: %s\n" % msg)
         out.flush()
     np_ = lpvd_volume._np
+    shq = []
     try:
         for np_now in ([np_, None] if np_ is not None else [None]):
             lpvd_volume._np = np_now
             _offline_probes(say)
+            shq.append(_offline_shq(say))
     finally:
         lpvd_volume._np = np_
+    if any(b != shq[0] for b in shq):
+        raise AssertionError("shq: numpy's and the standard library's decoders give different bytes")
     return 0
 
 
@@ -438,6 +690,47 @@ def _self_test_probes(c, say):
             vis.probes, vis.irradiance_side, vis.distance_side,
             sum(1 for i in range(vis.probes) if vis.probe(i)[3] != 0.0), len(points), close, peak,
             max(errs) / peak))
+
+
+def _self_test_shq(c, centre, say):
+    """SPEC R5.16: GET_VOLUME compression "shq" at two bounds and a delta
+    stream of it (a light moved 1 cm, then nothing changed), each volume the
+    client holds within the bound of GET_VOLUME fp32 of the newest tick."""
+    codecs = c.volume_codecs or {}
+    if "shq" not in codecs.get("compression", ()):
+        raise AssertionError("HELLO's volume_codecs %r do not list \"shq\"" % (codecs,))
+    if zstd_decoder() is None:
+        say("compression shq: not decoded (neither the zstandard module nor libzstd is there)")
+        return
+
+    def within(held, bound, what, tick):
+        exact = c.get_volume(format="fp32", compression="none")
+        excess, cell = shq_bound_excess(held.raw, exact.raw, bound)
+        if exact.tick != tick or excess > 0.0:
+            raise AssertionError("shq %s (tick %s) vs the exact volume of tick %s (newest: %s): cell %s is %.3g past "
+                                 "the bound %g" % (what, held.tick, exact.tick, tick, cell, excess, bound))
+    for bound in (0.01, 0.1):
+        vol = c.get_volume(compression="shq", error_bound=bound)
+        if vol.error_bound != bound or vol.format != "fp32":
+            raise AssertionError("GET_VOLUME shq: error_bound %r, format %r" % (vol.error_bound, vol.format))
+        within(vol, bound, "GET_VOLUME at %g" % bound, vol.tick)
+    c.subscribe("volume", compression="shq", delta=True, error_bound=0.01)
+    kinds, held = [], None
+    for step in range(3):
+        if step == 1:  # a light moved 1 cm re-sends the cells it moved beyond the bound; step 2 changes nothing
+            c.light_set("self-test", "point", 0.5, position=(centre[0] + 0.01, centre[1], centre[2]))
+        t, vol = c.tick_volume()
+        kinds.append("none" if vol is None else "keyframe" if vol.keyframe else "delta/%s" % vol.base_tick)
+        held = vol if vol is not None else held
+        if held is None:
+            raise AssertionError("no VOLUME after the first TICK of an shq subscription")
+        within(held, 0.01, "stream", t.get("tick"))
+    c.unsubscribe("volume")
+    if kinds[0] != "keyframe" or kinds[2] != "none":
+        raise AssertionError("shq stream: %s, expected a keyframe first and nothing for a tick without a change"
+                             % ", ".join(kinds))
+    say("compression shq (%s) -> GET_VOLUME at 0.01 and 0.1 and the stream at 0.01 (%s) within the bound of "
+        "GET_VOLUME fp32" % (zstd_decoder(), ", ".join(kinds)))
 
 
 def self_test(address, token=None, glb=None, out=sys.stdout):
@@ -544,6 +837,7 @@ def self_test(address, token=None, glb=None, out=sys.stdout):
         kinds.append("keyframe" if sv.keyframe else "delta/%s" % sv.base_tick)
     c.unsubscribe("volume")
     say("VOLUME stream (fp16, delta) -> %s, each equal to GET_VOLUME of its tick" % ", ".join(kinds))
+    _self_test_shq(c, centre, say)
     # SPEC R5.15: the probes' visibility only from technique probes
     try:
         c.get_volume(content="visibility")
@@ -626,5 +920,5 @@ def main(argv):
     except (LpvdError, ProtocolError, OSError, AssertionError, ValueError, LayoutError) as e:
         sys.stderr.write("self-test FAILED: %s: %s\n" % (type(e).__name__, e))
         return 1
-    print("self-test passed (numpy: %s, zstandard: %s)" % (HAVE_NUMPY, HAVE_ZSTD))
+    print("self-test passed (numpy: %s, zstandard: %s, zstd decoder: %s)" % (HAVE_NUMPY, HAVE_ZSTD, zstd_decoder()))
     return rc

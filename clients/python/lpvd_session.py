@@ -12,10 +12,11 @@ The protocol is protocol/SPEC.md; section numbers below refer to it.
 import json
 import socket
 import struct
+import time
 
 from lpvd_protocol import (ERROR_NAMES, HEADER, MAGIC, MSG, REPLY_BIT, SERVER_BYE, VERSION, LpvdError,
                            ProtocolError, _decompress, _default_compression, _parse_address, default_address)
-from lpvd_volume import Volume, _np, _xor
+from lpvd_volume import SHQ_COMPRESSION, Volume, _np, _xor, shq_decode
 
 
 class Frame(object):
@@ -257,6 +258,15 @@ class Client(object):
         """The GI techniques the server offers (HELLO "techniques", SPEC R4.14)."""
         return list((self.hello_reply or {}).get("techniques", []))
 
+    @property
+    def volume_codecs(self):
+        """The volume compressions the server sends and shq's error bounds
+        (HELLO "volume_codecs", SPEC R5.16): {"compression": ["none", "zstd",
+        "shq"], "error_bound": {"min", "max", "default"}}; None from a server
+        without shq."""
+        codecs = (self.hello_reply or {}).get("volume_codecs")
+        return dict(codecs) if isinstance(codecs, dict) else None
+
     @staticmethod
     def knob_value(knob, v):
         """v checked against a knob's description and typed for CONFIG:
@@ -298,12 +308,20 @@ class Client(object):
     def tick(self):
         return self.request(MSG["TICK"], {})[0]
 
-    def subscribe(self, stream="volume", format=None, compression=None, delta=None):
+    def subscribe(self, stream="volume", format=None, compression=None, delta=None, error_bound=None):
+        """SUBSCRIBE. A volume stream defaults to fp32 with deltas; with
+        compression "shq" (SPEC R5.16) each volume is quantised to
+        ``error_bound`` (None: the server's default, HELLO's
+        volume_codecs), a delta re-sends only the cells that moved beyond it,
+        and a tick whose cells all stayed within it sends no VOLUME at all
+        (the volume held stays within the bound of the newest tick)."""
         body = {"stream": stream}
         if stream == "volume":
             body["format"] = format or "fp32"
             body["compression"] = compression or _default_compression()
             body["delta"] = True if delta is None else bool(delta)
+            if error_bound is not None:
+                body["error_bound"] = error_bound
         else:
             if format is not None:
                 body["format"] = format
@@ -315,8 +333,11 @@ class Client(object):
     def unsubscribe(self, stream="volume"):
         return self.request(MSG["UNSUBSCRIBE"], {"stream": stream})[0]
 
-    def get_volume(self, format="fp32", compression=None, content=None):
-        """GET_VOLUME, decoded to a ``Volume`` (a keyframe). content: "merged"
+    def get_volume(self, format="fp32", compression=None, content=None, error_bound=None):
+        """GET_VOLUME, decoded to a ``Volume`` (a keyframe). compression "shq"
+        (SPEC R5.16, merged content only): the fp32 volume quantised so that
+        each cell is within ``error_bound`` (None: the server's default) x
+        its magnitude of the exact one's. content: "merged"
         (None: the server's default, the merged volume), "levels" (SPEC
         R5.13: an octree technique's levels, ``Volume.levels``, and its index
         volume, ``Volume.index``) or "visibility" (SPEC R5.15: technique
@@ -328,6 +349,8 @@ class Client(object):
         body = {"format": format, "compression": compression or _default_compression()}
         if content is not None:
             body["content"] = content
+        if error_bound is not None:
+            body["error_bound"] = error_bound
         hdr, att = self.request(MSG["GET_VOLUME"], body)
         return self._decode_volume(hdr, att, ack=False, content=content)
 
@@ -393,7 +416,8 @@ class Client(object):
     # -- streams ----------------------------------------------------------
 
     def _remember(self, tick, raw):
-        if tick in self._acked:
+        if tick in self._acked:  # sent again (a new subscription): the copy acknowledged last is the base
+            self._acked[tick] = raw
             return
         self._acked[tick] = raw
         self._acked_order.append(tick)
@@ -401,14 +425,20 @@ class Client(object):
             self._acked.pop(self._acked_order.pop(0), None)
 
     def _decode_volume(self, hdr, att, ack, content=None):
-        raw = _decompress(att, hdr.get("compression", "none"), hdr.get("raw_length", len(att)))
-        if "raw_length" in hdr and len(raw) != hdr["raw_length"]:
-            raise ProtocolError("volume of %d bytes, header says raw_length %d" % (len(raw), hdr["raw_length"]))
+        base = None
         if not hdr.get("keyframe", True):
-            base = hdr.get("base_tick")
-            if base not in self._acked:
-                raise ProtocolError("delta against tick %r which this client does not hold" % (base,))
-            raw = _xor(raw, self._acked[base])
+            tick = hdr.get("base_tick")
+            if tick not in self._acked:
+                raise ProtocolError("delta against tick %r which this client does not hold" % (tick,))
+            base = self._acked[tick]
+        if hdr.get("compression") == SHQ_COMPRESSION:  # SPEC R5.16: the cells sent replace the base's
+            raw = shq_decode(att, hdr, base)
+        else:
+            raw = _decompress(att, hdr.get("compression", "none"), hdr.get("raw_length", len(att)))
+            if "raw_length" in hdr and len(raw) != hdr["raw_length"]:
+                raise ProtocolError("volume of %d bytes, header says raw_length %d" % (len(raw), hdr["raw_length"]))
+            if base is not None:
+                raw = _xor(raw, base)
         vol = Volume(hdr, raw, content)
         if ack and vol.tick is not None:
             self._remember(vol.tick, raw)
@@ -420,6 +450,35 @@ class Client(object):
         if hdr.get("format") == "rgba8":
             data = _decompress(att, hdr.get("compression", "none"), hdr.get("raw_length", len(att)))
         return Frame(hdr, bytes(data))
+
+    def tick_volume(self, timeout=60.0):
+        """TICK, then the volume stream's answer to it: (the TICK reply, the
+        VOLUME of that tick as a ``Volume``, decoded and acknowledged, or None
+        when the server sent none). A subscriber to compression "shq" with
+        deltas gets no VOLUME for a tick that moved no cell beyond its bound
+        (SPEC R5.16): the volume it holds stays within the bound of that
+        tick, and STATS "session_stream_unchanged" counts the tick, which is
+        how this tells "none" from "not yet" (a VOLUME sent before a STATS
+        reply arrives before it). Frames that arrive meanwhile stay queued
+        for ``next_message``. ProtocolError when neither comes within
+        ``timeout`` seconds."""
+        before = self.stats().get("session_stream_unchanged", 0)
+        t = self.tick()
+        deadline = time.monotonic() + timeout
+        while True:
+            at = next((i for i, m in enumerate(self._stream_queue) if m[0] == MSG["VOLUME"]), None)
+            if at is not None:
+                _, body, att = self._stream_queue.pop(at)
+                vol = self._decode_volume(body, att, ack=True)
+                if vol.tick is None or vol.tick >= t.get("tick", 0):
+                    return t, vol
+                continue  # an earlier tick's, late: this tick's answer is still to come
+            if self.stats().get("session_stream_unchanged", 0) > before:
+                return t, None
+            if time.monotonic() > deadline:
+                raise ProtocolError("no VOLUME for tick %s and no unchanged tick counted within %g s"
+                                    % (t.get("tick"), timeout))
+            time.sleep(0.01)
 
     def next_message(self, ack=True):
         """Wait for the next stream message (after SUBSCRIBE) and return a

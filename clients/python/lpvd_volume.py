@@ -1,5 +1,6 @@
 """lpvd_volume.py - volumes of the lpvd Python client: decoding a VOLUME or
-GET_VOLUME reply's values (fp16/fp32, XOR deltas, the layout description)
+GET_VOLUME reply's values (fp16/fp32, XOR deltas, compression "shq"'s
+quantised SH and the bound it holds (SPEC R5.16), the layout description)
 into ``Volume`` and ``Cascade`` objects (and, for GET_VOLUME content
 "visibility", the probes' ``Visibility``), and their local lookups (SPEC
 R5.7, R5.14's ``iv_irradiance`` for technique iv and R5.15's
@@ -22,7 +23,7 @@ try:  # optional
 except ImportError:  # pragma: no cover - depends on the machine
     _np = None
 
-from lpvd_protocol import ProtocolError
+from lpvd_protocol import ProtocolError, _zstd_decompress
 
 HAVE_NUMPY = _np is not None
 
@@ -105,6 +106,308 @@ def _f32(x):
 _IV_HELD_WEIGHT = 1.0 / 64.0
 _LOBE0 = _f32(SH_LOBE0)
 _LOBE1 = _f32(SH_LOBE1)
+
+
+# -- quantised SH, compression "shq" (SPEC R5.16) ----------------------------
+#
+# The attachment is one zstd frame whose content is "SHQ1", flags, the counts,
+# a delta's bit map of the cells sent, one exponent per cell sent, a delta's
+# mode per cell sent (0: the mantissas are the values' steps, 1: the change
+# from the base's cell in those steps), the 12 zigzag mantissas in byte
+# planes, then the bytes after the values (an index). protocol/volume_shq.c's lpvp_shq_decode is the normative decoder;
+# this one rebuilds the same fp32 bytes, bit for bit, with numpy or without.
+
+SHQ_COMPRESSION = "shq"
+SHQ_BOUND_MIN, SHQ_BOUND_MAX, SHQ_BOUND_DEFAULT = 0.001, 0.25, 0.01  # HELLO's volume_codecs.error_bound
+SHQ_MAGIC = b"SHQ1"
+_SHQ_HEAD = struct.Struct("<4sIQQQ")  # magic, flags (bit 0: keyframe), C cells, S cells sent, X bytes after
+_SHQ_FLAG_KEY = 1
+_SHQ_ZERO_EXP = -128      # a cell sent as zero
+_SHQ_CELL_BYTES = 48      # R5.1's 12 fp32 values
+_SHQ_SENT_BYTES = 25      # per cell a keyframe sends: its exponent and 12 two-byte mantissas
+_SHQ_SENT_BYTES_DELTA = 26  # per cell a delta sends: its mode too
+_SHQ_ABSOLUTE, _SHQ_RELATIVE = 0, 1  # a delta's modes
+_SHQ_VALUE_LIMIT = _f32(1e30)  # the server clamps exact values beyond it (binary32 1e30f; NaN is 0) before coding
+_SHQ_TINY = 1e-30         # a cell of smaller magnitude is held as zero
+_F32_OVERFLOW = 2.0 ** 128  # q x 2^x at or above it is no binary32: it rounds to infinity, as ldexpf does
+
+
+def shq_error_bound(header):
+    """The error bound of an "shq" volume header, checked: R5.16's header says
+    "format": "fp32" (shq decodes into what an fp32 message carries) and an
+    "error_bound" number in [SHQ_BOUND_MIN, SHQ_BOUND_MAX]; anything else is
+    a ProtocolError naming the key."""
+    if header.get("format") != "fp32":
+        raise ProtocolError("format: %r with compression \"shq\", which decodes to \"fp32\" (SPEC R5.16)"
+                            % (header.get("format"),))
+    e = header.get("error_bound")
+    if isinstance(e, bool) or not isinstance(e, (int, float)) or not SHQ_BOUND_MIN <= e <= SHQ_BOUND_MAX:
+        raise ProtocolError("error_bound: %r with compression \"shq\", expected a number in [%g, %g] (SPEC R5.16)"
+                            % (e, SHQ_BOUND_MIN, SHQ_BOUND_MAX))
+    return float(e)
+
+
+def shq_cells(header):
+    """(C, X) of an "shq" volume header: C the cells of its values (the raw
+    volume up to the index, R5.12, in cells of R5.1's 12 fp32 values) and X
+    the bytes after them. shq codes the merged volume only: a description of
+    other values per cell, an octree's levels or the probes' visibility is a
+    ProtocolError."""
+    raw_length = header.get("raw_length")
+    if not _is_int(raw_length) or raw_length < 0:
+        raise ProtocolError("raw_length: %r, expected an integer >= 0" % (raw_length,))
+    d = header.get("volume")
+    values = raw_length
+    if d is not None:  # an older server's header without a description: R5.1's layout, no index
+        if not isinstance(d, dict):
+            raise ProtocolError("volume: expected an object")
+        if d.get("values_per_cell") != 12 or "visibility" in d or Volume._octree_levels(d):
+            raise ProtocolError("compression \"shq\" codes the merged volume of R5.1's 12 values per cell (SPEC "
+                                "R5.16); the description has %r values per cell%s" % (
+                                    d.get("values_per_cell"), ", the probes' visibility" if "visibility" in d else
+                                    ", octree levels" if Volume._octree_levels(d) else ""))
+        index = d.get("index")
+        if index is not None:
+            values = index.get("raw_offset") if isinstance(index, dict) else None
+            if not _is_int(values) or not 0 <= values <= raw_length:
+                raise ProtocolError("volume.index.raw_offset: %r, expected where the values end, in [0, %d]"
+                                    % (values, raw_length))
+    if values % _SHQ_CELL_BYTES:
+        raise ProtocolError("compression \"shq\": %d bytes of values are not whole cells of %d bytes (SPEC R5.16)"
+                            % (values, _SHQ_CELL_BYTES))
+    return values // _SHQ_CELL_BYTES, raw_length - values
+
+
+def shq_payload_max(cells, extra):
+    """The largest payload C cells and X bytes after them can need (a delta
+    that sends every cell): the bound zstd decompresses to."""
+    return _SHQ_HEAD.size + (cells + 7) // 8 + _SHQ_SENT_BYTES_DELTA * cells + extra
+
+
+def shq_decode(att, header, base=None):
+    """The raw fp32 volume (bytes, ``raw_length`` of them) of a VOLUME or
+    GET_VOLUME message of compression "shq" (SPEC R5.16): the header checked
+    (format, error_bound, the cells it describes), the attachment
+    decompressed (one zstd frame, R5.2) and decoded by ``shq_decode_payload``.
+    ``base``: for a delta, the raw bytes this client rebuilt for the tick the
+    header's base_tick names (the one it acknowledged)."""
+    shq_error_bound(header)
+    cells, extra = shq_cells(header)
+    keyframe = header.get("keyframe", True)
+    if not isinstance(keyframe, bool):
+        raise ProtocolError("keyframe: %r, expected true or false" % (keyframe,))
+    payload = _zstd_decompress(att, shq_payload_max(cells, extra))
+    return shq_decode_payload(payload, header["raw_length"], cells, keyframe, base)
+
+
+def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
+    """R5.16's payload (the zstd frame's content) -> the raw fp32 volume of
+    raw_length bytes whose first ``cells`` cells are the values. A keyframe's
+    cells are all sent; a delta's cells not flagged in its bit map keep
+    ``base``'s bytes (the raw volume of the acknowledged tick, raw_length
+    bytes), and its bytes after the values are XOR'd with the base's. Value
+    k of a cell sent is q x 2^x in binary32 (exact; 0 when x = -128), where
+    q is the mantissa, or for a delta's cell of mode 1 the mantissa plus the
+    base's value in steps of 2^x (rounded half to even).
+
+    Raises ProtocolError for what the SPEC says a client MUST reject: a
+    magic other than "SHQ1", flags other than bit 0, a keyframe flag that
+    disagrees with the header's ``keyframe``, C or X other than the header's,
+    S over C (or a keyframe's S not C), a bit map whose set bits are not S or
+    that sets bits past C, a mode other than 0 or 1 (or 1 with x = -128),
+    and a length other than 32 + 25 S + X (a keyframe) or 32 + ceil(C / 8) +
+    26 S + X (a delta)."""
+    p = bytes(payload)
+    values = cells * _SHQ_CELL_BYTES
+    if not 0 <= values <= raw_length:
+        raise ProtocolError("shq: %d cells do not fit a %d-byte volume" % (cells, raw_length))
+    extra = raw_length - values
+    if len(p) < _SHQ_HEAD.size or p[:4] != SHQ_MAGIC:
+        raise ProtocolError("shq: not an %r payload (%d bytes starting %r)" % (SHQ_MAGIC.decode(), len(p), p[:4]))
+    _, flags, n_cells, sent, n_extra = _SHQ_HEAD.unpack_from(p)
+    if flags & ~_SHQ_FLAG_KEY:
+        raise ProtocolError("shq: unknown flags 0x%x (only bit 0, keyframe, is defined)" % flags)
+    key = bool(flags & _SHQ_FLAG_KEY)
+    if key != bool(keyframe):
+        raise ProtocolError("shq: the payload is a %s, the header says keyframe %r" % (
+            "keyframe" if key else "delta", keyframe))
+    if n_cells != cells or n_extra != extra:
+        raise ProtocolError("shq: payload of %d cells and %d bytes after them, the header's volume has %d cells "
+                            "and %d" % (n_cells, n_extra, cells, extra))
+    if sent > cells or (key and sent != cells):
+        raise ProtocolError("shq: %d of %d cells sent%s" % (sent, cells, " in a keyframe, which sends every cell"
+                                                            if key else ""))
+    if not key and (base is None or len(base) != raw_length):
+        raise ProtocolError("shq: a delta needs the base volume of %d bytes, %s" % (
+            raw_length, "none was given" if base is None else "got %d" % len(base)))
+    map_len = 0 if key else (cells + 7) // 8
+    per = _SHQ_SENT_BYTES if key else _SHQ_SENT_BYTES_DELTA
+    need = _SHQ_HEAD.size + map_len + per * sent + extra
+    if len(p) != need:
+        raise ProtocolError("shq: payload of %d bytes, its counts need %d (32 + %d of bit map + %d x %d cells sent "
+                            "+ %d)" % (len(p), need, map_len, per, sent, extra))
+    bitmap = None
+    if not key:
+        bitmap = p[_SHQ_HEAD.size:_SHQ_HEAD.size + map_len]
+        flagged = bin(int.from_bytes(bitmap, "little")).count("1")
+        if flagged != sent or (cells % 8 and bitmap[-1] >> (cells % 8)):
+            raise ProtocolError("shq: the bit map flags %d cells%s, the payload sends %d" % (
+                flagged, " (some past the %d cells)" % cells if cells % 8 and bitmap[-1] >> (cells % 8) else "",
+                sent))
+    at = _SHQ_HEAD.size + map_len
+    modes = None
+    if not key:
+        exps, modes = p[at:at + sent], p[at + sent:at + 2 * sent]
+        for j, mode in enumerate(modes):
+            if mode > _SHQ_RELATIVE or (mode == _SHQ_RELATIVE and exps[j] == 0x80):
+                raise ProtocolError("shq: sent cell %d has mode %d%s" % (
+                    j, mode, "" if mode > _SHQ_RELATIVE else " with the zero exponent"))
+    rebuilt = (_shq_values_numpy if _np is not None else _shq_values_stdlib)(p, at, cells, sent, bitmap, modes, base)
+    after = p[at + per * sent:]
+    return rebuilt + (after if key else _xor(after, bytes(base[values:])))
+
+
+def _shq_values_numpy(p, at, cells, sent, bitmap, modes, base):
+    """The values' bytes (cells x 48) rebuilt with numpy (see shq_decode_payload)."""
+    x = _np.frombuffer(p, _np.int8, sent, at).astype(_np.int32)
+    planes_at = at + sent + (0 if modes is None else sent)
+    planes = _np.frombuffer(p, _np.uint8, 24 * sent, planes_at).astype(_np.int32).reshape(2, 12, sent)
+    z = planes[0] | (planes[1] << 8)
+    q = ((z >> 1) ^ -(z & 1)).T.astype(_np.float64)  # (sent, 12) mantissas
+    if modes is not None:  # mode 1: the change from the base's cell in steps of 2^x
+        sent_at = _np.unpackbits(_np.frombuffer(bitmap, _np.uint8), bitorder="little")[:cells].astype(bool)
+        b = _np.frombuffer(base, "<f4", 12 * cells).reshape(cells, 12)[sent_at].astype(_np.float64)
+        rel = _np.frombuffer(modes, _np.uint8) == _SHQ_RELATIVE
+        q[rel] += _np.rint(_np.ldexp(b[rel], -x[rel][:, None]))
+    v = _np.ldexp(q, x[:, None])  # exact in binary64
+    v[x == _SHQ_ZERO_EXP] = 0.0
+    with _np.errstate(over="ignore", invalid="ignore"):  # past the largest binary32: infinity, as C's cast
+        v = _np.where(_np.abs(v) >= _F32_OVERFLOW, _np.copysign(_np.inf, v), v).astype("<f4")
+    if bitmap is None:
+        return v.tobytes()
+    out = _np.frombuffer(base, "<f4", 12 * cells).reshape(cells, 12).copy()
+    out[_np.unpackbits(_np.frombuffer(bitmap, _np.uint8), bitorder="little")[:cells].astype(bool)] = v
+    return out.tobytes()
+
+
+def _shq_values_stdlib(p, at, cells, sent, bitmap, modes, base):
+    """The values' bytes (cells x 48) rebuilt with the standard library (see
+    shq_decode_payload); the same bytes as _shq_values_numpy."""
+    exps = struct.unpack_from("<%db" % sent, p, at)
+    lo = at + sent + (0 if modes is None else sent)
+    hi = lo + 12 * sent
+    zs = [[a | (b << 8) for a, b in zip(p[lo + k * sent:lo + (k + 1) * sent], p[hi + k * sent:hi + (k + 1) * sent])]
+          for k in range(12)]
+    based = None
+    if modes is not None:  # the base's cells that were sent, in order, for mode 1
+        b = struct.unpack_from("<%df" % (12 * cells), bytes(base))
+        based = [b[12 * i:12 * i + 12] for i in range(cells) if bitmap[i >> 3] >> (i & 7) & 1]
+    inf = float("inf")
+    flat = []
+    for j, (x, *cell) in enumerate(zip(exps, *zs)):
+        if x == _SHQ_ZERO_EXP:
+            flat.extend((0.0,) * 12)
+            continue
+        rel = modes is not None and modes[j] == _SHQ_RELATIVE
+        for k, z in enumerate(cell):
+            q = (z >> 1) ^ -(z & 1)
+            if rel:  # round() of a float is half to even, as the server's nearbyint
+                steps = math.ldexp(based[j][k], -x)
+                # a base of +-inf or NaN (which no server's stream gives) stays one, as in binary64
+                q = q + round(steps) if math.isfinite(steps) else q + steps
+            v = math.ldexp(q, x)  # exact in binary64 (q a float only when it is +-inf or NaN)
+            flat.append(math.copysign(inf, v) if abs(v) >= _F32_OVERFLOW else v)  # NaN stays NaN
+    out = array.array("f")
+    if bitmap is None:
+        out.fromlist(flat)
+    else:
+        out.frombytes(bytes(base[:cells * _SHQ_CELL_BYTES]))
+        if sys.byteorder != "little":
+            out.byteswap()
+        j = 0
+        for i in range(cells):
+            if bitmap[i >> 3] >> (i & 7) & 1:
+                out[12 * i:12 * i + 12] = array.array("f", flat[12 * j:12 * j + 12])
+                j += 1
+    if sys.byteorder != "little":
+        out.byteswap()
+    return out.tobytes()
+
+
+def _shq_clean(v):
+    """An exact value as the server codes it (R5.16): NaN 0, clamped to +-1e30 (binary32)."""
+    return 0.0 if v != v else min(max(v, -_SHQ_VALUE_LIMIT), _SHQ_VALUE_LIMIT)
+
+
+def shq_cell_magnitude(c):
+    """R5.16's M(c) of one cell's 12 values (r0..r3 g0..g3 b0..b3): max over
+    channels of L0 |c0| + L1 |(c1, c2, c3)|, the largest |E_ch(n)| of the
+    cosine-lobe lookup over all normals (before R5.7's 1 / cell^2); as
+    protocol/volume_shq.c's lpvp_shq_cell_magnitude, in binary64."""
+    m = 0.0
+    for ch in range(0, 12, 4):
+        e = SH_LOBE0 * abs(c[ch]) + SH_LOBE1 * math.sqrt(c[ch + 1] * c[ch + 1] + c[ch + 2] * c[ch + 2]
+                                                         + c[ch + 3] * c[ch + 3])
+        m = e if e > m else m
+    return m
+
+
+def shq_cell_distance(a, b):
+    """R5.16's D(a, b) of two cells: max over channels of L0 |a0 - b0| + L1
+    |(a1, a2, a3) - (b1, b2, b3)|, the most any lookup at the cell moves from
+    one to the other (lpvp_shq_cell_error)."""
+    return shq_cell_magnitude([float(x) - float(y) for x, y in zip(a, b)])
+
+
+def shq_distances(decoded, exact, cells=None):
+    """Per cell, D(decoded, exact) and M(exact) (R5.16), for two raw fp32
+    volumes (bytes, R5.1: 12 little-endian binary32 values per cell): what a
+    client holds and the exact volume of the same tick (GET_VOLUME "fp32",
+    "none"), whose values are cleaned as the server codes them (NaN 0,
+    clamped to +-1e30). ``cells``: the cells of the values (default: every
+    whole cell of ``exact``; what follows them, an index, is not compared).
+    Returns (D, M): float64 numpy arrays, or lists without numpy."""
+    n = len(exact) // _SHQ_CELL_BYTES if cells is None else int(cells)
+    if len(decoded) < n * _SHQ_CELL_BYTES or len(exact) < n * _SHQ_CELL_BYTES:
+        raise ValueError("volumes of %d and %d bytes hold fewer than %d cells" % (len(decoded), len(exact), n))
+    if _np is not None:
+        a = _np.frombuffer(decoded, "<f4", 12 * n).astype(_np.float64).reshape(n, 3, 4)
+        c = _np.clip(_np.nan_to_num(_np.frombuffer(exact, "<f4", 12 * n).astype(_np.float64), nan=0.0),
+                     -_SHQ_VALUE_LIMIT, _SHQ_VALUE_LIMIT).reshape(n, 3, 4)
+
+        def magnitude(v):
+            return (SH_LOBE0 * _np.abs(v[:, :, 0]) + SH_LOBE1 * _np.sqrt(
+                v[:, :, 1] * v[:, :, 1] + v[:, :, 2] * v[:, :, 2] + v[:, :, 3] * v[:, :, 3])).max(axis=1)
+        return magnitude(a - c), magnitude(c)
+    a = struct.unpack_from("<%df" % (12 * n), decoded)
+    c = [_shq_clean(v) for v in struct.unpack_from("<%df" % (12 * n), exact)]
+    D, M = [], []
+    for i in range(0, 12 * n, 12):
+        D.append(shq_cell_distance(a[i:i + 12], c[i:i + 12]))
+        M.append(shq_cell_magnitude(c[i:i + 12]))
+    return D, M
+
+
+def shq_bound_excess(decoded, exact, bound, cells=None):
+    """How far a client's volume is past R5.16's bound: (excess, cell), the
+    largest D(decoded, exact) - bound x M(exact) - (1e-6 M + 1e-30) over the
+    cells and the cell where it is (``shq_distances``' arguments). The bound
+    holds when excess <= 0; the tolerance is float rounding (the server
+    compares in binary64 too), and the 1e-30 covers the cells below R5.16's
+    magnitude floor, held as zero."""
+    D, M = shq_distances(decoded, exact, cells)
+    if _np is not None:
+        if not len(D):
+            return float("-inf"), None
+        ex = D - bound * M - (1e-6 * M + 1e-30)
+        i = int(_np.argmax(ex))
+        return float(ex[i]), i
+    worst, at = float("-inf"), None
+    for i, (d, m) in enumerate(zip(D, M)):
+        ex = d - bound * m - (1e-6 * m + 1e-30)
+        if ex > worst:
+            worst, at = ex, i
+    return worst, at
 
 
 def iv_irradiance(dims, origin, cell_size, cell, held, neighbours, p, n):
@@ -551,6 +854,10 @@ class Volume(Cascade):
     ``irradiance()`` and ``probes_irradiance()`` are then R5.15's lookup
     (``probes_irradiance``). Every other volume has ``visibility`` None.
 
+    ``compression`` is the header's; a volume of compression "shq" (SPEC
+    R5.16) holds quantised values, each cell within ``error_bound`` x its
+    magnitude of the exact volume's (``shq_distances``, ``shq_bound_excess``).
+
     ``content`` is what the request asked for: None for a VOLUME stream
     message or a GET_VOLUME without content (or "merged" / "levels", read
     from the description), "visibility" for GET_VOLUME content
@@ -565,6 +872,11 @@ class Volume(Cascade):
         self.tick = header.get("tick")
         self.revision = header.get("revision")
         self.format = header.get("format")
+        # "none", "zstd" or "shq"; for "shq" (SPEC R5.16) the bound the
+        # values hold: every cell within error_bound x its magnitude of the
+        # exact volume's (None for the other compressions)
+        self.compression = header.get("compression", "none")
+        self.error_bound = shq_error_bound(header) if self.compression == SHQ_COMPRESSION else None
         self.keyframe = bool(header.get("keyframe", True))
         self.base_tick = header.get("base_tick")
         self.plan = header.get("plan")
