@@ -1,0 +1,169 @@
+/*
+ * shq_codec.c - the "shq" codec (SPEC R5.16) alone, on volumes saved from a
+ * daemon: bytes per update, the bound, and the encoder's time, without a
+ * socket or a GL context in the way (issue 35; docs/streaming.md).
+ *
+ *   lpvd-shq-codec [--bound E]... [--level L] VOL0.bin VOL1.bin ...
+ *
+ * Each VOLn.bin is a raw fp32 volume of R5.1's 12 values per cell (what
+ * GET_VOLUME "fp32", "none" carries up to any index; bench/stream_bench.py
+ * --save DIR writes them), in update order. For each bound: a keyframe of
+ * the first, then a delta chain (each against the previous update's
+ * reconstruction, as a subscriber that ACKs everything gets), beside
+ * fp16 + zstd XOR deltas of the same volumes.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "proto.h"
+#include "volume_codec.h"
+
+#define CELL_BYTES (LPVP_VALUES_PER_CELL * 4)
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
+
+static uint8_t *read_all(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    uint8_t *b = n > 0 ? malloc((size_t)n) : NULL;
+    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) {
+        free(b);
+        b = NULL;
+    }
+    fclose(f);
+    *len = b ? (size_t)n : 0;
+    return b;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The 99th percentile and the largest D / M over the cells with M > 0. */
+static void bound_figures(const uint8_t *held, const uint8_t *exact, size_t cells, double *p99, double *max)
+{
+    double *r = malloc(cells * sizeof *r);
+    size_t n = 0;
+    for (size_t i = 0; i < cells; ++i) {
+        float a[LPVP_VALUES_PER_CELL], b[LPVP_VALUES_PER_CELL];
+        memcpy(a, held + i * CELL_BYTES, CELL_BYTES); /* little-endian hosts: the bench's files are */
+        memcpy(b, exact + i * CELL_BYTES, CELL_BYTES);
+        double m = lpvp_shq_cell_magnitude(b);
+        if (m > 0.0)
+            r[n++] = lpvp_shq_cell_error(a, b) / m;
+    }
+    qsort(r, n, sizeof *r, cmp_double);
+    *p99 = n ? r[(size_t)floor(0.99 * (double)(n - 1))] : 0.0;
+    *max = n ? r[n - 1] : 0.0;
+    free(r);
+}
+
+int main(int argc, char **argv)
+{
+    double bounds[16];
+    int nb = 0, first = 1;
+    for (; first < argc && strncmp(argv[first], "--", 2) == 0; first += 2) {
+        if (first + 1 >= argc)
+            break;
+        if (strcmp(argv[first], "--bound") == 0 && nb < 16)
+            bounds[nb++] = atof(argv[first + 1]);
+        else {
+            fprintf(stderr, "lpvd-shq-codec: unknown flag %s\n", argv[first]);
+            return 2;
+        }
+    }
+    if (!nb) {
+        const double dflt[] = {0.005, 0.01, 0.02, 0.05};
+        memcpy(bounds, dflt, sizeof dflt);
+        nb = 4;
+    }
+    int nv = argc - first;
+    if (nv < 2) {
+        fprintf(stderr, "usage: lpvd-shq-codec [--bound E]... VOL0.bin VOL1.bin ...\n");
+        return 2;
+    }
+    uint8_t **vol = calloc((size_t)nv, sizeof *vol);
+    size_t len = 0;
+    for (int i = 0; i < nv; ++i) {
+        size_t l = 0;
+        vol[i] = read_all(argv[first + i], &l);
+        if (!vol[i] || (i && l != len) || l % CELL_BYTES) {
+            fprintf(stderr, "lpvd-shq-codec: %s: unreadable, or not a volume of %zu bytes\n", argv[first + i], len);
+            return 1;
+        }
+        len = l;
+    }
+    const size_t cells = len / CELL_BYTES;
+    char err[256];
+    /* today's: fp16 + zstd XOR deltas */
+    uint8_t *h0 = malloc(cells * 24), *h1 = malloc(cells * 24), *x = malloc(cells * 24);
+    float *f = malloc(len);
+    double xor_bytes = 0.0;
+    for (int i = 0; i < nv; ++i) {
+        memcpy(f, vol[i], len);
+        lpvp_volume_pack(f, cells, LPVP_FMT_FP16, h1);
+        if (i) {
+            lpvp_xor(x, h1, h0, cells * 24);
+            uint8_t *z = NULL;
+            size_t zl = 0;
+            lpvp_zstd_compress(x, cells * 24, 0, &z, &zl, err, sizeof err);
+            xor_bytes += (double)zl;
+            free(z);
+        }
+        memcpy(h0, h1, cells * 24);
+    }
+    xor_bytes /= nv - 1;
+    printf("%zu cells, %d updates; fp16 + zstd XOR delta: %.0f bytes per update\n\n", cells, nv - 1, xor_bytes);
+    printf("| bound | keyframe bytes | delta bytes (mean) | delta / fp16 XOR | cells re-sent per update | "
+           "D/M p99 (worst update) | D/M max | encode ms per delta |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    uint8_t *held = malloc(len), *client = malloc(len);
+    for (int b = 0; b < nb; ++b) {
+        uint8_t *att = NULL;
+        size_t att_len = 0, sent = 0, key_bytes = 0;
+        double bytes = 0.0, resent = 0.0, ms = 0.0, p99w = 0.0, maxw = 0.0;
+        for (int i = 0; i < nv; ++i) {
+            double t0 = now_ms();
+            if (lpvp_shq_encode(vol[i], len, cells, i ? held : NULL, bounds[b], held, &att, &att_len, &sent, err,
+                                sizeof err) != 0) {
+                fprintf(stderr, "lpvd-shq-codec: %s\n", err);
+                return 1;
+            }
+            double t1 = now_ms();
+            if (lpvp_shq_decode(att, att_len, len, cells, i ? client : NULL, client, NULL, err, sizeof err) != 0 ||
+                memcmp(client, held, len) != 0) {
+                fprintf(stderr, "lpvd-shq-codec: update %d does not decode to the encoder's volume: %s\n", i, err);
+                return 1;
+            }
+            double p99, mx;
+            bound_figures(client, vol[i], cells, &p99, &mx);
+            p99w = fmax(p99w, p99);
+            maxw = fmax(maxw, mx);
+            if (i) {
+                bytes += (double)att_len;
+                resent += (double)sent;
+                ms += t1 - t0;
+            } else {
+                key_bytes = att_len;
+            }
+            free(att);
+        }
+        printf("| %g | %zu | %.0f | %.3f | %.0f of %zu | %.4f | %.4f | %.1f |\n", bounds[b], key_bytes,
+               bytes / (nv - 1), bytes / (nv - 1) / xor_bytes, resent / (nv - 1), cells, p99w, maxw, ms / (nv - 1));
+    }
+    return 0;
+}
