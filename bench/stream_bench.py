@@ -24,6 +24,8 @@ A benchmark, not a test: nothing is asserted. Prints Markdown tables
   4. lag: after a light moves 0.3 m, the TICKs until the client's shq volume
      is within the bound of the converged answer at the points of section 1,
      per technique.
+--save DIR instead writes each technique's exact volumes of 16 updates
+(the input of build/bench/lpvd-shq-codec, bench/shq_codec.c).
 numpy is required (the error figures).
 """
 
@@ -325,8 +327,7 @@ class Bench:
         print("| technique | grid | TICKs to within the bound | ms of ticks | VOLUMEs received | p99 error after "
               "1 TICK | p99 error at the end |")
         print("|---|---|---:|---:|---:|---:|---:|")
-        for tech, cfg in (("lpv", CONFIG), ("iv", {"technique": "iv"}),
-                          ("probes", {"technique": "probes", "grid": [16, 16, 16]})):
+        for tech, cfg in TECHNIQUES:
             light = dict(LIGHT)
             cl = Client(self, {"compression": "shq", "error_bound": bound, "delta": True}, config=cfg, light=light)
             for _ in range(n):  # settled before the move
@@ -355,11 +356,34 @@ class Bench:
         print()
 
 
+TECHNIQUES = (("lpv", CONFIG), ("iv", {"technique": "iv"}), ("probes", {"technique": "probes", "grid": [16, 16, 16]}))
+
+
+def save(bench, out, n=16):
+    """The exact volumes (fp32, the values without any index) of n updates of
+    each technique while the light moves 1 cm per update, as OUT/TECH-NN.bin:
+    the input of lpvd-shq-codec (bench/shq_codec.c)."""
+    os.makedirs(out, exist_ok=True)
+    for name, cfg in TECHNIQUES:
+        light = dict(LIGHT)
+        c = bench.session(cfg, light)
+        for i in range(n):
+            light["position"] = [0.01 * i, 1.2, 0.0]
+            bench.req(c, lc.LIGHT_SET, light)
+            bench.req(c, lc.TICK, timeout=600)
+            hx, ex = bench.exact(c)
+            with open(os.path.join(out, "%s-%02d.bin" % (name, i)), "wb") as f:
+                f.write(ex[:lv.shq_cells(hx)[0] * 48])
+        c.close()
+        print("saved %d volumes of %s in %s" % (n, name, out))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--lpvd", help="lpvd binary (default build/server/lpvd)")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", help="comma list of sections 1-4")
+    ap.add_argument("--save", metavar="DIR", help="only save each technique's exact volumes for lpvd-shq-codec")
     args = ap.parse_args()
     daemon = harness.Daemon(harness.find_lpvd(args.lpvd), optional=[("--max-clients", "128"),
                                                                     ("--max-preauth", "128")])
@@ -367,6 +391,9 @@ def main():
     b = Bench(("unix", daemon.unix), args.quick)
     sections = {"1": b.codecs, "2": b.static, "3": b.subscribers, "4": b.lag}
     try:
+        if args.save:
+            save(b, args.save)
+            return 0
         print("## lpvd stream benchmark (%s), %d CPU cores, %s\n" % (
             time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), os.cpu_count(), daemon.binary))
         for k in (args.only or "1,2,3,4").split(","):
