@@ -356,7 +356,8 @@ class Bench:
         print()
 
 
-TECHNIQUES = (("lpv", CONFIG), ("iv", {"technique": "iv"}), ("probes", {"technique": "probes", "grid": [16, 16, 16]}))
+TECHNIQUES = (("lpv", CONFIG), ("octree", {"technique": "octree", "grid": [32, 32, 32]}), ("iv", {"technique": "iv"}),
+              ("probes", {"technique": "probes", "grid": [16, 16, 16]}))
 
 
 def save(bench, out, n=16):

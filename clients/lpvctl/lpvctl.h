@@ -30,6 +30,9 @@ void print_json_line(const char *prefix, json_t *o);
 int parse_floats(const char *s, float *out, int n); /* "1,2.5,-3": exactly n finite numbers */
 int parse_int(const char *s, long lo, long hi, long *out);
 int parse_float(const char *s, float *out);
+/* --error-bound E (SPEC R5.16): a fraction > 0 (the server checks its
+ * range); 0, or the usage error printed and -1. */
+int parse_error_bound(const char *s, double *out);
 const char *ext_of(const char *path);
 unsigned char *read_file(const char *path, size_t *len);
 int write_file(const char *path, const void *data, size_t len);

@@ -120,6 +120,8 @@ static json_t *volume_summary(const lpvc_volume *v)
                           hdr ? hdr : json_object());
     json_object_set_new(o, "cascades", cascades);
     json_object_set_new(o, "content", json_string(v->content[0] ? v->content : "merged"));
+    if (v->error_bound > 0.0) /* SPEC R5.16: every cell within this fraction of its magnitude */
+        json_object_set_new(o, "error_bound", json_real(v->error_bound));
     if (v->visibility && v->values_per_probe > 0) { /* SPEC R5.15: how many probes are on, how far they moved */
         size_t probes = v->visibility_floats / (size_t)v->values_per_probe, active = 0;
         double moved = 0.0;
@@ -228,13 +230,10 @@ int cmd_volume(int argc, char **argv)
         case VOL_OUTPUT: out = v; break;
         case VOL_FORMAT: d.format = v; break;
         case VOL_COMPRESSION: d.compression = v; break;
-        case VOL_BOUND: {
-            float e;
-            if (parse_float(v, &e) != 0 || !(e > 0.0f))
-                return usage_error("bad --error-bound '%s' (a fraction, e.g. 0.01)", v);
-            d.error_bound = e;
+        case VOL_BOUND:
+            if (parse_error_bound(v, &d.error_bound) != 0)
+                return 2;
             break;
-        }
         case VOL_CONTENT: d.content = v; break;
         }
     }

@@ -51,13 +51,10 @@ int cmd_subscribe(int argc, char **argv)
         case SUB_TICK: tick = 1; break;
         case SUB_FORMAT: d.format = v; break;
         case SUB_COMPRESSION: d.compression = v; break;
-        case SUB_BOUND: {
-            float e;
-            if (parse_float(v, &e) != 0 || !(e > 0.0f))
-                return usage_error("bad --error-bound '%s' (a fraction, e.g. 0.01)", v);
-            d.error_bound = e;
+        case SUB_BOUND:
+            if (parse_error_bound(v, &d.error_bound) != 0)
+                return 2;
             break;
-        }
         case SUB_N:
             if (parse_int(v, 1, 1L << 30, &count) != 0)
                 return usage_error("bad count '%s'", v);

@@ -159,3 +159,14 @@ int args_next(lpv_flags *p, const lpv_flag *flags, int *idx, const char **v)
     *idx = it == LPV_FLAGS_POSITIONAL ? -1 : (int)(fl - flags);
     return 1;
 }
+
+int parse_error_bound(const char *s, double *out)
+{
+    float e;
+    if (parse_float(s, &e) != 0 || !(e > 0.0f)) {
+        usage_error("bad --error-bound '%s' (a fraction, e.g. 0.01)", s);
+        return -1;
+    }
+    *out = e;
+    return 0;
+}

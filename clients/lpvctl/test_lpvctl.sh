@@ -21,6 +21,7 @@ printf 'px,py,pz,nx,ny,nz\n0,0.01,0,0,1,0\n-0.9,1,0,1,0,0\n0.9,1,0,-1,0,0\n' >in
 
 # One session: every request message, in order.
 "$CTL" --address "$SOCK" hello + tick + volume + volume -o v.bin + volume -o v16.json --format fp16 \
+    + volume -o vq.bin --compression shq --error-bound 0.02 \
     + frame -o f.png + frame -o f.rgba --terms indirect + query --csv in.csv -o out.csv \
     + light-set probe --type point --intensity 5 --position 0,1.5,0 --color 1,1,1 + light-remove probe \
     + camera --eye 0,1,3.9 --target 0,1,0 --fov 40 --size 64x64 + knobs + config --iterations 4 --damping 0.25 --normal-bins off + tick + frame -o g.png \
@@ -30,6 +31,9 @@ cat session.txt
 
 [ -s v.bin ] && [ -s v.bin.json ] || fail "volume -o v.bin wrote nothing"
 [ -s v16.json ] || fail "volume -o v16.json wrote nothing"
+[ "$(wc -c <vq.bin)" -eq "$(wc -c <v.bin)" ] || fail "vq.bin (shq, decoded to fp32) is not v.bin's size"
+grep -q '^  "error_bound": 0\.0[12]' vq.bin.json || fail "vq.bin.json does not carry the bound"
+cmp -s vq.bin v.bin && fail "vq.bin is v.bin byte for byte: not quantised"
 grep -q '"fp16"' v16.json || fail "v16.json does not say fp16"
 cells=$(sed -n 's/^  "cells": \([0-9]*\),*$/\1/p' v.bin.json)
 size=$(wc -c <v.bin)
