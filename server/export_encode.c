@@ -372,22 +372,19 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
             return 1;
         goto header;
     }
-    if (shq && merged && raw_len == r->cell_count * LPVP_VALUES_PER_CELL * 4 && lpvp_host_little_endian()) {
-        /* the cells as they are in memory are the raw fp32 volume (the codec
-         * sends NaN as 0 itself): 4.7 MB less to write at 3 x 32^3 */
-        int rc = encode_shq(&vi, (const uint8_t *)r->cells, raw_len, how->bound, shq_from, keep, att, att_len, err, n);
-        if (rc >= 0)
-            shared_put(r, from, how->bound, &vi, keep, *att, *att_len, rc);
-        if (rc != 0)
-            return rc;
-        goto header;
-    }
-    uint8_t *raw = malloc(raw_len ? raw_len : 1);
-    if (!raw) {
+    /* shq reads the cells where they are when they are the raw fp32 volume
+     * (no index after them; the codec sends NaN as 0 itself): 4.7 MB less to
+     * write at 3 x 32^3 */
+    const int in_place = shq && merged && raw_len == r->cell_count * LPVP_VALUES_PER_CELL * 4 &&
+                         lpvp_host_little_endian();
+    uint8_t *raw = in_place ? NULL : malloc(raw_len ? raw_len : 1);
+    if (!in_place && !raw) {
         snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
         return -1;
     }
-    if (levels) {
+    if (in_place) {
+        /* nothing to pack */
+    } else if (levels) {
         pack_levels(r, &vi, raw);
     } else {
         lpvp_volume_pack(r->cells, r->cell_count, fmt, raw);
@@ -398,7 +395,8 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
     }
 
     if (shq) {
-        int rc = encode_shq(&vi, raw, raw_len, how->bound, shq_from, keep, att, att_len, err, n);
+        int rc = encode_shq(&vi, in_place ? (const uint8_t *)r->cells : raw, raw_len, how->bound, shq_from, keep, att,
+                            att_len, err, n);
         free(raw);
         if (rc >= 0 && merged)
             shared_put(r, from, how->bound, &vi, keep, *att, *att_len, rc);
