@@ -103,6 +103,7 @@ class Bench:
         self.quick = quick
         self.glb = lc.box_scene_glb(with_light=False)
         self.points = None
+        self.bounds = None
 
     def conn(self):
         c = lc.Conn(self.ep, timeout=600.0)
@@ -115,11 +116,14 @@ class Bench:
             raise RuntimeError("%s: %r" % (lc.type_name(t), r))
         return r
 
-    def session(self, config=None, light=None):
+    def session(self, config=None, light=None, camera=True):
+        """A session on self.glb (its bounds in self.bounds) with config, the
+        bench's camera (camera False: the scene's default) and light."""
         c = self.conn()
-        self.req(c, lc.SCENE_LOAD, {}, self.glb)
+        self.bounds = self.req(c, lc.SCENE_LOAD, {}, self.glb).body["scene"]["bounds"]
         self.req(c, lc.CONFIG, config or CONFIG)
-        self.req(c, lc.CAMERA_SET, CAMERA)
+        if camera:
+            self.req(c, lc.CAMERA_SET, CAMERA)
         self.req(c, lc.LIGHT_SET, light or LIGHT)
         return c
 
@@ -360,16 +364,27 @@ TECHNIQUES = (("lpv", CONFIG), ("octree", {"technique": "octree", "grid": [32, 3
               ("probes", {"technique": "probes", "grid": [16, 16, 16]}))
 
 
-def save(bench, out, n=16):
+def save(bench, out, n=16, scene=None):
     """The exact volumes (fp32, the values without any index) of n updates of
     each technique while the light moves 1 cm per update, as OUT/TECH-NN.bin:
-    the input of lpvd-shq-codec (bench/shq_codec.c)."""
+    the input of lpvd-shq-codec (bench/shq_codec.c). With scene (a .glb
+    path): that scene instead of the box, the light 10 % of the scene's
+    height above its centre, moved 0.5 % of its width per update (1 cm is to
+    the 2 m box)."""
     os.makedirs(out, exist_ok=True)
+    if scene:
+        with open(scene, "rb") as f:
+            bench.glb = f.read()
     for name, cfg in TECHNIQUES:
         light = dict(LIGHT)
-        c = bench.session(cfg, light)
+        c = bench.session(cfg, light, camera=not scene)
+        start, step = [0.0, 1.2, 0.0], 0.01
+        if scene:
+            b = bench.bounds
+            start = [(b[0] + b[3]) / 2, b[4] + 0.1 * (b[4] - b[1]), (b[2] + b[5]) / 2]
+            step = 0.005 * (b[3] - b[0])
         for i in range(n):
-            light["position"] = [0.01 * i, 1.2, 0.0]
+            light["position"] = [start[0] + step * i, start[1], start[2]]
             bench.req(c, lc.LIGHT_SET, light)
             bench.req(c, lc.TICK, timeout=600)
             hx, ex = bench.exact(c)
@@ -385,6 +400,7 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", help="comma list of sections 1-4")
     ap.add_argument("--save", metavar="DIR", help="only save each technique's exact volumes for lpvd-shq-codec")
+    ap.add_argument("--scene", metavar="GLB", help="with --save: this scene instead of the box")
     args = ap.parse_args()
     daemon = harness.Daemon(harness.find_lpvd(args.lpvd), optional=[("--max-clients", "128"),
                                                                     ("--max-preauth", "128")])
@@ -393,7 +409,7 @@ def main():
     sections = {"1": b.codecs, "2": b.static, "3": b.subscribers, "4": b.lag}
     try:
         if args.save:
-            save(b, args.save)
+            save(b, args.save, scene=args.scene)
             return 0
         print("## lpvd stream benchmark (%s), %d CPU cores, %s\n" % (
             time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), os.cpu_count(), daemon.binary))
