@@ -2,13 +2,15 @@
  * export.h - a tick's result as the wire sees it: read back from the engine
  * on the GL context's thread (sv_result, export_result.c) and encoded as a
  * VOLUME / GET_VOLUME or FRAME / GET_FRAME payload (SPEC sections 5 and 6,
- * export_encode.c). The daemon (serve_*.c) and lpvd batch's volume output
+ * export_encode.c); the volumes delta subscribers hold are shared by
+ * reference (sv_blob, export_blob.c). The daemon (serve_*.c) and lpvd batch's volume output
  * (batch_render.c) both export through it; it knows nothing of sessions,
  * sockets or jobs.
  */
 #ifndef LPVD_EXPORT_H
 #define LPVD_EXPORT_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -28,30 +30,47 @@ typedef struct sv_volume_coding {
     double bound;           /* shq: the client's error bound (R5.16) */
 } sv_volume_coding;
 
+/* Bytes that never change once filled, shared by reference (export_blob.c):
+ * the volume a delta subscriber holds, one copy for every subscriber that
+ * holds the same. held (NULL: none) counts the bytes of every live blob made
+ * with it (the daemon's memory term "bases", R7.6a). */
+typedef struct sv_blob {
+    atomic_int refs;
+    size_t len;
+    _Atomic uint64_t *held;
+    uint8_t bytes[];
+} sv_blob;
+
+/* refs 1 and len bytes to fill before the blob is shared; NULL without memory. */
+sv_blob *sv_blob_new(size_t len, _Atomic uint64_t *held);
+sv_blob *sv_blob_ref(sv_blob *b);
+void sv_blob_unref(sv_blob *b); /* NULL: nothing */
+
 typedef struct sv_sent {   /* a VOLUME sent to a delta subscriber, not yet ACKed */
     uint64_t tick;
     int dims[3];
     sv_volume_coding how;   /* a base serves only a volume coded the same way */
-    uint8_t *raw;           /* the raw volume the client holds (shq: its reconstruction) */
-    size_t raw_len;
+    sv_blob *raw;           /* a reference: the raw volume the client holds (shq: its reconstruction) */
     uint64_t lineage;       /* shq: equal lineages, equal raw bytes (export_encode.c) */
 } sv_sent;
 
-/* An shq encoding kept for the next subscriber that holds the same volume
- * (R5.16; export_encode.c): a world's subscribers in step share one. */
-#define SV_SHQ_SHARED 2
-typedef struct sv_shq_shared {
+/* A delta subscriber's encoding (shq, R5.16, or XOR, R5.3), or an shq
+ * reply's keyframe, kept for the next subscriber that holds the same volume
+ * (export_encode.c): a world's subscribers in step share one. */
+#define SV_SHARED_ENCODINGS 4
+typedef struct sv_shared_enc {
     int used;
+    int pending;            /* being encoded on a work thread: the others wait for it */
+    int keeps;              /* a subscriber's: recon is the client's volume (a reply's keeps none) */
     uint64_t from;          /* the base's lineage; 0: a keyframe */
-    double bound;
+    sv_volume_coding how;
     int outcome;            /* 0: sent; 1: nothing to send */
     int keyframe;
     uint64_t lineage;       /* the client's volume after it */
     uint8_t *att;
     size_t att_len;
-    uint8_t *recon;         /* the client's volume after it */
-    size_t recon_len;
-} sv_shq_shared;
+    sv_blob *recon;         /* a reference: the client's volume after it */
+} sv_shared_enc;
 
 /* The product of one tick: immutable once handed to the main thread. */
 typedef struct sv_result {
@@ -89,8 +108,8 @@ typedef struct sv_result {
     /* main thread: keyframe attachments already encoded, [fp16][zstd] */
     uint8_t *enc[2][2];
     size_t enc_len[2][2];
-    sv_shq_shared shq[SV_SHQ_SHARED]; /* under export_encode.c's lock, as enc */
-    int shq_next;
+    sv_shared_enc shared[SV_SHARED_ENCODINGS]; /* under export_encode.c's lock, as enc */
+    int shared_next;
 } sv_result;
 
 sv_result *sv_result_ref(sv_result *r);
@@ -116,13 +135,16 @@ int sv_volume_coding_parse(const json_t *j, sv_volume_coding *how, char *err, si
 /* Thread-safe (export_encode.c): the daemon runs them on libuv's work
  * threads, lpvd batch on its own. */
 /* Volume reply/stream body + attachment. A delta subscriber's encoding passes
- * keep: it gets the volume the client will hold (raw, its tick, coding and
- * lineage, for sv_sub_remember), and a delta against base (its ACKed
- * volume) when base fits; else keep and base are NULL. Returns 0, -1 with
- * err set, or 1 for an shq delta with nothing beyond the bound to send
- * (R5.16: nothing is sent; *body, *att and keep->raw are NULL). */
+ * keep: it gets the volume the client will hold (a reference in raw, its
+ * tick, coding and lineage, for sv_sub_remember), and a delta against base
+ * (its ACKed volume) when base fits; else keep and base are NULL. A new
+ * volume's bytes are counted in held (NULL: nowhere) while it lives; one
+ * shared with another subscriber's is counted once. Returns 0, -1 with err
+ * set, or 1 for an shq delta with nothing beyond the bound to send (R5.16:
+ * nothing is sent; *body, *att and keep->raw are NULL). */
 int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, const sv_sent *base, sv_sent *keep,
-                     uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n);
+                     _Atomic uint64_t *held, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len,
+                     char *err, size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,
                     uint64_t revision,

@@ -29,9 +29,11 @@
 #include "tonemap.h"
 #include "volume_codec.h"
 
-/* Guards every sv_result's enc / enc_len (the keyframe cache): encoders of
- * one result run on several work threads at once. */
+/* Guards every sv_result's enc / enc_len (the keyframe cache) and shq
+ * (the shared encodings): encoders of one result run on several work
+ * threads at once. enc_cv: a shared encoding was filled or given up. */
 static pthread_mutex_t enc_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t enc_cv = PTHREAD_COND_INITIALIZER;
 
 _Static_assert((int)LPVP_TERMS_AO == (int)LPV_TERMS_AO && (int)LPVP_TERMS_DIRECT == (int)LPV_TERMS_DIRECT_ONLY,
                "the protocol's frame terms are the engine's");
@@ -126,76 +128,120 @@ int sv_volume_coding_parse(const json_t *j, sv_volume_coding *how, char *err, si
 /* A lineage names the volume a subscriber holds: the hash of its bytes
  * (XXH3, 64 bits; 0 is kept for "a keyframe"). Subscribers of a world that
  * hold the same volume (they got the same keyframe, from whichever tick,
- * and the same deltas since) share one encoding of the next tick: a hundred
- * subscribers in step cost one encoding and a hundred copies. */
+ * and the same deltas since) share one encoding of the next tick and one
+ * reference-counted copy of the volume it leaves them with (sv_blob): a
+ * hundred subscribers in step cost one encoding, a hundred copies of the
+ * compressed attachment, and one volume. */
 static uint64_t lineage_of(const uint8_t *raw, size_t len)
 {
     uint64_t h = XXH3_64bits(raw, len);
     return h ? h : 1;
 }
 
-/* A copy of what an encoding of r against lineage `from` at bound made, when
- * one is cached; 1 when found (the outcome in *outcome). A delta's header
- * names this subscriber's base tick (base_tick), which may differ from the
- * one the encoding had: the same volume, acknowledged as another tick. */
-static int shared_copy(sv_result *r, uint64_t from, int64_t base_tick, double bound, lpvp_volume_info *vi,
-                       sv_sent *keep, uint8_t **att, size_t *att_len, int *outcome)
+/* A copy of what an encoding of r against lineage `from` at bound made
+ * (the outcome in *outcome), or a claim on making it. Returns 1 when found;
+ * else 0 with *claim the slot this encoder now fills (shared_fill, or
+ * shared_release on failure), or -1 when every slot is being filled by an
+ * encoding of something else (then it encodes for itself alone). An
+ * encoding of the same thing in flight on another work thread is waited
+ * for, not repeated: a world's subscribers in step reach the work threads
+ * together, and each repeat would cost an encoding and a volume of its own.
+ * A delta's header names this subscriber's base tick (base_tick), which may
+ * differ from the one the encoding had: the same volume, acknowledged as
+ * another tick. */
+static int shared_take(sv_result *r, uint64_t from, int64_t base_tick, const sv_volume_coding *how,
+                       lpvp_volume_info *vi, sv_sent *keep, uint8_t **att, size_t *att_len, int *outcome, int *claim)
 {
-    int got = 0;
+    *claim = -1;
     pthread_mutex_lock(&enc_mu);
-    for (int i = 0; i < SV_SHQ_SHARED && !got; ++i) {
-        const sv_shq_shared *s = &r->shq[i];
-        if (!s->used || s->from != from || s->bound != bound || (keep && s->outcome == 0 && !s->recon))
-            continue; /* (a reply's keyframe kept no client volume for a subscriber to hold) */
-        uint8_t *a = s->att_len ? malloc(s->att_len) : NULL;
-        uint8_t *k = keep && s->recon ? malloc(s->recon_len) : NULL;
-        if ((s->att_len && !a) || (keep && s->recon && !k)) {
-            free(a);
-            free(k);
-            break;
+    for (;;) {
+        int i, waited = 0;
+        for (i = 0; i < SV_SHARED_ENCODINGS; ++i) {
+            const sv_shared_enc *s = &r->shared[i];
+            /* a reply's keyframe keeps no client volume for a subscriber to hold */
+            if (s->used && s->from == from && s->how.comp == how->comp && s->how.fp16 == how->fp16 &&
+                s->how.bound == how->bound && (!keep || s->keeps))
+                break;
         }
-        if (a)
-            memcpy(a, s->att, s->att_len);
-        if (k) {
-            memcpy(k, s->recon, s->recon_len);
-            keep->raw = k;
-            keep->raw_len = s->recon_len;
-            keep->lineage = s->lineage;
+        if (i < SV_SHARED_ENCODINGS && r->shared[i].pending) {
+            pthread_cond_wait(&enc_cv, &enc_mu);
+            waited = 1;
+        } else if (i < SV_SHARED_ENCODINGS) {
+            const sv_shared_enc *s = &r->shared[i];
+            uint8_t *a = s->att_len ? malloc(s->att_len) : NULL;
+            if (s->att_len && !a)
+                break; /* encode it again, unshared */
+            if (a)
+                memcpy(a, s->att, s->att_len);
+            if (keep && s->recon) {
+                keep->raw = sv_blob_ref(s->recon);
+                keep->lineage = s->lineage;
+            }
+            *att = a;
+            *att_len = s->att_len;
+            vi->keyframe = s->keyframe;
+            vi->base_tick = s->keyframe ? -1 : base_tick;
+            *outcome = s->outcome;
+            pthread_mutex_unlock(&enc_mu);
+            return 1;
         }
-        *att = a;
-        *att_len = s->att_len;
-        vi->keyframe = s->keyframe;
-        vi->base_tick = s->keyframe ? -1 : base_tick;
-        *outcome = s->outcome;
-        got = 1;
+        if (waited)
+            continue; /* filled or released meanwhile: look again */
+        /* claim the oldest slot not being filled */
+        for (int k = 0; k < SV_SHARED_ENCODINGS && *claim < 0; ++k) {
+            int j = (r->shared_next + k) % SV_SHARED_ENCODINGS;
+            if (!r->shared[j].pending)
+                *claim = j;
+        }
+        if (*claim >= 0) {
+            sv_shared_enc *s = &r->shared[*claim];
+            r->shared_next = (*claim + 1) % SV_SHARED_ENCODINGS;
+            free(s->att);
+            sv_blob_unref(s->recon);
+            *s = (sv_shared_enc){.used = 1, .pending = 1, .keeps = keep != NULL, .from = from, .how = *how};
+        }
+        break;
     }
     pthread_mutex_unlock(&enc_mu);
-    return got;
+    return 0;
 }
 
-/* Keeps a copy of an encoding for the subscribers that hold the same volume
- * (the oldest entry makes room). */
-static void shared_put(sv_result *r, uint64_t from, double bound, const lpvp_volume_info *vi, const sv_sent *keep,
-                       const uint8_t *att, size_t att_len, int outcome)
+/* The claimed slot given up (the encoding failed): whoever waits on it
+ * encodes for itself. */
+static void shared_release(sv_result *r, int claim)
 {
-    uint8_t *a = att_len ? malloc(att_len) : NULL, *k = keep && keep->raw ? malloc(keep->raw_len) : NULL;
-    if ((att_len && !a) || (keep && keep->raw && !k)) {
-        free(a);
-        free(k);
+    if (claim < 0)
+        return;
+    pthread_mutex_lock(&enc_mu);
+    r->shared[claim] = (sv_shared_enc){0};
+    pthread_cond_broadcast(&enc_cv);
+    pthread_mutex_unlock(&enc_mu);
+}
+
+/* The claimed slot filled with a copy of the attachment and a reference to
+ * the client's volume, for the subscribers that hold the same base. */
+static void shared_fill(sv_result *r, int claim, const lpvp_volume_info *vi, const sv_sent *keep, const uint8_t *att,
+                        size_t att_len, int outcome)
+{
+    if (claim < 0)
+        return;
+    uint8_t *a = att_len ? malloc(att_len) : NULL;
+    if (att_len && !a) {
+        shared_release(r, claim);
         return;
     }
     if (a)
         memcpy(a, att, att_len);
-    if (k)
-        memcpy(k, keep->raw, keep->raw_len);
     pthread_mutex_lock(&enc_mu);
-    sv_shq_shared *s = &r->shq[r->shq_next];
-    r->shq_next = (r->shq_next + 1) % SV_SHQ_SHARED;
-    free(s->att);
-    free(s->recon);
-    *s = (sv_shq_shared){.used = 1, .from = from, .bound = bound, .outcome = outcome, .keyframe = vi->keyframe,
-                         .lineage = keep ? keep->lineage : 0, .att = a, .att_len = att_len,
-                         .recon = k, .recon_len = k ? keep->raw_len : 0};
+    sv_shared_enc *s = &r->shared[claim];
+    s->pending = 0;
+    s->outcome = outcome;
+    s->keyframe = vi->keyframe;
+    s->lineage = keep ? keep->lineage : 0;
+    s->att = a;
+    s->att_len = att_len;
+    s->recon = keep ? sv_blob_ref(keep->raw) : NULL;
+    pthread_cond_broadcast(&enc_cv);
     pthread_mutex_unlock(&enc_mu);
 }
 
@@ -203,28 +249,33 @@ static void shared_put(sv_result *r, uint64_t from, double bound, const lpvp_vol
  * tick (not necessarily an older one: a session that moves to another
  * world, R7.2, meets that world's tick numbers, and the client rebuilds
  * from whichever tick it acknowledged). */
-static const sv_sent *shq_base(const sv_result *r, const sv_sent *base, double bound, size_t raw_len)
+static const sv_sent *delta_base(const sv_result *r, const sv_sent *base, const sv_volume_coding *how,
+                                 size_t raw_len)
 {
-    if (base && base->raw && base->how.comp == LPVP_COMP_SHQ && base->how.bound == bound &&
-        base->raw_len == raw_len && memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick != r->tick)
+    const int shq = how->comp == LPVP_COMP_SHQ;
+    if (base && base->raw && (base->how.comp == LPVP_COMP_SHQ) == shq && base->how.fp16 == how->fp16 &&
+        base->how.bound == how->bound && base->raw->len == raw_len &&
+        memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick != r->tick)
         return base;
     return NULL;
 }
 
-/* raw (fp32) as shq: a delta against base when shq_base allows it, else a
+/* raw (fp32) as shq: a delta against base when delta_base allows it, else a
  * keyframe; the client's volume and its lineage in keep (NULL: a reply).
  * Returns 0, 1 for a delta with nothing to send, -1 with err. */
 static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, double bound,
-                      const sv_sent *base, sv_sent *keep, uint8_t **att, size_t *att_len, char *err, size_t n)
+                      const sv_sent *base, sv_sent *keep, _Atomic uint64_t *held, uint8_t **att, size_t *att_len,
+                      char *err, size_t n)
 {
     const size_t cells = (size_t)(lpvp_volume_values_bytes(vi) / (LPVP_VALUES_PER_CELL * 4));
-    const uint8_t *b = base ? base->raw : NULL;
-    uint8_t *recon = malloc(raw_len ? raw_len : 1);
+    const uint8_t *b = base ? base->raw->bytes : NULL;
+    sv_blob *rb = sv_blob_new(raw_len, keep ? held : NULL);
+    uint8_t *recon = rb ? rb->bytes : NULL;
     size_t sent = 0;
     if (!recon || lpvp_shq_encode(raw, raw_len, cells, b, bound, recon, att, att_len, &sent, err, n) != 0) {
         if (!recon)
             snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
-        free(recon);
+        sv_blob_unref(rb);
         return -1;
     }
     /* almost every cell re-sent: a keyframe costs no more and drops the map */
@@ -233,7 +284,7 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
         *att = NULL;
         b = NULL;
         if (lpvp_shq_encode(raw, raw_len, cells, NULL, bound, recon, att, att_len, &sent, err, n) != 0) {
-            free(recon);
+            sv_blob_unref(rb);
             return -1;
         }
     }
@@ -242,7 +293,7 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
         free(*att); /* nothing beyond the bound: nothing sent, the client's base stands */
         *att = NULL;
         *att_len = 0;
-        free(recon);
+        sv_blob_unref(rb);
         return 1;
     }
     if (b) {
@@ -250,17 +301,17 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
         vi->base_tick = (int64_t)base->tick;
     }
     if (keep) {
-        keep->raw = recon;
-        keep->raw_len = raw_len;
+        keep->raw = rb;
         keep->lineage = lineage_of(recon, raw_len);
     } else {
-        free(recon);
+        sv_blob_unref(rb);
     }
     return 0;
 }
 
 int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, const sv_sent *base, sv_sent *keep,
-                     uint64_t revision, json_t **body, uint8_t **att, size_t *att_len, char *err, size_t n)
+                     _Atomic uint64_t *held, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len,
+                     char *err, size_t n)
 {
     if (keep) {
         memset(keep, 0, sizeof *keep);
@@ -362,12 +413,13 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
         keep = NULL;
     if (merged && !shq && !keep && cache_copy(r, fp16, zstd, att, att_len)) /* another session had it encoded */
         goto header;
-    /* shq: another subscriber that holds the same volume had it encoded */
-    const sv_sent *shq_from = shq && keep ? shq_base(r, base, how->bound, raw_len) : NULL;
-    const uint64_t from = shq_from ? shq_from->lineage : 0;
-    int outcome = 0;
-    if (shq && merged &&
-        shared_copy(r, from, shq_from ? (int64_t)shq_from->tick : -1, how->bound, &vi, keep, att, att_len, &outcome)) {
+    /* another subscriber that holds the same volume had it encoded (or an
+     * shq reply's keyframe) */
+    const sv_sent *dbase = keep ? delta_base(r, base, how, raw_len) : NULL;
+    const uint64_t from = dbase ? dbase->lineage : 0;
+    int outcome = 0, claim = -1;
+    if (merged && (shq || keep) &&
+        shared_take(r, from, dbase ? (int64_t)dbase->tick : -1, how, &vi, keep, att, att_len, &outcome, &claim)) {
         if (outcome == 1)
             return 1;
         goto header;
@@ -377,8 +429,11 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
      * write at 3 x 32^3 */
     const int in_place = shq && merged && raw_len == r->cell_count * LPVP_VALUES_PER_CELL * 4 &&
                          lpvp_host_little_endian();
-    uint8_t *raw = in_place ? NULL : malloc(raw_len ? raw_len : 1);
+    /* an XOR subscriber keeps the packed volume itself as its next base */
+    sv_blob *kept = !shq && keep ? sv_blob_new(raw_len, held) : NULL;
+    uint8_t *raw = in_place ? NULL : kept ? kept->bytes : !shq && keep ? NULL : malloc(raw_len ? raw_len : 1);
     if (!in_place && !raw) {
+        shared_release(r, claim);
         snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
         return -1;
     }
@@ -395,26 +450,30 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
     }
 
     if (shq) {
-        int rc = encode_shq(&vi, in_place ? (const uint8_t *)r->cells : raw, raw_len, how->bound, shq_from, keep, att,
-                            att_len, err, n);
+        int rc = encode_shq(&vi, in_place ? (const uint8_t *)r->cells : raw, raw_len, how->bound, dbase, keep,
+                            held, att, att_len, err, n);
         free(raw);
-        if (rc >= 0 && merged)
-            shared_put(r, from, how->bound, &vi, keep, *att, *att_len, rc);
+        if (rc >= 0)
+            shared_fill(r, claim, &vi, keep, *att, *att_len, rc);
+        else
+            shared_release(r, claim);
         if (rc != 0)
             return rc;
         goto header;
     }
     uint8_t *payload = raw; /* what gets compressed / sent */
     uint8_t *delta = NULL;
-    if (keep && base && base->raw && base->how.comp != LPVP_COMP_SHQ && base->how.fp16 == fp16 &&
-        base->raw_len == raw_len &&
-        memcmp(base->dims, r->grid.dims, sizeof base->dims) == 0 && base->tick != r->tick) {
+    if (kept) {
+        raw = NULL; /* kept->bytes, freed with kept */
+        keep->lineage = lineage_of(kept->bytes, raw_len);
+    }
+    if (dbase) {
         delta = malloc(raw_len ? raw_len : 1);
         if (delta) {
-            lpvp_xor(delta, raw, base->raw, raw_len);
+            lpvp_xor(delta, payload, dbase->raw->bytes, raw_len);
             payload = delta;
             vi.keyframe = 0;
-            vi.base_tick = (int64_t)base->tick;
+            vi.base_tick = (int64_t)dbase->tick;
         }
     }
     if (vi.keyframe && merged && cache_copy(r, fp16, zstd, att, att_len)) {
@@ -424,7 +483,9 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
         size_t zlen = 0;
         if (lpvp_zstd_compress(payload, raw_len, 0, &z, &zlen, err, n) != 0) {
             free(raw);
+            sv_blob_unref(kept);
             free(delta);
+            shared_release(r, claim);
             return -1;
         }
         *att = z;
@@ -433,26 +494,26 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
         *att = delta;
         delta = NULL;
         *att_len = raw_len;
-    } else if (!keep) {
+    } else if (!kept) {
         *att = raw;
         raw = NULL;
         *att_len = raw_len;
     } else { /* sent and remembered: two copies */
         *att = malloc(raw_len ? raw_len : 1);
         if (!*att) {
-            free(raw);
+            sv_blob_unref(kept);
+            shared_release(r, claim);
             snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
             return -1;
         }
-        memcpy(*att, raw, raw_len);
+        memcpy(*att, payload, raw_len);
         *att_len = raw_len;
     }
     free(delta);
-    if (keep) { /* the subscriber remembers it (sv_sub_remember) */
-        keep->raw = raw;
-        keep->raw_len = raw_len;
-    } else {
-        free(raw);
+    free(raw);
+    if (keep) { /* the subscriber remembers it (sv_sub_remember); the others in step share it */
+        keep->raw = kept;
+        shared_fill(r, claim, &vi, keep, *att, *att_len, 0);
     }
     if (vi.keyframe && merged && *att)
         cache_put(r, fp16, zstd, *att, *att_len);

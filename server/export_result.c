@@ -36,9 +36,9 @@ static void result_free(sv_result *r)
         free(r->frames[i]);
     for (int i = 0; i < 4; ++i)
         free(r->enc[i / 2][i % 2]);
-    for (int i = 0; i < SV_SHQ_SHARED; ++i) {
-        free(r->shq[i].att);
-        free(r->shq[i].recon);
+    for (int i = 0; i < SV_SHARED_ENCODINGS; ++i) {
+        free(r->shared[i].att);
+        sv_blob_unref(r->shared[i].recon);
     }
     free(r);
 }

@@ -362,7 +362,7 @@ static int write_volume(lpvd_batch_renderer *r, const char *id, json_t *outputs,
         return -1;
     memset(&r->vol, 0, sizeof r->vol);
     const sv_volume_coding fp32 = {0}; /* fp32, uncompressed */
-    int rc = sv_encode_volume(res, LPVP_CONTENT_MERGED, &fp32, NULL, NULL, 0, &r->vol.body, &r->vol.att,
+    int rc = sv_encode_volume(res, LPVP_CONTENT_MERGED, &fp32, NULL, NULL, NULL, 0, &r->vol.body, &r->vol.att,
                               &r->vol.att_len, err, n);
     sv_result_unref(res);
     char rel[PATH_MAX];

@@ -501,6 +501,7 @@ struct sv_server {
     uint64_t bytes_sent;
     uint64_t ticks;         /* ticks computed, all worlds */
     uint64_t volumes_encoded; /* volume encodings on the work threads (STATS "encode") */
+    uint64_t bases_refused;   /* delta bases not kept: over the memory budget (STATS "encode", R7.6a) */
     uint64_t volume_encode_ns; /* their CPU time on the work threads */
     uint64_t ticks_coalesced; /* TICK requests answered by another request's tick */
     uint64_t ticks_cancelled; /* ticks skipped or abandoned because every requester had gone */

@@ -86,7 +86,7 @@ static void work_cb(uv_work_t *w)
     if (t->kind == ENC_VOLUME) {
         uint64_t t0 = thread_cpu_ns();
         int rc = sv_encode_volume(t->r, t->content, &t->how, t->base.raw ? &t->base : NULL, t->keep ? &t->kept : NULL,
-                                  t->revision, &t->body, &t->att, &t->att_len, t->err, sizeof t->err);
+                                  &t->c->srv->mem.held[SV_MEM_BASES], t->revision, &t->body, &t->att, &t->att_len, t->err, sizeof t->err);
         t->failed = rc < 0;
         t->unchanged = rc == 1;
         t->encode_ns = thread_cpu_ns() - t0;
@@ -145,12 +145,12 @@ static void volume_stream_state(sv_conn *c, enc_task *t, int sent)
         sub->acked = t->base;
         t->base.raw = NULL;
     }
-    free(t->base.raw);
+    sv_blob_unref(t->base.raw);
     t->base.raw = NULL;
     if (same && sent && t->kept.raw)
         sv_sub_remember(sub, &t->kept);
     else
-        free(t->kept.raw);
+        sv_blob_unref(t->kept.raw);
     t->kept.raw = NULL;
 }
 
@@ -200,8 +200,8 @@ static void after_work_cb(uv_work_t *w, int status)
     free(t->att);
     free(t->rgba_owned);
     free(t->out);
-    free(t->base.raw);
-    free(t->kept.raw);
+    sv_blob_unref(t->base.raw);
+    sv_blob_unref(t->kept.raw);
     sv_result_unref(t->r);
     if (reply) {
         if (!c->closing && !c->close_after_write)
@@ -333,7 +333,17 @@ static void stream_next(sv_conn *c, int stream)
     if (stream == SV_STREAM_VOLUME) {
         t->content = LPVP_CONTENT_MERGED;
         t->how = sub->vol;
+        /* R7.6a: a volume more for the bases must fit the daemon's budget;
+         * else the subscriber lets its bases go and gets a keyframe that it
+         * does not keep, until memory frees (a new volume is at most the
+         * fp32 cells; an index after them is small beside them) */
+        const uint64_t need = (uint64_t)r->cell_count * LPVP_VALUES_PER_CELL * 4;
         t->keep = sub->delta;
+        if (sub->delta && !sv_memory_fits(&c->srv->mem, SV_MEM_BASES, need)) {
+            c->srv->bases_refused++;
+            sv_sub_clear(sub);
+            t->keep = 0;
+        }
         t->epoch = sub->epoch;
         if (sub->delta) { /* lent for the XOR; back in volume_stream_state */
             t->base = sub->acked;

@@ -9,8 +9,9 @@
  * frame is left unread until memory frees), so the other terms leave room
  * for one largest message (--max-message): a frame can always be read once
  * the requests before it are handled, whatever the worlds, scenes and
- * replies hold. The worlds' term is written on the GL thread, the others on
- * the loop; each is an atomic counter.
+ * replies hold. The worlds' term is written on the GL thread, the bases
+ * (sv_blob's count, export.h) wherever a volume is made or let go, the
+ * others on the loop; each is an atomic counter.
  */
 #ifndef SV_MEMORY_H
 #define SV_MEMORY_H
@@ -24,6 +25,7 @@ typedef enum sv_mem_term {
     SV_MEM_SCENES,   /* sv_scene.bytes of every live scene, once each */
     SV_MEM_REQUESTS, /* request bytes reserved or pending, every connection (R7.5) */
     SV_MEM_REPLIES,  /* reply and stream bytes queued for writing, every connection */
+    SV_MEM_BASES,    /* the volumes delta subscribers hold (sent, ACKed), once each however many share one */
     SV_MEM_TERMS
 } sv_mem_term;
 

@@ -302,8 +302,9 @@ void sv_do_stats(sv_conn *c, sv_request *r)
         (json_int_t)(c->world && c->world->latest ? c->world->latest->tick : 0), "world_sessions", shared,
         "revision", (json_int_t)c->revision);
     json_object_set_new(b, "stream_unchanged", json_integer((json_int_t)unchanged)); /* R5.16 */
-    json_object_set_new(b, "encode", json_pack("{s:I, s:f}", "volumes", (json_int_t)s->volumes_encoded, "volume_cpu_ms",
-                                               (double)s->volume_encode_ns / 1e6));
+    json_object_set_new(b, "encode", json_pack("{s:I, s:f, s:I}", "volumes", (json_int_t)s->volumes_encoded, "volume_cpu_ms",
+                                               (double)s->volume_encode_ns / 1e6, "bases_refused",
+                                               (json_int_t)s->bases_refused));
     json_object_set_new(b, "session_stream_unchanged", json_integer((json_int_t)c->stream_unchanged));
     /* R7.5: request bytes held for all connections, against --max-request-memory */
     json_object_set_new(json_object_get(b, "queues"), "request_bytes",

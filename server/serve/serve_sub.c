@@ -14,10 +14,10 @@ void sv_sub_clear(sv_sub *sub)
 {
     sub->epoch++; /* an encoding in flight no longer hands its base back (sv_sub_restore_base) */
     for (int i = 0; i < SV_SENT_KEEP; ++i) {
-        free(sub->sent[i].raw);
+        sv_blob_unref(sub->sent[i].raw);
         sub->sent[i].raw = NULL;
     }
-    free(sub->acked.raw);
+    sv_blob_unref(sub->acked.raw);
     sub->acked.raw = NULL;
 }
 
@@ -25,13 +25,13 @@ void sv_sub_ack(sv_sub *sub, uint64_t tick)
 {
     for (int i = 0; i < SV_SENT_KEEP; ++i) {
         if (sub->sent[i].raw && sub->sent[i].tick == tick) {
-            free(sub->acked.raw);
+            sv_blob_unref(sub->acked.raw);
             sub->acked = sub->sent[i];
             sub->sent[i].raw = NULL;
             /* older unacknowledged volumes can never become a base now */
             for (int k = 0; k < SV_SENT_KEEP; ++k)
                 if (sub->sent[k].raw && sub->sent[k].tick < tick) {
-                    free(sub->sent[k].raw);
+                    sv_blob_unref(sub->sent[k].raw);
                     sub->sent[k].raw = NULL;
                 }
             return;
@@ -39,7 +39,7 @@ void sv_sub_ack(sv_sub *sub, uint64_t tick)
     }
 }
 
-/* Keeps sent (its raw taken, not copied) as a volume sent to sub that it may ACK. */
+/* Keeps sent (its raw reference taken) as a volume sent to sub that it may ACK. */
 void sv_sub_remember(sv_sub *sub, const sv_sent *sent)
 {
     int slot = 0;
@@ -51,6 +51,6 @@ void sv_sub_remember(sv_sub *sub, const sv_sent *sent)
         if (sub->sent[i].tick < sub->sent[slot].tick)
             slot = i;
     }
-    free(sub->sent[slot].raw);
+    sv_blob_unref(sub->sent[slot].raw);
     sub->sent[slot] = *sent;
 }
