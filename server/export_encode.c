@@ -29,8 +29,8 @@
 #include "tonemap.h"
 #include "volume_codec.h"
 
-/* Guards every sv_result's enc / enc_len (the keyframe cache) and shq
- * (the shared encodings): encoders of one result run on several work
+/* Guards every sv_result's enc / enc_len (the keyframe cache) and shared
+ * (the subscribers' shared encodings): encoders of one result run on several work
  * threads at once. enc_cv: a shared encoding was filled or given up. */
 static pthread_mutex_t enc_mu = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t enc_cv = PTHREAD_COND_INITIALIZER;
@@ -138,8 +138,8 @@ static uint64_t lineage_of(const uint8_t *raw, size_t len)
     return h ? h : 1;
 }
 
-/* A copy of what an encoding of r against lineage `from` at bound made
- * (the outcome in *outcome), or a claim on making it. Returns 1 when found;
+/* A copy of what an encoding of r coded as `how` against lineage `from`
+ * made (the outcome in *outcome), or a claim on making it. Returns 1 when found;
  * else 0 with *claim the slot this encoder now fills (shared_fill, or
  * shared_release on failure), or -1 when every slot is being filled by an
  * encoding of something else (then it encodes for itself alone). An
