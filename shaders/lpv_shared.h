@@ -721,6 +721,14 @@ struct LpvBvhNode {
  * darkness). The volume on the wire keeps the SH. */
 #define LPV_SSBO_PROBES_IRRADIANCE 22 /* float: rgb (W/m^2) per texel of each probe's irradiance map */
 #define LPV_PROBES_IRR_OCT 6          /* its texels per side (the paper's) */
+/* A camera-following cascade that moved by whole cells keeps the probes
+ * whose cells it still holds: probes_scroll.comp copies each of the four
+ * buffers above into the new layout (it runs alone, so the rays' 13 and 14
+ * are free), and only the probes it brought in warm up, a listed batch
+ * (probes_batch.glsl). */
+#define LPV_SSBO_PROBES_SCROLL_SRC 13
+#define LPV_SSBO_PROBES_SCROLL_DST 14
+#define LPV_SSBO_PROBES_LIST 23 /* uint: a listed batch's probe ids */
 /* The lookup's weights (probes_lookup.glsl and its CPU oracle,
  * techniques/probes/core/probes_lookup.c; SPEC R5.15 states them): a
  * probe's weight is (facing^2 + LPV_PROBES_FACING_FLOOR) x the Chebyshev

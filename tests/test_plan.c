@@ -752,6 +752,59 @@ static void test_probes_plan_light_stale(void **state)
     assert_non_null(strstr(p.pass[LPV_PASS_PROBES].reason, "warmup passes"));
 }
 
+/* The probes' scroll rule (lpv_probes_scroll_kept): camera-following
+ * cascades of one shape that moved by whole cells keep the probes whose
+ * cells both hold; anything else keeps none. And the plan says which
+ * probes the tick warms up. */
+static void test_probes_scroll_kept(void **state)
+{
+    (void)state;
+    lpv_cascade_set a = {.count = 2, .snapped = 1};
+    for (int k = 0; k < 2; ++k) {
+        a.grid[k] = (lpv_grid){.dims = {8, 8, 4}, .cell_size = 0.5f * (float)(k + 1)};
+        for (int i = 0; i < 3; ++i)
+            a.origin_cells[k][i] = -4.0f;
+    }
+    lpv_cascade_set b = a;
+    int shift[LPV_MAX_CASCADES][3];
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 2 * 8 * 8 * 4); /* no move: all stay */
+    b.origin_cells[0][0] += 2.0f; /* the fine cascade 2 cells along x, the coarse one 1 down z */
+    b.origin_cells[1][2] -= 1.0f;
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 6 * 8 * 4 + 8 * 8 * 3);
+    assert_int_equal(shift[0][0], 2);
+    assert_int_equal(shift[1][2], -1);
+    assert_int_equal(shift[0][1] | shift[0][2] | shift[1][0] | shift[1][1], 0);
+    b.origin_cells[0][0] += 6.0f; /* the fine one past its whole width: only the coarse one keeps probes */
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 8 * 8 * 3);
+    b.origin_cells[1][2] += 5.0f;
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    b = a;
+    b.grid[1].cell_size = 1.5f; /* another cell size: another place's light */
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    b = a;
+    b.origin_cells[0][1] += 0.5f; /* not whole cells */
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    b = a;
+    b.snapped = 0; /* one grid over the bounds */
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    b = a;
+    b.count = 1;
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+
+    const lpv_settings s = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_PROBES});
+    lpv_probes_progress g = {.history = 1, .sweeps = 1000, .probes = 512, .scroll = 1};
+    lpv_plan p;
+    lpv_plan_facts f = steady();
+    f.camera_move_cells = 2.0f;
+    f.placement_changed = 1;
+    lpv_plan_make_probes(&s, &f, &g, &p);
+    assert_true(p.pass[LPV_PASS_PROBES].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_PROBES].reason, "the probes the cascades' move brings in"));
+    g.scroll = 0;
+    lpv_plan_make_probes(&s, &f, &g, &p);
+    assert_non_null(strstr(p.pass[LPV_PASS_PROBES].reason, "a budget of probes"));
+}
+
 /* Technique auto: the planner's choice, with its reason; any other request is kept. */
 static void test_technique_choose(void **state)
 {
@@ -881,6 +934,7 @@ int main(void)
         cmocka_unit_test(test_technique_choose),
         cmocka_unit_test(test_technique_auto_never_the_worst),
         cmocka_unit_test(test_probes_plan_light_stale),
+        cmocka_unit_test(test_probes_scroll_kept),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cascades.h"
@@ -36,7 +37,10 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "planner off");
     else if (p->recompute) /* also with no history: set above */
         lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s: %s", p->recompute_reason,
-                        fresh ? "every probe, warmup passes" : "a budget of probes");
+                        fresh       ? "every probe, warmup passes"
+                        : g->scroll ? "warmup passes over the probes the cascades' move brings in, the others keep "
+                                      "their light"
+                                    : "a budget of probes");
     else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed)) {
         p->recompute = 1;
         snprintf(p->recompute_reason, sizeof p->recompute_reason, LPV_PROBES_SETTLE_REASON " (%d of %d sweeps)", g->sweeps,
@@ -45,6 +49,31 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
     } else
         lpv_plan_decide(p, LPV_PASS_PROBES, 0, "%s; the probes settled (%d sweeps since the last change)",
                         p->recompute_reason, g->sweeps);
+}
+
+size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set *to,
+                              int shift[LPV_MAX_CASCADES][3])
+{
+    if (!from->snapped || !to->snapped || from->count != to->count || from->handoff != to->handoff ||
+        to->count < 1 || to->count > LPV_MAX_CASCADES)
+        return 0;
+    size_t kept = 0;
+    for (int k = 0; k < to->count; ++k) {
+        if (from->grid[k].cell_size != to->grid[k].cell_size ||
+            memcmp(from->grid[k].dims, to->grid[k].dims, sizeof to->grid[k].dims) != 0)
+            return 0;
+        size_t stay = 1;
+        for (int i = 0; i < 3; ++i) {
+            const float d = to->origin_cells[k][i] - from->origin_cells[k][i];
+            if (d != floorf(d) || fabsf(d) > (float)LPV_MAX_GRID_DIM)
+                return 0;
+            shift[k][i] = (int)d;
+            const int n = to->grid[k].dims[i], s = abs(shift[k][i]);
+            stay *= s < n ? (size_t)(n - s) : 0;
+        }
+        kept += stay;
+    }
+    return kept;
 }
 
 float lpv_probes_hysteresis_now(float hysteresis, const lpv_probes_progress *g)

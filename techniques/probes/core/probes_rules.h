@@ -7,6 +7,10 @@
 #ifndef LPV_PROBES_RULES_H
 #define LPV_PROBES_RULES_H
 
+#include <stddef.h>
+
+#include "cascades.h"
+#include "lpv_shared.h"
 #include "plan.h"
 #include "settings_fields.h"
 #include "tick_cost.h"
@@ -36,6 +40,8 @@ typedef struct lpv_probes_progress {
     int history;  /* 1: the probes hold light from earlier ticks */
     int sweeps;   /* full sweeps over every probe since the last change */
     int changed;  /* 1: sweeps counts from a change of the scene or lights (0: from a warmup) */
+    int scroll;   /* 1: the camera moves the cascades by whole cells and some probes stay
+                     (lpv_probes_scroll_kept): only the probes it brings in warm up */
     size_t probes;
 } lpv_probes_progress;
 
@@ -71,6 +77,13 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
  * change (the ramp forgets faster). An upper bound: the blend lowers the
  * hysteresis further where a probe's light changed. */
 int lpv_probes_settle_sweeps(float hysteresis, int changed);
+
+/* Whole cells each cascade moves from `from` to `to` (a new cell's old cell
+ * is cell + shift[k]) and the probes whose cells both hold, which keep
+ * their light: 0 when they are not camera-following cascades of the same
+ * count, dims and cell sizes (nothing carries over), or no cell stays. */
+size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set *to,
+                              int shift[LPV_MAX_CASCADES][3]);
 
 /* Probes a tick (budget, or every probe of the grid's cascades on the
  * first tick's warmup) x rays, at LPV_TICK_COST_PROBES_RAYS_PER_STEP a

@@ -18,6 +18,9 @@
  *                  history runs probes_warmup passes over every probe (the
  *                  bounces a single tick, e.g. lpvd render, sees); after
  *                  that a tick updates probes_budget probes, round robin.
+ *                  A camera-following cascade that moved by whole cells
+ *                  keeps its probes' light (probes_scroll.comp moves it
+ *                  along) and warms up only the probes it brought in.
  *   lookup         probes_lookup.glsl: 8 probes, visibility-weighted
  *
  * The volume is an LpvCell per probe in the cascades' layout, so the wire's
@@ -45,7 +48,7 @@ typedef struct lpv_probes_gpu {
     lpv_technique base;
     lpv_settings settings;
     lpv_cascade_set cascades, pending;
-    GLuint prog_update, prog_blend;
+    GLuint prog_update, prog_blend, prog_scroll;
     GLuint grid_ubo;
     /* the scene (sample_scene) */
     GLuint nodes, leaf_tris, verts, materials;
@@ -54,20 +57,24 @@ typedef struct lpv_probes_gpu {
     /* the probes (commit) */
     GLuint sh, moments, state, ray_out, irradiance;
     GLuint ray_dirs, taps; /* the batch's ray table */
+    GLuint list;           /* uint per probe: the probes a scroll brought in, the first `fresh` */
     lpv_probes_table table;
     size_t probes, ray_out_rays;
     int oct;
     /* progress */
     uint32_t tick_no;
     size_t cursor;
+    size_t fresh;    /* probes a scroll brought in that await their warmup */
+    size_t scrolled; /* the last tick's warmed-up fresh probes */
     lpv_probes_progress progress;
     size_t updated, rays_traced; /* the last tick's */
     size_t off, moved;           /* probes off (inside geometry) and relocated after the last warmup */
 } lpv_probes_gpu;
 
 static const char *const LOOKUP[] = {"probes_lookup.glsl", NULL};
-static const char *const INC_UPDATE[] = {"grid.glsl", "lights.glsl", "probes_trace.glsl", "probes_lookup.glsl", NULL};
-static const char *const INC_BLEND[] = {"grid.glsl", NULL};
+static const char *const INC_UPDATE[] = {"grid.glsl",          "lights.glsl",        "probes_trace.glsl",
+                                         "probes_lookup.glsl", "probes_batch.glsl", NULL};
+static const char *const INC_BLEND[] = {"grid.glsl", "probes_batch.glsl", NULL};
 
 static void free_scene(lpv_probes_gpu *g)
 {
@@ -79,10 +86,10 @@ static void free_scene(lpv_probes_gpu *g)
 
 static void free_probes(lpv_probes_gpu *g)
 {
-    GLuint *b[] = {&g->sh, &g->moments, &g->state, &g->ray_out, &g->ray_dirs, &g->taps, &g->irradiance};
+    GLuint *b[] = {&g->sh, &g->moments, &g->state, &g->ray_out, &g->ray_dirs, &g->taps, &g->irradiance, &g->list};
     for (size_t i = 0; i < sizeof b / sizeof b[0]; ++i)
         lpv_gl_delete_buffer(b[i]);
-    g->probes = g->ray_out_rays = 0;
+    g->probes = g->ray_out_rays = g->fresh = 0;
     g->progress = (lpv_probes_progress){0};
 }
 
@@ -97,6 +104,8 @@ static void destroy(lpv_technique *t)
         glDeleteProgram(g->prog_update);
     if (g->prog_blend)
         glDeleteProgram(g->prog_blend);
+    if (g->prog_scroll)
+        glDeleteProgram(g->prog_scroll);
     lpv_gl_delete_buffer(&g->grid_ubo);
     lpv_probes_table_free(&g->table);
     free(g);
@@ -110,7 +119,8 @@ static lpv_technique *create(char *err, size_t err_size)
     g->base.cls = &lpv_technique_probes;
     g->prog_update = lpv_program_build("probes_update.comp", NULL, NULL, INC_UPDATE, err, err_size);
     g->prog_blend = g->prog_update ? lpv_program_build("probes_blend.comp", NULL, NULL, INC_BLEND, err, err_size) : 0;
-    if (!g->prog_blend) {
+    g->prog_scroll = g->prog_blend ? lpv_program_build("probes_scroll.comp", NULL, NULL, NULL, err, err_size) : 0;
+    if (!g->prog_scroll) {
         destroy(&g->base);
         return NULL;
     }
@@ -256,6 +266,26 @@ static void inset_grid(lpv_cascade_set *c)
     g->cell_size = cell;
 }
 
+static size_t probe_count(const lpv_cascade_set *c)
+{
+    return lpv_grid_cell_count(&c->grid[0]) * (size_t)(c->count > 0 ? c->count : 1);
+}
+
+/* The rays a batch holds: the budget's probes (at most every probe) x rays. */
+static size_t batch_rays(const lpv_settings *s, size_t probes)
+{
+    const size_t budget = (size_t)s->probes.budget;
+    return (budget < probes ? budget : probes) * (size_t)s->probes.rays;
+}
+
+/* Whether cascades `set` keep the probes' buffers (the same probes, distance
+ * maps and batch), so their light can stay. */
+static int keeps_buffers(const lpv_probes_gpu *g, const lpv_cascade_set *set)
+{
+    const size_t n = probe_count(set);
+    return n == g->probes && g->settings.probes.oct == g->oct && batch_rays(&g->settings, n) == g->ray_out_rays;
+}
+
 static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, char *err, size_t err_size)
 {
     lpv_probes_gpu *g = (lpv_probes_gpu *)t;
@@ -276,14 +306,72 @@ static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, cha
                          count, s.grid_dims[0], s.grid_dims[1], s.grid_dims[2]);
     if (!g->pending.snapped && g->pending.count == 1)
         inset_grid(&g->pending);
+    int shift[LPV_MAX_CASCADES][3];
+    const int differ = !lpv_cascades_equal(&g->pending, &g->cascades);
+    /* the plan's and commit's: the probes that stay keep their light */
+    g->progress.scroll = differ && g->progress.history && !g->fresh && keeps_buffers(g, &g->pending) &&
+                         lpv_probes_scroll_kept(&g->cascades, &g->pending, shift) > 0;
     if (moved)
-        *moved = !lpv_cascades_equal(&g->pending, &g->cascades);
+        *moved = differ;
     return 0;
 }
 
-static size_t probe_count(const lpv_cascade_set *c)
+/* Copies buffer *b (stride floats a probe) into the scrolled layout. */
+static void scroll_buffer(const lpv_probes_gpu *g, GLuint *b, size_t stride)
 {
-    return lpv_grid_cell_count(&c->grid[0]) * (size_t)(c->count > 0 ? c->count : 1);
+    const GLuint dst = lpv_gl_new_ssbo(g->probes * stride * sizeof(float));
+    glUniform1ui(glGetUniformLocation(g->prog_scroll, "u_stride"), (GLuint)stride);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_SCROLL_SRC, *b);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_SCROLL_DST, dst);
+    glDispatchCompute(lpv_div_up(g->probes, LPV_PROBES_WG), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    lpv_gl_delete_buffer(b); /* GL keeps it until the dispatch has read it */
+    *b = dst;
+}
+
+/* Moves the probes' light, distances and state with the cascades (shift
+ * as lpv_probes_scroll_kept's) and lists the probes the move brought in,
+ * which the next tick warms up alone: a camera crossing a cell pays for a
+ * slab of probes, not a warmup of every probe, and the others keep every
+ * bounce they gathered. Returns the probes kept (0: out of memory for the
+ * list, nothing moved). */
+static size_t scroll(lpv_probes_gpu *g, const int shift[LPV_MAX_CASCADES][3])
+{
+    const lpv_grid *grid = &g->cascades.grid[0];
+    const size_t cells = lpv_grid_cell_count(grid);
+    uint32_t *fresh = malloc(g->probes * sizeof *fresh);
+    if (!fresh)
+        return 0;
+    size_t n = 0;
+    for (size_t p = 0; p < g->probes; ++p) {
+        const size_t k = p / cells, cell = p % cells;
+        const int c[3] = {(int)(cell % (size_t)grid->dims[0]), (int)(cell / (size_t)grid->dims[0] % (size_t)grid->dims[1]),
+                          (int)(cell / ((size_t)grid->dims[0] * (size_t)grid->dims[1]))};
+        int kept = 1;
+        for (int i = 0; i < 3; ++i)
+            kept &= c[i] + shift[k][i] >= 0 && c[i] + shift[k][i] < grid->dims[i];
+        if (!kept)
+            fresh[n++] = (uint32_t)p;
+    }
+    if (n < g->probes) {
+        glUseProgram(g->prog_scroll);
+        glUniform1ui(glGetUniformLocation(g->prog_scroll, "u_total"), (GLuint)g->probes);
+        glUniform3iv(glGetUniformLocation(g->prog_scroll, "u_dims"), 1, grid->dims);
+        glUniform3iv(glGetUniformLocation(g->prog_scroll, "u_shift"), LPV_MAX_CASCADES, &shift[0][0]);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        const size_t oct2 = (size_t)g->oct * (size_t)g->oct;
+        scroll_buffer(g, &g->sh, sizeof(struct LpvCell) / sizeof(float));
+        scroll_buffer(g, &g->moments, 2 * oct2);
+        scroll_buffer(g, &g->state, 8);
+        scroll_buffer(g, &g->irradiance, 3 * (size_t)LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT);
+        glUseProgram(0);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->list);
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *fresh), fresh);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+        g->fresh = n;
+    }
+    free(fresh);
+    return g->probes - n;
 }
 
 static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, char *err, size_t err_size)
@@ -291,6 +379,9 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     lpv_probes_gpu *g = (lpv_probes_gpu *)t;
     const lpv_cascade_set *set = &g->pending;
     const int moved = !lpv_cascades_equal(set, &g->cascades);
+    int shift[LPV_MAX_CASCADES][3] = {{0}};
+    const int scrolls = moved && g->progress.scroll && lpv_probes_scroll_kept(&g->cascades, set, shift) > 0;
+    g->progress.scroll = 0;
     g->cascades = *set;
     struct LpvGridParams params;
     lpv_cascades_grid_params(set, &params);
@@ -300,14 +391,13 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
     const size_t n = probe_count(set);
     const int oct = g->settings.probes.oct;
-    const size_t batch = (size_t)g->settings.probes.budget < n ? (size_t)g->settings.probes.budget : n;
-    const size_t rays = batch * (size_t)g->settings.probes.rays;
+    const size_t rays = batch_rays(&g->settings, n);
     *reset = 0;
-    if (n == g->probes && oct == g->oct && rays == g->ray_out_rays) {
+    if (keeps_buffers(g, set)) {
         /* probes that moved with the camera hold another place's light:
-         * their history is gone (a whole-cell shift keeps most of it, which
-         * a later change may keep by moving the probes' data along) */
-        if (moved)
+         * a whole-cell move keeps the light of the cells that stay, any
+         * other move starts afresh */
+        if (moved && !(scrolls && scroll(g, shift) > 0))
             g->progress.history = 0;
         return 0;
     }
@@ -322,6 +412,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     g->state = lpv_gl_new_ssbo(n * 8 * sizeof(float));
     g->irradiance = lpv_gl_new_ssbo(n * LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT * 3 * sizeof(float));
     g->ray_out = lpv_gl_new_ssbo((rays ? rays : 1) * 4 * sizeof(float));
+    g->list = lpv_gl_new_ssbo(n * sizeof(uint32_t));
     clear_zero(g->sh);
     clear_zero(g->moments);
     clear_zero(g->state);
@@ -372,17 +463,20 @@ static int upload_table(lpv_probes_gpu *g, uint32_t tick)
     return 0;
 }
 
-static void set_batch(GLuint prog, size_t first, size_t batch, size_t total, int rays)
+static void set_batch(GLuint prog, size_t first, size_t batch, size_t total, int rays, int listed)
 {
+    glUniform1i(glGetUniformLocation(prog, "u_listed"), listed);
     glUniform1ui(glGetUniformLocation(prog, "u_first"), (GLuint)first);
     glUniform1ui(glGetUniformLocation(prog, "u_batch"), (GLuint)batch);
     glUniform1ui(glGetUniformLocation(prog, "u_total"), (GLuint)total);
     glUniform1ui(glGetUniformLocation(prog, "u_rays"), (GLuint)rays);
 }
 
-/* One batch: probes [first, first + batch) (mod the count) trace and blend. */
-static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t first, size_t batch, int feedback,
-                     float hysteresis, float moment_hysteresis, int relocate)
+/* One batch: probes [first, first + batch) (mod the count), or entries
+ * [first, first + batch) of the list of fresh probes (listed 1), trace and
+ * blend. */
+static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t first, size_t batch, int listed,
+                     int feedback, float hysteresis, float moment_hysteresis, int relocate)
 {
     const lpv_probes_settings *ps = &g->settings.probes;
     const size_t rays = batch * (size_t)ps->rays;
@@ -395,7 +489,8 @@ static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t f
     bind_probes(g);
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_RAY_OUT, g->ray_out);
-    set_batch(g->prog_update, first, batch, g->probes, ps->rays);
+    set_batch(g->prog_update, first, batch, g->probes, ps->rays, listed);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_LIST, g->list);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_RAY_DIRS, g->ray_dirs);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_PROBES_TAPS, g->taps);
     glUniform1ui(glGetUniformLocation(g->prog_update, "u_tick"), tick);
@@ -415,10 +510,11 @@ static int run_batch(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t f
 
     lpv_timer_begin(in->timer, "probes_blend");
     glUseProgram(g->prog_blend);
-    set_batch(g->prog_blend, first, batch, g->probes, ps->rays);
+    set_batch(g->prog_blend, first, batch, g->probes, ps->rays, listed);
     glUniform1i(glGetUniformLocation(g->prog_blend, "u_oct"), g->oct);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_hysteresis"), hysteresis);
-    glUniform1i(glGetUniformLocation(g->prog_blend, "u_change_test"), lpv_probes_change_test_on(&g->progress));
+    /* a listed warmup averages its passes: no change of the light to follow */
+    glUniform1i(glGetUniformLocation(g->prog_blend, "u_change_test"), !listed && lpv_probes_change_test_on(&g->progress));
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_hysteresis"), moment_hysteresis);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_moment_cells"), LPV_PROBES_MOMENT_CELLS);
     glUniform1f(glGetUniformLocation(g->prog_blend, "u_backface_off"), LPV_PROBES_BACKFACE_OFF);
@@ -453,28 +549,44 @@ static void count_state(lpv_probes_gpu *g)
     free(st);
 }
 
+/* Warmup passes over `count` probes: every probe (listed 0), whose pass b
+ * reads pass b - 1's probes for its hits' light and replaces it (each pass
+ * a bounce more), or the list's, the probes a scroll brought in, whose hits
+ * read the probes that stayed from the first pass on, so their passes
+ * after the first average (a third of the noise at 4 passes). Pass 0
+ * relocates; the distances average from pass 1 on, where the probes stay. */
+static int warm_up(lpv_probes_gpu *g, const lpv_technique_inputs *in, size_t count, int listed)
+{
+    const lpv_probes_settings *ps = &g->settings.probes;
+    const size_t batch = g->ray_out_rays / (size_t)ps->rays;
+    for (int pass = 0; pass < ps->warmup; ++pass) {
+        const float mean = pass < 2 ? 0.0f : (float)(pass - 1) / (float)pass; /* a running mean from pass 1 */
+        for (size_t first = 0; first < count; first += batch)
+            if (run_batch(g, in, first, count - first < batch ? count - first : batch, listed, pass > 0 || listed,
+                          listed ? mean : 0.0f, mean, pass == 0 && ps->warmup > 1) != 0)
+                return -1;
+    }
+    count_state(g);
+    return 0;
+}
+
 static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
 {
     lpv_probes_gpu *g = (lpv_probes_gpu *)t;
     const lpv_plan *p = in->plan;
-    g->updated = g->rays_traced = 0;
+    g->updated = g->rays_traced = g->scrolled = 0;
     if (!p->pass[LPV_PASS_PROBES].run || !g->probes)
         return 0;
     const lpv_probes_settings *ps = &g->settings.probes;
     const size_t batch = g->ray_out_rays / (size_t)ps->rays;
     if (!g->progress.history) {
-        /* every probe, warmup passes: pass b's hits read pass b - 1's
-         * probes; the rotations start over, so a fresh volume's light does
-         * not depend on what the technique did before */
+        /* every probe: the rotations start over, so a fresh volume's light
+         * does not depend on what the technique did before */
         g->tick_no = 0;
+        g->fresh = 0;
         clear_zero(g->state); /* no offsets: pass 0 places the probes again */
-        for (int pass = 0; pass < ps->warmup; ++pass)
-            for (size_t first = 0; first < g->probes; first += batch)
-                /* pass 0 relocates; the distances average from pass 1 on, where the probes stay */
-                if (run_batch(g, in, first, g->probes - first < batch ? g->probes - first : batch, pass > 0, 0.0f,
-                              pass < 2 ? 0.0f : (float)(pass - 1) / (float)pass, pass == 0 && ps->warmup > 1) != 0)
-                    return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
-        count_state(g);
+        if (warm_up(g, in, g->probes, 0) != 0)
+            return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->cursor = 0;
         g->progress.history = 1;
         g->progress.sweeps = 0;
@@ -484,10 +596,19 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
             g->progress.sweeps = 0; /* a change: settle again, forgetting the old light faster */
             g->progress.changed = 1;
         }
-        if (run_batch(g, in, g->cursor, batch, 1, lpv_probes_hysteresis_now(ps->hysteresis, &g->progress),
+        const size_t fresh = g->fresh;
+        g->fresh = 0;
+        if (fresh && warm_up(g, in, fresh, 1) != 0)
+            return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
+        g->scrolled = fresh;
+        /* after a scroll the kept probes wait for the next tick, unless
+         * the light changed too */
+        if ((!fresh || p->light_stale) &&
+            run_batch(g, in, g->cursor, batch, 0, 1, lpv_probes_hysteresis_now(ps->hysteresis, &g->progress),
                       ps->hysteresis, 0) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
-        g->cursor += batch;
+        if (!fresh || p->light_stale)
+            g->cursor += batch;
         if (g->cursor >= g->probes) {
             g->cursor %= g->probes;
             ++g->progress.sweeps;
@@ -595,6 +716,7 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     lpv_stats_put(s, "probes_rays", LPV_STAT_INT, ran ? (double)g->rays_traced : 0.0, 0, 0);
     lpv_stats_put(s, "probes_off", LPV_STAT_INT, (double)g->off, 0, 0);
     lpv_stats_put(s, "probes_moved", LPV_STAT_INT, (double)g->moved, 0, 0);
+    lpv_stats_put(s, "probes_scrolled_in", LPV_STAT_INT, ran ? (double)g->scrolled : 0.0, 0, 0);
     lpv_stats_put(s, "probes_sweeps", LPV_STAT_INT, (double)g->progress.sweeps, 0, 0);
     lpv_stats_put(s, "probes_triangles", LPV_STAT_INT, (double)g->triangles, 0, 0);
 }

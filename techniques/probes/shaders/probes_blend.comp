@@ -25,7 +25,7 @@ layout(std430, binding = LPV_SSBO_PROBES_RAY_DIRS) readonly buffer ProbesRayDirs
 layout(std430, binding = LPV_SSBO_PROBES_TAPS) readonly buffer ProbesTaps { uvec2 probes_taps[]; };
 layout(std430, binding = LPV_SSBO_PROBES_IRRADIANCE) buffer ProbesIrradiance { float probes_irradiance[]; };
 
-uniform uint u_first, u_batch, u_total, u_rays;
+uniform uint u_rays;
 uniform int u_oct;
 uniform float u_hysteresis;    // 0: the rays replace the old value
 uniform int u_change_test;     // 1: lower it where the light changed (the first sweeps after a change only)
@@ -42,7 +42,7 @@ void main()
     uint j = gl_GlobalInvocationID.x;
     if (j >= u_batch)
         return;
-    uint probe = (u_first + j) % u_total;
+    uint probe = probes_batch_probe(j);
     int k = int(probe) / grid_cells();
     float cell = cascade_cell(k), mmax = u_moment_cells * cell;
     uint first = j * u_rays;

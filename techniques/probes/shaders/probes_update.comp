@@ -16,9 +16,6 @@ layout(std430, binding = LPV_SSBO_PROBES_RAY_OUT) writeonly buffer ProbesRayOut 
 layout(std430, binding = LPV_SSBO_PROBES_MATERIALS) readonly buffer ProbesMaterials { vec4 probes_materials[]; };
 layout(std430, binding = LPV_SSBO_PROBES_RAY_DIRS) readonly buffer ProbesRayDirs { vec4 probes_ray_dirs[]; };
 
-uniform uint u_first;         // the batch's first probe (it wraps at u_total)
-uniform uint u_batch;         // probes in the batch
-uniform uint u_total;         // probes of every cascade
 uniform uint u_rays;          // per probe
 uniform uint u_tick;          // draws the area light sample
 uniform float u_max_distance; // m: a ray stops here and counts as a miss
@@ -74,7 +71,7 @@ void main()
     uint i = gl_GlobalInvocationID.x;
     if (i >= u_batch * u_rays)
         return;
-    uint probe = (u_first + i / u_rays) % u_total, r = i % u_rays;
+    uint probe = probes_batch_probe(i / u_rays), r = i % u_rays;
     int k = int(probe) / grid_cells(), cell = int(probe) % grid_cells();
     ivec3 dims = grid_dims();
     ivec3 c = ivec3(cell % dims.x, (cell / dims.x) % dims.y, cell / (dims.x * dims.y));

@@ -10,7 +10,10 @@
  *     on, and the frame's light is finite and not negative;
  *   - a light that moves: the probes keep their history and follow it (the
  *     ticks until the light is within 10 % of the settled light's: the time
- *     to converge).
+ *     to converge);
+ *   - a camera that moves a cascade by whole cells: the probes that stay
+ *     keep their light bit for bit at their new index, only the probes it
+ *     brought in warm up, and their light is a fresh warmup's.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -532,6 +535,105 @@ static void test_forget_gives_a_fresh_tick(void **state)
     lpv_scene_free(&room);
 }
 
+/* The GPU ms of the tick's probes passes (printed, never asserted). */
+static double probes_ms(const lpv_engine_stats *s)
+{
+    double ms = 0.0;
+    for (int i = 0; i < s->stage_count; ++i)
+        ms += strncmp(s->stages[i].name, "probes", 6) == 0 ? s->stages[i].gpu_ms : 0.0;
+    return ms;
+}
+
+/* A camera-following cascade that moves by whole cells (probes_scroll.comp):
+ * the probes whose cells it still holds keep their light, distances and
+ * state exactly, moved to their new index; only the probes it brought in
+ * trace rays (a slab, warmup passes, no round robin: the light did not
+ * change), and they come out lit like a fresh warmup's probes there. */
+static void test_probes_scroll_with_the_camera(void **state)
+{
+    (void)state;
+    enum { N = 8, CASCADES = 2, PROBES = CASCADES * N * N * N };
+    const float light[3] = {0.5f, 3.0f, 0.3f};
+    lpv_settings st = probe_settings(N);
+    st.area_lights = LPV_SWITCH_DEFAULT;
+    st.probes.warmup = 4;
+    st.probes.budget = 128;
+    st.lpv.cascades = CASCADES;
+    st.lpv.cascade_size = 4.0f; /* cascade 0: 0.5 m cells, following the camera in the 8 m room */
+    lpv_scene room = {0};
+    grey_room(&room, 4.0f);
+    lpv_scene_add_point_light(&room, light, 400.0f);
+    lpv_scene_compute_bounds(&room);
+    lpv_view view = {.eye = {-1.0f, 0.0f, 0.0f}, .forward = {1, 0, 0}, .up = {0, 1, 0}, .yfov = 1.0f, .width = 16,
+                     .height = 16};
+    char err[512];
+    assert_int_equal(lpv_engine_set_view(lpvt_engine, &view, err, sizeof err), 0);
+    run(&room, &st);
+    for (int i = 0; i < 6; ++i) /* some history past the warmup */
+        assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+    lpv_volume_desc was = lpv_engine_last_stats(lpvt_engine)->volume;
+    assert_int_equal(was.levels, CASCADES);
+    static lpv_cell before[PROBES], after[PROBES], fresh[PROBES];
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, before, PROBES), PROBES);
+
+    view.eye[0] += 2.2f * was.level[0].cell_size; /* two cells and a bit */
+    assert_int_equal(lpv_engine_set_view(lpvt_engine, &view, err, sizeof err), 0);
+    assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+    assert_non_null(strstr(lpv_engine_last_plan(lpvt_engine)->pass[LPV_PASS_PROBES].reason,
+                            "the probes the cascades' move brings in"));
+    const lpv_volume_desc now = lpv_engine_last_stats(lpvt_engine)->volume;
+    int shift[CASCADES][3], brought = 0;
+    for (int k = 0; k < CASCADES; ++k) {
+        assert_float_equal(now.level[k].cell_size, was.level[k].cell_size, 0.0f);
+        for (int i = 0; i < 3; ++i)
+            shift[k][i] = (int)(now.origin_cells[k][i] - was.origin_cells[k][i]);
+    }
+    assert_int_equal(shift[0][0], 2); /* the fine cascade followed the camera two cells; the coarse one spans the room */
+    assert_int_equal(shift[0][1] | shift[0][2] | shift[1][0] | shift[1][1] | shift[1][2], 0);
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, after, PROBES), PROBES);
+    size_t kept_same = 0;
+    for (int k = 0; k < CASCADES; ++k)
+        for (int z = 0; z < N; ++z)
+            for (int y = 0; y < N; ++y)
+                for (int x = 0; x < N; ++x) {
+                    const int p = k * N * N * N + x + N * (y + N * z), ox = x + shift[k][0];
+                    if (ox >= N) {
+                        ++brought;
+                        assert_true(after[p].r[0] > 0.0f && isfinite(after[p].r[0])); /* warmed up: lit */
+                        continue;
+                    }
+                    kept_same += memcmp(&after[p], &before[p + shift[k][0]], sizeof after[p]) == 0;
+                }
+    assert_int_equal(brought, 2 * N * N);
+    assert_int_equal(kept_same, PROBES - brought); /* bit for bit, at the new index */
+    const lpv_engine_stats *s = lpv_engine_last_stats(lpvt_engine);
+    const double scroll_ms = probes_ms(s);
+    assert_int_equal((int)lpv_stats_get(s, "probes_scrolled_in")->v[0], brought);
+    assert_int_equal((int)lpv_stats_get(s, "probes_updated")->v[0], 4 * brought); /* 4 warmup passes, nothing else */
+
+    /* the same place afresh: every probe, 4 passes */
+    lpv_engine_forget(lpvt_engine);
+    assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+    assert_int_equal((int)lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "probes_updated")->v[0], 4 * PROBES);
+    assert_int_equal(lpv_engine_read_grid(lpvt_engine, LPV_GRID_ACCUMULATED, fresh, PROBES), PROBES);
+    double sum_scrolled = 0.0, sum_fresh = 0.0;
+    for (int z = 0; z < N; ++z)
+        for (int y = 0; y < N; ++y)
+            for (int x = N - 2; x < N; ++x) {
+                const int p = x + N * (y + N * z);
+                sum_scrolled += after[p].r[0] + after[p].g[0] + after[p].b[0];
+                sum_fresh += fresh[p].r[0] + fresh[p].g[0] + fresh[p].b[0];
+            }
+    const double fresh_ms = probes_ms(lpv_engine_last_stats(lpvt_engine));
+    printf("the probes a scroll brought in: %.3f of a fresh warmup's light there; %d of %d probes traced, the probes' "
+           "passes %.1f ms against a fresh warmup's %.1f ms (%.3f)\n",
+           sum_scrolled / sum_fresh, brought, PROBES, scroll_ms, fresh_ms, scroll_ms / fresh_ms);
+    /* the same passes, their neighbours' light from more bounces: not
+     * darker, and not more than the bounces past the warmup's add */
+    assert_true(sum_scrolled >= 0.9 * sum_fresh && sum_scrolled <= 1.5 * sum_fresh);
+    lpv_scene_free(&room);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -541,6 +643,7 @@ int main(void)
         cmocka_unit_test(test_probes_relocate),
         cmocka_unit_test(test_lookup_matches_cpu_oracle),
         cmocka_unit_test(test_probes_follow_a_moved_light),
+        cmocka_unit_test(test_probes_scroll_with_the_camera),
         cmocka_unit_test(test_forget_gives_a_fresh_tick),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
