@@ -52,7 +52,8 @@ uint64_t lpv_memory_grid_bytes(const lpv_memory_need *n)
 {
     /* the lookup's normals take at most LPV_LOOKUP_NORMAL_TEXELS in all */
     const uint64_t normals = n->cells > 0 ? (uint64_t)LPV_LOOKUP_NORMAL_TEXELS * LPV_MEM_LOOKUP_NORMAL_TEXEL : 0;
-    return (uint64_t)n->cells * LPV_MEM_CELL + (uint64_t)n->gv_points * LPV_MEM_GV_POINT + normals;
+    return (uint64_t)n->cells * LPV_MEM_CELL + (uint64_t)n->gv_points * LPV_MEM_GV_POINT + normals +
+           n->technique_bytes;
 }
 
 uint64_t lpv_memory_image_bytes(const lpv_memory_need *n)
@@ -130,6 +131,12 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
                     "most %.2f GB: lower grid or cascades",
                     what, gb(cell_buffer), LPV_MEM_CELL_BUFFER, gb(lim->max_buffer));
     }
+    if (n->technique_buffer > lim->max_buffer)
+        return fail(err, err_size, "%s needs %.2f GB in one buffer; one shader storage buffer may hold at most "
+                    "%.2f GB: lower %s",
+                    n->technique_buffer_what ? n->technique_buffer_what : "the technique's largest buffer",
+                    gb(n->technique_buffer), gb(lim->max_buffer),
+                    n->technique_buffer_lower ? n->technique_buffer_lower : "the technique's knobs");
     uint64_t surfels = lpv_memory_block_samples(n->image_w, n->image_h) * LPV_MEM_SURFEL;
     if (surfels > lim->max_buffer) {
         part_name(n, 3, what, sizeof what);

@@ -58,6 +58,13 @@ typedef struct lpv_memory_need {
     int image_w, image_h;          /* 0 x 0 = no camera */
     int translucent;               /* 1: the scene has BLEND surfaces (the shadow maps' transmission, the
                                       frame's translucent layer) */
+    /* A technique's own storage beyond LPV_MEM_CELL a cell (the probes' maps,
+     * ray results and BVH), counted with the grid, and its largest single
+     * buffer, checked against max_buffer and named in a refusal. */
+    uint64_t technique_bytes;
+    uint64_t technique_buffer;
+    const char *technique_buffer_what;  /* e.g. "the probes' ray results (probes_budget x probes_rays x 16 B)" */
+    const char *technique_buffer_lower; /* the knobs that shrink it, e.g. "probes_budget or probes_rays" */
 } lpv_memory_need;
 
 /* Bytes of each part, and of all. */
@@ -83,8 +90,9 @@ int lpv_memory_check(const lpv_memory_need *n, const lpv_memory_limits *lim, cha
 /* The least any scene needs under settings s (resolved, core/settings.h):
  * one light face of RSM and of shadow map at their sizes times light_faces
  * (at least 1), and the technique's own floor (lpv_technique_memory_floor:
- * for the LPV and the octree their grid at the cascades asked for; nothing
- * for the imperfect volume or auto, whose grids the scene places). What
+ * for the LPV and the octree their grid at the cascades asked for, for the
+ * probes theirs with the probes' maps and a batch's rays; nothing for the
+ * imperfect volume or auto, whose grids the scene places). What
  * fails lpv_memory_check here can never run, so the daemon refuses it at
  * CONFIG (issue 31, item 11). */
 struct lpv_settings;

@@ -19,7 +19,7 @@ static const lpv_technique_rules TECHNIQUES[LPV_TECHNIQUE_ID_COUNT_] = {
                                  lpv_octree_memory_floor},
     [LPV_TECHNIQUE_ID_IV] = {LPV_TECHNIQUE_IV, LPV_CAP_AO, 1, lpv_iv_tick_cost, NULL, NULL},
     [LPV_TECHNIQUE_ID_AUTO] = {LPV_TECHNIQUE_AUTO, 0, 0, NULL, NULL, NULL}, /* nothing until the engine chose */
-    [LPV_TECHNIQUE_ID_PROBES] = {LPV_TECHNIQUE_PROBES, 0, 1, lpv_probes_tick_cost, NULL, NULL},
+    [LPV_TECHNIQUE_ID_PROBES] = {LPV_TECHNIQUE_PROBES, 0, 1, lpv_probes_tick_cost, NULL, lpv_probes_memory_floor},
 };
 
 const lpv_technique_rules *lpv_technique_rules_of(lpv_technique_id t)

@@ -12,7 +12,11 @@
  *     a shadow_size past the table's range is refused by the flag parser;
  *  4. area light samples are counted: 8 samples of an emitter have 40
  *     shadow-map faces, tiles four to a layer, so 10 layers of shadow_size^2
- *     (4096: 0.67 GB, refused under a 100 MB budget; 256 fits and lights).
+ *     (4096: 0.67 GB, refused under a 100 MB budget; 256 fits and lights);
+ *  5. the probes' own storage is counted (each probe's maps, a batch's ray
+ *     results): ray results and distance maps past what one shader storage
+ *     buffer holds are refused at their floor, naming the knobs, and
+ *     through the engine, which then works at its defaults.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -29,6 +33,7 @@
 #include "context.h"
 #include "engine.h"
 #include "memory_budget.h"
+#include "probes_rules.h"
 #include "scene_build.h"
 #include "test_util.h"
 #include "view.h"
@@ -219,6 +224,63 @@ static void test_area_light_faces_are_counted(void **state)
     lpv_scene_free(&s);
 }
 
+static lpv_settings probes_settings(int grid, int cascades, int rays, int budget, int oct)
+{
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_PROBES, .grid_dims = {grid, grid, grid}};
+    s.lpv.cascades = cascades;
+    s.probes.rays = rays;
+    s.probes.budget = budget;
+    s.probes.oct = oct;
+    lpv_settings_resolve(&s);
+    return s;
+}
+
+static void test_probes_storage_is_counted(void **state)
+{
+    (void)state;
+    /* SH 48 + distances 8 x 8^2 + irradiance 12 x 6^2 + state 32 + list 4,
+     * and the scroll's copy of the distances */
+    assert_int_equal(lpv_probes_bytes_per_probe(8), 48 + 512 + 432 + 32 + 4 + 512);
+    lpv_memory_need n;
+    char err[512] = "";
+    lpv_settings s = probes_settings(32, 3, 0, 0, 0); /* the knobs' defaults: 64 rays, 1024 probes a tick, 8^2 */
+    lpv_memory_need_floor(&s, 1, &n);
+    assert_int_equal(lpv_memory_check(&n, &LIMITS, err, sizeof err), 0);
+    const uint64_t probes = 3 * 32 * 32 * 32;
+    assert_int_equal(n.cells, probes);
+    assert_int_equal(n.technique_bytes, probes * (1540 - LPV_MEM_CELL) + 1024ull * 64 * 16);
+    /* 64^3 probes x 1024 rays in a batch of all of them: 4.3 GB of ray
+     * results in one buffer (it crashed llvmpipe past 2 GiB) */
+    s = probes_settings(64, 1, 1024, 1 << 20, 0);
+    lpv_memory_need_floor(&s, 1, &n);
+    expect_refused(&n, "probes_budget", "probes_rays");
+    /* 4 x 64^3 probes with 16^2 distance maps: 2 KiB each, 2 GiB in one buffer */
+    s = probes_settings(64, 4, 0, 0, 16);
+    lpv_memory_need_floor(&s, 1, &n);
+    expect_refused(&n, "distance maps", "probes_oct");
+
+    /* through an engine of its own (the tests before ran lpvd render, which
+     * leaves no context current): refused with the message, then the
+     * defaults work */
+    struct lpv_gl_context *ctx = NULL;
+    lpv_engine *e = NULL;
+    assert_int_equal(lpvt_gl_open(&ctx, &e), 0);
+    lpv_scene scene;
+    assert_int_equal(lpv_scene_builtin_cornell(&scene), 0);
+    s = probes_settings(64, 1, 1024, 1 << 20, 0);
+    if (lpv_engine_set_settings(e, &s, err, sizeof err) == 0 && lpv_engine_set_scene(e, &scene, err, sizeof err) == 0)
+        assert_int_not_equal(lpv_engine_tick(e, err, sizeof err), 0);
+    printf("engine: %s\n", err);
+    assert_non_null(strstr(err, "probes_rays"));
+    s = probes_settings(8, 0, 0, 0, 0);
+    assert_int_equal(lpv_engine_set_settings(e, &s, err, sizeof err), 0);
+    assert_int_equal(lpv_engine_set_scene(e, &scene, err, sizeof err), 0);
+    assert_int_equal(lpv_engine_tick(e, err, sizeof err), 0);
+    assert_true(lpv_engine_memory_bytes(e) > 8 * 8 * 8 * 1540ull); /* the probes' maps and the BVH */
+    lpv_scene_free(&scene);
+    lpvt_gl_close(ctx, e);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -226,6 +288,7 @@ int main(void)
         cmocka_unit_test(test_rsm_size_that_crashed_is_refused),
         cmocka_unit_test(test_shadow_size_over_the_budget_is_refused),
         cmocka_unit_test(test_area_light_faces_are_counted),
+        cmocka_unit_test(test_probes_storage_is_counted),
     };
     return cmocka_run_group_tests(tests, lpvt_gl_setup, lpvt_gl_teardown);
 }

@@ -101,6 +101,41 @@ int lpv_probes_settle_sweeps(float hysteresis, int changed)
     return g.sweeps;
 }
 
+uint64_t lpv_probes_bytes_per_probe(int oct)
+{
+    const uint64_t sh = 48, distances = 8ull * (uint64_t)oct * (uint64_t)oct,
+                   irradiance = 12ull * LPV_PROBES_IRR_OCT * LPV_PROBES_IRR_OCT, state = 32, list = 4;
+    return sh + distances + irradiance + state + list + (distances > irradiance ? distances : irradiance);
+}
+
+void lpv_probes_memory_need(const lpv_settings *s, size_t probes, uint64_t scene_bytes, lpv_memory_need *n)
+{
+    const uint64_t per = lpv_probes_bytes_per_probe(s->probes.oct), p = probes;
+    const uint64_t batch = (uint64_t)s->probes.budget < p ? (uint64_t)s->probes.budget : p;
+    const uint64_t rays = batch * (uint64_t)s->probes.rays * 16u,
+                   distances = p * 8ull * (uint64_t)s->probes.oct * (uint64_t)s->probes.oct;
+    n->cells += probes;
+    n->technique_bytes += p * (per > LPV_MEM_CELL ? per - LPV_MEM_CELL : 0) + rays + scene_bytes;
+    if (rays > n->technique_buffer) {
+        n->technique_buffer = rays;
+        n->technique_buffer_what = "the probes' ray results (probes_budget, at most every probe, x probes_rays x 16 B)";
+        n->technique_buffer_lower = "probes_budget or probes_rays";
+    }
+    if (distances > n->technique_buffer) {
+        n->technique_buffer = distances;
+        n->technique_buffer_what = "the probes' distance maps (8 B x probes_oct^2 a probe)";
+        n->technique_buffer_lower = "probes_oct, grid or cascades";
+    }
+}
+
+void lpv_probes_memory_floor(const lpv_settings *s, lpv_memory_need *n)
+{
+    const int asked = s->lpv.cascades > 0 ? (s->lpv.cascades < LPV_MAX_CASCADES ? s->lpv.cascades : LPV_MAX_CASCADES) : 1;
+    lpv_probes_memory_need(s, (size_t)lpv_settings_grid_cells(s) * (size_t)asked, 0, n);
+    n->cascades = asked;
+    memcpy(n->grid_dims, s->grid_dims, sizeof n->grid_dims);
+}
+
 void lpv_probes_tick_cost(const lpv_settings *s, lpv_tick_cost *out)
 {
     /* the cascades the planner may place (auto: the most it places) */

@@ -11,6 +11,7 @@
 
 #include "cascades.h"
 #include "lpv_shared.h"
+#include "memory_budget.h"
 #include "plan.h"
 #include "settings_fields.h"
 #include "tick_cost.h"
@@ -89,6 +90,22 @@ size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set
  * first tick's warmup) x rays, at LPV_TICK_COST_PROBES_RAYS_PER_STEP a
  * cell-step. */
 void lpv_probes_tick_cost(const lpv_settings *s, lpv_tick_cost *out);
+
+/* Bytes a probe holds (technique_probes.c's buffers): its SH (48), distance
+ * map (2 floats a texel, oct^2 texels), irradiance map (3 floats a texel,
+ * LPV_PROBES_IRR_OCT^2), state (8 floats) and place in a scroll's list (4),
+ * and the scroll's copy of the largest of those maps (it copies one buffer
+ * at a time). */
+uint64_t lpv_probes_bytes_per_probe(int oct);
+/* Adds the probes' storage to n: `probes` cells (LPV_MEM_CELL of each
+ * probe's bytes), the rest of each probe's, a batch's ray results
+ * (min(probes_budget, probes) x probes_rays x 16 B) and the scene's BVH and
+ * triangles (scene_bytes); the largest single buffer of them for the
+ * max_buffer check. */
+void lpv_probes_memory_need(const lpv_settings *s, size_t probes, uint64_t scene_bytes, lpv_memory_need *n);
+/* The least any scene needs: a probe per cell of the cascades asked for
+ * (one grid unless lpv.cascades is set), no scene (techniques/registry.c). */
+void lpv_probes_memory_floor(const lpv_settings *s, lpv_memory_need *n);
 
 /* Its knob rows (probes_fields.c), *count of them. */
 const lpv_field *lpv_probes_fields(size_t *count);

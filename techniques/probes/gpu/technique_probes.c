@@ -53,7 +53,8 @@ typedef struct lpv_probes_gpu {
     /* the scene (sample_scene) */
     GLuint nodes, leaf_tris, verts, materials;
     size_t triangles;
-    float scene_size; /* m, the bounds' diagonal: the rays' reach */
+    uint64_t scene_bytes; /* the four buffers' */
+    float scene_size;     /* m, the bounds' diagonal: the rays' reach */
     /* the probes (commit) */
     GLuint sh, moments, state, ray_out, irradiance;
     GLuint ray_dirs, taps; /* the batch's ray table */
@@ -82,6 +83,7 @@ static void free_scene(lpv_probes_gpu *g)
     for (size_t i = 0; i < sizeof b / sizeof b[0]; ++i)
         lpv_gl_delete_buffer(b[i]);
     g->triangles = 0;
+    g->scene_bytes = 0;
 }
 
 static void free_probes(lpv_probes_gpu *g)
@@ -223,6 +225,8 @@ static int sample_scene(lpv_technique *t, const lpv_technique_scene *in, char *e
     g->verts = upload(bvh.vertices, bvh.triangle_count * 3, 4 * sizeof(float));
     g->materials = upload(mat, n, 8 * sizeof(float));
     g->triangles = n;
+    g->scene_bytes = (uint64_t)bvh.node_count * sizeof *bvh.nodes + (uint64_t)bvh.leaf_tri_count * sizeof *bvh.leaf_tris +
+                     (uint64_t)bvh.triangle_count * 3 * 4 * sizeof(float) + (uint64_t)n * 8 * sizeof(float);
     free(mat);
     lpv_probes_bvh_free(&bvh);
     float d2 = 0.0f;
@@ -402,7 +406,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
         return 0;
     }
     lpv_memory_need need = w->others;
-    need.cells += n;
+    lpv_probes_memory_need(&g->settings, n, g->scene_bytes, &need);
     if (lpv_memory_check(&need, w->limits, err, err_size) != 0)
         return -1;
     free_probes(g);
@@ -699,7 +703,7 @@ static size_t read(lpv_technique *t, const lpv_plan *last, lpv_volume_part part,
 static void memory_need(const lpv_technique *t, lpv_memory_need *n)
 {
     const lpv_probes_gpu *g = (const lpv_probes_gpu *)t;
-    n->cells += g->probes;
+    lpv_probes_memory_need(&g->settings, g->probes, g->scene_bytes, n);
     n->cascades = g->cascades.count;
     memcpy(n->grid_dims, g->cascades.grid[0].dims, sizeof n->grid_dims);
 }
