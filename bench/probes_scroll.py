@@ -1,0 +1,184 @@
+#!/usr/bin/env python3
+"""probes_scroll.py - what a camera crossing cells costs the probes, and the
+light it leaves (a benchmark, not a test: nothing is asserted).
+
+    python3 bench/probes_scroll.py                        # build/server/lpvd
+    python3 bench/probes_scroll.py --lpvd OLD --lpvd NEW  # builds side by side, one run
+    python3 bench/probes_scroll.py --out /tmp/scroll      # and the frames as PNG
+
+On the built-in Cornell box, technique probes with two camera-following
+cascades (--cascade-size m, grid 16: 2 x 16^3 probes): a session's camera
+stands at --eye looking down -z and ticks --ticks times; then the camera
+moves --dx m along x (several cells of the fine cascade) and the session
+ticks once ("after the move"). A second daemon starts at the moved camera
+and ticks once: a fresh volume's warmup, what every cell crossing cost
+before the probes scrolled; it then ticks until the plan stops the probes
+(they settled: the warmup's light weighs at most 1 %) or --max-ticks. Each
+row gives the move's tick (probes updated, of them brought in by the
+scroll, the probes' passes' GPU ms, the server's tick_ms) and how far
+QUERY_IRRADIANCE at 100 points on the box's walls is from the settled
+answers (mean |E - E_settled| / mean E_settled), for the tick after the
+move and for the fresh warmup.
+
+With --out DIR, writes DIR/strip.png: the frame (indirect light, auto
+exposure) before the move, after it, the fresh warmup's and the settled one,
+side by side. Needs only the Python client (numpy optional).
+"""
+
+import argparse
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
+
+import lpvd_session  # noqa: E402
+
+SIZE = 256
+
+
+def surface_points():
+    """5 x 5 points on the floor, left, right and back walls of the built-in
+    box ([-1, 1] x [0, 2] x [-1, 1]), facing in."""
+    pts, nrm = [], []
+    ts = [-0.8, -0.4, 0.0, 0.4, 0.8]
+    for u in ts:
+        for v in ts:
+            pts.append([u, 0.01, v]); nrm.append([0, 1, 0])
+            pts.append([-0.99, 1.0 + u, v]); nrm.append([1, 0, 0])
+            pts.append([0.99, 1.0 + u, v]); nrm.append([-1, 0, 0])
+            pts.append([u, 1.0 + v, -0.99]); nrm.append([0, 0, 1])
+    return pts, nrm
+
+
+def start(lpvd):
+    addr = os.path.join(tempfile.mkdtemp(prefix="probes-scroll-"), "lpvd.sock")
+    proc = subprocess.Popen([lpvd, "serve", "--socket", addr], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(600):
+        if os.path.exists(addr):
+            break
+        time.sleep(0.1)
+    return proc, addr
+
+
+def session(addr, a, eye):
+    c = lpvd_session.Client(addr)
+    c.hello()
+    c.config(technique="probes", cascades=2, cascade_size=a.cascade_size, grid=16)
+    look(c, eye)
+    return c
+
+
+def look(c, eye):
+    c.camera_set(eye=eye, target=[eye[0], eye[1], eye[2] - 3.0], width=SIZE, height=SIZE, fov_deg=70)
+
+
+def answers(c):
+    pts, nrm = surface_points()
+    return [float(x) for row in c.query_irradiance(pts, nrm) for x in row]
+
+
+def frame(c):
+    return c.get_frame(format="rgba8", terms="indirect").data
+
+
+def tick_row(reply):
+    st = reply.get("stats", {})
+    pr = st.get("probes", {})
+    ms = sum(s["gpu_ms"] for s in st.get("stages", []) if s["name"].startswith("probes"))
+    return pr.get("probes_updated", 0), pr.get("probes_scrolled_in", 0), ms, float(st.get("tick_ms", 0.0))
+
+
+def off(e, ref):
+    return sum(abs(x - y) for x, y in zip(e, ref)) / max(sum(abs(y) for y in ref), 1e-30)
+
+
+def write_png(path, frames):
+    """rgba8 frames of SIZE x SIZE side by side, as an RGB PNG (zlib only)."""
+    rows = []
+    for y in range(SIZE):
+        row = bytearray(b"\x00")
+        for f in frames:
+            line = f[y * SIZE * 4:(y + 1) * SIZE * 4]  # top row first (SPEC R6.1)
+            for x in range(SIZE):
+                row += line[4 * x:4 * x + 3]
+        rows.append(bytes(row))
+
+    def chunk(t, d):
+        return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", SIZE * len(frames), SIZE, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(b"".join(rows))) + chunk(b"IEND", b""))
+
+
+def run(lpvd, a):
+    e0 = [float(v) for v in a.eye.split(",")]
+    e1 = [e0[0] + a.dx, e0[1], e0[2]]
+    proc, addr = start(lpvd)
+    try:
+        c = session(addr, a, e0)
+        for _ in range(a.ticks):
+            c.tick()
+        frames = [frame(c)]
+        look(c, e1)
+        moved = tick_row(c.tick())
+        e_moved = answers(c)
+        frames.append(frame(c))
+        c.close()
+    finally:
+        proc.terminate()
+        proc.wait()
+    proc, addr = start(lpvd)
+    try:
+        c = session(addr, a, e1)
+        fresh = tick_row(c.tick())
+        e_fresh = answers(c)
+        frames.append(frame(c))
+        settled = 1
+        while settled < a.max_ticks and tick_row(c.tick())[0] > 0:
+            settled += 1
+        e_settled = answers(c)
+        frames.append(frame(c))
+        c.close()
+    finally:
+        proc.terminate()
+        proc.wait()
+    return moved, fresh, off(e_moved, e_settled), off(e_fresh, e_settled), settled, frames
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--lpvd", action="append", help="lpvd binary (repeat to compare builds; default build/server/lpvd)")
+    ap.add_argument("--cascade-size", type=float, default=1.5, help="m, the fine cascade's side")
+    ap.add_argument("--eye", default="-0.25,1.0,0.9")
+    ap.add_argument("--dx", type=float, default=0.5, help="m the camera moves along x")
+    ap.add_argument("--ticks", type=int, default=60, help="ticks before the move")
+    ap.add_argument("--max-ticks", type=int, default=600, help="at most this many to the settled light")
+    ap.add_argument("--out", help="a folder for strip.png (the last build's frames)")
+    a = ap.parse_args()
+    builds = a.lpvd or [os.path.join(ROOT, "build", "server", "lpvd")]
+    print("| build | the move's tick: probes updated / brought in | its probes passes (ms) | tick_ms | "
+          "off the settled light after the move | the fresh warmup: probes | its probes passes (ms) | tick_ms | "
+          "off the settled light | ticks to settle | passes: move / fresh |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    frames = None
+    for b in builds:
+        moved, fresh, off_moved, off_fresh, settled, frames = run(b, a)
+        print("| %s | %d / %d | %.0f | %.0f | %.3f | %d | %.0f | %.0f | %.3f | %d | %.3f |" % (
+            b, moved[0], moved[1], moved[2], moved[3], off_moved, fresh[0], fresh[2], fresh[3], off_fresh, settled,
+            moved[2] / max(fresh[2], 1e-9)))
+        sys.stdout.flush()
+    if a.out and frames:
+        os.makedirs(a.out, exist_ok=True)
+        write_png(os.path.join(a.out, "strip.png"), frames)
+
+
+if __name__ == "__main__":
+    main()
