@@ -33,6 +33,7 @@
 #include "cascades.h"
 #include "error.h"
 #include "gl_util.h"
+#include "hash.h"
 #include "material_sample.h"
 #include "probes_bvh.h"
 #include "probes_lookup.h"
@@ -54,6 +55,8 @@ typedef struct lpv_probes_gpu {
     GLuint nodes, leaf_tris, verts, materials;
     size_t triangles;
     uint64_t scene_bytes; /* the four buffers' */
+    uint64_t topology;    /* the scene's source and its triangles' corners' indices, hashed: the same in a
+                             re-posed scene */
     float scene_size;     /* m, the bounds' diagonal: the rays' reach */
     /* the probes (commit) */
     GLuint sh, moments, state, ray_out, irradiance;
@@ -211,6 +214,9 @@ static int sample_scene(lpv_technique *t, const lpv_technique_scene *in, char *e
             triangle_material(sc, d, idx + 3 * n, mat + 8 * n);
         }
     }
+    uint64_t topology = lpv_hash_bytes(LPV_HASH_INIT, sc->source, strlen(sc->source));
+    topology = lpv_hash_bytes(topology, &sc->vertex_count, sizeof sc->vertex_count);
+    topology = lpv_hash_bytes(topology, idx, n * 3 * sizeof *idx);
     lpv_probes_bvh bvh;
     const int rc = lpv_probes_bvh_build(&bvh, pos, sc->vertex_count, idx, n, err, err_size);
     free(pos);
@@ -235,7 +241,13 @@ static int sample_scene(lpv_technique *t, const lpv_technique_scene *in, char *e
         d2 += e > 0.0f ? e * e : 0.0f;
     }
     g->scene_size = sqrtf(d2) > 1e-3f ? sqrtf(d2) : 1e-3f;
-    g->progress.history = 0; /* a new scene: no light is right any more */
+    /* A new scene: no light is right any more. The same file's triangles
+     * posed anew (nodes that moved, materials that changed): the probes keep
+     * their light and follow the change as they follow a moved light (the
+     * plan's light_stale: the hysteresis ramps, the probes settle again). */
+    if (topology != g->topology)
+        g->progress.history = 0;
+    g->topology = topology;
     return 0;
 }
 
