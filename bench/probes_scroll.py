@@ -26,6 +26,7 @@ side by side. Needs only the Python client (numpy optional).
 """
 
 import argparse
+import contextlib
 import os
 import struct
 import subprocess
@@ -39,32 +40,25 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 
 import lpvd_session  # noqa: E402
+from light_lag import surface_points  # noqa: E402  (100 points on the box's walls, facing in)
 
 SIZE = 256
 
 
-def surface_points():
-    """5 x 5 points on the floor, left, right and back walls of the built-in
-    box ([-1, 1] x [0, 2] x [-1, 1]), facing in."""
-    pts, nrm = [], []
-    ts = [-0.8, -0.4, 0.0, 0.4, 0.8]
-    for u in ts:
-        for v in ts:
-            pts.append([u, 0.01, v]); nrm.append([0, 1, 0])
-            pts.append([-0.99, 1.0 + u, v]); nrm.append([1, 0, 0])
-            pts.append([0.99, 1.0 + u, v]); nrm.append([-1, 0, 0])
-            pts.append([u, 1.0 + v, -0.99]); nrm.append([0, 0, 1])
-    return pts, nrm
-
-
-def start(lpvd):
+@contextlib.contextmanager
+def daemon(lpvd):
+    """A daemon of its own (no world shared with another run): its socket."""
     addr = os.path.join(tempfile.mkdtemp(prefix="probes-scroll-"), "lpvd.sock")
     proc = subprocess.Popen([lpvd, "serve", "--socket", addr], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    for _ in range(600):
-        if os.path.exists(addr):
-            break
-        time.sleep(0.1)
-    return proc, addr
+    try:
+        for _ in range(600):
+            if os.path.exists(addr):
+                break
+            time.sleep(0.1)
+        yield addr
+    finally:
+        proc.terminate()
+        proc.wait()
 
 
 def session(addr, a, eye):
@@ -121,8 +115,7 @@ def write_png(path, frames):
 def run(lpvd, a):
     e0 = [float(v) for v in a.eye.split(",")]
     e1 = [e0[0] + a.dx, e0[1], e0[2]]
-    proc, addr = start(lpvd)
-    try:
+    with daemon(lpvd) as addr:
         c = session(addr, a, e0)
         for _ in range(a.ticks):
             c.tick()
@@ -132,11 +125,7 @@ def run(lpvd, a):
         e_moved = answers(c)
         frames.append(frame(c))
         c.close()
-    finally:
-        proc.terminate()
-        proc.wait()
-    proc, addr = start(lpvd)
-    try:
+    with daemon(lpvd) as addr:
         c = session(addr, a, e1)
         fresh = tick_row(c.tick())
         e_fresh = answers(c)
@@ -147,9 +136,6 @@ def run(lpvd, a):
         e_settled = answers(c)
         frames.append(frame(c))
         c.close()
-    finally:
-        proc.terminate()
-        proc.wait()
     return moved, fresh, off(e_moved, e_settled), off(e_fresh, e_settled), settled, frames
 
 
