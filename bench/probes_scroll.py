@@ -130,8 +130,10 @@ def run(lpvd, a):
         fresh = tick_row(c.tick())
         e_fresh = answers(c)
         frames.append(frame(c))
+        # until a tick runs no probes pass: the plan served the cache, the
+        # probes settled (that tick's technique counts are the last run's)
         settled = 1
-        while settled < a.max_ticks and tick_row(c.tick())[0] > 0:
+        while settled < a.max_ticks and tick_row(c.tick())[2] > 0:
             settled += 1
         e_settled = answers(c)
         frames.append(frame(c))
