@@ -767,29 +767,51 @@ static void test_probes_scroll_kept(void **state)
     }
     lpv_cascade_set b = a;
     int shift[LPV_MAX_CASCADES][3];
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 2 * 8 * 8 * 4); /* no move: all stay */
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 2 * 8 * 8 * 4); /* no move: all stay */
     b.origin_cells[0][0] += 2.0f; /* the fine cascade 2 cells along x, the coarse one 1 down z */
     b.origin_cells[1][2] -= 1.0f;
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 6 * 8 * 4 + 8 * 8 * 3);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 6 * 8 * 4 + 8 * 8 * 3);
     assert_int_equal(shift[0][0], 2);
     assert_int_equal(shift[1][2], -1);
     assert_int_equal(shift[0][1] | shift[0][2] | shift[1][0] | shift[1][1], 0);
+    /* the list of the probes brought in: every probe not kept, in order,
+     * and each kept one takes the light of its cell's old probe */
+    enum { ALL = 2 * 8 * 8 * 4 };
+    uint32_t fresh[ALL];
+    size_t nfresh = 0;
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, fresh, &nfresh), 6 * 8 * 4 + 8 * 8 * 3);
+    assert_int_equal(nfresh, ALL - (6 * 8 * 4 + 8 * 8 * 3));
+    size_t listed = 0;
+    for (size_t p = 0; p < ALL; ++p) {
+        const long from = lpv_probes_scroll_source(a.grid[0].dims, shift, p);
+        if (from < 0) {
+            assert_true(listed < nfresh);
+            assert_int_equal(fresh[listed++], p);
+        }
+    }
+    assert_int_equal(listed, nfresh);
+    /* the fine cascade's cell (0,0,0) takes old cell (2,0,0); the coarse
+     * one's (0,0,1) takes its old (0,0,0); its (0,0,0) is new */
+    assert_int_equal(lpv_probes_scroll_source(a.grid[0].dims, shift, 0), 2);
+    assert_int_equal(lpv_probes_scroll_source(a.grid[0].dims, shift, 256 + 64), 256);
+    assert_int_equal(lpv_probes_scroll_source(a.grid[0].dims, shift, 256), -1);
+    assert_int_equal(lpv_probes_scroll_source(a.grid[0].dims, shift, 6), -1); /* x 6 + 2 is past 8 */
     b.origin_cells[0][0] += 6.0f; /* the fine one past its whole width: only the coarse one keeps probes */
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 8 * 8 * 3);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 8 * 8 * 3);
     b.origin_cells[1][2] += 5.0f;
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 0);
     b = a;
     b.grid[1].cell_size = 1.5f; /* another cell size: another place's light */
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 0);
     b = a;
     b.origin_cells[0][1] += 0.5f; /* not whole cells */
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 0);
     b = a;
     b.snapped = 0; /* one grid over the bounds */
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 0);
     b = a;
     b.count = 1;
-    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift), 0);
+    assert_int_equal(lpv_probes_scroll_kept(&a, &b, shift, NULL, NULL), 0);
 
     const lpv_settings s = resolved((lpv_settings){.technique = LPV_TECHNIQUE_ID_PROBES});
     lpv_probes_progress g = {.history = 1, .sweeps = 1000, .probes = 512, .scroll = 1};

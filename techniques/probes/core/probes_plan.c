@@ -51,16 +51,34 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
                         p->recompute_reason, g->sweeps);
 }
 
-size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set *to,
-                              int shift[LPV_MAX_CASCADES][3])
+long lpv_probes_scroll_source(const int dims[3], const int shift[LPV_MAX_CASCADES][3], size_t p)
 {
+    const size_t cells = (size_t)dims[0] * (size_t)dims[1] * (size_t)dims[2];
+    const size_t k = p / cells, cell = p % cells;
+    const int c[3] = {(int)(cell % (size_t)dims[0]), (int)(cell / (size_t)dims[0] % (size_t)dims[1]),
+                      (int)(cell / ((size_t)dims[0] * (size_t)dims[1]))};
+    int o[3];
+    for (int i = 0; i < 3; ++i) {
+        o[i] = c[i] + shift[k][i];
+        if (o[i] < 0 || o[i] >= dims[i])
+            return -1;
+    }
+    return (long)(k * cells + (size_t)o[0] + (size_t)dims[0] * ((size_t)o[1] + (size_t)dims[1] * (size_t)o[2]));
+}
+
+size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set *to,
+                              int shift[LPV_MAX_CASCADES][3], uint32_t *fresh, size_t *fresh_count)
+{
+    if (fresh_count)
+        *fresh_count = 0;
     if (!from->snapped || !to->snapped || from->count != to->count || from->handoff != to->handoff ||
         to->count < 1 || to->count > LPV_MAX_CASCADES)
         return 0;
     size_t kept = 0;
     for (int k = 0; k < to->count; ++k) {
         if (from->grid[k].cell_size != to->grid[k].cell_size ||
-            memcmp(from->grid[k].dims, to->grid[k].dims, sizeof to->grid[k].dims) != 0)
+            memcmp(from->grid[k].dims, to->grid[k].dims, sizeof to->grid[k].dims) != 0 ||
+            memcmp(to->grid[k].dims, to->grid[0].dims, sizeof to->grid[k].dims) != 0)
             return 0;
         size_t stay = 1;
         for (int i = 0; i < 3; ++i) {
@@ -72,6 +90,14 @@ size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set
             stay *= s < n ? (size_t)(n - s) : 0;
         }
         kept += stay;
+    }
+    if (fresh) {
+        const size_t total = (size_t)to->count * lpv_grid_cell_count(&to->grid[0]);
+        size_t n = 0;
+        for (size_t p = 0; p < total; ++p)
+            if (lpv_probes_scroll_source(to->grid[0].dims, shift, p) < 0)
+                fresh[n++] = (uint32_t)p;
+        *fresh_count = n;
     }
     return kept;
 }

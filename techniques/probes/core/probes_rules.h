@@ -8,6 +8,7 @@
 #define LPV_PROBES_RULES_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "cascades.h"
 #include "lpv_shared.h"
@@ -82,9 +83,17 @@ int lpv_probes_settle_sweeps(float hysteresis, int changed);
 /* Whole cells each cascade moves from `from` to `to` (a new cell's old cell
  * is cell + shift[k]) and the probes whose cells both hold, which keep
  * their light: 0 when they are not camera-following cascades of the same
- * count, dims and cell sizes (nothing carries over), or no cell stays. */
+ * count, dims and cell sizes (nothing carries over), or no cell stays.
+ * With `fresh` (room for every probe of `to`), also lists the indices of
+ * the probes the move brings in, in order, and sets *fresh_count. The one
+ * rule the plan, commit's list and probes_scroll.comp's copy follow (the
+ * shader mirrors lpv_probes_scroll_source). */
 size_t lpv_probes_scroll_kept(const lpv_cascade_set *from, const lpv_cascade_set *to,
-                              int shift[LPV_MAX_CASCADES][3]);
+                              int shift[LPV_MAX_CASCADES][3], uint32_t *fresh, size_t *fresh_count);
+/* The index of the probe in the old layout whose light probe `p` of the
+ * new one takes, or -1 when the move brought `p` in (probes_scroll.comp
+ * computes the same). */
+long lpv_probes_scroll_source(const int dims[3], const int shift[LPV_MAX_CASCADES][3], size_t p);
 
 /* Probes a tick (budget, or every probe of the grid's cascades on the
  * first tick's warmup) x rays, at LPV_TICK_COST_PROBES_RAYS_PER_STEP a

@@ -69,6 +69,7 @@ typedef struct lpv_probes_gpu {
     uint32_t tick_no;
     size_t cursor;
     size_t fresh;    /* probes a scroll brought in that await their warmup */
+    int shift[LPV_MAX_CASCADES][3]; /* place's scroll (progress.scroll), which commit carries out */
     size_t scrolled; /* the last tick's warmed-up fresh probes */
     lpv_probes_progress progress;
     size_t updated, rays_traced; /* the last tick's */
@@ -322,11 +323,10 @@ static int place(lpv_technique *t, const lpv_technique_where *w, int *moved, cha
                          count, s.grid_dims[0], s.grid_dims[1], s.grid_dims[2]);
     if (!g->pending.snapped && g->pending.count == 1)
         inset_grid(&g->pending);
-    int shift[LPV_MAX_CASCADES][3];
     const int differ = !lpv_cascades_equal(&g->pending, &g->cascades);
     /* the plan's and commit's: the probes that stay keep their light */
     g->progress.scroll = differ && g->progress.history && !g->fresh && keeps_buffers(g, &g->pending) &&
-                         lpv_probes_scroll_kept(&g->cascades, &g->pending, shift) > 0;
+                         lpv_probes_scroll_kept(&g->cascades, &g->pending, g->shift, NULL, NULL) > 0;
     if (moved)
         *moved = differ;
     return 0;
@@ -345,35 +345,25 @@ static void scroll_buffer(const lpv_probes_gpu *g, GLuint *b, size_t stride)
     *b = dst;
 }
 
-/* Moves the probes' light, distances and state with the cascades (shift
- * as lpv_probes_scroll_kept's) and lists the probes the move brought in,
+/* Moves the probes' light, distances and state from the cascades to
+ * `to` (place's g->shift) and lists the probes the move brought in,
  * which the next tick warms up alone: a camera crossing a cell pays for a
  * slab of probes, not a warmup of every probe, and the others keep every
  * bounce they gathered. Returns the probes kept (0: out of memory for the
  * list, nothing moved). */
-static size_t scroll(lpv_probes_gpu *g, const int shift[LPV_MAX_CASCADES][3])
+static size_t scroll(lpv_probes_gpu *g, const lpv_cascade_set *to)
 {
-    const lpv_grid *grid = &g->cascades.grid[0];
-    const size_t cells = lpv_grid_cell_count(grid);
+    const lpv_grid *grid = &to->grid[0];
     uint32_t *fresh = malloc(g->probes * sizeof *fresh);
     if (!fresh)
         return 0;
     size_t n = 0;
-    for (size_t p = 0; p < g->probes; ++p) {
-        const size_t k = p / cells, cell = p % cells;
-        const int c[3] = {(int)(cell % (size_t)grid->dims[0]), (int)(cell / (size_t)grid->dims[0] % (size_t)grid->dims[1]),
-                          (int)(cell / ((size_t)grid->dims[0] * (size_t)grid->dims[1]))};
-        int kept = 1;
-        for (int i = 0; i < 3; ++i)
-            kept &= c[i] + shift[k][i] >= 0 && c[i] + shift[k][i] < grid->dims[i];
-        if (!kept)
-            fresh[n++] = (uint32_t)p;
-    }
+    lpv_probes_scroll_kept(&g->cascades, to, g->shift, fresh, &n);
     if (n < g->probes) {
         glUseProgram(g->prog_scroll);
         glUniform1ui(glGetUniformLocation(g->prog_scroll, "u_total"), (GLuint)g->probes);
         glUniform3iv(glGetUniformLocation(g->prog_scroll, "u_dims"), 1, grid->dims);
-        glUniform3iv(glGetUniformLocation(g->prog_scroll, "u_shift"), LPV_MAX_CASCADES, &shift[0][0]);
+        glUniform3iv(glGetUniformLocation(g->prog_scroll, "u_shift"), LPV_MAX_CASCADES, &g->shift[0][0]);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         const size_t oct2 = (size_t)g->oct * (size_t)g->oct;
         scroll_buffer(g, &g->sh, sizeof(struct LpvCell) / sizeof(float));
@@ -395,9 +385,10 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
     lpv_probes_gpu *g = (lpv_probes_gpu *)t;
     const lpv_cascade_set *set = &g->pending;
     const int moved = !lpv_cascades_equal(set, &g->cascades);
-    int shift[LPV_MAX_CASCADES][3] = {{0}};
-    const int scrolls = moved && g->progress.scroll && lpv_probes_scroll_kept(&g->cascades, set, shift) > 0;
+    const int scrolls = moved && g->progress.scroll;
     g->progress.scroll = 0;
+    /* the scroll reads the old cascades: it runs before they change */
+    const size_t kept = scrolls && keeps_buffers(g, set) ? scroll(g, set) : 0;
     g->cascades = *set;
     struct LpvGridParams params;
     lpv_cascades_grid_params(set, &params);
@@ -413,7 +404,7 @@ static int commit(lpv_technique *t, const lpv_technique_where *w, int *reset, ch
         /* probes that moved with the camera hold another place's light:
          * a whole-cell move keeps the light of the cells that stay, any
          * other move starts afresh */
-        if (moved && !(scrolls && scroll(g, shift) > 0))
+        if (moved && kept == 0)
             g->progress.history = 0;
         return 0;
     }

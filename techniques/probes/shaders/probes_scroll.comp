@@ -3,7 +3,10 @@
 // layout): a probe whose world cell the old layout also held takes that
 // probe's u_stride floats (its light, distances, state and offset move with
 // the cell, not with the index); one the move brought in gets zeros (no
-// light, not active, no offset) until its warmup (technique_probes.c).
+// light, not active, no offset) until its warmup (technique_probes.c). The
+// rule is lpv_probes_scroll_source's (probes_plan.c), which lists the
+// probes brought in for the warmup; test_plan checks it, test_probes_gpu
+// checks this copy against an independent count.
 layout(local_size_x = LPV_PROBES_WG) in;
 
 layout(std430, binding = LPV_SSBO_PROBES_SCROLL_SRC) readonly buffer ScrollSrc { float scroll_src[]; };
