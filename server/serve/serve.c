@@ -209,7 +209,7 @@ static void idle_cb(uv_timer_t *t)
             continue;
         }
         sv_net_shrink_stalled(c, now);
-        if (limit && now - c->last_rx_ms > limit && !c->busy) {
+        if (limit && now - c->idle_since_ms > limit && !c->busy) {
             fprintf(stderr, "lpvd serve: client %llu (%s) idle for %g s: BYE\n", (unsigned long long)c->id, c->peer,
                     s->cfg.idle_timeout);
             sv_send(c, LPVP_BYE_REPLY, 0, json_object(), NULL, 0, SV_STREAM_NONE);

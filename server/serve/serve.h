@@ -399,7 +399,8 @@ struct sv_conn {
     int busy;               /* a request is being processed asynchronously */
     int work_inflight;      /* that request runs on a libuv worker (a scene load): it cannot be cancelled */
     uint32_t work_request_id;
-    uint64_t last_rx_ms;    /* when the last complete frame arrived (R4.9) */
+    uint64_t idle_since_ms; /* when the last complete frame arrived or the last busy request was answered:
+                               R4.9's idle time counts from the later (sv_session_answered) */
     uint64_t accepted_ms;   /* when the connection was accepted (--handshake-timeout) */
     /* writing */
     size_t wq_bytes;        /* bytes handed to uv_write, not yet completed */
@@ -550,6 +551,11 @@ void sv_session_pump(sv_conn *c);        /* processes pending requests in order 
 /* A request of c (request_id) starts / ends running on a libuv worker. */
 void sv_session_work_begin(sv_conn *c, uint32_t request_id);
 void sv_session_work_end(sv_conn *c);
+/* The busy request of c has its reply queued: the next may run, and the
+ * idle timeout (R4.9) counts from now. A tick longer than the timeout
+ * otherwise left its session idle the moment it was answered, and the
+ * idle timer could close it before the client's next request arrived. */
+void sv_session_answered(sv_conn *c);
 /* SIGTERM, after the GL thread has answered its jobs: every request of c not
  * yet answered gets ERROR SHUTTING_DOWN in order, then BYE; c closes once
  * that is written (R3.1, R7.4). */

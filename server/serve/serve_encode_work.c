@@ -161,7 +161,7 @@ static void after_work_cb(uv_work_t *w, int status)
     const int reply = t->stream == SV_STREAM_NONE;
     int sent = 0;
     if (reply)
-        c->busy = 0;
+        sv_session_answered(c);
     if (reply && t->on_worker)
         sv_session_work_end(c);
     if (reply && !c->closing && c->close_after_write && c->srv->stopping) {

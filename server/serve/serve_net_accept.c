@@ -161,7 +161,7 @@ void sv_net_on_connection(uv_stream_t *server, int status)
     } else {
         snprintf(c->peer, sizeof c->peer, "unix");
     }
-    c->last_rx_ms = c->accepted_ms = sv_now_ms();
+    c->idle_since_ms = c->accepted_ms = sv_now_ms();
     s->session.open(c);
     sv_net_preauth_join(c);
     peer_key_of(c, is_tcp);

@@ -109,7 +109,7 @@ void sv_net_on_read(uv_stream_t *st, ssize_t nread, const uv_buf_t *buf)
         if (stt == LPVP_PARSE_NEED_MORE && sv_net_reserve_frame(c) != 0)
             c->wait_memory = ++c->srv->memory_waits; /* all of this read is in the parser: stop reading below */
         if (stt == LPVP_PARSE_FRAME) {
-            c->last_rx_ms = sv_now_ms(); /* R4.9: idle counts from the last complete frame */
+            c->idle_since_ms = sv_now_ms(); /* R4.9: idle counts from the last complete frame (or answer) */
             if (enqueue_frame(c, &f) != 0) {
                 sv_send_error(c, f.header.request_id, LPVP_E_INTERNAL, "out of memory for the request");
                 sv_conn_close_after_write(c);

@@ -335,7 +335,7 @@ void sv_do_stats(sv_conn *c, sv_request *r)
 /* ---- completions of GL jobs ---------------------------------------------- */
 void sv_session_job_done(sv_job *j, sv_conn *c, uint32_t request_id)
 {
-    c->busy = 0;
+    sv_session_answered(c);
     if (c->closing || c->close_after_write)
         return;
     if (j->status) {

@@ -145,6 +145,12 @@ void sv_session_work_end(sv_conn *c)
     c->srv->works_inflight--;
 }
 
+void sv_session_answered(sv_conn *c)
+{
+    c->busy = 0;
+    c->idle_since_ms = sv_now_ms();
+}
+
 void sv_session_shutdown(sv_conn *c)
 {
     if (c->closing || c->close_after_write)

@@ -361,6 +361,10 @@ def main(argv=None):
         return 1
     if src != 0:
         print("harness: note: the daemon exited with status %r on SIGTERM (R7.4 wants 0)" % src)
+    if rc != 0:
+        # a failed case is often explained by what the daemon said (why it
+        # closed a connection, what it refused): keep it in the test's log
+        print("harness: the command failed (status %r); the daemon's log ends:\n%s" % (rc, tail))
     return rc
 
 
