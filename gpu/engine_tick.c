@@ -129,6 +129,10 @@ int lpv_engine_tick(lpv_engine *e, char *err, size_t err_size)
         /* the same volume, but a knob of its lookup (iv_neighbours) may have changed */
         e->tech->cls->describe(e->tech, &e->desc);
         e->stats.volume = e->desc;
+        /* what the technique ran is this tick's, nothing (its counts of
+         * the probes traced or the cells stepped go to 0; what the volume
+         * holds stays) */
+        t->stats(e->tech, p, &e->stats);
         e->ticked = 1;
         return 0;
     }
