@@ -73,7 +73,11 @@ typedef struct lpv_probes_gpu {
     size_t scrolled; /* the last tick's warmed-up fresh probes */
     lpv_probes_progress progress;
     size_t updated, rays_traced; /* the last tick's */
-    size_t off, moved;           /* probes off (inside geometry) and relocated after the last warmup */
+    size_t off, moved;           /* probes off (inside geometry) and relocated after the last warmup or
+                                    relocating sweep */
+    size_t relocate_left;        /* after the scene was posed anew: probes the round robin still relocates,
+                                    then still traces from where they moved before off and moved are
+                                    counted again (2 sweeps) */
 } lpv_probes_gpu;
 
 static const char *const LOOKUP[] = {"probes_lookup.glsl", NULL};
@@ -248,6 +252,8 @@ static int sample_scene(lpv_technique *t, const lpv_technique_scene *in, char *e
      * plan's light_stale: the hysteresis ramps, the probes settle again). */
     if (topology != g->topology)
         g->progress.history = 0;
+    else if (g->progress.history) /* moved geometry may hold probes now: the next sweep relocates them */
+        g->relocate_left = 2 * g->probes;
     g->topology = topology;
     return 0;
 }
@@ -591,6 +597,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
          * does not depend on what the technique did before */
         g->tick_no = 0;
         g->fresh = 0;
+        g->relocate_left = 0; /* the warmup's pass 0 relocates every probe */
         clear_zero(g->state); /* no offsets: pass 0 places the probes again */
         if (warm_up(g, in, g->probes, 0) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
@@ -609,12 +616,18 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->scrolled = fresh;
         /* after a scroll the kept probes wait for the next tick, unless
-         * the light changed too */
-        if ((!fresh || p->light_stale) &&
-            run_batch(g, in, g->cursor, batch, 0, 1, lpv_probes_hysteresis_now(ps->hysteresis, &g->progress),
-                      ps->hysteresis, 0) != 0)
+         * the light changed too; the sweep after geometry moved relocates
+         * (as pass 0 of a warmup: out of what now holds them) */
+        const int round = !fresh || p->light_stale, relocate = round && g->relocate_left > g->probes;
+        if (round && run_batch(g, in, g->cursor, batch, 0, 1, lpv_probes_hysteresis_now(ps->hysteresis, &g->progress),
+                               ps->hysteresis, relocate) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
-        if (!fresh || p->light_stale)
+        if (round && g->relocate_left) {
+            g->relocate_left -= g->relocate_left < batch ? g->relocate_left : batch;
+            if (!g->relocate_left)
+                count_state(g);
+        }
+        if (round)
             g->cursor += batch;
         if (g->cursor >= g->probes) {
             g->cursor %= g->probes;

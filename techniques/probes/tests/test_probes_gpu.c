@@ -308,6 +308,48 @@ static void test_probes_relocate(void **state)
     lpv_scene_free(&scene);
 }
 
+/* Geometry posed anew over probes that hold light: the slab of
+ * test_probes_relocate rises from the floor (the same triangles) through
+ * the probes' bottom layers. The probes keep their light, and the sweep
+ * after the move relocates as a warmup's pass 0 does: after the sweep
+ * after it, the same 4 moved out and 4 off as a fresh volume of the risen
+ * slab. */
+static void test_probes_relocate_after_geometry_moves(void **state)
+{
+    (void)state;
+    lpv_scene low = {0}, high = {0};
+    for (int i = 0; i < 2; ++i) {
+        lpv_scene *sc = i ? &high : &low;
+        const int m = grey_room(sc, 2.0f);
+        assert_true(lpv_scene_add_box(sc, m, (const float[3]){-1.0f, -2.0f, -1.0f},
+                                      (const float[3]){1.0f, i ? -0.2f : -1.9f, 1.0f}) >= 0);
+        lpv_scene_add_point_light(sc, (const float[3]){0.0f, 1.5f, 0.0f}, 20.0f);
+        lpv_scene_compute_bounds(sc);
+    }
+    lpv_settings st = probe_settings(4);
+    st.area_lights = LPV_SWITCH_DEFAULT;
+    st.probes.warmup = 2;
+    st.probes.budget = 16; /* a sweep: 4 ticks */
+    lpv_engine_forget(lpvt_engine);
+    run(&low, &st);
+    const lpv_engine_stats *s = lpv_engine_last_stats(lpvt_engine);
+    assert_int_equal((int)lpv_stats_get(s, "probes_off")->v[0], 0); /* 0.4 m above the slab: where they are */
+    assert_int_equal((int)lpv_stats_get(s, "probes_moved")->v[0], 0);
+    char err[512];
+    assert_int_equal(lpv_engine_set_scene(lpvt_engine, &high, err, sizeof err), 0);
+    /* a sweep relocates; the next traces from where the probes moved (a
+     * moved probe is off until then: its last rays left from inside) */
+    for (int t = 0; t < 8; ++t) {
+        assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+        assert_int_equal((int)lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "probes_updated")->v[0], 16);
+    }
+    s = lpv_engine_last_stats(lpvt_engine);
+    assert_int_equal((int)lpv_stats_get(s, "probes_off")->v[0], 4);
+    assert_int_equal((int)lpv_stats_get(s, "probes_moved")->v[0], 4);
+    lpv_scene_free(&low);
+    lpv_scene_free(&high);
+}
+
 /* The lookup (SPEC R5.15): the server's (probes_lookup.glsl, through
  * lpv_engine_irradiance) equals the CPU oracle's on the read-back records
  * (probes_lookup.c, the clients' code) at points on every surface of a
@@ -473,6 +515,13 @@ static void test_probes_follow_a_moved_light(void **state)
     assert_int_equal(lpv_probes_settle_sweeps(0.9f, 1), 32); /* after a change: the ramp forgets faster */
     const int first = settle(4 * sweeps + 8);
     assert_int_equal(first, 4 * sweeps); /* then the plan stops the probes */
+    /* and the cached tick's stats say nothing ran (not the last sweep's 16) */
+    const lpv_engine_stats *cached = lpv_engine_last_stats(lpvt_engine);
+    assert_int_equal(cached->stage_count, 0);
+    assert_int_equal((int)lpv_stats_get(cached, "probes_updated")->v[0], 0);
+    assert_int_equal((int)lpv_stats_get(cached, "probes_rays")->v[0], 0);
+    assert_float_equal(cached->cell_steps, 0.0, 0.0);
+    assert_int_equal((int)lpv_stats_get(cached, "probes_sweeps")->v[0], sweeps);
     float want[18], got[18];
     room_irradiance(want);
     lit_room(&at_a, a);
@@ -700,6 +749,7 @@ int main(void)
         cmocka_unit_test(test_update_matches_cpu_oracle),
         cmocka_unit_test(test_probes_in_a_block_are_off),
         cmocka_unit_test(test_probes_relocate),
+        cmocka_unit_test(test_probes_relocate_after_geometry_moves),
         cmocka_unit_test(test_lookup_matches_cpu_oracle),
         cmocka_unit_test(test_probes_follow_a_moved_light),
         cmocka_unit_test(test_probes_scroll_with_the_camera),
