@@ -825,6 +825,22 @@ static void test_probes_scroll_kept(void **state)
     g.scroll = 0;
     lpv_plan_make_probes(&s, &f, &g, &p);
     assert_non_null(strstr(p.pass[LPV_PASS_PROBES].reason, "a budget of probes"));
+    /* after the move, settled probes beside a slab still averaging: the
+     * pass runs for the slab, then stops */
+    f = steady();
+    g.refine = 5;
+    lpv_plan_make_probes(&s, &f, &g, &p);
+    assert_true(p.pass[LPV_PASS_PROBES].run);
+    assert_non_null(strstr(p.pass[LPV_PASS_PROBES].reason, "average more passes (5 of 19)"));
+    g.refine = 0;
+    lpv_plan_make_probes(&s, &f, &g, &p);
+    assert_false(p.pass[LPV_PASS_PROBES].run);
+    /* as many passes as the blend weighs, (1 + h) / (1 - h), at least the warmup's */
+    assert_int_equal(lpv_probes_refine_passes(0.9f, 4), 19);
+    assert_int_equal(lpv_probes_refine_passes(0.5f, 4), 4);
+    assert_int_equal(lpv_probes_refine_passes(0.95f, 4), 39);
+    assert_int_equal(lpv_probes_refine_passes(0.0f, 2), 2);
+    assert_int_equal(lpv_probes_refine_passes(1.0f, 1), 1);
 }
 
 /* Technique auto: the planner's choice, with its reason; any other request is kept. */

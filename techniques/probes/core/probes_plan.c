@@ -41,7 +41,13 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
                         : g->scroll ? "warmup passes over the probes the cascades' move brings in, the others keep "
                                       "their light"
                                     : "a budget of probes");
-    else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed)) {
+    else if (g->refine > 0) {
+        p->recompute = 1;
+        snprintf(p->recompute_reason, sizeof p->recompute_reason,
+                 "the probes the cascades' move brought in average more passes (%d of %d)", g->refine,
+                 lpv_probes_refine_passes(s->probes.hysteresis, s->probes.warmup));
+        lpv_plan_decide(p, LPV_PASS_PROBES, 1, "%s", p->recompute_reason);
+    } else if (g->sweeps < lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed)) {
         p->recompute = 1;
         snprintf(p->recompute_reason, sizeof p->recompute_reason, LPV_PROBES_SETTLE_REASON " (%d of %d sweeps)", g->sweeps,
                  lpv_probes_settle_sweeps(s->probes.hysteresis, g->changed));
@@ -125,6 +131,14 @@ int lpv_probes_settle_sweeps(float hysteresis, int changed)
     for (g.sweeps = 0; left > LPV_PROBES_SETTLE_RESIDUE; ++g.sweeps)
         left *= (double)lpv_probes_hysteresis_now(hysteresis, &g);
     return g.sweeps;
+}
+
+int lpv_probes_refine_passes(float hysteresis, int warmup)
+{
+    const int n = hysteresis > 0.0f && hysteresis < 1.0f
+                      ? (int)ceil((1.0 + (double)hysteresis) / (1.0 - (double)hysteresis) - 1e-9)
+                      : 1;
+    return n > warmup ? n : warmup;
 }
 
 uint64_t lpv_probes_bytes_per_probe(int oct)

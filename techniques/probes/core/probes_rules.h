@@ -44,6 +44,8 @@ typedef struct lpv_probes_progress {
     int changed;  /* 1: sweeps counts from a change of the scene or lights (0: from a warmup) */
     int scroll;   /* 1: the camera moves the cascades by whole cells and some probes stay
                      (lpv_probes_scroll_kept): only the probes it brings in warm up */
+    int refine;   /* passes averaged so far over the probes the last scroll brought in, while under
+                     lpv_probes_refine_passes (0: none refining) */
     size_t probes;
 } lpv_probes_progress;
 
@@ -79,6 +81,13 @@ void lpv_plan_make_probes(const lpv_settings *s, const lpv_plan_facts *f, const 
  * change (the ramp forgets faster). An upper bound: the blend lowers the
  * hysteresis further where a probe's light changed. */
 int lpv_probes_settle_sweeps(float hysteresis, int changed);
+
+/* The passes the probes a scroll brought in average before they stop:
+ * as many as the settled probes' running blend weighs, (1 + h) / (1 - h)
+ * (its variance is (1 - h) / (1 + h) of one update's; 19 at h 0.9), so
+ * the slab is no noisier than the probes beside it. At least `warmup`
+ * (its averaged passes count). */
+int lpv_probes_refine_passes(float hysteresis, int warmup);
 
 /* Whole cells each cascade moves from `from` to `to` (a new cell's old cell
  * is cell + shift[k]) and the probes whose cells both hold, which keep

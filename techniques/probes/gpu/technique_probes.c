@@ -71,6 +71,8 @@ typedef struct lpv_probes_gpu {
     size_t fresh;    /* probes a scroll brought in that await their warmup */
     int shift[LPV_MAX_CASCADES][3]; /* place's scroll (progress.scroll), which commit carries out */
     size_t scrolled; /* the last tick's warmed-up fresh probes */
+    size_t refine_probes, refine_cursor; /* the list's probes averaging more passes (progress.refine),
+                                            and the next to trace */
     lpv_probes_progress progress;
     size_t updated, rays_traced; /* the last tick's */
     size_t off, moved;           /* probes off (inside geometry) and relocated after the last warmup or
@@ -381,6 +383,7 @@ static size_t scroll(lpv_probes_gpu *g, const lpv_cascade_set *to)
         glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *fresh), fresh);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
         g->fresh = n;
+        g->progress.refine = 0; /* the list is this move's: an earlier slab stops refining */
     }
     free(fresh);
     return g->probes - n;
@@ -597,6 +600,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
          * does not depend on what the technique did before */
         g->tick_no = 0;
         g->fresh = 0;
+        g->progress.refine = 0;
         g->relocate_left = 0; /* the warmup's pass 0 relocates every probe */
         clear_zero(g->state); /* no offsets: pass 0 places the probes again */
         if (warm_up(g, in, g->probes, 0) != 0)
@@ -609,16 +613,42 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         if (p->light_stale) {
             g->progress.sweeps = 0; /* a change: settle again, forgetting the old light faster */
             g->progress.changed = 1;
+            g->progress.refine = 0; /* the round robin follows it; a running mean would lag */
         }
         const size_t fresh = g->fresh;
         g->fresh = 0;
         if (fresh && warm_up(g, in, fresh, 1) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
         g->scrolled = fresh;
+        /* the probes a scroll brought in then average more passes, a
+         * budget of them a tick, until they weigh as many as the settled
+         * probes' blend (lpv_probes_refine_passes): alone, as a settled
+         * volume runs nothing else */
+        const int passes = lpv_probes_refine_passes(ps->hysteresis, ps->warmup);
+        int refined = 0;
+        if (fresh && !p->light_stale) {
+            g->refine_probes = fresh;
+            g->refine_cursor = 0;
+            g->progress.refine = ps->warmup > 1 ? ps->warmup - 1 : 1; /* the warmup's averaged passes */
+            if (g->progress.refine >= passes)
+                g->progress.refine = 0;
+        } else if (!fresh && g->progress.refine > 0) {
+            const size_t left = g->refine_probes - g->refine_cursor, n = left < batch ? left : batch;
+            const float mean = (float)g->progress.refine / (float)(g->progress.refine + 1);
+            if (run_batch(g, in, g->refine_cursor, n, 1, 1, mean, mean, 0) != 0)
+                return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);
+            g->refine_cursor += n;
+            if (g->refine_cursor >= g->refine_probes) {
+                g->refine_cursor = 0;
+                if (++g->progress.refine >= passes)
+                    g->progress.refine = 0;
+            }
+            refined = 1;
+        }
         /* after a scroll the kept probes wait for the next tick, unless
          * the light changed too; the sweep after geometry moved relocates
          * (as pass 0 of a warmup: out of what now holds them) */
-        const int round = !fresh || p->light_stale, relocate = round && g->relocate_left > g->probes;
+        const int round = (!fresh && !refined) || p->light_stale, relocate = round && g->relocate_left > g->probes;
         if (round && run_batch(g, in, g->cursor, batch, 0, 1, lpv_probes_hysteresis_now(ps->hysteresis, &g->progress),
                                ps->hysteresis, relocate) != 0)
             return lpv_error(err, err_size, "%s: out of memory for the ray table", LPV_TECHNIQUE_PROBES);

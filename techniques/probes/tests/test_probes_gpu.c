@@ -719,6 +719,20 @@ static void test_probes_scroll_with_the_camera(void **state)
     assert_int_equal((int)lpv_stats_get(s, "probes_scrolled_in")->v[0], brought);
     assert_int_equal((int)lpv_stats_get(s, "probes_updated")->v[0], 4 * brought); /* 4 warmup passes, nothing else */
 
+    /* then the slab averages more passes alone, a budget (here all 128) a
+     * tick, until it weighs as many as the settled probes' blend: 3 of the
+     * warmup's averaged, 16 more at hysteresis 0.9 */
+    assert_int_equal(lpv_probes_refine_passes(0.9f, 4), 19);
+    for (int n = 3; n < 19; ++n) {
+        assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
+        char want[96];
+        snprintf(want, sizeof want, "average more passes (%d of 19)", n);
+        assert_non_null(strstr(lpv_engine_last_plan(lpvt_engine)->pass[LPV_PASS_PROBES].reason, want));
+        assert_int_equal((int)lpv_stats_get(lpv_engine_last_stats(lpvt_engine), "probes_updated")->v[0], brought);
+    }
+    assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0); /* then the round robin or nothing */
+    assert_null(strstr(lpv_engine_last_plan(lpvt_engine)->pass[LPV_PASS_PROBES].reason, "average more passes"));
+
     /* the same place afresh: every probe, 4 passes */
     lpv_engine_forget(lpvt_engine);
     assert_int_equal(lpv_engine_tick(lpvt_engine, err, sizeof err), 0);
