@@ -166,8 +166,7 @@ def write_png(path, frames):
                 + chunk(b"IDAT", zlib.compress(b"".join(rows))) + chunk(b"IEND", b""))
 
 
-def run(lpvd, a):
-    place = placement(lpvd, a)
+def run(lpvd, a, place):
     e0 = place["eye"]
     e1 = [e0[0] + place["dx"], e0[1], e0[2]]
     with daemon(lpvd, a.scene) as addr:
@@ -310,8 +309,11 @@ def main():
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     frames = None
     scored = []
+    # one placement for every build (from the first): the same camera,
+    # move and points, and the reference scores them all
+    place = placement(builds[0], a)
     for b in builds:
-        moved, fresh, (e_moved, e_refined, e_fresh, e_settled), (rt, rms), settled, frames, errors = run(b, a)
+        moved, fresh, (e_moved, e_refined, e_fresh, e_settled), (rt, rms), settled, frames, errors = run(b, a, place)
         print("| %s | %d / %d | %.0f | %.0f | %.3f | %d / %.0f | %.3f | %d | %.0f | %.0f | %.3f | %d | %.3f |" % (
             b, moved[0], moved[1], moved[2], moved[3], off(e_moved, e_settled), rt, rms, off(e_refined, e_settled),
             fresh[0], fresh[2], fresh[3], off(e_fresh, e_settled), settled, moved[2] / max(fresh[2], 1e-9)))
@@ -326,7 +328,7 @@ def main():
                 print("| %s | %.4f | %.4f |" % (what, slab, kept))
             print()
     if a.reference:
-        ref, se = reference(a, placement(builds[0], a))
+        ref, se = reference(a, place)
         print("\nAgainst converged light (lpvd-reference --bounces converged --spp %d at the same points; its noise "
               "%.4f):\n" % (a.reference_spp, sum(se) / max(sum(abs(x) for x in ref), 1e-30)))
         print("| build | after the move | after refining | the fresh warmup | settled |")
