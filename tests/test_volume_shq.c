@@ -1,7 +1,7 @@
 /*
  * test_volume_shq.c - the "shq" volume codec (protocol/volume_shq.c, SPEC
  * R5.16): the bound held on every cell of keyframes and of a chain of
- * deltas, unchanged cells cost nothing, a static volume sends no cell, the
+ * deltas, keyframes predicted from the cell before, unchanged cells cost nothing, a static volume sends no cell, the
  * bytes after the values travel exactly, hostile values stay finite, and
  * the decoder refuses every malformed payload the SPEC names.
  */
@@ -114,6 +114,58 @@ static void test_keyframe_holds_the_bound(void **state)
     free(raw);
     free(held);
     free(client);
+}
+
+/* A keyframe is predicted (flag bit 1): a cell equal to the one before it
+ * costs mantissas of 0, one at twice the value (one exponent up) is
+ * predicted as the value before it, rounded half to even to its step, and
+ * the decoder gives back every cell; the random
+ * volumes of the other tests cover exponent jumps beyond 15 and the 16-bit
+ * wrap. */
+static void test_keyframes_are_predicted(void **state)
+{
+    (void)state;
+    char err[256];
+    enum { CELLS = 64 };
+    const size_t len = CELLS * CELL_BYTES;
+    uint8_t raw[CELLS * CELL_BYTES], held[CELLS * CELL_BYTES], client[CELLS * CELL_BYTES];
+    float v[LPVP_VALUES_PER_CELL];
+    make_cell(v, 1.0);
+    for (size_t i = 0; i < CELLS; ++i) {
+        float w[LPVP_VALUES_PER_CELL];
+        for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k)
+            w[k] = i == CELLS / 2 ? 2.0f * v[k] : v[k]; /* one cell at twice the light */
+        put_cell(raw, i, w);
+    }
+    uint8_t *att = NULL, *p = NULL;
+    size_t att_len = 0, plen = 0, sent = 0;
+    assert_int_equal(lpvp_shq_encode(raw, len, CELLS, NULL, 0.01, held, &att, &att_len, &sent, err, sizeof err), 0);
+    assert_int_equal(lpvp_zstd_decompress(att, att_len, 1 << 20, &p, &plen, err, sizeof err), 0);
+    assert_int_equal(lpvp_get_u32(p + 4), 3); /* keyframe, predicted */
+    const uint8_t *exps = p + 32, *lo = exps + CELLS, *hi = lo + 12 * CELLS;
+    assert_int_equal((int8_t)exps[CELLS / 2], (int8_t)exps[0] + 1);
+    int nonzero_first = 0;
+    for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k) {
+        int32_t r[CELLS];
+        for (size_t j = 0; j < CELLS; ++j) {
+            const unsigned z = lo[(size_t)k * CELLS + j] | (unsigned)hi[(size_t)k * CELLS + j] << 8;
+            r[j] = (z & 1) ? -(int32_t)(z >> 1) - 1 : (int32_t)(z >> 1);
+        }
+        nonzero_first += r[0] != 0; /* the first cell has no predecessor: its mantissas as they are */
+        for (size_t j = 1; j < CELLS; ++j)
+            if (j == CELLS / 2) /* twice the light one step up: the same mantissa, predicted as half of it */
+                assert_int_equal(r[j], r[0] - (int32_t)nearbyint(r[0] / 2.0));
+            else if (j == CELLS / 2 + 1) /* back down: predicted as twice the doubled cell's */
+                assert_int_equal(r[j], -r[0]);
+            else /* a cell like the one before costs nothing */
+                assert_int_equal(r[j], 0);
+    }
+    assert_true(nonzero_first > 0);
+    assert_int_equal(lpvp_shq_decode(att, att_len, len, CELLS, NULL, client, NULL, err, sizeof err), 0);
+    assert_memory_equal(client, held, len);
+    assert_true(worst_ratio(client, raw, CELLS) <= 0.01);
+    free(att);
+    free(p);
 }
 
 /* A light that keeps moving: each step changes every cell a little and a
@@ -252,7 +304,7 @@ static void test_bad_bound_and_payloads(void **state)
         uint8_t value;
         const char *what;
     } breaks[] = {
-        {0, 'X', "magic"},        {4, 2, "flags"},           {8, 21, "cell count"}, {16, 2, "sent count"},
+        {0, 'X', "magic"},        {4, 2, "flags (predicted delta)"}, {4, 4, "flags"},           {8, 21, "cell count"}, {16, 2, "sent count"},
         {24, 1, "extra bytes"},  {32, 0x09, "bit map count"}, {34, 0x80, "bit past C"}, {36, 2, "mode"},
     };
     for (size_t b = 0; b < sizeof breaks / sizeof breaks[0]; ++b) {
@@ -342,7 +394,8 @@ static void test_header(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_keyframe_holds_the_bound), cmocka_unit_test(test_deltas_hold_the_bound),
+        cmocka_unit_test(test_keyframe_holds_the_bound), cmocka_unit_test(test_keyframes_are_predicted),
+        cmocka_unit_test(test_deltas_hold_the_bound),
         cmocka_unit_test(test_static_volume_sends_nothing), cmocka_unit_test(test_hostile_values),
         cmocka_unit_test(test_bad_bound_and_payloads), cmocka_unit_test(test_header),
     };

@@ -519,6 +519,19 @@ def _shq_steps(b, x):
     return q + 1 if 2 * r > den or (2 * r == den and q % 2) else q
 
 
+def _shq_predicted(prev_q, prev_x, x):
+    """R5.16's prediction of a predicted keyframe's mantissa: the previous
+    cell's q scaled from 2^prev_x to 2^x and rounded half to even, in exact
+    integers; 0 where either exponent is -128 or they differ by more than 15."""
+    if prev_x == -128 or x == -128 or abs(prev_x - x) > 15:
+        return 0
+    if prev_x >= x:
+        return prev_q << (prev_x - x)
+    den = 1 << (x - prev_x)
+    q, r = divmod(prev_q, den)  # q = floor
+    return q + 1 if 2 * r > den or (2 * r == den and q % 2) else q
+
+
 def _shq_decode(h, payload, base=None):
     """R5.16's payload (the zstd frame's content) checked against header h
     and decoded: (the raw fp32 volume of raw_length bytes, S the cells
@@ -534,8 +547,9 @@ def _shq_decode(h, payload, base=None):
     check(len(payload) >= 32 and payload[:4] == b"SHQ1", "R5.16: the payload (%d bytes) starts %r, not \"SHQ1\""
           % (len(payload), bytes(payload[:4])))
     flags, c, s, x = struct.unpack_from("<IQQQ", payload, 4)
-    key = flags == 1
-    check(flags in (0, 1), "R5.16: payload flags 0x%x (bit 0 alone is defined)" % flags)
+    key = flags & 1 == 1
+    predicted = flags == 3
+    check(flags in (0, 1, 3), "R5.16: payload flags 0x%x (bit 0 keyframe, bit 1 predicted only with it)" % flags)
     check(key == h["keyframe"], "R5.16: payload flags say keyframe %r, the header %r" % (key, h["keyframe"]))
     check(c == C and x == X, "R5.16: payload counts C %d, X %d; the header's volume has %d cells and %d bytes after "
           "them" % (c, x, C, X))
@@ -559,6 +573,7 @@ def _shq_decode(h, payload, base=None):
     lo = at + (1 if key else 2) * s
     hi = lo + 12 * s
     out = bytearray(values) if key else bytearray(base[:values])
+    prev_q, prev_x = [0] * 12, -128
     for j, i in enumerate(sent):
         x = struct.unpack_from("<b", payload, at + j)[0]
         check(modes[j] in (0, 1) and not (modes[j] == 1 and x == -128), "R5.16: sent cell %d (cell %d) has mode %d "
@@ -570,11 +585,15 @@ def _shq_decode(h, payload, base=None):
             q = z // 2 if z % 2 == 0 else -(z + 1) // 2
             if b is not None:
                 q += _shq_steps(b[k], x)
+            if predicted:  # the change from the previous cell's prediction, modulo 2^16
+                q = (q + _shq_predicted(prev_q[k], prev_x, x) + 32768) % 65536 - 32768
+                prev_q[k] = q
             cell.append(0.0 if x == -128 else math.ldexp(q, x))
             check(x == -128 or (abs(q) < 2 ** 53 and abs(cell[-1]) < 2.0 ** 128
                                 and struct.unpack("<f", struct.pack("<f", cell[-1]))[0] == cell[-1]),
                   "R5.16: cell %d's value %d is %d x 2^%d (mode %d), not exact in binary32" % (i, k, q, x, modes[j]))
         struct.pack_into("<12f", out, 48 * i, *cell)
+        prev_x = x
     tail = bytes(payload[hi + 12 * s:])
     if not key:
         tail = bytes(a ^ b for a, b in zip(tail, base[values:]))

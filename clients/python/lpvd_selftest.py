@@ -513,6 +513,29 @@ def _offline_shq(say):
     if seeded != b"".join(_shq_value(x, q) for x, qs in cells for q in qs):
         raise AssertionError("shq: the seeded keyframe differs from q x 2^x worked out with ** (numpy: %s)"
                              % (lpvd_volume._np is not None))
+    # -- predicted keyframes (flag bit 1): the residuals worked out here with ** and floor, the decoder's
+    # running sums must give back every q, through runs of one exponent, jumps of up to 15 and beyond, zero
+    # cells and mantissas at both ends of 16 bits
+    runs = [(rnd.choice([-128, 5, 5, 5, 6, 20, 21, 40]), [rnd.randint(-32768, 32767) if k % 2 else
+                                                       rnd.randint(-40, 40) for k in range(12)]) for _ in range(300)]
+    for plain in (cells, runs):
+        residual, prev, prev_x = [], [0] * 12, -128
+        for x, qs in plain:
+            preds = []
+            for pq in prev:
+                if prev_x == -128 or x == -128 or abs(prev_x - x) > 15:
+                    preds.append(0)
+                    continue
+                t = pq * 2.0 ** (prev_x - x)
+                near = math.floor(t)
+                preds.append(near + (1 if t - near > 0.5 or (t - near == 0.5 and near % 2) else 0))
+            residual.append((x, [(q - d + 32768) % 65536 - 32768 for q, d in zip(qs, preds)]))
+            prev, prev_x = qs, x
+        got = shq_decode_payload(_shq_payload(residual, flags=3), 300 * 48, 300, True)
+        if got != b"".join(_shq_value(x, q) for x, qs in plain for q in qs):
+            raise AssertionError("shq: a predicted keyframe does not give back its cells (numpy: %s) in cells %r" % (
+                lpvd_volume._np is not None, [i for i in range(300) if got[48 * i:48 * i + 48] != b"".join(
+                    _shq_value(plain[i][0], q) for q in plain[i][1])][:10]))
     flags = [rnd.random() < 0.3 for _ in range(300)]
     bitmap = bytes(sum(1 << b for b in range(8) if 8 * i + b < 300 and flags[8 * i + b]) for i in range(38))
     seeded_delta = shq_decode_payload(_shq_payload([c for c, f in zip(cells, flags) if f], bitmap=bitmap, cells=300),
@@ -545,7 +568,8 @@ def _offline_shq(say):
     k3 = key_cells[:3]
     refusals = [
         ("the magic", lambda: shq_decode_payload(_shq_payload(k3, magic=b"SHQ2"), 144, 3, True), "SHQ1"),
-        ("an unknown flag", lambda: shq_decode_payload(_shq_payload(k3, flags=3), 144, 3, True), "flags"),
+        ("an unknown flag", lambda: shq_decode_payload(_shq_payload(k3, flags=5), 144, 3, True), "flags"),
+        ("a predicted delta", lambda: shq_decode_payload(_shq_payload(k3, flags=2), 144, 3, True), "flags"),
         ("a keyframe flag where the header has a delta",
          lambda: shq_decode_payload(_shq_payload(k3), 144, 3, False, bytes(144)), "keyframe"),
         ("a delta flag where the header has a keyframe",

@@ -114,7 +114,9 @@ _LOBE1 = _f32(SH_LOBE1)
 # a delta's bit map of the cells sent, one exponent per cell sent, a delta's
 # mode per cell sent (0: the mantissas are the values' steps, 1: the change
 # from the base's cell in those steps), the 12 zigzag mantissas in byte
-# planes, then the bytes after the values (an index). protocol/volume_shq.c's lpvp_shq_decode is the normative decoder;
+# planes, then the bytes after the values (an index). A keyframe with flag bit 1
+# (predicted) holds each cell's mantissas as their change from the previous
+# cell's, scaled to the cell's step (_shq_predict). protocol/volume_shq.c's lpvp_shq_decode is the normative decoder;
 # this one rebuilds the same fp32 bytes, bit for bit, with numpy or without.
 
 SHQ_COMPRESSION = "shq"
@@ -122,6 +124,8 @@ SHQ_BOUND_MIN, SHQ_BOUND_MAX, SHQ_BOUND_DEFAULT = 0.001, 0.25, 0.01  # HELLO's v
 SHQ_MAGIC = b"SHQ1"
 _SHQ_HEAD = struct.Struct("<4sIQQQ")  # magic, flags (bit 0: keyframe), C cells, S cells sent, X bytes after
 _SHQ_FLAG_KEY = 1
+_SHQ_FLAG_PREDICTED = 2   # with bit 0 only: the mantissas are residuals of the previous cell's prediction
+_SHQ_PREDICT_SHIFT_MAX = 15  # exponents farther apart: no prediction
 _SHQ_ZERO_EXP = -128      # a cell sent as zero
 _SHQ_CELL_BYTES = 48      # R5.1's 12 fp32 values
 _SHQ_SENT_BYTES = 25      # per cell a keyframe sends: its exponent and 12 two-byte mantissas
@@ -208,10 +212,12 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
     bytes), and its bytes after the values are XOR'd with the base's. Value
     k of a cell sent is q x 2^x in binary32 (exact; 0 when x = -128), where
     q is the mantissa, or for a delta's cell of mode 1 the mantissa plus the
-    base's value in steps of 2^x (rounded half to even).
+    base's value in steps of 2^x (rounded half to even), or for a predicted
+    keyframe's cell the mantissa plus the previous cell's q scaled to 2^x
+    (_shq_predict), modulo 2^16.
 
     Raises ProtocolError for what the SPEC says a client MUST reject: a
-    magic other than "SHQ1", flags other than bit 0, a keyframe flag that
+    magic other than "SHQ1", flags other than bits 0 and 1 (1 only with 0), a keyframe flag that
     disagrees with the header's ``keyframe``, C or X other than the header's,
     S over C (or a keyframe's S not C), a bit map whose set bits are not S or
     that sets bits past C, a mode other than 0 or 1 (or 1 with x = -128),
@@ -225,9 +231,10 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
     if len(p) < _SHQ_HEAD.size or p[:4] != SHQ_MAGIC:
         raise ProtocolError("shq: not an %r payload (%d bytes starting %r)" % (SHQ_MAGIC.decode(), len(p), p[:4]))
     _, flags, n_cells, sent, n_extra = _SHQ_HEAD.unpack_from(p)
-    if flags & ~_SHQ_FLAG_KEY:
-        raise ProtocolError("shq: unknown flags 0x%x (only bit 0, keyframe, is defined)" % flags)
+    if flags & ~(_SHQ_FLAG_KEY | _SHQ_FLAG_PREDICTED) or flags == _SHQ_FLAG_PREDICTED:
+        raise ProtocolError("shq: unknown flags 0x%x (bit 0 is keyframe, bit 1 predicted, only with bit 0)" % flags)
     key = bool(flags & _SHQ_FLAG_KEY)
+    predicted = bool(flags & _SHQ_FLAG_PREDICTED)
     if key != bool(keyframe):
         raise ProtocolError("shq: the payload is a %s, the header says keyframe %r" % (
             "keyframe" if key else "delta", keyframe))
@@ -262,18 +269,55 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
             if mode > _SHQ_RELATIVE or (mode == _SHQ_RELATIVE and exps[j] == 0x80):
                 raise ProtocolError("shq: sent cell %d has mode %d%s" % (
                     j, mode, "" if mode > _SHQ_RELATIVE else " with the zero exponent"))
-    rebuilt = (_shq_values_numpy if _np is not None else _shq_values_stdlib)(p, at, cells, sent, bitmap, modes, base)
+    rebuilt = (_shq_values_numpy if _np is not None else _shq_values_stdlib)(p, at, cells, sent, bitmap, modes, base,
+                                                                             predicted)
     after = p[at + per * sent:]
     return rebuilt + (after if key else _xor(after, bytes(base[values:])))
 
 
-def _shq_values_numpy(p, at, cells, sent, bitmap, modes, base):
+def _shq_predict(prev_q, prev_x, x):
+    """A predicted keyframe's prediction of a cell's mantissa (SPEC R5.16):
+    the previous cell's q at exponent prev_x scaled to the cell's 2^x and
+    rounded half to even, or 0 where either exponent is -128 or they are
+    more than 15 apart (the first cell's predecessor is a zero cell)."""
+    if prev_x == _SHQ_ZERO_EXP or x == _SHQ_ZERO_EXP or abs(prev_x - x) > _SHQ_PREDICT_SHIFT_MAX:
+        return 0
+    return round(math.ldexp(prev_q, prev_x - x))
+
+
+def _wrap16(v):
+    """v modulo 2^16 as a signed 16-bit value."""
+    return (v + 32768) % 65536 - 32768
+
+
+def _shq_unpredict_numpy(r, x):
+    """A predicted keyframe's mantissas (sent x 12, int64) from their
+    residuals r and exponents x: along each run of one exponent the
+    prediction is the previous q itself, so q is the residuals' running sum
+    (modulo 2^16) from the run's first cell, predicted from the run before."""
+    q = _np.empty_like(r)
+    starts = _np.flatnonzero(_np.r_[True, x[1:] != x[:-1]]) if len(x) else _np.zeros(0, _np.int64)
+    prev, prev_x = _np.zeros(12, _np.int64), _SHQ_ZERO_EXP
+    for s, e in zip(starts, _np.r_[starts[1:], len(x)].astype(_np.int64)):
+        xs = int(x[s])
+        if xs == _SHQ_ZERO_EXP:  # every cell of the run predicted 0
+            q[s:e] = _wrap16(r[s:e])
+        else:
+            pred = _np.array([_shq_predict(int(v), prev_x, xs) for v in prev], _np.int64)
+            q[s:e] = _wrap16(pred + _np.cumsum(r[s:e], axis=0))
+        prev, prev_x = q[e - 1], xs
+    return q
+
+
+def _shq_values_numpy(p, at, cells, sent, bitmap, modes, base, predicted=False):
     """The values' bytes (cells x 48) rebuilt with numpy (see shq_decode_payload)."""
     x = _np.frombuffer(p, _np.int8, sent, at).astype(_np.int32)
     planes_at = at + sent + (0 if modes is None else sent)
     planes = _np.frombuffer(p, _np.uint8, 24 * sent, planes_at).astype(_np.int32).reshape(2, 12, sent)
     z = planes[0] | (planes[1] << 8)
     q = ((z >> 1) ^ -(z & 1)).T.astype(_np.float64)  # (sent, 12) mantissas
+    if predicted:
+        q = _shq_unpredict_numpy(q.astype(_np.int64), x).astype(_np.float64)
     if modes is not None:  # mode 1: the change from the base's cell in steps of 2^x
         sent_at = _np.unpackbits(_np.frombuffer(bitmap, _np.uint8), bitorder="little")[:cells].astype(bool)
         b = _np.frombuffer(base, "<f4", 12 * cells).reshape(cells, 12)[sent_at].astype(_np.float64)
@@ -290,7 +334,7 @@ def _shq_values_numpy(p, at, cells, sent, bitmap, modes, base):
     return out.tobytes()
 
 
-def _shq_values_stdlib(p, at, cells, sent, bitmap, modes, base):
+def _shq_values_stdlib(p, at, cells, sent, bitmap, modes, base, predicted=False):
     """The values' bytes (cells x 48) rebuilt with the standard library (see
     shq_decode_payload); the same bytes as _shq_values_numpy."""
     exps = struct.unpack_from("<%db" % sent, p, at)
@@ -304,13 +348,17 @@ def _shq_values_stdlib(p, at, cells, sent, bitmap, modes, base):
         based = [b[12 * i:12 * i + 12] for i in range(cells) if bitmap[i >> 3] >> (i & 7) & 1]
     inf = float("inf")
     flat = []
+    prev, prev_x = [0] * 12, _SHQ_ZERO_EXP
     for j, (x, *cell) in enumerate(zip(exps, *zs)):
+        if predicted:  # the change from the previous cell's prediction, modulo 2^16
+            prev = [_wrap16(((z >> 1) ^ -(z & 1)) + _shq_predict(pq, prev_x, x)) for z, pq in zip(cell, prev)]
+            prev_x = x
         if x == _SHQ_ZERO_EXP:
             flat.extend((0.0,) * 12)
             continue
         rel = modes is not None and modes[j] == _SHQ_RELATIVE
         for k, z in enumerate(cell):
-            q = (z >> 1) ^ -(z & 1)
+            q = prev[k] if predicted else (z >> 1) ^ -(z & 1)
             if rel:  # round() of a float is half to even, as the server's nearbyint
                 steps = math.ldexp(based[j][k], -x)
                 # a base of +-inf or NaN (which no server's stream gives) stays one, as in binary64
