@@ -69,8 +69,18 @@ typedef struct sv_shared_enc {
     uint64_t lineage;       /* the client's volume after it */
     uint8_t *att;
     size_t att_len;
+    size_t counted;         /* of att_len, the bytes in the encodings' count (sv_encode_memory) */
     sv_blob *recon;         /* a reference: the client's volume after it */
 } sv_shared_enc;
+
+/* Where an encoding counts the memory it keeps (the daemon's terms "bases"
+ * and "encodings", R7.6a); NULL (lpvd batch): nowhere, and every cache is
+ * kept. */
+typedef struct sv_encode_memory {
+    _Atomic uint64_t *bases;     /* the volumes subscribers hold (sv_blob's held) */
+    _Atomic uint64_t *encodings; /* the attachments a result keeps for the next subscriber or reply */
+    uint64_t encodings_limit;    /* the most *encodings may reach: a cache that would pass it is not kept */
+} sv_encode_memory;
 
 /* The product of one tick: immutable once handed to the main thread. */
 typedef struct sv_result {
@@ -108,6 +118,8 @@ typedef struct sv_result {
     /* main thread: keyframe attachments already encoded, [fp16][zstd] */
     uint8_t *enc[2][2];
     size_t enc_len[2][2];
+    size_t enc_counted[2][2];      /* of enc_len, the bytes in *enc_held */
+    _Atomic uint64_t *enc_held;    /* the encodings' count the caches' counted bytes are in */
     sv_shared_enc shared[SV_SHARED_ENCODINGS]; /* under export_encode.c's lock, as enc */
     int shared_next;
 } sv_result;
@@ -138,12 +150,14 @@ int sv_volume_coding_parse(const json_t *j, sv_volume_coding *how, char *err, si
  * keep: it gets the volume the client will hold (a reference in raw, its
  * tick, coding and lineage, for sv_sub_remember), and a delta against base
  * (its ACKed volume) when base fits; else keep and base are NULL. A new
- * volume's bytes are counted in held (NULL: nowhere) while it lives; one
- * shared with another subscriber's is counted once. Returns 0, -1 with err
+ * volume's bytes are counted in mem's bases while it lives; one shared with
+ * another subscriber's is counted once. The attachments r keeps for the
+ * next subscriber or reply are counted in mem's encodings until r is freed,
+ * and not kept where they would pass its limit. Returns 0, -1 with err
  * set, or 1 for an shq delta with nothing beyond the bound to send (R5.16:
  * nothing is sent; *body, *att and keep->raw are NULL). */
 int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, const sv_sent *base, sv_sent *keep,
-                     _Atomic uint64_t *held, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len,
+                     const sv_encode_memory *mem, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len,
                      char *err, size_t n);
 /* plan: the plan of the tick the frame shows, sent as "plan" (NULL: none). */
 int sv_encode_frame(const float *rgba, int w, int h, int fmt, int zstd, int terms, const lpv_display *display,

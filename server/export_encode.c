@@ -83,17 +83,47 @@ static int cache_copy(sv_result *r, int fp16, int zstd, uint8_t **att, size_t *a
     return got;
 }
 
+/* Counts len more bytes of r's caches in mem's encodings (under enc_mu):
+ * 1, or 0 when they would pass its limit (the cache is then not kept). No
+ * mem: nothing counted, always 1. */
+static int cache_count(sv_result *r, const sv_encode_memory *mem, size_t len, size_t *counted)
+{
+    *counted = 0;
+    if (!mem || !mem->encodings)
+        return 1;
+    uint64_t cur = atomic_load_explicit(mem->encodings, memory_order_relaxed);
+    do {
+        if (cur + len < cur || cur + len > mem->encodings_limit)
+            return 0;
+    } while (!atomic_compare_exchange_weak_explicit(mem->encodings, &cur, cur + len, memory_order_relaxed,
+                                                    memory_order_relaxed));
+    r->enc_held = mem->encodings; /* one daemon, one count */
+    *counted = len;
+    return 1;
+}
+
+/* A cache's counted bytes given back (under enc_mu). */
+static void cache_uncount(sv_result *r, size_t *counted)
+{
+    if (*counted && r->enc_held)
+        atomic_fetch_sub_explicit(r->enc_held, *counted, memory_order_relaxed);
+    *counted = 0;
+}
+
 /* Caches a copy of att as r's keyframe [fp16][zstd], unless another encoder
- * got there first. */
-static void cache_put(sv_result *r, int fp16, int zstd, const uint8_t *att, size_t len)
+ * got there first or it does not fit mem's encodings. */
+static void cache_put(sv_result *r, const sv_encode_memory *mem, int fp16, int zstd, const uint8_t *att, size_t len)
 {
     pthread_mutex_lock(&enc_mu);
-    uint8_t **c = &r->enc[fp16 ? 1 : 0][zstd ? 1 : 0];
-    if (!*c) {
+    const int f = fp16 ? 1 : 0, z = zstd ? 1 : 0;
+    uint8_t **c = &r->enc[f][z];
+    if (!*c && cache_count(r, mem, len, &r->enc_counted[f][z])) {
         *c = malloc(len ? len : 1);
         if (*c) {
             memcpy(*c, att, len);
-            r->enc_len[fp16 ? 1 : 0][zstd ? 1 : 0] = len;
+            r->enc_len[f][z] = len;
+        } else {
+            cache_uncount(r, &r->enc_counted[f][z]);
         }
     }
     pthread_mutex_unlock(&enc_mu);
@@ -197,6 +227,7 @@ static int shared_take(sv_result *r, uint64_t from, int64_t base_tick, const sv_
             sv_shared_enc *s = &r->shared[*claim];
             r->shared_next = (*claim + 1) % SV_SHARED_ENCODINGS;
             free(s->att);
+            cache_uncount(r, &s->counted);
             sv_blob_unref(s->recon);
             *s = (sv_shared_enc){.used = 1, .pending = 1, .keeps = keep != NULL, .from = from, .how = *how};
         }
@@ -219,9 +250,10 @@ static void shared_release(sv_result *r, int claim)
 }
 
 /* The claimed slot filled with a copy of the attachment and a reference to
- * the client's volume, for the subscribers that hold the same base. */
-static void shared_fill(sv_result *r, int claim, const lpvp_volume_info *vi, const sv_sent *keep, const uint8_t *att,
-                        size_t att_len, int outcome)
+ * the client's volume, for the subscribers that hold the same base; given
+ * up when the copy does not fit mem's encodings. */
+static void shared_fill(sv_result *r, const sv_encode_memory *mem, int claim, const lpvp_volume_info *vi,
+                        const sv_sent *keep, const uint8_t *att, size_t att_len, int outcome)
 {
     if (claim < 0)
         return;
@@ -234,6 +266,13 @@ static void shared_fill(sv_result *r, int claim, const lpvp_volume_info *vi, con
         memcpy(a, att, att_len);
     pthread_mutex_lock(&enc_mu);
     sv_shared_enc *s = &r->shared[claim];
+    if (!cache_count(r, mem, att_len, &s->counted)) { /* as shared_release: the waiters encode for themselves */
+        *s = (sv_shared_enc){0};
+        pthread_cond_broadcast(&enc_cv);
+        pthread_mutex_unlock(&enc_mu);
+        free(a);
+        return;
+    }
     s->pending = 0;
     s->outcome = outcome;
     s->keyframe = vi->keyframe;
@@ -310,9 +349,10 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
 }
 
 int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, const sv_sent *base, sv_sent *keep,
-                     _Atomic uint64_t *held, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len,
+                     const sv_encode_memory *mem, uint64_t revision, json_t **body, uint8_t **att, size_t *att_len,
                      char *err, size_t n)
 {
+    _Atomic uint64_t *held = mem ? mem->bases : NULL;
     if (keep) {
         memset(keep, 0, sizeof *keep);
         keep->tick = r->tick;
@@ -454,7 +494,7 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
                             held, att, att_len, err, n);
         free(raw);
         if (rc >= 0)
-            shared_fill(r, claim, &vi, keep, *att, *att_len, rc);
+            shared_fill(r, mem, claim, &vi, keep, *att, *att_len, rc);
         else
             shared_release(r, claim);
         if (rc != 0)
@@ -513,10 +553,10 @@ int sv_encode_volume(sv_result *r, int content, const sv_volume_coding *how, con
     free(raw);
     if (keep) { /* the subscriber remembers it (sv_sub_remember); the others in step share it */
         keep->raw = kept;
-        shared_fill(r, claim, &vi, keep, *att, *att_len, 0);
+        shared_fill(r, mem, claim, &vi, keep, *att, *att_len, 0);
     }
     if (vi.keyframe && merged && *att)
-        cache_put(r, fp16, zstd, *att, *att_len);
+        cache_put(r, mem, fp16, zstd, *att, *att_len);
 header:
     *body = lpvp_volume_header_build(&vi);
     if (*body && json_object_set_new(*body, "plan", lpvd_plan_json(&r->plan)) != 0) {

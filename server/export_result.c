@@ -34,12 +34,18 @@ static void result_free(sv_result *r)
     free(r->iv_held);
     for (int i = 0; i < LPVP_TERMS_COUNT; ++i)
         free(r->frames[i]);
-    for (int i = 0; i < 4; ++i)
+    uint64_t counted = 0;
+    for (int i = 0; i < 4; ++i) {
         free(r->enc[i / 2][i % 2]);
+        counted += r->enc_counted[i / 2][i % 2];
+    }
     for (int i = 0; i < SV_SHARED_ENCODINGS; ++i) {
         free(r->shared[i].att);
+        counted += r->shared[i].counted;
         sv_blob_unref(r->shared[i].recon);
     }
+    if (r->enc_held && counted) /* the encoding caches leave the daemon's count with the result */
+        atomic_fetch_sub_explicit(r->enc_held, counted, memory_order_relaxed);
     free(r);
 }
 

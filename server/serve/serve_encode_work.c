@@ -85,8 +85,13 @@ static void work_cb(uv_work_t *w)
     enc_task *t = w->data;
     if (t->kind == ENC_VOLUME) {
         uint64_t t0 = thread_cpu_ns();
+        sv_memory *m = &t->c->srv->mem;
+        /* the caches may take what the budget leaves now (R7.6a) */
+        const sv_encode_memory mem = {.bases = &m->held[SV_MEM_BASES],
+                                      .encodings = &m->held[SV_MEM_ENCODINGS],
+                                      .encodings_limit = sv_memory_room(m, SV_MEM_ENCODINGS)};
         int rc = sv_encode_volume(t->r, t->content, &t->how, t->base.raw ? &t->base : NULL, t->keep ? &t->kept : NULL,
-                                  &t->c->srv->mem.held[SV_MEM_BASES], t->revision, &t->body, &t->att, &t->att_len, t->err, sizeof t->err);
+                                  &mem, t->revision, &t->body, &t->att, &t->att_len, t->err, sizeof t->err);
         t->failed = rc < 0;
         t->unchanged = rc == 1;
         t->encode_ns = thread_cpu_ns() - t0;

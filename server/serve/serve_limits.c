@@ -41,7 +41,7 @@ const sv_limit sv_limits[] = {
     /* 0: sv_memory_init takes half of the machine's memory (or its cgroup's
      * limit); lpvd_cmd_serve then writes the budget back, which HELLO says */
     {"max-memory", "BYTES", LIMITS, "max_memory", ROW(max_memory), P2(20), P2(48), 0,
-     "all worlds' storage, live scenes, requests and replies together",
+     "all worlds' storage, live scenes, requests, replies, delta bases and kept encodings together",
      "half of the machine's memory, or of its cgroup's limit;\nthe worlds also stay within half of the video memory"},
     {"max-request-memory", "BYTES", LIMITS, "max_request_memory", ROW(max_request_memory), 1024, P2(44), P2(30),
      "request bytes held for all clients together; a frame that\ndoes not fit waits, unread",

@@ -5,7 +5,8 @@
 #include <string.h>
 #include <unistd.h>
 
-static const char *const k_names[SV_MEM_TERMS] = {"worlds", "scenes", "requests", "replies", "bases"};
+static const char *const k_names[SV_MEM_TERMS] = {"worlds", "scenes", "requests", "replies", "bases",
+                                                            "encodings"};
 
 const char *sv_mem_term_name(sv_mem_term t)
 {
@@ -97,9 +98,11 @@ int sv_memory_fits(const sv_memory *m, sv_mem_term t, uint64_t more)
 void sv_memory_describe(const sv_memory *m, char *buf, size_t size)
 {
     snprintf(buf, size, "the daemon's memory budget, %s, %.3f GB, holds worlds %.3f GB, scenes %.3f GB, requests %.3f GB, "
-                        "replies %.3f GB, bases %.3f GB (and keeps %.3f GB free for one --max-message)",
+                        "replies %.3f GB, bases %.3f GB, encodings %.3f GB (and keeps %.3f GB free for one "
+                        "--max-message)",
              m->source, (double)m->budget / 1e9, (double)sv_memory_held(m, SV_MEM_WORLDS) / 1e9,
              (double)sv_memory_held(m, SV_MEM_SCENES) / 1e9, (double)sv_memory_held(m, SV_MEM_REQUESTS) / 1e9,
              (double)sv_memory_held(m, SV_MEM_REPLIES) / 1e9,
-             (double)sv_memory_held(m, SV_MEM_BASES) / 1e9, (double)m->headroom / 1e9);
+             (double)sv_memory_held(m, SV_MEM_BASES) / 1e9, (double)sv_memory_held(m, SV_MEM_ENCODINGS) / 1e9,
+             (double)m->headroom / 1e9);
 }

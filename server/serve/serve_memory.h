@@ -1,7 +1,8 @@
 /*
  * serve_memory.h - the daemon's one memory budget (issue 31, "daemon-wide
  * memory"; SPEC R7.6a): the worlds' storage, the live scenes, the requests
- * being read and the replies queued, each term counted where it is taken
+ * being read and the replies queued, the subscribers' bases and
+ * the results' encoding caches, each term counted where it is taken
  * and given back, all of them together within --max-memory (default: half
  * of the machine's memory, or of the cgroup's limit when that is lower).
  *
@@ -26,6 +27,7 @@ typedef enum sv_mem_term {
     SV_MEM_REQUESTS, /* request bytes reserved or pending, every connection (R7.5) */
     SV_MEM_REPLIES,  /* reply and stream bytes queued for writing, every connection */
     SV_MEM_BASES,    /* the volumes delta subscribers hold (sent, ACKed), once each however many share one */
+    SV_MEM_ENCODINGS, /* the encodings a tick's result keeps for the next subscriber or reply (export.h) */
     SV_MEM_TERMS
 } sv_mem_term;
 

@@ -20,13 +20,17 @@ reference-counted copy, and STATS memory.bases counts each copy once.
    one copy (counted too); both rebuild the tick's volume byte for byte
    (GET_VOLUME fp16 of the same tick).
 3. When every subscriber has gone (and so have the worlds and their cached
-   encodings), a new session's STATS says bases 0: no reference kept, the
-   count given back exactly.
+   encodings), a new session's STATS says bases 0 and encodings 0: no
+   reference kept, the counts given back exactly. While they lived, the
+   encodings their results kept for the next subscriber (memory.encodings)
+   were counted: more than 0, at most 8 attachments (4 shared encodings
+   and 4 keyframes a result).
 4. The bases are within the budget: a daemon whose --max-memory leaves the
    bases room for one and a half volumes beside its world does not keep a
    second (STATS encode.bases_refused counts it); the subscriber gets a
    keyframe instead of a delta against what it was not kept, every TICK
-   is answered, and the bases never pass their room.
+   is answered, and the bases and the cached encodings together never pass
+   their room.
 """
 
 import os
@@ -74,7 +78,8 @@ def over_budget(rep, lpvd, world, scenes, raw_len):
             f = c.request(lc.TICK, {}, timeout=300)
             ticks.append(f.type == (lc.TICK | lc.REPLY) or f.body.get("message", "?"))
             drain(c, seen, 30.0)  # the VOLUME is sent before its base is kept or refused
-            most = max(most, stats(c)["memory"]["bases"])
+            m = stats(c)["memory"]
+            most = max(most, m["bases"] + m.get("encodings", 0))
         refused = stats(c)["encode"].get("bases_refused", 0)
         acked = set()
         chained = True
@@ -86,7 +91,7 @@ def over_budget(rep, lpvd, world, scenes, raw_len):
         rep.check(refused >= 1 and chained and sum(1 for h in seen if h["keyframe"]) >= 2,
                   "over the budget a second base is not kept: a keyframe follows, every delta's base was ACKed",
                   "bases_refused %d, keyframes %r" % (refused, [h["keyframe"] for h in seen]))
-        rep.check(most <= raw_len * 3 // 2, "the bases never pass their room",
+        rep.check(most <= raw_len * 3 // 2, "the bases and the cached encodings never pass their room",
                   "at most %d bytes after a VOLUME, room %d" % (most, raw_len * 3 // 2))
         c.close()
         rep.check(d.alive(), "the daemon is alive")
@@ -101,6 +106,7 @@ def main():
         ep = ("unix", d.unix)
         subs = [scene_session(ep, light=dict(LIGHT), timeout=120) for _ in range(3)]
         seen = [[] for _ in subs]
+        atts = [[] for _ in subs]
         for c in subs:
             ok(c.request(lc.SUBSCRIBE, SHQ, timeout=60), lc.SUBSCRIBE)
         ok(subs[0].request(lc.TICK, {}, timeout=300), lc.TICK)
@@ -115,8 +121,8 @@ def main():
             for c in subs:
                 ok(c.request(lc.LIGHT_SET, light, timeout=60), lc.LIGHT_SET)
             ok(subs[0].request(lc.TICK, {}, timeout=300), lc.TICK)
-            for c, s in zip(subs, seen):
-                drain(c, s, 30.0)
+            for c, s, a in zip(subs, seen, atts):
+                drain(c, s, 30.0, a)
         raw_len = max((h["raw_length"] for s in seen for h in s), default=0)
         keyframes = [sum(1 for h in s if h["keyframe"]) for s in seen]
         counts = [len(s) for s in seen]
@@ -128,6 +134,11 @@ def main():
         rep.check(bases is not None and raw_len > 0 and raw_len <= bases <= 2 * raw_len,
                   "three subscribers in step hold one shared volume: memory.bases within 1-2 raw volumes",
                   "bases %r bytes, one volume %d bytes (unshared: at least %d)" % (bases, raw_len, 3 * raw_len))
+        encodings = s.get("memory", {}).get("encodings")
+        att_max = max((len(a) for x in atts for a in x), default=0)
+        rep.check(isinstance(encodings, int) and 0 < encodings <= 8 * att_max,
+                  "the encodings the tick's result keeps for the next subscriber are counted (memory.encodings)",
+                  "encodings %r bytes, the largest attachment %d bytes" % (encodings, att_max))
 
         own = dict(LIGHT, id="own")
         xors = [scene_session(ep, light=own, timeout=120) for _ in range(2)]
@@ -170,6 +181,9 @@ def main():
         fresh = scene_session(ep, timeout=120)
         left = settle(lambda: stats(fresh).get("memory", {}).get("bases", -1), 0, 0, timeout=20.0)
         rep.check(left == 0, "every subscriber gone: memory.bases is 0 (no reference kept)", "bases %r" % left)
+        enc_left = settle(lambda: stats(fresh).get("memory", {}).get("encodings", -1), 0, 0, timeout=20.0)
+        rep.check(enc_left == 0, "every world gone: memory.encodings is 0 (every cache given back)",
+                  "encodings %r" % enc_left)
         fresh.close()
         rep.check(d.alive(), "the daemon is alive")
     over_budget(rep, lpvd, world, scenes, raw_len)
