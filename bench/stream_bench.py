@@ -24,12 +24,14 @@ A benchmark, not a test: nothing is asserted. Prints Markdown tables
   4. lag: after a light moves 0.3 m, the TICKs until the client's shq volume
      is within the bound of the converged answer at the points of section 1,
      per technique.
---save DIR instead writes each technique's exact volumes of 16 updates
+--set KEY=VALUE adds a CONFIG setting to the lpv runs (e.g. --set
+smooth_injection=true). --save DIR instead writes each technique's exact volumes of 16 updates
 (the input of build/bench/lpvd-shq-codec, bench/shq_codec.c).
 numpy is required (the error figures).
 """
 
 import argparse
+import json
 import os
 import random
 import socket
@@ -401,7 +403,15 @@ def main():
     ap.add_argument("--only", help="comma list of sections 1-4")
     ap.add_argument("--save", metavar="DIR", help="only save each technique's exact volumes for lpvd-shq-codec")
     ap.add_argument("--scene", metavar="GLB", help="with --save: this scene instead of the box")
+    ap.add_argument("--set", metavar="KEY=VALUE", action="append", default=[],
+                    help="a CONFIG setting of the lpv runs (JSON value, or a string), e.g. smooth_injection=true")
     args = ap.parse_args()
+    for kv in args.set:
+        key, _, value = kv.partition("=")
+        try:
+            CONFIG[key] = json.loads(value)
+        except ValueError:
+            CONFIG[key] = value
     daemon = harness.Daemon(harness.find_lpvd(args.lpvd), optional=[("--max-clients", "128"),
                                                                     ("--max-preauth", "128")])
     daemon.start()

@@ -75,6 +75,10 @@ typedef struct lpv_lpv_settings {
     int far_field_steps;          /* steps each level but the coarsest takes before handing its light
                                      on; the coarsest takes the rest of the iterations, so more
                                      iterations only add steps there */
+    lpv_switch smooth_injection;  /* each VPL's light spread bilinearly over the 2 x 2 cells around it
+                                     along its surface instead of the one cell holding it, so the volume
+                                     changes smoothly as a moving light's RSM texels slide over the
+                                     surfaces (grid.glsl vpl_stencil_at); default off */
 } lpv_lpv_settings;
 
 /* Everything the engine is told: the volume's resolution and bounds, the

@@ -83,6 +83,9 @@ static const lpv_field CORE_FIELDS[] = {
      "levels", D(1), "", "coarser levels (2x the cells each) over one grid", T_VOL, LPV_TECHNIQUE_LPV},
     {"far_field_steps", "far-field-steps", LPV_FIELD_INT, F(lpv.far_field_steps), 1, LPV_MAX_ITERATIONS, 0, "steps",
      D(1), "", "steps each far-field level but the coarsest takes before handing its light on", T_VOL, LPV_TECHNIQUE_LPV},
+    {"smooth_injection", "smooth-injection", LPV_FIELD_SWITCH, F(lpv.smooth_injection), 0, 1, 0, "", D(0), "",
+     "spread each VPL over the 2 x 2 cells around it along its surface: light that moves smoothly with a moving "
+     "lamp (steadier streams, less flicker; off: the cell holding it)", T_VOL, LPV_TECHNIQUE_LPV},
     {"scene_surfels", "scene-surfels", LPV_FIELD_SWITCH, F(scene_surfels), 0, 1, 0, "", D_PRESET("the preset's"), "",
      "surfels over every triangle join the geometry volume (walls no view sees block)", T_VOL | T_SAMPLES, ""},
     {"scene_surfel_count", "scene-surfel-count", LPV_FIELD_INT, F(scene_surfel_count), 1, 1 << 22, 0, "",

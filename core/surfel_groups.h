@@ -20,6 +20,7 @@
 typedef struct lpv_group_grid {
     float origin_cells[3];
     float cell_size;
+    int vpl_spread; /* VPLs key on the 2 x 2 stencil they are spread over (lpv_volume_desc.vpl_spread) */
 } lpv_group_grid;
 
 /* Groups n surfels by the GV point each snaps to in each of `levels` grids

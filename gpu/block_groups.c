@@ -20,6 +20,7 @@ int lpv_engine_group_grids(const lpv_engine *e, lpv_group_grid g[LPV_MAX_CASCADE
         /* in cells, as the technique's grid block holds it */
         memcpy(g[k].origin_cells, e->desc.origin_cells[k], sizeof g[k].origin_cells);
         g[k].cell_size = e->desc.level[k].cell_size;
+        g[k].vpl_spread = e->desc.vpl_spread;
         if (!(g[k].cell_size > 0.0f))
             return 0;
     }
@@ -41,4 +42,5 @@ void lpv_block_groups_bind(GLuint prog, const lpv_group_grid *g, int levels)
     }
     glUniform4fv(glGetUniformLocation(prog, "u_group_grid"), LPV_MAX_CASCADES, &grids[0][0]);
     glUniform1i(glGetUniformLocation(prog, "u_group_levels"), levels);
+    glUniform1i(glGetUniformLocation(prog, "u_group_spread"), levels > 0 && g[0].vpl_spread);
 }

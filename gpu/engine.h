@@ -59,6 +59,9 @@ typedef struct lpv_volume_desc {
     float origin_cells[LPV_MAX_CASCADES][3]; /* each level's lower corner in its cells, exactly as the shaders
                                                 place it (grid.glsl cascade_coords) */
     int far_field;                /* level k + 1 carries on the light of level k */
+    int vpl_spread;               /* VPLs are spread over the 2 x 2 cells around them along their surface
+                                     (settings lpv.smooth_injection): the RSMs' VPLs group by that
+                                     stencil (block_groups.glsl) */
     int volumes_per_level;        /* 1, or the normal bins */
     int values_per_cell;          /* floats: 12 = SH bands 0-1 of r, g, b */
     lpv_levels_kind kind;         /* what the levels are and how they are looked up */

@@ -6,7 +6,12 @@
 // one sample per group carries the group's sum at its weighted centroid
 // (camera_surfels.comp, vpl_blocks.comp). Since a centroid of points in one
 // cell lies in that cell, every cell or point receives what the samples gave
-// it one by one. The means are sums of differences from the group's first
+// it one by one. With smooth injection a VPL group is the samples of one
+// 2 x 2 stencil (grid.glsl vpl_stencil_at), spread from its centroid: each
+// axis's weights are linear in the position, so a cell receives what the
+// samples gave it but for the two axes' cross term (the members'
+// covariance within the block), and a sample that crosses into the next
+// stencil does so where its weight on the cells it leaves is 0. The means are sums of differences from the group's first
 // sample, so a group of samples at one position (a plane on a cell's
 // border: the grid's half-cell margin puts the scene's walls there) keeps
 // that position to the bit, and the injection puts it where it put them.
@@ -26,6 +31,7 @@
 
 uniform vec4 u_group_grid[LPV_MAX_CASCADES]; // each cascade: lower corner in cells, cell (m)
 uniform int u_group_levels;                  // cascades; 0: no grid, one group per block
+uniform int u_group_spread;                  // VPLs key on their smooth-injection stencil (grid.glsl)
 
 // 9 bits per axis (index + 1, clamped to 0..511: a grid has at most 257
 // points a side) and 3 bits for the normal bin.
@@ -39,13 +45,16 @@ ivec3 group_unpack(uint k) { return ivec3(int(k & 511u), int((k >> 9) & 511u), i
 
 // Cascade c's part of the key of a sample at x with unit normal n: the GV
 // point nearest x (points, inject_gv.vert), or the cell holding x + half a
-// cell along n (cells, inject_vpl.vert), with the normal's bin (-1: none);
+// cell along n (cells, inject_vpl.vert; with u_group_spread the lower cell
+// of its stencil), with the normal's bin (-1: none);
 // computed as those shaders compute it (grid.glsl cascade_coords), so a
 // sample on a cell's border falls on the same side.
 uint group_code(int c, vec3 x, vec3 n, bool points, int bin)
 {
     vec4 g = u_group_grid[c];
-    ivec3 q = points ? gv_point_at(x, n, g.w, g.xyz) : vpl_cell_at(x, n, g.w, g.xyz);
+    vec3 f;
+    ivec3 q = points ? gv_point_at(x, n, g.w, g.xyz)
+                     : u_group_spread != 0 ? vpl_stencil_at(x, n, g.w, g.xyz, f) : vpl_cell_at(x, n, g.w, g.xyz);
     return group_pack(q, max(bin, 0));
 }
 

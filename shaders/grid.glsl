@@ -75,6 +75,41 @@ int normal_bin(vec3 n)
     return 2 * axis + (n[axis] < 0.0 ? 1 : 0);
 }
 
+// Smooth injection (settings lpv.smooth_injection): a VPL at x with normal n
+// spreads its light bilinearly over the 2 x 2 cells around x + half a cell
+// along n, in the two axes but the normal's dominant one (normal_bin's),
+// and along that axis lands in the cell vpl_cell_at gives. A light that
+// moves slides its RSM texels over the surfaces, so the volume then changes
+// smoothly instead of by a texel's whole flux where one crosses a cell's
+// border; light still never lands behind the surface along the normal.
+// Returns the stencil's lower cell and sets f, the upper cells' weights
+// per axis (0 along the dominant one); corner j (0..3) is the lower cell
+// plus j & 1 along the first other axis and j >> 1 along the second.
+ivec3 vpl_stencil_at(vec3 x, vec3 n, float cell, vec3 origin_cells, out vec3 f)
+{
+    vec3 q = (x + LPV_VPL_SHIFT_CELLS * cell * n) / cell - origin_cells;
+    int ax = normal_bin(n) / 2;
+    vec3 b = floor(q - 0.5);
+    f = q - 0.5 - b;
+    b[ax] = floor(q[ax]);
+    f[ax] = 0.0;
+    return ivec3(b);
+}
+ivec3 vpl_stencil_corner(ivec3 b, vec3 n, int j)
+{
+    int ax = normal_bin(n) / 2;
+    ivec3 o = ivec3(0);
+    o[ax == 0 ? 1 : 0] = j & 1;
+    o[ax == 2 ? 1 : 2] = j >> 1;
+    return b + o;
+}
+float vpl_stencil_weight(vec3 f, vec3 n, int j)
+{
+    int ax = normal_bin(n) / 2;
+    int a0 = ax == 0 ? 1 : 0, a1 = ax == 2 ? 1 : 2;
+    return ((j & 1) != 0 ? f[a0] : 1.0 - f[a0]) * ((j >> 1) != 0 ? f[a1] : 1.0 - f[a1]);
+}
+
 // The unit vector of direction d in the order +x -x +y -y +z -z.
 vec3 dir_vector(int d)
 {

@@ -23,6 +23,13 @@ typedef struct LpvGvPoint lpv_gv_point;
  * per channel, in array order. VPLs landing outside the grid are dropped.
  * Returns the number injected. */
 size_t lpv_oracle_inject_vpls(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells);
+/* Smooth injection (settings lpv.smooth_injection, grid.glsl
+ * vpl_stencil_at): each valid VPL spread over the 2 x 2 cells around
+ * position + 0.5 * cell_size * normal in the two axes but the normal's
+ * dominant one, with bilinear weights, and along that axis into the cell
+ * lpv_oracle_inject_vpls would use. Corners outside the grid are dropped.
+ * Returns the number of VPLs that gave a cell light. */
+size_t lpv_oracle_inject_vpls_spread(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells);
 
 /* Adds each valid surfel (area > 0, finite, unit-able normal) to its nearest
  * GV point as (area / cell_size^2) * lobe(normal). gv has lpv_grid_gv_count

@@ -46,6 +46,53 @@ static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
     return 1;
 }
 
+/* One VPL spread over its 2 x 2 stencil along its surface (oracle.h). */
+static int inject_vpl_spread(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
+{
+    float n[3], q[3], f[3];
+    int b[3];
+    if (v->position[3] == 0.0f || !finite3(v->position) || !finite3(v->flux))
+        return 0;
+    if (!lpv_mean_direction(v->normal, n))
+        return 0;
+    const int ax = lpv_oracle_normal_bin(n) / 2, a0 = ax == 0 ? 1 : 0, a1 = ax == 2 ? 1 : 2;
+    for (int i = 0; i < 3; i++) {
+        q[i] = (v->position[i] + LPV_VPL_SHIFT_CELLS * g->cell_size * n[i]) / g->cell_size -
+               g->origin[i] / g->cell_size; /* as grid.glsl */
+        const float lo = floorf(i == ax ? q[i] : q[i] - 0.5f);
+        if (!(lo >= -1.0f && lo < (float)g->dims[i])) /* no corner inside (and no int overflow) */
+            return 0;
+        b[i] = (int)lo;
+        f[i] = i == ax ? 0.0f : q[i] - 0.5f - lo;
+    }
+    float lobe[4];
+    lpv_sh_cosine_lobe(n, lobe);
+    int given = 0;
+    for (int j = 0; j < 4; j++) {
+        int c[3] = {b[0], b[1], b[2]};
+        c[a0] += j & 1;
+        c[a1] += j >> 1;
+        const float w = ((j & 1) ? f[a0] : 1.0f - f[a0]) * ((j >> 1) ? f[a1] : 1.0f - f[a1]);
+        if (!(w > 0.0f) || c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= g->dims[0] || c[1] >= g->dims[1] ||
+            c[2] >= g->dims[2])
+            continue;
+        lpv_cell *cell = &cells[lpv_grid_index(g, c[0], c[1], c[2])];
+        add_scaled(cell->r, lobe, v->flux[0] * w / LPV_PI);
+        add_scaled(cell->g, lobe, v->flux[1] * w / LPV_PI);
+        add_scaled(cell->b, lobe, v->flux[2] * w / LPV_PI);
+        given = 1;
+    }
+    return given;
+}
+
+size_t lpv_oracle_inject_vpls_spread(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
+{
+    size_t injected = 0;
+    for (size_t i = 0; i < n; i++)
+        injected += (size_t)inject_vpl_spread(g, &vpls[i], cells);
+    return injected;
+}
+
 int lpv_oracle_normal_bin(const float n[3])
 {
     float a[3] = {fabsf(n[0]), fabsf(n[1]), fabsf(n[2])};

@@ -14,9 +14,11 @@ void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rs
     lpv_timer *timer = in->timer;
     /* a point per VPL and level, or with the far field one per VPL into the
      * finest level holding it (inject_vpl.vert) */
-    const int instances = c->cascades.handoff ? 1 : c->cascades.count;
+    const int spread = c->settings.lpv.smooth_injection == LPV_SWITCH_ON; /* four corners a VPL */
+    const int instances = (c->cascades.handoff ? 1 : c->cascades.count) * (spread ? 4 : 1);
     lpv_timer_begin(timer, "inject");
     lpv_atlas_begin(&c->lpv_atlas, c->prog_inject_vpl, c->grid_ubo, c->empty_vao);
+    glUniform1i(glGetUniformLocation(c->prog_inject_vpl, "u_spread"), spread);
     if (rsm_vpls)
         lpv_atlas_splat_indirect(c->prog_inject_vpl, LPV_SSBO_VPLS, in->rsm_vpls, in->rsm_vpl_draw, instances, timer);
     lpv_atlas_end();
@@ -26,6 +28,7 @@ void lpv_pass_inject_run(lpv_cascaded *c, const lpv_technique_inputs *in, int rs
     if (emissive_vpls) {
         lpv_timer_begin(timer, "emissive");
         lpv_atlas_begin_keep(&c->lpv_atlas, c->prog_inject_vpl, c->grid_ubo, c->empty_vao);
+        glUniform1i(glGetUniformLocation(c->prog_inject_vpl, "u_spread"), spread);
         lpv_atlas_splat(c->prog_inject_vpl, LPV_SSBO_VPLS, in->emissive_vpls, 0, in->emissive_vpl_count, instances,
                         timer);
         lpv_atlas_end();

@@ -175,6 +175,7 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
                                                           : c->grid.origin[i] / c->grid.cell_size;
     }
     d->far_field = c->cascades.handoff;
+    d->vpl_spread = c->settings.lpv.smooth_injection == LPV_SWITCH_ON;
     d->volumes_per_level = c->bins > 1 ? c->bins : 1;
     d->values_per_cell = 12;
     d->kind = LPV_LEVELS_CASCADES;

@@ -6,11 +6,15 @@
 // the vertex stage on one thread, and an instance per level whose points all
 // but one level drop cost the splat a third of its time at the default.
 // Additive blending sums VPLs in array order: portable, no float atomics,
-// deterministic.
+// deterministic. With u_spread (settings lpv.smooth_injection) each VPL is
+// four points, the corners of its 2 x 2 stencil along its surface, each
+// carrying its bilinear weight (grid.glsl vpl_stencil_at): instance
+// i = 4 * (cascade or 0) + corner.
 layout(std430, binding = LPV_SSBO_VPLS) readonly buffer Vpls { LpvVpl vpls[]; };
 
 uniform int u_first;
 uniform vec2 u_atlas_size;
+uniform int u_spread;
 
 flat out vec4 v_r;
 flat out vec4 v_g;
@@ -19,7 +23,8 @@ flat out vec4 v_b;
 void main()
 {
     LpvVpl v = vpls[u_first + gl_VertexID];
-    int k = gl_InstanceID; // one instance per cascade
+    int corner = u_spread != 0 ? gl_InstanceID % 4 : 0;
+    int k = u_spread != 0 ? gl_InstanceID / 4 : gl_InstanceID; // one instance per cascade (and corner)
     gl_PointSize = 1.0;
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
     v_r = v_g = v_b = vec4(0.0);
@@ -33,9 +38,18 @@ void main()
     // 2^3 of the finer level's)
     if (far_field()) {
         k = -1;
-        for (int j = cascade_count() - 1; j >= 0; --j)
-            if (cell_inside(cascade_vpl_cell(j, v.position.xyz, n)))
+        for (int j = cascade_count() - 1; j >= 0; --j) {
+            bool inside;
+            if (u_spread != 0) { /* the whole stencil: a level holds all of a VPL or none of it */
+                vec3 f;
+                ivec3 b = vpl_stencil_at(v.position.xyz, n, cascade_cell(j), cascade_origin_cells(j), f);
+                inside = cell_inside(b) && cell_inside(vpl_stencil_corner(b, n, 3));
+            } else {
+                inside = cell_inside(cascade_vpl_cell(j, v.position.xyz, n));
+            }
+            if (inside)
                 k = j;
+        }
         if (k < 0)
             return;
     }
@@ -43,6 +57,14 @@ void main()
     if (!(w > 0.0))
         return;
     ivec3 c = cascade_vpl_cell(k, v.position.xyz, n);
+    if (u_spread != 0) {
+        vec3 f;
+        ivec3 b = vpl_stencil_at(v.position.xyz, n, cascade_cell(k), cascade_origin_cells(k), f);
+        c = vpl_stencil_corner(b, n, corner);
+        w *= vpl_stencil_weight(f, n, corner);
+        if (!(w > 0.0))
+            return;
+    }
     if (!cell_inside(c))
         return;
 

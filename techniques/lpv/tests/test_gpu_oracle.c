@@ -126,6 +126,40 @@ static void test_injection_matches_oracle(void **state)
     free(ref);
 }
 
+/* Smooth injection (settings lpv.smooth_injection): the GPU's four points
+ * a VPL against the oracle's bilinear stencil, on the same VPLs (the RSMs'
+ * groups, keyed by the stencil); and not the point splat's volume. */
+static void test_smooth_injection_matches_oracle(void **state)
+{
+    fixture *f = *state;
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64,
+                      .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF, .lpv.smooth_injection = LPV_SWITCH_ON};
+    tick(f, &s, 0);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
+    size_t cells = lpv_grid_cell_count(g);
+    size_t vmax = 64 * 64 * 16;
+    lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
+    size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
+    assert_true(nv > 1000);
+    lpv_cell *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref), *point = calloc(cells, sizeof *point);
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, gpu, cells), cells);
+    assert_true(lpv_oracle_inject_vpls_spread(g, vpls, nv, ref) > 1000);
+    assert_close("injected LPV, smooth injection", (const float *)gpu, (const float *)ref, cells * 12);
+    /* the same VPLs as point splats differ by much more than the tolerance */
+    lpv_oracle_inject_vpls(g, vpls, nv, point);
+    double diff = 0.0, top = 0.0;
+    for (size_t i = 0; i < cells * 12; ++i) {
+        diff = fmax(diff, fabs((double)((const float *)point)[i] - ((const float *)ref)[i]));
+        top = fmax(top, fabs((double)((const float *)ref)[i]));
+    }
+    printf("point splats against the smooth injection: largest difference %.3g of the largest value\n", diff / top);
+    assert_true(diff > 0.05 * top);
+    free(vpls);
+    free(gpu);
+    free(ref);
+    free(point);
+}
+
 /* The blocking of n GV points, LPV_DIR_COUNT floats each. */
 static float *blocking_of(const lpv_gv_point *gv, size_t n)
 {
@@ -392,6 +426,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_injection_matches_oracle),
+        cmocka_unit_test(test_smooth_injection_matches_oracle),
         cmocka_unit_test(test_geometry_volume_matches_oracle),
         cmocka_unit_test(test_propagation_matches_oracle),
         cmocka_unit_test(test_lookup_matches_oracle),

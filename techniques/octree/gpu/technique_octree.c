@@ -326,6 +326,7 @@ static void describe(const lpv_technique *t, lpv_volume_desc *d)
     for (int i = 0; i < 3; ++i)
         d->origin_cells[0][i] = o->level[0]->cascades.origin_cells[0][i];
     d->far_field = 0;
+    d->vpl_spread = o->level[0]->settings.lpv.smooth_injection == LPV_SWITCH_ON; /* level 0 injects */
     d->volumes_per_level = 1;
     d->values_per_cell = 12;
     d->kind = LPV_LEVELS_CASCADES; /* the merged grid reads as one cascade */
