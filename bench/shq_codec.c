@@ -10,7 +10,10 @@
  * --save DIR writes them), in update order. For each bound: a keyframe of
  * the first, then a delta chain (each against the previous update's
  * reconstruction, as a subscriber that ACKs everything gets), beside
- * fp16 + zstd XOR deltas of the same volumes.
+ * fp16 + zstd XOR deltas of the same volumes. Then, for each bound, what a
+ * client that extrapolates could save (replenish_estimate): the cells a
+ * delta re-sends when the client holds each cell, against when it carries
+ * each cell on by the change it had when it was last sent.
  */
 #include <math.h>
 #include <stdio.h>
@@ -52,6 +55,44 @@ static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return x < y ? -1 : x > y;
+}
+
+/* Conditional replenishment with exact values (no quantisation: only where
+ * the cells go past the bound): the mean cells re-sent per update when the
+ * client's cell stands until it is re-sent (extrapolate 0), or when the
+ * client moves each cell on, every update, by the change the cell had over
+ * the update before it was last sent (extrapolate 1: a rate per re-sent
+ * cell, which shq does not carry yet). An estimate of what rates would
+ * save, for docs/streaming.md. */
+static double replenish_estimate(uint8_t *const *vol, int nv, size_t cells, double bound, int extrapolate)
+{
+    float *held = malloc(cells * CELL_BYTES), *rate = calloc(cells * LPVP_VALUES_PER_CELL, sizeof(float));
+    if (!held || !rate) {
+        free(held);
+        free(rate);
+        return -1.0;
+    }
+    memcpy(held, vol[0], cells * CELL_BYTES);
+    double resent = 0.0;
+    for (int t = 1; t < nv; ++t)
+        for (size_t c = 0; c < cells; ++c) {
+            float v[LPVP_VALUES_PER_CELL], before[LPVP_VALUES_PER_CELL], *h = held + c * LPVP_VALUES_PER_CELL;
+            float *dr = rate + c * LPVP_VALUES_PER_CELL;
+            memcpy(v, vol[t] + c * CELL_BYTES, CELL_BYTES);
+            memcpy(before, vol[t - 1] + c * CELL_BYTES, CELL_BYTES);
+            for (int k = 0; extrapolate && k < LPVP_VALUES_PER_CELL; ++k)
+                h[k] += dr[k];
+            if (lpvp_shq_cell_error(h, v) <= bound * lpvp_shq_cell_magnitude(v))
+                continue;
+            resent += 1.0;
+            for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k) {
+                h[k] = v[k];
+                dr[k] = v[k] - before[k];
+            }
+        }
+    free(held);
+    free(rate);
+    return resent / (nv - 1);
 }
 
 /* The 99th percentile and the largest D / M over the cells with M > 0. */
@@ -199,5 +240,10 @@ int main(int argc, char **argv)
         printf("| %g | %zu | %.0f | %.3f | %.0f of %zu | %.4f | %.4f | %.1f |\n", bounds[b], key_bytes,
                bytes / (nv - 1), bytes / (nv - 1) / xor_bytes, resent / (nv - 1), cells, p99w, maxw, ms / (nv - 1));
     }
+    printf("\nCells past the bound per update, values exact (no quantisation), if the client holds each cell / "
+           "carries it on by its last change:\n");
+    for (int b = 0; b < nb; ++b)
+        printf("  bound %g: %.0f / %.0f\n", bounds[b], replenish_estimate(vol, nv, cells, bounds[b], 0),
+               replenish_estimate(vol, nv, cells, bounds[b], 1));
     return 0;
 }
