@@ -317,14 +317,36 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
         sv_blob_unref(rb);
         return -1;
     }
-    /* almost every cell re-sent: a keyframe costs no more and drops the map */
-    if (b && sent > cells - cells / 16) {
-        free(*att);
-        *att = NULL;
-        b = NULL;
-        if (lpvp_shq_encode(raw, raw_len, cells, NULL, bound, recon, att, att_len, &sent, err, n) != 0) {
+    /* Many cells re-sent: a keyframe, whose cells are predicted from each
+     * other (R5.16 bit 1), may be smaller; send whichever is. Below a
+     * quarter of the cells the delta always was (the box's LPV: a keyframe
+     * is 1.7 bytes a cell, a re-sent cell 3 - 4), so only then are both
+     * encoded. */
+    if (b && sent > cells / 4) {
+        sv_blob *kb = sv_blob_new(raw_len, keep ? held : NULL);
+        uint8_t *katt = NULL;
+        size_t katt_len = 0, ksent = 0;
+        if (!kb || lpvp_shq_encode(raw, raw_len, cells, NULL, bound, kb->bytes, &katt, &katt_len, &ksent, err, n) != 0) {
+            if (!kb)
+                snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
+            sv_blob_unref(kb);
             sv_blob_unref(rb);
+            free(*att);
+            *att = NULL;
             return -1;
+        }
+        if (katt_len < *att_len) {
+            free(*att);
+            *att = katt;
+            *att_len = katt_len;
+            sent = ksent;
+            sv_blob_unref(rb);
+            rb = kb;
+            recon = kb->bytes;
+            b = NULL;
+        } else {
+            free(katt);
+            sv_blob_unref(kb);
         }
     }
     const size_t values = cells * LPVP_VALUES_PER_CELL * 4;
