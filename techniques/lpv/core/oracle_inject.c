@@ -19,6 +19,13 @@ static void add_scaled(float dst[4], const float src[4], float scale)
         dst[i] += src[i] * scale;
 }
 
+/* Whether a VPL is used (valid, finite, a normal with a direction), with
+ * its normal as the injection uses it in n. */
+static int vpl_usable(const lpv_vpl *v, float n[3])
+{
+    return v->position[3] != 0.0f && finite3(v->position) && finite3(v->flux) && lpv_mean_direction(v->normal, n);
+}
+
 /* One VPL: validated, moved half a cell along its normal (so it lights the
  * cell in front of its surface, not its own), then added as lobe * flux / pi:
  * the lobe integrates to pi, so the cell's intensity integrates to the flux. */
@@ -26,9 +33,7 @@ static int inject_vpl(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cells)
 {
     float n[3], p[3];
     int cell[3];
-    if (v->position[3] == 0.0f || !finite3(v->position) || !finite3(v->flux))
-        return 0;
-    if (!lpv_mean_direction(v->normal, n))
+    if (!vpl_usable(v, n))
         return 0;
     for (int i = 0; i < 3; i++)
         p[i] = v->position[i] + LPV_VPL_SHIFT_CELLS * g->cell_size * n[i];
@@ -51,9 +56,7 @@ static int inject_vpl_spread(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cell
 {
     float n[3], q[3], f[3];
     int b[3];
-    if (v->position[3] == 0.0f || !finite3(v->position) || !finite3(v->flux))
-        return 0;
-    if (!lpv_mean_direction(v->normal, n))
+    if (!vpl_usable(v, n))
         return 0;
     const int ax = lpv_oracle_normal_bin(n) / 2, a0 = ax == 0 ? 1 : 0, a1 = ax == 2 ? 1 : 2;
     for (int i = 0; i < 3; i++) {
@@ -85,12 +88,19 @@ static int inject_vpl_spread(const lpv_grid *g, const lpv_vpl *v, lpv_cell *cell
     return given;
 }
 
-size_t lpv_oracle_inject_vpls_spread(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
+/* The VPLs one by one, in array order, through one: how many it used. */
+static size_t inject_each(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells,
+                          int (*one)(const lpv_grid *, const lpv_vpl *, lpv_cell *))
 {
     size_t injected = 0;
     for (size_t i = 0; i < n; i++)
-        injected += (size_t)inject_vpl_spread(g, &vpls[i], cells);
+        injected += (size_t)one(g, &vpls[i], cells);
     return injected;
+}
+
+size_t lpv_oracle_inject_vpls_spread(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
+{
+    return inject_each(g, vpls, n, cells, inject_vpl_spread);
 }
 
 int lpv_oracle_normal_bin(const float n[3])
@@ -114,10 +124,7 @@ size_t lpv_oracle_inject_vpls_binned(const lpv_grid *g, const lpv_vpl *vpls, siz
 
 size_t lpv_oracle_inject_vpls(const lpv_grid *g, const lpv_vpl *vpls, size_t n, lpv_cell *cells)
 {
-    size_t injected = 0;
-    for (size_t i = 0; i < n; i++)
-        injected += (size_t)inject_vpl(g, &vpls[i], cells);
-    return injected;
+    return inject_each(g, vpls, n, cells, inject_vpl);
 }
 
 /* One surfel: blocking potential B(w) = area / cell_size^2 * max(0, <n, w>)

@@ -99,25 +99,39 @@ static void assert_close(const char *what, const float *gpu, const float *ref, s
         fail_msg("%s differs from the oracle at %zu: gpu %.9g oracle %.9g", what, worst, gpu[worst], ref[worst]);
 }
 
+/* A tick of the built-in box at 16^3 without occlusion (smooth: the
+ * setting smooth_injection), its VPLs (at most vmax) and its injected
+ * grid read back; the VPL count in *nv, the grid's cells in *cells. */
+static void injected_tick(fixture *f, int smooth, lpv_vpl **vpls, size_t vmax, size_t *nv, lpv_cell **gpu,
+                          size_t *cells)
+{
+    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64,
+                      .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF,
+                      .lpv.smooth_injection = smooth ? LPV_SWITCH_ON : LPV_SWITCH_OFF};
+    tick(f, &s, 0);
+    *cells = lpv_grid_cell_count(lpv_engine_grid(f->engine));
+    *vpls = calloc(vmax, sizeof **vpls);
+    *nv = lpv_engine_read_vpls(f->engine, *vpls, vmax);
+    *gpu = calloc(*cells, sizeof **gpu);
+    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, *gpu, *cells), *cells);
+}
+
 static void test_injection_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64, .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF};
-    tick(f, &s, 0);
-    const lpv_grid *g = lpv_engine_grid(f->engine);
-    size_t cells = lpv_grid_cell_count(g);
     /* the spot's RSM layer and the 8 area light samples' 40 faces as 32^2
      * tiles, 4 to a layer (docs/area-lights.md): 11 layers of 64^2; a slot
      * per texel in the spot's layer and the 2 holding the first sample's
      * faces (blocks of 2 x 2 texels, 4 slots), half that in the other 8,
      * which give VPLs only (blocks of 4 x 4, 8 slots: LPV_RSM_AUTO_VPL_STEP) */
-    size_t vmax = 64 * 64 * 16;
-    lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
-    size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
+    lpv_vpl *vpls;
+    lpv_cell *gpu;
+    size_t nv, cells;
+    injected_tick(f, 0, &vpls, 64 * 64 * 16, &nv, &gpu, &cells);
+    const lpv_grid *g = lpv_engine_grid(f->engine);
     assert_int_equal(lpv_engine_last_stats(f->engine)->area_lights, 8);
     assert_int_equal(nv, 64 * 64 * 3 + 64 * 64 * 8 / 2);
-    lpv_cell *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref);
-    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, gpu, cells), cells);
+    lpv_cell *ref = calloc(cells, sizeof *ref);
     size_t injected = lpv_oracle_inject_vpls(g, vpls, nv, ref);
     assert_true(injected > 1000);
     assert_close("injected LPV", (const float *)gpu, (const float *)ref, cells * 12);
@@ -132,17 +146,13 @@ static void test_injection_matches_oracle(void **state)
 static void test_smooth_injection_matches_oracle(void **state)
 {
     fixture *f = *state;
-    lpv_settings s = {.technique = LPV_TECHNIQUE_ID_LPV, .grid_dims = {16, 16, 16}, .rsm_size = 64,
-                      .lpv.iterations = 4, .lpv.occlusion = LPV_SWITCH_OFF, .lpv.smooth_injection = LPV_SWITCH_ON};
-    tick(f, &s, 0);
+    lpv_vpl *vpls;
+    lpv_cell *gpu;
+    size_t nv, cells;
+    injected_tick(f, 1, &vpls, 64 * 64 * 16, &nv, &gpu, &cells);
     const lpv_grid *g = lpv_engine_grid(f->engine);
-    size_t cells = lpv_grid_cell_count(g);
-    size_t vmax = 64 * 64 * 16;
-    lpv_vpl *vpls = calloc(vmax, sizeof *vpls);
-    size_t nv = lpv_engine_read_vpls(f->engine, vpls, vmax);
     assert_true(nv > 1000);
-    lpv_cell *gpu = calloc(cells, sizeof *gpu), *ref = calloc(cells, sizeof *ref), *point = calloc(cells, sizeof *point);
-    assert_int_equal(lpv_engine_read_grid(f->engine, LPV_GRID_INJECTED, gpu, cells), cells);
+    lpv_cell *ref = calloc(cells, sizeof *ref), *point = calloc(cells, sizeof *point);
     assert_true(lpv_oracle_inject_vpls_spread(g, vpls, nv, ref) > 1000);
     assert_close("injected LPV, smooth injection", (const float *)gpu, (const float *)ref, cells * 12);
     /* the same VPLs as point splats differ by much more than the tolerance */
