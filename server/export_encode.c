@@ -257,8 +257,19 @@ static void shared_fill(sv_result *r, const sv_encode_memory *mem, int claim, co
 {
     if (claim < 0)
         return;
+    size_t counted = 0;
+    pthread_mutex_lock(&enc_mu);
+    const int fits = cache_count(r, mem, att_len, &counted);
+    pthread_mutex_unlock(&enc_mu);
+    if (!fits) { /* not kept: the waiters encode for themselves */
+        shared_release(r, claim);
+        return;
+    }
     uint8_t *a = att_len ? malloc(att_len) : NULL;
     if (att_len && !a) {
+        pthread_mutex_lock(&enc_mu);
+        cache_uncount(r, &counted);
+        pthread_mutex_unlock(&enc_mu);
         shared_release(r, claim);
         return;
     }
@@ -266,13 +277,7 @@ static void shared_fill(sv_result *r, const sv_encode_memory *mem, int claim, co
         memcpy(a, att, att_len);
     pthread_mutex_lock(&enc_mu);
     sv_shared_enc *s = &r->shared[claim];
-    if (!cache_count(r, mem, att_len, &s->counted)) { /* as shared_release: the waiters encode for themselves */
-        *s = (sv_shared_enc){0};
-        pthread_cond_broadcast(&enc_cv);
-        pthread_mutex_unlock(&enc_mu);
-        free(a);
-        return;
-    }
+    s->counted = counted;
     s->pending = 0;
     s->outcome = outcome;
     s->keyframe = vi->keyframe;

@@ -50,13 +50,15 @@ void main()
             if (inside)
                 k = j;
         }
+        if (k < 0 && u_spread != 0)
+            k = cascade_count() - 1; /* no level holds the whole stencil: the coarsest keeps the corners inside it */
         if (k < 0)
             return;
     }
     float w = cascade_object_weight(k, v.normal.w);
     if (!(w > 0.0))
         return;
-    ivec3 c = cascade_vpl_cell(k, v.position.xyz, n);
+    ivec3 c;
     if (u_spread != 0) {
         vec3 f;
         ivec3 b = vpl_stencil_at(v.position.xyz, n, cascade_cell(k), cascade_origin_cells(k), f);
@@ -64,6 +66,8 @@ void main()
         w *= vpl_stencil_weight(f, n, corner);
         if (!(w > 0.0))
             return;
+    } else {
+        c = cascade_vpl_cell(k, v.position.xyz, n);
     }
     if (!cell_inside(c))
         return;
