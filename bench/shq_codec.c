@@ -3,14 +3,17 @@
  * daemon: bytes per update, the bound, and the encoder's time, without a
  * socket or a GL context in the way (issue 35; docs/streaming.md).
  *
- *   lpvd-shq-codec [--bound E]... [--level L] VOL0.bin VOL1.bin ...
+ *   lpvd-shq-codec [--bound E]... [--region NXxNYxNZ]... VOL0.bin VOL1.bin ...
  *
  * Each VOLn.bin is a raw fp32 volume of R5.1's 12 values per cell (what
  * GET_VOLUME "fp32", "none" carries up to any index; bench/stream_bench.py
  * --save DIR writes them), in update order. For each bound: a keyframe of
  * the first, then a delta chain (each against the previous update's
  * reconstruction, as a subscriber that ACKs everything gets), beside
- * fp16 + zstd XOR deltas of the same volumes. Then, for each bound, what a
+ * fp16 + zstd XOR deltas of the same volumes; with --region (the volume's
+ * cascades in order, e.g. three of 32x32x32 for the box's LPV, one of
+ * 17x17x17 for its iv) also the deltas that may move cells by blocks
+ * (R5.16 bit 2), as lpvd sends them. Then, for each bound, what a
  * client that extrapolates could save (replenish_estimate): the cells a
  * delta re-sends when the client holds each cell, against when it carries
  * each cell on by the change it had when it was last sent.
@@ -118,12 +121,23 @@ int main(int argc, char **argv)
 {
     double bounds[16];
     int nb = 0, first = 1;
+    lpvp_shq_layout lay;
+    memset(&lay, 0, sizeof lay);
+    uint64_t next_cell = 0;
     for (; first < argc && strncmp(argv[first], "--", 2) == 0; first += 2) {
         if (first + 1 >= argc)
             break;
+        unsigned d[3];
         if (strcmp(argv[first], "--bound") == 0 && nb < 16)
             bounds[nb++] = atof(argv[first + 1]);
-        else {
+        else if (strcmp(argv[first], "--region") == 0 && lay.count < LPVP_SHQ_MAX_REGIONS &&
+                 sscanf(argv[first + 1], "%ux%ux%u", &d[0], &d[1], &d[2]) == 3) {
+            lay.region[lay.count].first = next_cell;
+            for (int a = 0; a < 3; ++a)
+                lay.region[lay.count].dims[a] = d[a];
+            next_cell += (uint64_t)d[0] * d[1] * d[2];
+            lay.count++;
+        } else {
             fprintf(stderr, "lpvd-shq-codec: unknown flag %s\n", argv[first]);
             return 2;
         }
@@ -135,7 +149,7 @@ int main(int argc, char **argv)
     }
     int nv = argc - first;
     if (nv < 2) {
-        fprintf(stderr, "usage: lpvd-shq-codec [--bound E]... VOL0.bin VOL1.bin ...\n");
+        fprintf(stderr, "usage: lpvd-shq-codec [--bound E]... [--region NXxNYxNZ]... VOL0.bin VOL1.bin ...\n");
         return 2;
     }
     uint8_t **vol = calloc((size_t)nv, sizeof *vol);
@@ -204,42 +218,48 @@ int main(int argc, char **argv)
            nr ? (double)over[2] / (double)nr : 0.0,
            corr_xx > 0 && corr_yy > 0 ? corr_xy / sqrt(corr_xx * corr_yy) : 0.0);
     free(r);
-    printf("| bound | keyframe bytes | delta bytes (mean) | delta / fp16 XOR | cells re-sent per update | "
-           "D/M p99 (worst update) | D/M max | encode ms per delta |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    printf("| bound | blocks | keyframe bytes | delta bytes (mean) | delta / fp16 XOR | cells re-sent per update | "
+           "blocks moving per update | D/M p99 (worst update) | D/M max | encode ms per delta |\n"
+           "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     uint8_t *held = malloc(len), *client = malloc(len);
-    for (int b = 0; b < nb; ++b) {
-        uint8_t *att = NULL;
-        size_t att_len = 0, sent = 0, key_bytes = 0;
-        double bytes = 0.0, resent = 0.0, ms = 0.0, p99w = 0.0, maxw = 0.0;
-        for (int i = 0; i < nv; ++i) {
-            double t0 = now_ms();
-            if (lpvp_shq_encode(vol[i], len, cells, i ? held : NULL, bounds[b], held, &att, &att_len, &sent, err,
-                                sizeof err) != 0) {
-                fprintf(stderr, "lpvd-shq-codec: %s\n", err);
-                return 1;
+    for (int b = 0; b < nb; ++b)
+        for (int blocks = 0; blocks <= (lay.count > 0); ++blocks) {
+            uint8_t *att = NULL;
+            size_t att_len = 0, key_bytes = 0;
+            lpvp_shq_counts sent;
+            double bytes = 0.0, resent = 0.0, moving = 0.0, ms = 0.0, p99w = 0.0, maxw = 0.0;
+            for (int i = 0; i < nv; ++i) {
+                double t0 = now_ms();
+                if (lpvp_shq_encode(vol[i], len, cells, i ? held : NULL, bounds[b], blocks ? &lay : NULL, held, &att,
+                                    &att_len, &sent, err, sizeof err) != 0) {
+                    fprintf(stderr, "lpvd-shq-codec: %s\n", err);
+                    return 1;
+                }
+                double t1 = now_ms();
+                if (lpvp_shq_decode(att, att_len, len, cells, i ? client : NULL, client, NULL, err, sizeof err) != 0 ||
+                    memcmp(client, held, len) != 0) {
+                    fprintf(stderr, "lpvd-shq-codec: update %d does not decode to the encoder's volume: %s\n", i,
+                            err);
+                    return 1;
+                }
+                double p99, mx;
+                bound_figures(client, vol[i], cells, &p99, &mx);
+                p99w = fmax(p99w, p99);
+                maxw = fmax(maxw, mx);
+                if (i) {
+                    bytes += (double)att_len;
+                    resent += (double)sent.sent;
+                    moving += (double)sent.blocks;
+                    ms += t1 - t0;
+                } else {
+                    key_bytes = att_len;
+                }
+                free(att);
             }
-            double t1 = now_ms();
-            if (lpvp_shq_decode(att, att_len, len, cells, i ? client : NULL, client, NULL, err, sizeof err) != 0 ||
-                memcmp(client, held, len) != 0) {
-                fprintf(stderr, "lpvd-shq-codec: update %d does not decode to the encoder's volume: %s\n", i, err);
-                return 1;
-            }
-            double p99, mx;
-            bound_figures(client, vol[i], cells, &p99, &mx);
-            p99w = fmax(p99w, p99);
-            maxw = fmax(maxw, mx);
-            if (i) {
-                bytes += (double)att_len;
-                resent += (double)sent;
-                ms += t1 - t0;
-            } else {
-                key_bytes = att_len;
-            }
-            free(att);
+            printf("| %g | %s | %zu | %.0f | %.3f | %.0f of %zu | %.0f | %.4f | %.4f | %.1f |\n", bounds[b],
+                   blocks ? "yes" : "no", key_bytes, bytes / (nv - 1), bytes / (nv - 1) / xor_bytes, resent / (nv - 1),
+                   cells, moving / (nv - 1), p99w, maxw, ms / (nv - 1));
         }
-        printf("| %g | %zu | %.0f | %.3f | %.0f of %zu | %.4f | %.4f | %.1f |\n", bounds[b], key_bytes,
-               bytes / (nv - 1), bytes / (nv - 1) / xor_bytes, resent / (nv - 1), cells, p99w, maxw, ms / (nv - 1));
-    }
     printf("\nCells past the bound per update, values exact (no quantisation), if the client holds each cell / "
            "carries it on by its last change:\n");
     for (int b = 0; b < nb; ++b)

@@ -167,17 +167,45 @@ double lpvp_shq_cell_magnitude(const float v[LPVP_VALUES_PER_CELL]);
  * channels: what a client's lookup at the cell moves by from a to b. */
 double lpvp_shq_cell_error(const float a[LPVP_VALUES_PER_CELL], const float b[LPVP_VALUES_PER_CELL]);
 
+/* The boxes of cells a delta may move by blocks (R5.16 flag bit 2): each a
+ * run of the values' cells that is a dims[0] x dims[1] x dims[2] box, x
+ * fastest (a cascade, R5.6), in ascending order without overlap. */
+#define LPVP_SHQ_MAX_REGIONS 16
+typedef struct lpvp_shq_layout {
+    int count; /* 0: no blocks */
+    struct {
+        uint64_t first;   /* the box's first cell in the values */
+        uint32_t dims[3]; /* cells per axis, each >= 1 */
+    } region[LPVP_SHQ_MAX_REGIONS];
+} lpvp_shq_layout;
+
+/* The layout of vi's merged values: one region per cascade (count 0 when the
+ * values are not one volume per cascade, e.g. an octree's levels). */
+struct lpvp_volume_info;
+void lpvp_shq_layout_of(const struct lpvp_volume_info *vi, lpvp_shq_layout *out);
+
+/* What an encoding sends: the cells re-sent and the blocks that move the
+ * client's cells (a delta changes nothing when both are 0). */
+typedef struct lpvp_shq_counts {
+    size_t sent;
+    size_t blocks;
+} lpvp_shq_counts;
+
 /* Encodes raw (a raw fp32 volume of raw_len bytes: `cells` cells of R5.1's
  * 12 values, then any bytes that follow them, e.g. an index) as one zstd
  * frame in a malloc'd *out. base NULL: a keyframe, every cell quantised.
  * base (the client's volume, raw_len bytes): a delta that re-sends only the
  * cells whose base is off raw's by more than bound x the cell's magnitude
- * (lpvp_shq_cell_error). recon (raw_len bytes; may be base) gets the
- * volume the client rebuilds. *sent: the cells sent (0 on a delta: nothing
- * changed beyond the bound). NaN is sent as 0, values beyond +-1e30 clamp.
- * Returns 0, or -1 with err set (bound outside its range, no memory). */
+ * (lpvp_shq_cell_error). With a layout (may be NULL) the delta may first
+ * move the client's cells by a change per block of 3 x 3 x 3 cells (R5.16
+ * bit 2), which lpvd sends when that is smaller. recon (raw_len bytes; may
+ * be base) gets the volume the client rebuilds. *counts (may be NULL): what
+ * was sent (all 0 on a delta: nothing changed beyond the bound). NaN is
+ * sent as 0, values beyond +-1e30 clamp. Returns 0, or -1 with err set
+ * (bound outside its range, no memory). */
 int lpvp_shq_encode(const uint8_t *raw, size_t raw_len, size_t cells, const uint8_t *base, double bound,
-                    uint8_t *recon, uint8_t **out, size_t *out_len, size_t *sent, char *err, size_t err_n);
+                    const lpvp_shq_layout *layout, uint8_t *recon, uint8_t **out, size_t *out_len,
+                    lpvp_shq_counts *counts, char *err, size_t err_n);
 
 /* The inverse into raw_out (raw_len bytes; may equal base, a delta's base
  * of raw_len bytes; NULL for a keyframe). Checks every count against

@@ -315,8 +315,8 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
     const uint8_t *b = base ? base->raw->bytes : NULL;
     sv_blob *rb = sv_blob_new(raw_len, keep ? held : NULL);
     uint8_t *recon = rb ? rb->bytes : NULL;
-    size_t sent = 0;
-    if (!recon || lpvp_shq_encode(raw, raw_len, cells, b, bound, recon, att, att_len, &sent, err, n) != 0) {
+    lpvp_shq_counts sent = {0, 0};
+    if (!recon || lpvp_shq_encode(raw, raw_len, cells, b, bound, NULL, recon, att, att_len, &sent, err, n) != 0) {
         if (!recon)
             snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
         sv_blob_unref(rb);
@@ -327,11 +327,13 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
      * quarter of the cells the delta always was (the box's LPV: a keyframe
      * is 1.7 bytes a cell, a re-sent cell 3 - 4), so only then are both
      * encoded. */
-    if (b && sent > cells / 4) {
+    if (b && sent.sent > cells / 4) {
         sv_blob *kb = sv_blob_new(raw_len, keep ? held : NULL);
         uint8_t *katt = NULL;
-        size_t katt_len = 0, ksent = 0;
-        if (!kb || lpvp_shq_encode(raw, raw_len, cells, NULL, bound, kb->bytes, &katt, &katt_len, &ksent, err, n) != 0) {
+        size_t katt_len = 0;
+        lpvp_shq_counts ksent = {0, 0};
+        if (!kb ||
+            lpvp_shq_encode(raw, raw_len, cells, NULL, bound, NULL, kb->bytes, &katt, &katt_len, &ksent, err, n) != 0) {
             if (!kb)
                 snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
             sv_blob_unref(kb);
@@ -355,7 +357,7 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
         }
     }
     const size_t values = cells * LPVP_VALUES_PER_CELL * 4;
-    if (b && sent == 0 && memcmp(recon + values, b + values, raw_len - values) == 0) {
+    if (b && sent.sent == 0 && sent.blocks == 0 && memcmp(recon + values, b + values, raw_len - values) == 0) {
         free(*att); /* nothing beyond the bound: nothing sent, the client's base stands */
         *att = NULL;
         *att_len = 0;

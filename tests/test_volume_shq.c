@@ -3,7 +3,8 @@
  * R5.16): the bound held on every cell of keyframes and of a chain of
  * deltas, keyframes predicted from the cell before, unchanged cells cost nothing, a static volume sends no cell, the
  * bytes after the values travel exactly, hostile values stay finite, and
- * the decoder refuses every malformed payload the SPEC names.
+ * the decoder refuses every malformed payload the SPEC names; deltas with
+ * blocks carry light that changes smoothly in fewer bytes.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -74,24 +75,36 @@ static double worst_ratio(const uint8_t *held, const uint8_t *exact, size_t cell
     return worst;
 }
 
-/* Encode, decode (in place on the client's copy), check both sides agree. */
-static size_t round_trip(const uint8_t *raw, size_t len, size_t cells, uint8_t *server_held, uint8_t *client,
-                         int delta, double bound)
+/* Encode (with blocks over lay, when given), decode (in place on the
+ * client's copy), check both sides agree; *att_bytes (may be NULL) gets
+ * the attachment's size. */
+static lpvp_shq_counts round_trip_in(const uint8_t *raw, size_t len, size_t cells, uint8_t *server_held,
+                                     uint8_t *client, int delta, double bound, const lpvp_shq_layout *lay,
+                                     size_t *att_bytes)
 {
     char err[256];
     uint8_t *att = NULL, *recon = malloc(len);
-    size_t att_len = 0, sent = 9999, got = 7777;
+    size_t att_len = 0, got = 7777;
+    lpvp_shq_counts sent = {9999, 9999};
     assert_non_null(recon);
-    assert_int_equal(lpvp_shq_encode(raw, len, cells, delta ? server_held : NULL, bound, recon, &att, &att_len, &sent,
-                                     err, sizeof err),
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, delta ? server_held : NULL, bound, lay, recon, &att, &att_len,
+                                     &sent, err, sizeof err),
                      0);
     assert_int_equal(lpvp_shq_decode(att, att_len, len, cells, delta ? client : NULL, client, &got, err, sizeof err), 0);
-    assert_int_equal(got, sent);
+    assert_int_equal(got, sent.sent);
     assert_memory_equal(recon, client, len); /* the server knows what the client holds, bit for bit */
     memcpy(server_held, recon, len);
     free(recon);
     free(att);
+    if (att_bytes)
+        *att_bytes = att_len;
     return sent;
+}
+
+static size_t round_trip(const uint8_t *raw, size_t len, size_t cells, uint8_t *server_held, uint8_t *client,
+                         int delta, double bound)
+{
+    return round_trip_in(raw, len, cells, server_held, client, delta, bound, NULL, NULL).sent;
 }
 
 static void test_keyframe_holds_the_bound(void **state)
@@ -138,8 +151,9 @@ static void test_keyframes_are_predicted(void **state)
         put_cell(raw, i, w);
     }
     uint8_t *att = NULL, *p = NULL;
-    size_t att_len = 0, plen = 0, sent = 0;
-    assert_int_equal(lpvp_shq_encode(raw, len, CELLS, NULL, 0.01, held, &att, &att_len, &sent, err, sizeof err), 0);
+    size_t att_len = 0, plen = 0;
+    assert_int_equal(lpvp_shq_encode(raw, len, CELLS, NULL, 0.01, NULL, held, &att, &att_len, NULL, err, sizeof err),
+                     0);
     assert_int_equal(lpvp_zstd_decompress(att, att_len, 1 << 20, &p, &plen, err, sizeof err), 0);
     assert_int_equal(lpvp_get_u32(p + 4), 3); /* keyframe, predicted */
     const uint8_t *exps = p + 32, *lo = exps + CELLS, *hi = lo + 12 * CELLS;
@@ -283,18 +297,22 @@ static void test_bad_bound_and_payloads(void **state)
         put_cell(raw, i, v);
     }
     uint8_t *att = NULL;
-    size_t att_len = 0, sent = 0;
-    assert_int_equal(lpvp_shq_encode(raw, len, cells, NULL, 0.0005, held, &att, &att_len, &sent, err, sizeof err), -1);
+    size_t att_len = 0;
+    lpvp_shq_counts sent;
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, NULL, 0.0005, NULL, held, &att, &att_len, &sent, err, sizeof err),
+                     -1);
     assert_non_null(strstr(err, LPVP_SHQ_BOUND_KEY));
-    assert_int_equal(lpvp_shq_encode(raw, len, cells, NULL, NAN, held, &att, &att_len, &sent, err, sizeof err), -1);
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, NULL, NAN, NULL, held, &att, &att_len, &sent, err, sizeof err),
+                     -1);
 
     /* a good delta's payload, then each field broken in turn */
     round_trip(raw, len, cells, held, client, 0, 0.01);
     float v[LPVP_VALUES_PER_CELL];
     make_cell(v, 3.0);
     put_cell(raw, 3, v);
-    assert_int_equal(lpvp_shq_encode(raw, len, cells, held, 0.01, held, &att, &att_len, &sent, err, sizeof err), 0);
-    assert_int_equal(sent, 1);
+    assert_int_equal(lpvp_shq_encode(raw, len, cells, held, 0.01, NULL, held, &att, &att_len, &sent, err, sizeof err),
+                     0);
+    assert_int_equal(sent.sent, 1);
     uint8_t *p = NULL;
     size_t plen = 0;
     assert_int_equal(lpvp_zstd_decompress(att, att_len, 1 << 20, &p, &plen, err, sizeof err), 0);
@@ -304,7 +322,7 @@ static void test_bad_bound_and_payloads(void **state)
         uint8_t value;
         const char *what;
     } breaks[] = {
-        {0, 'X', "magic"},        {4, 2, "flags (predicted delta)"}, {4, 4, "flags"},           {8, 21, "cell count"}, {16, 2, "sent count"},
+        {0, 'X', "magic"},        {4, 2, "flags (predicted delta)"}, {4, 8, "flags"},           {8, 21, "cell count"}, {16, 2, "sent count"},
         {24, 1, "extra bytes"},  {32, 0x09, "bit map count"}, {34, 0x80, "bit past C"}, {36, 2, "mode"},
     };
     for (size_t b = 0; b < sizeof breaks / sizeof breaks[0]; ++b) {
@@ -347,6 +365,201 @@ static void test_bad_bound_and_payloads(void **state)
     free(p);
 }
 
+/* Blocks (R5.16 bit 2): light that changes smoothly across cells is
+ * carried by one change per block, so far fewer cells are re-sent and the
+ * deltas are smaller than without, with the bound held on every cell,
+ * zero cells left zero, the cells outside the regions untouched, and a
+ * static volume still sending nothing. */
+#define BLK_A 216 /* 9 x 6 x 4 */
+#define BLK_GAP 3
+#define BLK_B 125 /* 5 x 5 x 5 */
+#define BLK_CELLS (BLK_A + BLK_GAP + BLK_B)
+#define BLK_EXTRA 13
+
+static void blocks_layout(lpvp_shq_layout *lay)
+{
+    memset(lay, 0, sizeof *lay);
+    lay->count = 2;
+    lay->region[0].first = 0;
+    lay->region[0].dims[0] = 9, lay->region[0].dims[1] = 6, lay->region[0].dims[2] = 4;
+    lay->region[1].first = BLK_A + BLK_GAP;
+    lay->region[1].dims[0] = lay->region[1].dims[1] = lay->region[1].dims[2] = 5;
+}
+
+/* Cell i at update t: one lobe scaled by a smooth amplitude that grows by a
+ * smooth amount each update; every 17th cell black. */
+static void blocks_volume(uint8_t *raw, int t, const float lobe[LPVP_VALUES_PER_CELL])
+{
+    for (size_t i = 0; i < BLK_CELLS; ++i) {
+        const size_t j = i < BLK_A ? i : i - BLK_A;
+        const double x = (double)(j % 9), y = (double)(j / 9 % 6), z = (double)(j / 54);
+        const double a = i % 17 == 0 ? 0.0 : (1.0 + 0.1 * x + 0.05 * y + 0.2 * z) * (1.0 + 0.03 * t * (1.0 + 0.05 * x));
+        float v[LPVP_VALUES_PER_CELL];
+        for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k)
+            v[k] = (float)(lobe[k] * a);
+        put_cell(raw, i, v);
+    }
+    for (size_t i = 0; i < BLK_EXTRA; ++i)
+        raw[BLK_CELLS * CELL_BYTES + i] = (uint8_t)(3 * i + 1);
+}
+
+static void test_blocks_carry_smooth_change(void **state)
+{
+    (void)state;
+    const size_t len = BLK_CELLS * CELL_BYTES + BLK_EXTRA;
+    const double bound = 0.01;
+    lpvp_shq_layout lay;
+    blocks_layout(&lay);
+    float lobe[LPVP_VALUES_PER_CELL];
+    make_cell(lobe, 1.0);
+    uint8_t *raw = malloc(len), *held[2] = {malloc(len), malloc(len)}, *client[2] = {malloc(len), malloc(len)};
+    size_t bytes[2] = {0, 0}, resent[2] = {0, 0}, moving = 0;
+    for (int with = 0; with < 2; ++with) {
+        blocks_volume(raw, 0, lobe);
+        round_trip_in(raw, len, BLK_CELLS, held[with], client[with], 0, bound, with ? &lay : NULL, NULL);
+        for (int t = 1; t <= 10; ++t) {
+            blocks_volume(raw, t, lobe);
+            size_t n = 0;
+            lpvp_shq_counts c =
+                round_trip_in(raw, len, BLK_CELLS, held[with], client[with], 1, bound, with ? &lay : NULL, &n);
+            bytes[with] += n;
+            resent[with] += c.sent;
+            if (with)
+                moving += c.blocks;
+            else
+                assert_int_equal(c.blocks, 0);
+            assert_true(worst_ratio(client[with], raw, BLK_CELLS) <= bound * (1.0 + 1e-6));
+            for (size_t i = 0; i < BLK_CELLS; i += 17) { /* black stays exactly black */
+                float v[LPVP_VALUES_PER_CELL];
+                get_cell(client[with], i, v);
+                for (int k = 0; k < LPVP_VALUES_PER_CELL; ++k)
+                    assert_true(v[k] == 0.0f);
+            }
+            assert_memory_equal(client[with] + BLK_CELLS * CELL_BYTES, raw + BLK_CELLS * CELL_BYTES, BLK_EXTRA);
+        }
+    }
+    print_message("blocks: %zu cells re-sent, %zu bytes over 10 updates; without: %zu, %zu; %zu blocks moved\n",
+                  resent[1], bytes[1], resent[0], bytes[0], moving);
+    assert_true(moving > 0);
+    assert_true(resent[1] * 2 < resent[0]);
+    assert_true(bytes[1] < bytes[0]);
+    /* nothing changed: nothing sent, blocks or not */
+    lpvp_shq_counts c = round_trip_in(raw, len, BLK_CELLS, held[1], client[1], 1, bound, &lay, NULL);
+    assert_int_equal(c.sent, 0);
+    assert_int_equal(c.blocks, 0);
+    free(raw);
+    for (int w = 0; w < 2; ++w) {
+        free(held[w]);
+        free(client[w]);
+    }
+}
+
+/* A delta with blocks, each of its block fields broken in turn, and a block
+ * that would carry a value past binary32: refused, the client's volume as
+ * it was. */
+static void test_bad_blocks(void **state)
+{
+    (void)state;
+    char err[256];
+    const size_t len = BLK_CELLS * CELL_BYTES + BLK_EXTRA;
+    lpvp_shq_layout lay;
+    blocks_layout(&lay);
+    float lobe[LPVP_VALUES_PER_CELL];
+    make_cell(lobe, 1.0);
+    uint8_t *raw = malloc(len), *held = malloc(len), *client = malloc(len), *saved = malloc(len);
+    blocks_volume(raw, 0, lobe);
+    round_trip_in(raw, len, BLK_CELLS, held, client, 0, 0.01, &lay, NULL);
+    memcpy(saved, held, len);
+    blocks_volume(raw, 1, lobe);
+    uint8_t *att = NULL, *recon = malloc(len), *p = NULL;
+    size_t att_len = 0, plen = 0;
+    lpvp_shq_counts c;
+    assert_int_equal(lpvp_shq_encode(raw, len, BLK_CELLS, held, 0.01, &lay, recon, &att, &att_len, &c, err, sizeof err),
+                     0);
+    assert_true(c.blocks > 0);
+    assert_int_equal(lpvp_zstd_decompress(att, att_len, 1 << 20, &p, &plen, err, sizeof err), 0);
+    assert_int_equal(lpvp_get_u32(p + 4), 4); /* a delta with blocks */
+    assert_int_equal(lpvp_get_u32(p + 32), 2);
+    assert_int_equal(lpvp_get_u32(p + 36), 3);
+    const size_t blk = 32 + 8 + 2 * 20; /* the blocks' exponents */
+    size_t first_moving = 0;
+    while ((int8_t)p[blk + first_moving] == -128)
+        first_moving++;
+    struct {
+        size_t at;
+        uint32_t value;
+        int bytes;
+        const char *what;
+    } breaks[] = {
+        {32, 0, 4, "no regions"},
+        {32, 17, 4, "too many regions"},
+        {36, 0, 4, "edge 0"},
+        {36, 65, 4, "edge 65"},
+        {40 + 20, 10, 4, "region 1 overlapping region 0"},
+        {40 + 20, BLK_CELLS - 100, 4, "region 1 past the cells"},
+        {40 + 8, 0, 4, "a region 0 cells wide"},
+        {40 + 8, 10, 4, "a region wider than its cells in order"},
+        {blk + first_moving, 101, 1, "block exponent 101"},
+        {4, 5, 4, "blocks on a keyframe"},
+    };
+    for (size_t b = 0; b < sizeof breaks / sizeof breaks[0]; ++b) {
+        uint8_t *q = malloc(plen), *z = NULL;
+        size_t zlen = 0;
+        memcpy(q, p, plen);
+        if (breaks[b].bytes == 4)
+            lpvp_put_u32(q + breaks[b].at, breaks[b].value);
+        else
+            q[breaks[b].at] = (uint8_t)breaks[b].value;
+        assert_int_equal(lpvp_zstd_compress(q, plen, 1, &z, &zlen, err, sizeof err), 0);
+        err[0] = 0;
+        int rc = lpvp_shq_decode(z, zlen, len, BLK_CELLS, client, client, NULL, err, sizeof err);
+        if (rc == 0)
+            print_error("accepted a payload with %s\n", breaks[b].what);
+        assert_int_equal(rc, -1);
+        assert_true(strlen(err) > 0);
+        assert_memory_equal(client, saved, len);
+        free(z);
+        free(q);
+    }
+    /* a client cell at binary32's largest value in the first moving block, moved up by the most a block can:
+     * infinity, refused */
+    size_t victim = 0;
+    {
+        const size_t per[3] = {3, 2, 2}; /* region 0's blocks of edge 3 */
+        const size_t bx = first_moving % per[0], by = first_moving / per[0] % per[1], bz = first_moving / 6;
+        assert_true(first_moving < 12); /* in region 0 */
+        victim = bx * 3 + 9 * (by * 3 + 6 * (bz * 3));
+        if (victim % 17 == 0)
+            victim += 1; /* a live cell */
+    }
+    float v[LPVP_VALUES_PER_CELL];
+    get_cell(client, victim, v);
+    v[0] = FLT_MAX;
+    put_cell(client, victim, v);
+    memcpy(saved, client, len);
+    {
+        uint8_t *q = malloc(plen), *z = NULL;
+        size_t zlen = 0, nb = 12 + 8; /* region 0: 3 x 2 x 2 blocks, region 1: 2 x 2 x 2 */
+        memcpy(q, p, plen);
+        q[blk + first_moving] = 100;
+        q[blk + nb + first_moving] = 0xFE; /* value 0's zigzag 0xFFFE: +32767 */
+        q[blk + nb + 12 * nb + first_moving] = 0xFF;
+        assert_int_equal(lpvp_zstd_compress(q, plen, 1, &z, &zlen, err, sizeof err), 0);
+        assert_int_equal(lpvp_shq_decode(z, zlen, len, BLK_CELLS, client, client, NULL, err, sizeof err), -1);
+        assert_non_null(strstr(err, "binary32"));
+        assert_memory_equal(client, saved, len);
+        free(z);
+        free(q);
+    }
+    free(att);
+    free(p);
+    free(recon);
+    free(raw);
+    free(held);
+    free(client);
+    free(saved);
+}
+
 /* The header: "shq" needs fp32 and a bound in range; decode goes through it. */
 static void test_header(void **state)
 {
@@ -371,9 +584,9 @@ static void test_header(void **state)
         put_cell(raw, i, v);
     }
     uint8_t *att = NULL;
-    size_t att_len = 0, sent = 0;
-    assert_int_equal(lpvp_shq_encode(raw, sizeof raw, cells, NULL, 0.02, held, &att, &att_len, &sent, err, sizeof err),
-                     0);
+    size_t att_len = 0;
+    assert_int_equal(
+        lpvp_shq_encode(raw, sizeof raw, cells, NULL, 0.02, NULL, held, &att, &att_len, NULL, err, sizeof err), 0);
     assert_int_equal(lpvp_volume_decode(&back, att, att_len, NULL, 0, out, err, sizeof err), 0);
     assert_memory_equal(out, held, sizeof out);
     free(att);
@@ -397,7 +610,8 @@ int main(void)
         cmocka_unit_test(test_keyframe_holds_the_bound), cmocka_unit_test(test_keyframes_are_predicted),
         cmocka_unit_test(test_deltas_hold_the_bound),
         cmocka_unit_test(test_static_volume_sends_nothing), cmocka_unit_test(test_hostile_values),
-        cmocka_unit_test(test_bad_bound_and_payloads), cmocka_unit_test(test_header),
+        cmocka_unit_test(test_bad_bound_and_payloads), cmocka_unit_test(test_blocks_carry_smooth_change),
+        cmocka_unit_test(test_bad_blocks), cmocka_unit_test(test_header),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

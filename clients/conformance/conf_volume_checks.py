@@ -538,7 +538,8 @@ def _shq_decode(h, payload, base=None):
     sent). A delta's cells not flagged keep base's bytes (the volume rebuilt
     for the acknowledged tick) and its bytes after the values are XOR'd with
     the base's; a delta's cell of mode 1 sends the change from the base's
-    cell in its steps."""
+    cell in its steps; a delta with blocks (flag bit 2) first moves the
+    base's cells by them (_shq_blocks)."""
     raw_length = h["raw_length"]
     ix = (h.get("volume") or {}).get("index")
     values = ix["raw_offset"] if ix else raw_length
@@ -549,26 +550,33 @@ def _shq_decode(h, payload, base=None):
     flags, c, s, x = struct.unpack_from("<IQQQ", payload, 4)
     key = flags & 1 == 1
     predicted = flags == 3
-    check(flags in (0, 1, 3), "R5.16: payload flags 0x%x (bit 0 keyframe, bit 1 predicted only with it)" % flags)
+    check(flags in (0, 1, 3, 4), "R5.16: payload flags 0x%x (bit 0 keyframe, bit 1 predicted only with it, bit 2 "
+          "blocks only without it)" % flags)
     check(key == h["keyframe"], "R5.16: payload flags say keyframe %r, the header %r" % (key, h["keyframe"]))
     check(c == C and x == X, "R5.16: payload counts C %d, X %d; the header's volume has %d cells and %d bytes after "
           "them" % (c, x, C, X))
     check(s <= C and (not key or s == C), "R5.16: %d cells sent of %d in a %s" % (s, C, "keyframe" if key else
                                                                                   "delta"))
+    B = 0
+    if flags == 4:
+        check(base is not None and len(base) == raw_length, "a delta without the acknowledged base of %d bytes"
+              % raw_length)
+        B, moved = _shq_blocks(payload, C, base[:values])
+        base = moved + bytes(base[values:])
     map_len = 0 if key else (C + 7) // 8
     per = 25 if key else 26  # exponent, a delta's mode, 12 two-byte mantissas
-    check(len(payload) == 32 + map_len + per * s + X, "R5.16: payload of %d bytes, 32 + %d + %d x %d + %d = %d "
-          "expected" % (len(payload), map_len, per, s, X, 32 + map_len + per * s + X))
+    check(len(payload) == 32 + B + map_len + per * s + X, "R5.16: payload of %d bytes, 32 + %d + %d + %d x %d + %d "
+          "= %d expected" % (len(payload), B, map_len, per, s, X, 32 + B + map_len + per * s + X))
     if key:
         sent = range(C)
     else:
         check(base is not None and len(base) == raw_length, "a delta without the acknowledged base of %d bytes"
               % raw_length)
-        sent = [i for i in range(C) if payload[32 + i // 8] >> (i % 8) & 1]
-        past = [b for b in range(C, 8 * map_len) if payload[32 + b // 8] >> (b % 8) & 1]
+        sent = [i for i in range(C) if payload[32 + B + i // 8] >> (i % 8) & 1]
+        past = [b for b in range(C, 8 * map_len) if payload[32 + B + b // 8] >> (b % 8) & 1]
         check(len(sent) == s and not past, "R5.16: the bit map flags %d cells (%d past C), S is %d"
               % (len(sent), len(past), s))
-    at = 32 + map_len
+    at = 32 + B + map_len
     modes = [0] * s if key else payload[at + s:at + 2 * s]
     lo = at + (1 if key else 2) * s
     hi = lo + 12 * s
@@ -598,6 +606,71 @@ def _shq_decode(h, payload, base=None):
     if not key:
         tail = bytes(a ^ b for a, b in zip(tail, base[values:]))
     return bytes(out) + tail, s
+
+
+def _f32_sum(a, d, x):
+    """The binary32 value nearest a + d 2^x (a a binary32 value, d and x
+    integers), ties to even, +-inf past the largest: the exact sum as an
+    integer times a power of two, rounded to 24 significant bits by hand."""
+    num, den = a.as_integer_ratio()  # den a power of two
+    e = min(-(den.bit_length() - 1), x)
+    n = (num << (-(den.bit_length() - 1) - e)) + (d << (x - e))  # the sum is n 2^e, exactly
+    if n == 0:
+        return 0.0
+    sign, n = (-1.0 if n < 0 else 1.0), abs(n)
+    ulp = max(n.bit_length() - 1 + e - 23, -149)  # 24 significant bits, subnormals below 2^-126
+    if ulp > e:
+        shift = ulp - e
+        q, r = n >> shift, n & ((1 << shift) - 1)
+        if 2 * r > (1 << shift) or (2 * r == (1 << shift) and q & 1):
+            q += 1
+    else:
+        q = n << (e - ulp)
+    if q.bit_length() + ulp > 128:  # q 2^ulp >= 2^128: past the largest binary32
+        return sign * float("inf")
+    return sign * math.ldexp(q, ulp)
+
+
+def _shq_blocks(payload, C, values):
+    """A delta's blocks (R5.16 bit 2) at payload[32:], checked: (B, their
+    bytes; values, the base's values, moved: to each value of each cell of a
+    block that is not all zeros, d x 2^x, the sum rounded to binary32)."""
+    check(len(payload) >= 40, "R5.16: the blocks' counts are cut off")
+    R, edge = struct.unpack_from("<II", payload, 32)
+    check(1 <= R <= 16 and 1 <= edge <= 64, "R5.16: %d regions of blocks of edge %d" % (R, edge))
+    check(len(payload) >= 40 + 20 * R, "R5.16: the blocks' regions are cut off")
+    regions, end, T = [], 0, 0
+    for r in range(R):
+        f, nx, ny, nz = struct.unpack_from("<QIII", payload, 40 + 20 * r)
+        check(nx >= 1 and ny >= 1 and nz >= 1 and f >= end and f + nx * ny * nz <= C,
+              "R5.16: region %d (first %d, %d x %d x %d) is not a box of the %d cells after the one before"
+              % (r, f, nx, ny, nz, C))
+        end = f + nx * ny * nz
+        regions.append((f, nx, ny, nz, T))
+        T += -(-nx // edge) * -(-ny // edge) * -(-nz // edge)
+    at = 40 + 20 * R
+    check(len(payload) >= at + 25 * T, "R5.16: the %d blocks are cut off" % T)
+    out = bytearray(values)
+    for f, nx, ny, nz, t0 in regions:
+        bx, by = -(-nx // edge), -(-ny // edge)
+        for i in range(nx * ny * nz):
+            xc, yc, zc = i % nx, i // nx % ny, i // (nx * ny)
+            t = t0 + xc // edge + bx * (yc // edge + by * (zc // edge))
+            x = struct.unpack_from("<b", payload, at + t)[0]
+            check(x == -128 or x <= 100, "R5.16: block %d has exponent %d" % (t, x))
+            cell = struct.unpack_from("<12f", out, 48 * (f + i))
+            if x == -128 or all(v == 0 for v in cell):
+                continue
+            moved = []
+            for k in range(12):
+                z = payload[at + T + k * T + t] + 256 * payload[at + 13 * T + k * T + t]
+                d = z // 2 if z % 2 == 0 else -(z + 1) // 2
+                check(math.isfinite(cell[k]), "R5.16: a block moves cell %d's value %d, %r" % (f + i, k, cell[k]))
+                moved.append(_f32_sum(cell[k], d, x))
+                check(math.isfinite(moved[-1]), "R5.16: block %d moves cell %d's value %d past binary32"
+                      % (t, f + i, k))
+            struct.pack_into("<12f", out, 48 * (f + i), *moved)
+    return 8 + 20 * R + 25 * T, bytes(out)
 
 
 def _shq_magnitude(c):

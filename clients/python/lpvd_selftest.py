@@ -564,6 +564,73 @@ def _offline_shq(say):
         raise AssertionError("shq: the seeded delta of modes 0 and 1 differs from (r + round(b 2^-x)) 2^x worked "
                              "out with ** (numpy: %s) in cells %r" % (lpvd_volume._np is not None, [
                                  i for i in range(300) if seeded_mixed[48 * i:48 * i + 48] != want[i]][:10]))
+    # -- a delta with blocks (flag bit 2) of 12 cells: region A, cells 0-5 as 3 x 2 x 1, region B, cells 7-10
+    # as 2 x 2 x 1, blocks of edge 2 (A: 2 blocks, B: 1); cells 6 and 11 outside both. Block 0 moves A's cells
+    # 0, 1, 3, 4 by d 2^-1 but cell 4, black, stays black; block 1 (x = -128) leaves cells 2, 5; block 2
+    # moves B's cells by d 2^0 from 2^24, where binary32's steps are 2: 2^24 + 1 and + 3 are ties (to even:
+    # 2^24 and 2^24 + 4). Then cell 1 is re-sent as mode 1 (from the moved cell) and cell 9 as mode 0.
+    bvals = [float(i - 5) + k / 16.0 for i in range(12) for k in range(12)]
+    bvals[48:60] = [0.0] * 12  # cell 4 black
+    bvals[84:132] = [2.0 ** 24] * 48  # cells 7-10
+    bbase = struct.pack("<144f", *bvals) + b"\x05\x06\x07\x08"
+    d0 = [1, -1, 2, -2, 3, -3, 32767, -32768, 0, 5, -5, 7]
+    d2 = [1, 3, -1, -3, 2, 0, 5, 7, 1, 1, 3, 3]
+    blocks_d = [(-1, d0), (-128, [9] * 12), (0, d2)]
+
+    def blocks_section(regions, edge, blks):
+        zz = [[2 * d if d >= 0 else -2 * d - 1 for d in ds] for _, ds in blks]
+        return (struct.pack("<II", len(regions), edge) + b"".join(struct.pack("<QIII", *r) for r in regions)
+                + struct.pack("<%db" % len(blks), *[x for x, _ in blks])
+                + bytes(zz[t][k] & 0xFF for k in range(12) for t in range(len(blks)))
+                + bytes(zz[t][k] >> 8 for k in range(12) for t in range(len(blks))))
+
+    regions_ab = [(0, 3, 2, 1), (7, 2, 2, 1)]
+    sent_b = [(-2, [4] * 12), (3, [1, -1] * 6)]
+
+    def with_blocks(regions=regions_ab, edge=2, blks=blocks_d, flags=4):
+        plain = _shq_payload(sent_b, b"\x01\x00\x00\x01", bitmap=b"\x02\x02", cells=12, modes=[1, 0], flags=flags)
+        return plain[:32] + blocks_section(regions, edge, blks) + plain[32:]
+    moved = list(bvals)
+    for i in (0, 1, 3):  # block 0: + d 2^-1, exact here (values of steps 1/16 plus halves)
+        for k in range(12):
+            moved[12 * i + k] = struct.unpack("<f", struct.pack("<f", bvals[12 * i + k] + d0[k] * 0.5))[0]
+    ties = {1: 2.0 ** 24, 3: 2.0 ** 24 + 4, -1: 2.0 ** 24 - 1, -3: 2.0 ** 24 - 3, 2: 2.0 ** 24 + 2, 0: 2.0 ** 24,
+            5: 2.0 ** 24 + 4, 7: 2.0 ** 24 + 8}  # 2^24 + d by hand: steps of 2 above 2^24 (ties to even), 1 below
+    for i in (7, 8, 9, 10):
+        moved[12 * i:12 * i + 12] = [ties[d] for d in d2]
+    want_b = bytearray(struct.pack("<144f", *moved))
+    want_b[48:96] = b"".join(_shq_value(-2, 4, moved[12 + k]) for k in range(12))  # cell 1, mode 1 from the moved
+    want_b[9 * 48:10 * 48] = b"".join(_shq_value(3, q) for q in [1, -1] * 6)
+    want_b = bytes(want_b) + b"\x04\x06\x07\x09"
+    got = shq_decode_payload(with_blocks(), len(bbase), 12, False, bbase)
+    if got != want_b:
+        raise AssertionError("shq delta with blocks: cells %r differ from the values by hand (numpy: %s)" % (
+            [i for i in range(12) if got[48 * i:48 * i + 48] != want_b[48 * i:48 * i + 48]],
+            lpvd_volume._np is not None))
+    big = bytearray(bbase)
+    big[0:4] = struct.pack("<f", 3.4028234663852886e38)  # cell 0 at the largest binary32, block 0 moves it up
+    block_refusals = [
+        ("blocks on a keyframe", lambda: shq_decode_payload(with_blocks(flags=5), len(bbase), 12, True), "flags"),
+        ("no regions", lambda: shq_decode_payload(with_blocks(regions=[]), len(bbase), 12, False, bbase), "regions"),
+        ("an edge 0", lambda: shq_decode_payload(with_blocks(edge=0), len(bbase), 12, False, bbase), "edge"),
+        ("overlapping regions", lambda: shq_decode_payload(with_blocks(regions=[(0, 3, 2, 1), (5, 2, 2, 1)]),
+                                                           len(bbase), 12, False, bbase), "in order"),
+        ("a region past C", lambda: shq_decode_payload(with_blocks(regions=[(0, 3, 2, 1), (9, 2, 2, 1)]),
+                                                       len(bbase), 12, False, bbase), "in order"),
+        ("a block exponent of 101", lambda: shq_decode_payload(with_blocks(blks=[(101, d0)] + blocks_d[1:]),
+                                                               len(bbase), 12, False, bbase), "exponent 101"),
+        ("a sum past binary32", lambda: shq_decode_payload(with_blocks(blks=[(100, [32767] * 12)] + blocks_d[1:]),
+                                                           len(bbase), 12, False, bytes(big)), "binary32"),
+        ("a block too few", lambda: shq_decode_payload(with_blocks(blks=blocks_d[:2]), len(bbase), 12, False, bbase),
+         "counts need"),
+    ]
+    for what, decode, word in block_refusals:
+        try:
+            decode()
+            raise AssertionError("shq: %s was read" % what)
+        except ProtocolError as e:
+            if word not in str(e):
+                raise AssertionError("shq: %s refused without saying %r: %s" % (what, word, e))
     # -- what a client MUST refuse (R5.16): header, magic, flags, counts, bit map, length
     k3 = key_cells[:3]
     refusals = [
@@ -641,9 +708,10 @@ def _offline_shq(say):
             list(D), list(M), over, cell, within))
     say("offline R5.16 (numpy: %s): a hand-made keyframe (zero, subnormal, infinite values) and delta decoded to the "
         "values by hand (mode 1: ties to even, negative), %s; seeded payloads of 300 cells as q x 2^x and (r + "
-        "round(b 2^-x)) 2^x; %d malformed payloads and headers refused; "
-        "D and M by hand" % (lpvd_volume._np is not None, through, len(refusals)))
-    return seeded + seeded_delta + seeded_mixed
+        "round(b 2^-x)) 2^x; a delta with blocks (binary32 sums, ties to even, black cells kept) by hand; %d "
+        "malformed payloads and headers refused; D and M by hand" % (
+            lpvd_volume._np is not None, through, len(refusals) + len(block_refusals)))
+    return seeded + seeded_delta + seeded_mixed + got
 
 
 def offline_self_test(out=sys.stdout):

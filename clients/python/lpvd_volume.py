@@ -134,6 +134,11 @@ _SHQ_ABSOLUTE, _SHQ_RELATIVE = 0, 1  # a delta's modes
 _SHQ_VALUE_LIMIT = _f32(1e30)  # the server clamps exact values beyond it (binary32 1e30f; NaN is 0) before coding
 _SHQ_TINY = 1e-30         # a cell of smaller magnitude is held as zero
 _F32_OVERFLOW = 2.0 ** 128  # q x 2^x at or above it is no binary32: it rounds to infinity, as ldexpf does
+_SHQ_FLAG_BLOCKS = 4      # a delta only: blocks move the client's cells before the cells sent
+_SHQ_MAX_REGIONS = 16
+_SHQ_BLOCK_EDGE_MAX = 64
+_SHQ_BLOCK_EXP_MAX = 100  # a block's d x 2^x stays a binary32 value
+_SHQ_REGION = struct.Struct("<QIII")  # first cell, nx, ny, nz
 
 
 def shq_error_bound(header):
@@ -185,7 +190,8 @@ def shq_cells(header):
 def shq_payload_max(cells, extra):
     """The largest payload C cells and X bytes after them can need (a delta
     that sends every cell): the bound zstd decompresses to."""
-    return _SHQ_HEAD.size + (cells + 7) // 8 + _SHQ_SENT_BYTES_DELTA * cells + extra
+    return (_SHQ_HEAD.size + 8 + _SHQ_REGION.size * _SHQ_MAX_REGIONS + _SHQ_SENT_BYTES * cells + (cells + 7) // 8
+            + _SHQ_SENT_BYTES_DELTA * cells + extra)
 
 
 def shq_decode(att, header, base=None):
@@ -214,15 +220,18 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
     q is the mantissa, or for a delta's cell of mode 1 the mantissa plus the
     base's value in steps of 2^x (rounded half to even), or for a predicted
     keyframe's cell the mantissa plus the previous cell's q scaled to 2^x
-    (_shq_predict), modulo 2^16.
+    (_shq_predict), modulo 2^16. A delta with flag bit 2 first moves the
+    base's cells by its blocks (_shq_move): mode 1 is then the change from
+    the moved cell.
 
     Raises ProtocolError for what the SPEC says a client MUST reject: a
-    magic other than "SHQ1", flags other than bits 0 and 1 (1 only with 0), a keyframe flag that
+    magic other than "SHQ1", flags other than bits 0, 1 and 2 (1 only with 0, 2 only without), a keyframe flag that
     disagrees with the header's ``keyframe``, C or X other than the header's,
     S over C (or a keyframe's S not C), a bit map whose set bits are not S or
     that sets bits past C, a mode other than 0 or 1 (or 1 with x = -128),
-    and a length other than 32 + 25 S + X (a keyframe) or 32 + ceil(C / 8) +
-    26 S + X (a delta)."""
+    blocks whose counts, regions or exponents are out of range or that move a
+    value past binary32, and a length other than 32 + 25 S + X (a keyframe)
+    or 32 + B + ceil(C / 8) + 26 S + X (a delta; B the blocks' bytes)."""
     p = bytes(payload)
     values = cells * _SHQ_CELL_BYTES
     if not 0 <= values <= raw_length:
@@ -231,9 +240,11 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
     if len(p) < _SHQ_HEAD.size or p[:4] != SHQ_MAGIC:
         raise ProtocolError("shq: not an %r payload (%d bytes starting %r)" % (SHQ_MAGIC.decode(), len(p), p[:4]))
     _, flags, n_cells, sent, n_extra = _SHQ_HEAD.unpack_from(p)
-    if flags & ~(_SHQ_FLAG_KEY | _SHQ_FLAG_PREDICTED) or flags == _SHQ_FLAG_PREDICTED:
-        raise ProtocolError("shq: unknown flags 0x%x (bit 0 is keyframe, bit 1 predicted, only with bit 0)" % flags)
     key = bool(flags & _SHQ_FLAG_KEY)
+    if (flags & ~(_SHQ_FLAG_KEY | _SHQ_FLAG_PREDICTED | _SHQ_FLAG_BLOCKS) or (flags & _SHQ_FLAG_PREDICTED and not key)
+            or (flags & _SHQ_FLAG_BLOCKS and key)):
+        raise ProtocolError("shq: unknown flags 0x%x (bit 0 is keyframe, bit 1 predicted, only with bit 0, bit 2 "
+                            "blocks, only without bit 0)" % flags)
     predicted = bool(flags & _SHQ_FLAG_PREDICTED)
     if key != bool(keyframe):
         raise ProtocolError("shq: the payload is a %s, the header says keyframe %r" % (
@@ -247,21 +258,25 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
     if not key and (base is None or len(base) != raw_length):
         raise ProtocolError("shq: a delta needs the base volume of %d bytes, %s" % (
             raw_length, "none was given" if base is None else "got %d" % len(base)))
+    blocks, blocks_len = None, 0
+    if flags & _SHQ_FLAG_BLOCKS:
+        blocks = _shq_blocks(p, _SHQ_HEAD.size, cells)
+        blocks_len = blocks[-1]
     map_len = 0 if key else (cells + 7) // 8
     per = _SHQ_SENT_BYTES if key else _SHQ_SENT_BYTES_DELTA
-    need = _SHQ_HEAD.size + map_len + per * sent + extra
+    need = _SHQ_HEAD.size + blocks_len + map_len + per * sent + extra
     if len(p) != need:
-        raise ProtocolError("shq: payload of %d bytes, its counts need %d (32 + %d of bit map + %d x %d cells sent "
-                            "+ %d)" % (len(p), need, map_len, per, sent, extra))
+        raise ProtocolError("shq: payload of %d bytes, its counts need %d (32 + %d of blocks + %d of bit map + %d x %d "
+                            "cells sent + %d)" % (len(p), need, blocks_len, map_len, per, sent, extra))
     bitmap = None
     if not key:
-        bitmap = p[_SHQ_HEAD.size:_SHQ_HEAD.size + map_len]
+        bitmap = p[_SHQ_HEAD.size + blocks_len:_SHQ_HEAD.size + blocks_len + map_len]
         flagged = bin(int.from_bytes(bitmap, "little")).count("1")
         if flagged != sent or (cells % 8 and bitmap[-1] >> (cells % 8)):
             raise ProtocolError("shq: the bit map flags %d cells%s, the payload sends %d" % (
                 flagged, " (some past the %d cells)" % cells if cells % 8 and bitmap[-1] >> (cells % 8) else "",
                 sent))
-    at = _SHQ_HEAD.size + map_len
+    at = _SHQ_HEAD.size + blocks_len + map_len
     modes = None
     if not key:
         exps, modes = p[at:at + sent], p[at + sent:at + 2 * sent]
@@ -269,10 +284,105 @@ def shq_decode_payload(payload, raw_length, cells, keyframe, base=None):
             if mode > _SHQ_RELATIVE or (mode == _SHQ_RELATIVE and exps[j] == 0x80):
                 raise ProtocolError("shq: sent cell %d has mode %d%s" % (
                     j, mode, "" if mode > _SHQ_RELATIVE else " with the zero exponent"))
+    if blocks is not None:  # the client's cells moved by the blocks, then the cells sent as against that base
+        base = _shq_move(p, blocks, bytes(base[:values]), cells) + bytes(base[values:])
     rebuilt = (_shq_values_numpy if _np is not None else _shq_values_stdlib)(p, at, cells, sent, bitmap, modes, base,
                                                                              predicted)
     after = p[at + per * sent:]
     return rebuilt + (after if key else _xor(after, bytes(base[values:])))
+
+
+def _shq_blocks(p, at, cells):
+    """A delta's blocks (SPEC R5.16 bit 2) at p[at:], checked: (regions as
+    (first, nx, ny, nz), edge, T blocks, where their exponents start, B the
+    section's bytes)."""
+    if len(p) < at + 8:
+        raise ProtocolError("shq: the blocks' counts are cut off")
+    regions, edge = struct.unpack_from("<II", p, at)
+    if not 1 <= regions <= _SHQ_MAX_REGIONS or not 1 <= edge <= _SHQ_BLOCK_EDGE_MAX:
+        raise ProtocolError("shq: %d regions of blocks of edge %d (1..%d regions, edge 1..%d)" % (
+            regions, edge, _SHQ_MAX_REGIONS, _SHQ_BLOCK_EDGE_MAX))
+    if len(p) < at + 8 + _SHQ_REGION.size * regions:
+        raise ProtocolError("shq: the blocks' regions are cut off")
+    regs, end, count = [], 0, 0
+    for r in range(regions):
+        first, nx, ny, nz = _SHQ_REGION.unpack_from(p, at + 8 + _SHQ_REGION.size * r)
+        if not (nx and ny and nz) or first < end or first + nx * ny * nz > cells:
+            raise ProtocolError("shq: the blocks' regions are not boxes of the %d cells in order" % cells)
+        end = first + nx * ny * nz
+        regs.append((first, nx, ny, nz))
+        count += -(-nx // edge) * -(-ny // edge) * -(-nz // edge)
+    exps_at = at + 8 + _SHQ_REGION.size * regions
+    return regs, edge, count, exps_at, 8 + _SHQ_REGION.size * regions + _SHQ_SENT_BYTES * count
+
+
+def _shq_move(p, blocks, values, cells):
+    """The base's values (bytes, cells x 48) moved by the blocks: each block's
+    d x 2^x added to every value of its cells that are not all zero, each sum
+    rounded to binary32 once; a sum that is not finite is refused."""
+    regs, edge, count, at, _ = blocks
+    xs = struct.unpack_from("<%db" % count, p, at)
+    for t, x in enumerate(xs):
+        if x > _SHQ_BLOCK_EXP_MAX:
+            raise ProtocolError("shq: block %d has exponent %d (at most %d, or -128)" % (t, x, _SHQ_BLOCK_EXP_MAX))
+    lo = at + count
+    hi = lo + 12 * count
+    if _np is not None:
+        return _shq_move_numpy(p, regs, edge, count, xs, lo, values, cells)
+    d = [[(z >> 1) ^ -(z & 1) for z in (p[lo + k * count + t] | (p[hi + k * count + t] << 8) for t in range(count))]
+         for k in range(12)]
+    out = array.array("f")
+    out.frombytes(values)
+    if sys.byteorder != "little":
+        out.byteswap()
+    t0 = 0
+    for first, nx, ny, nz in regs:
+        bx, by = -(-nx // edge), -(-ny // edge)
+        i = first
+        for zc in range(nz):
+            for yc in range(ny):
+                for xc in range(nx):
+                    t = t0 + xc // edge + bx * (yc // edge + by * (zc // edge))
+                    c = 12 * i
+                    i += 1
+                    if xs[t] == _SHQ_ZERO_EXP or not any(out[c:c + 12]):
+                        continue
+                    for k in range(12):
+                        v = _f32(out[c + k] + math.ldexp(d[k][t], xs[t]))  # once to binary32: binary32 addition
+                        if not math.isfinite(v):
+                            raise ProtocolError("shq: a block moves a value past binary32's range")
+                        out[c + k] = v
+        t0 += bx * by * -(-nz // edge)
+    if sys.byteorder != "little":
+        out.byteswap()
+    return out.tobytes()
+
+
+def _shq_move_numpy(p, regs, edge, count, xs, lo, values, cells):
+    """_shq_move with numpy: the same bytes."""
+    planes = _np.frombuffer(p, _np.uint8, 24 * count, lo).astype(_np.int32).reshape(2, 12, count)
+    z = planes[0] | (planes[1] << 8)
+    x = _np.array(xs, _np.int32)
+    step = _np.ldexp(((z >> 1) ^ -(z & 1)).T.astype(_np.float64), x[:, None]).astype(_np.float32)  # exact
+    vals = _np.frombuffer(values, "<f4", 12 * cells).reshape(cells, 12).astype(_np.float32)
+    t0 = 0
+    for first, nx, ny, nz in regs:
+        bx, by, bz = -(-nx // edge), -(-ny // edge), -(-nz // edge)
+        n = bx * by * bz
+
+        def up(a):
+            return a.repeat(edge, 0).repeat(edge, 1).repeat(edge, 2)[:nz, :ny, :nx]
+        add = up(step[t0:t0 + n].reshape(bz, by, bx, 12))
+        moving = up((x[t0:t0 + n] != _SHQ_ZERO_EXP).reshape(bz, by, bx))
+        region = vals[first:first + nx * ny * nz].reshape(nz, ny, nx, 12)
+        live = moving & (region != 0).any(axis=-1)
+        with _np.errstate(over="ignore", invalid="ignore"):
+            moved = region[live] + add[live]  # binary32 addition
+        if not _np.isfinite(moved).all():
+            raise ProtocolError("shq: a block moves a value past binary32's range")
+        region[live] = moved
+        t0 += n
+    return vals.astype("<f4").tobytes()
 
 
 def _shq_predict(prev_q, prev_x, x):
