@@ -315,8 +315,10 @@ static int encode_shq(lpvp_volume_info *vi, const uint8_t *raw, size_t raw_len, 
     const uint8_t *b = base ? base->raw->bytes : NULL;
     sv_blob *rb = sv_blob_new(raw_len, keep ? held : NULL);
     uint8_t *recon = rb ? rb->bytes : NULL;
+    lpvp_shq_layout lay;
+    lpvp_shq_layout_of(vi, &lay);
     lpvp_shq_counts sent = {0, 0};
-    if (!recon || lpvp_shq_encode(raw, raw_len, cells, b, bound, NULL, recon, att, att_len, &sent, err, n) != 0) {
+    if (!recon || lpvp_shq_encode(raw, raw_len, cells, b, bound, &lay, recon, att, att_len, &sent, err, n) != 0) {
         if (!recon)
             snprintf(err, n, "out of memory for a %zu-byte volume", raw_len);
         sv_blob_unref(rb);

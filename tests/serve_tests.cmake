@@ -38,7 +38,7 @@ add_test(NAME conformance
 set(_lpvd_serve_tests conformance)
 foreach(_name midmessage slow_reader churn sigterm sighup fifo preauth sigterm_load request_memory root_race
                 scene_budgets fair_gl encode_offloop memory_budgets world_churn sigterm_frame query_limits settings_that_run stalled_headers preauth_burst loads_and_encodes all_worlds_memory measured_ticks
-                yield_points daemon_memory start_self_test shared_bases idle_after_reply shq_keyframes)
+                yield_points daemon_memory start_self_test shared_bases idle_after_reply shq_keyframes shq_blocks)
   add_test(NAME reliability_${_name}
     COMMAND "${LPVD_SERVE_TESTS_PYTHON}" "${_lpvd_serve_dir}/reliability/${_name}.py" --lpvd "$<TARGET_FILE:lpvd>")
   list(APPEND _lpvd_serve_tests reliability_${_name})

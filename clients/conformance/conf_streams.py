@@ -219,7 +219,8 @@ def c_delta_shq(ctx):
             if payload is None:
                 return "no zstd tool: the stream's payloads cannot be checked (%d B keyframe)" % len(v.att)
             held, sent = _shq_decode(v.body, payload, held)
-            kinds.append("keyframe" if v.body["keyframe"] else "delta/%d of %d cells" % (sent, len(held) // 48))
+            kinds.append("keyframe" if v.body["keyframe"] else "delta/%d of %d cells%s" % (
+                sent, len(held) // 48, " after blocks" if struct.unpack_from("<I", payload, 4)[0] & 4 else ""))
             acked = v.body["tick"]
             c.send(ACK, {"stream": "volume", "tick": acked})
         g = expect_reply(c.request(GET_VOLUME, {"format": "fp32", "compression": "none"}), GET_VOLUME)
