@@ -23,7 +23,11 @@
  * 228 to 170 kB; the probes' from 48 to 29 kB, iv's from 31 to 27 kB. A
  * delta's re-sent cells are not predicted from each other: neighbours are
  * re-sent at different ticks, so their changes from the client's cells
- * differ (predicting them cost 6 % more bytes).
+ * differ (predicting them cost 6 % more bytes). What neighbours do share
+ * when a lamp moves is the change itself where the light is smooth, so a
+ * delta may first move the client's cells by one change per block of
+ * cells of each cascade (R5.16 bit 2, SHQ_BLOCK_EDGE below), and the
+ * encoder sends it when that is the smaller delta.
  *
  * Reconstruction is q x 2^e in fp32, exact (|q| < 2^15), so the encoder's
  * copy of the client's volume is the client's bit for bit.
@@ -59,6 +63,7 @@
 #define SHQ_FLAG_BLOCKS 4u
 #define SHQ_BLOCK_EDGE 3
 #define SHQ_BLOCK_SHARE 0.25
+#define SHQ_BLOCK_MIN_SHARE 16 /* blocks are tried when a delta re-sends more than 1/16 of the cells */
 #define SHQ_BLOCK_EXP_MAX 100  /* q 2^x stays a binary32 value well inside its range */
 #define SHQ_BLOCK_EDGE_MAX 64
 #define SHQ_REGION_BYTES 20    /* first u64, dims 3 x u32 */
@@ -615,7 +620,11 @@ int lpvp_shq_encode(const uint8_t *raw, size_t raw_len, size_t cells, const uint
         return -1;
     }
     int rc = encode_one(raw, raw_len, cells, base, bound, NULL, plain, out, out_len, &counts.sent, err, err_n);
-    if (rc == 0 && blocks && counts.sent > 0) { /* nothing past the bound stays nothing */
+    /* Nothing past the bound stays nothing. A delta that re-sends few cells
+     * leaves the blocks little to carry: on the engine of docs/streaming.md
+     * (2.8 % of the LPV's cells re-sent per update) they were never the
+     * smaller and trying them tripled the encoding time. */
+    if (rc == 0 && blocks && counts.sent > cells / SHQ_BLOCK_MIN_SHARE) {
         rc = try_blocks(raw, raw_len, cells, base, bound, layout, plain, out, out_len, &counts, err, err_n);
         if (rc != 0) {
             free(*out);
