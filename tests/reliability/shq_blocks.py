@@ -20,7 +20,7 @@ import os
 import struct
 import sys
 
-from rel_common import harness, lc, ok, scene_session
+from rel_common import harness, lc, ok, shq_subscribe, shq_tick
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
@@ -41,36 +41,23 @@ def main():
     rep = harness.Report("shq_blocks")
     lpvd = harness.find_lpvd(args.lpvd)
     with harness.Daemon(lpvd, quiet=True) as d:
-        c = scene_session(("unix", d.unix), config=CONFIG, light=dict(LIGHT), timeout=120)
-        ok(c.request(lc.SUBSCRIBE, {"stream": "volume", "compression": "shq", "error_bound": BOUND, "delta": True},
-                     timeout=60), lc.SUBSCRIBE)
+        c = shq_subscribe(("unix", d.unix), CONFIG, LIGHT, BOUND)
         held, seen, same = None, [], []
         for step in range(STEPS + 1):
             before = held
             if step:
                 ok(c.request(lc.LIGHT_SET, dict(LIGHT, position=[0.01 * step, 1.2, 0.0]), timeout=60), lc.LIGHT_SET)
-            ok(c.request(lc.TICK, {}, timeout=300), lc.TICK)
-            v = c.recv_stream(lc.VOLUME, timeout=60)
-            held = lv.shq_decode(v.att, v.body, before)
+            v, held, _, cells, worst, moved = shq_tick(c, before, BOUND)
             np_ = lv._np
             try:
                 lv._np = None
                 plain = lv.shq_decode(v.att, v.body, before)
             finally:
                 lv._np = np_
-            cells, extra = lv.shq_cells(v.body)
+            _, extra = lv.shq_cells(v.body)
             payload = _zstd_decompress(v.att, lv.shq_payload_max(cells, extra))
             exact_rat, sent = conformance_decode(v.body, payload, before)
             same.append(held == plain == exact_rat)
-            c.send(lc.ACK, {"stream": "volume", "tick": v.body["tick"]})
-            exact = ok(c.request(lc.GET_VOLUME, {"format": "fp32", "compression": "none"}, timeout=120),
-                       lc.GET_VOLUME)
-            D, M = lv.shq_distances(held, bytes(exact.att), cells)
-            worst = max((dd / mm for dd, mm in zip(D, M) if mm > 0), default=0.0)
-            moved = None
-            if before is not None:
-                Db, Mb = lv.shq_distances(before, bytes(exact.att), cells)
-                moved = sum(1 for dd, mm in zip(Db, Mb) if dd > BOUND * mm)
             flags = struct.unpack_from("<I", payload, 4)[0]
             seen.append((v.body["keyframe"], flags, len(v.att), moved, sent, worst))
         deltas = seen[1:]

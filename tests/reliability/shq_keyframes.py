@@ -21,7 +21,7 @@ every VOLUME:
 import os
 import sys
 
-from rel_common import harness, lc, ok, scene_session
+from rel_common import harness, lc, ok, shq_subscribe, shq_tick
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                                 "clients", "python"))
@@ -39,28 +39,14 @@ def main():
     rep = harness.Report("shq_keyframes")
     lpvd = harness.find_lpvd(args.lpvd)
     with harness.Daemon(lpvd, quiet=True) as d:
-        c = scene_session(("unix", d.unix), config=CONFIG, light=dict(LIGHT), timeout=120)
-        ok(c.request(lc.SUBSCRIBE, {"stream": "volume", "compression": "shq", "error_bound": BOUND, "delta": True},
-                     timeout=60), lc.SUBSCRIBE)
+        c = shq_subscribe(("unix", d.unix), CONFIG, LIGHT, BOUND)
         held, seen = None, []
         for step, pos in enumerate(([-0.6, 1.2, -0.4], [-0.59, 1.2, -0.4], [0.6, 0.5, 0.4])):
-            before = held
             if step:
                 ok(c.request(lc.LIGHT_SET, dict(LIGHT, position=pos), timeout=60), lc.LIGHT_SET)
-            ok(c.request(lc.TICK, {}, timeout=300), lc.TICK)
-            v = c.recv_stream(lc.VOLUME, timeout=60)
-            held = lv.shq_decode(v.att, v.body, held)
-            c.send(lc.ACK, {"stream": "volume", "tick": v.body["tick"]})
-            exact = ok(c.request(lc.GET_VOLUME, {"format": "fp32", "compression": "none"}, timeout=120),
-                       lc.GET_VOLUME)
-            cells, extra = lv.shq_cells(v.body)
+            v, held, _, cells, worst, moved = shq_tick(c, held, BOUND)
+            _, extra = lv.shq_cells(v.body)
             flags = int.from_bytes(_zstd_decompress(v.att, lv.shq_payload_max(cells, extra))[4:8], "little")
-            D, M = lv.shq_distances(held, bytes(exact.att), cells)
-            worst = max((dd / mm for dd, mm in zip(D, M) if mm > 0), default=0.0)
-            moved = None
-            if before is not None:
-                Db, Mb = lv.shq_distances(before, bytes(exact.att), cells)
-                moved = sum(1 for dd, mm in zip(Db, Mb) if dd > BOUND * mm)
             seen.append((v.body["keyframe"], flags, len(v.att), moved, cells, worst))
         rep.check(seen[0][0] and seen[0][1] == 3, "the first VOLUME is a predicted keyframe (flags 3)",
                   "keyframe %r, flags %d, %d bytes" % seen[0][:3])
