@@ -369,7 +369,8 @@ TECHNIQUES = (("lpv", CONFIG), ("octree", {"technique": "octree", "grid": [32, 3
 def save(bench, out, n=16, scene=None):
     """The exact volumes (fp32, the values without any index) of n updates of
     each technique while the light moves 1 cm per update, as OUT/TECH-NN.bin:
-    the input of lpvd-shq-codec (bench/shq_codec.c). With scene (a .glb
+    the input of lpvd-shq-codec (bench/shq_codec.c), and OUT/TECH.regions,
+    its --region flags (the cascades' dims). With scene (a .glb
     path): that scene instead of the box, the light 10 % of the scene's
     height above its centre, moved 0.5 % of its width per update (1 cm is to
     the 2 m box)."""
@@ -392,6 +393,8 @@ def save(bench, out, n=16, scene=None):
             hx, ex = bench.exact(c)
             with open(os.path.join(out, "%s-%02d.bin" % (name, i)), "wb") as f:
                 f.write(ex[:lv.shq_cells(hx)[0] * 48])
+        with open(os.path.join(out, "%s.regions" % name), "w") as f:  # lpvd-shq-codec's --region per cascade
+            f.write(" ".join("--region %dx%dx%d" % tuple(k["dims"]) for k in hx["cascades"]) + "\n")
         c.close()
         print("saved %d volumes of %s in %s" % (n, name, out))
 
