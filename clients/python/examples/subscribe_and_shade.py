@@ -120,8 +120,10 @@ def main(argv):
     # imperfect volume's voxels (which lpvd's default technique, auto, picks on
     # most scenes), R5.7's for the LPV's cells, which is the server's exactly
     # for one volume per cascade: the LPV's normal bins and far field (its
-    # defaults) off.
-    c.config(normal_bins=False, far_field=False)
+    # defaults) off. A light that moves: the LPV injects it smoothly, so its
+    # cells change little by little and the shq deltas are a fraction of
+    # the bytes (docs/streaming.md, 1b).
+    c.config(normal_bins=False, far_field=False, smooth_injection=not args.static)
     if shq:
         bound = args.error_bound
         if bound is None:
