@@ -613,8 +613,9 @@ int lpvp_shq_encode(const uint8_t *raw, size_t raw_len, size_t cells, const uint
     }
     lpvp_shq_counts counts = {0, 0};
     const int blocks = base && layout_usable(layout, cells);
-    /* With blocks to try, the plain delta goes to a copy first: recon may be base, which the blocks need. */
-    uint8_t *plain = blocks ? malloc(raw_len) : recon;
+    /* The blocks need the base and raw after the plain delta: when recon is
+     * either (coding in place), the plain delta goes to a copy first. */
+    uint8_t *plain = blocks && (recon == base || recon == raw) ? malloc(raw_len) : recon;
     if (!plain) {
         lpvp_set_error(err, err_n, "out of memory for a %zu-byte volume", raw_len);
         return -1;
@@ -632,7 +633,7 @@ int lpvp_shq_encode(const uint8_t *raw, size_t raw_len, size_t cells, const uint
             *out_len = 0;
         }
     }
-    if (blocks) {
+    if (plain != recon) {
         if (rc == 0)
             memcpy(recon, plain, raw_len);
         free(plain);
