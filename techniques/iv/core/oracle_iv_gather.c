@@ -59,25 +59,31 @@ static void ray(const lpv_grid *g, uint32_t seed, int x, int y, int z, int j, in
 }
 
 /* c's one occupied face neighbour own (and the unit axis side from it to c),
- * if it has exactly one. As iv_gather.comp's surface_beside. */
+ * if it has exactly one; else own stays c (the march skips own: left at the
+ * last of two neighbours, it let an edge voxel's rays through a wall) and
+ * side 0. As iv_gather.comp's surface_beside. */
 static int surface_beside(const lpv_grid *g, const lpv_iv_voxel *voxels, const int c[3], int own[3], float side[3])
 {
     int n = 0;
-    for (int k = 0; k < 3; k++)
+    memcpy(own, c, 3 * sizeof *own);
+    side[0] = side[1] = side[2] = 0.0f;
+    for (int k = 0; k < 3 && n < 2; k++)
         for (int sgn = -1; sgn <= 1; sgn += 2) {
             int q[3] = {c[0], c[1], c[2]};
             q[k] += sgn;
-            if (occupied_at(g, voxels, q[0], q[1], q[2])) {
-                n++;
+            if (occupied_at(g, voxels, q[0], q[1], q[2]) && ++n == 1) {
                 memcpy(own, q, sizeof q);
-                side[0] = side[1] = side[2] = 0.0f;
                 side[k] = -(float)sgn;
             }
         }
+    if (n != 1) {
+        memcpy(own, c, 3 * sizeof *own);
+        side[0] = side[1] = side[2] = 0.0f;
+    }
     return n == 1;
 }
 
-/* Whether a surface ray's stretch through occupied voxel h at q, from
+/* Whether a ray's stretch through occupied voxel h at q, from
  * o + t_in w to o + t_out w (in voxels), meets its surface: passes through
  * its slab (LPV_IV_SLAB, widened by LPV_IV_SLAB_PAD), anywhere in it where
  * it has none. As iv_gather.comp's meets. */
@@ -93,11 +99,15 @@ static int meets(const lpv_iv_voxel *h, const int q[3], const float o[3], const 
 
 /* The march from o (in voxels) along w (Amanatides & Woo, as iv_gather.comp
  * walks it): every voxel the ray crosses but c and own, until an occupied
- * one (with surf, one whose slab it meets: LPV_IV_SURFACE_GATHER), the
- * grid's edge (LPV_IV_ESCAPED) or, entering a voxel more than reach voxels
- * from the start (start + the distance from o), LPV_IV_BEYOND. */
+ * one (with slabs, one whose slab it meets: LPV_IV_SLAB_MARCH), the grid's
+ * edge (LPV_IV_ESCAPED) or, entering a voxel more than reach voxels from the
+ * start (start + the distance from o), LPV_IV_BEYOND. With slabs, *corner
+ * gets the axis of the face through which the ray entered the voxel it hit
+ * when it came straight from an occupied voxel it passed (LPV_IV_CORNER_READ),
+ * else -1; q_hit the voxel's coordinates. */
 static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int c[3], const int own[3],
-                       const float o[3], const float w[3], int surf, float start, float reach)
+                       const float o[3], const float w[3], int slabs, float start, float reach, int q_hit[3],
+                       int *corner)
 {
     float inv[3], cross[3];
     int q[3], st[3];
@@ -108,6 +118,8 @@ static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int 
         cross[a] = (w[a] > 0.0f ? (float)q[a] + 1.0f - o[a] : o[a] - (float)q[a]) * inv[a];
     }
     float t = 0.0f;
+    int entered = -1, passed = 0; /* the face q was entered through; the voxel before it was occupied */
+    *corner = -1;
     const long max_steps = (long)g->dims[0] + g->dims[1] + g->dims[2] + 3;
     for (long i = 0; i < max_steps; i++) {
         if (start + t > reach)
@@ -118,13 +130,51 @@ static long march_from(const lpv_grid *g, const lpv_iv_voxel *voxels, const int 
         const int a = cross[0] < cross[1] ? (cross[0] < cross[2] ? 0 : 2) : (cross[1] < cross[2] ? 1 : 2);
         const int skip = (q[0] == c[0] && q[1] == c[1] && q[2] == c[2]) ||
                          (q[0] == own[0] && q[1] == own[1] && q[2] == own[2]);
-        if (!skip && lpv_iv_occupied(&voxels[h]) && (!surf || meets(&voxels[h], q, o, w, t, cross[a])))
+        const int held = !skip && lpv_iv_occupied(&voxels[h]);
+        if (held && (!slabs || meets(&voxels[h], q, o, w, t, cross[a]))) {
+            memcpy(q_hit, q, sizeof q);
+            *corner = slabs && passed ? entered : -1;
             return (long)h;
+        }
+        passed = held;
+        entered = a;
         t = cross[a];
         q[a] += st[a];
         cross[a] += inv[a];
     }
     return LPV_IV_ESCAPED;
+}
+
+/* LPV_IV_CORNER_READ: what a ray that reached voxel q through the face
+ * across `axis`, straight from a surface it passed, sees there. A voxel
+ * without a slab (a corner: a floor's and a wall's ends, a thin wall's two
+ * faces and the floor under it) shows its points' mean as two hemispheres
+ * along one axis, which reads a wall's lit face behind its dark back and
+ * hidden faces; the ray is looking at the surfaces that continue into it, so
+ * it reads the mean of its face neighbours that hold a slab across `axis`
+ * (the wall above a floor's corner, for a ray that skimmed the floor
+ * towards the wall), or q itself where none does. Returns the voxels read
+ * (their indices in out[0..]). */
+static int corner_read(const lpv_grid *g, const lpv_iv_voxel *voxels, const int q[3], long h, int axis, long out[4])
+{
+    int n = 0;
+    if (axis >= 0 && voxels[h].slab[0] < 0.0f)
+        for (int b = 0; b < 3; b++) {
+            if (b == axis)
+                continue;
+            for (int sg = -1; sg <= 1; sg += 2) {
+                int p[3] = {q[0], q[1], q[2]};
+                p[b] += sg;
+                if (!occupied_at(g, voxels, p[0], p[1], p[2]))
+                    continue;
+                const size_t k = lpv_grid_index(g, p[0], p[1], p[2]);
+                if (voxels[k].slab[0] == (float)axis)
+                    out[n++] = (long)k;
+            }
+        }
+    if (n == 0)
+        out[n++] = h;
+    return n;
 }
 
 long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z, const float w[3], float reach)
@@ -136,7 +186,8 @@ long lpv_iv_march(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, i
     float o[3];
     for (int a = 0; a < 3; a++)
         o[a] = (float)c[a] + 0.5f + start * w[a];
-    return march_from(g, voxels, c, c, o, w, 0, start, reach / g->cell_size);
+    int q_hit[3], corner;
+    return march_from(g, voxels, c, c, o, w, 0, start, reach / g->cell_size, q_hit, &corner);
 }
 
 void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *emit, uint32_t seed, int rays,
@@ -172,21 +223,29 @@ void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell
                 for (int j = 0; j < rays; j++) {
                     float w[3], yb[4];
                     ray(g, seed, x, y, z, j, rays, w, yb);
-                    long h;
+                    long h, read[4];
+                    int n_read = 1;
                     if (surf && w[0] * side[0] + w[1] * side[1] + w[2] * side[2] <= 0.0f) {
                         h = (long)lpv_grid_index(g, own[0], own[1], own[2]); /* into the surface */
+                        read[0] = h;
                     } else {
                         float o[3];
+                        int q_hit[3], corner;
                         for (int k = 0; k < 3; k++)
                             o[k] = surf ? origin[k] : (float)c[k] + 0.5f + start * w[k];
-                        h = march_from(g, voxels, c, own, o, w, surf, start, INFINITY);
+                        h = march_from(g, voxels, c, own, o, w, 1, start, INFINITY, q_hit, &corner);
+                        if (h >= 0)
+                            n_read = corner_read(g, voxels, q_hit, h, corner, read);
                     }
                     if (h < 0)
                         continue; /* escaped: no light */
                     const float back[3] = {-w[0], -w[1], -w[2]};
                     const float up = axis[0] * w[0] + axis[1] * w[1] + axis[2] * w[2];
                     for (int ch = 0; ch < 3; ch++) {
-                        float L = lpv_iv_emitted(cchannel(&emit[h], ch), back);
+                        float L = 0.0f;
+                        for (int r = 0; r < n_read; r++)
+                            L += lpv_iv_emitted(cchannel(&emit[read[r]], ch), back);
+                        L /= (float)n_read;
                         if (!(L > 0.0f))
                             continue;
                         for (int k = 0; k < 4; k++)

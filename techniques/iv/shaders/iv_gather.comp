@@ -1,11 +1,13 @@
 // iv_gather.comp - radiance caching (paper 3.3): every voxel that a lookup
 // can read (one with an occupied voxel among its 27) marches u_rays
 // stratified rays (lpv_iv_ray) through the occupancy and visits every voxel
-// each crosses, until an occupied voxel or the volume's edge. An occupied
-// voxel's rays start LPV_IV_START voxels out; an empty one's at its centre,
-// or on the surface beside it (LPV_IV_SURFACE_GATHER: those rays pass the
-// occupied voxels whose slab they run clear of, LPV_IV_SLAB). A hit sees
-// what that voxel emits towards the ray's origin; a ray that leaves the
+// each crosses, until an occupied voxel whose slab it meets
+// (LPV_IV_SLAB_MARCH; any occupied voxel for the AO) or the volume's edge.
+// An occupied voxel's rays start LPV_IV_START voxels out; an empty one's at
+// its centre, or on the surface beside it (LPV_IV_SURFACE_GATHER). A hit
+// sees what that voxel emits towards the ray's origin (a corner reached
+// past a surface: what the surfaces beside it emit, LPV_IV_CORNER_READ); a
+// ray that leaves the
 // volume sees nothing (lpvd has no environment light: the path-traced
 // reference sees black there too). The Monte-Carlo projection
 // 4 pi / N sum L Y stores the arriving radiance as SH of the direction it
@@ -45,10 +47,10 @@ float emitted(vec4 e, vec3 t)
     return max(dot(v, t) > 0.0 ? sum + diff : sum - diff, 0.0) * (0.5 / LPV_PI);
 }
 
-// Whether a surface ray's stretch through occupied voxel q, from
+// Whether a ray's stretch through occupied voxel q, from
 // o + t_in w to o + t_out w (in voxels), meets its surface: passes through
 // the slab its points lie in where they lie thin along an axis
-// (LPV_IV_SLAB), else anywhere in it (techniques/iv/core/oracle_iv.c, march).
+// (LPV_IV_SLAB), else anywhere in it (techniques/iv/core/oracle_iv_gather.c, meets).
 bool meets(ivec3 q, vec3 o, vec3 w, float t_in, float t_out)
 {
     vec4 slab = voxels[cell_index(q)].slab;
@@ -60,7 +62,9 @@ bool meets(ivec3 q, vec3 o, vec3 w, float t_in, float t_out)
 }
 
 // c's one occupied face neighbour qs (a floor's voxel under it), if it has
-// exactly one; a the unit axis from qs to c.
+// exactly one; a the unit axis from qs to c. Else qs stays c and a 0: the
+// march skips qs, and left at the last of two neighbours it let an edge
+// voxel's rays through that wall.
 bool surface_beside(ivec3 c, out ivec3 qs, out vec3 a)
 {
     int n = 0;
@@ -70,14 +74,49 @@ bool surface_beside(ivec3 c, out ivec3 qs, out vec3 a)
         for (int sgn = -1; sgn <= 1; sgn += 2) {
             ivec3 q = c;
             q[k] += sgn;
-            if (cell_inside(q) && occupied(q)) {
-                ++n;
+            if (cell_inside(q) && occupied(q) && ++n == 1) {
                 qs = q;
-                a = vec3(0.0);
                 a[k] = -float(sgn);
             }
         }
+    if (n != 1) {
+        qs = c;
+        a = vec3(0.0);
+    }
     return n == 1;
+}
+
+vec3 emitted3(int v, vec3 t)
+{
+    LpvCell e = emit[v];
+    return vec3(emitted(e.r, t), emitted(e.g, t), emitted(e.b, t));
+}
+
+// What a ray that hit voxel v at q sees along -t (LPV_IV_CORNER_READ): with
+// axis >= 0 (it came through the face across that axis straight from a
+// surface it passed) and no slab in v, the mean of v's face neighbours that
+// hold a slab across axis; else v's own light (techniques/iv/core/oracle_iv_gather.c, corner_read).
+vec3 corner_read(ivec3 q, int v, int axis, vec3 t)
+{
+    if (axis >= 0 && voxels[v].slab.x < 0.0) {
+        vec3 sum = vec3(0.0);
+        float n = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            if (k == axis)
+                continue;
+            for (int sg = -1; sg <= 1; sg += 2) {
+                ivec3 p = q;
+                p[k] += sg;
+                if (!cell_inside(p) || !occupied(p) || voxels[cell_index(p)].slab.x != float(axis))
+                    continue;
+                sum += emitted3(cell_index(p), t);
+                n += 1.0;
+            }
+        }
+        if (n > 0.0)
+            return sum / n;
+    }
+    return emitted3(v, t);
 }
 
 bool needed(ivec3 c)
@@ -137,6 +176,8 @@ void main()
         lpv_iv_ray(u_seed, uint(i), uint(j), uint(u_rays), w);
         vec4 y = sh_basis(-w); // the light arrives travelling along -w
         int hit = -1;
+        ivec3 hit_q = ivec3(0);
+        int hit_axis = -1;
         bool out_of_reach = false;
         if (surf && dot(w, side) <= 0.0) {
             hit = cell_index(own); // into the surface: its own light
@@ -151,6 +192,8 @@ void main()
                             abs(w.z) > 1e-12 ? 1.0 / abs(w.z) : 1e30);
             vec3 cross_at = mix(o - vec3(q), vec3(q) + 1.0 - o, greaterThan(w, vec3(0.0))) * inv; // next faces
             float t = 0.0; // where the ray enters q, from o
+            int entered = -1;     // the axis of the face the ray entered q through (-1: it starts in q)
+            bool passed = false;  // the voxel before q holds a surface whose slab the ray ran clear of
             for (int s = 0; s < max_steps; ++s) {
                 if (u_ao != 0 && start + t > u_ao_reach) {
                     out_of_reach = true;
@@ -159,10 +202,16 @@ void main()
                 if (!cell_inside(q))
                     break;
                 int a = cross_at.x < cross_at.y ? (cross_at.x < cross_at.z ? 0 : 2) : (cross_at.y < cross_at.z ? 1 : 2);
-                if (q != c && q != own && occupied(q) && (!surf || meets(q, o, w, t, cross_at[a]))) {
+                bool held = q != c && q != own && occupied(q);
+                // LPV_IV_SLAB_MARCH: radiance rays pass the slabs they run clear of; AO keeps blocks
+                if (held && (u_ao != 0 || meets(q, o, w, t, cross_at[a]))) {
                     hit = cell_index(q);
+                    hit_q = q;
+                    hit_axis = passed ? entered : -1;
                     break;
                 }
+                passed = held;
+                entered = a;
                 t = cross_at[a];
                 q[a] += st[a];
                 cross_at[a] += inv[a];
@@ -175,8 +224,7 @@ void main()
         }
         if (hit < 0)
             continue;
-        LpvCell e = emit[hit];
-        vec3 L = vec3(emitted(e.r, -w), emitted(e.g, -w), emitted(e.b, -w));
+        vec3 L = corner_read(hit_q, hit, hit_axis, -w);
         r += L.r * y;
         g += L.g * y;
         b += L.b * y;
