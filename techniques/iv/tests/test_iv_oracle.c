@@ -143,27 +143,36 @@ static void furnace_run(const furnace *f, int rays, int bounces, uint32_t ray_se
         fail_msg("lpv_iv_run: %s", err);
 }
 
-/* Calls fn at points on the inner faces whose reconstruction corners are all
- * inside the box (1.5 .. 8.5 voxels along the face: nearer an edge the
- * corners would include wall voxels, whose rays leave the box), every
- * quarter voxel, on all six walls. */
+/* Calls fn at points on the six inner faces (inset voxels further out than
+ * the furnace's, 0.99 of the outer voxel layer's depth), from `from` voxels
+ * along each face in count steps of `step`. */
 typedef void (*wall_fn)(const float p[3], const float n[3], void *user);
 
-static void for_wall_points(const lpv_grid *g, wall_fn fn, void *user)
+static void for_face_points(const lpv_grid *g, float inset, float from, float step, int count, wall_fn fn,
+                            void *user)
 {
     for (int a = 0; a < 3; a++)
         for (int side = 0; side < 2; side++) {
             const int b = (a + 1) % 3, c = (a + 2) % 3;
-            for (int i = 0; i <= 28; i++)
-                for (int j = 0; j <= 28; j++) {
+            for (int i = 0; i < count; i++)
+                for (int j = 0; j < count; j++) {
                     float p[3], nrm[3] = {0.0f, 0.0f, 0.0f};
-                    p[a] = at(g, a, side == 0 ? 0.99f : (float)(g->dims[a] - 1) + 0.01f);
-                    p[b] = at(g, b, 1.5f + 0.25f * (float)i);
-                    p[c] = at(g, c, 1.5f + 0.25f * (float)j);
+                    p[a] = at(g, a, side == 0 ? 0.99f - inset : (float)(g->dims[a] - 1) + 0.01f + inset);
+                    p[b] = at(g, b, from + step * (float)i);
+                    p[c] = at(g, c, from + step * (float)j);
                     nrm[a] = side == 0 ? 1.0f : -1.0f;
                     fn(p, nrm, user);
                 }
         }
+}
+
+/* Calls fn at points on the inner faces whose reconstruction corners are all
+ * inside the box (1.5 .. 8.5 voxels along the face: nearer an edge the
+ * corners would include wall voxels, whose rays leave the box), every
+ * quarter voxel, on all six walls. */
+static void for_wall_points(const lpv_grid *g, wall_fn fn, void *user)
+{
+    for_face_points(g, 0.0f, 1.5f, 0.25f, 29, fn, user);
 }
 
 typedef struct ratio_stats {
@@ -345,19 +354,7 @@ static void test_thin_walls_glow_inside(void **state)
         st.hi[k] = -INFINITY;
     }
     /* on every inner face up to 1.1 voxels from its edges, every tenth of a voxel */
-    for (int a = 0; a < 3; a++)
-        for (int side = 0; side < 2; side++) {
-            const int b = (a + 1) % 3, c = (a + 2) % 3;
-            for (int i = 0; i <= 78; i++)
-                for (int j = 0; j <= 78; j++) {
-                    float p[3], nrm[3] = {0.0f, 0.0f, 0.0f};
-                    p[a] = at(&f.g, a, side == 0 ? 0.99f - THIN_INSET : (float)(f.g.dims[a] - 1) + 0.01f + THIN_INSET);
-                    p[b] = at(&f.g, b, 1.1f + 0.1f * (float)i);
-                    p[c] = at(&f.g, c, 1.1f + 0.1f * (float)j);
-                    nrm[a] = side == 0 ? 1.0f : -1.0f;
-                    ratio_at(p, nrm, &st);
-                }
-        }
+    for_face_points(&f.g, THIN_INSET, 1.1f, 0.1f, 79, ratio_at, &st);
     const double mean = st.sum[0] / st.count;
     print_message("thin walls glowing inside: E / B0 min %.4f mean %.4f max %.4f\n", st.lo[0], mean, st.hi[0]);
     assert_true(fabs(st.lo[0] - 1.0) <= 0.025 && fabs(st.hi[0] - 1.0) <= 0.025);
