@@ -30,6 +30,8 @@ typedef struct lpv_iv_settings {
     int bounces;            /* diffuse bounces (ping-pong passes) */
     lpv_switch tail;        /* the bounces after these (3 or more) as the series the last ones set
                                (iv_tail.comp) */
+    lpv_switch filter;      /* after the last bounce, each surface voxel takes the mean of those beside
+                               it on its plane (LPV_IV_FILTER) */
     lpv_switch reprojection; /* the camera's visible points refine the volume */
     int neighbours;         /* the reconstruction blends the nearest this many of the 8 voxels around
                                the shifted point: 6 (the paper's text) .. 8 (its figure 2) */

@@ -3,8 +3,9 @@
  * over voxels, rays and corners, sums in double. This file holds the entry
  * points (lpv_iv_run, lpv_iv_run_ao: checks, then creation and the bounces)
  * and the tail after the last bounce; the steps live beside it:
- * oracle_iv_create.c, oracle_iv_emit.c, oracle_iv_gather.c and
- * oracle_iv_reconstruct.c, sharing oracle_iv_internal.h.
+ * oracle_iv_create.c, oracle_iv_emit.c, oracle_iv_gather.c,
+ * oracle_iv_filter.c and oracle_iv_reconstruct.c, sharing
+ * oracle_iv_internal.h.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -109,6 +110,10 @@ int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, c
         float q[3];
         lpv_iv_tail_share((const double(*)[3])totals, d->bounces, q);
         lpv_iv_add_tail(cells, base, q, incoming);
+    }
+    if (d->filter) { /* prev is free now */
+        memcpy(prev, incoming, cells * sizeof *prev);
+        lpv_iv_filter(g, vox, prev, incoming);
     }
     rc = 0;
 done:

@@ -17,6 +17,7 @@
  *   for k = 1..K:
  *     lpv_iv_emit     what each occupied voxel sends out at bounce k
  *     lpv_iv_gather   the march: the radiance arriving at every voxel, I_k
+ *   lpv_iv_filter     the surface voxels' plane means (LPV_IV_FILTER)
  *   lpv_iv_irradiance at a surface point from I_K (the final lookup)
  * or lpv_iv_run for all of it; lpv_iv_gather_ao / lpv_iv_run_ao and
  * lpv_iv_ao for ambient occlusion.
@@ -172,6 +173,15 @@ void lpv_iv_total(size_t cells, const lpv_cell *incoming, double total[3]);
 void lpv_iv_tail_share(const double (*totals)[3], int K, float q[3]);
 void lpv_iv_add_tail(size_t cells, const lpv_cell *base, const float q[3], lpv_cell *last);
 
+/* LPV_IV_FILTER on I_K (after the tail): a voxel that gathers on a surface
+ * (empty, its one occupied face neighbour holding a slab across the axis k
+ * between them) gets sum w I / sum w over the voxels of the 3 x 3 block
+ * around it across k that do too, beside the same axis and side, with slab
+ * faces within LPV_IV_FILTER_PLANE voxels of its own, w = (2 - |du|) (2 -
+ * |dv|) (itself 4); every other voxel is copied. raw and out are different
+ * arrays of lpv_grid_cell_count cells. */
+void lpv_iv_filter(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell *raw, lpv_cell *out);
+
 /* The whole volume. */
 typedef struct lpv_iv_desc {
     lpv_grid grid;                /* cubic voxels; finite origin, finite cell size > 0 */
@@ -183,10 +193,12 @@ typedef struct lpv_iv_desc {
     int bounces;                  /* K >= 1 */
     int neighbours;               /* 1..8 */
     int tail;                     /* 1: the bounces after K (>= 3) as a series (lpv_iv_add_tail) */
+    int filter;                   /* 1: then the surface voxels' plane means (lpv_iv_filter) */
 } lpv_iv_desc;
 
 /* create, then for k = 1..K emit_k and gather_k: incoming gets I_K (which
- * already holds bounces 1..K), plus the tail with d->tail. voxels (may be NULL) gets the created
+ * already holds bounces 1..K), plus the tail with d->tail, filtered with
+ * d->filter. voxels (may be NULL) gets the created
  * volume. Both have lpv_grid_cell_count entries. Returns 0, or -1 with a
  * message in err (bad grid or knobs, out of memory). */
 int lpv_iv_run(const lpv_iv_desc *d, lpv_iv_voxel *voxels, lpv_cell *incoming, char *err, size_t err_size);

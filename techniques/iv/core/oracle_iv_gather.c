@@ -18,13 +18,6 @@ static void basis(const float d[3], float y[4])
     y[3] = LPV_SH_C1 * d[0];
 }
 
-/* 1 when voxel (x, y, z) is inside the grid and holds a surface. */
-static int occupied_at(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
-{
-    return x >= 0 && y >= 0 && z >= 0 && x < g->dims[0] && y < g->dims[1] && z < g->dims[2] &&
-           lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]);
-}
-
 /* 1 when any voxel of the 3x3x3 block around (x, y, z), itself included and
  * clipped to the grid, is occupied. */
 static int near_occupied(const lpv_grid *g, const lpv_iv_voxel *voxels, int x, int y, int z)
@@ -56,31 +49,6 @@ static void ray(const lpv_grid *g, uint32_t seed, int x, int y, int z, int j, in
     lpv_iv_ray(seed, (uint32_t)lpv_grid_index(g, x, y, z), (uint32_t)j, (uint32_t)rays, dir);
     const float back[3] = {-dir[0], -dir[1], -dir[2]};
     basis(back, y4);
-}
-
-/* c's one occupied face neighbour own (and the unit axis side from it to c),
- * if it has exactly one; else own stays c (the march skips own: left at the
- * last of two neighbours, it let an edge voxel's rays through a wall) and
- * side 0. As iv_gather.comp's surface_beside. */
-static int surface_beside(const lpv_grid *g, const lpv_iv_voxel *voxels, const int c[3], int own[3], float side[3])
-{
-    int n = 0;
-    memcpy(own, c, 3 * sizeof *own);
-    side[0] = side[1] = side[2] = 0.0f;
-    for (int k = 0; k < 3 && n < 2; k++)
-        for (int sgn = -1; sgn <= 1; sgn += 2) {
-            int q[3] = {c[0], c[1], c[2]};
-            q[k] += sgn;
-            if (occupied_at(g, voxels, q[0], q[1], q[2]) && ++n == 1) {
-                memcpy(own, q, sizeof q);
-                side[k] = -(float)sgn;
-            }
-        }
-    if (n != 1) {
-        memcpy(own, c, 3 * sizeof *own);
-        side[0] = side[1] = side[2] = 0.0f;
-    }
-    return n == 1;
 }
 
 /* Whether a ray's stretch through occupied voxel h at q, from
@@ -203,21 +171,15 @@ void lpv_iv_gather(const lpv_grid *g, const lpv_iv_voxel *voxels, const lpv_cell
                     continue;
                 const int c[3] = {x, y, z};
                 const float start = lpv_iv_occupied(&voxels[lpv_grid_index(g, x, y, z)]) ? LPV_IV_START : 0.0f;
-                float axis[3] = {0.0f, 0.0f, 0.0f}, side[3] = {0.0f, 0.0f, 0.0f}, origin[3];
-                int own[3] = {x, y, z}, surf = 0;
+                float axis[3] = {0.0f, 0.0f, 0.0f}, side[3], origin[3], plane;
+                int own[3], k_plane;
                 for (int k = 0; k < 3; k++)
                     origin[k] = (float)c[k] + 0.5f;
                 /* LPV_IV_SURFACE_GATHER: on the slab of the one surface beside it */
-                if (start == 0.0f && surface_beside(g, voxels, c, own, side)) {
-                    const int k = side[0] != 0.0f ? 0 : side[1] != 0.0f ? 1 : 2;
-                    const float *slab = voxels[lpv_grid_index(g, own[0], own[1], own[2])].slab;
-                    surf = slab[0] == (float)k;
-                    if (surf) {
-                        origin[k] = (float)own[k] + (side[k] > 0.0f ? slab[2] : slab[1]) + LPV_IV_SLAB_PAD * side[k];
-                        memcpy(axis, side, sizeof axis); /* LPV_IV_AXIS_L0 */
-                    } else {
-                        memcpy(own, c, sizeof own);
-                    }
+                const int surf = surface_plane(g, voxels, c, own, side, &k_plane, &plane);
+                if (surf) {
+                    origin[k_plane] = plane + LPV_IV_SLAB_PAD * side[k_plane];
+                    memcpy(axis, side, sizeof axis); /* LPV_IV_AXIS_L0 */
                 }
                 double acc[3][4] = {{0.0}}, e_plus[3] = {0.0}, e_minus[3] = {0.0};
                 for (int j = 0; j < rays; j++) {

@@ -28,7 +28,7 @@ typedef struct lpv_iv_gpu {
     lpv_settings settings;
     lpv_grid grid;    /* of the last commit */
     lpv_grid pending; /* of the last place */
-    GLuint prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail;
+    GLuint prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail, prog_filter;
     GLuint empty_vao, grid_ubo, tail; /* tail: iv_tail.comp's totals and ratio */
     lpv_atlas atlas;
     GLuint voxels, occupancy, emit, radiance[2], tail_base, ao; /* tail_base: I_{K-2} for the tail */
@@ -37,6 +37,7 @@ typedef struct lpv_iv_gpu {
     int alloc_dims[3];
     int bounces_run;  /* by the last computed tick */
     int tail_run;     /* the last computed tick added the tail (iv_tail.comp) */
+    int filter_run;   /* the last computed tick filtered the surface voxels (iv_filter.comp) */
     /* the scene's point cloud (iv_cloud.c; techniques/iv/core/iv_points.h) */
     GLuint points;            /* IvPoint, 0 = not sampled */
     lpv_iv_point_stats cloud; /* what sampling it gave (cloud.points: its count) */
@@ -61,8 +62,8 @@ void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in);
  * visibility into the AO volume (ao 1). */
 void lpv_iv_march_volume(lpv_iv_gpu *v, const lpv_settings *s, GLuint out, int ao, lpv_timer *timer);
 /* iv_gather: bounces 1..K, each an emission pass and a march, then with
- * iv_tail on (K >= 3) the bounces after K as a series; the result in
- * v->radiance[v->result]. */
+ * iv_tail on (K >= 3) the bounces after K as a series, then with iv_filter
+ * on the surface voxels' plane means; the result in v->radiance[v->result]. */
 void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in);
 /* The ratios (r, g, b) the last tail used (0: none), read back from the GPU. */
 void lpv_iv_gpu_tail_ratio(const lpv_iv_gpu *v, float rgb[3]);

@@ -132,7 +132,8 @@ static void tail_pass(lpv_iv_gpu *v, int mode, int k, GLuint last, GLuint before
 /* Bounces 1..K: emission from the previous gather, then a march; then the
  * tail (iv_tail on, K >= 3): the totals of the last four gathers and the
  * series they set, from I_K and I_{K-2} (kept in v->tail_base before the last
- * gather overwrites it). */
+ * gather overwrites it); then iv_filter (LPV_IV_FILTER) into the other
+ * volume. */
 void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
 {
     const lpv_settings *s = in->settings;
@@ -167,6 +168,19 @@ void lpv_iv_gather_bounces(lpv_iv_gpu *v, const lpv_technique_inputs *in)
     }
     if (tail)
         tail_pass(v, 1, s->iv.bounces, v->radiance[cur], v->tail_base, in->timer);
+    v->filter_run = s->iv.filter == LPV_SWITCH_ON && !lpv_timer_abandoned(in->timer);
+    if (v->filter_run) { /* LPV_IV_FILTER: into the other volume, which then holds the result */
+        glUseProgram(v->prog_filter);
+        glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_OCCUPANCY, v->occupancy);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_VOXELS, v->voxels);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_ACC, v->radiance[cur]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_LPV_OUT, v->radiance[1 - cur]);
+        glDispatchCompute(groups(v), 1, 1);
+        lpv_timer_count(in->timer, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        cur = 1 - cur;
+    }
     v->result = cur;
     v->bounces_run = s->iv.bounces;
     v->tail_run = tail;

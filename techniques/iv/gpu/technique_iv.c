@@ -17,7 +17,9 @@
  *                 then every voxel a lookup reads marches its rays and
  *                 stores the arriving radiance as SH (3.3), ping-ponging
  *                 two volumes; then the bounces after the last as the
- *                 series the last ones set (iv_tail.comp)
+ *                 series the last ones set (iv_tail.comp); then each
+ *                 surface voxel's the mean of those beside it on its
+ *                 plane (iv_filter.comp, LPV_IV_FILTER)
  *   iv_ao         the same march for visibility within a reach (3.5)
  *
  * The lookup (iv_volume.glsl, iv_lookup.glsl) reconstructs irradiance at a
@@ -36,6 +38,7 @@
 
 static const char *const INC_SPLAT[] = {"grid.glsl", "lights.glsl", "iv_direct.glsl", "iv_volume.glsl", NULL};
 static const char *const INC_GRID[] = {"grid.glsl", NULL};
+static const char *const INC_SURFACE[] = {"grid.glsl", "iv_surface.glsl", NULL};
 static const char *const LOOKUP[] = {"grid.glsl", "iv_volume.glsl", "iv_lookup.glsl", NULL};
 
 static void free_storage(lpv_iv_gpu *v)
@@ -59,7 +62,7 @@ static void destroy(lpv_technique *t)
         return;
     free_storage(v);
     lpv_iv_free_cloud(v);
-    GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail};
+    GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail, v->prog_filter};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (progs[i])
             glDeleteProgram(progs[i]);
@@ -81,9 +84,10 @@ static lpv_technique *create(char *err, size_t err_size)
     v->prog_splat = lpv_program_build("iv_splat.vert", NULL, "iv_splat.frag", INC_SPLAT, err, err_size);
     v->prog_resolve = v->prog_splat ? lpv_program_build("iv_resolve.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
     v->prog_emit = v->prog_resolve ? lpv_program_build("iv_emit.comp", NULL, NULL, LOOKUP, err, err_size) : 0;
-    v->prog_gather = v->prog_emit ? lpv_program_build("iv_gather.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
+    v->prog_gather = v->prog_emit ? lpv_program_build("iv_gather.comp", NULL, NULL, INC_SURFACE, err, err_size) : 0;
     v->prog_tail = v->prog_gather ? lpv_program_build("iv_tail.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
-    if (!v->prog_tail) {
+    v->prog_filter = v->prog_tail ? lpv_program_build("iv_filter.comp", NULL, NULL, INC_SURFACE, err, err_size) : 0;
+    if (!v->prog_filter) {
         destroy(&v->base);
         return NULL;
     }
@@ -200,6 +204,7 @@ static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, siz
         v->result = 0;
         v->bounces_run = 0;
         v->tail_run = 0;
+        v->filter_run = 0;
         lpv_iv_clear_buffer(v->radiance[0]);
     }
     if (p->pass[LPV_PASS_IV_AO].run) {
@@ -301,6 +306,8 @@ static void stats(const lpv_technique *t, const lpv_plan *last, lpv_engine_stats
     lpv_stats_put(s, "ao", LPV_STAT_BOOL, last->pass[LPV_PASS_IV_AO].run, 0, 0); /* the ao term has a volume */
     lpv_stats_put(s, "tail", LPV_STAT_BOOL, tail, 0, 0); /* the bounces after these added as a series */
     lpv_stats_put(s, "tail_ratio", LPV_STAT_REAL3, ratio[0], ratio[1], ratio[2]);
+    /* the surface voxels took their plane's mean (LPV_IV_FILTER) */
+    lpv_stats_put(s, "filtered", LPV_STAT_BOOL, last->pass[LPV_PASS_IV_GATHER].run && v->filter_run, 0, 0);
 }
 
 const lpv_technique_class lpv_technique_iv = {

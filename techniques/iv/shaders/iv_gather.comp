@@ -17,8 +17,6 @@
 // from the centre as the paper's.
 layout(local_size_x = LPV_IV_WG) in;
 
-layout(std430, binding = LPV_SSBO_IV_OCCUPANCY) readonly buffer Occupancy { uint occupancy[]; };
-layout(std430, binding = LPV_SSBO_IV_VOXELS) readonly buffer Voxels { IvVoxel voxels[]; };
 layout(std430, binding = LPV_SSBO_IV_EMIT) readonly buffer Emit { LpvCell emit[]; };
 layout(std430, binding = LPV_SSBO_LPV_OUT) writeonly buffer Out { LpvCell gathered[]; };
 layout(std430, binding = LPV_SSBO_IV_AO) writeonly buffer Ao { vec4 ao[]; };
@@ -28,8 +26,6 @@ uniform int u_cell_first; // this dispatch's first cell (the march goes in chunk
 uniform uint u_seed;
 uniform int u_ao;
 uniform float u_ao_reach; // voxels
-
-bool occupied(ivec3 c) { int i = cell_index(c); return (occupancy[i >> 5] & (1u << uint(i & 31))) != 0u; }
 
 // The radiance one channel of a voxel's emission e sends along unit t
 // (techniques/iv/core/oracle_iv.c, emitted): e is the SH of the Lambertian hemispheres of
@@ -59,31 +55,6 @@ bool meets(ivec3 q, vec3 o, vec3 w, float t_in, float t_out)
     int k = int(slab.x);
     float x_in = o[k] - float(q[k]) + t_in * w[k], x_out = o[k] - float(q[k]) + t_out * w[k];
     return max(x_in, x_out) >= slab.y - LPV_IV_SLAB_PAD && min(x_in, x_out) <= slab.z + LPV_IV_SLAB_PAD;
-}
-
-// c's one occupied face neighbour qs (a floor's voxel under it), if it has
-// exactly one; a the unit axis from qs to c. Else qs stays c and a 0: the
-// march skips qs, and left at the last of two neighbours it let an edge
-// voxel's rays through that wall.
-bool surface_beside(ivec3 c, out ivec3 qs, out vec3 a)
-{
-    int n = 0;
-    qs = c;
-    a = vec3(0.0);
-    for (int k = 0; k < 3; ++k)
-        for (int sgn = -1; sgn <= 1; sgn += 2) {
-            ivec3 q = c;
-            q[k] += sgn;
-            if (cell_inside(q) && occupied(q) && ++n == 1) {
-                qs = q;
-                a[k] = -float(sgn);
-            }
-        }
-    if (n != 1) {
-        qs = c;
-        a = vec3(0.0);
-    }
-    return n == 1;
 }
 
 vec3 emitted3(int v, vec3 t)
@@ -159,16 +130,13 @@ void main()
     vec3 side = vec3(0.0), axis = vec3(0.0); // axis: LPV_IV_AXIS_L0
     bool surf = false;
     vec3 origin = centre;
-    if (u_ao == 0 && start == 0.0 && surface_beside(c, own, side)) {
-        int k = side.x != 0.0 ? 0 : side.y != 0.0 ? 1 : 2;
-        vec4 slab = voxels[cell_index(own)].slab;
-        surf = slab.x == float(k);
-        if (surf) {
-            origin[k] = float(own[k]) + (side[k] > 0.0 ? slab.z : slab.y) + LPV_IV_SLAB_PAD * side[k];
-            axis = side;
-        } else {
-            own = c; // a corner, a curved or tilted piece: from the centre, as any
-        }
+    int plane_axis;
+    float plane;
+    // a corner, a curved or tilted piece (no slab across the axis): from the centre, as any
+    if (u_ao == 0 && surface_plane(c, own, side, plane_axis, plane)) {
+        surf = true;
+        origin[plane_axis] = plane + LPV_IV_SLAB_PAD * side[plane_axis];
+        axis = side;
     }
     int max_steps = d.x + d.y + d.z + 3;
     for (int j = 0; j < u_rays; ++j) {

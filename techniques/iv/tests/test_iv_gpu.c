@@ -185,6 +185,9 @@ static void test_gather_and_lookup_match_oracle(void **state)
         lpv_iv_emit(g, vox, cpu, k, r->iv.neighbours, emit);
         lpv_iv_gather(g, vox, emit, (uint32_t)r->iv.seed, rays, cpu);
     }
+    assert_int_equal(r->iv.filter, LPV_SWITCH_ON); /* the default: the surface voxels' plane means */
+    memcpy(emit, cpu, cells * sizeof *emit);
+    lpv_iv_filter(g, vox, emit, cpu);
     assert_gather_matches(gpu, cpu, cells, "gather");
 
     /* the lookup, at points on the floor, the back wall and the boxes' tops */
@@ -353,6 +356,8 @@ static void test_thick_walls_match_oracle(void **state)
     float q[3];
     lpv_iv_tail_share((const double(*)[3])totals, bounces, q);
     lpv_iv_add_tail(cells, base, q, cpu);
+    memcpy(emit, cpu, cells * sizeof *emit);
+    lpv_iv_filter(g, vox, emit, cpu);
     print_message("thick walls: per-bounce tail ratio (red) GPU %.6f, oracle %.6f (red per bounce %.4g %.4g %.4g)\n",
                   lpv_stats_get(st, "tail_ratio")->v[0], sqrt((double)q[0]), totals[1][0], totals[2][0] - totals[1][0],
                   totals[3][0] - totals[2][0]);
