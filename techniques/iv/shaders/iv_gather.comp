@@ -149,6 +149,7 @@ void main()
         bool out_of_reach = false;
         if (surf && dot(w, side) <= 0.0) {
             hit = cell_index(own); // into the surface: its own light
+            hit_q = own;           // (hit_axis -1: corner_read reads it as it is)
         } else {
             // walk every voxel the ray crosses (Amanatides & Woo): a fixed
             // one-voxel step would skip voxels the ray only clips and leak
