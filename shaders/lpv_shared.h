@@ -563,6 +563,7 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_IV_OCCUPANCY 12 /* one bit per voxel, 32 to a uint, voxel index order */
 #define LPV_SSBO_IV_EMIT 13     /* LpvCell per voxel: what each occupied voxel sends out this bounce */
 #define LPV_SSBO_IV_AO 14       /* vec4 per voxel: the SH of the visible directions (travel convention) */
+#define LPV_SSBO_IV_POINT_STARTS 16 /* uint per voxel + 1: where its points begin in the sorted cloud (iv_points.comp) */
 #define LPV_SSBO_IV_TAIL 3       /* float[3 x LPV_IV_TAIL_SLOTS]: iv_tail.comp's totals and ratio (shares 3 with
                                     LPV_SSBO_TRANSMIT, which no iv pass binds) */
 #define LPV_SSBO_SHADE_REST 15  /* the frame's pixels left for shade_rest.comp (shading.glsl, LPV_LOOKUP_SPLIT) */

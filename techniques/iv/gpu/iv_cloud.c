@@ -1,10 +1,14 @@
 /*
  * iv_cloud.c - the imperfect volume's point cloud of the scene
  * (techniques/iv/core/iv_points.h), sampled at the voxel size its settings
- * place over where light can go, and kept on the GPU for iv_points. The
- * engine calls these through the class (sample_scene, samples_stale) when
- * the scene, the technique or a knob that touches samples changes.
+ * place over where light can go, sorted by the voxel each point falls in and
+ * kept on the GPU for iv_points (iv_points.comp: each voxel gathers its own
+ * points). The engine calls these through the class (sample_scene,
+ * samples_stale) when the scene, the technique or a knob that touches
+ * samples changes.
  */
+#include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,8 +18,95 @@
 void lpv_iv_free_cloud(lpv_iv_gpu *v)
 {
     lpv_gl_delete_buffer(&v->points);
+    lpv_gl_delete_buffer(&v->point_starts);
+    free(v->chunk_ends);
+    v->chunk_ends = NULL;
+    v->chunk_count = 0;
     memset(&v->cloud, 0, sizeof v->cloud);
     memset(&v->cloud_grid, 0, sizeof v->cloud_grid);
+}
+
+/* The voxel of g a point falls in, as iv_volume.glsl's iv_cell_of computes
+ * it from the grid's uniforms (the origin in cells, as upload_grid stores
+ * it); -1 for a point the splat would skip (no surface, not finite, no
+ * normal) or one outside the grid. A point on a voxel face may round to the
+ * other side on the GPU: it is then counted here and clamped to this
+ * voxel's face there. */
+static long voxel_of(const lpv_grid *g, const struct IvPoint *q)
+{
+    const float *p = q->position, *n = q->normal;
+    const float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (p[3] == 0.0f || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]) || !(len > 1e-8f) || isinf(len))
+        return -1;
+    long cell = 0, stride = 1;
+    for (int a = 0; a < 3; ++a) {
+        const float origin_cells = g->origin[a] / g->cell_size;
+        const float fc = floorf(p[a] / g->cell_size - origin_cells - LPV_IV_BEHIND * (n[a] / len));
+        if (!(fc >= 0.0f && fc < (float)g->dims[a]))
+            return -1;
+        cell += (long)fc * stride;
+        stride *= g->dims[a];
+    }
+    return cell;
+}
+
+/* Sorts the cloud by voxel (stable: a voxel sums its points in the cloud's
+ * order, as the splat's blending did), drops the points no voxel takes, and
+ * stores the sorted points, each voxel's start and the dispatch chunks. */
+static int store_sorted(lpv_iv_gpu *v, const lpv_grid *g, const struct IvPoint *pts, size_t n)
+{
+    const size_t cells = lpv_grid_cell_count(g);
+    uint32_t *starts = calloc(cells + 1, sizeof *starts);
+    long *cell_of = malloc((n ? n : 1) * sizeof *cell_of);
+    struct IvPoint *sorted = malloc((n ? n : 1) * sizeof *sorted);
+    size_t *ends = malloc((cells + 1) * sizeof *ends);
+    if (!starts || !cell_of || !sorted || !ends) {
+        free(starts);
+        free(cell_of);
+        free(sorted);
+        free(ends);
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        cell_of[i] = voxel_of(g, &pts[i]);
+        if (cell_of[i] >= 0)
+            starts[cell_of[i] + 1]++;
+    }
+    for (size_t c = 0; c < cells; ++c)
+        starts[c + 1] += starts[c];
+    const size_t kept = starts[cells];
+    uint32_t *fill = malloc((cells ? cells : 1) * sizeof *fill);
+    if (!fill) {
+        free(starts);
+        free(cell_of);
+        free(sorted);
+        free(ends);
+        return -1;
+    }
+    memcpy(fill, starts, cells * sizeof *fill);
+    for (size_t i = 0; i < n; ++i)
+        if (cell_of[i] >= 0)
+            sorted[fill[cell_of[i]]++] = pts[i];
+    free(fill);
+    free(cell_of);
+    /* dispatch chunks of whole voxels, about LPV_ATLAS_SPLAT_CHUNK points
+     * each, with a yield point between them (timer.h), as the splat had */
+    size_t chunks = 0, from = 0;
+    for (size_t c = 0; c < cells; ++c)
+        if (starts[c + 1] - starts[from] >= LPV_ATLAS_SPLAT_CHUNK || c + 1 == cells) {
+            ends[chunks++] = c + 1;
+            from = c + 1;
+        }
+    v->points = lpv_gl_new_ssbo((kept ? kept : 1) * sizeof *sorted);
+    if (kept)
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(kept * sizeof *sorted), sorted);
+    v->point_starts = lpv_gl_new_ssbo((cells + 1) * sizeof *starts);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)((cells + 1) * sizeof *starts), starts);
+    v->chunk_ends = ends;
+    v->chunk_count = chunks;
+    free(sorted);
+    free(starts);
+    return 0;
 }
 
 int lpv_iv_sample_scene(lpv_technique *t, const lpv_technique_scene *sc, char *err, size_t err_size)
@@ -33,12 +124,12 @@ int lpv_iv_sample_scene(lpv_technique *t, const lpv_technique_scene *sc, char *e
     if (lpv_iv_points_make(sc->geometry, &p, &pts, &n, &v->cloud) != 0)
         return lpv_error(err, err_size, "out of memory for the imperfect volume's points (iv_max_points %d)",
                          s->iv.max_points);
-    v->points = lpv_gl_new_ssbo(n * sizeof *pts);
-    if (n)
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * sizeof *pts), pts);
+    const int stored = store_sorted(v, &g, pts, n);
+    free(pts);
+    if (stored != 0)
+        return lpv_error(err, err_size, "out of memory sorting the imperfect volume's %zu points", n);
     v->cloud.points = n;
     v->cloud_grid = g;
-    free(pts);
     if (glGetError() != GL_NO_ERROR)
         return lpv_error(err, err_size, "%s: GL error while storing %zu imperfect-volume points",
                          sc->geometry->source, n);

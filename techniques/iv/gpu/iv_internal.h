@@ -28,7 +28,7 @@ typedef struct lpv_iv_gpu {
     lpv_settings settings;
     lpv_grid grid;    /* of the last commit */
     lpv_grid pending; /* of the last place */
-    GLuint prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail, prog_filter;
+    GLuint prog_points, prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail, prog_filter;
     GLuint empty_vao, grid_ubo, tail; /* tail: iv_tail.comp's totals and ratio */
     lpv_atlas atlas;
     GLuint voxels, occupancy, emit, radiance[2], tail_base, ao; /* tail_base: I_{K-2} for the tail */
@@ -39,7 +39,10 @@ typedef struct lpv_iv_gpu {
     int tail_run;     /* the last computed tick added the tail (iv_tail.comp) */
     int filter_run;   /* the last computed tick filtered the surface voxels (iv_filter.comp) */
     /* the scene's point cloud (iv_cloud.c; techniques/iv/core/iv_points.h) */
-    GLuint points;            /* IvPoint, 0 = not sampled */
+    GLuint points;            /* IvPoint sorted by voxel of cloud_grid, 0 = not sampled */
+    GLuint point_starts;      /* uint per voxel + 1: where each voxel's points begin (iv_points.comp) */
+    size_t *chunk_ends;       /* voxel ends of iv_points' dispatches, about LPV_ATLAS_SPLAT_CHUNK points each */
+    size_t chunk_count;
     lpv_iv_point_stats cloud; /* what sampling it gave (cloud.points: its count) */
     lpv_grid cloud_grid;      /* the volume it was made for (its pieces split by its voxel, kept in its box) */
 } lpv_iv_gpu;

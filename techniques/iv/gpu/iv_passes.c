@@ -3,6 +3,7 @@
  * (technique_iv.c's header lists them; docs/imperfect-volumes.md).
  */
 #include <stdint.h>
+#include <string.h>
 
 #include "iv_internal.h"
 
@@ -18,33 +19,75 @@ void lpv_iv_clear_buffer(GLuint b)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
 }
 
+/* iv_points: each voxel gathers its own points of the sorted cloud into its
+ * atlas texels (iv_points.comp), every texel of the volume written, in
+ * dispatches of whole voxels with a yield point between them. Returns
+ * whether it wrote the atlas (else the caller clears it). */
+static int gather_points(lpv_iv_gpu *v, const lpv_technique_inputs *in)
+{
+    if (!in->plan->pass[LPV_PASS_IV_POINTS].run || !v->cloud.points || !v->chunk_count ||
+        memcmp(&v->grid, &v->cloud_grid, sizeof v->grid) != 0)
+        return 0;
+    lpv_timer_begin(in->timer, "iv_points");
+    const GLuint prog = v->prog_points;
+    glUseProgram(prog);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_POINTS, v->points);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_POINT_STARTS, v->point_starts);
+    glActiveTexture(GL_TEXTURE0 + 5);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
+    glActiveTexture(GL_TEXTURE0 + 6);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
+    glActiveTexture(GL_TEXTURE0);
+    for (int i = 0; i < IV_ATTACHMENTS; ++i)
+        glBindImageTexture((GLuint)i, v->atlas.tex[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
+    glUniform1i(glGetUniformLocation(prog, "u_tiles_x"), v->atlas.tiles_x);
+    const GLint loc_first = glGetUniformLocation(prog, "u_cell_first");
+    const GLint loc_end = glGetUniformLocation(prog, "u_cell_end");
+    size_t first = 0;
+    for (size_t k = 0; k < v->chunk_count && !lpv_timer_abandoned(in->timer); ++k) {
+        const size_t end = v->chunk_ends[k];
+        glUniform1i(loc_first, (GLint)first);
+        glUniform1i(loc_end, (GLint)end);
+        glDispatchCompute(lpv_div_up(end - first, LPV_IV_WG), 1, 1);
+        lpv_timer_count(in->timer, 1);
+        first = end;
+        if (k + 1 < v->chunk_count)
+            lpv_timer_yield(in->timer);
+    }
+    for (int i = 0; i < IV_ATTACHMENTS; ++i)
+        glBindImageTexture((GLuint)i, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    /* the reprojection blends into these texels, the resolve fetches them */
+    glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    lpv_timer_end(in->timer);
+    return 1;
+}
+
 /* iv_points and iv_reproject: the points into the atlas. */
 void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
 {
     const lpv_plan *p = in->plan;
     GLuint prog = v->prog_splat;
-    lpv_atlas_begin(&v->atlas, prog, v->grid_ubo, v->empty_vao);
+    if (gather_points(v, in))
+        lpv_atlas_begin_keep(&v->atlas, prog, v->grid_ubo, v->empty_vao);
+    else
+        lpv_atlas_begin(&v->atlas, prog, v->grid_ubo, v->empty_vao);
     for (GLuint i = IV_ATTACHMENT_MAX; i < IV_ATTACHMENTS; ++i)
-        glBlendEquationi(i, GL_MAX); /* the points' extent (LPV_IV_COVER); the atlas was cleared to 0 */
+        glBlendEquationi(i, GL_MAX); /* the points' extent (LPV_IV_COVER) */
     glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
     glActiveTexture(GL_TEXTURE0 + 5);
     glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
     glActiveTexture(GL_TEXTURE0 + 6);
     glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
     glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
-    if (p->pass[LPV_PASS_IV_POINTS].run && v->cloud.points) {
-        lpv_timer_begin(in->timer, "iv_points");
-        glUniform1i(glGetUniformLocation(prog, "u_source"), 0);
-        lpv_atlas_splat(prog, LPV_SSBO_IV_POINTS, v->points, 0, v->cloud.points, 1, in->timer);
-        lpv_timer_end(in->timer);
-    }
     if (p->pass[LPV_PASS_IV_REPROJECT].run && in->gbuffer_w > 0 && in->gbuffer_h > 0) {
         lpv_timer_begin(in->timer, "iv_reproject");
         for (int i = 0; i < 4; ++i) {
             glActiveTexture(GL_TEXTURE0 + (GLenum)i);
             glBindTexture(GL_TEXTURE_2D, in->gbuffer[i]);
         }
-        glUniform1i(glGetUniformLocation(prog, "u_source"), 1);
         glUniform2i(glGetUniformLocation(prog, "u_gbuf_size"), in->gbuffer_w, in->gbuffer_h);
         int stride = 1;
         while ((size_t)((in->gbuffer_w + stride - 1) / stride) * (size_t)((in->gbuffer_h + stride - 1) / stride) >

@@ -7,8 +7,8 @@
  *
  *   iv_points     the scene's point cloud (techniques/iv/core/iv_points.h, N points per
  *                 triangle by Turk's formula, made when the geometry or its
- *                 knobs change) lit by the lights through their RSMs and
- *                 splatted into the voxels (paper 3.1)
+ *                 knobs change, sorted by voxel) lit by the lights through
+ *                 their RSMs, each voxel summing its own (paper 3.1)
  *   iv_reproject  the camera's visible pixels, lit the same way, splatted
  *                 into the same voxels (3.2)
  *   iv_resolve    the sums into per-voxel means and occupancy bits
@@ -62,7 +62,7 @@ static void destroy(lpv_technique *t)
         return;
     free_storage(v);
     lpv_iv_free_cloud(v);
-    GLuint progs[] = {v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail, v->prog_filter};
+    GLuint progs[] = {v->prog_points, v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail, v->prog_filter};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (progs[i])
             glDeleteProgram(progs[i]);
@@ -81,7 +81,9 @@ static lpv_technique *create(char *err, size_t err_size)
         return NULL;
     }
     v->base.cls = &lpv_technique_iv;
-    v->prog_splat = lpv_program_build("iv_splat.vert", NULL, "iv_splat.frag", INC_SPLAT, err, err_size);
+    v->prog_points = lpv_program_build("iv_points.comp", NULL, NULL, INC_SPLAT, err, err_size);
+    v->prog_splat =
+        v->prog_points ? lpv_program_build("iv_splat.vert", NULL, "iv_splat.frag", INC_SPLAT, err, err_size) : 0;
     v->prog_resolve = v->prog_splat ? lpv_program_build("iv_resolve.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
     v->prog_emit = v->prog_resolve ? lpv_program_build("iv_emit.comp", NULL, NULL, LOOKUP, err, err_size) : 0;
     v->prog_gather = v->prog_emit ? lpv_program_build("iv_gather.comp", NULL, NULL, INC_SURFACE, err, err_size) : 0;

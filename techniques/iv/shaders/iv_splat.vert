@@ -1,20 +1,18 @@
-// iv_splat.vert - one point into the voxel that holds it (paper 3.1 and
-// 3.2): a point of the cloud (u_source 0) or a visible pixel of the camera's
-// G-buffer (u_source 1). Each is lit here (iv_direct.glsl) and carries its
+// iv_splat.vert - one visible pixel of the camera's G-buffer into the voxel
+// that holds it (paper 3.2; the point cloud's voxels gather theirs in
+// iv_points.comp, which has written every voxel's texel before this draw
+// blends on top). Each is lit here (iv_direct.glsl) and carries its
 // outgoing radiance B / pi over its normal's hemisphere as SH (B = albedo x
 // E_direct + pi x emission), its normal, its albedo, a count of 1 and its
 // folded normal (LPV_IV_FOLD); the atlas sums them and iv_resolve.comp
-// divides by the count. A cloud point also carries its area, plain and
-// signed by its fold, and every point its place in the voxel to the two
-// attachments that keep the greatest (LPV_IV_COVER).
-layout(std430, binding = LPV_SSBO_IV_POINTS) readonly buffer Points { IvPoint points[]; };
+// divides by the count. A pixel carries no area (LPV_IV_COVER: only the
+// cloud's points stand for one), and its place in the voxel goes to the two
+// attachments that keep the greatest.
 layout(binding = 0) uniform sampler2D u_gbuf_position;
 layout(binding = 1) uniform sampler2D u_gbuf_normal;
 layout(binding = 2) uniform sampler2D u_gbuf_albedo;
 layout(binding = 3) uniform sampler2D u_gbuf_emission;
 
-uniform int u_source;      // 0 the cloud, 1 the G-buffer
-uniform int u_first;       // the cloud's first point
 uniform ivec2 u_gbuf_size;
 uniform int u_stride;      // every u_stride-th pixel in x and y
 uniform vec2 u_atlas_size;
@@ -34,29 +32,15 @@ void main()
     gl_PointSize = 1.0;
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0); // outside the clip volume: dropped
     v_r = v_g = v_b = v_n = v_a = v_f = v_hi = v_lo = vec4(0.0);
-    vec3 p, n, albedo, emission;
-    float area = 0.0; // m^2; the camera's pixels carry none (LPV_IV_COVER)
-    if (u_source == 0) {
-        IvPoint q = points[u_first + gl_VertexID];
-        if (q.position.w == 0.0)
-            return;
-        p = q.position.xyz;
-        n = q.normal.xyz;
-        albedo = q.albedo.rgb;
-        emission = q.emission.rgb;
-        area = q.normal.w;
-    } else {
-        int cols = (u_gbuf_size.x + u_stride - 1) / u_stride;
-        ivec2 t = ivec2(gl_VertexID % cols, gl_VertexID / cols) * u_stride;
-        vec4 gn = texelFetch(u_gbuf_normal, t, 0);
-        if (gn.w < 0.5 || lpv_gbuffer_wire(gn.w))
-            return; // background, or a point's or line's pixel (no surface)
-        p = texelFetch(u_gbuf_position, t, 0).xyz;
-        n = gn.xyz;
-        albedo = texelFetch(u_gbuf_albedo, t, 0).rgb * lpv_gbuffer_kd(gn.w); // diffuse
-        // an unlit pixel's emission target is what the camera sees, not light
-        emission = lpv_gbuffer_unlit(gn.w) ? vec3(0.0) : texelFetch(u_gbuf_emission, t, 0).rgb;
-    }
+    int cols = (u_gbuf_size.x + u_stride - 1) / u_stride;
+    ivec2 t = ivec2(gl_VertexID % cols, gl_VertexID / cols) * u_stride;
+    vec4 gn = texelFetch(u_gbuf_normal, t, 0);
+    if (gn.w < 0.5 || lpv_gbuffer_wire(gn.w))
+        return; // background, or a point's or line's pixel (no surface)
+    vec3 p = texelFetch(u_gbuf_position, t, 0).xyz, n = gn.xyz;
+    vec3 albedo = texelFetch(u_gbuf_albedo, t, 0).rgb * lpv_gbuffer_kd(gn.w); // diffuse
+    // an unlit pixel's emission target is what the camera sees, not light
+    vec3 emission = lpv_gbuffer_unlit(gn.w) ? vec3(0.0) : texelFetch(u_gbuf_emission, t, 0).rgb;
     float len = length(n);
     if (!finite3(p) || !(len > 1e-8) || isinf(len) || !finite3(albedo) || !finite3(emission))
         return;
@@ -73,12 +57,10 @@ void main()
     v_g = h * radiosity.g;
     v_b = h * radiosity.b;
     v_n = vec4(n, 1.0);
-    if (!(area >= 0.0) || isinf(area))
-        area = 0.0;
-    v_a = vec4(albedo, area);
+    v_a = vec4(albedo, 0.0);
     vec3 an = abs(n); // LPV_IV_FOLD
     float fs = (an.x >= an.y && an.x >= an.z ? n.x : an.y >= an.z ? n.y : n.z) >= 0.0 ? 1.0 : -1.0;
-    v_f = vec4(fs * n, fs * area);
+    v_f = vec4(fs * n, 0.0);
     vec3 local = clamp(u - vec3(c), 0.0, 1.0);
     v_hi = vec4(local, 0.0);
     v_lo = vec4(1.0 - local, 0.0);
