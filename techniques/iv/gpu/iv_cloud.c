@@ -50,45 +50,49 @@ static long voxel_of(const lpv_grid *g, const struct IvPoint *q)
     return cell;
 }
 
-/* Sorts the cloud by voxel (stable: a voxel sums its points in the cloud's
- * order, as the splat's blending did), drops the points no voxel takes, and
- * stores the sorted points, each voxel's start and the dispatch chunks. */
-static int store_sorted(lpv_iv_gpu *v, const lpv_grid *g, const struct IvPoint *pts, size_t n)
+/* Sorts the cloud by voxel in place (stable: a voxel sums its points in the
+ * cloud's order, as the splat's blending did; the points no voxel takes go
+ * last and are not stored), then stores the sorted points, each voxel's
+ * start and the dispatch chunks. In place, so that sampling needs 4 bytes a
+ * point beyond the cloud itself, not a second cloud. */
+static int store_sorted(lpv_iv_gpu *v, const lpv_grid *g, struct IvPoint *pts, size_t n)
 {
     const size_t cells = lpv_grid_cell_count(g);
-    uint32_t *starts = calloc(cells + 1, sizeof *starts);
-    long *cell_of = malloc((n ? n : 1) * sizeof *cell_of);
-    struct IvPoint *sorted = malloc((n ? n : 1) * sizeof *sorted);
-    size_t *ends = malloc((cells + 1) * sizeof *ends);
-    if (!starts || !cell_of || !sorted || !ends) {
+    uint32_t *starts = calloc(cells + 1, sizeof *starts), *fill = malloc(cells * sizeof *fill);
+    uint32_t *dest = malloc((n ? n : 1) * sizeof *dest); /* first each point's voxel, then its place */
+    size_t *ends = malloc(cells * sizeof *ends);
+    if (!starts || !fill || !dest || !ends || n > UINT32_MAX - 1) {
         free(starts);
-        free(cell_of);
-        free(sorted);
+        free(fill);
+        free(dest);
         free(ends);
         return -1;
     }
     for (size_t i = 0; i < n; ++i) {
-        cell_of[i] = voxel_of(g, &pts[i]);
-        if (cell_of[i] >= 0)
-            starts[cell_of[i] + 1]++;
+        const long c = voxel_of(g, &pts[i]);
+        dest[i] = c >= 0 ? (uint32_t)c : UINT32_MAX;
+        if (c >= 0)
+            starts[c + 1]++;
     }
     for (size_t c = 0; c < cells; ++c)
         starts[c + 1] += starts[c];
     const size_t kept = starts[cells];
-    uint32_t *fill = malloc((cells ? cells : 1) * sizeof *fill);
-    if (!fill) {
-        free(starts);
-        free(cell_of);
-        free(sorted);
-        free(ends);
-        return -1;
-    }
     memcpy(fill, starts, cells * sizeof *fill);
+    uint32_t dropped = (uint32_t)kept;
     for (size_t i = 0; i < n; ++i)
-        if (cell_of[i] >= 0)
-            sorted[fill[cell_of[i]]++] = pts[i];
+        dest[i] = dest[i] == UINT32_MAX ? dropped++ : fill[dest[i]]++;
+    /* each swap puts one point in its place: n swaps at most */
+    for (size_t i = 0; i < n; ++i)
+        while (dest[i] != i) {
+            const uint32_t j = dest[i];
+            const struct IvPoint t = pts[j];
+            pts[j] = pts[i];
+            pts[i] = t;
+            dest[i] = dest[j];
+            dest[j] = j;
+        }
+    free(dest);
     free(fill);
-    free(cell_of);
     /* dispatch chunks of whole voxels, about LPV_ATLAS_SPLAT_CHUNK points
      * each, with a yield point between them (timer.h), as the splat had */
     size_t chunks = 0, from = 0;
@@ -97,14 +101,13 @@ static int store_sorted(lpv_iv_gpu *v, const lpv_grid *g, const struct IvPoint *
             ends[chunks++] = c + 1;
             from = c + 1;
         }
-    v->points = lpv_gl_new_ssbo((kept ? kept : 1) * sizeof *sorted);
+    v->points = lpv_gl_new_ssbo((kept ? kept : 1) * sizeof *pts);
     if (kept)
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(kept * sizeof *sorted), sorted);
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(kept * sizeof *pts), pts);
     v->point_starts = lpv_gl_new_ssbo((cells + 1) * sizeof *starts);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)((cells + 1) * sizeof *starts), starts);
     v->chunk_ends = ends;
     v->chunk_count = chunks;
-    free(sorted);
     free(starts);
     return 0;
 }
