@@ -14,6 +14,7 @@
 
 #include "error.h"
 #include "iv_internal.h"
+#include "oracle_iv.h"
 
 void lpv_iv_free_cloud(lpv_iv_gpu *v)
 {
@@ -26,28 +27,20 @@ void lpv_iv_free_cloud(lpv_iv_gpu *v)
     memset(&v->cloud_grid, 0, sizeof v->cloud_grid);
 }
 
-/* The voxel of g a point falls in, as iv_volume.glsl's iv_cell_of computes
- * it from the grid's uniforms (the origin in cells, as upload_grid stores
- * it); -1 for a point the splat would skip (no surface, not finite, no
- * normal) or one outside the grid. A point on a voxel face may round to the
- * other side on the GPU: it is then counted here and clamped to this
- * voxel's face there. */
+/* The voxel of g a point falls in (oracle_iv.h lpv_iv_surface_voxel_of,
+ * the oracle's reading of iv_volume.glsl's iv_cell_of), as a voxel index;
+ * -1 for a point the voxels would skip (no surface, not finite, no normal)
+ * or one outside the grid. A point on a voxel face may round to the other
+ * side on the GPU: it is counted here and clamped to this voxel's face
+ * there. */
 static long voxel_of(const lpv_grid *g, const struct IvPoint *q)
 {
     const float *p = q->position, *n = q->normal;
     const float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (p[3] == 0.0f || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]) || !(len > 1e-8f) || isinf(len))
+    int c[3];
+    if (p[3] == 0.0f || !(len > 1e-8f) || isinf(len) || !lpv_iv_surface_voxel_of(g, p, n, c))
         return -1;
-    long cell = 0, stride = 1;
-    for (int a = 0; a < 3; ++a) {
-        const float origin_cells = g->origin[a] / g->cell_size;
-        const float fc = floorf(p[a] / g->cell_size - origin_cells - LPV_IV_BEHIND * (n[a] / len));
-        if (!(fc >= 0.0f && fc < (float)g->dims[a]))
-            return -1;
-        cell += (long)fc * stride;
-        stride *= g->dims[a];
-    }
-    return cell;
+    return (long)lpv_grid_index(g, c[0], c[1], c[2]);
 }
 
 /* Sorts the cloud by voxel in place (stable: a voxel sums its points in the
