@@ -94,10 +94,12 @@ typedef struct lpv_plan {
     int cascades;                           /* grids in use: lpv_plan_cascades' count, with the far
                                                field's levels added to one grid (lpv_cascades_count) */
     char cascades_reason[LPV_PLAN_REASON_MAX];
-    char iterations_reason[2 * LPV_PLAN_REASON_MAX]; /* why the propagation takes the steps it does
+    char iterations_reason[4 * LPV_PLAN_REASON_MAX]; /* why the propagation takes the steps it does
                                                (lpv_settings_iterations_note); "" for technique iv */
     int iterations_warning;                 /* 1: the steps leave light short of the grid (an explicit
-                                               count under half its longest axis, or the clamp cut) */
+                                               count under half its longest axis, or the clamp cut),
+                                               or the LPV's grid is too fine to carry it
+                                               (lpv_plan_grid_reach_note) */
     int recompute;                          /* 0: the cached volume is served, no tick pass runs */
     char recompute_reason[LPV_PLAN_REASON_MAX];
     int light_stale;                        /* set by a technique that carries light from tick to tick

@@ -460,6 +460,28 @@ static void test_planner_off_runs_everything(void **state)
     assert_false(p.recompute);
 }
 
+/* The LPV's grid finer than its transport carries light (issue 30): a grid
+ * over 16 cells on every axis warns and says why; 16, a long grid with a
+ * short axis at 16, and the preset's own grid do not. */
+static void test_grid_reach_note(void **state)
+{
+    (void)state;
+    static const struct {
+        int dims[3], warns;
+    } cases[] = {{{32, 32, 32}, 1}, {{24, 20, 17}, 1}, {{16, 16, 16}, 0}, {{16, 16, 128}, 0}, {{0, 0, 0}, 0}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        lpv_settings s = {.grid_dims = {cases[i].dims[0], cases[i].dims[1], cases[i].dims[2]}};
+        lpv_plan p = plan_of(s, baseline());
+        const int before = p.iterations_warning;
+        s = resolved(s);
+        lpv_plan_grid_reach_note(&s, &p);
+        assert_int_equal(p.iterations_warning, before || cases[i].warns);
+        assert_int_equal(strstr(p.iterations_reason, "finer than 16 cells") != NULL, cases[i].warns);
+        if (cases[i].warns) /* the note comes after the steps' own reason, which is kept */
+            assert_non_null(strstr(p.iterations_reason, "steps"));
+    }
+}
+
 static void test_bounce_needs_gv(void **state)
 {
     (void)state;
@@ -966,6 +988,7 @@ int main(void)
         cmocka_unit_test(test_recompute_rules),
         cmocka_unit_test(test_planner_off_runs_everything),
         cmocka_unit_test(test_bounce_needs_gv),
+        cmocka_unit_test(test_grid_reach_note),
         cmocka_unit_test(test_place_snapping_and_nesting),
         cmocka_unit_test(test_place_temporal),
         cmocka_unit_test(test_iv_plan),

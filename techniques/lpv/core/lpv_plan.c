@@ -92,3 +92,20 @@ void lpv_plan_make_lpv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan 
     p->consumes.camera_surfels = p->pass[LPV_PASS_GV].run && p->pass[LPV_PASS_GBUFFER].run;
 }
 
+
+void lpv_plan_grid_reach_note(const lpv_settings *s, lpv_plan *p)
+{
+    int shortest = s->grid_dims[0];
+    for (int i = 1; i < 3; ++i)
+        shortest = s->grid_dims[i] < shortest ? s->grid_dims[i] : shortest;
+    if (shortest <= LPV_GRID_REACH_CELLS)
+        return;
+    size_t len = strlen(p->iterations_reason);
+    snprintf(p->iterations_reason + len, sizeof p->iterations_reason - len,
+             "%sgrid %dx%dx%d is finer than %d cells on every axis: the LPV's transport spreads light sideways each "
+             "step, so finer cells carry it fewer metres and the frame gets darker (docs/accuracy.md, \"Knobs that "
+             "never make it worse\"); technique iv or grid %d give better light",
+             len ? "; " : "", s->grid_dims[0], s->grid_dims[1], s->grid_dims[2], LPV_GRID_REACH_CELLS,
+             LPV_GRID_REACH_CELLS);
+    p->iterations_warning = 1;
+}

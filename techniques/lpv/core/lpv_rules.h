@@ -13,6 +13,15 @@
  * producers it reads and its passes, each with its reason. s resolved. */
 void lpv_plan_make_lpv(const lpv_settings *s, const lpv_plan_facts *f, lpv_plan *out);
 
+/* The LPV's own (not the octree's) warning for a grid finer than
+ * LPV_GRID_REACH_CELLS on every axis: appended to out's iterations_reason,
+ * with iterations_warning set. Its transport spreads light sideways at each
+ * step, so light crosses fewer metres the finer the cells, and against
+ * converged light every scene of the accuracy set is worse at 32^3 than at
+ * 16^3 (docs/accuracy.md, "Knobs that never make it worse"). */
+#define LPV_GRID_REACH_CELLS 16
+void lpv_plan_grid_reach_note(const lpv_settings *s, lpv_plan *out);
+
 /* Cells x cascades (auto: the most the planner may place, the far field's
  * levels included) x normal bins x iterations. */
 void lpv_lpv_tick_cost(const lpv_settings *s, lpv_tick_cost *out);

@@ -131,6 +131,7 @@ static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_f
 {
     (void)t;
     lpv_plan_make_lpv(s, f, p);
+    lpv_plan_grid_reach_note(s, p);
 }
 
 static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
