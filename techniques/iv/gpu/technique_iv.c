@@ -191,6 +191,15 @@ static void plan(const lpv_technique *t, const lpv_settings *s, const lpv_plan_f
 {
     const lpv_iv_gpu *v = (const lpv_iv_gpu *)t;
     lpv_plan_make_iv(s, f, &v->cloud, p);
+    /* The cloud is sorted by the voxels of the placement it was sampled for;
+     * the engine samples again when the placement moves (samples_stale), so
+     * this only says so if a path ever forgets to. */
+    if (p->pass[LPV_PASS_IV_POINTS].run && v->points && memcmp(&v->pending, &v->cloud_grid, sizeof v->pending) != 0)
+        lpv_plan_decide(p, LPV_PASS_IV_POINTS, 0,
+                        "the point cloud was sampled for another placement (%dx%dx%d voxels, now %dx%dx%d): only the "
+                        "camera's pixels fill the volume until the scene is sampled again",
+                        v->cloud_grid.dims[0], v->cloud_grid.dims[1], v->cloud_grid.dims[2], v->pending.dims[0],
+                        v->pending.dims[1], v->pending.dims[2]);
 }
 
 static int tick(lpv_technique *t, const lpv_technique_inputs *in, char *err, size_t err_size)
