@@ -119,9 +119,11 @@ static void closure_faces(const float c[4], float flux[6], float mom[6][3])
     }
 }
 
-/* One closure step of one channel (r), copied to g and b. */
-static void closure_step(const lpv_grid *g, const lpv_cell *in, lpv_cell *out)
+/* One closure step of one channel (r), copied to g and b; no occlusion. */
+static void closure_step(const lpv_grid *g, const lpv_cell *in, const float *t, void *ctx, lpv_cell *out)
 {
+    (void)t;
+    (void)ctx;
     static const int dir[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     size_t cells = lpv_grid_cell_count(g);
     memset(out, 0, cells * sizeof *out);
@@ -147,35 +149,6 @@ static void closure_step(const lpv_grid *g, const lpv_cell *in, lpv_cell *out)
     }
 }
 
-static int closure_propagate(const lpv_grid *g, const lpv_cell *injected, int steps, lpv_cell *acc)
-{
-    size_t cells = lpv_grid_cell_count(g);
-    lpv_cell *cur = malloc(cells * sizeof *cur), *next = malloc(cells * sizeof *next);
-    if (!cur || !next) {
-        free(cur);
-        free(next);
-        return -1;
-    }
-    memcpy(cur, injected, cells * sizeof *cur);
-    memcpy(acc, injected, cells * sizeof *acc);
-    for (int i = 0; i < steps; i++) {
-        closure_step(g, cur, next);
-        for (size_t c = 0; c < cells; c++) {
-            for (int k = 0; k < 4; k++) {
-                acc[c].r[k] += next[c].r[k];
-                acc[c].g[k] += next[c].g[k];
-                acc[c].b[k] += next[c].b[k];
-            }
-        }
-        lpv_cell *tmp = cur;
-        cur = next;
-        next = tmp;
-    }
-    free(cur);
-    free(next);
-    return 0;
-}
-
 #define TRANSPORT_CLOSURE (-1)
 
 /* Every VPL faces +y, so the binned injection fills the +y bin alone and
@@ -195,8 +168,9 @@ static int run_grid(int n, int steps, int transport, double offset, const lpv_vp
     const float plus_y[3] = {0.0f, 1.0f, 0.0f};
     const size_t up = (size_t)lpv_oracle_normal_bin(plus_y) * cells; /* the +y bin */
     lpv_oracle_inject_vpls_binned(&g, vpls, nvpl, inj);
-    int rc = transport == TRANSPORT_CLOSURE ? closure_propagate(&g, inj + up, steps, acc + up)
-                                            : lpv_oracle_propagate_with(&g, inj + up, NULL, steps, transport, acc + up);
+    int rc = transport == TRANSPORT_CLOSURE
+                 ? lpv_oracle_propagate_steps(&g, inj + up, NULL, steps, closure_step, NULL, acc + up)
+                 : lpv_oracle_propagate_with(&g, inj + up, NULL, steps, transport, acc + up);
     if (rc == 0) {
         for (int lookup = 0; lookup < 2; lookup++) {
             printf("%4d %4d %-6s", n, steps, lookup == 0 ? "bins" : "plain");

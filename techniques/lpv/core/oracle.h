@@ -70,6 +70,13 @@ void lpv_oracle_propagate_step_with(const lpv_grid *g, const lpv_cell *in, const
 int lpv_oracle_propagate_with(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
                               int transport, lpv_cell *acc);
 
+/* The whole propagation's loop with any step (the oracle's, or a trial
+ * transport's in bench/lpv_plane_reach.c): step(g, in, t or NULL, ctx, out)
+ * overwrites out; acc, occlusion and the return as lpv_oracle_propagate. */
+typedef void (*lpv_oracle_step_fn)(const lpv_grid *g, const lpv_cell *in, const float *t, void *ctx, lpv_cell *out);
+int lpv_oracle_propagate_steps(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
+                               lpv_oracle_step_fn step, void *ctx, lpv_cell *acc);
+
 /* Normal bins (docs/propagation.md section 6b). The bin of a unit normal: its
  * dominant axis and sign in the direction order +x -x +y -y +z -z (ties go to
  * the lower axis). */

@@ -200,8 +200,19 @@ int lpv_oracle_propagate(const lpv_grid *g, const lpv_cell *injected, const floa
     return lpv_oracle_propagate_with(g, injected, t, iterations, LPV_TRANSPORT_PAPER, acc);
 }
 
+static void transport_step(const lpv_grid *g, const lpv_cell *in, const float *t, void *ctx, lpv_cell *out)
+{
+    lpv_oracle_propagate_step_with(g, in, t, *(const int *)ctx, out);
+}
+
 int lpv_oracle_propagate_with(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
                               int transport, lpv_cell *acc)
+{
+    return lpv_oracle_propagate_steps(g, injected, t, iterations, transport_step, &transport, acc);
+}
+
+int lpv_oracle_propagate_steps(const lpv_grid *g, const lpv_cell *injected, const float *t, int iterations,
+                               lpv_oracle_step_fn step, void *ctx, lpv_cell *acc)
 {
     size_t count = lpv_grid_cell_count(g);
     size_t bytes = count * sizeof(lpv_cell);
@@ -221,7 +232,7 @@ int lpv_oracle_propagate_with(const lpv_grid *g, const lpv_cell *injected, const
 
     for (int i = 0; i < iterations; i++) {
         /* No occlusion on the first step: a VPL's own surface would shadow it. */
-        lpv_oracle_propagate_step_with(g, cur, i == 0 ? NULL : t, transport, next);
+        step(g, cur, i == 0 ? NULL : t, ctx, next);
         accumulate(count, next, acc);
         lpv_cell *tmp = cur;
         cur = next;
