@@ -4,8 +4,8 @@
  * behind the grid knob that makes the Cornell box worse at 32^3
  * (docs/accuracy.md, "Knobs that never make it worse").
  *
- *   lpvd-lpv-plane-reach [--paper | --closure] [--steps-per-cell K] [--max-grid N]
- *                        [--offset X]
+ *   lpvd-lpv-plane-reach [--paper | --closure | --ordinates K] [--steps-per-cell K]
+ *                        [--max-grid N] [--offset X]
  *
  * A 1 m x 1 m patch of exitance 1 W/m^2 (50 x 50 VPLs facing +y) lies on the
  * floor of an open 2 m cube. For grids 8^3, 16^3, ... N^3 (default 32) the
@@ -26,6 +26,17 @@
  * faces it points through by its direction cosines), and the neighbour
  * receives what went through each face as its flux and first moment, so a
  * beam stays a beam and the scheme's spread shrinks with the cell.
+ *
+ * --ordinates K is another trial (docs/accuracy.md's seventh): the
+ * light in flight is K directions per cell (discrete ordinates on a
+ * Fibonacci sphere) instead of four SH coefficients. The injected L1 cells
+ * are spread over the directions (the clamped L1 lobe), each direction moves
+ * upwind at the speed of light (a share LAMBDA |w_a| through the face its
+ * axis a points at, the rest stays: LAMBDA = 1/sqrt(3) keeps every share
+ * positive), and every step adds its L1 moments, times LAMBDA, to the same
+ * accumulated volume, so the lookups are unchanged. Light crossing light
+ * stays two directions, so nothing merges and nothing spreads but the
+ * scheme's own O(cell) error.
  */
 #include <math.h>
 #include <stdio.h>
@@ -39,6 +50,8 @@
 #define HEIGHTS 6
 #define CLOSURE_DIRS 400 /* quadrature directions (a Fibonacci sphere) */
 #define CLOSURE_MAX_F 0.995 /* the mean cosine the closure reads at most */
+#define ORDINATES_MAX 512
+#define ORDINATES_LAMBDA 0.57735026918962576 /* 1 / sqrt(3): a step moves light LAMBDA cells */
 
 static const float heights[HEIGHTS] = {0.1f, 0.25f, 0.5f, 1.0f, 1.5f, 1.9f};
 
@@ -71,14 +84,15 @@ static double exact_irradiance(double offset, double h)
 
 static float closure_dirs[CLOSURE_DIRS][3];
 
-static void closure_init(void)
+/* k directions spread evenly over the sphere (a Fibonacci lattice). */
+static void fibonacci_dirs(int k, float (*out)[3])
 {
     const double golden = M_PI * (3.0 - sqrt(5.0));
-    for (int k = 0; k < CLOSURE_DIRS; k++) {
-        double y = 1.0 - 2.0 * (k + 0.5) / CLOSURE_DIRS, r = sqrt(1.0 - y * y);
-        closure_dirs[k][0] = (float)(r * cos(golden * k));
-        closure_dirs[k][1] = (float)y;
-        closure_dirs[k][2] = (float)(r * sin(golden * k));
+    for (int i = 0; i < k; i++) {
+        double y = 1.0 - 2.0 * (i + 0.5) / k, r = sqrt(1.0 - y * y);
+        out[i][0] = (float)(r * cos(golden * i));
+        out[i][1] = (float)y;
+        out[i][2] = (float)(r * sin(golden * i));
     }
 }
 
@@ -150,6 +164,98 @@ static void closure_step(const lpv_grid *g, const lpv_cell *in, const float *t, 
 }
 
 #define TRANSPORT_CLOSURE (-1)
+#define TRANSPORT_ORDINATES (-2)
+
+/* ---- The ordinates trial ------------------------------------------------ */
+
+static float ordinate_dirs[ORDINATES_MAX][3];
+static int ordinate_count;
+
+/* acc (channel r, copied to g and b) += LAMBDA x the L1 moments of the
+ * directions' light p (ordinate_count per cell). */
+static void ordinates_accumulate(size_t cells, const float *p, lpv_cell *acc)
+{
+    for (size_t c = 0; c < cells; c++) {
+        double sum = 0.0, m[3] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < ordinate_count; k++) {
+            double x = p[c * (size_t)ordinate_count + (size_t)k];
+            sum += x;
+            for (int j = 0; j < 3; j++)
+                m[j] += x * ordinate_dirs[k][j];
+        }
+        float add[4] = {(float)(ORDINATES_LAMBDA * LPV_SH_C0 * sum), (float)(ORDINATES_LAMBDA * LPV_SH_C1 * m[1]),
+                        (float)(ORDINATES_LAMBDA * LPV_SH_C1 * m[2]), (float)(ORDINATES_LAMBDA * LPV_SH_C1 * m[0])};
+        for (int j = 0; j < 4; j++) {
+            acc[c].r[j] += add[j];
+            acc[c].g[j] += add[j];
+            acc[c].b[j] += add[j];
+        }
+    }
+}
+
+/* One upwind step of every direction: p -> q (overwritten). */
+static void ordinates_step(const lpv_grid *g, const float *p, float *q)
+{
+    const size_t k_count = (size_t)ordinate_count;
+    memset(q, 0, lpv_grid_cell_count(g) * k_count * sizeof *q);
+    for (int z = 0; z < g->dims[2]; z++) {
+        for (int y = 0; y < g->dims[1]; y++) {
+            for (int x = 0; x < g->dims[0]; x++) {
+                const size_t c = lpv_grid_index(g, x, y, z);
+                for (size_t k = 0; k < k_count; k++) {
+                    const float v = p[c * k_count + k], *o = ordinate_dirs[k];
+                    if (v == 0.0f)
+                        continue;
+                    q[c * k_count + k] += v * (float)(1.0 - ORDINATES_LAMBDA * (fabs(o[0]) + fabs(o[1]) + fabs(o[2])));
+                    for (int a = 0; a < 3; a++) {
+                        int r[3] = {x, y, z};
+                        r[a] += o[a] > 0.0f ? 1 : -1;
+                        if (r[a] >= 0 && r[a] < g->dims[a]) /* what leaves the grid is gone */
+                            q[lpv_grid_index(g, r[0], r[1], r[2]) * k_count + k] +=
+                                v * (float)(ORDINATES_LAMBDA * fabs(o[a]));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* The injected L1 cells (channel r) spread over the directions as their
+ * clamped L1 lobes, moved for the steps light needs to cross `steps` cells,
+ * each step's moments accumulated. */
+static int ordinates_propagate(const lpv_grid *g, const lpv_cell *injected, int steps, lpv_cell *acc)
+{
+    const size_t cells = lpv_grid_cell_count(g), k_count = (size_t)ordinate_count;
+    float *p = calloc(cells * k_count, sizeof *p), *q = calloc(cells * k_count, sizeof *q);
+    if (!p || !q) {
+        free(p);
+        free(q);
+        return -1;
+    }
+    for (size_t c = 0; c < cells; c++) {
+        const float *s = injected[c].r;
+        double w[ORDINATES_MAX], sum = 0.0;
+        for (size_t k = 0; k < k_count && s[0] > 0.0f; k++) {
+            const float *o = ordinate_dirs[k];
+            w[k] = fmax(LPV_SH_C0 * s[0] + LPV_SH_C1 * (s[3] * o[0] + s[1] * o[1] + s[2] * o[2]), 0.0);
+            sum += w[k];
+        }
+        for (size_t k = 0; k < k_count && sum > 0.0; k++)
+            p[c * k_count + k] = (float)(s[0] / LPV_SH_C0 * w[k] / sum);
+    }
+    memset(acc, 0, cells * sizeof *acc);
+    ordinates_accumulate(cells, p, acc);
+    for (int i = 0, n = (int)ceil(steps / ORDINATES_LAMBDA); i < n; i++) {
+        ordinates_step(g, p, q);
+        ordinates_accumulate(cells, q, acc);
+        float *tmp = p;
+        p = q;
+        q = tmp;
+    }
+    free(p);
+    free(q);
+    return 0;
+}
 
 /* Every VPL faces +y, so the binned injection fills the +y bin alone and
  * that bin's field is also the plain (unbinned) one: one propagation serves
@@ -170,6 +276,8 @@ static int run_grid(int n, int steps, int transport, double offset, const lpv_vp
     lpv_oracle_inject_vpls_binned(&g, vpls, nvpl, inj);
     int rc = transport == TRANSPORT_CLOSURE
                  ? lpv_oracle_propagate_steps(&g, inj + up, NULL, steps, closure_step, NULL, acc + up)
+             : transport == TRANSPORT_ORDINATES
+                 ? ordinates_propagate(&g, inj + up, steps, acc + up)
                  : lpv_oracle_propagate_with(&g, inj + up, NULL, steps, transport, acc + up);
     if (rc == 0) {
         for (int lookup = 0; lookup < 2; lookup++) {
@@ -200,6 +308,9 @@ int main(int argc, char **argv)
             transport = LPV_TRANSPORT_PAPER;
         } else if (strcmp(argv[i], "--closure") == 0) {
             transport = TRANSPORT_CLOSURE;
+        } else if (strcmp(argv[i], "--ordinates") == 0 && i + 1 < argc) {
+            transport = TRANSPORT_ORDINATES;
+            ordinate_count = atoi(argv[++i]);
         } else if (strcmp(argv[i], "--offset") == 0 && i + 1 < argc) {
             offset = atof(argv[++i]);
         } else if (strcmp(argv[i], "--steps-per-cell") == 0 && i + 1 < argc) {
@@ -207,14 +318,15 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--max-grid") == 0 && i + 1 < argc) {
             max_grid = atoi(argv[++i]);
         } else {
-            fprintf(stderr, "usage: lpvd-lpv-plane-reach [--paper | --closure] [--steps-per-cell K] [--max-grid N] "
-                            "[--offset X]\n");
+            fprintf(stderr, "usage: lpvd-lpv-plane-reach [--paper | --closure | --ordinates K] [--steps-per-cell K] "
+                            "[--max-grid N] [--offset X]\n");
             return 2;
         }
     }
-    if (per_cell < 1 || per_cell > 64 || max_grid < 8 || max_grid > 128 || !(fabs(offset) <= 0.9)) {
-        fprintf(stderr, "lpvd-lpv-plane-reach: --steps-per-cell must be 1..64, --max-grid 8..128 and --offset "
-                        "-0.9..0.9 (m)\n");
+    if (per_cell < 1 || per_cell > 64 || max_grid < 8 || max_grid > 128 || !(fabs(offset) <= 0.9) ||
+        (transport == TRANSPORT_ORDINATES && (ordinate_count < 6 || ordinate_count > ORDINATES_MAX))) {
+        fprintf(stderr, "lpvd-lpv-plane-reach: --steps-per-cell must be 1..64, --max-grid 8..128, --offset "
+                        "-0.9..0.9 (m) and --ordinates 6..%d\n", ORDINATES_MAX);
         return 2;
     }
     static lpv_vpl vpls[PATCH_VPLS * PATCH_VPLS];
@@ -231,11 +343,14 @@ int main(int argc, char **argv)
                 v->flux[c] = 1.0f / (PATCH_VPLS * PATCH_VPLS);
         }
     }
-    closure_init();
+    fibonacci_dirs(CLOSURE_DIRS, closure_dirs);
+    if (transport == TRANSPORT_ORDINATES)
+        fibonacci_dirs(ordinate_count, ordinate_dirs);
     printf("# E on a surface facing down %.2f m along x from the patch's centre / exact; %s transport, %d step(s) "
            "a cell\n",
            offset,
            transport == TRANSPORT_CLOSURE        ? "closure (trial)"
+           : transport == TRANSPORT_ORDINATES   ? "ordinates (trial)"
            : transport == LPV_TRANSPORT_CENTRAL ? "central"
                                                 : "paper",
            per_cell);
