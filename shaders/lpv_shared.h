@@ -282,6 +282,21 @@ struct IvPoint {
     vec4 emission; /* rgb emitted radiance W/(m^2 sr) (0 where area lights carry the emitters); a unused */
 };
 
+/* One voxel's share of one block of the camera's pixels (iv_reproject.comp):
+ * the sums iv_points.comp stores for the cloud's points, over the block's
+ * pixels in that voxel; iv_splat.vert blends it into the atlas. */
+struct IvSplat {
+    vec4 r;     /* SH of B / pi over each pixel's hemisphere, summed (r, g, b) */
+    vec4 g;
+    vec4 b;
+    vec4 n;     /* xyz the pixels' unit normals summed; w the pixel count */
+    vec4 a;     /* rgb the albedos summed; w 0 (a pixel stands for no area, LPV_IV_COVER) */
+    vec4 f;     /* xyz the folded normals summed (LPV_IV_FOLD); w 0 */
+    vec4 hi;    /* xyz the greatest place in the voxel (0..1) */
+    vec4 lo;    /* xyz 1 - the least */
+    vec4 texel; /* xy the voxel's atlas texel; w 1 = a used slot, 0 = none */
+};
+
 /* A voxel after creation: the mean of the points it received. */
 struct IvVoxel {
     vec4 r;        /* SH of the surfaces' outgoing radiance, W/(m^2 sr): the mean over the  */
@@ -432,6 +447,11 @@ struct IvVoxel {
  * number of the visible points ... is considerably larger than the number of
  * the visible voxels"). */
 #define LPV_IV_REPROJECT_POINTS 65536
+/* iv_reproject.comp sums the sampled pixels of each block of this many x
+ * this many per voxel, so the splat (iv_splat.vert) blends a point per voxel
+ * a block touches instead of one per pixel: llvmpipe blends a draw into a
+ * small atlas on one thread, and lit pixels in a compute pass use them all. */
+#define LPV_IV_REPROJECT_BLOCK 8
 /* A point belongs to the voxel holding it moved this many voxels against its
  * normal, so a surface that lies exactly on a voxel face (a wall on a room's
  * bounds, a box on the lattice) goes wholly to the voxel behind it instead
@@ -563,6 +583,8 @@ LPV_INLINE void lpv_iv_ray(LPV_U32 seed, LPV_U32 voxel, LPV_U32 j, LPV_U32 rays,
 #define LPV_SSBO_IV_OCCUPANCY 12 /* one bit per voxel, 32 to a uint, voxel index order */
 #define LPV_SSBO_IV_EMIT 13     /* LpvCell per voxel: what each occupied voxel sends out this bounce */
 #define LPV_SSBO_IV_AO 14       /* vec4 per voxel: the SH of the visible directions (travel convention) */
+#define LPV_SSBO_IV_SPLATS 17      /* IvSplat, LPV_IV_REPROJECT_BLOCK^2 per block (iv_reproject.comp; shares 17
+                                      with LPV_SSBO_PROBES_SH: one technique runs) */
 #define LPV_SSBO_IV_POINT_STARTS 16 /* uint per voxel + 1: where its points begin in the sorted cloud (iv_points.comp) */
 #define LPV_SSBO_IV_TAIL 3       /* float[3 x LPV_IV_TAIL_SLOTS]: iv_tail.comp's totals and ratio (shares 3 with
                                     LPV_SSBO_TRANSMIT, which no iv pass binds) */

@@ -28,10 +28,12 @@ typedef struct lpv_iv_gpu {
     lpv_settings settings;
     lpv_grid grid;    /* of the last commit */
     lpv_grid pending; /* of the last place */
-    GLuint prog_points, prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail, prog_filter;
+    GLuint prog_points, prog_reproject, prog_splat, prog_resolve, prog_emit, prog_gather, prog_tail, prog_filter;
     GLuint empty_vao, grid_ubo, tail; /* tail: iv_tail.comp's totals and ratio */
     lpv_atlas atlas;
     GLuint voxels, occupancy, emit, radiance[2], tail_base, ao; /* tail_base: I_{K-2} for the tail */
+    GLuint splats;       /* IvSplat: iv_reproject.comp's sums per block and voxel, for the splat */
+    size_t splat_slots;  /* allocated for */
     int result;       /* radiance[result] holds the last gather: what the lookup reads */
     size_t cells;     /* allocated for */
     int alloc_dims[3];

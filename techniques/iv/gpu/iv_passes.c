@@ -65,41 +65,79 @@ static int gather_points(lpv_iv_gpu *v, const lpv_technique_inputs *in)
     return 1;
 }
 
+/* iv_reproject's first half: the camera's sampled pixels lit and summed per
+ * block and voxel into v->splats (iv_reproject.comp). Returns the slots to
+ * splat, 0 when there are none (or no memory for them). */
+static size_t reproject_pixels(lpv_iv_gpu *v, const lpv_technique_inputs *in)
+{
+    int stride = 1;
+    while ((size_t)((in->gbuffer_w + stride - 1) / stride) * (size_t)((in->gbuffer_h + stride - 1) / stride) >
+           LPV_IV_REPROJECT_POINTS)
+        ++stride;
+    const int bx = lpv_div_up((size_t)((in->gbuffer_w + stride - 1) / stride), LPV_IV_REPROJECT_BLOCK);
+    const int by = lpv_div_up((size_t)((in->gbuffer_h + stride - 1) / stride), LPV_IV_REPROJECT_BLOCK);
+    const size_t slots = (size_t)bx * (size_t)by * LPV_IV_REPROJECT_BLOCK * LPV_IV_REPROJECT_BLOCK;
+    if (slots > v->splat_slots) {
+        lpv_gl_delete_buffer(&v->splats);
+        v->splat_slots = 0;
+        v->splats = lpv_gl_new_ssbo(slots * sizeof(struct IvSplat));
+        if (glGetError() != GL_NO_ERROR) { /* no splat this tick; the cloud's points stand */
+            lpv_gl_delete_buffer(&v->splats);
+            return 0;
+        }
+        v->splat_slots = slots;
+    }
+    const GLuint prog = v->prog_reproject;
+    glUseProgram(prog);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_GRID, v->grid_ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_SPLATS, v->splats);
+    for (int i = 0; i < 4; ++i) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, in->gbuffer[i]);
+    }
+    glActiveTexture(GL_TEXTURE0 + 5);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
+    glActiveTexture(GL_TEXTURE0 + 6);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform2i(glGetUniformLocation(prog, "u_gbuf_size"), in->gbuffer_w, in->gbuffer_h);
+    glUniform1i(glGetUniformLocation(prog, "u_stride"), stride);
+    glUniform2i(glGetUniformLocation(prog, "u_blocks"), bx, by);
+    glUniform1i(glGetUniformLocation(prog, "u_tiles_x"), v->atlas.tiles_x);
+    glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
+    glDispatchCompute(lpv_div_up((size_t)bx * (size_t)by, LPV_IV_WG), 1, 1);
+    lpv_timer_count(in->timer, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    return slots;
+}
+
 /* iv_points and iv_reproject: the points into the atlas. */
 void lpv_iv_create_volume(lpv_iv_gpu *v, const lpv_technique_inputs *in)
 {
     const lpv_plan *p = in->plan;
+    const int kept = gather_points(v, in);
+    const int reproject = p->pass[LPV_PASS_IV_REPROJECT].run && in->gbuffer_w > 0 && in->gbuffer_h > 0;
+    size_t slots = 0;
+    if (reproject) {
+        lpv_timer_begin(in->timer, "iv_reproject");
+        slots = reproject_pixels(v, in);
+    }
     GLuint prog = v->prog_splat;
-    if (gather_points(v, in))
+    if (kept)
         lpv_atlas_begin_keep(&v->atlas, prog, v->grid_ubo, v->empty_vao);
     else
         lpv_atlas_begin(&v->atlas, prog, v->grid_ubo, v->empty_vao);
     for (GLuint i = IV_ATTACHMENT_MAX; i < IV_ATTACHMENTS; ++i)
         glBlendEquationi(i, GL_MAX); /* the points' extent (LPV_IV_COVER) */
-    glBindBufferBase(GL_UNIFORM_BUFFER, LPV_UBO_LIGHT, in->light_ubo);
-    glActiveTexture(GL_TEXTURE0 + 5);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_position);
-    glActiveTexture(GL_TEXTURE0 + 6);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, in->rsm_albedo);
-    glUniform1f(glGetUniformLocation(prog, "u_emission"), in->settings->area_lights == LPV_SWITCH_OFF ? 1.0f : 0.0f);
-    if (p->pass[LPV_PASS_IV_REPROJECT].run && in->gbuffer_w > 0 && in->gbuffer_h > 0) {
-        lpv_timer_begin(in->timer, "iv_reproject");
-        for (int i = 0; i < 4; ++i) {
-            glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-            glBindTexture(GL_TEXTURE_2D, in->gbuffer[i]);
-        }
-        glUniform2i(glGetUniformLocation(prog, "u_gbuf_size"), in->gbuffer_w, in->gbuffer_h);
-        int stride = 1;
-        while ((size_t)((in->gbuffer_w + stride - 1) / stride) * (size_t)((in->gbuffer_h + stride - 1) / stride) >
-               LPV_IV_REPROJECT_POINTS)
-            ++stride;
-        glUniform1i(glGetUniformLocation(prog, "u_stride"), stride);
-        glDrawArrays(GL_POINTS, 0, ((in->gbuffer_w + stride - 1) / stride) * ((in->gbuffer_h + stride - 1) / stride));
+    if (slots) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LPV_SSBO_IV_SPLATS, v->splats);
+        glDrawArrays(GL_POINTS, 0, (GLsizei)slots);
         lpv_timer_count(in->timer, 1);
-        lpv_timer_end(in->timer);
     }
     lpv_atlas_end();
-    glActiveTexture(GL_TEXTURE0);
+    if (reproject)
+        lpv_timer_end(in->timer);
 
     lpv_timer_begin(in->timer, "iv_resolve");
     lpv_iv_clear_buffer(v->occupancy); /* all bits 0 */

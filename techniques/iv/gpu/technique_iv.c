@@ -62,7 +62,9 @@ static void destroy(lpv_technique *t)
         return;
     free_storage(v);
     lpv_iv_free_cloud(v);
-    GLuint progs[] = {v->prog_points, v->prog_splat, v->prog_resolve, v->prog_emit, v->prog_gather, v->prog_tail, v->prog_filter};
+    lpv_gl_delete_buffer(&v->splats);
+    GLuint progs[] = {v->prog_points, v->prog_reproject, v->prog_splat, v->prog_resolve,
+                      v->prog_emit,   v->prog_gather,    v->prog_tail,  v->prog_filter};
     for (size_t i = 0; i < sizeof progs / sizeof progs[0]; ++i)
         if (progs[i])
             glDeleteProgram(progs[i]);
@@ -82,8 +84,10 @@ static lpv_technique *create(char *err, size_t err_size)
     }
     v->base.cls = &lpv_technique_iv;
     v->prog_points = lpv_program_build("iv_points.comp", NULL, NULL, INC_SPLAT, err, err_size);
+    v->prog_reproject =
+        v->prog_points ? lpv_program_build("iv_reproject.comp", NULL, NULL, INC_SPLAT, err, err_size) : 0;
     v->prog_splat =
-        v->prog_points ? lpv_program_build("iv_splat.vert", NULL, "iv_splat.frag", INC_SPLAT, err, err_size) : 0;
+        v->prog_reproject ? lpv_program_build("iv_splat.vert", NULL, "iv_splat.frag", INC_GRID, err, err_size) : 0;
     v->prog_resolve = v->prog_splat ? lpv_program_build("iv_resolve.comp", NULL, NULL, INC_GRID, err, err_size) : 0;
     v->prog_emit = v->prog_resolve ? lpv_program_build("iv_emit.comp", NULL, NULL, LOOKUP, err, err_size) : 0;
     v->prog_gather = v->prog_emit ? lpv_program_build("iv_gather.comp", NULL, NULL, INC_SURFACE, err, err_size) : 0;
