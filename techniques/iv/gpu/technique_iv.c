@@ -36,7 +36,8 @@
 #include "shader.h"
 
 
-static const char *const INC_SPLAT[] = {"grid.glsl", "lights.glsl", "iv_direct.glsl", "iv_volume.glsl", NULL};
+static const char *const INC_SPLAT[] = {"grid.glsl", "lights.glsl", "iv_direct.glsl", "iv_volume.glsl", "iv_sums.glsl",
+                                        NULL};
 static const char *const INC_GRID[] = {"grid.glsl", NULL};
 static const char *const INC_SURFACE[] = {"grid.glsl", "iv_surface.glsl", NULL};
 static const char *const LOOKUP[] = {"grid.glsl", "iv_volume.glsl", "iv_lookup.glsl", NULL};

@@ -1,11 +1,10 @@
 // iv_points.comp - the point cloud into the atlas, one invocation per voxel
 // (paper 3.1): iv_cloud.c sorted the cloud by the voxel each point falls in
 // (iv_volume.glsl's iv_cell_of, counted on the CPU), so a voxel loops over
-// its own points, lights each (iv_direct.glsl), and stores the same sums the
-// additive splat (iv_splat.vert / .frag) would have blended: the SH of
-// B / pi over the normal's hemisphere, normal + count, albedo + area, folded
-// normal + signed area, and the greatest place in the voxel and 1 - the
-// least (LPV_IV_COVER). Every voxel's texel is written, so the atlas needs no
+// its own points, lights each (iv_direct.glsl), and stores their sums
+// (iv_sums.glsl: the SH of B / pi over the normal's hemisphere, normal +
+// count, albedo + area, folded normal + signed area, and the greatest place
+// in the voxel and 1 - the least, LPV_IV_COVER). Every voxel's texel is written, so the atlas needs no
 // clear; the camera's points (iv_reproject) are then blended on top. A
 // gather instead of a scatter: no rasterised points, and the voxels run in
 // parallel (llvmpipe runs a draw's vertex stage on one thread).
@@ -33,8 +32,8 @@ void main()
         return;
     ivec3 d = grid_dims();
     ivec3 c = ivec3(i % d.x, (i / d.x) % d.y, i / (d.x * d.y));
-    vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0), sn = vec4(0.0), sa = vec4(0.0), sf = vec4(0.0);
-    vec4 hi = vec4(0.0), lo = vec4(0.0);
+    IvSplat sum;
+    sum.r = sum.g = sum.b = sum.n = sum.a = sum.f = sum.hi = sum.lo = sum.texel = vec4(0.0);
     for (uint k = starts[i]; k < starts[i + 1]; ++k) {
         IvPoint q = points[k];
         vec3 p = q.position.xyz, n = q.normal.xyz, albedo = q.albedo.rgb, emission = q.emission.rgb;
@@ -46,30 +45,19 @@ void main()
         vec3 radiosity = albedo * iv_direct_irradiance(p, n) + LPV_PI * u_emission * emission;
         if (!finite3(radiosity))
             continue;
-        vec4 h = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * n.y, LPV_IV_HEMI1 * n.z, LPV_IV_HEMI1 * n.x);
-        r += h * radiosity.r;
-        g += h * radiosity.g;
-        b += h * radiosity.b;
-        sn += vec4(n, 1.0);
         if (!(area >= 0.0) || isinf(area))
             area = 0.0;
-        sa += vec4(albedo, area);
-        vec3 an = abs(n); // LPV_IV_FOLD
-        float fs = (an.x >= an.y && an.x >= an.z ? n.x : an.y >= an.z ? n.y : n.z) >= 0.0 ? 1.0 : -1.0;
-        sf += vec4(fs * n, fs * area);
         // the place in the voxel the CPU counted it in (a point on a face may
         // round to the neighbour there: it is clamped to this voxel's face)
-        vec3 local = clamp(iv_coords_of(p, n) - vec3(c), 0.0, 1.0);
-        hi = max(hi, vec4(local, 0.0));
-        lo = max(lo, vec4(1.0 - local, 0.0));
+        iv_sum_point(sum, n, albedo, radiosity, area, clamp(iv_coords_of(p, n) - vec3(c), 0.0, 1.0));
     }
     ivec2 t = atlas_texel(c, d.xy);
-    imageStore(u_sum_r, t, r);
-    imageStore(u_sum_g, t, g);
-    imageStore(u_sum_b, t, b);
-    imageStore(u_sum_n, t, sn);
-    imageStore(u_sum_a, t, sa);
-    imageStore(u_sum_f, t, sf);
-    imageStore(u_max_hi, t, hi);
-    imageStore(u_max_lo, t, lo);
+    imageStore(u_sum_r, t, sum.r);
+    imageStore(u_sum_g, t, sum.g);
+    imageStore(u_sum_b, t, sum.b);
+    imageStore(u_sum_n, t, sum.n);
+    imageStore(u_sum_a, t, sum.a);
+    imageStore(u_sum_f, t, sum.f);
+    imageStore(u_max_hi, t, sum.hi);
+    imageStore(u_max_lo, t, sum.lo);
 }

@@ -63,26 +63,16 @@ void main()
             int id = cell_index(c), k = 0;
             while (k < used && ids[k] != id)
                 ++k;
-            int slot = base + k;
+            IvSplat sum;
             if (k == used) { // the block's first pixel in this voxel
                 ids[used++] = id;
-                IvSplat z;
-                z.r = z.g = z.b = z.n = z.a = z.f = z.hi = z.lo = vec4(0.0);
-                z.texel = vec4(vec2(atlas_texel(c, grid_dims().xy)), 0.0, 1.0);
-                splats[slot] = z;
+                sum.r = sum.g = sum.b = sum.n = sum.a = sum.f = sum.hi = sum.lo = vec4(0.0);
+                sum.texel = vec4(vec2(atlas_texel(c, grid_dims().xy)), 0.0, 1.0);
+            } else {
+                sum = splats[base + k];
             }
-            vec4 h = vec4(LPV_IV_HEMI0, LPV_IV_HEMI1 * n.y, LPV_IV_HEMI1 * n.z, LPV_IV_HEMI1 * n.x);
-            splats[slot].r += h * radiosity.r;
-            splats[slot].g += h * radiosity.g;
-            splats[slot].b += h * radiosity.b;
-            splats[slot].n += vec4(n, 1.0);
-            splats[slot].a += vec4(albedo, 0.0);
-            vec3 an = abs(n); // LPV_IV_FOLD
-            float fs = (an.x >= an.y && an.x >= an.z ? n.x : an.y >= an.z ? n.y : n.z) >= 0.0 ? 1.0 : -1.0;
-            splats[slot].f += vec4(fs * n, 0.0);
-            vec3 local = clamp(u - vec3(c), 0.0, 1.0);
-            splats[slot].hi = max(splats[slot].hi, vec4(local, 0.0));
-            splats[slot].lo = max(splats[slot].lo, vec4(1.0 - local, 0.0));
+            iv_sum_point(sum, n, albedo, radiosity, 0.0, clamp(u - vec3(c), 0.0, 1.0));
+            splats[base + k] = sum;
         }
     }
     for (int k = used; k < BLOCK * BLOCK; ++k)
